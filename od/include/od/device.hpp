@@ -1,0 +1,87 @@
+#pragma once
+// What a master learns about the device besides the dictionary: identity, mailbox and SyncManager layout,
+// supported protocols, DC modes. Declared once here; the SII image and the ESI file (esi/), the state
+// machine's checks (ecat/) and object 0x1018 all read it.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace od {
+
+struct Identity {
+    uint32_t vendor_id = 0x000000FB;  // maxon motor ag
+    uint32_t product_code = 0;        // seed 001 §7.2.4.3
+    uint32_t revision = 0;            // high word software version, low word application version
+    uint32_t serial_number = 0;
+    std::string vendor_name = "maxon motor ag";
+    std::string device_name = "MAXPOS";    // 0x1008
+    std::string hardware_version;          // 0x1009
+    std::string software_version;          // 0x100A
+    std::string order_code;                // ESI Type text
+    std::string group_type = "Drives";     // ESI group
+};
+
+struct MailboxLayout {
+    uint16_t out_start = 0x1000;  // SM0, master -> slave
+    uint16_t out_size = 128;
+    uint16_t in_start = 0x1080;   // SM1, slave -> master
+    uint16_t in_size = 128;
+};
+
+// Mailbox protocol bits as in SII word 0x1C and the ESI.
+namespace mailbox_protocol {
+constexpr uint16_t AoE = 0x0001;
+constexpr uint16_t EoE = 0x0002;
+constexpr uint16_t CoE = 0x0004;
+constexpr uint16_t FoE = 0x0008;
+constexpr uint16_t SoE = 0x0010;
+constexpr uint16_t VoE = 0x0020;
+}  // namespace mailbox_protocol
+
+// CoE details bits as in the SII General category.
+namespace coe_details {
+constexpr uint8_t Sdo = 0x01;
+constexpr uint8_t SdoInfo = 0x02;
+constexpr uint8_t PdoAssign = 0x04;
+constexpr uint8_t PdoConfig = 0x08;
+constexpr uint8_t PdoUpload = 0x10;
+constexpr uint8_t CompleteAccess = 0x20;
+}  // namespace coe_details
+
+enum class SmKind : uint8_t { MBoxOut = 1, MBoxIn = 2, Outputs = 3, Inputs = 4 };
+
+struct SyncManagerDefault {
+    SmKind kind = SmKind::MBoxOut;
+    uint16_t start = 0;
+    uint16_t default_size = 0;  // process-data SMs: size of the default mapping
+    uint8_t control = 0;        // 0x0804 control byte
+    bool enable = true;
+};
+
+struct DcOpMode {
+    std::string name;             // "SM-Synchron", "DC"
+    std::string description;
+    uint16_t assign_activate = 0; // value for 0x0980/0x0981 (e.g. 0x0300: SYNC0 + cyclic unit)
+    int32_t cycle_time_sync0_factor = 1;
+    int32_t shift_time_sync0 = 0;
+};
+
+struct DeviceDescription {
+    Identity identity;
+    MailboxLayout standard_mailbox;
+    MailboxLayout bootstrap_mailbox{0x1000, 1024, 0x1400, 1024};
+    uint16_t mailbox_protocols = mailbox_protocol::CoE;
+    uint8_t coe_details = coe_details::Sdo | coe_details::SdoInfo | coe_details::PdoAssign |
+                          coe_details::PdoConfig | coe_details::CompleteAccess;
+    uint8_t foe_details = 0;
+    std::vector<SyncManagerDefault> sync_managers;  // SM0..SM3 in order
+    std::vector<DcOpMode> dc_modes;
+    uint16_t eeprom_bytes = 2048;
+    uint8_t pdi_control = 0x05;       // SII word 0 low: SPI (as the MAXPOS's ESC) -- see docs/decisions.md
+    uint8_t esc_config = 0x0C;        // SII word 0 high: DC SYNC out and latch in units on
+    uint16_t pdi_config = 0x0000;     // SII word 1
+    uint16_t sync_pulse_length = 1000;  // SII word 2, 10 ns units
+    uint16_t station_alias = 0;       // SII word 4
+};
+
+}  // namespace od

@@ -1,0 +1,88 @@
+#pragma once
+// Basic vocabulary of the object model: CANopen data types, object codes, access bits, results.
+#include <cstdint>
+#include <string_view>
+
+namespace od {
+
+// CANopen / ETG.1000.6 data type codes.
+enum class DataType : uint16_t {
+    Boolean = 0x0001,
+    Integer8 = 0x0002,
+    Integer16 = 0x0003,
+    Integer32 = 0x0004,
+    Unsigned8 = 0x0005,
+    Unsigned16 = 0x0006,
+    Unsigned32 = 0x0007,
+    Real32 = 0x0008,
+    VisibleString = 0x0009,
+    OctetString = 0x000A,
+    UnicodeString = 0x000B,
+    Real64 = 0x0011,
+    Integer64 = 0x0015,
+    Unsigned64 = 0x001B,
+    PdoMapping = 0x0021,
+    Identity = 0x0023,
+    SyncManagerParameter = 0x0029,  // not a scalar: used as the type of RECORD objects
+};
+
+enum class ObjectCode : uint8_t { Var = 0x07, Array = 0x08, Record = 0x09 };
+
+// EtherCAT AL states, for state-dependent access ("rw only in Pre-Op").
+enum class AlState : uint8_t { Init = 0x01, PreOp = 0x02, Boot = 0x03, SafeOp = 0x04, Op = 0x08 };
+
+// Access and flag bits exactly as the SDO information "entry description" ObjectAccess word (ETG.1000.6):
+namespace access {
+constexpr uint16_t ReadPreOp = 0x0001;
+constexpr uint16_t ReadSafeOp = 0x0002;
+constexpr uint16_t ReadOp = 0x0004;
+constexpr uint16_t WritePreOp = 0x0008;
+constexpr uint16_t WriteSafeOp = 0x0010;
+constexpr uint16_t WriteOp = 0x0020;
+constexpr uint16_t RxPdo = 0x0040;     // mappable into an RxPDO (master -> slave)
+constexpr uint16_t TxPdo = 0x0080;     // mappable into a TxPDO (slave -> master)
+constexpr uint16_t Backup = 0x0100;    // stored by "store parameters" (0x1010)
+constexpr uint16_t Settings = 0x0200;  // a setting (startup parameter)
+
+constexpr uint16_t RO = ReadPreOp | ReadSafeOp | ReadOp;
+constexpr uint16_t WO = WritePreOp | WriteSafeOp | WriteOp;
+constexpr uint16_t RW = RO | WO;
+constexpr uint16_t RW_PreOp = RO | WritePreOp;  // writable only in Pre-Operational
+constexpr uint16_t ReadMask = RO;
+constexpr uint16_t WriteMask = WO;
+}  // namespace access
+
+// Why an access failed. Each maps to exactly one SDO abort code (coe/) and is what the drive sees too.
+enum class Status : uint8_t {
+    Ok,
+    NoObject,            // 0x06020000 object does not exist
+    NoSubindex,          // 0x06090011 subindex does not exist
+    ReadOnly,            // 0x06010002 attempt to write a read-only object
+    WriteOnly,           // 0x06010001 attempt to read a write-only object
+    LengthMismatch,      // 0x06070010 data type does not match, length of service parameter does not match
+    LengthTooHigh,       // 0x06070012
+    LengthTooLow,        // 0x06070013
+    ValueTooHigh,        // 0x06090031
+    ValueTooLow,         // 0x06090032
+    InvalidValue,        // 0x06090030 value range of parameter exceeded
+    MaxBelowMin,         // 0x06090036
+    NotMappable,         // 0x06040041 object cannot be mapped to the PDO
+    PdoLengthExceeded,   // 0x06040042 number and length of objects to be mapped would exceed PDO length
+    Incompatible,        // 0x06040043 general parameter incompatibility
+    WrongState,          // 0x08000022 data cannot be transferred/stored because of the present device state
+    CannotStore,         // 0x08000020 data cannot be transferred or stored
+    HardwareError,       // 0x06060000 access failed due to a hardware error
+    OutOfMemory,         // 0x05040005
+    GeneralError,        // 0x08000000
+};
+
+std::string_view to_string(Status s);
+std::string_view to_string(DataType t);
+
+// Bit size of a scalar data type (0 for strings and structured types).
+uint16_t bit_size(DataType t);
+bool is_signed(DataType t);
+bool is_real(DataType t);
+bool is_string(DataType t);
+
+}  // namespace od

@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Installs every Debian package the project needs to build, run and test.
+# Used by both README commands and by .ci/run. Idempotent; quiet when all is present.
+set -euo pipefail
+PKGS=(build-essential cmake ninja-build pkg-config
+      libpcap-dev libeigen3-dev libgtest-dev libgmock-dev libcli11-dev libxml2-dev libxml2-utils
+      iproute2 tshark python3 python3-scapy gnuplot-nox clang-format)
+missing=()
+for p in "${PKGS[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+    SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+    export DEBIAN_FRONTEND=noninteractive
+    echo "install-deps: installing ${missing[*]}"
+    $SUDO apt-get update -qq
+    $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
