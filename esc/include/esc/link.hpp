@@ -1,23 +1,66 @@
 #pragma once
 // A link carries whole Ethernet frames (destination MAC .. payload, no FCS) between the ESC and the wire.
+//
+// Implementations (each in its own header):
+//   esc/link_pcap.hpp      PcapLink      libpcap, immediate mode, inbound only, BPF "ether proto 0x88a4"
+//   esc/link_packet.hpp    PacketLink    AF_PACKET socket with a TPACKET_V2 memory-mapped receive ring
+//   esc/link_loopback.hpp  LoopbackLink  two in-process ends joined by frame queues (tests)
+//   esc/link_capture.hpp   PcapWriter    records frames to a .pcap file for Wireshark
 #include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <stdexcept>
 #include <string>
 
 namespace esc {
 
 class Link {
-public:
+  public:
     virtual ~Link() = default;
     // File descriptor that becomes readable when a frame may be waiting (for poll()); -1 if none.
     virtual int fd() const = 0;
     // Receives one frame into buf without blocking. Returns its length, 0 if nothing is waiting.
     // Frames this host sent itself (PACKET_OUTGOING) are never returned.
+    // A frame longer than buf is truncated to buf.size().
     virtual std::size_t receive(std::span<uint8_t> buf) = 0;
     // Sends one frame. Returns false on error.
     virtual bool send(std::span<const uint8_t> frame) = 0;
+    // (extension) Short description for logs, e.g. "packet:ecat0".
+    virtual std::string describe() const { return {}; }
 };
+
+// Why a link could not be opened. The message says what to do about it.
+class LinkError : public std::runtime_error {
+  public:
+    enum class Kind {
+        NoSuchInterface,   // the interface name does not exist
+        PermissionDenied,  // no CAP_NET_RAW (raw sockets) / CAP_NET_ADMIN (promiscuous mode, veth)
+        InterfaceDown,     // the interface exists but is administratively down
+        BadArgument,       // unknown backend name, empty interface name, ...
+        System,            // any other failure of the operating system or libpcap
+    };
+    LinkError(Kind kind, const std::string& message) : std::runtime_error(message), kind_(kind) {}
+    Kind kind() const { return kind_; }
+
+  private:
+    Kind kind_;
+};
+
+// Largest frame a link returns (Ethernet header + 1500 payload + VLAN tag, rounded up).
+inline constexpr std::size_t kMaxFrameSize = 2048;
+
+// Throws LinkError (NoSuchInterface / InterfaceDown) unless iface exists and is up.
+void check_interface(const std::string& iface);
+
+// Backend names understood by open_link().
+inline constexpr const char* kBackendPcap = "pcap";
+inline constexpr const char* kBackendPacket = "packet";
+// The backend open_link() uses when none is named (the faster one measured, see docs/decisions/link.md).
+const char* default_link_backend();
+
+// Opens iface with the named backend ("pcap" | "packet"; empty = default_link_backend()).
+// Throws LinkError on failure.
+std::unique_ptr<Link> open_link(const std::string& iface, const std::string& backend = {});
 
 }  // namespace esc

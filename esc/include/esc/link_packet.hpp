@@ -1,0 +1,38 @@
+#pragma once
+// PacketLink: a Link over an AF_PACKET raw socket bound to one interface and EtherType 0x88A4.
+// Receives through a TPACKET_V2 memory-mapped ring (one frame per slot, so poll() wakes per frame; TPACKET_V3
+// would hand over whole blocks after a retire timeout of at least a millisecond). Own transmissions are
+// dropped by PACKET_IGNORE_OUTGOING and, as a second line, by skipping slots marked PACKET_OUTGOING.
+// The interface is put in promiscuous mode (PACKET_MR_PROMISC) because masters do not always send to
+// broadcast. Sends with send() on the bound socket, bypassing the qdisc (PACKET_QDISC_BYPASS).
+#include <string>
+
+#include "esc/link.hpp"
+
+namespace esc {
+
+class PacketLink final : public Link {
+  public:
+    // Throws LinkError.
+    explicit PacketLink(const std::string& iface);
+    ~PacketLink() override;
+    PacketLink(const PacketLink&) = delete;
+    PacketLink& operator=(const PacketLink&) = delete;
+
+    int fd() const override { return fd_; }
+    std::size_t receive(std::span<uint8_t> buf) override;
+    bool send(std::span<const uint8_t> frame) override;
+    std::string describe() const override { return "packet:" + iface_; }
+
+  private:
+    std::string iface_;
+    int fd_ = -1;
+    int ifindex_ = 0;
+    uint8_t* ring_ = nullptr;
+    std::size_t ring_size_ = 0;
+    std::size_t frame_size_ = 0;
+    std::size_t frame_count_ = 0;
+    std::size_t next_ = 0;  // ring slot to look at next
+};
+
+}  // namespace esc

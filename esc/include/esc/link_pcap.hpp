@@ -1,0 +1,33 @@
+#pragma once
+// PcapLink: a Link over libpcap. Opens the interface promiscuous, in immediate mode (every frame is handed
+// over as it arrives, no buffering timeout), snaplen 2048, inbound only (pcap_setdirection PCAP_D_IN, so
+// our own replies never come back in), with the BPF filter "ether proto 0x88a4", non-blocking, and exposes
+// pcap_get_selectable_fd() for poll(). Sends with pcap_inject().
+#include <string>
+
+#include "esc/link.hpp"
+
+struct pcap;
+
+namespace esc {
+
+class PcapLink final : public Link {
+  public:
+    // Throws LinkError.
+    explicit PcapLink(const std::string& iface);
+    ~PcapLink() override;
+    PcapLink(const PcapLink&) = delete;
+    PcapLink& operator=(const PcapLink&) = delete;
+
+    int fd() const override { return fd_; }
+    std::size_t receive(std::span<uint8_t> buf) override;
+    bool send(std::span<const uint8_t> frame) override;
+    std::string describe() const override { return "pcap:" + iface_; }
+
+  private:
+    std::string iface_;
+    struct pcap* handle_ = nullptr;
+    int fd_ = -1;
+};
+
+}  // namespace esc
