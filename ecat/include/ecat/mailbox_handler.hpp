@@ -11,7 +11,15 @@
 namespace ecat {
 
 // Mailbox types (header byte 5, bits 3:0).
-enum class MailboxType : uint8_t { Error = 0x0, AoE = 0x1, EoE = 0x2, CoE = 0x3, FoE = 0x4, SoE = 0x5, VoE = 0xF };
+enum class MailboxType : uint8_t {
+    Error = 0x0,
+    AoE = 0x1,
+    EoE = 0x2,
+    CoE = 0x3,
+    FoE = 0x4,
+    SoE = 0x5,
+    VoE = 0xF
+};
 
 // Mailbox error codes (mailbox type 0 reply, ETG.1000.4).
 enum class MailboxError : uint16_t {
@@ -30,7 +38,7 @@ constexpr std::size_t kMailboxHeaderSize = 6;
 
 // The outgoing side of the mailbox, as a protocol handler sees it.
 class MailboxSender {
-public:
+  public:
     virtual ~MailboxSender() = default;
     // Queues one message (payload = bytes after the mailbox header). False if the queue is full or the
     // payload does not fit the SM1 mailbox.
@@ -40,7 +48,7 @@ public:
 };
 
 class MailboxHandler {
-public:
+  public:
     virtual ~MailboxHandler() = default;
     virtual MailboxType type() const = 0;
     // Whether the protocol is served in this AL state (FoE in Bootstrap, CoE not in Bootstrap, ...).

@@ -1,0 +1,27 @@
+#pragma once
+// What the slave stack asks of the device application (the drive glue implements it).
+#include <cstdint>
+
+#include "od/types.hpp"
+
+namespace ecat {
+
+class Application {
+  public:
+    virtual ~Application() = default;
+    // Extra application checks on a requested transition, after the stack's own checks passed.
+    // Returns 0 to allow it or an AL status code (ecat/al_status.hpp) to refuse it.
+    virtual uint16_t check_transition(od::AlState /*from*/, od::AlState /*to*/) { return 0; }
+    // The AL state changed (also on fall-backs with the error flag).
+    virtual void on_state_change(od::AlState /*from*/, od::AlState /*to*/) {}
+    // One application cycle: outputs were copied into the dictionary (Op only) before, inputs are copied
+    // out of it after this returns. Called in Safe-Op and Op.
+    virtual void on_cycle(uint64_t /*now_ns*/) {}
+    // Outputs are no longer valid: process-data watchdog, sync loss or leaving Op (the drive's 0x6007
+    // reaction). Called before on_state_change of the same event.
+    virtual void on_outputs_lost() {}
+    // Bootstrap -> Init: the device restarts (e.g. loads a new firmware image).
+    virtual void on_restart() {}
+};
+
+}  // namespace ecat

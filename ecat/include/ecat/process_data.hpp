@@ -1,0 +1,59 @@
+#pragma once
+// Process-data copy plan (ethercat-protocol.md §9.6): built from the PDO assignment (0x1C12 outputs/SM2,
+// 0x1C13 inputs/SM3) and the mapping objects (0x16xx / 0x1Axx) when the slave enters Safe-Op, then used every
+// cycle to copy bit-exactly between the SM buffers and the dictionary's value storage, allocating nothing.
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "od/dictionary.hpp"
+
+namespace ecat {
+
+struct PdoCopy {
+    uint8_t* storage = nullptr;  // entry value in the dictionary's image (nullptr: padding, never copied)
+    uint32_t bit_offset = 0;     // position in the SM buffer
+    uint16_t bits = 0;
+};
+
+class ProcessData {
+  public:
+    static constexpr std::size_t kMaxEntries = 256;  // per direction
+    static constexpr uint16_t kRxAssign = 0x1C12;
+    static constexpr uint16_t kTxAssign = 0x1C13;
+
+    explicit ProcessData(od::Dictionary& dictionary);
+
+    // Reads the assignment and mapping objects and builds both plans. Returns 0 or the AL status code:
+    // 0x0025 invalid output mapping (RxPDO side) / 0x0024 invalid input mapping (TxPDO side).
+    uint16_t build();
+    void clear();
+
+    std::size_t rx_bits() const { return rx_bits_; }
+    std::size_t tx_bits() const { return tx_bits_; }
+    std::size_t rx_bytes() const { return (rx_bits_ + 7) / 8; }
+    std::size_t tx_bytes() const { return (tx_bits_ + 7) / 8; }
+    std::span<const PdoCopy> rx_plan() const { return {rx_.data(), rx_.size()}; }
+    std::span<const PdoCopy> tx_plan() const { return {tx_.data(), tx_.size()}; }
+
+    // SM2 buffer -> dictionary (outputs).
+    void outputs_to_dictionary(std::span<const uint8_t> sm2) const;
+    // Dictionary -> SM3 buffer (inputs); bits not mapped keep their value.
+    void dictionary_to_inputs(std::span<uint8_t> sm3) const;
+
+    // Copies n bits from src (starting at bit src_bit) to dst (starting at bit dst_bit), LSB first.
+    static void copy_bits(const uint8_t* src, std::size_t src_bit, uint8_t* dst, std::size_t dst_bit,
+                          std::size_t n);
+
+  private:
+    uint16_t build_side(uint16_t assign_index, bool rx, std::vector<PdoCopy>& plan, std::size_t& bits);
+
+    od::Dictionary& dict_;
+    std::vector<PdoCopy> rx_;
+    std::vector<PdoCopy> tx_;
+    std::size_t rx_bits_ = 0;
+    std::size_t tx_bits_ = 0;
+};
+
+}  // namespace ecat

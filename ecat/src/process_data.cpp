@@ -1,0 +1,119 @@
+#include "ecat/process_data.hpp"
+
+#include <cstring>
+
+#include "ecat/al_status.hpp"
+
+namespace ecat {
+
+ProcessData::ProcessData(od::Dictionary& dictionary) : dict_(dictionary) {
+    rx_.reserve(kMaxEntries);
+    tx_.reserve(kMaxEntries);
+}
+
+void ProcessData::clear() {
+    rx_.clear();
+    tx_.clear();
+    rx_bits_ = 0;
+    tx_bits_ = 0;
+}
+
+namespace {
+
+// Reads an unsigned value of up to 8 bytes from the dictionary; false if the entry does not exist.
+bool read_unsigned(const od::Dictionary& d, uint16_t index, uint8_t sub, uint64_t& value) {
+    const auto raw = d.raw(index, sub);
+    if (raw.empty() || raw.size() > 8) return false;
+    value = 0;
+    for (std::size_t i = 0; i < raw.size(); ++i)
+        value |= static_cast<uint64_t>(raw[i]) << (8 * i);
+    return true;
+}
+
+bool is_padding(uint16_t index, uint8_t sub) {
+    // Index 0 or the standard data type "dummy" objects 0x0001..0x0007 (BOOLEAN .. UNSIGNED32), sub 0.
+    return index == 0 || (index <= 0x0007 && sub == 0);
+}
+
+}  // namespace
+
+uint16_t ProcessData::build_side(uint16_t assign_index, bool rx, std::vector<PdoCopy>& plan,
+                                 std::size_t& bits) {
+    const uint16_t code = rx ? al::InvalidOutputMapping : al::InvalidInputMapping;
+    const uint16_t first = rx ? 0x1600 : 0x1A00;
+    const uint16_t last = rx ? 0x17FF : 0x1BFF;
+    plan.clear();
+    bits = 0;
+    if (dict_.find(assign_index) == nullptr) return 0;  // no such SM: no process data in that direction
+    uint64_t pdo_count = 0;
+    if (!read_unsigned(dict_, assign_index, 0, pdo_count)) return code;
+    for (uint8_t i = 1; i <= pdo_count; ++i) {
+        uint64_t pdo = 0;
+        if (!read_unsigned(dict_, assign_index, i, pdo)) return code;
+        if (pdo < first || pdo > last || dict_.find(static_cast<uint16_t>(pdo)) == nullptr) return code;
+        uint64_t entry_count = 0;
+        if (!read_unsigned(dict_, static_cast<uint16_t>(pdo), 0, entry_count)) return code;
+        for (uint8_t k = 1; k <= entry_count; ++k) {
+            uint64_t m = 0;
+            if (!read_unsigned(dict_, static_cast<uint16_t>(pdo), k, m)) return code;
+            const auto index = static_cast<uint16_t>(m >> 16);
+            const auto sub = static_cast<uint8_t>(m >> 8);
+            const auto length = static_cast<uint16_t>(m & 0xFF);
+            if (length == 0) return code;
+            if (!is_padding(index, sub)) {
+                const od::Entry* e = dict_.find(index, sub);
+                if (e == nullptr || e->bit_length != length) return code;
+                if (rx ? !e->rx_mappable() : !e->tx_mappable()) return code;
+                if (plan.size() == kMaxEntries) return code;
+                const auto raw = dict_.raw(index, sub);
+                if (raw.size() * 8 < length) return code;
+                // The value image is owned by the dictionary and never moves after declaration; the plan
+                // writes outputs straight into it, as od::Ref<T> does.
+                plan.push_back({const_cast<uint8_t*>(raw.data()), static_cast<uint32_t>(bits), length});
+            }
+            bits += length;
+        }
+    }
+    return 0;
+}
+
+uint16_t ProcessData::build() {
+    uint16_t code = build_side(kRxAssign, true, rx_, rx_bits_);
+    if (code == 0) code = build_side(kTxAssign, false, tx_, tx_bits_);
+    if (code != 0) clear();
+    return code;
+}
+
+void ProcessData::copy_bits(const uint8_t* src, std::size_t src_bit, uint8_t* dst, std::size_t dst_bit,
+                            std::size_t n) {
+    if (src_bit % 8 == 0 && dst_bit % 8 == 0) {
+        const std::size_t whole = n / 8;
+        std::memcpy(dst + dst_bit / 8, src + src_bit / 8, whole);
+        src_bit += whole * 8;
+        dst_bit += whole * 8;
+        n -= whole * 8;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::size_t s = src_bit + i;
+        const std::size_t d = dst_bit + i;
+        const bool bit = (src[s / 8] >> (s % 8)) & 1u;
+        const auto mask = static_cast<uint8_t>(1u << (d % 8));
+        dst[d / 8] = bit ? static_cast<uint8_t>(dst[d / 8] | mask) : static_cast<uint8_t>(dst[d / 8] & ~mask);
+    }
+}
+
+void ProcessData::outputs_to_dictionary(std::span<const uint8_t> sm2) const {
+    for (const PdoCopy& c : rx_) {
+        if (c.bit_offset + c.bits > sm2.size() * 8) continue;
+        copy_bits(sm2.data(), c.bit_offset, c.storage, 0, c.bits);
+    }
+}
+
+void ProcessData::dictionary_to_inputs(std::span<uint8_t> sm3) const {
+    for (const PdoCopy& c : tx_) {
+        if (c.bit_offset + c.bits > sm3.size() * 8) continue;
+        copy_bits(c.storage, 0, sm3.data(), c.bit_offset, c.bits);
+    }
+}
+
+}  // namespace ecat
