@@ -1,0 +1,40 @@
+#pragma once
+// Text in and out for ecatctl: number parsing, hex dumps, typed register values. Pure functions, tested
+// in tests/master/ecatctl_format_test.cpp.
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace ecatctl {
+
+// Exit codes (also listed in `ecatctl --help`).
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFailure = 1;       // anything not listed below
+inline constexpr int kExitUsage = 2;         // bad command line, bad input file
+inline constexpr int kExitNoInterface = 3;   // the interface does not exist or is down
+inline constexpr int kExitNoPrivileges = 4;  // raw sockets need CAP_NET_RAW
+inline constexpr int kExitNoSlave = 5;       // no slave answered
+inline constexpr int kExitProtocol = 6;  // a slave answered, but not as expected (working counter, SII, AL)
+
+// Decimal, 0x-hex, 0b-binary; nullopt if not a whole number within max.
+std::optional<uint64_t> parse_number(std::string_view text, uint64_t max);
+
+enum class ValueType { U8, U16, U32, U64, I8, I16, I32, I64 };
+std::optional<ValueType> parse_type(std::string_view name);
+std::size_t type_size(ValueType t);
+// Little-endian bytes -> "0x1234 (4660)"; data.size() must be type_size(t).
+std::string format_value(ValueType t, std::span<const uint8_t> data);
+// Text -> little-endian bytes of the type (negative numbers allowed for signed types); nullopt if out of
+// range.
+std::optional<std::vector<uint8_t>> encode_value(ValueType t, std::string_view text);
+
+// 16 bytes per line: "0x0130: 02 00 00 00 ...", addresses starting at base.
+std::string hex_dump(uint32_t base, std::span<const uint8_t> data);
+
+// CRC-8 of SII words 0-6 (poly 0x07, init 0xFF), ethercat-protocol.md §7.1.
+uint8_t sii_crc(std::span<const uint8_t> first14);
+
+}  // namespace ecatctl

@@ -1,0 +1,433 @@
+// ecatctl: a small EtherCAT master on the command line, in the spirit of IgH's `ethercat` tool.
+//   ecatctl [--iface NAME] [--backend pcap|packet] [--timeout MS] [--retries N] <verb> ...
+// Verbs: scan | reg read | reg write | sii read | sii write | sii decode | state
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "esc/link.hpp"
+#include "format.hpp"
+#include "master/master.hpp"
+#if __has_include("esi/sii.hpp") && defined(ECATCTL_HAVE_ESI)
+#include "esi/sii.hpp"
+#define ECATCTL_SII_DECODE 1
+#endif
+
+namespace {
+
+using namespace ecatctl;
+using master::Address;
+using master::Error;
+
+struct Globals {
+    std::string iface = "ecat1";
+    std::string backend;
+    unsigned timeout_ms = 100;
+    unsigned retries = 2;
+};
+
+int exit_code(Error e) {
+    switch (e) {
+        case Error::Ok:
+            return kExitOk;
+        case Error::Timeout:
+            return kExitNoSlave;
+        case Error::InvalidArgument:
+            return kExitUsage;
+        case Error::SendFailed:
+            return kExitFailure;
+        default:
+            return kExitProtocol;
+    }
+}
+
+int fail(Error e, const std::string& what) {
+    std::cerr << "ecatctl: " << what << ": " << master::to_string(e) << "\n";
+    if (e == Error::Timeout)
+        std::cerr << "ecatctl: check that a slave is connected and running on the interface\n";
+    return exit_code(e);
+}
+
+int usage(const std::string& what) {
+    std::cerr << "ecatctl: " << what << "\n";
+    return kExitUsage;
+}
+
+// Opens the link and runs fn with a master on it; maps link errors to exit codes.
+template <typename Fn>
+int with_master(const Globals& g, Fn fn) {
+    std::unique_ptr<esc::Link> link;
+    try {
+        link = esc::open_link(g.iface, g.backend);
+    } catch (const esc::LinkError& e) {
+        std::cerr << "ecatctl: " << e.what() << "\n";
+        switch (e.kind()) {
+            case esc::LinkError::Kind::NoSuchInterface:
+            case esc::LinkError::Kind::InterfaceDown:
+                return kExitNoInterface;
+            case esc::LinkError::Kind::PermissionDenied:
+                std::cerr << "ecatctl: raw sockets need root or CAP_NET_RAW (try sudo)\n";
+                return kExitNoPrivileges;
+            case esc::LinkError::Kind::BadArgument:
+                return kExitUsage;
+            case esc::LinkError::Kind::System:
+                return kExitFailure;
+        }
+        return kExitFailure;
+    }
+    master::MasterOptions o;
+    o.timeout = std::chrono::milliseconds(g.timeout_ms);
+    o.retries = g.retries;
+    master::Master m(*link, o);
+    return fn(m);
+}
+
+std::optional<Address> parse_slave(const std::string& text, bool station) {
+    auto v = parse_number(text, 0xFFFF);
+    if (!v) return std::nullopt;
+    return station ? Address::station(static_cast<uint16_t>(*v))
+                   : Address::position(static_cast<uint16_t>(*v));
+}
+
+std::string slave_text(Address a) {
+    char b[32];
+    std::snprintf(b, sizeof b, a.mode == Address::Mode::Station ? "station 0x%04x" : "slave %u", a.value);
+    return b;
+}
+
+// ---- scan ----------------------------------------------------------------------------------------
+
+int scan(master::Master& m) {
+    auto n = m.count_slaves();
+    if (!n) return fail(n.error(), "counting slaves (BRD 0x0000)");
+    if (*n == 0) {
+        std::cerr << "ecatctl: no slave answered\n";
+        return kExitNoSlave;
+    }
+    if (Error e = m.assign_station_addresses(*n); e != Error::Ok)
+        return fail(e, "assigning station addresses");
+    std::printf("%u slave%s\n", *n, *n == 1 ? "" : "s");
+    std::printf("%-4s %-7s %-10s %-10s %-10s %-10s %-10s\n", "pos", "station", "state", "vendor", "product",
+                "revision", "serial");
+    int rc = kExitOk;
+    for (uint16_t i = 0; i < *n; ++i) {
+        const uint16_t station = static_cast<uint16_t>(0x1001 + i);
+        const Address a = Address::station(station);
+        std::string state = "?";
+        if (auto st = m.al_status(a)) {
+            state = std::string(master::al_state_name(st->state));
+            if (st->error) {
+                char b[32];
+                std::snprintf(b, sizeof b, "+ERR(0x%04x)", st->code);
+                state += b;
+            }
+        } else {
+            rc = exit_code(st.error());
+        }
+        uint8_t id[16];
+        const Error e = m.sii_read(a, master::sii::VendorId, id);
+        if (e != Error::Ok) {
+            std::printf("%-4u 0x%04x  %-10s SII: %s\n", i, station, state.c_str(),
+                        std::string(master::to_string(e)).c_str());
+            rc = exit_code(e);
+            continue;
+        }
+        auto u32 = [&](int k) {
+            return static_cast<unsigned>(id[4 * k] | (id[4 * k + 1] << 8) | (id[4 * k + 2] << 16) |
+                                         (static_cast<unsigned>(id[4 * k + 3]) << 24));
+        };
+        std::printf("%-4u 0x%04x  %-10s 0x%08x 0x%08x 0x%08x 0x%08x\n", i, station, state.c_str(), u32(0),
+                    u32(1), u32(2), u32(3));
+    }
+    return rc;
+}
+
+// ---- reg -----------------------------------------------------------------------------------------
+
+struct RegArgs {
+    std::string slave;
+    std::string address;
+    std::string length;
+    std::vector<std::string> values;
+    std::string type;
+    bool station = false;
+};
+
+int reg_read(master::Master& m, const RegArgs& r) {
+    auto a = parse_slave(r.slave, r.station);
+    if (!a) return usage("bad slave '" + r.slave + "'");
+    auto addr = parse_number(r.address, 0xFFFF);
+    if (!addr) return usage("bad register address '" + r.address + "'");
+    std::optional<ValueType> type;
+    if (!r.type.empty() && !(type = parse_type(r.type))) return usage("bad type '" + r.type + "'");
+    std::size_t len = type ? type_size(*type) : 0;
+    if (!r.length.empty()) {
+        auto l = parse_number(r.length, master::kMaxDatagramData);
+        if (!l || *l == 0)
+            return usage("bad length '" + r.length + "' (1.." + std::to_string(master::kMaxDatagramData) +
+                         ")");
+        len = *l;
+    }
+    if (len == 0) return usage("give a length or --type");
+    if (type && len % type_size(*type) != 0) return usage("length is not a multiple of the type size");
+    if (*addr + len > 0x10000) return usage("register range runs past 0xffff");
+    std::vector<uint8_t> data(len);
+    if (Error e = m.read(*a, static_cast<uint16_t>(*addr), data); e != Error::Ok)
+        return fail(e, "reading " + slave_text(*a));
+    if (type) {
+        const std::size_t n = type_size(*type);
+        for (std::size_t i = 0; i < len; i += n)
+            std::printf("%s\n", format_value(*type, std::span<const uint8_t>(data).subspan(i, n)).c_str());
+    } else {
+        std::fputs(hex_dump(static_cast<uint32_t>(*addr), data).c_str(), stdout);
+    }
+    return kExitOk;
+}
+
+int reg_write(master::Master& m, const RegArgs& r) {
+    auto a = parse_slave(r.slave, r.station);
+    if (!a) return usage("bad slave '" + r.slave + "'");
+    auto addr = parse_number(r.address, 0xFFFF);
+    if (!addr) return usage("bad register address '" + r.address + "'");
+    std::optional<ValueType> type;
+    if (!r.type.empty() && !(type = parse_type(r.type))) return usage("bad type '" + r.type + "'");
+    std::vector<uint8_t> data;
+    for (const std::string& v : r.values) {
+        if (type) {
+            auto b = encode_value(*type, v);
+            if (!b) return usage("value '" + v + "' does not fit " + r.type);
+            data.insert(data.end(), b->begin(), b->end());
+        } else {
+            auto b = parse_number(v, 0xFF);
+            if (!b) return usage("bad byte '" + v + "' (0..0xff; use --type for wider values)");
+            data.push_back(static_cast<uint8_t>(*b));
+        }
+    }
+    if (data.empty() || data.size() > master::kMaxDatagramData) return usage("nothing to write, or too much");
+    if (*addr + data.size() > 0x10000) return usage("register range runs past 0xffff");
+    if (Error e = m.write(*a, static_cast<uint16_t>(*addr), data); e != Error::Ok)
+        return fail(e, "writing " + slave_text(*a));
+    return kExitOk;
+}
+
+// ---- sii -----------------------------------------------------------------------------------------
+
+struct SiiArgs {
+    std::string slave = "0";
+    bool station = false;
+    std::string output;
+    std::string input;
+    bool all = false;
+    bool force = false;
+};
+
+int sii_read(master::Master& m, const SiiArgs& s) {
+    auto a = parse_slave(s.slave, s.station);
+    if (!a) return usage("bad slave '" + s.slave + "'");
+    auto img = m.sii_read_image(*a, s.all);
+    if (!img) return fail(img.error(), "reading the SII of " + slave_text(*a));
+    if (s.output.empty()) {
+        std::fputs(hex_dump(0, *img).c_str(), stdout);
+        return kExitOk;
+    }
+    if (s.output == "-") {
+        std::fwrite(img->data(), 1, img->size(), stdout);
+        return kExitOk;
+    }
+    std::ofstream f(s.output, std::ios::binary | std::ios::trunc);
+    f.write(reinterpret_cast<const char*>(img->data()), static_cast<std::streamsize>(img->size()));
+    if (!f) {
+        std::cerr << "ecatctl: cannot write " << s.output << "\n";
+        return kExitFailure;
+    }
+    std::cerr << "ecatctl: " << img->size() << " bytes written to " << s.output << "\n";
+    return kExitOk;
+}
+
+std::optional<std::vector<uint8_t>> read_file(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) return std::nullopt;
+    return std::vector<uint8_t>(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+int sii_write(master::Master& m, const SiiArgs& s) {
+    auto a = parse_slave(s.slave, s.station);
+    if (!a) return usage("bad slave '" + s.slave + "'");
+    auto img = read_file(s.input);
+    if (!img) return usage("cannot read " + s.input);
+    if (img->size() < 16 || img->size() % 2 != 0 || img->size() > 65536)
+        return usage(s.input + ": an SII image is an even number of bytes, 16 to 65536");
+    const uint16_t w7 = static_cast<uint16_t>((*img)[14] | ((*img)[15] << 8));
+    const uint8_t crc = sii_crc(std::span<const uint8_t>(img->data(), 14));
+    if (w7 != 0x88A4 && (w7 & 0xFF) != crc && !s.force) {
+        char b[96];
+        std::snprintf(b, sizeof b, "%s: checksum word 7 is 0x%04x, CRC of words 0-6 is 0x%02x (use --force)",
+                      s.input.c_str(), w7, crc);
+        return usage(b);
+    }
+    const std::size_t words = img->size() / 2;
+    for (std::size_t w = 0; w < words; ++w) {
+        const uint16_t v = static_cast<uint16_t>((*img)[2 * w] | ((*img)[2 * w + 1] << 8));
+        if (Error e = m.sii_write_word(*a, static_cast<uint32_t>(w), v); e != Error::Ok)
+            return fail(e, "writing SII word " + std::to_string(w) + " of " + slave_text(*a));
+    }
+    std::cerr << "ecatctl: " << words << " words written\n";
+    return kExitOk;
+}
+
+int state(master::Master& m, const std::string& slave, bool station, const std::string& target) {
+    auto a = parse_slave(slave, station);
+    if (!a) return usage("bad slave '" + slave + "'");
+    if (target.empty()) {
+        auto st = m.al_status(*a);
+        if (!st) return fail(st.error(), "reading the AL status of " + slave_text(*a));
+        std::printf("%s%s", std::string(master::al_state_name(st->state)).c_str(), st->error ? " +ERR" : "");
+        if (st->error || st->code)
+            std::printf(" 0x%04x %s", st->code, std::string(master::al_status_code_name(st->code)).c_str());
+        std::printf("\n");
+        return kExitOk;
+    }
+    std::string t = target;
+    for (auto& c : t)
+        c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    master::AlState s;
+    if (t == "INIT")
+        s = master::AlState::Init;
+    else if (t == "PREOP")
+        s = master::AlState::PreOp;
+    else if (t == "BOOT")
+        s = master::AlState::Boot;
+    else if (t == "SAFEOP")
+        s = master::AlState::SafeOp;
+    else if (t == "OP")
+        s = master::AlState::Op;
+    else
+        return usage("unknown state '" + target + "' (INIT, PREOP, BOOT, SAFEOP, OP)");
+    master::AlStatus st;
+    const Error e = m.request_state(*a, s, &st);
+    if (e == Error::AlRefused) {
+        std::fprintf(stderr, "ecatctl: %s refused %s: stays in %s, AL status code 0x%04x (%s)\n",
+                     slave_text(*a).c_str(), t.c_str(), std::string(master::al_state_name(st.state)).c_str(),
+                     st.code, std::string(master::al_status_code_name(st.code)).c_str());
+        return kExitProtocol;
+    }
+    if (e != Error::Ok) return fail(e, "requesting " + t + " from " + slave_text(*a));
+    std::printf("%s\n", std::string(master::al_state_name(st.state)).c_str());
+    return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    Globals g;
+    CLI::App app{
+        "A small EtherCAT master for the command line.\n"
+        "Exit codes: 0 ok, 1 failure, 2 usage, 3 interface missing or down, 4 no privileges,\n"
+        "5 no slave answered, 6 unexpected answer (working counter, SII, AL state)",
+        "ecatctl"};
+    app.require_subcommand(1);
+    app.add_option("-i,--iface", g.iface, "Network interface (the master end of the slave's veth pair)")
+        ->envname("ECATCTL_IFACE")
+        ->capture_default_str();
+    app.add_option("-b,--backend", g.backend, "Link backend: pcap or packet (default: the link library's)")
+        ->check(CLI::IsMember({"pcap", "packet"}));
+    app.add_option("-t,--timeout", g.timeout_ms, "Reply timeout per frame in milliseconds")
+        ->check(CLI::Range(1u, 60000u))
+        ->capture_default_str();
+    app.add_option("--retries", g.retries, "Extra attempts after a lost frame")
+        ->check(CLI::Range(0u, 100u))
+        ->capture_default_str();
+
+    int rc = kExitOk;
+    auto* scan_cmd = app.add_subcommand(
+        "scan", "Count the slaves, assign station addresses 0x1001.., list identity and AL state");
+    scan_cmd->callback([&] { rc = with_master(g, [](master::Master& m) { return scan(m); }); });
+
+    RegArgs r;
+    auto* reg = app.add_subcommand("reg", "Read or write ESC registers and memory")->require_subcommand(1);
+    auto* reg_rd = reg->add_subcommand("read", "Read <len> bytes (hex dump) or values of --type");
+    reg_rd->add_option("slave", r.slave, "Slave position (or station address with --station)")->required();
+    reg_rd->add_option("address", r.address, "Register address")->required();
+    reg_rd->add_option("length", r.length, "Bytes to read (default: the size of --type)");
+    reg_rd->add_option("--type", r.type, "u8|u16|u32|u64|i8|i16|i32|i64");
+    reg_rd->add_flag("-s,--station", r.station, "<slave> is a configured station address (FPRD)");
+    reg_rd->callback([&] { rc = with_master(g, [&](master::Master& m) { return reg_read(m, r); }); });
+    auto* reg_wr = reg->add_subcommand("write", "Write bytes (or values of --type)");
+    reg_wr->add_option("slave", r.slave, "Slave position (or station address with --station)")->required();
+    reg_wr->add_option("address", r.address, "Register address")->required();
+    reg_wr->add_option("values", r.values, "Bytes, or values of --type")->required();
+    reg_wr->add_option("--type", r.type, "u8|u16|u32|u64|i8|i16|i32|i64");
+    reg_wr->add_flag("-s,--station", r.station, "<slave> is a configured station address (FPWR)");
+    reg_wr->callback([&] { rc = with_master(g, [&](master::Master& m) { return reg_write(m, r); }); });
+
+    SiiArgs s;
+    auto* sii = app.add_subcommand("sii", "SII EEPROM")->require_subcommand(1);
+    auto* sii_rd = sii->add_subcommand("read", "Read the image (header and categories up to the end marker)");
+    sii_rd->add_option("-p,--position", s.slave, "Slave position (or station address with --station)")
+        ->capture_default_str();
+    sii_rd->add_flag("-s,--station", s.station, "--position is a station address");
+    sii_rd->add_option("-o,--output", s.output,
+                       "Write the raw image to this file ('-': stdout); default: hex dump");
+    sii_rd->add_flag("-a,--all", s.all,
+                     "Read the whole EEPROM size from word 0x3E, not only up to the end marker");
+    sii_rd->callback([&] { rc = with_master(g, [&](master::Master& m) { return sii_read(m, s); }); });
+    auto* sii_wr = sii->add_subcommand("write", "Write an image file word by word");
+    sii_wr->add_option("file", s.input, "Binary image")->required()->check(CLI::ExistingFile);
+    sii_wr->add_option("-p,--position", s.slave, "Slave position (or station address with --station)")
+        ->capture_default_str();
+    sii_wr->add_flag("-s,--station", s.station, "--position is a station address");
+    sii_wr->add_flag("-f,--force", s.force, "Write even if the checksum in word 7 is wrong");
+    sii_wr->callback([&] { rc = with_master(g, [&](master::Master& m) { return sii_write(m, s); }); });
+#ifdef ECATCTL_SII_DECODE
+    auto* sii_dec =
+        sii->add_subcommand("decode", "Print the content of an image file, or of the slave's SII");
+    sii_dec->add_option("file", s.input, "Binary image (default: read it from the slave)");
+    sii_dec->add_option("-p,--position", s.slave, "Slave position (or station address with --station)")
+        ->capture_default_str();
+    sii_dec->add_flag("-s,--station", s.station, "--position is a station address");
+    sii_dec->callback([&] {
+        if (!s.input.empty()) {
+            auto img = read_file(s.input);
+            if (!img) {
+                rc = usage("cannot read " + s.input);
+                return;
+            }
+            std::fputs(esi::decode_sii(*img).c_str(), stdout);
+            return;
+        }
+        rc = with_master(g, [&](master::Master& m) {
+            auto a = parse_slave(s.slave, s.station);
+            if (!a) return usage("bad slave '" + s.slave + "'");
+            auto img = m.sii_read_image(*a);
+            if (!img) return fail(img.error(), "reading the SII of " + slave_text(*a));
+            std::fputs(esi::decode_sii(*img).c_str(), stdout);
+            return kExitOk;
+        });
+    });
+#endif
+
+    std::string st_slave, st_target;
+    bool st_station = false;
+    auto* st = app.add_subcommand("state", "Show the AL state, or request one (with the error acknowledge)");
+    st->add_option("slave", st_slave, "Slave position (or station address with --station)")->required();
+    st->add_option("state", st_target, "INIT|PREOP|BOOT|SAFEOP|OP (omit to show the current state)");
+    st->add_flag("-s,--station", st_station, "<slave> is a station address");
+    st->callback([&] {
+        rc = with_master(g, [&](master::Master& m) { return state(m, st_slave, st_station, st_target); });
+    });
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return kExitUsage;
+    }
+    return rc;
+}
