@@ -1,0 +1,78 @@
+#pragma once
+// What the SII image and the ESI file both say about the device, derived once from od::DeviceDescription and
+// od::Dictionary: the default PDO mapping (0x1600-/0x1A00- read through the assignment objects 0x1C1n), the
+// SyncManager layout with the process-data sizes that mapping gives, the FMMU usage, the profile number
+// (0x1000) and the EEPROM configuration words. build_sii() and build_esi() both render this, so the two
+// files cannot disagree with each other or with the dictionary.
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "od/device.hpp"
+#include "od/dictionary.hpp"
+
+namespace esi {
+
+// One entry of a default PDO mapping (the value of 0x16xx:n / 0x1Axx:n: index << 16 | sub << 8 | bits).
+struct PdoEntryInfo {
+    uint16_t index = 0;  // 0 = padding (gap) entry
+    uint8_t subindex = 0;
+    uint8_t bit_length = 0;
+    std::string name;                  // the mapped entry's name (object name for a VAR); empty for padding
+    od::DataType type{};               // the mapped entry's type (meaningless for padding)
+    const od::Entry* entry = nullptr;  // the mapped entry, nullptr for padding or a dangling mapping
+};
+
+struct PdoInfo {
+    uint16_t index = 0;                 // 0x1600.. (RxPDO) or 0x1A00.. (TxPDO)
+    bool rx = false;                    // true: RxPDO (master -> slave, outputs)
+    std::string name;                   // the mapping object's name
+    int sm = -1;                        // SyncManager that assigns it by default (0x1C1n), -1 = not assigned
+    bool fixed = false;                 // mapping not writable in any state (PdoFixedContent / ESI Fixed)
+    std::vector<PdoEntryInfo> entries;  // the default mapping, in order
+    uint32_t bit_size() const;
+};
+
+struct SmInfo {
+    od::SmKind kind = od::SmKind::MBoxOut;
+    uint16_t start = 0;
+    uint16_t size = 0;  // mailbox: the mailbox size; process data: bytes of the default mapping
+    uint8_t control = 0;
+    bool enable = true;
+};
+
+// ESI Fmmu text / SII FMMU category byte.
+enum class FmmuUse : uint8_t { Unused = 0x00, Outputs = 0x01, Inputs = 0x02, MBoxState = 0x03 };
+
+// Mailbox data-link-layer (repeat) support is not part of od::DeviceDescription; the stack does not claim it.
+// Physical ports: two MII ports (as the MAXPOS, and as esc::EscConfig's 0x0007 default 0x0F).
+constexpr uint16_t kPhysicalPorts = 0x0011;  // SII General bytes 16-17: 4 bits per port, 1 = MII
+constexpr const char* kPhysics = "YY";       // ESI Device Physics
+
+struct DeviceModel {
+    std::vector<PdoInfo>
+        pdos;  // every mapping object of the dictionary, by index (Rx first: 0x16xx < 0x1Axx)
+    std::vector<SmInfo> sync_managers;
+    std::vector<FmmuUse> fmmus;
+    uint16_t profile_number = 0;            // 0x1000 bits 0-15 (402 for a drive), 0 if 0x1000 has no default
+    uint16_t profile_add_info = 0;          // 0x1000 bits 16-31 (CiA 402: 2 = servo)
+    std::array<uint8_t, 14> config_data{};  // SII words 0-6 (ESI Eeprom/ConfigData)
+    std::array<uint8_t, 8> bootstrap{};     // SII words 0x14-0x17 (ESI Eeprom/BootStrap)
+    // Contradictions between the description and the dictionary (the dictionary wins in the output): a
+    // default mapping that names a missing or unmappable entry, a process-data SyncManager whose declared
+    // default_size differs from the size of its default mapping, ... Empty for a consistent device.
+    std::vector<std::string> warnings;
+};
+
+DeviceModel derive_model(const od::DeviceDescription& description, const od::Dictionary& dictionary);
+
+// The integral value of a declared number (default/min/max) as raw little-endian bits for an entry of the
+// given type and bit length: reals become their IEEE-754 bits, integers are truncated two's complement.
+std::optional<uint64_t> number_bits(const od::Number& n, od::DataType type, uint16_t bit_length);
+
+// CRC-8 of the SII header (polynomial 0x07, initial 0xFF, MSB first) over the given bytes.
+uint8_t sii_crc8(const uint8_t* data, std::size_t size);
+
+}  // namespace esi

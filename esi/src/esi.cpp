@@ -1,0 +1,527 @@
+#include "esi/esi.hpp"
+
+#include <libxml/tree.h>
+
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <set>
+#include <stdexcept>
+
+#include "esi/model.hpp"
+#include "type_names.hpp"
+
+namespace esi {
+namespace {
+
+using od::DataType;
+using od::Entry;
+using od::Object;
+using od::ObjectCode;
+
+const xmlChar* X(const char* s) {
+    return reinterpret_cast<const xmlChar*>(s);
+}
+
+std::string hex(uint64_t v) {
+    char b[24];
+    std::snprintf(b, sizeof b, "#x%llx", static_cast<unsigned long long>(v));
+    return b;
+}
+
+std::string hex_index(uint16_t v) {
+    char b[8];
+    std::snprintf(b, sizeof b, "#x%04x", static_cast<unsigned>(v));
+    return b;
+}
+
+std::string hex_bytes(const uint8_t* p, std::size_t n) {
+    static const char* digits = "0123456789abcdef";
+    std::string s;
+    for (std::size_t i = 0; i < n; ++i) {
+        s += digits[p[i] >> 4];
+        s += digits[p[i] & 0xF];
+    }
+    return s;
+}
+
+// Builder helpers over libxml2's tree API (xmlNewTextChild escapes the content).
+xmlNodePtr child(xmlNodePtr parent, const char* name, const std::string& text) {
+    return xmlNewTextChild(parent, nullptr, X(name), X(text.c_str()));
+}
+xmlNodePtr child(xmlNodePtr parent, const char* name) {
+    return xmlNewChild(parent, nullptr, X(name), nullptr);
+}
+void attr(xmlNodePtr node, const char* name, const std::string& value) {
+    xmlNewProp(node, X(name), X(value.c_str()));
+}
+xmlNodePtr named(xmlNodePtr parent, const char* name, const std::string& text) {
+    xmlNodePtr n = child(parent, name, text);
+    attr(n, "LcId", "1033");
+    return n;
+}
+
+// ---- Access flags ------------------------------------------------------------------------------------
+
+// "PreOP", "SafeOP", "OP", "PreOP_SafeOP", ... for a subset of the three states; empty for all or none.
+std::string restriction(uint16_t bits, uint16_t preop, uint16_t safeop, uint16_t op) {
+    const bool p = bits & preop, s = bits & safeop, o = bits & op;
+    if ((p && s && o) || (!p && !s && !o)) return {};
+    if (p && s) return "PreOP_SafeOP";
+    if (p && o) return "PreOP_OP";
+    if (s && o) return "SafeOP_OP";
+    if (p) return "PreOP";
+    if (s) return "SafeOP";
+    return "OP";
+}
+
+void access_flags(xmlNodePtr flags, const Entry& e, const char* category) {
+    namespace a = od::access;
+    const uint16_t r = e.access & a::ReadMask;
+    const uint16_t w = e.access & a::WriteMask;
+    const char* text = w == 0 ? "ro" : (r == 0 ? "wo" : "rw");
+    xmlNodePtr acc = child(flags, "Access", text);
+    const std::string rr = restriction(r, a::ReadPreOp, a::ReadSafeOp, a::ReadOp);
+    const std::string wr = restriction(w, a::WritePreOp, a::WriteSafeOp, a::WriteOp);
+    if (!rr.empty()) attr(acc, "ReadRestrictions", rr);
+    if (!wr.empty()) attr(acc, "WriteRestrictions", wr);
+    if (category != nullptr) child(flags, "Category", category);
+    if (e.rx_mappable() || e.tx_mappable())
+        child(flags, "PdoMapping", e.rx_mappable() && e.tx_mappable() ? "RT" : (e.rx_mappable() ? "R" : "T"));
+}
+
+void backup_flags(xmlNodePtr flags, const Entry& e) {
+    if (e.access & od::access::Backup) child(flags, "Backup", "1");
+    if (e.access & od::access::Settings) child(flags, "Setting", "1");
+}
+
+// ETG.1000.6: 0x1000 and 0x1018 are mandatory for every CoE device; everything else is optional here.
+const char* object_category(uint16_t index) {
+    return (index == 0x1000 || index == 0x1018) ? "m" : "o";
+}
+
+// ---- Values ------------------------------------------------------------------------------------------
+
+std::string number_text(uint64_t bits, const Entry& e) {
+    if (od::is_signed(e.type)) {
+        const unsigned width = (e.bit_length == 0 || e.bit_length > 64) ? 64u : e.bit_length;
+        int64_t v = static_cast<int64_t>(bits);
+        if (width < 64 && (bits >> (width - 1)) & 1) v = static_cast<int64_t>(bits | (~uint64_t{0} << width));
+        return std::to_string(v);
+    }
+    return hex(bits);
+}
+
+std::string le_hex(uint64_t bits, std::size_t bytes) {
+    uint8_t b[8] = {};
+    for (std::size_t i = 0; i < 8; ++i)
+        b[i] = static_cast<uint8_t>(bits >> (8 * i));
+    return hex_bytes(b, bytes > 8 ? 8 : bytes);
+}
+
+// Info content of one entry: default, limits, unit (ObjectInfoType).
+void value_info(xmlNodePtr info, const Entry& e) {
+    if (od::is_string(e.type)) {
+        if (e.type == DataType::VisibleString) {
+            if (!e.default_string.empty()) child(info, "DefaultString", e.default_string);
+        } else if (!e.default_string.empty()) {
+            child(info, "DefaultData",
+                  hex_bytes(reinterpret_cast<const uint8_t*>(e.default_string.data()),
+                            e.default_string.size()));
+        }
+    } else {
+        const auto def = number_bits(e.default_value, e.type, e.bit_length);
+        const auto min = number_bits(e.minimum, e.type, e.bit_length);
+        const auto max = number_bits(e.maximum, e.type, e.bit_length);
+        const std::size_t bytes = e.byte_size() == 0 ? 1 : e.byte_size();
+        if ((min || max) && !od::is_real(e.type)) {
+            if (min) child(info, "MinValue", number_text(*min, e));
+            if (max) child(info, "MaxValue", number_text(*max, e));
+            if (def) child(info, "DefaultValue", number_text(*def, e));
+        } else {
+            if (min) child(info, "MinData", le_hex(*min, bytes));
+            if (max) child(info, "MaxData", le_hex(*max, bytes));
+            if (def) child(info, "DefaultData", le_hex(*def, bytes));
+        }
+    }
+    if (const auto u = unit_code(e.unit)) child(info, "Unit", hex(*u));
+}
+
+// ---- Data types --------------------------------------------------------------------------------------
+
+struct TypeSet {
+    std::map<std::string, uint32_t> base;  // name -> bit size (scalars and strings)
+    std::string use(const Entry& e) {
+        const std::string n = esi_type_name(e.type, e.bit_length);
+        if (e.type == DataType::OctetString) base["BYTE"] = 8;
+        base[n] = od::is_string(e.type) ? e.bit_length : (e.bit_length ? e.bit_length : od::bit_size(e.type));
+        return n;
+    }
+};
+
+// An ARRAY object that can be described with ArrayInfo: subindices 1..n all present, one type, size and
+// access for all elements.
+bool uniform_array(const Object& o) {
+    if (o.code != ObjectCode::Array || o.entries.size() < 2 || o.entries[0].subindex != 0) return false;
+    const Entry& first = o.entries[1];
+    for (std::size_t i = 1; i < o.entries.size(); ++i) {
+        const Entry& e = o.entries[i];
+        if (e.subindex != i || e.type != first.type || e.bit_length != first.bit_length ||
+            (e.access & ~(od::access::Backup | od::access::Settings)) !=
+                (first.access & ~(od::access::Backup | od::access::Settings)))
+            return false;
+    }
+    return true;
+}
+
+std::string sub_name(unsigned sub) {
+    char b[16];
+    std::snprintf(b, sizeof b, "SubIndex %03u", sub);
+    return b;
+}
+
+// Record-style SubItem names: the entry names, made unique (the XSD keys SubItems by Name).
+std::vector<std::string> record_item_names(const Object& o) {
+    std::vector<std::string> names;
+    std::set<std::string> seen;
+    for (const Entry& e : o.entries) {
+        std::string n = e.name.empty() ? sub_name(e.subindex) : e.name;
+        if (!seen.insert(n).second) n += " (" + sub_name(e.subindex) + ")";
+        seen.insert(n);
+        names.push_back(n);
+    }
+    return names;
+}
+
+// Bit offsets in the complete-access layout: subindex 0 padded to 16 bits, the rest packed.
+std::vector<uint32_t> bit_offsets(const Object& o, uint32_t& total) {
+    std::vector<uint32_t> offs;
+    uint32_t off = 0;
+    for (const Entry& e : o.entries) {
+        offs.push_back(off);
+        off += e.bit_length;
+        if (e.subindex == 0 && off < 16) off = 16;
+    }
+    total = off;
+    return offs;
+}
+
+std::string dt_name(uint16_t index) {
+    char b[16];
+    std::snprintf(b, sizeof b, "DT%04X", static_cast<unsigned>(index));
+    return b;
+}
+
+void sub_item(xmlNodePtr dt, const Entry* idx_entry, const std::string& name, const std::string& type,
+              uint32_t bits, uint32_t offs, const Entry& flags_of) {
+    xmlNodePtr si = child(dt, "SubItem");
+    if (idx_entry != nullptr) child(si, "SubIdx", std::to_string(idx_entry->subindex));
+    child(si, "Name", name);
+    child(si, "Type", type);
+    child(si, "BitSize", std::to_string(bits));
+    child(si, "BitOffs", std::to_string(offs));
+    xmlNodePtr flags = child(si, "Flags");
+    access_flags(flags, flags_of, nullptr);
+    backup_flags(flags, flags_of);
+}
+
+// Emits the DataType(s) of a structured object; returns its type name and bit size.
+std::string structured_type(xmlNodePtr types, const Object& o, TypeSet& ts, uint32_t& bits) {
+    const std::string name = dt_name(o.index);
+    if (uniform_array(o)) {
+        const Entry& si0 = o.entries[0];
+        const Entry& el = o.entries[1];
+        const std::string base = ts.use(el);
+        const std::string si0_type = ts.use(si0);
+        const auto n = static_cast<uint32_t>(o.entries.size() - 1);
+        const uint32_t arr_bits = n * el.bit_length;
+        xmlNodePtr arr = child(types, "DataType");
+        child(arr, "Name", name + "ARR");
+        child(arr, "BaseType", base);
+        child(arr, "BitSize", std::to_string(arr_bits));
+        xmlNodePtr ai = child(arr, "ArrayInfo");
+        child(ai, "LBound", "1");
+        child(ai, "Elements", std::to_string(n));
+        const uint32_t elements_offs = si0.bit_length < 16 ? 16 : si0.bit_length;
+        bits = elements_offs + arr_bits;
+        xmlNodePtr dt = child(types, "DataType");
+        child(dt, "Name", name);
+        child(dt, "BitSize", std::to_string(bits));
+        sub_item(dt, &si0, sub_name(0), si0_type, si0.bit_length, 0, si0);
+        sub_item(dt, nullptr, "Elements", name + "ARR", arr_bits, elements_offs, el);
+        return name;
+    }
+    const auto names = record_item_names(o);
+    const auto offs = bit_offsets(o, bits);
+    std::vector<std::string> types_of;
+    for (const Entry& e : o.entries)
+        types_of.push_back(ts.use(e));
+    xmlNodePtr dt = child(types, "DataType");
+    child(dt, "Name", name);
+    child(dt, "BitSize", std::to_string(bits));
+    for (std::size_t i = 0; i < o.entries.size(); ++i)
+        sub_item(dt, &o.entries[i], names[i], types_of[i], o.entries[i].bit_length, offs[i], o.entries[i]);
+    return name;
+}
+
+void dictionary(xmlNodePtr profile, const od::Dictionary& dict) {
+    xmlNodePtr dictionary = child(profile, "Dictionary");
+    xmlNodePtr types = child(dictionary, "DataTypes");
+    xmlNodePtr objects = child(dictionary, "Objects");
+    TypeSet ts;
+    // Structured types go into a separate list so the base types can be emitted first.
+    xmlNodePtr structured = xmlNewNode(nullptr, X("Structured"));
+
+    for (const Object& o : dict.objects()) {
+        if (o.entries.empty()) continue;
+        xmlNodePtr obj = child(objects, "Object");
+        child(obj, "Index", hex_index(o.index));
+        named(obj, "Name", o.name);
+        if (o.code == ObjectCode::Var) {
+            const Entry& e = o.entries[0];
+            child(obj, "Type", ts.use(e));
+            child(obj, "BitSize", std::to_string(e.bit_length));
+            xmlNodePtr info = child(obj, "Info");
+            value_info(info, e);
+            if (info->children == nullptr) {
+                xmlUnlinkNode(info);
+                xmlFreeNode(info);
+            }
+            xmlNodePtr flags = child(obj, "Flags");
+            access_flags(flags, e, object_category(o.index));
+            backup_flags(flags, e);
+            continue;
+        }
+        uint32_t bits = 0;
+        child(obj, "Type", structured_type(structured, o, ts, bits));
+        child(obj, "BitSize", std::to_string(bits));
+        xmlNodePtr info = child(obj, "Info");
+        const bool array = uniform_array(o);
+        const auto names = record_item_names(o);
+        for (std::size_t i = 0; i < o.entries.size(); ++i) {
+            xmlNodePtr si = child(info, "SubItem");
+            child(si, "Name", array ? sub_name(o.entries[i].subindex) : names[i]);
+            value_info(child(si, "Info"), o.entries[i]);
+        }
+        xmlNodePtr flags = child(obj, "Flags");
+        access_flags(flags, o.entries[0], object_category(o.index));
+    }
+
+    for (const auto& [name, bits] : ts.base) {
+        xmlNodePtr dt = child(types, "DataType");
+        child(dt, "Name", name);
+        if (name.rfind("ARRAY ", 0) == 0) child(dt, "BaseType", "BYTE");
+        child(dt, "BitSize", std::to_string(bits));
+        if (name.rfind("ARRAY ", 0) == 0) {
+            xmlNodePtr ai = child(dt, "ArrayInfo");
+            child(ai, "LBound", "0");
+            child(ai, "Elements", std::to_string(bits / 8));
+        }
+    }
+    // Move the structured types behind the base types.
+    for (xmlNodePtr n = structured->children; n != nullptr;) {
+        xmlNodePtr next = n->next;
+        xmlUnlinkNode(n);
+        xmlAddChild(types, n);
+        n = next;
+    }
+    xmlFreeNode(structured);
+}
+
+// ---- PDOs --------------------------------------------------------------------------------------------
+
+void pdo(xmlNodePtr device, const PdoInfo& p) {
+    xmlNodePtr n = child(device, p.rx ? "RxPdo" : "TxPdo");
+    if (p.fixed) attr(n, "Fixed", "1");
+    if (p.sm >= 0) attr(n, "Sm", std::to_string(p.sm));
+    child(n, "Index", hex_index(p.index));
+    named(n, "Name", p.name);
+    for (const PdoEntryInfo& e : p.entries) {
+        xmlNodePtr en = child(n, "Entry");
+        child(en, "Index", hex_index(e.index));
+        if (e.index != 0) child(en, "SubIndex", std::to_string(e.subindex));
+        child(en, "BitLen", std::to_string(e.bit_length));
+        if (e.index != 0) {
+            named(en, "Name", e.name);
+            if (e.entry != nullptr) child(en, "DataType", esi_type_name(e.type, e.bit_length));
+        }
+    }
+}
+
+const char* sm_text(od::SmKind k) {
+    switch (k) {
+        case od::SmKind::MBoxOut:
+            return "MBoxOut";
+        case od::SmKind::MBoxIn:
+            return "MBoxIn";
+        case od::SmKind::Outputs:
+            return "Outputs";
+        case od::SmKind::Inputs:
+            return "Inputs";
+    }
+    return "MBoxOut";
+}
+
+const char* fmmu_text(FmmuUse f) {
+    switch (f) {
+        case FmmuUse::Outputs:
+            return "Outputs";
+        case FmmuUse::Inputs:
+            return "Inputs";
+        case FmmuUse::MBoxState:
+            return "MBoxState";
+        case FmmuUse::Unused:
+            break;
+    }
+    return "";
+}
+
+const char* boolean(bool b) {
+    return b ? "true" : "false";
+}
+
+}  // namespace
+
+std::string esi_type_name(od::DataType type, uint16_t bit_length) {
+    switch (type) {
+        case DataType::VisibleString:
+            return "STRING(" + std::to_string(bit_length / 8) + ")";
+        case DataType::UnicodeString:
+            return "UNICODE_STRING(" + std::to_string(bit_length / 16) + ")";
+        case DataType::OctetString:
+            if (bit_length < 8) return "ARRAY [0..0] OF BYTE";
+            return "ARRAY [0.." + std::to_string(bit_length / 8 - 1) + "] OF BYTE";
+        default:
+            break;
+    }
+    const uint16_t natural = od::bit_size(type);
+    if (natural > 1 && bit_length != 0 && bit_length < natural) return "BIT" + std::to_string(bit_length);
+    if (const char* n = detail::base_type_name(static_cast<uint16_t>(type))) return n;
+    char b[16];
+    std::snprintf(b, sizeof b, "DT%04X", static_cast<unsigned>(type));
+    return b;
+}
+
+std::optional<uint32_t> unit_code(const std::string& unit) {
+    struct U {
+        const char* text;
+        uint8_t prefix;
+        uint8_t unit;
+    };
+    static const U table[] = {
+        {"s", 0x00, 0x03},  {"ms", 0xFD, 0x03}, {"us", 0xFA, 0x03},  {"\xC2\xB5s", 0xFA, 0x03},
+        {"ns", 0xF7, 0x03}, {"A", 0x00, 0x04},  {"mA", 0xFD, 0x04},  {"V", 0x00, 0x26},
+        {"mV", 0xFD, 0x26}, {"Hz", 0x00, 0x20}, {"kHz", 0x03, 0x20},
+    };
+    for (const U& u : table)
+        if (unit == u.text) return (uint32_t{u.prefix} << 24) | (uint32_t{u.unit} << 16);
+    return std::nullopt;
+}
+
+std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict) {
+    const DeviceModel m = derive_model(d, dict);
+    std::unique_ptr<xmlDoc, decltype(&xmlFreeDoc)> doc(xmlNewDoc(X("1.0")), &xmlFreeDoc);
+    xmlNodePtr root = xmlNewNode(nullptr, X("EtherCATInfo"));
+    xmlDocSetRootElement(doc.get(), root);
+    xmlNsPtr xsi = xmlNewNs(root, X("http://www.w3.org/2001/XMLSchema-instance"), X("xsi"));
+    xmlNewNsProp(root, xsi, X("noNamespaceSchemaLocation"), X("EtherCATInfo.xsd"));
+    attr(root, "Version", "1.14");
+
+    const od::Identity& id = d.identity;
+    xmlNodePtr vendor = child(root, "Vendor");
+    child(vendor, "Id", hex(id.vendor_id));
+    named(vendor, "Name", id.vendor_name);
+
+    xmlNodePtr descriptions = child(root, "Descriptions");
+    xmlNodePtr group = child(child(descriptions, "Groups"), "Group");
+    child(group, "Type", id.group_type);
+    named(group, "Name", id.group_type);
+
+    xmlNodePtr device = child(child(descriptions, "Devices"), "Device");
+    attr(device, "Physics", kPhysics);
+    xmlNodePtr type = child(device, "Type", id.order_code.empty() ? id.device_name : id.order_code);
+    attr(type, "ProductCode", hex(id.product_code));
+    attr(type, "RevisionNo", hex(id.revision));
+    named(device, "Name", id.device_name);
+    child(device, "GroupType", id.group_type);
+
+    xmlNodePtr profile = child(device, "Profile");
+    if (m.profile_number != 0) {
+        child(profile, "ProfileNo", std::to_string(m.profile_number));
+        child(profile, "AddInfo", std::to_string(m.profile_add_info));
+    }
+    dictionary(profile, dict);
+
+    for (FmmuUse f : m.fmmus)
+        child(device, "Fmmu", fmmu_text(f));
+    for (const SmInfo& s : m.sync_managers) {
+        xmlNodePtr sm = child(device, "Sm", sm_text(s.kind));
+        if (s.size != 0) attr(sm, "DefaultSize", std::to_string(s.size));
+        attr(sm, "StartAddress", hex_index(s.start));
+        attr(sm, "ControlByte", hex(s.control));
+        attr(sm, "Enable", s.enable ? "1" : "0");
+    }
+    for (const PdoInfo& p : m.pdos)
+        if (p.rx) pdo(device, p);
+    for (const PdoInfo& p : m.pdos)
+        if (!p.rx) pdo(device, p);
+
+    if (d.mailbox_protocols != 0) {
+        namespace mp = od::mailbox_protocol;
+        namespace cd = od::coe_details;
+        xmlNodePtr mbx = child(device, "Mailbox");
+        if (d.mailbox_protocols & mp::AoE) child(mbx, "AoE");
+        if (d.mailbox_protocols & mp::EoE) child(mbx, "EoE");
+        if (d.mailbox_protocols & mp::CoE) {
+            xmlNodePtr coe = child(mbx, "CoE");
+            attr(coe, "SdoInfo", boolean(d.coe_details & cd::SdoInfo));
+            attr(coe, "PdoAssign", boolean(d.coe_details & cd::PdoAssign));
+            attr(coe, "PdoConfig", boolean(d.coe_details & cd::PdoConfig));
+            attr(coe, "PdoUpload", boolean(d.coe_details & cd::PdoUpload));
+            attr(coe, "CompleteAccess", boolean(d.coe_details & cd::CompleteAccess));
+            if (m.profile_number == 402) attr(coe, "DS402Channels", "1");
+        }
+        if (d.mailbox_protocols & mp::FoE) child(mbx, "FoE");
+        if (d.mailbox_protocols & mp::SoE) child(mbx, "SoE");
+        if (d.mailbox_protocols & mp::VoE) child(mbx, "VoE");
+    }
+
+    if (!d.dc_modes.empty()) {
+        xmlNodePtr dc = child(device, "Dc");
+        for (const od::DcOpMode& mode : d.dc_modes) {
+            xmlNodePtr op = child(dc, "OpMode");
+            child(op, "Name", mode.name);
+            if (!mode.description.empty()) child(op, "Desc", mode.description);
+            child(op, "AssignActivate", hex(mode.assign_activate));
+            if (mode.assign_activate != 0) {
+                xmlNodePtr c0 = child(op, "CycleTimeSync0", "0");
+                attr(c0, "Factor", std::to_string(mode.cycle_time_sync0_factor));
+                child(op, "ShiftTimeSync0", std::to_string(mode.shift_time_sync0));
+            }
+        }
+    }
+
+    xmlNodePtr eeprom = child(device, "Eeprom");
+    child(eeprom, "ByteSize", std::to_string(d.eeprom_bytes));
+    child(eeprom, "ConfigData", hex_bytes(m.config_data.data(), m.config_data.size()));
+    child(eeprom, "BootStrap", hex_bytes(m.bootstrap.data(), m.bootstrap.size()));
+
+    xmlChar* buf = nullptr;
+    int size = 0;
+    xmlDocDumpFormatMemoryEnc(doc.get(), &buf, &size, "UTF-8", 1);
+    if (buf == nullptr) throw std::runtime_error("ESI: libxml2 could not serialise the document");
+    std::string out(reinterpret_cast<const char*>(buf), static_cast<std::size_t>(size));
+    xmlFree(buf);
+    return out;
+}
+
+void write_esi(const std::filesystem::path& path, const od::DeviceDescription& d,
+               const od::Dictionary& dict) {
+    const std::string xml = build_esi(d, dict);
+    std::ofstream f(path, std::ios::binary | std::ios::trunc);
+    f << xml;
+    if (!f) throw std::runtime_error("cannot write " + path.string());
+}
+
+}  // namespace esi

@@ -1,0 +1,222 @@
+#include "esi/model.hpp"
+
+#include <bit>
+#include <cmath>
+#include <cstdio>
+
+namespace esi {
+namespace {
+
+std::string hex4(uint32_t v) {
+    char b[16];
+    std::snprintf(b, sizeof b, "0x%04X", static_cast<unsigned>(v));
+    return b;
+}
+
+std::string where(uint16_t index, uint8_t sub) {
+    char b[24];
+    std::snprintf(b, sizeof b, "0x%04X:%02X", static_cast<unsigned>(index), static_cast<unsigned>(sub));
+    return b;
+}
+
+// Declared default of an entry as an unsigned integer (0 if none).
+uint64_t default_of(const od::Entry* e) {
+    if (e == nullptr) return 0;
+    return number_bits(e->default_value, e->type, e->bit_length).value_or(0);
+}
+
+bool is_rx_mapping(uint16_t index) {
+    return index >= 0x1600 && index <= 0x17FF;
+}
+bool is_tx_mapping(uint16_t index) {
+    return index >= 0x1A00 && index <= 0x1BFF;
+}
+
+void read_mapping(const od::Dictionary& dict, const od::Object& obj, PdoInfo& pdo,
+                  std::vector<std::string>& warnings) {
+    const od::Entry* count_entry = obj.entry(0);
+    const uint64_t count = default_of(count_entry);
+    if (count_entry != nullptr) pdo.fixed = (count_entry->access & od::access::WriteMask) == 0;
+    for (uint64_t i = 1; i <= count && i <= 0xFF; ++i) {
+        const auto sub = static_cast<uint8_t>(i);
+        const od::Entry* slot = obj.entry(sub);
+        if (slot == nullptr) {
+            warnings.push_back(where(obj.index, 0) + " counts " + std::to_string(count) +
+                               " entries but subindex " + std::to_string(i) + " does not exist");
+            break;
+        }
+        const auto word = static_cast<uint32_t>(default_of(slot));
+        PdoEntryInfo pe;
+        pe.index = static_cast<uint16_t>(word >> 16);
+        pe.subindex = static_cast<uint8_t>(word >> 8);
+        pe.bit_length = static_cast<uint8_t>(word);
+        if (pe.index != 0) {
+            const od::Object* target_obj = dict.find(pe.index);
+            const od::Entry* target = dict.find(pe.index, pe.subindex);
+            if (target == nullptr || target_obj == nullptr) {
+                warnings.push_back(where(obj.index, sub) + " maps " + where(pe.index, pe.subindex) +
+                                   " which does not exist");
+            } else {
+                pe.entry = target;
+                pe.type = target->type;
+                pe.name = (target_obj->code == od::ObjectCode::Var || target->name.empty()) ? target_obj->name
+                                                                                            : target->name;
+                const bool mappable = pdo.rx ? target->rx_mappable() : target->tx_mappable();
+                if (!mappable)
+                    warnings.push_back(where(obj.index, sub) + " maps " + where(pe.index, pe.subindex) +
+                                       " which is not " + (pdo.rx ? "RxPDO" : "TxPDO") + " mappable");
+                if (target->bit_length != pe.bit_length)
+                    warnings.push_back(where(obj.index, sub) + " maps " + where(pe.index, pe.subindex) +
+                                       " with " + std::to_string(pe.bit_length) + " bits, the entry has " +
+                                       std::to_string(target->bit_length));
+            }
+        }
+        pdo.entries.push_back(std::move(pe));
+    }
+}
+
+}  // namespace
+
+uint32_t PdoInfo::bit_size() const {
+    uint32_t bits = 0;
+    for (const auto& e : entries)
+        bits += e.bit_length;
+    return bits;
+}
+
+std::optional<uint64_t> number_bits(const od::Number& n, od::DataType type, uint16_t bit_length) {
+    if (std::holds_alternative<std::monostate>(n)) return std::nullopt;
+    const unsigned width = (bit_length == 0 || bit_length > 64) ? 64u : bit_length;
+    const uint64_t mask = width == 64 ? ~uint64_t{0} : ((uint64_t{1} << width) - 1);
+    if (od::is_real(type)) {
+        double d = 0;
+        if (const auto* pd = std::get_if<double>(&n)) d = *pd;
+        if (const auto* pi = std::get_if<int64_t>(&n)) d = static_cast<double>(*pi);
+        if (const auto* pu = std::get_if<uint64_t>(&n)) d = static_cast<double>(*pu);
+        if (width == 32) return std::bit_cast<uint32_t>(static_cast<float>(d));
+        return std::bit_cast<uint64_t>(d);
+    }
+    uint64_t v = 0;
+    if (const auto* pd = std::get_if<double>(&n))
+        v = static_cast<uint64_t>(static_cast<int64_t>(std::llround(*pd)));
+    if (const auto* pi = std::get_if<int64_t>(&n)) v = static_cast<uint64_t>(*pi);
+    if (const auto* pu = std::get_if<uint64_t>(&n)) v = *pu;
+    return v & mask;
+}
+
+uint8_t sii_crc8(const uint8_t* data, std::size_t size) {
+    uint8_t crc = 0xFF;
+    for (std::size_t i = 0; i < size; ++i) {
+        crc ^= data[i];
+        for (int b = 0; b < 8; ++b)
+            crc = (crc & 0x80) ? static_cast<uint8_t>((crc << 1) ^ 0x07) : (crc << 1);
+    }
+    return crc;
+}
+
+DeviceModel derive_model(const od::DeviceDescription& d, const od::Dictionary& dict) {
+    DeviceModel m;
+
+    // ---- PDOs: every mapping object with its default mapping ----
+    for (const od::Object& obj : dict.objects()) {
+        if (!is_rx_mapping(obj.index) && !is_tx_mapping(obj.index)) continue;
+        PdoInfo pdo;
+        pdo.index = obj.index;
+        pdo.rx = is_rx_mapping(obj.index);
+        pdo.name = obj.name;
+        read_mapping(dict, obj, pdo, m.warnings);
+        m.pdos.push_back(std::move(pdo));
+    }
+
+    // ---- SyncManagers and their default PDO assignment (0x1C10 + n) ----
+    for (std::size_t n = 0; n < d.sync_managers.size(); ++n) {
+        const od::SyncManagerDefault& sm = d.sync_managers[n];
+        SmInfo si{sm.kind, sm.start, sm.default_size, sm.control, sm.enable};
+        const std::string name = "SM" + std::to_string(n);
+        switch (sm.kind) {
+            case od::SmKind::MBoxOut:
+            case od::SmKind::MBoxIn: {
+                const bool out = sm.kind == od::SmKind::MBoxOut;
+                const uint16_t start = out ? d.standard_mailbox.out_start : d.standard_mailbox.in_start;
+                const uint16_t size = out ? d.standard_mailbox.out_size : d.standard_mailbox.in_size;
+                if ((sm.start != 0 && sm.start != start) || (sm.default_size != 0 && sm.default_size != size))
+                    m.warnings.push_back(name + " declares " + hex4(sm.start) + "/" +
+                                         std::to_string(sm.default_size) + ", the standard mailbox is " +
+                                         hex4(start) + "/" + std::to_string(size));
+                si.start = start;
+                si.size = size;
+                break;
+            }
+            case od::SmKind::Outputs:
+            case od::SmKind::Inputs: {
+                const bool rx = sm.kind == od::SmKind::Outputs;
+                const auto assign_index = static_cast<uint16_t>(0x1C10 + n);
+                uint32_t bits = 0;
+                if (const od::Object* assign = dict.find(assign_index)) {
+                    const uint64_t count = default_of(assign->entry(0));
+                    for (uint64_t k = 1; k <= count && k <= 0xFF; ++k) {
+                        const od::Entry* e = assign->entry(static_cast<uint8_t>(k));
+                        const auto pdo_index = static_cast<uint16_t>(default_of(e));
+                        PdoInfo* found = nullptr;
+                        for (auto& p : m.pdos)
+                            if (p.index == pdo_index) found = &p;
+                        if (found == nullptr || found->rx != rx) {
+                            m.warnings.push_back(where(assign_index, static_cast<uint8_t>(k)) + " assigns " +
+                                                 hex4(pdo_index) + " which is not an " +
+                                                 (rx ? "RxPDO" : "TxPDO") + " of this dictionary");
+                            continue;
+                        }
+                        if (found->sm >= 0)
+                            m.warnings.push_back(hex4(pdo_index) + " assigned to SM" +
+                                                 std::to_string(found->sm) + " and " + name);
+                        found->sm = static_cast<int>(n);
+                        bits += found->bit_size();
+                    }
+                }
+                const auto bytes = static_cast<uint16_t>((bits + 7) / 8);
+                if (sm.default_size != 0 && sm.default_size != bytes)
+                    m.warnings.push_back(name + " declares default size " + std::to_string(sm.default_size) +
+                                         ", its default mapping has " + std::to_string(bytes) + " bytes");
+                si.size = bytes;
+                break;
+            }
+        }
+        m.sync_managers.push_back(si);
+    }
+
+    // ---- FMMUs: one per process-data direction, one for the mailbox status ----
+    auto has = [&](od::SmKind k) {
+        for (const auto& s : m.sync_managers)
+            if (s.kind == k) return true;
+        return false;
+    };
+    if (has(od::SmKind::Outputs)) m.fmmus.push_back(FmmuUse::Outputs);
+    if (has(od::SmKind::Inputs)) m.fmmus.push_back(FmmuUse::Inputs);
+    if (has(od::SmKind::MBoxIn)) m.fmmus.push_back(FmmuUse::MBoxState);
+
+    // ---- Profile from the device type 0x1000 ----
+    if (const od::Entry* dt = dict.find(0x1000, 0)) {
+        const auto v = static_cast<uint32_t>(default_of(dt));
+        m.profile_number = static_cast<uint16_t>(v);
+        m.profile_add_info = static_cast<uint16_t>(v >> 16);
+    }
+
+    // ---- EEPROM configuration words 0-6 and bootstrap mailbox words 0x14-0x17 ----
+    auto put16 = [](uint8_t* p, uint16_t v) {
+        p[0] = static_cast<uint8_t>(v);
+        p[1] = static_cast<uint8_t>(v >> 8);
+    };
+    m.config_data[0] = d.pdi_control;
+    m.config_data[1] = d.esc_config;
+    put16(&m.config_data[2], d.pdi_config);
+    put16(&m.config_data[4], d.sync_pulse_length);
+    put16(&m.config_data[6], 0);  // extended PDI configuration: not in the description
+    put16(&m.config_data[8], d.station_alias);
+    put16(&m.bootstrap[0], d.bootstrap_mailbox.out_start);
+    put16(&m.bootstrap[2], d.bootstrap_mailbox.out_size);
+    put16(&m.bootstrap[4], d.bootstrap_mailbox.in_start);
+    put16(&m.bootstrap[6], d.bootstrap_mailbox.in_size);
+    return m;
+}
+
+}  // namespace esi
