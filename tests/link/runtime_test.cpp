@@ -1,0 +1,194 @@
+// The slave runtime (tools/slave) over a LoopbackLink with a real esc::Esc.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <array>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <thread>
+#include <vector>
+
+#include <pcap/pcap.h>
+
+#include "esc/esc.hpp"
+#include "esc/link_capture.hpp"
+#include "esc/link_loopback.hpp"
+#include "softslave/runtime.hpp"
+
+namespace {
+
+// BRD of the ESC type register (0x0000, 1 byte): every ESC answers with WKC 1.
+std::vector<uint8_t> brd_type_frame(std::size_t total = 60) {
+    std::vector<uint8_t> f(total, 0);
+    for (int i = 0; i < 6; ++i)
+        f[static_cast<std::size_t>(i)] = 0xFF;
+    for (int i = 6; i < 12; ++i)
+        f[static_cast<std::size_t>(i)] = 0x01;
+    f[12] = 0x88;
+    f[13] = 0xA4;
+    f[14] = 13;  // 10 header + 1 data + 2 WKC
+    f[15] = 0x10;
+    f[16] = 7;  // BRD
+    f[17] = 0x42;
+    f[22] = 1;  // length 1
+    return f;
+}
+constexpr std::size_t kWkcOffset = 16 + 10 + 1;
+
+struct RecordingFirmware : softslave::Firmware {
+    explicit RecordingFirmware(esc::LoopbackLink& master_end) : master(master_end) {}
+    void poll(uint64_t now_ns) override {
+        ++polls;
+        last_now = now_ns;
+        replies_waiting_at_poll = master.pending();
+        if (deadline != 0 && now_ns >= deadline) deadline_hit = true;
+    }
+    uint64_t next_deadline_ns() const override {
+        return deadline_hit || deadline == 0 ? UINT64_MAX : deadline;
+    }
+
+    esc::LoopbackLink& master;
+    int polls = 0;
+    uint64_t last_now = 0;
+    std::size_t replies_waiting_at_poll = 0;
+    uint64_t deadline = 0;
+    bool deadline_hit = false;
+};
+
+struct Fixture : ::testing::Test {
+    Fixture()
+        : links(esc::LoopbackLink::make_pair()),
+          esc(esc::EscConfig{}, clock),
+          runtime(*links.second, esc, clock) {}
+    esc::LoopbackLink& master() { return *links.first; }
+    esc::SystemClock clock;
+    std::pair<std::unique_ptr<esc::LoopbackLink>, std::unique_ptr<esc::LoopbackLink>> links;
+    esc::Esc esc;
+    softslave::Runtime runtime;
+};
+
+using Runtime = Fixture;
+
+TEST_F(Runtime, ProcessesAFrameAndSendsTheReplyBeforeTheFirmwareRuns) {
+    RecordingFirmware fw(master());
+    runtime.set_firmware(&fw);
+    const auto f = brd_type_frame();
+    ASSERT_TRUE(master().send(f));
+    ASSERT_TRUE(runtime.run_once(1000));
+    std::array<uint8_t, esc::kMaxFrameSize> buf{};
+    ASSERT_EQ(master().receive(buf), f.size());
+    EXPECT_EQ(buf[6], 0x03) << "source MAC bit 1 set by the ESC";
+    EXPECT_EQ(buf[kWkcOffset], 1) << "BRD answered";
+    EXPECT_EQ(fw.polls, 1);
+    EXPECT_EQ(fw.replies_waiting_at_poll, 1u) << "the reply was already sent when the firmware ran";
+    EXPECT_EQ(runtime.stats().frames_received, 1u);
+    EXPECT_EQ(runtime.stats().frames_sent, 1u);
+}
+
+TEST_F(Runtime, ABurstOfFramesIsAnsweredInOrderThenTheFirmwareRunsOnce) {
+    RecordingFirmware fw(master());
+    runtime.set_firmware(&fw);
+    for (uint8_t i = 0; i < 10; ++i) {
+        auto f = brd_type_frame();
+        f[17] = i;
+        ASSERT_TRUE(master().send(f));
+    }
+    ASSERT_TRUE(runtime.run_once(1000));
+    EXPECT_EQ(fw.polls, 1);
+    EXPECT_EQ(fw.replies_waiting_at_poll, 10u);
+    std::array<uint8_t, esc::kMaxFrameSize> buf{};
+    for (uint8_t i = 0; i < 10; ++i) {
+        ASSERT_EQ(master().receive(buf), 60u);
+        EXPECT_EQ(buf[17], i);
+    }
+}
+
+TEST_F(Runtime, RuntFramesComeBackAtTheirLength) {
+    const auto f = brd_type_frame(29);
+    ASSERT_TRUE(master().send(f));
+    ASSERT_TRUE(runtime.run_once(1000));
+    std::array<uint8_t, esc::kMaxFrameSize> buf{};
+    ASSERT_EQ(master().receive(buf), 29u);
+    EXPECT_EQ(buf[kWkcOffset], 1);
+}
+
+TEST_F(Runtime, NonEtherCatFramesAreNotSentBack) {
+    auto f = brd_type_frame();
+    f[12] = 0x08;
+    f[13] = 0x00;
+    ASSERT_TRUE(master().send(f));
+    ASSERT_TRUE(runtime.run_once(1000));
+    std::array<uint8_t, esc::kMaxFrameSize> buf{};
+    EXPECT_EQ(master().receive(buf), 0u);
+    EXPECT_EQ(runtime.stats().frames_dropped, 1u);
+}
+
+TEST_F(Runtime, TheTimerWakesTheFirmwareAtItsDeadlineWithoutFrames) {
+    RecordingFirmware fw(master());
+    runtime.set_firmware(&fw);
+    fw.deadline = clock.now_ns() + 20'000'000;  // 20 ms
+    const uint64_t start = clock.now_ns();
+    int rounds = 0;
+    while (!fw.deadline_hit && rounds < 100) {
+        ASSERT_TRUE(runtime.run_once(2000));
+        ++rounds;
+    }
+    EXPECT_TRUE(fw.deadline_hit);
+    EXPECT_GE(fw.last_now, fw.deadline);
+    EXPECT_LT(clock.now_ns() - start, 1'000'000'000ull) << "woken by the timer, not by the 2 s poll timeout";
+    EXPECT_GE(runtime.stats().timer_expiries, 1u);
+}
+
+TEST_F(Runtime, RequestStopEndsRunFromAnotherThread) {
+    std::thread stopper([this] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        runtime.request_stop();
+    });
+    runtime.run();  // returns, or the test times out
+    stopper.join();
+    EXPECT_TRUE(runtime.stop_requested());
+}
+
+TEST_F(Runtime, SigtermEndsRun) {
+    softslave::install_stop_signals();
+    softslave::set_signal_target(&runtime);
+    std::thread killer([] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        ::kill(::getpid(), SIGTERM);
+    });
+    runtime.run();
+    killer.join();
+    softslave::set_signal_target(nullptr);
+    EXPECT_TRUE(softslave::stop_signalled());
+}
+
+TEST_F(Runtime, CaptureRecordsTheFrameAsReceivedAndAsSent) {
+    const std::string path =
+        (std::filesystem::temp_directory_path() / ("runtime-capture-" + std::to_string(::getpid()) + ".pcap"))
+            .string();
+    {
+        esc::PcapWriter capture(path);
+        runtime.set_capture(&capture);
+        ASSERT_TRUE(master().send(brd_type_frame()));
+        ASSERT_TRUE(runtime.run_once(1000));
+        runtime.set_capture(nullptr);
+    }
+    char errbuf[PCAP_ERRBUF_SIZE];
+    pcap_t* p = pcap_open_offline(path.c_str(), errbuf);
+    ASSERT_NE(p, nullptr) << errbuf;
+    pcap_pkthdr* hdr = nullptr;
+    const u_char* data = nullptr;
+    ASSERT_EQ(pcap_next_ex(p, &hdr, &data), 1);
+    EXPECT_EQ(hdr->caplen, 60u);
+    EXPECT_EQ(data[6], 0x01) << "first record: the frame as it came in";
+    EXPECT_EQ(data[kWkcOffset], 0);
+    ASSERT_EQ(pcap_next_ex(p, &hdr, &data), 1);
+    EXPECT_EQ(data[6], 0x03) << "second record: the reply";
+    EXPECT_EQ(data[kWkcOffset], 1);
+    EXPECT_NE(pcap_next_ex(p, &hdr, &data), 1);
+    pcap_close(p);
+    std::remove(path.c_str());
+}
+
+}  // namespace

@@ -1,0 +1,190 @@
+// The ecat-slave program: options, exit codes, and (as root) the veth pair it creates, serves and removes.
+// The root test runs ecat-slave in a network namespace of its own (the child unshares before exec), so it
+// never collides with interfaces on the host and everything vanishes with the process.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <sched.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "esc/link_packet.hpp"
+#include "netns_util.hpp"
+#include "softslave/netif.hpp"
+
+namespace {
+
+struct Proc {
+    pid_t pid = -1;
+    int out = -1;  // stdout + stderr of the child
+};
+
+// Starts ecat-slave with args; with own_netns the child first enters a new network namespace and, with
+// stale_pair, creates ecat0/ecat1 there as a killed earlier run would have left them.
+Proc start(const std::vector<std::string>& args, bool own_netns = false, bool stale_pair = false) {
+    int fds[2];
+    if (::pipe2(fds, O_CLOEXEC) != 0) return {};
+    const pid_t parent = ::getpid();
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+        if (::getppid() != parent) ::_exit(126);
+        ::dup2(fds[1], 1);
+        ::dup2(fds[1], 2);
+        if (own_netns && ::unshare(CLONE_NEWNET) != 0) ::_exit(125);
+        if (stale_pair) {
+            try {
+                softslave::create_veth("ecat0", "ecat1");
+            } catch (...) {
+                ::_exit(124);
+            }
+        }
+        std::vector<char*> argv{const_cast<char*>(ECAT_SLAVE_PATH)};
+        for (const auto& a : args)
+            argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        ::execv(argv[0], argv.data());
+        ::_exit(127);
+    }
+    ::close(fds[1]);
+    return {pid, fds[0]};
+}
+
+// Reads the child's output until `needle` appears or the timeout passes.
+std::string read_until(int fd, const std::string& needle, int timeout_ms) {
+    std::string out;
+    const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+    while (out.find(needle) == std::string::npos && std::chrono::steady_clock::now() < end) {
+        pollfd p{fd, POLLIN, 0};
+        if (::poll(&p, 1, 50) <= 0) continue;
+        char buf[512];
+        const ssize_t n = ::read(fd, buf, sizeof buf);
+        if (n <= 0) break;
+        out.append(buf, static_cast<std::size_t>(n));
+    }
+    return out;
+}
+
+int wait_exit(pid_t pid, int timeout_ms) {
+    for (int i = 0; i < timeout_ms / 10; ++i) {
+        int status = 0;
+        if (::waitpid(pid, &status, WNOHANG) == pid)
+            return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, nullptr, 0);
+    return -1;
+}
+
+struct RunResult {
+    int code;
+    std::string output;
+};
+
+RunResult run(const std::vector<std::string>& args) {
+    Proc p = start(args);
+    std::string out = read_until(p.out, "\x01never", 3000);
+    const int code = wait_exit(p.pid, 3000);
+    ::close(p.out);
+    return {code, out};
+}
+
+TEST(EcatSlaveCli, VersionPrintsTheProjectVersion) {
+    const RunResult r = run({"--version"});
+    EXPECT_EQ(r.code, 0);
+    EXPECT_NE(r.output.find("ecat-slave"), std::string::npos) << r.output;
+}
+
+TEST(EcatSlaveCli, MissingInterfaceExitsWith2AndSaysWhich) {
+    const RunResult r = run({"--iface", "nosuchif0"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.output.find("nosuchif0"), std::string::npos) << r.output;
+}
+
+TEST(EcatSlaveCli, BadOptionsExitWith2) {
+    EXPECT_EQ(run({"--backend", "dpdk", "--iface", "lo"}).code, 2);
+    EXPECT_EQ(run({"--ram-kib", "0", "--iface", "lo"}).code, 2);
+    EXPECT_EQ(run({"--no-such-option"}).code, 2);
+    EXPECT_EQ(run({"--eeprom", "/nonexistent/eeprom.bin", "--iface", "lo"}).code, 2);
+}
+
+// Joins the network namespace of pid on a helper thread, runs fn there.
+template <typename F>
+void in_netns_of(pid_t pid, F&& fn) {
+    std::exception_ptr error;
+    std::thread t([&] {
+        try {
+            const std::string path = "/proc/" + std::to_string(pid) + "/ns/net";
+            const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+            if (fd < 0 || ::setns(fd, CLONE_NEWNET) != 0) throw std::runtime_error("setns " + path);
+            ::close(fd);
+            fn();
+        } catch (...) {
+            error = std::current_exception();
+        }
+    });
+    t.join();
+    if (error) std::rethrow_exception(error);
+}
+
+TEST(EcatSlaveVeth, CreatesThePairAnswersOnItAndRemovesItOnSigterm) {
+    if (!linktest::is_root()) GTEST_SKIP() << "needs root (CAP_NET_ADMIN, CAP_NET_RAW)";
+    Proc p = start({}, /*own_netns=*/true, /*stale_pair=*/true);
+    ASSERT_GT(p.pid, 0);
+    const std::string out = read_until(p.out, "running on", 5000);
+    ASSERT_NE(out.find("master interface: ecat1"), std::string::npos) << out;
+
+    std::unique_ptr<esc::PacketLink> master;
+    in_netns_of(p.pid, [&] { master = std::make_unique<esc::PacketLink>("ecat1"); });
+    // BRD of the ESC type register: the slave answers with WKC 1 and the source MAC bit set.
+    std::vector<uint8_t> f(60, 0);
+    for (int i = 0; i < 6; ++i)
+        f[static_cast<std::size_t>(i)] = 0xFF;
+    for (int i = 6; i < 12; ++i)
+        f[static_cast<std::size_t>(i)] = 0x01;
+    f[12] = 0x88;
+    f[13] = 0xA4;
+    f[14] = 13;
+    f[15] = 0x10;
+    f[16] = 7;
+    f[22] = 1;
+    ASSERT_TRUE(master->send(f));
+    std::array<uint8_t, esc::kMaxFrameSize> buf{};
+    std::size_t n = 0;
+    for (int i = 0; i < 100 && n == 0; ++i) {
+        pollfd pf{master->fd(), POLLIN, 0};
+        ::poll(&pf, 1, 20);
+        n = master->receive(buf);
+    }
+    ASSERT_EQ(n, 60u);
+    EXPECT_EQ(buf[6], 0x03);
+    EXPECT_EQ(buf[27], 1) << "working counter";
+
+    bool exists_before = false, exists_after = true;
+    in_netns_of(p.pid, [&] { exists_before = softslave::interface_exists("ecat0"); });
+    // Keep a handle on the namespace so it outlives the slave and we can look inside afterwards.
+    const int ns = ::open(("/proc/" + std::to_string(p.pid) + "/ns/net").c_str(), O_RDONLY | O_CLOEXEC);
+    ASSERT_GE(ns, 0);
+    ::kill(p.pid, SIGTERM);
+    EXPECT_EQ(wait_exit(p.pid, 5000), 0);
+    std::thread t([&] {
+        if (::setns(ns, CLONE_NEWNET) == 0)
+            exists_after = softslave::interface_exists("ecat0") || softslave::interface_exists("ecat1");
+    });
+    t.join();
+    ::close(ns);
+    ::close(p.out);
+    EXPECT_TRUE(exists_before);
+    EXPECT_FALSE(exists_after) << "the veth pair must be gone after SIGTERM";
+}
+
+}  // namespace

@@ -1,0 +1,210 @@
+// PcapLink and PacketLink on a real veth pair inside a network namespace the test creates. The namespace
+// is anonymous (unshare on a helper thread) and dies with the last socket in it, taking the veth pair along,
+// so nothing stays behind even when a test fails. Skipped when not root.
+#include <gtest/gtest.h>
+#include <net/if.h>
+#include <poll.h>
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "esc/link.hpp"
+#include "esc/link_packet.hpp"
+#include "esc/link_pcap.hpp"
+#include "netns_util.hpp"
+#include "softslave/netif.hpp"
+
+namespace {
+
+using linktest::in_new_netns;
+
+bool wait_readable(const esc::Link& link, int timeout_ms) {
+    pollfd p{link.fd(), POLLIN, 0};
+    return ::poll(&p, 1, timeout_ms) == 1 && (p.revents & POLLIN) != 0;
+}
+
+// Receives one frame, waiting up to timeout_ms; returns its length (0 if none came).
+std::size_t receive_within(esc::Link& link, std::span<uint8_t> buf, int timeout_ms) {
+    for (int i = 0; i < 4; ++i) {
+        if (const std::size_t n = link.receive(buf)) return n;
+        if (!wait_readable(link, timeout_ms / 4)) continue;
+    }
+    return link.receive(buf);
+}
+
+std::vector<uint8_t> ecat_frame(std::size_t total_len, uint8_t tag) {
+    std::vector<uint8_t> f(total_len, 0);
+    for (int i = 0; i < 6; ++i)
+        f[static_cast<std::size_t>(i)] = 0xFF;  // broadcast
+    for (int i = 6; i < 12; ++i)
+        f[static_cast<std::size_t>(i)] = 0x01;  // as SOEM sends
+    f[12] = 0x88;
+    f[13] = 0xA4;
+    if (total_len >= 16) {
+        f[14] = 0x0E;  // one datagram of 2 data bytes: length 14, type 1
+        f[15] = 0x10;
+    }
+    if (total_len > 17) f[17] = tag;  // datagram index
+    return f;
+}
+
+struct Pair {
+    std::unique_ptr<esc::Link> slave;   // the end under test
+    std::unique_ptr<esc::Link> master;  // the other end (always a PacketLink)
+};
+
+// Creates veth "s0"/"m0" in a fresh namespace and opens the slave end with `backend`.
+Pair make_pair(const std::string& backend) {
+    Pair p;
+    in_new_netns([&] {
+        softslave::create_veth("s0", "m0");
+        softslave::disable_ipv6("s0");
+        softslave::disable_ipv6("m0");
+        softslave::set_interface_up("s0");
+        softslave::set_interface_up("m0");
+        p.slave = esc::open_link("s0", backend);
+        p.master = std::make_unique<esc::PacketLink>("m0");
+    });
+    return p;
+}
+
+class VethLink : public ::testing::TestWithParam<std::string> {
+  protected:
+    void SetUp() override {
+        if (!linktest::is_root()) GTEST_SKIP() << "needs root (CAP_NET_ADMIN, CAP_NET_RAW)";
+    }
+};
+
+TEST_P(VethLink, EchoesFramesBothWaysAtTheirExactLength) {
+    Pair p = make_pair(GetParam());
+    std::array<uint8_t, esc::kMaxFrameSize> buf{};
+    // Runt (29 bytes), minimum (60) and full-size frames all arrive at their length: a veth does not pad.
+    for (std::size_t len : {std::size_t{29}, std::size_t{60}, std::size_t{1514}}) {
+        const auto f = ecat_frame(len, static_cast<uint8_t>(len));
+        ASSERT_TRUE(p.master->send(f));
+        ASSERT_EQ(receive_within(*p.slave, buf, 2000), len);
+        EXPECT_TRUE(std::equal(f.begin(), f.end(), buf.begin()));
+        buf[6] |= 0x02;  // what an ESC does to the source MAC
+        ASSERT_TRUE(p.slave->send(std::span<const uint8_t>(buf.data(), len)));
+        std::array<uint8_t, esc::kMaxFrameSize> back{};
+        ASSERT_EQ(receive_within(*p.master, back, 2000), len);
+        EXPECT_EQ(back[6], 0x03);
+    }
+}
+
+TEST_P(VethLink, OwnRepliesNeverComeBackIn) {
+    Pair p = make_pair(GetParam());
+    std::array<uint8_t, esc::kMaxFrameSize> buf{};
+    const auto f = ecat_frame(60, 7);
+    ASSERT_TRUE(p.slave->send(f));
+    std::array<uint8_t, esc::kMaxFrameSize> back{};
+    ASSERT_EQ(receive_within(*p.master, back, 2000), 60u);
+    // The master also never sees its own frame, and the slave sees nothing.
+    EXPECT_EQ(receive_within(*p.slave, buf, 200), 0u);
+    ASSERT_TRUE(p.master->send(f));
+    ASSERT_EQ(receive_within(*p.slave, buf, 2000), 60u);
+    EXPECT_EQ(receive_within(*p.master, back, 200), 0u);
+}
+
+TEST_P(VethLink, OnlyEtherCatFramesAreReceived) {
+    Pair p = make_pair(GetParam());
+    auto other = ecat_frame(60, 1);
+    other[12] = 0x08;  // IPv4
+    other[13] = 0x00;
+    ASSERT_TRUE(p.master->send(other));
+    const auto f = ecat_frame(60, 2);
+    ASSERT_TRUE(p.master->send(f));
+    std::array<uint8_t, esc::kMaxFrameSize> buf{};
+    ASSERT_EQ(receive_within(*p.slave, buf, 2000), 60u);
+    EXPECT_EQ(buf[12], 0x88);
+    EXPECT_EQ(buf[17], 2);
+    EXPECT_EQ(receive_within(*p.slave, buf, 200), 0u);
+}
+
+TEST_P(VethLink, UnicastToAnotherMacIsReceived) {
+    Pair p = make_pair(GetParam());
+    auto f = ecat_frame(60, 3);
+    for (int i = 0; i < 6; ++i)
+        f[static_cast<std::size_t>(i)] = 0x02;  // not our MAC, not broadcast
+    ASSERT_TRUE(p.master->send(f));
+    std::array<uint8_t, esc::kMaxFrameSize> buf{};
+    EXPECT_EQ(receive_within(*p.slave, buf, 2000), 60u);
+}
+
+TEST_P(VethLink, DownAndMissingInterfacesAreClearErrors) {
+    in_new_netns([&] {
+        softslave::create_veth("s0", "m0");
+        try {
+            esc::open_link("s0", GetParam());
+            ADD_FAILURE() << "opening a down interface must fail";
+        } catch (const esc::LinkError& e) {
+            EXPECT_EQ(e.kind(), esc::LinkError::Kind::InterfaceDown) << e.what();
+            EXPECT_NE(std::string(e.what()).find("ip link set s0 up"), std::string::npos) << e.what();
+        }
+        try {
+            esc::open_link("s9", GetParam());
+            ADD_FAILURE() << "opening a missing interface must fail";
+        } catch (const esc::LinkError& e) {
+            EXPECT_EQ(e.kind(), esc::LinkError::Kind::NoSuchInterface) << e.what();
+        }
+        softslave::delete_interface("s0");
+    });
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, VethLink, ::testing::Values(std::string("pcap"), std::string("packet")),
+                         [](const ::testing::TestParamInfo<std::string>& param_info) {
+                             return param_info.param;
+                         });
+
+class VethPairTest : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        if (!linktest::is_root()) GTEST_SKIP() << "needs root (CAP_NET_ADMIN)";
+    }
+};
+
+TEST_F(VethPairTest, CreatesUpPairWithoutIpv6AndRemovesItAgain) {
+    in_new_netns([] {
+        {
+            softslave::VethPair pair("ecat0", "ecat1");
+            EXPECT_TRUE(softslave::interface_exists("ecat0"));
+            EXPECT_TRUE(softslave::interface_exists("ecat1"));
+            EXPECT_NO_THROW(esc::check_interface("ecat0"));  // up
+            EXPECT_NO_THROW(esc::check_interface("ecat1"));
+            for (const char* name : {"ecat0", "ecat1"}) {
+                const std::string path = std::string("/proc/sys/net/ipv6/conf/") + name + "/disable_ipv6";
+                if (FILE* f = std::fopen(path.c_str(), "r")) {
+                    EXPECT_EQ(std::fgetc(f), '1') << name;
+                    std::fclose(f);
+                }
+            }
+        }
+        EXPECT_FALSE(softslave::interface_exists("ecat0"));
+        EXPECT_FALSE(softslave::interface_exists("ecat1"));
+    });
+}
+
+TEST_F(VethPairTest, RemovesAStalePairLeftByAKilledRun) {
+    in_new_netns([] {
+        softslave::create_veth("ecat0", "ecat1");  // as if a previous run was killed
+        {
+            softslave::VethPair pair("ecat0", "ecat1");
+            EXPECT_TRUE(softslave::interface_exists("ecat0"));
+        }
+        EXPECT_FALSE(softslave::interface_exists("ecat0"));
+        EXPECT_FALSE(softslave::interface_exists("ecat1"));
+    });
+}
+
+TEST_F(VethPairTest, CreatingAnExistingPairFailsClearly) {
+    in_new_netns([] {
+        softslave::create_veth("x0", "x1");
+        EXPECT_THROW(softslave::create_veth("x0", "x1"), esc::LinkError);
+        softslave::delete_interface("x0");
+        EXPECT_FALSE(softslave::interface_exists("x1"));
+        EXPECT_NO_THROW(softslave::delete_interface("x0"));  // already gone: nothing to do
+    });
+}
+
+}  // namespace

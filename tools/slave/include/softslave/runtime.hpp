@@ -1,0 +1,82 @@
+#pragma once
+// The slave runtime: a single-threaded event loop that owns the link and the ESC and runs the firmware.
+//
+//   poll(link fd, timerfd, stop eventfd)
+//   for each frame waiting (a burst, at most kMaxBurst):  rx time = clock now
+//       esc.process_frame(frame, rx time); if it says so, link.send(frame); record in/out to the capture
+//   then esc.tick() and firmware.poll(now)                (after the replies: the firmware never delays a
+//   frame) re-arm the timerfd (CLOCK_MONOTONIC, TFD_TIMER_ABSTIME) for min(esc.next_event_ns(), firmware
+//   deadline)
+//
+// One receive buffer, allocated at construction; nothing is allocated per frame or per cycle.
+// The clock must count CLOCK_MONOTONIC nanoseconds (esc::SystemClock) because the timer runs on it.
+#include <cstdint>
+#include <vector>
+
+#include "esc/clock.hpp"
+#include "esc/esc.hpp"
+#include "esc/link.hpp"
+#include "esc/link_capture.hpp"
+#include "softslave/firmware.hpp"
+
+namespace softslave {
+
+struct RuntimeStats {
+    uint64_t frames_received = 0;
+    uint64_t frames_sent = 0;
+    uint64_t frames_dropped = 0;  // process_frame() said "do not send"
+    uint64_t send_errors = 0;
+    uint64_t link_errors = 0;  // POLLERR on the link (interface went down, ...)
+    uint64_t wakeups = 0;
+    uint64_t timer_expiries = 0;
+};
+
+class Runtime {
+  public:
+    static constexpr int kMaxBurst = 64;
+
+    Runtime(esc::Link& link, esc::Esc& esc, const esc::Clock& clock);
+    ~Runtime();
+    Runtime(const Runtime&) = delete;
+    Runtime& operator=(const Runtime&) = delete;
+
+    void set_firmware(Firmware* firmware) { firmware_ = firmware; }
+    void set_capture(esc::PcapWriter* capture) { capture_ = capture; }
+
+    // Runs until request_stop().
+    void run();
+    // One wait and what follows it; waits at most timeout_ms (-1: no limit). Returns false once stop was
+    // requested. For tests and for callers that interleave other work.
+    bool run_once(int timeout_ms);
+    // Asks run() to return. Async-signal-safe and callable from any thread.
+    void request_stop();
+    bool stop_requested() const;
+
+    const RuntimeStats& stats() const { return stats_; }
+
+  private:
+    void handle_frames();
+    void service();
+    void arm_timer();
+
+    esc::Link& link_;
+    esc::Esc& esc_;
+    const esc::Clock& clock_;
+    Firmware* firmware_ = nullptr;
+    esc::PcapWriter* capture_ = nullptr;
+    int timer_fd_ = -1;
+    int stop_fd_ = -1;
+    uint64_t armed_ns_ = 0;         // deadline the timerfd is armed for; 0 = disarmed
+    std::vector<uint8_t> buffer_;   // the receive buffer (frame processed in place)
+    std::vector<uint8_t> in_copy_;  // the frame as received, kept for the capture
+    RuntimeStats stats_;
+};
+
+// SIGINT / SIGTERM handling: install_stop_signals() makes both signals set a flag (stop_signalled()) and
+// stop the runtime registered with set_signal_target(), if any. SA_RESTART is not set, so a blocking call
+// returns with EINTR. Registering a target after a signal arrived stops it at once.
+void install_stop_signals();
+void set_signal_target(Runtime* runtime);
+bool stop_signalled();
+
+}  // namespace softslave

@@ -1,0 +1,51 @@
+#pragma once
+// Everything the `ecat-slave` program does besides parsing its command line: open (or create) the
+// interface, build the ESC, load the SII EEPROM image, start the firmware, run the event loop until
+// SIGINT/SIGTERM, clean up. Options are plain data so other modules can add their own.
+#include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "esc/esc.hpp"
+#include "softslave/firmware.hpp"
+
+namespace softslave {
+
+struct SlaveOptions;
+
+// Produces the SII EEPROM image (little-endian words) the ESC serves. Replaceable: the default reads the
+// binary file named by --eeprom; a generator from the object model can take its place.
+using EepromLoader = std::function<std::vector<uint8_t>(const SlaveOptions&)>;
+// Creates the firmware that runs behind the ESC's PDI; may return nullptr (ESC only, no state machine).
+using FirmwareFactory = std::function<std::unique_ptr<Firmware>(esc::Esc&, const SlaveOptions&)>;
+
+// Reads options.eeprom_file (empty name: returns an empty image). Throws std::runtime_error on an
+// unreadable file or an image that is empty, of odd length or larger than 64 KiB words.
+std::vector<uint8_t> load_eeprom_file(const SlaveOptions& options);
+
+struct SlaveOptions {
+    std::string iface;                // run on this interface; empty: create a veth pair
+    std::string veth_name = "ecat0";  // slave end of the veth pair we create
+    std::string veth_peer;            // master end; empty: veth_peer_name(veth_name) ("ecat1")
+    std::string backend;              // "pcap" | "packet" | empty (esc::default_link_backend())
+    std::string capture_file;         // record every frame in and out (.pcap)
+    std::string eeprom_file;          // binary SII image
+    bool eeprom_write_back = true;    // write the image back to eeprom_file at exit if the master changed it
+    uint32_t ram_kib = 8;             // process RAM size (ESC register 0x0006)
+    bool verbose = false;
+    EepromLoader eeprom_loader = load_eeprom_file;
+    FirmwareFactory firmware_factory;  // empty: no firmware
+};
+
+// Exit codes of run_slave() (and of ecat-slave).
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFailure = 1;  // failed while running
+inline constexpr int kExitUsage = 2;    // bad options, missing interface, missing privileges
+
+// Runs the slave until SIGINT/SIGTERM. Messages go to out (status) and err (errors).
+int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err);
+
+}  // namespace softslave

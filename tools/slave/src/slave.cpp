@@ -1,0 +1,119 @@
+// run_slave(): the ecat-slave program minus its command line. See softslave/slave.hpp.
+#include "softslave/slave.hpp"
+
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <optional>
+#include <stdexcept>
+
+#include "esc/link.hpp"
+#include "esc/link_capture.hpp"
+#include "softslave/netif.hpp"
+#include "softslave/runtime.hpp"
+
+namespace softslave {
+
+std::vector<uint8_t> load_eeprom_file(const SlaveOptions& options) {
+    if (options.eeprom_file.empty()) return {};
+    std::ifstream in(options.eeprom_file, std::ios::binary);
+    if (!in) throw std::runtime_error("cannot open EEPROM image '" + options.eeprom_file + "'");
+    std::vector<uint8_t> image((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) throw std::runtime_error("cannot read EEPROM image '" + options.eeprom_file + "'");
+    if (image.empty() || image.size() % 2 != 0 || image.size() > 2 * 65536)
+        throw std::runtime_error("EEPROM image '" + options.eeprom_file + "' has " +
+                                 std::to_string(image.size()) +
+                                 " bytes; expected a non-empty, even number of bytes up to 128 KiB");
+    return image;
+}
+
+namespace {
+
+bool write_file(const std::string& path, std::span<const uint8_t> data) {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size()));
+    return static_cast<bool>(out);
+}
+
+}  // namespace
+
+int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err) {
+    if (options.ram_kib == 0 || options.ram_kib > 60) {
+        err << "ecat-slave: --ram-kib must be 1..60 (process RAM lies between 0x1000 and 0xFFFF)\n";
+        return kExitUsage;
+    }
+    install_stop_signals();
+    try {
+        std::vector<uint8_t> image =
+            options.eeprom_loader ? options.eeprom_loader(options) : std::vector<uint8_t>{};
+
+        std::optional<VethPair> veth;
+        std::string iface = options.iface;
+        if (iface.empty()) {
+            const std::string peer =
+                options.veth_peer.empty() ? veth_peer_name(options.veth_name) : options.veth_peer;
+            veth.emplace(options.veth_name, peer);
+            iface = veth->slave_end();
+        }
+        auto link = esc::open_link(iface, options.backend);
+        std::unique_ptr<esc::PcapWriter> capture;
+        if (!options.capture_file.empty()) capture = std::make_unique<esc::PcapWriter>(options.capture_file);
+
+        esc::EscConfig config;
+        config.process_ram_kib = options.ram_kib;
+        esc::SystemClock clock;
+        esc::Esc esc(config, clock);
+        bool eeprom_dirty = false;
+        if (!image.empty()) {
+            esc.load_eeprom(image);
+            esc.on_eeprom_write([&eeprom_dirty](uint16_t, uint16_t) { eeprom_dirty = true; });
+        } else {
+            err << "ecat-slave: warning: no EEPROM image (--eeprom); masters will not identify this slave\n";
+        }
+        std::unique_ptr<Firmware> firmware;
+        if (options.firmware_factory) firmware = options.firmware_factory(esc, options);
+
+        Runtime runtime(*link, esc, clock);
+        runtime.set_firmware(firmware.get());
+        runtime.set_capture(capture.get());
+        set_signal_target(&runtime);
+
+        if (veth) out << "master interface: " << veth->master_end() << '\n';
+        out << "ecat-slave: running on " << link->describe()
+            << (capture ? ", capturing to " + options.capture_file : "") << '\n';
+        out.flush();
+
+        try {
+            runtime.run();
+        } catch (...) {
+            set_signal_target(nullptr);
+            throw;
+        }
+        set_signal_target(nullptr);
+
+        if (capture) capture->flush();
+        if (eeprom_dirty && options.eeprom_write_back && !options.eeprom_file.empty()) {
+            if (!write_file(options.eeprom_file, esc.eeprom()))
+                err << "ecat-slave: warning: could not write the EEPROM image back to " << options.eeprom_file
+                    << '\n';
+        }
+        if (options.verbose) {
+            const RuntimeStats& s = runtime.stats();
+            const esc::EscStats e = esc.stats();
+            out << "frames received " << s.frames_received << ", sent " << s.frames_sent << ", dropped "
+                << s.frames_dropped << ", send errors " << s.send_errors << ", link errors " << s.link_errors
+                << "; ESC: processed " << e.frames_processed << ", ignored " << e.frames_ignored
+                << ", malformed " << e.frames_malformed << ", datagrams " << e.datagrams << '\n';
+        }
+        out << "ecat-slave: stopped\n";
+        return kExitOk;
+    } catch (const esc::LinkError& e) {
+        err << "ecat-slave: " << e.what() << '\n';
+        return e.kind() == esc::LinkError::Kind::System ? kExitFailure : kExitUsage;
+    } catch (const std::exception& e) {
+        err << "ecat-slave: " << e.what() << '\n';
+        return kExitFailure;
+    }
+}
+
+}  // namespace softslave
