@@ -1,0 +1,167 @@
+// The master against the real emulated ESC (esc::Esc), connected in-process through a tiny Link that
+// hands every frame to Esc::process_frame(): what the integration tests check on a veth pair, without
+// sockets or privileges.
+#include <gtest/gtest.h>
+
+#include <deque>
+#include <vector>
+
+#include "esc/clock.hpp"
+#include "esc/esc.hpp"
+#include "master/master.hpp"
+
+using namespace master;
+
+namespace {
+
+class EscLink final : public esc::Link {
+  public:
+    explicit EscLink(esc::Esc& e) : esc_(e) {}
+    int fd() const override { return -1; }
+    std::size_t receive(std::span<uint8_t> buf) override {
+        if (replies_.empty()) return 0;
+        const auto f = std::move(replies_.front());
+        replies_.pop_front();
+        const std::size_t n = std::min(buf.size(), f.size());
+        std::copy_n(f.begin(), n, buf.begin());
+        return n;
+    }
+    bool send(std::span<const uint8_t> frame) override {
+        std::vector<uint8_t> f(frame.begin(), frame.end());
+        if (esc_.process_frame(f)) replies_.push_back(std::move(f));
+        return true;
+    }
+
+  private:
+    esc::Esc& esc_;
+    std::deque<std::vector<uint8_t>> replies_;
+};
+
+uint8_t crc8(const uint8_t* p, std::size_t n) {
+    uint8_t crc = 0xFF;
+    for (std::size_t i = 0; i < n; ++i) {
+        crc ^= p[i];
+        for (int b = 0; b < 8; ++b)
+            crc = static_cast<uint8_t>((crc & 0x80) ? (crc << 1) ^ 0x07 : crc << 1);
+    }
+    return crc;
+}
+
+// Header + one STRINGS category + end, 2 KiB. esc_config goes to word 0 high byte (0x0141).
+std::vector<uint8_t> image(uint8_t esc_config = 0x0C) {
+    std::vector<uint16_t> w(0x40, 0);
+    w[0] = static_cast<uint16_t>(0x05 | (esc_config << 8));
+    w[8] = 0x00FB;
+    w[10] = 0x0000;
+    w[11] = 0x3001;
+    w[12] = 0x0000;
+    w[13] = 0x0120;
+    w[14] = 0x4321;
+    w[0x18] = 0x1000;
+    w[0x19] = 128;
+    w[0x1A] = 0x1080;
+    w[0x1B] = 128;
+    w[0x1C] = 0x0004;
+    w[0x3E] = 0x000F;
+    w[0x3F] = 1;
+    w.insert(w.end(), {10, 3, 0x4101, 0x4242, 0x0042, 0xFFFF});
+    std::vector<uint8_t> b;
+    for (uint16_t x : w) {
+        b.push_back(static_cast<uint8_t>(x));
+        b.push_back(static_cast<uint8_t>(x >> 8));
+    }
+    b[14] = crc8(b.data(), 14);
+    b.resize(2048, 0xFF);
+    return b;
+}
+
+constexpr std::size_t kImageEnd = (0x40 + 6) * 2;
+
+struct Rig {
+    esc::ManualClock clock;
+    esc::Esc esc{esc::EscConfig{}, clock};
+    EscLink link{esc};
+    Master m{link, [] {
+                 MasterOptions o;
+                 o.timeout = std::chrono::milliseconds(20);
+                 o.al_timeout = std::chrono::milliseconds(200);
+                 return o;
+             }()};
+    explicit Rig(uint8_t esc_config = 0x0C) { esc.load_eeprom(image(esc_config)); }
+};
+
+}  // namespace
+
+TEST(MasterWithEsc, CountsOneSlaveAndAssignsItsAddress) {
+    Rig r;
+    auto n = r.m.count_slaves();
+    ASSERT_TRUE(n.ok()) << to_string(n.error());
+    EXPECT_EQ(*n, 1);
+    ASSERT_EQ(r.m.assign_station_addresses(1), Error::Ok);
+    EXPECT_EQ(r.esc.read_reg<uint16_t>(0x0010), 0x1001);
+    EXPECT_EQ(r.m.read_reg<uint16_t>(Address::station(0x1001), reg::StationAddress).value(), 0x1001);
+    EXPECT_EQ(r.m.read_reg<uint8_t>(Address::position(1), reg::Type).error(), Error::WorkingCounter);
+}
+
+TEST(MasterWithEsc, RegistersRoundTripAndReadOnlyStaysUnchanged) {
+    Rig r;
+    const Address a = Address::position(0);
+    ASSERT_EQ(r.m.write_reg<uint32_t>(a, 0x0F80, 0xA1B2C3D4), Error::Ok);
+    EXPECT_EQ(r.m.read_reg<uint32_t>(a, 0x0F80).value(), 0xA1B2C3D4u);
+    EXPECT_EQ(r.esc.read_reg<uint32_t>(0x0F80), 0xA1B2C3D4u);
+    const uint8_t type = r.m.read_reg<uint8_t>(a, reg::Type).value();
+    (void)r.m.write_reg<uint8_t>(a, reg::Type, static_cast<uint8_t>(~type));
+    EXPECT_EQ(r.m.read_reg<uint8_t>(a, reg::Type).value(), type);
+}
+
+TEST(MasterWithEsc, SiiImageAndIdentity) {
+    Rig r;
+    const Address a = Address::position(0);
+    EXPECT_EQ(r.m.sii_read_u32(a, sii::VendorId).value(), 0x000000FBu);
+    EXPECT_EQ(r.m.sii_read_u32(a, sii::ProductCode).value(), 0x30010000u);
+    EXPECT_EQ(r.m.sii_read_u32(a, sii::Revision).value(), 0x01200000u);
+    EXPECT_EQ(r.m.sii_read_u32(a, sii::SerialNumber).value(), 0x00004321u);
+    auto img = r.m.sii_read_image(a);
+    ASSERT_TRUE(img.ok()) << to_string(img.error());
+    const auto full = image();
+    EXPECT_EQ(*img, std::vector<uint8_t>(full.begin(), full.begin() + kImageEnd));
+    auto all = r.m.sii_read_image(a, true);
+    ASSERT_TRUE(all.ok());
+    EXPECT_EQ(*all, full);
+}
+
+TEST(MasterWithEsc, SiiWriteReachesTheEepromAndItsOwner) {
+    Rig r;
+    std::vector<std::pair<uint16_t, uint16_t>> writes;
+    r.esc.on_eeprom_write([&](uint16_t word, uint16_t value) { writes.emplace_back(word, value); });
+    const Address a = Address::position(0);
+    ASSERT_EQ(r.m.sii_write_word(a, 0x0E, 0xBEEF), Error::Ok);
+    EXPECT_EQ(r.m.sii_read_word(a, 0x0E).value(), 0xBEEF);
+    EXPECT_EQ(r.esc.eeprom()[0x1C], 0xEF);
+    EXPECT_EQ(r.esc.eeprom()[0x1D], 0xBE);
+    ASSERT_EQ(writes.size(), 1u);
+    EXPECT_EQ(writes[0], (std::pair<uint16_t, uint16_t>{0x0E, 0xBEEF}));
+}
+
+TEST(MasterWithEsc, AlStateFollowsWithDeviceEmulation) {
+    Rig r(0x0D);  // 0x0141 bit 0: device emulation, AL status mirrors AL control
+    const Address a = Address::position(0);
+    AlStatus st;
+    ASSERT_EQ(r.m.request_state(a, AlState::PreOp, &st), Error::Ok);
+    EXPECT_EQ(st.state, 0x02);
+    ASSERT_EQ(r.m.request_state(a, AlState::Init, &st), Error::Ok);
+    EXPECT_EQ(st.state, 0x01);
+}
+
+TEST(MasterWithEsc, FrameWithManyDatagramsIsAnsweredInOne) {
+    Rig r;
+    std::array<std::array<uint8_t, 2>, 20> bufs{};
+    std::array<Datagram, 20> d;
+    for (std::size_t i = 0; i < d.size(); ++i)
+        d[i] = Datagram{Command::APRD, 0, static_cast<uint16_t>(2 * i), bufs[i]};
+    ASSERT_EQ(r.m.exchange(d), Error::Ok);
+    for (const Datagram& x : d)
+        EXPECT_EQ(x.wkc, 1);
+    EXPECT_EQ(bufs[0][0], r.esc.read_reg<uint8_t>(0x0000));
+    EXPECT_EQ(r.m.stats().frames_sent, 1u);
+}
