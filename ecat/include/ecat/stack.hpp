@@ -61,6 +61,8 @@ class Stack {
     SyncMode sync_mode() const { return sync_mode_; }
     const StackStats& stats() const { return stats_; }
     const Mailbox& mailbox() const { return mailbox_; }
+    // The outgoing mailbox, for spontaneous messages (e.g. CoE emergencies from the application).
+    Mailbox& mailbox() { return mailbox_; }
     const ProcessData& process_data() const { return pd_; }
 
     // How long a Safe-Op -> Op request may wait for the first outputs / the first SYNC0 events.

@@ -1,0 +1,561 @@
+// EtherCAT state machine: one test per row of the ETG transition table (ethercat-protocol.md §6.2), the AL
+// status codes of §6.3 for the checks of §6.4, error indication / acknowledge and device identification.
+#include "fixture.hpp"
+
+namespace ecat::test {
+namespace {
+
+using Esm = StackTest;
+using od::AlState;
+
+constexpr uint16_t kErr = 0x10;
+
+// ---- Init ---------------------------------------------------------------------------------------------
+
+TEST_F(Esm, PowerOn_InitNoError) {
+    EXPECT_EQ(al_status(), 0x01);
+    EXPECT_EQ(al_code(), 0x0000);
+    EXPECT_EQ(stack->state(), AlState::Init);
+}
+
+TEST_F(Esm, II_InitToInit_Stays) {
+    request(0x01);
+    EXPECT_EQ(al_status(), 0x01);
+    EXPECT_EQ(al_code(), 0);
+    EXPECT_TRUE(app.changes.empty());
+}
+
+TEST_F(Esm, IP_InitToPreOp_ValidMailbox) {
+    configure_mailbox();
+    request(0x02);
+    EXPECT_EQ(al_status(), 0x02);
+    EXPECT_EQ(al_code(), 0);
+    ASSERT_EQ(app.changes.size(), 1u);
+    EXPECT_EQ(app.changes[0], std::make_pair(AlState::Init, AlState::PreOp));
+    EXPECT_TRUE(stack->mailbox().running());
+}
+
+TEST_F(Esm, IP_InitToPreOp_MailboxNotEnabled_0x0016) {
+    configure_sm(0, 0x1000, 128, 0x26, false);
+    configure_sm(1, 0x1080, 128, 0x22, true);
+    request(0x02);
+    EXPECT_EQ(al_status(), 0x01 | kErr);
+    EXPECT_EQ(al_code(), 0x0016);
+}
+
+TEST_F(Esm, IP_InitToPreOp_WrongSm0Start_0x0016) {
+    configure_sm(0, 0x1010, 128, 0x26, true);
+    configure_sm(1, 0x1090, 128, 0x22, true);
+    request(0x02);
+    EXPECT_EQ(al_status(), 0x01 | kErr);
+    EXPECT_EQ(al_code(), 0x0016);
+}
+
+TEST_F(Esm, IP_InitToPreOp_WrongSm1Length_0x0016) {
+    configure_sm(0, 0x1000, 128, 0x26, true);
+    configure_sm(1, 0x1080, 64, 0x22, true);
+    request(0x02);
+    EXPECT_EQ(al_status(), 0x01 | kErr);
+    EXPECT_EQ(al_code(), 0x0016);
+}
+
+TEST_F(Esm, IP_InitToPreOp_WrongSm0Control_0x0016) {
+    configure_sm(0, 0x1000, 128, 0x22, true);  // mailbox but read direction
+    configure_sm(1, 0x1080, 128, 0x22, true);
+    request(0x02);
+    EXPECT_EQ(al_status(), 0x01 | kErr);
+    EXPECT_EQ(al_code(), 0x0016);
+}
+
+TEST_F(Esm, IP_InitToPreOp_EventBitsAreMastersChoice) {
+    configure_sm(0, 0x1000, 128, 0x06, true);  // mailbox, write, no PDI event
+    configure_sm(1, 0x1080, 128, 0x02, true);
+    request(0x02);
+    EXPECT_EQ(al_status(), 0x02);
+}
+
+TEST_F(Esm, IP_InitToPreOp_ApplicationVeto_0x0014) {
+    app.veto_state = AlState::PreOp;
+    app.veto_code = 0x0014;
+    configure_mailbox();
+    request(0x02);
+    EXPECT_EQ(al_status(), 0x01 | kErr);
+    EXPECT_EQ(al_code(), 0x0014);
+}
+
+TEST_F(Esm, IB_InitToBoot_ValidBootstrapMailbox) {
+    configure_bootstrap_mailbox();
+    request(0x03);
+    EXPECT_EQ(al_status(), 0x03);
+    EXPECT_EQ(al_code(), 0);
+    EXPECT_TRUE(stack->mailbox().running());
+    EXPECT_EQ(stack->mailbox().max_payload(), 256u - 6u);
+}
+
+TEST_F(Esm, IB_InitToBoot_StandardMailbox_0x0015) {
+    configure_mailbox();
+    request(0x03);
+    EXPECT_EQ(al_status(), 0x01 | kErr);
+    EXPECT_EQ(al_code(), 0x0015);
+}
+
+TEST_F(Esm, IB_InitToBoot_NotSupported_0x0013) {
+    desc.mailbox_protocols = od::mailbox_protocol::CoE;  // no FoE: no bootstrap
+    start();
+    configure_bootstrap_mailbox();
+    request(0x03);
+    EXPECT_EQ(al_status(), 0x01 | kErr);
+    EXPECT_EQ(al_code(), 0x0013);
+}
+
+TEST_F(Esm, Invalid_InitToSafeOp_0x0011) {
+    configure_mailbox();
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x01 | kErr);
+    EXPECT_EQ(al_code(), 0x0011);
+}
+
+TEST_F(Esm, Invalid_InitToOp_0x0011) {
+    configure_mailbox();
+    request(0x08);
+    EXPECT_EQ(al_status(), 0x01 | kErr);
+    EXPECT_EQ(al_code(), 0x0011);
+}
+
+// ---- Pre-Op -------------------------------------------------------------------------------------------
+
+TEST_F(Esm, PP_PreOpToPreOp_Stays) {
+    go_preop();
+    app.changes.clear();
+    request(0x02);
+    EXPECT_EQ(al_status(), 0x02);
+    EXPECT_TRUE(app.changes.empty());
+}
+
+TEST_F(Esm, PI_PreOpToInit_StopsMailbox) {
+    go_preop();
+    request(0x01);
+    EXPECT_EQ(al_status(), 0x01);
+    EXPECT_FALSE(stack->mailbox().running());
+    EXPECT_EQ(app.changes.back(), std::make_pair(AlState::PreOp, AlState::Init));
+}
+
+TEST_F(Esm, Invalid_PreOpToBoot_0x0011) {
+    go_preop();
+    request(0x03);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0011);
+}
+
+TEST_F(Esm, Invalid_PreOpToOp_0x0011) {
+    go_preop();
+    request(0x08);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0011);
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_Valid) {
+    go_preop();
+    configure_process_data(6, 6);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x04);
+    EXPECT_EQ(al_code(), 0);
+    EXPECT_EQ(stack->process_data().rx_bytes(), 6u);
+    EXPECT_EQ(stack->process_data().tx_bytes(), 6u);
+    EXPECT_EQ(stack->sync_mode(), SyncMode::SmSync);
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_Sm2LengthNotMapping_0x001D) {
+    go_preop();
+    configure_process_data(4, 6);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x001D);
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_Sm2Disabled_0x001D) {
+    go_preop();
+    configure_process_data(6, 6);
+    configure_sm(2, kSm2Start, 6, 0x64, false);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x001D);
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_Sm2WrongDirection_0x001D) {
+    go_preop();
+    configure_process_data(6, 6, 0x20);  // buffered, read direction: not an output SM
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x001D);
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_Sm2WrongStart_0x001D) {
+    go_preop();
+    configure_process_data(6, 6);
+    configure_sm(2, 0x1400, 6, 0x64, true);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x001D);
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_Sm3LengthNotMapping_0x001E) {
+    go_preop();
+    configure_process_data(6, 8);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x001E);
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_Sm3EnabledWithoutInputs_0x001E) {
+    go_preop();
+    ASSERT_EQ(dict.write(0x1C13, 0, AlState::PreOp, std::vector<uint8_t>{0}), od::Status::Ok);
+    configure_process_data(6, 6);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x001E);
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_Sm2MailboxMode_0x001C) {
+    go_preop();
+    configure_process_data(6, 6, 0x66);  // mailbox mode on the output SM
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x001C);
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_OverlappingSms_0x0017) {
+    desc.sync_managers[3].start = 0;  // no fixed start for SM3: overlap is the only thing wrong
+    start();
+    go_preop();
+    configure_process_data(6, 6);
+    configure_sm(3, kSm2Start + 12, 6, 0x20, true);  // inside SM2's three buffers
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0017);
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_InvalidOutputMapping_0x0025) {
+    go_preop();
+    // 0x6041 is not RxPDO-mappable.
+    ASSERT_EQ(dict.write(0x1600, 0, AlState::PreOp, std::vector<uint8_t>{0}), od::Status::Ok);
+    ASSERT_EQ(dict.write(0x1600, 1, AlState::PreOp, std::vector<uint8_t>{0x10, 0x00, 0x41, 0x60}),
+              od::Status::Ok);
+    ASSERT_EQ(dict.write(0x1600, 0, AlState::PreOp, std::vector<uint8_t>{1}), od::Status::Ok);
+    configure_process_data(2, 6);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0025);
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_InvalidInputMapping_0x0024) {
+    go_preop();
+    // Bit length 8 for a 32-bit object.
+    ASSERT_EQ(dict.write(0x1A00, 0, AlState::PreOp, std::vector<uint8_t>{0}), od::Status::Ok);
+    ASSERT_EQ(dict.write(0x1A00, 2, AlState::PreOp, std::vector<uint8_t>{0x08, 0x00, 0x64, 0x60}),
+              od::Status::Ok);
+    ASSERT_EQ(dict.write(0x1A00, 0, AlState::PreOp, std::vector<uint8_t>{2}), od::Status::Ok);
+    configure_process_data(6, 3);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0024);
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_AssignedPdoOutOfRange_0x0025) {
+    go_preop();
+    ASSERT_EQ(dict.write(0x1C12, 0, AlState::PreOp, std::vector<uint8_t>{0}), od::Status::Ok);
+    ASSERT_EQ(dict.write(0x1C12, 1, AlState::PreOp, std::vector<uint8_t>{0x00, 0x1A}), od::Status::Ok);
+    ASSERT_EQ(dict.write(0x1C12, 0, AlState::PreOp, std::vector<uint8_t>{1}), od::Status::Ok);
+    configure_process_data(6, 6);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0025);
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_WatchdogShorterThanCycle_0x001F) {
+    go_preop();
+    configure_process_data(6, 6);
+    master.wr<uint16_t>(0x0420, 5);  // 5 x 100 us = 0.5 ms < 1 ms cycle (0x1C32:02)
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x001F);
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_WatchdogOff_Accepted) {
+    go_preop();
+    configure_process_data(6, 6);
+    master.wr<uint16_t>(0x0420, 0);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x04);
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_ApplicationVeto) {
+    go_preop();
+    configure_process_data(6, 6);
+    app.veto_state = AlState::SafeOp;
+    app.veto_code = 0x0026;
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0026);
+}
+
+// ---- Bootstrap ----------------------------------------------------------------------------------------
+
+TEST_F(Esm, BI_BootToInit_Restarts) {
+    configure_bootstrap_mailbox();
+    request(0x03);
+    ASSERT_EQ(al_status(), 0x03);
+    request(0x01);
+    EXPECT_EQ(al_status(), 0x01);
+    EXPECT_EQ(app.restarts, 1);
+    EXPECT_FALSE(stack->mailbox().running());
+}
+
+TEST_F(Esm, Invalid_BootToPreOp_0x0011) {
+    configure_bootstrap_mailbox();
+    request(0x03);
+    request(0x02);
+    EXPECT_EQ(al_status(), 0x03 | kErr);
+    EXPECT_EQ(al_code(), 0x0011);
+}
+
+TEST_F(Esm, Invalid_BootToSafeOp_0x0011) {
+    configure_bootstrap_mailbox();
+    request(0x03);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x03 | kErr);
+    EXPECT_EQ(al_code(), 0x0011);
+}
+
+TEST_F(Esm, Invalid_BootToOp_0x0011) {
+    configure_bootstrap_mailbox();
+    request(0x03);
+    request(0x08);
+    EXPECT_EQ(al_status(), 0x03 | kErr);
+    EXPECT_EQ(al_code(), 0x0011);
+}
+
+// ---- Safe-Op ------------------------------------------------------------------------------------------
+
+TEST_F(Esm, SP_SafeOpToPreOp_StopsProcessData) {
+    go_safeop();
+    request(0x02);
+    EXPECT_EQ(al_status(), 0x02);
+    EXPECT_EQ(stack->process_data().rx_bytes(), 0u);
+    EXPECT_TRUE(stack->mailbox().running());
+}
+
+TEST_F(Esm, SI_SafeOpToInit_StopsAll) {
+    go_safeop();
+    request(0x01);
+    EXPECT_EQ(al_status(), 0x01);
+    EXPECT_FALSE(stack->mailbox().running());
+    EXPECT_EQ(stack->process_data().tx_bytes(), 0u);
+}
+
+TEST_F(Esm, Invalid_SafeOpToBoot_0x0011) {
+    go_safeop();
+    request(0x03);
+    EXPECT_EQ(al_status(), 0x04 | kErr);
+    EXPECT_EQ(al_code(), 0x0011);
+}
+
+TEST_F(Esm, SO_SafeOpToOp_Valid) {
+    go_op();
+    EXPECT_EQ(al_code(), 0);
+    EXPECT_EQ(app.changes.back(), std::make_pair(AlState::SafeOp, AlState::Op));
+}
+
+TEST_F(Esm, SO_SafeOpToOp_WaitsForFirstOutputs) {
+    go_safeop();
+    request(0x08);
+    EXPECT_EQ(al_status(), 0x04);  // still Safe-Op, no error: waiting for outputs
+    std::vector<uint8_t> out(6, 0), in(6, 0);
+    exchange_pd(out, in);
+    poll();
+    EXPECT_EQ(al_status(), 0x08);
+}
+
+TEST_F(Esm, SO_SafeOpToOp_NoOutputs_0x001B) {
+    go_safeop();
+    request(0x08);
+    EXPECT_EQ(al_status(), 0x04);
+    advance(2'000'000'000);
+    EXPECT_EQ(al_status(), 0x04 | kErr);
+    EXPECT_EQ(al_code(), 0x001B);
+}
+
+TEST_F(Esm, SO_SafeOpToOp_ApplicationVeto) {
+    go_safeop();
+    app.veto_state = AlState::Op;
+    app.veto_code = 0x0019;
+    request(0x08);
+    EXPECT_EQ(al_status(), 0x04 | kErr);
+    EXPECT_EQ(al_code(), 0x0019);
+}
+
+// ---- Op -----------------------------------------------------------------------------------------------
+
+TEST_F(Esm, OS_OpToSafeOp_OutputsLost) {
+    go_op();
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x04);
+    EXPECT_EQ(app.outputs_lost, 1);
+}
+
+TEST_F(Esm, OP_OpToPreOp_StopsProcessData) {
+    go_op();
+    request(0x02);
+    EXPECT_EQ(al_status(), 0x02);
+    EXPECT_EQ(app.outputs_lost, 1);
+    EXPECT_EQ(stack->process_data().rx_bytes(), 0u);
+}
+
+TEST_F(Esm, OI_OpToInit_StopsAll) {
+    go_op();
+    request(0x01);
+    EXPECT_EQ(al_status(), 0x01);
+    EXPECT_EQ(app.outputs_lost, 1);
+    EXPECT_FALSE(stack->mailbox().running());
+}
+
+TEST_F(Esm, Invalid_OpToBoot_0x0011) {
+    go_op();
+    request(0x03);
+    EXPECT_EQ(al_status(), 0x08 | kErr);
+    EXPECT_EQ(al_code(), 0x0011);
+}
+
+TEST_F(Esm, OO_OpToOp_Stays) {
+    go_op();
+    request(0x08);
+    EXPECT_EQ(al_status(), 0x08);
+}
+
+// ---- Unknown states, error indication and acknowledge ---------------------------------------------------
+
+TEST_F(Esm, Unknown_State5_0x0012) {
+    request(0x05);
+    EXPECT_EQ(al_status(), 0x01 | kErr);
+    EXPECT_EQ(al_code(), 0x0012);
+}
+
+TEST_F(Esm, Unknown_StateF_InPreOp_0x0012) {
+    go_preop();
+    request(0x0F);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0012);
+}
+
+TEST_F(Esm, ErrorInd_RequestWithoutAckIgnored) {
+    go_preop();
+    request(0x08);  // invalid: error
+    ASSERT_EQ(al_status(), 0x02 | kErr);
+    configure_process_data(6, 6);
+    request(0x04);  // valid, but no acknowledge
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0011);
+}
+
+TEST_F(Esm, ErrorAck_ClearsAndPerformsRequest) {
+    go_preop();
+    request(0x08);
+    ASSERT_EQ(al_status(), 0x02 | kErr);
+    configure_process_data(6, 6);
+    request(0x04 | 0x10);
+    EXPECT_EQ(al_status(), 0x04);
+    EXPECT_EQ(al_code(), 0);
+}
+
+TEST_F(Esm, ErrorAck_SameState_ClearsOnly) {
+    go_preop();
+    request(0x08);
+    request(0x12);
+    EXPECT_EQ(al_status(), 0x02);
+    EXPECT_EQ(al_code(), 0);
+}
+
+TEST_F(Esm, ErrorAck_InitRequestActsAsAck) {
+    go_preop();
+    request(0x08);
+    request(0x01);
+    EXPECT_EQ(al_status(), 0x01);
+    EXPECT_EQ(al_code(), 0);
+}
+
+TEST_F(Esm, ErrorAck_FailingRequestSetsNewError) {
+    go_preop();
+    request(0x08);
+    configure_process_data(2, 6);  // wrong SM2 length
+    request(0x14);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x001D);
+}
+
+// ---- Device identification ---------------------------------------------------------------------------
+
+TEST_F(Esm, DeviceId_RequestShowsAliasInStatusCode) {
+    master.wr<uint16_t>(0x0012, 0x1234);  // configured station alias (normally from SII word 4)
+    request(0x21);
+    EXPECT_EQ(al_status(), 0x21);
+    EXPECT_EQ(al_code(), master.rd<uint16_t>(0x0012));
+    request(0x01);
+    EXPECT_EQ(al_status(), 0x01);
+    EXPECT_EQ(al_code(), 0);
+}
+
+TEST_F(Esm, DeviceId_WithTransition) {
+    configure_mailbox();
+    request(0x22);
+    EXPECT_EQ(al_status(), 0x22);
+    EXPECT_EQ(al_code(), master.rd<uint16_t>(0x0012));
+}
+
+TEST_F(Esm, DeviceId_NotWhileErrorPending) {
+    request(0x04);  // invalid from Init
+    request(0x24);  // ID request without ack: ignored, error stays
+    EXPECT_EQ(al_status(), 0x01 | kErr);
+    EXPECT_EQ(al_code(), 0x0011);
+}
+
+// ---- Runtime fall-backs --------------------------------------------------------------------------------
+
+TEST_F(Esm, Watchdog_InOp_SafeOpWith0x001B) {
+    go_op();
+    // Default PD watchdog: 1000 x 100 us = 100 ms without an SM2 write.
+    advance(150'000'000);
+    EXPECT_EQ(al_status(), 0x04 | kErr);
+    EXPECT_EQ(al_code(), 0x001B);
+    EXPECT_EQ(app.outputs_lost, 1);
+    EXPECT_GE(stack->stats().watchdog_expiries, 1u);
+}
+
+TEST_F(Esm, Watchdog_RefreshedOutputsKeepOp) {
+    go_op();
+    std::vector<uint8_t> out(6, 0), in(6, 0);
+    for (int i = 0; i < 10; ++i) {
+        clock.advance(50'000'000);
+        exchange_pd(out, in);
+        poll();
+    }
+    EXPECT_EQ(al_status(), 0x08);
+}
+
+TEST_F(Esm, Watchdog_InSafeOp_NoStateChange) {
+    go_safeop();
+    std::vector<uint8_t> out(6, 0), in(6, 0);
+    exchange_pd(out, in);
+    advance(150'000'000);
+    EXPECT_EQ(al_status(), 0x04);
+}
+
+TEST_F(Esm, LocalError_FallsBack) {
+    go_op();
+    stack->local_error(0x001A, AlState::SafeOp);
+    EXPECT_EQ(al_status(), 0x04 | kErr);
+    EXPECT_EQ(al_code(), 0x001A);
+    EXPECT_EQ(app.outputs_lost, 1);
+}
+
+}  // namespace
+}  // namespace ecat::test

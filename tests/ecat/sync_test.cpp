@@ -1,0 +1,274 @@
+// Synchronisation: 0x1C32/0x1C33 say what really runs (free run, SM-synchronous, DC SYNC0), the cycle runs on
+// the right event, misses are counted, and the DC/SM sync checks of Pre-Op -> Safe-Op give their AL codes.
+#include "fixture.hpp"
+
+namespace ecat::test {
+namespace {
+
+using od::AlState;
+constexpr uint16_t kErr = 0x10;
+
+class Sync : public StackTest {
+  protected:
+    // DC SYNC0 as masters set it up (ethercat-protocol.md §11.2 step 8): cycle time, start time in the near
+    // future (system time), then activation.
+    void enable_dc(uint32_t cycle_ns, uint8_t activation = 0x03, uint64_t start_delay_ns = 1'000'000) {
+        master.wr<uint8_t>(0x0980, 0);
+        master.wr<uint32_t>(0x09A0, cycle_ns);
+        const uint64_t now_sys = master.rd<uint64_t>(0x0910);
+        master.wr<uint64_t>(0x0990, now_sys + start_delay_ns);
+        master.wr<uint8_t>(0x0981, activation);
+    }
+    void safeop_dc(uint32_t cycle_ns) {
+        go_preop();
+        configure_process_data(6, 6);
+        enable_dc(cycle_ns);
+        request(0x04);
+        ASSERT_EQ(al_status(), 0x04) << std::hex << al_code();
+    }
+    // Advances in steps, polling after each (the runtime's timer).
+    void run_for(uint64_t total_ns, uint64_t step_ns, bool send_outputs) {
+        std::vector<uint8_t> out(rx_bytes, 0), in(tx_bytes, 0);
+        for (uint64_t t = 0; t < total_ns; t += step_ns) {
+            clock.advance(step_ns);
+            if (send_outputs) exchange_pd(out, in);
+            poll();
+        }
+    }
+    uint16_t u16(uint16_t i, uint8_t s) { return dict.get<uint16_t>(i, s); }
+    uint32_t u32(uint16_t i, uint8_t s) { return dict.get<uint32_t>(i, s); }
+    od::Status master_write16(uint16_t i, uint8_t s, uint16_t v) {
+        return dict.write(i, s, AlState::PreOp,
+                          std::vector<uint8_t>{static_cast<uint8_t>(v), static_cast<uint8_t>(v >> 8)});
+    }
+    od::Status master_write32(uint16_t i, uint8_t s, uint32_t v) {
+        std::vector<uint8_t> b(4);
+        for (int k = 0; k < 4; ++k)
+            b[k] = static_cast<uint8_t>(v >> (8 * k));
+        return dict.write(i, s, AlState::PreOp, b);
+    }
+};
+
+TEST_F(Sync, SmSync_ReportedIn1C32And1C33) {
+    go_safeop();
+    EXPECT_EQ(stack->sync_mode(), SyncMode::SmSync);
+    EXPECT_EQ(u16(0x1C32, 1), 1);
+    EXPECT_EQ(u16(0x1C33, 1), 0x22);  // inputs follow the SM2 event
+}
+
+TEST_F(Sync, SmSync_CycleOnEachSm2Write) {
+    go_op();
+    const int before = app.cycles;
+    std::vector<uint8_t> out(6), in(6);
+    for (int i = 0; i < 5; ++i) {
+        exchange_pd(out, in);
+        poll();
+        poll();  // no new outputs: no extra cycle
+    }
+    EXPECT_EQ(app.cycles - before, 5);
+}
+
+TEST_F(Sync, Dc_ModeAndCycleTimeFrom0x09A0) {
+    safeop_dc(2'000'000);
+    EXPECT_EQ(stack->sync_mode(), SyncMode::DcSync0);
+    EXPECT_EQ(u16(0x1C32, 1), 2);
+    EXPECT_EQ(u16(0x1C33, 1), 2);
+    EXPECT_EQ(u32(0x1C32, 2), 2'000'000u);
+    EXPECT_EQ(u32(0x1C33, 2), 2'000'000u);
+}
+
+TEST_F(Sync, Dc_CycleRunsOnSync0) {
+    safeop_dc(1'000'000);
+    const int before = app.cycles;
+    run_for(10'500'000, 250'000, false);
+    EXPECT_GE(stack->stats().sync0_events, 9u);
+    EXPECT_LE(stack->stats().sync0_events, 11u);
+    EXPECT_EQ(static_cast<uint64_t>(app.cycles - before), stack->stats().sync0_events);
+}
+
+TEST_F(Sync, Dc_SafeOpToOp_WaitsForSync0) {
+    go_preop();
+    configure_process_data(6, 6);
+    enable_dc(1'000'000, 0x03, 5'000'000);  // first SYNC0 5 ms from now
+    request(0x04);
+    ASSERT_EQ(al_status(), 0x04);
+    std::vector<uint8_t> out(6), in(6);
+    exchange_pd(out, in);
+    poll();
+    request(0x08);
+    EXPECT_EQ(al_status(), 0x04);  // waiting, no error
+    run_for(8'000'000, 500'000, true);
+    EXPECT_EQ(al_status(), 0x08);
+}
+
+TEST_F(Sync, Dc_SafeOpToOp_NoSync0_0x002D) {
+    go_preop();
+    configure_process_data(6, 6);
+    enable_dc(1'000'000, 0x03, 60'000'000'000ull);  // start time a minute away
+    request(0x04);
+    ASSERT_EQ(al_status(), 0x04);
+    std::vector<uint8_t> out(6), in(6);
+    exchange_pd(out, in);
+    poll();
+    request(0x08);
+    run_for(1'500'000'000, 50'000'000, true);
+    EXPECT_EQ(al_status(), 0x04 | kErr);
+    EXPECT_EQ(al_code(), 0x002D);
+}
+
+TEST_F(Sync, Dc_SmEventMissedCountedAndSyncError) {
+    safeop_dc(1'000'000);
+    run_for(3'000'000, 250'000, true);
+    request(0x08);
+    ASSERT_EQ(al_status(), 0x08);
+    run_for(3'000'000, 250'000, true);
+    EXPECT_EQ(u16(0x1C32, 0x0B), 0);
+    EXPECT_EQ(dict.get<uint8_t>(0x1C32, 0x20), 0);
+    run_for(3'000'000, 250'000, false);  // SYNC0 keeps coming, outputs do not
+    EXPECT_GE(u16(0x1C32, 0x0B), 2);
+    EXPECT_EQ(u16(0x1C33, 0x0B), u16(0x1C32, 0x0B));
+    EXPECT_EQ(dict.get<uint8_t>(0x1C32, 0x20), 1);
+    EXPECT_EQ(al_status(), 0x08);  // counted, not fatal
+}
+
+TEST_F(Sync, Dc_CycleExceededCounted) {
+    safeop_dc(1'000'000);
+    run_for(3'000'000, 250'000, true);
+    request(0x08);
+    ASSERT_EQ(al_status(), 0x08);
+    run_for(2'000'000, 250'000, true);
+    const uint16_t before = u16(0x1C32, 0x0C);
+    run_for(5'000'000, 5'000'000, true);  // the runtime stalls for 5 cycles
+    EXPECT_GE(u16(0x1C32, 0x0C), before + 3);
+}
+
+TEST_F(Sync, Dc_SyncLoss_0x002C) {
+    safeop_dc(1'000'000);
+    run_for(3'000'000, 250'000, true);
+    request(0x08);
+    ASSERT_EQ(al_status(), 0x08);
+    master.wr<uint8_t>(0x0981, 0);  // SYNC0 stops
+    run_for(20'000'000, 1'000'000, true);
+    EXPECT_EQ(al_status(), 0x04 | kErr);
+    EXPECT_EQ(al_code(), 0x002C);
+    EXPECT_EQ(app.outputs_lost, 1);
+}
+
+TEST_F(Sync, Dc_Sync0CycleBelowMinimum_0x0036) {
+    go_preop();
+    configure_process_data(6, 6);
+    enable_dc(50'000);  // 0x1C32:05 = 100 us
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0036);
+}
+
+TEST_F(Sync, Dc_Sync0CycleZero_0x0035) {
+    go_preop();
+    configure_process_data(6, 6);
+    enable_dc(0);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0035);
+}
+
+TEST_F(Sync, Dc_Sync1WithoutSync0_0x0030) {
+    go_preop();
+    configure_process_data(6, 6);
+    enable_dc(1'000'000, 0x05);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0030);
+}
+
+TEST_F(Sync, Dc_SyncModeSaysDcButNotActivated_0x0030) {
+    go_preop();
+    ASSERT_EQ(master_write16(0x1C32, 1, 2), od::Status::Ok);
+    configure_process_data(6, 6);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0030);
+}
+
+TEST_F(Sync, SmSyncRequestedButDcActive_0x0030) {
+    go_preop();
+    ASSERT_EQ(master_write16(0x1C32, 1, 1), od::Status::Ok);
+    configure_process_data(6, 6);
+    enable_dc(1'000'000);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0030);
+}
+
+TEST_F(Sync, Dc_SyncModeWrittenAndActivated_Accepted) {
+    go_preop();
+    ASSERT_EQ(master_write16(0x1C32, 1, 2), od::Status::Ok);
+    configure_process_data(6, 6);
+    enable_dc(1'000'000);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x04);
+    EXPECT_EQ(stack->sync_mode(), SyncMode::DcSync0);
+}
+
+TEST_F(Sync, FreeRunNotSupported_0x0027) {
+    go_preop();
+    ASSERT_EQ(master_write16(0x1C32, 1, 0), od::Status::Ok);
+    configure_process_data(6, 6);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0027);
+}
+
+TEST_F(Sync, UnknownSyncMode_0x0028) {
+    go_preop();
+    ASSERT_EQ(master_write16(0x1C32, 1, 7), od::Status::Ok);
+    configure_process_data(6, 6);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0028);
+}
+
+TEST_F(Sync, Dc_Sync1ModeNotSupported_0x0028) {
+    go_preop();
+    ASSERT_EQ(master_write16(0x1C32, 1, 3), od::Status::Ok);
+    configure_process_data(6, 6);
+    enable_dc(1'000'000, 0x07);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0028);  // 0x1C32:04 = 0x0006: no SYNC1 mode
+}
+
+TEST_F(Sync, SmSync_CycleTimeTooSmall_0x002E) {
+    go_preop();
+    ASSERT_EQ(master_write32(0x1C32, 2, 50'000), od::Status::Ok);
+    configure_process_data(6, 6);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x002E);
+}
+
+TEST_F(Sync, FreeRun_TimerDrivesCycle) {
+    ASSERT_EQ(dict.set<uint16_t>(0x1C32, 4, 0x0007), od::Status::Ok);  // a device that supports free run
+    go_preop();
+    ASSERT_EQ(master_write16(0x1C32, 1, 0), od::Status::Ok);
+    ASSERT_EQ(master_write32(0x1C32, 2, 2'000'000), od::Status::Ok);
+    configure_process_data(6, 6);
+    request(0x04);
+    ASSERT_EQ(al_status(), 0x04) << std::hex << al_code();
+    EXPECT_EQ(stack->sync_mode(), SyncMode::FreeRun);
+    EXPECT_EQ(u16(0x1C33, 1), 0);
+    EXPECT_EQ(stack->next_deadline_ns(), clock.now_ns() + 2'000'000);
+    const int before = app.cycles;
+    run_for(10'000'000, 1'000'000, false);
+    EXPECT_EQ(app.cycles - before, 5);
+}
+
+TEST_F(Sync, SmTypesReflectedIn1C00) {
+    EXPECT_EQ(dict.get<uint8_t>(0x1C00, 1), 1);
+    EXPECT_EQ(dict.get<uint8_t>(0x1C00, 2), 2);
+    EXPECT_EQ(dict.get<uint8_t>(0x1C00, 3), 3);
+    EXPECT_EQ(dict.get<uint8_t>(0x1C00, 4), 4);
+}
+
+}  // namespace
+}  // namespace ecat::test
