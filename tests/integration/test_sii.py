@@ -72,6 +72,21 @@ class Sii(unittest.TestCase):
                 dump = f.read()
             self.assertEqual(struct.unpack_from("<II", dump, 0x10), (0xFB, 0x11223344))
 
+    def test_decode_from_the_slave_and_from_a_file(self):
+        image, end = harness.build_sii(product=0x0BADCAFE, name="DecodeMe")
+        with harness.Bus(eeprom=image) as bus:
+            r = bus.ecatctl("sii", "decode", check=False)
+            if r.returncode == 2 and "decode" in r.stderr:
+                self.skipTest("ecatctl built without the esi library")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("product 0x0BADCAFE", r.stdout)
+            self.assertIn('"DecodeMe"', r.stdout)
+            self.assertIn("end of categories", r.stdout)
+            path = os.path.join(bus.dir, "img.bin")
+            with open(path, "wb") as f:
+                f.write(image[:end])
+            self.assertEqual(bus.ecatctl("sii", "decode", path).stdout, r.stdout)
+
 
 if __name__ == "__main__":
     harness.main()

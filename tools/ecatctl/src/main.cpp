@@ -13,9 +13,8 @@
 #include "esc/link.hpp"
 #include "format.hpp"
 #include "master/master.hpp"
-#if __has_include("esi/sii.hpp") && defined(ECATCTL_HAVE_ESI)
+#ifdef ECATCTL_HAVE_ESI
 #include "esi/sii.hpp"
-#define ECATCTL_SII_DECODE 1
 #endif
 
 namespace {
@@ -383,7 +382,7 @@ int main(int argc, char** argv) {
     sii_wr->add_flag("-s,--station", s.station, "--position is a station address");
     sii_wr->add_flag("-f,--force", s.force, "Write even if the checksum in word 7 is wrong");
     sii_wr->callback([&] { rc = with_master(g, [&](master::Master& m) { return sii_write(m, s); }); });
-#ifdef ECATCTL_SII_DECODE
+#ifdef ECATCTL_HAVE_ESI
     auto* sii_dec =
         sii->add_subcommand("decode", "Print the content of an image file, or of the slave's SII");
     sii_dec->add_option("file", s.input, "Binary image (default: read it from the slave)");
