@@ -29,7 +29,9 @@ struct Proc {
 
 // Starts ecat-slave with args; with own_netns the child first enters a new network namespace and, with
 // stale_pair, creates ecat0/ecat1 there as a killed earlier run would have left them.
-Proc start(const std::vector<std::string>& args, bool own_netns = false, bool stale_pair = false) {
+// With unprivileged, the child drops to uid/gid 65534 (nobody) before exec, losing every capability.
+Proc start(const std::vector<std::string>& args, bool own_netns = false, bool stale_pair = false,
+           bool unprivileged = false) {
     int fds[2];
     if (::pipe2(fds, O_CLOEXEC) != 0) return {};
     const pid_t parent = ::getpid();
@@ -47,6 +49,8 @@ Proc start(const std::vector<std::string>& args, bool own_netns = false, bool st
                 ::_exit(124);
             }
         }
+        if (unprivileged && (::setresgid(65534, 65534, 65534) != 0 || ::setresuid(65534, 65534, 65534) != 0))
+            ::_exit(123);
         std::vector<char*> argv{const_cast<char*>(ECAT_SLAVE_PATH)};
         for (const auto& a : args)
             argv.push_back(const_cast<char*>(a.c_str()));
@@ -90,8 +94,8 @@ struct RunResult {
     std::string output;
 };
 
-RunResult run(const std::vector<std::string>& args) {
-    Proc p = start(args);
+RunResult run(const std::vector<std::string>& args, bool unprivileged = false) {
+    Proc p = start(args, false, false, unprivileged);
     std::string out = read_until(p.out, "\x01never", 3000);
     const int code = wait_exit(p.pid, 3000);
     ::close(p.out);
@@ -115,6 +119,21 @@ TEST(EcatSlaveCli, BadOptionsExitWith2) {
     EXPECT_EQ(run({"--ram-kib", "0", "--iface", "lo"}).code, 2);
     EXPECT_EQ(run({"--no-such-option"}).code, 2);
     EXPECT_EQ(run({"--eeprom", "/nonexistent/eeprom.bin", "--iface", "lo"}).code, 2);
+}
+
+TEST(EcatSlaveCli, MissingPrivilegesExitWith2AndNameTheCapability) {
+    if (!linktest::is_root()) GTEST_SKIP() << "needs root to drop to an unprivileged user";
+    if (::access(ECAT_SLAVE_PATH, X_OK) != 0) GTEST_SKIP() << "binary not reachable";
+    for (const char* backend : {"pcap", "packet"}) {
+        const RunResult r = run({"--iface", "lo", "--backend", backend}, /*unprivileged=*/true);
+        if (r.code == 127) GTEST_SKIP() << "the build directory is not accessible to user nobody";
+        EXPECT_EQ(r.code, 2) << backend << ": " << r.output;
+        EXPECT_NE(r.output.find("CAP_NET_RAW"), std::string::npos) << backend << ": " << r.output;
+    }
+    const RunResult r = run({"--veth-name", "nopriv0"}, /*unprivileged=*/true);
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find("CAP_NET_ADMIN"), std::string::npos) << r.output;
+    EXPECT_FALSE(softslave::interface_exists("nopriv0"));
 }
 
 // Joins the network namespace of pid on a helper thread, runs fn there.

@@ -197,6 +197,20 @@ TEST_F(VethPairTest, RemovesAStalePairLeftByAKilledRun) {
     });
 }
 
+TEST_F(VethPairTest, APairOwnedByARunningSlaveIsNotTakenAsStale) {
+    in_new_netns([] {
+        softslave::VethPair first("ecat0", "ecat1");
+        try {
+            softslave::VethPair second("ecat0", "ecat1");
+            ADD_FAILURE() << "a second owner must be refused";
+        } catch (const esc::LinkError& e) {
+            EXPECT_EQ(e.kind(), esc::LinkError::Kind::BadArgument);
+            EXPECT_NE(std::string(e.what()).find("in use"), std::string::npos) << e.what();
+        }
+        EXPECT_TRUE(softslave::interface_exists("ecat0")) << "the first owner's pair must survive";
+    });
+}
+
 TEST_F(VethPairTest, CreatingAnExistingPairFailsClearly) {
     in_new_netns([] {
         softslave::create_veth("x0", "x1");

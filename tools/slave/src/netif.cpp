@@ -7,7 +7,9 @@
 #include <linux/rtnetlink.h>
 #include <linux/veth.h>
 #include <net/if.h>
+#include <sys/file.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cctype>
@@ -213,12 +215,55 @@ std::string veth_peer_name(const std::string& slave_end) {
     return slave_end.substr(0, digits) + std::to_string(n + 1);
 }
 
+namespace {
+
+// Takes the ownership lock of a veth name in the current network namespace. Returns the fd (kept open for
+// the lifetime of the pair), or -1 if no lock directory is writable (then ownership is not checked).
+int lock_veth_name(const std::string& name, std::string& lock_path) {
+    struct stat ns {};
+    const unsigned long long ns_id = ::stat("/proc/thread-self/ns/net", &ns) == 0 ? ns.st_ino : 0;
+    for (const char* dir : {"/run/softecat", "/tmp/softecat"}) {
+        ::mkdir(dir, 0755);
+        const std::string path = std::string(dir) + "/veth-" + std::to_string(ns_id) + "-" + name + ".lock";
+        const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+        if (fd < 0) continue;
+        if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+            ::close(fd);
+            throw LinkError(LinkError::Kind::BadArgument,
+                            "veth interface '" + name + "' is in use by another running ecat-slave (lock " +
+                                path + "); choose another name with --veth-name");
+        }
+        lock_path = path;
+        return fd;
+    }
+    return -1;
+}
+
+}  // namespace
+
 VethPair::VethPair(std::string slave_end, std::string master_end)
     : slave_end_(std::move(slave_end)), master_end_(std::move(master_end)) {
     check_name(slave_end_);
     check_name(master_end_);
     if (slave_end_ == master_end_)
         throw LinkError(LinkError::Kind::BadArgument, "the two ends of a veth pair need different names");
+    lock_fd_ = lock_veth_name(slave_end_, lock_path_);
+    try {
+        create();
+    } catch (...) {
+        release_lock();
+        throw;
+    }
+}
+
+void VethPair::release_lock() {
+    if (lock_fd_ < 0) return;
+    ::unlink(lock_path_.c_str());
+    ::close(lock_fd_);
+    lock_fd_ = -1;
+}
+
+void VethPair::create() {
     // A killed earlier run may have left the pair (or one name) behind.
     delete_interface(slave_end_);
     delete_interface(master_end_);
@@ -240,6 +285,7 @@ VethPair::~VethPair() {
     } catch (...) {
         // Nothing sensible to do in a destructor; the next run removes a stale pair.
     }
+    release_lock();
 }
 
 }  // namespace softslave

@@ -22,6 +22,8 @@ void move_to_netns(const std::string& name, int netns_fd);
 
 // A veth pair that exists as long as this object: created (after removing a stale pair of the same names
 // left by a killed run), IPv6 off and up on both ends; deleted by the destructor.
+// An existing pair is only taken as stale if no live VethPair owns it: each owner holds an flock on
+// /run/softecat/veth-<netns inode>-<name>.lock, and a second owner gets LinkError(BadArgument, "in use").
 class VethPair {
   public:
     VethPair(std::string slave_end, std::string master_end);
@@ -32,8 +34,12 @@ class VethPair {
     const std::string& master_end() const { return master_end_; }
 
   private:
+    void create();
+    void release_lock();
     std::string slave_end_;
     std::string master_end_;
+    std::string lock_path_;
+    int lock_fd_ = -1;
 };
 
 // The master-side name for a slave-side veth name: a trailing number is incremented (ecat0 -> ecat1),
