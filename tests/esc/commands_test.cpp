@@ -1,0 +1,200 @@
+// Datagram commands and working counters (protocol reference §2.1, §2.2).
+#include <gtest/gtest.h>
+
+#include <optional>
+#include <string>
+
+#include "frame.hpp"
+
+using namespace esc_test;
+
+namespace {
+
+struct CommandCase {
+    std::string name;
+    uint8_t cmd;
+    uint16_t adp;
+    std::vector<uint8_t> in;
+    std::vector<uint8_t> out;  // data returned
+    uint16_t wkc;
+    uint16_t adp_after;
+    std::vector<uint8_t> mem_after;  // RAM 0x1000..0x1001 afterwards
+};
+
+class Command : public ::testing::TestWithParam<CommandCase> {};
+
+TEST_P(Command, DataWkcAdpAndMemory) {
+    const CommandCase& c = GetParam();
+    esc::ManualClock clk;
+    clk.set(1'000'000);
+    esc::Esc e({}, clk);
+    set_station(e, 0x1001);
+    e.write_reg<uint16_t>(0x1000, 0x2211);  // PDI writes the memory the commands address
+    Datagram d = run1(e, dg(c.cmd, c.adp, 0x1000, c.in));
+    EXPECT_EQ(d.data, c.out);
+    EXPECT_EQ(d.wkc, c.wkc);
+    EXPECT_EQ(d.adp, c.adp_after);
+    EXPECT_EQ(d.ado, 0x1000);
+    EXPECT_EQ(e.read_reg<uint16_t>(0x1000), static_cast<uint16_t>(c.mem_after[0] | (c.mem_after[1] << 8)));
+}
+
+const std::vector<uint8_t> kMem{0x11, 0x22};
+const std::vector<uint8_t> kIn{0xA5, 0x0F};
+const std::vector<uint8_t> kZero{0x00, 0x00};
+
+INSTANTIATE_TEST_SUITE_P(
+    Commands, Command,
+    ::testing::Values(CommandCase{"NOP", NOP, 0, kIn, kIn, 0, 0, kMem},
+                      CommandCase{"APRD_addressed", APRD, 0, kZero, kMem, 1, 1, kMem},
+                      CommandCase{"APRD_other", APRD, 0xFFFF, kZero, kZero, 0, 0, kMem},
+                      CommandCase{"APWR_addressed", APWR, 0, kIn, kIn, 1, 1, kIn},
+                      CommandCase{"APWR_other", APWR, 0xFFFE, kIn, kIn, 0, 0xFFFF, kMem},
+                      CommandCase{"APRW_addressed", APRW, 0, kIn, kMem, 3, 1, kIn},
+                      CommandCase{"APRW_other", APRW, 7, kIn, kIn, 0, 8, kMem},
+                      CommandCase{"FPRD_match", FPRD, 0x1001, kZero, kMem, 1, 0x1001, kMem},
+                      CommandCase{"FPRD_other", FPRD, 0x1002, kZero, kZero, 0, 0x1002, kMem},
+                      CommandCase{"FPWR_match", FPWR, 0x1001, kIn, kIn, 1, 0x1001, kIn},
+                      CommandCase{"FPWR_other", FPWR, 0x0000, kIn, kIn, 0, 0x0000, kMem},
+                      CommandCase{"FPRW_match", FPRW, 0x1001, kIn, kMem, 3, 0x1001, kIn},
+                      CommandCase{"FPRW_other", FPRW, 0x1000, kIn, kIn, 0, 0x1000, kMem},
+                      CommandCase{"BRD_ors", BRD, 0x1234, kIn, {0xB5, 0x2F}, 1, 0x1235, kMem},
+                      CommandCase{"BWR", BWR, 0xFFFF, kIn, kIn, 1, 0x0000, kIn},
+                      CommandCase{"BRW", BRW, 0, kIn, {0xB5, 0x2F}, 3, 1, kIn},
+                      CommandCase{"ARMW_addressed_reads", ARMW, 0, kIn, kMem, 1, 1, kMem},
+                      CommandCase{"ARMW_other_writes", ARMW, 0xFFFF, kIn, kIn, 1, 0, kIn},
+                      CommandCase{"FRMW_match_reads", FRMW, 0x1001, kIn, kMem, 1, 0x1001, kMem},
+                      CommandCase{"FRMW_other_writes", FRMW, 0x2000, kIn, kIn, 1, 0x2000, kIn},
+                      CommandCase{"Unknown_0x20", 0x20, 0, kIn, kIn, 0, 0, kMem},
+                      CommandCase{"EXT_0xFF", 0xFF, 0, kIn, kIn, 0, 0, kMem}),
+    [](const auto& p) { return p.param.name; });
+
+struct Fixture : ::testing::Test {
+    esc::ManualClock clk;
+    std::optional<esc::Esc> e;
+    void SetUp() override {
+        clk.set(1'000'000);
+        e.emplace(esc::EscConfig{}, clk);
+        set_station(*e, 0x1001);
+    }
+};
+
+using Addressing = Fixture;
+
+TEST_F(Addressing, AliasOnlyWithDlControlBit24) {
+    e->write_reg<uint16_t>(0x0012, 0x0BAD);
+    EXPECT_EQ(fprd(*e, 0x0010, 2, 0x0BAD).wkc, 0);
+    fpwr(*e, 0x0103, {0x01});
+    Datagram d = fprd(*e, 0x0010, 2, 0x0BAD);
+    EXPECT_EQ(d.wkc, 1);
+    EXPECT_EQ(d.u16(), 0x1001);
+    EXPECT_EQ(fprd(*e, 0x0010, 2, 0x1001).wkc, 1);  // station address still matches
+}
+
+TEST_F(Addressing, AliasNotWritableFromEcat) {
+    EXPECT_EQ(fpwr(*e, 0x0012, {0x34, 0x12}).wkc, 1);  // register exists, write ignored
+    EXPECT_EQ(fprd(*e, 0x0012, 2).u16(), 0x0000);
+}
+
+TEST_F(Addressing, AccessSpanningRegistersAndRam) {
+    e->write_reg<uint8_t>(0x0FFF, 0x5A);
+    e->write_reg<uint8_t>(0x1000, 0xA5);
+    Datagram d = fprd(*e, 0x0FFF, 2);
+    EXPECT_EQ(d.wkc, 1);
+    EXPECT_EQ(d.data, (std::vector<uint8_t>{0x5A, 0xA5}));
+    EXPECT_EQ(fpwr(*e, 0x0FFF, {0x01, 0x02}).wkc, 1);
+    EXPECT_EQ(e->read_reg<uint16_t>(0x0FFF), 0x0201);
+}
+
+TEST_F(Addressing, BeyondProcessRamIsNotAccessible) {
+    // 8 KiB RAM: 0x1000..0x2FFF.
+    EXPECT_EQ(fprd(*e, 0x3000, 4).wkc, 0);
+    EXPECT_EQ(fpwr(*e, 0x3000, {1, 2}).wkc, 0);
+    EXPECT_EQ(fprd(*e, 0x2FFF, 2).wkc, 1);  // one byte accessible is enough
+    EXPECT_EQ(fprd(*e, 0xFFFF, 2).wkc, 0);  // no wrap into 0x0000
+}
+
+TEST_F(Addressing, ReadOnlyRegistersIgnoreEcatWrites) {
+    EXPECT_EQ(fpwr(*e, 0x0000, {0xFF, 0xFF, 0xFF, 0xFF}).wkc, 1);
+    Datagram d = fprd(*e, 0x0000, 10);
+    EXPECT_EQ(d.data[0], 0x04);  // type
+    EXPECT_EQ(d.data[4], 8);     // FMMUs
+    EXPECT_EQ(d.data[5], 8);     // SMs
+    EXPECT_EQ(d.data[6], 8);     // RAM KiB
+    EXPECT_EQ(d.data[7], 0x0F);
+    EXPECT_EQ(d.u16(8), 0x01CC);
+    fpwr(*e, 0x0130, {0x08, 0x00});  // AL status: PDI only
+    EXPECT_EQ(fprd(*e, 0x0130, 2).u16(), 0x0001);
+}
+
+TEST_F(Addressing, ResetValues) {
+    EXPECT_EQ(fprd(*e, 0x0100, 4).u32(), 0x0007C001u);
+    EXPECT_EQ(fprd(*e, 0x0110, 2).u16(), 0x5613);  // single port, EEPROM loaded
+    EXPECT_EQ(fprd(*e, 0x0120, 2).u16(), 0x0001);
+    EXPECT_EQ(fprd(*e, 0x0130, 2).u16(), 0x0001);
+    EXPECT_EQ(fprd(*e, 0x0204, 4).u32(), 0x00FFFF2Fu);
+    EXPECT_EQ(fprd(*e, 0x0400, 2).u16(), 0x09C2);
+    EXPECT_EQ(fprd(*e, 0x0410, 2).u16(), 0x03E8);
+    EXPECT_EQ(fprd(*e, 0x0420, 2).u16(), 0x03E8);
+    EXPECT_EQ(fprd(*e, 0x0930, 2).u16(), 0x1000);
+    EXPECT_EQ(fprd(*e, 0x0934, 2).u16(), 0x0C04);
+    EXPECT_EQ(fprd(*e, 0x0805, 1).data[0], 0x30);
+}
+
+TEST_F(Addressing, RegisterWriteProtection) {
+    fpwr(*e, 0x0021, {0x01});
+    EXPECT_EQ(fpwr(*e, 0x0010, {0x02, 0x10}).wkc, 0);  // protected: not written, not counted
+    EXPECT_EQ(fprd(*e, 0x0010, 2).u16(), 0x1001);
+    // Write enable in the same frame, then the write.
+    auto r = run(*e, {dg(FPWR, 0x1001, 0x0020, {0x01}), dg(FPWR, 0x1001, 0x0010, {0x02, 0x10})});
+    EXPECT_EQ(r[1].wkc, 1);
+    EXPECT_EQ(fprd(*e, 0x0010, 2, 0x1002).u16(), 0x1002);
+    // Enable does not carry over to the next frame.
+    EXPECT_EQ(fpwr(*e, 0x0010, {0x01, 0x10}, 0x1002).wkc, 0);
+    // User RAM 0x0F80.. is not protected.
+    EXPECT_EQ(fpwr(*e, 0x0F80, {0x77}, 0x1002).wkc, 1);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x0F80), 0x77);
+}
+
+TEST_F(Addressing, EscWriteProtectionCoversRam) {
+    fpwr(*e, 0x0031, {0x01});
+    EXPECT_EQ(fpwr(*e, 0x1000, {0x42}).wkc, 0);
+    auto r = run(*e, {dg(FPWR, 0x1001, 0x0030, {0x01}), dg(FPWR, 0x1001, 0x1000, {0x42})});
+    EXPECT_EQ(r[1].wkc, 1);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x1000), 0x42);
+}
+
+TEST_F(Addressing, EscResetSequence) {
+    fpwr(*e, 0x0F80, {0x99});
+    fpwr(*e, 0x0200, {0x0C, 0x00});
+    fpwr(*e, 0x0040, {0x52});
+    EXPECT_EQ(fprd(*e, 0x0040, 1).data[0], 0x01);
+    fpwr(*e, 0x0040, {0x45});
+    EXPECT_EQ(fprd(*e, 0x0040, 1).data[0], 0x02);
+    fpwr(*e, 0x0040, {0x53});
+    // Registers back at reset values: station address 0 now.
+    EXPECT_EQ(fprd(*e, 0x0010, 2).wkc, 0);
+    Datagram d = run1(*e, dg_len(APRD, 0, 0x0200, 2));
+    EXPECT_EQ(d.u16(), 0x0000);
+    EXPECT_EQ(run1(*e, dg_len(APRD, 0, 0x0040, 1)).data[0], 0x00);
+}
+
+TEST_F(Addressing, EscResetWrongSequenceRestarts) {
+    fpwr(*e, 0x0040, {0x52});
+    fpwr(*e, 0x0040, {0x53});
+    EXPECT_EQ(fprd(*e, 0x0040, 1).data[0], 0x00);
+    fpwr(*e, 0x0040, {0x45});
+    EXPECT_EQ(fprd(*e, 0x0010, 2).wkc, 1);  // no reset happened
+}
+
+TEST_F(Addressing, ErrorCountersClearOnWrite) {
+    std::vector<uint8_t> bad = build({dg_len(FPRD, 0x1001, 0x0130, 2)});
+    bad[14] = 0xFF;  // header length beyond the frame
+    e->process_frame(bad);
+    EXPECT_EQ(fprd(*e, 0x0300, 1).data[0], 1);
+    EXPECT_EQ(fprd(*e, 0x030C, 1).data[0], 1);
+    fpwr(*e, 0x0300, std::vector<uint8_t>(0x14, 0xAB));
+    EXPECT_EQ(fprd(*e, 0x0300, 1).data[0], 0);
+    EXPECT_EQ(fprd(*e, 0x030C, 1).data[0], 0);
+}
+
+}  // namespace
