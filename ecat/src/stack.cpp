@@ -185,10 +185,8 @@ void Stack::write_status() {
 
 void Stack::poll(uint64_t now_ns) {
     last_now_ns_ = now_ns;
-    if (irq_ && !first_poll_ && !irq_() && now_ns < next_deadline_ns()) {
-        // Nothing signalled and no timer due; the mailbox SM status is still polled by its own pass
-        // only when an event says so.
-        return;
+    if (irq_ && irq_usable_ && !first_poll_ && !irq_() && now_ns < next_deadline_ns()) {
+        return;  // nothing signalled and no timer due
     }
     uint32_t events = pdi_.read_reg<uint32_t>(reg::kAlEventRequest);
     if (first_poll_) {
@@ -534,9 +532,23 @@ void Stack::go(AlState to, uint64_t now_ns) {
     }
     state_ = to;
     ++stats_.transitions;
+    update_irq_usable();
     mailbox_.set_state(from, to);
     app_.on_state_change(from, to);
     if (from == AlState::Boot && to == AlState::Init) app_.on_restart();
+}
+
+void Stack::update_irq_usable() {
+    constexpr uint8_t kPdiEvent = 0x20;
+    bool usable = true;
+    if (mailbox_.running()) {
+        usable = usable && (read_sm(0).control & kPdiEvent) && (read_sm(1).control & kPdiEvent);
+    }
+    if (process_data_state(state_)) {
+        if (!sm2_buf_.empty()) usable = usable && (read_sm(2).control & kPdiEvent);
+        if (!sm3_buf_.empty()) usable = usable && (read_sm(3).control & kPdiEvent);
+    }
+    irq_usable_ = usable;
 }
 
 void Stack::refuse(uint16_t code) {

@@ -215,10 +215,16 @@ void StackTest::configure_bootstrap_mailbox() {
 void StackTest::configure_process_data(uint16_t rx, uint16_t tx, uint8_t sm2_control) {
     rx_bytes = rx;
     tx_bytes = tx;
-    configure_sm(2, kSm2Start, rx, sm2_control, rx > 0);
-    configure_sm(3, kSm3Start, tx, 0x20, tx > 0);
-    if (rx > 0) configure_fmmu(0, kLogical, rx, kSm2Start, 2);
-    if (tx > 0) configure_fmmu(1, kLogical + rx, tx, kSm3Start, 1);
+    const uint16_t sm2 = desc.sync_managers.size() > 2 && desc.sync_managers[2].start
+                             ? desc.sync_managers[2].start
+                             : kSm2Start;
+    const uint16_t sm3 = desc.sync_managers.size() > 3 && desc.sync_managers[3].start
+                             ? desc.sync_managers[3].start
+                             : kSm3Start;
+    configure_sm(2, sm2, rx, sm2_control, rx > 0);
+    configure_sm(3, sm3, tx, 0x20, tx > 0);
+    if (rx > 0) configure_fmmu(0, kLogical, rx, sm2, 2);
+    if (tx > 0) configure_fmmu(1, kLogical + rx, tx, sm3, 1);
 }
 
 void StackTest::go_preop() {

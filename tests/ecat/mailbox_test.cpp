@@ -309,3 +309,19 @@ TEST_F(MailboxTest, SafeOpAndOp_MailboxKeepsRunning) {
 
 }  // namespace
 }  // namespace ecat::test
+
+namespace ecat::test {
+namespace {
+
+TEST_F(MailboxTest, NoPdiEventBits_MailboxStillServedAtOnce) {
+    configure_sm(0, 0x1000, 128, 0x06, true);  // no PDI event: the interrupt line will not tell us
+    configure_sm(1, 0x1080, 128, 0x02, true);
+    request(0x02);
+    ASSERT_EQ(al_status(), 0x02);
+    const auto reply = roundtrip(mbx_message(0x3, 1, sdo));  // no clock advance in between
+    EXPECT_FALSE(reply.empty());
+    EXPECT_EQ(coe.handled, 1);
+}
+
+}  // namespace
+}  // namespace ecat::test

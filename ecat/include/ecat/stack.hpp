@@ -150,6 +150,10 @@ class Stack {
     od::Ref<uint16_t> cycle_exceeded_[2];
     od::Ref<uint8_t> sync_error_[2];
 
+    // Whether the interrupt line covers every SM event the stack waits on (SM control bit 5 set).
+    bool irq_usable_ = true;
+    void update_irq_usable();
+
     uint64_t housekeeping_at_ns_ = 0;
     uint64_t last_now_ns_ = 0;
     bool first_poll_ = true;
