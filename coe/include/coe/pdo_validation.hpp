@@ -1,0 +1,28 @@
+#pragma once
+// PDO mapping (0x1600-0x17FF RxPDO, 0x1A00-0x1BFF TxPDO) and assignment (0x1C12 SM2, 0x1C13 SM3) checks,
+// installed as validators on the dictionary so SDO downloads, complete-access downloads and any other
+// master-side write meet them. Entries are UINT32 index<<16 | subindex<<8 | bit length (index 0: a gap).
+// Pre-Op-only writing comes from the entries' od access flags, not from here.
+#include <cstddef>
+#include <cstdint>
+
+#include "od/dictionary.hpp"
+
+namespace coe {
+
+struct PdoLimits {
+    // Largest process-data image one SyncManager may carry (SM2 outputs, SM3 inputs), in bytes.
+    std::size_t max_sm_bytes = 256;
+};
+
+// Mapping entry check: Ok for 0, for a gap, or for an existing object mappable in that direction whose bit
+// length matches; NotMappable otherwise.
+od::Status check_mapping_entry(const od::Dictionary& dict, bool rx, uint32_t value);
+// Bits a mapping object maps with its current count (subindex 0); 0 if the object does not exist.
+std::size_t mapped_bits(const od::Dictionary& dict, uint16_t pdo);
+
+// Installs the validators on every mapping object present and on 0x1C12/0x1C13. The validators keep a
+// pointer to dict: install after the dictionary has reached its final place.
+void install_pdo_validators(od::Dictionary& dict, PdoLimits limits = {});
+
+}  // namespace coe

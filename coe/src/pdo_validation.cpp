@@ -1,0 +1,142 @@
+#include "coe/pdo_validation.hpp"
+
+#include "wire.hpp"
+
+namespace coe {
+
+namespace {
+
+constexpr uint16_t kRxAssign = 0x1C12;
+constexpr uint16_t kTxAssign = 0x1C13;
+
+bool is_rx_mapping(uint16_t i) {
+    return i >= 0x1600 && i <= 0x17FF;
+}
+bool is_tx_mapping(uint16_t i) {
+    return i >= 0x1A00 && i <= 0x1BFF;
+}
+
+uint8_t u8(const od::Dictionary& d, uint16_t i, uint8_t s) {
+    auto r = d.raw(i, s);
+    return r.empty() ? 0 : r[0];
+}
+uint16_t u16(const od::Dictionary& d, uint16_t i, uint8_t s) {
+    auto r = d.raw(i, s);
+    return r.size() < 2 ? 0 : wire::get16(r, 0);
+}
+uint32_t u32(const od::Dictionary& d, uint16_t i, uint8_t s) {
+    auto r = d.raw(i, s);
+    return r.size() < 4 ? 0 : wire::get32(r, 0);
+}
+
+std::size_t bits_of(const od::Dictionary& d, uint16_t pdo, uint8_t count) {
+    std::size_t bits = 0;
+    for (uint8_t s = 1; s <= count && s != 0; ++s)
+        bits += u32(d, pdo, s) & 0xFF;
+    return bits;
+}
+
+// Bytes an assignment maps when PDO `changed` maps `changed_bits` (or as it stands when changed == 0).
+std::size_t assigned_bytes(const od::Dictionary& d, uint16_t assign, uint8_t count, uint16_t changed,
+                           std::size_t changed_bits) {
+    std::size_t bits = 0;
+    for (uint8_t s = 1; s <= count && s != 0; ++s) {
+        uint16_t pdo = u16(d, assign, s);
+        bits += pdo == changed && changed != 0 ? changed_bits : mapped_bits(d, pdo);
+    }
+    return (bits + 7) / 8;
+}
+
+od::Status check_mapping(const od::Dictionary& d, uint16_t pdo, const od::Entry& e,
+                         std::span<const uint8_t> v, const PdoLimits& lim) {
+    const bool rx = is_rx_mapping(pdo);
+    if (e.subindex != 0) {
+        if (v.size() != 4) return od::Status::LengthMismatch;
+        return check_mapping_entry(d, rx, wire::get32(v, 0));
+    }
+    if (v.size() != 1) return od::Status::LengthMismatch;
+    const uint8_t n = v[0];
+    const od::Object* obj = d.find(pdo);
+    if (obj == nullptr) return od::Status::NoObject;
+    for (uint8_t s = 1; s <= n && s != 0; ++s) {
+        if (obj->entry(s) == nullptr) return od::Status::ValueTooHigh;
+        if (check_mapping_entry(d, rx, u32(d, pdo, s)) != od::Status::Ok) return od::Status::NotMappable;
+    }
+    const std::size_t bits = bits_of(d, pdo, n);
+    if ((bits + 7) / 8 > lim.max_sm_bytes) return od::Status::PdoLengthExceeded;
+    // If the PDO is assigned to its SyncManager, the SyncManager's image must still fit.
+    const uint16_t assign = rx ? kRxAssign : kTxAssign;
+    const uint8_t count = u8(d, assign, 0);
+    bool assigned = false;
+    for (uint8_t s = 1; s <= count && s != 0; ++s)
+        assigned = assigned || u16(d, assign, s) == pdo;
+    if (assigned && assigned_bytes(d, assign, count, pdo, bits) > lim.max_sm_bytes)
+        return od::Status::PdoLengthExceeded;
+    return od::Status::Ok;
+}
+
+bool valid_pdo_for(const od::Dictionary& d, uint16_t assign, uint16_t pdo) {
+    bool range = assign == kRxAssign ? is_rx_mapping(pdo) : is_tx_mapping(pdo);
+    return range && d.find(pdo) != nullptr;
+}
+
+od::Status check_assignment(const od::Dictionary& d, uint16_t assign, const od::Entry& e,
+                            std::span<const uint8_t> v, const PdoLimits& lim) {
+    if (e.subindex != 0) {
+        if (v.size() != 2) return od::Status::LengthMismatch;
+        uint16_t pdo = wire::get16(v, 0);
+        return pdo == 0 || valid_pdo_for(d, assign, pdo) ? od::Status::Ok : od::Status::InvalidValue;
+    }
+    if (v.size() != 1) return od::Status::LengthMismatch;
+    const uint8_t n = v[0];
+    const od::Object* obj = d.find(assign);
+    if (obj == nullptr) return od::Status::NoObject;
+    for (uint8_t s = 1; s <= n && s != 0; ++s) {
+        if (obj->entry(s) == nullptr) return od::Status::ValueTooHigh;
+        uint16_t pdo = u16(d, assign, s);
+        if (!valid_pdo_for(d, assign, pdo)) return od::Status::InvalidValue;
+        for (uint8_t t = 1; t < s; ++t)
+            if (u16(d, assign, t) == pdo) return od::Status::InvalidValue;  // assigned twice
+    }
+    if (assigned_bytes(d, assign, n, 0, 0) > lim.max_sm_bytes) return od::Status::PdoLengthExceeded;
+    return od::Status::Ok;
+}
+
+}  // namespace
+
+od::Status check_mapping_entry(const od::Dictionary& dict, bool rx, uint32_t value) {
+    if (value == 0) return od::Status::Ok;
+    const uint16_t index = static_cast<uint16_t>(value >> 16);
+    const uint8_t sub = static_cast<uint8_t>(value >> 8);
+    const uint8_t bits = static_cast<uint8_t>(value);
+    if (bits == 0) return od::Status::NotMappable;
+    if (index == 0) return sub == 0 ? od::Status::Ok : od::Status::NotMappable;  // gap of `bits` bits
+    const od::Entry* e = dict.find(index, sub);
+    if (e == nullptr) return od::Status::NotMappable;
+    if (rx ? !e->rx_mappable() : !e->tx_mappable()) return od::Status::NotMappable;
+    if (e->bit_length != bits) return od::Status::NotMappable;
+    return od::Status::Ok;
+}
+
+std::size_t mapped_bits(const od::Dictionary& dict, uint16_t pdo) {
+    if (dict.find(pdo) == nullptr) return 0;
+    return bits_of(dict, pdo, u8(dict, pdo, 0));
+}
+
+void install_pdo_validators(od::Dictionary& dict, PdoLimits limits) {
+    od::Dictionary* d = &dict;
+    for (const auto& obj : dict.objects()) {
+        const uint16_t index = obj.index;
+        if (is_rx_mapping(index) || is_tx_mapping(index)) {
+            dict.add_validator(index, [d, index, limits](const od::Entry& e, std::span<const uint8_t> v) {
+                return check_mapping(*d, index, e, v, limits);
+            });
+        } else if (index == kRxAssign || index == kTxAssign) {
+            dict.add_validator(index, [d, index, limits](const od::Entry& e, std::span<const uint8_t> v) {
+                return check_assignment(*d, index, e, v, limits);
+            });
+        }
+    }
+}
+
+}  // namespace coe

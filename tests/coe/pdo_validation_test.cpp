@@ -1,0 +1,129 @@
+// PDO mapping and assignment checks (seed 001 §7.2.6-16, digest §5.3/5.4; ETG.1000.6 mapping entry format).
+#include <gtest/gtest.h>
+
+#include "coe/pdo_validation.hpp"
+#include "coe/sdo_server.hpp"
+#include "coe_test_support.hpp"
+
+using namespace coe_test;
+
+namespace {
+
+class PdoChecks : public ::testing::Test {
+  protected:
+    od::Dictionary dict = make_test_dictionary();
+    od::AlState state = od::AlState::PreOp;
+    coe::CoeServer server{dict, [this] { return state; }};
+    RecordingSender out;
+
+    void SetUp() override { coe::install_pdo_validators(dict, coe::PdoLimits{16}); }
+
+    // Returns 0 for a download response, the abort code otherwise.
+    uint32_t write(uint16_t index, uint8_t sub, uint32_t value, uint8_t bytes) {
+        static const uint8_t cmd[] = {0, 0x2F, 0x2B, 0x27, 0x23};
+        server.handle(sdo(cmd[bytes], index, sub, value), out);
+        EXPECT_EQ(out.messages.size(), 1u);
+        Bytes r = out.take().payload;
+        return r[2] == 0x80 ? le32(r, 6) : 0;
+    }
+};
+
+TEST_F(PdoChecks, MasterRemapSequenceIsAccepted) {
+    // zub MACS sequence [004 §6.4.3], in Pre-Op.
+    EXPECT_EQ(write(0x1C12, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1C13, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1A00, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1A00, 1, 0x60410010, 4), 0u);
+    EXPECT_EQ(write(0x1A00, 2, 0x60640020, 4), 0u);
+    EXPECT_EQ(write(0x1A00, 0, 2, 1), 0u);
+    EXPECT_EQ(write(0x1600, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1600, 1, 0x60400010, 4), 0u);
+    EXPECT_EQ(write(0x1600, 2, 0x607A0020, 4), 0u);
+    EXPECT_EQ(write(0x1600, 3, 0x60600008, 4), 0u);
+    EXPECT_EQ(write(0x1600, 0, 3, 1), 0u);
+    EXPECT_EQ(write(0x1C12, 1, 0x1600, 2), 0u);
+    EXPECT_EQ(write(0x1C12, 0, 1, 1), 0u);
+    EXPECT_EQ(write(0x1C13, 1, 0x1A00, 2), 0u);
+    EXPECT_EQ(write(0x1C13, 0, 1, 1), 0u);
+    EXPECT_EQ(coe::mapped_bits(dict, 0x1600), 56u);
+    EXPECT_EQ(coe::mapped_bits(dict, 0x1A00), 48u);
+}
+
+TEST_F(PdoChecks, MappingEntriesMustBeMappableInTheirDirectionWithTheirLength) {
+    EXPECT_EQ(write(0x1600, 1, 0x60410010, 4), 0x06040041u);  // TxPDO-only object in an RxPDO
+    EXPECT_EQ(write(0x1A00, 1, 0x60400010, 4), 0x06040041u);  // RxPDO-only object in a TxPDO
+    EXPECT_EQ(write(0x1600, 1, 0x60400020, 4), 0x06040041u);  // wrong bit length
+    EXPECT_EQ(write(0x1600, 1, 0x70000010, 4), 0x06040041u);  // no such object
+    EXPECT_EQ(write(0x1600, 1, 0x60400110, 4), 0x06040041u);  // no such subindex
+    EXPECT_EQ(write(0x1600, 1, 0x10000020, 4), 0x06040041u);  // exists, not mappable
+    EXPECT_EQ(write(0x1600, 1, 0x60400000, 4), 0x06040041u);  // zero length
+    EXPECT_EQ(write(0x1600, 1, 0x00000008, 4), 0u);           // an 8-bit gap
+    EXPECT_EQ(write(0x1600, 1, 0, 4), 0u);                    // cleared entry
+    EXPECT_EQ(dict.get<uint32_t>(0x1600, 1), 0u);
+}
+
+TEST_F(PdoChecks, CountCoveringAnInvalidEntryIsRefused) {
+    // Entry 1 cleared while the count still says 2: setting the count again must find it invalid.
+    EXPECT_EQ(write(0x1600, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1600, 1, 0x60400000 | 0, 4), 0x06040041u);
+    ASSERT_EQ(dict.set<uint32_t>(0x1600, 1, 0x12345678), od::Status::Ok);  // device-side garbage
+    EXPECT_EQ(write(0x1600, 0, 2, 1), 0x06040041u);
+}
+
+TEST_F(PdoChecks, CountAboveTheDeclaredEntriesIsTooHigh) {
+    EXPECT_EQ(write(0x1600, 0, 5, 1), 0x06090031u);
+}
+
+TEST_F(PdoChecks, PdoLongerThanTheSyncManagerIsRefused) {
+    // Limit 16 bytes: 0x1600 with 4 x 32 bits = 16 bytes fits, with 0x1601 assigned too it does not.
+    EXPECT_EQ(write(0x1600, 0, 0, 1), 0u);
+    for (uint8_t s = 1; s <= 4; ++s)
+        EXPECT_EQ(write(0x1600, s, 0x607A0020, 4), 0u);
+    EXPECT_EQ(write(0x1600, 0, 4, 1), 0u);
+    EXPECT_EQ(write(0x1C12, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1C12, 2, 0x1601, 2), 0u);
+    EXPECT_EQ(write(0x1C12, 0, 2, 1), 0x06040042u);
+    EXPECT_EQ(write(0x1C12, 0, 1, 1), 0u);
+    // Growing an assigned PDO beyond the SyncManager's room is refused at its count too.
+    coe::install_pdo_validators(dict, coe::PdoLimits{8});
+    EXPECT_EQ(write(0x1600, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1600, 0, 3, 1), 0x06040042u);
+}
+
+TEST_F(PdoChecks, AssignmentOnlyTakesMappingObjectsOfItsDirection) {
+    EXPECT_EQ(write(0x1C12, 1, 0x1A00, 2), 0x06090030u);
+    EXPECT_EQ(write(0x1C12, 1, 0x1602, 2), 0x06090030u);  // not declared
+    EXPECT_EQ(write(0x1C13, 1, 0x1600, 2), 0x06090030u);
+    EXPECT_EQ(write(0x1C12, 1, 0x2000, 2), 0x06090030u);
+    EXPECT_EQ(write(0x1C12, 1, 0x1601, 2), 0u);
+}
+
+TEST_F(PdoChecks, AssignmentCountChecksEveryCountedEntry) {
+    EXPECT_EQ(write(0x1C12, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1C12, 0, 2, 1), 0x06090030u);  // :02 is 0
+    EXPECT_EQ(write(0x1C12, 2, 0x1600, 2), 0u);
+    EXPECT_EQ(write(0x1C12, 0, 2, 1), 0x06090030u);  // 0x1600 twice
+    EXPECT_EQ(write(0x1C12, 2, 0x1601, 2), 0u);
+    EXPECT_EQ(write(0x1C12, 0, 2, 1), 0u);
+}
+
+TEST_F(PdoChecks, ConfigurationIsWritableInPreOpOnly) {
+    state = od::AlState::SafeOp;
+    EXPECT_EQ(write(0x1C12, 0, 0, 1), 0x08000022u);
+    EXPECT_EQ(write(0x1600, 1, 0x60400010, 4), 0x08000022u);
+    state = od::AlState::Op;
+    EXPECT_EQ(write(0x1A00, 0, 0, 1), 0x08000022u);
+}
+
+TEST(PdoMappingEntry, Checks) {
+    od::Dictionary dict = make_test_dictionary();
+    EXPECT_EQ(coe::check_mapping_entry(dict, true, 0x60400010), od::Status::Ok);
+    EXPECT_EQ(coe::check_mapping_entry(dict, false, 0x60400010), od::Status::NotMappable);
+    EXPECT_EQ(coe::check_mapping_entry(dict, false, 0x10F30401), od::Status::Ok);  // BOOLEAN, 1 bit
+    EXPECT_EQ(coe::check_mapping_entry(dict, true, 0x00000110),
+              od::Status::NotMappable);  // gap with a subindex
+    EXPECT_EQ(coe::mapped_bits(dict, 0x1600), 48u);
+    EXPECT_EQ(coe::mapped_bits(dict, 0x1602), 0u);
+}
+
+}  // namespace
