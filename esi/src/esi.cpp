@@ -30,6 +30,12 @@ std::string hex(uint64_t v) {
     return b;
 }
 
+std::string hex32(uint32_t v) {
+    char b[16];
+    std::snprintf(b, sizeof b, "#x%08x", static_cast<unsigned>(v));
+    return b;
+}
+
 std::string hex_index(uint16_t v) {
     char b[8];
     std::snprintf(b, sizeof b, "#x%04x", static_cast<unsigned>(v));
@@ -430,7 +436,7 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
 
     const od::Identity& id = d.identity;
     xmlNodePtr vendor = child(root, "Vendor");
-    child(vendor, "Id", hex(id.vendor_id));
+    child(vendor, "Id", hex32(id.vendor_id));
     named(vendor, "Name", id.vendor_name);
 
     xmlNodePtr descriptions = child(root, "Descriptions");
@@ -441,8 +447,8 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
     xmlNodePtr device = child(child(descriptions, "Devices"), "Device");
     attr(device, "Physics", kPhysics);
     xmlNodePtr type = child(device, "Type", id.order_code.empty() ? id.device_name : id.order_code);
-    attr(type, "ProductCode", hex(id.product_code));
-    attr(type, "RevisionNo", hex(id.revision));
+    attr(type, "ProductCode", hex32(id.product_code));
+    attr(type, "RevisionNo", hex32(id.revision));
     named(device, "Name", id.device_name);
     child(device, "GroupType", id.group_type);
 

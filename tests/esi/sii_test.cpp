@@ -452,6 +452,43 @@ TEST(SiiParse, GarbageNeverCrashes) {
     }
 }
 
+// Every category kind (known, FMMUX, vendor range), then every truncation and every single-byte corruption
+// of the image: the parser must stay inside the span (ASan in CI) and the decoder must always answer.
+TEST(SiiParse, EveryTruncationAndByteFlipOfAFullImage) {
+    Image img;
+    img.b[0] = 0x05;
+    img.fix_crc();
+    img.category(esi::category::Strings, {2, 3, 'a', 'b', 'c', 1, 'Z'});
+    img.category(esi::category::General, std::vector<uint8_t>(32, 1));
+    img.category(esi::category::Fmmu, {1, 2, 3});
+    img.category(esi::category::SyncM, std::vector<uint8_t>(16, 0x10));
+    img.category(esi::category::FmmuX, {0xFA, 0xFF, 0x02, 0x00});
+    img.category(0x1234, {1, 2, 3, 4, 5, 6});
+    img.category(esi::category::TxPdo, {0x00, 0x1A, 2, 3, 0,    2,    0,    0, 0x00, 0x60, 0x01, 1,
+                                        0x06, 16,   0, 0, 0x00, 0x00, 0x00, 0, 0,    8,    0,    0});
+    img.category(esi::category::RxPdo, {0x00, 0x16, 1, 2, 0, 1, 0, 0, 0x00, 0x70, 0x00, 2, 0x07, 32, 0, 0});
+    img.category(esi::category::Dc, std::vector<uint8_t>(48, 2));
+    img.add16(0xFFFF);
+    const auto whole = esi::parse_sii(img.b);
+    ASSERT_TRUE(whole.end_found);
+    EXPECT_EQ(whole.categories.size(), 9u);
+    for (std::size_t len = 0; len <= img.b.size(); ++len) {
+        const std::vector<uint8_t> cut(img.b.begin(), img.b.begin() + static_cast<std::ptrdiff_t>(len));
+        const auto info = esi::parse_sii(cut);
+        EXPECT_FALSE(esi::decode_sii(cut).empty());
+        if (len < img.b.size()) {
+            EXPECT_FALSE(info.problems.empty()) << len;
+        }
+    }
+    for (std::size_t i = 0; i < img.b.size(); ++i)
+        for (uint8_t v : {uint8_t{0x00}, uint8_t{0xFF}, static_cast<uint8_t>(img.b[i] ^ 0x80)}) {
+            std::vector<uint8_t> bad = img.b;
+            bad[i] = v;
+            (void)esi::parse_sii(bad);
+            EXPECT_FALSE(esi::decode_sii(bad).empty());
+        }
+}
+
 TEST(SiiBuild, ContentThatDoesNotFitThrows) {
     const Device d = esi_test::small_device();
     od::DeviceDescription tiny = d.description;
