@@ -14,17 +14,17 @@ struct Identity {
     uint32_t revision = 0;            // high word software version, low word application version
     uint32_t serial_number = 0;
     std::string vendor_name = "maxon motor ag";
-    std::string device_name = "MAXPOS";    // 0x1008
-    std::string hardware_version;          // 0x1009
-    std::string software_version;          // 0x100A
-    std::string order_code;                // ESI Type text
-    std::string group_type = "Drives";     // ESI group
+    std::string device_name = "MAXPOS";  // 0x1008
+    std::string hardware_version;        // 0x1009
+    std::string software_version;        // 0x100A
+    std::string order_code;              // ESI Type text
+    std::string group_type = "Drives";   // ESI group
 };
 
 struct MailboxLayout {
     uint16_t out_start = 0x1000;  // SM0, master -> slave
     uint16_t out_size = 128;
-    uint16_t in_start = 0x1080;   // SM1, slave -> master
+    uint16_t in_start = 0x1080;  // SM1, slave -> master
     uint16_t in_size = 128;
 };
 
@@ -59,9 +59,9 @@ struct SyncManagerDefault {
 };
 
 struct DcOpMode {
-    std::string name;             // "SM-Synchron", "DC"
+    std::string name;  // "SM-Synchron", "DC"
     std::string description;
-    uint16_t assign_activate = 0; // value for 0x0980/0x0981 (e.g. 0x0300: SYNC0 + cyclic unit)
+    uint16_t assign_activate = 0;  // value for 0x0980/0x0981 (e.g. 0x0300: SYNC0 + cyclic unit)
     int32_t cycle_time_sync0_factor = 1;
     int32_t shift_time_sync0 = 0;
 };
@@ -77,11 +77,11 @@ struct DeviceDescription {
     std::vector<SyncManagerDefault> sync_managers;  // SM0..SM3 in order
     std::vector<DcOpMode> dc_modes;
     uint16_t eeprom_bytes = 2048;
-    uint8_t pdi_control = 0x05;       // SII word 0 low: SPI (as the MAXPOS's ESC) -- see docs/decisions.md
-    uint8_t esc_config = 0x0C;        // SII word 0 high: DC SYNC out and latch in units on
-    uint16_t pdi_config = 0x0000;     // SII word 1
+    uint8_t pdi_control = 0x05;         // SII word 0 low: SPI (as the MAXPOS's ESC) -- see docs/decisions.md
+    uint8_t esc_config = 0x0C;          // SII word 0 high: DC SYNC out and latch in units on
+    uint16_t pdi_config = 0x0000;       // SII word 1
     uint16_t sync_pulse_length = 1000;  // SII word 2, 10 ns units
-    uint16_t station_alias = 0;       // SII word 4
+    uint16_t station_alias = 0;         // SII word 4
 };
 
 }  // namespace od

@@ -29,7 +29,7 @@ struct Entry {
     uint8_t subindex = 0;
     std::string name;
     DataType type = DataType::Unsigned8;
-    uint16_t bit_length = 0;  // for strings: capacity in bits
+    uint16_t bit_length = 0;       // for strings: capacity in bits
     uint16_t access = access::RO;  // od::access bits, including PDO mappability, backup and settings
     Number default_value;
     Number minimum;
@@ -60,7 +60,7 @@ struct Object {
 // Typed handle to one entry's storage. T must match the entry's byte size.
 template <typename T>
 class Ref {
-public:
+  public:
     Ref() = default;
     explicit Ref(uint8_t* p) : p_(p) {}
     T get() const {
@@ -71,12 +71,12 @@ public:
     void set(T v) { std::memcpy(p_, &v, sizeof(T)); }
     bool valid() const { return p_ != nullptr; }
 
-private:
+  private:
     uint8_t* p_ = nullptr;
 };
 
 class Dictionary {
-public:
+  public:
     // Called before a master write (SDO or PDO configuration) is committed; a non-Ok result vetoes it.
     using Validator = std::function<Status(const Entry&, std::span<const uint8_t> value)>;
     // Called after a value changed through write() or set()/set_raw() (not through Ref<T>).
@@ -109,10 +109,20 @@ public:
     Status set_raw(uint16_t index, uint8_t sub, std::span<const uint8_t> value);
     std::span<const uint8_t> raw(uint16_t index, uint8_t sub) const;  // current value bytes
 
+    // Extension: type, length and limit check of a would-be value without committing it (no access
+    // rights, no validators). Used by the parameter store to validate a whole file before applying it.
+    Status check(uint16_t index, uint8_t sub, std::span<const uint8_t> value) const;
+    // Extension: the declared default's bytes (strings: the default's length); empty if no such entry.
+    std::span<const uint8_t> default_raw(uint16_t index, uint8_t sub) const;
+    // Extension: writable view of a scalar entry's storage for the process-data copy (no checks, no
+    // listeners, like Ref<T>); empty for strings and missing entries. Valid until the next add().
+    std::span<uint8_t> mutable_raw(uint16_t index, uint8_t sub);
+
     template <typename T>
     T get(uint16_t index, uint8_t sub) const {
         auto r = raw(index, sub);
-        if (r.size() < sizeof(T)) throw std::out_of_range("od::Dictionary::get: no such entry or size mismatch");
+        if (r.size() < sizeof(T))
+            throw std::out_of_range("od::Dictionary::get: no such entry or size mismatch");
         T v;
         std::memcpy(&v, r.data(), sizeof(T));
         return v;
@@ -135,10 +145,10 @@ public:
     void add_listener(uint16_t index, Listener l);
     void add_read_hook(uint16_t index, ReadHook h);
 
-    // Every entry back to its declared default.
+    // Every entry back to its declared default. Listeners are not called.
     void reset_to_defaults();
 
-private:
+  private:
     uint8_t* storage(uint16_t index, uint8_t sub, std::size_t size);
     struct Impl;
     std::unique_ptr<Impl> impl_;

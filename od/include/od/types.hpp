@@ -55,25 +55,25 @@ constexpr uint16_t WriteMask = WO;
 // Why an access failed. Each maps to exactly one SDO abort code (coe/) and is what the drive sees too.
 enum class Status : uint8_t {
     Ok,
-    NoObject,            // 0x06020000 object does not exist
-    NoSubindex,          // 0x06090011 subindex does not exist
-    ReadOnly,            // 0x06010002 attempt to write a read-only object
-    WriteOnly,           // 0x06010001 attempt to read a write-only object
-    LengthMismatch,      // 0x06070010 data type does not match, length of service parameter does not match
-    LengthTooHigh,       // 0x06070012
-    LengthTooLow,        // 0x06070013
-    ValueTooHigh,        // 0x06090031
-    ValueTooLow,         // 0x06090032
-    InvalidValue,        // 0x06090030 value range of parameter exceeded
-    MaxBelowMin,         // 0x06090036
-    NotMappable,         // 0x06040041 object cannot be mapped to the PDO
-    PdoLengthExceeded,   // 0x06040042 number and length of objects to be mapped would exceed PDO length
-    Incompatible,        // 0x06040043 general parameter incompatibility
-    WrongState,          // 0x08000022 data cannot be transferred/stored because of the present device state
-    CannotStore,         // 0x08000020 data cannot be transferred or stored
-    HardwareError,       // 0x06060000 access failed due to a hardware error
-    OutOfMemory,         // 0x05040005
-    GeneralError,        // 0x08000000
+    NoObject,           // 0x06020000 object does not exist
+    NoSubindex,         // 0x06090011 subindex does not exist
+    ReadOnly,           // 0x06010002 attempt to write a read-only object
+    WriteOnly,          // 0x06010001 attempt to read a write-only object
+    LengthMismatch,     // 0x06070010 data type does not match, length of service parameter does not match
+    LengthTooHigh,      // 0x06070012
+    LengthTooLow,       // 0x06070013
+    ValueTooHigh,       // 0x06090031
+    ValueTooLow,        // 0x06090032
+    InvalidValue,       // 0x06090030 value range of parameter exceeded
+    MaxBelowMin,        // 0x06090036
+    NotMappable,        // 0x06040041 object cannot be mapped to the PDO
+    PdoLengthExceeded,  // 0x06040042 number and length of objects to be mapped would exceed PDO length
+    Incompatible,       // 0x06040043 general parameter incompatibility
+    WrongState,         // 0x08000022 data cannot be transferred/stored because of the present device state
+    CannotStore,        // 0x08000020 data cannot be transferred or stored
+    HardwareError,      // 0x06060000 access failed due to a hardware error
+    OutOfMemory,        // 0x05040005
+    GeneralError,       // 0x08000000
 };
 
 std::string_view to_string(Status s);

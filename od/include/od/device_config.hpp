@@ -1,0 +1,41 @@
+#pragma once
+// The device's identity and layout from a configuration file, so one binary can be any drive of the family.
+//
+// Format (the subset of CLI11's INI/TOML config that the `ecat-slave` program reads from the same file):
+//   # comment            ; comment
+//   [identity]           section headers; keys before any section are read as [identity] keys
+//   vendor_id = 0xFB     integers: decimal or 0x hex;  strings: "quoted" (\" \\ escapes), 'literal' or bare
+// Sections and keys this module knows (see od/examples/device.conf):
+//   [identity]           vendor_id product_code revision serial_number vendor_name device_name
+//                        hardware_version software_version order_code group_type
+//   [mailbox]            out_start out_size in_start in_size            (standard mailbox, SM0/SM1)
+//   [bootstrap_mailbox]  out_start out_size in_start in_size
+//   [eeprom]             bytes station_alias pdi_control esc_config pdi_config sync_pulse_length
+// Other sections, and unknown keys before the first section, belong to the program and are ignored;
+// an unknown key inside a known section, a duplicate key, a bad value or a malformed line is an error.
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "od/device.hpp"
+
+namespace od {
+
+class ConfigError : public std::runtime_error {
+  public:
+    ConfigError(const std::string& source, int line, const std::string& message)
+        : std::runtime_error(source + ":" + std::to_string(line) + ": " + message), line_(line) {}
+    int line() const { return line_; }  // 1-based; 0 if the error is not tied to a line
+
+  private:
+    int line_;
+};
+
+// Reads `path` on top of default_drive_description(). Throws ConfigError (file:line: message).
+DeviceDescription load_device_config(const std::filesystem::path& path);
+
+// Same, from text; `source` names it in error messages.
+DeviceDescription parse_device_config(std::string_view text, const std::string& source = "<config>");
+
+}  // namespace od

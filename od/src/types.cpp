@@ -1,0 +1,127 @@
+#include "od/types.hpp"
+
+namespace od {
+
+std::string_view to_string(Status s) {
+    switch (s) {
+        case Status::Ok:
+            return "ok";
+        case Status::NoObject:
+            return "object does not exist";
+        case Status::NoSubindex:
+            return "subindex does not exist";
+        case Status::ReadOnly:
+            return "attempt to write a read-only object";
+        case Status::WriteOnly:
+            return "attempt to read a write-only object";
+        case Status::LengthMismatch:
+            return "length of service parameter does not match";
+        case Status::LengthTooHigh:
+            return "length of service parameter too high";
+        case Status::LengthTooLow:
+            return "length of service parameter too low";
+        case Status::ValueTooHigh:
+            return "value of parameter written too high";
+        case Status::ValueTooLow:
+            return "value of parameter written too low";
+        case Status::InvalidValue:
+            return "value range of parameter exceeded";
+        case Status::MaxBelowMin:
+            return "maximum value is less than minimum value";
+        case Status::NotMappable:
+            return "object cannot be mapped to the PDO";
+        case Status::PdoLengthExceeded:
+            return "number and length of mapped objects exceed PDO length";
+        case Status::Incompatible:
+            return "general parameter incompatibility";
+        case Status::WrongState:
+            return "not possible in the present device state";
+        case Status::CannotStore:
+            return "data cannot be transferred or stored";
+        case Status::HardwareError:
+            return "access failed due to a hardware error";
+        case Status::OutOfMemory:
+            return "out of memory";
+        case Status::GeneralError:
+            return "general error";
+    }
+    return "unknown status";
+}
+
+std::string_view to_string(DataType t) {
+    switch (t) {
+        case DataType::Boolean:
+            return "BOOL";
+        case DataType::Integer8:
+            return "SINT";
+        case DataType::Integer16:
+            return "INT";
+        case DataType::Integer32:
+            return "DINT";
+        case DataType::Unsigned8:
+            return "USINT";
+        case DataType::Unsigned16:
+            return "UINT";
+        case DataType::Unsigned32:
+            return "UDINT";
+        case DataType::Real32:
+            return "REAL";
+        case DataType::VisibleString:
+            return "STRING";
+        case DataType::OctetString:
+            return "OCTET_STRING";
+        case DataType::UnicodeString:
+            return "UNICODE_STRING";
+        case DataType::Real64:
+            return "LREAL";
+        case DataType::Integer64:
+            return "LINT";
+        case DataType::Unsigned64:
+            return "ULINT";
+        case DataType::PdoMapping:
+            return "PDO_MAPPING";
+        case DataType::Identity:
+            return "IDENTITY";
+        case DataType::SyncManagerParameter:
+            return "SYNC_PAR";
+    }
+    return "UNKNOWN";
+}
+
+uint16_t bit_size(DataType t) {
+    switch (t) {
+        case DataType::Boolean:
+            return 1;
+        case DataType::Integer8:
+        case DataType::Unsigned8:
+            return 8;
+        case DataType::Integer16:
+        case DataType::Unsigned16:
+            return 16;
+        case DataType::Integer32:
+        case DataType::Unsigned32:
+        case DataType::Real32:
+            return 32;
+        case DataType::Integer64:
+        case DataType::Unsigned64:
+        case DataType::Real64:
+            return 64;
+        default:
+            return 0;
+    }
+}
+
+bool is_signed(DataType t) {
+    return t == DataType::Integer8 || t == DataType::Integer16 || t == DataType::Integer32 ||
+           t == DataType::Integer64;
+}
+
+bool is_real(DataType t) {
+    return t == DataType::Real32 || t == DataType::Real64;
+}
+
+bool is_string(DataType t) {
+    return t == DataType::VisibleString || t == DataType::OctetString || t == DataType::UnicodeString;
+}
+
+}  // namespace od

@@ -1,0 +1,133 @@
+// Device configuration file: the example, every key, and errors with line numbers.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "od/device_config.hpp"
+#include "od/drive_profile.hpp"
+
+using namespace od;
+
+namespace {
+
+// Runs the parser and returns the ConfigError line (or -1 if it did not throw).
+int error_line(const std::string& text, std::string* message = nullptr) {
+    try {
+        parse_device_config(text, "t.conf");
+    } catch (const ConfigError& e) {
+        if (message) *message = e.what();
+        return e.line();
+    }
+    return -1;
+}
+
+}  // namespace
+
+TEST(DeviceConfig, ExampleFileLoads) {
+    const DeviceDescription d = load_device_config(std::filesystem::path(OD_EXAMPLES_DIR) / "device.conf");
+    EXPECT_EQ(d.identity.vendor_id, 0xFBu);
+    EXPECT_EQ(d.identity.product_code, 0x30010000u);
+    EXPECT_EQ(d.identity.revision, 0x01200000u);
+    EXPECT_EQ(d.identity.serial_number, 0x12345678u);
+    EXPECT_EQ(d.identity.device_name, "MAXPOS");
+    EXPECT_EQ(d.identity.vendor_name, "maxon motor ag");
+    EXPECT_EQ(d.standard_mailbox.in_start, 0x1080);
+    EXPECT_EQ(d.bootstrap_mailbox.in_size, 1024);
+    EXPECT_EQ(d.eeprom_bytes, 2048);
+    Dictionary dict = make_drive_dictionary(d);
+    EXPECT_EQ(dict.get<uint32_t>(0x1018, 4), 0x12345678u);
+}
+
+TEST(DeviceConfig, EveryKeyAndValueForm) {
+    const DeviceDescription d = parse_device_config(R"(
+vendor_id = 0x22        # top-level identity key
+interface = veth0       # a program option before any section: ignored
+[identity]
+product_code = 4660
+revision: 0x00010002
+serial_number = 0XABCDEF01
+vendor_name = 'single # quoted'
+device_name = "say \"hi\" \\ ok"  ; trailing comment
+hardware_version = bare words here # comment
+software_version = ""
+order_code = "X-1"
+group_type = Servo
+[link]
+whatever = [1, 2, 3]
+[mailbox]
+out_start = 0x1800
+out_size = 256
+in_start = 0x1900
+in_size = 256
+[bootstrap_mailbox]
+out_start = 0x1000
+out_size = 512
+in_start = 0x1200
+in_size = 512
+[eeprom]
+bytes = 4096
+station_alias = 7
+pdi_control = 0x08
+esc_config = 0x0E
+pdi_config = 0x0102
+sync_pulse_length = 500
+)");
+    EXPECT_EQ(d.identity.vendor_id, 0x22u);
+    EXPECT_EQ(d.identity.product_code, 4660u);
+    EXPECT_EQ(d.identity.revision, 0x00010002u);
+    EXPECT_EQ(d.identity.serial_number, 0xABCDEF01u);
+    EXPECT_EQ(d.identity.vendor_name, "single # quoted");
+    EXPECT_EQ(d.identity.device_name, "say \"hi\" \\ ok");
+    EXPECT_EQ(d.identity.hardware_version, "bare words here");
+    EXPECT_EQ(d.identity.software_version, "");
+    EXPECT_EQ(d.identity.order_code, "X-1");
+    EXPECT_EQ(d.identity.group_type, "Servo");
+    EXPECT_EQ(d.standard_mailbox.out_start, 0x1800);
+    EXPECT_EQ(d.standard_mailbox.in_size, 256);
+    EXPECT_EQ(d.bootstrap_mailbox.in_start, 0x1200);
+    EXPECT_EQ(d.eeprom_bytes, 4096);
+    EXPECT_EQ(d.station_alias, 7);
+    EXPECT_EQ(d.pdi_control, 0x08);
+    EXPECT_EQ(d.esc_config, 0x0E);
+    EXPECT_EQ(d.pdi_config, 0x0102);
+    EXPECT_EQ(d.sync_pulse_length, 500);
+    // SyncManagers follow the configured mailbox
+    ASSERT_EQ(d.sync_managers.size(), 4u);
+    EXPECT_EQ(d.sync_managers[0].start, 0x1800);
+    EXPECT_EQ(d.sync_managers[0].default_size, 256);
+    EXPECT_EQ(d.sync_managers[1].start, 0x1900);
+    EXPECT_GE(d.sync_managers[2].start, 0x1A00);
+}
+
+TEST(DeviceConfig, ErrorsNameTheLine) {
+    std::string msg;
+    EXPECT_EQ(error_line("[identity]\nvendor_id = 0xZZ\n", &msg), 2);
+    EXPECT_NE(msg.find("t.conf:2:"), std::string::npos) << msg;
+    EXPECT_EQ(error_line("\n\n[identity]\nvendor_id = 0x100000000\n"), 4);  // out of UNSIGNED32
+    EXPECT_EQ(error_line("[identity]\nvendr_id = 1\n", &msg), 2);           // typo in a known section
+    EXPECT_NE(msg.find("unknown key"), std::string::npos);
+    EXPECT_EQ(error_line("[identity\n"), 1);
+    EXPECT_EQ(error_line("[identity]\njust words\n"), 2);
+    EXPECT_EQ(error_line("[identity]\n= 5\n"), 2);
+    EXPECT_EQ(error_line("[identity]\ndevice_name = \"unterminated\n"), 2);
+    EXPECT_EQ(error_line("[identity]\ndevice_name = \"a\" b\n"), 2);
+    EXPECT_EQ(error_line("[identity]\nserial_number = 1\nserial_number = 2\n"), 3);  // duplicate
+    EXPECT_EQ(error_line("[identity]\nserial_number = -1\n"), 2);
+    EXPECT_EQ(error_line("[identity]\nserial_number =\n"), 2);
+    EXPECT_EQ(error_line("[mailbox]\nout_size = 0x10000\n"), 2);
+    EXPECT_EQ(error_line("[eeprom]\nbytes = 1000\n"), 2);
+    EXPECT_EQ(error_line("[eeprom]\nbytes = 65536\n"), 2);
+    EXPECT_EQ(error_line("[]\n"), 1);
+    // whole-file checks carry line 0
+    EXPECT_EQ(error_line("[mailbox]\nin_start = 0x1040\n", &msg), 0);  // overlaps SM0
+    EXPECT_NE(msg.find("overlap"), std::string::npos);
+    EXPECT_EQ(error_line("[mailbox]\nout_size = 8\n"), 0);
+    EXPECT_EQ(error_line("[mailbox]\nout_start = 0x0800\n"), 0);
+    EXPECT_EQ(error_line("[identity]\ndevice_name = \"\"\n"), 0);
+    EXPECT_EQ(error_line("# only a comment\n; and another\n"), -1);
+}
+
+TEST(DeviceConfig, MissingFileIsAnError) {
+    EXPECT_THROW(load_device_config("/nonexistent/dir/device.conf"), ConfigError);
+}
