@@ -1,0 +1,281 @@
+// Distributed clocks (§3.13, §11): receive-time latch, system time, offset/delay, drift loop, SYNC0/SYNC1,
+// plus the PDI watchdog.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <optional>
+
+#include "frame.hpp"
+
+using namespace esc_test;
+
+namespace {
+
+constexpr uint64_t kT0 = 1'000'000'000;  // clock at construction (local time starts equal to it)
+
+struct DcTest : ::testing::Test {
+    esc::ManualClock clk;
+    std::optional<esc::Esc> e;
+    void SetUp() override {
+        clk.set(kT0);
+        e.emplace(esc::EscConfig{}, clk);
+        set_station(*e, 0x1001);
+        fpwr(*e, 0x0410, {0x00, 0x00});  // PDI watchdog off: next_event_ns() only shows DC events
+    }
+    uint32_t al_event() { return e->read_reg<uint32_t>(0x0220); }
+    // Programs SYNC0 (and SYNC1) like IgH/SOEM: cycle times, start time, activation.
+    uint64_t start_sync(uint32_t c0, uint32_t c1, uint8_t activation, int64_t start_in = 100'000) {
+        auto c = le(c0, 4);
+        auto c1b = le(c1, 4);
+        c.insert(c.end(), c1b.begin(), c1b.end());
+        EXPECT_EQ(fpwr(*e, 0x09A0, c).wkc, 1);
+        const uint64_t start = clk.now_ns() + static_cast<uint64_t>(start_in);
+        EXPECT_EQ(fpwr(*e, 0x0990, le(start, 8)).wkc, 1);
+        EXPECT_EQ(fpwr(*e, 0x0981, {activation}).wkc, 1);
+        return start;
+    }
+};
+
+TEST_F(DcTest, ReceiveTimeLatch) {
+    auto r = run(*e, {dg(BWR, 0, 0x0900, {0, 0, 0, 0}), dg_len(FPRD, 0x1001, 0x0900, 4)}, kT0 + 5'000'123);
+    EXPECT_EQ(r[0].wkc, 1);
+    EXPECT_EQ(r[1].u32(), 0u);  // not readable in the same frame
+    Datagram d = fprd(*e, 0x0900, 16);
+    for (int p = 0; p < 4; ++p)
+        EXPECT_EQ(d.u32(4 * p), static_cast<uint32_t>(kT0 + 5'000'123)) << "port " << p;
+    EXPECT_EQ(fprd(*e, 0x0918, 8).u64(), kT0 + 5'000'123);
+}
+
+TEST_F(DcTest, SystemTimeWithOffsetAndDelay) {
+    fpwr(*e, 0x0920, le(1'000'000'000'000ull, 8));
+    fpwr(*e, 0x0928, le(500, 4));
+    Datagram d = run1(*e, dg_len(FPRD, 0x1001, 0x0910, 8), kT0 + 2'000'000);
+    EXPECT_EQ(d.u64(), 1'000'000'000'000ull + kT0 + 2'000'000 - 500);
+    clk.set(kT0 + 3'000'000);
+    EXPECT_EQ(e->read_reg<uint64_t>(0x0910), 1'000'000'000'000ull + kT0 + 3'000'000);
+    EXPECT_EQ(e->local_time_ns(), kT0 + 3'000'000);
+}
+
+TEST_F(DcTest, SystemTimeDifferenceSign) {
+    const uint64_t t = kT0 + 1'000'000;
+    // Received time larger than the local copy: local < received -> bit 31 set.
+    run1(*e, dg(FPWR, 0x1001, 0x0910, le(t + 1000, 8)), t);
+    EXPECT_EQ(fprd(*e, 0x092C, 4).u32(), 0x80000000u | 1000u);
+    fpwr(*e, 0x0930, {0x00, 0x10});  // reset filters
+    EXPECT_EQ(fprd(*e, 0x092C, 4).u32(), 0u);
+    run1(*e, dg(FPWR, 0x1001, 0x0910, le(t - 700, 8)), t);
+    EXPECT_EQ(fprd(*e, 0x092C, 4).u32(), 700u);
+}
+
+TEST_F(DcTest, DriftLoopChangesLocalClockRate) {
+    // The ESC's oscillator runs 50 ppm fast against the reference clock.
+    fpwr(*e, 0x0930, {0x00, 0x10});
+    uint64_t ref = clk.now_ns();
+    for (int i = 0; i < 3000; ++i) {
+        clk.advance(1'000'050);
+        ref += 1'000'000;
+        Datagram d = run1(*e, dg(FRMW, 0x7777, 0x0910, le(ref, 8)));  // not the reference: written
+        ASSERT_EQ(d.wkc, 1);
+    }
+    const uint32_t diff = fprd(*e, 0x092C, 4).u32();
+    EXPECT_LT(diff & 0x7FFFFFFF, 50u) << std::hex << diff;
+    const int16_t speed = static_cast<int16_t>(fprd(*e, 0x0932, 2).u16());
+    EXPECT_NEAR(speed, -500, 25);  // -50 ppm in 0.1 ppm units
+    const uint64_t l0 = e->local_time_ns();
+    clk.advance(1'000'050);
+    const uint64_t l1 = e->local_time_ns();
+    EXPECT_NEAR(static_cast<double>(l1 - l0), 1'000'000.0, 5.0);
+    // Resetting the filters (write 0x0930) drops the correction.
+    fpwr(*e, 0x0930, {0x00, 0x10});
+    EXPECT_EQ(fprd(*e, 0x0932, 2).u16(), 0);
+    const uint64_t l2 = e->local_time_ns();
+    clk.advance(1'000'050);
+    EXPECT_EQ(e->local_time_ns() - l2, 1'000'050u);
+}
+
+TEST_F(DcTest, DriftLoopFollowsSlowerOscillator) {
+    uint64_t ref = clk.now_ns() + 2'000;  // also a 2 us initial phase error
+    for (int i = 0; i < 3000; ++i) {
+        clk.advance(999'980);  // 20 ppm slow
+        ref += 1'000'000;
+        run1(*e, dg(ARMW, 0xFFFF, 0x0910, le(ref, 4)));  // 32-bit write, as IgH
+    }
+    EXPECT_LT(fprd(*e, 0x092C, 4).u32() & 0x7FFFFFFF, 50u);
+    EXPECT_NEAR(static_cast<int16_t>(fprd(*e, 0x0932, 2).u16()), 200, 20);
+}
+
+TEST_F(DcTest, ReferenceClockReadIsNotWritten) {
+    run1(*e, dg(FRMW, 0x1001, 0x0910, le(12345, 8)));
+    EXPECT_EQ(fprd(*e, 0x092C, 4).u32(), 0u);
+}
+
+TEST_F(DcTest, Sync0Generation) {
+    const uint64_t start = start_sync(1'000'000, 0, 0x03);
+    EXPECT_EQ(fprd(*e, 0x0984, 1).data[0], 0x01);  // first SYNC0 pending
+    EXPECT_EQ(e->next_event_ns(), start);
+    clk.set(start - 1);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x04, 0u);
+    clk.set(start);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x04, 0x04u);
+    EXPECT_TRUE(e->irq());
+    EXPECT_EQ(fprd(*e, 0x0984, 1).data[0], 0x00);
+    EXPECT_EQ(fprd(*e, 0x0990, 8).u64(), start + 1'000'000);  // next SYNC0
+    EXPECT_EQ(e->next_event_ns(), start + 1'000'000);
+    // Pulse mode (0x0982 = 1000 x 10 ns): status high during the pulse; PDI read clears the event.
+    EXPECT_EQ(e->read_reg<uint8_t>(0x098E), 1);
+    EXPECT_EQ(al_event() & 0x04, 0u);
+    clk.set(start + 10'000);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x098E), 0);
+    // Several cycles late: one pulse, then back on the grid.
+    clk.set(start + 5'500'000);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x04, 0x04u);
+    EXPECT_EQ(fprd(*e, 0x0990, 8).u64(), start + 6'000'000);
+    // Deactivation stops it.
+    fpwr(*e, 0x0981, {0x00});
+    EXPECT_EQ(e->next_event_ns(), UINT64_MAX);
+}
+
+TEST_F(DcTest, StartTimeLockedWhileActive) {
+    const uint64_t start = start_sync(1'000'000, 0, 0x03);
+    fpwr(*e, 0x0990, le(start + 777, 8));
+    EXPECT_EQ(fprd(*e, 0x0990, 8).u64(), start);
+}
+
+TEST_F(DcTest, Sync1DelayedAfterSync0) {
+    const uint64_t start = start_sync(1'000'000, 200'000, 0x07);
+    EXPECT_EQ(fprd(*e, 0x0984, 1).data[0], 0x03);
+    clk.set(start);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x0C, 0x04u);
+    EXPECT_EQ(fprd(*e, 0x0998, 8).u64(), start + 200'000);
+    EXPECT_EQ(e->next_event_ns(), start + 200'000);
+    clk.set(start + 200'000);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x08, 0x08u);
+    e->read_reg<uint8_t>(0x098F);
+    EXPECT_EQ(al_event() & 0x08, 0u);
+    clk.set(start + 1'200'000);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x08, 0x08u);
+}
+
+TEST_F(DcTest, Sync1CycleZeroMirrorsSync0) {
+    const uint64_t start = start_sync(500'000, 0, 0x07);
+    clk.set(start);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x0C, 0x0Cu);
+}
+
+TEST_F(DcTest, Sync1LongerThanSync0) {
+    // SYNC1 cycle 2 x SYNC0: SYNC1 at start + 2 ms, the next SYNC0 after it restarts the timer.
+    const uint64_t start = start_sync(1'000'000, 2'000'000, 0x07);
+    clk.set(start + 1'999'999);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x08, 0u);
+    clk.set(start + 2'000'000);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x08, 0x08u);
+    e->read_reg<uint8_t>(0x098F);
+    clk.set(start + 4'999'999);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x08, 0u);
+    clk.set(start + 5'000'000);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x08, 0x08u);
+}
+
+TEST_F(DcTest, SingleShotWithCycleZero) {
+    const uint64_t start = start_sync(0, 0, 0x03);
+    clk.set(start);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x04, 0x04u);
+    EXPECT_EQ(e->next_event_ns(), UINT64_MAX);
+}
+
+TEST_F(DcTest, StartTimeInThePast) {
+    start_sync(1'000'000, 0, 0x03, -1000);
+    EXPECT_EQ(fprd(*e, 0x0984, 1).data[0] & 0x04, 0x04);
+    clk.advance(10'000'000);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x04, 0u);
+    // With the plausibility check (bit 5) the unit starts at once.
+    fpwr(*e, 0x0981, {0x00});
+    start_sync(1'000'000, 0, 0x23, -1000);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x04, 0x04u);
+}
+
+TEST_F(DcTest, SyncNotMappedToAlEvent) {
+    std::vector<uint8_t> img(e->eeprom().begin(), e->eeprom().end());
+    img[2] = 0x00;
+    img[3] = 0x00;  // word 1: 0x0151 = 0 (SYNC0/1 not mapped)
+    img[4] = 0x00;
+    img[5] = 0x00;  // word 2: pulse length 0 = acknowledge mode
+    uint8_t crc = 0xFF;
+    for (int i = 0; i < 14; ++i) {
+        crc ^= img[i];
+        for (int b = 0; b < 8; ++b)
+            crc = static_cast<uint8_t>((crc & 0x80) ? (crc << 1) ^ 0x07 : (crc << 1));
+    }
+    img[14] = crc;
+    e->load_eeprom(img);
+    const uint64_t start = start_sync(1'000'000, 0, 0x03);
+    clk.set(start + 50'000);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x04, 0u);
+    // Acknowledge mode: the status stays until the PDI reads it.
+    EXPECT_EQ(fprd(*e, 0x098E, 1).data[0], 1);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x098E), 1);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x098E), 0);
+}
+
+TEST_F(DcTest, SyncUnitDisabledInEscConfig) {
+    std::vector<uint8_t> img(e->eeprom().begin(), e->eeprom().end());
+    img[1] = 0x00;  // 0x0141 = 0: SYNC out unit off
+    uint8_t crc = 0xFF;
+    for (int i = 0; i < 14; ++i) {
+        crc ^= img[i];
+        for (int b = 0; b < 8; ++b)
+            crc = static_cast<uint8_t>((crc & 0x80) ? (crc << 1) ^ 0x07 : (crc << 1));
+    }
+    img[14] = crc;
+    e->load_eeprom(img);
+    const uint64_t start = start_sync(1'000'000, 0, 0x03);
+    clk.set(start + 1);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x04, 0u);
+    EXPECT_EQ(e->next_event_ns(), UINT64_MAX);
+}
+
+TEST_F(DcTest, PdiControlledSyncUnit) {
+    fpwr(*e, 0x0980, {0x01});
+    fpwr(*e, 0x0981, {0x03});
+    EXPECT_EQ(fprd(*e, 0x0981, 1).data[0], 0x00);  // ECAT write ignored
+    e->write_reg<uint32_t>(0x09A0, 1'000'000);
+    e->write_reg<uint64_t>(0x0990, clk.now_ns() + 1000);
+    e->write_reg<uint8_t>(0x0981, 0x03);
+    EXPECT_EQ(fprd(*e, 0x0981, 1).data[0], 0x03);
+    clk.advance(1000);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x04, 0x04u);
+}
+
+TEST_F(DcTest, PdiWatchdog) {
+    fpwr(*e, 0x0410, le(10, 2));  // 1 ms
+    e->read_reg<uint8_t>(0x0000);
+    e->tick();
+    EXPECT_EQ(e->next_event_ns(), clk.now_ns() + 1'000'000);
+    clk.advance(1'000'000);
+    e->tick();
+    Datagram d = fprd(*e, 0x0110, 2);
+    EXPECT_EQ(d.u16() & 0x0002, 0);
+    EXPECT_EQ(fprd(*e, 0x0443, 1).data[0], 1);
+    e->read_reg<uint8_t>(0x0000);
+    e->tick();
+    EXPECT_EQ(fprd(*e, 0x0110, 2).u16() & 0x0002, 0x0002);
+}
+
+}  // namespace
