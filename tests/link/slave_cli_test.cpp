@@ -10,8 +10,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <pcap/pcap.h>
+
 #include <array>
 #include <chrono>
+#include <cstdio>
 #include <string>
 #include <thread>
 #include <vector>
@@ -157,7 +160,8 @@ void in_netns_of(pid_t pid, F&& fn) {
 
 TEST(EcatSlaveVeth, CreatesThePairAnswersOnItAndRemovesItOnSigterm) {
     if (!linktest::is_root()) GTEST_SKIP() << "needs root (CAP_NET_ADMIN, CAP_NET_RAW)";
-    Proc p = start({}, /*own_netns=*/true, /*stale_pair=*/true);
+    const std::string capture = "/tmp/ecat-slave-test-" + std::to_string(::getpid()) + ".pcap";
+    Proc p = start({"--capture", capture, "--verbose"}, /*own_netns=*/true, /*stale_pair=*/true);
     ASSERT_GT(p.pid, 0);
     const std::string out = read_until(p.out, "running on", 5000);
     ASSERT_NE(out.find("master interface: ecat1"), std::string::npos) << out;
@@ -204,6 +208,21 @@ TEST(EcatSlaveVeth, CreatesThePairAnswersOnItAndRemovesItOnSigterm) {
     ::close(p.out);
     EXPECT_TRUE(exists_before);
     EXPECT_FALSE(exists_after) << "the veth pair must be gone after SIGTERM";
+
+    // The capture holds the frame as received and the reply.
+    char errbuf[PCAP_ERRBUF_SIZE];
+    pcap_t* pc = pcap_open_offline(capture.c_str(), errbuf);
+    ASSERT_NE(pc, nullptr) << errbuf;
+    pcap_pkthdr* hdr = nullptr;
+    const u_char* data = nullptr;
+    ASSERT_EQ(pcap_next_ex(pc, &hdr, &data), 1);
+    EXPECT_EQ(hdr->caplen, 60u);
+    EXPECT_EQ(data[6], 0x01);
+    ASSERT_EQ(pcap_next_ex(pc, &hdr, &data), 1);
+    EXPECT_EQ(data[6], 0x03);
+    EXPECT_EQ(data[27], 1);
+    pcap_close(pc);
+    std::remove(capture.c_str());
 }
 
 }  // namespace
