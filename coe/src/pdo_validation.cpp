@@ -110,7 +110,8 @@ od::Status check_mapping_entry(const od::Dictionary& dict, bool rx, uint32_t val
     const uint8_t sub = static_cast<uint8_t>(value >> 8);
     const uint8_t bits = static_cast<uint8_t>(value);
     if (bits == 0) return od::Status::NotMappable;
-    if (index == 0) return sub == 0 ? od::Status::Ok : od::Status::NotMappable;  // gap of `bits` bits
+    // A gap of `bits` bits: index 0, or a dummy data-type object (BOOLEAN..UNSIGNED32), as ecat/ reads it.
+    if (index <= 0x0007) return sub == 0 ? od::Status::Ok : od::Status::NotMappable;
     const od::Entry* e = dict.find(index, sub);
     if (e == nullptr) return od::Status::NotMappable;
     if (rx ? !e->rx_mappable() : !e->tx_mappable()) return od::Status::NotMappable;

@@ -11,11 +11,13 @@
 namespace coe {
 
 struct PdoLimits {
-    // Largest process-data image one SyncManager may carry (SM2 outputs, SM3 inputs), in bytes.
-    std::size_t max_sm_bytes = 256;
+    // Largest process-data image one SyncManager may carry (SM2 outputs, SM3 inputs), in bytes. The default
+    // is the room od::place_sync_managers() leaves: 4 PDOs x 10 entries x 32 bits (seed 001 §7.2.6-16).
+    std::size_t max_sm_bytes = 160;
 };
 
-// Mapping entry check: Ok for 0, for a gap, or for an existing object mappable in that direction whose bit
+// Mapping entry check: Ok for 0, for a gap (index 0, or a dummy data-type object 0x0001-0x0007, subindex 0),
+// or for an existing object mappable in that direction whose bit
 // length matches; NotMappable otherwise.
 od::Status check_mapping_entry(const od::Dictionary& dict, bool rx, uint32_t value);
 // Bits a mapping object maps with its current count (subindex 0); 0 if the object does not exist.
