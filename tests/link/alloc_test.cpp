@@ -1,0 +1,115 @@
+// The per-frame path allocates nothing: counts global operator new calls around the runtime's handling of
+// frames (LoopbackLink -> Esc::process_frame -> send -> capture -> tick -> firmware).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <new>
+#include <vector>
+
+#include "esc/esc.hpp"
+#include "esc/link_capture.hpp"
+#include "esc/link_loopback.hpp"
+#include "softslave/runtime.hpp"
+
+namespace {
+std::atomic<uint64_t> g_allocations{0};
+}
+
+void* operator new(std::size_t n) {
+    g_allocations.fetch_add(1, std::memory_order_relaxed);
+    if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+    throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) {
+    g_allocations.fetch_add(1, std::memory_order_relaxed);
+    if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+    throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept {
+    std::free(p);
+}
+void operator delete[](void* p) noexcept {
+    std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+    std::free(p);
+}
+void operator delete[](void* p, std::size_t) noexcept {
+    std::free(p);
+}
+
+namespace {
+
+std::vector<uint8_t> frame_with(uint8_t cmd, uint16_t adp, uint16_t ado, std::size_t len) {
+    std::vector<uint8_t> f(std::max<std::size_t>(60, 16 + 12 + len), 0);
+    for (int i = 0; i < 6; ++i)
+        f[static_cast<std::size_t>(i)] = 0xFF;
+    for (int i = 6; i < 12; ++i)
+        f[static_cast<std::size_t>(i)] = 0x01;
+    f[12] = 0x88;
+    f[13] = 0xA4;
+    const std::size_t dl = 12 + len;
+    f[14] = static_cast<uint8_t>(dl);
+    f[15] = static_cast<uint8_t>(0x10 | (dl >> 8));
+    f[16] = cmd;
+    f[18] = static_cast<uint8_t>(adp);
+    f[19] = static_cast<uint8_t>(adp >> 8);
+    f[20] = static_cast<uint8_t>(ado);
+    f[21] = static_cast<uint8_t>(ado >> 8);
+    f[22] = static_cast<uint8_t>(len);
+    f[23] = static_cast<uint8_t>(len >> 8);
+    return f;
+}
+
+struct NullFirmware : softslave::Firmware {
+    void poll(uint64_t) override { ++polls; }
+    int polls = 0;
+};
+
+TEST(RuntimeAllocation, HandlingFramesAllocatesNothing) {
+    auto links = esc::LoopbackLink::make_pair(256);
+    esc::SystemClock clock;
+    esc::Esc esc(esc::EscConfig{}, clock);
+    softslave::Runtime runtime(*links.second, esc, clock);
+    NullFirmware fw;
+    runtime.set_firmware(&fw);
+    const std::string path =
+        (std::filesystem::temp_directory_path() / ("alloc-capture-" + std::to_string(::getpid()) + ".pcap"))
+            .string();
+    esc::PcapWriter capture(path);
+    runtime.set_capture(&capture);
+    const std::vector<std::vector<uint8_t>> frames = {
+        frame_with(7, 0, 0x0000, 1),    // BRD type
+        frame_with(1, 0, 0x0130, 2),    // APRD AL status
+        frame_with(8, 0, 0x1000, 64),   // BWR process RAM
+        frame_with(12, 0, 0x0000, 32),  // LRW without FMMUs
+        frame_with(4, 0, 0x0910, 8),    // FPRD system time
+        frame_with(14, 0, 0x0910, 8),   // FRMW system time
+    };
+    // Warm up once (first-use allocations of the ESC, if any, are not per-frame).
+    for (const auto& f : frames)
+        ASSERT_TRUE(links.first->send(f));
+    ASSERT_TRUE(runtime.run_once(1000));
+    std::vector<uint8_t> sink(esc::kMaxFrameSize);
+    while (links.first->receive(sink) > 0) {
+    }
+
+    for (int round = 0; round < 20; ++round)
+        for (const auto& f : frames)
+            ASSERT_TRUE(links.first->send(f));
+    const uint64_t before = g_allocations.load();
+    while (links.second->pending() > 0)
+        ASSERT_TRUE(runtime.run_once(1000));
+    const uint64_t after = g_allocations.load();
+    EXPECT_EQ(after - before, 0u) << "allocations while handling " << 20 * frames.size() << " frames";
+    EXPECT_EQ(runtime.stats().frames_sent, 21 * frames.size());
+    EXPECT_GT(fw.polls, 0);
+    runtime.set_capture(nullptr);
+    std::remove(path.c_str());
+}
+
+}  // namespace
