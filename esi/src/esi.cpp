@@ -2,6 +2,7 @@
 
 #include <libxml/tree.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -200,14 +201,15 @@ std::vector<std::string> record_item_names(const Object& o) {
     return names;
 }
 
-// Bit offsets in the complete-access layout: subindex 0 padded to 16 bits, the rest packed.
+// Bit offsets in the complete-access layout (as coe/ lays out a complete-access image): subindex 0 takes 16
+// bits, byte-sized entries (and strings) start on a byte boundary, bit-sized ones are packed; gaps skipped.
 std::vector<uint32_t> bit_offsets(const Object& o, uint32_t& total) {
     std::vector<uint32_t> offs;
     uint32_t off = 0;
     for (const Entry& e : o.entries) {
+        if (e.subindex != 0 && (e.bit_length % 8 == 0 || od::is_string(e.type))) off = (off + 7u) & ~7u;
         offs.push_back(off);
-        off += e.bit_length;
-        if (e.subindex == 0 && off < 16) off = 16;
+        off += e.subindex == 0 ? std::max<uint32_t>(16u, e.bit_length) : e.bit_length;
     }
     total = off;
     return offs;

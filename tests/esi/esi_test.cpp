@@ -517,6 +517,33 @@ TEST(Esi, StateDependentAccessUsesRestrictions) {
     EXPECT_NE(xml.find(">wo</Access>"), std::string::npos);
 }
 
+// BitOffs follow the complete-access image coe/ produces: subindex 0 in 16 bits, byte-sized entries on a
+// byte boundary, bits packed, missing subindices skipped.
+TEST(Esi, RecordBitOffsetsFollowTheCompleteAccessLayout) {
+    const Device d = esi_test::small_device();
+    Doc doc = parse(esi::build_esi(d.description, d.dictionary));
+    ASSERT_NE(doc, nullptr);
+    xmlNodePtr types = path(xmlDocGetRootElement(doc.get()),
+                            {"Descriptions", "Devices", "Device", "Profile", "Dictionary", "DataTypes"});
+    auto offsets = [&](const std::string& name, std::string& bits) {
+        std::vector<int> v;
+        for (xmlNodePtr t : all(types, "DataType"))
+            if (text(first(t, "Name")) == name) {
+                bits = text(first(t, "BitSize"));
+                for (xmlNodePtr si : all(t, "SubItem"))
+                    v.push_back(std::stoi(text(first(si, "BitOffs"))));
+            }
+        return v;
+    };
+    std::string bits;
+    EXPECT_EQ(offsets("DT2003", bits), (std::vector<int>{0, 16, 17, 24}));
+    EXPECT_EQ(bits, "40");
+    EXPECT_EQ(offsets("DT1C32", bits), (std::vector<int>{0, 16, 32, 64, 80}));  // subindices 0, 1, 2, 4, 32
+    EXPECT_EQ(bits, "81");
+    EXPECT_EQ(offsets("DT1C12", bits), (std::vector<int>{0, 16}));  // SI0 + "Elements" (2 x UINT)
+    EXPECT_EQ(bits, "48");
+}
+
 TEST(Esi, UnitsOnlyWhereTheCodeIsKnown) {
     EXPECT_EQ(esi::unit_code("mA"), 0xFD040000u);  // as in the EJ7211 ESI
     EXPECT_EQ(esi::unit_code("ns"), 0xF7030000u);

@@ -201,6 +201,18 @@ inline od::Dictionary small_dictionary(const od::DeviceDescription& d) {
         o.entries[0].unit = "mA";
         dict.add(std::move(o));
     }
+    {
+        od::Object o;
+        o.index = 0x2003;
+        o.code = od::ObjectCode::Record;
+        o.name = "Bits and a word";
+        o.type = DataType::Unsigned8;
+        o.entries = {entry(0x2003, 0, "Number of entries", DataType::Unsigned8, a::RO, uint64_t{3}),
+                     entry(0x2003, 1, "Flag A", DataType::Boolean, a::RW, uint64_t{1}),
+                     entry(0x2003, 2, "Flag B", DataType::Boolean, a::RW, uint64_t{0}),
+                     entry(0x2003, 3, "Word", DataType::Unsigned16, a::RW, uint64_t{0xBEEF})};
+        dict.add(std::move(o));
+    }
     return dict;
 }
 
