@@ -53,15 +53,57 @@ std::string hex_bytes(const uint8_t* p, std::size_t n) {
     return s;
 }
 
+// Text as XML 1.0 can carry it: valid UTF-8 sequences are kept, any other byte and the control characters
+// XML 1.0 forbids (everything below 0x20 but tab, LF, CR) become '?'. Names come from the dictionary and
+// the description, which are byte strings.
+std::string xml_text(const std::string& in) {
+    std::string out;
+    out.reserve(in.size());
+    for (std::size_t i = 0; i < in.size();) {
+        const auto c = static_cast<unsigned char>(in[i]);
+        if (c < 0x80) {
+            out += (c < 0x20 && c != '\t' && c != '\n' && c != '\r') ? '?' : static_cast<char>(c);
+            ++i;
+            continue;
+        }
+        std::size_t n = 0;
+        uint32_t cp = 0;
+        if ((c & 0xE0) == 0xC0)
+            n = 2, cp = c & 0x1F;
+        else if ((c & 0xF0) == 0xE0)
+            n = 3, cp = c & 0x0F;
+        else if ((c & 0xF8) == 0xF0)
+            n = 4, cp = c & 0x07;
+        bool ok = n != 0 && i + n <= in.size();
+        for (std::size_t k = 1; ok && k < n; ++k) {
+            const auto cc = static_cast<unsigned char>(in[i + k]);
+            ok = (cc & 0xC0) == 0x80;
+            cp = (cp << 6) | (cc & 0x3F);
+        }
+        // Reject overlong forms, surrogates and code points past U+10FFFF.
+        if (ok)
+            ok = !((n == 2 && cp < 0x80) || (n == 3 && cp < 0x800) || (n == 4 && cp < 0x10000) ||
+                   (cp >= 0xD800 && cp <= 0xDFFF) || cp > 0x10FFFF || cp == 0xFFFE || cp == 0xFFFF);
+        if (ok) {
+            out.append(in, i, n);
+            i += n;
+        } else {
+            out += '?';
+            ++i;
+        }
+    }
+    return out;
+}
+
 // Builder helpers over libxml2's tree API (xmlNewTextChild escapes the content).
 xmlNodePtr child(xmlNodePtr parent, const char* name, const std::string& text) {
-    return xmlNewTextChild(parent, nullptr, X(name), X(text.c_str()));
+    return xmlNewTextChild(parent, nullptr, X(name), X(xml_text(text).c_str()));
 }
 xmlNodePtr child(xmlNodePtr parent, const char* name) {
     return xmlNewChild(parent, nullptr, X(name), nullptr);
 }
 void attr(xmlNodePtr node, const char* name, const std::string& value) {
-    xmlNewProp(node, X(name), X(value.c_str()));
+    xmlNewProp(node, X(name), X(xml_text(value).c_str()));
 }
 xmlNodePtr named(xmlNodePtr parent, const char* name, const std::string& text) {
     xmlNodePtr n = child(parent, name, text);

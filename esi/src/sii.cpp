@@ -211,12 +211,16 @@ struct Reader {
 
 std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 std::string format(const char* fmt, ...) {
-    char buf[512];
     va_list ap;
     va_start(ap, fmt);
-    const int n = std::vsnprintf(buf, sizeof buf, fmt, ap);
+    va_list ap2;
+    va_copy(ap2, ap);
+    const int n = std::vsnprintf(nullptr, 0, fmt, ap);
     va_end(ap);
-    return std::string(buf, n < 0 ? 0 : std::min<std::size_t>(static_cast<std::size_t>(n), sizeof buf - 1));
+    std::string out(n > 0 ? static_cast<std::size_t>(n) : 0, '\0');
+    if (n > 0) std::vsnprintf(out.data(), out.size() + 1, fmt, ap2);
+    va_end(ap2);
+    return out;
 }
 
 void parse_strings(std::span<const uint8_t> body, SiiInfo& info) {
@@ -460,6 +464,19 @@ SiiInfo parse_sii(std::span<const uint8_t> image) {
 
 namespace {
 
+// A string from the image, with control characters shown as \xNN so the text stays one line per item.
+std::string printable(const std::string& in) {
+    std::string out;
+    for (char ch : in) {
+        const auto c = static_cast<unsigned char>(ch);
+        if (c < 0x20 || c == 0x7F || c == '"' || c == '\\')
+            out += format("\\x%02X", c);
+        else
+            out += ch;
+    }
+    return out;
+}
+
 const char* category_name(uint16_t t) {
     switch (t) {
         case category::Nop:
@@ -545,22 +562,22 @@ void hexdump(std::string& out, std::span<const uint8_t> bytes, std::size_t base)
 
 void decode_pdos(std::string& out, const std::vector<SiiPdo>& pdos) {
     for (const auto& p : pdos) {
-        out +=
-            format("    PDO 0x%04X \"%s\" entries %zu, SM %s, flags 0x%04X (%s)\n", p.index, p.name.c_str(),
-                   p.entries.size(), p.sm == 0xFF ? "none" : std::to_string(p.sm).c_str(), p.flags,
-                   bit_names(p.flags, {{pdo_flags::Mandatory, "mandatory"},
-                                       {pdo_flags::Default, "default"},
-                                       {pdo_flags::FixedContent, "fixed"},
-                                       {pdo_flags::VirtualContent, "virtual"},
-                                       {pdo_flags::OverwrittenByModule, "overwritten-by-module"}})
-                       .c_str());
+        out += format("    PDO 0x%04X \"%s\" entries %zu, SM %s, flags 0x%04X (%s)\n", p.index,
+                      printable(p.name).c_str(), p.entries.size(),
+                      p.sm == 0xFF ? "none" : std::to_string(p.sm).c_str(), p.flags,
+                      bit_names(p.flags, {{pdo_flags::Mandatory, "mandatory"},
+                                          {pdo_flags::Default, "default"},
+                                          {pdo_flags::FixedContent, "fixed"},
+                                          {pdo_flags::VirtualContent, "virtual"},
+                                          {pdo_flags::OverwrittenByModule, "overwritten-by-module"}})
+                          .c_str());
         for (const auto& e : p.entries) {
             const char* tn = detail::base_type_name(e.data_type);
             if (e.index == 0)
                 out += format("      gap %u bits\n", e.bit_length);
             else
                 out += format("      0x%04X:%02X %2u bits %-6s \"%s\"\n", e.index, e.subindex, e.bit_length,
-                              tn ? tn : format("0x%02X", e.data_type).c_str(), e.name.c_str());
+                              tn ? tn : format("0x%02X", e.data_type).c_str(), printable(e.name).c_str());
         }
     }
 }
@@ -604,14 +621,15 @@ std::string decode_sii(std::span<const uint8_t> image) {
         switch (c.type) {
             case category::Strings:
                 for (std::size_t i = 0; i < info.strings.size(); ++i)
-                    out += format("    %3zu \"%s\"\n", i + 1, info.strings[i].c_str());
+                    out += format("    %3zu \"%s\"\n", i + 1, printable(info.strings[i]).c_str());
                 break;
             case category::General:
                 if (info.general) {
                     const auto& g = *info.general;
                     out += format("    group %u \"%s\", image %u \"%s\", order %u \"%s\", name %u \"%s\"\n",
-                                  g.group_idx, g.group.c_str(), g.image_idx, g.image.c_str(), g.order_idx,
-                                  g.order.c_str(), g.name_idx, g.name.c_str());
+                                  g.group_idx, printable(g.group).c_str(), g.image_idx,
+                                  printable(g.image).c_str(), g.order_idx, printable(g.order).c_str(),
+                                  g.name_idx, printable(g.name).c_str());
                     out += format(
                         "    CoE details 0x%02X (%s), FoE 0x%02X, EoE 0x%02X, SoE channels %u, DS402 "
                         "channels %u\n",
@@ -654,8 +672,9 @@ std::string decode_sii(std::span<const uint8_t> image) {
                     out += format(
                         "    \"%s\" (%s): AssignActivate 0x%04X, SYNC0 cycle %u factor %d shift %d, "
                         "SYNC1 factor %d shift %d\n",
-                        m.name.c_str(), m.description.c_str(), m.assign_activate, m.sync0_cycle_time,
-                        m.sync0_cycle_factor, m.sync0_shift_time, m.sync1_cycle_factor, m.sync1_shift_time);
+                        printable(m.name).c_str(), printable(m.description).c_str(), m.assign_activate,
+                        m.sync0_cycle_time, m.sync0_cycle_factor, m.sync0_shift_time, m.sync1_cycle_factor,
+                        m.sync1_shift_time);
                 break;
             default: {
                 const std::size_t start = (c.word_offset + 2) * 2;

@@ -507,6 +507,27 @@ TEST(Esi, SpecialCharactersAreEscapedAndRoundTrip) {
               d.description.identity.device_name);
 }
 
+// Byte strings that are not valid XML text (control characters, broken UTF-8) still give a valid file.
+TEST(Esi, InvalidTextBytesStillGiveAValidFile) {
+    od::DeviceDescription desc = esi_test::small_description();
+    desc.identity.device_name = "Bad\x01name\xFF\xC3Z\xE2\x82\xAC ok \xC2\xB5s";
+    desc.identity.group_type = "Drives\x1F";
+    od::Dictionary dict = esi_test::small_dictionary(desc);
+    const std::string xml = esi::build_esi(desc, dict);
+    Doc doc = parse(xml);
+    ASSERT_NE(doc, nullptr);
+    const std::string name =
+        text(path(xmlDocGetRootElement(doc.get()), {"Descriptions", "Devices", "Device", "Name"}));
+    EXPECT_EQ(name, "Bad?name??Z\xE2\x82\xAC ok \xC2\xB5s");
+    std::unique_ptr<xmlSchemaParserCtxt, decltype(&xmlSchemaFreeParserCtxt)> pc(
+        xmlSchemaNewParserCtxt(kXsd.c_str()), &xmlSchemaFreeParserCtxt);
+    std::unique_ptr<xmlSchema, decltype(&xmlSchemaFree)> schema(xmlSchemaParse(pc.get()), &xmlSchemaFree);
+    ASSERT_NE(schema, nullptr);
+    std::unique_ptr<xmlSchemaValidCtxt, decltype(&xmlSchemaFreeValidCtxt)> vc(
+        xmlSchemaNewValidCtxt(schema.get()), &xmlSchemaFreeValidCtxt);
+    EXPECT_EQ(xmlSchemaValidateDoc(vc.get(), doc.get()), 0);
+}
+
 TEST(Esi, StateDependentAccessUsesRestrictions) {
     const Device d = esi_test::small_device();
     const std::string xml = esi::build_esi(d.description, d.dictionary);

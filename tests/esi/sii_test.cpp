@@ -370,6 +370,22 @@ TEST(SiiParse, UnknownCategoryShownAsHexAndSkippedByLength) {
     EXPECT_NE(text.find(" DE AD BE EF"), std::string::npos) << text;
 }
 
+TEST(SiiParse, ControlCharactersInStringsAreEscapedInTheText) {
+    Image img;
+    img.fix_crc();
+    std::vector<uint8_t> str = {1, 255};
+    for (int i = 0; i < 255; ++i)
+        str.push_back(i % 2 ? '\n' : 'x');
+    img.category(esi::category::Strings, str);
+    img.add16(0xFFFF);
+    const auto info = esi::parse_sii(img.b);
+    ASSERT_EQ(info.strings.size(), 1u);
+    EXPECT_EQ(info.strings[0].size(), 255u);
+    const std::string text = esi::decode_sii(img.b);
+    EXPECT_NE(text.find("x\\x0Ax\\x0Ax"), std::string::npos) << text;
+    EXPECT_NE(text.find("x\\x0Ax\"\n"), std::string::npos) << "the whole string is shown";
+}
+
 TEST(SiiParse, BadCrcIsReported) {
     Image img;
     img.b[0] = 0x05;
