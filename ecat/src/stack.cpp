@@ -198,6 +198,7 @@ void Stack::poll(uint64_t now_ns) {
         // Reading the activation registers acknowledges the event; the mailbox checks the repeat bit.
         for (unsigned n = 0; n < 4; ++n)
             (void)pdi_.read_reg<uint8_t>(reg::sm_base(n) + reg::kSmActivate);
+        if (process_data_state(state_)) check_process_data_sms(now_ns);
     }
     if (events & reg::kEvWatchdogPd) {
         const uint16_t wd = pdi_.read_reg<uint16_t>(reg::kWatchdogStatusPd);
@@ -485,6 +486,22 @@ uint16_t Stack::check_watchdog() {
     // A watchdog shorter than one cycle would expire between two correct output updates.
     if (cycle_ns_ != 0 && timeout_ns < cycle_ns_) return al::InvalidWatchdogConfig;
     return al::NoError;
+}
+
+void Stack::check_process_data_sms(uint64_t now_ns) {
+    // The master changed an SM while process data runs: SM2/SM3 must still be what Safe-Op was entered
+    // with (ref §6.3: 0x001D / 0x001E, O,S -> S + E).
+    auto still_valid = [this](unsigned n, std::size_t bytes, uint16_t start_address) {
+        const SmRegs r = read_sm(n);
+        const bool enabled = (r.activate & reg::kSmEnable) && r.length > 0;
+        if (bytes == 0) return !enabled;
+        return enabled && r.length == bytes && r.start == start_address;
+    };
+    if (!still_valid(2, sm2_buf_.size(), sm2_start_)) {
+        fall_back(AlState::SafeOp, al::InvalidOutputConfig, now_ns);
+    } else if (!still_valid(3, sm3_buf_.size(), sm3_start_)) {
+        fall_back(AlState::SafeOp, al::InvalidInputConfig, now_ns);
+    }
 }
 
 bool Stack::op_conditions_met() const {

@@ -549,6 +549,30 @@ TEST_F(Esm, Watchdog_InSafeOp_NoStateChange) {
     EXPECT_EQ(al_status(), 0x04);
 }
 
+TEST_F(Esm, Runtime_Sm2DisabledInOp_SafeOpWith0x001D) {
+    go_op();
+    master.wr<uint8_t>(0x0816, 0);  // SM2 activate = 0
+    poll();
+    EXPECT_EQ(al_status(), 0x04 | kErr);
+    EXPECT_EQ(al_code(), 0x001D);
+    EXPECT_EQ(app.outputs_lost, 1);
+}
+
+TEST_F(Esm, Runtime_Sm3DisabledInSafeOp_0x001E) {
+    go_safeop();
+    master.wr<uint8_t>(0x081E, 0);
+    poll();
+    EXPECT_EQ(al_status(), 0x04 | kErr);
+    EXPECT_EQ(al_code(), 0x001E);
+}
+
+TEST_F(Esm, Runtime_RepeatRequestInOp_NoFallBack) {
+    go_op();
+    master.wr<uint8_t>(0x080E, 0x03);  // SM1 repeat request toggled: an activation event, SMs unchanged
+    poll();
+    EXPECT_EQ(al_status(), 0x08);
+}
+
 TEST_F(Esm, LocalError_FallsBack) {
     go_op();
     stack->local_error(0x001A, AlState::SafeOp);

@@ -93,6 +93,7 @@ class Stack {
     uint16_t check_sync_configuration();
     uint16_t check_watchdog();
     bool op_conditions_met() const;
+    void check_process_data_sms(uint64_t now_ns);
     void try_complete_op(uint64_t now_ns);
 
     void go(od::AlState to, uint64_t now_ns);
