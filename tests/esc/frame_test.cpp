@@ -195,3 +195,53 @@ TEST_F(FrameTest, IndexAndCirculatingBitUntouched) {
 }
 
 }  // namespace
+
+namespace {
+
+// Random frames (valid Ethernet/EtherCAT headers, random datagrams, random register/SM/FMMU writes) must
+// never read or write outside the frame or the ESC's memory (run under ASan), and the frame length never
+// changes.
+TEST(FrameRobustness, RandomFramesNeverCrash) {
+    esc::ManualClock clk;
+    clk.set(1'000'000);
+    esc::Esc e({}, clk);
+    uint32_t s = 12345;
+    auto rnd = [&]() {
+        s = s * 1103515245u + 12345u;
+        return (s >> 8) & 0xFFFF;
+    };
+    for (int iter = 0; iter < 20000; ++iter) {
+        std::vector<Datagram> dgs;
+        const int n = 1 + static_cast<int>(rnd() % 4);
+        for (int k = 0; k < n; ++k) {
+            Datagram d;
+            d.cmd = static_cast<uint8_t>(rnd() % 16);
+            d.adp = static_cast<uint16_t>(rnd() % 3 == 0 ? 0 : rnd());
+            // Bias towards interesting places: registers, SM/FMMU config, RAM, the end of the address space.
+            static const uint16_t bases[] = {0x0000, 0x0120, 0x0500, 0x0600, 0x0800,
+                                             0x0900, 0x0980, 0x1000, 0x2FF0, 0xFFF0};
+            d.ado = static_cast<uint16_t>(bases[rnd() % 10] + rnd() % 64);
+            d.data.resize(rnd() % 48);
+            for (auto& b : d.data)
+                b = static_cast<uint8_t>(rnd());
+            if (d.cmd == LRW || d.cmd == LRD || d.cmd == LWR) d.ado = static_cast<uint16_t>(rnd() % 4);
+            dgs.push_back(d);
+        }
+        auto f = build(dgs, rnd() % 2 ? 60 : 0);
+        // Corrupt lengths now and then.
+        if (rnd() % 8 == 0) f[14] = static_cast<uint8_t>(rnd());
+        if (rnd() % 8 == 0 && f.size() > 23) f[16 + 6] = static_cast<uint8_t>(rnd());
+        if (rnd() % 8 == 0 && f.size() > 20) f.resize(20 + rnd() % (f.size() - 20));
+        const auto size = f.size();
+        EXPECT_TRUE(e.process_frame(f, clk.now_ns()));
+        ASSERT_EQ(f.size(), size);
+        uint8_t buf[64];
+        e.read(static_cast<uint16_t>(rnd()), std::span<uint8_t>(buf, rnd() % 64));
+        e.write(static_cast<uint16_t>(0x1000 + rnd() % 0x2000), std::span<const uint8_t>(buf, rnd() % 64));
+        clk.advance(rnd() * 100);
+        e.tick();
+    }
+    EXPECT_GT(e.stats().frames_processed, 0u);
+}
+
+}  // namespace
