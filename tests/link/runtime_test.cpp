@@ -140,6 +140,26 @@ TEST_F(Runtime, TheTimerWakesTheFirmwareAtItsDeadlineWithoutFrames) {
     EXPECT_GE(runtime.stats().timer_expiries, 1u);
 }
 
+TEST_F(Runtime, FirmwareAdapterDrivesAnyObjectWithPollAndDeadline) {
+    struct Stackish {
+        void poll(uint64_t now) { seen = now; }
+        uint64_t next_deadline_ns() const { return deadline; }
+        uint64_t seen = 0;
+        uint64_t deadline = 0;
+    } stack;
+    stack.deadline = clock.now_ns() + 5'000'000;
+    softslave::FirmwareAdapter<Stackish> adapter(stack);
+    EXPECT_EQ(adapter.next_deadline_ns(), stack.deadline);
+    runtime.set_firmware(&adapter);
+    const uint64_t start = clock.now_ns();
+    for (int i = 0; i < 100 && stack.seen < stack.deadline; ++i)
+        ASSERT_TRUE(runtime.run_once(2000));
+    EXPECT_GE(stack.seen, stack.deadline);
+    EXPECT_LT(clock.now_ns() - start, 1'000'000'000ull) << "woken by the timer, not by the poll timeout";
+    EXPECT_GE(runtime.stats().timer_expiries, 1u);
+    runtime.set_firmware(nullptr);
+}
+
 TEST_F(Runtime, RequestStopEndsRunFromAnotherThread) {
     std::thread stopper([this] {
         std::this_thread::sleep_for(std::chrono::milliseconds(20));

@@ -121,6 +121,8 @@ TEST(EcatSlaveCli, BadOptionsExitWith2) {
     EXPECT_EQ(run({"--backend", "dpdk", "--iface", "lo"}).code, 2);
     EXPECT_EQ(run({"--ram-kib", "0", "--iface", "lo"}).code, 2);
     EXPECT_EQ(run({"--no-such-option"}).code, 2);
+    EXPECT_EQ(run({"--cpu", "100000", "--iface", "lo"}).code, 2);
+    EXPECT_EQ(run({"--rt-priority", "100", "--iface", "lo"}).code, 2);
     EXPECT_EQ(run({"--eeprom", "/nonexistent/eeprom.bin", "--iface", "lo"}).code, 2);
 }
 

@@ -25,6 +25,10 @@ int main(int argc, char** argv) {
     app.add_option("--ram-kib", options.ram_kib, "Process RAM size in KiB")
         ->check(CLI::Range(1, 60))
         ->capture_default_str();
+    app.add_option("--rt-priority", options.rt_priority,
+                   "Run with SCHED_FIFO at this priority (1-99) and lock all memory")
+        ->check(CLI::Range(1, 99));
+    app.add_option("--cpu", options.cpu, "Pin the slave to this CPU")->check(CLI::NonNegativeNumber);
     app.add_flag("--verbose,-v", options.verbose, "Print statistics at exit");
     try {
         app.parse(argc, argv);

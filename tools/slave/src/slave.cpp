@@ -1,6 +1,11 @@
 // run_slave(): the ecat-slave program minus its command line. See softslave/slave.hpp.
 #include "softslave/slave.hpp"
 
+#include <sched.h>
+#include <sys/mman.h>
+
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <iterator>
@@ -35,11 +40,37 @@ bool write_file(const std::string& path, std::span<const uint8_t> data) {
     return static_cast<bool>(out);
 }
 
+// Real-time setup. Returns an error message, empty on success.
+std::string apply_scheduling(const SlaveOptions& options) {
+    if (options.cpu >= CPU_SETSIZE) return "CPU " + std::to_string(options.cpu) + " does not exist";
+    if (options.cpu >= 0) {
+        cpu_set_t set;
+        CPU_ZERO(&set);
+        CPU_SET(options.cpu, &set);
+        if (::sched_setaffinity(0, sizeof set, &set) != 0)
+            return "cannot pin to CPU " + std::to_string(options.cpu) + ": " + std::strerror(errno);
+    }
+    if (options.rt_priority > 0) {
+        sched_param param{};
+        param.sched_priority = options.rt_priority;
+        if (::sched_setscheduler(0, SCHED_FIFO, &param) != 0)
+            return "cannot switch to SCHED_FIFO priority " + std::to_string(options.rt_priority) + ": " +
+                   std::strerror(errno) + (errno == EPERM ? " (needs CAP_SYS_NICE or root)" : "");
+        if (::mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
+            return std::string("cannot lock memory (mlockall): ") + std::strerror(errno);
+    }
+    return {};
+}
+
 }  // namespace
 
 int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err) {
     if (options.ram_kib == 0 || options.ram_kib > 60) {
         err << "ecat-slave: --ram-kib must be 1..60 (process RAM lies between 0x1000 and 0xFFFF)\n";
+        return kExitUsage;
+    }
+    if (const std::string problem = apply_scheduling(options); !problem.empty()) {
+        err << "ecat-slave: " << problem << '\n';
         return kExitUsage;
     }
     install_stop_signals();

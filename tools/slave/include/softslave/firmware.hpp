@@ -17,4 +17,17 @@ class Firmware {
     virtual uint64_t next_deadline_ns() const { return std::numeric_limits<uint64_t>::max(); }
 };
 
+// Adapts any object with poll(uint64_t) and next_deadline_ns() (e.g. ecat::Stack, which cannot depend on
+// this library) to Firmware without owning it.
+template <typename T>
+class FirmwareAdapter final : public Firmware {
+  public:
+    explicit FirmwareAdapter(T& target) : target_(target) {}
+    void poll(uint64_t now_ns) override { target_.poll(now_ns); }
+    uint64_t next_deadline_ns() const override { return target_.next_deadline_ns(); }
+
+  private:
+    T& target_;
+};
+
 }  // namespace softslave
