@@ -494,6 +494,10 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
     attr(type, "ProductCode", hex32(id.product_code));
     attr(type, "RevisionNo", hex32(id.revision));
     named(device, "Name", id.device_name);
+    xmlNodePtr info = child(device, "Info");
+    for (int port = 0; port < 2; ++port)
+        child(child(info, "Port"), "Type", "MII");  // kPhysicalPorts
+    if (kIdentificationInAlStatusCode) child(info, "IdentificationReg134", "true");
     child(device, "GroupType", id.group_type);
 
     xmlNodePtr profile = child(device, "Profile");
@@ -521,6 +525,7 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
         namespace mp = od::mailbox_protocol;
         namespace cd = od::coe_details;
         xmlNodePtr mbx = child(device, "Mailbox");
+        if (kMailboxDataLinkLayer) attr(mbx, "DataLinkLayer", "true");
         if (d.mailbox_protocols & mp::AoE) child(mbx, "AoE");
         if (d.mailbox_protocols & mp::EoE) child(mbx, "EoE");
         if (d.mailbox_protocols & mp::CoE) {

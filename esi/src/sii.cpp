@@ -78,6 +78,7 @@ std::vector<uint8_t> build_sii(const od::DeviceDescription& d, const od::Diction
         general[6] = static_cast<uint8_t>(d.foe_details | 0x01);
     if (d.mailbox_protocols & od::mailbox_protocol::EoE) general[7] = 0x01;
     general[9] = m.profile_number == 402 ? 1 : 0;  // DS402 channels
+    general[11] = kGeneralFlags;
     general[14] = group_idx;
     general[16] = static_cast<uint8_t>(kPhysicalPorts);
     general[17] = static_cast<uint8_t>(kPhysicalPorts >> 8);

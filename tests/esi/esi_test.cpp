@@ -443,8 +443,17 @@ TEST_P(EsiDevice, AgreesWithTheSiiImage) {
     check_pdos("RxPdo", sii.rx_pdos);
     check_pdos("TxPdo", sii.tx_pdos);
 
-    // Mailbox
+    // Stack properties: mailbox data link layer (General flags bit 2), identification in 0x0134 (bit 3),
+    // two MII ports.
     xmlNodePtr mbx = first(device, "Mailbox");
+    EXPECT_EQ(prop(mbx, "DataLinkLayer") == "true", (sii.general->flags & 0x04) != 0);
+    EXPECT_EQ(text(path(device, {"Info", "IdentificationReg134"})) == "true",
+              (sii.general->flags & 0x08) != 0);
+    EXPECT_EQ(all(first(device, "Info"), "Port").size(), 2u);
+    EXPECT_EQ(sii.general->physical_ports, 0x0011);
+    EXPECT_EQ(prop(device, "Physics"), "YY");
+
+    // Mailbox
     xmlNodePtr coe = first(mbx, "CoE");
     EXPECT_EQ(coe != nullptr, (sii.mailbox_protocols & od::mailbox_protocol::CoE) != 0);
     EXPECT_EQ(first(mbx, "FoE") != nullptr, (sii.mailbox_protocols & od::mailbox_protocol::FoE) != 0);

@@ -46,10 +46,18 @@ struct SmInfo {
 // ESI Fmmu text / SII FMMU category byte.
 enum class FmmuUse : uint8_t { Unused = 0x00, Outputs = 0x01, Inputs = 0x02, MBoxState = 0x03 };
 
-// Mailbox data-link-layer (repeat) support is not part of od::DeviceDescription; the stack does not claim it.
+// Properties of the stack itself rather than of one device, so not in od::DeviceDescription:
 // Physical ports: two MII ports (as the MAXPOS, and as esc::EscConfig's 0x0007 default 0x0F).
 constexpr uint16_t kPhysicalPorts = 0x0011;  // SII General bytes 16-17: 4 bits per port, 1 = MII
 constexpr const char* kPhysics = "YY";       // ESI Device Physics
+// Mailbox data link layer: ecat/ serves the SM1 repeat request and drops a repeated request with the same
+// non-zero counter (ecat/src/mailbox.cpp). SII General flags bit 2, ESI Mailbox DataLinkLayer.
+constexpr bool kMailboxDataLinkLayer = true;
+// Device identification in AL status code 0x0134 on AL control bit 5 (ecat/src/stack.cpp).
+// SII General flags bit 3 (IdentALSts), ESI Info/IdentificationReg134.
+constexpr bool kIdentificationInAlStatusCode = true;
+constexpr uint8_t kGeneralFlags =
+    (kMailboxDataLinkLayer ? 0x04 : 0) | (kIdentificationInAlStatusCode ? 0x08 : 0);
 
 struct DeviceModel {
     std::vector<PdoInfo>
