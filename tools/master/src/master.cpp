@@ -209,9 +209,9 @@ Master::Master(esc::Link& link, MasterOptions options) : link_(link), options_(o
 
 // ---- Frames --------------------------------------------------------------------------------------
 
-Error Master::exchange(std::span<Datagram> datagrams) {
+Error Master::exchange(std::span<Datagram> datagrams, unsigned retries) {
     if (datagrams.empty() || datagrams.size() > 255) return Error::InvalidArgument;
-    for (unsigned attempt = 0; attempt <= options_.retries; ++attempt) {
+    for (unsigned attempt = 0; attempt <= retries; ++attempt) {
         // A fresh index range per attempt: a late reply to an earlier attempt is then told apart
         // from the reply to this one (and dropped as stale).
         const uint8_t first = next_index_;
@@ -288,7 +288,7 @@ Error Master::wait_frame(uint8_t first_index, std::span<Datagram> datagrams, Clo
 
 // ---- Registers -----------------------------------------------------------------------------------
 
-Datagram Master::addressed(Address a, bool write, uint16_t address, std::span<uint8_t> data) const {
+Datagram Master::addressed(Address a, bool write, uint16_t address, std::span<uint8_t> data) {
     Datagram d;
     if (a.mode == Address::Mode::Position) {
         d.command = write ? Command::APWR : Command::APRD;

@@ -116,13 +116,18 @@ class Master {
     // Sends all datagrams in one frame and waits for the reply with the same datagram indices; on a
     // timeout sends again (options().retries times). Fills each datagram's data (read commands), wkc
     // and irq from the reply. Working counters are not checked here. Allocates nothing.
-    Error exchange(std::span<Datagram> datagrams);
+    Error exchange(std::span<Datagram> datagrams) { return exchange(datagrams, options_.retries); }
+    // Same with an explicit number of retries (0: one attempt; for requests that must not be repeated
+    // blindly, such as the read of a mailbox whose reply may have been lost).
+    Error exchange(std::span<Datagram> datagrams, unsigned retries);
     Error exchange(Datagram& datagram) { return exchange(std::span<Datagram>(&datagram, 1)); }
 
     // ---- Registers -------------------------------------------------------------------------------
     // APRD/FPRD and APWR/FPWR; the working counter must be 1.
     Error read(Address a, uint16_t address, std::span<uint8_t> out);
     Error write(Address a, uint16_t address, std::span<const uint8_t> in);
+    // The datagram read()/write() would send (APxx for a position, FPxx for a station address).
+    static Datagram addressed(Address a, bool write, uint16_t address, std::span<uint8_t> data);
     template <typename T>
     Result<T> read_reg(Address a, uint16_t address) {
         uint8_t b[sizeof(T)] = {};
@@ -172,7 +177,6 @@ class Master {
     Error request_state_all(AlState state, std::span<const uint16_t> stations);
 
   private:
-    Datagram addressed(Address a, bool write, uint16_t address, std::span<uint8_t> data) const;
     Error sii_take(Address a);
     Error sii_wait(Address a, uint16_t& status, std::span<uint8_t> data_out = {});
     Error sii_command(Address a, uint16_t command, uint32_t word, std::span<uint8_t> data_out,

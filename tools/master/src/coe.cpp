@@ -1,0 +1,302 @@
+// CoE SDO client (ethercat-protocol.md §9.2 transfers, §9.3 abort codes, §9.5 emergencies).
+#include "master/coe.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+namespace master {
+
+using Clock = std::chrono::steady_clock;
+
+namespace {
+constexpr uint8_t kServiceEmergency = 1;
+constexpr uint8_t kServiceSdoRequest = 2;
+constexpr uint8_t kServiceSdoResponse = 3;
+constexpr uint32_t kAbortToggle = 0x05030000;
+constexpr uint32_t kAbortCommand = 0x05040001;
+constexpr uint32_t kAbortOutOfMemory = 0x05040005;
+constexpr uint32_t kAbortGeneral = 0x08000000;
+
+uint16_t get16(const uint8_t* p) {
+    return static_cast<uint16_t>(p[0] | (p[1] << 8));
+}
+uint32_t get32(const uint8_t* p) {
+    return static_cast<uint32_t>(p[0] | (p[1] << 8) | (p[2] << 16) | (static_cast<uint32_t>(p[3]) << 24));
+}
+void put16(uint8_t* p, uint16_t v) {
+    p[0] = static_cast<uint8_t>(v);
+    p[1] = static_cast<uint8_t>(v >> 8);
+}
+void put32(uint8_t* p, uint32_t v) {
+    for (int i = 0; i < 4; ++i)
+        p[i] = static_cast<uint8_t>(v >> (8 * i));
+}
+// CoE header + SDO command + index + subindex.
+void sdo_head(uint8_t* p, uint8_t cmd, uint16_t index, uint8_t sub) {
+    put16(p, static_cast<uint16_t>(kServiceSdoRequest << 12));
+    p[2] = cmd;
+    put16(p + 3, index);
+    p[5] = sub;
+}
+}  // namespace
+
+std::string_view sdo_abort_text(uint32_t code) {
+    switch (code) {
+        case 0x05030000:
+            return "Toggle bit not changed";
+        case 0x05040000:
+            return "SDO protocol timeout";
+        case 0x05040001:
+            return "Client/server command specifier not valid or unknown";
+        case 0x05040005:
+            return "Out of memory";
+        case 0x06010000:
+            return "Unsupported access to an object";
+        case 0x06010001:
+            return "Attempt to read a write-only object";
+        case 0x06010002:
+            return "Attempt to write a read-only object";
+        case 0x06010003:
+            return "Subindex cannot be written, SI0 must be 0 for write access";
+        case 0x06010004:
+            return "SDO complete access not supported";
+        case 0x06010005:
+            return "Object length exceeds mailbox size";
+        case 0x06010006:
+            return "Object mapped to RxPDO, SDO download blocked";
+        case 0x06020000:
+            return "Object does not exist in the object dictionary";
+        case 0x06040041:
+            return "Object cannot be mapped into the PDO";
+        case 0x06040042:
+            return "Number and length of mapped objects would exceed PDO length";
+        case 0x06040043:
+            return "General parameter incompatibility";
+        case 0x06040047:
+            return "General internal incompatibility in the device";
+        case 0x06060000:
+            return "Access failed due to a hardware error";
+        case 0x06070010:
+            return "Data type does not match, length of service parameter does not match";
+        case 0x06070012:
+            return "Data type does not match, length too high";
+        case 0x06070013:
+            return "Data type does not match, length too low";
+        case 0x06090011:
+            return "Subindex does not exist";
+        case 0x06090030:
+            return "Value range of parameter exceeded";
+        case 0x06090031:
+            return "Value written too high";
+        case 0x06090032:
+            return "Value written too low";
+        case 0x06090036:
+            return "Maximum value is less than minimum value";
+        case 0x060A0023:
+            return "Resource not available";
+        case 0x08000000:
+            return "General error";
+        case 0x08000020:
+            return "Data cannot be transferred or stored to the application";
+        case 0x08000021:
+            return "Data cannot be transferred or stored because of local control";
+        case 0x08000022:
+            return "Data cannot be transferred or stored because of the present device state";
+        case 0x08000023:
+            return "Object dictionary not present";
+        case 0x08000024:
+            return "No data available";
+        default:
+            return "unknown abort code";
+    }
+}
+
+SdoClient::SdoClient(Mailbox& mailbox)
+    : mbx_(mailbox), req_(std::max<std::size_t>(mailbox.max_out_payload(), 10)) {}
+
+Error SdoClient::prepare() {
+    // The mailbox may have been (re)configured since construction: follow its size (allocates only then).
+    if (mbx_.max_out_payload() < 10 || mbx_.max_in_payload() < 10) return Error::MailboxNotConfigured;
+    if (req_.size() != mbx_.max_out_payload()) req_.assign(mbx_.max_out_payload(), 0);
+    return Error::Ok;
+}
+
+Error SdoClient::send(std::size_t length) {
+    return mbx_.send(MailboxType::CoE, std::span<const uint8_t>(req_.data(), length));
+}
+
+void SdoClient::abort(uint16_t index, uint8_t sub, uint32_t code) {
+    std::fill(req_.begin(), req_.begin() + 10, 0);
+    sdo_head(req_.data(), 0x80, index, sub);
+    put32(req_.data() + 6, code);
+    (void)send(10);  // best effort: the transfer is over for us either way
+    last_abort_ = code;
+}
+
+Error SdoClient::response(MailboxMessage& msg) {
+    const auto deadline = Clock::now() + mbx_.timeout();
+    for (;;) {
+        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+        if (left.count() <= 0) return Error::MailboxTimeout;
+        if (Error e = mbx_.receive(msg, left); e != Error::Ok) return e;
+        const auto p = msg.payload;
+        if (msg.type == MailboxType::Error) {
+            last_mailbox_error_ = p.size() >= 4 ? get16(p.data() + 2) : 0;
+            return Error::MailboxError;
+        }
+        if (msg.type != MailboxType::CoE || p.size() < 2) continue;  // not for us
+        const uint8_t service = static_cast<uint8_t>(p[1] >> 4);
+        if (service == kServiceEmergency) {
+            if (p.size() >= 10) {
+                last_emergency_.code = get16(p.data() + 2);
+                last_emergency_.error_register = p[4];
+                std::copy_n(p.begin() + 5, 5, last_emergency_.data.begin());
+            }
+            ++emergencies_;
+            continue;
+        }
+        // An abort may come as an SDO request (service 2, as SOES sends it) or response: SOEM takes it
+        // by its command byte alone, and so does this client.
+        const bool abort_request = service == kServiceSdoRequest && p.size() >= 10 && p[2] == 0x80;
+        if (service != kServiceSdoResponse && !abort_request) continue;
+        if (p.size() < 10) return Error::MailboxProtocol;
+        return Error::Ok;
+    }
+}
+
+Result<std::size_t> SdoClient::upload(uint16_t index, uint8_t sub, std::span<uint8_t> out,
+                                      bool complete_access) {
+    if (Error e = prepare(); e != Error::Ok) return e;
+    std::fill(req_.begin(), req_.begin() + 10, 0);
+    sdo_head(req_.data(), static_cast<uint8_t>(0x40 | (complete_access ? 0x10 : 0)), index, sub);
+    if (Error e = send(10); e != Error::Ok) return e;
+    MailboxMessage msg;
+    if (Error e = response(msg); e != Error::Ok) return e;
+    auto p = msg.payload;
+    uint8_t cmd = p[2];
+    if (cmd == 0x80) {
+        last_abort_ = get32(p.data() + 6);
+        return Error::SdoAbort;
+    }
+    if ((cmd >> 5) != 2 || get16(p.data() + 3) != index) {
+        abort(index, sub, kAbortCommand);
+        return Error::MailboxProtocol;
+    }
+    if (cmd & 0x02) {  // expedited: data in the 4-byte field
+        const std::size_t n = (cmd & 0x01) ? 4u - ((cmd >> 2) & 0x03) : 4u;
+        if (n > out.size()) return Error::BufferTooSmall;
+        std::copy_n(p.begin() + 6, n, out.begin());
+        return n;
+    }
+    const bool size_known = cmd & 0x01;
+    const std::size_t size = size_known ? get32(p.data() + 6) : out.size();
+    if (size_known && size > out.size()) {
+        abort(index, sub, kAbortOutOfMemory);
+        return Error::BufferTooSmall;
+    }
+    std::size_t done = std::min(p.size() - 10, size);
+    std::copy_n(p.begin() + 10, done, out.begin());
+    uint8_t toggle = 0;
+    while (done < size) {
+        std::fill(req_.begin(), req_.begin() + 10, 0);
+        sdo_head(req_.data(), static_cast<uint8_t>(0x60 | (toggle << 4)), index, sub);
+        if (Error e = send(10); e != Error::Ok) return e;
+        if (Error e = response(msg); e != Error::Ok) return e;
+        p = msg.payload;
+        cmd = p[2];
+        if (cmd == 0x80) {
+            last_abort_ = get32(p.data() + 6);
+            return Error::SdoAbort;
+        }
+        if ((cmd >> 5) != 0) {
+            abort(index, sub, kAbortCommand);
+            return Error::MailboxProtocol;
+        }
+        if (((cmd >> 4) & 1) != toggle) {
+            abort(index, sub, kAbortToggle);
+            return Error::MailboxProtocol;
+        }
+        // A segment carries 7 bytes minus the unused count in a 10-byte message, else length - 3.
+        const std::size_t n = p.size() == 10 ? 7u - ((cmd >> 1) & 0x07) : p.size() - 3;
+        if (n > size - done) {
+            if (size_known) {
+                abort(index, sub, kAbortGeneral);
+                return Error::MailboxProtocol;
+            }
+            abort(index, sub, kAbortOutOfMemory);
+            return Error::BufferTooSmall;
+        }
+        std::copy_n(p.begin() + 3, n, out.begin() + static_cast<std::ptrdiff_t>(done));
+        done += n;
+        toggle ^= 1;
+        if (cmd & 0x01) break;  // last segment
+    }
+    if (size_known && done != size) return Error::MailboxProtocol;
+    return done;
+}
+
+Error SdoClient::download(uint16_t index, uint8_t sub, std::span<const uint8_t> data, bool complete_access) {
+    if (Error e = prepare(); e != Error::Ok) return e;
+    const std::size_t max_payload = req_.size();
+    if (data.empty()) return Error::InvalidArgument;
+    MailboxMessage msg;
+    std::size_t done = 0;
+    std::fill(req_.begin(), req_.end(), 0);
+    if (data.size() <= 4 && !complete_access) {
+        sdo_head(req_.data(), static_cast<uint8_t>(0x23 | ((4 - data.size()) << 2)), index, sub);
+        std::copy(data.begin(), data.end(), req_.begin() + 6);
+        if (Error e = send(10); e != Error::Ok) return e;
+        done = data.size();
+    } else {
+        sdo_head(req_.data(), static_cast<uint8_t>(0x21 | (complete_access ? 0x10 : 0)), index, sub);
+        put32(req_.data() + 6, static_cast<uint32_t>(data.size()));
+        done = std::min(data.size(), max_payload - 10);
+        std::copy_n(data.begin(), done, req_.begin() + 10);
+        if (Error e = send(10 + done); e != Error::Ok) return e;
+    }
+    if (Error e = response(msg); e != Error::Ok) return e;
+    auto p = msg.payload;
+    if (p[2] == 0x80) {
+        last_abort_ = get32(p.data() + 6);
+        return Error::SdoAbort;
+    }
+    if ((p[2] >> 5) != 3 || get16(p.data() + 3) != index) {
+        abort(index, sub, kAbortCommand);
+        return Error::MailboxProtocol;
+    }
+    uint8_t toggle = 0;
+    while (done < data.size()) {
+        const std::size_t n = std::min(data.size() - done, max_payload - 3);
+        const bool last = done + n == data.size();
+        uint8_t cmd = static_cast<uint8_t>((toggle << 4) | (last ? 1 : 0));
+        std::fill(req_.begin(), req_.end(), 0);
+        put16(req_.data(), static_cast<uint16_t>(kServiceSdoRequest << 12));
+        std::copy_n(data.begin() + static_cast<std::ptrdiff_t>(done), n, req_.begin() + 3);
+        std::size_t length = 3 + n;
+        if (n < 7) {
+            cmd = static_cast<uint8_t>(cmd | ((7 - n) << 1));
+            length = 10;
+        }
+        req_[2] = cmd;
+        if (Error e = send(length); e != Error::Ok) return e;
+        if (Error e = response(msg); e != Error::Ok) return e;
+        p = msg.payload;
+        if (p[2] == 0x80) {
+            last_abort_ = get32(p.data() + 6);
+            return Error::SdoAbort;
+        }
+        if ((p[2] >> 5) != 1) {
+            abort(index, sub, kAbortCommand);
+            return Error::MailboxProtocol;
+        }
+        if (((p[2] >> 4) & 1) != toggle) {
+            abort(index, sub, kAbortToggle);
+            return Error::MailboxProtocol;
+        }
+        done += n;
+        toggle ^= 1;
+    }
+    return Error::Ok;
+}
+
+}  // namespace master
