@@ -224,9 +224,10 @@ uint64_t Stack::next_deadline_ns() const {
     if (op_pending_) t = std::min(t, op_deadline_ns_);
     if (process_data_state(state_)) {
         if (sync_mode_ == SyncMode::FreeRun) t = std::min(t, next_cycle_ns_);
-        if ((sync_mode_ == SyncMode::DcSync0 || sync_mode_ == SyncMode::DcSync1) && state_ == AlState::Op &&
-            cycle_ns_ > 0) {
-            t = std::min(t, last_sync0_ns_ + std::max<uint64_t>(10ull * cycle_ns_, 10'000'000));
+        if (sync_mode_ == SyncMode::DcSync0 || sync_mode_ == SyncMode::DcSync1) {
+            t = std::min(t, sync0_deadline_ns_);
+            if (state_ == AlState::Op && cycle_ns_ > 0)
+                t = std::min(t, last_sync0_ns_ + std::max<uint64_t>(10ull * cycle_ns_, 10'000'000));
         }
     }
     return t;
@@ -596,6 +597,8 @@ void Stack::start_process_data(uint64_t now_ns) {
     sync0_count_ = 0;
     last_sync0_ns_ = now_ns;
     next_cycle_ns_ = now_ns + cycle_ns_;
+    next_sync0_sys_ = pdi_.read_reg<uint64_t>(reg::kDcStartTime);
+    sync0_deadline_ns_ = UINT64_MAX;
     for (int i = 0; i < 2; ++i) {
         if (sm_missed_[i].valid()) sm_missed_[i].set(0);
         if (cycle_exceeded_[i].valid()) cycle_exceeded_[i].set(0);
@@ -663,17 +666,28 @@ void Stack::process_data_events(uint32_t events, uint64_t now_ns) {
             break;
         case SyncMode::DcSync0:
         case SyncMode::DcSync1: {
+            // SYNC0 is seen as the AL event (when 0x0151 maps it) and, in any case, as the "next SYNC0"
+            // time 0x0990 moving on; the latter also says how many periods passed since the last look.
+            uint64_t periods = 0;
             if (events & reg::kEvSync0) {
                 (void)pdi_.read_reg<uint8_t>(reg::kDcSync0Status);  // acknowledges the SYNC0 event
+                periods = 1;
+            }
+            const uint64_t next = pdi_.read_reg<uint64_t>(reg::kDcStartTime);
+            if (next != next_sync0_sys_) {
+                if (cycle_ns_ > 0 && next > next_sync0_sys_) periods = (next - next_sync0_sys_) / cycle_ns_;
+                if (periods == 0) periods = 1;
+                next_sync0_sys_ = next;
+            }
+            const uint64_t sys = pdi_.read_reg<uint64_t>(reg::kDcSystemTime);  // local copy of system time
+            sync0_deadline_ns_ = next > sys ? now_ns + (next - sys) : UINT64_MAX;
+            if (periods > 0) {
                 ++stats_.sync0_events;
-                if (sync0_seen_ && cycle_ns_ > 0 && now_ns > last_sync0_ns_) {
+                if (sync0_seen_ && periods > 1) {
                     // SYNC0 periods that passed without a cycle of ours.
-                    const uint64_t periods = (now_ns - last_sync0_ns_ + cycle_ns_ / 2) / cycle_ns_;
-                    if (periods > 1) {
-                        stats_.cycles_exceeded += periods - 1;
-                        for (auto& r : cycle_exceeded_)
-                            if (r.valid()) r.set(static_cast<uint16_t>(r.get() + (periods - 1)));
-                    }
+                    stats_.cycles_exceeded += periods - 1;
+                    for (auto& r : cycle_exceeded_)
+                        if (r.valid()) r.set(static_cast<uint16_t>(r.get() + (periods - 1)));
                 }
                 sync0_seen_ = true;
                 ++sync0_count_;

@@ -86,6 +86,39 @@ TEST_F(Sync, Dc_CycleRunsOnSync0) {
     EXPECT_EQ(static_cast<uint64_t>(app.cycles - before), stack->stats().sync0_events);
 }
 
+TEST_F(Sync, Dc_Sync0NotMappedToAlEvent_SeenThrough0x0990) {
+    // An SII whose word 1 leaves 0x0151 bit 3 clear: SYNC0 never reaches AL event bit 2.
+    std::vector<uint8_t> image(esc->eeprom().begin(), esc->eeprom().end());
+    ASSERT_GE(image.size(), 16u);
+    image[2] = 0x00;
+    image[3] = 0x00;
+    uint8_t crc = 0xFF;
+    for (int i = 0; i < 14; ++i) {
+        crc ^= image[i];
+        for (int b = 0; b < 8; ++b)
+            crc = static_cast<uint8_t>((crc & 0x80) ? (crc << 1) ^ 0x07 : (crc << 1));
+    }
+    image[14] = crc;
+    esc->load_eeprom(image);
+    ASSERT_EQ(master.rd<uint8_t>(0x0151) & 0x08, 0);
+    safeop_dc(1'000'000);
+    // The stack asks to be polled when the next SYNC0 is due.
+    EXPECT_LE(stack->next_deadline_ns(), clock.now_ns() + 1'000'000);
+    run_for(10'000'000, 250'000, true);
+    EXPECT_GE(stack->stats().sync0_events, 9u);
+    request(0x08);
+    run_for(2'000'000, 250'000, true);
+    EXPECT_EQ(al_status(), 0x08);
+    // A runtime that only wakes on the stack's deadline still runs one cycle per SYNC0.
+    const int before = app.cycles;
+    for (int i = 0; i < 5; ++i) {
+        clock.set(stack->next_deadline_ns());
+        poll();
+    }
+    EXPECT_EQ(app.cycles - before, 5);
+    EXPECT_EQ(stack->stats().cycles_exceeded, 0u);
+}
+
 TEST_F(Sync, Dc_SafeOpToOp_WaitsForSync0) {
     go_preop();
     configure_process_data(6, 6);

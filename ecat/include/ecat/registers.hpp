@@ -14,10 +14,12 @@ constexpr uint16_t kAlEventRequest = 0x0220;
 constexpr uint16_t kWatchdogDivider = 0x0400;
 constexpr uint16_t kWatchdogTimePd = 0x0420;
 constexpr uint16_t kWatchdogStatusPd = 0x0440;
+constexpr uint16_t kDcSystemTime = 0x0910;
 constexpr uint16_t kDcCyclicUnitControl = 0x0980;
 constexpr uint16_t kDcActivation = 0x0981;
 constexpr uint16_t kDcSync0Status = 0x098E;
 constexpr uint16_t kDcSync1Status = 0x098F;
+constexpr uint16_t kDcStartTime = 0x0990;  // read: system time of the next SYNC0 pulse
 constexpr uint16_t kDcSync0CycleTime = 0x09A0;
 constexpr uint16_t kDcSync1CycleTime = 0x09A4;
 
