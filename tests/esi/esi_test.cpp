@@ -537,6 +537,28 @@ TEST(Esi, InvalidTextBytesStillGiveAValidFile) {
     EXPECT_EQ(xmlSchemaValidateDoc(vc.get(), doc.get()), 0);
 }
 
+// A device with nothing but an identity: no objects, no SyncManagers, no DC modes, no mailbox.
+TEST(Esi, EmptyDeviceGivesValidFiles) {
+    od::DeviceDescription desc;
+    desc.mailbox_protocols = 0;
+    od::Dictionary dict;
+    Doc doc = parse(esi::build_esi(desc, dict));
+    ASSERT_NE(doc, nullptr);
+    std::unique_ptr<xmlSchemaParserCtxt, decltype(&xmlSchemaFreeParserCtxt)> pc(
+        xmlSchemaNewParserCtxt(kXsd.c_str()), &xmlSchemaFreeParserCtxt);
+    std::unique_ptr<xmlSchema, decltype(&xmlSchemaFree)> schema(xmlSchemaParse(pc.get()), &xmlSchemaFree);
+    ASSERT_NE(schema, nullptr);
+    std::unique_ptr<xmlSchemaValidCtxt, decltype(&xmlSchemaFreeValidCtxt)> vc(
+        xmlSchemaNewValidCtxt(schema.get()), &xmlSchemaFreeValidCtxt);
+    EXPECT_EQ(xmlSchemaValidateDoc(vc.get(), doc.get()), 0);
+    const auto sii = esi::parse_sii(esi::build_sii(desc, dict));
+    EXPECT_TRUE(sii.problems.empty());
+    EXPECT_TRUE(sii.sync_managers.empty());
+    EXPECT_TRUE(sii.tx_pdos.empty());
+    ASSERT_TRUE(sii.general.has_value());
+    EXPECT_EQ(sii.general->coe_details, 0);
+}
+
 TEST(Esi, StateDependentAccessUsesRestrictions) {
     const Device d = esi_test::small_device();
     const std::string xml = esi::build_esi(d.description, d.dictionary);
