@@ -1,4 +1,5 @@
 // The slave runtime (tools/slave) over a LoopbackLink with a real esc::Esc.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -14,6 +15,8 @@
 #include "esc/esc.hpp"
 #include "esc/link_capture.hpp"
 #include "esc/link_loopback.hpp"
+#include "netns_util.hpp"
+#include "softslave/netif.hpp"
 #include "softslave/runtime.hpp"
 
 namespace {
@@ -210,5 +213,49 @@ TEST_F(Runtime, CaptureRecordsTheFrameAsReceivedAndAsSent) {
     pcap_close(p);
     std::remove(path.c_str());
 }
+
+class RuntimeOnVeth : public ::testing::TestWithParam<std::string> {
+  protected:
+    void SetUp() override {
+        if (!linktest::is_root()) GTEST_SKIP() << "needs root (network namespace, veth)";
+    }
+};
+
+TEST_P(RuntimeOnVeth, StopsWhenTheInterfaceIsRemoved) {
+    std::unique_ptr<esc::Link> link;
+    int ns = -1;
+    linktest::in_new_netns([&] {
+        softslave::create_veth("s0", "m0");
+        softslave::set_interface_up("s0");
+        softslave::set_interface_up("m0");
+        link = esc::open_link("s0", GetParam());
+        ns = ::open("/proc/thread-self/ns/net", O_RDONLY | O_CLOEXEC);
+    });
+    ASSERT_GE(ns, 0);
+    esc::SystemClock clock;
+    esc::Esc esc(esc::EscConfig{}, clock);
+    softslave::Runtime runtime(*link, esc, clock);
+    bool exists = true;
+    runtime.set_link_check([&] {
+        linktest::in_netns(ns, [&] { exists = softslave::interface_exists("s0"); });
+        return exists;
+    });
+    EXPECT_TRUE(runtime.run_once(50));  // nothing happens: still running
+    EXPECT_FALSE(runtime.link_lost());
+    linktest::in_netns(ns, [] { softslave::delete_interface("s0"); });
+    bool running = true;
+    for (int i = 0; i < 20 && running; ++i)
+        running = runtime.run_once(100);
+    EXPECT_FALSE(running);
+    EXPECT_TRUE(runtime.link_lost());
+    EXPECT_FALSE(exists);
+    ::close(ns);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, RuntimeOnVeth,
+                         ::testing::Values(std::string("pcap"), std::string("packet")),
+                         [](const ::testing::TestParamInfo<std::string>& param_info) {
+                             return param_info.param;
+                         });
 
 }  // namespace

@@ -87,6 +87,10 @@ bool Runtime::run_once(int timeout_ms) {
             socklen_t len = sizeof err;
             (void)::getsockopt(fds[0].fd, SOL_SOCKET, SO_ERROR, &err, &len);
             ++stats_.link_errors;
+            if (link_check_ && !link_check_()) {
+                link_lost_ = true;
+                return false;
+            }
         }
     }
     if (fds[1].revents & POLLIN) {

@@ -107,6 +107,7 @@ int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err)
         Runtime runtime(*link, esc, clock);
         runtime.set_firmware(firmware.get());
         runtime.set_capture(capture.get());
+        runtime.set_link_check([&iface] { return interface_exists(iface); });
         set_signal_target(&runtime);
 
         if (veth) out << "master interface: " << veth->master_end() << '\n';
@@ -123,6 +124,10 @@ int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err)
         set_signal_target(nullptr);
 
         if (capture) capture->flush();
+        if (runtime.link_lost()) {
+            err << "ecat-slave: network interface '" << iface << "' disappeared\n";
+            return kExitFailure;
+        }
         if (eeprom_dirty && options.eeprom_write_back && !options.eeprom_file.empty()) {
             if (!write_file(options.eeprom_file, esc.eeprom()))
                 err << "ecat-slave: warning: could not write the EEPROM image back to " << options.eeprom_file

@@ -11,6 +11,7 @@
 // One receive buffer, allocated at construction; nothing is allocated per frame or per cycle.
 // The clock must count CLOCK_MONOTONIC nanoseconds (esc::SystemClock) because the timer runs on it.
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "esc/clock.hpp"
@@ -42,6 +43,10 @@ class Runtime {
 
     void set_firmware(Firmware* firmware) { firmware_ = firmware; }
     void set_capture(esc::PcapWriter* capture) { capture_ = capture; }
+    // Called when poll() reports an error on the link (interface down or removed); returns whether the link
+    // is still usable. If it returns false, run() ends and link_lost() is true. Not called per frame.
+    void set_link_check(std::function<bool()> check) { link_check_ = std::move(check); }
+    bool link_lost() const { return link_lost_; }
 
     // Runs until request_stop().
     void run();
@@ -64,6 +69,8 @@ class Runtime {
     const esc::Clock& clock_;
     Firmware* firmware_ = nullptr;
     esc::PcapWriter* capture_ = nullptr;
+    std::function<bool()> link_check_;
+    bool link_lost_ = false;
     int timer_fd_ = -1;
     int stop_fd_ = -1;
     uint64_t armed_ns_ = 0;         // deadline the timerfd is armed for; 0 = disarmed
