@@ -673,14 +673,18 @@ void Stack::process_data_events(uint32_t events, uint64_t now_ns) {
                 (void)pdi_.read_reg<uint8_t>(reg::kDcSync0Status);  // acknowledges the SYNC0 event
                 periods = 1;
             }
-            const uint64_t next = pdi_.read_reg<uint64_t>(reg::kDcStartTime);
+            // 0x0990 is the next pulse only while SYNC0 runs; otherwise it is whatever the master wrote.
+            const uint8_t activation = pdi_.read_reg<uint8_t>(reg::kDcActivation);
+            const bool running = (activation & (reg::kDcActCyclic | reg::kDcActSync0)) ==
+                                 (reg::kDcActCyclic | reg::kDcActSync0);
+            const uint64_t next = running ? pdi_.read_reg<uint64_t>(reg::kDcStartTime) : next_sync0_sys_;
             if (next != next_sync0_sys_) {
                 if (cycle_ns_ > 0 && next > next_sync0_sys_) periods = (next - next_sync0_sys_) / cycle_ns_;
                 if (periods == 0) periods = 1;
                 next_sync0_sys_ = next;
             }
             const uint64_t sys = pdi_.read_reg<uint64_t>(reg::kDcSystemTime);  // local copy of system time
-            sync0_deadline_ns_ = next > sys ? now_ns + (next - sys) : UINT64_MAX;
+            sync0_deadline_ns_ = running && next > sys ? now_ns + (next - sys) : UINT64_MAX;
             if (periods > 0) {
                 ++stats_.sync0_events;
                 if (sync0_seen_ && periods > 1) {

@@ -274,6 +274,19 @@ TEST_F(MailboxTest, Send_TooLargeRefused) {
     EXPECT_EQ(stack->mailbox().max_payload(), 122u);
 }
 
+TEST_F(MailboxTest, Send_SpontaneousMessageHasAddressZero) {
+    go_preop();
+    roundtrip(mbx_message(0x3, 1, sdo, 0x1001));  // a request with an address, answered and read
+    const std::vector<uint8_t> emergency{0x00, 0x10, 0x10, 0x82, 0x11, 0, 0, 0, 0, 0};
+    ASSERT_TRUE(stack->mailbox().send(MailboxType::CoE, emergency));
+    poll();
+    const auto m = mbx_read();
+    ASSERT_FALSE(m.empty());
+    EXPECT_EQ(m[2] | (m[3] << 8), 0);
+    EXPECT_EQ(m[0], emergency.size());
+    EXPECT_EQ((m[5] >> 4) & 7, 2);
+}
+
 TEST_F(MailboxTest, Send_RefusedInInit) {
     std::vector<uint8_t> small(4, 0);
     EXPECT_FALSE(stack->mailbox().send(MailboxType::CoE, small));

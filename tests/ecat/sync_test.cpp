@@ -187,6 +187,17 @@ TEST_F(Sync, Dc_SyncLoss_0x002C) {
     EXPECT_EQ(app.outputs_lost, 1);
 }
 
+TEST_F(Sync, Dc_StartTimeRewrittenWhileStopped_NoSpuriousCycle) {
+    safeop_dc(1'000'000);
+    run_for(3'000'000, 250'000, true);
+    master.wr<uint8_t>(0x0981, 0);
+    const int before = app.cycles;
+    master.wr<uint64_t>(0x0990, master.rd<uint64_t>(0x0910) + 50'000'000);
+    poll();
+    poll();
+    EXPECT_EQ(app.cycles, before);
+}
+
 TEST_F(Sync, Dc_Sync0CycleBelowMinimum_0x0036) {
     go_preop();
     configure_process_data(6, 6);
