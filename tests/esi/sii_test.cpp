@@ -505,6 +505,59 @@ TEST(SiiParse, EveryTruncationAndByteFlipOfAFullImage) {
         }
 }
 
+// Contradictions between description and dictionary are reported; the dictionary wins in the output.
+TEST(SiiModel, ContradictionsAreReportedAndTheDictionaryWins) {
+    using esi_test::entry;
+    namespace a = od::access;
+    od::DeviceDescription desc = esi_test::small_description();
+    desc.sync_managers[2].default_size = 99;  // the default mapping has 6 bytes
+    desc.sync_managers[0].start = 0x1800;     // the standard mailbox says 0x1000
+    od::Dictionary dict;
+    od::Object map;
+    map.index = 0x1600;
+    map.code = od::ObjectCode::Record;
+    map.name = "RxPDO";
+    map.type = od::DataType::PdoMapping;
+    map.entries = {
+        entry(0x1600, 0, "n", od::DataType::Unsigned8, a::RW_PreOp, uint64_t{3}),
+        entry(0x1600, 1, "e1", od::DataType::Unsigned32, a::RW_PreOp, uint64_t{0x99990010}),   // missing
+        entry(0x1600, 2, "e2", od::DataType::Unsigned32, a::RW_PreOp, uint64_t{0x60410010})};  // not Rx
+    dict.add(std::move(map));
+    dict.add(esi_test::var(0x6041, "Statusword", od::DataType::Unsigned16, a::RO | a::TxPdo, uint64_t{0}));
+    od::Object assign;
+    assign.index = 0x1C12;
+    assign.code = od::ObjectCode::Array;
+    assign.name = "RxPDO assign";
+    assign.type = od::DataType::Unsigned16;
+    assign.entries = {
+        entry(0x1C12, 0, "n", od::DataType::Unsigned8, a::RW_PreOp, uint64_t{2}),
+        entry(0x1C12, 1, "p1", od::DataType::Unsigned16, a::RW_PreOp, uint64_t{0x1600}),
+        entry(0x1C12, 2, "p2", od::DataType::Unsigned16, a::RW_PreOp, uint64_t{0x1A07})};  // no such
+    dict.add(std::move(assign));
+
+    const auto m = esi::derive_model(desc, dict);
+    auto said = [&](const std::string& what) {
+        for (const auto& w : m.warnings)
+            if (w.find(what) != std::string::npos) return true;
+        return false;
+    };
+    EXPECT_TRUE(said("0x9999:00 which does not exist"));
+    EXPECT_TRUE(said("0x6041:00 which is not RxPDO mappable"));
+    EXPECT_TRUE(said("counts 3 entries but subindex 3 does not exist"));
+    EXPECT_TRUE(said("assigns 0x1A07"));
+    EXPECT_TRUE(said("SM2 declares default size 99"));
+    EXPECT_TRUE(said("SM0 declares 0x1800"));
+
+    const auto info = esi::parse_sii(esi::build_sii(desc, dict));
+    EXPECT_TRUE(info.problems.empty());
+    ASSERT_EQ(info.sync_managers.size(), 4u);
+    EXPECT_EQ(info.sync_managers[0].start, desc.standard_mailbox.out_start);
+    EXPECT_EQ(info.sync_managers[2].length, 4);  // 16 + 16 bits actually mapped
+    ASSERT_EQ(info.rx_pdos.size(), 1u);
+    EXPECT_EQ(info.rx_pdos[0].entries.size(), 2u);
+    EXPECT_EQ(info.rx_pdos[0].sm, 2);
+}
+
 TEST(SiiBuild, ContentThatDoesNotFitThrows) {
     const Device d = esi_test::small_device();
     od::DeviceDescription tiny = d.description;
