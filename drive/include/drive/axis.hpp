@@ -1,0 +1,316 @@
+#pragma once
+// One servo axis without any object dictionary: CiA 402 device control, the operating modes, homing, touch
+// probe, error handling, the cascaded control loops and the simulated machine. Drive (drive.hpp) copies the
+// dictionary's values into `Parameters`/`Command` before each cycle and the `Feedback` back after it; tests
+// can drive an Axis directly.
+//
+// Units at this interface are the device units of seed 001 §3.3: position inc, velocity rpm, acceleration
+// rpm/s, torque per mille of the motor rated torque, current mA.
+#include <array>
+#include <cstdint>
+#include <limits>
+
+#include "drive/environment.hpp"
+#include "drive/event_sink.hpp"
+#include "drive/plant.hpp"
+#include "drive/profile.hpp"
+#include "drive/state_machine.hpp"
+
+namespace drive {
+
+namespace mode {
+constexpr int8_t None = 0;
+constexpr int8_t ProfilePosition = 1;
+constexpr int8_t ProfileVelocity = 3;
+constexpr int8_t Homing = 6;
+constexpr int8_t CyclicSyncPosition = 8;
+constexpr int8_t CyclicSyncVelocity = 9;
+constexpr int8_t CyclicSyncTorque = 10;
+bool supported(int8_t m);
+}  // namespace mode
+
+// Configuration objects (defaults = seed 001 defaults, except where noted).
+struct Parameters {
+    // Motor data 0x3001, 0x6402
+    uint16_t nominal_current = 5000;        // :01 mA
+    uint16_t output_current_limit = 15000;  // :02 mA
+    uint8_t pole_pairs = 1;                 // :03
+    uint16_t thermal_time_constant = 40;    // :04 in 100 ms
+    uint32_t torque_constant = 0;           // :05 uNm/A (0 -> 0x8331 on enable)
+    uint16_t motor_type = 10;               // 0x6402
+    // Encoder 0x3010
+    uint32_t encoder_pulses = 500;   // :01 pulses/rev, inc/rev = 4 x
+    uint16_t encoder_type = 0x0001;  // :02 bit0 index present
+    // Current loop 0x30A0 (2^-16 V/A; I gain per 40 us current-loop sample, see decisions)
+    uint32_t current_p = 32768, current_i = 4096, current_ff = 0;
+    // Position (and velocity) loop 0x30A1
+    uint32_t bandwidth = 4000;      // :01 0.001 Hz
+    uint32_t damping = 1000;        // :02 per mille of critical
+    uint32_t reset_time = 1000000;  // :03 us
+    uint32_t inertia = 100000;      // :04 mg cm^2
+    uint32_t friction = 0;          // :05 nNm/rpm (viscous)
+    // Option codes
+    int16_t abort_connection = 3, quick_stop = 6, shutdown = 0, disable_operation = 1, halt = 2,
+            fault_reaction = 2;
+    // Motion limits and profile
+    uint32_t following_error_window = 2000;                      // 0x6065 inc; 0xFFFFFFFF = off
+    uint16_t following_error_timeout = 0;                        // 0x6066 ms
+    int32_t sw_limit_min = std::numeric_limits<int32_t>::min();  // 0x607D:01
+    int32_t sw_limit_max = std::numeric_limits<int32_t>::max();  // 0x607D:02
+    uint32_t max_profile_velocity = 200000;                      // 0x607F rpm
+    uint32_t max_motor_speed = 200000;                           // 0x6080 rpm
+    uint32_t profile_velocity = 1000;                            // 0x6081 rpm
+    uint32_t profile_acceleration = 10000;                       // 0x6083 rpm/s
+    uint32_t profile_deceleration = 10000;                       // 0x6084 rpm/s
+    uint32_t quick_stop_deceleration = 15000;                    // 0x6085 rpm/s
+    uint32_t max_acceleration = 0xFFFFFFFF;                      // 0x60C5 rpm/s
+    // Homing
+    int8_t homing_method = 37;                // 0x6098
+    uint32_t homing_speed_switch = 100;       // 0x6099:01 rpm
+    uint32_t homing_speed_zero = 10;          // 0x6099:02 rpm
+    uint32_t homing_acceleration = 1000;      // 0x609A rpm/s
+    int32_t home_position = 0;                // 0x30B0 inc
+    int32_t home_offset_move = 0;             // 0x30B1 inc
+    uint16_t homing_current_threshold = 500;  // 0x30B2 mA
+    // Interpolation 0x60C2 (value x 10^index s); 0 = no interpolation
+    uint8_t interpolation_value = 1;
+    int8_t interpolation_index = -3;
+    // Standstill 0x30E0
+    uint32_t standstill_window = 30;     // rpm; 0xFFFFFFFF = detection off
+    uint16_t standstill_time = 50;       // ms
+    uint16_t standstill_timeout = 1000;  // ms; 0xFFFF = no timeout
+    // Digital inputs 0x3141:02, 0x3142:01..06
+    uint16_t input_polarity = 0;
+    std::array<uint8_t, 6> input_function{0, 1, 2, 19, 20, 21};
+    int16_t touch_probe_source = 5;  // 0x60D0:01
+};
+
+// Process-data outputs of the master (RxPDO objects).
+struct Command {
+    uint16_t controlword = 0;                // 0x6040
+    int8_t mode = mode::CyclicSyncPosition;  // 0x6060
+    int32_t target_position = 0;             // 0x607A
+    int32_t target_velocity = 0;             // 0x60FF
+    int16_t target_torque = 0;               // 0x6071
+    int32_t position_offset = 0;             // 0x60B0
+    int32_t velocity_offset = 0;             // 0x60B1
+    int16_t torque_offset = 0;               // 0x60B2
+    uint16_t touch_probe_function = 0;       // 0x60B8
+};
+
+// Process-data inputs and other values the drive computes.
+struct Feedback {
+    uint16_t statusword = 0;             // 0x6041
+    int8_t mode_display = 0;             // 0x6061
+    int32_t position_demand = 0;         // 0x6062
+    int32_t position_actual = 0;         // 0x6064 (also 0x60E4:01)
+    int32_t velocity_demand = 0;         // 0x606B
+    int32_t velocity_actual = 0;         // 0x606C (also 0x60E5:01)
+    int32_t velocity_averaged = 0;       // 0x30D5 (also 0x60E5:09)
+    int16_t torque_actual = 0;           // 0x6077
+    int16_t current_actual = 0;          // 0x6078
+    int16_t current_demand = 0;          // 0x30D0
+    int16_t current_averaged = 0;        // 0x30D1
+    int32_t following_error = 0;         // 0x60F4
+    uint32_t motor_rated_torque = 0;     // 0x6076 uNm
+    uint32_t digital_inputs = 0;         // 0x60FD
+    uint16_t input_logic_state = 0;      // 0x3141:01
+    int32_t index_position = 0;          // 0x3010:04
+    uint16_t touch_probe_status = 0;     // 0x60B9
+    int32_t touch_probe_pos = 0;         // 0x60BA
+    int32_t touch_probe_neg = 0;         // 0x60BB
+    uint16_t touch_probe_pos_count = 0;  // 0x60D5
+    uint16_t touch_probe_neg_count = 0;  // 0x60D6
+    uint16_t error_code = 0;             // 0x603F
+    uint8_t error_register = 0;          // 0x1001
+};
+
+// Loop rates: current loop 25 kHz, velocity loop 5 kHz, position loop and trajectory 2.5 kHz; the plant is
+// integrated in 10 us steps.
+constexpr int64_t kCurrentTickNs = 40000;
+constexpr int kPlantStepsPerTick = 4;
+constexpr int kVelocityDivider = 5;
+constexpr int kPositionDivider = 10;
+
+class Axis {
+  public:
+    explicit Axis(EventSink* sink = nullptr);
+
+    Parameters params;
+    Command command;
+    const Feedback& feedback() const { return fb_; }
+
+    Environment& environment() { return env_; }
+    MotorModel& motor() { return motor_; }  // call reconfigure() after changing it
+    void reconfigure() { plant_dirty_ = true; }
+    void set_event_sink(EventSink* s) { sink_ = s ? s : &null_sink_; }
+
+    // One drive cycle: evaluates `command` (written by the master before), runs the loops and the machine for
+    // dt_ns, and updates feedback(). now_ns is the time at the start of the cycle.
+    void cycle(int64_t now_ns, int64_t dt_ns);
+    // The master is gone (SM watchdog, ESM left Op): reaction per 0x6007 with error 0x8180.
+    void connection_lost();
+    // Raise an error from outside (e.g. the communication side); reaction per its class.
+    void raise_error(uint16_t code);
+
+    State state() const { return state_; }
+    int8_t active_mode() const { return mode_; }
+    bool power_on() const { return power_; }
+    bool referenced() const { return referenced_; }
+    bool i2t_limiting() const { return i2t_active_; }
+    double thermal_load() const { return thermal_; }  // I2t state, 1.0 = limit
+    const Plant& plant() const { return plant_; }
+    double position_demand_inc() const { return demand_pos_ + shift_; }  // reported frame, unrounded
+    double raw_position_inc() const;  // exact simulated position in raw increments
+    int64_t home_shift() const { return shift_; }
+    int32_t increments_per_rev() const { return res_; }
+    // Ids of active errors (up to 8), for tests and diagnostics.
+    bool error_active(uint16_t code) const;
+
+  private:
+    enum class Control : uint8_t { Position, Velocity, Torque };
+    enum class StopKind : uint8_t { None, Ramp, Disable };
+    enum class HomingStatus : uint8_t { Idle, InProgress, Done, Error, Interrupted };
+    enum class HomingPhase : uint8_t { Search, Backoff, ToIndex, Offset, Stopping, Finished };
+
+    struct Pending {  // a transition waiting for the drive to stop
+        bool active = false;
+        State to = State::SwitchOnDisabled;
+        int number = -1;
+        int64_t since_ns = 0;
+    };
+
+    void derive();
+    void device_control(int64_t now_ns);
+    void enter(State s, int number);
+    void begin_stop(StopKind kind, double decel_rpm_s, int64_t now_ns);
+    void check_pending(int64_t now_ns);
+    void fault(uint16_t code, int64_t now_ns);
+    void fault_reset();
+    bool cause_present(uint16_t code) const;
+    void mode_commands(int64_t now_ns, int64_t dt_ns);
+    void switch_mode(int8_t m);
+    void trajectory_tick(int64_t t_ns);
+    void position_tick();
+    void velocity_tick();
+    void current_tick(int64_t t_ns);
+    void plant_step(int64_t t_ns, double u);
+    void on_edge(int bit, bool rising, double raw_pos);
+    void tp_latch(bool rising, double raw_pos);
+    void on_index(double raw_pos);
+    void supervise(int64_t now_ns, int64_t dt_ns);
+    void standstill(int64_t dt_ns);
+    void touch_probe_config();
+    void homing_start();
+    void homing_tick(double h);
+    void homing_finish_ok();
+    void homing_fail();
+    void update_feedback();
+    uint64_t functions(uint16_t pins) const;
+    int32_t clamp_i32(double v) const;
+    double rpm_to_inc_s(double rpm) const { return rpm * res_ / 60.0; }
+    double inc_to_rad(double inc) const { return inc * 6.283185307179586 / res_; }
+    double decel_limit(double d) const;
+
+    EventSink* sink_;
+    NullEventSink null_sink_;
+    Environment env_;
+    MotorModel motor_;
+    Plant plant_;
+    Profile profile_;
+    Feedback fb_;
+
+    // configuration derived from params
+    int32_t res_ = 2000;
+    double km_ctrl_ = 0, j_ctrl_ = 1e-5, r_ctrl_ = 0;
+    double kv_ = 0, kiv_ = 0, kpp_ = 0;     // velocity PI (A s/rad, A/rad), position P (1/s)
+    double kpi_ = 0, kii_ = 0, kff_i_ = 0;  // current PI
+    double km_plant_ = -1;
+    bool plant_dirty_ = true;
+
+    // device control
+    State state_ = State::NotReadyToSwitchOn;
+    uint16_t prev_cw_ = 0;
+    bool power_ = false;
+    uint16_t cw_prev_ = 0;  // controlword of the previous cycle (mode bits)
+    Pending pending_;
+    StopKind stop_ = StopKind::None;
+    double stop_decel_ = 0;  // inc/s^2
+    bool ramp_done_ = false;
+    bool fra_ = false;  // fault reaction running
+    bool fra_power_off_ = false;
+    int64_t now_ns_ = 0;
+
+    // errors
+    std::array<uint16_t, 8> active_{};
+    std::array<uint16_t, 8> warnings_{};
+    uint16_t last_error_ = 0;
+    uint8_t error_register_ = 0;
+    bool connection_lost_flag_ = false;
+
+    // modes
+    int8_t mode_ = mode::None;
+    bool halted_ = false;
+    // PPM
+    bool ppm_moving_ = false, ppm_buffered_ = false, ppm_ack_ = false, ppm_reached_ = true;
+    double ppm_target_ = 0, ppm_next_target_ = 0;
+    bool ppm_next_rel_ = false;
+    int32_t ppm_next_raw_ = 0;
+    bool ppm_limited_ = false;
+    // CSP interpolation (raw increments)
+    double ip_from_ = 0, ip_to_ = 0;
+    int64_t ip_t0_ = 0, ip_period_ = 0;
+    bool csp_limit_violation_ = false;
+    // demand (raw increments, inc/s, inc/s^2) and control
+    Control control_ = Control::Position;
+    double demand_pos_ = 0, demand_vel_ = 0, demand_acc_ = 0;
+    double vel_ref_ = 0;      // rad/s, output of the position loop / CSV input
+    double vel_ff_ = 0;       // rad/s
+    double torque_ff_a_ = 0;  // A (current feed-forward)
+    double cur_ref_ = 0;      // A
+    double vel_int_ = 0, cur_int_ = 0;
+    double voltage_ = 0;
+    // observer
+    double obs_pos_ = 0, obs_vel_ = 0;  // rad, rad/s (raw frame)
+    double obs_load_ = 0;               // Nm, estimated load + friction torque
+    double vel_avg_rpm_ = 0, cur_avg_a_ = 0;
+    // encoder
+    int64_t count_ = 0;  // raw encoder count
+    int64_t shift_ = 0;  // reported = raw + shift
+    int64_t index_count_ = 0;
+    double prev_raw_pos_ = 0;
+    uint64_t func_ = 0;  // 0x60FD-style function bits, bit 26 = touch probe input, bits 32..37 = pins
+    uint16_t pins_ = 0;
+    // I2t
+    double thermal_ = 0;
+    bool i2t_active_ = false;
+    // timing
+    int64_t tick_ = 0;
+    int64_t residual_ns_ = 0;
+    // supervision
+    double ferr_time_ms_ = 0;
+    double still_ms_ = 0;
+    bool still_ = false;
+    // touch probe
+    uint16_t tp_prev_fn_ = 0;
+    uint16_t tp_status_ = 0;
+    int32_t tp_pos_ = 0, tp_neg_ = 0;
+    uint16_t tp_pos_cnt_ = 0, tp_neg_cnt_ = 0;
+    // homing
+    HomingStatus hstat_ = HomingStatus::Idle;
+    HomingPhase hphase_ = HomingPhase::Finished;
+    int hdir_ = 1;        // current search direction
+    bool hedge_ = false;  // the awaited event happened
+    double href_ = 0;     // reference point (raw inc)
+    double hevent_pos_ = 0;
+    double hindex_budget_ = 0;
+    int hbit_ = -1;        // function bit awaited (-1 none)
+    bool hrise_ = true;    // awaited edge direction
+    bool hindex_ = false;  // index seen in ToIndex
+    int hsettle_ = 0;      // position ticks at constant search speed (current-threshold methods)
+    double hsearch_origin_ = 0;
+    bool referenced_ = false;
+    int8_t hmethod_ = 0;
+};
+
+}  // namespace drive

@@ -1,0 +1,57 @@
+#pragma once
+// The CiA 402 drive on top of the object dictionary. The process-data cycle (or a test) writes the outputs
+// (0x6040, 0x607A, ...) into the dictionary, then calls Drive::cycle(now, dt) once per cycle; the drive reads
+// its configuration and commands from the dictionary, runs the axis for dt and writes the inputs (0x6041,
+// 0x6064, ...) back. Objects the dictionary does not declare keep the Axis defaults (Parameters), so the
+// drive also runs on a partial dictionary.
+#include <cstdint>
+#include <vector>
+
+#include "drive/axis.hpp"
+#include "drive/event_sink.hpp"
+#include "od/dictionary.hpp"
+
+namespace drive {
+
+class Drive {
+  public:
+    explicit Drive(od::Dictionary& dictionary, EventSink* sink = nullptr);
+
+    void cycle(int64_t now_ns, int64_t dt_ns);
+    // The master is gone: error 0x8180 with the reaction of 0x6007.
+    void connection_lost();
+
+    Axis& axis() { return axis_; }
+    const Axis& axis() const { return axis_; }
+    Environment& environment() { return axis_.environment(); }
+    MotorModel& motor() { return axis_.motor(); }
+    // How many (index, subindex) pairs the drive found in the dictionary, and how many it had to run without.
+    std::size_t bound() const { return bound_; }
+    std::size_t missing() const { return missing_; }
+
+  private:
+    struct Link {
+        od::Ref<uint8_t> r8;
+        od::Ref<uint16_t> r16;
+        od::Ref<uint32_t> r32;
+        uint8_t* field;
+        uint8_t size;
+    };
+    template <typename T>
+    void in(uint16_t index, uint8_t sub, T& field);
+    template <typename T>
+    void out(uint16_t index, uint8_t sub, const T& field);
+    bool locate(uint16_t index, uint8_t sub, std::size_t size, Link& link);
+    static void load(const Link& l);
+    static void store(Link l);
+
+    od::Dictionary& dict_;
+    Axis axis_;
+    std::vector<Link> inputs_;   // dictionary -> axis (parameters, commands)
+    std::vector<Link> outputs_;  // axis -> dictionary (feedback)
+    Feedback fb_copy_;
+    int32_t resolution_ = 0;
+    std::size_t bound_ = 0, missing_ = 0;
+};
+
+}  // namespace drive

@@ -1,0 +1,91 @@
+#include "drive/plant.hpp"
+
+#include <cmath>
+
+namespace drive {
+
+Eigen::MatrixXd expm(const Eigen::MatrixXd& m) {
+    const double norm = m.cwiseAbs().rowwise().sum().maxCoeff();
+    int squarings = 0;
+    if (norm > 0.5) squarings = static_cast<int>(std::ceil(std::log2(norm / 0.5)));
+    const Eigen::MatrixXd a = m / std::ldexp(1.0, squarings);
+    Eigen::MatrixXd term = Eigen::MatrixXd::Identity(m.rows(), m.cols());
+    Eigen::MatrixXd sum = term;
+    for (int k = 1; k <= 18; ++k) {
+        term = term * a / static_cast<double>(k);
+        sum += term;
+    }
+    for (int i = 0; i < squarings; ++i)
+        sum = sum * sum;
+    return sum;
+}
+
+void Plant::configure(const MotorModel& m, double torque_constant, double h) {
+    km_ = torque_constant;
+    j_ = m.rotor_inertia + m.load_inertia;
+    coulomb_ = m.coulomb_friction;
+    h_ = h;
+    l_ = m.inductance;
+    r_ = m.resistance;
+    const double b = m.viscous_friction;
+    // Augmented system [x; u; T]' = [[A, B, E], [0, 0, 0]] [x; u; T] with inputs held over the step.
+    Eigen::MatrixXd aug = Eigen::MatrixXd::Zero(5, 5);
+    aug(0, 0) = -m.resistance / m.inductance;
+    aug(0, 1) = -km_ / m.inductance;
+    aug(1, 0) = km_ / j_;
+    aug(1, 1) = -b / j_;
+    aug(2, 1) = 1.0;
+    aug(0, 3) = 1.0 / m.inductance;
+    aug(1, 4) = 1.0 / j_;
+    const Eigen::MatrixXd e = expm(aug * h);
+    phi_ = e.block<3, 3>(0, 0);
+    gamma_u_ = e.block<3, 1>(0, 3);
+    gamma_t_ = e.block<3, 1>(0, 4);
+    // Power off: mechanics alone, [omega, theta].
+    Eigen::MatrixXd mech = Eigen::MatrixXd::Zero(3, 3);
+    mech(0, 0) = -b / j_;
+    mech(1, 0) = 1.0;
+    mech(0, 2) = 1.0 / j_;
+    const Eigen::MatrixXd em = expm(mech * h);
+    phi_mech_ = em.block<2, 2>(0, 0);
+    gamma_mech_ = em.block<2, 1>(0, 2);
+}
+
+void Plant::step(double u, bool power_on, double load_torque) {
+    const double w0 = x_(1);
+    const double motor_torque = power_on ? km_ * x_(0) : 0.0;
+    // Coulomb friction: opposes motion; at rest it holds as long as the driving torque is below it.
+    double friction;
+    if (w0 != 0.0) {
+        friction = w0 > 0 ? -coulomb_ : coulomb_;
+    } else {
+        const double drive = motor_torque + load_torque;
+        friction = std::abs(drive) <= coulomb_ ? -drive : (drive > 0 ? -coulomb_ : coulomb_);
+    }
+    const double torque = load_torque + friction;
+    if (power_on) {
+        x_ = phi_ * x_ + gamma_u_ * u + gamma_t_ * torque;
+    } else {
+        // Open winding: no current path (the power stage is off), current ends at once.
+        Eigen::Vector2d m(x_(1), x_(2));
+        m = phi_mech_ * m + gamma_mech_ * torque;
+        x_ << 0.0, m(0), m(1);
+    }
+    // Friction cannot reverse the motion within one step: stop at the zero crossing instead.
+    if (w0 != 0.0 && (x_(1) > 0) != (w0 > 0)) {
+        const double drive = (power_on ? km_ * x_(0) : 0.0) + load_torque;
+        if (std::abs(drive) <= coulomb_) x_(1) = 0.0;
+    }
+    at_stop_ = false;
+    if (x_(2) >= hi_) {
+        x_(2) = hi_;
+        if (x_(1) > 0) x_(1) = 0.0;
+        at_stop_ = true;
+    } else if (x_(2) <= lo_) {
+        x_(2) = lo_;
+        if (x_(1) < 0) x_(1) = 0.0;
+        at_stop_ = true;
+    }
+}
+
+}  // namespace drive

@@ -1,0 +1,61 @@
+// Drive on the real drive dictionary: commands in through 0x6040/0x607A..., feedback out through 0x6041...
+#include <gtest/gtest.h>
+
+#include "drive/drive.hpp"
+#include "od/drive_profile.hpp"
+#include "rig.hpp"
+
+using namespace drive;
+
+TEST(DriveOd, RunsCspThroughTheDictionary) {
+    od::Dictionary d = od::make_drive_dictionary(od::default_drive_description());
+    test::Recorder rec;
+    Drive drv(d, &rec);
+    EXPECT_GT(drv.bound(), 80u);
+    ASSERT_EQ(d.set<uint32_t>(0x3001, 5, 25500), od::Status::Ok);
+    ASSERT_EQ(d.set<uint32_t>(0x30A1, 1, 20000), od::Status::Ok);   // 20 Hz
+    ASSERT_EQ(d.set<uint32_t>(0x30A1, 3, 50000), od::Status::Ok);   // 50 ms reset time
+    ASSERT_EQ(d.set<uint32_t>(0x30A1, 4, 188300), od::Status::Ok);  // the simulated inertia
+    ASSERT_EQ(d.set<uint32_t>(0x30A1, 5, 46670), od::Status::Ok);   // and viscous friction
+    int64_t t = 0;
+    auto cycle = [&](uint16_t cw, int n = 1) {
+        d.set<uint16_t>(0x6040, 0, cw);
+        for (int i = 0; i < n; ++i, t += 1'000'000)
+            drv.cycle(t, 1'000'000);
+    };
+    cycle(0x00);
+    EXPECT_EQ(d.get<uint16_t>(0x6041, 0) & 0x6F, 0x40);
+    EXPECT_EQ(d.get<int8_t>(0x6061, 0), 8);  // follows 0x6060 = 8 (default)
+    d.set<int32_t>(0x607A, 0, d.get<int32_t>(0x6064, 0));
+    cycle(0x06);
+    cycle(0x07);
+    cycle(0x0F);
+    EXPECT_EQ(d.get<uint16_t>(0x6041, 0) & 0x6F, 0x27);
+    int32_t target = d.get<int32_t>(0x6064, 0);
+    for (int k = 0; k < 500; ++k) {
+        target += std::min(k, 30);
+        d.set<int32_t>(0x607A, 0, target);
+        cycle(0x0F);
+    }
+    cycle(0x0F, 100);
+    EXPECT_NEAR(d.get<int32_t>(0x6064, 0), target, 5);
+    EXPECT_EQ(d.get<uint16_t>(0x603F, 0), 0);
+    EXPECT_EQ(d.get<uint32_t>(0x6076, 0), 127500u);
+    EXPECT_EQ(d.get<uint32_t>(0x3000, 5), 2000u);
+}
+
+TEST(DriveOd, ConnectionLostWritesTheErrorIntoTheDictionary) {
+    od::Dictionary d = od::make_drive_dictionary(od::default_drive_description());
+    Drive drv(d);
+    d.set<uint32_t>(0x3001, 5, 25500);
+    int64_t t = 0;
+    for (uint16_t cw : {0x06, 0x07, 0x0F}) {
+        d.set<uint16_t>(0x6040, 0, cw);
+        drv.cycle(t, 1'000'000);
+        t += 1'000'000;
+    }
+    drv.connection_lost();
+    EXPECT_EQ(d.get<uint16_t>(0x603F, 0), 0x8180);
+    EXPECT_EQ(d.get<uint8_t>(0x1001, 0), 0x10);
+    EXPECT_EQ(d.get<uint16_t>(0x6041, 0) & 0x4F, 0x0F);  // fault reaction active
+}

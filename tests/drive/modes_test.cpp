@@ -1,0 +1,298 @@
+// Operating modes: CSP, CSV, CST, PPM, PVM, on-the-fly switching, following error, position limits.
+#include "rig.hpp"
+
+using namespace drive;
+using namespace drive::test;
+
+TEST(Modes, DisplayFollowsSupportedModesOnly) {
+    Rig r;
+    EXPECT_EQ(r.fb().mode_display, mode::CyclicSyncPosition);
+    r.ax.command.mode = 2;  // velocity mode: not supported (0x6502 = 0x3A5)
+    r.run(1);
+    EXPECT_EQ(r.fb().mode_display, mode::CyclicSyncPosition);
+    r.ax.command.mode = mode::CyclicSyncTorque;
+    r.run(1);
+    EXPECT_EQ(r.fb().mode_display, mode::CyclicSyncTorque);
+}
+
+TEST(Modes, CspRampIsFollowedWithinTheFollowingErrorWindow) {
+    Rig r;
+    r.enable();
+    // Master trajectory: accelerate at 20000 rpm/s to 1500 rpm, cruise, decelerate; 1 ms set-points.
+    const double res = 2000, acc = 20000.0 / 60 * res, vmax = 1500.0 / 60 * res;  // inc/s^2, inc/s
+    double p = r.fb().position_actual, v = 0;
+    const double start = p;
+    int32_t max_ferr = 0;
+    bool follows = true;
+    for (int k = 0; k < 1200; ++k) {
+        const double vt = k < 900 ? vmax : 0.0;
+        if (v < vt) v = std::min(vt, v + acc * 1e-3);
+        if (v > vt) v = std::max(vt, v - acc * 1e-3);
+        p += v * 1e-3;
+        r.ax.command.target_position = static_cast<int32_t>(std::lround(p));
+        r.run(1);
+        max_ferr = std::max(max_ferr, std::abs(r.fb().following_error));
+        follows = follows && (r.sw() & sw::Bit12);
+    }
+    r.run(200);
+    EXPECT_TRUE(follows);
+    EXPECT_FALSE(r.rec.has(error_code::FollowingError));
+    EXPECT_LT(max_ferr, 2000);
+    EXPECT_GT(p - start, 20000);
+    EXPECT_NEAR(r.fb().position_actual, std::lround(p), 2);
+    EXPECT_FALSE(r.sw() & sw::Bit13);
+}
+
+TEST(Modes, CspVelocityOffsetIsFeedForward) {
+    auto run_with = [](bool ff) {
+        Rig r;
+        r.enable();
+        const double v = 1000.0 / 60 * 2000;  // 1000 rpm in inc/s
+        double p = r.fb().position_actual;
+        int32_t worst = 0;
+        for (int k = 0; k < 600; ++k) {
+            p += v * 1e-3 * std::min(1.0, k / 100.0);
+            r.ax.command.target_position = static_cast<int32_t>(std::lround(p));
+            r.ax.command.velocity_offset = ff ? static_cast<int32_t>(1000 * std::min(1.0, k / 100.0)) : 0;
+            r.run(1);
+            if (k > 400) worst = std::max(worst, std::abs(r.fb().following_error));
+        }
+        return worst;
+    };
+    EXPECT_LT(run_with(true), run_with(false) / 3);
+}
+
+TEST(Modes, CsvStepReachesAndHoldsTheVelocity) {
+    Rig r;
+    r.ax.command.mode = mode::CyclicSyncVelocity;
+    r.enable();
+    r.ax.command.target_velocity = 2000;
+    r.run_ms(300);
+    for (int i = 0; i < 200; ++i) {
+        r.run(1);
+        EXPECT_NEAR(r.rpm(), 2000, 2000 * 0.02);
+    }
+    EXPECT_NEAR(r.fb().velocity_actual, 2000, 40);
+    EXPECT_TRUE(r.sw() & sw::Bit12);
+    EXPECT_EQ(r.fb().velocity_demand, 2000);
+    // The velocity offset adds to the target.
+    r.ax.command.velocity_offset = -500;
+    r.run_ms(300);
+    EXPECT_NEAR(r.rpm(), 1500, 40);
+}
+
+TEST(Modes, CstTorqueGivesTheAccelerationTheInertiaPredicts) {
+    Rig r;
+    r.ax.motor().coulomb_friction = 0;
+    r.ax.motor().viscous_friction = 0;
+    r.ax.reconfigure();
+    r.ax.command.mode = mode::CyclicSyncTorque;
+    r.enable();
+    r.ax.command.target_torque = 100;  // 100 per mille of 5 A x 25.5 mNm/A = 12.75 mNm
+    r.run_ms(20);
+    const double w0 = r.ax.plant().velocity();
+    r.run_ms(100);
+    const double alpha = (r.ax.plant().velocity() - w0) / 0.1;
+    const double j = r.ax.motor().rotor_inertia + r.ax.motor().load_inertia;
+    const double expected = 0.1 * 5.0 * 0.0255 / j;
+    EXPECT_NEAR(alpha, expected, expected * 0.03);
+    EXPECT_NEAR(r.fb().torque_actual, 100, 5);
+    EXPECT_NEAR(r.fb().current_actual, 500, 20);
+    EXPECT_EQ(r.fb().motor_rated_torque, 127500u);
+    // The torque offset adds.
+    r.ax.command.target_torque = 0;
+    r.ax.command.torque_offset = -100;
+    r.run_ms(10);
+    EXPECT_NEAR(r.fb().current_actual, -500, 20);
+}
+
+TEST(Modes, PpmAbsoluteMoveWithSetpointHandshake) {
+    Rig r;
+    r.ax.command.mode = mode::ProfilePosition;
+    r.ax.params.profile_velocity = 2000;
+    r.ax.params.profile_acceleration = 20000;
+    r.ax.params.profile_deceleration = 20000;
+    r.enable();
+    const int32_t start = r.fb().position_actual;
+    r.ax.command.target_position = start + 10000;
+    r.cw(0x1F);
+    EXPECT_TRUE(r.sw() & sw::Bit12);  // set-point acknowledged
+    EXPECT_FALSE(r.sw() & sw::TargetReached);
+    r.cw(0x0F);
+    EXPECT_FALSE(r.sw() & sw::Bit12);  // ready for the next one
+    // Peak demand velocity = 0x6081.
+    int32_t vmax = 0;
+    ASSERT_TRUE(r.until(
+        [&] {
+            vmax = std::max(vmax, r.fb().velocity_demand);
+            return (r.sw() & sw::TargetReached) != 0;
+        },
+        2000));
+    EXPECT_NEAR(vmax, 2000, 20);
+    EXPECT_EQ(r.fb().position_demand, start + 10000);
+    r.run_ms(200);
+    EXPECT_NEAR(r.fb().position_actual, start + 10000, 5);
+}
+
+TEST(Modes, PpmRelativeAndChangeImmediately) {
+    Rig r;
+    r.ax.command.mode = mode::ProfilePosition;
+    r.ax.params.profile_velocity = 1000;
+    r.enable();
+    const int32_t start = r.fb().position_actual;
+    r.ax.command.target_position = 4000;
+    r.cw(0x5F);  // relative
+    r.cw(0x0F);
+    ASSERT_TRUE(r.until([&] { return (r.sw() & sw::TargetReached) != 0; }, 3000));
+    EXPECT_EQ(r.fb().position_demand, start + 4000);
+    // A long move, replaced half-way by an immediate new target behind us.
+    r.ax.command.target_position = start + 40000;
+    r.cw(0x1F);
+    r.cw(0x0F);
+    r.run_ms(300);
+    r.ax.command.target_position = start;
+    r.cw(0x3F);
+    r.cw(0x0F);
+    ASSERT_TRUE(r.until([&] { return (r.sw() & sw::TargetReached) != 0; }, 5000));
+    EXPECT_EQ(r.fb().position_demand, start);
+}
+
+TEST(Modes, PpmBufferedSetpointRunsAfterTheFirst) {
+    Rig r;
+    r.ax.command.mode = mode::ProfilePosition;
+    r.ax.params.profile_velocity = 3000;
+    r.ax.params.profile_acceleration = 30000;
+    r.ax.params.profile_deceleration = 30000;
+    r.enable();
+    const int32_t start = r.fb().position_actual;
+    r.ax.command.target_position = start + 6000;
+    r.cw(0x1F);
+    r.cw(0x0F);
+    r.run_ms(20);
+    r.ax.command.target_position = start - 2000;
+    r.cw(0x1F);  // not immediate: buffered, acknowledged
+    EXPECT_TRUE(r.sw() & sw::Bit12);
+    r.cw(0x0F);
+    EXPECT_TRUE(r.sw() & sw::Bit12);  // buffer full: no further set-point accepted yet
+    int32_t furthest = start;
+    ASSERT_TRUE(r.until(
+        [&] {
+            furthest = std::max(furthest, r.fb().position_demand);
+            return (r.sw() & sw::TargetReached) != 0 && r.fb().position_demand == start - 2000;
+        },
+        5000));
+    EXPECT_EQ(furthest, start + 6000);  // the first move completed first
+    EXPECT_FALSE(r.sw() & sw::Bit12);
+}
+
+TEST(Modes, PpmTargetClampedBySoftwareLimitSetsInternalLimit) {
+    Rig r;
+    r.ax.command.mode = mode::ProfilePosition;
+    const int32_t start = r.fb().position_actual;
+    r.ax.params.sw_limit_max = start + 3000;
+    r.enable();
+    r.ax.command.target_position = start + 9000;
+    r.cw(0x1F);
+    r.cw(0x0F);
+    ASSERT_TRUE(r.until([&] { return (r.sw() & sw::TargetReached) != 0; }, 3000));
+    EXPECT_EQ(r.fb().position_demand, start + 3000);
+    EXPECT_TRUE(r.sw() & sw::InternalLimit);
+}
+
+TEST(Modes, PvmReachesVelocityAndReportsSpeedZero) {
+    Rig r;
+    r.ax.command.mode = mode::ProfileVelocity;
+    r.ax.params.profile_acceleration = 10000;
+    r.enable();
+    EXPECT_TRUE(r.sw() & sw::Bit12);  // speed = 0
+    r.ax.command.target_velocity = -1000;
+    r.run(1);
+    EXPECT_FALSE(r.sw() & sw::TargetReached);
+    r.run_ms(80);
+    EXPECT_NEAR(r.fb().velocity_demand, -800, 30);  // 10000 rpm/s ramp
+    ASSERT_TRUE(r.until([&] { return (r.sw() & sw::TargetReached) != 0; }, 500));
+    r.run_ms(100);
+    EXPECT_NEAR(r.rpm(), -1000, 20);
+    EXPECT_FALSE(r.sw() & sw::Bit12);
+}
+
+TEST(Modes, SwitchingOnTheFlyFromCspToCsvKeepsMoving) {
+    Rig r;
+    r.enable();
+    double p = r.fb().position_actual;
+    for (int k = 0; k < 500; ++k) {
+        p += 1000.0 / 60 * 2000 * 1e-3 * std::min(1.0, k / 200.0);
+        r.ax.command.target_position = static_cast<int32_t>(std::lround(p));
+        r.ax.command.velocity_offset = static_cast<int32_t>(1000 * std::min(1.0, k / 200.0));
+        r.run(1);
+    }
+    EXPECT_NEAR(r.rpm(), 1000, 50);
+    r.ax.command.mode = mode::CyclicSyncVelocity;
+    r.ax.command.target_velocity = 1000;
+    r.ax.command.velocity_offset = 0;
+    for (int k = 0; k < 50; ++k) {
+        r.run(1);
+        EXPECT_NEAR(r.rpm(), 1000, 60);
+    }
+    EXPECT_EQ(r.fb().mode_display, mode::CyclicSyncVelocity);
+    EXPECT_EQ(r.ax.state(), State::OperationEnabled);
+}
+
+TEST(Modes, FollowingErrorRaises8611AndRunsTheFaultReaction) {
+    Rig r;
+    r.enable();
+    r.ax.command.target_position = r.fb().position_actual + 5000;  // a jump the loop cannot follow
+    r.run(1);
+    EXPECT_TRUE(r.rec.has(error_code::FollowingError));
+    EXPECT_EQ(r.fb().error_code, 0x8611);
+    EXPECT_EQ(r.fb().error_register, 0x80);
+    EXPECT_EQ(r.ax.state(), State::FaultReactionActive);
+    ASSERT_TRUE(r.until([&] { return r.ax.state() == State::Fault; }, 1000));
+    r.cw(0x00);
+    r.cw(0x80);
+    EXPECT_EQ(r.ax.state(), State::SwitchOnDisabled);
+}
+
+TEST(Modes, FollowingErrorTimeoutDelaysTheError) {
+    Rig r;
+    r.ax.params.following_error_window = 100;
+    r.ax.params.following_error_timeout = 5;
+    r.enable();
+    r.ax.command.target_position = r.fb().position_actual + 150;
+    r.run(1);
+    EXPECT_TRUE(r.sw() & sw::Bit13);  // window exceeded, reported
+    EXPECT_FALSE(r.rec.has(error_code::FollowingError));
+    r.run(3);
+    EXPECT_FALSE(r.rec.has(error_code::FollowingError));  // the loop pulled it back in time
+}
+
+TEST(Modes, CspTargetOutsideSoftwareLimitRaises8A82) {
+    Rig r;
+    const int32_t start = r.fb().position_actual;
+    r.ax.params.sw_limit_min = start - 1000;
+    r.ax.params.sw_limit_max = start + 1000;
+    r.enable();
+    r.ax.command.target_position = start + 1001;
+    r.run(1);
+    EXPECT_TRUE(r.rec.has(error_code::SoftwarePositionLimit));
+}
+
+TEST(Modes, LimitSwitchRaises8A81WhenDrivingIntoIt) {
+    Rig r;
+    r.ax.environment().set_positive_limit(3000);
+    r.ax.command.mode = mode::ProfileVelocity;
+    r.enable();
+    r.ax.command.target_velocity = 300;
+    ASSERT_TRUE(r.until([&] { return r.rec.has(error_code::PositiveLimitSwitch); }, 3000));
+    EXPECT_TRUE(r.fb().digital_inputs & 0x2);
+    EXPECT_GE(r.ax.raw_position_inc(), 2999);
+    ASSERT_TRUE(r.until([&] { return r.ax.state() == State::Fault; }, 1000));
+    // After the reset the axis may leave the switch the other way.
+    r.cw(0x00);
+    r.cw(0x80);
+    r.ax.command.target_velocity = -300;
+    r.cw(0x06);
+    r.cw(0x0F);
+    ASSERT_TRUE(r.until([&] { return !(r.fb().digital_inputs & 0x2); }, 2000));
+    EXPECT_EQ(r.ax.state(), State::OperationEnabled);
+}
