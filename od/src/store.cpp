@@ -340,7 +340,7 @@ std::string ParameterStore::restore_defaults(const Dictionary& dict, StoreScope 
     return write_atomic(serialize(dict, keep));
 }
 
-void attach_store(Dictionary& dict, ParameterStore& store) {
+void attach_store(Dictionary& dict, ParameterStore& store, std::function<Status()> restore_allowed) {
     struct Command {
         uint16_t index;
         bool save;
@@ -352,22 +352,25 @@ void attach_store(Dictionary& dict, ParameterStore& store) {
         if (!dict.find(cmd.index)) continue;
         Dictionary* d = &dict;
         ParameterStore* s = &store;
-        dict.add_validator(cmd.index, [d, s, cmd](const Entry& e, std::span<const uint8_t> v) {
-            if (e.subindex == 0 || v.size() != 4) return Status::Ok;
-            StoreScope scope = StoreScope::All;
-            if (e.subindex == 2)
-                scope = StoreScope::Communication;
-            else if (e.subindex == (cmd.cia ? 3 : 6))
-                scope = StoreScope::Application;
-            else if (e.subindex != 1)
-                return Status::InvalidValue;
-            uint32_t sig;
-            std::memcpy(&sig, v.data(), 4);
-            if (sig != (cmd.save ? kSignatureSave : kSignatureLoad)) return Status::CannotStore;
-            const std::string err = cmd.save ? s->save(*d, scope) : s->restore_defaults(*d, scope);
-            if (!cmd.cia) d->ref<uint32_t>(e.index, e.subindex).set(err.empty() ? 0x1u : 0x2u);
-            return err.empty() ? Status::Ok : Status::HardwareError;
-        });
+        dict.add_validator(
+            cmd.index, [d, s, cmd, restore_allowed](const Entry& e, std::span<const uint8_t> v) {
+                if (e.subindex == 0 || v.size() != 4) return Status::Ok;
+                StoreScope scope = StoreScope::All;
+                if (e.subindex == 2)
+                    scope = StoreScope::Communication;
+                else if (e.subindex == (cmd.cia ? 3 : 6))
+                    scope = StoreScope::Application;
+                else if (e.subindex != 1)
+                    return Status::InvalidValue;
+                uint32_t sig;
+                std::memcpy(&sig, v.data(), 4);
+                if (sig != (cmd.save ? kSignatureSave : kSignatureLoad)) return Status::CannotStore;
+                if (!cmd.save && restore_allowed)
+                    if (const Status st = restore_allowed(); st != Status::Ok) return st;
+                const std::string err = cmd.save ? s->save(*d, scope) : s->restore_defaults(*d, scope);
+                if (!cmd.cia) d->ref<uint32_t>(e.index, e.subindex).set(err.empty() ? 0x1u : 0x2u);
+                return err.empty() ? Status::Ok : Status::HardwareError;
+            });
         // After a command the entry reads as capability (CiA 301) or state "done" (maxon), not the signature.
         dict.add_listener(cmd.index, [d](const Entry& e) {
             if (e.subindex != 0) d->ref<uint32_t>(e.index, e.subindex).set(0x1u);

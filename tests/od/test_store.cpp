@@ -325,3 +325,17 @@ TEST_F(StoreTest, SdoStoreFailureIsAHardwareErrorAndShowsInTheState) {
     EXPECT_EQ(d.write(0x2110, 1, AlState::PreOp, save), Status::HardwareError);
     EXPECT_EQ(d.get<uint32_t>(0x2110, 1), 2u);  // bit 1: error during store
 }
+
+TEST_F(StoreTest, RestoreWaitsForThePowerDisableCondition) {
+    Dictionary d = make_drive_dictionary(desc);
+    ParameterStore store(dir);
+    bool power_disabled = false;
+    attach_store(d, store, [&] { return power_disabled ? Status::Ok : Status::WrongState; });
+    ASSERT_EQ(store.save(d), "");
+    const std::vector<uint8_t> load{0x6C, 0x6F, 0x61, 0x64};  // "load"
+    EXPECT_EQ(d.write(0x2111, 1, AlState::PreOp, load), Status::WrongState);
+    EXPECT_TRUE(fs::exists(store.file()));
+    power_disabled = true;
+    EXPECT_EQ(d.write(0x2111, 1, AlState::PreOp, load), Status::Ok);
+    EXPECT_FALSE(fs::exists(store.file()));
+}

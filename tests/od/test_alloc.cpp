@@ -1,0 +1,52 @@
+// The per-frame / per-cycle paths of the dictionary allocate nothing: read, write (with validators and
+// listeners), set, Ref<T>, lookup.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#include "od/drive_profile.hpp"
+
+namespace {
+std::atomic<long> g_allocations{0};
+}
+
+void* operator new(std::size_t n) {
+    ++g_allocations;
+    if (void* p = std::malloc(n ? n : 1)) return p;
+    throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept {
+    std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+    std::free(p);
+}
+
+TEST(OdAlloc, AccessPathsAllocateNothing) {
+    od::Dictionary d = od::make_drive_dictionary(od::default_drive_description());
+    int heard = 0;
+    d.add_listener(0x6040, [&heard](const od::Entry&) { ++heard; });
+    d.add_validator(0x6040, [](const od::Entry&, std::span<const uint8_t>) { return od::Status::Ok; });
+    auto pos = d.ref<int32_t>(0x6064, 0);
+    uint8_t out[64];
+    std::size_t len = 0;
+    const uint8_t cw[2] = {0x0F, 0x00};
+    const uint8_t mode[1] = {9};
+    const long before = g_allocations.load();
+    ASSERT_GT(before, 0);  // the counting operator new is the one in use
+    for (int i = 0; i < 1000; ++i) {
+        ASSERT_EQ(d.write(0x6040, 0, od::AlState::Op, cw), od::Status::Ok);
+        ASSERT_EQ(d.write(0x6060, 0, od::AlState::Op, mode), od::Status::Ok);  // value-set validator
+        ASSERT_EQ(d.read(0x6041, 0, od::AlState::Op, out, len), od::Status::Ok);
+        ASSERT_EQ(d.read(0x1008, 0, od::AlState::Op, out, len), od::Status::Ok);
+        ASSERT_EQ(d.set<int32_t>(0x6064, 0, i), od::Status::Ok);
+        pos.set(pos.get() + 1);
+        ASSERT_NE(d.find(0x1A00, 3), nullptr);
+        ASSERT_FALSE(d.raw(0x607A, 0).empty());
+        ASSERT_EQ(d.write(0x6060, 0, od::AlState::Op, cw), od::Status::LengthTooHigh);
+    }
+    EXPECT_EQ(g_allocations.load() - before, 0);
+    EXPECT_EQ(heard, 1000);
+}
