@@ -198,4 +198,30 @@ TEST_P(WithSlave, RefusedStateReportsTheAlCode) {
     EXPECT_EQ(m.request_state(a, AlState::Init), Error::Ok);
 }
 
+TEST_P(WithSlave, ASecondMasterProcessAdoptsTheMailboxAndIsNotTakenForARepeat) {
+    uint8_t b[4];
+    ASSERT_TRUE(sdo.upload(0x1018, 1, b).ok());  // the slave now remembers counter 1
+    // A new process: fresh Mailbox, counter state lost, slave still in PREOP.
+    Mailbox again(m, a);
+    ASSERT_EQ(again.adopt_current(), Error::Ok);
+    EXPECT_EQ(again.config().out_size, GetParam());
+    SdoClient sdo2(again);
+    for (int i = 0; i < 9; ++i) {
+        auto n = sdo2.upload(0x1018, 1, b);
+        ASSERT_TRUE(n.ok()) << i << ": " << to_string(n.error());
+        EXPECT_EQ(b[0], 0xFB);
+    }
+}
+
+TEST_P(WithSlave, AdoptRefusesAMailboxThatIsNotSetUp) {
+    ASSERT_EQ(m.request_state(a, AlState::Init), Error::Ok);
+    const uint8_t off[16] = {};
+    ASSERT_EQ(m.write(a, reg::Sm0, off), Error::Ok);
+    Mailbox again(m, a);
+    EXPECT_EQ(again.adopt_current(), Error::MailboxNotConfigured);
+    SdoClient none(again);
+    uint8_t b[4];
+    EXPECT_EQ(none.upload(0x1018, 1, b).error(), Error::MailboxNotConfigured);
+}
+
 INSTANTIATE_TEST_SUITE_P(MailboxSizes, WithSlave, ::testing::Values(uint16_t{128}, uint16_t{32}));

@@ -54,6 +54,7 @@ Error Mailbox::configure(const MailboxConfig& c) {
     tx_.assign(c.out_size, 0);
     rx_.assign(c.in_size, 0);
     counter_ = 0;
+    send_zero_ = false;
     return Error::Ok;
 }
 
@@ -71,6 +72,12 @@ Error Mailbox::adopt_current() {
     config_ = c;
     tx_.assign(c.out_size, 0);
     rx_.assign(c.in_size, 0);
+    // The slave remembers the counter of the last request it took, which another master process may
+    // have sent; a first request with that counter would be dropped as a repeat. Counter 0 ("not
+    // used", §8.1) is never a repeat, and 1, 2, ... follow it.
+    counter_ = 0;
+    send_zero_ = true;
+    drain();  // an answer an earlier process abandoned is not ours
     return Error::Ok;
 }
 
@@ -87,7 +94,9 @@ Error Mailbox::send(MailboxType type, std::span<const uint8_t> payload) {
     put16(tx_.data(), static_cast<uint16_t>(payload.size()));
     put16(tx_.data() + 2, 0);
     tx_[4] = 0;
-    tx_[5] = static_cast<uint8_t>(static_cast<uint8_t>(type) | (next_counter() << 4));
+    const uint8_t counter = send_zero_ ? 0 : next_counter();
+    send_zero_ = false;
+    tx_[5] = static_cast<uint8_t>(static_cast<uint8_t>(type) | (counter << 4));
     std::copy(payload.begin(), payload.end(), tx_.begin() + 6);
     const auto deadline = Clock::now() + timeout_;
     for (;;) {

@@ -86,6 +86,7 @@ class Mailbox {
     std::vector<uint8_t> tx_;
     std::vector<uint8_t> rx_;
     uint8_t counter_ = 0;
+    bool send_zero_ = false;       // next request goes out with counter 0 (after adopt_current)
     uint8_t last_rx_counter_ = 0;  // counter of the last message received (repeat duplicates)
     uint64_t repeats_ = 0;
 };
