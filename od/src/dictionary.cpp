@@ -279,6 +279,10 @@ void Dictionary::add(Object object) {
         }
         if (object.entries[0].type != DataType::Unsigned8)
             declaration_error(object.entries[0], "sub-index 0 of an ARRAY/RECORD must be UNSIGNED8");
+        if (object.code == ObjectCode::Array)
+            for (std::size_t i = 1; i < object.entries.size(); ++i)
+                if (object.entries[i].type != object.type)
+                    declaration_error(object.entries[i], "ARRAY element of another type than the array's");
     }
     // Storage: each entry aligned to its natural size (max 8); strings get a 2-byte length prefix.
     for (auto& e : object.entries) {

@@ -129,6 +129,23 @@ TEST(OdDictionary, DeclarationErrorsThrow) {
                  std::logic_error);
     // VAR must have exactly subindex 0
     EXPECT_THROW(d.add(var(0x3003, entry(1, DataType::Unsigned8, access::RO))), std::logic_error);
+    // ARRAY elements share the array's type; sub-index 0 is UNSIGNED8
+    Object arr;
+    arr.index = 0x3004;
+    arr.code = ObjectCode::Array;
+    arr.type = DataType::Unsigned16;
+    arr.entries.push_back(entry(1, DataType::Unsigned16, access::RO));
+    arr.entries.push_back(entry(2, DataType::Unsigned32, access::RO));
+    EXPECT_THROW(d.add(arr), std::logic_error);
+    arr.entries[1].type = DataType::Unsigned16;
+    arr.entries.push_back(entry(0, DataType::Unsigned16, access::RO, uint64_t{2}));
+    EXPECT_THROW(d.add(arr), std::logic_error);
+    arr.entries.pop_back();
+    arr.entries.push_back(entry(2, DataType::Unsigned16, access::RO));  // duplicate subindex
+    EXPECT_THROW(d.add(arr), std::logic_error);
+    arr.entries.pop_back();
+    d.add(arr);
+    EXPECT_EQ(d.get<uint8_t>(0x3004, 0), 2);
     EXPECT_EQ(d.find(0x3000), nullptr);
 }
 
