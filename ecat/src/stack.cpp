@@ -505,8 +505,14 @@ void Stack::check_process_data_sms(uint64_t now_ns) {
     }
 }
 
-bool Stack::op_conditions_met() const {
-    if (pd_.rx_bytes() > 0 && !outputs_seen_) return false;
+bool Stack::op_conditions_met() {
+    if (pd_.rx_bytes() > 0) {
+        if (!outputs_seen_) return false;
+        // Outputs seen once but since stopped: the process-data watchdog says they are stale.
+        const bool watched = (read_sm(2).control & reg::kSmWatchdogEnable) &&
+                             pdi_.read_reg<uint16_t>(reg::kWatchdogTimePd) != 0;
+        if (watched && !(pdi_.read_reg<uint16_t>(reg::kWatchdogStatusPd) & 0x0001)) return false;
+    }
     if ((sync_mode_ == SyncMode::DcSync0 || sync_mode_ == SyncMode::DcSync1) && !sync0_seen_) return false;
     return true;
 }

@@ -385,6 +385,20 @@ TEST_F(Esm, SO_SafeOpToOp_NoOutputs_0x001B) {
     EXPECT_EQ(al_code(), 0x001B);
 }
 
+TEST_F(Esm, SO_SafeOpToOp_StaleOutputs_WaitsThen0x001B) {
+    go_safeop();
+    std::vector<uint8_t> out(6, 0), in(6, 0);
+    exchange_pd(out, in);
+    poll();
+    advance(150'000'000);  // the master stopped sending: the PD watchdog expires in Safe-Op
+    ASSERT_EQ(al_status(), 0x04);
+    request(0x08);
+    EXPECT_EQ(al_status(), 0x04);  // not with stale outputs
+    exchange_pd(out, in);          // fresh outputs re-arm the watchdog
+    poll();
+    EXPECT_EQ(al_status(), 0x08);
+}
+
 TEST_F(Esm, SO_SafeOpToOp_ApplicationVeto) {
     go_safeop();
     app.veto_state = AlState::Op;

@@ -92,7 +92,7 @@ class Stack {
     uint16_t check_pre_op_to_safe_op();
     uint16_t check_sync_configuration();
     uint16_t check_watchdog();
-    bool op_conditions_met() const;
+    bool op_conditions_met();
     void check_process_data_sms(uint64_t now_ns);
     void try_complete_op(uint64_t now_ns);
 
