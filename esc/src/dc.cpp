@@ -68,14 +68,17 @@ void Esc::Impl::dc_system_time_written(uint32_t received) {
         const double dt = static_cast<double>(frame_local - dc_prev_local);
         const uint16_t start = r16(reg::kDcSpeedStart) & 0x7FFF;
         const double max_rate = 1.0 / std::max<uint16_t>(start, 1);  // bandwidth: 0x1000 -> 244 ppm
-        // Integral gain from the speed counter filter depth 0x0935 (default 12 -> 1/16), kept stable (<=
-        // 1/4).
+        // PI loop. Proportional gain 2^-d1 (0x0934, default 4 -> 1/16 of the error per interval), integral
+        // gain 2^-(d2-2) (0x0935, default 12 -> 1/1024): critically damped for the defaults, and kept below
+        // half the proportional gain so that any register setting stays stable.
         const int d2 = r8(reg::kDcFilterSpeed) & 0x0F;
-        const int ki_shift = std::clamp(d2 - 8, 2, 15);
+        const int kp_shift = static_cast<int>(d1);
+        const int ki_shift = std::max(d2 - 2, kp_shift + 1);
         const double ratio = e / dt;
         rate_integral =
             std::clamp(rate_integral - ratio / static_cast<double>(1u << ki_shift), -max_rate, max_rate);
-        const double r = std::clamp(rate_integral - 0.5 * ratio, -max_rate, max_rate);
+        const double r =
+            std::clamp(rate_integral - ratio / static_cast<double>(1u << kp_shift), -max_rate, max_rate);
         set_rate(r, frame_clock);
         // 0x0932: the drift estimate in units of 0.1 ppm.
         const double sd = std::clamp(rate_integral * 1e7, -32768.0, 32767.0);

@@ -104,6 +104,23 @@ TEST_F(DcTest, DriftLoopFollowsSlowerOscillator) {
     EXPECT_NEAR(static_cast<int16_t>(fprd(*e, 0x0932, 2).u16()), 200, 20);
 }
 
+TEST_F(DcTest, DriftLoopToleratesTimestampJitter) {
+    // Receive timestamps with +-2 us jitter (a user-space link): the drift estimate stays close and the
+    // clock does not run away.
+    uint64_t ref = clk.now_ns();
+    uint32_t s = 99;
+    for (int i = 0; i < 6000; ++i) {
+        clk.advance(1'000'030);  // 30 ppm fast
+        ref += 1'000'000;
+        s = s * 1103515245u + 12345u;
+        const uint64_t jitter = (s >> 8) % 4001;  // the frame is seen 0..4 us late
+        run1(*e, dg(FRMW, 0x7777, 0x0910, le(ref, 8)), clk.now_ns() + jitter);
+    }
+    EXPECT_NEAR(static_cast<int16_t>(fprd(*e, 0x0932, 2).u16()), -300, 60);
+    // Mean phase error stays within the jitter band.
+    EXPECT_LT(fprd(*e, 0x092C, 4).u32() & 0x7FFFFFFF, 4000u);
+}
+
 TEST_F(DcTest, ReferenceClockReadIsNotWritten) {
     run1(*e, dg(FRMW, 0x1001, 0x0910, le(12345, 8)));
     EXPECT_EQ(fprd(*e, 0x092C, 4).u32(), 0u);
