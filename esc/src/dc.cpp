@@ -75,10 +75,13 @@ void Esc::Impl::dc_system_time_written(uint32_t received) {
         const int kp_shift = static_cast<int>(d1);
         const int ki_shift = std::max(d2 - 2, kp_shift + 1);
         const double ratio = e / dt;
-        rate_integral =
-            std::clamp(rate_integral - ratio / static_cast<double>(1u << ki_shift), -max_rate, max_rate);
-        const double r =
-            std::clamp(rate_integral - ratio / static_cast<double>(1u << kp_shift), -max_rate, max_rate);
+        const double p = ratio / static_cast<double>(1u << kp_shift);
+        // No integration while the proportional term alone saturates (a large phase error is being slewed
+        // away, e.g. before the master wrote the offset): the drift estimate does not wind up.
+        if (std::fabs(p) < max_rate)
+            rate_integral =
+                std::clamp(rate_integral - ratio / static_cast<double>(1u << ki_shift), -max_rate, max_rate);
+        const double r = std::clamp(rate_integral - p, -max_rate, max_rate);
         set_rate(r, frame_clock);
         // 0x0932: the drift estimate in units of 0.1 ppm.
         const double sd = std::clamp(rate_integral * 1e7, -32768.0, 32767.0);

@@ -121,6 +121,21 @@ TEST_F(DcTest, DriftLoopToleratesTimestampJitter) {
     EXPECT_LT(fprd(*e, 0x092C, 4).u32() & 0x7FFFFFFF, 4000u);
 }
 
+TEST_F(DcTest, NoWindUpBeforeOffsetIsSet) {
+    // The master writes the system time before it has set this slave's offset: 10 ms apart. The clock is
+    // slewed at most by the bandwidth, and the drift estimate is not touched.
+    uint64_t ref = clk.now_ns() + 10'000'000;
+    for (int i = 0; i < 100; ++i) {
+        clk.advance(1'000'000);
+        ref += 1'000'000;
+        run1(*e, dg(FRMW, 0x7777, 0x0910, le(ref, 8)));
+    }
+    EXPECT_EQ(fprd(*e, 0x0932, 2).u16(), 0);
+    const uint64_t l0 = e->local_time_ns();
+    clk.advance(1'000'000);
+    EXPECT_EQ(e->local_time_ns() - l0, 1'000'244u);  // +244 ppm: speeding up towards the reference
+}
+
 TEST_F(DcTest, ReferenceClockReadIsNotWritten) {
     run1(*e, dg(FRMW, 0x1001, 0x0910, le(12345, 8)));
     EXPECT_EQ(fprd(*e, 0x092C, 4).u32(), 0u);
