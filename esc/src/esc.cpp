@@ -118,7 +118,7 @@ void Esc::Impl::init_tables() {
     ecat(reg::kWdTimePdi, 2, kPlain);
     ecat(reg::kWdTimePd, 2, kPlain);
     ecat(reg::kWdCounterPd, 2, kSpecial);
-    ecat(reg::kSiiConfig, 1, kPlain, 0x03);
+    ecat(reg::kSiiConfig, 1, kSpecial);
     ecat(reg::kSiiControl, 2, kSpecial);
     ecat(reg::kSiiAddress, 12, kSpecial);  // address + data: blocked while busy / PDI owns the interface
     ecat(0x0510, 1, kPlain, 0x01);         // MII: inert, stored

@@ -243,6 +243,12 @@ void Esc::Impl::reg_special_write(uint16_t a, uint16_t e, const uint8_t* src, co
             regs[reg::kWdCounterPd] = 0;
             regs[reg::kWdCounterPdi] = 0;
         }
+        if (hit(reg::kSiiConfig, 1)) {
+            const uint8_t v = static_cast<uint8_t>(M(reg::kSiiConfig, 1) & 0x03);
+            w8(reg::kSiiConfig, v);
+            // Force ECAT access: takes the interface back from the PDI.
+            if (v & 0x02) w8(reg::kSiiPdiAccess, static_cast<uint8_t>(r8(reg::kSiiPdiAccess) & ~0x01));
+        }
         const bool pdi_owns_sii = (r8(reg::kSiiConfig) & 0x01) && (r8(reg::kSiiPdiAccess) & 0x01);
         const bool sii_busy = r16(reg::kSiiControl) & 0x8000;
         if (hit(reg::kSiiAddress, 12) && !pdi_owns_sii && !sii_busy) {

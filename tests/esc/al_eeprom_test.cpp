@@ -192,6 +192,21 @@ TEST_F(EscTest, WriteWithoutEnableIsAnError) {
     EXPECT_EQ(fprd(*e, 0x0502, 2).u16() & 0x0001, 0);  // write enable consumed
 }
 
+TEST_F(EscTest, PdiOwnedInterfaceAndForcedEcatAccess) {
+    fpwr(*e, 0x0500, {0x01});             // offer the interface to the PDI
+    e->write_reg<uint8_t>(0x0501, 0x01);  // the PDI takes it
+    fpwr(*e, 0x0502, {0x00, 0x01, 0x08, 0x00, 0x00, 0x00});
+    EXPECT_EQ(fprd(*e, 0x0504, 4).u32(), 0u);  // ECAT command and address ignored
+    // The PDI reads word 0 itself (command runs at once).
+    e->write(0x0502, std::vector<uint8_t>{0x00, 0x01, 0x00, 0x00, 0x00, 0x00});
+    EXPECT_EQ(e->read_reg<uint16_t>(0x0508), e->eeprom()[0] | (e->eeprom()[1] << 8));
+    fpwr(*e, 0x0500, {0x03});  // force ECAT access
+    EXPECT_EQ(e->read_reg<uint8_t>(0x0501) & 0x01, 0);
+    fpwr(*e, 0x0500, {0x00});
+    fpwr(*e, 0x0502, {0x00, 0x01, 0x3E, 0x00, 0x00, 0x00});
+    EXPECT_EQ(fprd(*e, 0x0508, 2).u16(), 0x000F);
+}
+
 TEST_F(EscTest, InvalidCommandSetsError) {
     fpwr(*e, 0x0502, {0x00, 0x07});
     EXPECT_EQ(fprd(*e, 0x0502, 2).u16() & 0x2000, 0x2000);
