@@ -72,7 +72,8 @@ void Esc::Impl::dc_system_time_written(uint32_t received) {
         // gain 2^-(d2-2) (0x0935, default 12 -> 1/1024): critically damped for the defaults, and kept below
         // half the proportional gain so that any register setting stays stable.
         const int d2 = r8(reg::kDcFilterSpeed) & 0x0F;
-        const int kp_shift = static_cast<int>(d1);
+        // Depths below 4 act as 4: silicon timestamps are exact, ours jitter by microseconds (SOEM writes 0).
+        const int kp_shift = std::max(static_cast<int>(d1), 4);
         const int ki_shift = std::max(d2 - 2, kp_shift + 1);
         const double ratio = e / dt;
         const double p = ratio / static_cast<double>(1u << kp_shift);

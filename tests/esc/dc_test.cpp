@@ -121,6 +121,20 @@ TEST_F(DcTest, DriftLoopToleratesTimestampJitter) {
     EXPECT_LT(fprd(*e, 0x092C, 4).u32() & 0x7FFFFFFF, 4000u);
 }
 
+TEST_F(DcTest, DriftLoopWithSoemFilterSettings) {
+    // SOEM initialises 0x0930 = 0x1000 and 0x0934/0x0935 = 0x00/0x0C.
+    run1(*e, dg(BWR, 0, 0x0930, {0x00, 0x10}));
+    run1(*e, dg(BWR, 0, 0x0934, {0x00, 0x0C}));
+    uint64_t ref = clk.now_ns() - 3'000;
+    for (int i = 0; i < 3000; ++i) {
+        clk.advance(999'900);  // 100 ppm slow
+        ref += 1'000'000;
+        run1(*e, dg(FRMW, 0x7777, 0x0910, le(ref, 8)));
+    }
+    EXPECT_LT(fprd(*e, 0x092C, 4).u32() & 0x7FFFFFFF, 20u);
+    EXPECT_NEAR(static_cast<int16_t>(fprd(*e, 0x0932, 2).u16()), 1000, 20);
+}
+
 TEST_F(DcTest, NoWindUpBeforeOffsetIsSet) {
     // The master writes the system time before it has set this slave's offset: 10 ms apart. The clock is
     // slewed at most by the bandwidth, and the drift estimate is not touched.
