@@ -201,10 +201,12 @@ namespace {
 // Random frames (valid Ethernet/EtherCAT headers, random datagrams, random register/SM/FMMU writes) must
 // never read or write outside the frame or the ESC's memory (run under ASan), and the frame length never
 // changes.
-TEST(FrameRobustness, RandomFramesNeverCrash) {
+class FrameRobustness : public ::testing::TestWithParam<esc::EscConfig> {};
+
+TEST_P(FrameRobustness, RandomFramesNeverCrash) {
     esc::ManualClock clk;
     clk.set(1'000'000);
-    esc::Esc e({}, clk);
+    esc::Esc e(GetParam(), clk);
     uint32_t s = 12345;
     auto rnd = [&]() {
         s = s * 1103515245u + 12345u;
@@ -243,5 +245,17 @@ TEST(FrameRobustness, RandomFramesNeverCrash) {
     }
     EXPECT_GT(e.stats().frames_processed, 0u);
 }
+
+esc::EscConfig config(uint8_t fmmus, uint8_t sms, uint32_t kib) {
+    esc::EscConfig c;
+    c.fmmu_count = fmmus;
+    c.sm_count = sms;
+    c.process_ram_kib = kib;
+    return c;
+}
+
+INSTANTIATE_TEST_SUITE_P(Configs, FrameRobustness,
+                         ::testing::Values(esc::EscConfig{}, config(16, 16, 64), config(0, 0, 0),
+                                           config(3, 4, 1)));
 
 }  // namespace
