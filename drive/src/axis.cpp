@@ -820,6 +820,14 @@ void Axis::cycle(int64_t now_ns, int64_t dt_ns) {
             current_tick(t);
             ++tick_;
         }
+        // A loop that diverged numerically (absurd gains for the machine) must not poison the outputs:
+        // reset the estimates and report a controller gain error.
+        if (!std::isfinite(obs_vel_) || !std::isfinite(obs_pos_) || !std::isfinite(obs_load_) ||
+            !std::isfinite(vel_int_) || !std::isfinite(cur_int_) || !std::isfinite(cur_ref_)) {
+            obs_pos_ = inc_to_rad(static_cast<double>(count_) + 0.5);
+            obs_vel_ = obs_load_ = vel_int_ = cur_int_ = cur_ref_ = vel_ref_ = 0;
+            fault(error_code::ControllerGain, now_ns);
+        }
         supervise(now_ns + dt_ns, dt_ns);
     }
     update_feedback();
