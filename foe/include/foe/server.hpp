@@ -1,0 +1,112 @@
+#pragma once
+// FoE server (ethercat-protocol.md §10): firmware download into a FirmwareStore (Bootstrap only) and upload
+// of the stored images. An ecat::MailboxHandler for mailbox type FoE: it sees the bytes after the mailbox
+// header and answers through the MailboxSender.
+//
+// Files: "<device>" (e.g. "MAXPOS", the FoE target as seed 004 §4.8.3 names it for EPOS4) and
+// "<device>_<SW>h_<HW>h_<AppNo>h_<AppVer>h.bin" (seed 001 §9.2) are writable in Bootstrap; the written image
+// decides its version, the name only selects the firmware. Readable in every mailbox state: "<device>"
+// (the active image) and the file name of each stored valid image (active and previous slot).
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ecat/mailbox_handler.hpp"
+#include "foe/errors.hpp"
+#include "foe/store.hpp"
+#include "od/device.hpp"
+#include "od/types.hpp"
+
+namespace foe {
+
+struct ServerConfig {
+    std::string device_name = "MAXPOS";
+    uint32_t password = 0;                    // seed 004 §4.8.3: password 0
+    uint64_t timeout_ns = 10'000'000'000ull;  // an idle transfer is dropped after this
+    // Largest DATA payload the master sends (SM0 length - 12), per mailbox; a shorter DATA ends the file.
+    // 0: take the largest payload the reply mailbox allows (SM1 length - 12).
+    std::size_t standard_data_size = 0;
+    std::size_t bootstrap_data_size = 0;
+    std::size_t max_file_name = 64;
+
+    // Sizes and device name from the device description.
+    static ServerConfig from(const od::DeviceDescription& d);
+};
+
+struct ServerStats {
+    uint64_t writes_started = 0;
+    uint64_t writes_completed = 0;
+    uint64_t reads_started = 0;
+    uint64_t reads_completed = 0;
+    uint64_t errors_sent = 0;
+    uint64_t busy_sent = 0;
+    uint64_t timeouts = 0;
+    uint64_t cancelled = 0;
+};
+
+class FoeServer final : public ecat::MailboxHandler {
+  public:
+    FoeServer(FirmwareStore& store, ServerConfig config = {});
+    ~FoeServer() override;
+    FoeServer(const FoeServer&) = delete;
+    FoeServer& operator=(const FoeServer&) = delete;
+
+    ecat::MailboxType type() const override { return ecat::MailboxType::FoE; }
+    bool available(od::AlState state) const override { return state != od::AlState::Init; }
+    void handle(std::span<const uint8_t> payload, ecat::MailboxSender& out) override;
+    void poll(uint64_t now_ns, ecat::MailboxSender& out) override;
+    void on_state_change(od::AlState from, od::AlState to) override;
+
+    // Sets the AL state without a transition (e.g. a server created while the stack is in Bootstrap).
+    void set_state(od::AlState state) { state_ = state; }
+    bool idle() const { return phase_ == Phase::Idle; }
+    bool storing() const { return phase_ == Phase::Storing && result_ == Result::Running; }
+    const ServerStats& stats() const { return stats_; }
+
+    // The answer to a file name: 0 if well-formed, else why not (decisions in docs/decisions/foe.md).
+    static ErrorCode check_name(std::string_view name, std::size_t max_length);
+
+  private:
+    enum class Phase : uint8_t { Idle, Writing, Storing, Reading };
+    enum class Result : uint8_t { Running, Done, Failed };
+
+    void start_write(uint32_t password, std::string_view name, ecat::MailboxSender& out);
+    void start_read(uint32_t password, std::string_view name, ecat::MailboxSender& out);
+    void on_data(uint32_t packet, std::span<const uint8_t> data, ecat::MailboxSender& out);
+    void on_ack(uint32_t packet, ecat::MailboxSender& out);
+    void send_data(ecat::MailboxSender& out);
+    void send_ack(uint32_t packet, ecat::MailboxSender& out);
+    void send_busy(ecat::MailboxSender& out);
+    void send_error(ErrorCode code, std::string_view detail, ecat::MailboxSender& out);
+    void cancel();
+    std::size_t full_data_size(const ecat::MailboxSender& out) const;
+    bool writable(std::string_view name) const;
+
+    FirmwareStore& store_;
+    ServerConfig config_;
+    od::AlState state_ = od::AlState::Init;
+    Phase phase_ = Phase::Idle;
+    Result result_ = Result::Running;
+    StoreError error_;
+    uint64_t now_ns_ = 0;
+    uint64_t activity_ns_ = 0;
+
+    // Writing: next expected packet; the largest DATA payload seen this transfer.
+    uint32_t packet_ = 0;
+    std::size_t seen_data_size_ = 0;
+
+    // Reading.
+    int read_fd_ = -1;
+    uint64_t read_offset_ = 0;
+    uint64_t read_size_ = 0;
+    std::size_t last_sent_ = 0;
+    bool last_was_final_ = false;
+
+    std::vector<uint8_t> tx_;
+    ServerStats stats_;
+};
+
+}  // namespace foe

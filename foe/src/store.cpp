@@ -1,0 +1,416 @@
+#include "foe/store.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+namespace foe {
+namespace {
+
+std::string errno_text(const char* what) {
+    return std::string(what) + ": " + std::strerror(errno);
+}
+
+bool write_all(int fd, const uint8_t* p, std::size_t n) {
+    while (n > 0) {
+        const ssize_t w = ::write(fd, p, n);
+        if (w < 0) {
+            if (errno == EINTR) continue;
+            return false;
+        }
+        p += w;
+        n -= static_cast<std::size_t>(w);
+    }
+    return true;
+}
+
+// Reads exactly n bytes at offset; false on error or end of file.
+bool pread_all(int fd, uint8_t* p, std::size_t n, uint64_t offset) {
+    while (n > 0) {
+        const ssize_t r = ::pread(fd, p, n, static_cast<off_t>(offset));
+        if (r < 0 && errno == EINTR) continue;
+        if (r <= 0) return false;
+        p += r;
+        n -= static_cast<std::size_t>(r);
+        offset += static_cast<uint64_t>(r);
+    }
+    return true;
+}
+
+}  // namespace
+
+std::string_view to_string(StoreStep s) {
+    switch (s) {
+        case StoreStep::CreateTemp:
+            return "create temp";
+        case StoreStep::Append:
+            return "append";
+        case StoreStep::SyncTemp:
+            return "sync temp";
+        case StoreStep::RenameSlot:
+            return "rename slot";
+        case StoreStep::SyncDir:
+            return "sync dir";
+        case StoreStep::ReadBack:
+            return "read back";
+        case StoreStep::WritePointer:
+            return "write pointer";
+        case StoreStep::SyncPointer:
+            return "sync pointer";
+        case StoreStep::RenamePointer:
+            return "rename pointer";
+        case StoreStep::SyncPointerDir:
+            return "sync pointer dir";
+    }
+    return "?";
+}
+
+FirmwareStore::FirmwareStore(StoreConfig config) : config_(std::move(config)) {
+    if (config_.read_back_chunk < 512) config_.read_back_chunk = 512;
+    buffer_.resize(config_.read_back_chunk);
+}
+
+FirmwareStore::~FirmwareStore() {
+    if (fd_ >= 0) ::close(fd_);
+}
+
+std::filesystem::path FirmwareStore::slot_path(unsigned slot) const {
+    return config_.dir / (slot == 0 ? "slot0.bin" : "slot1.bin");
+}
+
+std::filesystem::path FirmwareStore::pointer_path() const {
+    return config_.dir / "active";
+}
+
+bool FirmwareStore::fail(StoreError& error, ErrorCode code, std::string text) {
+    error.code = code;
+    error.text = std::move(text);
+    abort();
+    return false;
+}
+
+bool FirmwareStore::sync_dir(StoreError& error) {
+    const int d = ::open(config_.dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (d < 0) {
+        error = {ErrorCode::FlashError, errno_text("open directory")};
+        return false;
+    }
+    const bool ok = ::fsync(d) == 0;
+    if (!ok) error = {ErrorCode::FlashError, errno_text("fsync directory")};
+    ::close(d);
+    return ok;
+}
+
+std::optional<StoredImage> FirmwareStore::verify_slot(unsigned slot) {
+    const auto path = slot_path(slot);
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return std::nullopt;
+    struct stat st {};
+    std::optional<StoredImage> result;
+    uint8_t head[kImageHeaderSize];
+    if (::fstat(fd, &st) == 0 && pread_all(fd, head, kImageHeaderSize, 0)) {
+        std::span<const uint8_t, kImageHeaderSize> hs(head, kImageHeaderSize);
+        const ImageHeader h = decode_header(hs);
+        const uint64_t size = static_cast<uint64_t>(st.st_size);
+        if (check_header(h, config_.identity) == ImageError::Ok &&
+            size == kImageHeaderSize + h.payload_length) {
+            uint32_t crc = header_crc(hs);
+            uint64_t off = kImageHeaderSize;
+            bool ok = true;
+            while (ok && off < size) {
+                const std::size_t n =
+                    static_cast<std::size_t>(std::min<uint64_t>(buffer_.size(), size - off));
+                ok = pread_all(fd, buffer_.data(), n, off);
+                if (ok) crc = crc32({buffer_.data(), n}, crc);
+                off += n;
+            }
+            if (ok && crc == h.crc)
+                result = StoredImage{
+                    slot, h, firmware_file_name(config_.device_name, h.product_code, h.version), path, size};
+        }
+    }
+    ::close(fd);
+    return result;
+}
+
+bool FirmwareStore::open(StoreError* error) {
+    StoreError local;
+    StoreError& err = error ? *error : local;
+    abort();
+    std::error_code ec;
+    std::filesystem::create_directories(config_.dir, ec);
+    if (ec) {
+        err = {ErrorCode::FlashError, "create " + config_.dir.string() + ": " + ec.message()};
+        return false;
+    }
+    // Leftovers of an interrupted write: never valid, never pointed at.
+    for (const char* tmp : {"slot0.bin.tmp", "slot1.bin.tmp", "active.tmp"})
+        std::filesystem::remove(config_.dir / tmp, ec);
+
+    slots_[0] = verify_slot(0);
+    slots_[1] = verify_slot(1);
+
+    int pointed = -1;
+    const int fd = ::open(pointer_path().c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd >= 0) {
+        char text[16] = {};
+        const ssize_t n = ::read(fd, text, sizeof text - 1);
+        ::close(fd);
+        const std::string_view s(text, n > 0 ? static_cast<std::size_t>(n) : 0);
+        if (s == "slot0\n" || s == "slot0") pointed = 0;
+        if (s == "slot1\n" || s == "slot1") pointed = 1;
+    }
+    active_.reset();
+    if (pointed >= 0 && slots_[pointed]) {
+        active_ = slots_[pointed];
+    } else {
+        for (unsigned s : {0u, 1u}) {
+            if (!active_ && slots_[s]) active_ = slots_[s];
+        }
+        if (active_) {
+            // Repair the pointer so that the slot written next is never the one it names.
+            target_ = active_->slot;
+            next_ = StoreStep::WritePointer;
+            phase_ = Phase::Committing;
+            const bool ok = commit_all(err) == Progress::Done;
+            return ok;
+        }
+    }
+    return true;
+}
+
+const StoredImage* FirmwareStore::find(std::string_view name) const {
+    if (active_ && active_->file_name == name) return &*active_;
+    for (const auto& s : slots_) {
+        if (s && s->file_name == name) return &*s;
+    }
+    return nullptr;
+}
+
+bool FirmwareStore::begin_write(StoreError& error) {
+    abort();
+    target_ = active_ ? 1 - active_->slot : 0;
+    received_ = 0;
+    header_ok_ = false;
+    crc_ = 0;
+    step(StoreStep::CreateTemp);
+    const auto tmp = slot_path(target_).string() + ".tmp";
+    fd_ = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd_ < 0) {
+        error = {errno == ENOSPC ? ErrorCode::DiskFull : ErrorCode::FlashError,
+                 errno_text("create slot file")};
+        return false;
+    }
+    phase_ = Phase::Receiving;
+    return true;
+}
+
+bool FirmwareStore::append(std::span<const uint8_t> data, StoreError& error) {
+    if (phase_ != Phase::Receiving) return fail(error, ErrorCode::Illegal, "no image being written");
+    if (data.empty()) return true;
+    std::span<const uint8_t> payload = data;
+    if (!header_ok_) {
+        const std::size_t take = std::min<std::size_t>(kImageHeaderSize - received_, data.size());
+        std::memcpy(header_bytes_ + received_, data.data(), take);
+        payload = data.subspan(take);
+        if (received_ + take == kImageHeaderSize) {
+            std::span<const uint8_t, kImageHeaderSize> hs(header_bytes_, kImageHeaderSize);
+            header_ = decode_header(hs);
+            const ImageError e = check_header(header_, config_.identity);
+            if (e != ImageError::Ok) {
+                VerifyResult r{e, header_};
+                return fail(error, foe_error(e), describe(r, config_.identity));
+            }
+            if (kImageHeaderSize + uint64_t{header_.payload_length} > config_.max_image_bytes)
+                return fail(error, ErrorCode::DiskFull, "image larger than the slot allows");
+            header_ok_ = true;
+            crc_ = header_crc(hs);
+        }
+    }
+    if (header_ok_ && received_ + data.size() > kImageHeaderSize + uint64_t{header_.payload_length})
+        return fail(error, ErrorCode::FileHeaderError, std::string(to_string(ImageError::TrailingData)));
+    if (!payload.empty()) crc_ = crc32(payload, crc_);
+    step(StoreStep::Append);
+    if (!write_all(fd_, data.data(), data.size())) {
+        const bool full = errno == ENOSPC || errno == EFBIG || errno == EDQUOT;
+        return fail(error, full ? ErrorCode::DiskFull : ErrorCode::FlashError, errno_text("write slot file"));
+    }
+    received_ += data.size();
+    return true;
+}
+
+bool FirmwareStore::finish(StoreError& error) {
+    if (phase_ != Phase::Receiving) return fail(error, ErrorCode::Illegal, "no image being written");
+    if (!header_ok_) {
+        return fail(error, ErrorCode::FileHeaderError, std::string(to_string(ImageError::TooShort)));
+    }
+    if (received_ != kImageHeaderSize + uint64_t{header_.payload_length})
+        return fail(error, ErrorCode::FileHeaderError, std::string(to_string(ImageError::Truncated)));
+    if (crc_ != header_.crc)
+        return fail(error, ErrorCode::InvalidChecksum, std::string(to_string(ImageError::BadChecksum)));
+    phase_ = Phase::Committing;
+    next_ = StoreStep::SyncTemp;
+    return true;
+}
+
+FirmwareStore::Progress FirmwareStore::commit_step(StoreError& error) {
+    if (phase_ != Phase::Committing) {
+        error = {ErrorCode::Illegal, "nothing to commit"};
+        return Progress::Failed;
+    }
+    auto failed = [&](ErrorCode code, std::string text) {
+        fail(error, code, std::move(text));
+        return Progress::Failed;
+    };
+    const StoreStep s = next_;
+    step(s);
+    switch (s) {
+        case StoreStep::SyncTemp: {
+            const bool ok = ::fsync(fd_) == 0;
+            const int e = errno;
+            ::close(fd_);
+            fd_ = -1;
+            if (!ok) {
+                errno = e;
+                return failed(ErrorCode::FlashError, errno_text("fsync slot file"));
+            }
+            next_ = StoreStep::RenameSlot;
+            return Progress::Running;
+        }
+        case StoreStep::RenameSlot: {
+            const auto path = slot_path(target_);
+            if (::rename((path.string() + ".tmp").c_str(), path.c_str()) != 0)
+                return failed(ErrorCode::FlashError, errno_text("rename slot file"));
+            slots_[target_].reset();  // the old content of the inactive slot is gone
+            next_ = StoreStep::SyncDir;
+            return Progress::Running;
+        }
+        case StoreStep::SyncDir:
+            if (!sync_dir(error)) return failed(error.code, error.text);
+            next_ = StoreStep::ReadBack;
+            read_back_offset_ = 0;
+            return Progress::Running;
+        case StoreStep::ReadBack: {
+            const uint64_t size = kImageHeaderSize + uint64_t{header_.payload_length};
+            if (read_back_offset_ == 0) {
+                fd_ = ::open(slot_path(target_).c_str(), O_RDONLY | O_CLOEXEC);
+                if (fd_ < 0) return failed(ErrorCode::FlashError, errno_text("open slot file"));
+                struct stat st {};
+                uint8_t head[kImageHeaderSize];
+                if (::fstat(fd_, &st) != 0 || static_cast<uint64_t>(st.st_size) != size ||
+                    !pread_all(fd_, head, kImageHeaderSize, 0) ||
+                    std::memcmp(head, header_bytes_, kImageHeaderSize) != 0)
+                    return failed(ErrorCode::FlashError, "slot file differs from the received image");
+                read_back_crc_ =
+                    header_crc(std::span<const uint8_t, kImageHeaderSize>(head, kImageHeaderSize));
+                read_back_offset_ = kImageHeaderSize;
+            } else {
+                const std::size_t n =
+                    static_cast<std::size_t>(std::min<uint64_t>(buffer_.size(), size - read_back_offset_));
+                if (!pread_all(fd_, buffer_.data(), n, read_back_offset_))
+                    return failed(ErrorCode::FlashError, errno_text("read back slot file"));
+                read_back_crc_ = crc32({buffer_.data(), n}, read_back_crc_);
+                read_back_offset_ += n;
+            }
+            if (read_back_offset_ >= size) {
+                ::close(fd_);
+                fd_ = -1;
+                if (read_back_crc_ != header_.crc)
+                    return failed(ErrorCode::FlashError, "slot file read back with a wrong checksum");
+                slots_[target_] = StoredImage{
+                    target_, header_,
+                    firmware_file_name(config_.device_name, header_.product_code, header_.version),
+                    slot_path(target_), size};
+                next_ = StoreStep::WritePointer;
+            }
+            return Progress::Running;
+        }
+        case StoreStep::WritePointer: {
+            const auto tmp = pointer_path().string() + ".tmp";
+            fd_ = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+            const char* text = target_ == 0 ? "slot0\n" : "slot1\n";
+            if (fd_ < 0 || !write_all(fd_, reinterpret_cast<const uint8_t*>(text), 6))
+                return failed(errno == ENOSPC ? ErrorCode::DiskFull : ErrorCode::FlashError,
+                              errno_text("write pointer file"));
+            next_ = StoreStep::SyncPointer;
+            return Progress::Running;
+        }
+        case StoreStep::SyncPointer: {
+            const bool ok = ::fsync(fd_) == 0;
+            ::close(fd_);
+            fd_ = -1;
+            if (!ok) return failed(ErrorCode::FlashError, errno_text("fsync pointer file"));
+            next_ = StoreStep::RenamePointer;
+            return Progress::Running;
+        }
+        case StoreStep::RenamePointer: {
+            const auto tmp = pointer_path().string() + ".tmp";
+            if (::rename(tmp.c_str(), pointer_path().c_str()) != 0)
+                return failed(ErrorCode::FlashError, errno_text("rename pointer file"));
+            active_ = slots_[target_];  // the switch
+            next_ = StoreStep::SyncPointerDir;
+            return Progress::Running;
+        }
+        case StoreStep::SyncPointerDir: {
+            phase_ = Phase::Idle;
+            if (!sync_dir(error)) return Progress::Failed;
+            return Progress::Done;
+        }
+        case StoreStep::CreateTemp:
+        case StoreStep::Append:
+            break;
+    }
+    return failed(ErrorCode::ProgramError, "bad commit step");
+}
+
+FirmwareStore::Progress FirmwareStore::commit_all(StoreError& error) {
+    for (;;) {
+        const Progress p = commit_step(error);
+        if (p != Progress::Running) return p;
+    }
+}
+
+void FirmwareStore::abort() {
+    if (fd_ >= 0) {
+        ::close(fd_);
+        fd_ = -1;
+    }
+    std::error_code ec;
+    if (phase_ == Phase::Receiving || (phase_ == Phase::Committing && next_ <= StoreStep::RenameSlot))
+        std::filesystem::remove(slot_path(target_).string() + ".tmp", ec);
+    if (phase_ == Phase::Committing && next_ > StoreStep::WritePointer && next_ <= StoreStep::RenamePointer)
+        std::filesystem::remove(pointer_path().string() + ".tmp", ec);
+    phase_ = Phase::Idle;
+}
+
+uint16_t FirmwareStore::progress_done() const {
+    if (phase_ != Phase::Committing) return 0;
+    switch (next_) {
+        case StoreStep::CreateTemp:
+        case StoreStep::Append:
+        case StoreStep::SyncTemp:
+            return 5;
+        case StoreStep::RenameSlot:
+            return 10;
+        case StoreStep::SyncDir:
+            return 15;
+        case StoreStep::ReadBack: {
+            const uint64_t size = kImageHeaderSize + uint64_t{header_.payload_length};
+            return static_cast<uint16_t>(20 + 60 * read_back_offset_ / (size ? size : 1));
+        }
+        case StoreStep::WritePointer:
+            return 80;
+        case StoreStep::SyncPointer:
+            return 85;
+        case StoreStep::RenamePointer:
+            return 90;
+        case StoreStep::SyncPointerDir:
+            return 95;
+    }
+    return 0;
+}
+
+}  // namespace foe

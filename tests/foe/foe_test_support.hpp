@@ -1,0 +1,63 @@
+#pragma once
+#include <stdlib.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "ecat/mailbox_handler.hpp"
+#include "foe/image.hpp"
+
+namespace foe_test {
+
+constexpr foe::ImageIdentity kMaxpos{0x000000FB, 0x30010000};
+
+// A fresh directory under /tmp, removed with the object.
+struct TempDir {
+    std::filesystem::path path;
+    TempDir() {
+        char tmpl[] = "/tmp/foe_test_XXXXXX";
+        path = ::mkdtemp(tmpl);
+    }
+    ~TempDir() {
+        std::error_code ec;
+        std::filesystem::remove_all(path, ec);
+    }
+};
+
+// Collects what a handler sends.
+struct FakeSender final : ecat::MailboxSender {
+    std::size_t max = 128 - 6;  // SM1 of 128 bytes
+    std::vector<std::vector<uint8_t>> sent;
+    bool send(ecat::MailboxType type, std::span<const uint8_t> payload) override {
+        if (type != ecat::MailboxType::FoE || payload.size() > max) return false;
+        sent.emplace_back(payload.begin(), payload.end());
+        return true;
+    }
+    std::size_t max_payload() const override { return max; }
+    std::vector<uint8_t> take() {
+        if (sent.empty()) return {};
+        auto m = sent.front();
+        sent.erase(sent.begin());
+        return m;
+    }
+};
+
+inline std::vector<uint8_t> payload_bytes(std::size_t n, uint32_t seed) {
+    std::vector<uint8_t> v(n);
+    uint32_t x = seed * 2654435761u + 1;
+    for (auto& b : v) {
+        x = x * 1103515245u + 12345u;
+        b = static_cast<uint8_t>(x >> 16);
+    }
+    return v;
+}
+
+inline uint32_t le32(const std::vector<uint8_t>& m, std::size_t at) {
+    return static_cast<uint32_t>(m[at]) | static_cast<uint32_t>(m[at + 1]) << 8 |
+           static_cast<uint32_t>(m[at + 2]) << 16 | static_cast<uint32_t>(m[at + 3]) << 24;
+}
+
+}  // namespace foe_test

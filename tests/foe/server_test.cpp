@@ -1,0 +1,423 @@
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "foe/server.hpp"
+#include "foe_test_support.hpp"
+
+using namespace foe;
+using foe_test::FakeSender;
+using foe_test::kMaxpos;
+using foe_test::le32;
+using foe_test::TempDir;
+
+namespace {
+
+using Bytes = std::vector<uint8_t>;
+
+Bytes request(Opcode op, uint32_t value, std::string_view tail = {}) {
+    Bytes m = {static_cast<uint8_t>(op),          0,
+               static_cast<uint8_t>(value),       static_cast<uint8_t>(value >> 8),
+               static_cast<uint8_t>(value >> 16), static_cast<uint8_t>(value >> 24)};
+    m.insert(m.end(), tail.begin(), tail.end());
+    return m;
+}
+Bytes data(uint32_t packet, std::span<const uint8_t> bytes) {
+    Bytes m = request(Opcode::Data, packet);
+    m.insert(m.end(), bytes.begin(), bytes.end());
+    return m;
+}
+
+bool is_ack(const Bytes& m, uint32_t packet) {
+    return m.size() == 6 && m[0] == 4 && le32(m, 2) == packet;
+}
+bool is_busy(const Bytes& m) {
+    return m.size() == 6 && m[0] == 6;
+}
+uint32_t error_code(const Bytes& m) {
+    return m.size() >= 6 && m[0] == 5 ? le32(m, 2) : 0;
+}
+std::string error_string(const Bytes& m) {
+    return m.size() > 6 ? std::string(m.begin() + 6, m.end()) : "";
+}
+
+struct Fixture : ::testing::Test {
+    TempDir dir;
+    FirmwareStore store{[&] {
+        StoreConfig c;
+        c.dir = dir.path;
+        c.identity = kMaxpos;
+        return c;
+    }()};
+    FoeServer server{store};
+    FakeSender out;  // 128-byte mailbox: 116 data bytes per packet
+    uint64_t now = 1'000'000;
+    static constexpr std::size_t kChunk = 128 - 12;
+
+    void SetUp() override {
+        ASSERT_TRUE(store.open());
+        server.on_state_change(od::AlState::Init, od::AlState::Boot);
+    }
+    Bytes exchange(const Bytes& m) {
+        server.handle(m, out);
+        EXPECT_EQ(out.sent.size(), 1u) << "one reply per request";
+        Bytes r = out.take();
+        out.sent.clear();
+        return r;
+    }
+    void poll(uint64_t advance_ns = 1'000'000) {
+        now += advance_ns;
+        server.poll(now, out);
+        EXPECT_TRUE(out.sent.empty()) << "poll() never sends on its own";
+    }
+    // A complete download as SOEM/IgH do it: WRQ, DATA..., repeat the last DATA after BUSY until ACK.
+    // Returns the final answer (ACK or ERR).
+    Bytes download(const Bytes& image, std::string_view name = "MAXPOS", uint32_t password = 0) {
+        Bytes r = exchange(request(Opcode::Write, password, name));
+        if (!is_ack(r, 0)) return r;
+        uint32_t packet = 1;
+        std::size_t off = 0;
+        for (;;) {
+            const std::size_t n = std::min(kChunk, image.size() - off);
+            const Bytes d = data(packet, {image.data() + off, n});
+            r = exchange(d);
+            off += n;
+            if (n < kChunk) {
+                for (int i = 0; i < 1000 && is_busy(r); ++i) {
+                    poll();
+                    r = exchange(d);
+                }
+                return r;
+            }
+            if (!is_ack(r, packet)) return r;
+            ++packet;
+        }
+    }
+    // A complete upload; returns the file, or the ERR message in *error.
+    Bytes upload(std::string_view name, Bytes* error = nullptr, uint32_t password = 0) {
+        Bytes file;
+        Bytes r = exchange(request(Opcode::Read, password, name));
+        for (uint32_t packet = 1;; ++packet) {
+            if (r.empty() || r[0] != 3 || le32(r, 2) != packet) {
+                if (error) *error = r;
+                return {};
+            }
+            file.insert(file.end(), r.begin() + 6, r.end());
+            const bool last = r.size() - 6 < kChunk;
+            server.handle(request(Opcode::Ack, packet), out);
+            if (last) {
+                EXPECT_TRUE(out.sent.empty()) << "no answer to the last ACK";
+                return file;
+            }
+            r = out.take();
+        }
+    }
+    uint32_t active_version() const {
+        return store.active_image() ? store.active_image()->header.version : 0;
+    }
+};
+
+Bytes image_v(uint32_t version, std::size_t size = 1000) {
+    return build_image(foe_test::payload_bytes(size, version), kMaxpos, version);
+}
+
+}  // namespace
+
+using FoeServerTest = Fixture;
+
+TEST_F(FoeServerTest, FullWriteInBootstrapThenReadBack) {
+    const auto image = image_v(0x01300000, 5000);
+    const Bytes answer = download(image);
+    EXPECT_TRUE(is_ack(answer, static_cast<uint32_t>(image.size() / kChunk + 1)));
+    EXPECT_EQ(active_version(), 0x01300000u);
+    EXPECT_TRUE(server.idle());
+    EXPECT_EQ(server.stats().writes_completed, 1u);
+
+    // Read back in Pre-Op: by the device name and by the firmware file name.
+    server.on_state_change(od::AlState::Boot, od::AlState::Init);
+    server.on_state_change(od::AlState::Init, od::AlState::PreOp);
+    EXPECT_EQ(upload("MAXPOS"), image);
+    EXPECT_EQ(upload("MAXPOS_0130h_3001h_0000h_0000h.bin"), image);
+    EXPECT_EQ(upload("maxpos_0130H_3001h_0000h_0000h.BIN"), image);
+}
+
+TEST_F(FoeServerTest, PreviousImageStaysReadableByItsName) {
+    ASSERT_TRUE(is_ack(download(image_v(0x01200000)), 9));
+    ASSERT_TRUE(is_ack(download(image_v(0x01300000)), 9));
+    EXPECT_EQ(upload("MAXPOS_0120h_3001h_0000h_0000h.bin"), image_v(0x01200000));
+    EXPECT_EQ(upload("MAXPOS"), image_v(0x01300000));
+}
+
+TEST_F(FoeServerTest, ReadWithoutImageOrUnknownNameIsNotFound) {
+    Bytes err;
+    EXPECT_TRUE(upload("MAXPOS", &err).empty());
+    EXPECT_EQ(error_code(err), 0x8001u);
+    EXPECT_EQ(error_string(err).rfind("Not found", 0), 0u);
+    ASSERT_TRUE(is_ack(download(image_v(0x01200000)), 9));
+    EXPECT_TRUE(upload("EPOS4", &err).empty());
+    EXPECT_EQ(error_code(err), 0x8001u);
+}
+
+TEST_F(FoeServerTest, WrongPasswordIsNoRights) {
+    const Bytes r = exchange(request(Opcode::Write, 0x1234, "MAXPOS"));
+    EXPECT_EQ(error_code(r), 0x800Au);
+    EXPECT_EQ(error_string(r).rfind("No rights", 0), 0u);
+    ASSERT_TRUE(is_ack(download(image_v(0x01200000)), 9));
+    Bytes err;
+    EXPECT_TRUE(upload("MAXPOS", &err, 7).empty());
+    EXPECT_EQ(error_code(err), 0x800Au);
+}
+
+TEST_F(FoeServerTest, ConfiguredPasswordIsRequired) {
+    ServerConfig c;
+    c.password = 0x12345678;
+    FoeServer s(store, c);
+    s.set_state(od::AlState::Boot);
+    s.handle(request(Opcode::Write, 0, "MAXPOS"), out);
+    EXPECT_EQ(error_code(out.take()), 0x800Au);
+    s.handle(request(Opcode::Write, 0x12345678, "MAXPOS"), out);
+    EXPECT_TRUE(is_ack(out.take(), 0));
+}
+
+TEST_F(FoeServerTest, ImageForAnotherProductIsRefusedAtItsFirstPacket) {
+    ASSERT_TRUE(is_ack(download(image_v(0x01200000)), 9));
+    const auto other = build_image(foe_test::payload_bytes(3000, 5), {0xFB, 0x30020000}, 0x01300000);
+    ASSERT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS")), 0));
+    const Bytes r = exchange(data(1, {other.data(), kChunk}));
+    EXPECT_EQ(error_code(r), 0x800Du);
+    EXPECT_NE(error_string(r).find("0x30020000"), std::string::npos) << error_string(r);
+    EXPECT_TRUE(server.idle());
+    EXPECT_EQ(active_version(), 0x01200000u);
+    const auto vendor = build_image(foe_test::payload_bytes(300, 5), {0xAA, 0x30010000}, 0x01300000);
+    EXPECT_EQ(error_code(download(vendor)), 0x800Du);
+    EXPECT_EQ(active_version(), 0x01200000u);
+}
+
+TEST_F(FoeServerTest, CorruptedImageIsInvalidChecksum) {
+    ASSERT_TRUE(is_ack(download(image_v(0x01200000)), 9));
+    auto bad = image_v(0x01300000, 2000);
+    bad[1500] ^= 0x10;
+    const Bytes r = download(bad);
+    EXPECT_EQ(error_code(r), 0x800Cu);
+    EXPECT_EQ(error_string(r).rfind("Invalid checksum", 0), 0u);
+    EXPECT_EQ(active_version(), 0x01200000u);
+    // Not an image at all.
+    EXPECT_EQ(error_code(download(Bytes(500, 0xAB))), 0x8010u);
+    EXPECT_EQ(active_version(), 0x01200000u);
+}
+
+TEST_F(FoeServerTest, TransferCutOffThenNewRequestStartsClean) {
+    ASSERT_TRUE(is_ack(download(image_v(0x01200000)), 9));
+    const auto image = image_v(0x01300000, 4000);
+    ASSERT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS")), 0));
+    for (uint32_t p = 1; p <= 10; ++p)
+        ASSERT_TRUE(is_ack(exchange(data(p, {image.data() + (p - 1) * kChunk, kChunk})), p));
+    // The master gives up and starts again.
+    EXPECT_TRUE(is_ack(download(image), 35));
+    EXPECT_EQ(active_version(), 0x01300000u);
+    EXPECT_EQ(server.stats().cancelled, 1u);
+    // A read request also cancels a write half-way.
+    ASSERT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS")), 0));
+    ASSERT_TRUE(is_ack(exchange(data(1, {image.data(), kChunk})), 1));
+    EXPECT_EQ(upload("MAXPOS"), image);
+    EXPECT_EQ(error_code(exchange(data(2, {image.data() + kChunk, kChunk}))), 0x8004u);
+    EXPECT_EQ(active_version(), 0x01300000u);
+}
+
+TEST_F(FoeServerTest, StaleTransferTimesOut) {
+    const auto image = image_v(0x01300000, 4000);
+    ASSERT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS")), 0));
+    ASSERT_TRUE(is_ack(exchange(data(1, {image.data(), kChunk})), 1));
+    poll(5'000'000'000ull);
+    EXPECT_FALSE(server.idle());
+    poll(6'000'000'000ull);
+    EXPECT_TRUE(server.idle());
+    EXPECT_EQ(server.stats().timeouts, 1u);
+    EXPECT_EQ(error_code(exchange(data(2, {image.data() + kChunk, kChunk}))), 0x8004u);
+    EXPECT_FALSE(store.active_image());
+}
+
+TEST_F(FoeServerTest, PathLikeAndMalformedNamesAreRefused) {
+    for (std::string name :
+         {std::string("../MAXPOS"), std::string("/MAXPOS"), std::string("a/b"), std::string("a\\b"),
+          std::string("C:MAXPOS"), std::string(".."), std::string("MAX\0POS", 7), std::string("MAX\x01POS"),
+          std::string("MAX\x7fPOS"), std::string("MAX\xc3\xa9POS"), std::string(65, 'A')}) {
+        SCOPED_TRACE(name);
+        for (Opcode op : {Opcode::Write, Opcode::Read}) {
+            const Bytes r = exchange(request(op, 0, name));
+            EXPECT_EQ(error_code(r), 0x8002u);
+            EXPECT_EQ(error_string(r).rfind("Access denied", 0), 0u);
+        }
+    }
+    EXPECT_EQ(error_code(exchange(request(Opcode::Write, 0, ""))), 0x8001u);
+    EXPECT_EQ(error_code(exchange(request(Opcode::Write, 0, "OTHER"))), 0x8001u);
+    // A C-string terminator is not part of the name.
+    EXPECT_TRUE(is_ack(exchange(request(Opcode::Write, 0, std::string("MAXPOS\0\0", 8))), 0));
+    EXPECT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS_0130h_3001h_0000h_0000h.bin")), 0));
+    EXPECT_EQ(error_code(exchange(request(Opcode::Write, 0, "MAXPOS_0130h_3001h_0000h.bin"))), 0x8001u);
+}
+
+TEST_F(FoeServerTest, WriteOutsideBootstrapIsBootstrapOnly) {
+    for (od::AlState s : {od::AlState::PreOp, od::AlState::SafeOp, od::AlState::Op}) {
+        server.on_state_change(od::AlState::Init, s);
+        const Bytes r = exchange(request(Opcode::Write, 0, "MAXPOS"));
+        EXPECT_EQ(error_code(r), 0x8008u);
+        EXPECT_EQ(error_string(r).rfind("Bootstrap only", 0), 0u);
+    }
+    EXPECT_FALSE(server.available(od::AlState::Init));
+    EXPECT_TRUE(server.available(od::AlState::Boot));
+    EXPECT_TRUE(server.available(od::AlState::PreOp));
+}
+
+TEST_F(FoeServerTest, LeavingBootstrapDropsTheDownload) {
+    const auto image = image_v(0x01300000, 4000);
+    ASSERT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS")), 0));
+    ASSERT_TRUE(is_ack(exchange(data(1, {image.data(), kChunk})), 1));
+    server.on_state_change(od::AlState::Boot, od::AlState::Init);
+    EXPECT_TRUE(server.idle());
+    EXPECT_FALSE(store.writing());
+}
+
+TEST_F(FoeServerTest, PacketNumberWrong) {
+    const auto image = image_v(0x01300000, 4000);
+    ASSERT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS")), 0));
+    ASSERT_TRUE(is_ack(exchange(data(1, {image.data(), kChunk})), 1));
+    // A repeated packet (lost ACK) is acknowledged again, not stored twice.
+    ASSERT_TRUE(is_ack(exchange(data(1, {image.data(), kChunk})), 1));
+    EXPECT_EQ(store.received(), kChunk);
+    const Bytes r = exchange(data(3, {image.data() + kChunk, kChunk}));
+    EXPECT_EQ(error_code(r), 0x8005u);
+    EXPECT_EQ(error_string(r).rfind("Packet number wrong", 0), 0u);
+    EXPECT_TRUE(server.idle());
+    // On a read: an ACK for another packet.
+    ASSERT_TRUE(is_ack(download(image), 35));
+    const Bytes d = exchange(request(Opcode::Read, 0, "MAXPOS"));
+    ASSERT_EQ(d[0], 3);
+    EXPECT_EQ(error_code(exchange(request(Opcode::Ack, 2))), 0x8005u);
+}
+
+TEST_F(FoeServerTest, BusyWhileStoring) {
+    const auto image = image_v(0x01300000, 500'000);  // several read-back steps
+    ASSERT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS")), 0));
+    uint32_t packet = 1;
+    std::size_t off = 0;
+    for (; image.size() - off >= kChunk; off += kChunk, ++packet)
+        ASSERT_TRUE(is_ack(exchange(data(packet, {image.data() + off, kChunk})), packet));
+    const Bytes last = data(packet, {image.data() + off, image.size() - off});
+    Bytes r = exchange(last);
+    ASSERT_TRUE(is_busy(r));
+    EXPECT_EQ(r[4] | r[5] << 8, 100);  // entire
+    EXPECT_TRUE(server.storing());
+    // Without poll() nothing moves: the repeated DATA gets BUSY again.
+    EXPECT_TRUE(is_busy(exchange(last)));
+    EXPECT_EQ(active_version(), 0u);
+    unsigned busy = 2, previous_done = 0;
+    while (is_busy(r)) {
+        const unsigned done = r[2] | r[3] << 8;
+        EXPECT_GE(done, previous_done);
+        EXPECT_LE(done, 100u);
+        previous_done = done;
+        poll();
+        r = exchange(last);
+        if (is_busy(r)) ++busy;
+        ASSERT_LT(busy, 100u);
+    }
+    EXPECT_TRUE(is_ack(r, packet));
+    EXPECT_GE(busy, 5u);
+    EXPECT_EQ(active_version(), 0x01300000u);
+    EXPECT_TRUE(server.idle());
+}
+
+TEST_F(FoeServerTest, FileLengthMultipleOfThePacketSize) {
+    // 3 full packets exactly: the master ends with an empty DATA.
+    const auto image = image_v(0x01300000, 3 * kChunk - kImageHeaderSize);
+    ASSERT_EQ(image.size(), 3 * kChunk);
+    ASSERT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS")), 0));
+    for (uint32_t p = 1; p <= 3; ++p)
+        ASSERT_TRUE(is_ack(exchange(data(p, {image.data() + (p - 1) * kChunk, kChunk})), p));
+    EXPECT_EQ(active_version(), 0u);
+    EXPECT_FALSE(server.storing());
+    Bytes r = exchange(data(4, {}));
+    ASSERT_TRUE(is_busy(r));
+    while (is_busy(r)) {
+        poll();
+        r = exchange(data(4, {}));
+    }
+    EXPECT_TRUE(is_ack(r, 4));
+    EXPECT_EQ(active_version(), 0x01300000u);
+
+    // Reading it back ends with an empty DATA 4.
+    ASSERT_EQ(exchange(request(Opcode::Read, 0, "MAXPOS")).size(), 6 + kChunk);
+    ASSERT_EQ(exchange(request(Opcode::Ack, 1)).size(), 6 + kChunk);
+    ASSERT_EQ(exchange(request(Opcode::Ack, 2)).size(), 6 + kChunk);
+    const Bytes empty = exchange(request(Opcode::Ack, 3));
+    EXPECT_EQ(empty, request(Opcode::Data, 4));
+    server.handle(request(Opcode::Ack, 4), out);
+    EXPECT_TRUE(out.sent.empty());
+    EXPECT_TRUE(server.idle());
+}
+
+TEST_F(FoeServerTest, ConfiguredSm0SizeDecidesTheEndOfFile) {
+    // The master's mailbox (SM0) is larger than the reply mailbox: packets of 500 bytes are full ones.
+    ServerConfig c;
+    c.bootstrap_data_size = 500;
+    FoeServer s(store, c);
+    s.set_state(od::AlState::Boot);
+    const auto image = image_v(0x01300000, 1200 - kImageHeaderSize);
+    s.handle(request(Opcode::Write, 0, "MAXPOS"), out);
+    ASSERT_TRUE(is_ack(out.take(), 0));
+    s.handle(data(1, {image.data(), 500}), out);
+    ASSERT_TRUE(is_ack(out.take(), 1));
+    s.handle(data(2, {image.data() + 500, 500}), out);
+    ASSERT_TRUE(is_ack(out.take(), 2));
+    s.handle(data(3, {image.data() + 1000, 200}), out);
+    ASSERT_TRUE(is_busy(out.take()));
+    od::DeviceDescription d;
+    EXPECT_EQ(ServerConfig::from(d).bootstrap_data_size, 1024u - 12u);
+    EXPECT_EQ(ServerConfig::from(d).standard_data_size, 128u - 12u);
+    EXPECT_EQ(ServerConfig::from(d).device_name, "MAXPOS");
+}
+
+TEST_F(FoeServerTest, UnexpectedPacketsAreIllegal) {
+    Bytes r = exchange(Bytes{0x09, 0, 0, 0, 0, 0});
+    EXPECT_EQ(error_code(r), 0x8004u);
+    EXPECT_EQ(error_string(r).rfind("Illegal", 0), 0u);
+    EXPECT_EQ(error_code(exchange(Bytes{0x02, 0})), 0x8004u);
+    EXPECT_EQ(error_code(exchange(request(Opcode::Ack, 1))), 0x8004u);
+    EXPECT_EQ(error_code(exchange(request(Opcode::Data, 1))), 0x8004u);
+    EXPECT_EQ(error_code(exchange(request(Opcode::Busy, 0))), 0x8004u);
+    // ERR from the master aborts without an answer.
+    ASSERT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS")), 0));
+    server.handle(request(Opcode::Error, 0x8000), out);
+    EXPECT_TRUE(out.sent.empty());
+    EXPECT_TRUE(server.idle());
+    EXPECT_FALSE(store.writing());
+}
+
+TEST_F(FoeServerTest, ErrorTextIsCutToTheMailbox) {
+    out.max = 14;
+    const Bytes r = exchange(request(Opcode::Write, 0, "../x"));
+    EXPECT_EQ(r.size(), 14u);
+    EXPECT_EQ(error_code(r), 0x8002u);
+    EXPECT_EQ(error_string(r), "Access d");
+}
+
+TEST_F(FoeServerTest, RandomPacketsNeverCrash) {
+    ASSERT_TRUE(is_ack(download(image_v(0x01200000)), 9));
+    uint32_t x = 12345;
+    auto next = [&] {
+        x = x * 1103515245u + 12345u;
+        return x >> 16;
+    };
+    for (int i = 0; i < 20000; ++i) {
+        Bytes m(next() % 40);
+        for (auto& b : m)
+            b = static_cast<uint8_t>(next());
+        if (!m.empty()) m[0] = static_cast<uint8_t>(next() % 8);
+        server.handle(m, out);
+        EXPECT_LE(out.sent.size(), 1u);
+        out.sent.clear();
+        if (i % 100 == 0) poll();
+    }
+    EXPECT_EQ(active_version(), 0x01200000u);
+}

@@ -1,0 +1,222 @@
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <fstream>
+
+#include "foe/store.hpp"
+#include "foe_test_support.hpp"
+
+using namespace foe;
+using foe_test::kMaxpos;
+using foe_test::TempDir;
+
+namespace {
+
+StoreConfig config(const std::filesystem::path& dir) {
+    StoreConfig c;
+    c.dir = dir;
+    c.identity = kMaxpos;
+    c.read_back_chunk = 64 << 10;
+    return c;
+}
+
+// Writes an image the way the FoE server does: begin, append in pieces, finish, commit.
+StoreError install(FirmwareStore& s, const std::vector<uint8_t>& image, std::size_t piece = 50'000) {
+    StoreError e;
+    if (!s.begin_write(e)) return e;
+    for (std::size_t off = 0; off < image.size(); off += piece) {
+        const std::size_t n = std::min(piece, image.size() - off);
+        if (!s.append({image.data() + off, n}, e)) return e;
+    }
+    if (!s.finish(e)) return e;
+    if (s.commit_all(e) != FirmwareStore::Progress::Done) return e;
+    return {};
+}
+
+std::vector<uint8_t> image_v(uint32_t version, std::size_t size = 150'000) {
+    return build_image(foe_test::payload_bytes(size, version), kMaxpos, version);
+}
+
+bool no_temp_files(const std::filesystem::path& dir) {
+    for (const auto& f : std::filesystem::directory_iterator(dir))
+        if (f.path().extension() == ".tmp") return false;
+    return true;
+}
+
+}  // namespace
+
+TEST(FoeStore, EmptyDirectoryHasNoActiveImage) {
+    TempDir d;
+    FirmwareStore s(config(d.path / "state"));
+    ASSERT_TRUE(s.open());
+    EXPECT_FALSE(s.active_image().has_value());
+}
+
+TEST(FoeStore, InstallAlternatesSlotsAndSurvivesReopen) {
+    TempDir d;
+    {
+        FirmwareStore s(config(d.path));
+        ASSERT_TRUE(s.open());
+        EXPECT_EQ(install(s, image_v(0x01200000)).code, ErrorCode::NotDefined);
+        ASSERT_TRUE(s.active_image());
+        EXPECT_EQ(s.active_image()->slot, 0u);
+        EXPECT_EQ(s.active_image()->header.version, 0x01200000u);
+        EXPECT_EQ(s.active_image()->file_name, "MAXPOS_0120h_3001h_0000h_0000h.bin");
+        EXPECT_EQ(install(s, image_v(0x01300000)).code, ErrorCode::NotDefined);
+        EXPECT_EQ(s.active_image()->slot, 1u);
+        ASSERT_TRUE(s.image(0));  // the previous image is kept in the other slot
+        EXPECT_EQ(s.image(0)->header.version, 0x01200000u);
+    }
+    FirmwareStore s(config(d.path));
+    ASSERT_TRUE(s.open());
+    ASSERT_TRUE(s.active_image());
+    EXPECT_EQ(s.active_image()->header.version, 0x01300000u);
+    EXPECT_NE(s.find("MAXPOS_0120h_3001h_0000h_0000h.bin"), nullptr);
+    EXPECT_TRUE(no_temp_files(d.path));
+}
+
+TEST(FoeStore, RefusedImagesLeaveTheActiveOne) {
+    TempDir d;
+    FirmwareStore s(config(d.path));
+    ASSERT_TRUE(s.open());
+    ASSERT_EQ(install(s, image_v(0x01200000)).code, ErrorCode::NotDefined);
+
+    auto other = build_image(foe_test::payload_bytes(1000, 3), {0xFB, 0x30020000}, 0x01300000);
+    EXPECT_EQ(install(s, other).code, ErrorCode::InvalidFirmware);
+    auto corrupt = image_v(0x01300000);
+    corrupt[5000] ^= 0xFF;
+    EXPECT_EQ(install(s, corrupt).code, ErrorCode::InvalidChecksum);
+    auto shortened = image_v(0x01300000);
+    shortened.resize(shortened.size() - 10);
+    EXPECT_EQ(install(s, shortened).code, ErrorCode::FileHeaderError);
+    auto longer = image_v(0x01300000);
+    longer.push_back(1);
+    EXPECT_EQ(install(s, longer).code, ErrorCode::FileHeaderError);
+    EXPECT_EQ(install(s, {1, 2, 3}).code, ErrorCode::FileHeaderError);
+
+    ASSERT_TRUE(s.active_image());
+    EXPECT_EQ(s.active_image()->header.version, 0x01200000u);
+    EXPECT_TRUE(no_temp_files(d.path));
+    FirmwareStore again(config(d.path));
+    ASSERT_TRUE(again.open());
+    EXPECT_EQ(again.active_image()->header.version, 0x01200000u);
+}
+
+TEST(FoeStore, OversizedImageIsDiskFull) {
+    TempDir d;
+    auto c = config(d.path);
+    c.max_image_bytes = 10'000;
+    FirmwareStore s(c);
+    ASSERT_TRUE(s.open());
+    EXPECT_EQ(install(s, image_v(0x01200000, 20'000)).code, ErrorCode::DiskFull);
+}
+
+TEST(FoeStore, CorruptedActiveSlotFallsBackToTheOtherAndRepairsThePointer) {
+    TempDir d;
+    {
+        FirmwareStore s(config(d.path));
+        ASSERT_TRUE(s.open());
+        ASSERT_EQ(install(s, image_v(0x01200000)).code, ErrorCode::NotDefined);
+        ASSERT_EQ(install(s, image_v(0x01300000)).code, ErrorCode::NotDefined);
+    }
+    {
+        std::fstream f(d.path / "slot1.bin", std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(1000);
+        f.put('\x55');
+    }
+    FirmwareStore s(config(d.path));
+    ASSERT_TRUE(s.open());
+    ASSERT_TRUE(s.active_image());
+    EXPECT_EQ(s.active_image()->header.version, 0x01200000u);
+    std::ifstream p(d.path / "active");
+    std::string text;
+    std::getline(p, text);
+    EXPECT_EQ(text, "slot0");
+    // The next image goes to slot 1, never over the one that boots.
+    ASSERT_EQ(install(s, image_v(0x01400000)).code, ErrorCode::NotDefined);
+    EXPECT_EQ(s.active_image()->slot, 1u);
+}
+
+TEST(FoeStore, GarbagePointerStillBoots) {
+    TempDir d;
+    {
+        FirmwareStore s(config(d.path));
+        ASSERT_TRUE(s.open());
+        ASSERT_EQ(install(s, image_v(0x01200000)).code, ErrorCode::NotDefined);
+    }
+    std::ofstream(d.path / "active") << "slot7\n";
+    FirmwareStore s(config(d.path));
+    ASSERT_TRUE(s.open());
+    ASSERT_TRUE(s.active_image());
+    EXPECT_EQ(s.active_image()->header.version, 0x01200000u);
+}
+
+TEST(FoeStore, StaleTempFilesAreRemovedAtOpen) {
+    TempDir d;
+    std::ofstream(d.path / "slot0.bin.tmp") << "half an image";
+    std::ofstream(d.path / "active.tmp") << "slot0\n";
+    FirmwareStore s(config(d.path));
+    ASSERT_TRUE(s.open());
+    EXPECT_FALSE(s.active_image());
+    EXPECT_TRUE(no_temp_files(d.path));
+}
+
+// The process dies just before storage step k, for every k: the previous image stays active (or, once the
+// pointer was switched, the new one), the device boots, and the next download works.
+TEST(FoeStore, KilledAtEveryStepLeavesABootableDevice) {
+    const auto old_image = image_v(0x01200000);
+    const auto new_image = image_v(0x01300000, 200'000);
+
+    // Dry run: the sequence of steps.
+    std::vector<StoreStep> steps;
+    {
+        TempDir d;
+        FirmwareStore s(config(d.path));
+        ASSERT_TRUE(s.open());
+        ASSERT_EQ(install(s, old_image).code, ErrorCode::NotDefined);
+        s.set_step_hook([&](StoreStep st) { steps.push_back(st); });
+        ASSERT_EQ(install(s, new_image).code, ErrorCode::NotDefined);
+    }
+    std::size_t switch_at = steps.size();
+    for (std::size_t i = 0; i < steps.size(); ++i)
+        if (steps[i] == StoreStep::RenamePointer) switch_at = i;
+    ASSERT_LT(switch_at, steps.size());
+    ASSERT_GE(steps.size(), 12u);  // create, 4 appends, sync, rename, sync, >= 3 read-backs, pointer x4
+
+    for (std::size_t k = 0; k < steps.size(); ++k) {
+        SCOPED_TRACE("killed before step " + std::to_string(k) + " (" + std::string(to_string(steps[k])) +
+                     ")");
+        TempDir d;
+        {
+            FirmwareStore s(config(d.path));
+            ASSERT_TRUE(s.open());
+            ASSERT_EQ(install(s, old_image).code, ErrorCode::NotDefined);
+        }
+        const pid_t child = ::fork();
+        ASSERT_GE(child, 0);
+        if (child == 0) {
+            FirmwareStore s(config(d.path));
+            if (!s.open()) ::_exit(3);
+            std::size_t count = 0;
+            s.set_step_hook([&](StoreStep) {
+                if (count++ == k) ::_exit(0);
+            });
+            install(s, new_image);
+            ::_exit(2);  // not killed: the step list changed
+        }
+        int status = 0;
+        ASSERT_EQ(::waitpid(child, &status, 0), child);
+        ASSERT_TRUE(WIFEXITED(status));
+        ASSERT_EQ(WEXITSTATUS(status), 0);
+
+        FirmwareStore s(config(d.path));
+        ASSERT_TRUE(s.open());
+        ASSERT_TRUE(s.active_image());
+        EXPECT_EQ(s.active_image()->header.version, k <= switch_at ? 0x01200000u : 0x01300000u);
+        EXPECT_TRUE(no_temp_files(d.path));
+        // And the download can simply be repeated.
+        EXPECT_EQ(install(s, new_image).code, ErrorCode::NotDefined);
+        EXPECT_EQ(s.active_image()->header.version, 0x01300000u);
+    }
+}
