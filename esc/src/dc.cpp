@@ -117,7 +117,7 @@ void Esc::Impl::dc_activation_written(uint8_t old, uint8_t v) {
         if (v & 0x02) status |= 0x01;
         if (v & 0x04) status |= 0x02;
         const bool unit_on = r8(reg::kEscConfig) & 0x04;
-        if (unit_on && (v & 0x06)) {
+        if (unit_on) {  // the cyclic unit runs; bits 1/2 gate the outputs when a pulse is due
             const uint64_t sys = cur_local() + r64(reg::kDcOffset);
             uint64_t start = r64(reg::kDcStartTime);
             bool fire = true;

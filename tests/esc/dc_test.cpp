@@ -184,6 +184,17 @@ TEST_F(DcTest, Sync0Generation) {
     EXPECT_EQ(e->next_event_ns(), UINT64_MAX);
 }
 
+TEST_F(DcTest, OutputsEnabledAfterActivation) {
+    const uint64_t start = start_sync(1'000'000, 0, 0x01);  // cyclic unit only, no SYNC output yet
+    clk.set(start);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x04, 0u);
+    fpwr(*e, 0x0981, {0x03});
+    clk.set(start + 1'000'000);
+    e->tick();
+    EXPECT_EQ(al_event() & 0x04, 0x04u);
+}
+
 TEST_F(DcTest, StartTimeLockedWhileActive) {
     const uint64_t start = start_sync(1'000'000, 0, 0x03);
     fpwr(*e, 0x0990, le(start + 777, 8));
