@@ -214,7 +214,11 @@ DeviceDescription parse_device_config(std::string_view text, const std::string& 
         if (s->size() > 255) p.fail("identity strings are limited to 255 characters (SII string length)");
     check_mailbox(p, d.standard_mailbox, "mailbox");
     check_mailbox(p, d.bootstrap_mailbox, "bootstrap_mailbox");
-    place_sync_managers(d);
+    try {
+        place_sync_managers(d);
+    } catch (const std::out_of_range& e) {
+        p.fail(e.what());
+    }
     return d;
 }
 

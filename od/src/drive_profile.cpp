@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cstring>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 
@@ -558,6 +559,8 @@ void place_sync_managers(DeviceDescription& d) {
         std::max<uint32_t>(uint32_t{m.out_start} + m.out_size, uint32_t{m.in_start} + m.in_size);
     const uint32_t sm2 = round_up(mbx_end, 0x80);
     const uint32_t sm3 = round_up(sm2 + 3 * kMaxPdoBytes, 0x80);
+    if (sm3 + 3 * kMaxPdoBytes > 0x10000)
+        throw std::out_of_range("od: no room for the process-data SyncManagers after the mailbox");
     const auto rx_bytes = static_cast<uint16_t>((default_pdo_bits(0x1600) + 7) / 8);
     const auto tx_bytes = static_cast<uint16_t>((default_pdo_bits(0x1A00) + 7) / 8);
     d.sync_managers = {

@@ -125,6 +125,9 @@ TEST(DeviceConfig, ErrorsNameTheLine) {
     EXPECT_EQ(error_line("[mailbox]\nout_size = 8\n"), 0);
     EXPECT_EQ(error_line("[mailbox]\nout_start = 0x0800\n"), 0);
     EXPECT_EQ(error_line("[identity]\ndevice_name = \"\"\n"), 0);
+    EXPECT_EQ(error_line("[mailbox]\nout_start = 0xFE00\nin_start = 0xFF00\n", &msg),
+              0);  // no room for SM2/SM3
+    EXPECT_NE(msg.find("process-data"), std::string::npos) << msg;
     EXPECT_EQ(error_line("# only a comment\n; and another\n"), -1);
 }
 
