@@ -281,7 +281,8 @@ void Stack::request(AlState to, uint64_t now_ns) {
         return;
     }
     uint16_t code = al::NoError;
-    if (rank(to) > rank(from) || (from == AlState::Init && to == AlState::Boot)) {
+    const bool upward = rank(to) > rank(from) || (from == AlState::Init && to == AlState::Boot);
+    if (upward) {
         if (from == AlState::Init && to == AlState::PreOp) {
             code = check_mailbox(desc_.standard_mailbox, al::InvalidMailboxConfigPreOp);
         } else if (from == AlState::Init && to == AlState::Boot) {
@@ -290,7 +291,8 @@ void Stack::request(AlState to, uint64_t now_ns) {
             code = check_pre_op_to_safe_op();
         }
     }
-    if (code == al::NoError) code = app_.check_transition(from, to);
+    // Going down always succeeds (ref §6.2); the application vetoes only transitions up.
+    if (code == al::NoError && upward) code = app_.check_transition(from, to);
     if (code != al::NoError) {
         if (from == AlState::PreOp && to == AlState::SafeOp) pd_.clear();
         refuse(code);

@@ -417,6 +417,14 @@ TEST_F(Esm, OS_OpToSafeOp_OutputsLost) {
     EXPECT_EQ(app.outputs_lost, 1);
 }
 
+TEST_F(Esm, OS_OpToSafeOp_NotVetoedByApplication) {
+    go_op();
+    app.veto_state = AlState::SafeOp;
+    app.veto_code = 0x0001;
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x04);
+}
+
 TEST_F(Esm, OP_OpToPreOp_StopsProcessData) {
     go_op();
     request(0x02);
