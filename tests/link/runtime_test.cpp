@@ -143,6 +143,42 @@ TEST_F(Runtime, TheTimerWakesTheFirmwareAtItsDeadlineWithoutFrames) {
     EXPECT_GE(runtime.stats().timer_expiries, 1u);
 }
 
+TEST_F(Runtime, TheTimerMovesEarlierAtOnceButLaterOnlyAfterFiring) {
+    struct Movable : softslave::Firmware {
+        void poll(uint64_t now_ns) override { last = now_ns; }
+        uint64_t next_deadline_ns() const override { return deadline; }
+        uint64_t deadline = UINT64_MAX;
+        uint64_t last = 0;
+    } fw;
+    runtime.set_firmware(&fw);
+    const uint64_t t0 = clock.now_ns();
+    fw.deadline = t0 + 10'000'000;
+    ASSERT_TRUE(runtime.run_once(0));
+    const uint64_t arms = runtime.stats().timer_arms;
+    EXPECT_GE(arms, 1u);
+    fw.deadline = t0 + 30'000'000;  // later: no re-arm (a watchdog re-triggered per frame costs no syscall)
+    ASSERT_TRUE(runtime.run_once(0));
+    EXPECT_EQ(runtime.stats().timer_arms, arms);
+    fw.deadline = t0 + 20'000'000;  // earlier than 30 ms but later than the armed 10 ms: still none
+    ASSERT_TRUE(runtime.run_once(0));
+    EXPECT_EQ(runtime.stats().timer_arms, arms);
+    // The timer fires early at 10 ms, is re-armed for 20 ms, and the firmware runs at or after 20 ms.
+    for (int i = 0; i < 100 && fw.last < fw.deadline; ++i)
+        ASSERT_TRUE(runtime.run_once(2000));
+    EXPECT_GE(fw.last, t0 + 20'000'000);
+    EXPECT_LT(clock.now_ns() - t0, 1'000'000'000ull);
+    EXPECT_GE(runtime.stats().timer_expiries, 2u);
+    EXPECT_GE(runtime.stats().timer_arms, arms + 1);
+    // An earlier deadline re-arms at once.
+    fw.deadline = clock.now_ns() + 50'000'000;
+    ASSERT_TRUE(runtime.run_once(0));
+    const uint64_t arms2 = runtime.stats().timer_arms;
+    fw.deadline = clock.now_ns() + 5'000'000;
+    ASSERT_TRUE(runtime.run_once(0));
+    EXPECT_EQ(runtime.stats().timer_arms, arms2 + 1);
+    runtime.set_firmware(nullptr);
+}
+
 TEST_F(Runtime, FirmwareAdapterDrivesAnyObjectWithPollAndDeadline) {
     struct Stackish {
         void poll(uint64_t now) { seen = now; }

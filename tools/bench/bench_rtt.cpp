@@ -105,10 +105,72 @@ bool wait_until_answering(esc::Link& link, std::vector<uint8_t>& frame, std::vec
     return false;
 }
 
+// Measures `count` exchanges on link (after a short warm-up); lost frames are counted, not sampled.
+void measure(esc::Link& link, std::vector<uint8_t>& frame, std::vector<uint8_t>& rx, std::size_t count,
+             std::vector<uint64_t>& out, std::size_t& lost) {
+    for (std::size_t i = 0; i < 100 + count; ++i) {
+        const uint64_t t = exchange(link, frame, static_cast<uint8_t>(i), rx, 200);
+        if (i < 100) continue;
+        if (t != 0)
+            out.push_back(t);
+        else
+            ++lost;
+    }
+}
+
+// --same-pair: (a) and (b) on the same veth pair, one after the other, in alternating blocks (the echo and
+// the slave are restarted for each block) so that both see the same load on average.
+int run_same_pair(std::size_t frames, const std::string& backend, const std::string& slave_path,
+                  const std::string& echo_path, bool verbose) {
+    softslave::VethPair pair("rtt-s0", "rtt-m0");
+    esc::PacketLink master("rtt-m0");
+    std::vector<uint8_t> rx(esc::kMaxFrameSize);
+    const uint16_t station = 0x1001;
+    std::vector<uint8_t> frame = bench::cyclic_frame(station, 0);
+    std::vector<uint64_t> rtt_echo, rtt_slave;
+    std::size_t lost_echo = 0, lost_slave = 0;
+    constexpr std::size_t kBlocks = 4;
+    int wkc_lrw = -1;
+    for (std::size_t block = 0; block < kBlocks; ++block) {
+        const std::size_t n = frames / kBlocks + (block < frames % kBlocks ? 1 : 0);
+        {
+            Child echo({echo_path, "--iface", "rtt-s0", "--backend", backend}, !verbose);
+            if (!wait_until_answering(master, frame, rx))
+                throw std::runtime_error("bench-echo does not answer");
+            measure(master, frame, rx, n, rtt_echo, lost_echo);
+        }
+        {
+            std::vector<std::string> args = {slave_path, "--iface", "rtt-s0", "--backend", backend};
+            if (verbose) args.push_back("--verbose");
+            Child slave(args, !verbose);
+            if (!wait_until_answering(master, frame, rx))
+                throw std::runtime_error("ecat-slave does not answer");
+            for (auto cfg : bench::configuration_frames(station))
+                if (exchange(master, cfg, 0xE0, rx, 500) == 0)
+                    throw std::runtime_error("configuration frame lost");
+            measure(master, frame, rx, n, rtt_slave, lost_slave);
+            wkc_lrw = bench::datagram_wkc(rx, 0);
+        }
+    }
+    const bench::Summary se = bench::summarize(rtt_echo);
+    const bench::Summary ss = bench::summarize(rtt_slave);
+    std::printf(
+        "bench-rtt: backend %s, same veth pair, %zu frames of %zu bytes in %zu alternating blocks; "
+        "last slave reply LRW wkc %d\n",
+        backend.c_str(), frames, frame.size(), kBlocks, wkc_lrw);
+    bench::print("(a) bare echo", se, "us", 1000.0);
+    bench::print("(b) ecat-slave", ss, "us", 1000.0);
+    std::printf("lost: echo %zu, slave %zu\n", lost_echo, lost_slave);
+    if (se.median > 0 && se.p99 > 0)
+        std::printf("ratio slave/echo: median %.3f  p99 %.3f  (target < 1.2)\n", ss.median / se.median,
+                    ss.p99 / se.p99);
+    return 0;
+}
+
 void usage() {
     std::fprintf(stderr,
                  "usage: bench-rtt [--frames N] [--backend pcap|packet] [--slave PATH] [--echo PATH] "
-                 "[--eeprom FILE] [--verbose] [--compare-backends]\n");
+                 "[--eeprom FILE] [--verbose] [--compare-backends | --same-pair]\n");
 }
 
 }  // namespace
@@ -121,6 +183,7 @@ int main(int argc, char** argv) {
     std::string eeprom;
     bool verbose = false;
     bool compare_backends = false;
+    bool same_pair = false;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto next = [&]() -> std::string {
@@ -144,6 +207,8 @@ int main(int argc, char** argv) {
             verbose = true;
         } else if (a == "--compare-backends") {
             compare_backends = true;
+        } else if (a == "--same-pair") {
+            same_pair = true;
         } else {
             usage();
             return 2;
@@ -159,6 +224,7 @@ int main(int argc, char** argv) {
         return 2;
     }
     try {
+        if (same_pair) return run_same_pair(frames, backend, slave_path, echo_path, verbose);
         softslave::VethPair echo_pair("rtt-s0", "rtt-m0");
         softslave::VethPair slave_pair("rtt-s1", "rtt-m1");
         // (a) on pair 0, (b) on pair 1. With --compare-backends: (a) echo over pcap, (b) echo over packet.

@@ -2,11 +2,13 @@
 #include "softslave/runtime.hpp"
 
 #include <poll.h>
+#include <sys/epoll.h>
 #include <sys/eventfd.h>
 #include <sys/socket.h>
 #include <sys/timerfd.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <csignal>
@@ -37,16 +39,40 @@ Runtime::Runtime(esc::Link& link, esc::Esc& esc, const esc::Clock& clock)
     timer_fd_ = ::timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC);
     if (timer_fd_ < 0) throw std::runtime_error(std::string("timerfd_create: ") + std::strerror(errno));
     stop_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-    if (stop_fd_ < 0) {
-        ::close(timer_fd_);
-        throw std::runtime_error(std::string("eventfd: ") + std::strerror(errno));
+    epoll_fd_ = ::epoll_create1(EPOLL_CLOEXEC);
+    if (stop_fd_ < 0 || epoll_fd_ < 0) {
+        const int err = errno;
+        close_fds();
+        throw std::runtime_error(std::string("eventfd/epoll_create1: ") + std::strerror(err));
+    }
+    // Registered once: an epoll wait costs the same however many descriptors it watches, unlike poll().
+    const struct {
+        int fd;
+        uint32_t tag;
+    } watched[] = {{link_.fd(), kTagLink}, {timer_fd_, kTagTimer}, {stop_fd_, kTagStop}};
+    for (const auto& w : watched) {
+        if (w.fd < 0) continue;
+        epoll_event ev{};
+        ev.events = EPOLLIN;
+        ev.data.u32 = w.tag;
+        if (::epoll_ctl(epoll_fd_, EPOLL_CTL_ADD, w.fd, &ev) != 0) {
+            const int err = errno;
+            close_fds();
+            throw std::runtime_error(std::string("epoll_ctl: ") + std::strerror(err));
+        }
+    }
+}
+
+void Runtime::close_fds() {
+    for (int* fd : {&timer_fd_, &stop_fd_, &epoll_fd_}) {
+        if (*fd >= 0) ::close(*fd);
+        *fd = -1;
     }
 }
 
 Runtime::~Runtime() {
     if (g_signal_target.load() == this) g_signal_target.store(nullptr);
-    ::close(timer_fd_);
-    ::close(stop_fd_);
+    close_fds();
 }
 
 void Runtime::request_stop() {
@@ -66,26 +92,37 @@ void Runtime::run() {
 
 bool Runtime::run_once(int timeout_ms) {
     arm_timer();
-    pollfd fds[3] = {
-        {link_.fd(), POLLIN, 0},
-        {timer_fd_, POLLIN, 0},
-        {stop_fd_, POLLIN, 0},
-    };
-    const int n = ::poll(fds, 3, timeout_ms);
+    epoll_event events[3];
+    const int n = ::epoll_wait(epoll_fd_, events, 3, timeout_ms);
     if (n < 0) {
         if (errno == EINTR) return !stop_requested();
-        throw std::runtime_error(std::string("poll: ") + std::strerror(errno));
+        throw std::runtime_error(std::string("epoll_wait: ") + std::strerror(errno));
     }
-    if (fds[2].revents & POLLIN) return false;
+    uint32_t link_events = 0;
+    bool timer = false;
+    for (int i = 0; i < n; ++i) {
+        switch (events[i].data.u32) {
+            case kTagStop:
+                return false;
+            case kTagLink:
+                link_events = events[i].events;
+                break;
+            case kTagTimer:
+                timer = true;
+                break;
+            default:
+                break;
+        }
+    }
     ++stats_.wakeups;
-    const bool link_event = link_.fd() < 0 || fds[0].revents != 0;
+    const bool link_event = link_.fd() < 0 || link_events != 0;
     if (link_event) {
         handle_frames();
-        if (fds[0].revents & POLLERR) {
-            // A pending socket error (e.g. ENETDOWN) keeps poll() returning; reading SO_ERROR clears it.
+        if (link_events & EPOLLERR) {
+            // A pending socket error (e.g. ENETDOWN) keeps the descriptor ready; reading SO_ERROR clears it.
             int err = 0;
             socklen_t len = sizeof err;
-            (void)::getsockopt(fds[0].fd, SOL_SOCKET, SO_ERROR, &err, &len);
+            (void)::getsockopt(link_.fd(), SOL_SOCKET, SO_ERROR, &err, &len);
             ++stats_.link_errors;
             if (link_check_ && !link_check_()) {
                 link_lost_ = true;
@@ -93,13 +130,13 @@ bool Runtime::run_once(int timeout_ms) {
             }
         }
     }
-    if (fds[1].revents & POLLIN) {
+    if (timer) {
         uint64_t expirations = 0;
         if (::read(timer_fd_, &expirations, sizeof expirations) == sizeof expirations)
             ++stats_.timer_expiries;
         armed_ns_ = 0;
     }
-    if (link_event || (fds[1].revents & POLLIN) || n == 0) service();
+    if (link_event || timer || n == 0) service();
     return true;
 }
 
@@ -112,6 +149,9 @@ void Runtime::handle_frames() {
         std::span<uint8_t> frame(buffer_.data(), len);
         if (capture_ != nullptr) std::memcpy(in_copy_.data(), buffer_.data(), len);
         const bool reply = esc_.process_frame(frame, rx_ns);
+        const uint64_t done_ns = clock_.now_ns() - rx_ns;
+        stats_.frame_ns_total += done_ns;
+        stats_.frame_ns_max = std::max(stats_.frame_ns_max, done_ns);
         if (reply) {
             if (link_.send(frame))
                 ++stats_.frames_sent;
@@ -136,17 +176,19 @@ void Runtime::service() {
 void Runtime::arm_timer() {
     uint64_t deadline = esc_.next_event_ns();
     if (firmware_ != nullptr) deadline = std::min(deadline, firmware_->next_deadline_ns());
-    if (deadline == kNever) deadline = 0;  // disarm
-    if (deadline == 0 && armed_ns_ == 0) return;
-    if (deadline == armed_ns_) return;
+    // The timer is only ever moved earlier. A deadline that moved later (a watchdog re-triggered by every
+    // process-data frame) or went away leaves the timer where it is: it then fires early once, service()
+    // finds nothing due, and the timer is re-armed for the real deadline. This saves a timerfd_settime()
+    // per frame, and on a shared CPU every microsecond after the reply delays the master too.
+    if (deadline == kNever || (armed_ns_ != 0 && deadline >= armed_ns_)) return;
     itimerspec spec{};
-    if (deadline != 0) {
-        spec.it_value.tv_sec = static_cast<time_t>(deadline / 1000000000ull);
-        spec.it_value.tv_nsec = static_cast<long>(deadline % 1000000000ull);
-    }
+    spec.it_value.tv_sec = static_cast<time_t>(deadline / 1000000000ull);
+    spec.it_value.tv_nsec = static_cast<long>(deadline % 1000000000ull);
+    if (spec.it_value.tv_sec == 0 && spec.it_value.tv_nsec == 0) spec.it_value.tv_nsec = 1;  // 0 would disarm
     if (::timerfd_settime(timer_fd_, TFD_TIMER_ABSTIME, &spec, nullptr) < 0)
         throw std::runtime_error(std::string("timerfd_settime: ") + std::strerror(errno));
-    armed_ns_ = deadline;
+    ++stats_.timer_arms;
+    armed_ns_ = deadline == 0 ? 1 : deadline;
 }
 
 void install_stop_signals() {

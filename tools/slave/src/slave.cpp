@@ -136,10 +136,14 @@ int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err)
         if (options.verbose) {
             const RuntimeStats& s = runtime.stats();
             const esc::EscStats e = esc.stats();
+            if (s.frames_received > 0)
+                out << "frame processing (received to reply ready): mean "
+                    << s.frame_ns_total / s.frames_received << " ns, max " << s.frame_ns_max << " ns\n";
             out << "frames received " << s.frames_received << ", sent " << s.frames_sent << ", dropped "
                 << s.frames_dropped << ", send errors " << s.send_errors << ", link errors " << s.link_errors
-                << "; ESC: processed " << e.frames_processed << ", ignored " << e.frames_ignored
-                << ", malformed " << e.frames_malformed << ", datagrams " << e.datagrams << '\n';
+                << ", timer arms " << s.timer_arms << ", expiries " << s.timer_expiries << "; ESC: processed "
+                << e.frames_processed << ", ignored " << e.frames_ignored << ", malformed "
+                << e.frames_malformed << ", datagrams " << e.datagrams << '\n';
         }
         out << "ecat-slave: stopped\n";
         return kExitOk;

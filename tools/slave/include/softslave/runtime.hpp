@@ -1,7 +1,7 @@
 #pragma once
 // The slave runtime: a single-threaded event loop that owns the link and the ESC and runs the firmware.
 //
-//   poll(link fd, timerfd, stop eventfd)
+//   epoll_wait(link fd, timerfd, stop eventfd)
 //   for each frame waiting (a burst, at most kMaxBurst):  rx time = clock now
 //       esc.process_frame(frame, rx time); if it says so, link.send(frame); record in/out to the capture
 //   then esc.tick() and firmware.poll(now)                (after the replies: the firmware never delays a
@@ -30,6 +30,9 @@ struct RuntimeStats {
     uint64_t link_errors = 0;  // POLLERR on the link (interface went down, ...)
     uint64_t wakeups = 0;
     uint64_t timer_expiries = 0;
+    uint64_t timer_arms = 0;      // timerfd_settime() calls
+    uint64_t frame_ns_total = 0;  // sum over frames of (reply ready to send - frame received), clock ns
+    uint64_t frame_ns_max = 0;
 };
 
 class Runtime {
@@ -63,6 +66,8 @@ class Runtime {
     void handle_frames();
     void service();
     void arm_timer();
+    void close_fds();
+    static constexpr uint32_t kTagLink = 1, kTagTimer = 2, kTagStop = 3;
 
     esc::Link& link_;
     esc::Esc& esc_;
@@ -73,7 +78,8 @@ class Runtime {
     bool link_lost_ = false;
     int timer_fd_ = -1;
     int stop_fd_ = -1;
-    uint64_t armed_ns_ = 0;         // deadline the timerfd is armed for; 0 = disarmed
+    int epoll_fd_ = -1;
+    uint64_t armed_ns_ = 0;         // deadline the timerfd is armed for; 0 = not armed or expired
     std::vector<uint8_t> buffer_;   // the receive buffer (frame processed in place)
     std::vector<uint8_t> in_copy_;  // the frame as received, kept for the capture
     RuntimeStats stats_;
