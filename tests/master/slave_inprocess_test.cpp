@@ -16,6 +16,7 @@
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
+#include "master/session.hpp"
 #include "od/drive_profile.hpp"
 
 using namespace master;
@@ -24,6 +25,9 @@ namespace {
 
 struct Slave {
     esc::ManualClock clock;
+    esc::SystemClock system_clock;
+    bool real_time = false;  // DC tests: the ESC runs on CLOCK_MONOTONIC, as in ecat-slave
+    const esc::Clock& clk() const { return real_time ? static_cast<const esc::Clock&>(system_clock) : clock; }
     od::DeviceDescription desc;
     od::Dictionary dict;
     std::unique_ptr<esc::Esc> esc;
@@ -32,7 +36,7 @@ struct Slave {
     std::unique_ptr<coe::CoeServer> coe;
     bool lose_next_reply = false;
 
-    explicit Slave(uint16_t mailbox_size) {
+    explicit Slave(uint16_t mailbox_size, bool real = false) : real_time(real) {
         desc = od::default_drive_description();
         desc.standard_mailbox.out_size = mailbox_size;
         desc.standard_mailbox.in_start =
@@ -41,12 +45,12 @@ struct Slave {
         od::place_sync_managers(desc);
         dict = od::make_drive_dictionary(desc);
         clock.set(1'000'000'000);
-        esc = std::make_unique<esc::Esc>(esc::EscConfig{}, clock);
+        esc = std::make_unique<esc::Esc>(esc::EscConfig{}, clk());
         esc->load_eeprom(esi::build_sii(desc, dict));
         stack = std::make_unique<ecat::Stack>(*esc, dict, desc, app);
         coe = std::make_unique<coe::CoeServer>(dict, [this] { return stack->state(); });
         stack->add_handler(*coe);
-        stack->poll(clock.now_ns());
+        stack->poll(clk().now_ns());
     }
 };
 
@@ -64,10 +68,10 @@ class SlaveLink final : public esc::Link {
     }
     bool send(std::span<const uint8_t> frame) override {
         std::vector<uint8_t> f(frame.begin(), frame.end());
-        s_.clock.advance(20'000);
+        if (!s_.real_time) s_.clock.advance(20'000);
         const bool back = s_.esc->process_frame(f);
         s_.esc->tick();
-        s_.stack->poll(s_.clock.now_ns());  // firmware after the reply, as the runtime does
+        s_.stack->poll(s_.clk().now_ns());  // firmware after the reply, as the runtime does
         if (back && !drop_) replies_.push_back(std::move(f));
         drop_ = false;
         return true;
@@ -224,4 +228,71 @@ TEST_P(WithSlave, AdoptRefusesAMailboxThatIsNotSetUp) {
     EXPECT_EQ(none.upload(0x1018, 1, b).error(), Error::MailboxNotConfigured);
 }
 
+TEST_P(WithSlave, ProcessDataSessionReachesOpAndExchanges) {
+    ProcessDataSession pd(m, a, sdo);
+    ASSERT_EQ(pd.discover(), Error::Ok);
+    const auto& l = pd.layout();
+    // The layout the slave expects: its own SM defaults and PDO sizes.
+    ASSERT_GE(slave.desc.sync_managers.size(), 4u);
+    EXPECT_EQ(l.sm2_start, slave.desc.sync_managers[2].start);
+    EXPECT_EQ(l.sm3_start, slave.desc.sync_managers[3].start);
+    EXPECT_EQ(l.sm2_length, slave.desc.sync_managers[2].default_size);
+    EXPECT_EQ(l.sm3_length, slave.desc.sync_managers[3].default_size);
+    EXPECT_EQ(l.rx_pdos, (std::vector<uint16_t>{0x1600}));
+    EXPECT_EQ(l.tx_pdos, (std::vector<uint16_t>{0x1A00}));
+    ASSERT_EQ(pd.configure(), Error::Ok) << std::hex << sdo.last_abort();
+    AlStatus st;
+    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(200), &st), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(200), &st), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    EXPECT_EQ(pd.expected_wkc(), 3);
+    ASSERT_EQ(pd.run(50, std::chrono::microseconds(100)), Error::Ok);
+    EXPECT_EQ(pd.last_wkc(), 3);
+    EXPECT_EQ(pd.stats().wkc_errors, 0u);
+    EXPECT_EQ(pd.stats().lost, 0u);
+    // Outputs reach the dictionary: controlword (0x6040) is the first mapped RxPDO entry.
+    pd.outputs()[0] = 0x06;
+    pd.outputs()[1] = 0x00;
+    ASSERT_EQ(pd.run(3, std::chrono::microseconds(100)), Error::Ok);
+    EXPECT_EQ(slave.dict.get<uint16_t>(0x6040, 0), 0x0006);
+    // Inputs come from it: statusword (0x6041) is the first mapped TxPDO entry.
+    EXPECT_EQ(pd.inputs()[0] | (pd.inputs()[1] << 8), slave.dict.get<uint16_t>(0x6041, 0));
+    EXPECT_EQ(m.al_status(a)->state, 0x08);
+}
+
 INSTANTIATE_TEST_SUITE_P(MailboxSizes, WithSlave, ::testing::Values(uint16_t{128}, uint16_t{32}));
+
+TEST(ProcessDataDc, Sync0RunsAndTheSlaveReachesOpInDcMode) {
+    Slave slave(128, true);
+    SlaveLink link(slave);
+    Master m(link, options());
+    const Address a = Address::station(0x1001);
+    ASSERT_EQ(m.count_slaves().value(), 1);
+    ASSERT_EQ(m.assign_station_addresses(1), Error::Ok);
+    Mailbox mbx(m, a);
+    ASSERT_EQ(mbx.configure_from_sii(), Error::Ok);
+    ASSERT_EQ(m.request_state(a, AlState::PreOp), Error::Ok);
+    SdoClient sdo(mbx);
+    ProcessDataSession pd(m, a, sdo);
+    ASSERT_EQ(pd.discover(), Error::Ok);
+    DcConfig dc;
+    dc.enable = true;
+    dc.cycle_ns = 1'000'000;
+    dc.start_delay = std::chrono::milliseconds(20);
+    ASSERT_EQ(pd.configure(dc), Error::Ok) << std::hex << sdo.last_abort();
+    EXPECT_EQ(m.read_reg<uint8_t>(a, 0x0981).value(), 0x03);
+    EXPECT_EQ(m.read_reg<uint32_t>(a, 0x09A0).value(), 1'000'000u);
+    AlStatus st;
+    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(1000), &st), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(1000), &st), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(pd.run(100, std::chrono::microseconds(1000)), Error::Ok);
+    EXPECT_EQ(pd.stats().wkc_errors, 0u);
+    // The reference clock's system time follows the master's (set through the offset, 0x0920).
+    EXPECT_NE(pd.reference_time(), 0u);
+    EXPECT_GT(slave.stack->stats().sync0_events, 50u);
+    EXPECT_EQ(slave.stack->sync_mode(), ecat::SyncMode::DcSync0);
+    EXPECT_EQ(m.al_status(a)->state, 0x08);
+}
