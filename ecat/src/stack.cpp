@@ -456,6 +456,8 @@ uint16_t Stack::check_sync_configuration() {
             if (!(supported & 0x0004) || (mode == SyncMode::DcSync1 && !(supported & 0x0008)))
                 return al::SyncModeNotSupported;
             if (sync0_cycle == 0) return al::DcInvalidSyncCycleTime;
+            // Start time already past when activated (0x0984 bit 2): SYNC0 would not come (ref §11.4).
+            if (pdi_.read_reg<uint8_t>(reg::kDcActivationStatus) & 0x04) return al::InvalidDcSyncConfig;
             if (min_cycle != 0 && sync0_cycle < min_cycle) return al::DcSync0CycleTime;
             cycle = sync0_cycle;
             break;

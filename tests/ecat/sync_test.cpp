@@ -207,6 +207,17 @@ TEST_F(Sync, Dc_Sync0CycleBelowMinimum_0x0036) {
     EXPECT_EQ(al_code(), 0x0036);
 }
 
+TEST_F(Sync, Dc_StartTimeInThePast_0x0030) {
+    go_preop();
+    configure_process_data(6, 6);
+    master.wr<uint32_t>(0x09A0, 1'000'000);
+    master.wr<uint64_t>(0x0990, master.rd<uint64_t>(0x0910) - 5'000'000);
+    master.wr<uint8_t>(0x0981, 0x03);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x02 | kErr);
+    EXPECT_EQ(al_code(), 0x0030);
+}
+
 TEST_F(Sync, Dc_Sync0CycleZero_0x0035) {
     go_preop();
     configure_process_data(6, 6);

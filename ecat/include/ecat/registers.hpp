@@ -17,6 +17,7 @@ constexpr uint16_t kWatchdogStatusPd = 0x0440;
 constexpr uint16_t kDcSystemTime = 0x0910;
 constexpr uint16_t kDcCyclicUnitControl = 0x0980;
 constexpr uint16_t kDcActivation = 0x0981;
+constexpr uint16_t kDcActivationStatus = 0x0984;
 constexpr uint16_t kDcSync0Status = 0x098E;
 constexpr uint16_t kDcSync1Status = 0x098F;
 constexpr uint16_t kDcStartTime = 0x0990;  // read: system time of the next SYNC0 pulse
