@@ -222,6 +222,28 @@ TEST_F(Runtime, SigtermEndsRun) {
     EXPECT_TRUE(softslave::stop_signalled());
 }
 
+TEST_F(Runtime, CapturedFramesReachTheFileWithinTheFlushIntervalWithoutMoreTraffic) {
+    const std::string path =
+        (std::filesystem::temp_directory_path() / ("runtime-flush-" + std::to_string(::getpid()) + ".pcap"))
+            .string();
+    esc::PcapWriter capture(path);
+    runtime.set_capture(&capture);
+    for (int i = 0; i < 3; ++i) {
+        ASSERT_TRUE(master().send(brd_type_frame()));
+        ASSERT_TRUE(runtime.run_once(1000));
+    }
+    // The first burst flushes at once (nothing flushed yet); later ones wait for the interval, and the
+    // timer brings the runtime back for it even though no frame arrives.
+    const uint64_t start = clock.now_ns();
+    const auto expected = 24u + 6u * (16u + 60u);
+    while (std::filesystem::file_size(path) < expected && clock.now_ns() - start < 2'000'000'000ull)
+        ASSERT_TRUE(runtime.run_once(1000));
+    EXPECT_EQ(std::filesystem::file_size(path), expected);
+    EXPECT_LT(clock.now_ns() - start, 1'000'000'000ull);
+    runtime.set_capture(nullptr);
+    std::remove(path.c_str());
+}
+
 TEST_F(Runtime, CaptureRecordsTheFrameAsReceivedAndAsSent) {
     const std::string path =
         (std::filesystem::temp_directory_path() / ("runtime-capture-" + std::to_string(::getpid()) + ".pcap"))

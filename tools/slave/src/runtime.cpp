@@ -170,12 +170,23 @@ void Runtime::handle_frames() {
 
 void Runtime::service() {
     esc_.tick();
-    if (firmware_ != nullptr) firmware_->poll(clock_.now_ns());
+    const uint64_t now = clock_.now_ns();
+    if (firmware_ != nullptr) firmware_->poll(now);
+    // Capture: pushed to the file at most every kCaptureFlushNs, so a reader (or a SIGKILL) sees frames
+    // that are at most that old, without a write() per frame.
+    if (capture_ != nullptr && capture_->frames_written() != flushed_frames_ &&
+        now >= capture_flush_due_ns_) {
+        capture_->flush();
+        flushed_frames_ = capture_->frames_written();
+        capture_flush_due_ns_ = now + kCaptureFlushNs;
+    }
 }
 
 void Runtime::arm_timer() {
     uint64_t deadline = esc_.next_event_ns();
     if (firmware_ != nullptr) deadline = std::min(deadline, firmware_->next_deadline_ns());
+    if (capture_ != nullptr && capture_->frames_written() != flushed_frames_)
+        deadline = std::min(deadline, capture_flush_due_ns_);
     // The timer is only ever moved earlier. A deadline that moved later (a watchdog re-triggered by every
     // process-data frame) or went away leaves the timer where it is: it then fires early once, service()
     // finds nothing due, and the timer is re-armed for the real deadline. This saves a timerfd_settime()

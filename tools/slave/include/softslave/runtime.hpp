@@ -38,6 +38,8 @@ struct RuntimeStats {
 class Runtime {
   public:
     static constexpr int kMaxBurst = 64;
+    // Longest time a captured frame stays in the capture's buffer before it is written to the file.
+    static constexpr uint64_t kCaptureFlushNs = 200'000'000;
 
     Runtime(esc::Link& link, esc::Esc& esc, const esc::Clock& clock);
     ~Runtime();
@@ -79,9 +81,11 @@ class Runtime {
     int timer_fd_ = -1;
     int stop_fd_ = -1;
     int epoll_fd_ = -1;
-    uint64_t armed_ns_ = 0;         // deadline the timerfd is armed for; 0 = not armed or expired
-    std::vector<uint8_t> buffer_;   // the receive buffer (frame processed in place)
-    std::vector<uint8_t> in_copy_;  // the frame as received, kept for the capture
+    uint64_t armed_ns_ = 0;              // deadline the timerfd is armed for; 0 = not armed or expired
+    uint64_t flushed_frames_ = 0;        // capture frames already pushed to the file
+    uint64_t capture_flush_due_ns_ = 0;  // earliest time of the next capture flush
+    std::vector<uint8_t> buffer_;        // the receive buffer (frame processed in place)
+    std::vector<uint8_t> in_copy_;       // the frame as received, kept for the capture
     RuntimeStats stats_;
 };
 
