@@ -374,7 +374,20 @@ void Axis::mode_commands(int64_t now_ns, int64_t dt_ns) {
             break;
         }
         case mode::Homing:
-            if (rise4 && enabled) homing_start();
+            if (rise4 && enabled) {
+                homing_start();
+            } else if (rise4 && !power_ && params.homing_method == 37 && state_ != State::Fault &&
+                       state_ != State::FaultReactionActive) {
+                // Method 37 while disabled: no offset move, the actual position becomes the home position
+                // [001 §4.5.3.11].
+                hmethod_ = 37;
+                href_ = static_cast<double>(count_);
+                shift_ = static_cast<int64_t>(params.home_position) - count_;
+                hstat_ = HomingStatus::Done;
+                hphase_ = HomingPhase::Finished;
+                referenced_ = true;
+                sink_->diag(Severity::Info, 0, "Homing attained");
+            }
             if (fall4 && hstat_ == HomingStatus::InProgress) {
                 hstat_ = HomingStatus::Interrupted;
                 hphase_ = HomingPhase::Stopping;

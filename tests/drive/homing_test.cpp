@@ -124,3 +124,31 @@ TEST(Homing, HaltInterruptsWithStatus001) {
     EXPECT_EQ(r.sw() & (sw::Bit13 | sw::Bit12 | sw::TargetReached), sw::TargetReached);
     EXPECT_FALSE(r.sw() & sw::Referenced);
 }
+
+TEST(Homing, Method37WhileDisabledSetsThePositionWithoutMoving) {
+    Rig r;
+    r.ax.params.homing_method = 37;
+    r.ax.params.home_position = -1234;
+    r.ax.params.home_offset_move = 500;  // omitted while disabled
+    r.ax.command.mode = mode::Homing;
+    r.cw(0x06);
+    r.cw(0x07);
+    r.cw(0x17);  // bit 4 rising in Switched On
+    EXPECT_EQ(r.fb().position_actual, -1234);
+    EXPECT_TRUE(r.sw() & sw::Referenced);
+    EXPECT_EQ(r.sw() & (sw::Bit13 | sw::Bit12 | sw::TargetReached), sw::Bit12 | sw::TargetReached);
+    EXPECT_EQ(r.ax.plant().velocity(), 0.0);
+}
+
+TEST(Homing, TouchProbeIsOffDuringHoming) {
+    Rig r;
+    r.ax.params.homing_method = 34;
+    r.ax.params.homing_speed_zero = 300;
+    r.ax.command.mode = mode::Homing;
+    r.ax.command.touch_probe_function = 0x0017;  // index source, continuous
+    r.enable();
+    r.cw(0x1F);
+    ASSERT_TRUE(r.until([&] { return (r.sw() & sw::Bit12) != 0; }, 5000));
+    EXPECT_EQ(r.fb().touch_probe_pos_count, 0);
+    EXPECT_EQ(r.fb().touch_probe_status & 0x6, 0);
+}

@@ -296,3 +296,42 @@ TEST(Modes, LimitSwitchRaises8A81WhenDrivingIntoIt) {
     ASSERT_TRUE(r.until([&] { return !(r.fb().digital_inputs & 0x2); }, 2000));
     EXPECT_EQ(r.ax.state(), State::OperationEnabled);
 }
+
+TEST(Modes, SpeedAboveMaxMotorSpeedRaises8A83) {
+    Rig r;
+    r.ax.params.max_motor_speed = 800;
+    r.ax.command.mode = mode::CyclicSyncTorque;
+    r.enable();
+    r.ax.command.target_torque = 600;  // would settle at ~1490 rpm against the friction
+    ASSERT_TRUE(r.until([&] { return r.rec.has(error_code::MaxSpeed); }, 2000));
+    EXPECT_GT(std::abs(r.rpm()), 780);
+    EXPECT_EQ(r.fb().error_register, 0x20);
+    ASSERT_TRUE(r.until([&] { return r.ax.state() == State::Fault; }, 2000));
+}
+
+TEST(Modes, SecondErrorAddsItsRegisterBitsAndBecomesTheLastError) {
+    Rig r;
+    r.ax.raise_error(error_code::FollowingError);
+    r.ax.raise_error(error_code::Overvoltage);
+    r.run(1);
+    EXPECT_EQ(r.fb().error_code, error_code::Overvoltage);
+    EXPECT_EQ(r.fb().error_register, 0x84);
+    EXPECT_EQ(r.rec.raised.size(), 2u);
+    r.ax.raise_error(error_code::Overvoltage);  // already active: no second emergency
+    EXPECT_EQ(r.rec.raised.size(), 2u);
+    r.cw(0x80);
+    EXPECT_EQ(r.fb().error_register, 0);
+    EXPECT_EQ(r.rec.cleared.size(), 2u);
+}
+
+TEST(Modes, CsvActualOutsideSoftwareLimitRaises8A82) {
+    Rig r;
+    const int32_t start = r.fb().position_actual;
+    r.ax.params.sw_limit_max = start + 2000;
+    r.ax.command.mode = mode::CyclicSyncVelocity;
+    r.enable();
+    r.ax.command.target_velocity = 600;
+    ASSERT_TRUE(r.until([&] { return r.rec.has(error_code::SoftwarePositionLimit); }, 2000));
+    EXPECT_GT(r.fb().position_actual, start + 2000);
+    EXPECT_LT(r.fb().position_actual, start + 2100);
+}
