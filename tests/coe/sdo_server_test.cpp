@@ -335,6 +335,13 @@ TEST_F(SdoServer, CompleteAccessDownloadOfAnAssignment) {
     EXPECT_EQ(dict.get<uint16_t>(0x1C12, 1), 0x1601);
 }
 
+TEST_F(SdoServer, CompleteAccessDownloadFromSubindex1KeepsSubindex0) {
+    EXPECT_EQ(ask(sdo(0x33, 0x1C12, 1, 0x16011600)), (Bytes{0x00, 0x30, 0x70, 0x12, 0x1C, 0x01, 0, 0, 0, 0}));
+    EXPECT_EQ(dict.get<uint8_t>(0x1C12, 0), 1);
+    EXPECT_EQ(dict.get<uint16_t>(0x1C12, 1), 0x1600);
+    EXPECT_EQ(dict.get<uint16_t>(0x1C12, 2), 0x1601);
+}
+
 TEST_F(SdoServer, CompleteAccessDownloadOfAWholePdoMappingAsTwinCatDoes) {
     coe::install_pdo_validators(dict);
     Bytes req = sdo(0x31, 0x1600, 0, 14,
