@@ -216,6 +216,11 @@ void Stack::poll(uint64_t now_ns) {
         mailbox_.poll(now_ns);
         housekeeping_at_ns_ = now_ns + kHousekeepingNs;
     }
+    if (restart_pending_) {
+        // Last: AL status already says Init, so the application may restart the device from here.
+        restart_pending_ = false;
+        app_.on_restart();
+    }
 }
 
 uint64_t Stack::next_deadline_ns() const {
@@ -563,7 +568,8 @@ void Stack::go(AlState to, uint64_t now_ns) {
     update_irq_usable();
     mailbox_.set_state(from, to);
     app_.on_state_change(from, to);
-    if (from == AlState::Boot && to == AlState::Init) app_.on_restart();
+    if (from == AlState::Boot && to == AlState::Init)
+        restart_pending_ = true;  // reported at the end of poll()
 }
 
 void Stack::update_irq_usable() {

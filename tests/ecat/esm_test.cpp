@@ -309,6 +309,8 @@ TEST_F(Esm, BI_BootToInit_Restarts) {
     EXPECT_EQ(al_status(), 0x01);
     EXPECT_EQ(app.restarts, 1);
     EXPECT_FALSE(stack->mailbox().running());
+    poll();
+    EXPECT_EQ(app.restarts, 1);  // once
 }
 
 TEST_F(Esm, Invalid_BootToPreOp_0x0011) {

@@ -157,6 +157,7 @@ class Stack {
     bool irq_usable_ = true;
     void update_irq_usable();
 
+    bool restart_pending_ = false;
     uint64_t housekeeping_at_ns_ = 0;
     uint64_t last_now_ns_ = 0;
     bool first_poll_ = true;
