@@ -259,6 +259,18 @@ def parse_datagrams(frame):
     return out
 
 
+def tshark_problems(capture):
+    """Lines of `tshark -V` that report malformed packets or expert errors; None if tshark is missing."""
+    tshark = shutil.which("tshark")
+    if not tshark:
+        return None
+    r = subprocess.run([tshark, "-r", capture, "-V"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                       timeout=300)
+    if r.returncode != 0:
+        return [f"tshark failed: {r.stderr.strip()}"]
+    return [line for line in r.stdout.splitlines() if "Malformed" in line or "Expert Info (Error" in line]
+
+
 def main():
     """Entry point of every test script: skip (exit 77) unless root with network namespaces."""
     if os.geteuid() != 0:

@@ -158,6 +158,9 @@ Error ProcessDataSession::configure(const DcConfig& dc) {
     image_.assign(static_cast<std::size_t>(layout_.sm2_length) + layout_.sm3_length, 0);
     lrw_ = Datagram::logical(Command::LRW, kLogicalBase, image_);
     if (dc.enable) return configure_dc(dc);
+    // Not DC: SYNC0 left running by an earlier session would contradict sync mode 1 (AL code 0x0030).
+    const uint8_t zero2[2] = {};
+    if (Error e = m_.write(slave_, 0x0980, zero2); e != Error::Ok) return e;
     dc_ = false;
     return Error::Ok;
 }
