@@ -220,7 +220,9 @@ od::Status download(od::Dictionary& dict, const od::Object& obj, uint8_t first, 
         std::span<const uint8_t> value(scratch.data(), len);
         if (!writable_at_all(e)) continue;
         od::Status st = dict.write(obj.index, e.subindex, state, value);
-        if (st != od::Status::Ok) return fail(st);
+        // Entries past the new count are "don't care" (a master may send the whole array with zeros there):
+        // one the dictionary refuses keeps its old value instead of failing the download.
+        if (st != od::Status::Ok && !(sub0_writable && e.subindex > new_count)) return fail(st);
     }
     if (sub0_writable) {
         od::Status st = dict.write(obj.index, 0, state, std::span<const uint8_t>(&new_count, 1));

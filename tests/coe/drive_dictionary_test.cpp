@@ -70,6 +70,20 @@ TEST_F(DriveDictionary, RemapAndCompleteAccessDownloadOfThePdoObjects) {
     EXPECT_EQ(ask(sdo(0x2F, 0x1C12, 0, 0)), abort_reply(0x1C12, 0, 0x08000022));
 }
 
+TEST_F(DriveDictionary, WholeArrayDownloadWithZerosPastTheCount) {
+    // 0x1C12 entries only take 0x1600..0x1603 (seed 001 §7.2.15); zeros past the count are not an error.
+    Bytes req = sdo(0x31, 0x1C12, 0, 10, {0x01, 0x00, 0x01, 0x16, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00});
+    EXPECT_EQ(ask(req), (Bytes{0x00, 0x30, 0x70, 0x12, 0x1C, 0x00, 0, 0, 0, 0}));
+    EXPECT_EQ(dict.get<uint8_t>(0x1C12, 0), 1);
+    EXPECT_EQ(dict.get<uint16_t>(0x1C12, 1), 0x1601);
+    EXPECT_EQ(dict.get<uint16_t>(0x1C12, 2), 0x1601);  // kept its default
+    // A zero inside the count is still refused, and nothing changes.
+    req = sdo(0x31, 0x1C12, 0, 6, {0x02, 0x00, 0x00, 0x16, 0x00, 0x00});
+    EXPECT_EQ(ask(req), abort_reply(0x1C12, 0, 0x06090032));
+    EXPECT_EQ(dict.get<uint8_t>(0x1C12, 0), 1);
+    EXPECT_EQ(dict.get<uint16_t>(0x1C12, 1), 0x1601);
+}
+
 TEST_F(DriveDictionary, SdoInfoListsAreConsistentWithTheDictionary) {
     RecordingSender small(42, 64);
     server.handle(info(0x01, {0x00, 0x00}), small);
