@@ -1,9 +1,13 @@
 // PcapLink and PacketLink on a real veth pair inside a network namespace the test creates. The namespace
 // is anonymous (unshare on a helper thread) and dies with the last socket in it, taking the veth pair along,
 // so nothing stays behind even when a test fails. Skipped when not root.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <linux/if_packet.h>
 #include <net/if.h>
 #include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <array>
 #include <memory>
@@ -105,6 +109,41 @@ TEST_P(VethLink, OwnRepliesNeverComeBackIn) {
     ASSERT_TRUE(p.master->send(f));
     ASSERT_EQ(receive_within(*p.slave, buf, 2000), 60u);
     EXPECT_EQ(receive_within(*p.master, back, 200), 0u);
+}
+
+// A plain AF_PACKET socket (through the qdisc, so packet taps see its frames as PACKET_OUTGOING), as a
+// capture tool or a second program on the slave's interface would use.
+int plain_packet_socket(const char* iface) {
+    const int fd = ::socket(AF_PACKET, SOCK_RAW | SOCK_CLOEXEC, htons(0x88A4));
+    if (fd < 0) throw std::runtime_error("socket(AF_PACKET)");
+    sockaddr_ll addr{};
+    addr.sll_family = AF_PACKET;
+    addr.sll_protocol = htons(0x88A4);
+    addr.sll_ifindex = static_cast<int>(if_nametoindex(iface));
+    if (::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+        ::close(fd);
+        throw std::runtime_error("bind");
+    }
+    return fd;
+}
+
+TEST_P(VethLink, FramesAnotherSocketSendsOutOfTheSameInterfaceAreNotReceived) {
+    std::unique_ptr<esc::Link> slave, master;
+    int other = -1;
+    in_new_netns([&] {
+        softslave::create_veth("s0", "m0");
+        softslave::set_interface_up("s0");
+        softslave::set_interface_up("m0");
+        slave = esc::open_link("s0", GetParam());
+        master = std::make_unique<esc::PacketLink>("m0");
+        other = plain_packet_socket("s0");
+    });
+    const auto f = ecat_frame(60, 9);
+    ASSERT_EQ(::send(other, f.data(), f.size(), 0), 60);
+    std::array<uint8_t, esc::kMaxFrameSize> buf{};
+    ASSERT_EQ(receive_within(*master, buf, 2000), 60u) << "the frame went out on the wire";
+    EXPECT_EQ(receive_within(*slave, buf, 200), 0u) << "an outgoing frame must not be taken as received";
+    ::close(other);
 }
 
 TEST_P(VethLink, OnlyEtherCatFramesAreReceived) {
