@@ -101,8 +101,13 @@ class Dictionary {
     // ---- Master-side access (SDO, complete access, PDO configuration) ------------------------------
     // Checks access rights for the AL state, runs read hooks, copies the current value to out.
     // length receives the number of bytes of the value (strings: their current length).
+    // NoObject / NoSubindex; WriteOnly if never readable; WrongState if not readable in `state` (Init and
+    // Bootstrap: always); LengthTooHigh if `out` is too small (length then says how much is needed).
     Status read(uint16_t index, uint8_t sub, AlState state, std::span<uint8_t> out, std::size_t& length);
     // Checks access rights, length, limits and validators; commits; notifies listeners.
+    // ReadOnly if never writable, WrongState if not writable in `state`; LengthTooHigh/LengthTooLow for a
+    // scalar of the wrong size (strings: up to their capacity, shorter allowed); ValueTooHigh/ValueTooLow
+    // outside minimum/maximum (BOOLEAN: 0/1; REAL NaN: InvalidValue); then the first non-Ok validator.
     Status write(uint16_t index, uint8_t sub, AlState state, std::span<const uint8_t> value);
 
     // ---- Device-side access (no access-rights check; type, length and limits are still checked) -----
