@@ -61,6 +61,15 @@ class CoeAndState(unittest.TestCase):
         # Acknowledged: no error flag left, still in PREOP.
         self.assertEqual(self.bus.ecatctl("state", "0").stdout.strip(), "PREOP")
 
+    def test_object_dictionary_listing(self):
+        r = self.bus.ecatctl("sdos", "0")
+        self.assertIn('SDO 0x1018, "', r.stdout)
+        self.assertIn("  0x1018:01, r-r-r-, uint32, 32 bit, ", r.stdout)
+        self.assertRegex(r.stdout, r"  0x6040:00, rwrwrw, uint16, 16 bit, ")
+        quiet = self.bus.ecatctl("sdos", "0", "-q").stdout.splitlines()
+        self.assertTrue(all(line.startswith("SDO 0x") for line in quiet))
+        self.assertEqual(len(quiet), r.stdout.count("SDO 0x"))
+
 
 if __name__ == "__main__":
     harness.main()

@@ -261,6 +261,34 @@ TEST_P(WithSlave, ProcessDataSessionReachesOpAndExchanges) {
     EXPECT_EQ(m.al_status(a)->state, 0x08);
 }
 
+TEST_P(WithSlave, SdoInformationListsAndDescribesTheDictionary) {
+    auto list = sdo.od_list(1);
+    ASSERT_TRUE(list.ok()) << to_string(list.error()) << std::hex << sdo.last_abort();
+    ASSERT_EQ(list->size(), slave.dict.objects().size());  // fragmented on the small mailbox
+    for (std::size_t i = 0; i < list->size(); ++i)
+        EXPECT_EQ((*list)[i], slave.dict.objects()[i].index);
+    auto od = sdo.object_description(0x1018);
+    ASSERT_TRUE(od.ok()) << to_string(od.error());
+    EXPECT_EQ(od->name, slave.dict.find(0x1018)->name);
+    EXPECT_EQ(od->object_code, 9);
+    EXPECT_EQ(od->max_subindex, slave.dict.find(0x1018)->max_subindex());
+    auto e = sdo.entry_description(0x1018, 1, 0x07);
+    ASSERT_TRUE(e.ok()) << to_string(e.error());
+    EXPECT_EQ(e->data_type, 0x0007);
+    EXPECT_EQ(e->bit_length, 32);
+    EXPECT_EQ(e->access & 0x3F, 0x07);
+    EXPECT_EQ(e->name, slave.dict.find(0x1018, 1)->name);
+    auto d = sdo.entry_description(0x1600, 1, 0x10);  // with the default value
+    ASSERT_TRUE(d.ok());
+    ASSERT_EQ(d->values.size(), 4u);
+    EXPECT_EQ(d->values[3], 0x60);
+    EXPECT_EQ(sdo.object_description(0x5FFF).error(), Error::SdoAbort);
+    EXPECT_EQ(sdo.last_abort(), 0x06020000u);
+    // Plain SDO traffic still in step afterwards.
+    uint8_t b[4];
+    EXPECT_TRUE(sdo.upload(0x1018, 1, b).ok());
+}
+
 INSTANTIATE_TEST_SUITE_P(MailboxSizes, WithSlave, ::testing::Values(uint16_t{128}, uint16_t{32}));
 
 TEST(ProcessDataDc, Sync0RunsAndTheSlaveReachesOpInDcMode) {

@@ -1,6 +1,7 @@
 // ecatctl: a small EtherCAT master on the command line, in the spirit of IgH's `ethercat` tool.
 //   ecatctl [--iface NAME] [--backend pcap|packet] [--timeout MS] [--retries N] <verb> ...
-// Verbs: scan | reg read | reg write | sii read | sii write | sii decode | state | upload | download | pd
+// Verbs: scan | reg read | reg write | sii read | sii write | sii decode | state | upload | download | sdos |
+// pd
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <fstream>
@@ -530,6 +531,83 @@ int process_data(master::Master& m, const PdArgs& p) {
     return clean ? kExitOk : kExitProtocol;
 }
 
+// ---- SDO information -----------------------------------------------------------------------------
+
+const char* type_name(uint16_t t) {
+    switch (t) {
+        case 0x0001:
+            return "bool";
+        case 0x0002:
+            return "int8";
+        case 0x0003:
+            return "int16";
+        case 0x0004:
+            return "int32";
+        case 0x0005:
+            return "uint8";
+        case 0x0006:
+            return "uint16";
+        case 0x0007:
+            return "uint32";
+        case 0x0008:
+            return "float";
+        case 0x0009:
+            return "string";
+        case 0x000A:
+            return "octet_string";
+        case 0x000B:
+            return "unicode_string";
+        case 0x0011:
+            return "double";
+        case 0x0015:
+            return "int64";
+        case 0x001B:
+            return "uint64";
+        default:
+            return nullptr;
+    }
+}
+
+int sdos(master::Master& m, const std::string& slave, bool station, bool quiet) {
+    auto a = parse_slave(slave, station);
+    if (!a) return usage("bad slave '" + slave + "'");
+    master::Mailbox mbx(m, *a);
+    if (Error e = open_mailbox(m, mbx, *a); e != Error::Ok)
+        return fail(e, "opening the mailbox of " + slave_text(*a));
+    master::SdoClient sdo(mbx);
+    auto list = sdo.od_list(1);
+    if (!list) return sdo_failed(sdo, list.error(), "reading the object list");
+    for (uint16_t index : *list) {
+        auto od = sdo.object_description(index);
+        if (!od) return sdo_failed(sdo, od.error(), "describing object " + std::to_string(index));
+        std::printf("SDO 0x%04x, \"%s\"\n", index, od->name.c_str());
+        if (quiet) continue;
+        const unsigned last = od->object_code == 7 ? 0 : od->max_subindex;
+        for (unsigned sub = 0; sub <= last; ++sub) {
+            auto e = sdo.entry_description(index, static_cast<uint8_t>(sub), 0);
+            if (!e) {
+                if (e.error() == Error::SdoAbort) continue;  // a gap in the subindices
+                return sdo_failed(sdo, e.error(), "describing an entry");
+            }
+            char acc[7];
+            for (int st = 0; st < 3; ++st) {
+                acc[2 * st] = (e->access & (1u << st)) ? 'r' : '-';
+                acc[2 * st + 1] = (e->access & (8u << st)) ? 'w' : '-';
+            }
+            acc[6] = 0;
+            const char* tn = type_name(e->data_type);
+            char tb[16];
+            if (!tn) {
+                std::snprintf(tb, sizeof tb, "type 0x%04x", e->data_type);
+                tn = tb;
+            }
+            std::printf("  0x%04x:%02x, %s, %s, %u bit, \"%s\"\n", index, sub, acc, tn, e->bit_length,
+                        e->name.c_str());
+        }
+    }
+    return kExitOk;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -665,6 +743,17 @@ int main(int argc, char** argv) {
     pdc->add_option("--outputs", pa.outputs, "Output bytes sent every cycle (from the first byte)");
     pdc->add_flag("--keep", pa.keep, "Leave the slave in the state reached (default: back to PREOP)");
     pdc->callback([&] { rc = with_master(g, [&](master::Master& m) { return process_data(m, pa); }); });
+
+    std::string sd_slave = "0";
+    bool sd_station = false, sd_quiet = false;
+    auto* sd = app.add_subcommand("sdos", "List the object dictionary through the SDO information service");
+    sd->add_option("slave", sd_slave, "Slave position (or station address with --station)")
+        ->capture_default_str();
+    sd->add_flag("-s,--station", sd_station, "<slave> is a station address");
+    sd->add_flag("-q,--quiet", sd_quiet, "Objects only, no entries");
+    sd->callback([&] {
+        rc = with_master(g, [&](master::Master& m) { return sdos(m, sd_slave, sd_station, sd_quiet); });
+    });
 
     try {
         app.parse(argc, argv);

@@ -12,6 +12,9 @@ namespace {
 constexpr uint8_t kServiceEmergency = 1;
 constexpr uint8_t kServiceSdoRequest = 2;
 constexpr uint8_t kServiceSdoResponse = 3;
+constexpr uint8_t kServiceSdoInfo = 8;
+constexpr uint8_t kInfoError = 0x07;
+constexpr uint8_t kInfoIncomplete = 0x80;
 constexpr uint32_t kAbortToggle = 0x05030000;
 constexpr uint32_t kAbortCommand = 0x05040001;
 constexpr uint32_t kAbortOutOfMemory = 0x05040005;
@@ -133,7 +136,7 @@ void SdoClient::abort(uint16_t index, uint8_t sub, uint32_t code) {
     last_abort_ = code;
 }
 
-Error SdoClient::response(MailboxMessage& msg) {
+Error SdoClient::response(MailboxMessage& msg, uint8_t wanted) {
     const auto deadline = Clock::now() + mbx_.timeout();
     for (;;) {
         const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
@@ -154,6 +157,11 @@ Error SdoClient::response(MailboxMessage& msg) {
             }
             ++emergencies_;
             continue;
+        }
+        if (wanted == kServiceSdoInfo) {
+            if (service != kServiceSdoInfo) continue;
+            if (p.size() < 6) return Error::MailboxProtocol;
+            return Error::Ok;
         }
         // An abort may come as an SDO request (service 2, as SOES sends it) or response: SOEM takes it
         // by its command byte alone, and so does this client.
@@ -297,6 +305,86 @@ Error SdoClient::download(uint16_t index, uint8_t sub, std::span<const uint8_t> 
         toggle ^= 1;
     }
     return Error::Ok;
+}
+
+Error SdoClient::info(uint8_t opcode, std::span<const uint8_t> body, std::vector<uint8_t>& answer) {
+    if (Error e = prepare(); e != Error::Ok) return e;
+    if (6 + body.size() > req_.size()) return Error::InvalidArgument;
+    std::fill(req_.begin(), req_.begin() + 6, 0);
+    put16(req_.data(), static_cast<uint16_t>(kServiceSdoInfo << 12));
+    req_[2] = opcode;
+    std::copy(body.begin(), body.end(), req_.begin() + 6);
+    if (Error e = send(6 + body.size()); e != Error::Ok) return e;
+    answer.clear();
+    const uint8_t want = static_cast<uint8_t>(opcode + 1);
+    for (;;) {
+        MailboxMessage msg;
+        if (Error e = response(msg, kServiceSdoInfo); e != Error::Ok) return e;
+        const auto p = msg.payload;
+        const uint8_t op = p[2] & 0x7F;
+        if (op == kInfoError) {
+            last_abort_ = p.size() >= 10 ? get32(p.data() + 6) : kAbortGeneral;
+            return Error::SdoAbort;
+        }
+        if (op != want) return Error::MailboxProtocol;
+        answer.insert(answer.end(), p.begin() + 6, p.end());
+        // Fragments follow while the incomplete bit is set (fragments-left counts down to 0).
+        if (!(p[2] & kInfoIncomplete) || get16(p.data() + 4) == 0) return Error::Ok;
+    }
+}
+
+Result<std::vector<uint16_t>> SdoClient::od_list(uint16_t list_type) {
+    uint8_t body[2];
+    put16(body, list_type);
+    std::vector<uint8_t> a;
+    if (Error e = info(0x01, body, a); e != Error::Ok) return e;
+    if (a.size() < 2 || get16(a.data()) != list_type) return Error::MailboxProtocol;
+    std::vector<uint16_t> out;
+    for (std::size_t i = 2; i + 1 < a.size(); i += 2)
+        out.push_back(get16(&a[i]));
+    return out;
+}
+
+Result<ObjectDescription> SdoClient::object_description(uint16_t index) {
+    uint8_t body[2];
+    put16(body, index);
+    std::vector<uint8_t> a;
+    if (Error e = info(0x03, body, a); e != Error::Ok) return e;
+    if (a.size() < 6 || get16(a.data()) != index) return Error::MailboxProtocol;
+    ObjectDescription d;
+    d.index = index;
+    d.data_type = get16(&a[2]);
+    d.max_subindex = a[4];
+    d.object_code = a[5];
+    d.name.assign(a.begin() + 6, a.end());
+    return d;
+}
+
+Result<EntryDescription> SdoClient::entry_description(uint16_t index, uint8_t sub, uint8_t value_info) {
+    uint8_t body[4];
+    put16(body, index);
+    body[2] = sub;
+    body[3] = value_info;
+    std::vector<uint8_t> a;
+    if (Error e = info(0x05, body, a); e != Error::Ok) return e;
+    if (a.size() < 10 || get16(a.data()) != index || a[2] != sub) return Error::MailboxProtocol;
+    EntryDescription d;
+    d.index = index;
+    d.subindex = sub;
+    d.value_info = a[3];
+    d.data_type = get16(&a[4]);
+    d.bit_length = get16(&a[6]);
+    d.access = get16(&a[8]);
+    // Unit (4 bytes), then default, minimum, maximum (each of the entry's byte size), then the name.
+    std::size_t extra = 0;
+    const std::size_t value_bytes = (d.bit_length + 7u) / 8u;
+    if (d.value_info & 0x08) extra += 4;
+    for (uint8_t bit : {uint8_t{0x10}, uint8_t{0x20}, uint8_t{0x40}})
+        if (d.value_info & bit) extra += value_bytes;
+    if (10 + extra > a.size()) return Error::MailboxProtocol;
+    d.values.assign(a.begin() + 10, a.begin() + static_cast<std::ptrdiff_t>(10 + extra));
+    d.name.assign(a.begin() + static_cast<std::ptrdiff_t>(10 + extra), a.end());
+    return d;
 }
 
 }  // namespace master

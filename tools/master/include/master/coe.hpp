@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "master/mailbox.hpp"
@@ -17,6 +18,26 @@ struct EmergencyMessage {
     std::array<uint8_t, 5> data{};
 };
 
+// SDO information service (§9.4).
+struct ObjectDescription {
+    uint16_t index = 0;
+    uint16_t data_type = 0;
+    uint8_t max_subindex = 0;
+    uint8_t object_code = 0;  // 7 VAR, 8 ARRAY, 9 RECORD
+    std::string name;
+};
+
+struct EntryDescription {
+    uint16_t index = 0;
+    uint8_t subindex = 0;
+    uint8_t value_info = 0;
+    uint16_t data_type = 0;
+    uint16_t bit_length = 0;
+    uint16_t access = 0;  // bits 0-5 read/write in PreOp/SafeOp/Op, 6 RxPDO, 7 TxPDO, 8 backup, 9 setting
+    std::vector<uint8_t> values;  // unit, default, minimum, maximum as value_info asked for them
+    std::string name;
+};
+
 class SdoClient {
   public:
     explicit SdoClient(Mailbox& mailbox);
@@ -26,6 +47,13 @@ class SdoClient {
     Result<std::size_t> upload(uint16_t index, uint8_t sub, std::span<uint8_t> out,
                                bool complete_access = false);
     Error download(uint16_t index, uint8_t sub, std::span<const uint8_t> data, bool complete_access = false);
+
+    // SDO information: the object indices of a list (1 = all objects, 2 RxPDO-mappable, 3 TxPDO-mappable,
+    // 4 backup, 5 settings), an object's description, an entry's description. An SDO info error response
+    // is Error::SdoAbort with last_abort().
+    Result<std::vector<uint16_t>> od_list(uint16_t list_type = 1);
+    Result<ObjectDescription> object_description(uint16_t index);
+    Result<EntryDescription> entry_description(uint16_t index, uint8_t sub, uint8_t value_info = 0);
 
     // Abort code of the last Error::SdoAbort (from the slave, or sent by us when we gave up).
     uint32_t last_abort() const { return last_abort_; }
@@ -37,7 +65,9 @@ class SdoClient {
   private:
     Error prepare();
     Error send(std::size_t length);
-    Error response(MailboxMessage& message);
+    Error response(MailboxMessage& message, uint8_t service = 3);
+    // Sends one SDO info request and collects every fragment of the answer (after the 6-byte head).
+    Error info(uint8_t opcode, std::span<const uint8_t> body, std::vector<uint8_t>& answer);
     void abort(uint16_t index, uint8_t sub, uint32_t code);
 
     Mailbox& mbx_;
