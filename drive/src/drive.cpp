@@ -1,5 +1,6 @@
 #include "drive/drive.hpp"
 
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 
@@ -164,6 +165,27 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink) : dict_(dictionary), a
     out(0x603F, 0, f.error_code);
     out(0x1001, 0, f.error_register);
     out(0x3000, 5, resolution_);
+}
+
+od::Status commission(od::Dictionary& d, const MotorModel& m) {
+    const double j = m.rotor_inertia + m.load_inertia;
+    const struct {
+        uint16_t index;
+        uint8_t sub;
+        uint32_t value;
+    } rows[] = {
+        {0x3001, 5, static_cast<uint32_t>(std::lround(m.torque_constant * 1e6))},  // uNm/A
+        {0x30A1, 1, 20000},                                                        // 20 Hz
+        {0x30A1, 2, 1000},                                                         // critical damping
+        {0x30A1, 3, 50000},                                                        // 50 ms
+        {0x30A1, 4, static_cast<uint32_t>(std::lround(j * 1e10))},                 // mg cm^2
+        {0x30A1, 5, static_cast<uint32_t>(std::lround(m.viscous_friction * 1e9 * 6.283185307179586 / 60.0))},
+    };
+    for (const auto& r : rows) {
+        const od::Status s = d.set<uint32_t>(r.index, r.sub, r.value);
+        if (s != od::Status::Ok) return s;
+    }
+    return od::Status::Ok;
 }
 
 void Drive::cycle(int64_t now_ns, int64_t dt_ns) {

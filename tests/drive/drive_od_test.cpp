@@ -59,3 +59,33 @@ TEST(DriveOd, ConnectionLostWritesTheErrorIntoTheDictionary) {
     EXPECT_EQ(d.get<uint8_t>(0x1001, 0), 0x10);
     EXPECT_EQ(d.get<uint16_t>(0x6041, 0) & 0x4F, 0x0F);  // fault reaction active
 }
+
+TEST(DriveOd, CommissionWritesAMatchedTuningSoTheDriveEnables) {
+    od::Dictionary d = od::make_drive_dictionary(od::default_drive_description());
+    ASSERT_EQ(commission(d), od::Status::Ok);
+    EXPECT_EQ(d.get<uint32_t>(0x3001, 5), 25500u);
+    EXPECT_EQ(d.get<uint32_t>(0x30A1, 4), 188300u);
+    EXPECT_EQ(d.get<uint32_t>(0x30A1, 5), 46674u);  // 445.7 uNm/(rad/s) in nNm/rpm
+    Drive drv(d);
+    int64_t t = 0;
+    for (uint16_t cw : {0x06, 0x07, 0x0F}) {
+        d.set<uint16_t>(0x6040, 0, cw);
+        drv.cycle(t, 1'000'000);
+        t += 1'000'000;
+    }
+    EXPECT_EQ(d.get<uint16_t>(0x6041, 0) & 0x6F, 0x27);
+    EXPECT_EQ(d.get<uint16_t>(0x603F, 0), 0);
+}
+
+TEST(DriveOd, SeedDefaultsRefuseToEnableWith8331) {
+    od::Dictionary d = od::make_drive_dictionary(od::default_drive_description());
+    Drive drv(d);
+    int64_t t = 0;
+    for (uint16_t cw : {0x06, 0x07, 0x0F}) {
+        d.set<uint16_t>(0x6040, 0, cw);
+        drv.cycle(t, 1'000'000);
+        t += 1'000'000;
+    }
+    EXPECT_EQ(d.get<uint16_t>(0x603F, 0), 0x8331);
+    EXPECT_EQ(d.get<uint16_t>(0x6041, 0) & 0x4F, 0x08);
+}

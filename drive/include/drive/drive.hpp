@@ -13,6 +13,12 @@
 
 namespace drive {
 
+// Writes the parameters a commissioning tool would have stored for the simulated motor into the dictionary:
+// torque constant 0x3001:05 (the seed default 0 refuses to enable with 0x8331), and a position/velocity
+// tuning 0x30A1 matched to the motor and load (20 Hz bandwidth, critical damping, 50 ms reset time, the
+// model's inertia and viscous friction). Device-side writes, range-checked; returns the first failure or Ok.
+od::Status commission(od::Dictionary& dictionary, const MotorModel& motor = MotorModel{});
+
 class Drive {
   public:
     explicit Drive(od::Dictionary& dictionary, EventSink* sink = nullptr);
