@@ -335,3 +335,31 @@ TEST(Modes, CsvActualOutsideSoftwareLimitRaises8A82) {
     EXPECT_GT(r.fb().position_actual, start + 2000);
     EXPECT_LT(r.fb().position_actual, start + 2100);
 }
+
+// CSP at the cycle times real masters use (TwinCAT 2 ms, 1 ms, fast DC 250 us / 125 us): the same master
+// trajectory is followed inside the window and ends at the target.
+class CspCycle : public ::testing::TestWithParam<int64_t> {};
+
+TEST_P(CspCycle, FollowsTheSameTrajectory) {
+    Rig r;
+    r.dt = GetParam();
+    r.enable();
+    Profile master;
+    master.reset(r.fb().position_actual, 0);
+    const double h = static_cast<double>(r.dt) * 1e-9;
+    const double target = r.fb().position_actual + 30000.0;
+    int32_t worst = 0;
+    for (int64_t t = 0; t < 1'500'000'000; t += r.dt) {
+        master.step_position(target, 2000.0 / 60 * 2000, 20000.0 / 60 * 2000, 20000.0 / 60 * 2000, h);
+        r.ax.command.target_position = static_cast<int32_t>(std::lround(master.position()));
+        r.ax.command.velocity_offset = static_cast<int32_t>(std::lround(master.velocity() * 60.0 / 2000));
+        r.run(1);
+        worst = std::max(worst, std::abs(r.fb().following_error));
+    }
+    EXPECT_LT(worst, 200);  // with velocity pre-control through 0x60B1
+    EXPECT_NEAR(r.fb().position_actual, target, 5);
+    EXPECT_FALSE(r.rec.has(error_code::FollowingError));
+}
+
+INSTANTIATE_TEST_SUITE_P(CycleTimes, CspCycle,
+                         ::testing::Values(125'000, 250'000, 1'000'000, 2'000'000, 4'000'000));

@@ -13,6 +13,7 @@
 //   at <ms> set <index>:<sub> <value>   any object, e.g. "set 0x6083:0 20000"
 //   at <ms> input <pin 1..6> <0|1>      a digital input of the simulated machine
 //   at <ms> limit-neg|limit-pos <inc>   limit switches; home <from> <to>; stops <lo> <hi>
+// The dictionary starts commissioned for the simulated motor (drive::commission) unless --seed-defaults.
 //   end <ms>
 #include <CLI/CLI.hpp>
 
@@ -49,11 +50,6 @@ struct Script {
 };
 
 const char* kDemo = R"(# Default demo: CSP move and back, CSV step, PPM move, CST pulse.
-at 0 set 0x3001:5 25500
-at 0 set 0x30A1:1 20000
-at 0 set 0x30A1:3 50000
-at 0 set 0x30A1:4 188300
-at 0 set 0x30A1:5 46670
 at 0 mode 8
 at 1 enable
 at 10 csp 20000 2000 20000
@@ -157,7 +153,13 @@ struct Sample {
 
 class Sim {
   public:
-    Sim() : dict_(od::make_drive_dictionary(od::default_drive_description())), drive_(dict_) {}
+    // commissioned = the dictionary holds the simulated motor's data and a matched tuning
+    // (drive::commission); otherwise the seed defaults (torque constant 0: enabling fails with 0x8331 until
+    // the script sets it).
+    explicit Sim(bool commissioned = true)
+        : dict_(od::make_drive_dictionary(od::default_drive_description())), drive_(dict_) {
+        if (commissioned) drive::commission(dict_, drive_.motor());
+    }
 
     bool apply(const Step& st, std::string& err) {
         auto arg = [&](std::size_t i, double& out) {
@@ -360,10 +362,7 @@ int bench(int axes, int cycles, int64_t dt_ns) {
     for (int i = 0; i < axes; ++i) {
         sims.push_back(std::make_unique<Sim>());
         std::string err;
-        Sim& s = *sims.back();
-        s.apply({0, "set", {"0x3001:5", "25500"}}, err);
-        s.apply({0, "set", {"0x30A1:1", "20000"}}, err);
-        s.apply({0, "enable", {}}, err);
+        sims.back()->apply({0, "enable", {}}, err);
     }
     std::vector<double> per_axis;
     per_axis.reserve(static_cast<std::size_t>(cycles));
@@ -397,7 +396,7 @@ int main(int argc, char** argv) {
     CLI::App app{"drive-sim: the CiA 402 drive without EtherCAT, through a scripted motion"};
     std::string script_path, csv_path = "drive-sim.csv", png_path;
     double cycle_us = 1000;
-    bool do_bench = false, print_demo = false;
+    bool do_bench = false, print_demo = false, seed_defaults = false;
     int axes = 1, cycles = 5000;
     app.add_option("-s,--script", script_path, "motion script (default: a built-in demo, see --print-demo)");
     app.add_option("-o,--csv", csv_path, "CSV output")->capture_default_str();
@@ -411,6 +410,8 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->check(CLI::Range(100, 10000000));
     app.add_flag("--print-demo", print_demo, "print the built-in demo script and exit");
+    app.add_flag("--seed-defaults", seed_defaults,
+                 "start from the seed's defaults instead of the commissioned motor data (torque constant 0)");
     CLI11_PARSE(app, argc, argv);
 
     const auto dt_ns = static_cast<int64_t>(std::llround(cycle_us * 1000.0));
@@ -436,7 +437,7 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
-    Sim sim;
+    Sim sim(!seed_defaults);
     std::vector<Sample> samples;
     const auto n = static_cast<int64_t>(sc.end_ms * 1e6 / static_cast<double>(dt_ns));
     samples.reserve(static_cast<std::size_t>(n + 1));
