@@ -67,6 +67,17 @@ TEST_F(Esm, IP_InitToPreOp_WrongSm0Control_0x0016) {
     EXPECT_EQ(al_code(), 0x0016);
 }
 
+TEST_F(Esm, IP_InitToPreOp_MailboxesOverlap_0x0016) {
+    desc.standard_mailbox = {0x1000, 128, 0x1040, 128};  // a (bad) description the master follows
+    desc.sync_managers[1].start = 0x1040;
+    start();
+    configure_sm(0, 0x1000, 128, 0x26, true);
+    configure_sm(1, 0x1040, 128, 0x22, true);
+    request(0x02);
+    EXPECT_EQ(al_status(), 0x01 | kErr);
+    EXPECT_EQ(al_code(), 0x0016);
+}
+
 TEST_F(Esm, IP_InitToPreOp_EventBitsAreMastersChoice) {
     configure_sm(0, 0x1000, 128, 0x06, true);  // mailbox, write, no PDI event
     configure_sm(1, 0x1080, 128, 0x02, true);

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include "ecat/al_status.hpp"
 #include "ecat/application.hpp"
