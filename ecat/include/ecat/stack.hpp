@@ -3,7 +3,10 @@
 // cycle. It reaches the ESC only through esc::Pdi (register reads/writes with PDI side effects) and,
 // optionally, the PDI interrupt line, so the same code could drive an ESC chip over SPI.
 //
-// The runtime calls poll(now) after every burst of frames and when next_deadline_ns() has passed.
+// The runtime calls poll(now) after every burst of frames and when next_deadline_ns() has passed, each
+// time after esc::Esc::tick() (so SYNC0 and the watchdogs are up to date), with the ESC's time base.
+// pdi, dictionary, description and application must outlive the Stack, and the dictionary must not be
+// replaced while it exists (the process-data plan and the 0x1C32/0x1C33 counters point into its values).
 #include <cstddef>
 #include <cstdint>
 #include <functional>
