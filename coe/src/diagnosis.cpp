@@ -57,10 +57,22 @@ std::size_t DiagnosisHistory::encode(const DiagMessage& m, std::span<uint8_t> ou
     std::size_t at = kHead;
     unsigned n = 0;
     for (const auto& prm : m.params) {
-        if (n == 255 || at + 2 + prm.data.size() > out.size()) break;
-        wire::put16(p + at, prm.flags);
-        std::memcpy(p + at + 2, prm.data.data(), prm.data.size());
-        at += 2 + prm.data.size();
+        if (n == 255 || at + 2 > out.size()) break;
+        std::size_t len = prm.data.size();
+        uint16_t pflags = prm.flags;
+        if (at + 2 + len > out.size()) {
+            // Byte arrays and strings are cut to the room left (Unicode to whole characters); values are
+            // left out whole.
+            const unsigned kind = pflags >> 12;
+            if (kind < 1 || kind > 3) break;
+            len = out.size() - at - 2;
+            if (kind == 3) len &= ~std::size_t{1};
+            if (len == 0) break;
+            pflags = static_cast<uint16_t>((pflags & 0xF000) | len);
+        }
+        wire::put16(p + at, pflags);
+        std::memcpy(p + at + 2, prm.data.data(), len);
+        at += 2 + len;
         ++n;
     }
     wire::put32(p, m.code);
@@ -172,7 +184,9 @@ DiagnosisHistory::Result DiagnosisHistory::add(const DiagMessage& m) {
         uint8_t mfr[5];
         wire::put32(mfr, m.code);
         mfr[4] = static_cast<uint8_t>(m.type);
-        emergency_->send(code, mfr);
+        // The error register as the dictionary holds it (the application may keep 0x1001 itself).
+        auto reg = dict_.raw(0x1001, 0);
+        emergency_->send(code, reg.empty() ? emergency_->error_register() : reg[0], mfr);
     }
     return result;
 }

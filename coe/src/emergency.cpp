@@ -8,7 +8,6 @@ namespace coe {
 
 namespace {
 constexpr uint16_t kErrorRegister = 0x1001;
-constexpr uint8_t kGenericBit = 0x01;
 }  // namespace
 
 Emergency::Emergency(od::Dictionary* dict, std::size_t capacity)
@@ -34,7 +33,6 @@ void Emergency::update_register() {
     uint8_t reg = 0;
     for (std::size_t i = 0; i < active_count_; ++i)
         reg = static_cast<uint8_t>(reg | active_[i].bits);
-    if (active_count_ > 0) reg = static_cast<uint8_t>(reg | kGenericBit);
     register_ = reg;
     if (dict_ != nullptr && dict_->find(kErrorRegister, 0) != nullptr)
         dict_->set<uint8_t>(kErrorRegister, 0, reg);
@@ -70,8 +68,8 @@ void Emergency::clear_all() {
     push(encode(0x0000, register_, {}));
 }
 
-void Emergency::send(uint16_t error_code, std::span<const uint8_t> mfr) {
-    push(encode(error_code, register_, mfr));
+void Emergency::send(uint16_t error_code, uint8_t error_register, std::span<const uint8_t> mfr) {
+    push(encode(error_code, error_register, mfr));
 }
 
 void Emergency::push(const Message& m) {

@@ -61,14 +61,23 @@ TEST_F(Diagnosis, MessageEncodingFollowsEtg1020) {
                      0x02, 0x20, 'o',  'k'}));                                          // ASCII string of 2
 }
 
-TEST_F(Diagnosis, ParametersThatDoNotFitAreLeftOut) {
+TEST_F(Diagnosis, ValuesThatDoNotFitAreLeftOutTextsAreCut) {
     const uint8_t big[20] = {};
-    const coe::DiagParam params[] = {coe::DiagParam::byte_array(big), coe::DiagParam::byte_array(big)};
+    const uint8_t u32[4] = {1, 2, 3, 4};
+    const coe::DiagParam params[] = {coe::DiagParam::byte_array(big),
+                                     coe::DiagParam::value(od::DataType::Unsigned32, u32)};
     coe::DiagMessage m{1, coe::DiagType::Info, 0, 0, false, params};
     uint8_t buf[40];
     std::size_t n = DiagnosisHistory::encode(m, buf);
     EXPECT_EQ(n, 16u + 22u);
-    EXPECT_EQ(buf[5], 1);  // one parameter in
+    EXPECT_EQ(buf[5], 1);  // the UINT32 needs 6 bytes, only 2 are left: one parameter in
+    const coe::DiagParam text[] = {coe::DiagParam::ascii("Fault reset refused: cause still present")};
+    m.params = text;
+    n = DiagnosisHistory::encode(m, buf);
+    EXPECT_EQ(n, 40u);
+    EXPECT_EQ(buf[5], 1);
+    EXPECT_EQ(buf[16] | (buf[17] << 8), 0x2000 | 22);  // ASCII, cut to 22 characters
+    EXPECT_EQ(std::string(buf + 18, buf + 40), "Fault reset refused: c");
 }
 
 TEST_F(Diagnosis, AddStoresFromSubindex6AndFlagsNewMessage) {

@@ -1,6 +1,8 @@
 // Emergency (CoE service 1, reference §9.5; seed digest 000 "EMCY = code + error register + 5 bytes").
 #include <gtest/gtest.h>
 
+#include <array>
+
 #include "coe/emergency.hpp"
 #include "coe/sdo_server.hpp"
 #include "coe_test_support.hpp"
@@ -21,13 +23,13 @@ TEST(Emergency, EncodingIsCoeHeaderCodeRegisterAndFiveBytes) {
 TEST(Emergency, RaiseAndClearMaintainTheErrorRegister) {
     od::Dictionary dict = make_test_dictionary();
     coe::Emergency e(&dict);
-    e.raise(0x2310, 0x02);                          // overcurrent: current bit
-    EXPECT_EQ(dict.get<uint8_t>(0x1001, 0), 0x03);  // + generic
-    e.raise(0x8611, 0x80);                          // following error: motion bit
+    e.raise(0x2310, 0x03);  // overcurrent: generic + current (seed 001 Table 8-141: 00000010 -> as given)
+    EXPECT_EQ(dict.get<uint8_t>(0x1001, 0), 0x03);
+    e.raise(0x8611, 0x80);  // following error: motion bit only, no generic bit forced
     EXPECT_EQ(dict.get<uint8_t>(0x1001, 0), 0x83);
     EXPECT_TRUE(e.active(0x2310));
     e.clear(0x2310);
-    EXPECT_EQ(dict.get<uint8_t>(0x1001, 0), 0x81);
+    EXPECT_EQ(dict.get<uint8_t>(0x1001, 0), 0x80);
     EXPECT_FALSE(e.active(0x2310));
     e.clear(0x2310);  // not active: nothing
     e.clear(0x8611);
@@ -39,6 +41,20 @@ TEST(Emergency, RaiseAndClearMaintainTheErrorRegister) {
     e.pop();
     // All cleared: the "no error" emergency, code 0000, register 00.
     EXPECT_EQ(Bytes(e.front().begin(), e.front().end()), (Bytes{0x00, 0x10, 0, 0, 0, 0, 0, 0, 0, 0}));
+}
+
+TEST(Emergency, SendLeavesTheApplicationsErrorRegisterAlone) {
+    od::Dictionary dict = make_test_dictionary();
+    ASSERT_EQ(dict.set<uint8_t>(0x1001, 0, 0x80), od::Status::Ok);  // kept by the drive itself
+    coe::Emergency e(&dict);
+    const std::array<uint8_t, 5> mfr{0x08, 0x01, 0, 0, 0};
+    e.send(0x8611, 0x80, mfr);
+    e.send(0x0000, 0x00);
+    EXPECT_EQ(dict.get<uint8_t>(0x1001, 0), 0x80);
+    EXPECT_EQ(e.active_count(), 0u);
+    ASSERT_EQ(e.pending(), 2u);
+    EXPECT_EQ(Bytes(e.front().begin(), e.front().end()),
+              (Bytes{0x00, 0x10, 0x11, 0x86, 0x80, 0x08, 0x01, 0, 0, 0}));
 }
 
 TEST(Emergency, ClearAllSendsOneNoErrorMessage) {
@@ -78,7 +94,7 @@ TEST(Emergency, ServerSendsQueuedEmergenciesFromPollInMailboxStates) {
     ASSERT_EQ(out.messages.size(), 1u);
     Sent s = out.take();
     EXPECT_EQ(s.type, ecat::MailboxType::CoE);
-    EXPECT_EQ(s.payload, (Bytes{0x00, 0x10, 0x80, 0x81, 0x11, 0, 0, 0, 0, 0}));
+    EXPECT_EQ(s.payload, (Bytes{0x00, 0x10, 0x80, 0x81, 0x10, 0, 0, 0, 0, 0}));
     EXPECT_TRUE(server.emergency().empty());
 }
 

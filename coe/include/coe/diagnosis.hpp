@@ -72,7 +72,8 @@ class DiagnosisHistory {
     static constexpr uint32_t from_emergency(uint16_t error_code) {
         return (static_cast<uint32_t>(error_code) << 16) | 0xE800u;
     }
-    // Encodes one message; parameters that do not fit `out` are left out (the count says how many are in).
+    // Encodes one message. A byte array or string that does not fit `out` is cut to the room left; a value
+    // that does not fit is left out with everything after it (the count says how many are in).
     static std::size_t encode(const DiagMessage& m, std::span<uint8_t> out);
 
     // Installs the write/read semantics on 0x10F3. emergency may be null (flag b0 then cannot be set).

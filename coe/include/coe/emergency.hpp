@@ -21,8 +21,9 @@ class Emergency {
     // dict may be null (no 0x1001 to maintain). capacity is clamped to 1..kQueueCapacity.
     explicit Emergency(od::Dictionary* dict = nullptr, std::size_t capacity = 8);
 
-    // An error occurred: remember it as active, OR its register bits (bit 0 "generic" is always set while
-    // any error is active, CiA 301) into 0x1001 and queue an emergency carrying the new register value.
+    // An error occurred: remember it as active, OR its register bits into 0x1001 (the bits the error table
+    // gives: seed 001 Table 8-141 sets e.g. only the motion bit for 0x8611, so no generic bit is forced) and
+    // queue an emergency carrying the new register value.
     // mfr: up to 5 manufacturer-specific bytes (more are cut, fewer are zero-padded).
     void raise(uint16_t error_code, uint8_t register_bits, std::span<const uint8_t> mfr = {});
     // The error went away: recompute 0x1001; when no error is left, queue the "no error" emergency
@@ -30,8 +31,9 @@ class Emergency {
     void clear(uint16_t error_code);
     // All errors went away (fault reset): one "no error" emergency if any was active.
     void clear_all();
-    // Queue a message without touching the active set (diagnosis messages sent as emergency).
-    void send(uint16_t error_code, std::span<const uint8_t> mfr = {});
+    // Queue one message as given, without touching the active set or 0x1001: for an application that keeps
+    // its own error register (drive::EventSink passes the new 0x1001 value with every raise/clear).
+    void send(uint16_t error_code, uint8_t error_register, std::span<const uint8_t> mfr = {});
 
     uint8_t error_register() const { return register_; }
     bool active(uint16_t error_code) const;
