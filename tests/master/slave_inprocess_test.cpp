@@ -2,8 +2,10 @@
 // esc::Esc + ecat::Stack + coe::CoeServer on the drive's object dictionary, the SII built by esi from the
 // same description. The link hands each frame to the ESC and then runs the firmware, as the runtime does.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <deque>
+#include <filesystem>
 #include <memory>
 #include <vector>
 
@@ -13,7 +15,11 @@
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
 #include "esi/sii.hpp"
+#include "foe/image.hpp"
+#include "foe/server.hpp"
+#include "foe/store.hpp"
 #include "master/coe.hpp"
+#include "master/foe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
@@ -34,7 +40,9 @@ struct Slave {
     ecat::Application app;
     std::unique_ptr<ecat::Stack> stack;
     std::unique_ptr<coe::CoeServer> coe;
-    bool lose_next_reply = false;
+    std::filesystem::path store_dir;
+    std::unique_ptr<foe::FirmwareStore> store;
+    std::unique_ptr<foe::FoeServer> foe;
 
     explicit Slave(uint16_t mailbox_size, bool real = false) : real_time(real) {
         desc = od::default_drive_description();
@@ -50,7 +58,25 @@ struct Slave {
         stack = std::make_unique<ecat::Stack>(*esc, dict, desc, app);
         coe = std::make_unique<coe::CoeServer>(dict, [this] { return stack->state(); });
         stack->add_handler(*coe);
+        store_dir = std::filesystem::temp_directory_path() /
+                    ("master-foe-" + std::to_string(::getpid()) + "-" + std::to_string(counter()++));
+        foe::StoreConfig sc;
+        sc.dir = store_dir;
+        sc.identity = foe::ImageIdentity::from(desc.identity);
+        sc.device_name = desc.identity.device_name;
+        store = std::make_unique<foe::FirmwareStore>(sc);
+        store->open();
+        foe = std::make_unique<foe::FoeServer>(*store, foe::ServerConfig::from(desc));
+        stack->add_handler(*foe);
         stack->poll(clk().now_ns());
+    }
+    ~Slave() {
+        std::error_code ec;
+        std::filesystem::remove_all(store_dir, ec);
+    }
+    static int& counter() {
+        static int n = 0;
+        return n;
     }
 };
 
@@ -323,4 +349,39 @@ TEST(ProcessDataDc, Sync0RunsAndTheSlaveReachesOpInDcMode) {
     EXPECT_GT(slave.stack->stats().sync0_events, 50u);
     EXPECT_EQ(slave.stack->sync_mode(), ecat::SyncMode::DcSync0);
     EXPECT_EQ(m.al_status(a)->state, 0x08);
+}
+
+TEST(FoeWithSlave, FirmwareWrittenInBootstrapIsReadBack) {
+    Slave slave(128);
+    SlaveLink link(slave);
+    Master m(link, options());
+    const Address a = Address::station(0x1001);
+    ASSERT_EQ(m.count_slaves().value(), 1);
+    ASSERT_EQ(m.assign_station_addresses(1), Error::Ok);
+    // Outside Bootstrap a firmware write is refused with an FoE error.
+    Mailbox std_mbx(m, a);
+    ASSERT_EQ(std_mbx.configure_from_sii(), Error::Ok);
+    ASSERT_EQ(m.request_state(a, AlState::PreOp), Error::Ok);
+    FoeClient refused(std_mbx);
+    const std::vector<uint8_t> payload(3000, 0x5A);
+    const auto image = foe::build_image(payload, foe::ImageIdentity::from(slave.desc.identity), 0x01300000);
+    EXPECT_EQ(refused.write(slave.desc.identity.device_name, image), Error::FoeError);
+    EXPECT_EQ(refused.last_error(), 0x8008u);  // bootstrap only
+    // INIT -> BOOT with the bootstrap mailbox from the SII.
+    ASSERT_EQ(m.request_state(a, AlState::Init), Error::Ok);
+    Mailbox boot(m, a);
+    ASSERT_EQ(boot.configure_from_sii(true), Error::Ok);
+    EXPECT_EQ(boot.config().out_size, slave.desc.bootstrap_mailbox.out_size);
+    AlStatus st;
+    ASSERT_EQ(m.request_state(a, AlState::Boot, &st), Error::Ok) << std::hex << st.code;
+    FoeClient foe(boot);
+    ASSERT_EQ(foe.write(slave.desc.identity.device_name, image), Error::Ok)
+        << std::hex << foe.last_error() << " " << foe.last_error_text();
+    auto back = foe.read(slave.desc.identity.device_name);
+    ASSERT_TRUE(back.ok()) << to_string(back.error()) << std::hex << foe.last_error();
+    EXPECT_EQ(*back, image);
+    // A name that does not exist.
+    EXPECT_EQ(foe.read("nothing.bin").error(), Error::FoeError);
+    EXPECT_EQ(foe.last_error() & 0xFF00u, 0x8000u);
+    ASSERT_EQ(m.request_state(a, AlState::Init), Error::Ok);
 }

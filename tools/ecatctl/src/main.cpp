@@ -4,6 +4,7 @@
 // pd
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <iterator>
@@ -14,6 +15,7 @@
 #include "esc/link.hpp"
 #include "format.hpp"
 #include "master/coe.hpp"
+#include "master/foe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
@@ -608,6 +610,96 @@ int sdos(master::Master& m, const std::string& slave, bool station, bool quiet) 
     return kExitOk;
 }
 
+// ---- FoE -----------------------------------------------------------------------------------------
+
+struct FoeArgs {
+    std::string slave = "0";
+    bool station = false;
+    std::string name;
+    std::string file;
+    std::string output;
+    std::string password = "0";
+    bool stay = false;
+};
+
+int foe_failed(const master::FoeClient& foe, Error e, const std::string& what) {
+    if (e == Error::FoeError) {
+        std::fprintf(stderr, "ecatctl: %s: FoE error 0x%04x%s%s\n", what.c_str(), foe.last_error(),
+                     foe.last_error_text().empty() ? "" : ": ", foe.last_error_text().c_str());
+        return kExitProtocol;
+    }
+    return fail(e, what);
+}
+
+int foe_transfer(master::Master& m, const FoeArgs& f, bool read) {
+    auto a = parse_slave(f.slave, f.station);
+    if (!a) return usage("bad slave '" + f.slave + "'");
+    auto password = parse_number(f.password, 0xFFFFFFFF);
+    if (!password) return usage("bad password '" + f.password + "'");
+    std::vector<uint8_t> data;
+    std::string name = f.name;
+    if (!read) {
+        auto d = read_file(f.file);
+        if (!d) return usage("cannot read " + f.file);
+        data = std::move(*d);
+        if (name.empty()) name = std::filesystem::path(f.file).filename().string();
+    }
+    if (name.empty()) return usage("give the file name on the slave (--name)");
+    master::Mailbox mbx(m, *a);
+    auto st = m.al_status(*a);
+    if (!st) return fail(st.error(), "reading the AL status of " + slave_text(*a));
+    const auto boot = static_cast<uint8_t>(master::AlState::Boot);
+    bool entered_boot = false;
+    if (st->state == boot) {
+        if (Error e = mbx.adopt_current(); e != Error::Ok) return fail(e, "opening the bootstrap mailbox");
+    } else if (!read) {
+        // Firmware goes in through Bootstrap: INIT, the bootstrap mailbox from the SII, BOOT.
+        if (Error e = m.request_state(*a, master::AlState::Init); e != Error::Ok)
+            return fail(e, "going to INIT");
+        if (Error e = mbx.configure_from_sii(true); e != Error::Ok)
+            return fail(e, "setting up the bootstrap mailbox");
+        master::AlStatus final;
+        if (Error e = m.request_state(*a, master::AlState::Boot, &final); e != Error::Ok) {
+            if (e == Error::AlRefused)
+                std::fprintf(stderr, "ecatctl: BOOT refused, AL status code 0x%04x (%s)\n", final.code,
+                             std::string(master::al_status_code_name(final.code)).c_str());
+            return fail(e, "going to BOOT");
+        }
+        entered_boot = true;
+    } else if (Error e = open_mailbox(m, mbx, *a); e != Error::Ok) {
+        return fail(e, "opening the mailbox of " + slave_text(*a));
+    }
+    master::FoeClient foe(mbx);
+    int rc = kExitOk;
+    if (read) {
+        auto file = foe.read(name, static_cast<uint32_t>(*password));
+        if (!file) return foe_failed(foe, file.error(), "reading '" + name + "'");
+        if (f.output.empty()) {
+            std::fputs(hex_dump(0, *file).c_str(), stdout);
+        } else {
+            std::ofstream o(f.output, std::ios::binary | std::ios::trunc);
+            o.write(reinterpret_cast<const char*>(file->data()), static_cast<std::streamsize>(file->size()));
+            if (!o) {
+                std::cerr << "ecatctl: cannot write " << f.output << "\n";
+                return kExitFailure;
+            }
+            std::cerr << "ecatctl: " << file->size() << " bytes written to " << f.output << "\n";
+        }
+    } else {
+        const Error e = foe.write(name, data, static_cast<uint32_t>(*password));
+        if (e != Error::Ok)
+            rc = foe_failed(foe, e, "writing '" + name + "'");
+        else
+            std::cerr << "ecatctl: " << data.size() << " bytes written to '" << name << "'\n";
+    }
+    if (entered_boot && !f.stay) {
+        // Leaving Bootstrap restarts the device with the new firmware (B -> I).
+        if (Error e = m.request_state(*a, master::AlState::Init); e != Error::Ok && rc == kExitOk)
+            rc = fail(e, "leaving BOOT");
+    }
+    return rc;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -754,6 +846,28 @@ int main(int argc, char** argv) {
     sd->callback([&] {
         rc = with_master(g, [&](master::Master& m) { return sdos(m, sd_slave, sd_station, sd_quiet); });
     });
+
+    FoeArgs fa;
+    auto* foe = app.add_subcommand("foe", "File access over EtherCAT")->require_subcommand(1);
+    auto* foe_rd = foe->add_subcommand("read", "Read a file from the slave (hex dump, or -o FILE)");
+    foe_rd->add_option("name", fa.name, "File name on the slave")->required();
+    foe_rd->add_option("-o,--output", fa.output, "Write the file here");
+    foe_rd->add_option("-p,--position", fa.slave, "Slave position (or station address with --station)")
+        ->capture_default_str();
+    foe_rd->add_flag("-s,--station", fa.station, "--position is a station address");
+    foe_rd->add_option("--password", fa.password, "FoE password")->capture_default_str();
+    foe_rd->callback(
+        [&] { rc = with_master(g, [&](master::Master& m) { return foe_transfer(m, fa, true); }); });
+    auto* foe_wr = foe->add_subcommand("write", "Write a file (firmware) through BOOT, then back to INIT");
+    foe_wr->add_option("file", fa.file, "Local file")->required()->check(CLI::ExistingFile);
+    foe_wr->add_option("-n,--name", fa.name, "File name on the slave (default: the local file's name)");
+    foe_wr->add_option("-p,--position", fa.slave, "Slave position (or station address with --station)")
+        ->capture_default_str();
+    foe_wr->add_flag("-s,--station", fa.station, "--position is a station address");
+    foe_wr->add_option("--password", fa.password, "FoE password")->capture_default_str();
+    foe_wr->add_flag("--stay", fa.stay, "Stay in BOOT afterwards");
+    foe_wr->callback(
+        [&] { rc = with_master(g, [&](master::Master& m) { return foe_transfer(m, fa, false); }); });
 
     try {
         app.parse(argc, argv);

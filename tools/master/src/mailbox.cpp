@@ -22,9 +22,13 @@ void put16(uint8_t* p, uint16_t v) {
 Mailbox::Mailbox(Master& master, Address slave, std::chrono::milliseconds timeout)
     : m_(master), slave_(slave), timeout_(timeout) {}
 
-Error Mailbox::configure_from_sii() {
-    uint8_t w[10];  // words 0x18-0x1C: SM0 start/size, SM1 start/size, protocols
+Error Mailbox::configure_from_sii(bool bootstrap) {
+    uint8_t w[10];  // words 0x18-0x1C (0x14-0x17 bootstrap): SM0 start/size, SM1 start/size, protocols
     if (Error e = m_.sii_read(slave_, sii::StdMailboxOut, w); e != Error::Ok) return e;
+    if (bootstrap) {
+        if (Error e = m_.sii_read(slave_, sii::BootMailboxOut, std::span<uint8_t>(w, 8)); e != Error::Ok)
+            return e;
+    }
     MailboxConfig c;
     c.out_start = get16(w);
     c.out_size = get16(w + 2);

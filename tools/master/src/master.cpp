@@ -47,6 +47,8 @@ std::string_view to_string(Error e) {
             return "SDO transfer aborted";
         case Error::BufferTooSmall:
             return "buffer too small";
+        case Error::FoeError:
+            return "FoE error reply";
     }
     return "unknown error";
 }

@@ -24,6 +24,7 @@ enum class Error : uint8_t {
     MailboxProtocol,  // the answer does not fit the request (wrong type, service, length)
     SdoAbort,         // the SDO server aborted the transfer (abort code tells why)
     BufferTooSmall,   // the caller's buffer cannot hold the answer
+    FoeError,         // the FoE server answered with an ERR packet (code and text kept by the client)
 };
 
 std::string_view to_string(Error e);

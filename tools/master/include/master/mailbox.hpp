@@ -50,7 +50,8 @@ class Mailbox {
 
     // Reads the standard mailbox from the SII (words 0x18-0x1C) and configures SM0/SM1 (the slave should
     // be in INIT: SMs can be set only while disabled; the state machine checks them on INIT -> PREOP).
-    Error configure_from_sii();
+    // bootstrap: the bootstrap mailbox (words 0x14-0x17) for the BOOT state instead.
+    Error configure_from_sii(bool bootstrap = false);
     // Writes SM0/SM1 (start, length, control, activate = 1) in one 16-byte write.
     Error configure(const MailboxConfig& config);
     // Takes SM0/SM1 as the slave has them now (a slave already in PREOP or above), without writing.
