@@ -248,6 +248,7 @@ void FoeServer::on_ack(uint32_t packet, ecat::MailboxSender& out) {
 }
 
 void FoeServer::on_data(uint32_t packet, std::span<const uint8_t> data, ecat::MailboxSender& out) {
+    reap_commit();
     if (phase_ == Phase::Storing && packet == packet_) {
         // The master repeats the last DATA after BUSY: answer with the state of the commit.
         if (result_ == Result::Running) {
@@ -296,13 +297,43 @@ void FoeServer::on_data(uint32_t packet, std::span<const uint8_t> data, ecat::Ma
     }
     phase_ = Phase::Storing;
     result_ = Result::Running;
+    start_commit();
     send_busy(out);
+}
+
+void FoeServer::start_commit() {
+    if (!config_.commit_in_thread) return;
+    worker_result_.store(0);
+    worker_stop_.store(false);
+    worker_ = std::thread([this] {
+        StoreError e;
+        FirmwareStore::Progress p = FirmwareStore::Progress::Running;
+        while (p == FirmwareStore::Progress::Running && !worker_stop_.load())
+            p = store_.commit_step(e);
+        if (p == FirmwareStore::Progress::Running) return;  // stopped: cancel() aborts after the join
+        error_ = std::move(e);
+        worker_result_.store(p == FirmwareStore::Progress::Done ? 1 : 2);
+    });
+}
+
+// Takes the worker's result once it has finished (the worker wrote error_ before its result).
+void FoeServer::reap_commit() {
+    if (!worker_.joinable() || worker_result_.load() == 0) return;
+    worker_.join();
+    if (worker_result_.load() == 1) {
+        result_ = Result::Done;
+        ++stats_.writes_completed;
+    } else {
+        result_ = Result::Failed;
+    }
 }
 
 void FoeServer::poll(uint64_t now_ns, ecat::MailboxSender& /*out*/) {
     now_ns_ = now_ns;
+    reap_commit();
     if (phase_ == Phase::Storing && result_ == Result::Running) {
         activity_ns_ = now_ns;
+        if (worker_.joinable()) return;
         const auto p = store_.commit_step(error_);
         if (p == FirmwareStore::Progress::Done) {
             result_ = Result::Done;
@@ -326,6 +357,12 @@ void FoeServer::on_state_change(od::AlState /*from*/, od::AlState to) {
 }
 
 void FoeServer::cancel() {
+    if (worker_.joinable()) {
+        worker_stop_.store(true);
+        worker_.join();  // at most one storage step
+        if (worker_result_.load() == 1) ++stats_.writes_completed;
+        if (worker_result_.load() != 0) result_ = worker_result_.load() == 1 ? Result::Done : Result::Failed;
+    }
     if (phase_ == Phase::Writing || (phase_ == Phase::Storing && result_ == Result::Running)) store_.abort();
     if (read_fd_ >= 0) {
         ::close(read_fd_);

@@ -196,6 +196,7 @@ bool FirmwareStore::begin_write(StoreError& error) {
     received_ = 0;
     header_ok_ = false;
     crc_ = 0;
+    progress_.store(0, std::memory_order_relaxed);
     step(StoreStep::CreateTemp);
     const auto tmp = slot_path(target_).string() + ".tmp";
     fd_ = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -253,10 +254,17 @@ bool FirmwareStore::finish(StoreError& error) {
         return fail(error, ErrorCode::InvalidChecksum, std::string(to_string(ImageError::BadChecksum)));
     phase_ = Phase::Committing;
     next_ = StoreStep::SyncTemp;
+    progress_.store(compute_progress(), std::memory_order_relaxed);
     return true;
 }
 
 FirmwareStore::Progress FirmwareStore::commit_step(StoreError& error) {
+    const Progress p = run_step(error);
+    progress_.store(p == Progress::Done ? 100 : compute_progress(), std::memory_order_relaxed);
+    return p;
+}
+
+FirmwareStore::Progress FirmwareStore::run_step(StoreError& error) {
     if (phase_ != Phase::Committing) {
         error = {ErrorCode::Illegal, "nothing to commit"};
         return Progress::Failed;
@@ -386,7 +394,7 @@ void FirmwareStore::abort() {
     phase_ = Phase::Idle;
 }
 
-uint16_t FirmwareStore::progress_done() const {
+uint16_t FirmwareStore::compute_progress() const {
     if (phase_ != Phase::Committing) return 0;
     switch (next_) {
         case StoreStep::CreateTemp:

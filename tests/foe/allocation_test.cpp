@@ -4,8 +4,10 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cstdlib>
 #include <new>
+#include <thread>
 
 #include "foe/server.hpp"
 #include "foe_test_support.hpp"
@@ -105,7 +107,8 @@ TEST(FoeAllocation, DataAckAndIdlePollAllocateNothing) {
     m = packet(3, 101, {image.data() + 100 * chunk, image.size() - 100 * chunk}, len);
     server.handle({m.data(), len}, out);
     ASSERT_EQ(out.last[0], 6);
-    for (int i = 0; i < 100 && !server.idle(); ++i) {
+    for (int i = 0; i < 10000 && !server.idle(); ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));  // the commit runs on its worker
         server.poll(1'000'000 + i, out);
         server.handle({m.data(), len}, out);
     }

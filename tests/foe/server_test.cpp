@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <string>
+#include <thread>
 
 #include "foe/server.hpp"
 #include "foe_test_support.hpp"
@@ -41,6 +43,13 @@ std::string error_string(const Bytes& m) {
     return m.size() > 6 ? std::string(m.begin() + 6, m.end()) : "";
 }
 
+// Commit steps from poll() only: deterministic.
+ServerConfig stepped() {
+    ServerConfig c;
+    c.commit_in_thread = false;
+    return c;
+}
+
 struct Fixture : ::testing::Test {
     TempDir dir;
     FirmwareStore store{[&] {
@@ -49,7 +58,7 @@ struct Fixture : ::testing::Test {
         c.identity = kMaxpos;
         return c;
     }()};
-    FoeServer server{store};
+    FoeServer server{store, stepped()};
     FakeSender out;  // 128-byte mailbox: 116 data bytes per packet
     uint64_t now = 1'000'000;
     static constexpr std::size_t kChunk = 128 - 12;
@@ -169,7 +178,7 @@ TEST_F(FoeServerTest, WrongPasswordIsNoRights) {
 }
 
 TEST_F(FoeServerTest, ConfiguredPasswordIsRequired) {
-    ServerConfig c;
+    ServerConfig c = stepped();
     c.password = 0x12345678;
     FoeServer s(store, c);
     s.set_state(od::AlState::Boot);
@@ -359,7 +368,7 @@ TEST_F(FoeServerTest, FileLengthMultipleOfThePacketSize) {
 
 TEST_F(FoeServerTest, ConfiguredSm0SizeDecidesTheEndOfFile) {
     // The master's mailbox (SM0) is larger than the reply mailbox: packets of 500 bytes are full ones.
-    ServerConfig c;
+    ServerConfig c = stepped();
     c.bootstrap_data_size = 500;
     FoeServer s(store, c);
     s.set_state(od::AlState::Boot);
@@ -420,4 +429,59 @@ TEST_F(FoeServerTest, RandomPacketsNeverCrash) {
         if (i % 100 == 0) poll();
     }
     EXPECT_EQ(active_version(), 0x01200000u);
+}
+
+TEST_F(FoeServerTest, CommitOnAWorkerThread) {
+    ServerConfig c;
+    ASSERT_TRUE(c.commit_in_thread);
+    FoeServer s(store, c);
+    s.set_state(od::AlState::Boot);
+    const auto image = image_v(0x01300000, 2'000'000);
+    s.handle(request(Opcode::Write, 0, "MAXPOS"), out);
+    ASSERT_TRUE(is_ack(out.take(), 0));
+    uint32_t packet = 1;
+    std::size_t off = 0;
+    for (; image.size() - off >= kChunk; off += kChunk, ++packet) {
+        s.handle(data(packet, {image.data() + off, kChunk}), out);
+        ASSERT_TRUE(is_ack(out.take(), packet));
+    }
+    const Bytes last = data(packet, {image.data() + off, image.size() - off});
+    s.handle(last, out);
+    Bytes r = out.take();
+    unsigned busy = 0;
+    // No poll(): the worker stores on its own; the repeated DATA sees BUSY, then the ACK.
+    for (int i = 0; i < 20000 && is_busy(r); ++i, ++busy) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        s.handle(last, out);
+        r = out.take();
+    }
+    EXPECT_TRUE(is_ack(r, packet));
+    EXPECT_GE(busy, 1u);
+    EXPECT_EQ(active_version(), 0x01300000u);
+    EXPECT_EQ(s.stats().writes_completed, 1u);
+}
+
+TEST_F(FoeServerTest, NewRequestStopsAWorkerCommit) {
+    ASSERT_TRUE(is_ack(download(image_v(0x01200000)), 9));
+    ServerConfig c;
+    FoeServer s(store, c);
+    s.set_state(od::AlState::Boot);
+    const auto image = image_v(0x01300000, 1000);
+    s.handle(request(Opcode::Write, 0, "MAXPOS"), out);
+    ASSERT_TRUE(is_ack(out.take(), 0));
+    for (uint32_t p = 1; p <= 8; ++p) {
+        s.handle(data(p, {image.data() + (p - 1) * kChunk, kChunk}), out);
+        ASSERT_TRUE(is_ack(out.take(), p));
+    }
+    s.handle(data(9, {image.data() + 8 * kChunk, image.size() - 8 * kChunk}), out);
+    ASSERT_TRUE(is_busy(out.take()));
+    s.handle(request(Opcode::Read, 0, "MAXPOS"), out);  // joins the worker, then reads
+    const Bytes d = out.take();
+    ASSERT_EQ(d[0], 3);
+    // Whichever image the commit had reached, it is a complete one and it is what is read.
+    const uint32_t v = active_version();
+    EXPECT_TRUE(v == 0x01200000u || v == 0x01300000u);
+    EXPECT_TRUE(std::equal(d.begin() + 6, d.end(), image_v(v).begin()));
+    for (const auto& f : std::filesystem::directory_iterator(dir.path))
+        EXPECT_NE(f.path().extension(), ".tmp");
 }

@@ -2,7 +2,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <cstdio>
 #include <fstream>
+#include <map>
 
 #include "foe/store.hpp"
 #include "foe_test_support.hpp"
@@ -219,4 +222,40 @@ TEST(FoeStore, KilledAtEveryStepLeavesABootableDevice) {
         EXPECT_EQ(install(s, new_image).code, ErrorCode::NotDefined);
         EXPECT_EQ(s.active_image()->header.version, 0x01300000u);
     }
+}
+
+// Each commit step does a bounded amount of work (one fsync, one rename or one read-back chunk), so a
+// poll() that runs one step never stalls the frame loop for the whole image. Prints the step times.
+TEST(FoeStore, CommitStepsAreBounded) {
+    TempDir d;
+    auto c = config(d.path);
+    c.read_back_chunk = 64 << 10;
+    FirmwareStore s(c);
+    ASSERT_TRUE(s.open());
+    const auto image = image_v(0x01300000, 1 << 20);
+    StoreError e;
+    ASSERT_TRUE(s.begin_write(e));
+    for (std::size_t off = 0; off < image.size(); off += 1012)
+        ASSERT_TRUE(s.append({image.data() + off, std::min<std::size_t>(1012, image.size() - off)}, e));
+    ASSERT_TRUE(s.finish(e));
+    std::size_t steps = 0, read_backs = 0;
+    std::map<std::string, double> worst_ms;
+    s.set_step_hook([&](StoreStep st) { read_backs += st == StoreStep::ReadBack; });
+    for (;;) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const auto before = s.progress_done();
+        const auto p = s.commit_step(e);
+        const double ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        ++steps;
+        std::string key = before >= 20 && before < 80 ? "read back" : "step@" + std::to_string(before);
+        worst_ms[key] = std::max(worst_ms[key], ms);
+        ASSERT_NE(p, FirmwareStore::Progress::Failed) << e.text;
+        if (p == FirmwareStore::Progress::Done) break;
+    }
+    EXPECT_GE(read_backs, image.size() / (64 << 10));  // 1 MiB in >= 16 chunks
+    EXPECT_EQ(s.active_image()->header.version, 0x01300000u);
+    for (const auto& [k, v] : worst_ms)
+        std::printf("  commit %-10s worst %.3f ms\n", k.c_str(), v);
+    std::printf("  %zu commit steps for a 1 MiB image\n", steps);
 }

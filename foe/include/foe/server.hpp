@@ -7,11 +7,13 @@
 // "<device>_<SW>h_<HW>h_<AppNo>h_<AppVer>h.bin" (seed 001 §9.2) are writable in Bootstrap; the written image
 // decides its version, the name only selects the firmware. Readable in every mailbox state: "<device>"
 // (the active image) and the file name of each stored valid image (active and previous slot).
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <span>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <vector>
 
 #include "ecat/mailbox_handler.hpp"
@@ -31,6 +33,9 @@ struct ServerConfig {
     std::size_t standard_data_size = 0;
     std::size_t bootstrap_data_size = 0;
     std::size_t max_file_name = 64;
+    // Run the commit steps on a worker thread instead of one per poll(): an fsync (10-20 ms on a disk)
+    // then never holds up the frame loop. poll() and the repeated DATA only look at its progress.
+    bool commit_in_thread = true;
 
     // Sizes and device name from the device description.
     static ServerConfig from(const od::DeviceDescription& d);
@@ -82,6 +87,8 @@ class FoeServer final : public ecat::MailboxHandler {
     void send_busy(ecat::MailboxSender& out);
     void send_error(ErrorCode code, std::string_view detail, ecat::MailboxSender& out);
     void cancel();
+    void start_commit();
+    void reap_commit();
     std::size_t full_data_size(const ecat::MailboxSender& out) const;
     bool writable(std::string_view name) const;
 
@@ -107,6 +114,11 @@ class FoeServer final : public ecat::MailboxHandler {
 
     std::vector<uint8_t> tx_;
     ServerStats stats_;
+
+    // Commit on a worker thread (commit_in_thread): 0 running, 1 done, 2 failed.
+    std::thread worker_;
+    std::atomic<int> worker_result_{0};
+    std::atomic<bool> worker_stop_{false};
 };
 
 }  // namespace foe

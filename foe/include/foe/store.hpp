@@ -5,6 +5,7 @@
 // the directory holds the previous active image and a pointer to it, or the new image and a pointer to it.
 //
 // Files in the directory: slot0.bin, slot1.bin, active ("slot0\n" or "slot1\n"), and *.tmp while writing.
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -91,8 +92,8 @@ class FirmwareStore {
     bool writing() const { return phase_ == Phase::Receiving; }
     bool committing() const { return phase_ == Phase::Committing; }
     uint64_t received() const { return received_; }
-    // Commit progress for FoE BUSY (done of entire).
-    uint16_t progress_done() const;
+    // Commit progress for FoE BUSY (done of entire). Safe to read while another thread runs commit_step().
+    uint16_t progress_done() const { return progress_.load(std::memory_order_relaxed); }
     uint16_t progress_entire() const { return 100; }
 
     // Test hook: called just before each storage step.
@@ -108,6 +109,8 @@ class FirmwareStore {
         if (hook_) hook_(s);
     }
     bool fail(StoreError& error, ErrorCode code, std::string text);
+    uint16_t compute_progress() const;
+    Progress run_step(StoreError& error);
 
     StoreConfig config_;
     std::optional<StoredImage> active_;
@@ -126,6 +129,7 @@ class FirmwareStore {
     StoreStep next_ = StoreStep::SyncTemp;
     uint64_t read_back_offset_ = 0;
     uint32_t read_back_crc_ = 0;
+    std::atomic<uint16_t> progress_{0};
 };
 
 }  // namespace foe
