@@ -15,7 +15,7 @@
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
 #include "esi/sii.hpp"
-#include "foe/server.hpp"
+#include "foe/firmware.hpp"
 #include "foe_test_support.hpp"
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
@@ -27,15 +27,15 @@ namespace {
 using Bytes = std::vector<uint8_t>;
 
 // On Bootstrap -> Init the device "restarts": the store is reopened and the active image decides the
-// revision, as the drive glue would do before it rebuilds its dictionary.
+// revision, as the drive glue does before it rebuilds its dictionary.
 struct RestartingApp final : ecat::Application {
-    foe::FirmwareStore* store = nullptr;
+    foe::FirmwareUpdate* fw = nullptr;
+    od::Identity* identity = nullptr;
     int restarts = 0;
-    uint32_t booted_version = 0;
     void on_restart() override {
         ++restarts;
-        store->open();
-        booted_version = store->active_image() ? store->active_image()->header.version : 0;
+        fw->restart();
+        fw->apply_to(*identity);
     }
 };
 
@@ -44,8 +44,8 @@ struct Slave {
     od::DeviceDescription desc;
     od::Dictionary dict;
     foe_test::TempDir dir;
-    std::unique_ptr<foe::FirmwareStore> store;
-    std::unique_ptr<foe::FoeServer> foe;
+    std::unique_ptr<foe::FirmwareUpdate> fw;
+    foe::FirmwareStore* store = nullptr;
     std::unique_ptr<esc::Esc> esc;
     RestartingApp app;
     std::unique_ptr<ecat::Stack> stack;
@@ -56,20 +56,18 @@ struct Slave {
         od::place_sync_managers(desc);
         dict = od::make_drive_dictionary(desc);
         clock.set(1'000'000'000);
-        foe::StoreConfig sc;
-        sc.dir = dir.path;
-        sc.identity = foe::ImageIdentity::from(desc.identity);
-        sc.device_name = desc.identity.device_name;
-        store = std::make_unique<foe::FirmwareStore>(sc);
-        store->open();
-        app.store = store.get();
-        foe = std::make_unique<foe::FoeServer>(*store, foe::ServerConfig::from(desc));
+        fw = std::make_unique<foe::FirmwareUpdate>(dir.path, desc);
+        EXPECT_TRUE(fw->ok());
+        EXPECT_FALSE(fw->apply_to(desc.identity));  // nothing stored yet: the built-in identity stays
+        store = &fw->store();
+        app.fw = fw.get();
+        app.identity = &desc.identity;
         esc = std::make_unique<esc::Esc>(esc::EscConfig{}, clock);
         esc->load_eeprom(esi::build_sii(desc, dict));
         stack = std::make_unique<ecat::Stack>(*esc, dict, desc, app);
         coe = std::make_unique<coe::CoeServer>(dict, [this] { return stack->state(); });
         stack->add_handler(*coe);
-        stack->add_handler(*foe);
+        stack->add_handler(fw->server());
         stack->poll(clock.now_ns());
     }
 };
@@ -211,7 +209,8 @@ TEST_F(FoeOverTheStack, DownloadInBootstrapRestartOnNewImageUploadInPreOp) {
     // Bootstrap -> Init: the device restarts on the new image.
     ASSERT_EQ(m.request_state(a, master::AlState::Init), master::Error::Ok);
     EXPECT_EQ(slave.app.restarts, 1);
-    EXPECT_EQ(slave.app.booted_version, 0x01300000u);
+    EXPECT_EQ(slave.desc.identity.revision, 0x01300000u);
+    EXPECT_EQ(slave.desc.identity.software_version, "0130h");
 
     enter_preop();
     Bytes error;
@@ -236,7 +235,8 @@ TEST_F(FoeOverTheStack, ImageForAnotherProductKeepsTheOldOne) {
     EXPECT_EQ(r[0], 5);
     EXPECT_EQ(foe_test::le32(r, 2), 0x800Du);
     ASSERT_EQ(m.request_state(a, master::AlState::Init), master::Error::Ok);
-    EXPECT_EQ(slave.app.booted_version, 0x01200000u);
+    EXPECT_EQ(slave.desc.identity.revision, 0x01200000u);
+    EXPECT_EQ(slave.fw->active_version(), 0x01200000u);
 }
 
 TEST_F(FoeOverTheStack, LengthAMultipleOfTheBootstrapPacketSize) {

@@ -67,6 +67,8 @@ class FoeServer final : public ecat::MailboxHandler {
 
     // Sets the AL state without a transition (e.g. a server created while the stack is in Bootstrap).
     void set_state(od::AlState state) { state_ = state; }
+    // Ends any transfer (an unfinished download is deleted; a worker commit is stopped after its step).
+    void abort_transfer() { cancel(); }
     bool idle() const { return phase_ == Phase::Idle; }
     bool storing() const { return phase_ == Phase::Storing && result_ == Result::Running; }
     const ServerStats& stats() const { return stats_; }
