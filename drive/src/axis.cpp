@@ -149,7 +149,6 @@ void Axis::device_control(int64_t now_ns) {
                 ip_from_ = ip_to_ = demand_pos_;
                 ip_period_ = 0;
                 ppm_moving_ = ppm_buffered_ = false;
-                ppm_reached_ = true;
                 enter(State::OperationEnabled, 4);
                 break;
             }
@@ -220,7 +219,6 @@ void Axis::raise_error(uint16_t code) {
 }
 
 void Axis::connection_lost() {
-    connection_lost_flag_ = true;
     fault(error_code::EthercatStateMachine, now_ns_);
     update_feedback();
 }
@@ -314,7 +312,6 @@ void Axis::fault_reset() {
     }
     error_register_ = 0;
     last_error_ = 0;
-    connection_lost_flag_ = false;
     enter(State::SwitchOnDisabled, 15);
 }
 
@@ -329,7 +326,6 @@ void Axis::switch_mode(int8_t m) {
     ip_from_ = ip_to_ = from;
     ip_period_ = 0;
     ppm_moving_ = ppm_buffered_ = ppm_ack_ = false;
-    ppm_reached_ = true;
     vel_ref_ = power_ ? vel_ref_ : 0.0;
     if (m == mode::Homing && hstat_ != HomingStatus::Done) hstat_ = HomingStatus::Idle;
 }
@@ -360,7 +356,6 @@ void Axis::mode_commands(int64_t now_ns, int64_t dt_ns) {
                     ppm_limited_ = t < lo || t > hi;
                     ppm_target_ = std::clamp(t, lo, hi);
                     ppm_moving_ = true;
-                    ppm_reached_ = false;
                     ppm_buffered_ = false;
                     if (!immediate) profile_.reset(demand_pos_, demand_vel_);
                 } else {
@@ -487,7 +482,6 @@ void Axis::trajectory_tick(int64_t t_ns) {
             } else if (ppm_moving_) {
                 if (profile_.step_position(ppm_target_, vmax, acc, dec, h)) {
                     ppm_moving_ = false;
-                    ppm_reached_ = true;
                     if (ppm_buffered_) {
                         ppm_buffered_ = false;
                         const double t = ppm_next_rel_ ? profile_.position() + ppm_next_raw_
@@ -501,7 +495,6 @@ void Axis::trajectory_tick(int64_t t_ns) {
                         ppm_limited_ = t < lo || t > hi;
                         ppm_target_ = std::clamp(t, lo, hi);
                         ppm_moving_ = true;
-                        ppm_reached_ = false;
                     }
                 }
             } else {

@@ -309,3 +309,36 @@ TEST(DeviceControl, HaltInPvmUsesQuickStopDecelerationAndStaysEnabled) {
     r.cw(0x0F);  // halt released: back to the target velocity
     EXPECT_TRUE(r.until([&] { return std::abs(r.rpm() - 1200) < 20; }, 1000));
 }
+
+TEST(DeviceControl, ACommandCompletesBeforeTheNextIsTaken) {
+    Rig r;
+    r.ax.params.disable_operation = 1;
+    r.ax.params.profile_deceleration = 2000;
+    spin(r, 1000);
+    r.cw(0x07);      // transition 5 with a 0.5 s ramp
+    r.cw(0x0F, 50);  // "enable operation" during the ramp is not taken
+    EXPECT_LT(r.rpm(), 950);
+    ASSERT_TRUE(r.until([&] { return r.ax.state() == State::SwitchedOn; }, 2000));
+    r.cw(0x0F);
+    EXPECT_EQ(r.ax.state(), State::OperationEnabled);  // now it is
+}
+
+TEST(DeviceControl, ErrorsReachTheSinkWithStateAndModeAndStateChangesAsDiagnosis) {
+    struct Sink : EventSink {
+        std::array<uint8_t, 5> mfr{};
+        uint16_t code = 0;
+        int diags = 0;
+        void raise(uint16_t c, uint8_t, const std::array<uint8_t, 5>& m) override { code = c, mfr = m; }
+        void clear(uint16_t, uint8_t) override {}
+        void diag(Severity, uint16_t, std::string_view) override { ++diags; }
+    } sink;
+    Rig r;
+    r.ax.set_event_sink(&sink);
+    r.ax.command.mode = mode::CyclicSyncVelocity;
+    r.enable();
+    EXPECT_GE(sink.diags, 3);  // Ready, Switched On, Operation Enabled
+    r.ax.raise_error(error_code::FollowingError);
+    EXPECT_EQ(sink.code, 0x8611);
+    EXPECT_EQ(sink.mfr[0], static_cast<uint8_t>(State::OperationEnabled));
+    EXPECT_EQ(sink.mfr[1], static_cast<uint8_t>(mode::CyclicSyncVelocity));
+}

@@ -230,7 +230,6 @@ class Axis {
 
     // device control
     State state_ = State::NotReadyToSwitchOn;
-    uint16_t prev_cw_ = 0;
     bool power_ = false;
     uint16_t cw_prev_ = 0;  // controlword of the previous cycle (mode bits)
     Pending pending_;
@@ -246,13 +245,12 @@ class Axis {
     std::array<uint16_t, 8> warnings_{};
     uint16_t last_error_ = 0;
     uint8_t error_register_ = 0;
-    bool connection_lost_flag_ = false;
 
     // modes
     int8_t mode_ = mode::None;
     bool halted_ = false;
     // PPM
-    bool ppm_moving_ = false, ppm_buffered_ = false, ppm_ack_ = false, ppm_reached_ = true;
+    bool ppm_moving_ = false, ppm_buffered_ = false, ppm_ack_ = false;
     double ppm_target_ = 0, ppm_next_target_ = 0;
     bool ppm_next_rel_ = false;
     int32_t ppm_next_raw_ = 0;
@@ -303,7 +301,6 @@ class Axis {
     bool hedge_ = false;  // the awaited event happened
     double href_ = 0;     // reference point (raw inc)
     double hevent_pos_ = 0;
-    double hindex_budget_ = 0;
     int hbit_ = -1;        // function bit awaited (-1 none)
     bool hrise_ = true;    // awaited edge direction
     bool hindex_ = false;  // index seen in ToIndex
