@@ -610,7 +610,6 @@ void Stack::start_process_data(uint64_t now_ns) {
     sm3_buf_.assign(pd_.tx_bytes(), 0);
     outputs_seen_ = false;
     sync0_seen_ = false;
-    sync0_count_ = 0;
     last_sync0_ns_ = now_ns;
     next_cycle_ns_ = now_ns + cycle_ns_;
     next_sync0_sys_ = pdi_.read_reg<uint64_t>(reg::kDcStartTime);
@@ -710,7 +709,6 @@ void Stack::process_data_events(uint32_t events, uint64_t now_ns) {
                         if (r.valid()) r.set(static_cast<uint16_t>(r.get() + (periods - 1)));
                 }
                 sync0_seen_ = true;
-                ++sync0_count_;
                 last_sync0_ns_ = now_ns;
                 const bool missed = state_ == AlState::Op && has_outputs && !new_outputs;
                 if (missed) {

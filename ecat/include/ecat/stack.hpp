@@ -151,7 +151,6 @@ class Stack {
     uint64_t last_sync0_ns_ = 0;
     uint64_t next_sync0_sys_ = 0;              // 0x0990 as last read (system time of the next SYNC0)
     uint64_t sync0_deadline_ns_ = UINT64_MAX;  // when the next SYNC0 is due, in poll() time
-    uint32_t sync0_count_ = 0;
     bool sync0_seen_ = false;
     od::Ref<uint16_t> sm_missed_[2];
     od::Ref<uint16_t> cycle_exceeded_[2];
