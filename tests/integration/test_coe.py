@@ -70,6 +70,17 @@ class CoeAndState(unittest.TestCase):
         self.assertTrue(all(line.startswith("SDO 0x") for line in quiet))
         self.assertEqual(len(quiet), r.stdout.count("SDO 0x"))
 
+    def test_z_capture_of_mailbox_traffic_decodes_cleanly(self):
+        # Runs last (name order): stops the slave to flush its capture.
+        self.bus.ecatctl("upload", "0", "0x1008", "0", "--type", "string")
+        self.bus.ecatctl("upload", "0", "0x5fff", "0", check=False)
+        self.bus.ecatctl("sdos", "0", "-q")
+        self.assertEqual(self.bus.stop_slave(), 0, self.bus.slave_output())
+        problems = harness.tshark_problems(self.bus.capture)
+        if problems is None:
+            self.skipTest("tshark not installed")
+        self.assertEqual(problems, [], "\n".join(problems[:20]))
+
 
 if __name__ == "__main__":
     harness.main()

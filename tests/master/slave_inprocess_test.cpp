@@ -315,6 +315,30 @@ TEST_P(WithSlave, SdoInformationListsAndDescribesTheDictionary) {
     EXPECT_TRUE(sdo.upload(0x1018, 1, b).ok());
 }
 
+TEST_P(WithSlave, UnsupportedProtocolGetsAMailboxErrorReply) {
+    const uint8_t voe[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+    ASSERT_EQ(mbx.send(MailboxType::VoE, voe), Error::Ok);
+    MailboxMessage msg;
+    ASSERT_EQ(mbx.receive(msg), Error::Ok);
+    EXPECT_EQ(msg.type, MailboxType::Error);
+    ASSERT_GE(msg.payload.size(), 4u);
+    EXPECT_EQ(msg.payload[0] | (msg.payload[1] << 8), 0x0001);  // mailbox command error
+    EXPECT_EQ(msg.payload[2] | (msg.payload[3] << 8), 0x0002);  // unsupported protocol
+    // The mailbox stays in step for the next exchange.
+    uint8_t b[4];
+    EXPECT_TRUE(sdo.upload(0x1018, 1, b).ok());
+}
+
+TEST_P(WithSlave, ReceiveOnAnEmptyMailboxTimesOut) {
+    MailboxMessage msg;
+    const auto t0 = std::chrono::steady_clock::now();
+    EXPECT_EQ(mbx.receive(msg, std::chrono::milliseconds(30)), Error::MailboxTimeout);
+    EXPECT_GE(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(30));
+    const uint8_t big[200] = {};
+    EXPECT_EQ(mbx.send(MailboxType::CoE, std::span<const uint8_t>(big, mbx.max_out_payload() + 1)),
+              Error::InvalidArgument);
+}
+
 INSTANTIATE_TEST_SUITE_P(MailboxSizes, WithSlave, ::testing::Values(uint16_t{128}, uint16_t{32}));
 
 TEST(ProcessDataDc, Sync0RunsAndTheSlaveReachesOpInDcMode) {
