@@ -131,6 +131,10 @@ class Bus:
         self._run("ip", "netns", "exec", self.ns, "ip", "link", "set", self.slave_iface, "up")
         cmd = ["ip", "netns", "exec", self.ns, self.slave_bin, "--iface", self.slave_iface,
                "--capture", self.capture]
+        if self.slave_supports("--state-dir"):
+            # Parameters and firmware images of this run only: nothing shared between parallel tests,
+            # nothing left in the machine's default state directory.
+            cmd += ["--state-dir", os.path.join(self.dir, "state")]
         if self.eeprom_path:
             cmd += ["--eeprom", self.eeprom_path]
         cmd += self.slave_args
@@ -147,6 +151,11 @@ class Bus:
             if time.monotonic() > deadline:
                 raise RuntimeError(f"ecat-slave did not answer: {r.stderr} / {self.slave_output()}")
             time.sleep(0.05)
+
+    def slave_supports(self, option):
+        r = subprocess.run([self.slave_bin, "--help"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                           timeout=30)
+        return option in r.stdout
 
     def stop_slave(self):
         """Stops ecat-slave with SIGTERM (so it flushes its capture); returns its exit code."""
@@ -172,6 +181,8 @@ class Bus:
             self._run("ip", "netns", "del", self.ns, check=False)  # takes the slave end (and its peer) along
             if os.path.exists(f"/sys/class/net/{self.iface}"):
                 self._run("ip", "link", "del", self.iface, check=False)
+            if not os.environ.get("ECAT_TEST_KEEP"):
+                self.cleanup_files()  # capture, logs, state; ECAT_TEST_KEEP=1 keeps them for a post-mortem
 
     def cleanup_files(self):
         shutil.rmtree(self.dir, ignore_errors=True)

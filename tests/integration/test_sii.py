@@ -1,6 +1,7 @@
 """ecatctl sii read / sii write against the real ecat-slave's SII EEPROM."""
 import os
 import struct
+import subprocess
 import unittest
 
 import harness
@@ -22,6 +23,25 @@ class Sii(unittest.TestCase):
             r = bus.ecatctl("sii", "read")
             first = " ".join(f"{b:02x}" for b in image[:16])
             self.assertEqual(r.stdout.split("\n")[0], "0x0000: " + first)
+
+    def test_dump_equals_the_default_image(self):
+        with harness.Bus() as bus:
+            if not bus.slave_supports("--write-sii"):
+                self.skipTest("ecat-slave cannot write out its SII image")
+            served = os.path.join(bus.dir, "served.bin")
+            subprocess.run([bus.slave_bin, "--write-sii", served, "--state-dir", os.path.join(bus.dir, "state")],
+                           check=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=30)
+            with open(served, "rb") as f:
+                image = f.read()
+            out = os.path.join(bus.dir, "dump.bin")
+            bus.ecatctl("sii", "read", "--all", "-o", out)
+            with open(out, "rb") as f:
+                self.assertEqual(f.read(), image)
+            bus.ecatctl("sii", "read", "-o", out)
+            with open(out, "rb") as f:
+                chain = f.read()
+            self.assertEqual(chain, image[:len(chain)])
+            self.assertEqual(chain[-2:], b"\xff\xff")  # ends with the end category
 
     def test_write_changes_the_slave_and_its_file(self):
         image, end = harness.build_sii(serial=1)
