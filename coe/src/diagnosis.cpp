@@ -145,7 +145,7 @@ void DiagnosisHistory::store(uint8_t sub, std::span<const uint8_t> bytes) {
     dict_.set_raw(kIndex, sub, std::span<const uint8_t>(buf_.data(), capacity_));
 }
 
-DiagnosisHistory::Result DiagnosisHistory::add(const DiagMessage& m) {
+DiagnosisHistory::Result DiagnosisHistory::add(const DiagMessage& m, bool may_send_emergency) {
     const uint16_t f = flags();
     if ((m.type == DiagType::Info && (f & kFlagNoInfo)) ||
         (m.type == DiagType::Warning && (f & kFlagNoWarning)) ||
@@ -177,7 +177,7 @@ DiagnosisHistory::Result DiagnosisHistory::add(const DiagMessage& m) {
     set_flags(static_cast<uint16_t>((f & ~kFlagOverflow) | (overflow_ ? kFlagOverflow : 0)));
     updating_ = false;
 
-    if (result == Result::Stored && (f & kFlagEmergency) && emergency_ != nullptr) {
+    if (result == Result::Stored && may_send_emergency && (f & kFlagEmergency) && emergency_ != nullptr) {
         // Emergency-derived codes carry their error code; others go out as "device specific" (0xFF00) with
         // the diag code and the message type as manufacturer data.
         uint16_t code = (m.code & 0xFFFF) == 0xE800 ? static_cast<uint16_t>(m.code >> 16) : 0xFF00;

@@ -8,6 +8,7 @@
 #include <new>
 
 #include "coe/diagnosis.hpp"
+#include "coe/events.hpp"
 #include "coe/pdo_validation.hpp"
 #include "coe/sdo_server.hpp"
 #include "coe_test_support.hpp"
@@ -111,8 +112,15 @@ TEST(CoeAllocation, ServingRequestsAllocatesNothingOnceWarm) {
     const coe::DiagMessage m{
         coe::DiagnosisHistory::from_emergency(0x2310), coe::DiagType::Error, 1, 2, false, p};
 
+    uint64_t now = 5;
+    coe::EventReporter events(server.emergency(), &diag, [&now] { return now; });
+    const uint8_t mfr[5] = {8, 8, 0, 0, 0};
+
     g_allocations = 0;
     g_counting = true;
+    events.raise(0x8611, 0x80, mfr);
+    events.diag(coe::DiagType::Warning, 0x8A80, "Negative limit");
+    events.clear(0x8611, 0);
     for (const auto& r : reqs) {
         server.handle(r, out);
         for (int i = 0; i < 4; ++i)

@@ -82,7 +82,9 @@ class DiagnosisHistory {
     DiagnosisHistory(const DiagnosisHistory&) = delete;
     DiagnosisHistory& operator=(const DiagnosisHistory&) = delete;
 
-    Result add(const DiagMessage& m);
+    // Stores a message (unless its type is suppressed or acknowledge mode is full). With flag b0 set it also
+    // goes out as an emergency, unless may_send_emergency is false (the caller sent one already).
+    Result add(const DiagMessage& m, bool may_send_emergency = true);
     // Removes every message (what a master write of 0 to :03 does).
     void clear();
 
