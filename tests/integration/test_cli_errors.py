@@ -30,6 +30,16 @@ class CliErrors(unittest.TestCase):
         finally:
             subprocess.run(["ip", "link", "del", a])
 
+    def test_interface_down(self):
+        a, b = f"edn{os.getpid() % 100000}a", f"edn{os.getpid() % 100000}b"
+        subprocess.run(["ip", "link", "add", a, "type", "veth", "peer", "name", b], check=True)
+        try:
+            r = run("--iface", a, "scan")  # never set up
+            self.assertEqual(r.returncode, 3, r.stderr)
+            self.assertIn(a, r.stderr)
+        finally:
+            subprocess.run(["ip", "link", "del", a])
+
     def test_no_privileges(self):
         setpriv = shutil.which("setpriv")
         if not setpriv:
