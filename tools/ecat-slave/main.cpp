@@ -1,14 +1,50 @@
-// ecat-slave: parses the command line and hands over to softslave::run_slave().
+// ecat-slave: parses the command line (and the configuration file) and hands over to
+// softslave::run_slave() with the soft drive (softdrive) as firmware.
 #include <CLI/CLI.hpp>
+#include <fstream>
 #include <iostream>
 
 #include "esc/link.hpp"
+#include "od/device_config.hpp"
+#include "softdrive/firmware.hpp"
 #include "softslave/slave.hpp"
+
+namespace {
+
+// Config file sections that belong to the object model (od::load_device_config), not to the program.
+bool device_section(const std::string& item) {
+    for (const char* s : {"identity.", "mailbox.", "bootstrap_mailbox.", "eeprom."})
+        if (item.rfind(s, 0) == 0) return true;
+    return false;
+}
+
+bool write_text(const std::string& path, const std::string& text) {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out << text;
+    return static_cast<bool>(out.flush());
+}
+
+bool write_bytes(const std::string& path, const std::vector<uint8_t>& data) {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size()));
+    return static_cast<bool>(out.flush());
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
     softslave::SlaveOptions options;
+    softdrive::DeviceOptions device;
+    std::string state_dir = device.state_dir.string();
+    std::string write_sii, write_esi, control;
+    std::vector<double> home, stops;
     CLI::App app{"Soft EtherCAT slave: a CiA 402 servo drive on a Linux network interface", "ecat-slave"};
     app.set_version_flag("--version", std::string("ecat-slave ") + SOFTECAT_VERSION);
+    app.set_config("--config", "",
+                   "Device configuration file: the [identity], [mailbox], [bootstrap_mailbox] and [eeprom] "
+                   "sections describe the device, keys before the first section (or in [default]) are "
+                   "options of this program (e.g. state-dir = /tmp/drive)");
+    app.allow_config_extras(CLI::config_extras_mode::capture);
     app.add_option("--iface", options.iface,
                    "Network interface to serve; without it a veth pair is created and its other end printed");
     app.add_option("--veth-name", options.veth_name,
@@ -20,8 +56,25 @@ int main(int argc, char** argv) {
                    std::string("Link backend (default: ") + esc::default_link_backend() + ")")
         ->check(CLI::IsMember({"pcap", "packet"}));
     app.add_option("--capture", options.capture_file, "Record every frame in and out to this .pcap file");
-    app.add_option("--eeprom", options.eeprom_file, "Binary SII EEPROM image to serve")
+    app.add_option("--eeprom", options.eeprom_file,
+                   "Serve this binary SII EEPROM image instead of the one built from the device model")
         ->check(CLI::ExistingFile);
+    app.add_option("--state-dir", state_dir,
+                   "Directory for stored parameters and firmware images (created if missing)")
+        ->capture_default_str();
+    app.add_option("--write-sii", write_sii, "Write the device's SII EEPROM image to FILE and exit");
+    app.add_option("--write-esi", write_esi, "Write the device's ESI (EtherCATInfo XML) to FILE and exit");
+    app.add_option("--control", control,
+                   "Create a UNIX datagram socket here that changes the simulated machine at run time "
+                   "(lines like 'input 4 on', 'sto off', 'limit-pos 50000', 'status'; "
+                   "e.g. echo 'input 4 on' | nc -uU -w0 PATH)");
+    auto* env = app.add_option_group("Simulated machine", "Positions in raw encoder increments");
+    env->add_option("--limit-neg", device.environment.negative_limit,
+                    "Negative limit switch (DigIN1), active at and below this position");
+    env->add_option("--limit-pos", device.environment.positive_limit,
+                    "Positive limit switch (DigIN2), active at and above this position");
+    env->add_option("--home", home, "Home switch (DigIN3), active from FROM to TO")->expected(2);
+    env->add_option("--stops", stops, "Mechanical stops LO HI")->expected(2);
     app.add_option("--ram-kib", options.ram_kib, "Process RAM size in KiB")
         ->check(CLI::Range(1, 60))
         ->capture_default_str();
@@ -32,6 +85,9 @@ int main(int argc, char** argv) {
     app.add_flag("--verbose,-v", options.verbose, "Print statistics at exit");
     try {
         app.parse(argc, argv);
+        for (const std::string& extra : app.remaining())
+            if (!device_section(extra))
+                throw CLI::ConfigError("unknown option '" + extra + "' in the configuration file");
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);
     } catch (const CLI::CallForVersion& e) {
@@ -40,5 +96,33 @@ int main(int argc, char** argv) {
         app.exit(e);
         return softslave::kExitUsage;
     }
+    if (home.size() == 2) device.environment.home_from = home[0], device.environment.home_to = home[1];
+    if (stops.size() == 2) device.environment.stop_lo = stops[0], device.environment.stop_hi = stops[1];
+    if (auto* config = app.get_config_ptr(); config != nullptr && config->count() > 0)
+        device.config_file = config->as<std::string>();
+    device.state_dir = state_dir;
+
+    try {
+        if (!write_sii.empty() || !write_esi.empty()) {
+            if (!write_sii.empty() && !write_bytes(write_sii, softdrive::make_sii(device))) {
+                std::cerr << "ecat-slave: cannot write " << write_sii << '\n';
+                return softslave::kExitFailure;
+            }
+            if (!write_esi.empty() && !write_text(write_esi, softdrive::make_esi(device))) {
+                std::cerr << "ecat-slave: cannot write " << write_esi << '\n';
+                return softslave::kExitFailure;
+            }
+            return softslave::kExitOk;
+        }
+        (void)softdrive::make_description(device);  // a bad configuration is a usage error, before any setup
+    } catch (const od::ConfigError& e) {
+        std::cerr << "ecat-slave: " << e.what() << '\n';
+        return softslave::kExitUsage;
+    } catch (const std::exception& e) {
+        std::cerr << "ecat-slave: " << e.what() << '\n';
+        return softslave::kExitFailure;
+    }
+    options.eeprom_loader = softdrive::eeprom_loader(device);
+    options.firmware_factory = softdrive::firmware_factory(device, control);
     return softslave::run_slave(options, std::cout, std::cerr);
 }

@@ -70,6 +70,22 @@ void Runtime::close_fds() {
     }
 }
 
+void Runtime::set_firmware(Firmware* firmware) {
+    if (control_fd_ >= 0) {
+        (void)::epoll_ctl(epoll_fd_, EPOLL_CTL_DEL, control_fd_, nullptr);
+        control_fd_ = -1;
+    }
+    firmware_ = firmware;
+    const int fd = firmware != nullptr ? firmware->control_fd() : -1;
+    if (fd < 0) return;
+    epoll_event ev{};
+    ev.events = EPOLLIN;
+    ev.data.u32 = kTagControl;
+    if (::epoll_ctl(epoll_fd_, EPOLL_CTL_ADD, fd, &ev) != 0)
+        throw std::runtime_error(std::string("epoll_ctl (control): ") + std::strerror(errno));
+    control_fd_ = fd;
+}
+
 Runtime::~Runtime() {
     if (g_signal_target.load() == this) g_signal_target.store(nullptr);
     close_fds();
@@ -92,14 +108,15 @@ void Runtime::run() {
 
 bool Runtime::run_once(int timeout_ms) {
     arm_timer();
-    epoll_event events[3];
-    const int n = ::epoll_wait(epoll_fd_, events, 3, timeout_ms);
+    epoll_event events[4];
+    const int n = ::epoll_wait(epoll_fd_, events, 4, timeout_ms);
     if (n < 0) {
         if (errno == EINTR) return !stop_requested();
         throw std::runtime_error(std::string("epoll_wait: ") + std::strerror(errno));
     }
     uint32_t link_events = 0;
     bool timer = false;
+    bool control = false;
     for (int i = 0; i < n; ++i) {
         switch (events[i].data.u32) {
             case kTagStop:
@@ -109,6 +126,9 @@ bool Runtime::run_once(int timeout_ms) {
                 break;
             case kTagTimer:
                 timer = true;
+                break;
+            case kTagControl:
+                control = true;
                 break;
             default:
                 break;
@@ -136,7 +156,8 @@ bool Runtime::run_once(int timeout_ms) {
             ++stats_.timer_expiries;
         armed_ns_ = 0;
     }
-    if (link_event || timer || n == 0) service();
+    if (control && firmware_ != nullptr) firmware_->on_control(clock_.now_ns());
+    if (link_event || timer || control || n == 0) service();
     return true;
 }
 

@@ -15,6 +15,11 @@ class Firmware {
     virtual void poll(uint64_t now_ns) = 0;
     // Monotonic time (ns) at which poll() must run again even if no frame arrives; UINT64_MAX if never.
     virtual uint64_t next_deadline_ns() const { return std::numeric_limits<uint64_t>::max(); }
+    // An extra descriptor the runtime watches with the link, for input that is not EtherCAT (e.g. a control
+    // socket that toggles the simulated machine's inputs); -1: none. Read once, when the firmware is set.
+    virtual int control_fd() const { return -1; }
+    // control_fd() is readable; poll(now_ns) follows in the same wakeup.
+    virtual void on_control(uint64_t /*now_ns*/) {}
 };
 
 // Adapts any object with poll(uint64_t) and next_deadline_ns() (e.g. ecat::Stack, which cannot depend on

@@ -46,7 +46,8 @@ class Runtime {
     Runtime(const Runtime&) = delete;
     Runtime& operator=(const Runtime&) = delete;
 
-    void set_firmware(Firmware* firmware) { firmware_ = firmware; }
+    // Also watches the firmware's control_fd(), if it has one.
+    void set_firmware(Firmware* firmware);
     void set_capture(esc::PcapWriter* capture) { capture_ = capture; }
     // Called when poll() reports an error on the link (interface down or removed); returns whether the link
     // is still usable. If it returns false, run() ends and link_lost() is true. Not called per frame.
@@ -69,7 +70,7 @@ class Runtime {
     void service();
     void arm_timer();
     void close_fds();
-    static constexpr uint32_t kTagLink = 1, kTagTimer = 2, kTagStop = 3;
+    static constexpr uint32_t kTagLink = 1, kTagTimer = 2, kTagStop = 3, kTagControl = 4;
 
     esc::Link& link_;
     esc::Esc& esc_;
@@ -81,6 +82,7 @@ class Runtime {
     int timer_fd_ = -1;
     int stop_fd_ = -1;
     int epoll_fd_ = -1;
+    int control_fd_ = -1;                // the firmware's control descriptor registered with epoll, -1: none
     uint64_t armed_ns_ = 0;              // deadline the timerfd is armed for; 0 = not armed or expired
     uint64_t flushed_frames_ = 0;        // capture frames already pushed to the file
     uint64_t capture_flush_due_ns_ = 0;  // earliest time of the next capture flush

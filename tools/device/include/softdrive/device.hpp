@@ -1,0 +1,145 @@
+#pragma once
+// The soft drive's firmware, composed: everything that runs behind the ESC's PDI of a MAXPOS.
+//
+//   description  od::load_device_config (or the default), revision/0x100A from the active FoE image
+//   dictionary   od::make_drive_dictionary + PDO validators + parameter store (0x1010/0x1011, state dir)
+//   SII          esi::build_sii of the same description and dictionary, loaded into the ESC
+//   ecat::Stack  over the ESC's PDI, esc.irq() as interrupt line, with this as its Application
+//   CoE          coe::CoeServer (SDO, SDO info, emergencies) + coe::DiagnosisHistory (0x10F3)
+//   FoE          foe::FoeServer over a two-slot foe::FirmwareStore in the state dir
+//   drive        drive::Drive on the dictionary, with this as its EventSink
+//
+// A Bootstrap -> Init restart rebuilds all of it from the then active firmware image, after the Stack's
+// poll() returned. The Device runs in the runtime's thread; nothing here is thread-safe.
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <iosfwd>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "coe/diagnosis.hpp"
+#include "coe/sdo_server.hpp"
+#include "drive/drive.hpp"
+#include "drive/event_sink.hpp"
+#include "ecat/application.hpp"
+#include "ecat/stack.hpp"
+#include "esc/esc.hpp"
+#include "foe/server.hpp"
+#include "foe/store.hpp"
+#include "od/device.hpp"
+#include "od/dictionary.hpp"
+#include "od/store.hpp"
+
+namespace softdrive {
+
+// The simulated machine around the motor (drive::Environment), positions in raw encoder increments.
+// NaN: not fitted.
+struct EnvironmentOptions {
+    static constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+    double negative_limit = kNone;  // negative limit switch (DigIN1) active at and below
+    double positive_limit = kNone;  // positive limit switch (DigIN2) active at and above
+    double home_from = kNone;       // home switch (DigIN3) active on [home_from, home_to]
+    double home_to = kNone;
+    double stop_lo = kNone;  // mechanical stops
+    double stop_hi = kNone;
+};
+
+struct DeviceOptions {
+    std::filesystem::path config_file;  // device configuration (od::load_device_config); empty: defaults
+    std::filesystem::path state_dir = "/var/lib/softecat";  // parameters.bin, firmware/
+    EnvironmentOptions environment;
+    bool load_sii = true;         // false: the ESC serves a user's image (--eeprom), leave it alone
+    bool commission = true;       // drive::commission() before the stored parameters are applied
+    std::ostream* log = nullptr;  // warnings (bad parameter file, ...); null: std::cerr
+};
+
+// Where the firmware slots live inside the state directory.
+std::filesystem::path firmware_dir(const DeviceOptions& options);
+
+// The description the device runs with: the configuration file (or od's default, SyncManagers placed),
+// with revision and software version of the active firmware image in the state directory, if there is
+// one (the state directory is only read if it exists). Throws od::ConfigError on a bad configuration.
+od::DeviceDescription make_description(const DeviceOptions& options);
+// The SII image and the ESI text of that description and its dictionary (what --write-sii/--write-esi
+// write and what the ESC serves).
+std::vector<uint8_t> make_sii(const DeviceOptions& options);
+std::string make_esi(const DeviceOptions& options);
+
+struct DeviceStats {
+    uint64_t builds = 0;       // 1 + restarts from Bootstrap
+    uint64_t cycles = 0;       // drive cycles run
+    uint64_t emergencies = 0;  // raise() + clear() calls from the drive
+    uint64_t diagnoses = 0;    // messages offered to the diagnosis history
+};
+
+class Device final : public ecat::Application, public drive::EventSink {
+  public:
+    // Builds the whole device; loads the SII into esc unless options.load_sii is false.
+    // Throws od::ConfigError on a bad configuration file and std::runtime_error if the state directory
+    // cannot be used.
+    Device(esc::Esc& esc, DeviceOptions options);
+    ~Device() override;
+    Device(const Device&) = delete;
+    Device& operator=(const Device&) = delete;
+
+    // Firmware entry points (softslave::Firmware through an adapter).
+    void poll(uint64_t now_ns);
+    uint64_t next_deadline_ns() const;
+
+    // The machine at run time: a digital input pin 1..6 (not wired to a switch). Kept across restarts.
+    // Returns false for a pin outside 1..6.
+    bool set_input(int pin, bool level);
+    // Replaces the switches / stops; kept across restarts.
+    void set_environment(const EnvironmentOptions& environment);
+    const EnvironmentOptions& environment() const { return options_.environment; }
+
+    // ---- ecat::Application --------------------------------------------------------------------------
+    uint16_t check_transition(od::AlState from, od::AlState to) override;
+    void on_state_change(od::AlState from, od::AlState to) override;
+    void on_cycle(uint64_t now_ns) override;
+    void on_outputs_lost() override;
+    void on_restart() override;
+
+    // ---- drive::EventSink ---------------------------------------------------------------------------
+    void raise(uint16_t error_code, uint8_t error_register, const std::array<uint8_t, 5>& mfr) override;
+    void clear(uint16_t error_code, uint8_t error_register) override;
+    void diag(drive::Severity severity, uint16_t code, std::string_view text) override;
+
+    // ---- the parts (valid until the next restart) ---------------------------------------------------
+    const DeviceOptions& options() const { return options_; }
+    const od::DeviceDescription& description() const;
+    od::Dictionary& dictionary();
+    ecat::Stack& stack();
+    const ecat::Stack& stack() const;
+    coe::CoeServer& coe();
+    coe::DiagnosisHistory& diagnosis();
+    foe::FoeServer& foe();
+    foe::FirmwareStore& firmware_store();
+    drive::Drive& drive();
+    od::ParameterStore& parameters();
+    // What loading the parameter file at the last build did.
+    const od::ParameterStore::LoadResult& parameter_load() const;
+    const DeviceStats& stats() const { return stats_; }
+    // The DC system time (0x0910) as the PDI reads it.
+    uint64_t system_time_ns();
+
+  private:
+    struct Parts;
+    void build();
+    void apply_environment();
+    std::ostream& log() const;
+
+    esc::Esc& esc_;
+    DeviceOptions options_;
+    std::unique_ptr<Parts> parts_;
+    std::array<int8_t, 6> inputs_{-1, -1, -1, -1, -1, -1};  // user-set pin levels, -1: untouched
+    bool restart_pending_ = false;
+    bool outputs_lost_reported_ = false;
+    uint64_t last_cycle_ns_ = 0;
+    DeviceStats stats_;
+};
+
+}  // namespace softdrive

@@ -1,0 +1,40 @@
+#pragma once
+// The soft drive as the slave runtime's firmware: a Device (plus an optional control socket) behind the
+// softslave::Firmware interface, and the factory/loader that plug it into softslave::SlaveOptions.
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+
+#include "softdrive/control.hpp"
+#include "softdrive/device.hpp"
+#include "softslave/firmware.hpp"
+#include "softslave/slave.hpp"
+
+namespace softdrive {
+
+class DeviceFirmware final : public softslave::Firmware {
+  public:
+    // control_path: where to create the control socket; empty: none.
+    DeviceFirmware(esc::Esc& esc, DeviceOptions options, const std::filesystem::path& control_path = {});
+
+    void poll(uint64_t now_ns) override { device_.poll(now_ns); }
+    uint64_t next_deadline_ns() const override { return device_.next_deadline_ns(); }
+    int control_fd() const override { return control_ ? control_->fd() : -1; }
+    void on_control(uint64_t now_ns) override {
+        if (control_) control_->service(device_, now_ns);
+    }
+
+    Device& device() { return device_; }
+
+  private:
+    Device device_;
+    std::unique_ptr<ControlSocket> control_;
+};
+
+// SlaveOptions::firmware_factory for the soft drive. options.load_sii is set from whether the slave
+// serves a user's image (SlaveOptions::eeprom_file).
+softslave::FirmwareFactory firmware_factory(DeviceOptions options, std::filesystem::path control_path = {});
+// SlaveOptions::eeprom_loader: the user's --eeprom file if one is given, else the SII built from the model.
+softslave::EepromLoader eeprom_loader(DeviceOptions options);
+
+}  // namespace softdrive

@@ -1,0 +1,305 @@
+// softdrive::Device: the soft drive's firmware composed from od, ecat, coe, foe, drive and esi.
+#include "softdrive/device.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <stdexcept>
+#include <system_error>
+
+#include "coe/pdo_validation.hpp"
+#include "esi/esi.hpp"
+#include "esi/sii.hpp"
+#include "foe/image.hpp"
+#include "od/device_config.hpp"
+#include "od/drive_profile.hpp"
+
+namespace softdrive {
+
+namespace {
+
+// Longest time step one drive cycle simulates. A master that pauses (or a slave that waited in Safe-Op)
+// does not make the simulated machine catch up for the whole gap in one call.
+constexpr int64_t kMaxCycleStepNs = 100'000'000;
+
+foe::StoreConfig store_config(const DeviceOptions& options, const od::DeviceDescription& d) {
+    foe::StoreConfig c;
+    c.dir = firmware_dir(options);
+    c.identity = foe::ImageIdentity::from(d.identity);
+    c.device_name = d.identity.device_name.empty() ? "MAXPOS" : d.identity.device_name;
+    return c;
+}
+
+od::DeviceDescription base_description(const DeviceOptions& options) {
+    return options.config_file.empty() ? od::default_drive_description()
+                                       : od::load_device_config(options.config_file);
+}
+
+// The description with the version of the active image of an opened store.
+void apply_active_image(od::DeviceDescription& d, const foe::FirmwareStore& store) {
+    if (const auto& active = store.active_image()) foe::apply_version(d.identity, active->header.version);
+}
+
+bool is_nan(double v) {
+    return std::isnan(v);
+}
+
+}  // namespace
+
+std::filesystem::path firmware_dir(const DeviceOptions& options) {
+    return options.state_dir / "firmware";
+}
+
+od::DeviceDescription make_description(const DeviceOptions& options) {
+    od::DeviceDescription d = base_description(options);
+    std::error_code ec;
+    if (std::filesystem::is_directory(firmware_dir(options), ec)) {
+        foe::FirmwareStore store(store_config(options, d));
+        if (store.open()) apply_active_image(d, store);
+    }
+    return d;
+}
+
+std::vector<uint8_t> make_sii(const DeviceOptions& options) {
+    const od::DeviceDescription d = make_description(options);
+    const od::Dictionary dict = od::make_drive_dictionary(d);
+    return esi::build_sii(d, dict);
+}
+
+std::string make_esi(const DeviceOptions& options) {
+    const od::DeviceDescription d = make_description(options);
+    const od::Dictionary dict = od::make_drive_dictionary(d);
+    return esi::build_esi(d, dict);
+}
+
+// Everything a restart rebuilds, in construction order (members are destroyed in reverse).
+struct Device::Parts {
+    od::DeviceDescription desc;
+    std::unique_ptr<foe::FirmwareStore> firmware;
+    od::Dictionary dict;
+    std::unique_ptr<od::ParameterStore> params;
+    od::ParameterStore::LoadResult load;
+    std::unique_ptr<ecat::Stack> stack;
+    std::unique_ptr<coe::CoeServer> coe;
+    std::unique_ptr<coe::DiagnosisHistory> diag;
+    std::unique_ptr<foe::FoeServer> foe;
+    std::unique_ptr<drive::Drive> drive;
+};
+
+Device::Device(esc::Esc& esc, DeviceOptions options) : esc_(esc), options_(std::move(options)) {
+    build();
+}
+
+Device::~Device() = default;
+
+std::ostream& Device::log() const {
+    return options_.log != nullptr ? *options_.log : std::cerr;
+}
+
+void Device::build() {
+    std::error_code ec;
+    std::filesystem::create_directories(options_.state_dir, ec);
+    if (ec)
+        throw std::runtime_error("cannot create the state directory '" + options_.state_dir.string() +
+                                 "': " + ec.message());
+
+    // Tear down the old device first: its servers hold references into its dictionary and store.
+    parts_.reset();
+    auto p = std::make_unique<Parts>();
+    p->desc = base_description(options_);
+    p->firmware = std::make_unique<foe::FirmwareStore>(store_config(options_, p->desc));
+    foe::StoreError store_error;
+    if (!p->firmware->open(&store_error))
+        log() << "softdrive: firmware store " << firmware_dir(options_).string() << ": " << store_error.text
+              << " (running the built-in firmware)\n";
+    apply_active_image(p->desc, *p->firmware);
+
+    p->dict = od::make_drive_dictionary(p->desc);
+    coe::install_pdo_validators(p->dict);
+    if (options_.commission) {
+        if (const od::Status s = drive::commission(p->dict); s != od::Status::Ok)
+            log() << "softdrive: commissioning the motor parameters failed: " << od::to_string(s) << '\n';
+    }
+    p->params = std::make_unique<od::ParameterStore>(options_.state_dir);
+    p->load = p->params->load(p->dict);
+    if (p->load.found && !p->load.applied)
+        log() << "softdrive: stored parameters " << p->params->file().string() << " not used ("
+              << p->load.error << "); running with the defaults\n";
+    Parts* raw = p.get();
+    od::attach_store(p->dict, *p->params, [raw] {
+        // Seed 001 §7.2.21: restoring defaults only with the axis in "Power Disable" (not switched on).
+        const od::Entry* e = raw->dict.find(0x6041, 0);
+        if (e == nullptr) return od::Status::Ok;
+        return (raw->dict.get<uint16_t>(0x6041, 0) & 0x0002) != 0 ? od::Status::WrongState : od::Status::Ok;
+    });
+
+    if (options_.load_sii) esc_.load_eeprom(esi::build_sii(p->desc, p->dict));
+
+    p->stack = std::make_unique<ecat::Stack>(esc_, p->dict, p->desc, *this, [this] { return esc_.irq(); });
+    p->coe = std::make_unique<coe::CoeServer>(p->dict, [raw] { return raw->stack->state(); });
+    p->diag = std::make_unique<coe::DiagnosisHistory>(p->dict, &p->coe->emergency());
+    p->foe = std::make_unique<foe::FoeServer>(*p->firmware, foe::ServerConfig::from(p->desc));
+    p->stack->add_handler(*p->coe);
+    p->stack->add_handler(*p->foe);
+    p->drive = std::make_unique<drive::Drive>(p->dict, this);
+
+    parts_ = std::move(p);
+    restart_pending_ = false;
+    outputs_lost_reported_ = false;
+    last_cycle_ns_ = 0;
+    ++stats_.builds;
+    apply_environment();
+}
+
+void Device::apply_environment() {
+    drive::Environment& env = parts_->drive->environment();
+    const EnvironmentOptions& e = options_.environment;
+    env.remove_switches();
+    if (!is_nan(e.negative_limit)) env.set_negative_limit(e.negative_limit);
+    if (!is_nan(e.positive_limit)) env.set_positive_limit(e.positive_limit);
+    if (!is_nan(e.home_from) || !is_nan(e.home_to)) {
+        const double from = is_nan(e.home_from) ? e.home_to : e.home_from;
+        const double to = is_nan(e.home_to) ? e.home_from : e.home_to;
+        env.set_home_switch(std::min(from, to), std::max(from, to));
+    }
+    env.set_mechanical_stops(e.stop_lo, e.stop_hi);
+    for (int pin = 1; pin <= static_cast<int>(inputs_.size()); ++pin)
+        if (inputs_[static_cast<std::size_t>(pin - 1)] >= 0)
+            env.set_input(pin, inputs_[static_cast<std::size_t>(pin - 1)] != 0);
+}
+
+bool Device::set_input(int pin, bool level) {
+    if (pin < 1 || pin > static_cast<int>(inputs_.size())) return false;
+    inputs_[static_cast<std::size_t>(pin - 1)] = level ? 1 : 0;
+    parts_->drive->environment().set_input(pin, level);
+    return true;
+}
+
+void Device::set_environment(const EnvironmentOptions& environment) {
+    options_.environment = environment;
+    apply_environment();
+}
+
+void Device::poll(uint64_t now_ns) {
+    parts_->stack->poll(now_ns);
+    // The restart runs here, after the Stack's poll() returned: the Stack is destroyed with the rest.
+    if (restart_pending_) {
+        build();
+        parts_->stack->poll(now_ns);
+    }
+}
+
+uint64_t Device::next_deadline_ns() const {
+    return parts_->stack->next_deadline_ns();
+}
+
+uint64_t Device::system_time_ns() {
+    uint8_t b[8] = {};
+    esc_.read(0x0910, b);
+    uint64_t v = 0;
+    for (int i = 7; i >= 0; --i)
+        v = (v << 8) | b[i];
+    return v;
+}
+
+// ---- ecat::Application ------------------------------------------------------------------------------
+
+uint16_t Device::check_transition(od::AlState /*from*/, od::AlState /*to*/) {
+    return 0;
+}
+
+void Device::on_state_change(od::AlState from, od::AlState to) {
+    // Leaving Op: the drive's 0x6007 reaction, unless the stack already reported the outputs lost.
+    if (from == od::AlState::Op && to != od::AlState::Op && !outputs_lost_reported_)
+        parts_->drive->connection_lost();
+    if (to == od::AlState::Op) outputs_lost_reported_ = false;
+    // A new cycle sequence starts whenever the slave enters Safe-Op again.
+    if (to != od::AlState::Op && to != od::AlState::SafeOp) last_cycle_ns_ = 0;
+}
+
+void Device::on_cycle(uint64_t now_ns) {
+    int64_t dt = 0;
+    if (last_cycle_ns_ != 0 && now_ns > last_cycle_ns_)
+        dt = std::min<int64_t>(static_cast<int64_t>(now_ns - last_cycle_ns_), kMaxCycleStepNs);
+    last_cycle_ns_ = now_ns;
+    parts_->drive->cycle(static_cast<int64_t>(now_ns), dt);
+    ++stats_.cycles;
+}
+
+void Device::on_outputs_lost() {
+    outputs_lost_reported_ = true;
+    parts_->drive->connection_lost();
+}
+
+void Device::on_restart() {
+    restart_pending_ = true;
+}
+
+// ---- drive::EventSink -------------------------------------------------------------------------------
+
+void Device::raise(uint16_t error_code, uint8_t error_register, const std::array<uint8_t, 5>& mfr) {
+    ++stats_.emergencies;
+    parts_->coe->emergency().raise(error_code, error_register, mfr);
+    coe::DiagMessage m;
+    m.code = coe::DiagnosisHistory::from_emergency(error_code);
+    m.type = coe::DiagType::Error;
+    m.timestamp_ns = system_time_ns();
+    ++stats_.diagnoses;
+    parts_->diag->add(m);
+}
+
+void Device::clear(uint16_t error_code, uint8_t /*error_register*/) {
+    ++stats_.emergencies;
+    parts_->coe->emergency().clear(error_code);
+}
+
+void Device::diag(drive::Severity severity, uint16_t code, std::string_view text) {
+    coe::DiagMessage m;
+    m.code = code != 0 ? coe::DiagnosisHistory::from_emergency(code) : 0xE0000000u;
+    m.type = severity == drive::Severity::Error     ? coe::DiagType::Error
+             : severity == drive::Severity::Warning ? coe::DiagType::Warning
+                                                    : coe::DiagType::Info;
+    m.timestamp_ns = system_time_ns();
+    const coe::DiagParam param = coe::DiagParam::ascii(text);
+    m.params = std::span<const coe::DiagParam>(&param, text.empty() ? 0 : 1);
+    ++stats_.diagnoses;
+    parts_->diag->add(m);
+}
+
+// ---- parts ------------------------------------------------------------------------------------------
+
+const od::DeviceDescription& Device::description() const {
+    return parts_->desc;
+}
+od::Dictionary& Device::dictionary() {
+    return parts_->dict;
+}
+ecat::Stack& Device::stack() {
+    return *parts_->stack;
+}
+const ecat::Stack& Device::stack() const {
+    return *parts_->stack;
+}
+coe::CoeServer& Device::coe() {
+    return *parts_->coe;
+}
+coe::DiagnosisHistory& Device::diagnosis() {
+    return *parts_->diag;
+}
+foe::FoeServer& Device::foe() {
+    return *parts_->foe;
+}
+foe::FirmwareStore& Device::firmware_store() {
+    return *parts_->firmware;
+}
+drive::Drive& Device::drive() {
+    return *parts_->drive;
+}
+od::ParameterStore& Device::parameters() {
+    return *parts_->params;
+}
+const od::ParameterStore::LoadResult& Device::parameter_load() const {
+    return parts_->load;
+}
+
+}  // namespace softdrive
