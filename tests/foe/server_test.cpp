@@ -485,3 +485,77 @@ TEST_F(FoeServerTest, NewRequestStopsAWorkerCommit) {
     for (const auto& f : std::filesystem::directory_iterator(dir.path))
         EXPECT_NE(f.path().extension(), ".tmp");
 }
+
+// Downloads disturbed at random (wrong packet numbers, short packets, bit flips, aborts, new requests,
+// state changes, timeouts): one answer per request at most, and whatever happened, the store reopens with
+// one of the complete images active.
+TEST_F(FoeServerTest, DisturbedDownloadsNeverLeaveAHalfImage) {
+    const Bytes v1 = image_v(0x01200000, 600), v2 = image_v(0x01300000, 900);
+    ASSERT_TRUE(is_ack(download(v1), 6));
+    uint32_t x = 777;
+    auto next = [&] {
+        x = x * 1103515245u + 12345u;
+        return x >> 16;
+    };
+    for (int round = 0; round < 300; ++round) {
+        const Bytes& img = (next() & 1) ? v1 : v2;
+        server.handle(request(Opcode::Write, 0, "MAXPOS"), out);
+        out.sent.clear();
+        uint32_t packet = 1;
+        for (std::size_t off = 0; off <= img.size();) {
+            std::size_t n = std::min(kChunk, img.size() - off);
+            Bytes d = data(packet, {img.data() + off, n});
+            switch (next() % 16) {
+                case 0:
+                    d[2] = static_cast<uint8_t>(d[2] + 1 + next() % 3);  // wrong number
+                    break;
+                case 1:
+                    if (d.size() > 6)
+                        d[6 + next() % (d.size() - 6)] ^= static_cast<uint8_t>(1 + next() % 255);
+                    break;
+                case 2:
+                    d.resize(6 + next() % (n + 1));  // cut short
+                    break;
+                case 3:
+                    d = request(Opcode::Error, 0x8000);
+                    break;
+                case 4:
+                    server.on_state_change(od::AlState::Boot, od::AlState::Init);
+                    server.on_state_change(od::AlState::Init, od::AlState::Boot);
+                    break;
+                case 5:
+                    poll(11'000'000'000ull);
+                    break;
+                default:
+                    break;
+            }
+            server.handle(d, out);
+            EXPECT_LE(out.sent.size(), 1u);
+            const Bytes r = out.take();
+            out.sent.clear();
+            for (int i = 0; i < 50 && is_busy(r) && !server.idle(); ++i) {
+                poll();
+                server.handle(d, out);
+                out.sent.clear();
+            }
+            if (!is_ack(r, packet) || n < kChunk) break;
+            off += n;
+            ++packet;
+        }
+    }
+    EXPECT_GT(server.stats().writes_completed, 5u);  // both outcomes were exercised
+    EXPECT_GT(server.stats().errors_sent, 20u);
+    server.abort_transfer();
+    FirmwareStore again([&] {
+        StoreConfig c;
+        c.dir = dir.path;
+        c.identity = kMaxpos;
+        return c;
+    }());
+    ASSERT_TRUE(again.open());
+    ASSERT_TRUE(again.active_image());
+    const uint32_t v = again.active_image()->header.version;
+    EXPECT_TRUE(v == 0x01200000u || v == 0x01300000u);
+    for (const auto& f : std::filesystem::directory_iterator(dir.path))
+        EXPECT_NE(f.path().extension(), ".tmp");
+}
