@@ -138,6 +138,9 @@ class Bus:
         if self.eeprom_path:
             cmd += ["--eeprom", self.eeprom_path]
         cmd += self.slave_args
+        if not any(a == "--state-dir" or a.startswith("--state-dir=") for a in self.slave_args):
+            # Stored parameters and firmware images of this bus only (not the system's /var/lib/softecat).
+            cmd += ["--state-dir", os.path.join(self.dir, "state")]
         self._log = open(self.slave_log, "w")
         self.proc = subprocess.Popen(cmd, stdout=self._log, stderr=subprocess.STDOUT, start_new_session=True)
         # Ready when it answers a register read.
