@@ -1,0 +1,129 @@
+// The master's per-cycle and per-message paths allocate nothing (ProcessDataSession::cycle, Mailbox
+// send/receive, SDO expedited transfers), measured with a counting global operator new against the real
+// ESC and slave stack behind a fixed-buffer link.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#include "coe/sdo_server.hpp"
+#include "ecat/application.hpp"
+#include "ecat/stack.hpp"
+#include "esc/clock.hpp"
+#include "esc/esc.hpp"
+#include "esi/sii.hpp"
+#include "master/coe.hpp"
+#include "master/mailbox.hpp"
+#include "master/master.hpp"
+#include "master/session.hpp"
+#include "od/drive_profile.hpp"
+
+namespace {
+std::atomic<uint64_t> g_allocations{0};
+}
+
+void* operator new(std::size_t n) {
+    ++g_allocations;
+    if (void* p = std::malloc(n ? n : 1)) return p;
+    throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) {
+    ++g_allocations;
+    if (void* p = std::malloc(n ? n : 1)) return p;
+    throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept {
+    std::free(p);
+}
+void operator delete[](void* p) noexcept {
+    std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+    std::free(p);
+}
+void operator delete[](void* p, std::size_t) noexcept {
+    std::free(p);
+}
+
+using namespace master;
+
+namespace {
+
+// One frame in flight, in a fixed buffer: the ESC answers in place, then the firmware runs.
+class FixedLink final : public esc::Link {
+  public:
+    FixedLink(esc::Esc& e, ecat::Stack& s, esc::ManualClock& c) : esc_(e), stack_(s), clock_(c) {}
+    int fd() const override { return -1; }
+    std::size_t receive(std::span<uint8_t> buf) override {
+        if (len_ == 0) return 0;
+        const std::size_t n = std::min(buf.size(), len_);
+        std::copy_n(frame_.begin(), n, buf.begin());
+        len_ = 0;
+        return n;
+    }
+    bool send(std::span<const uint8_t> f) override {
+        if (f.size() > frame_.size()) return false;
+        std::copy(f.begin(), f.end(), frame_.begin());
+        clock_.advance(20'000);
+        len_ = esc_.process_frame(std::span<uint8_t>(frame_.data(), f.size())) ? f.size() : 0;
+        esc_.tick();
+        stack_.poll(clock_.now_ns());
+        return true;
+    }
+
+  private:
+    esc::Esc& esc_;
+    ecat::Stack& stack_;
+    esc::ManualClock& clock_;
+    std::array<uint8_t, 2048> frame_{};
+    std::size_t len_ = 0;
+};
+
+}  // namespace
+
+TEST(MasterAllocations, CyclesAndMailboxMessagesAllocateNothing) {
+    esc::ManualClock clock;
+    clock.set(1'000'000'000);
+    od::DeviceDescription desc = od::default_drive_description();
+    od::Dictionary dict = od::make_drive_dictionary(desc);
+    esc::Esc esc(esc::EscConfig{}, clock);
+    esc.load_eeprom(esi::build_sii(desc, dict));
+    ecat::Application app;
+    ecat::Stack stack(esc, dict, desc, app);
+    coe::CoeServer coe(dict, [&] { return stack.state(); });
+    stack.add_handler(coe);
+    FixedLink link(esc, stack, clock);
+    MasterOptions o;
+    o.timeout = std::chrono::milliseconds(20);
+    Master m(link, o);
+    const Address a = Address::station(0x1001);
+    ASSERT_EQ(m.count_slaves().value(), 1);
+    ASSERT_EQ(m.assign_station_addresses(1), Error::Ok);
+    Mailbox mbx(m, a);
+    ASSERT_EQ(mbx.configure_from_sii(), Error::Ok);
+    ASSERT_EQ(m.request_state(a, AlState::PreOp), Error::Ok);
+    SdoClient sdo(mbx);
+    ProcessDataSession pd(m, a, sdo);
+    ASSERT_EQ(pd.discover(), Error::Ok);
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(0)), Error::Ok);
+    ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(0)), Error::Ok);
+    uint8_t b[4];
+    ASSERT_TRUE(sdo.upload(0x1018, 1, b).ok());  // warm-up: buffers sized
+
+    const uint64_t before = g_allocations.load();
+    for (int i = 0; i < 200; ++i) {
+        pd.outputs()[0] = static_cast<uint8_t>(i);
+        ASSERT_EQ(pd.cycle(), Error::Ok);
+    }
+    for (int i = 0; i < 20; ++i) {
+        ASSERT_TRUE(sdo.upload(0x1018, 1, b).ok());
+        const uint8_t v[4] = {0x20, 0x00, 0x7A, 0x60};
+        ASSERT_EQ(sdo.download(0x1600, 1, v), Error::SdoAbort);  // RWP: refused in OP, still no allocation
+    }
+    const uint64_t after = g_allocations.load();
+    EXPECT_EQ(after - before, 0u) << "allocations on the cycle / mailbox paths (master and slave side)";
+    EXPECT_EQ(pd.stats().wkc_errors, 0u);
+}
