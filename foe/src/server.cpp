@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <system_error>
 
 namespace foe {
 namespace {
@@ -305,15 +306,19 @@ void FoeServer::start_commit() {
     if (!config_.commit_in_thread) return;
     worker_result_.store(0);
     worker_stop_.store(false);
-    worker_ = std::thread([this] {
-        StoreError e;
-        FirmwareStore::Progress p = FirmwareStore::Progress::Running;
-        while (p == FirmwareStore::Progress::Running && !worker_stop_.load())
-            p = store_.commit_step(e);
-        if (p == FirmwareStore::Progress::Running) return;  // stopped: cancel() aborts after the join
-        error_ = std::move(e);
-        worker_result_.store(p == FirmwareStore::Progress::Done ? 1 : 2);
-    });
+    try {
+        worker_ = std::thread([this] {
+            StoreError e;
+            FirmwareStore::Progress p = FirmwareStore::Progress::Running;
+            while (p == FirmwareStore::Progress::Running && !worker_stop_.load())
+                p = store_.commit_step(e);
+            if (p == FirmwareStore::Progress::Running) return;  // stopped: cancel() aborts after the join
+            error_ = std::move(e);
+            worker_result_.store(p == FirmwareStore::Progress::Done ? 1 : 2);
+        });
+    } catch (const std::system_error&) {
+        // No thread to be had: the commit runs one step per poll() instead.
+    }
 }
 
 // Takes the worker's result once it has finished (the worker wrote error_ before its result).
