@@ -34,6 +34,10 @@ bool mode::supported(int8_t m) {
 Axis::Axis(EventSink* sink) : sink_(sink ? sink : &null_sink_) {}
 
 double Axis::raw_position_inc() const {
+    return pol_ * phys_position_inc();
+}
+
+double Axis::phys_position_inc() const {
     return plant_.angle() * res_ / kTwoPi;
 }
 
@@ -53,7 +57,23 @@ double Axis::decel_limit(double rpm_s) const {
 // ---- configuration ------------------------------------------------------------------------------------
 
 void Axis::derive() {
-    res_ = static_cast<int32_t>(std::clamp<uint64_t>(4ull * params.encoder_pulses, 4ull, 1ull << 30));
+    const int32_t res =
+        static_cast<int32_t>(std::clamp<uint64_t>(4ull * params.encoder_pulses, 4ull, 1ull << 30));
+    const double pol = (params.axis_misc & 0x1) ? -1.0 : 1.0;
+    if (res != res_ || pol != pol_) {
+        // A new resolution or polarity invalidates the position and the reference [001 §7.2.22].
+        const double phys_angle = plant_.angle();
+        res_ = res;
+        pol_ = pol;
+        count_ = static_cast<int64_t>(std::floor(pol_ * phys_angle * res_ / kTwoPi));
+        prev_raw_pos_ = phys_angle * res_ / kTwoPi;
+        shift_ = 0;
+        referenced_ = false;
+        obs_pos_ = inc_to_rad(static_cast<double>(count_) + 0.5);
+        obs_vel_ = obs_load_ = 0;
+        demand_pos_ = static_cast<double>(count_);
+        profile_.reset(demand_pos_, 0);
+    }
     km_ctrl_ = params.torque_constant * 1e-6;
     const double km_plant = km_ctrl_ > 0 ? km_ctrl_ : motor_.torque_constant;
     if (plant_dirty_ || km_plant != km_plant_ || env_.take_stops_changed()) {
@@ -567,7 +587,7 @@ void Axis::current_tick(int64_t t_ns) {
     if (power_) {
         const double limit = (i2t_active_ ? params.nominal_current : params.output_current_limit) * 1e-3;
         if (control_ == Control::Torque) cur_ref_ = std::clamp(cur_ref_, -limit, limit);
-        const double e = cur_ref_ - plant_.current();
+        const double e = cur_ref_ - i_meas();
         cur_int_ += kii_ * e * kTick;
         // Back-EMF decoupling with the estimated speed, plus the 0x30A0:03 feed-forward.
         const double unclamped = kpi_ * e + cur_int_ + km * obs_vel_ + kff_i_ * cur_ref_;
@@ -590,14 +610,13 @@ void Axis::current_tick(int64_t t_ns) {
     const double err = meas - obs_pos_;
     const double kmc = km_ctrl_ > 0 ? km_ctrl_ : km;
     obs_pos_ += kTick * (obs_vel_ + 3.0 * wo * err);
-    obs_vel_ +=
-        kTick * ((kmc * plant_.current() - obs_load_ - r_ctrl_ * obs_vel_) / j_ctrl_ + 3.0 * wo * wo * err);
+    obs_vel_ += kTick * ((kmc * i_meas() - obs_load_ - r_ctrl_ * obs_vel_) / j_ctrl_ + 3.0 * wo * wo * err);
     obs_load_ -= kTick * j_ctrl_ * wo * wo * wo * err;
 
     // I2t: normalized winding temperature rise, 1.0 = the level continuous nominal current reaches.
     const double tau = std::max<double>(params.thermal_time_constant, 1.0) * 0.1;
     const double in = std::max<double>(params.nominal_current, 1.0) * 1e-3;
-    const double ratio = plant_.current() / in;
+    const double ratio = i_meas() / in;
     thermal_ += kTick / tau * (ratio * ratio - thermal_);
     if (thermal_ >= 1.0)
         i2t_active_ = true;
@@ -606,7 +625,7 @@ void Axis::current_tick(int64_t t_ns) {
 
     const double rpm = obs_vel_ * 60.0 / kTwoPi;
     vel_avg_rpm_ += kAvgAlpha * (rpm - vel_avg_rpm_);
-    cur_avg_a_ += kAvgAlpha * (plant_.current() - cur_avg_a_);
+    cur_avg_a_ += kAvgAlpha * (i_meas() - cur_avg_a_);
 }
 
 uint64_t Axis::functions(uint16_t pins) const {
@@ -622,8 +641,8 @@ uint64_t Axis::functions(uint16_t pins) const {
 
 void Axis::plant_step(int64_t t_ns, double u) {
     const double prev = prev_raw_pos_;
-    plant_.step(u, power_);
-    const double raw = raw_position_inc();
+    plant_.step(pol_ * u, power_);           // polarity: the motor turns the other way
+    const double raw = phys_position_inc();  // the machine sees physical positions
     const uint16_t p = env_.pins(raw, t_ns);
     const uint64_t f = functions(p);
     const uint64_t changed = f ^ func_;
@@ -644,7 +663,7 @@ void Axis::plant_step(int64_t t_ns, double u) {
                 else
                     hi = mid;
             }
-            on_edge(bit, !before, prev + (raw - prev) * hi);
+            on_edge(bit, !before, pol_ * (prev + (raw - prev) * hi));
         }
     }
     func_ = f;
@@ -653,9 +672,9 @@ void Axis::plant_step(int64_t t_ns, double u) {
     if (params.encoder_type & 0x0001) {
         const double p0 = motor_.index_angle / kTwoPi * res_;
         const double k0 = std::floor((prev - p0) / res_), k1 = std::floor((raw - p0) / res_);
-        if (k0 != k1) on_index(p0 + std::max(k0, k1) * res_);
+        if (k0 != k1) on_index(pol_ * (p0 + std::max(k0, k1) * res_));
     }
-    count_ = static_cast<int64_t>(std::floor(raw));
+    count_ = static_cast<int64_t>(std::floor(pol_ * raw));
     prev_raw_pos_ = raw;
 }
 
@@ -801,10 +820,10 @@ void Axis::cycle(int64_t now_ns, int64_t dt_ns) {
     now_ns_ = now_ns;
     derive();
     if (state_ == State::NotReadyToSwitchOn) {
-        pins_ = env_.pins(raw_position_inc(), now_ns);
+        pins_ = env_.pins(phys_position_inc(), now_ns);
         func_ = functions(pins_);
-        prev_raw_pos_ = raw_position_inc();
-        count_ = static_cast<int64_t>(std::floor(prev_raw_pos_));
+        prev_raw_pos_ = phys_position_inc();
+        count_ = static_cast<int64_t>(std::floor(raw_position_inc()));
         obs_pos_ = inc_to_rad(static_cast<double>(count_) + 0.5);
         enter(State::SwitchOnDisabled, 1);
     }
@@ -908,8 +927,8 @@ void Axis::update_feedback() {
     f.velocity_actual = clamp_i32(std::round(obs_vel_ * 60.0 / kTwoPi));
     f.velocity_averaged = clamp_i32(std::round(vel_avg_rpm_));
     const double in = std::max<double>(params.nominal_current, 1.0) * 1e-3;
-    f.torque_actual = sat16(plant_.current() / in * 1000.0);
-    f.current_actual = sat16(plant_.current() * 1000.0);
+    f.torque_actual = sat16(i_meas() / in * 1000.0);
+    f.current_actual = sat16(i_meas() * 1000.0);
     f.current_demand = sat16(power_ ? cur_ref_ * 1000.0 : 0.0);
     f.current_averaged = sat16(cur_avg_a_ * 1000.0);
     f.motor_rated_torque =

@@ -85,6 +85,7 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink) : dict_(dictionary), a
     in(0x6402, 0, p.motor_type);
     in(0x3010, 1, p.encoder_pulses);
     in(0x3010, 2, p.encoder_type);
+    in(0x3000, 4, p.axis_misc);
     in(0x30A0, 1, p.current_p);
     in(0x30A0, 2, p.current_i);
     in(0x30A0, 3, p.current_ff);
@@ -165,6 +166,20 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink) : dict_(dictionary), a
     out(0x603F, 0, f.error_code);
     out(0x1001, 0, f.error_register);
     out(0x3000, 5, resolution_);
+
+    const uint16_t power_disable_only[] = {0x3000, 0x3001, 0x3010, 0x3011, 0x3012, 0x3014,
+                                           0x301A, 0x3020, 0x60A8, 0x60A9, 0x60AA, 0x6402};
+    for (uint16_t index : power_disable_only) {
+        if (!dict_.find(index)) continue;
+        dict_.add_validator(index, [flag = powered_](const od::Entry& e, std::span<const uint8_t>) {
+            if (e.index == 0x3001 && e.subindex != 3) return od::Status::Ok;  // only the pole pairs
+            return flag->load(std::memory_order_relaxed) ? od::Status::WrongState : od::Status::Ok;
+        });
+    }
+}
+
+Drive::~Drive() {
+    powered_->store(false);
 }
 
 od::Status commission(od::Dictionary& d, const MotorModel& m) {
@@ -196,6 +211,7 @@ void Drive::cycle(int64_t now_ns, int64_t dt_ns) {
     resolution_ = axis_.increments_per_rev();
     for (const Link& l : outputs_)
         store(l);
+    powered_->store(axis_.power_on(), std::memory_order_relaxed);
 }
 
 void Drive::connection_lost() {

@@ -89,3 +89,27 @@ TEST(DriveOd, SeedDefaultsRefuseToEnableWith8331) {
     EXPECT_EQ(d.get<uint16_t>(0x603F, 0), 0x8331);
     EXPECT_EQ(d.get<uint16_t>(0x6041, 0) & 0x4F, 0x08);
 }
+
+TEST(DriveOd, PowerDisableOnlyObjectsRefuseMasterWritesWhileEnabled) {
+    od::Dictionary d = od::make_drive_dictionary(od::default_drive_description());
+    ASSERT_EQ(commission(d), od::Status::Ok);
+    Drive drv(d);
+    const uint8_t pulses[4] = {0x00, 0x04, 0x00, 0x00};  // 1024
+    EXPECT_EQ(d.write(0x3010, 1, od::AlState::PreOp, pulses), od::Status::Ok);
+    int64_t t = 0;
+    for (uint16_t cw : {0x06, 0x07, 0x0F}) {
+        d.set<uint16_t>(0x6040, 0, cw);
+        drv.cycle(t, 1'000'000);
+        t += 1'000'000;
+    }
+    EXPECT_EQ(drv.axis().increments_per_rev(), 4096);
+    EXPECT_EQ(d.write(0x3010, 1, od::AlState::Op, pulses), od::Status::WrongState);
+    const uint8_t pp[1] = {2};
+    EXPECT_EQ(d.write(0x3001, 3, od::AlState::Op, pp), od::Status::WrongState);
+    const uint8_t nominal[2] = {0x88, 0x13};  // 5000 mA: allowed while enabled
+    EXPECT_EQ(d.write(0x3001, 1, od::AlState::Op, nominal), od::Status::Ok);
+    d.set<uint16_t>(0x6040, 0, 0x06);
+    for (int i = 0; i < 200; ++i, t += 1'000'000)
+        drv.cycle(t, 1'000'000);
+    EXPECT_EQ(d.write(0x3001, 3, od::AlState::Op, pp), od::Status::Ok);
+}

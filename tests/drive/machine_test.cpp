@@ -148,3 +148,31 @@ TEST(Profile, ReachesTargetsWithoutOvershootAndWithinTheRamps) {
         }
     }
 }
+
+TEST(Machine, InversePolarityTurnsTheMotorTheOtherWayAndKeepsTheLoopStable) {
+    Rig r;
+    r.ax.params.axis_misc = 1;
+    r.ax.command.mode = mode::CyclicSyncVelocity;
+    r.enable();
+    r.ax.command.target_velocity = 1000;
+    r.run_ms(400);
+    EXPECT_NEAR(r.fb().velocity_actual, 1000, 30);
+    EXPECT_NEAR(r.rpm(), -1000, 30);  // physically negative
+    EXPECT_GT(r.fb().current_actual, 0);
+    EXPECT_LT(r.ax.phys_position_inc(), -1000);
+    EXPECT_GT(r.fb().position_actual, 1000);
+}
+
+TEST(Machine, PolarityAppliesToSwitchEdgesToo) {
+    Rig r;
+    r.ax.params.axis_misc = 1;
+    r.ax.params.input_function[3] = 26;
+    r.ax.environment().set_home_switch(-5000.5, -4000.5, 4);  // physical positions
+    r.ax.command.touch_probe_function = 0x0031;
+    r.ax.command.mode = mode::ProfileVelocity;
+    r.ax.command.target_velocity = 1500;  // axis positive = physically negative
+    r.enable();
+    ASSERT_TRUE(r.until([&] { return (r.fb().touch_probe_status & 0x6) == 0x6; }, 2000));
+    EXPECT_NEAR(r.fb().touch_probe_pos, 4000, 1);  // reached first, at axis position +4000.5
+    EXPECT_NEAR(r.fb().touch_probe_neg, 5000, 1);
+}

@@ -41,6 +41,7 @@ struct Parameters {
     // Encoder 0x3010
     uint32_t encoder_pulses = 500;   // :01 pulses/rev, inc/rev = 4 x
     uint16_t encoder_type = 0x0001;  // :02 bit0 index present
+    uint32_t axis_misc = 0;          // 0x3000:04 bit0 polarity: 1 = inverse
     // Current loop 0x30A0 (2^-16 V/A; I gain per 40 us current-loop sample, see decisions)
     uint32_t current_p = 32768, current_i = 4096, current_ff = 0;
     // Position (and velocity) loop 0x30A1
@@ -161,7 +162,8 @@ class Axis {
     double thermal_load() const { return thermal_; }  // I2t state, 1.0 = limit
     const Plant& plant() const { return plant_; }
     double position_demand_inc() const { return demand_pos_ + shift_; }  // reported frame, unrounded
-    double raw_position_inc() const;  // exact simulated position in raw increments
+    double raw_position_inc() const;   // exact simulated position in raw increments (after polarity)
+    double phys_position_inc() const;  // the same before polarity: the frame of the Environment
     int64_t home_shift() const { return shift_; }
     int32_t increments_per_rev() const { return res_; }
     // Ids of active errors (up to 8), for tests and diagnostics.
@@ -208,6 +210,7 @@ class Axis {
     void update_feedback();
     uint64_t functions(uint16_t pins) const;
     int32_t clamp_i32(double v) const;
+    double i_meas() const { return pol_ * plant_.current(); }  // current in the axis' direction
     double rpm_to_inc_s(double rpm) const { return rpm * res_ / 60.0; }
     double inc_to_rad(double inc) const { return inc * 6.283185307179586 / res_; }
     double decel_limit(double d) const;
@@ -222,6 +225,7 @@ class Axis {
 
     // configuration derived from params
     int32_t res_ = 2000;
+    double pol_ = 1.0;  // 0x3000:04 bit 0: -1 = inverse polarity
     double km_ctrl_ = 0, j_ctrl_ = 1e-5, r_ctrl_ = 0;
     double kv_ = 0, kiv_ = 0, kpp_ = 0;     // velocity PI (A s/rad, A/rad), position P (1/s)
     double kpi_ = 0, kii_ = 0, kff_i_ = 0;  // current PI

@@ -4,7 +4,9 @@
 // its configuration and commands from the dictionary, runs the axis for dt and writes the inputs (0x6041,
 // 0x6064, ...) back. Objects the dictionary does not declare keep the Axis defaults (Parameters), so the
 // drive also runs on a partial dictionary.
+#include <atomic>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "drive/axis.hpp"
@@ -21,7 +23,13 @@ od::Status commission(od::Dictionary& dictionary, const MotorModel& motor = Moto
 
 class Drive {
   public:
+    // Also registers validators on the objects seed 001 lets a master write only in "Power Disable"
+    // (0x3000, 0x3001:03, the sensor records, 0x60A8..0x60AA, 0x6402): such writes answer WrongState
+    // (SDO abort 0x08000022) while the power stage is on.
     explicit Drive(od::Dictionary& dictionary, EventSink* sink = nullptr);
+    Drive(const Drive&) = delete;
+    Drive& operator=(const Drive&) = delete;
+    ~Drive();
 
     void cycle(int64_t now_ns, int64_t dt_ns);
     // The master is gone: error 0x8180 with the reaction of 0x6007.
@@ -58,6 +66,8 @@ class Drive {
     Feedback fb_copy_;
     int32_t resolution_ = 0;
     std::size_t bound_ = 0, missing_ = 0;
+    // Read by the validators (the mailbox side); shared so a validator outliving the Drive stays safe.
+    std::shared_ptr<std::atomic<bool>> powered_ = std::make_shared<std::atomic<bool>>(false);
 };
 
 }  // namespace drive

@@ -6,6 +6,7 @@
 // Wiring: each switch drives one physical input DigIN1..6 (pin high = switch active, before the drive's
 // polarity 0x3141:02). The drive maps pins to functions with 0x3142 (defaults: DigIN1 negative limit,
 // DigIN2 positive limit, DigIN3 home switch), so the default wiring below matches the default configuration.
+// Positions here are physical: inverting the axis polarity (0x3000:04) does not move the switches.
 #include <array>
 #include <cstdint>
 #include <limits>
