@@ -131,10 +131,6 @@ class Bus:
         self._run("ip", "netns", "exec", self.ns, "ip", "link", "set", self.slave_iface, "up")
         cmd = ["ip", "netns", "exec", self.ns, self.slave_bin, "--iface", self.slave_iface,
                "--capture", self.capture]
-        if self.slave_supports("--state-dir"):
-            # Parameters and firmware images of this run only: nothing shared between parallel tests,
-            # nothing left in the machine's default state directory.
-            cmd += ["--state-dir", os.path.join(self.dir, "state")]
         if self.eeprom_path:
             cmd += ["--eeprom", self.eeprom_path]
         cmd += self.slave_args

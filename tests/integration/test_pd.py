@@ -52,6 +52,41 @@ class ProcessData(unittest.TestCase):
         r, _, lost, wkc_errors, _, _ = self.run_pd("-n", "200")
         self.assertEqual((lost, wkc_errors), (0, 0))
 
+    def mapping(self, pdo):
+        """[(index, sub, bits)] of a PDO mapping object, read over CoE."""
+        count = int(self.bus.ecatctl("upload", "0", hex(pdo), "0", "--type", "u8").stdout.split()[0], 16)
+        out = []
+        for sub in range(1, count + 1):
+            v = int(self.bus.ecatctl("upload", "0", hex(pdo), str(sub), "--type", "u32").stdout.split()[0], 16)
+            out.append((v >> 16, (v >> 8) & 0xFF, v & 0xFF))
+        return out
+
+    def test_cia402_drive_reaches_operation_enabled(self):
+        rx = self.mapping(0x1600)
+        tx = self.mapping(0x1A00)
+        self.assertEqual(rx[0][:2], (0x6040, 0))  # controlword first
+        self.assertEqual(tx[0][:2], (0x6041, 0))  # statusword first
+        size = sum(bits for _, _, bits in rx) // 8
+        # Modes of operation (0x6060) = 8 (cyclic synchronous position), if it is mapped.
+        mode = [0] * size
+        offset = 0
+        for index, _sub, bits in rx:
+            if index == 0x6060:
+                mode[offset // 8] = 8
+            offset += bits
+
+        def step(cycles, controlword):
+            data = [controlword & 0xFF, controlword >> 8] + mode[2:]
+            return ["--step", f"{cycles}:" + ",".join(f"{b:02x}" for b in data)]
+
+        # Fault reset, shutdown, switch on, enable operation (CiA 402 state machine).
+        args = step(50, 0x80) + step(50, 0x06) + step(50, 0x07) + step(100, 0x0F)
+        r, _, lost, wkc_errors, _, _ = self.run_pd("-n", "100", *args)
+        self.assertEqual((lost, wkc_errors), (0, 0))
+        first = r.stdout.split("inputs:\n")[1].split()[1:3]
+        statusword = int(first[0], 16) | int(first[1], 16) << 8
+        self.assertEqual(statusword & 0x6F, 0x27, f"statusword 0x{statusword:04x}: not 'operation enabled'")
+
     def test_capture_of_a_cyclic_session_decodes_cleanly(self):
         self.run_pd("-n", "300", "--dc")
         self.assertEqual(self.bus.stop_slave(), 0, self.bus.slave_output())

@@ -446,8 +446,38 @@ struct PdArgs {
     bool dc = false;
     std::string state = "OP";
     std::vector<std::string> outputs;
+    std::vector<std::string> steps;
     bool keep = false;
 };
+
+// "CYCLES:B0,B1,..." -> cycles and the output bytes sent (from the first byte) during them.
+struct Step {
+    uint64_t cycles = 0;
+    std::vector<uint8_t> bytes;
+};
+std::optional<Step> parse_step(const std::string& text) {
+    const auto colon = text.find(':');
+    if (colon == std::string::npos) return std::nullopt;
+    auto n = parse_number(text.substr(0, colon), 10'000'000);
+    if (!n) return std::nullopt;
+    Step st;
+    st.cycles = *n;
+    std::string rest = text.substr(colon + 1);
+    std::size_t pos = 0;
+    while (pos <= rest.size()) {
+        const auto comma = rest.find(',', pos);
+        const std::string item =
+            rest.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+        if (item.empty()) return std::nullopt;
+        const bool hex_digits = item.find_first_not_of("0123456789abcdefABCDEF") == std::string::npos;
+        auto b = parse_number(hex_digits && item.size() <= 2 ? "0x" + item : item, 0xFF);
+        if (!b) return std::nullopt;
+        st.bytes.push_back(static_cast<uint8_t>(*b));
+        if (comma == std::string::npos) break;
+        pos = comma + 1;
+    }
+    return st;
+}
 
 int process_data(master::Master& m, const PdArgs& p) {
     auto pos = parse_number(p.slave, 0xFFFF);
@@ -456,6 +486,8 @@ int process_data(master::Master& m, const PdArgs& p) {
     for (auto& c : t)
         c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
     if (t != "OP" && t != "SAFEOP") return usage("--state must be SAFEOP or OP");
+    for (const std::string& text : p.steps)
+        if (!parse_step(text)) return usage("bad --step '" + text + "' (CYCLES:BYTE,BYTE,... e.g. 50:06,00)");
     std::vector<uint8_t> out_bytes;
     for (const std::string& v : p.outputs) {
         auto b = parse_number(v, 0xFF);
@@ -509,6 +541,13 @@ int process_data(master::Master& m, const PdArgs& p) {
     if (t == "OP")
         if (int rc = go(master::AlState::Op, "OP"); rc != kExitOk) return rc;
     const master::CycleStats before = pd.stats();
+    const std::vector<uint8_t> final_outputs = out_bytes;
+    for (const std::string& text : p.steps) {
+        auto step = parse_step(text);  // validated before anything was sent
+        out_bytes = step->bytes;
+        pd.run(step->cycles, period, fill);
+    }
+    if (!p.outputs.empty() || p.steps.empty()) out_bytes = final_outputs;  // else the last step's bytes stay
     pd.run(p.count, period, fill);
     const auto& s = pd.stats();
     const uint64_t cycles = s.cycles - before.cycles;
@@ -833,6 +872,9 @@ int main(int argc, char** argv) {
     pdc->add_flag("--dc", pa.dc, "Distributed clocks: SYNC0 at the cycle time, sync mode DC SYNC0");
     pdc->add_option("--state", pa.state, "SAFEOP or OP")->capture_default_str();
     pdc->add_option("--outputs", pa.outputs, "Output bytes sent every cycle (from the first byte)");
+    pdc->add_option("--step", pa.steps,
+                    "CYCLES:BYTES before the --count cycles, in order; bytes in hex, comma-separated "
+                    "(e.g. --step 50:06,00 --step 50:0f,00)");
     pdc->add_flag("--keep", pa.keep, "Leave the slave in the state reached (default: back to PREOP)");
     pdc->callback([&] { rc = with_master(g, [&](master::Master& m) { return process_data(m, pa); }); });
 
