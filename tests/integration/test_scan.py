@@ -4,7 +4,7 @@ import unittest
 
 import harness
 
-ROW = re.compile(r"^(\d+)\s+0x([0-9a-f]{4})\s+(\S+)\s+0x([0-9a-f]{8}) 0x([0-9a-f]{8}) 0x([0-9a-f]{8}) 0x([0-9a-f]{8})$",
+ROW = re.compile(r"^(\d+)\s+0x([0-9a-f]{4})\s+(\S+)\s+0x([0-9a-f]{8}) 0x([0-9a-f]{8}) 0x([0-9a-f]{8}) 0x([0-9a-f]{8}) ?(.*)$",
                  re.M)
 
 
@@ -21,7 +21,8 @@ class Scan(unittest.TestCase):
             r, rows = scan(bus)
             self.assertIn("1 slave\n", r.stdout)
             self.assertEqual(len(rows), 1, r.stdout)
-            pos, station, _state, vendor, product, revision, serial = rows[0]
+            pos, station, _state, vendor, product, revision, serial, name = rows[0]
+            self.assertEqual(name, "Soft slave")  # from the SII General/STRINGS categories
             self.assertEqual(pos, "0")
             self.assertEqual(station, "1001")
             self.assertEqual(int(vendor, 16), 0x000000FB)
@@ -39,7 +40,8 @@ class Scan(unittest.TestCase):
                 self.skipTest("ecat-slave serves no SII image without --eeprom")
             _, rows = scan(bus)
             self.assertEqual(len(rows), 1)
-            _, _, state, vendor, product, _revision, _serial = rows[0]
+            _, _, state, vendor, product, _revision, _serial, name = rows[0]
+            self.assertTrue(name, "no device name from the SII")
             self.assertEqual(int(vendor, 16), 0x000000FB)  # maxon motor ag
             self.assertEqual(int(product, 16), 0x30010000)  # MAXPOS 50/5 (seed 001 §7.2.4.3)
             self.assertRegex(state, r"^(INIT|PREOP|SAFEOP|OP|BOOT)")

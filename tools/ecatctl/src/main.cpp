@@ -117,8 +117,8 @@ int scan(master::Master& m) {
     if (Error e = m.assign_station_addresses(*n); e != Error::Ok)
         return fail(e, "assigning station addresses");
     std::printf("%u slave%s\n", *n, *n == 1 ? "" : "s");
-    std::printf("%-4s %-7s %-10s %-10s %-10s %-10s %-10s\n", "pos", "station", "state", "vendor", "product",
-                "revision", "serial");
+    std::printf("%-4s %-7s %-10s %-10s %-10s %-10s %-10s %s\n", "pos", "station", "state", "vendor",
+                "product", "revision", "serial", "name");
     int rc = kExitOk;
     for (uint16_t i = 0; i < *n; ++i) {
         const uint16_t station = static_cast<uint16_t>(0x1001 + i);
@@ -146,8 +146,16 @@ int scan(master::Master& m) {
             return static_cast<unsigned>(id[4 * k] | (id[4 * k + 1] << 8) | (id[4 * k + 2] << 16) |
                                          (static_cast<unsigned>(id[4 * k + 3]) << 24));
         };
-        std::printf("%-4u 0x%04x  %-10s 0x%08x 0x%08x 0x%08x 0x%08x\n", i, station, state.c_str(), u32(0),
-                    u32(1), u32(2), u32(3));
+        std::string name;
+#ifdef ECATCTL_HAVE_ESI
+        // The device name from the SII General category (through the STRINGS category).
+        if (auto img = m.sii_read_image(a)) {
+            const esi::SiiInfo info = esi::parse_sii(*img);
+            if (info.general) name = info.general->name;
+        }
+#endif
+        std::printf("%-4u 0x%04x  %-10s 0x%08x 0x%08x 0x%08x 0x%08x %s\n", i, station, state.c_str(), u32(0),
+                    u32(1), u32(2), u32(3), name.c_str());
     }
     return rc;
 }
