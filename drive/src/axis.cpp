@@ -831,6 +831,9 @@ void Axis::cycle(int64_t now_ns, int64_t dt_ns) {
     if (command.mode != mode_ && mode::supported(command.mode)) switch_mode(command.mode);
     device_control(now_ns);
     mode_commands(now_ns, dt_ns);
+    // At most one second of simulated time per call: a caller that skipped time (or passed a bogus dt)
+    // must not stall its thread for minutes.
+    dt_ns = std::min<int64_t>(dt_ns, 1'000'000'000);
     if (dt_ns > 0) {
         const int64_t total = residual_ns_ + dt_ns;
         const int64_t ticks = total / kCurrentTickNs;
