@@ -363,3 +363,49 @@ TEST_P(CspCycle, FollowsTheSameTrajectory) {
 
 INSTANTIATE_TEST_SUITE_P(CycleTimes, CspCycle,
                          ::testing::Values(125'000, 250'000, 1'000'000, 2'000'000, 4'000'000));
+
+TEST(Modes, LimitSwitchWithoutErrorFunctionOnlyShowsIn60FD) {
+    Rig r;
+    r.ax.params.input_function[1] = 25;  // DigIN2: positive limit switch without error
+    r.ax.environment().set_positive_limit(2000);
+    r.ax.command.mode = mode::ProfileVelocity;
+    r.enable();
+    r.ax.command.target_velocity = 300;
+    ASSERT_TRUE(r.until([&] { return (r.fb().digital_inputs & (1u << 25)) != 0; }, 3000));
+    r.run(20);
+    EXPECT_FALSE(r.rec.has(error_code::PositiveLimitSwitch));
+    EXPECT_EQ(r.fb().digital_inputs & 0x2, 0u);
+    EXPECT_EQ(r.fb().input_logic_state & 0x2, 0x2);
+}
+
+TEST(Modes, InputPolarityInvertsTheFunction) {
+    Rig r;
+    r.ax.params.input_polarity = 0x0004;  // DigIN3 low active
+    r.run(1);
+    EXPECT_EQ(r.fb().digital_inputs & 0x4, 0x4u);  // pin low = home switch active
+    EXPECT_EQ(r.fb().input_logic_state & 0x4, 0);
+    r.ax.environment().set_input(3, true);
+    r.run(1);
+    EXPECT_EQ(r.fb().digital_inputs & 0x4, 0u);
+}
+
+TEST(Modes, PpmHaltStopsWithQuickStopDecelerationAndResumes) {
+    Rig r;
+    r.ax.command.mode = mode::ProfilePosition;
+    r.ax.params.profile_velocity = 2000;
+    r.ax.params.quick_stop_deceleration = 40000;
+    r.enable();
+    const int32_t start = r.fb().position_actual;
+    r.ax.command.target_position = start + 30000;
+    r.cw(0x1F);
+    r.cw(0x0F);
+    r.run_ms(400);
+    r.cw(0x10F);  // halt
+    EXPECT_FALSE(r.sw() & sw::TargetReached);
+    ASSERT_TRUE(r.until([&] { return (r.sw() & sw::TargetReached) != 0; }, 500));  // halted: velocity 0
+    EXPECT_LT(r.fb().position_demand, start + 30000);
+    r.cw(0x0F);  // halt released: the move continues to the target
+    EXPECT_FALSE(r.sw() & sw::TargetReached);
+    ASSERT_TRUE(r.until([&] { return (r.sw() & sw::TargetReached) != 0; }, 3000));
+    EXPECT_EQ(r.fb().position_demand, start + 30000);
+}
