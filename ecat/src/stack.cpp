@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <ostream>
 
 #include "ecat/registers.hpp"
 
@@ -599,6 +600,18 @@ void Stack::fall_back(AlState to, uint16_t code, uint64_t now_ns) {
     write_status();
 }
 
+void print_stats(std::ostream& out, const StackStats& s) {
+    out << "stack.transitions " << s.transitions << '\n'
+        << "stack.refused " << s.refused << '\n'
+        << "stack.cycles " << s.cycles << '\n'
+        << "stack.sync0_events " << s.sync0_events << '\n'
+        << "stack.sm_events_missed " << s.sm_events_missed << '\n'
+        << "stack.cycles_exceeded " << s.cycles_exceeded << '\n'
+        << "stack.watchdog_expiries " << s.watchdog_expiries << '\n';
+    s.sync0_latency.print(out, "stack.sync0_latency");
+    s.sm2_latency.print(out, "stack.sm2_latency");
+}
+
 void Stack::local_error(uint16_t code, AlState fallback) {
     fall_back(fallback, code, last_now_ns_);
 }
@@ -614,6 +627,7 @@ void Stack::start_process_data(uint64_t now_ns) {
     next_cycle_ns_ = now_ns + cycle_ns_;
     next_sync0_sys_ = pdi_.read_reg<uint64_t>(reg::kDcStartTime);
     sync0_deadline_ns_ = UINT64_MAX;
+    last_sm_change_time_ = pdi_.read_reg<uint32_t>(reg::kDcEcatBufferChangeTime);
     for (int i = 0; i < 2; ++i) {
         if (sm_missed_[i].valid()) sm_missed_[i].set(0);
         if (cycle_exceeded_[i].valid()) cycle_exceeded_[i].set(0);
@@ -653,6 +667,30 @@ void Stack::run_cycle(uint64_t now_ns, bool fresh_outputs) {
     ++stats_.cycles;
 }
 
+// The pulse that started this cycle is the one before the next (0x0990), on the SYNC0 grid; sys is 0x0910
+// read at the cycle start. A pulse that came between the two reads would make the difference negative or
+// longer than a period: such a sample is not taken (cycles_exceeded counts periods without a cycle).
+void Stack::sample_sync0_latency(uint64_t sys, uint64_t next_sync0, bool running) {
+    if (!running) return;
+    const uint32_t period = pdi_.read_reg<uint32_t>(reg::kDcSync0CycleTime);
+    if (period == 0 || next_sync0 < period) return;
+    const uint64_t pulse = next_sync0 - period;
+    if (sys < pulse || sys - pulse >= period) return;
+    stats_.sync0_latency.add(sys - pulse);
+}
+
+// 0x09F0 holds the local time (low 32 bits) of the last ECAT-side buffer change; the local time now is the
+// system time copy minus the offset. Differences are taken modulo 2^32 (valid up to 4.29 s).
+void Stack::sample_sm2_latency() {
+    const uint32_t changed = pdi_.read_reg<uint32_t>(reg::kDcEcatBufferChangeTime);
+    if (changed == last_sm_change_time_) return;  // not latched by this ESC, or no new event
+    last_sm_change_time_ = changed;
+    const uint64_t sys = pdi_.read_reg<uint64_t>(reg::kDcSystemTime);
+    const uint64_t offset = pdi_.read_reg<uint64_t>(reg::kDcSystemTimeOffset);
+    const auto local = static_cast<uint32_t>(sys - offset);
+    stats_.sm2_latency.add(static_cast<uint32_t>(local - changed));
+}
+
 void Stack::process_data_events(uint32_t events, uint64_t now_ns) {
     const bool has_outputs = !sm2_buf_.empty();
     bool new_outputs = false;
@@ -665,7 +703,10 @@ void Stack::process_data_events(uint32_t events, uint64_t now_ns) {
         case SyncMode::SmSync:
         case SyncMode::SmSync2:
             if (has_outputs) {
-                if (new_outputs) run_cycle(now_ns, true);
+                if (new_outputs) {
+                    sample_sm2_latency();
+                    run_cycle(now_ns, true);
+                }
             } else if (!sm3_buf_.empty()) {
                 // Inputs only: a new cycle each time the master has read the inputs.
                 const uint8_t st = pdi_.read_reg<uint8_t>(reg::sm_base(3) + reg::kSmStatus);
@@ -718,6 +759,7 @@ void Stack::process_data_events(uint32_t events, uint64_t now_ns) {
                 }
                 for (auto& r : sync_error_)
                     if (r.valid()) r.set(missed ? 1 : 0);
+                sample_sync0_latency(sys, next, running);
                 run_cycle(now_ns, new_outputs);
             } else if (state_ == AlState::Op && cycle_ns_ > 0 &&
                        now_ns >= last_sync0_ns_ + std::max<uint64_t>(10ull * cycle_ns_, 10'000'000)) {

@@ -15,6 +15,7 @@ constexpr uint16_t kWatchdogDivider = 0x0400;
 constexpr uint16_t kWatchdogTimePd = 0x0420;
 constexpr uint16_t kWatchdogStatusPd = 0x0440;
 constexpr uint16_t kDcSystemTime = 0x0910;
+constexpr uint16_t kDcSystemTimeOffset = 0x0920;
 constexpr uint16_t kDcCyclicUnitControl = 0x0980;
 constexpr uint16_t kDcActivation = 0x0981;
 constexpr uint16_t kDcActivationStatus = 0x0984;
@@ -23,6 +24,7 @@ constexpr uint16_t kDcSync1Status = 0x098F;
 constexpr uint16_t kDcStartTime = 0x0990;  // read: system time of the next SYNC0 pulse
 constexpr uint16_t kDcSync0CycleTime = 0x09A0;
 constexpr uint16_t kDcSync1CycleTime = 0x09A4;
+constexpr uint16_t kDcEcatBufferChangeTime = 0x09F0;  // local time (32 bit) of the last ECAT SM buffer change
 
 // SyncManager n register block (8 bytes at 0x0800 + 8n).
 constexpr uint16_t sm_base(unsigned n) {

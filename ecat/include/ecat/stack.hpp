@@ -10,10 +10,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <iosfwd>
 #include <vector>
 
 #include "ecat/al_status.hpp"
 #include "ecat/application.hpp"
+#include "ecat/latency.hpp"
 #include "ecat/mailbox.hpp"
 #include "ecat/mailbox_handler.hpp"
 #include "ecat/process_data.hpp"
@@ -34,7 +36,17 @@ struct StackStats {
     uint64_t sm_events_missed = 0;   // DC: SYNC0 without new outputs since the last one (Op)
     uint64_t cycles_exceeded = 0;    // DC: SYNC0 periods that passed without a cycle
     uint64_t watchdog_expiries = 0;  // process-data watchdog events seen
+    // DC: how late each application cycle started after its SYNC0 pulse, against the DC system time:
+    // 0x0910 read at the cycle start minus the pulse's system time (next pulse 0x0990 - SYNC0 cycle 0x09A0).
+    LatencyHistogram sync0_latency;
+    // SM-synchronous: from the ECAT-side SM buffer change (0x09F0, local time, 32 bit) to the cycle start
+    // (local time = 0x0910 - offset 0x0920). Only samples where 0x09F0 changed since the last cycle count,
+    // so an ESC that does not latch 0x09F0 leaves this empty rather than wrong.
+    LatencyHistogram sm2_latency;
 };
+
+// The statistics as "stack.<name> <value>" lines (latencies in ns), for logs and benchmark scripts.
+void print_stats(std::ostream& out, const StackStats& stats);
 
 class Stack {
   public:
@@ -64,6 +76,8 @@ class Stack {
     uint16_t status_code() const { return code_; }
     SyncMode sync_mode() const { return sync_mode_; }
     const StackStats& stats() const { return stats_; }
+    // print_stats() of stats(); the runtime prints it at exit (softslave::FirmwareAdapter forwards it).
+    void report(std::ostream& out) const { print_stats(out, stats_); }
     const Mailbox& mailbox() const { return mailbox_; }
     // The outgoing mailbox, for spontaneous messages (e.g. CoE emergencies from the application).
     Mailbox& mailbox() { return mailbox_; }
@@ -110,6 +124,8 @@ class Stack {
     void set_sm_pdi_deactivated(unsigned n, bool deactivated);
     void process_data_events(uint32_t events, uint64_t now_ns);
     void run_cycle(uint64_t now_ns, bool copy_outputs);
+    void sample_sync0_latency(uint64_t sys, uint64_t next_sync0, bool running);
+    void sample_sm2_latency();
     void write_inputs();
 
     uint64_t get_u(uint16_t index, uint8_t sub, uint64_t fallback) const;
@@ -155,6 +171,7 @@ class Stack {
     od::Ref<uint16_t> sm_missed_[2];
     od::Ref<uint16_t> cycle_exceeded_[2];
     od::Ref<uint8_t> sync_error_[2];
+    uint32_t last_sm_change_time_ = 0;  // 0x09F0 as read at the last SM-synchronous cycle
 
     // Whether the interrupt line covers every SM event the stack waits on (SM control bit 5 set).
     bool irq_usable_ = true;
