@@ -73,18 +73,16 @@ void Axis::derive() {
         obs_vel_ = obs_load_ = 0;
         demand_pos_ = static_cast<double>(count_);
         profile_.reset(demand_pos_, 0);
+        plant_dirty_ = true;  // the stops are given in increments
     }
     km_ctrl_ = params.torque_constant * 1e-6;
     const double km_plant = km_ctrl_ > 0 ? km_ctrl_ : motor_.torque_constant;
     if (plant_dirty_ || km_plant != km_plant_ || env_.take_stops_changed()) {
-        const double theta = plant_.angle();
-        const double w = plant_.velocity();
-        (void)w;
+        // configure() keeps the state (current, speed, angle): changing the model does not jump.
         plant_.configure(motor_, km_plant, kPlantStep);
         const double lo = std::isnan(env_.stop_lo()) ? -INFINITY : env_.stop_lo() * kTwoPi / res_;
         const double hi = std::isnan(env_.stop_hi()) ? INFINITY : env_.stop_hi() * kTwoPi / res_;
         plant_.set_stops(lo, hi);
-        if (plant_dirty_) plant_.set_angle(theta);
         km_plant_ = km_plant;
         plant_dirty_ = false;
     }
