@@ -18,10 +18,6 @@ namespace softdrive {
 
 namespace {
 
-// Longest time step one drive cycle simulates. A master that pauses (or a slave that waited in Safe-Op)
-// does not make the simulated machine catch up for the whole gap in one call.
-constexpr int64_t kMaxCycleStepNs = 100'000'000;
-
 foe::StoreConfig store_config(const DeviceOptions& options, const od::DeviceDescription& d) {
     foe::StoreConfig c;
     c.dir = firmware_dir(options);
@@ -187,10 +183,26 @@ void Device::poll(uint64_t now_ns) {
         build();
         parts_->stack->poll(now_ns);
     }
+    // The drive's own loop: it runs when no master cycle drives it (outside Op), as the controller of a
+    // hardware drive never stops; the first run right after a build sets the statusword.
+    if (last_cycle_ns_ == 0 ||
+        (parts_->stack->state() != od::AlState::Op && now_ns >= last_cycle_ns_ + kFreeRunNs))
+        run_drive(now_ns);
 }
 
 uint64_t Device::next_deadline_ns() const {
-    return parts_->stack->next_deadline_ns();
+    const uint64_t stack = parts_->stack->next_deadline_ns();
+    if (parts_->stack->state() == od::AlState::Op || last_cycle_ns_ == 0) return stack;
+    return std::min(stack, last_cycle_ns_ + kFreeRunNs);
+}
+
+void Device::run_drive(uint64_t now_ns) {
+    int64_t dt = 0;
+    if (last_cycle_ns_ != 0 && now_ns > last_cycle_ns_)
+        dt = std::min<int64_t>(static_cast<int64_t>(now_ns - last_cycle_ns_), kMaxCycleStepNs);
+    last_cycle_ns_ = now_ns;
+    parts_->drive->cycle(static_cast<int64_t>(now_ns), dt);
+    ++stats_.cycles;
 }
 
 uint64_t Device::system_time_ns() {
@@ -213,17 +225,10 @@ void Device::on_state_change(od::AlState from, od::AlState to) {
     if (from == od::AlState::Op && to != od::AlState::Op && !outputs_lost_reported_)
         parts_->drive->connection_lost();
     if (to == od::AlState::Op) outputs_lost_reported_ = false;
-    // A new cycle sequence starts whenever the slave enters Safe-Op again.
-    if (to != od::AlState::Op && to != od::AlState::SafeOp) last_cycle_ns_ = 0;
 }
 
 void Device::on_cycle(uint64_t now_ns) {
-    int64_t dt = 0;
-    if (last_cycle_ns_ != 0 && now_ns > last_cycle_ns_)
-        dt = std::min<int64_t>(static_cast<int64_t>(now_ns - last_cycle_ns_), kMaxCycleStepNs);
-    last_cycle_ns_ = now_ns;
-    parts_->drive->cycle(static_cast<int64_t>(now_ns), dt);
-    ++stats_.cycles;
+    run_drive(now_ns);
 }
 
 void Device::on_outputs_lost() {
@@ -255,7 +260,7 @@ void Device::clear(uint16_t error_code, uint8_t /*error_register*/) {
 
 void Device::diag(drive::Severity severity, uint16_t code, std::string_view text) {
     coe::DiagMessage m;
-    m.code = code != 0 ? coe::DiagnosisHistory::from_emergency(code) : 0xE0000000u;
+    m.code = code != 0 ? coe::DiagnosisHistory::from_emergency(code) : 0x0000E000u;  // manufacturer code
     m.type = severity == drive::Severity::Error     ? coe::DiagType::Error
              : severity == drive::Severity::Warning ? coe::DiagType::Warning
                                                     : coe::DiagType::Info;

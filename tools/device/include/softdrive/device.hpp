@@ -85,6 +85,12 @@ class Device final : public ecat::Application, public drive::EventSink {
     Device(const Device&) = delete;
     Device& operator=(const Device&) = delete;
 
+    // Outside Op, the drive runs on its own every kFreeRunNs when no master cycle ran it (the controller of
+    // a hardware drive never stops: a fault reaction ramps down after the master is gone).
+    static constexpr uint64_t kFreeRunNs = 10'000'000;
+    // Longest time one drive cycle simulates: after a longer pause the machine does not catch up.
+    static constexpr int64_t kMaxCycleStepNs = 100'000'000;
+
     // Firmware entry points (softslave::Firmware through an adapter).
     void poll(uint64_t now_ns);
     uint64_t next_deadline_ns() const;
@@ -130,6 +136,7 @@ class Device final : public ecat::Application, public drive::EventSink {
     struct Parts;
     void build();
     void apply_environment();
+    void run_drive(uint64_t now_ns);
     std::ostream& log() const;
 
     esc::Esc& esc_;
@@ -138,7 +145,7 @@ class Device final : public ecat::Application, public drive::EventSink {
     std::array<int8_t, 6> inputs_{-1, -1, -1, -1, -1, -1};  // user-set pin levels, -1: untouched
     bool restart_pending_ = false;
     bool outputs_lost_reported_ = false;
-    uint64_t last_cycle_ns_ = 0;
+    uint64_t last_cycle_ns_ = 0;  // last drive cycle (master's or our own); 0: none since the build
     DeviceStats stats_;
 };
 

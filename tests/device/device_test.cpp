@@ -1,0 +1,447 @@
+// The composed soft drive (softdrive::Device) against the master library, in process: each frame the master
+// sends goes through esc::Esc::process_frame(), then the ESC's time-driven parts and the Device run, as the
+// slave runtime does. The ESC and the Device run on a manual clock that moves on with every frame.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cstring>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "esc/clock.hpp"
+#include "esc/esc.hpp"
+#include "esi/sii.hpp"
+#include "foe/image.hpp"
+#include "master/coe.hpp"
+#include "master/mailbox.hpp"
+#include "master/master.hpp"
+#include "master/session.hpp"
+#include "od/drive_profile.hpp"
+#include "softdrive/device.hpp"
+
+using namespace master;
+
+namespace {
+
+std::filesystem::path temp_dir() {
+    std::string pattern = (std::filesystem::temp_directory_path() / "softdrive-test-XXXXXX").string();
+    std::vector<char> buf(pattern.begin(), pattern.end());
+    buf.push_back('\0');
+    if (::mkdtemp(buf.data()) == nullptr) throw std::runtime_error("mkdtemp");
+    return buf.data();
+}
+
+// One soft drive "powered" on a manual clock.
+struct Drive {
+    esc::ManualClock clock;
+    softdrive::DeviceOptions options;
+    std::ostringstream log;
+    std::unique_ptr<esc::Esc> esc;
+    std::unique_ptr<softdrive::Device> dev;
+    uint64_t frame_ns = 20'000;  // slave time that passes with each frame
+
+    explicit Drive(const std::filesystem::path& state_dir) {
+        clock.set(1'000'000'000);
+        options.state_dir = state_dir;
+        options.log = &log;
+        power_on();
+    }
+    // A power cycle: new ESC, new Device from the same state directory.
+    void power_on() {
+        dev.reset();
+        esc = std::make_unique<esc::Esc>(esc::EscConfig{}, clock);
+        dev = std::make_unique<softdrive::Device>(*esc, options);
+        service();
+    }
+    void service() {
+        esc->tick();
+        dev->poll(clock.now_ns());
+    }
+    // Time passes without frames; the slave runs at least every millisecond, as the runtime's timer would.
+    void idle(uint64_t ns) {
+        for (uint64_t t = 0; t < ns; t += 1'000'000) {
+            clock.advance(1'000'000);
+            service();
+        }
+    }
+    od::Dictionary& dict() { return dev->dictionary(); }
+};
+
+class DriveLink final : public esc::Link {
+  public:
+    explicit DriveLink(Drive& d) : d_(d) {}
+    int fd() const override { return -1; }
+    std::size_t receive(std::span<uint8_t> buf) override {
+        if (replies_.empty()) return 0;
+        const auto f = std::move(replies_.front());
+        replies_.pop_front();
+        const std::size_t n = std::min(buf.size(), f.size());
+        std::copy_n(f.begin(), n, buf.begin());
+        return n;
+    }
+    bool send(std::span<const uint8_t> frame) override {
+        std::vector<uint8_t> f(frame.begin(), frame.end());
+        d_.clock.advance(d_.frame_ns);
+        const bool back = d_.esc->process_frame(f);
+        d_.service();
+        if (back) replies_.push_back(std::move(f));
+        return true;
+    }
+
+  private:
+    Drive& d_;
+    std::deque<std::vector<uint8_t>> replies_;
+};
+
+MasterOptions master_options() {
+    MasterOptions o;
+    o.timeout = std::chrono::milliseconds(5);
+    o.al_timeout = std::chrono::milliseconds(500);
+    return o;
+}
+
+// Byte offset of index:sub in the process image of the PDOs assigned in `assign` (0x1C12 / 0x1C13).
+int pdo_offset(const od::Dictionary& d, uint16_t assign, uint16_t index, uint8_t sub) {
+    std::size_t bits = 0;
+    const uint8_t pdos = d.get<uint8_t>(assign, 0);
+    for (uint8_t i = 1; i <= pdos; ++i) {
+        const uint16_t pdo = d.get<uint16_t>(assign, i);
+        const uint8_t n = d.get<uint8_t>(pdo, 0);
+        for (uint8_t k = 1; k <= n; ++k) {
+            const uint32_t e = d.get<uint32_t>(pdo, k);
+            if ((e >> 16) == index && ((e >> 8) & 0xFF) == sub) return static_cast<int>(bits / 8);
+            bits += e & 0xFF;
+        }
+    }
+    return -1;
+}
+
+template <typename T>
+void put(std::span<uint8_t> image, int offset, T v) {
+    ASSERT_GE(offset, 0);
+    std::memcpy(image.data() + offset, &v, sizeof v);
+}
+template <typename T>
+T take(std::span<const uint8_t> image, int offset) {
+    T v{};
+    if (offset >= 0) std::memcpy(&v, image.data() + offset, sizeof v);
+    return v;
+}
+
+uint32_t u32(const uint8_t* b) {
+    return static_cast<uint32_t>(b[0] | (b[1] << 8) | (b[2] << 16) | (static_cast<uint32_t>(b[3]) << 24));
+}
+
+class DeviceTest : public ::testing::Test {
+  protected:
+    DeviceTest() : dir(temp_dir()), drive(dir), link(drive), m(link, master_options()), mbx(m, a), sdo(mbx) {}
+    ~DeviceTest() override {
+        std::error_code ec;
+        std::filesystem::remove_all(dir, ec);
+    }
+    void SetUp() override { ASSERT_NO_FATAL_FAILURE(to_preop()); }
+
+    void to_preop() {
+        ASSERT_EQ(m.count_slaves().value(), 1);
+        ASSERT_EQ(m.assign_station_addresses(1), Error::Ok);
+        ASSERT_EQ(mbx.configure_from_sii(), Error::Ok);
+        AlStatus st;
+        ASSERT_EQ(m.request_state(a, AlState::PreOp, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
+    }
+
+    uint32_t sdo_u32(uint16_t index, uint8_t sub) {
+        uint8_t b[4] = {};
+        auto n = sdo.upload(index, sub, b);
+        EXPECT_TRUE(n.ok()) << std::hex << index << ":" << int(sub) << " " << to_string(n.error());
+        return u32(b);
+    }
+
+    // Process data up to Op with the default mapping; outputs: controlword 0, CSP, target = actual.
+    void to_op(ProcessDataSession& pd) {
+        ASSERT_EQ(pd.discover(), Error::Ok);
+        ASSERT_EQ(pd.configure(), Error::Ok) << std::hex << sdo.last_abort();
+        out_cw = pdo_offset(drive.dict(), 0x1C12, 0x6040, 0);
+        out_target = pdo_offset(drive.dict(), 0x1C12, 0x607A, 0);
+        out_mode = pdo_offset(drive.dict(), 0x1C12, 0x6060, 0);
+        in_sw = pdo_offset(drive.dict(), 0x1C13, 0x6041, 0);
+        in_pos = pdo_offset(drive.dict(), 0x1C13, 0x6064, 0);
+        ASSERT_GE(out_cw, 0);
+        ASSERT_GE(out_target, 0);
+        ASSERT_GE(out_mode, 0);
+        ASSERT_GE(in_sw, 0);
+        ASSERT_GE(in_pos, 0);
+        auto fill = [&] {
+            put<uint16_t>(pd.outputs(), out_cw, 0);
+            put<int8_t>(pd.outputs(), out_mode, 8);
+            put<int32_t>(pd.outputs(), out_target, drive.dict().get<int32_t>(0x6064, 0));
+        };
+        AlStatus st;
+        ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(100), &st, fill), Error::Ok)
+            << "AL code 0x" << std::hex << st.code;
+        ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(100), &st, fill), Error::Ok)
+            << "AL code 0x" << std::hex << st.code;
+        EXPECT_EQ(drive.dev->stack().state(), od::AlState::Op);
+    }
+
+    // Controlword sequence 6, 7, 15 over process data; returns with the drive in "operation enabled".
+    void enable(ProcessDataSession& pd, int32_t target) {
+        for (uint16_t cw : {0x0006, 0x0007, 0x000F}) {
+            ASSERT_EQ(pd.run(10, std::chrono::microseconds(50),
+                             [&] {
+                                 put<uint16_t>(pd.outputs(), out_cw, cw);
+                                 put<int8_t>(pd.outputs(), out_mode, 8);
+                                 put<int32_t>(pd.outputs(), out_target, target);
+                             }),
+                      Error::Ok);
+        }
+        const uint16_t sw = take<uint16_t>(pd.inputs(), in_sw);
+        ASSERT_EQ(sw & 0x006F, 0x0027) << "statusword 0x" << std::hex << sw;
+    }
+
+    std::filesystem::path dir;
+    Drive drive;
+    DriveLink link;
+    Master m;
+    const Address a = Address::station(0x1001);
+    Mailbox mbx;
+    SdoClient sdo;
+    int out_cw = -1, out_target = -1, out_mode = -1, in_sw = -1, in_pos = -1;
+};
+
+}  // namespace
+
+TEST_F(DeviceTest, IdentityInTheSiiEqualsObject1018AndTheEsi) {
+    const od::Identity& id = drive.dev->description().identity;
+    EXPECT_EQ(id.vendor_id, 0x000000FBu);
+    EXPECT_EQ(m.sii_read_u32(a, sii::VendorId).value(), sdo_u32(0x1018, 1));
+    EXPECT_EQ(m.sii_read_u32(a, sii::ProductCode).value(), sdo_u32(0x1018, 2));
+    EXPECT_EQ(m.sii_read_u32(a, sii::Revision).value(), sdo_u32(0x1018, 3));
+    EXPECT_EQ(m.sii_read_u32(a, sii::SerialNumber).value(), sdo_u32(0x1018, 4));
+    EXPECT_EQ(sdo_u32(0x1018, 2), id.product_code);
+    EXPECT_EQ(sdo_u32(0x1018, 3), id.revision);
+
+    // The ESI of the same configuration names the same device.
+    const std::string esi = softdrive::make_esi(drive.options);
+    auto hex = [](uint32_t v) {
+        char b[16];
+        std::snprintf(b, sizeof b, "#x%08x", v);
+        return std::string(b);
+    };
+    EXPECT_NE(
+        esi.find("ProductCode=\"" + hex(id.product_code) + "\" RevisionNo=\"" + hex(id.revision) + "\""),
+        std::string::npos)
+        << esi.substr(0, 2000);
+    EXPECT_NE(esi.find("<Id>" + hex(id.vendor_id) + "</Id>"), std::string::npos) << esi.substr(0, 2000);
+    // And the image the slave serves is the one make_sii() writes.
+    const auto served = m.sii_read_image(a);
+    ASSERT_TRUE(served.ok());
+    const auto built = softdrive::make_sii(drive.options);
+    ASSERT_LE(served->size(), built.size());
+    EXPECT_TRUE(std::equal(served->begin(), served->end(), built.begin()));
+
+    // Device name over SDO.
+    std::array<uint8_t, 64> name{};
+    auto n = sdo.upload(0x1008, 0, name);
+    ASSERT_TRUE(n.ok());
+    EXPECT_EQ(std::string(name.begin(), name.begin() + static_cast<long>(*n)), id.device_name);
+}
+
+TEST_F(DeviceTest, ReachesOpWithTheDefaultMappingAndTheDriveMovesInCsp) {
+    ProcessDataSession pd(m, a, sdo);
+    ASSERT_NO_FATAL_FAILURE(to_op(pd));
+    EXPECT_EQ(pd.layout().rx_pdos, (std::vector<uint16_t>{0x1600}));
+    EXPECT_EQ(pd.layout().tx_pdos, (std::vector<uint16_t>{0x1A00}));
+    drive.frame_ns = 1'000'000;  // one cycle = 1 ms of slave time from now on
+    const int32_t start = take<int32_t>(pd.inputs(), in_pos);
+    ASSERT_NO_FATAL_FAILURE(enable(pd, start));
+
+    // A ramp of 20 increments per millisecond for 500 ms, then hold.
+    int32_t target = start;
+    ASSERT_EQ(pd.run(700, std::chrono::microseconds(20),
+                     [&] {
+                         if (target < start + 10000) target += 20;
+                         put<uint16_t>(pd.outputs(), out_cw, 0x000F);
+                         put<int8_t>(pd.outputs(), out_mode, 8);
+                         put<int32_t>(pd.outputs(), out_target, target);
+                     }),
+              Error::Ok);
+    const int32_t actual = take<int32_t>(pd.inputs(), in_pos);
+    EXPECT_NEAR(actual, start + 10000, 200) << "start " << start;
+    const uint16_t sw = take<uint16_t>(pd.inputs(), in_sw);
+    EXPECT_EQ(sw & 0x006F, 0x0027) << "still enabled, statusword 0x" << std::hex << sw;
+    EXPECT_EQ(pd.stats().wkc_errors, 0u);
+    EXPECT_GE(drive.dev->stats().cycles, 700u);
+}
+
+TEST_F(DeviceTest, WatchdogFallsBackToSafeOpAndTheDriveReactsWith6007) {
+    ProcessDataSession pd(m, a, sdo);
+    ASSERT_NO_FATAL_FAILURE(to_op(pd));
+    drive.frame_ns = 1'000'000;
+    ASSERT_NO_FATAL_FAILURE(enable(pd, take<int32_t>(pd.inputs(), in_pos)));
+    const uint64_t emergencies_before = drive.dev->stats().emergencies;
+    // The master stops: no process data for 500 ms (SM watchdog 100 ms by default).
+    drive.idle(500'000'000);
+    EXPECT_EQ(drive.dev->stack().state(), od::AlState::SafeOp);
+    EXPECT_TRUE(drive.dev->stack().error());
+    EXPECT_EQ(drive.dev->stack().status_code(), 0x001B);
+    auto st = m.al_status(a);
+    ASSERT_TRUE(st.ok());
+    EXPECT_EQ(st->state, 0x04);
+    EXPECT_TRUE(st->error);
+    EXPECT_EQ(st->code, 0x001B);
+    // 0x6007 = 3 (seed default): quick-stop ramp, then Fault with 0x8180; the drive kept running on its own.
+    EXPECT_EQ(drive.dict().get<int16_t>(0x6007, 0), 3);
+    EXPECT_EQ(drive.dict().get<uint16_t>(0x603F, 0), 0x8180);
+    const uint16_t sw = drive.dict().get<uint16_t>(0x6041, 0);
+    EXPECT_EQ(sw & 0x004F, 0x0008) << "Fault, statusword 0x" << std::hex << sw;
+    EXPECT_GT(drive.dev->stats().emergencies, emergencies_before);
+}
+
+TEST_F(DeviceTest, AProvokedFaultSendsAnEmergencyAndIsInTheDiagnosisHistory) {
+    ProcessDataSession pd(m, a, sdo);
+    ASSERT_NO_FATAL_FAILURE(to_op(pd));
+    drive.frame_ns = 1'000'000;
+    const int32_t pos = take<int32_t>(pd.inputs(), in_pos);
+    ASSERT_NO_FATAL_FAILURE(enable(pd, pos));
+    const uint8_t newest_before = static_cast<uint8_t>(sdo_u32(0x10F3, 2) & 0xFF);
+    // STO: both safe-torque-off inputs drop while the power stage runs.
+    drive.dev->set_input(5, false);
+    drive.dev->set_input(6, false);
+    ASSERT_EQ(pd.run(20, std::chrono::microseconds(20),
+                     [&] {
+                         put<uint16_t>(pd.outputs(), out_cw, 0x000F);
+                         put<int8_t>(pd.outputs(), out_mode, 8);
+                         put<int32_t>(pd.outputs(), out_target, pos);
+                     }),
+              Error::Ok);
+    EXPECT_EQ(drive.dict().get<uint16_t>(0x603F, 0), 0x8A88);
+    // The emergency waits in the mailbox; an SDO exchange collects it on the way.
+    MailboxMessage msg;
+    bool found = false;
+    for (int i = 0; i < 10 && !found; ++i) {
+        if (mbx.receive(msg, std::chrono::milliseconds(20)) != Error::Ok) continue;
+        if (msg.type == MailboxType::CoE && msg.payload.size() >= 10 && (msg.payload[1] >> 4) == 1) {
+            const uint16_t code = static_cast<uint16_t>(msg.payload[2] | (msg.payload[3] << 8));
+            found = code == 0x8A88;
+        }
+    }
+    EXPECT_TRUE(found || sdo.last_emergency().code == 0x8A88) << "no emergency 0x8A88";
+    // Diagnosis history: a new message, the newest one with the diag code of the error.
+    const uint8_t newest = static_cast<uint8_t>(sdo_u32(0x10F3, 2) & 0xFF);
+    EXPECT_NE(newest, newest_before);
+    ASSERT_GE(newest, 6);
+    std::array<uint8_t, 64> message{};
+    auto n = sdo.upload(0x10F3, newest, message);
+    ASSERT_TRUE(n.ok());
+    ASSERT_GE(*n, 16u);
+    uint32_t code = 0;
+    // Any message since the fault carries it; the newest is the error itself or a later state message.
+    bool in_history = false;
+    for (uint8_t sub = 6; sub < 6 + od::kDiagMaxMessages; ++sub) {
+        std::array<uint8_t, 64> b{};
+        auto k = sdo.upload(0x10F3, sub, b);
+        if (!k.ok() || *k < 16) continue;
+        code = u32(b.data());
+        if (code == coe::DiagnosisHistory::from_emergency(0x8A88)) {
+            in_history = true;
+            uint64_t ts = 0;
+            std::memcpy(&ts, b.data() + 8, 8);
+            EXPECT_GT(ts, 0u) << "DC system time stamp";
+        }
+    }
+    EXPECT_TRUE(in_history);
+}
+
+TEST_F(DeviceTest, StoredParametersSurviveAPowerCycle) {
+    // 0x6065 following error window: a backup parameter.
+    const uint8_t v[4] = {0x34, 0x12, 0, 0};
+    ASSERT_EQ(sdo.download(0x6065, 0, v), Error::Ok) << std::hex << sdo.last_abort();
+    const uint8_t save[4] = {'s', 'a', 'v', 'e'};
+    ASSERT_EQ(sdo.download(0x1010, 1, save), Error::Ok) << std::hex << sdo.last_abort();
+    // And one more change that is not saved.
+    const uint8_t w[4] = {0x78, 0x56, 0, 0};
+    ASSERT_EQ(sdo.download(0x6065, 0, w), Error::Ok);
+
+    drive.power_on();
+    EXPECT_TRUE(drive.dev->parameter_load().applied);
+    EXPECT_EQ(drive.dict().get<uint32_t>(0x6065, 0), 0x1234u);
+    ASSERT_NO_FATAL_FAILURE(to_preop());
+    EXPECT_EQ(sdo_u32(0x6065, 0), 0x1234u);
+}
+
+TEST_F(DeviceTest, ABadParameterFileIsReportedAndTheDefaultsRun) {
+    const uint32_t def = drive.dict().get<uint32_t>(0x6065, 0);
+    {
+        std::ofstream f(dir / "parameters.bin", std::ios::binary | std::ios::trunc);
+        f << "SECATPRM garbage that is not a parameter set";
+    }
+    drive.power_on();
+    EXPECT_FALSE(drive.dev->parameter_load().applied);
+    EXPECT_NE(drive.log.str().find("not used"), std::string::npos) << drive.log.str();
+    EXPECT_EQ(drive.dict().get<uint32_t>(0x6065, 0), def);
+    ASSERT_NO_FATAL_FAILURE(to_preop());
+}
+
+TEST_F(DeviceTest, BootstrapRestartRebuildsFromTheNewFirmwareImage) {
+    const od::Identity id = drive.dev->description().identity;
+    const uint32_t version = 0x01300002;
+    // A new image lands in the store (as an FoE download in Bootstrap would leave it).
+    const std::vector<uint8_t> payload(300, 0xA5);
+    const auto image = foe::build_image(payload, foe::ImageIdentity::from(id), version);
+    foe::FirmwareStore& store = drive.dev->firmware_store();
+    foe::StoreError e;
+    ASSERT_TRUE(store.begin_write(e)) << e.text;
+    ASSERT_TRUE(store.append(image, e)) << e.text;
+    ASSERT_TRUE(store.finish(e)) << e.text;
+    ASSERT_EQ(store.commit_all(e), foe::FirmwareStore::Progress::Done) << e.text;
+
+    AlStatus st;
+    ASSERT_EQ(m.request_state(a, AlState::Init, &st), Error::Ok);
+    Mailbox boot(m, a);
+    ASSERT_EQ(boot.configure_from_sii(true), Error::Ok);
+    ASSERT_EQ(m.request_state(a, AlState::Boot, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(m.request_state(a, AlState::Init, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
+    EXPECT_EQ(drive.dev->stats().builds, 2u);
+    EXPECT_EQ(drive.dev->description().identity.revision, version);
+    // The SII the ESC serves now carries the new revision, and so does 0x1018:03 / 0x100A.
+    EXPECT_EQ(m.sii_read_u32(a, sii::Revision).value(), version);
+    ASSERT_NO_FATAL_FAILURE(to_preop());
+    EXPECT_EQ(sdo_u32(0x1018, 3), version);
+    std::array<uint8_t, 32> sw{};
+    auto n = sdo.upload(0x100A, 0, sw);
+    ASSERT_TRUE(n.ok());
+    EXPECT_EQ(std::string(sw.begin(), sw.begin() + static_cast<long>(*n)),
+              foe::software_version_text(version));
+}
+
+TEST_F(DeviceTest, DriveRunsOnItsOwnOutsideOp) {
+    // In Pre-Op, without any process data, the drive's loop still runs (statusword valid, time passes).
+    const uint64_t cycles = drive.dev->stats().cycles;
+    drive.idle(100'000'000);
+    EXPECT_GE(drive.dev->stats().cycles, cycles + 9);
+    EXPECT_EQ(drive.dict().get<uint16_t>(0x6041, 0) & 0x004F, 0x0040) << "switch on disabled";
+}
+
+TEST(DeviceEnvironment, InputsAndSwitchesReachTheDriveAndSurviveARestart) {
+    const auto dir = temp_dir();
+    Drive d(dir);
+    softdrive::EnvironmentOptions env;
+    env.negative_limit = -1000;
+    env.positive_limit = 1000;
+    d.dev->set_environment(env);
+    EXPECT_TRUE(d.dev->set_input(4, true));
+    EXPECT_FALSE(d.dev->set_input(0, true));
+    EXPECT_FALSE(d.dev->set_input(7, true));
+    d.idle(20'000'000);
+    // 0x60FD digital inputs: the drive reads the pins; 0x3141:01 shows the physical levels (bit 3 = DigIN4).
+    const od::Entry* e = d.dict().find(0x3141, 1);
+    ASSERT_NE(e, nullptr);
+    EXPECT_NE(d.dict().get<uint16_t>(0x3141, 1) & 0x0008, 0);
+    std::filesystem::remove_all(dir);
+}
