@@ -59,6 +59,16 @@ class Registers(unittest.TestCase):
             r = self.reg(*args, check=False)
             self.assertEqual(r.returncode, 2, f"{args}: {r.stdout} {r.stderr}")
 
+    def test_device_identification_gives_the_alias_from_the_sii(self):
+        image, _ = harness.build_sii(alias=0x4242)
+        with harness.Bus(eeprom=image) as bus:
+            r = bus.ecatctl("state", "0", "--identify", check=False)
+            if r.returncode == 6 and "not reached in time" in r.stderr:
+                self.skipTest("ecat-slave runs without firmware")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertEqual(r.stdout.strip(), "identification value 0x4242 (16962)")
+            self.assertEqual(bus.ecatctl("state", "0").stdout.strip(), "INIT")
+
     def test_absent_position_has_no_answer(self):
         r = self.reg("read", "1", "0x0000", "1", check=False)
         self.assertEqual(r.returncode, 6, r.stderr)

@@ -339,6 +339,18 @@ TEST_P(WithSlave, ReceiveOnAnEmptyMailboxTimesOut) {
               Error::InvalidArgument);
 }
 
+TEST_P(WithSlave, DeviceIdentificationReturnsTheStationAlias) {
+    slave.esc->write_reg<uint16_t>(0x0012, 0x4242);  // as the SII alias word would have loaded it
+    auto id = m.identify(a);
+    ASSERT_TRUE(id.ok()) << to_string(id.error());
+    EXPECT_EQ(*id, 0x4242);
+    auto st = m.al_status(a);
+    ASSERT_TRUE(st.ok());
+    EXPECT_FALSE(st->id_loaded);  // request withdrawn
+    EXPECT_EQ(st->state, 0x02);
+    EXPECT_EQ(st->code, 0x0000);
+}
+
 INSTANTIATE_TEST_SUITE_P(MailboxSizes, WithSlave, ::testing::Values(uint16_t{128}, uint16_t{32}));
 
 TEST(ProcessDataDc, Sync0RunsAndTheSlaveReachesOpInDcMode) {

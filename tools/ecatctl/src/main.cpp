@@ -293,9 +293,16 @@ int sii_write(master::Master& m, const SiiArgs& s) {
     return kExitOk;
 }
 
-int state(master::Master& m, const std::string& slave, bool station, const std::string& target) {
+int state(master::Master& m, const std::string& slave, bool station, const std::string& target,
+          bool identify) {
     auto a = parse_slave(slave, station);
     if (!a) return usage("bad slave '" + slave + "'");
+    if (identify) {
+        auto id = m.identify(*a);
+        if (!id) return fail(id.error(), "device identification of " + slave_text(*a));
+        std::printf("identification value 0x%04x (%u)\n", *id, *id);
+        return kExitOk;
+    }
     if (target.empty()) {
         auto st = m.al_status(*a);
         if (!st) return fail(st.error(), "reading the AL status of " + slave_text(*a));
@@ -838,13 +845,15 @@ int main(int argc, char** argv) {
 #endif
 
     std::string st_slave, st_target;
-    bool st_station = false;
+    bool st_station = false, st_identify = false;
     auto* st = app.add_subcommand("state", "Show the AL state, or request one (with the error acknowledge)");
     st->add_option("slave", st_slave, "Slave position (or station address with --station)")->required();
     st->add_option("state", st_target, "INIT|PREOP|BOOT|SAFEOP|OP (omit to show the current state)");
     st->add_flag("-s,--station", st_station, "<slave> is a station address");
+    st->add_flag("--identify", st_identify, "Device identification: AL control bit 5, value from 0x0134");
     st->callback([&] {
-        rc = with_master(g, [&](master::Master& m) { return state(m, st_slave, st_station, st_target); });
+        rc = with_master(
+            g, [&](master::Master& m) { return state(m, st_slave, st_station, st_target, st_identify); });
     });
 
     SdoArgs so;

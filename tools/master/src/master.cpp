@@ -421,6 +421,28 @@ Error Master::request_state(Address a, AlState state, AlStatus* final) {
     }
 }
 
+Result<uint16_t> Master::identify(Address a) {
+    const auto deadline = Clock::now() + options_.al_timeout;
+    auto st = al_status(a);
+    if (!st) return st.error();
+    if (st->error) return Error::AlRefused;
+    if (Error e = write_al_control(*this, a, static_cast<uint16_t>(st->state | kAlIdentify), deadline);
+        e != Error::Ok)
+        return e;
+    for (;;) {
+        auto now = al_status(a);
+        if (!now) return now.error();
+        if (now->error) return Error::AlRefused;
+        if (now->id_loaded) {
+            const uint16_t value = now->code;
+            (void)write_al_control(*this, a, st->state, deadline);  // request off again
+            return value;
+        }
+        if (Clock::now() >= deadline) return Error::AlTimeout;
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+}
+
 Error Master::request_state_all(AlState state, std::span<const uint16_t> stations) {
     const uint8_t v[2] = {static_cast<uint8_t>(state), 0};
     auto w = broadcast_write(reg::AlControl, v);

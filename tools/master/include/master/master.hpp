@@ -173,6 +173,10 @@ class Master {
     // is acknowledged (AL control = actual state | 0x10) and Error::AlRefused is returned; `final`
     // then holds the refused status with its AL status code.
     Error request_state(Address a, AlState state, AlStatus* final = nullptr);
+    // Device identification (§6.2): AL control bit 5 set with the current state; once AL status bit 5
+    // says the value is loaded, 0x0134 holds it (the station alias or ID selector). The request bit is
+    // cleared again afterwards. Error::AlRefused if an error indication is pending.
+    Result<uint16_t> identify(Address a);
     // Same on every slave at once (BWR 0x0120), then each of the given station addresses is polled.
     Error request_state_all(AlState state, std::span<const uint16_t> stations);
 

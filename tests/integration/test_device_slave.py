@@ -1,0 +1,193 @@
+"""The real ecat-slave as the composed soft drive (softdrive) against the real ecatctl: the MAXPOS identity
+from the model's SII, OP with the default mapping, SDO uploads, --write-sii / --write-esi, the configuration
+file (identity and program options in one file), the control socket, parameters stored across a restart."""
+import os
+import re
+import shutil
+import socket
+import subprocess
+import tempfile
+import time
+import unittest
+
+import harness
+
+ROW = re.compile(r"^(\d+)\s+0x([0-9a-f]{4})\s+(\S+)\s+0x([0-9a-f]{8}) 0x([0-9a-f]{8}) 0x([0-9a-f]{8}) 0x([0-9a-f]{8})(?: +(\S.*))?$",
+                 re.M)
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCHEMA = os.path.normpath(os.path.join(HERE, "..", "..", "..", "shared", "esi-schema", "EtherCATInfo.xsd"))
+
+
+def out_dir():
+    return os.environ.get("ECAT_TEST_OUT") or None
+
+
+class DeviceOnTheWire(unittest.TestCase):
+    def test_scan_shows_the_maxpos_identity(self):
+        with harness.Bus() as bus:
+            r = bus.ecatctl("scan")
+            rows = ROW.findall(r.stdout)
+            self.assertEqual(len(rows), 1, r.stdout)
+            _pos, _station, state, vendor, product, revision, _serial, name = rows[0]
+            self.assertEqual(state, "INIT")
+            self.assertEqual(int(vendor, 16), 0x000000FB)
+            self.assertEqual(int(product, 16), 0x30010000)
+            self.assertEqual(int(revision, 16), 0x01200000)
+            self.assertIn(name, ("", "MAXPOS"))  # newer ecatctl prints the SII device name
+            self.assertNotIn("no EEPROM image", bus.slave_output())
+
+    def test_sdo_uploads_of_the_identity(self):
+        with harness.Bus() as bus:
+            self.assertEqual(bus.ecatctl("upload", "0", "0x1018", "1").stdout.strip(), "0x000000fb (251)")
+            self.assertEqual(bus.ecatctl("upload", "0", "0x1018", "2").stdout.strip(), "0x30010000 (805371904)")
+            self.assertEqual(bus.ecatctl("upload", "0", "0x1008", "0", "--type", "string").stdout.strip(), "MAXPOS")
+            self.assertEqual(bus.ecatctl("upload", "0", "0x100a", "0", "--type", "string").stdout.strip(), "0120h")
+
+    def test_state_op_with_the_default_mapping(self):
+        with harness.Bus() as bus:
+            r = bus.ecatctl("pd", "0", "-n", "300", "--cycle-us", "1000")
+            self.assertIn("state: OP\n", r.stdout)
+            self.assertIn("outputs: SM2 0x1100, 23 bytes; inputs: SM3 0x1300, 27 bytes", r.stdout)
+            self.assertRegex(r.stdout, r"cycles 300, lost 0, wkc errors 0 \(expected wkc 3\)")
+            # Statusword (first input word) of a drive that is powered but not enabled: switch on disabled.
+            m = re.search(r"0x0000: ([0-9a-f]{2}) ([0-9a-f]{2})", r.stdout)
+            self.assertIsNotNone(m, r.stdout)
+            sw = int(m.group(1), 16) | int(m.group(2), 16) << 8
+            self.assertEqual(sw & 0x4F, 0x40, r.stdout)
+            self.assertEqual(bus.ecatctl("state", "0").stdout.strip(), "PREOP")
+
+    def test_sii_on_the_wire_is_the_one_write_sii_writes(self):
+        d = tempfile.mkdtemp(dir=out_dir())
+        self.addCleanup(shutil.rmtree, d, True)
+        path = os.path.join(d, "sii.bin")
+        with harness.Bus() as bus:
+            r = subprocess.run([bus.slave_bin, "--write-sii", path, "--state-dir", os.path.join(bus.dir, "state")],
+                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=30)
+            self.assertEqual(r.returncode, 0, r.stdout)
+            r = bus.ecatctl("sii", "read", "-o", os.path.join(d, "read.bin"))
+            with open(path, "rb") as f:
+                written = f.read()
+            with open(os.path.join(d, "read.bin"), "rb") as f:
+                read = f.read()
+            self.assertGreater(len(read), 64 * 2)
+            self.assertEqual(written[:len(read)], read)
+
+
+class OfflineOutputs(unittest.TestCase):
+    """--write-sii / --write-esi need no network and no root."""
+
+    def setUp(self):
+        self.slave = harness.env_path("ECAT_SLAVE")
+        self.ecatctl = harness.env_path("ECATCTL")
+        self.dir = tempfile.mkdtemp(dir=out_dir())
+        self.addCleanup(shutil.rmtree, self.dir, True)
+
+    def run_slave(self, *args):
+        return subprocess.run([self.slave, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                              timeout=60)
+
+    def test_write_esi_validates_against_the_schema(self):
+        if not shutil.which("xmllint") or not os.path.exists(SCHEMA):
+            self.skipTest("xmllint or the ESI schema missing")
+        esi = os.path.join(self.dir, "device.xml")
+        r = self.run_slave("--write-esi", esi, "--state-dir", os.path.join(self.dir, "state"))
+        self.assertEqual(r.returncode, 0, r.stderr)
+        v = subprocess.run(["xmllint", "--noout", "--schema", SCHEMA, esi], stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, text=True, timeout=120)
+        self.assertEqual(v.returncode, 0, v.stdout[-2000:])
+        with open(esi) as f:
+            text = f.read()
+        self.assertIn('ProductCode="#x30010000" RevisionNo="#x01200000"', text)
+
+    def test_write_sii_decodes(self):
+        sii = os.path.join(self.dir, "device.sii")
+        r = self.run_slave("--write-sii", sii, "--state-dir", os.path.join(self.dir, "state"))
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(os.path.getsize(sii), 2048)
+        d = subprocess.run([self.ecatctl, "sii", "decode", sii], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           text=True, timeout=30)
+        self.assertEqual(d.returncode, 0, d.stderr)
+        self.assertIn("vendor 0x000000FB, product 0x30010000, revision 0x01200000", d.stdout)
+        self.assertIn("checksum 0x", d.stdout)
+        self.assertIn(": ok", d.stdout)
+        self.assertIn("mailbox protocols 0x000C (CoE FoE)", d.stdout)
+        self.assertNotIn("problem", d.stdout.lower())
+
+    def test_configuration_file_carries_identity_and_program_options(self):
+        conf = os.path.join(self.dir, "drive.conf")
+        state = os.path.join(self.dir, "from-config")
+        with open(conf, "w") as f:
+            f.write(f"state-dir = {state}\nwrite-sii = {self.dir}/c.sii\n\n"
+                    "[identity]\nserial_number = 0x00C0FFEE\ndevice_name = \"MAXPOS-X\"\n")
+        r = self.run_slave("--config", conf)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        d = subprocess.run([self.ecatctl, "sii", "decode", os.path.join(self.dir, "c.sii")], stdout=subprocess.PIPE,
+                           text=True, timeout=30)
+        self.assertIn("serial 0x00C0FFEE", d.stdout)
+        self.assertIn('"MAXPOS-X"', d.stdout)
+
+    def test_configuration_errors_are_usage_errors(self):
+        conf = os.path.join(self.dir, "bad.conf")
+        with open(conf, "w") as f:
+            f.write("[identity]\nvendor_idd = 1\n")
+        r = self.run_slave("--config", conf, "--write-sii", os.path.join(self.dir, "x.sii"))
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("bad.conf:2", r.stderr)
+        with open(conf, "w") as f:
+            f.write("no-such-option = 1\n")
+        r = self.run_slave("--config", conf, "--write-sii", os.path.join(self.dir, "x.sii"))
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("no-such-option", r.stderr)
+
+
+class RunTime(unittest.TestCase):
+    def test_control_socket_toggles_a_digital_input(self):
+        d = tempfile.mkdtemp(dir=out_dir())
+        self.addCleanup(shutil.rmtree, d, True)
+        path = os.path.join(d, "ctl.sock")
+        me = os.path.join(d, "me.sock")
+        with harness.Bus(slave_args=["--control", path]) as bus:
+            before = int(bus.ecatctl("upload", "0", "0x3141", "1", "--type", "u16").stdout.split()[0], 16)
+            self.assertEqual(before & 0x08, 0)
+            s = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+            self.addCleanup(s.close)
+            s.bind(me)
+            s.settimeout(5)
+            # The socket lives in the slave's mount namespace = ours (ip netns exec keeps /tmp).
+            s.sendto(b"input 4 on\n", path)
+            self.assertEqual(s.recv(256), b"ok input 4 on\n")
+            time.sleep(0.1)  # the drive runs every 10 ms outside Op
+            after = int(bus.ecatctl("upload", "0", "0x3141", "1", "--type", "u16").stdout.split()[0], 16)
+            self.assertEqual(after & 0x08, 0x08)
+            s.sendto(b"status\n", path)
+            self.assertTrue(s.recv(256).startswith(b"ok state PREOP statusword 0x"))
+            s.sendto(b"input 9 on\n", path)
+            self.assertTrue(s.recv(256).startswith(b"error: "))
+            self.assertTrue(bus.slave_alive())
+
+    def test_stored_parameters_survive_a_restart_of_the_program(self):
+        d = tempfile.mkdtemp(dir=out_dir())
+        self.addCleanup(shutil.rmtree, d, True)
+        state = os.path.join(d, "state")
+        with harness.Bus(slave_args=["--state-dir", state]) as bus:
+            bus.ecatctl("download", "0", "0x6065", "0", "0x4321", "--type", "u32")
+            bus.ecatctl("download", "0", "0x1010", "1", "save", "--type", "string")
+        self.assertTrue(os.path.exists(os.path.join(state, "parameters.bin")))
+        with harness.Bus(slave_args=["--state-dir", state]) as bus:
+            r = bus.ecatctl("upload", "0", "0x6065", "0", "--type", "u32")
+            self.assertEqual(r.stdout.strip(), "0x00004321 (17185)")
+        # A damaged file: reported, defaults used, the slave still runs.
+        with open(os.path.join(state, "parameters.bin"), "r+b") as f:
+            f.seek(50)
+            f.write(b"\xde\xad")
+        with harness.Bus(slave_args=["--state-dir", state]) as bus:
+            r = bus.ecatctl("upload", "0", "0x6065", "0", "--type", "u32")
+            self.assertNotEqual(r.stdout.strip(), "0x00004321 (17185)")
+            self.assertIn("not used", bus.slave_output())
+
+
+if __name__ == "__main__":
+    if os.geteuid() != 0:
+        print("integration tests need root (network namespaces, veth pairs)")
+        raise SystemExit(harness.SKIP)
+    unittest.main()
