@@ -46,6 +46,18 @@ class Scan(unittest.TestCase):
             self.assertEqual(int(product, 16), 0x30010000)  # MAXPOS 50/5 (seed 001 §7.2.4.3)
             self.assertRegex(state, r"^(INIT|PREOP|SAFEOP|OP|BOOT)")
 
+    def test_both_link_backends_on_the_master_side(self):
+        image, _ = harness.build_sii(serial=0x77)
+        with harness.Bus(eeprom=image) as bus:
+            for backend in ("pcap", "packet"):
+                r = bus.ecatctl("--backend", backend, "scan")
+                rows = ROW.findall(r.stdout)
+                self.assertEqual(len(rows), 1, f"{backend}: {r.stdout}")
+                self.assertEqual(int(rows[0][6], 16), 0x77)
+                r = bus.ecatctl("--backend", backend, "sii", "read", "-o", bus.dir + f"/{backend}.bin")
+            with open(bus.dir + "/pcap.bin", "rb") as a, open(bus.dir + "/packet.bin", "rb") as b:
+                self.assertEqual(a.read(), b.read())
+
     def test_scan_twice_gives_the_same_answer(self):
         image, _ = harness.build_sii(serial=7)
         with harness.Bus(eeprom=image) as bus:
