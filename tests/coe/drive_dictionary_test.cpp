@@ -1,12 +1,16 @@
 // The CoE server on od's real drive dictionary (seed 001 chapter 7).
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+#include <filesystem>
+
 #include "coe/diagnosis.hpp"
 #include "coe/pdo_validation.hpp"
 #include "coe/sdo_info.hpp"
 #include "coe/sdo_server.hpp"
 #include "coe_test_support.hpp"
 #include "od/drive_profile.hpp"
+#include "od/store.hpp"
 
 using namespace coe_test;
 
@@ -141,6 +145,18 @@ TEST_F(DriveDictionary, DiagnosisHistoryOnTheDriveObject) {
     EXPECT_EQ(le32(r, 10), 0x8611E800u);
     EXPECT_EQ(ask(sdo(0x2F, 0x10F3, 3, 0)), (Bytes{0x00, 0x30, 0x60, 0xF3, 0x10, 0x03, 0, 0, 0, 0}));
     EXPECT_EQ(diag.stored(), 0u);
+}
+
+TEST_F(DriveDictionary, StoreWithAWrongSignatureIs08000020) {
+    const auto dir =
+        std::filesystem::temp_directory_path() / ("coe_test_store_" + std::to_string(::getpid()));
+    od::ParameterStore store(dir);
+    od::attach_store(dict, store, {});
+    EXPECT_EQ(ask(sdo(0x23, 0x1010, 1, 0x12345678)), abort_reply(0x1010, 1, 0x08000020));
+    EXPECT_EQ(ask(sdo(0x23, 0x1010, 1, od::kSignatureSave)),
+              (Bytes{0x00, 0x30, 0x60, 0x10, 0x10, 0x01, 0, 0, 0, 0}));
+    EXPECT_TRUE(std::filesystem::exists(store.file()));
+    std::filesystem::remove_all(dir);
 }
 
 TEST_F(DriveDictionary, EmergencyUpdatesTheErrorRegister) {
