@@ -352,6 +352,25 @@ TEST_F(SdoServer, CompleteAccessDownloadOfAWholePdoMappingAsTwinCatDoes) {
     EXPECT_EQ(coe::mapped_bits(dict, 0x1600), 56u);
 }
 
+TEST_F(SdoServer, SegmentedCompleteAccessDownload) {
+    coe::install_pdo_validators(dict);
+    // 0x1600 whole: SI0 = 4 + four entries = 18 bytes, sent as 6 + 7 + 5.
+    Bytes img{0x04, 0x00, 0x10, 0x00, 0x40, 0x60, 0x20, 0x00, 0x7A,
+              0x60, 0x08, 0x00, 0x60, 0x60, 0x08, 0x00, 0x00, 0x00};
+    Bytes req = sdo(0x31, 0x1600, 0, 18);
+    req.insert(req.end(), img.begin(), img.begin() + 6);
+    EXPECT_EQ(ask(req), (Bytes{0x00, 0x30, 0x70, 0x00, 0x16, 0x00, 0, 0, 0, 0}));
+    EXPECT_EQ(ask(segment(0x00, Bytes(img.begin() + 6, img.begin() + 13))),
+              (Bytes{0x00, 0x30, 0x20, 0, 0, 0, 0, 0, 0, 0}));
+    Bytes last(img.begin() + 13, img.end());
+    last.resize(7, 0);
+    EXPECT_EQ(ask(segment(0x15, last)), (Bytes{0x00, 0x30, 0x30, 0, 0, 0, 0, 0, 0, 0}));
+    EXPECT_EQ(dict.get<uint8_t>(0x1600, 0), 4);
+    EXPECT_EQ(dict.get<uint32_t>(0x1600, 3), 0x60600008u);
+    EXPECT_EQ(dict.get<uint32_t>(0x1600, 4), 0x00000008u);  // an 8-bit gap
+    EXPECT_EQ(coe::mapped_bits(dict, 0x1600), 64u);
+}
+
 TEST_F(SdoServer, FailedCompleteAccessDownloadLeavesTheObjectAsItWas) {
     coe::install_pdo_validators(dict);
     // Entry 2 maps a TxPDO object into an RxPDO: refused, entry 1 and SI0 restored.
