@@ -54,6 +54,30 @@ double Axis::decel_limit(double rpm_s) const {
     return rpm_to_inc_s(a);
 }
 
+// ---- position range limit 0x607B (modulo axis) ----------------------------------------------------------
+
+bool Axis::range_on() const {
+    return params.range_min != std::numeric_limits<int32_t>::min() && params.range_max > params.range_min;
+}
+
+int32_t Axis::report(int64_t v) const {
+    if (!range_on()) return wrap32(v);
+    const int64_t span = static_cast<int64_t>(params.range_max) - params.range_min + 1;
+    int64_t m = (v - params.range_min) % span;
+    if (m < 0) m += span;
+    return static_cast<int32_t>(params.range_min + m);
+}
+
+double Axis::unwrap(int32_t target, double near_raw) const {
+    // The target inside the range, taken the short way from where the axis is (raw increments).
+    const double span = static_cast<double>(params.range_max) - params.range_min + 1.0;
+    const double here = std::round(near_raw + static_cast<double>(shift_));
+    const double here_wrapped = static_cast<double>(report(static_cast<int64_t>(here)));
+    double d = static_cast<double>(target) - here_wrapped;
+    d -= span * std::round(d / span);
+    return here + d - static_cast<double>(shift_);
+}
+
 // ---- configuration ------------------------------------------------------------------------------------
 
 void Axis::derive() {
@@ -361,9 +385,10 @@ void Axis::mode_commands(int64_t now_ns, int64_t dt_ns) {
                 const bool rel = c & cw::Relative;
                 const bool immediate = c & cw::ChangeImmediately;
                 if (immediate || !ppm_moving_) {
-                    double t =
-                        rel ? demand_pos_ + command.target_position
-                            : static_cast<double>(command.target_position) - static_cast<double>(shift_);
+                    double t = rel          ? demand_pos_ + command.target_position
+                               : range_on() ? unwrap(command.target_position, demand_pos_)
+                                            : static_cast<double>(command.target_position) -
+                                                  static_cast<double>(shift_);
                     // Software position limits act on the demand: clamp the target (internal limit bit).
                     const double lo = params.sw_limit_min == std::numeric_limits<int32_t>::min()
                                           ? -INFINITY
@@ -410,7 +435,8 @@ void Axis::mode_commands(int64_t now_ns, int64_t dt_ns) {
             // New target each cycle, interpolated linearly over the interpolation period (= this cycle when
             // 0x60C2 is set, as MAXPOS sets it to the SYNC0 cycle; 0 = no interpolation).
             const int64_t tgt = static_cast<int64_t>(command.target_position) + command.position_offset;
-            const double t_raw = static_cast<double>(tgt - shift_);
+            const double t_raw =
+                range_on() ? unwrap(static_cast<int32_t>(tgt), ip_to_) : static_cast<double>(tgt - shift_);
             const double now_val =
                 ip_period_ > 0
                     ? ip_from_ + (ip_to_ - ip_from_) *
@@ -503,6 +529,7 @@ void Axis::trajectory_tick(int64_t t_ns) {
                     if (ppm_buffered_) {
                         ppm_buffered_ = false;
                         const double t = ppm_next_rel_ ? profile_.position() + ppm_next_raw_
+                                         : range_on()  ? unwrap(ppm_next_raw_, profile_.position())
                                                        : static_cast<double>(ppm_next_raw_) - shift_;
                         const double lo = params.sw_limit_min == std::numeric_limits<int32_t>::min()
                                               ? -INFINITY
@@ -700,7 +727,7 @@ void Axis::tp_latch(bool rising, double raw_pos) {
     const uint16_t fn = command.touch_probe_function;
     if (!(fn & 0x1) || mode_ == mode::Homing) return;  // TP and homing are mutually exclusive [001 §4.5]
     const bool continuous = fn & 0x2;
-    const int32_t value = wrap32(static_cast<int64_t>(std::floor(raw_pos)) + shift_);
+    const int32_t value = report(static_cast<int64_t>(std::floor(raw_pos)) + shift_);
     if (rising && (fn & 0x10)) {
         if (continuous || !(tp_status_ & 0x2)) {
             tp_pos_ = value;
@@ -920,8 +947,8 @@ void Axis::update_feedback() {
     if (state_ == State::QuickStopActive && ramp_done_) s |= sw::TargetReached;
     f.statusword = s;
     f.mode_display = mode_;
-    f.position_actual = wrap32(count_ + shift_);
-    f.position_demand = wrap32(static_cast<int64_t>(std::llround(demand_pos_)) + shift_);
+    f.position_actual = report(count_ + shift_);
+    f.position_demand = report(static_cast<int64_t>(std::llround(demand_pos_)) + shift_);
     f.following_error = clamp_i32(std::round(demand_pos_ - static_cast<double>(count_)));
     const double vd = control_ == Control::Velocity ? vel_ref_ * 60.0 / kTwoPi : demand_vel_ * 60.0 / res_;
     f.velocity_demand = clamp_i32(std::round(vd));
@@ -936,7 +963,7 @@ void Axis::update_feedback() {
         static_cast<uint32_t>(static_cast<uint64_t>(params.nominal_current) * params.torque_constant / 1000u);
     f.digital_inputs = static_cast<uint32_t>(func_ & 0x033F0007ull);
     f.input_logic_state = pins_;
-    f.index_position = wrap32(index_count_ + shift_);
+    f.index_position = report(index_count_ + shift_);
     f.touch_probe_status = tp_status_;
     f.touch_probe_pos = tp_pos_;
     f.touch_probe_neg = tp_neg_;

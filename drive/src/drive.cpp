@@ -104,6 +104,8 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink) : dict_(dictionary), a
     in(0x6066, 0, p.following_error_timeout);
     in(0x607D, 1, p.sw_limit_min);
     in(0x607D, 2, p.sw_limit_max);
+    in(0x607B, 1, p.range_min);
+    in(0x607B, 2, p.range_max);
     in(0x607F, 0, p.max_profile_velocity);
     in(0x6080, 0, p.max_motor_speed);
     in(0x6081, 0, p.profile_velocity);

@@ -409,3 +409,66 @@ TEST(Modes, PpmHaltStopsWithQuickStopDecelerationAndResumes) {
     ASSERT_TRUE(r.until([&] { return (r.sw() & sw::TargetReached) != 0; }, 3000));
     EXPECT_EQ(r.fb().position_demand, start + 30000);
 }
+
+TEST(Modes, PositionRangeLimitWrapsTheReportedPosition) {
+    Rig r;
+    r.ax.params.range_min = 0;
+    r.ax.params.range_max = 3999;
+    r.ax.command.mode = mode::CyclicSyncVelocity;
+    r.enable();
+    r.ax.command.target_velocity = 600;  // 20 inc/ms
+    bool wrapped = false;
+    int32_t prev = r.fb().position_actual;
+    for (int k = 0; k < 600; ++k) {
+        r.run(1);
+        const int32_t p = r.fb().position_actual;
+        ASSERT_GE(p, 0);
+        ASSERT_LE(p, 3999);
+        wrapped = wrapped || p < prev - 2000;
+        prev = p;
+    }
+    EXPECT_TRUE(wrapped);
+}
+
+TEST(Modes, CspTargetsAcrossTheRangeEndMoveTheShortWay) {
+    Rig r;
+    r.ax.params.range_min = 0;
+    r.ax.params.range_max = 3999;
+    r.enable();
+    double p = r.fb().position_actual;  // continuous master position
+    const double p0 = p;
+    const double start_raw = r.ax.raw_position_inc();
+    for (int k = 0; k < 800; ++k) {
+        p += 10.0 * std::min(1.0, k / 50.0);  // 10 inc/ms = 300 rpm
+        r.ax.command.target_position = static_cast<int32_t>(std::llround(p)) % 4000;
+        r.ax.command.velocity_offset = static_cast<int32_t>(300 * std::min(1.0, k / 50.0));
+        r.run(1);
+        ASSERT_LT(std::abs(r.fb().following_error), 100) << k;
+    }
+    EXPECT_NEAR(r.ax.raw_position_inc() - start_raw, p - p0, 60);  // followed 1:1, no jump back
+    EXPECT_GT(r.ax.raw_position_inc() - start_raw, 7000);          // went forward through two wraps
+    EXPECT_FALSE(r.rec.has(error_code::FollowingError));
+}
+
+TEST(Modes, PpmAbsoluteTargetInARangeTakesTheShortWay) {
+    Rig r;
+    r.ax.params.range_min = 0;
+    r.ax.params.range_max = 3999;
+    r.ax.params.home_position = 3900;
+    r.ax.params.homing_method = 37;
+    r.ax.command.mode = mode::Homing;
+    r.cw(0x06);
+    r.cw(0x07);
+    r.cw(0x17);  // method 37 while disabled: here is 3900
+    ASSERT_EQ(r.fb().position_actual, 3900);
+    r.ax.command.mode = mode::ProfilePosition;
+    r.enable();
+    const double raw0 = r.ax.raw_position_inc();
+    r.ax.command.target_position = 100;
+    r.cw(0x1F);
+    r.cw(0x0F);
+    ASSERT_TRUE(r.until([&] { return (r.sw() & sw::TargetReached) != 0; }, 3000));
+    r.run_ms(100);
+    EXPECT_NEAR(r.ax.raw_position_inc() - raw0, 200, 6);  // +200, not -3800
+    EXPECT_NEAR(r.fb().position_actual, 100, 5);
+}

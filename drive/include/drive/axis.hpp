@@ -58,6 +58,8 @@ struct Parameters {
     uint16_t following_error_timeout = 0;                        // 0x6066 ms
     int32_t sw_limit_min = std::numeric_limits<int32_t>::min();  // 0x607D:01
     int32_t sw_limit_max = std::numeric_limits<int32_t>::max();  // 0x607D:02
+    int32_t range_min = std::numeric_limits<int32_t>::min();     // 0x607B:01 (-2^31 = off)
+    int32_t range_max = std::numeric_limits<int32_t>::max();     // 0x607B:02
     uint32_t max_profile_velocity = 200000;                      // 0x607F rpm
     uint32_t max_motor_speed = 200000;                           // 0x6080 rpm
     uint32_t profile_velocity = 1000;                            // 0x6081 rpm
@@ -210,6 +212,9 @@ class Axis {
     void update_feedback();
     uint64_t functions(uint16_t pins) const;
     int32_t clamp_i32(double v) const;
+    bool range_on() const;
+    int32_t report(int64_t v) const;                           // a position as the dictionary shows it
+    double unwrap(int32_t target, double near_raw) const;      // modulo target -> raw increments
     double i_meas() const { return pol_ * plant_.current(); }  // current in the axis' direction
     double rpm_to_inc_s(double rpm) const { return rpm * res_ / 60.0; }
     double inc_to_rad(double inc) const { return inc * 6.283185307179586 / res_; }
