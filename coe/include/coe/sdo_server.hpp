@@ -6,6 +6,12 @@
 // answer goes out through the MailboxSender; what the sender cannot take right now (queue full, SDO info
 // fragments, emergencies) waits and is sent from poll(). Nothing on the request path allocates once the
 // server is built (buffers are sized from the dictionary at construction).
+//
+// Wiring, as the runtime does it (the dictionary first in its final place, since hooks keep pointers to it):
+//   coe::install_pdo_validators(dict);                          // 0x16xx/0x1Axx/0x1C12/0x1C13 checks
+//   coe::CoeServer coe(dict, [&] { return stack.state(); });    // stack.add_handler(coe)
+//   coe::DiagnosisHistory diag(dict, &coe.emergency());        // 0x10F3
+//   coe::EventReporter events(coe.emergency(), &diag, dc_time); // behind the drive's EventSink
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -19,8 +25,7 @@
 namespace coe {
 
 struct CoeConfig {
-    // A segmented transfer (or a fragmented SDO info answer) the master leaves alone this long is dropped
-    // and answered with abort 0x05040000.
+    // A segmented transfer the master leaves alone this long is dropped and answered with abort 0x05040000.
     uint64_t transfer_timeout_ns = 2'000'000'000;
     std::size_t emergency_queue = 8;
 };
