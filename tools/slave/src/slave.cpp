@@ -40,6 +40,22 @@ bool write_file(const std::string& path, std::span<const uint8_t> data) {
     return static_cast<bool>(out);
 }
 
+// The runtime's, the ESC's and the firmware's figures as "name value" lines.
+void write_stats(std::ostream& out, const RuntimeStats& s, const esc::EscStats& e, const Firmware* firmware) {
+    out << "runtime.frames_received " << s.frames_received << '\n'
+        << "runtime.frames_sent " << s.frames_sent << '\n'
+        << "runtime.frames_dropped " << s.frames_dropped << '\n'
+        << "runtime.send_errors " << s.send_errors << '\n'
+        << "runtime.link_errors " << s.link_errors << '\n'
+        << "runtime.wakeups " << s.wakeups << '\n'
+        << "runtime.timer_expiries " << s.timer_expiries << '\n'
+        << "runtime.frame_ns_mean " << (s.frames_received ? s.frame_ns_total / s.frames_received : 0) << '\n'
+        << "runtime.frame_ns_max " << s.frame_ns_max << '\n'
+        << "esc.frames_processed " << e.frames_processed << '\n'
+        << "esc.frames_malformed " << e.frames_malformed << '\n';
+    if (firmware != nullptr) firmware->report(out);
+}
+
 // Real-time setup. Returns an error message, empty on success.
 std::string apply_scheduling(const SlaveOptions& options) {
     if (options.cpu >= CPU_SETSIZE) return "CPU " + std::to_string(options.cpu) + " does not exist";
@@ -144,6 +160,12 @@ int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err)
                 << ", timer arms " << s.timer_arms << ", expiries " << s.timer_expiries << "; ESC: processed "
                 << e.frames_processed << ", ignored " << e.frames_ignored << ", malformed "
                 << e.frames_malformed << ", datagrams " << e.datagrams << '\n';
+            if (firmware) firmware->report(out);
+        }
+        if (!options.stats_file.empty()) {
+            std::ofstream stats(options.stats_file, std::ios::trunc);
+            write_stats(stats, runtime.stats(), esc.stats(), firmware.get());
+            if (!stats.flush()) err << "ecat-slave: warning: could not write " << options.stats_file << '\n';
         }
         out << "ecat-slave: stopped\n";
         return kExitOk;

@@ -4,6 +4,7 @@
 // replies went out, so it never delays a frame) and whenever its deadline passes.
 // Time base: the runtime's clock, CLOCK_MONOTONIC nanoseconds, the same as the ESC's local time.
 #include <cstdint>
+#include <iosfwd>
 #include <limits>
 
 namespace softslave {
@@ -20,6 +21,9 @@ class Firmware {
     virtual int control_fd() const { return -1; }
     // control_fd() is readable; poll(now_ns) follows in the same wakeup.
     virtual void on_control(uint64_t /*now_ns*/) {}
+    // Statistics for the end of the run ("name value" lines, e.g. ecat::print_stats()); printed by
+    // run_slave() at exit with --verbose and written to SlaveOptions::stats_file. Default: nothing.
+    virtual void report(std::ostream& /*out*/) const {}
 };
 
 // Adapts any object with poll(uint64_t) and next_deadline_ns() (e.g. ecat::Stack, which cannot depend on
@@ -30,6 +34,10 @@ class FirmwareAdapter final : public Firmware {
     explicit FirmwareAdapter(T& target) : target_(target) {}
     void poll(uint64_t now_ns) override { target_.poll(now_ns); }
     uint64_t next_deadline_ns() const override { return target_.next_deadline_ns(); }
+    // Forwarded when T has report(std::ostream&) const (ecat::Stack has).
+    void report(std::ostream& out) const override {
+        if constexpr (requires(const T& t) { t.report(out); }) target_.report(out);
+    }
 
   private:
     T& target_;

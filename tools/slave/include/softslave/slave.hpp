@@ -35,9 +35,10 @@ struct SlaveOptions {
     std::string eeprom_file;          // binary SII image
     bool eeprom_write_back = true;    // write the image back to eeprom_file at exit if the master changed it
     uint32_t ram_kib = 8;             // process RAM size (ESC register 0x0006)
-    bool verbose = false;
-    int rt_priority = 0;  // > 0: SCHED_FIFO at this priority and all memory locked (mlockall)
-    int cpu = -1;         // >= 0: pin the slave to this CPU
+    bool verbose = false;             // print statistics (runtime, ESC, firmware report) at exit
+    std::string stats_file;           // write the same statistics as "name value" lines here at exit
+    int rt_priority = 0;              // > 0: SCHED_FIFO at this priority and all memory locked (mlockall)
+    int cpu = -1;                     // >= 0: pin the slave to this CPU
     EepromLoader eeprom_loader = load_eeprom_file;
     FirmwareFactory firmware_factory;  // empty: no firmware
 };

@@ -1,0 +1,46 @@
+// softslave::Firmware::report(): the hook through which run_slave() prints the firmware's statistics at
+// exit (--verbose, SlaveOptions::stats_file); FirmwareAdapter forwards it when the target has one.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <ostream>
+#include <sstream>
+
+#include "softslave/firmware.hpp"
+
+namespace {
+
+struct WithReport {
+    void poll(uint64_t) {}
+    uint64_t next_deadline_ns() const { return 0; }
+    void report(std::ostream& out) const { out << "stack.cycles " << cycles << '\n'; }
+    uint64_t cycles = 42;
+};
+
+struct WithoutReport {
+    void poll(uint64_t) {}
+    uint64_t next_deadline_ns() const { return 0; }
+};
+
+TEST(FirmwareReport, AdapterForwardsReportOfItsTarget) {
+    WithReport target;
+    softslave::FirmwareAdapter<WithReport> adapter(target);
+    const softslave::Firmware& fw = adapter;
+    std::ostringstream out;
+    fw.report(out);
+    EXPECT_EQ(out.str(), "stack.cycles 42\n");
+    target.cycles = 7;
+    out.str("");
+    fw.report(out);
+    EXPECT_EQ(out.str(), "stack.cycles 7\n");
+}
+
+TEST(FirmwareReport, TargetWithoutReportPrintsNothing) {
+    WithoutReport target;
+    softslave::FirmwareAdapter<WithoutReport> adapter(target);
+    std::ostringstream out;
+    static_cast<const softslave::Firmware&>(adapter).report(out);
+    EXPECT_TRUE(out.str().empty());
+}
+
+}  // namespace
