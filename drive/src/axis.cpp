@@ -261,6 +261,9 @@ void Axis::raise_error(uint16_t code) {
 }
 
 void Axis::connection_lost() {
+    // Only a drive that has power on its motor reacts: without power there is nothing to stop, and a master
+    // that merely walks the ESM down after disabling the drive must not find a fault on its next start.
+    if (!power_) return;
     fault(error_code::EthercatStateMachine, now_ns_);
     update_feedback();
 }

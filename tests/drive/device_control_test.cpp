@@ -342,3 +342,12 @@ TEST(DeviceControl, ErrorsReachTheSinkWithStateAndModeAndStateChangesAsDiagnosis
     EXPECT_EQ(sink.mfr[0], static_cast<uint8_t>(State::OperationEnabled));
     EXPECT_EQ(sink.mfr[1], static_cast<uint8_t>(mode::CyclicSyncVelocity));
 }
+
+TEST(DeviceControl, ConnectionLostWhileDisabledIsNoFault) {
+    Rig r;
+    r.cw(0x06);
+    r.ax.connection_lost();
+    r.run(2);
+    EXPECT_EQ(r.ax.state(), State::ReadyToSwitchOn);
+    EXPECT_FALSE(r.rec.has(error_code::EthercatStateMachine));
+}
