@@ -44,7 +44,7 @@ TEST_F(DriveDictionary, DefaultAssignmentReadsWithPaddedSubindex0) {
     EXPECT_EQ(ask(sdo(0x50, 0x1C13, 0)), (Bytes{0x00, 0x30, 0x53, 0x13, 0x1C, 0x00, 0x01, 0x00, 0x00, 0x1A}));
 }
 
-TEST_F(DriveDictionary, CompleteAccessUploadOfEveryObjectSucceedsOrIsRefusedWithAnAbort) {
+TEST_F(DriveDictionary, CompleteAccessUploadOfEveryObjectSucceeds) {
     // Every object of the drive can be read whole; segmented ones are read to the end.
     for (const auto& obj : dict.objects()) {
         server.handle(sdo(0x50, obj.index, 0), out);
