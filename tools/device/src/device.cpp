@@ -7,9 +7,11 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "coe/events.hpp"
 #include "coe/pdo_validation.hpp"
 #include "esi/esi.hpp"
 #include "esi/sii.hpp"
+#include "foe/firmware.hpp"
 #include "foe/image.hpp"
 #include "od/device_config.hpp"
 #include "od/drive_profile.hpp"
@@ -71,14 +73,14 @@ std::string make_esi(const DeviceOptions& options) {
 // Everything a restart rebuilds, in construction order (members are destroyed in reverse).
 struct Device::Parts {
     od::DeviceDescription desc;
-    std::unique_ptr<foe::FirmwareStore> firmware;
+    std::unique_ptr<foe::FirmwareUpdate> firmware;  // store in <state>/firmware + FoE server
     od::Dictionary dict;
     std::unique_ptr<od::ParameterStore> params;
     od::ParameterStore::LoadResult load;
     std::unique_ptr<ecat::Stack> stack;
     std::unique_ptr<coe::CoeServer> coe;
     std::unique_ptr<coe::DiagnosisHistory> diag;
-    std::unique_ptr<foe::FoeServer> foe;
+    std::unique_ptr<coe::EventReporter> events;
     std::unique_ptr<drive::Drive> drive;
 };
 
@@ -103,12 +105,11 @@ void Device::build() {
     parts_.reset();
     auto p = std::make_unique<Parts>();
     p->desc = base_description(options_);
-    p->firmware = std::make_unique<foe::FirmwareStore>(store_config(options_, p->desc));
-    foe::StoreError store_error;
-    if (!p->firmware->open(&store_error))
-        log() << "softdrive: firmware store " << firmware_dir(options_).string() << ": " << store_error.text
-              << " (running the built-in firmware)\n";
-    apply_active_image(p->desc, *p->firmware);
+    p->firmware = std::make_unique<foe::FirmwareUpdate>(options_.state_dir, p->desc);
+    if (!p->firmware->ok())
+        log() << "softdrive: firmware store " << firmware_dir(options_).string() << ": "
+              << p->firmware->error().text << " (running the built-in firmware)\n";
+    p->firmware->apply_to(p->desc.identity);
 
     p->dict = od::make_drive_dictionary(p->desc);
     coe::install_pdo_validators(p->dict);
@@ -134,9 +135,10 @@ void Device::build() {
     p->stack = std::make_unique<ecat::Stack>(esc_, p->dict, p->desc, *this, [this] { return esc_.irq(); });
     p->coe = std::make_unique<coe::CoeServer>(p->dict, [raw] { return raw->stack->state(); });
     p->diag = std::make_unique<coe::DiagnosisHistory>(p->dict, &p->coe->emergency());
-    p->foe = std::make_unique<foe::FoeServer>(*p->firmware, foe::ServerConfig::from(p->desc));
+    p->events = std::make_unique<coe::EventReporter>(p->coe->emergency(), p->diag.get(),
+                                                     [this] { return system_time_ns(); });
     p->stack->add_handler(*p->coe);
-    p->stack->add_handler(*p->foe);
+    p->stack->add_handler(p->firmware->server());
     p->drive = std::make_unique<drive::Drive>(p->dict, this);
 
     parts_ = std::move(p);
@@ -244,31 +246,21 @@ void Device::on_restart() {
 
 void Device::raise(uint16_t error_code, uint8_t error_register, const std::array<uint8_t, 5>& mfr) {
     ++stats_.emergencies;
-    parts_->coe->emergency().raise(error_code, error_register, mfr);
-    coe::DiagMessage m;
-    m.code = coe::DiagnosisHistory::from_emergency(error_code);
-    m.type = coe::DiagType::Error;
-    m.timestamp_ns = system_time_ns();
     ++stats_.diagnoses;
-    parts_->diag->add(m);
+    parts_->events->raise(error_code, error_register, mfr);
 }
 
-void Device::clear(uint16_t error_code, uint8_t /*error_register*/) {
+void Device::clear(uint16_t error_code, uint8_t error_register) {
     ++stats_.emergencies;
-    parts_->coe->emergency().clear(error_code);
+    parts_->events->clear(error_code, error_register);
 }
 
 void Device::diag(drive::Severity severity, uint16_t code, std::string_view text) {
-    coe::DiagMessage m;
-    m.code = code != 0 ? coe::DiagnosisHistory::from_emergency(code) : 0x0000E000u;  // manufacturer code
-    m.type = severity == drive::Severity::Error     ? coe::DiagType::Error
-             : severity == drive::Severity::Warning ? coe::DiagType::Warning
-                                                    : coe::DiagType::Info;
-    m.timestamp_ns = system_time_ns();
-    const coe::DiagParam param = coe::DiagParam::ascii(text);
-    m.params = std::span<const coe::DiagParam>(&param, text.empty() ? 0 : 1);
     ++stats_.diagnoses;
-    parts_->diag->add(m);
+    parts_->events->diag(severity == drive::Severity::Error     ? coe::DiagType::Error
+                         : severity == drive::Severity::Warning ? coe::DiagType::Warning
+                                                                : coe::DiagType::Info,
+                         code, text);
 }
 
 // ---- parts ------------------------------------------------------------------------------------------
@@ -292,10 +284,10 @@ coe::DiagnosisHistory& Device::diagnosis() {
     return *parts_->diag;
 }
 foe::FoeServer& Device::foe() {
-    return *parts_->foe;
+    return parts_->firmware->server();
 }
 foe::FirmwareStore& Device::firmware_store() {
-    return *parts_->firmware;
+    return parts_->firmware->store();
 }
 drive::Drive& Device::drive() {
     return *parts_->drive;
