@@ -20,11 +20,21 @@ Eigen::MatrixXd expm(const Eigen::MatrixXd& m) {
     return sum;
 }
 
-void Plant::configure(const MotorModel& m, double torque_constant, double h) {
-    km_ = torque_constant;
+void Plant::configure(const MotorModel& model, double torque_constant, double h) {
+    // A physical motor has positive R, L and J; keep the model there whatever the caller set (NaN included).
+    auto at_least = [](double v, double lo) { return std::isfinite(v) && v > lo ? v : lo; };
+    MotorModel m = model;
+    m.resistance = at_least(m.resistance, 1e-3);
+    m.inductance = at_least(m.inductance, 1e-6);
+    m.rotor_inertia = at_least(m.rotor_inertia, 1e-9);
+    m.load_inertia = at_least(m.load_inertia, 0.0);
+    m.viscous_friction = at_least(m.viscous_friction, 0.0);
+    m.coulomb_friction = at_least(m.coulomb_friction, 0.0);
+    km_ = std::isfinite(torque_constant) ? torque_constant : 0.0;
     j_ = m.rotor_inertia + m.load_inertia;
     coulomb_ = m.coulomb_friction;
-    h_ = h;
+    h_ = at_least(h, 1e-9);
+    h = h_;
     l_ = m.inductance;
     r_ = m.resistance;
     const double b = m.viscous_friction;

@@ -176,3 +176,17 @@ TEST(Machine, PolarityAppliesToSwitchEdgesToo) {
     EXPECT_NEAR(r.fb().touch_probe_pos, 4000, 1);  // reached first, at axis position +4000.5
     EXPECT_NEAR(r.fb().touch_probe_neg, 5000, 1);
 }
+
+TEST(Plant, NonsenseModelValuesAreClampedToAPhysicalMotor) {
+    MotorModel m;
+    m.inductance = 0;
+    m.rotor_inertia = -1;
+    m.load_inertia = std::numeric_limits<double>::quiet_NaN();
+    m.resistance = 0;
+    Plant p;
+    p.configure(m, 0.0255, 1e-5);
+    for (int i = 0; i < 1000; ++i)
+        p.step(1.0, true);
+    EXPECT_TRUE(std::isfinite(p.current()));
+    EXPECT_TRUE(std::isfinite(p.velocity()));
+}
