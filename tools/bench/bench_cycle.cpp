@@ -1,0 +1,607 @@
+// bench-cycle: process data in step with the master. For each cycle time (default 1 ms, 250 us, 125 us)
+// it starts the real ecat-slave on one end of a veth pair, brings it to OP with distributed clocks as SOEM
+// and TwinCAT do (clock offset, SYNC0 on the cycle grid 100 ms ahead, sync mode 2), then runs the cyclic
+// exchange for --seconds: one frame per cycle with the LRW of the process data and an FRMW of the reference
+// clock's system time (0x0910), sent from an absolute-time clock_nanosleep loop whose phase is steered so
+// that the frame passes the slave half a cycle away from SYNC0 (SOEM's ec_sync() idea).
+//
+// Master side it counts lost replies, working-counter errors, late replies (back after the next cycle
+// should have started) and missed cycles (the loop woke a whole period or more late); slave side it reads
+// the stack's statistics that ecat-slave --verbose prints at exit: SYNC0 periods without a cycle,
+// SYNC0 without new outputs, and the lateness of the application cycle after its SYNC0 pulse measured
+// against the DC system time (p50 / p99 / max). Prints one table; asserts nothing.
+//
+// Everything lives in a private network namespace (unshare) that disappears with this process; the slave
+// is killed with us (PR_SET_PDEATHSIG); the temporary state directory is removed. Needs root.
+#include <fcntl.h>
+#include <sched.h>
+#include <signal.h>
+#include <sys/mman.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "ecat/latency.hpp"
+#include "esc/link.hpp"
+#include "master/coe.hpp"
+#include "master/mailbox.hpp"
+#include "master/master.hpp"
+#include "master/session.hpp"
+#include "softdrive/firmware.hpp"
+#include "softslave/netif.hpp"
+#include "softslave/slave.hpp"
+
+namespace {
+
+using master::Address;
+using master::Error;
+
+constexpr const char* kSlaveEnd = "cyc-s0";
+constexpr const char* kMasterEnd = "cyc-m0";
+constexpr uint16_t kStation = 0x1001;
+
+std::atomic<bool> g_stop{false};
+void on_signal(int) {
+    g_stop.store(true);
+}
+
+uint64_t mono_ns() {
+    timespec ts{};
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return static_cast<uint64_t>(ts.tv_sec) * 1'000'000'000ull + static_cast<uint64_t>(ts.tv_nsec);
+}
+
+void sleep_until_ns(uint64_t t) {
+    timespec ts{};
+    ts.tv_sec = static_cast<time_t>(t / 1'000'000'000ull);
+    ts.tv_nsec = static_cast<long>(t % 1'000'000'000ull);
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+        if (g_stop.load()) return;
+    }
+}
+
+struct Options {
+    unsigned seconds = 60;
+    std::vector<unsigned> cycles_us{1000, 250, 125};
+    std::string slave_path = BENCH_ECAT_SLAVE_PATH;
+    std::string backend;
+    int rt_priority = 80;  // 0: no SCHED_FIFO
+    int master_cpu = 0;    // -1: not pinned
+    int slave_cpu = 1;
+    unsigned phase_percent = 50;  // where in the cycle (after SYNC0) the frame passes the slave
+    bool verbose = false;
+    std::string keep_logs;  // copy the slave logs here
+};
+
+// The slave process: its output goes to a log file; killed with us and by the destructor (SIGTERM first,
+// so it prints its statistics).
+class SlaveProcess {
+  public:
+    SlaveProcess(const std::vector<std::string>& args, const std::string& log) {
+        const pid_t parent = ::getpid();
+        pid_ = ::fork();
+        if (pid_ < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
+        if (pid_ == 0) {
+            ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+            if (::getppid() != parent) ::_exit(127);
+            const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+            if (fd >= 0) {
+                ::dup2(fd, 1);
+                ::dup2(fd, 2);
+            }
+            std::vector<char*> argv;
+            for (const auto& a : args)
+                argv.push_back(const_cast<char*>(a.c_str()));
+            argv.push_back(nullptr);
+            ::execv(argv[0], argv.data());
+            std::fprintf(stderr, "bench-cycle: cannot run %s: %s\n", argv[0], std::strerror(errno));
+            ::_exit(127);
+        }
+    }
+    ~SlaveProcess() { (void)stop(); }
+    SlaveProcess(const SlaveProcess&) = delete;
+    SlaveProcess& operator=(const SlaveProcess&) = delete;
+
+    bool alive() {
+        if (pid_ <= 0) return false;
+        int status = 0;
+        if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+            exit_status_ = status;
+            pid_ = -1;
+            return false;
+        }
+        return true;
+    }
+    // SIGTERM, wait up to 5 s, then SIGKILL. Returns the wait status (-1 if it was gone already).
+    int stop() {
+        if (pid_ <= 0) return exit_status_;
+        ::kill(pid_, SIGTERM);
+        int status = 0;
+        for (int i = 0; i < 500; ++i) {
+            if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+                pid_ = -1;
+                exit_status_ = status;
+                return status;
+            }
+            ::usleep(10'000);
+        }
+        ::kill(pid_, SIGKILL);
+        ::waitpid(pid_, &status, 0);
+        pid_ = -1;
+        exit_status_ = status;
+        return status;
+    }
+
+  private:
+    pid_t pid_ = -1;
+    int exit_status_ = -1;
+};
+
+// --slave builtin: this program runs the slave itself (re-executed as `bench-cycle --as-slave ...`): the
+// same runtime (softslave::run_slave) and the same firmware (softdrive::DeviceFirmware) as ecat-slave, plus
+// the stack's statistics at exit for a DeviceFirmware that does not report them itself.
+class ReportingFirmware final : public softslave::Firmware {
+  public:
+    explicit ReportingFirmware(std::unique_ptr<softslave::Firmware> inner) : inner_(std::move(inner)) {}
+    void poll(uint64_t now_ns) override { inner_->poll(now_ns); }
+    uint64_t next_deadline_ns() const override { return inner_->next_deadline_ns(); }
+    int control_fd() const override { return inner_->control_fd(); }
+    void on_control(uint64_t now_ns) override { inner_->on_control(now_ns); }
+    void report(std::ostream& out) const override {
+        std::ostringstream own;
+        inner_->report(own);
+        out << own.str();
+        if (own.str().find("stack.") != std::string::npos) return;
+        if (auto* d = dynamic_cast<softdrive::DeviceFirmware*>(inner_.get())) d->device().stack().report(out);
+    }
+
+  private:
+    std::unique_ptr<softslave::Firmware> inner_;
+};
+
+int run_as_slave(int argc, char** argv) {
+    softslave::SlaveOptions options;
+    softdrive::DeviceOptions device;
+    for (int i = 2; i + 1 < argc; i += 2) {
+        const std::string a = argv[i], v = argv[i + 1];
+        if (a == "--iface") {
+            options.iface = v;
+        } else if (a == "--state-dir") {
+            device.state_dir = v;
+        } else if (a == "--backend") {
+            options.backend = v;
+        } else if (a == "--rt-priority") {
+            options.rt_priority = std::atoi(v.c_str());
+        } else if (a == "--cpu") {
+            options.cpu = std::atoi(v.c_str());
+        } else {
+            std::fprintf(stderr, "bench-cycle --as-slave: unknown option %s\n", a.c_str());
+            return 2;
+        }
+    }
+    options.verbose = true;
+    options.eeprom_loader = softdrive::eeprom_loader(device);
+    auto factory = softdrive::firmware_factory(device);
+    options.firmware_factory = [factory](esc::Esc& esc, const softslave::SlaveOptions& o) {
+        return std::unique_ptr<softslave::Firmware>(std::make_unique<ReportingFirmware>(factory(esc, o)));
+    };
+    return softslave::run_slave(options, std::cout, std::cerr);
+}
+
+// "stack.cycles 123" lines of the slave's log.
+std::map<std::string, uint64_t> read_figures(const std::string& log) {
+    std::map<std::string, uint64_t> m;
+    std::ifstream in(log);
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.rfind("stack.", 0) != 0) continue;
+        std::istringstream ls(line);
+        std::string key;
+        unsigned long long v = 0;
+        if (ls >> key >> v) m[key] = v;
+    }
+    return m;
+}
+
+struct Result {
+    unsigned cycle_us = 0;
+    bool ok = false;  // reached OP and ran
+    std::string failure;
+    // Master side.
+    uint64_t cycles = 0, lost = 0, wkc_errors = 0, late = 0, missed = 0;
+    ecat::LatencyHistogram wake;   // clock_nanosleep wake-up lateness
+    ecat::LatencyHistogram rtt;    // send to matched reply
+    ecat::LatencyHistogram phase;  // |frame at the slave - target phase| (DC time, from the FRMW)
+    std::string end_state;
+    // Slave side (from its --verbose output).
+    std::map<std::string, uint64_t> slave;
+};
+
+std::string state_text(master::Master& m, Address a) {
+    auto st = m.al_status(a);
+    if (!st) return std::string("? (") + std::string(master::to_string(st.error())) + ")";
+    std::string s(master::al_state_name(st->state));
+    if (st->error) {
+        char b[32];
+        std::snprintf(b, sizeof b, "+ERR 0x%04x", st->code);
+        s += b;
+    }
+    return s;
+}
+
+// Brings the slave to OP with DC and runs the measured loop. Fills r; throws on setup failures.
+void run_master(const Options& o, unsigned cycle_us, Result& r) {
+    auto link = esc::open_link(kMasterEnd, o.backend);
+    master::MasterOptions mo;
+    mo.timeout = std::chrono::milliseconds(100);
+    mo.retries = 0;
+    master::Master m(*link, mo);
+    // The slave needs a moment to open its end.
+    uint16_t n = 0;
+    for (int i = 0; i < 100 && n == 0 && !g_stop.load(); ++i) {
+        auto c = m.count_slaves();
+        if (c) n = *c;
+        if (n == 0) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    if (n == 0) throw std::runtime_error("the slave does not answer");
+    m.set_timeout(std::chrono::milliseconds(100));
+    auto check = [](Error e, const char* what) {
+        if (e != Error::Ok)
+            throw std::runtime_error(std::string(what) + ": " + std::string(master::to_string(e)));
+    };
+    check(m.assign_station_addresses(n), "assigning station addresses");
+    const Address a = Address::station(kStation);
+    master::Mailbox mbx(m, a);
+    check(mbx.configure_from_sii(), "mailbox from SII");
+    master::AlStatus final{};
+    if (Error e = m.request_state(a, master::AlState::PreOp, &final); e != Error::Ok) {
+        char b[64];
+        std::snprintf(b, sizeof b, " (AL status code 0x%04x)", final.code);
+        throw std::runtime_error("INIT -> PREOP: " + std::string(master::to_string(e)) + b);
+    }
+    master::SdoClient sdo(mbx);
+    master::ProcessDataSession pd(m, a, sdo);
+    check(pd.discover(), "reading the process-data layout");
+    master::DcConfig dc;
+    dc.enable = true;
+    dc.cycle_ns = cycle_us * 1000u;
+    check(pd.configure(dc), "configuring process data and DC");
+    const auto period = std::chrono::microseconds(cycle_us);
+    for (auto [s, name] :
+         {std::pair{master::AlState::SafeOp, "SAFEOP"}, std::pair{master::AlState::Op, "OP"}}) {
+        const Error e = pd.request_state(s, period, &final);
+        if (e != Error::Ok) {
+            char b[96];
+            std::snprintf(b, sizeof b, "requesting %s: %s (AL status code 0x%04x)", name,
+                          std::string(master::to_string(e)).c_str(), final.code);
+            throw std::runtime_error(b);
+        }
+    }
+
+    // The measured loop. A reply that is not back within one period counts as lost.
+    m.set_timeout(period);
+    const uint64_t p = cycle_us * 1000ull;
+    const uint64_t target_phase = p * o.phase_percent / 100;
+    const uint64_t total = static_cast<uint64_t>(o.seconds) * 1'000'000'000ull / p;
+    constexpr uint64_t kSettle = 200;  // cycles to lock the phase before counting
+    uint64_t t = mono_ns() + p;
+    for (uint64_t i = 0; i < kSettle + total && !g_stop.load(); ++i) {
+        const bool counted = i >= kSettle;
+        sleep_until_ns(t);
+        const uint64_t woke = mono_ns();
+        const uint64_t late_by = woke > t ? woke - t : 0;
+        if (counted) r.wake.add(late_by);
+        if (late_by >= p) {
+            // Whole periods slept through: those cycles are gone; continue on the grid.
+            const uint64_t skipped = late_by / p;
+            if (counted) r.missed += skipped;
+            t += skipped * p;
+        }
+        const uint64_t sent = mono_ns();
+        const Error e = pd.cycle();
+        const uint64_t done = mono_ns();
+        if (counted) {
+            ++r.cycles;
+            if (e == Error::Timeout) {
+                ++r.lost;
+            } else {
+                r.rtt.add(done - sent);
+                if (e == Error::WorkingCounter) ++r.wkc_errors;
+                if (done > t + p) ++r.late;
+            }
+        }
+        // Phase control on the DC time the FRMW brought back: where in the SYNC0 cycle the frame passed.
+        int64_t correction = 0;
+        if (e != Error::Timeout && e != Error::SendFailed) {
+            int64_t delta = static_cast<int64_t>((pd.reference_time() + p - target_phase) % p);
+            if (delta > static_cast<int64_t>(p / 2)) delta -= static_cast<int64_t>(p);
+            if (counted) r.phase.add(static_cast<uint64_t>(delta < 0 ? -delta : delta));
+            // Jump once the first replies are in, then a gentle proportional pull (both clocks are the same
+            // oscillator here, so only the wake-up noise is left to average out).
+            correction = i == 20 ? -delta : -delta / 32;
+        }
+        t = static_cast<uint64_t>(static_cast<int64_t>(t + p) + correction);
+    }
+    m.set_timeout(std::chrono::milliseconds(100));
+    r.end_state = state_text(m, a);
+    (void)m.request_state(a, master::AlState::Init);
+    r.ok = !g_stop.load();
+}
+
+Result run_one(const Options& o, unsigned cycle_us, const std::filesystem::path& dir) {
+    Result r;
+    r.cycle_us = cycle_us;
+    const std::string log = (dir / ("slave-" + std::to_string(cycle_us) + "us.log")).string();
+    std::vector<std::string> args;
+    if (o.slave_path == "builtin")
+        args = {"/proc/self/exe", "--as-slave"};
+    else
+        args = {o.slave_path, "--verbose"};
+    args.insert(args.end(), {"--iface", kSlaveEnd, "--state-dir", (dir / "state").string()});
+    if (!o.backend.empty()) args.insert(args.end(), {"--backend", o.backend});
+    if (o.rt_priority > 0) args.insert(args.end(), {"--rt-priority", std::to_string(o.rt_priority)});
+    if (o.slave_cpu >= 0) args.insert(args.end(), {"--cpu", std::to_string(o.slave_cpu)});
+    {
+        SlaveProcess slave(args, log);
+        try {
+            run_master(o, cycle_us, r);
+        } catch (const std::exception& e) {
+            r.failure = e.what();
+        }
+        if (!slave.alive())
+            r.failure += (r.failure.empty() ? "" : "; ") + std::string("ecat-slave exited early");
+        const int status = slave.stop();
+        if (status != -1 && !(WIFEXITED(status) && WEXITSTATUS(status) == 0))
+            r.failure += (r.failure.empty() ? "" : "; ") + std::string("ecat-slave did not exit cleanly");
+    }
+    r.slave = read_figures(log);
+    if (!r.failure.empty() || o.verbose) {
+        std::ifstream in(log);
+        std::fprintf(stderr, "---- ecat-slave log (%u us) ----\n%s", cycle_us,
+                     std::string(std::istreambuf_iterator<char>(in), {}).c_str());
+    }
+    if (!o.keep_logs.empty()) {
+        std::error_code ec;
+        std::filesystem::create_directories(o.keep_logs, ec);
+        std::filesystem::copy_file(log,
+                                   std::filesystem::path(o.keep_logs) / std::filesystem::path(log).filename(),
+                                   std::filesystem::copy_options::overwrite_existing, ec);
+    }
+    return r;
+}
+
+double us(uint64_t ns) {
+    return static_cast<double>(ns) / 1000.0;
+}
+
+std::string slave_figure(const Result& r, const std::string& key, bool in_us) {
+    auto it = r.slave.find("stack." + key);
+    if (it == r.slave.end()) return "n/a";
+    char b[32];
+    if (in_us)
+        std::snprintf(b, sizeof b, "%.1f", us(it->second));
+    else
+        std::snprintf(b, sizeof b, "%llu", static_cast<unsigned long long>(it->second));
+    return b;
+}
+
+void print_table(const Options& o, const std::vector<Result>& results, const std::string& sched) {
+    std::printf(
+        "\nbench-cycle: %u s per cycle time, backend %s, %s; frame at %u%% of the cycle after SYNC0\n",
+        o.seconds, o.backend.empty() ? esc::default_link_backend() : o.backend.c_str(), sched.c_str(),
+        o.phase_percent);
+    std::printf("%-7s | %-9s %5s %5s %5s %6s | %-9s %8s %8s | %-22s | %-22s | %-16s\n", "", "master", "lost",
+                "wkc", "late", "missed", "slave", "exceeded", "no-outp", "SYNC0->cycle us", "master wake us",
+                "rtt us");
+    std::printf("%-7s | %-9s %5s %5s %5s %6s | %-9s %8s %8s | %6s %7s %7s | %6s %7s %7s | %7s %8s\n", "cycle",
+                "cycles", "", "err", "", "", "cycles", "", "", "p50", "p99", "max", "p50", "p99", "max",
+                "p50", "p99");
+    for (const Result& r : results) {
+        std::printf(
+            "%4u us | %-9llu %5llu %5llu %5llu %6llu | %-9s %8s %8s | %6s %7s %7s | %6.1f %7.1f %7.1f | "
+            "%7.1f %8.1f\n",
+            r.cycle_us, static_cast<unsigned long long>(r.cycles), static_cast<unsigned long long>(r.lost),
+            static_cast<unsigned long long>(r.wkc_errors), static_cast<unsigned long long>(r.late),
+            static_cast<unsigned long long>(r.missed), slave_figure(r, "cycles", false).c_str(),
+            slave_figure(r, "cycles_exceeded", false).c_str(),
+            slave_figure(r, "sm_events_missed", false).c_str(),
+            slave_figure(r, "sync0_latency.p50_ns", true).c_str(),
+            slave_figure(r, "sync0_latency.p99_ns", true).c_str(),
+            slave_figure(r, "sync0_latency.max_ns", true).c_str(), us(r.wake.percentile_ns(0.5)),
+            us(r.wake.percentile_ns(0.99)), us(r.wake.max_ns()), us(r.rtt.percentile_ns(0.5)),
+            us(r.rtt.percentile_ns(0.99)));
+    }
+    std::printf(
+        "lost: no reply within one cycle; late: reply after the next cycle was due; missed: cycles the "
+        "master "
+        "slept through;\nexceeded: SYNC0 periods without a slave cycle; no-outp: SYNC0 without new outputs "
+        "(sm_events_missed);\nSYNC0->cycle: DC system time at the start of the slave's application cycle "
+        "minus "
+        "its SYNC0 pulse.\n");
+    for (const Result& r : results) {
+        std::printf("%4u us: end state %s, phase error p99 %.1f us (max %.1f)", r.cycle_us,
+                    r.end_state.empty() ? "?" : r.end_state.c_str(), us(r.phase.percentile_ns(0.99)),
+                    us(r.phase.max_ns()));
+        if (!r.failure.empty()) std::printf(", FAILED: %s", r.failure.c_str());
+        if (r.slave.empty()) std::printf(", no slave figures (ecat-slave printed no stack.* lines)");
+        std::printf("\n");
+    }
+}
+
+void usage() {
+    std::fprintf(
+        stderr,
+        "usage: bench-cycle [--seconds N] [--cycles-us LIST] [--slave PATH] [--backend pcap|packet]\n"
+        "                   [--rt-priority N | --no-rt] [--master-cpu N] [--slave-cpu N] "
+        "[--phase PERCENT]\n"
+        "                   [--keep-logs DIR] [--verbose]\n"
+        "  --seconds N        measured time per cycle time (default 60; 5 is a quick check)\n"
+        "  --slave PATH       the slave program (default: the ecat-slave of this build); builtin: run\n"
+        "                     the same runtime and drive firmware from this program, with the stack's\n"
+        "                     figures even where ecat-slave's firmware does not report them\n"
+        "  --cycles-us LIST   cycle times in microseconds (default 1000,250,125)\n"
+        "  --rt-priority N    SCHED_FIFO priority of master and slave (default 80), --no-rt: none\n"
+        "  --master-cpu/--slave-cpu N  pin to a CPU (default 0 / 1; -1: not pinned)\n"
+        "  --phase PERCENT    where the frame passes the slave, in %% of the cycle after SYNC0 (50)\n");
+}
+
+bool parse_list(const std::string& s, std::vector<unsigned>& out) {
+    out.clear();
+    std::stringstream ss(s);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        char* end = nullptr;
+        const unsigned long v = std::strtoul(item.c_str(), &end, 10);
+        if (item.empty() || *end != '\0' || v < 20 || v > 1'000'000) return false;
+        out.push_back(static_cast<unsigned>(v));
+    }
+    return !out.empty();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc > 1 && std::string(argv[1]) == "--as-slave") return run_as_slave(argc, argv);
+    Options o;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto next = [&]() -> std::string {
+            if (i + 1 >= argc) {
+                usage();
+                std::exit(2);
+            }
+            return argv[++i];
+        };
+        auto number = [&](long lo, long hi) -> long {
+            const std::string v = next();
+            char* end = nullptr;
+            const long n = std::strtol(v.c_str(), &end, 10);
+            if (v.empty() || *end != '\0' || n < lo || n > hi) {
+                std::fprintf(stderr, "bench-cycle: bad value '%s' for %s\n", v.c_str(), a.c_str());
+                std::exit(2);
+            }
+            return n;
+        };
+        if (a == "--seconds") {
+            o.seconds = static_cast<unsigned>(number(1, 86400));
+        } else if (a == "--cycles-us") {
+            if (!parse_list(next(), o.cycles_us)) {
+                std::fprintf(stderr,
+                             "bench-cycle: --cycles-us wants a list like 1000,250,125 (20..1000000)\n");
+                return 2;
+            }
+        } else if (a == "--slave") {
+            o.slave_path = next();
+        } else if (a == "--backend") {
+            o.backend = next();
+        } else if (a == "--rt-priority") {
+            o.rt_priority = static_cast<int>(number(1, 99));
+        } else if (a == "--no-rt") {
+            o.rt_priority = 0;
+        } else if (a == "--master-cpu") {
+            o.master_cpu = static_cast<int>(number(-1, 1023));
+        } else if (a == "--slave-cpu") {
+            o.slave_cpu = static_cast<int>(number(-1, 1023));
+        } else if (a == "--phase") {
+            o.phase_percent = static_cast<unsigned>(number(0, 99));
+        } else if (a == "--keep-logs") {
+            o.keep_logs = next();
+        } else if (a == "--verbose") {
+            o.verbose = true;
+        } else if (a == "--help" || a == "-h") {
+            usage();
+            return 0;
+        } else {
+            usage();
+            return 2;
+        }
+    }
+    if (::geteuid() != 0) {
+        std::fprintf(stderr,
+                     "bench-cycle: needs root (network namespace, veth pair, raw sockets, SCHED_FIFO); "
+                     "run it with sudo\n");
+        return 2;
+    }
+    if (o.slave_path != "builtin" && ::access(o.slave_path.c_str(), X_OK) != 0) {
+        std::fprintf(stderr, "bench-cycle: cannot run the slave %s\n", o.slave_path.c_str());
+        return 2;
+    }
+    const long cpus = ::sysconf(_SC_NPROCESSORS_ONLN);
+    if (o.master_cpu >= cpus) o.master_cpu = -1;
+    if (o.slave_cpu >= cpus) o.slave_cpu = -1;
+    if (::unshare(CLONE_NEWNET) != 0) {
+        std::fprintf(stderr, "bench-cycle: unshare(CLONE_NEWNET): %s\n", std::strerror(errno));
+        return 2;
+    }
+    struct sigaction sa {};
+    sa.sa_handler = on_signal;
+    ::sigaction(SIGINT, &sa, nullptr);
+    ::sigaction(SIGTERM, &sa, nullptr);
+
+    // The master's own scheduling; if SCHED_FIFO is refused, neither side gets it (a fair comparison).
+    std::string sched = "SCHED_OTHER";
+    if (o.master_cpu >= 0) {
+        cpu_set_t set;
+        CPU_ZERO(&set);
+        CPU_SET(o.master_cpu, &set);
+        if (::sched_setaffinity(0, sizeof set, &set) != 0) o.master_cpu = -1;
+    }
+    if (o.rt_priority > 0) {
+        sched_param sp{};
+        sp.sched_priority = o.rt_priority;
+        if (::sched_setscheduler(0, SCHED_FIFO, &sp) != 0) {
+            std::fprintf(stderr, "bench-cycle: SCHED_FIFO refused (%s); running without real-time priority\n",
+                         std::strerror(errno));
+            o.rt_priority = 0;
+        } else {
+            (void)::mlockall(MCL_CURRENT | MCL_FUTURE);
+            sched = "SCHED_FIFO " + std::to_string(o.rt_priority);
+        }
+    }
+    sched += ", master CPU " + (o.master_cpu >= 0 ? std::to_string(o.master_cpu) : std::string("any")) +
+             ", slave CPU " + (o.slave_cpu >= 0 ? std::to_string(o.slave_cpu) : std::string("any"));
+
+    char tmpl[] = "/tmp/bench-cycle.XXXXXX";
+    if (::mkdtemp(tmpl) == nullptr) {
+        std::fprintf(stderr, "bench-cycle: mkdtemp: %s\n", std::strerror(errno));
+        return 1;
+    }
+    const std::filesystem::path dir = tmpl;
+    int rc = 0;
+    try {
+        softslave::VethPair pair(kSlaveEnd, kMasterEnd);
+        std::vector<Result> results;
+        for (unsigned c : o.cycles_us) {
+            if (g_stop.load()) break;
+            std::fprintf(stderr, "bench-cycle: %u us for %u s ...\n", c, o.seconds);
+            results.push_back(run_one(o, c, dir));
+            if (!results.back().ok || !results.back().failure.empty()) rc = 1;
+        }
+        print_table(o, results, sched);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench-cycle: %s\n", e.what());
+        rc = 1;
+    }
+    std::error_code ec;
+    std::filesystem::remove_all(dir, ec);
+    return rc;
+}
