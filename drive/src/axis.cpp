@@ -139,6 +139,11 @@ void Axis::enter(State s, int number) {
 void Axis::begin_stop(StopKind kind, double decel_rpm_s, int64_t) {
     stop_ = kind;
     ramp_done_ = false;
+    // A stop (quick stop, shutdown, fault) ends a running homing: interrupted, to be started again.
+    if (hstat_ == HomingStatus::InProgress) {
+        hstat_ = HomingStatus::Interrupted;
+        hphase_ = HomingPhase::Finished;
+    }
     if (kind == StopKind::Ramp) {
         stop_decel_ = decel_limit(decel_rpm_s);
         // The ramp starts where the motor really is (position and speed), whatever the set-points did.

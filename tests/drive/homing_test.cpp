@@ -152,3 +152,20 @@ TEST(Homing, TouchProbeIsOffDuringHoming) {
     EXPECT_EQ(r.fb().touch_probe_pos_count, 0);
     EXPECT_EQ(r.fb().touch_probe_status & 0x6, 0);
 }
+
+TEST(Homing, QuickStopInterruptsHoming) {
+    Rig r;
+    r.ax.params.homing_method = 34;
+    r.ax.params.homing_speed_zero = 1;
+    r.ax.command.mode = mode::Homing;
+    r.enable();
+    r.cw(0x1F);
+    r.run_ms(30);
+    r.cw(0x0B);
+    r.run_ms(100);
+    r.cw(0x0F);  // 16: back to Operation Enabled
+    EXPECT_EQ(r.ax.state(), State::OperationEnabled);
+    EXPECT_EQ(r.sw() & (sw::Bit13 | sw::Bit12 | sw::TargetReached), sw::TargetReached);  // 001
+    r.run_ms(100);
+    EXPECT_LT(std::abs(r.rpm()), 1.0);  // it does not resume on its own
+}
