@@ -167,6 +167,19 @@ class RunTime(unittest.TestCase):
             self.assertTrue(s.recv(256).startswith(b"error: "))
             self.assertTrue(bus.slave_alive())
 
+    def test_statistics_at_exit(self):
+        d = tempfile.mkdtemp(dir=out_dir())
+        self.addCleanup(shutil.rmtree, d, True)
+        stats = os.path.join(d, "stats.txt")
+        with harness.Bus(slave_args=["--stats-file", stats]) as bus:
+            bus.ecatctl("pd", "0", "-n", "100")
+            self.assertEqual(bus.stop_slave(), 0)
+        with open(stats) as f:
+            values = dict(line.split() for line in f if line.strip())
+        self.assertEqual(values["device.builds"], "1")
+        self.assertGreaterEqual(int(values["device.drive_cycles"]), 100)
+        self.assertGreaterEqual(int(values["stack.transitions"]), 4)  # I->P->S->O->P at least
+
     def test_stored_parameters_survive_a_restart_of_the_program(self):
         d = tempfile.mkdtemp(dir=out_dir())
         self.addCleanup(shutil.rmtree, d, True)

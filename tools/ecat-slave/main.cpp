@@ -83,6 +83,8 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 99));
     app.add_option("--cpu", options.cpu, "Pin the slave to this CPU")->check(CLI::NonNegativeNumber);
     app.add_flag("--verbose,-v", options.verbose, "Print statistics at exit");
+    app.add_option("--stats-file", options.stats_file,
+                   "Write the statistics as 'name value' lines to this file at exit");
     try {
         app.parse(argc, argv);
         for (const std::string& extra : app.remaining())

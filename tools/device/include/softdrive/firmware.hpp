@@ -24,6 +24,9 @@ class DeviceFirmware final : public softslave::Firmware {
         if (control_) control_->service(device_, now_ns);
     }
 
+    // The stack's statistics (ecat::print_stats) and the device's, as "name value" lines.
+    void report(std::ostream& out) const override;
+
     Device& device() { return device_; }
 
   private:
