@@ -286,26 +286,28 @@ void run_master(const Options& o, unsigned cycle_us, Result& r) {
     dc.cycle_ns = cycle_us * 1000u;
     check(pd.configure(dc), "configuring process data and DC");
     const auto period = std::chrono::microseconds(cycle_us);
-    for (auto [s, name] :
-         {std::pair{master::AlState::SafeOp, "SAFEOP"}, std::pair{master::AlState::Op, "OP"}}) {
-        const Error e = pd.request_state(s, period, &final);
-        if (e != Error::Ok) {
-            char b[96];
-            std::snprintf(b, sizeof b, "requesting %s: %s (AL status code 0x%04x)", name,
-                          std::string(master::to_string(e)).c_str(), final.code);
-            throw std::runtime_error(b);
-        }
+    if (Error e = pd.request_state(master::AlState::SafeOp, period, &final); e != Error::Ok) {
+        char b[96];
+        std::snprintf(b, sizeof b, "requesting SAFEOP: %s (AL status code 0x%04x)",
+                      std::string(master::to_string(e)).c_str(), final.code);
+        throw std::runtime_error(b);
     }
 
-    // The measured loop. A reply that is not back within one period counts as lost.
+    // The cyclic loop: first the phase is locked (Safe-Op), then OP is requested between cycles (as masters
+    // do, the frames keep their phase), then the measured cycles. A reply that is not back within one period
+    // counts as lost.
     m.set_timeout(period);
     const uint64_t p = cycle_us * 1000ull;
     const uint64_t target_phase = p * o.phase_percent / 100;
     const uint64_t total = static_cast<uint64_t>(o.seconds) * 1'000'000'000ull / p;
-    constexpr uint64_t kSettle = 200;  // cycles to lock the phase before counting
+    constexpr uint64_t kLock = 200;  // cycles to lock the phase before asking for OP
+    const uint64_t status_every = std::max<uint64_t>(1, 5'000'000 / p);  // AL status polls while waiting
+    const uint64_t op_deadline = mono_ns() + 10'000'000'000ull;
+    uint64_t counting_from = UINT64_MAX;
     uint64_t t = mono_ns() + p;
-    for (uint64_t i = 0; i < kSettle + total && !g_stop.load(); ++i) {
-        const bool counted = i >= kSettle;
+    for (uint64_t i = 0; !g_stop.load(); ++i) {
+        if (counting_from != UINT64_MAX && i >= counting_from + total) break;
+        const bool counted = i >= counting_from;
         sleep_until_ns(t);
         const uint64_t woke = mono_ns();
         const uint64_t late_by = woke > t ? woke - t : 0;
@@ -340,6 +342,23 @@ void run_master(const Options& o, unsigned cycle_us, Result& r) {
             correction = i == 20 ? -delta : -delta / 32;
         }
         t = static_cast<uint64_t>(static_cast<int64_t>(t + p) + correction);
+        if (counting_from != UINT64_MAX) continue;
+        if (i == kLock) {
+            if (Error e2 = m.write_reg<uint16_t>(a, master::reg::AlControl,
+                                                 static_cast<uint8_t>(master::AlState::Op));
+                e2 != Error::Ok)
+                throw std::runtime_error("requesting OP: " + std::string(master::to_string(e2)));
+        } else if (i > kLock && (i - kLock) % status_every == 0) {
+            auto st = m.al_status(a);
+            if (st && st->error) {
+                char b[80];
+                std::snprintf(b, sizeof b, "OP refused: AL status code 0x%04x (%s)", st->code,
+                              std::string(master::al_status_code_name(st->code)).c_str());
+                throw std::runtime_error(b);
+            }
+            if (st && st->state == static_cast<uint8_t>(master::AlState::Op)) counting_from = i + 1;
+            if (mono_ns() > op_deadline) throw std::runtime_error("OP not reached within 10 s");
+        }
     }
     m.set_timeout(std::chrono::milliseconds(100));
     r.end_state = state_text(m, a);
