@@ -445,3 +445,45 @@ TEST(DeviceEnvironment, InputsAndSwitchesReachTheDriveAndSurviveARestart) {
     EXPECT_NE(d.dict().get<uint16_t>(0x3141, 1) & 0x0008, 0);
     std::filesystem::remove_all(dir);
 }
+
+TEST_F(DeviceTest, EepromWordsAMasterWritesSurviveARestartAndAPowerCycle) {
+    // Station alias 0x0042 in word 4, and the checksum of words 0-6 in word 7 (as a master tool writes them).
+    std::array<uint8_t, 14> header{};
+    for (uint16_t w = 0; w < 7; ++w) {
+        const uint16_t v = w == 4 ? 0x0042 : m.sii_read_word(a, w).value();
+        header[2 * w] = static_cast<uint8_t>(v);
+        header[2 * w + 1] = static_cast<uint8_t>(v >> 8);
+    }
+    uint8_t crc = 0xFF;
+    for (uint8_t byte : header) {
+        crc ^= byte;
+        for (int i = 0; i < 8; ++i)
+            crc = static_cast<uint8_t>((crc & 0x80) ? (crc << 1) ^ 0x07 : crc << 1);
+    }
+    ASSERT_EQ(m.sii_write_word(a, 4, 0x0042), Error::Ok);
+    ASSERT_EQ(m.sii_write_word(a, 7, crc), Error::Ok);
+    EXPECT_EQ(drive.dev->eeprom_writes().size(), 2u);
+    // Saved once the writes have settled.
+    drive.idle(300'000'000);
+    EXPECT_TRUE(std::filesystem::exists(dir / softdrive::EepromWrites::kFileName));
+
+    // The served image, --write-sii and a power cycle all keep the words; the alias register loads from it.
+    EXPECT_EQ(softdrive::make_sii(drive.options)[8], 0x42);
+    drive.power_on();
+    EXPECT_EQ(esi::parse_sii(drive.esc->eeprom()).station_alias, 0x0042);
+    EXPECT_TRUE(esi::parse_sii(drive.esc->eeprom()).crc_ok);
+    uint8_t alias[2] = {};
+    drive.esc->read(0x0012, alias);
+    EXPECT_EQ(alias[0] | alias[1] << 8, 0x0042);
+
+    // A damaged file is reported and the SII is served as built.
+    {
+        std::fstream f(dir / softdrive::EepromWrites::kFileName,
+                       std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(12);
+        f.put('\x55');
+    }
+    drive.power_on();
+    EXPECT_EQ(esi::parse_sii(drive.esc->eeprom()).station_alias, 0);
+    EXPECT_NE(drive.log.str().find("not used"), std::string::npos) << drive.log.str();
+}

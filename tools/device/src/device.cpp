@@ -61,7 +61,10 @@ od::DeviceDescription make_description(const DeviceOptions& options) {
 std::vector<uint8_t> make_sii(const DeviceOptions& options) {
     const od::DeviceDescription d = make_description(options);
     const od::Dictionary dict = od::make_drive_dictionary(d);
-    return esi::build_sii(d, dict);
+    std::vector<uint8_t> image = esi::build_sii(d, dict);
+    EepromWrites writes(options.state_dir);
+    if (writes.load().empty()) writes.apply(image);
+    return image;
 }
 
 std::string make_esi(const DeviceOptions& options) {
@@ -84,11 +87,32 @@ struct Device::Parts {
     std::unique_ptr<drive::Drive> drive;
 };
 
-Device::Device(esc::Esc& esc, DeviceOptions options) : esc_(esc), options_(std::move(options)) {
+Device::Device(esc::Esc& esc, DeviceOptions options)
+    : esc_(esc), options_(std::move(options)), eeprom_writes_(options_.state_dir) {
+    if (options_.load_sii) {
+        if (const std::string error = eeprom_writes_.load(); !error.empty())
+            log() << "softdrive: " << eeprom_writes_.file().string() << " not used (" << error
+                  << "); serving the SII as built\n";
+        esc_.on_eeprom_write([this](uint16_t address, uint16_t value) {
+            eeprom_writes_.record(address, value);
+            eeprom_dirty_ = true;
+            eeprom_save_ns_ = 0;  // scheduled by the next poll()
+        });
+    }
     build();
 }
 
-Device::~Device() = default;
+Device::~Device() {
+    if (options_.load_sii) esc_.on_eeprom_write({});
+    if (eeprom_dirty_) save_eeprom_writes();
+}
+
+void Device::save_eeprom_writes() {
+    eeprom_dirty_ = false;
+    eeprom_save_ns_ = 0;
+    if (const std::string error = eeprom_writes_.save(); !error.empty())
+        log() << "softdrive: the EEPROM content the master wrote is not kept: " << error << '\n';
+}
 
 std::ostream& Device::log() const {
     return options_.log != nullptr ? *options_.log : std::cerr;
@@ -130,7 +154,11 @@ void Device::build() {
         return (raw->dict.get<uint16_t>(0x6041, 0) & 0x0002) != 0 ? od::Status::WrongState : od::Status::Ok;
     });
 
-    if (options_.load_sii) esc_.load_eeprom(esi::build_sii(p->desc, p->dict));
+    if (options_.load_sii) {
+        std::vector<uint8_t> image = esi::build_sii(p->desc, p->dict);
+        eeprom_writes_.apply(image);
+        esc_.load_eeprom(image);
+    }
 
     p->stack = std::make_unique<ecat::Stack>(esc_, p->dict, p->desc, *this, [this] { return esc_.irq(); });
     p->coe = std::make_unique<coe::CoeServer>(p->dict, [raw] { return raw->stack->state(); });
@@ -190,12 +218,19 @@ void Device::poll(uint64_t now_ns) {
     if (last_cycle_ns_ == 0 ||
         (parts_->stack->state() != od::AlState::Op && now_ns >= last_cycle_ns_ + kFreeRunNs))
         run_drive(now_ns);
+    if (eeprom_dirty_) {
+        if (eeprom_save_ns_ == 0)
+            eeprom_save_ns_ = now_ns + kEepromSaveDelayNs;
+        else if (now_ns >= eeprom_save_ns_)
+            save_eeprom_writes();
+    }
 }
 
 uint64_t Device::next_deadline_ns() const {
-    const uint64_t stack = parts_->stack->next_deadline_ns();
-    if (parts_->stack->state() == od::AlState::Op || last_cycle_ns_ == 0) return stack;
-    return std::min(stack, last_cycle_ns_ + kFreeRunNs);
+    uint64_t next = parts_->stack->next_deadline_ns();
+    if (eeprom_dirty_ && eeprom_save_ns_ != 0) next = std::min(next, eeprom_save_ns_);
+    if (parts_->stack->state() == od::AlState::Op || last_cycle_ns_ == 0) return next;
+    return std::min(next, last_cycle_ns_ + kFreeRunNs);
 }
 
 void Device::run_drive(uint64_t now_ns) {

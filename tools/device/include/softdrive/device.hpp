@@ -32,6 +32,7 @@
 #include "od/device.hpp"
 #include "od/dictionary.hpp"
 #include "od/store.hpp"
+#include "softdrive/eeprom_writes.hpp"
 
 namespace softdrive {
 
@@ -64,7 +65,7 @@ std::filesystem::path firmware_dir(const DeviceOptions& options);
 // one (the state directory is only read if it exists). Throws od::ConfigError on a bad configuration.
 od::DeviceDescription make_description(const DeviceOptions& options);
 // The SII image and the ESI text of that description and its dictionary (what --write-sii/--write-esi
-// write and what the ESC serves).
+// write and what the ESC serves: the SII with the words a master wrote into the EEPROM on top).
 std::vector<uint8_t> make_sii(const DeviceOptions& options);
 std::string make_esi(const DeviceOptions& options);
 
@@ -131,12 +132,17 @@ class Device final : public ecat::Application, public drive::EventSink {
     const DeviceStats& stats() const { return stats_; }
     // The DC system time (0x0910) as the PDI reads it.
     uint64_t system_time_ns();
+    // Words a master wrote into the EEPROM (kept in the state directory; see eeprom_writes.hpp).
+    const EepromWrites& eeprom_writes() const { return eeprom_writes_; }
+    // Time after the last EEPROM write at which the written words are saved (one file write for a burst).
+    static constexpr uint64_t kEepromSaveDelayNs = 200'000'000;
 
   private:
     struct Parts;
     void build();
     void apply_environment();
     void run_drive(uint64_t now_ns);
+    void save_eeprom_writes();
     std::ostream& log() const;
 
     esc::Esc& esc_;
@@ -147,6 +153,9 @@ class Device final : public ecat::Application, public drive::EventSink {
     bool outputs_lost_reported_ = false;
     uint64_t last_cycle_ns_ = 0;  // last drive cycle (master's or our own); 0: none since the build
     DeviceStats stats_;
+    EepromWrites eeprom_writes_;
+    bool eeprom_dirty_ = false;
+    uint64_t eeprom_save_ns_ = 0;  // when the written words are saved; 0: not yet scheduled
 };
 
 }  // namespace softdrive

@@ -1,0 +1,110 @@
+// Master-written SII words kept across restarts (see softdrive/eeprom_writes.hpp).
+#include "softdrive/eeprom_writes.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include "od/store.hpp"
+
+namespace softdrive {
+
+namespace {
+
+constexpr char kMagic[8] = {'S', 'E', 'C', 'A', 'T', 'S', 'I', 'I'};
+constexpr std::size_t kMaxWords = 65536;
+
+void put32(std::vector<uint8_t>& b, uint32_t v) {
+    for (int i = 0; i < 4; ++i)
+        b.push_back(static_cast<uint8_t>(v >> (8 * i)));
+}
+uint32_t get32(const uint8_t* p) {
+    return static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 |
+           static_cast<uint32_t>(p[2]) << 16 | static_cast<uint32_t>(p[3]) << 24;
+}
+std::string sys_error(const std::string& what, const std::filesystem::path& p) {
+    return what + " " + p.string() + ": " + std::strerror(errno);
+}
+
+}  // namespace
+
+EepromWrites::EepromWrites(std::filesystem::path state_dir)
+    : dir_(std::move(state_dir)), file_(dir_ / kFileName) {}
+
+std::string EepromWrites::load() {
+    words_.clear();
+    std::ifstream in(file_, std::ios::binary);
+    if (!in) return {};
+    const std::vector<uint8_t> b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (b.size() < 16 || std::memcmp(b.data(), kMagic, 8) != 0) return "not an SII writes file";
+    const uint32_t n = get32(b.data() + 8);
+    if (n > kMaxWords || b.size() != 16 + 4 * static_cast<std::size_t>(n)) return "length does not match";
+    if (od::crc32(std::span<const uint8_t>(b.data(), b.size() - 4)) != get32(b.data() + b.size() - 4))
+        return "checksum mismatch";
+    for (uint32_t i = 0; i < n; ++i) {
+        const uint8_t* p = b.data() + 12 + 4 * i;
+        words_[static_cast<uint16_t>(p[0] | p[1] << 8)] = static_cast<uint16_t>(p[2] | p[3] << 8);
+    }
+    return {};
+}
+
+std::string EepromWrites::save() {
+    std::vector<uint8_t> b(kMagic, kMagic + 8);
+    put32(b, static_cast<uint32_t>(words_.size()));
+    for (const auto& [address, value] : words_) {
+        b.push_back(static_cast<uint8_t>(address));
+        b.push_back(static_cast<uint8_t>(address >> 8));
+        b.push_back(static_cast<uint8_t>(value));
+        b.push_back(static_cast<uint8_t>(value >> 8));
+    }
+    put32(b, od::crc32(b));
+
+    std::filesystem::path tmp = file_;
+    tmp += ".tmp";
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) return sys_error("cannot create", tmp);
+    std::size_t done = 0;
+    while (done < b.size()) {
+        const ssize_t n = ::write(fd, b.data() + done, b.size() - done);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {
+            const std::string e = sys_error("cannot write", tmp);
+            ::close(fd);
+            ::unlink(tmp.c_str());
+            return e;
+        }
+        done += static_cast<std::size_t>(n);
+    }
+    if (::fsync(fd) != 0) {
+        const std::string e = sys_error("cannot sync", tmp);
+        ::close(fd);
+        ::unlink(tmp.c_str());
+        return e;
+    }
+    ::close(fd);
+    if (::rename(tmp.c_str(), file_.c_str()) != 0) {
+        const std::string e = sys_error("cannot rename onto", file_);
+        ::unlink(tmp.c_str());
+        return e;
+    }
+    const int dfd = ::open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (dfd < 0) return sys_error("cannot open", dir_);
+    const bool synced = ::fsync(dfd) == 0;
+    ::close(dfd);
+    return synced ? std::string{} : sys_error("cannot sync", dir_);
+}
+
+void EepromWrites::apply(std::vector<uint8_t>& image) const {
+    for (const auto& [address, value] : words_) {
+        const std::size_t at = 2 * static_cast<std::size_t>(address);
+        if (at + 1 >= image.size()) continue;
+        image[at] = static_cast<uint8_t>(value);
+        image[at + 1] = static_cast<uint8_t>(value >> 8);
+    }
+}
+
+}  // namespace softdrive
