@@ -140,6 +140,9 @@ class OfflineOutputs(unittest.TestCase):
         r = self.run_slave("--config", conf, "--write-sii", os.path.join(self.dir, "x.sii"))
         self.assertEqual(r.returncode, 2)
         self.assertIn("no-such-option", r.stderr)
+        r = self.run_slave("--control", "/nonexistent-dir/ctl.sock", "--iface", "lo")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("--control", r.stderr)
 
 
 class RunTime(unittest.TestCase):

@@ -1,6 +1,7 @@
 // ecat-slave: parses the command line (and the configuration file) and hands over to
 // softslave::run_slave() with the soft drive (softdrive) as firmware.
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -62,12 +63,15 @@ int main(int argc, char** argv) {
     app.add_option("--state-dir", state_dir,
                    "Directory for stored parameters and firmware images (created if missing)")
         ->capture_default_str();
-    app.add_option("--write-sii", write_sii, "Write the device's SII EEPROM image to FILE and exit");
-    app.add_option("--write-esi", write_esi, "Write the device's ESI (EtherCATInfo XML) to FILE and exit");
+    app.add_option("--write-sii", write_sii, "Write the device's SII EEPROM image to FILE and exit")
+        ->type_name("FILE");
+    app.add_option("--write-esi", write_esi, "Write the device's ESI (EtherCATInfo XML) to FILE and exit")
+        ->type_name("FILE");
     app.add_option("--control", control,
                    "Create a UNIX datagram socket here that changes the simulated machine at run time "
                    "(lines like 'input 4 on', 'sto off', 'limit-pos 50000', 'status'; "
-                   "e.g. echo 'input 4 on' | nc -uU -w0 PATH)");
+                   "e.g. echo 'input 4 on' | nc -uUN -w0 PATH)")
+        ->type_name("PATH");
     auto* env = app.add_option_group("Simulated machine", "Positions in raw encoder increments");
     env->add_option("--limit-neg", device.environment.negative_limit,
                     "Negative limit switch (DigIN1), active at and below this position");
@@ -103,6 +107,14 @@ int main(int argc, char** argv) {
     if (auto* config = app.get_config_ptr(); config != nullptr && config->count() > 0)
         device.config_file = config->as<std::string>();
     device.state_dir = state_dir;
+    if (!control.empty()) {
+        const std::filesystem::path parent = std::filesystem::absolute(control).parent_path();
+        std::error_code ec;
+        if (!std::filesystem::is_directory(parent, ec)) {
+            std::cerr << "ecat-slave: --control: directory " << parent.string() << " does not exist\n";
+            return softslave::kExitUsage;
+        }
+    }
 
     try {
         if (!write_sii.empty() || !write_esi.empty()) {
