@@ -133,3 +133,35 @@ TEST(ControlSocket, ReplacesAStaleSocketAndRemovesItsFile) {
     }
     EXPECT_THROW(ControlSocket(r.dir / std::string(200, 'x')), std::runtime_error);
 }
+
+TEST(ControlCommands, RandomLinesNeverBreakTheDevice) {
+    Rig r;
+    uint32_t x = 12345;
+    auto next = [&x] {
+        x ^= x << 13, x ^= x >> 17, x ^= x << 5;
+        return x;
+    };
+    const char* words[] = {"input", "sto",  "limit-neg", "limit-pos", "home", "stops", "status",
+                           "on",    "off",  "none",      "1",         "-1",   "1e308", "nan",
+                           "inf",   "0x10", "6",         "7",         "\t",   " "};
+    for (int i = 0; i < 5000; ++i) {
+        std::string line;
+        const int n = static_cast<int>(next() % 5);
+        for (int k = 0; k < n; ++k) {
+            if (next() % 4 == 0) {
+                line.push_back(static_cast<char>(next() & 0xFF));
+            } else {
+                line += words[next() % std::size(words)];
+                line.push_back(' ');
+            }
+        }
+        const std::string answer = ControlSocket::apply(*r.dev, line);
+        EXPECT_TRUE(answer.empty() || answer.rfind("ok", 0) == 0 || answer.rfind("error: ", 0) == 0)
+            << line << " -> " << answer;
+        if (i % 100 == 0) r.run(1);
+    }
+    const auto& env = r.dev->environment();
+    for (double v :
+         {env.negative_limit, env.positive_limit, env.home_from, env.home_to, env.stop_lo, env.stop_hi})
+        EXPECT_TRUE(std::isnan(v) || std::isfinite(v));
+}
