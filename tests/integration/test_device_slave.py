@@ -170,6 +170,34 @@ class RunTime(unittest.TestCase):
             self.assertTrue(s.recv(256).startswith(b"error: "))
             self.assertTrue(bus.slave_alive())
 
+    def test_drive_moves_and_reacts_to_the_watchdog(self):
+        with harness.Bus() as bus:
+            if "--step" not in bus.ecatctl("pd", "--help").stdout:
+                self.skipTest("ecatctl pd has no --step")
+            bus.ecatctl("download", "0", "0x6081", "0", "3000", "--type", "u32")  # profile velocity
+            # Profile position (mode 1 at output byte 16) to 30000 inc: shutdown, switch on, enable, new set-point.
+            t = "30,75,00,00"
+            z = ",".join(["00"] * 10)
+            steps = []
+            for cw in ("06", "07", "0f"):
+                steps += ["--step", f"20:{cw},00,{t},{z},01"]
+            out = "0x1f 0 0x30 0x75 0 0 0 0 0 0 0 0 0 0 0 0 1".split()
+            r = bus.ecatctl("pd", "0", "--cycle-us", "1000", *steps, "-n", "1200", "--keep", "--outputs", *out)
+            self.assertIn("state: OP\n", r.stdout)
+            m = re.search(r"0x0000: ([0-9a-f]{2}) ([0-9a-f]{2}) ([0-9a-f]{2}) ([0-9a-f]{2}) ([0-9a-f]{2}) ([0-9a-f]{2})",
+                          r.stdout)
+            sw = int(m.group(1), 16) | int(m.group(2), 16) << 8
+            pos = int.from_bytes(bytes(int(m.group(i), 16) for i in range(3, 7)), "little", signed=True)
+            self.assertEqual(sw & 0x6F, 0x27, r.stdout)  # operation enabled
+            self.assertLessEqual(abs(pos - 30000), 5, r.stdout)  # at the target (position window)
+            # The master is gone (--keep): SM watchdog -> SAFEOP + error 0x001B, and the drive's 0x6007 reaction
+            # (3: quick-stop ramp, then Fault 0x8180) completes although nobody cycles any more.
+            time.sleep(0.5)
+            self.assertTrue(bus.ecatctl("state", "0").stdout.strip().startswith("SAFEOP +ERR 0x001b"))
+            self.assertEqual(bus.ecatctl("upload", "0", "0x603f", "0").stdout.strip(), "0x8180 (33152)")
+            sw = int(bus.ecatctl("upload", "0", "0x6041", "0", "--type", "u16").stdout.split()[0], 16)
+            self.assertEqual(sw & 0x4F, 0x08, hex(sw))  # Fault
+
     def test_statistics_at_exit(self):
         d = tempfile.mkdtemp(dir=out_dir())
         self.addCleanup(shutil.rmtree, d, True)
