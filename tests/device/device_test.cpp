@@ -487,3 +487,21 @@ TEST_F(DeviceTest, EepromWordsAMasterWritesSurviveARestartAndAPowerCycle) {
     EXPECT_EQ(esi::parse_sii(drive.esc->eeprom()).station_alias, 0);
     EXPECT_NE(drive.log.str().find("not used"), std::string::npos) << drive.log.str();
 }
+
+TEST_F(DeviceTest, ARestartThatCannotBuildKeepsTheRunningFirmware) {
+    AlStatus st;
+    ASSERT_EQ(m.request_state(a, AlState::Init, &st), Error::Ok);
+    Mailbox boot(m, a);
+    ASSERT_EQ(boot.configure_from_sii(true), Error::Ok);
+    ASSERT_EQ(m.request_state(a, AlState::Boot, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
+    // The state directory goes away and a file takes its place: the rebuild cannot create it.
+    std::filesystem::remove_all(dir);
+    { std::ofstream(dir) << "not a directory"; }
+    ASSERT_EQ(m.request_state(a, AlState::Init, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
+    EXPECT_EQ(drive.dev->stats().builds, 1u);
+    EXPECT_NE(drive.log.str().find("restart failed"), std::string::npos) << drive.log.str();
+    ASSERT_NO_FATAL_FAILURE(to_preop());
+    EXPECT_EQ(sdo_u32(0x1018, 1), 0xFBu);
+    std::filesystem::remove(dir);
+    std::filesystem::create_directories(dir);
+}

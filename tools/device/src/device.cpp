@@ -93,13 +93,15 @@ Device::Device(esc::Esc& esc, DeviceOptions options)
         if (const std::string error = eeprom_writes_.load(); !error.empty())
             log() << "softdrive: " << eeprom_writes_.file().string() << " not used (" << error
                   << "); serving the SII as built\n";
+    }
+    build();
+    // Registered once the device exists: a constructor that throws leaves no callback behind.
+    if (options_.load_sii)
         esc_.on_eeprom_write([this](uint16_t address, uint16_t value) {
             eeprom_writes_.record(address, value);
             eeprom_dirty_ = true;
             eeprom_save_ns_ = 0;  // scheduled by the next poll()
         });
-    }
-    build();
 }
 
 Device::~Device() {
@@ -125,8 +127,8 @@ void Device::build() {
         throw std::runtime_error("cannot create the state directory '" + options_.state_dir.string() +
                                  "': " + ec.message());
 
-    // Tear down the old device first: its servers hold references into its dictionary and store.
-    parts_.reset();
+    // The new device is built beside the old one and replaces it only when complete: a restart that fails
+    // (e.g. the state directory became unusable) leaves the old firmware running.
     auto p = std::make_unique<Parts>();
     p->desc = base_description(options_);
     p->firmware = std::make_unique<foe::FirmwareUpdate>(options_.state_dir, p->desc);
@@ -154,10 +156,10 @@ void Device::build() {
         return (raw->dict.get<uint16_t>(0x6041, 0) & 0x0002) != 0 ? od::Status::WrongState : od::Status::Ok;
     });
 
+    std::vector<uint8_t> image;
     if (options_.load_sii) {
-        std::vector<uint8_t> image = esi::build_sii(p->desc, p->dict);
+        image = esi::build_sii(p->desc, p->dict);
         eeprom_writes_.apply(image);
-        esc_.load_eeprom(image);
     }
 
     p->stack = std::make_unique<ecat::Stack>(esc_, p->dict, p->desc, *this, [this] { return esc_.irq(); });
@@ -169,6 +171,7 @@ void Device::build() {
     p->stack->add_handler(p->firmware->server());
     p->drive = std::make_unique<drive::Drive>(p->dict, this);
 
+    if (options_.load_sii) esc_.load_eeprom(image);
     parts_ = std::move(p);
     restart_pending_ = false;
     outputs_lost_reported_ = false;
@@ -210,7 +213,12 @@ void Device::poll(uint64_t now_ns) {
     parts_->stack->poll(now_ns);
     // The restart runs here, after the Stack's poll() returned: the Stack is destroyed with the rest.
     if (restart_pending_) {
-        build();
+        restart_pending_ = false;
+        try {
+            build();
+        } catch (const std::exception& e) {
+            log() << "softdrive: restart failed, the running firmware stays: " << e.what() << '\n';
+        }
         parts_->stack->poll(now_ns);
     }
     // The drive's own loop: it runs when no master cycle drives it (outside Op), as the controller of a
