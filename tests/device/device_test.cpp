@@ -505,3 +505,33 @@ TEST_F(DeviceTest, ARestartThatCannotBuildKeepsTheRunningFirmware) {
     std::filesystem::remove(dir);
     std::filesystem::create_directories(dir);
 }
+
+TEST_F(DeviceTest, DcSync0OpRunsTheDriveOnEverySync0) {
+    ProcessDataSession pd(m, a, sdo);
+    ASSERT_EQ(pd.discover(), Error::Ok);
+    DcConfig dc;
+    dc.enable = true;
+    dc.cycle_ns = 1'000'000;
+    dc.start_delay = std::chrono::milliseconds(20);
+    ASSERT_EQ(pd.configure(dc), Error::Ok) << std::hex << sdo.last_abort();
+    drive.frame_ns = 1'000'000;  // one exchange per SYNC0 period of slave time
+    const int cw = pdo_offset(drive.dict(), 0x1C12, 0x6040, 0);
+    const int mode = pdo_offset(drive.dict(), 0x1C12, 0x6060, 0);
+    auto fill = [&] {
+        put<uint16_t>(pd.outputs(), cw, 0);
+        put<int8_t>(pd.outputs(), mode, 8);
+    };
+    AlStatus st;
+    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(50), &st, fill), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(50), &st, fill), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    EXPECT_EQ(drive.dev->stack().sync_mode(), ecat::SyncMode::DcSync0);
+    const uint64_t sync0 = drive.dev->stack().stats().sync0_events;
+    const uint64_t cycles = drive.dev->stats().cycles;
+    ASSERT_EQ(pd.run(200, std::chrono::microseconds(20), fill), Error::Ok);
+    EXPECT_EQ(pd.stats().wkc_errors, 0u);
+    EXPECT_GE(drive.dev->stack().stats().sync0_events - sync0, 190u);
+    EXPECT_GE(drive.dev->stats().cycles - cycles, 190u);
+    EXPECT_EQ(drive.dict().get<uint16_t>(0x1C32, 1), 2) << "0x1C32:01 says DC SYNC0";
+}
