@@ -535,3 +535,28 @@ TEST_F(DeviceTest, DcSync0OpRunsTheDriveOnEverySync0) {
     EXPECT_GE(drive.dev->stats().cycles - cycles, 190u);
     EXPECT_EQ(drive.dict().get<uint16_t>(0x1C32, 1), 2) << "0x1C32:01 says DC SYNC0";
 }
+
+TEST_F(DeviceTest, LeavingOpOnRequestReactsOnlyWhileTheDriveIsEnabled) {
+    ProcessDataSession pd(m, a, sdo);
+    ASSERT_NO_FATAL_FAILURE(to_op(pd));
+    drive.frame_ns = 1'000'000;
+    // Disabled drive: a master that switches back to Safe-Op is no communication failure.
+    AlStatus st;
+    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(20), &st), Error::Ok);
+    drive.idle(50'000'000);
+    EXPECT_EQ(drive.dict().get<uint16_t>(0x603F, 0), 0);
+    EXPECT_EQ(drive.dict().get<uint16_t>(0x6041, 0) & 0x0008, 0);
+    // Enabled drive: the same request gets the 0x6007 reaction (quick stop, then Fault 0x8180).
+    auto fill = [&] {
+        put<uint16_t>(pd.outputs(), out_cw, 0);
+        put<int8_t>(pd.outputs(), out_mode, 8);
+        put<int32_t>(pd.outputs(), out_target, drive.dict().get<int32_t>(0x6064, 0));
+    };
+    ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(20), &st, fill), Error::Ok);
+    ASSERT_NO_FATAL_FAILURE(enable(pd, take<int32_t>(pd.inputs(), in_pos)));
+    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(20), &st), Error::Ok);
+    EXPECT_FALSE(st.error);
+    drive.idle(300'000'000);
+    EXPECT_EQ(drive.dict().get<uint16_t>(0x603F, 0), 0x8180);
+    EXPECT_EQ(drive.dict().get<uint16_t>(0x6041, 0) & 0x004F, 0x0008);
+}

@@ -174,7 +174,7 @@ void Device::build() {
     if (options_.load_sii) esc_.load_eeprom(image);
     parts_ = std::move(p);
     restart_pending_ = false;
-    outputs_lost_reported_ = false;
+    outputs_lost_pending_ = false;
     last_cycle_ns_ = 0;
     ++stats_.builds;
     apply_environment();
@@ -211,6 +211,7 @@ void Device::set_environment(const EnvironmentOptions& environment) {
 
 void Device::poll(uint64_t now_ns) {
     parts_->stack->poll(now_ns);
+    if (outputs_lost_pending_) react_to_outputs_lost();  // after poll(): the error indication is set by now
     // The restart runs here, after the Stack's poll() returned: the Stack is destroyed with the rest.
     if (restart_pending_) {
         restart_pending_ = false;
@@ -266,10 +267,8 @@ uint16_t Device::check_transition(od::AlState /*from*/, od::AlState /*to*/) {
 }
 
 void Device::on_state_change(od::AlState from, od::AlState to) {
-    // Leaving Op: the drive's 0x6007 reaction, unless the stack already reported the outputs lost.
-    if (from == od::AlState::Op && to != od::AlState::Op && !outputs_lost_reported_)
-        parts_->drive->connection_lost();
-    if (to == od::AlState::Op) outputs_lost_reported_ = false;
+    // Leaving Op by any path ends the outputs, whether or not on_outputs_lost() came first.
+    if (from == od::AlState::Op && to != od::AlState::Op) outputs_lost_pending_ = true;
 }
 
 void Device::on_cycle(uint64_t now_ns) {
@@ -277,8 +276,18 @@ void Device::on_cycle(uint64_t now_ns) {
 }
 
 void Device::on_outputs_lost() {
-    outputs_lost_reported_ = true;
-    parts_->drive->connection_lost();
+    outputs_lost_pending_ = true;
+}
+
+void Device::react_to_outputs_lost() {
+    outputs_lost_pending_ = false;
+    // A fall-back (watchdog, sync loss: the stack set the error indication) is a communication failure:
+    // 0x8180 with the 0x6007 reaction in any drive state. A master that asks to leave Op is not an error; it
+    // gets the reaction only while its outputs were commanding motion (operation enabled, statusword bit 2).
+    const bool fall_back = parts_->stack->error();
+    const od::Entry* sw = parts_->dict.find(0x6041, 0);
+    const bool enabled = sw != nullptr && (parts_->dict.get<uint16_t>(0x6041, 0) & 0x0004) != 0;
+    if (fall_back || enabled) parts_->drive->connection_lost();
 }
 
 void Device::on_restart() {

@@ -143,6 +143,7 @@ class Device final : public ecat::Application, public drive::EventSink {
     void apply_environment();
     void run_drive(uint64_t now_ns);
     void save_eeprom_writes();
+    void react_to_outputs_lost();
     std::ostream& log() const;
 
     esc::Esc& esc_;
@@ -150,8 +151,8 @@ class Device final : public ecat::Application, public drive::EventSink {
     std::unique_ptr<Parts> parts_;
     std::array<int8_t, 6> inputs_{-1, -1, -1, -1, -1, -1};  // user-set pin levels, -1: untouched
     bool restart_pending_ = false;
-    bool outputs_lost_reported_ = false;
-    uint64_t last_cycle_ns_ = 0;  // last drive cycle (master's or our own); 0: none since the build
+    bool outputs_lost_pending_ = false;  // outputs ended in this poll(); reacted to when it returns
+    uint64_t last_cycle_ns_ = 0;         // last drive cycle (master's or our own); 0: none since the build
     DeviceStats stats_;
     EepromWrites eeprom_writes_;
     bool eeprom_dirty_ = false;
