@@ -7,7 +7,7 @@
 //
 // Master side it counts lost replies, working-counter errors, late replies (back after the next cycle
 // should have started) and missed cycles (the loop woke a whole period or more late); slave side it reads
-// the stack's statistics that ecat-slave --verbose prints at exit: SYNC0 periods without a cycle,
+// the stack's statistics that ecat-slave writes at exit (--stats-file): SYNC0 periods without a cycle,
 // SYNC0 without new outputs, and the lateness of the application cycle after its SYNC0 pulse measured
 // against the DC system time (p50 / p99 / max). Prints one table; asserts nothing.
 //
@@ -31,7 +31,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iostream>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -46,9 +45,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
-#include "softdrive/firmware.hpp"
 #include "softslave/netif.hpp"
-#include "softslave/slave.hpp"
 
 namespace {
 
@@ -156,58 +153,7 @@ class SlaveProcess {
     int exit_status_ = -1;
 };
 
-// --slave builtin: this program runs the slave itself (re-executed as `bench-cycle --as-slave ...`): the
-// same runtime (softslave::run_slave) and the same firmware (softdrive::DeviceFirmware) as ecat-slave, plus
-// the stack's statistics at exit for a DeviceFirmware that does not report them itself.
-class ReportingFirmware final : public softslave::Firmware {
-  public:
-    explicit ReportingFirmware(std::unique_ptr<softslave::Firmware> inner) : inner_(std::move(inner)) {}
-    void poll(uint64_t now_ns) override { inner_->poll(now_ns); }
-    uint64_t next_deadline_ns() const override { return inner_->next_deadline_ns(); }
-    int control_fd() const override { return inner_->control_fd(); }
-    void on_control(uint64_t now_ns) override { inner_->on_control(now_ns); }
-    void report(std::ostream& out) const override {
-        std::ostringstream own;
-        inner_->report(own);
-        out << own.str();
-        if (own.str().find("stack.") != std::string::npos) return;
-        if (auto* d = dynamic_cast<softdrive::DeviceFirmware*>(inner_.get())) d->device().stack().report(out);
-    }
-
-  private:
-    std::unique_ptr<softslave::Firmware> inner_;
-};
-
-int run_as_slave(int argc, char** argv) {
-    softslave::SlaveOptions options;
-    softdrive::DeviceOptions device;
-    for (int i = 2; i + 1 < argc; i += 2) {
-        const std::string a = argv[i], v = argv[i + 1];
-        if (a == "--iface") {
-            options.iface = v;
-        } else if (a == "--state-dir") {
-            device.state_dir = v;
-        } else if (a == "--backend") {
-            options.backend = v;
-        } else if (a == "--rt-priority") {
-            options.rt_priority = std::atoi(v.c_str());
-        } else if (a == "--cpu") {
-            options.cpu = std::atoi(v.c_str());
-        } else {
-            std::fprintf(stderr, "bench-cycle --as-slave: unknown option %s\n", a.c_str());
-            return 2;
-        }
-    }
-    options.verbose = true;
-    options.eeprom_loader = softdrive::eeprom_loader(device);
-    auto factory = softdrive::firmware_factory(device);
-    options.firmware_factory = [factory](esc::Esc& esc, const softslave::SlaveOptions& o) {
-        return std::unique_ptr<softslave::Firmware>(std::make_unique<ReportingFirmware>(factory(esc, o)));
-    };
-    return softslave::run_slave(options, std::cout, std::cerr);
-}
-
-// "stack.cycles 123" lines of the slave's log.
+// "stack.cycles 123" lines of the slave's --stats-file (or of its --verbose output).
 std::map<std::string, uint64_t> read_figures(const std::string& log) {
     std::map<std::string, uint64_t> m;
     std::ifstream in(log);
@@ -370,12 +316,9 @@ Result run_one(const Options& o, unsigned cycle_us, const std::filesystem::path&
     Result r;
     r.cycle_us = cycle_us;
     const std::string log = (dir / ("slave-" + std::to_string(cycle_us) + "us.log")).string();
-    std::vector<std::string> args;
-    if (o.slave_path == "builtin")
-        args = {"/proc/self/exe", "--as-slave"};
-    else
-        args = {o.slave_path, "--verbose"};
-    args.insert(args.end(), {"--iface", kSlaveEnd, "--state-dir", (dir / "state").string()});
+    const std::string stats = (dir / ("slave-" + std::to_string(cycle_us) + "us.stats")).string();
+    std::vector<std::string> args = {o.slave_path, "--verbose", "--stats-file", stats,
+                                     "--iface",    kSlaveEnd,   "--state-dir",  (dir / "state").string()};
     if (!o.backend.empty()) args.insert(args.end(), {"--backend", o.backend});
     if (o.rt_priority > 0) args.insert(args.end(), {"--rt-priority", std::to_string(o.rt_priority)});
     if (o.slave_cpu >= 0) args.insert(args.end(), {"--cpu", std::to_string(o.slave_cpu)});
@@ -392,7 +335,7 @@ Result run_one(const Options& o, unsigned cycle_us, const std::filesystem::path&
         if (status != -1 && !(WIFEXITED(status) && WEXITSTATUS(status) == 0))
             r.failure += (r.failure.empty() ? "" : "; ") + std::string("ecat-slave did not exit cleanly");
     }
-    r.slave = read_figures(log);
+    r.slave = read_figures(std::filesystem::exists(stats) ? stats : log);
     if (!r.failure.empty() || o.verbose) {
         std::ifstream in(log);
         std::fprintf(stderr, "---- ecat-slave log (%u us) ----\n%s", cycle_us,
@@ -474,9 +417,7 @@ void usage() {
         "[--phase PERCENT]\n"
         "                   [--keep-logs DIR] [--verbose]\n"
         "  --seconds N        measured time per cycle time (default 60; 5 is a quick check)\n"
-        "  --slave PATH       the slave program (default: the ecat-slave of this build); builtin: run\n"
-        "                     the same runtime and drive firmware from this program, with the stack's\n"
-        "                     figures even where ecat-slave's firmware does not report them\n"
+        "  --slave PATH       the slave program (default: the ecat-slave of this build)\n"
         "  --cycles-us LIST   cycle times in microseconds (default 1000,250,125)\n"
         "  --rt-priority N    SCHED_FIFO priority of master and slave (default 80), --no-rt: none\n"
         "  --master-cpu/--slave-cpu N  pin to a CPU (default 0 / 1; -1: not pinned)\n"
@@ -499,7 +440,6 @@ bool parse_list(const std::string& s, std::vector<unsigned>& out) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    if (argc > 1 && std::string(argv[1]) == "--as-slave") return run_as_slave(argc, argv);
     Options o;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -560,7 +500,7 @@ int main(int argc, char** argv) {
                      "run it with sudo\n");
         return 2;
     }
-    if (o.slave_path != "builtin" && ::access(o.slave_path.c_str(), X_OK) != 0) {
+    if (::access(o.slave_path.c_str(), X_OK) != 0) {
         std::fprintf(stderr, "bench-cycle: cannot run the slave %s\n", o.slave_path.c_str());
         return 2;
     }
