@@ -1,0 +1,166 @@
+// ecatctl diag [slave] [--oldest-first] [--new] [--ack]: the diagnosis history 0x10F3 (ETG.1020) read over
+// CoE SDO and printed as text: the header subindices, the flags, then one line per message with its time
+// stamp (DC system time), type, diag code, text and parameters. Texts of emergency-derived codes come from
+// the drive's error table (drive::find_error) when ecatctl is built with the drive library.
+#include "cmd_diag.hpp"
+
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "format.hpp"
+#include "master/coe.hpp"
+#include "master/diag.hpp"
+#include "master/mailbox.hpp"
+#ifdef ECATCTL_HAVE_DRIVE
+#include "drive/errors.hpp"
+#endif
+
+namespace ecatctl {
+
+namespace {
+
+using master::Error;
+
+struct DiagArgs {
+    std::string slave = "0";
+    bool station = false;
+    bool oldest_first = false;
+    bool only_new = false;
+    bool ack = false;
+};
+
+std::string_view drive_error_name(uint16_t code) {
+#ifdef ECATCTL_HAVE_DRIVE
+    if (const drive::ErrorInfo* e = drive::find_error(code)) return e->name;
+#else
+    (void)code;
+#endif
+    return {};
+}
+
+int report(const master::SdoClient& sdo, Error e, const char* what) {
+    if (e == Error::SdoAbort) {
+        std::fprintf(stderr, "ecatctl: %s: SDO abort 0x%08x (%s)\n", what, sdo.last_abort(),
+                     std::string(master::sdo_abort_text(sdo.last_abort())).c_str());
+        return kExitProtocol;
+    }
+    if (e == Error::MailboxError) {
+        std::fprintf(stderr, "ecatctl: %s: mailbox error 0x%04x\n", what, sdo.last_mailbox_error());
+        return kExitProtocol;
+    }
+    std::fprintf(stderr, "ecatctl: %s: %s\n", what, std::string(master::to_string(e)).c_str());
+    return e == Error::Timeout || e == Error::MailboxTimeout ? kExitNoSlave : kExitProtocol;
+}
+
+// Same rule as the SDO verbs: a slave in INIT gets its mailbox from the SII and goes to PREOP.
+Error open_mailbox(master::Master& m, master::Mailbox& mbx, master::Address a) {
+    auto st = m.al_status(a);
+    if (!st) return st.error();
+    if (st->state == static_cast<uint8_t>(master::AlState::Init)) {
+        if (Error e = mbx.configure_from_sii(); e != Error::Ok) return e;
+        return m.request_state(a, master::AlState::PreOp);
+    }
+    return mbx.adopt_current();
+}
+
+int run_diag(master::Master& m, const DiagArgs& d) {
+    auto v = parse_number(d.slave, 0xFFFF);
+    if (!v) {
+        std::fprintf(stderr, "ecatctl: bad slave '%s'\n", d.slave.c_str());
+        return kExitUsage;
+    }
+    const auto a = d.station ? master::Address::station(static_cast<uint16_t>(*v))
+                             : master::Address::position(static_cast<uint16_t>(*v));
+    master::Mailbox mbx(m, a);
+    if (Error e = open_mailbox(m, mbx, a); e != Error::Ok) {
+        std::fprintf(stderr, "ecatctl: opening the mailbox: %s\n", std::string(master::to_string(e)).c_str());
+        return e == Error::Timeout ? kExitNoSlave : kExitProtocol;
+    }
+    master::SdoClient sdo(mbx);
+    uint8_t buf[8];
+    auto read_uint = [&](uint8_t sub, uint16_t& out) -> Error {
+        auto n = sdo.upload(master::kDiagIndex, sub, buf);
+        if (!n) return n.error();
+        if (*n < 1 || *n > 2) return Error::MailboxProtocol;
+        out = static_cast<uint16_t>(buf[0] | (*n == 2 ? buf[1] << 8 : 0));
+        return Error::Ok;
+    };
+    master::DiagHeader h;
+    uint16_t val = 0;
+    static const char* const kWhat[] = {"",
+                                        "reading 0x10F3:01",
+                                        "reading 0x10F3:02",
+                                        "reading 0x10F3:03",
+                                        "reading 0x10F3:04",
+                                        "reading 0x10F3:05"};
+    for (uint8_t sub = 1; sub <= 5; ++sub) {
+        if (Error e = read_uint(sub, val); e != Error::Ok) return report(sdo, e, kWhat[sub]);
+        switch (sub) {
+            case 1:
+                h.max_messages = static_cast<uint8_t>(val);
+                break;
+            case 2:
+                h.newest = static_cast<uint8_t>(val);
+                break;
+            case 3:
+                h.acknowledged = static_cast<uint8_t>(val);
+                break;
+            case 4:
+                h.new_available = val != 0;
+                break;
+            default:
+                h.flags = val;
+        }
+    }
+    std::printf("diagnosis history 0x10F3: %u messages at most, newest :%02u, acknowledged :%02u, %s\n",
+                h.max_messages, h.newest, h.acknowledged,
+                h.new_available ? "new messages" : "no new messages");
+    std::printf("flags 0x%04x: %s\n", h.flags, master::format_diag_flags(h.flags).c_str());
+
+    const auto order = master::diag_message_order(h, !d.oldest_first, d.only_new);
+    std::vector<uint8_t> msg(512);
+    unsigned shown = 0;
+    for (uint8_t sub : order) {
+        auto n = sdo.upload(master::kDiagIndex, sub, msg);
+        if (!n) {
+            char what[40];
+            std::snprintf(what, sizeof what, "reading 0x10F3:%02x", sub);
+            return report(sdo, n.error(), what);
+        }
+        auto e = master::decode_diag_message(std::span<const uint8_t>(msg.data(), *n), sub);
+        if (!e) continue;  // an empty slot of a ring not yet full
+        std::printf("%s\n", master::format_diag_line(*e, drive_error_name).c_str());
+        ++shown;
+    }
+    if (shown == 0) std::printf("%s\n", d.only_new ? "no new messages" : "no messages");
+
+    if (d.ack && h.newest != 0) {
+        const uint8_t newest = h.newest;
+        if (Error e = sdo.download(master::kDiagIndex, 3, std::span<const uint8_t>(&newest, 1));
+            e != Error::Ok)
+            return report(sdo, e, "acknowledging (0x10F3:03)");
+        std::printf("acknowledged up to :%02u%s\n", newest,
+                    (h.flags & master::kDiagFlagAcknowledgeMode) ? "" : " (the slave is in overwrite mode)");
+    }
+    return kExitOk;
+}
+
+}  // namespace
+
+void add_diag_command(CLI::App& app, MasterRunner run, int& rc) {
+    auto args = std::make_shared<DiagArgs>();
+    auto* c = app.add_subcommand("diag", "Print the diagnosis history (0x10F3) read through CoE SDO");
+    c->add_option("slave", args->slave, "Slave position (or station address with --station)")
+        ->capture_default_str();
+    c->add_flag("-s,--station", args->station, "<slave> is a station address");
+    c->add_flag("--oldest-first", args->oldest_first, "Oldest message first (default: newest first)");
+    c->add_flag("--new", args->only_new, "Only messages newer than the acknowledged one");
+    c->add_flag("--ack", args->ack, "Acknowledge up to the newest message afterwards (write 0x10F3:03)");
+    c->callback([args, run = std::move(run), &rc] {
+        rc = run([&](master::Master& m) { return run_diag(m, *args); });
+    });
+}
+
+}  // namespace ecatctl

@@ -1,0 +1,282 @@
+#include "master/diag.hpp"
+
+#include <cstdio>
+
+namespace master {
+
+namespace {
+
+uint16_t le16(const uint8_t* p) {
+    return static_cast<uint16_t>(p[0] | (p[1] << 8));
+}
+uint32_t le32(const uint8_t* p) {
+    return static_cast<uint32_t>(le16(p)) | (static_cast<uint32_t>(le16(p + 2)) << 16);
+}
+uint64_t le64(const uint8_t* p) {
+    return static_cast<uint64_t>(le32(p)) | (static_cast<uint64_t>(le32(p + 4)) << 32);
+}
+
+constexpr std::size_t kHead = 16;
+
+uint64_t le_n(std::span<const uint8_t> d) {
+    uint64_t v = 0;
+    for (std::size_t i = d.size(); i-- > 0;)
+        v = (v << 8) | d[i];
+    return v;
+}
+
+bool is_signed(uint16_t t) {
+    return t == 0x0002 || t == 0x0003 || t == 0x0004 || t == 0x0010 || (t >= 0x0012 && t <= 0x0015);
+}
+
+}  // namespace
+
+std::size_t diag_value_size(uint16_t t) {
+    switch (t) {
+        case 0x0001:  // BOOLEAN
+        case 0x0002:  // INTEGER8
+        case 0x0005:  // UNSIGNED8
+            return 1;
+        case 0x0003:  // INTEGER16
+        case 0x0006:  // UNSIGNED16
+            return 2;
+        case 0x0010:  // INTEGER24
+        case 0x0016:  // UNSIGNED24
+            return 3;
+        case 0x0004:  // INTEGER32
+        case 0x0007:  // UNSIGNED32
+        case 0x0008:  // REAL32
+            return 4;
+        case 0x0012:  // INTEGER40
+        case 0x0018:  // UNSIGNED40
+            return 5;
+        case 0x000C:  // TIME_OF_DAY
+        case 0x000D:  // TIME_DIFFERENCE
+        case 0x0013:  // INTEGER48
+        case 0x0019:  // UNSIGNED48
+            return 6;
+        case 0x0014:  // INTEGER56
+        case 0x001A:  // UNSIGNED56
+            return 7;
+        case 0x0011:  // REAL64
+        case 0x0015:  // INTEGER64
+        case 0x001B:  // UNSIGNED64
+            return 8;
+        default:
+            return 0;
+    }
+}
+
+std::optional<DiagEntry> decode_diag_message(std::span<const uint8_t> bytes, uint8_t subindex) {
+    if (bytes.size() < kHead) return std::nullopt;
+    DiagEntry e;
+    e.subindex = subindex;
+    e.code = le32(bytes.data());
+    const uint16_t flags = le16(bytes.data() + 4);
+    e.type = static_cast<uint8_t>(flags & 0x0F);
+    e.local_time = (flags & 0x10) != 0;
+    e.text_id = le16(bytes.data() + 6);
+    e.timestamp_ns = le64(bytes.data() + 8);
+    // An erased slot (all zero) is no message.
+    bool all_zero = true;
+    for (uint8_t b : bytes.first(kHead))
+        all_zero = all_zero && b == 0;
+    if (all_zero) return std::nullopt;
+    const unsigned count = flags >> 8;
+    std::size_t at = kHead;
+    for (unsigned i = 0; i < count; ++i) {
+        if (at + 2 > bytes.size()) {
+            e.truncated = true;
+            break;
+        }
+        DiagParameter p;
+        p.flags = le16(bytes.data() + at);
+        const std::size_t len = p.kind() == 0 ? diag_value_size(p.flags & 0x0FFF) : (p.flags & 0x0FFFu);
+        if ((p.kind() == 0 && len == 0) || p.kind() > 3 || at + 2 + len > bytes.size()) {
+            e.truncated = true;  // unknown data type or kind: the rest cannot be delimited
+            break;
+        }
+        p.data.assign(bytes.begin() + static_cast<std::ptrdiff_t>(at + 2),
+                      bytes.begin() + static_cast<std::ptrdiff_t>(at + 2 + len));
+        e.params.push_back(std::move(p));
+        at += 2 + len;
+    }
+    return e;
+}
+
+std::vector<uint8_t> diag_message_order(const DiagHeader& h, bool newest_first, bool only_new) {
+    std::vector<uint8_t> out;
+    const unsigned max = h.max_messages;
+    if (max == 0 || h.newest < kDiagFirstMessage || h.newest >= kDiagFirstMessage + max) return out;
+    const bool acked_valid = h.acknowledged >= kDiagFirstMessage && h.acknowledged < kDiagFirstMessage + max;
+    // Walk backwards from the newest; stop at the acknowledged one when only new ones are asked for.
+    unsigned pos = h.newest - kDiagFirstMessage;
+    for (unsigned i = 0; i < max; ++i) {
+        const auto sub = static_cast<uint8_t>(kDiagFirstMessage + pos);
+        if (only_new && acked_valid && sub == h.acknowledged) break;
+        out.push_back(sub);
+        pos = (pos + max - 1) % max;
+    }
+    if (!newest_first) {
+        for (std::size_t i = 0, j = out.size(); i + 1 < j; ++i, --j)
+            std::swap(out[i], out[j - 1]);
+    }
+    return out;
+}
+
+std::string_view diag_type_name(uint8_t type) {
+    switch (type) {
+        case 0:
+            return "info";
+        case 1:
+            return "warning";
+        case 2:
+            return "error";
+        default:
+            return "unknown";
+    }
+}
+
+std::string format_diag_param(const DiagParameter& p) {
+    std::string s;
+    char b[64];
+    switch (p.kind()) {
+        case 0: {
+            const uint16_t t = p.flags & 0x0FFF;
+            const uint64_t v = le_n(p.data);
+            if (is_signed(t)) {
+                const unsigned bits = static_cast<unsigned>(p.data.size() * 8);
+                int64_t sv = static_cast<int64_t>(v);
+                if (bits < 64 && (v >> (bits - 1)) & 1) sv = static_cast<int64_t>(v | (~uint64_t{0} << bits));
+                std::snprintf(b, sizeof b, "%lld", static_cast<long long>(sv));
+            } else {
+                std::snprintf(b, sizeof b, "0x%0*llx (%llu)", static_cast<int>(p.data.size() * 2),
+                              static_cast<unsigned long long>(v), static_cast<unsigned long long>(v));
+            }
+            return b;
+        }
+        case 1:
+            s = "bytes";
+            for (uint8_t x : p.data) {
+                std::snprintf(b, sizeof b, " %02x", x);
+                s += b;
+            }
+            return s;
+        case 2:
+            s = "\"";
+            for (uint8_t x : p.data) {
+                if (x == 0) break;
+                s += (x >= 0x20 && x < 0x7F) ? static_cast<char>(x) : '?';
+            }
+            return s + "\"";
+        case 3:
+            s = "\"";
+            for (std::size_t i = 0; i + 1 < p.data.size(); i += 2) {
+                const uint16_t c = le16(p.data.data() + i);
+                if (c == 0) break;
+                s += (c >= 0x20 && c < 0x7F) ? static_cast<char>(c) : '?';
+            }
+            return s + "\"";
+        default:
+            return "?";
+    }
+}
+
+std::string_view emergency_class_name(uint16_t code) {
+    if (code == 0x0000) return "";
+    if ((code & 0xFF00) == 0x8100) return "communication error";
+    if ((code & 0xFF00) == 0x8200) return "protocol error";
+    switch (code >> 12) {
+        case 0x1:
+            return "generic error";
+        case 0x2:
+            return "current error";
+        case 0x3:
+            return "voltage error";
+        case 0x4:
+            return "temperature error";
+        case 0x5:
+            return "device hardware error";
+        case 0x6:
+            return "device software error";
+        case 0x7:
+            return "additional modules error";
+        case 0x8:
+            return "monitoring error";
+        case 0x9:
+            return "external error";
+        case 0xF:
+            return (code & 0xFF00) == 0xFF00 ? "device specific error" : "additional functions error";
+        default:
+            return "error code";
+    }
+}
+
+std::string diag_text(const DiagEntry& e, ErrorNameLookup lookup) {
+    if (e.from_emergency()) {
+        const uint16_t c = e.emergency_code();
+        if (c == 0x0000) return "no error (error reset)";
+        if (lookup != nullptr) {
+            const std::string_view n = lookup(c);
+            if (!n.empty()) return std::string(n);
+        }
+        return std::string(emergency_class_name(c));
+    }
+    if (e.text_id != 0) {
+        char b[48];
+        std::snprintf(b, sizeof b, "text id 0x%04x", e.text_id);
+        return b;
+    }
+    for (const auto& p : e.params) {
+        if (p.kind() == 2 || p.kind() == 3) {
+            const std::string quoted = format_diag_param(p);
+            return quoted.substr(1, quoted.size() - 2);
+        }
+    }
+    if ((e.code & 0xFFFF) >= 0xE000 && (e.code & 0xFFFF) < 0xE800) return "manufacturer-specific message";
+    return "";
+}
+
+std::string format_diag_time(uint64_t ns) {
+    char b[48];
+    std::snprintf(b, sizeof b, "%llu.%09llu s", static_cast<unsigned long long>(ns / 1000000000u),
+                  static_cast<unsigned long long>(ns % 1000000000u));
+    return b;
+}
+
+std::string format_diag_flags(uint16_t flags) {
+    std::string s;
+    auto add = [&](const char* t) {
+        if (!s.empty()) s += ", ";
+        s += t;
+    };
+    if (flags & kDiagFlagEmergency) add("send as emergency");
+    if (flags & kDiagFlagNoInfo) add("info not stored");
+    if (flags & kDiagFlagNoWarning) add("warnings not stored");
+    if (flags & kDiagFlagNoError) add("errors not stored");
+    add(flags & kDiagFlagAcknowledgeMode ? "acknowledge mode" : "overwrite mode");
+    if (flags & kDiagFlagOverflow) add("overflow");
+    if (flags & 0xFFC0) add("reserved bits set");
+    return s;
+}
+
+std::string format_diag_line(const DiagEntry& e, ErrorNameLookup lookup) {
+    char b[96];
+    std::snprintf(b, sizeof b, ":%02u  %s%s  %-7s  0x%08x  ", e.subindex,
+                  format_diag_time(e.timestamp_ns).c_str(), e.local_time ? " (local)" : "",
+                  std::string(diag_type_name(e.type)).c_str(), e.code);
+    std::string s = b;
+    s += diag_text(e, lookup);
+    if (!e.params.empty() || e.truncated) {
+        s += "  [";
+        for (std::size_t i = 0; i < e.params.size(); ++i) {
+            if (i) s += ", ";
+            s += format_diag_param(e.params[i]);
+        }
+        if (e.truncated) s += e.params.empty() ? "cut short" : ", cut short";
+        s += "]";
+    }
+    return s;
+}
+
+}  // namespace master
