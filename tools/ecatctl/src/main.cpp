@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cmd_diag.hpp"
+#include "cmd_firmware.hpp"
 #include "esc/link.hpp"
 #include "format.hpp"
 #include "master/coe.hpp"
@@ -675,6 +676,7 @@ struct FoeArgs {
     std::string output;
     std::string password = "0";
     bool stay = false;
+    bool progress = false;
 };
 
 int foe_failed(const master::FoeClient& foe, Error e, const std::string& what) {
@@ -741,7 +743,10 @@ int foe_transfer(master::Master& m, const FoeArgs& f, bool read) {
             std::cerr << "ecatctl: " << file->size() << " bytes written to " << f.output << "\n";
         }
     } else {
+        ProgressBar bar("writing '" + name + "'", f.progress);
+        foe.set_progress(bar.callback());
         const Error e = foe.write(name, data, static_cast<uint32_t>(*password));
+        bar.finish();
         if (e != Error::Ok)
             rc = foe_failed(foe, e, "writing '" + name + "'");
         else
@@ -926,10 +931,14 @@ int main(int argc, char** argv) {
     foe_wr->add_flag("-s,--station", fa.station, "--position is a station address");
     foe_wr->add_option("--password", fa.password, "FoE password")->capture_default_str();
     foe_wr->add_flag("--stay", fa.stay, "Stay in BOOT afterwards");
+    foe_wr->add_flag("--progress", fa.progress, "Show progress also when stderr is not a terminal");
     foe_wr->callback(
         [&] { rc = with_master(g, [&](master::Master& m) { return foe_transfer(m, fa, false); }); });
 
     add_diag_command(
+        app, [&](const auto& fn) { return with_master(g, fn); }, rc);
+
+    add_firmware_update(
         app, [&](const auto& fn) { return with_master(g, fn); }, rc);
 
     try {

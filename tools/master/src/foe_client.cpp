@@ -78,6 +78,7 @@ Result<std::vector<uint8_t>> FoeClient::read(std::string_view name, uint32_t pas
         }
         file.insert(file.end(), data.begin(), data.end());
         if (Error e = send(kAck, packet, {}); e != Error::Ok) return e;
+        if (progress_) progress_(FoeProgress{file.size(), 0, false});
         if (data.size() < full) return file;
     }
 }
@@ -104,6 +105,7 @@ Error FoeClient::write(std::string_view name, std::span<const uint8_t> data, uin
             if (op == kBusy) {
                 // Still working (e.g. storing the image): send the same packet again (SOEM).
                 ++busy_;
+                if (progress_) progress_(FoeProgress{done + n, data.size(), true});
                 if (Error e = send(kData, packet, chunk); e != Error::Ok) return e;
                 continue;
             }
@@ -111,6 +113,7 @@ Error FoeClient::write(std::string_view name, std::span<const uint8_t> data, uin
             break;
         }
         done += n;
+        if (progress_) progress_(FoeProgress{done, data.size(), false});
         if (n < full) return Error::Ok;  // a short (or empty) packet was the last one
     }
 }

@@ -3,6 +3,7 @@
 // shorter than the largest one ends the file (an empty one when the length is a multiple of it); BUSY
 // answers to a DATA packet make the client send that packet again.
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -12,9 +13,20 @@
 
 namespace master {
 
+// Progress of a transfer: bytes acknowledged so far, the total (0 when unknown, as on a read), and whether
+// the slave's last answer was BUSY (e.g. storing the image after the last DATA packet).
+struct FoeProgress {
+    std::size_t done = 0;
+    std::size_t total = 0;
+    bool busy = false;
+};
+
 class FoeClient {
   public:
     explicit FoeClient(Mailbox& mailbox);
+
+    // Called after each acknowledged DATA packet and each BUSY answer (never when empty).
+    void set_progress(std::function<void(const FoeProgress&)> callback) { progress_ = std::move(callback); }
 
     Result<std::vector<uint8_t>> read(std::string_view name, uint32_t password = 0,
                                       std::size_t max_size = 64u << 20);
@@ -35,6 +47,7 @@ class FoeClient {
     uint32_t last_error_ = 0;
     std::string last_error_text_;
     uint64_t busy_ = 0;
+    std::function<void(const FoeProgress&)> progress_;
 };
 
 }  // namespace master
