@@ -163,6 +163,23 @@ class FirmwareUpdate(unittest.TestCase):
         self.assertEqual(self.bus.ecatctl("state", "0").stdout.split()[0], "PREOP")
         self.assert_old_firmware()
 
+    def test_device_refusing_boot_is_named_with_its_al_status_code(self):
+        # The SII announces a bootstrap mailbox the slave does not have (SM0 512 bytes instead of its
+        # 1024): the master sets up what the SII says and the slave refuses INIT -> BOOT with 0x0015.
+        sii = os.path.join(self.bus.dir, "sii.bin")
+        subprocess.run([self.bus.slave_bin, "--state-dir", os.path.join(self.bus.dir, "none"), "--write-sii", sii],
+                       check=True, timeout=30, stdout=subprocess.DEVNULL)
+        with open(sii, "rb") as f:
+            image = bytearray(f.read())
+        self.assertEqual(struct.unpack_from("<H", image, 0x15 * 2)[0], 1024)
+        struct.pack_into("<H", image, 0x15 * 2, 512)
+        bus = harness.Bus(eeprom=bytes(image)).__enter__()
+        self.addCleanup(bus.close)
+        r = self.update(self.write_local("fw.bin", self.good_image(), bus), bus=bus)
+        self.assertEqual(r.returncode, 6, r.stderr)
+        self.assertIn("device refused BOOT: stays in INIT, AL status code 0x0015", r.stderr)
+        self.assert_old_firmware(bus)
+
     # -- interrupted -------------------------------------------------------------------------------
     def start_update(self, path, bus=None):
         bus = bus or self.bus
