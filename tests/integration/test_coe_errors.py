@@ -365,5 +365,56 @@ class CraftedRequests(unittest.TestCase):
         self.assertGreater(len(r.stdout.split()), 10, r.stderr)
 
 
+class DiagnosisHistoryThroughEcatctl(unittest.TestCase):
+    """An error the drive raises (0x8180 after the SM watchdog while enabled) read back from 0x10F3 with
+    `ecatctl diag`, named from the drive's error table; --new and --ack against :03."""
+
+    LINE = re.compile(r"^:(\d\d)  (\d+)\.(\d{9}) s  (info|warning|error) +0x([0-9a-f]{8})  (.*)$", re.M)
+
+    def test_error_message_named_ordered_and_acknowledged(self):
+        with harness.Bus() as bus:
+            r = bus.ecatctl("pd", "0", "--step", "30:06,00", "--step", "30:07,00", "--step", "30:0f,00", "-n", "100",
+                            "--keep", "--outputs", "0x0f", "0", check=False)
+            if "state: OP" not in r.stdout:
+                self.skipTest(f"OP not reached: {r.stderr.strip()}")
+            # The master is gone: SM watchdog, the drive's 0x6007 reaction, Fault 0x8180.
+            deadline = time.monotonic() + 5
+            while time.monotonic() < deadline:
+                if bus.ecatctl("upload", "0", "0x603f", "0").stdout.split()[0] == "0x8180":
+                    break
+                time.sleep(0.1)
+            newest_first = bus.ecatctl("diag").stdout
+            head = newest_first.splitlines()[0]
+            self.assertRegex(head, r"^diagnosis history 0x10F3: 10 messages at most, newest :\d\d, "
+                                   r"acknowledged :00, new messages$")
+            lines = self.LINE.findall(newest_first)
+            self.assertGreaterEqual(len(lines), 2, newest_first)
+            errors = [m for m in lines if m[4] == "8180e800"]
+            self.assertEqual(len(errors), 1, newest_first)
+            self.assertEqual(errors[0][3], "error")
+            self.assertTrue(errors[0][5].startswith("EtherCAT state machine error  [bytes "), newest_first)
+            # Newest first: time stamps do not increase; --oldest-first is the same list reversed.
+            stamps = [int(m[1]) * 10**9 + int(m[2]) for m in lines]
+            self.assertEqual(stamps, sorted(stamps, reverse=True))
+            oldest_first = self.LINE.findall(bus.ecatctl("diag", "--oldest-first").stdout)
+            self.assertEqual(oldest_first, lines[::-1])
+            # Acknowledge: :03 follows :02, and nothing is new any more.
+            newest = re.search(r"newest :(\d\d)", head).group(1)
+            r = bus.ecatctl("diag", "--new", "--ack")
+            self.assertIn(f"acknowledged up to :{newest}", r.stdout)
+            self.assertEqual(len(self.LINE.findall(r.stdout)), len(lines))
+            self.assertEqual(int(bus.ecatctl("upload", "0", "0x10f3", "3").stdout.split()[0], 16), int(newest))
+            r = bus.ecatctl("diag", "--new")
+            self.assertEqual(self.LINE.findall(r.stdout), [])
+            self.assertIn("no new messages\n", r.stdout)
+            # A message after the acknowledgement is new again: leave the fault (fault reset).
+            bus.ecatctl("state", "0", "PREOP")
+            bus.ecatctl("download", "0", "0x6040", "0", "0x80", "--type", "u16")
+            time.sleep(0.3)
+            fresh = self.LINE.findall(bus.ecatctl("diag", "--new").stdout)
+            self.assertGreaterEqual(len(fresh), 1)
+            self.assertNotIn(newest, [m[0] for m in fresh])
+
+
 if __name__ == "__main__":
     harness.main()
