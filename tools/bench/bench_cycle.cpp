@@ -67,12 +67,16 @@ uint64_t mono_ns() {
     return static_cast<uint64_t>(ts.tv_sec) * 1'000'000'000ull + static_cast<uint64_t>(ts.tv_nsec);
 }
 
-void sleep_until_ns(uint64_t t) {
+// Sleeps until t - spin_ns, then spins on the clock until t (spin_ns 0: sleeps all the way).
+void sleep_until_ns(uint64_t t, uint64_t spin_ns) {
+    const uint64_t wake = t > spin_ns ? t - spin_ns : 0;
     timespec ts{};
-    ts.tv_sec = static_cast<time_t>(t / 1'000'000'000ull);
-    ts.tv_nsec = static_cast<long>(t % 1'000'000'000ull);
+    ts.tv_sec = static_cast<time_t>(wake / 1'000'000'000ull);
+    ts.tv_nsec = static_cast<long>(wake % 1'000'000'000ull);
     while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
         if (g_stop.load()) return;
+    }
+    while (spin_ns != 0 && mono_ns() < t) {
     }
 }
 
@@ -85,6 +89,7 @@ struct Options {
     int master_cpu = 0;    // -1: not pinned
     int slave_cpu = 1;
     unsigned phase_percent = 50;  // where in the cycle (after SYNC0) the frame passes the slave
+    unsigned master_spin_us = 0;  // the master loop wakes this early and spins to its deadline
     bool verbose = false;
     std::string keep_logs;  // copy the slave logs here
 };
@@ -254,7 +259,7 @@ void run_master(const Options& o, unsigned cycle_us, Result& r) {
     for (uint64_t i = 0; !g_stop.load(); ++i) {
         if (counting_from != UINT64_MAX && i >= counting_from + total) break;
         const bool counted = i >= counting_from;
-        sleep_until_ns(t);
+        sleep_until_ns(t, std::min<uint64_t>(o.master_spin_us * 1000ull, p / 2));
         const uint64_t woke = mono_ns();
         const uint64_t late_by = woke > t ? woke - t : 0;
         if (counted) r.wake.add(late_by);
@@ -415,13 +420,15 @@ void usage() {
         "usage: bench-cycle [--seconds N] [--cycles-us LIST] [--slave PATH] [--backend pcap|packet]\n"
         "                   [--rt-priority N | --no-rt] [--master-cpu N] [--slave-cpu N] "
         "[--phase PERCENT]\n"
-        "                   [--keep-logs DIR] [--verbose]\n"
+        "                   [--master-spin-us N] [--keep-logs DIR] [--verbose]\n"
         "  --seconds N        measured time per cycle time (default 60; 5 is a quick check)\n"
         "  --slave PATH       the slave program (default: the ecat-slave of this build)\n"
         "  --cycles-us LIST   cycle times in microseconds (default 1000,250,125)\n"
         "  --rt-priority N    SCHED_FIFO priority of master and slave (default 80), --no-rt: none\n"
         "  --master-cpu/--slave-cpu N  pin to a CPU (default 0 / 1; -1: not pinned)\n"
-        "  --phase PERCENT    where the frame passes the slave, in %% of the cycle after SYNC0 (50)\n");
+        "  --phase PERCENT    where the frame passes the slave, in %% of the cycle after SYNC0 (50)\n"
+        "  --master-spin-us N the master wakes N us early and spins to its deadline (default 0, at most\n"
+        "                     half the cycle); the slave's runtime always sleeps on its timer\n");
 }
 
 bool parse_list(const std::string& s, std::vector<unsigned>& out) {
@@ -480,6 +487,8 @@ int main(int argc, char** argv) {
             o.master_cpu = static_cast<int>(number(-1, 1023));
         } else if (a == "--slave-cpu") {
             o.slave_cpu = static_cast<int>(number(-1, 1023));
+        } else if (a == "--master-spin-us") {
+            o.master_spin_us = static_cast<unsigned>(number(0, 1'000'000));
         } else if (a == "--phase") {
             o.phase_percent = static_cast<unsigned>(number(0, 99));
         } else if (a == "--keep-logs") {
@@ -538,6 +547,7 @@ int main(int argc, char** argv) {
     }
     sched += ", master CPU " + (o.master_cpu >= 0 ? std::to_string(o.master_cpu) : std::string("any")) +
              ", slave CPU " + (o.slave_cpu >= 0 ? std::to_string(o.slave_cpu) : std::string("any"));
+    if (o.master_spin_us > 0) sched += ", master spins the last " + std::to_string(o.master_spin_us) + " us";
 
     char tmpl[] = "/tmp/bench-cycle.XXXXXX";
     if (::mkdtemp(tmpl) == nullptr) {
