@@ -69,7 +69,9 @@ inline Bytes sdo(uint8_t cmd, uint16_t index, uint8_t sub, uint32_t data = 0,
 // A segment request: CoE header, command, data (padded to 7 bytes by the caller if wanted).
 inline Bytes segment(uint8_t cmd, const Bytes& data) {
     Bytes b{0x00, 0x20, cmd};
-    b.insert(b.end(), data.begin(), data.end());
+    b.reserve(3 + data.size());
+    for (uint8_t x : data)
+        b.push_back(x);  // (vector::insert here trips GCC 12's -Warray-bounds at -O2)
     return b;
 }
 // An SDO info request: CoE header 0x8000, opcode, reserved, fragments left 0, body.
