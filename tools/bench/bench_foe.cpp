@@ -195,6 +195,7 @@ struct Throughput {
     std::size_t bytes = 0;
     Stats data_s, commit_s, total_s;
     uint64_t busy = 0, repeats = 0;
+    uint64_t frames = 0, packets = 0;  // EtherCAT frames the master sent, FoE DATA packets
     std::string failure;
 };
 
@@ -250,6 +251,7 @@ void measure_throughput(const Options& o, unsigned size, const std::filesystem::
         foe.set_progress([&](const master::FoeProgress& p) {
             if (p.busy && sent == Clock::time_point{}) sent = Clock::now();
         });
+        const uint64_t frames0 = m.stats().frames_sent;
         const auto t0 = Clock::now();
         const Error e = foe.write("MAXPOS", image);
         const auto t1 = Clock::now();
@@ -263,6 +265,8 @@ void measure_throughput(const Options& o, unsigned size, const std::filesystem::
         r.commit_s.add(seconds(t1 - sent));
         r.total_s.add(seconds(t1 - t0));
         r.busy += foe.busy_answers();
+        r.frames += m.stats().frames_sent - frames0;
+        r.packets += image.size() / (mbx.max_out_payload() - 6) + 1;
         r.repeats += mbx.repeats();
     }
     (void)to_init(m);
@@ -448,8 +452,13 @@ int main(int argc, char** argv) {
             std::snprintf(c3, sizeof c3, "%.3f / %.2f", t.total_s.median(), mb / t.total_s.median());
             std::printf("%-8u %-10zu %-24s %-22s %-24s %.0f\n", size, t.bytes, c1, c2, c3,
                         static_cast<double>(t.busy) / o.runs);
-            std::printf("         data phase MB/s min-max %.2f-%.2f, mailbox repeat requests %llu\n",
-                        mb / t.data_s.max(), mb / t.data_s.min(), static_cast<unsigned long long>(t.repeats));
+            std::printf(
+                "         data phase MB/s min-max %.2f-%.2f; %.0f us and %.1f frames per DATA packet (%u "
+                "data bytes); mailbox repeat requests %llu\n",
+                mb / t.data_s.max(), mb / t.data_s.min(),
+                1e6 * t.data_s.median() / (static_cast<double>(t.packets) / o.runs),
+                static_cast<double>(t.frames) / static_cast<double>(t.packets), size - 12,
+                static_cast<unsigned long long>(t.repeats));
         }
         if (o.update_runs > 0) {
             std::fprintf(stderr, "bench-foe: whole firmware update ...\n");
