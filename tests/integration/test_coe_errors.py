@@ -299,6 +299,18 @@ class CraftedRequests(unittest.TestCase):
         seg = struct.pack("<HB", COE_SDO_REQ << 12, 0x10 | (3 << 1) | 1) + b"\x01\x00\x00\x00\x00\x00\x00"
         self.assert_sdo_abort(self.exchange(MBX_COE, seg), 0x05030000, 0x607A, 0)
 
+    def test_toggle_bit_not_alternated_in_an_upload(self):
+        # 0x10F3 read with complete access is longer than one mailbox answer: upload segments follow.
+        reply = self.exchange(MBX_COE, sdo(0x40 | 0x10, 0x10F3, 0))
+        mtype, p = reply
+        self.assertEqual(mtype, MBX_COE, p.hex())
+        self.assertEqual(p[2] & 0xE3, 0x41, p.hex())  # initiate upload response, normal, size indicated
+        size = struct.unpack_from("<I", p, 6)[0]
+        self.assertGreater(size, len(p) - 10, "the answer fits one message: no segments to test")
+        # The first upload segment request must carry toggle 0.
+        seg = struct.pack("<HB", COE_SDO_REQ << 12, 0x60 | 0x10) + bytes(7)
+        self.assert_sdo_abort(self.exchange(MBX_COE, seg), 0x05030000, 0x10F3, 0)
+
     def test_sdo_protocol_timed_out(self):
         self.start_segmented_download()
         # No segment follows: the server gives up after its transfer timeout (2 s) and says so.
