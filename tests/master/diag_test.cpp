@@ -137,6 +137,13 @@ TEST(DiagText, FlagsTimeAndClasses) {
     EXPECT_EQ(master::emergency_class_name(0x2310), "current error");
     EXPECT_EQ(master::emergency_class_name(0x8180), "communication error");
     EXPECT_EQ(master::emergency_class_name(0xFF01), "device specific error");
+    EXPECT_EQ(master::diag_type_name(2), "error");
+    EXPECT_EQ(master::diag_type_name(7), "unknown");
+    // A Unicode string parameter (UTF-16LE) is the text of a message with text id 0.
+    auto b = message(0x0000E001, 0x0100, 0, 0, {0x06, 0x30, 'o', 0, 'k', 0, '!', 0});
+    auto u = master::decode_diag_message(b);
+    ASSERT_TRUE(u);
+    EXPECT_EQ(master::diag_text(*u), "ok!");
     DiagEntry reset;
     reset.code = 0x0000E800;
     EXPECT_EQ(master::diag_text(reset), "no error (error reset)");

@@ -59,7 +59,7 @@ std::optional<DiagEntry> decode_diag_message(std::span<const uint8_t> bytes, uin
 // only_new: only those after the acknowledged one (all when nothing is acknowledged).
 std::vector<uint8_t> diag_message_order(const DiagHeader& h, bool newest_first, bool only_new);
 
-std::string_view diag_type_name(uint8_t type);  // "info", "warning", "error", "type N" is "unknown"
+std::string_view diag_type_name(uint8_t type);  // "info", "warning", "error"; "unknown" otherwise
 // Size in bytes of a CoE basic data type used as a parameter value (0 if not a fixed-size basic type).
 std::size_t diag_value_size(uint16_t data_type);
 // "0x0000002a (42)", "\"text\"", "bytes 01 02 03" ...
