@@ -183,7 +183,7 @@ struct Result {
     ecat::LatencyHistogram rtt;    // send to matched reply
     ecat::LatencyHistogram phase;  // |frame at the slave - target phase| (DC time, from the FRMW)
     std::string end_state;
-    // Slave side (from its --verbose output).
+    // Slave side (the stack.* lines of its --stats-file).
     std::map<std::string, uint64_t> slave;
 };
 
