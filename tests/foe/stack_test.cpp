@@ -106,7 +106,8 @@ Bytes foe_packet(uint8_t op, uint32_t value, std::span<const uint8_t> tail = {})
                static_cast<uint8_t>(value >> 8),
                static_cast<uint8_t>(value >> 16),
                static_cast<uint8_t>(value >> 24)};
-    m.insert(m.end(), tail.begin(), tail.end());
+    for (auto c : tail)
+        m.push_back(static_cast<uint8_t>(c));  // (vector::insert here trips GCC 12's -Warray-bounds at -O2)
     return m;
 }
 std::span<const uint8_t> text(std::string_view s) {
