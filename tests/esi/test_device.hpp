@@ -84,7 +84,7 @@ inline od::Dictionary small_dictionary(const od::DeviceDescription& d) {
     {
         od::Object o;
         o.index = 0x10F3;
-        o.code = od::ObjectCode::Array;
+        o.code = od::ObjectCode::Record;  // mixed entry types: a RECORD (od refuses such an ARRAY)
         o.name = "Diagnosis history";
         o.type = DataType::OctetString;
         o.entries = {entry(0x10F3, 0, "Number of entries", DataType::Unsigned8, a::RO, uint64_t{6}),
