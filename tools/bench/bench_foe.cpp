@@ -181,6 +181,11 @@ bool wait_for_slave(master::Master& m) {
 // B -> I (the device restarts from the stored image) or any state -> I; waits out the restart.
 bool to_init(master::Master& m) {
     const auto deadline = Clock::now() + std::chrono::seconds(20);
+    // Not from INIT: AL control is a mailbox the slave must read before it takes the next write (ESC with
+    // device emulation off), and "INIT reached" would not wait for that read: the BOOT request that follows
+    // could be dropped.
+    auto now = m.al_status(kSlave);
+    if (now && now->state == static_cast<uint8_t>(AlState::Init) && !now->error) return true;
     (void)m.request_state(kSlave, AlState::Init);
     while (Clock::now() < deadline) {
         auto st = m.al_status(kSlave);
@@ -243,7 +248,11 @@ void measure_throughput(const Options& o, unsigned size, const std::filesystem::
         }
         master::AlStatus st;
         if (Error e = m.request_state(kSlave, AlState::Boot, &st); e != Error::Ok) {
-            r.failure = std::string("BOOT: ") + err(e) + " AL status code " + std::to_string(st.code);
+            auto now = m.al_status(kSlave);
+            r.failure =
+                "run " + std::to_string(run + 1) + ": BOOT: " + err(e) + ", AL status " +
+                (now ? std::string(master::al_state_name(now->state)) : std::string(err(now.error()))) +
+                " code " + std::to_string(st.code) + "; slave log:\n" + read_text(log);
             return;
         }
         master::FoeClient foe(mbx);

@@ -710,9 +710,14 @@ int foe_transfer(master::Master& m, const FoeArgs& f, bool read) {
     if (st->state == boot) {
         if (Error e = mbx.adopt_current(); e != Error::Ok) return fail(e, "opening the bootstrap mailbox");
     } else if (!read) {
-        // Firmware goes in through Bootstrap: INIT, the bootstrap mailbox from the SII, BOOT.
-        if (Error e = m.request_state(*a, master::AlState::Init); e != Error::Ok)
-            return fail(e, "going to INIT");
+        // Firmware goes in through Bootstrap: INIT, the bootstrap mailbox from the SII, BOOT. INIT is not
+        // requested again from a slave in INIT: with device emulation off AL control is a mailbox the slave
+        // must read before it takes the next write, and "INIT reached" would not wait for that read, so the
+        // BOOT request right after could be dropped by the ESC.
+        if (st->state != static_cast<uint8_t>(master::AlState::Init)) {
+            if (Error e = m.request_state(*a, master::AlState::Init); e != Error::Ok)
+                return fail(e, "going to INIT");
+        }
         if (Error e = mbx.configure_from_sii(true); e != Error::Ok)
             return fail(e, "setting up the bootstrap mailbox");
         master::AlStatus final;
