@@ -62,7 +62,6 @@ class FirmwareUpdate(unittest.TestCase):
     def assert_runs(self, version, bus=None):
         """The SII, 0x1018:03 and 0x100A all report `version`."""
         bus = bus or self.bus
-        bus.ecatctl("state", "0", "INIT")
         m = ROW.search(bus.ecatctl("scan").stdout)
         self.assertEqual(int(m.group(4), 16), version, "SII revision")
         self.assertEqual(bus.ecatctl("upload", "0", "0x1018", "3").stdout.split()[0], f"0x{version:08x}")
@@ -211,7 +210,8 @@ class FirmwareUpdate(unittest.TestCase):
         self.wait_for_line(proc, r"bytes (4|5|6)\d% ")
         self.stop(proc)  # the master vanishes mid-transfer: no ERR, no INIT
         self.assertEqual(self.bus.ecatctl("state", "0").stdout.split()[0], "BOOT")
-        self.assert_old_firmware()  # BOOT -> INIT drops the half image
+        self.bus.ecatctl("state", "0", "INIT")  # BOOT -> INIT: the device restarts, the half image is dropped
+        self.assert_old_firmware()
         # A new update from BOOT works too (firmware-update resets a device it finds in BOOT first).
         proc = self.start_update(path)
         self.wait_for_line(proc, r"bytes [1-3]\d% ")
