@@ -317,22 +317,14 @@ void recover(master::Master& m, Address a, const Args& args, Steps& steps) {
         steps.say("device back in INIT, running revision 0x%08x", now.revision);
 }
 
-int firmware_update(master::Master& m, const Args& args) {
-    Steps steps;
-    auto slave_no = parse_number(args.slave, 0xFFFF);
-    if (!slave_no) {
-        std::fprintf(stderr, "ecatctl: bad slave '%s'\n", args.slave.c_str());
-        return kExitUsage;
-    }
-    const Address a = args.station ? Address::station(static_cast<uint16_t>(*slave_no))
-                                   : Address::position(static_cast<uint16_t>(*slave_no));
-    auto password = parse_number(args.password, 0xFFFFFFFF);
-    if (!password) {
-        std::fprintf(stderr, "ecatctl: bad password '%s'\n", args.password.c_str());
-        return kExitUsage;
-    }
+struct Image {
+    std::vector<uint8_t> bytes;
+    foe::ImageHeader head{};
+};
 
-    // The image: a well-formed header and the right CRC, checked before the device is touched.
+// The image: a well-formed header and the right CRC, checked before the link is opened and the device
+// touched.
+int load_image(const Args& args, Image& out) {
     auto image = read_file(args.file);
     if (!image) {
         std::fprintf(stderr, "ecatctl: cannot read %s\n", args.file.c_str());
@@ -347,15 +339,35 @@ int firmware_update(master::Master& m, const Args& args) {
     if (image->size() >= foe::kImageHeaderSize)
         head = foe::decode_header(
             std::span<const uint8_t, foe::kImageHeaderSize>(image->data(), foe::kImageHeaderSize));
-    {
-        const foe::ImageIdentity own{head.vendor_id, head.product_code};
-        const foe::VerifyResult v = foe::verify_image(*image, own);
-        if (!v.ok()) {
-            std::fprintf(stderr, "ecatctl: %s: not a valid firmware image: %s%s\n", args.file.c_str(),
-                         foe::describe(v, own).c_str(), args.force ? " (--force: sending it anyway)" : "");
-            if (!args.force) return kExitUsage;
-        }
+    const foe::ImageIdentity own{head.vendor_id, head.product_code};
+    const foe::VerifyResult v = foe::verify_image(*image, own);
+    if (!v.ok()) {
+        std::fprintf(stderr, "ecatctl: %s: not a valid firmware image: %s%s\n", args.file.c_str(),
+                     foe::describe(v, own).c_str(), args.force ? " (--force: sending it anyway)" : "");
+        if (!args.force) return kExitUsage;
     }
+    out.bytes = std::move(*image);
+    out.head = head;
+    return kExitOk;
+}
+
+int firmware_update(master::Master& m, const Args& args, const Image& img) {
+    const std::vector<uint8_t>* image = &img.bytes;
+    const foe::ImageHeader& head = img.head;
+    Steps steps;
+    auto slave_no = parse_number(args.slave, 0xFFFF);
+    if (!slave_no) {
+        std::fprintf(stderr, "ecatctl: bad slave '%s'\n", args.slave.c_str());
+        return kExitUsage;
+    }
+    const Address a = args.station ? Address::station(static_cast<uint16_t>(*slave_no))
+                                   : Address::position(static_cast<uint16_t>(*slave_no));
+    auto password = parse_number(args.password, 0xFFFFFFFF);
+    if (!password) {
+        std::fprintf(stderr, "ecatctl: bad password '%s'\n", args.password.c_str());
+        return kExitUsage;
+    }
+
     steps.say("image %s: %zu bytes, vendor 0x%08x, product 0x%08x, version 0x%08x (%s)", args.file.c_str(),
               image->size(), head.vendor_id, head.product_code, head.version,
               foe::software_version_text(head.version).c_str());
@@ -501,8 +513,11 @@ void add_firmware_update(CLI::App& app, RunWithMaster run, int& rc) {
     c->add_option("--restart-timeout", args->restart_timeout_ms, "Milliseconds to wait for the restart")
         ->check(CLI::Range(100u, 600000u))
         ->capture_default_str();
-    c->callback(
-        [args, run, &rc] { rc = run([args](master::Master& m) { return firmware_update(m, *args); }); });
+    c->callback([args, run, &rc] {
+        auto image = std::make_shared<Image>();
+        if ((rc = load_image(*args, *image)) != kExitOk) return;
+        rc = run([args, image](master::Master& m) { return firmware_update(m, *args, *image); });
+    });
 }
 
 }  // namespace ecatctl
