@@ -433,16 +433,27 @@ TEST(DeviceEnvironment, InputsAndSwitchesReachTheDriveAndSurviveARestart) {
     Drive d(dir);
     softdrive::EnvironmentOptions env;
     env.negative_limit = -1000;
-    env.positive_limit = 1000;
+    env.positive_limit = -5;  // the axis (at 0) stands on the positive limit switch
     d.dev->set_environment(env);
     EXPECT_TRUE(d.dev->set_input(4, true));
     EXPECT_FALSE(d.dev->set_input(0, true));
     EXPECT_FALSE(d.dev->set_input(7, true));
     d.idle(20'000'000);
-    // 0x60FD digital inputs: the drive reads the pins; 0x3141:01 shows the physical levels (bit 3 = DigIN4).
-    const od::Entry* e = d.dict().find(0x3141, 1);
-    ASSERT_NE(e, nullptr);
-    EXPECT_NE(d.dict().get<uint16_t>(0x3141, 1) & 0x0008, 0);
+    // 0x3141:01 shows the physical pin levels: bit 0 DigIN1 (negative limit), bit 1 DigIN2 (positive limit),
+    // bit 3 DigIN4 (set by hand).
+    ASSERT_NE(d.dict().find(0x3141, 1), nullptr);
+    auto pins = [&] { return d.dict().get<uint16_t>(0x3141, 1); };
+    EXPECT_EQ(pins() & 0x000B, 0x000A) << std::hex << pins();
+    // A Bootstrap restart builds a new drive: the machine around it stays as it was.
+    d.dev->on_restart();
+    d.service();
+    EXPECT_EQ(d.dev->stats().builds, 2u);
+    d.idle(20'000'000);
+    EXPECT_EQ(pins() & 0x000B, 0x000A) << std::hex << pins();
+    // Switches removed: only the hand-set pin remains.
+    d.dev->set_environment({});
+    d.idle(20'000'000);
+    EXPECT_EQ(pins() & 0x000B, 0x0008) << std::hex << pins();
     std::filesystem::remove_all(dir);
 }
 

@@ -128,6 +128,14 @@ class OfflineOutputs(unittest.TestCase):
         self.assertIn("serial 0x00C0FFEE", d.stdout)
         self.assertIn('"MAXPOS-X"', d.stdout)
 
+    def test_the_example_configuration_loads(self):
+        example = os.path.join(HERE, "..", "..", "tools", "ecat-slave", "drive.conf")
+        sii = os.path.join(self.dir, "example.sii")
+        r = self.run_slave("--config", example, "--state-dir", os.path.join(self.dir, "state"), "--write-sii", sii)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        d = subprocess.run([self.ecatctl, "sii", "decode", sii], stdout=subprocess.PIPE, text=True, timeout=30)
+        self.assertIn("serial 0x00000001", d.stdout)
+
     def test_configuration_errors_are_usage_errors(self):
         conf = os.path.join(self.dir, "bad.conf")
         with open(conf, "w") as f:
