@@ -134,6 +134,13 @@ class FirmwareUpdate(unittest.TestCase):
         self.assertIn("device back in INIT", r.stderr)
         self.assert_old_firmware()
 
+    def test_bad_image_file_is_a_usage_error_before_the_link_is_opened(self):
+        path = self.write_local("junk.bin", b"not an image")
+        r = subprocess.run([self.bus.ecatctl_bin, "--iface", "nosuchif0", "firmware-update", path],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=30)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn("not a firmware image", r.stderr)
+
     def test_path_like_file_names(self):
         path = self.write_local("fw.bin", self.good_image())
         for name in ("../x", "a/b", "..", "/MAXPOS", "MAXPOS\\x"):
