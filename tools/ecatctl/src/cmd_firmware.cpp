@@ -476,6 +476,13 @@ int firmware_update(master::Master& m, const Args& args, const Image& img) {
                      after.id.revision, head.version);
         ok = false;
     }
+    if (after.id.vendor != head.vendor_id || after.id.product != head.product_code) {
+        // Seed step 6 checks 0x1018:02 (hardware version and application number) as well.
+        std::fprintf(stderr,
+                     "ecatctl: 0x1018 reports vendor 0x%08x product 0x%08x, the image is for 0x%08x 0x%08x\n",
+                     after.id.vendor, after.id.product, head.vendor_id, head.product_code);
+        ok = false;
+    }
     if (after.version != want_text) {
         std::fprintf(stderr, "ecatctl: 0x100A reports '%s', the image is '%s'\n", after.version.c_str(),
                      want_text.c_str());
