@@ -403,6 +403,13 @@ Error Master::request_state(Address a, AlState state, AlStatus* final) {
             std::this_thread::sleep_for(std::chrono::milliseconds(1));
         }
     }
+    if (st->state == static_cast<uint8_t>(state)) {
+        // Already there: write nothing. AL control is a one-message mailbox in the ESC (device emulation
+        // off): a write the firmware has not read yet blocks the next one, so a needless request here could
+        // swallow the caller's next, real request (seen as a BOOT request lost after INIT -> INIT).
+        if (final) *final = *st;
+        return Error::Ok;
+    }
     if (Error e = write_al_control(*this, a, static_cast<uint8_t>(state), deadline); e != Error::Ok) return e;
     for (;;) {
         st = al_status(a);
