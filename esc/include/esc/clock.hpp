@@ -5,25 +5,25 @@
 namespace esc {
 
 class Clock {
-public:
+  public:
     virtual ~Clock() = default;
     virtual uint64_t now_ns() const = 0;
 };
 
 // CLOCK_MONOTONIC.
 class SystemClock final : public Clock {
-public:
+  public:
     uint64_t now_ns() const override;
 };
 
 // A clock that moves only when told to (unit tests, simulations).
 class ManualClock final : public Clock {
-public:
+  public:
     uint64_t now_ns() const override { return now_; }
     void set(uint64_t t) { now_ = t; }
     void advance(uint64_t dt) { now_ += dt; }
 
-private:
+  private:
     uint64_t now_ = 0;
 };
 

@@ -17,14 +17,14 @@
 namespace esc {
 
 struct EscConfig {
-    uint8_t type = 0x04;          // 0x0000 ESC type (0x04: "IP core" style emulated ESC)
-    uint8_t revision = 0x01;      // 0x0001
-    uint16_t build = 0x0001;      // 0x0002
-    uint8_t fmmu_count = 8;       // 0x0004
-    uint8_t sm_count = 8;         // 0x0005
-    uint32_t process_ram_kib = 8; // 0x0006; process RAM 0x1000 .. 0x1000 + kib*1024 - 1 (ET1100: 8 KiB)
+    uint8_t type = 0x04;             // 0x0000 ESC type (0x04: "IP core" style emulated ESC)
+    uint8_t revision = 0x01;         // 0x0001
+    uint16_t build = 0x0001;         // 0x0002
+    uint8_t fmmu_count = 8;          // 0x0004
+    uint8_t sm_count = 8;            // 0x0005
+    uint32_t process_ram_kib = 8;    // 0x0006; process RAM 0x1000 .. 0x1000 + kib*1024 - 1 (ET1100: 8 KiB)
     uint8_t port_descriptor = 0x0F;  // 0x0007: port0 MII, port1 EBUS... (single port used)
-    uint16_t features = 0x01CC;   // 0x0008: DC available, 64-bit DC, ...
+    uint16_t features = 0x01CC;      // 0x0008: DC available, 64-bit DC, ...
 };
 
 // Counters of what the ECAT side saw (also reflected in the error counter registers 0x0300-0x0313).
@@ -36,7 +36,7 @@ struct EscStats {
 };
 
 class Esc final : public Pdi {
-public:
+  public:
     Esc(const EscConfig& config, const Clock& clock);
     ~Esc() override;
     Esc(const Esc&) = delete;
@@ -74,7 +74,7 @@ public:
 
     EscStats stats() const;
 
-private:
+  private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };

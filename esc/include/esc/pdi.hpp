@@ -10,7 +10,7 @@
 namespace esc {
 
 class Pdi {
-public:
+  public:
     virtual ~Pdi() = default;
     virtual void read(uint16_t address, std::span<uint8_t> out) = 0;
     virtual void write(uint16_t address, std::span<const uint8_t> in) = 0;
@@ -21,13 +21,15 @@ public:
         uint8_t b[sizeof(T)];
         read(address, b);
         T v{};
-        for (std::size_t i = 0; i < sizeof(T); ++i) v = static_cast<T>(v | (static_cast<T>(b[i]) << (8 * i)));
+        for (std::size_t i = 0; i < sizeof(T); ++i)
+            v = static_cast<T>(v | (static_cast<T>(b[i]) << (8 * i)));
         return v;
     }
     template <typename T>
     void write_reg(uint16_t address, T value) {
         uint8_t b[sizeof(T)];
-        for (std::size_t i = 0; i < sizeof(T); ++i) b[i] = static_cast<uint8_t>(static_cast<uint64_t>(value) >> (8 * i));
+        for (std::size_t i = 0; i < sizeof(T); ++i)
+            b[i] = static_cast<uint8_t>(static_cast<uint64_t>(value) >> (8 * i));
         write(address, b);
     }
 };

@@ -77,9 +77,10 @@ struct DeviceDescription {
     std::vector<SyncManagerDefault> sync_managers;  // SM0..SM3 in order
     std::vector<DcOpMode> dc_modes;
     uint16_t eeprom_bytes = 2048;
-    uint8_t pdi_control = 0x05;         // SII word 0 low: SPI (as the MAXPOS's ESC) -- see docs/decisions.md
-    uint8_t esc_config = 0x0C;          // SII word 0 high: DC SYNC out and latch in units on
-    uint16_t pdi_config = 0xCC00;       // SII word 1: 0x0151 = 0xCC, SYNC0/SYNC1 driven and mapped to AL event bits 2/3 (as EJ7211)
+    uint8_t pdi_control = 0x05;  // SII word 0 low: SPI (as the MAXPOS's ESC) -- see docs/decisions.md
+    uint8_t esc_config = 0x0C;   // SII word 0 high: DC SYNC out and latch in units on
+    uint16_t pdi_config =
+        0xCC00;  // SII word 1: 0x0151 = 0xCC, SYNC0/SYNC1 driven and mapped to AL event bits 2/3 (as EJ7211)
     uint16_t sync_pulse_length = 1000;  // SII word 2, 10 ns units
     uint16_t station_alias = 0;         // SII word 4
 };
