@@ -13,11 +13,9 @@
 //
 // Everything lives in a private network namespace (unshare) that disappears with this process; the slave
 // is killed with us (PR_SET_PDEATHSIG); the temporary state directory is removed. Needs root.
-#include <fcntl.h>
 #include <sched.h>
 #include <signal.h>
 #include <sys/mman.h>
-#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -41,6 +39,7 @@
 
 #include "ecat/latency.hpp"
 #include "esc/link.hpp"
+#include "harness.hpp"
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
@@ -61,12 +60,6 @@ void on_signal(int) {
     g_stop.store(true);
 }
 
-uint64_t mono_ns() {
-    timespec ts{};
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return static_cast<uint64_t>(ts.tv_sec) * 1'000'000'000ull + static_cast<uint64_t>(ts.tv_nsec);
-}
-
 // Sleeps until t - spin_ns, then spins on the clock until t (spin_ns 0: sleeps all the way).
 void sleep_until_ns(uint64_t t, uint64_t spin_ns) {
     const uint64_t wake = t > spin_ns ? t - spin_ns : 0;
@@ -76,7 +69,7 @@ void sleep_until_ns(uint64_t t, uint64_t spin_ns) {
     while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
         if (g_stop.load()) return;
     }
-    while (spin_ns != 0 && mono_ns() < t) {
+    while (spin_ns != 0 && bench::now_ns() < t) {
     }
 }
 
@@ -92,70 +85,6 @@ struct Options {
     unsigned master_spin_us = 0;  // the master loop wakes this early and spins to its deadline
     bool verbose = false;
     std::string keep_logs;  // copy the slave logs here
-};
-
-// The slave process: its output goes to a log file; killed with us and by the destructor (SIGTERM first,
-// so it prints its statistics).
-class SlaveProcess {
-  public:
-    SlaveProcess(const std::vector<std::string>& args, const std::string& log) {
-        const pid_t parent = ::getpid();
-        pid_ = ::fork();
-        if (pid_ < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
-        if (pid_ == 0) {
-            ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-            if (::getppid() != parent) ::_exit(127);
-            const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-            if (fd >= 0) {
-                ::dup2(fd, 1);
-                ::dup2(fd, 2);
-            }
-            std::vector<char*> argv;
-            for (const auto& a : args)
-                argv.push_back(const_cast<char*>(a.c_str()));
-            argv.push_back(nullptr);
-            ::execv(argv[0], argv.data());
-            std::fprintf(stderr, "bench-cycle: cannot run %s: %s\n", argv[0], std::strerror(errno));
-            ::_exit(127);
-        }
-    }
-    ~SlaveProcess() { (void)stop(); }
-    SlaveProcess(const SlaveProcess&) = delete;
-    SlaveProcess& operator=(const SlaveProcess&) = delete;
-
-    bool alive() {
-        if (pid_ <= 0) return false;
-        int status = 0;
-        if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-            exit_status_ = status;
-            pid_ = -1;
-            return false;
-        }
-        return true;
-    }
-    // SIGTERM, wait up to 5 s, then SIGKILL. Returns the wait status (-1 if it was gone already).
-    int stop() {
-        if (pid_ <= 0) return exit_status_;
-        ::kill(pid_, SIGTERM);
-        int status = 0;
-        for (int i = 0; i < 500; ++i) {
-            if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-                pid_ = -1;
-                exit_status_ = status;
-                return status;
-            }
-            ::usleep(10'000);
-        }
-        ::kill(pid_, SIGKILL);
-        ::waitpid(pid_, &status, 0);
-        pid_ = -1;
-        exit_status_ = status;
-        return status;
-    }
-
-  private:
-    pid_t pid_ = -1;
-    int exit_status_ = -1;
 };
 
 // "stack.cycles 123" lines of the slave's --stats-file (or of its --verbose output).
@@ -253,14 +182,14 @@ void run_master(const Options& o, unsigned cycle_us, Result& r) {
     const uint64_t total = static_cast<uint64_t>(o.seconds) * 1'000'000'000ull / p;
     constexpr uint64_t kLock = 200;  // cycles to lock the phase before asking for OP
     const uint64_t status_every = std::max<uint64_t>(1, 5'000'000 / p);  // AL status polls while waiting
-    const uint64_t op_deadline = mono_ns() + 10'000'000'000ull;
+    const uint64_t op_deadline = bench::now_ns() + 10'000'000'000ull;
     uint64_t counting_from = UINT64_MAX;
-    uint64_t t = mono_ns() + p;
+    uint64_t t = bench::now_ns() + p;
     for (uint64_t i = 0; !g_stop.load(); ++i) {
         if (counting_from != UINT64_MAX && i >= counting_from + total) break;
         const bool counted = i >= counting_from;
         sleep_until_ns(t, std::min<uint64_t>(o.master_spin_us * 1000ull, p / 2));
-        const uint64_t woke = mono_ns();
+        const uint64_t woke = bench::now_ns();
         const uint64_t late_by = woke > t ? woke - t : 0;
         if (counted) r.wake.add(late_by);
         if (late_by >= p) {
@@ -269,9 +198,9 @@ void run_master(const Options& o, unsigned cycle_us, Result& r) {
             if (counted) r.missed += skipped;
             t += skipped * p;
         }
-        const uint64_t sent = mono_ns();
+        const uint64_t sent = bench::now_ns();
         const Error e = pd.cycle();
-        const uint64_t done = mono_ns();
+        const uint64_t done = bench::now_ns();
         if (counted) {
             ++r.cycles;
             if (e == Error::Timeout) {
@@ -308,7 +237,7 @@ void run_master(const Options& o, unsigned cycle_us, Result& r) {
                 throw std::runtime_error(b);
             }
             if (st && st->state == static_cast<uint8_t>(master::AlState::Op)) counting_from = i + 1;
-            if (mono_ns() > op_deadline) throw std::runtime_error("OP not reached within 10 s");
+            if (bench::now_ns() > op_deadline) throw std::runtime_error("OP not reached within 10 s");
         }
     }
     m.set_timeout(std::chrono::milliseconds(100));
@@ -328,7 +257,7 @@ Result run_one(const Options& o, unsigned cycle_us, const std::filesystem::path&
     if (o.rt_priority > 0) args.insert(args.end(), {"--rt-priority", std::to_string(o.rt_priority)});
     if (o.slave_cpu >= 0) args.insert(args.end(), {"--cpu", std::to_string(o.slave_cpu)});
     {
-        SlaveProcess slave(args, log);
+        bench::Child slave(args, log);
         try {
             run_master(o, cycle_us, r);
         } catch (const std::exception& e) {
@@ -503,12 +432,8 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
-    if (::geteuid() != 0) {
-        std::fprintf(stderr,
-                     "bench-cycle: needs root (network namespace, veth pair, raw sockets, SCHED_FIFO); "
-                     "run it with sudo\n");
+    if (!bench::require_root("(network namespace, veth pair, raw sockets, SCHED_FIFO); run it with sudo"))
         return 2;
-    }
     if (::access(o.slave_path.c_str(), X_OK) != 0) {
         std::fprintf(stderr, "bench-cycle: cannot run the slave %s\n", o.slave_path.c_str());
         return 2;
@@ -516,10 +441,7 @@ int main(int argc, char** argv) {
     const long cpus = ::sysconf(_SC_NPROCESSORS_ONLN);
     if (o.master_cpu >= cpus) o.master_cpu = -1;
     if (o.slave_cpu >= cpus) o.slave_cpu = -1;
-    if (::unshare(CLONE_NEWNET) != 0) {
-        std::fprintf(stderr, "bench-cycle: unshare(CLONE_NEWNET): %s\n", std::strerror(errno));
-        return 2;
-    }
+    if (!bench::enter_network_namespace()) return 2;
     struct sigaction sa {};
     sa.sa_handler = on_signal;
     ::sigaction(SIGINT, &sa, nullptr);

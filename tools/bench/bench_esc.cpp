@@ -2,8 +2,6 @@
 // configured FMMUs + FRMW 0x0910 + FPRD 0x0130). The slave is configured first through frames, as a master
 // does. Between frames the "firmware" side refreshes the inputs and takes the outputs through the PDI, so the
 // 3-buffer SyncManagers rotate as in operation. Prints median / p99 per call; asserts nothing.
-#include <time.h>
-
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -13,17 +11,10 @@
 
 #include "esc/esc.hpp"
 #include "frame.hpp"
+#include "harness.hpp"
 #include "stats.hpp"
 
-namespace {
-
-uint64_t now_ns() {
-    timespec ts{};
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return static_cast<uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<uint64_t>(ts.tv_nsec);
-}
-
-}  // namespace
+using bench::now_ns;
 
 int main(int argc, char** argv) {
     std::size_t iterations = 200000;

@@ -14,11 +14,6 @@
 // Everything lives in a private network namespace (unshare) that disappears with this process; the slave is
 // killed with us (PR_SET_PDEATHSIG); the temporary state directories are removed. Needs root. Prints figures;
 // asserts nothing (a failed step is reported and the exit code is 1).
-#include <fcntl.h>
-#include <sched.h>
-#include <signal.h>
-#include <sys/prctl.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -37,6 +32,7 @@
 
 #include "esc/link.hpp"
 #include "foe/image.hpp"
+#include "harness.hpp"
 #include "master/foe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
@@ -44,6 +40,7 @@
 
 namespace {
 
+using bench::Child;
 using master::Address;
 using master::AlState;
 using master::Error;
@@ -67,65 +64,6 @@ struct Options {
 double seconds(Clock::duration d) {
     return std::chrono::duration<double>(d).count();
 }
-
-// A child process with its output in a log file; killed with us and by the destructor.
-class Child {
-  public:
-    Child(const std::vector<std::string>& args, const std::string& log) {
-        const pid_t parent = ::getpid();
-        pid_ = ::fork();
-        if (pid_ < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
-        if (pid_ == 0) {
-            ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-            if (::getppid() != parent) ::_exit(127);
-            const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-            if (fd >= 0) {
-                ::dup2(fd, 1);
-                ::dup2(fd, 2);
-            }
-            std::vector<char*> argv;
-            for (const auto& a : args)
-                argv.push_back(const_cast<char*>(a.c_str()));
-            argv.push_back(nullptr);
-            ::execv(argv[0], argv.data());
-            std::fprintf(stderr, "bench-foe: cannot run %s: %s\n", argv[0], std::strerror(errno));
-            ::_exit(127);
-        }
-    }
-    ~Child() { (void)stop(); }
-    Child(const Child&) = delete;
-    Child& operator=(const Child&) = delete;
-
-    // Waits for the exit; returns the exit code (-1 if killed by a signal).
-    int wait() {
-        if (pid_ <= 0) return status_;
-        int st = 0;
-        while (::waitpid(pid_, &st, 0) < 0 && errno == EINTR) {
-        }
-        pid_ = -1;
-        status_ = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-        return status_;
-    }
-    int stop() {
-        if (pid_ <= 0) return status_;
-        ::kill(pid_, SIGTERM);
-        for (int i = 0; i < 500; ++i) {
-            int st = 0;
-            if (::waitpid(pid_, &st, WNOHANG) == pid_) {
-                pid_ = -1;
-                status_ = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-                return status_;
-            }
-            ::usleep(10'000);
-        }
-        ::kill(pid_, SIGKILL);
-        return wait();
-    }
-
-  private:
-    pid_t pid_ = -1;
-    int status_ = -1;
-};
 
 std::string read_text(const std::filesystem::path& p) {
     std::ifstream f(p);
@@ -334,7 +272,7 @@ void measure_update(const Options& o, const std::filesystem::path& dir, UpdateTi
         const std::filesystem::path out = dir / "ecatctl.log";
         const auto t0 = Clock::now();
         Child ctl({o.ecatctl_path, "--iface", kMasterEnd, "firmware-update", file.string()}, out.string());
-        const int rc = ctl.wait();
+        const int rc = bench::exit_code(ctl.wait());
         const auto t1 = Clock::now();
         const std::string text = read_text(out);
         if (rc != 0) {
@@ -416,21 +354,14 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
-    if (::geteuid() != 0) {
-        std::fprintf(stderr,
-                     "bench-foe: needs root (network namespace, veth pair, raw sockets); run it with sudo\n");
-        return 2;
-    }
+    if (!bench::require_root("(network namespace, veth pair, raw sockets); run it with sudo")) return 2;
     for (const std::string& p : {o.slave_path, o.ecatctl_path}) {
         if (::access(p.c_str(), X_OK) != 0) {
             std::fprintf(stderr, "bench-foe: cannot run %s\n", p.c_str());
             return 2;
         }
     }
-    if (::unshare(CLONE_NEWNET) != 0) {
-        std::fprintf(stderr, "bench-foe: unshare(CLONE_NEWNET): %s\n", std::strerror(errno));
-        return 2;
-    }
+    if (!bench::enter_network_namespace()) return 2;
     char tmpl[] = "/tmp/bench-foe.XXXXXX";
     if (::mkdtemp(tmpl) == nullptr) {
         std::fprintf(stderr, "bench-foe: mkdtemp: %s\n", std::strerror(errno));

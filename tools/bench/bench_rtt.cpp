@@ -5,80 +5,26 @@
 // Everything lives in a private network namespace created at start (unshare), which the kernel removes with
 // the two veth pairs when this program and its children exit, however they exit. Needs root.
 // Prints median / p99 for both and their ratio; asserts nothing.
-#include <fcntl.h>
 #include <poll.h>
-#include <sched.h>
-#include <signal.h>
-#include <sys/prctl.h>
-#include <sys/wait.h>
-#include <time.h>
-#include <unistd.h>
 
-#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "esc/link.hpp"
 #include "esc/link_packet.hpp"
 #include "frame.hpp"
+#include "harness.hpp"
 #include "softslave/netif.hpp"
 #include "stats.hpp"
 
 namespace {
 
-uint64_t now_ns() {
-    timespec ts{};
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return static_cast<uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<uint64_t>(ts.tv_nsec);
-}
-
-// A child process killed with us (PR_SET_PDEATHSIG) and by the destructor.
-class Child {
-  public:
-    Child(const std::vector<std::string>& args, bool quiet) {
-        const pid_t parent = ::getpid();
-        pid_ = ::fork();
-        if (pid_ < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
-        if (pid_ == 0) {
-            ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-            if (::getppid() != parent) ::_exit(127);
-            if (quiet) {
-                const int devnull = ::open("/dev/null", O_WRONLY);
-                if (devnull >= 0) {
-                    ::dup2(devnull, 1);
-                    ::dup2(devnull, 2);
-                }
-            }
-            std::vector<char*> argv;
-            for (const auto& a : args)
-                argv.push_back(const_cast<char*>(a.c_str()));
-            argv.push_back(nullptr);
-            ::execv(argv[0], argv.data());
-            std::fprintf(stderr, "bench-rtt: cannot run %s: %s\n", argv[0], std::strerror(errno));
-            ::_exit(127);
-        }
-    }
-    ~Child() {
-        ::kill(pid_, SIGTERM);
-        int status = 0;
-        for (int i = 0; i < 200; ++i) {
-            if (::waitpid(pid_, &status, WNOHANG) == pid_) return;
-            ::usleep(10000);
-        }
-        ::kill(pid_, SIGKILL);
-        ::waitpid(pid_, &status, 0);
-    }
-    Child(const Child&) = delete;
-    Child& operator=(const Child&) = delete;
-    bool alive() const { return ::waitpid(pid_, nullptr, WNOHANG) == 0; }
-
-  private:
-    pid_t pid_ = -1;
-};
+using bench::Child;
+using bench::now_ns;
 
 // Sends frame (datagram 0 index = seq) and waits for the processed reply. Returns the round trip in ns,
 // 0 if no reply came within timeout_ms.
@@ -134,7 +80,8 @@ int run_same_pair(std::size_t frames, const std::string& backend, const std::str
     for (std::size_t block = 0; block < kBlocks; ++block) {
         const std::size_t n = frames / kBlocks + (block < frames % kBlocks ? 1 : 0);
         {
-            Child echo({echo_path, "--iface", "rtt-s0", "--backend", backend}, !verbose);
+            Child echo({echo_path, "--iface", "rtt-s0", "--backend", backend}, verbose ? "" : "/dev/null",
+                       2000);
             if (!wait_until_answering(master, frame, rx))
                 throw std::runtime_error("bench-echo does not answer");
             measure(master, frame, rx, n, rtt_echo, lost_echo);
@@ -142,7 +89,7 @@ int run_same_pair(std::size_t frames, const std::string& backend, const std::str
         {
             std::vector<std::string> args = {slave_path, "--iface", "rtt-s0", "--backend", backend};
             if (verbose) args.push_back("--verbose");
-            Child slave(args, !verbose);
+            Child slave(args, verbose ? "" : "/dev/null", 2000);
             if (!wait_until_answering(master, frame, rx))
                 throw std::runtime_error("ecat-slave does not answer");
             for (auto cfg : bench::configuration_frames(station))
@@ -215,21 +162,16 @@ int main(int argc, char** argv) {
         }
     }
     if (frames == 0) frames = 1;
-    if (::geteuid() != 0) {
-        std::fprintf(stderr, "bench-rtt: needs root (network namespace, veth pairs, raw sockets)\n");
-        return 2;
-    }
-    if (::unshare(CLONE_NEWNET) != 0) {
-        std::fprintf(stderr, "bench-rtt: unshare(CLONE_NEWNET): %s\n", std::strerror(errno));
-        return 2;
-    }
+    if (!bench::require_root("(network namespace, veth pairs, raw sockets)")) return 2;
+    if (!bench::enter_network_namespace()) return 2;
     try {
         if (same_pair) return run_same_pair(frames, backend, slave_path, echo_path, verbose);
         softslave::VethPair echo_pair("rtt-s0", "rtt-m0");
         softslave::VethPair slave_pair("rtt-s1", "rtt-m1");
         // (a) on pair 0, (b) on pair 1. With --compare-backends: (a) echo over pcap, (b) echo over packet.
         const std::string backend_a = compare_backends ? std::string("pcap") : backend;
-        Child echo({echo_path, "--iface", "rtt-s0", "--backend", backend_a}, !verbose);
+        Child echo({echo_path, "--iface", "rtt-s0", "--backend", backend_a}, verbose ? "" : "/dev/null",
+                   2000);
         std::vector<std::string> slave_args = {slave_path, "--iface", "rtt-s1", "--backend", backend};
         if (compare_backends) {
             slave_args = {echo_path, "--iface", "rtt-s1", "--backend", "packet"};
@@ -240,7 +182,7 @@ int main(int argc, char** argv) {
             }
             if (verbose) slave_args.push_back("--verbose");
         }
-        Child slave(slave_args, !verbose);
+        Child slave(slave_args, verbose ? "" : "/dev/null", 2000);
 
         esc::PacketLink to_echo("rtt-m0");
         esc::PacketLink to_slave("rtt-m1");

@@ -8,13 +8,6 @@
 //   (0) the bare frame round trip on the same pair (one APRD of the AL status register), interleaved with
 //       (2) and (3) so every figure sees the same machine load; ratios against it.
 // Needs root. Prints figures; asserts nothing (docs/benchmarks-coe.md).
-#include <fcntl.h>
-#include <sched.h>
-#include <signal.h>
-#include <sys/prctl.h>
-#include <sys/wait.h>
-#include <time.h>
-#include <unistd.h>
 
 #include <cerrno>
 #include <chrono>
@@ -30,6 +23,7 @@
 #include <vector>
 
 #include "esc/link.hpp"
+#include "harness.hpp"
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
@@ -38,55 +32,8 @@
 
 namespace {
 
-uint64_t now_ns() {
-    timespec ts{};
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return static_cast<uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<uint64_t>(ts.tv_nsec);
-}
-
-// ecat-slave as a child, killed with us (PR_SET_PDEATHSIG) and by the destructor.
-class Child {
-  public:
-    Child(const std::vector<std::string>& args, bool quiet) {
-        const pid_t parent = ::getpid();
-        pid_ = ::fork();
-        if (pid_ < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
-        if (pid_ == 0) {
-            ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-            if (::getppid() != parent) ::_exit(127);
-            if (quiet) {
-                const int devnull = ::open("/dev/null", O_WRONLY);
-                if (devnull >= 0) {
-                    ::dup2(devnull, 1);
-                    ::dup2(devnull, 2);
-                }
-            }
-            std::vector<char*> argv;
-            for (const auto& a : args)
-                argv.push_back(const_cast<char*>(a.c_str()));
-            argv.push_back(nullptr);
-            ::execv(argv[0], argv.data());
-            std::fprintf(stderr, "bench-sdo: cannot run %s: %s\n", argv[0], std::strerror(errno));
-            ::_exit(127);
-        }
-    }
-    ~Child() {
-        ::kill(pid_, SIGTERM);
-        int status = 0;
-        for (int i = 0; i < 200; ++i) {
-            if (::waitpid(pid_, &status, WNOHANG) == pid_) return;
-            ::usleep(10000);
-        }
-        ::kill(pid_, SIGKILL);
-        ::waitpid(pid_, &status, 0);
-    }
-    Child(const Child&) = delete;
-    Child& operator=(const Child&) = delete;
-    bool alive() const { return ::waitpid(pid_, nullptr, WNOHANG) == 0; }
-
-  private:
-    pid_t pid_ = -1;
-};
+using bench::Child;
+using bench::now_ns;
 
 // A temporary directory removed at exit.
 struct TempDir {
@@ -188,14 +135,8 @@ int main(int argc, char** argv) {
     if (requests == 0) requests = 1;
     if (segmented == 0) segmented = 1;
     if (dict_runs == 0) dict_runs = 1;
-    if (::geteuid() != 0) {
-        std::fprintf(stderr, "bench-sdo: needs root (network namespace, veth pair, raw sockets)\n");
-        return 2;
-    }
-    if (::unshare(CLONE_NEWNET) != 0) {
-        std::fprintf(stderr, "bench-sdo: unshare(CLONE_NEWNET): %s\n", std::strerror(errno));
-        return 2;
-    }
+    if (!bench::require_root("(network namespace, veth pair, raw sockets)")) return 2;
+    if (!bench::enter_network_namespace()) return 2;
     try {
         TempDir dir;
         // A device name of 255 characters (the SII string limit): 0x1008 then needs segments.
@@ -218,7 +159,7 @@ int main(int argc, char** argv) {
                                          "--state-dir",
                                          (dir.path / "state").string()};
         if (verbose) args.push_back("--verbose");
-        Child slave(args, !verbose);
+        Child slave(args, verbose ? "" : "/dev/null", 2000);
 
         auto link = esc::open_link("sdo-m0", backend);
         master::MasterOptions opt;
