@@ -1,12 +1,10 @@
 // "Hot paths allocate nothing": once warm, serving CoE requests, emergencies and diagnosis messages does not
-// touch the heap. Global operator new is replaced in this test binary to count allocations.
+// touch the heap. The test binary links the counting global operator new (tests/support/alloc_counter.hpp).
 #include <gtest/gtest.h>
 
 #include <array>
-#include <atomic>
-#include <cstdlib>
-#include <new>
 
+#include "alloc_counter.hpp"
 #include "coe/diagnosis.hpp"
 #include "coe/events.hpp"
 #include "coe/pdo_validation.hpp"
@@ -15,23 +13,6 @@
 
 // The replacement pairs malloc with free on purpose; GCC cannot see that once gtest's new/delete are inlined.
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<std::size_t> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t n) {
-    if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-    if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-    throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-    std::free(p);
-}
 
 using namespace coe_test;
 
@@ -116,8 +97,7 @@ TEST(CoeAllocation, ServingRequestsAllocatesNothingOnceWarm) {
     coe::EventReporter events(server.emergency(), &diag, [&now] { return now; });
     const uint8_t mfr[5] = {8, 8, 0, 0, 0};
 
-    g_allocations = 0;
-    g_counting = true;
+    const alloc_counter::Scope counting;
     events.raise(0x8611, 0x80, mfr);
     events.diag(coe::DiagType::Warning, 0x8A80, "Negative limit");
     events.clear(0x8611, 0);
@@ -130,8 +110,7 @@ TEST(CoeAllocation, ServingRequestsAllocatesNothingOnceWarm) {
     server.emergency().clear(0x2310);
     diag.add(m);
     server.poll(2, out);
-    g_counting = false;
-    EXPECT_EQ(g_allocations.load(), 0u);
+    EXPECT_EQ(counting.count(), 0u);
     EXPECT_GT(out.count, before + reqs.size());
 }
 

@@ -1,17 +1,16 @@
 // The composed drive's cycle allocates nothing: counts global operator new calls while the master exchanges
 // process data with the Device in Op (frame -> ESC -> Stack -> drive cycle -> inputs), including a fault with
-// its emergency and diagnosis message. Own binary: it replaces the global operator new.
+// its emergency and diagnosis message. Own binary: it links the counting global operator new.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <array>
-#include <atomic>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <memory>
-#include <new>
 
+#include "alloc_counter.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
 #include "master/coe.hpp"
@@ -19,33 +18,6 @@
 #include "master/master.hpp"
 #include "master/session.hpp"
 #include "softdrive/device.hpp"
-
-namespace {
-std::atomic<uint64_t> g_allocations{0};
-}
-
-void* operator new(std::size_t n) {
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-    if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-    throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) {
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-    if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-    throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-    std::free(p);
-}
 
 namespace {
 
@@ -132,27 +104,27 @@ TEST(DeviceAllocation, ProcessDataCyclesInOpAllocateNothing) {
         ASSERT_EQ(pd.cycle(), master::Error::Ok);
     }
 
-    const uint64_t before = g_allocations.load();
+    const alloc_counter::Scope cycles;
     int32_t target = 1000;
     for (int i = 0; i < 2000; ++i) {
         target += 5;
         set(0x0F, target);
         ASSERT_EQ(pd.cycle(), master::Error::Ok);
     }
-    const uint64_t cycles_allocs = g_allocations.load() - before;
+    const uint64_t cycles_allocs = cycles.count();
     EXPECT_EQ(cycles_allocs, 0u) << "allocations in 2000 process-data cycles in Op";
 
     // A fault inside the measured window: STO drops, the drive raises 0x8A88 (emergency + 0x10F3).
     const uint64_t errors = dev->stats().emergencies;
     dev->set_input(5, false);
     dev->set_input(6, false);
-    const uint64_t before_fault = g_allocations.load();
+    const alloc_counter::Scope fault;
     for (int i = 0; i < 50; ++i) {
         set(0x0F, target);
         ASSERT_EQ(pd.cycle(), master::Error::Ok);
     }
     EXPECT_GT(dev->stats().emergencies, errors);
-    EXPECT_EQ(g_allocations.load() - before_fault, 0u) << "allocations while a fault is raised and reported";
+    EXPECT_EQ(fault.count(), 0u) << "allocations while a fault is raised and reported";
     dev.reset();
     std::filesystem::remove_all(dir);
 }

@@ -1,29 +1,12 @@
 // Bad configuration and commands never crash the drive or poison its outputs; the cycle allocates nothing.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
 #include <random>
 
+#include "alloc_counter.hpp"
 #include "drive/drive.hpp"
 #include "od/drive_profile.hpp"
 #include "rig.hpp"
-
-namespace {
-std::atomic<long> g_allocs{0};
-}
-void* operator new(std::size_t n) {
-    g_allocs.fetch_add(1, std::memory_order_relaxed);
-    if (void* p = std::malloc(n ? n : 1)) return p;
-    throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-    std::free(p);
-}
 
 using namespace drive;
 using namespace drive::test;
@@ -100,11 +83,11 @@ TEST(Robustness, SteadyStateCycleAllocatesNothing) {
         drv.cycle(t, 1'000'000);
         t += 1'000'000;
     }
-    const long before = g_allocs.load();
+    const alloc_counter::Scope counting;
     for (int k = 0; k < 500; ++k) {
         d.set<int32_t>(0x607A, 0, k * 20);
         drv.cycle(t, 1'000'000);
         t += 1'000'000;
     }
-    EXPECT_EQ(g_allocs.load() - before, 0);
+    EXPECT_EQ(counting.count(), 0u);
 }

@@ -1,27 +1,8 @@
-// Hot paths allocate nothing: the process-data cycle and a mailbox request/reply, counted with a replaced
-// global operator new while only Stack::poll() runs.
-#include <atomic>
-#include <cstdlib>
-#include <new>
+// Hot paths allocate nothing: the process-data cycle and a mailbox request/reply, counted with the counting
+// global operator new (tests/support/alloc_counter.hpp) while only Stack::poll() runs.
 
+#include "alloc_counter.hpp"
 #include "fixture.hpp"
-
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<std::size_t> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t n) {
-    if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-    if (void* p = std::malloc(n != 0 ? n : 1)) return p;
-    throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-    std::free(p);
-}
 
 namespace ecat::test {
 namespace {
@@ -45,11 +26,9 @@ class Alloc : public StackTest {
   protected:
     std::size_t counted_poll() {
         esc->tick();
-        g_allocations = 0;
-        g_counting = true;
+        const alloc_counter::Scope counting;
         stack->poll(clock.now_ns());
-        g_counting = false;
-        return g_allocations;
+        return counting.count();
     }
 };
 
@@ -83,12 +62,12 @@ namespace ecat::test {
 namespace {
 
 TEST(AllocCounter, CountsAllocations) {
-    g_allocations = 0;
-    g_counting = true;
-    auto* p = new std::vector<int>(4);
-    g_counting = false;
+    const alloc_counter::Scope counting;
+    // volatile: the pointer escapes, so the compiler cannot elide the new/delete pair.
+    std::vector<int>* volatile p = new std::vector<int>(4);
+    const auto allocations = counting.count();
     delete p;
-    EXPECT_GE(g_allocations.load(), 2u);
+    EXPECT_GE(allocations, 2u);
 }
 
 }  // namespace

@@ -1,35 +1,17 @@
 // "Hot paths allocate nothing": once a transfer runs, each DATA/ACK packet and each idle poll() is served
-// without touching the heap. Global operator new is replaced in this binary to count allocations.
+// without touching the heap. This binary links the counting global operator new
+// (tests/support/alloc_counter.hpp).
 #include <gtest/gtest.h>
 
 #include <array>
-#include <atomic>
 #include <chrono>
-#include <cstdlib>
-#include <new>
 #include <thread>
 
+#include "alloc_counter.hpp"
 #include "foe/server.hpp"
 #include "foe_test_support.hpp"
 
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<std::size_t> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t n) {
-    if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-    if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-    throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-    std::free(p);
-}
 
 namespace {
 
@@ -44,14 +26,6 @@ class FixedSender final : public ecat::MailboxSender {
     std::size_t max_payload() const override { return 128 - 6; }
     std::array<uint8_t, 128> last{};
     std::size_t last_len = 0;
-};
-
-struct Counting {
-    Counting() {
-        g_allocations = 0;
-        g_counting = true;
-    }
-    ~Counting() { g_counting = false; }
 };
 
 std::array<uint8_t, 128> packet(uint8_t op, uint32_t value, std::span<const uint8_t> tail, std::size_t& len) {
@@ -86,23 +60,23 @@ TEST(FoeAllocation, DataAckAndIdlePollAllocateNothing) {
     const std::string_view name = "MAXPOS";
     auto m = packet(2, 0, {reinterpret_cast<const uint8_t*>(name.data()), name.size()}, len);
     {
-        Counting counting;
+        const alloc_counter::Scope counting;
         server.handle({m.data(), len}, out);  // opening the slot file builds its path: the counter is live
-        EXPECT_GT(g_allocations.load(), 0u);
+        EXPECT_GT(counting.count(), 0u);
     }
     ASSERT_EQ(out.last[0], 4);
     m = packet(3, 1, {image.data(), chunk}, len);
     server.handle({m.data(), len}, out);  // first packet: header checked
     ASSERT_EQ(out.last[0], 4);
     {
-        Counting counting;
+        const alloc_counter::Scope counting;
         for (uint32_t p = 2; p <= 100; ++p) {
             m = packet(3, p, {image.data() + (p - 1) * chunk, chunk}, len);
             server.handle({m.data(), len}, out);
             ASSERT_EQ(out.last[0], 4);
             server.poll(p * 1000, out);
         }
-        EXPECT_EQ(g_allocations.load(), 0u) << "per DATA packet";
+        EXPECT_EQ(counting.count(), 0u) << "per DATA packet";
     }
     m = packet(3, 101, {image.data() + 100 * chunk, image.size() - 100 * chunk}, len);
     server.handle({m.data(), len}, out);
@@ -118,13 +92,13 @@ TEST(FoeAllocation, DataAckAndIdlePollAllocateNothing) {
     server.handle({m.data(), len}, out);
     ASSERT_EQ(out.last[0], 3);
     {
-        Counting counting;
+        const alloc_counter::Scope counting;
         for (uint32_t p = 1; p <= 100; ++p) {
             m = packet(4, p, {}, len);
             server.handle({m.data(), len}, out);
             ASSERT_EQ(out.last[0], 3);
             server.poll(2'000'000 + p, out);
         }
-        EXPECT_EQ(g_allocations.load(), 0u) << "per ACK while reading";
+        EXPECT_EQ(counting.count(), 0u) << "per ACK while reading";
     }
 }

@@ -3,44 +3,15 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
-#include <atomic>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
-#include <new>
 #include <vector>
 
+#include "alloc_counter.hpp"
 #include "esc/esc.hpp"
 #include "esc/link_capture.hpp"
 #include "esc/link_loopback.hpp"
 #include "softslave/runtime.hpp"
-
-namespace {
-std::atomic<uint64_t> g_allocations{0};
-}
-
-void* operator new(std::size_t n) {
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-    if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-    throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) {
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-    if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-    throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-    std::free(p);
-}
 
 namespace {
 
@@ -101,11 +72,10 @@ TEST(RuntimeAllocation, HandlingFramesAllocatesNothing) {
     for (int round = 0; round < 20; ++round)
         for (const auto& f : frames)
             ASSERT_TRUE(links.first->send(f));
-    const uint64_t before = g_allocations.load();
+    const alloc_counter::Scope counting;
     while (links.second->pending() > 0)
         ASSERT_TRUE(runtime.run_once(1000));
-    const uint64_t after = g_allocations.load();
-    EXPECT_EQ(after - before, 0u) << "allocations while handling " << 20 * frames.size() << " frames";
+    EXPECT_EQ(counting.count(), 0u) << "allocations while handling " << 20 * frames.size() << " frames";
     EXPECT_EQ(runtime.stats().frames_sent, 21 * frames.size());
     EXPECT_GT(fw.polls, 0);
     runtime.set_capture(nullptr);

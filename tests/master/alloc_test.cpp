@@ -4,10 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <array>
-#include <atomic>
-#include <cstdlib>
-#include <new>
 
+#include "alloc_counter.hpp"
 #include "coe/sdo_server.hpp"
 #include "ecat/application.hpp"
 #include "ecat/stack.hpp"
@@ -19,33 +17,6 @@
 #include "master/master.hpp"
 #include "master/session.hpp"
 #include "od/drive_profile.hpp"
-
-namespace {
-std::atomic<uint64_t> g_allocations{0};
-}
-
-void* operator new(std::size_t n) {
-    ++g_allocations;
-    if (void* p = std::malloc(n ? n : 1)) return p;
-    throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) {
-    ++g_allocations;
-    if (void* p = std::malloc(n ? n : 1)) return p;
-    throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-    std::free(p);
-}
 
 using namespace master;
 
@@ -113,7 +84,7 @@ TEST(MasterAllocations, CyclesAndMailboxMessagesAllocateNothing) {
     uint8_t b[4];
     ASSERT_TRUE(sdo.upload(0x1018, 1, b).ok());  // warm-up: buffers sized
 
-    const uint64_t before = g_allocations.load();
+    const alloc_counter::Scope counting;
     for (int i = 0; i < 200; ++i) {
         pd.outputs()[0] = static_cast<uint8_t>(i);
         ASSERT_EQ(pd.cycle(), Error::Ok);
@@ -123,7 +94,6 @@ TEST(MasterAllocations, CyclesAndMailboxMessagesAllocateNothing) {
         const uint8_t v[4] = {0x20, 0x00, 0x7A, 0x60};
         ASSERT_EQ(sdo.download(0x1600, 1, v), Error::SdoAbort);  // RWP: refused in OP, still no allocation
     }
-    const uint64_t after = g_allocations.load();
-    EXPECT_EQ(after - before, 0u) << "allocations on the cycle / mailbox paths (master and slave side)";
+    EXPECT_EQ(counting.count(), 0u) << "allocations on the cycle / mailbox paths (master and slave side)";
     EXPECT_EQ(pd.stats().wkc_errors, 0u);
 }

@@ -2,27 +2,8 @@
 // listeners), set, Ref<T>, lookup.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
-
+#include "alloc_counter.hpp"
 #include "od/drive_profile.hpp"
-
-namespace {
-std::atomic<long> g_allocations{0};
-}
-
-void* operator new(std::size_t n) {
-    ++g_allocations;
-    if (void* p = std::malloc(n ? n : 1)) return p;
-    throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-    std::free(p);
-}
 
 TEST(OdAlloc, AccessPathsAllocateNothing) {
     od::Dictionary d = od::make_drive_dictionary(od::default_drive_description());
@@ -34,8 +15,8 @@ TEST(OdAlloc, AccessPathsAllocateNothing) {
     std::size_t len = 0;
     const uint8_t cw[2] = {0x0F, 0x00};
     const uint8_t mode[1] = {9};
-    const long before = g_allocations.load();
-    ASSERT_GT(before, 0);  // the counting operator new is the one in use
+    const uint64_t before = alloc_counter::total();
+    ASSERT_GT(before, 0u);  // the counting operator new is the one in use
     for (int i = 0; i < 1000; ++i) {
         ASSERT_EQ(d.write(0x6040, 0, od::AlState::Op, cw), od::Status::Ok);
         ASSERT_EQ(d.write(0x6060, 0, od::AlState::Op, mode), od::Status::Ok);  // value-set validator
@@ -47,6 +28,6 @@ TEST(OdAlloc, AccessPathsAllocateNothing) {
         ASSERT_FALSE(d.raw(0x607A, 0).empty());
         ASSERT_EQ(d.write(0x6060, 0, od::AlState::Op, cw), od::Status::LengthTooHigh);
     }
-    EXPECT_EQ(g_allocations.load() - before, 0);
+    EXPECT_EQ(alloc_counter::total() - before, 0u);
     EXPECT_EQ(heard, 1000);
 }
