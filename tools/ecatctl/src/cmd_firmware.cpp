@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "common.hpp"
 #include "foe/image.hpp"
 #include "format.hpp"
 #include "master/coe.hpp"
@@ -154,21 +155,6 @@ class Steps {
     Clock::time_point start_ = Clock::now();
 };
 
-int exit_code(Error e) {
-    switch (e) {
-        case Error::Ok:
-            return kExitOk;
-        case Error::Timeout:
-            return kExitNoSlave;
-        case Error::InvalidArgument:
-            return kExitUsage;
-        case Error::SendFailed:
-            return kExitFailure;
-        default:
-            return kExitProtocol;
-    }
-}
-
 int fail(Error e, const std::string& what) {
     std::fprintf(stderr, "ecatctl: %s: %s\n", what.c_str(), std::string(master::to_string(e)).c_str());
     return exit_code(e);
@@ -195,16 +181,7 @@ struct CoeIdentity {
 };
 
 int sdo_failed(const master::SdoClient& sdo, Error e, const std::string& what) {
-    if (e == Error::SdoAbort) {
-        std::fprintf(stderr, "ecatctl: %s: SDO abort 0x%08x (%s)\n", what.c_str(), sdo.last_abort(),
-                     std::string(master::sdo_abort_text(sdo.last_abort())).c_str());
-        return kExitProtocol;
-    }
-    if (e == Error::MailboxError) {
-        std::fprintf(stderr, "ecatctl: %s: mailbox error 0x%04x\n", what.c_str(), sdo.last_mailbox_error());
-        return kExitProtocol;
-    }
-    return fail(e, what);
+    return report_sdo_failure(sdo, e, what, fail);
 }
 
 int refused(const char* target, const master::AlStatus& st) {

@@ -14,6 +14,7 @@
 
 #include "cmd_diag.hpp"
 #include "cmd_firmware.hpp"
+#include "common.hpp"
 #include "esc/link.hpp"
 #include "format.hpp"
 #include "master/coe.hpp"
@@ -37,21 +38,6 @@ struct Globals {
     unsigned timeout_ms = 100;
     unsigned retries = 2;
 };
-
-int exit_code(Error e) {
-    switch (e) {
-        case Error::Ok:
-            return kExitOk;
-        case Error::Timeout:
-            return kExitNoSlave;
-        case Error::InvalidArgument:
-            return kExitUsage;
-        case Error::SendFailed:
-            return kExitFailure;
-        default:
-            return kExitProtocol;
-    }
-}
 
 int fail(Error e, const std::string& what) {
     std::cerr << "ecatctl: " << what << ": " << master::to_string(e) << "\n";
@@ -99,6 +85,13 @@ std::optional<Address> parse_slave(const std::string& text, bool station) {
     if (!v) return std::nullopt;
     return station ? Address::station(static_cast<uint16_t>(*v))
                    : Address::position(static_cast<uint16_t>(*v));
+}
+
+// The slave a command names; a bad one is reported as a usage error (exit kExitUsage) and gives nullopt.
+std::optional<Address> named_slave(const std::string& text, bool station) {
+    auto a = parse_slave(text, station);
+    if (!a) usage("bad slave '" + text + "'");
+    return a;
 }
 
 std::string slave_text(Address a) {
@@ -174,8 +167,8 @@ struct RegArgs {
 };
 
 int reg_read(master::Master& m, const RegArgs& r) {
-    auto a = parse_slave(r.slave, r.station);
-    if (!a) return usage("bad slave '" + r.slave + "'");
+    auto a = named_slave(r.slave, r.station);
+    if (!a) return kExitUsage;
     auto addr = parse_number(r.address, 0xFFFF);
     if (!addr) return usage("bad register address '" + r.address + "'");
     std::optional<ValueType> type;
@@ -205,8 +198,8 @@ int reg_read(master::Master& m, const RegArgs& r) {
 }
 
 int reg_write(master::Master& m, const RegArgs& r) {
-    auto a = parse_slave(r.slave, r.station);
-    if (!a) return usage("bad slave '" + r.slave + "'");
+    auto a = named_slave(r.slave, r.station);
+    if (!a) return kExitUsage;
     auto addr = parse_number(r.address, 0xFFFF);
     if (!addr) return usage("bad register address '" + r.address + "'");
     std::optional<ValueType> type;
@@ -242,8 +235,8 @@ struct SiiArgs {
 };
 
 int sii_read(master::Master& m, const SiiArgs& s) {
-    auto a = parse_slave(s.slave, s.station);
-    if (!a) return usage("bad slave '" + s.slave + "'");
+    auto a = named_slave(s.slave, s.station);
+    if (!a) return kExitUsage;
     auto img = m.sii_read_image(*a, s.all);
     if (!img) return fail(img.error(), "reading the SII of " + slave_text(*a));
     if (s.output.empty()) {
@@ -271,8 +264,8 @@ std::optional<std::vector<uint8_t>> read_file(const std::string& path) {
 }
 
 int sii_write(master::Master& m, const SiiArgs& s) {
-    auto a = parse_slave(s.slave, s.station);
-    if (!a) return usage("bad slave '" + s.slave + "'");
+    auto a = named_slave(s.slave, s.station);
+    if (!a) return kExitUsage;
     auto img = read_file(s.input);
     if (!img) return usage("cannot read " + s.input);
     if (img->size() < 16 || img->size() % 2 != 0 || img->size() > 65536)
@@ -297,8 +290,8 @@ int sii_write(master::Master& m, const SiiArgs& s) {
 
 int state(master::Master& m, const std::string& slave, bool station, const std::string& target,
           bool identify) {
-    auto a = parse_slave(slave, station);
-    if (!a) return usage("bad slave '" + slave + "'");
+    auto a = named_slave(slave, station);
+    if (!a) return kExitUsage;
     if (identify) {
         auto id = m.identify(*a);
         if (!id) return fail(id.error(), "device identification of " + slave_text(*a));
@@ -373,21 +366,12 @@ Error open_mailbox(master::Master& m, master::Mailbox& mbx, Address a) {
 }
 
 int sdo_failed(const master::SdoClient& sdo, Error e, const std::string& what) {
-    if (e == Error::SdoAbort) {
-        std::fprintf(stderr, "ecatctl: %s: SDO abort 0x%08x (%s)\n", what.c_str(), sdo.last_abort(),
-                     std::string(master::sdo_abort_text(sdo.last_abort())).c_str());
-        return kExitProtocol;
-    }
-    if (e == Error::MailboxError) {
-        std::fprintf(stderr, "ecatctl: %s: mailbox error 0x%04x\n", what.c_str(), sdo.last_mailbox_error());
-        return kExitProtocol;
-    }
-    return fail(e, what);
+    return report_sdo_failure(sdo, e, what, fail);
 }
 
 int sdo_transfer(master::Master& m, const SdoArgs& s, bool upload) {
-    auto a = parse_slave(s.slave, s.station);
-    if (!a) return usage("bad slave '" + s.slave + "'");
+    auto a = named_slave(s.slave, s.station);
+    if (!a) return kExitUsage;
     auto index = parse_number(s.index, 0xFFFF);
     if (!index) return usage("bad index '" + s.index + "'");
     auto sub = parse_number(s.sub, 0xFF);
@@ -627,8 +611,8 @@ const char* type_name(uint16_t t) {
 }
 
 int sdos(master::Master& m, const std::string& slave, bool station, bool quiet) {
-    auto a = parse_slave(slave, station);
-    if (!a) return usage("bad slave '" + slave + "'");
+    auto a = named_slave(slave, station);
+    if (!a) return kExitUsage;
     master::Mailbox mbx(m, *a);
     if (Error e = open_mailbox(m, mbx, *a); e != Error::Ok)
         return fail(e, "opening the mailbox of " + slave_text(*a));
@@ -689,8 +673,8 @@ int foe_failed(const master::FoeClient& foe, Error e, const std::string& what) {
 }
 
 int foe_transfer(master::Master& m, const FoeArgs& f, bool read) {
-    auto a = parse_slave(f.slave, f.station);
-    if (!a) return usage("bad slave '" + f.slave + "'");
+    auto a = named_slave(f.slave, f.station);
+    if (!a) return kExitUsage;
     auto password = parse_number(f.password, 0xFFFFFFFF);
     if (!password) return usage("bad password '" + f.password + "'");
     std::vector<uint8_t> data;
@@ -845,8 +829,8 @@ int main(int argc, char** argv) {
             return;
         }
         rc = with_master(g, [&](master::Master& m) {
-            auto a = parse_slave(s.slave, s.station);
-            if (!a) return usage("bad slave '" + s.slave + "'");
+            auto a = named_slave(s.slave, s.station);
+            if (!a) return kExitUsage;
             auto img = m.sii_read_image(*a);
             if (!img) return fail(img.error(), "reading the SII of " + slave_text(*a));
             std::fputs(esi::decode_sii(*img).c_str(), stdout);
