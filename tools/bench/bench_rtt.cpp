@@ -133,13 +133,7 @@ int main(int argc, char** argv) {
     bool same_pair = false;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
-        auto next = [&]() -> std::string {
-            if (i + 1 >= argc) {
-                usage();
-                std::exit(2);
-            }
-            return argv[++i];
-        };
+        auto next = [&] { return bench::option_value(argc, argv, i, usage); };
         if (a == "--frames") {
             frames = std::strtoull(next().c_str(), nullptr, 10);
         } else if (a == "--backend") {

@@ -108,13 +108,7 @@ int main(int argc, char** argv) {
     bool verbose = false;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
-        auto next = [&]() -> std::string {
-            if (i + 1 >= argc) {
-                usage();
-                std::exit(2);
-            }
-            return argv[++i];
-        };
+        auto next = [&] { return bench::option_value(argc, argv, i, usage); };
         if (a == "--requests") {
             requests = std::strtoull(next().c_str(), nullptr, 10);
         } else if (a == "--segmented") {

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 
@@ -87,6 +88,14 @@ int Child::stop() {
 int exit_code(int wait_status) {
     if (wait_status == -1) return -1;
     return WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : -1;
+}
+
+std::string option_value(int argc, char** argv, int& i, void (*usage)()) {
+    if (i + 1 >= argc) {
+        usage();
+        std::exit(2);
+    }
+    return argv[++i];
 }
 
 bool require_root(const char* why) {

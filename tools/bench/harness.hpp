@@ -39,6 +39,9 @@ class Child {
 // The exit code in a wait status; -1 if the process did not exit normally (or for status -1).
 int exit_code(int wait_status);
 
+// The value of the option at argv[i] (argv[i + 1]; i moves on to it). Without one: usage(), exit status 2.
+std::string option_value(int argc, char** argv, int& i, void (*usage)());
+
 // Prints "<program>: needs root <why>" and returns false unless running as root.
 bool require_root(const char* why);
 
