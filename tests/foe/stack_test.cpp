@@ -159,7 +159,10 @@ class FoeOverTheStack : public ::testing::Test {
             const Bytes d = foe_packet(3, packet, {image.data() + off, n});
             off += n;
             r = exchange(d);
-            for (int i = 0; i < 10000 && r.size() >= 6 && r[0] == 6; ++i) {
+            // Storing runs on a worker thread and fsyncs: bound the wait by time, not by a count of polls
+            // (a count ran out before a slow disk finished).
+            const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+            while (r.size() >= 6 && r[0] == 6 && std::chrono::steady_clock::now() < give_up) {
                 if (busy) ++*busy;
                 r = exchange(d);  // SOEM / IgH: repeat the last DATA after BUSY
             }
