@@ -104,10 +104,16 @@ DiagnosisHistory::DiagnosisHistory(od::Dictionary& dict, Emergency* emergency)
     updating_ = true;
     set_u8(kSubMax, static_cast<uint8_t>(slots_));
     updating_ = false;
-    dict_.add_validator(kIndex,
-                        [this](const od::Entry& e, std::span<const uint8_t> v) { return validate(e, v); });
-    dict_.add_listener(kIndex, [this](const od::Entry& e) { on_written(e); });
-    dict_.add_read_hook(kIndex, [this](const od::Entry& e) { on_read(e); });
+    dict_.add_validator(
+        kIndex, [this](const od::Entry& e, std::span<const uint8_t> v) { return validate(e, v); }, this);
+    dict_.add_listener(
+        kIndex, [this](const od::Entry& e) { on_written(e); }, this);
+    dict_.add_read_hook(
+        kIndex, [this](const od::Entry& e) { on_read(e); }, this);
+}
+
+DiagnosisHistory::~DiagnosisHistory() {
+    dict_.remove_hooks(this);
 }
 
 uint16_t DiagnosisHistory::flags() const {

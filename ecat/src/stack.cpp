@@ -95,6 +95,10 @@ Stack::Stack(esc::Pdi& pdi, od::Dictionary& dictionary, const od::DeviceDescript
     sync_objects_init();
 }
 
+Stack::~Stack() {
+    dict_.remove_hooks(this);
+}
+
 // ---- Dictionary helpers ------------------------------------------------------------------------------
 
 uint64_t Stack::get_u(uint16_t index, uint8_t sub, uint64_t fallback) const {
@@ -127,9 +131,12 @@ void Stack::sync_objects_init() {
     }
     // Notice master writes of the sync mode (SDO in Pre-Op), so Pre-Op -> Safe-Op can check them.
     if (dict_.find(kSmOutputParams) != nullptr) {
-        dict_.add_listener(kSmOutputParams, [this](const od::Entry& e) {
-            if (!internal_write_ && e.subindex == kSiSyncMode) master_wrote_sync_mode_ = true;
-        });
+        dict_.add_listener(
+            kSmOutputParams,
+            [this](const od::Entry& e) {
+                if (!internal_write_ && e.subindex == kSiSyncMode) master_wrote_sync_mode_ = true;
+            },
+            this);
     }
     for (int i = 0; i < 2; ++i) {
         const uint16_t index = i == 0 ? kSmOutputParams : kSmInputParams;

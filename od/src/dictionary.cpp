@@ -196,10 +196,17 @@ void encode_default(const Entry& e, uint8_t* out) {
 // ---- Dictionary -------------------------------------------------------------------------------------
 
 struct Dictionary::Impl {
+    // Each hook remembers who installed it, so that an owner that goes away first can take its hooks
+    // with it (remove_hooks) instead of leaving a dangling callback behind.
+    template <typename F>
+    struct Owned {
+        const void* owner;
+        F fn;
+    };
     struct Hooks {
-        std::vector<Validator> validators;
-        std::vector<Listener> listeners;
-        std::vector<ReadHook> read_hooks;
+        std::vector<Owned<Validator>> validators;
+        std::vector<Owned<Listener>> listeners;
+        std::vector<Owned<ReadHook>> read_hooks;
     };
     std::vector<Object> objects;  // sorted by index
     std::vector<Hooks> hooks;     // parallel to objects
@@ -242,7 +249,7 @@ struct Dictionary::Impl {
 
     void notify(std::size_t pos, const Entry& e) {
         for (auto& l : hooks[pos].listeners)
-            l(e);
+            l.fn(e);
     }
 };
 
@@ -345,7 +352,7 @@ Status Dictionary::read(uint16_t index, uint8_t sub, AlState state, std::span<ui
     if ((e->access & access::ReadMask) == 0) return Status::WriteOnly;
     if (!e->readable(state)) return Status::WrongState;
     for (auto& h : im.hooks[pos].read_hooks)
-        h(*e);
+        h.fn(*e);
     const auto v = im.value_of(*e, im.image);
     length = v.size();
     if (out.size() < v.size()) return Status::LengthTooHigh;
@@ -362,7 +369,7 @@ Status Dictionary::write(uint16_t index, uint8_t sub, AlState state, std::span<c
     if (!e->writable(state)) return Status::WrongState;
     if (Status st = check_value(*e, value); st != Status::Ok) return st;
     for (auto& v : im.hooks[pos].validators)
-        if (Status st = v(*e, value); st != Status::Ok) return st;
+        if (Status st = v.fn(*e, value); st != Status::Ok) return st;
     im.commit(*e, value);
     im.notify(pos, *e);
     return Status::Ok;
@@ -402,24 +409,36 @@ std::span<uint8_t> Dictionary::mutable_raw(uint16_t index, uint8_t sub) {
     return {impl_->image.data() + e->offset, e->byte_size()};
 }
 
-void Dictionary::add_validator(uint16_t index, Validator v) {
+void Dictionary::add_validator(uint16_t index, Validator v, const void* owner) {
     const std::size_t pos = impl_->position(index);
     if (pos == impl_->objects.size())
         throw std::out_of_range("od::Dictionary::add_validator: no such object");
-    impl_->hooks[pos].validators.push_back(std::move(v));
+    impl_->hooks[pos].validators.push_back({owner, std::move(v)});
 }
 
-void Dictionary::add_listener(uint16_t index, Listener l) {
+void Dictionary::add_listener(uint16_t index, Listener l, const void* owner) {
     const std::size_t pos = impl_->position(index);
     if (pos == impl_->objects.size()) throw std::out_of_range("od::Dictionary::add_listener: no such object");
-    impl_->hooks[pos].listeners.push_back(std::move(l));
+    impl_->hooks[pos].listeners.push_back({owner, std::move(l)});
 }
 
-void Dictionary::add_read_hook(uint16_t index, ReadHook h) {
+void Dictionary::add_read_hook(uint16_t index, ReadHook h, const void* owner) {
     const std::size_t pos = impl_->position(index);
     if (pos == impl_->objects.size())
         throw std::out_of_range("od::Dictionary::add_read_hook: no such object");
-    impl_->hooks[pos].read_hooks.push_back(std::move(h));
+    impl_->hooks[pos].read_hooks.push_back({owner, std::move(h)});
+}
+
+void Dictionary::remove_hooks(const void* owner) {
+    if (owner == nullptr) return;
+    auto drop = [owner](auto& list) {
+        std::erase_if(list, [owner](const auto& h) { return h.owner == owner; });
+    };
+    for (auto& h : impl_->hooks) {
+        drop(h.validators);
+        drop(h.listeners);
+        drop(h.read_hooks);
+    }
 }
 
 void Dictionary::reset_to_defaults() {

@@ -344,6 +344,31 @@ TEST(OdDictionary, ValidatorsVetoAndListenersFollowCommits) {
     EXPECT_THROW(d.add_listener(0x7777, [](const Entry&) {}), std::out_of_range);
 }
 
+TEST(OdDictionary, RemoveHooksTakesOnlyTheOwnersHooks) {
+    Dictionary d = sample();
+    int mine = 0, other = 0, anonymous = 0;
+    const int owner_a = 0, owner_b = 0;  // any two distinct addresses
+    d.add_validator(
+        0x6040, [&](const Entry&, std::span<const uint8_t>) { return Status::InvalidValue; }, &owner_a);
+    d.add_listener(
+        0x6040, [&](const Entry&) { ++mine; }, &owner_a);
+    d.add_read_hook(
+        0x6040, [&](const Entry&) { ++mine; }, &owner_a);
+    d.add_listener(
+        0x6040, [&](const Entry&) { ++other; }, &owner_b);
+    d.add_listener(0x6040, [&](const Entry&) { ++anonymous; });
+    EXPECT_EQ(d.write(0x6040, 0, AlState::Op, bytes({1, 0})), Status::InvalidValue);
+    d.remove_hooks(&owner_a);
+    d.remove_hooks(nullptr);  // removes nothing
+    EXPECT_EQ(d.write(0x6040, 0, AlState::Op, bytes({1, 0})), Status::Ok);
+    uint8_t out[2];
+    std::size_t n = 0;
+    EXPECT_EQ(d.read(0x6040, 0, AlState::Op, out, n), Status::Ok);
+    EXPECT_EQ(mine, 0);
+    EXPECT_EQ(other, 1);
+    EXPECT_EQ(anonymous, 1);
+}
+
 TEST(OdDictionary, ReadHookRefreshesBeforeTheCopy) {
     Dictionary d = sample();
     int32_t source = 0;

@@ -79,6 +79,7 @@ class DiagnosisHistory {
     // Installs the write/read semantics on 0x10F3. emergency may be null (flag b0 then cannot be set).
     // Throws std::logic_error if the dictionary has no usable 0x10F3. Must not outlive dict, must not move.
     DiagnosisHistory(od::Dictionary& dict, Emergency* emergency = nullptr);
+    ~DiagnosisHistory();  // takes its hooks off the dictionary, which may outlive it
     DiagnosisHistory(const DiagnosisHistory&) = delete;
     DiagnosisHistory& operator=(const DiagnosisHistory&) = delete;
 

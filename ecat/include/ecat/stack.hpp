@@ -56,6 +56,8 @@ class Stack {
 
     Stack(esc::Pdi& pdi, od::Dictionary& dictionary, const od::DeviceDescription& description,
           Application& application, IrqLine irq = {});
+    // Takes its hooks off the dictionary, which may outlive the stack (a firmware restart).
+    ~Stack();
     Stack(const Stack&) = delete;
     Stack& operator=(const Stack&) = delete;
 

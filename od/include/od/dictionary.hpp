@@ -146,9 +146,13 @@ class Dictionary {
     }
 
     // ---- Hooks ------------------------------------------------------------------------------------
-    void add_validator(uint16_t index, Validator v);
-    void add_listener(uint16_t index, Listener l);
-    void add_read_hook(uint16_t index, ReadHook h);
+    // owner: whoever installs the hook and may be destroyed before the dictionary; it calls
+    // remove_hooks(this) in its destructor. Hooks installed without an owner live as long as the dictionary.
+    void add_validator(uint16_t index, Validator v, const void* owner = nullptr);
+    void add_listener(uint16_t index, Listener l, const void* owner = nullptr);
+    void add_read_hook(uint16_t index, ReadHook h, const void* owner = nullptr);
+    // Removes every hook installed with this owner (nullptr: nothing).
+    void remove_hooks(const void* owner);
 
     // Every entry back to its declared default. Listeners are not called.
     void reset_to_defaults();
