@@ -15,6 +15,7 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <thread>
 #include <vector>
@@ -30,11 +31,30 @@ struct Proc {
     int out = -1;  // stdout + stderr of the child
 };
 
+// A state directory of this test process for every privileged run, so no run writes the default
+// /var/lib/softecat of the machine; removed when the test binary exits.
+const std::string& state_dir() {
+    struct Dir {
+        std::string path;
+        Dir() {
+            char tmpl[] = "/tmp/ecat-slave-cli-XXXXXX";
+            if (::mkdtemp(tmpl) != nullptr) path = tmpl;
+        }
+        ~Dir() {
+            std::error_code ec;
+            if (!path.empty()) std::filesystem::remove_all(path, ec);
+        }
+    };
+    static Dir dir;
+    return dir.path;
+}
+
 // Starts ecat-slave with args; with own_netns the child first enters a new network namespace and, with
 // stale_pair, creates ecat0/ecat1 there as a killed earlier run would have left them.
 // With unprivileged, the child drops to uid/gid 65534 (nobody) before exec, losing every capability.
 Proc start(const std::vector<std::string>& args, bool own_netns = false, bool stale_pair = false,
            bool unprivileged = false) {
+    std::string state_option = "--state-dir=" + state_dir();  // before fork: the parent owns the directory
     int fds[2];
     if (::pipe2(fds, O_CLOEXEC) != 0) return {};
     const pid_t parent = ::getpid();
@@ -57,6 +77,7 @@ Proc start(const std::vector<std::string>& args, bool own_netns = false, bool st
         std::vector<char*> argv{const_cast<char*>(ECAT_SLAVE_PATH)};
         for (const auto& a : args)
             argv.push_back(const_cast<char*>(a.c_str()));
+        if (!unprivileged && !state_dir().empty()) argv.push_back(state_option.data());
         argv.push_back(nullptr);
         ::execv(argv[0], argv.data());
         ::_exit(127);
