@@ -25,6 +25,8 @@
 #include "od/drive_profile.hpp"
 #include "softdrive/device.hpp"
 
+#include "../support/wire_link.hpp"
+
 using namespace master;
 
 namespace {
@@ -73,30 +75,22 @@ struct Drive {
     od::Dictionary& dict() { return dev->dictionary(); }
 };
 
+// The master's link to this slave: each frame through the ESC, then the firmware, as the runtime does.
 class DriveLink final : public esc::Link {
   public:
-    explicit DriveLink(Drive& d) : d_(d) {}
-    int fd() const override { return -1; }
-    std::size_t receive(std::span<uint8_t> buf) override {
-        if (replies_.empty()) return 0;
-        const auto f = std::move(replies_.front());
-        replies_.pop_front();
-        const std::size_t n = std::min(buf.size(), f.size());
-        std::copy_n(f.begin(), n, buf.begin());
-        return n;
-    }
-    bool send(std::span<const uint8_t> frame) override {
-        std::vector<uint8_t> f(frame.begin(), frame.end());
-        d_.clock.advance(d_.frame_ns);
-        const bool back = d_.esc->process_frame(f);
-        d_.service();
-        if (back) replies_.push_back(std::move(f));
-        return true;
-    }
+    explicit DriveLink(Drive& d)
+        : wire_([&d](std::vector<uint8_t>& f) {
+              d.clock.advance(d.frame_ns);
+              const bool back = d.esc->process_frame(f);
+              d.service();
+              return back;
+          }) {}
+    int fd() const override { return wire_.fd(); }
+    std::size_t receive(std::span<uint8_t> buf) override { return wire_.receive(buf); }
+    bool send(std::span<const uint8_t> frame) override { return wire_.send(frame); }
 
   private:
-    Drive& d_;
-    std::deque<std::vector<uint8_t>> replies_;
+    test_support::WireLink wire_;
 };
 
 MasterOptions master_options() {

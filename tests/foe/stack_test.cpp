@@ -22,6 +22,8 @@
 #include "master/master.hpp"
 #include "od/drive_profile.hpp"
 
+#include "../support/wire_link.hpp"
+
 namespace {
 
 using Bytes = std::vector<uint8_t>;
@@ -72,31 +74,23 @@ struct Slave {
     }
 };
 
+// The master's link to this slave: each frame through the ESC, then the firmware, as the runtime does.
 class SlaveLink final : public esc::Link {
   public:
-    explicit SlaveLink(Slave& s) : s_(s) {}
-    int fd() const override { return -1; }
-    std::size_t receive(std::span<uint8_t> buf) override {
-        if (replies_.empty()) return 0;
-        const auto f = std::move(replies_.front());
-        replies_.pop_front();
-        const std::size_t n = std::min(buf.size(), f.size());
-        std::copy_n(f.begin(), n, buf.begin());
-        return n;
-    }
-    bool send(std::span<const uint8_t> frame) override {
-        std::vector<uint8_t> f(frame.begin(), frame.end());
-        s_.clock.advance(50'000);
-        const bool back = s_.esc->process_frame(f);
-        s_.esc->tick();
-        s_.stack->poll(s_.clock.now_ns());
-        if (back) replies_.push_back(std::move(f));
-        return true;
-    }
+    explicit SlaveLink(Slave& s)
+        : wire_([&s](std::vector<uint8_t>& f) {
+              s.clock.advance(50'000);
+              const bool back = s.esc->process_frame(f);
+              s.esc->tick();
+              s.stack->poll(s.clock.now_ns());
+              return back;
+          }) {}
+    int fd() const override { return wire_.fd(); }
+    std::size_t receive(std::span<uint8_t> buf) override { return wire_.receive(buf); }
+    bool send(std::span<const uint8_t> frame) override { return wire_.send(frame); }
 
   private:
-    Slave& s_;
-    std::deque<std::vector<uint8_t>> replies_;
+    test_support::WireLink wire_;
 };
 
 Bytes foe_packet(uint8_t op, uint32_t value, std::span<const uint8_t> tail = {}) {

@@ -25,6 +25,8 @@
 #include "master/session.hpp"
 #include "od/drive_profile.hpp"
 
+#include "../support/wire_link.hpp"
+
 using namespace master;
 
 namespace {
@@ -80,34 +82,24 @@ struct Slave {
     }
 };
 
+// The master's link to this slave: each frame through the ESC, then the firmware, as the runtime does.
 class SlaveLink final : public esc::Link {
   public:
-    explicit SlaveLink(Slave& s) : s_(s) {}
-    int fd() const override { return -1; }
-    std::size_t receive(std::span<uint8_t> buf) override {
-        if (replies_.empty()) return 0;
-        const auto f = std::move(replies_.front());
-        replies_.pop_front();
-        const std::size_t n = std::min(buf.size(), f.size());
-        std::copy_n(f.begin(), n, buf.begin());
-        return n;
-    }
-    bool send(std::span<const uint8_t> frame) override {
-        std::vector<uint8_t> f(frame.begin(), frame.end());
-        if (!s_.real_time) s_.clock.advance(20'000);
-        const bool back = s_.esc->process_frame(f);
-        s_.esc->tick();
-        s_.stack->poll(s_.clk().now_ns());  // firmware after the reply, as the runtime does
-        if (back && !drop_) replies_.push_back(std::move(f));
-        drop_ = false;
-        return true;
-    }
-    void drop_next() { drop_ = true; }
+    explicit SlaveLink(Slave& s)
+        : wire_([&s](std::vector<uint8_t>& f) {
+              if (!s.real_time) s.clock.advance(20'000);
+              const bool back = s.esc->process_frame(f);
+              s.esc->tick();
+              s.stack->poll(s.clk().now_ns());  // firmware after the reply, as the runtime does
+              return back;
+          }) {}
+    int fd() const override { return wire_.fd(); }
+    std::size_t receive(std::span<uint8_t> buf) override { return wire_.receive(buf); }
+    bool send(std::span<const uint8_t> frame) override { return wire_.send(frame); }
+    void drop_next() { wire_.drop_next(); }
 
   private:
-    Slave& s_;
-    bool drop_ = false;
-    std::deque<std::vector<uint8_t>> replies_;
+    test_support::WireLink wire_;
 };
 
 MasterOptions options() {
