@@ -337,9 +337,11 @@ bool Esc::Impl::process(std::span<uint8_t> frame, uint64_t rx_clock) {
 }
 
 void Esc::Impl::end_of_frame(bool ok) {
-    // SyncManager buffer changes of ECAT accesses take effect at the end of a correct frame.
+    // SyncManager buffer changes of ECAT accesses take effect at the end of a correct frame. 0x09F0 latches
+    // the local time of the beginning of a frame that changed at least one buffer (docs/decisions/esc.md).
     uint16_t pend = sm_pending_mask;
     sm_pending_mask = 0;
+    bool buffer_changed = false;
     for (unsigned n = 0; pend != 0; ++n, pend = static_cast<uint16_t>(pend >> 1)) {
         if (!(pend & 1)) continue;
         SyncManager& s = sm[n];
@@ -347,11 +349,13 @@ void Esc::Impl::end_of_frame(bool ok) {
         s.pending = false;
         if (ok) {
             sm_commit(n, s.pending_write, Side::Ecat);
+            buffer_changed = true;
         } else {
             (s.pending_write ? s.prod_open : s.cons_open) = false;
             sm_update_status(n);
         }
     }
+    if (buffer_changed) w32(reg::kDcEcatBufferChange, static_cast<uint32_t>(frame_local));
     if (dc_latch_pending) {
         dc_latch_pending = false;
         if (ok) {

@@ -73,6 +73,7 @@ constexpr uint16_t kDcLatch0Control = 0x09A8;
 constexpr uint16_t kDcLatch1Control = 0x09A9;
 constexpr uint16_t kDcLatch0Status = 0x09AE;
 constexpr uint16_t kDcLatchTimes = 0x09B0;
+constexpr uint16_t kDcEcatBufferChange = 0x09F0;
 constexpr uint16_t kUserRam = 0x0F80;
 constexpr uint32_t kRamBase = 0x1000;
 }  // namespace reg

@@ -276,3 +276,28 @@ TEST_F(SmTest, InputsDoNotTriggerWatchdog) {
 }
 
 }  // namespace
+
+// 0x09F0 (ECAT buffer change event time): local time of the beginning of a frame that completed an ECAT-side
+// buffer access; frames that leave the buffers alone, a partial access or a malformed frame do not move it.
+TEST_F(SmTest, EcatBufferChangeTimeLatchesTheFrameStart) {
+    auto change_time = [&] { return e->read_reg<uint32_t>(0x09F0); };
+    EXPECT_EQ(change_time(), 0u);
+    clk.set(5'000'000);
+    const uint64_t first = e->local_time_ns();
+    EXPECT_EQ(fpwr(*e, 0x1100, {1, 2, 3, 4}).wkc, 1);  // outputs, whole buffer
+    EXPECT_EQ(change_time(), static_cast<uint32_t>(first));
+
+    clk.set(6'000'000);
+    EXPECT_EQ(fprd(*e, 0x0000, 4).wkc, 1);       // no buffer touched
+    EXPECT_EQ(fpwr(*e, 0x1100, {9, 9}).wkc, 1);  // buffer opened, not completed
+    EXPECT_EQ(change_time(), static_cast<uint32_t>(first));
+
+    clk.set(7'000'000);
+    const uint64_t second = e->local_time_ns();
+    EXPECT_EQ(fprd(*e, 0x1180, 4).wkc, 1);  // inputs read by the master: also a buffer change
+    EXPECT_EQ(change_time(), static_cast<uint32_t>(second));
+
+    // Not writable from either side.
+    EXPECT_EQ(fpwr(*e, 0x09F0, {0, 0, 0, 0}).wkc, 1);
+    EXPECT_EQ(change_time(), static_cast<uint32_t>(second));
+}
