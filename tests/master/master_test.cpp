@@ -133,3 +133,19 @@ TEST(MasterNames, StatesAndCodes) {
     EXPECT_EQ(al_status_code_name(0x9000), "Vendor specific");
     EXPECT_EQ(to_string(Error::Timeout), "no slave answered (timeout)");
 }
+
+// busy_poll waits for replies without sleeping; matching, retries and the timeout work as before.
+TEST(MasterExchange, BusyPollMatchesRetriesAndTimesOutLikeTheDefault) {
+    fake::Bus bus(1);
+    MasterOptions o = fast();
+    o.busy_poll = true;
+    Master m(bus, o);
+    bus.drop_next = 1;
+    auto n = m.count_slaves();
+    ASSERT_TRUE(n.ok());
+    EXPECT_EQ(*n, 1);
+    EXPECT_EQ(m.stats().timeouts, 1u);
+    bus.drop_next = 100;
+    EXPECT_EQ(m.count_slaves().error(), Error::Timeout);
+    EXPECT_EQ(m.stats().timeouts, 4u);
+}

@@ -275,7 +275,10 @@ Error Master::wait_frame(uint8_t first_index, std::span<Datagram> datagrams, Clo
         const auto now = Clock::now();
         if (now >= deadline) return Error::Timeout;
         const int fd = link_.fd();
-        if (fd >= 0) {
+        if (options_.busy_poll) {
+            // No PAUSE here: in a virtual machine a tight PAUSE loop makes the host give the vCPU away
+            // (pause-loop exiting), the opposite of what busy polling is for.
+        } else if (fd >= 0) {
             const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - now);
             timespec ts{static_cast<time_t>(left.count() / 1'000'000'000),
                         static_cast<long>(left.count() % 1'000'000'000)};

@@ -93,6 +93,7 @@ struct MasterOptions {
     MacAddress source_mac{0x01, 0x01, 0x01, 0x01, 0x01, 0x01};  // bit 1 of byte 0 clear: replies set it
     std::chrono::milliseconds sii_timeout{100};                 // busy polling of one SII command
     std::chrono::milliseconds al_timeout{5000};                 // reaching a requested AL state
+    bool busy_poll = false;  // wait for replies by polling the link in a loop instead of sleeping in ppoll()
 };
 
 struct MasterStats {
