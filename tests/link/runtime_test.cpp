@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -176,6 +177,100 @@ TEST_F(Runtime, TheTimerMovesEarlierAtOnceButLaterOnlyAfterFiring) {
     fw.deadline = clock.now_ns() + 5'000'000;
     ASSERT_TRUE(runtime.run_once(0));
     EXPECT_EQ(runtime.stats().timer_arms, arms2 + 1);
+    runtime.set_firmware(nullptr);
+}
+
+// --spin-us: the timer is armed spin_ns before the deadline and the runtime busy-waits the rest; the deadline
+// is serviced by that same wake-up, at or after its time, and the wait is counted.
+TEST_F(Runtime, SpinWakesEarlyAndServicesTheDeadlineInTheSameWakeUp) {
+    RecordingFirmware fw(master());
+    runtime.set_firmware(&fw);
+    runtime.set_spin(30'000'000);               // 30 ms
+    fw.deadline = clock.now_ns() + 60'000'000;  // 60 ms: the timer is armed for 30 ms
+    int rounds = 0;
+    while (!fw.deadline_hit && rounds < 100) {
+        ASSERT_TRUE(runtime.run_once(2000));
+        ++rounds;
+    }
+    ASSERT_TRUE(fw.deadline_hit);
+    EXPECT_GE(fw.last_now, fw.deadline);
+    EXPECT_EQ(runtime.stats().timer_expiries, 1u) << "one early wake-up, the rest was spun";
+    EXPECT_EQ(runtime.stats().spin_waits, 1u);
+    EXPECT_GT(runtime.stats().spin_ns_total, 0u);
+    runtime.set_firmware(nullptr);
+}
+
+// Frames that arrive while the runtime spins towards a deadline are answered at once (not after the deadline)
+// and the firmware is polled for them as after any frame.
+TEST_F(Runtime, FramesArrivingDuringASpinAreAnsweredBeforeTheDeadline) {
+    struct Watching : RecordingFirmware {
+        using RecordingFirmware::RecordingFirmware;
+        void poll(uint64_t now_ns) override {
+            RecordingFirmware::poll(now_ns);
+            if (first_reply_seen == 0 && master.pending() > 0) first_reply_seen = now_ns;
+        }
+        uint64_t first_reply_seen = 0;
+    } fw(master());
+    runtime.set_firmware(&fw);
+    runtime.set_spin(10'000'000'000);            // longer than the wait: spins from the first wake-up
+    fw.deadline = clock.now_ns() + 300'000'000;  // 300 ms
+    std::thread sender([this] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        const auto f = brd_type_frame();
+        (void)master().send(f);
+    });
+    ASSERT_TRUE(runtime.run_once(2000));
+    sender.join();
+    EXPECT_TRUE(fw.deadline_hit) << "one run_once spun all the way to the deadline";
+    EXPECT_EQ(runtime.stats().frames_sent, 1u);
+    ASSERT_NE(fw.first_reply_seen, 0u);
+    EXPECT_LT(fw.first_reply_seen, fw.deadline) << "the reply went out during the spin";
+    EXPECT_GE(fw.polls, 2) << "polled for the frame and at the deadline";
+    runtime.set_firmware(nullptr);
+}
+
+TEST_F(Runtime, RequestStopEndsASpin) {
+    RecordingFirmware fw(master());
+    runtime.set_firmware(&fw);
+    runtime.set_spin(60'000'000'000);
+    fw.deadline = clock.now_ns() + 30'000'000'000;  // 30 s away, spun from the start
+    std::thread stopper([this] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        runtime.request_stop();
+    });
+    EXPECT_FALSE(runtime.run_once(2000));
+    stopper.join();
+    EXPECT_FALSE(fw.deadline_hit);
+    runtime.set_firmware(nullptr);
+}
+
+// --busy-poll: run_once never blocks, never arms the timer, and still answers frames and meets deadlines.
+TEST_F(Runtime, BusyPollNeverSleepsNorArmsTheTimer) {
+    RecordingFirmware fw(master());
+    runtime.set_firmware(&fw);
+    runtime.set_busy_poll(true);
+    std::atomic<bool> done{false};
+    std::thread stopper([this, &done] {  // if run_once blocked, this would end it and the check below fails
+        for (int i = 0; i < 500 && !done.load(); ++i)
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        if (!done.load()) runtime.request_stop();
+    });
+    EXPECT_TRUE(runtime.run_once(-1)) << "returned without waiting for anything";
+    fw.deadline = clock.now_ns() + 10'000'000;
+    const auto f = brd_type_frame();
+    ASSERT_TRUE(master().send(f));
+    int passes = 0;
+    while (!fw.deadline_hit && runtime.run_once(-1))
+        ++passes;
+    EXPECT_TRUE(fw.deadline_hit);
+    EXPECT_GE(fw.last_now, fw.deadline);
+    EXPECT_GT(passes, 1);
+    EXPECT_EQ(runtime.stats().timer_arms, 0u);
+    EXPECT_EQ(runtime.stats().frames_sent, 1u);
+    done.store(true);
+    stopper.join();
+    runtime.request_stop();
+    EXPECT_FALSE(runtime.run_once(-1));
     runtime.set_firmware(nullptr);
 }
 

@@ -145,6 +145,8 @@ TEST(EcatSlaveCli, BadOptionsExitWith2) {
     EXPECT_EQ(run({"--cpu", "100000", "--iface", "lo"}).code, 2);
     EXPECT_EQ(run({"--rt-priority", "100", "--iface", "lo"}).code, 2);
     EXPECT_EQ(run({"--eeprom", "/nonexistent/eeprom.bin", "--iface", "lo"}).code, 2);
+    EXPECT_EQ(run({"--spin-us", "50", "--busy-poll", "--iface", "lo"}).code, 2);  // one way of waiting
+    EXPECT_EQ(run({"--spin-us", "0", "--iface", "lo"}).code, 2);
 }
 
 TEST(EcatSlaveCli, MissingPrivilegesExitWith2AndNameTheCapability) {
@@ -181,16 +183,11 @@ void in_netns_of(pid_t pid, F&& fn) {
     if (error) std::rethrow_exception(error);
 }
 
-TEST(EcatSlaveVeth, CreatesThePairAnswersOnItAndRemovesItOnSigterm) {
-    if (!linktest::is_root()) GTEST_SKIP() << "needs root (CAP_NET_ADMIN, CAP_NET_RAW)";
-    const std::string capture = "/tmp/ecat-slave-test-" + std::to_string(::getpid()) + ".pcap";
-    Proc p = start({"--capture", capture, "--verbose"}, /*own_netns=*/true, /*stale_pair=*/true);
-    ASSERT_GT(p.pid, 0);
-    const std::string out = read_until(p.out, "running on", 5000);
-    ASSERT_NE(out.find("master interface: ecat1"), std::string::npos) << out;
-
+// Sends a BRD of the ESC type register from ecat1 in the namespace of `pid` and expects the slave's answer:
+// working counter 1 and the source MAC bit set.
+void expect_brd_answer(pid_t pid) {
     std::unique_ptr<esc::PacketLink> master;
-    in_netns_of(p.pid, [&] { master = std::make_unique<esc::PacketLink>("ecat1"); });
+    in_netns_of(pid, [&] { master = std::make_unique<esc::PacketLink>("ecat1"); });
     // BRD of the ESC type register: the slave answers with WKC 1 and the source MAC bit set.
     std::vector<uint8_t> f(60, 0);
     for (int i = 0; i < 6; ++i)
@@ -214,6 +211,17 @@ TEST(EcatSlaveVeth, CreatesThePairAnswersOnItAndRemovesItOnSigterm) {
     ASSERT_EQ(n, 60u);
     EXPECT_EQ(buf[6], 0x03);
     EXPECT_EQ(buf[27], 1) << "working counter";
+}
+
+TEST(EcatSlaveVeth, CreatesThePairAnswersOnItAndRemovesItOnSigterm) {
+    if (!linktest::is_root()) GTEST_SKIP() << "needs root (CAP_NET_ADMIN, CAP_NET_RAW)";
+    const std::string capture = "/tmp/ecat-slave-test-" + std::to_string(::getpid()) + ".pcap";
+    Proc p = start({"--capture", capture, "--verbose"}, /*own_netns=*/true, /*stale_pair=*/true);
+    ASSERT_GT(p.pid, 0);
+    const std::string out = read_until(p.out, "running on", 5000);
+    ASSERT_NE(out.find("master interface: ecat1"), std::string::npos) << out;
+
+    expect_brd_answer(p.pid);
 
     bool exists_before = false, exists_after = true;
     in_netns_of(p.pid, [&] { exists_before = softslave::interface_exists("ecat0"); });
@@ -246,6 +254,24 @@ TEST(EcatSlaveVeth, CreatesThePairAnswersOnItAndRemovesItOnSigterm) {
     EXPECT_EQ(data[27], 1);
     pcap_close(pc);
     std::remove(capture.c_str());
+}
+
+// The ways of waiting (--spin-us, --busy-poll) answer frames on a real veth pair like the default and end on
+// SIGTERM, the busy loop included.
+TEST(EcatSlaveVeth, SpinAndBusyPollAnswerAndStopOnSigterm) {
+    if (!linktest::is_root()) GTEST_SKIP() << "needs root (CAP_NET_ADMIN, CAP_NET_RAW)";
+    for (const std::vector<std::string>& waiting :
+         {std::vector<std::string>{"--spin-us", "200"}, std::vector<std::string>{"--busy-poll"}}) {
+        std::vector<std::string> args = waiting;
+        args.push_back("--verbose");
+        Proc p = start(args, /*own_netns=*/true, /*stale_pair=*/false);
+        ASSERT_GT(p.pid, 0);
+        const std::string out = read_until(p.out, "running on", 5000);
+        ASSERT_NE(out.find("running on"), std::string::npos) << waiting[0] << ": " << out;
+        expect_brd_answer(p.pid);
+        ::kill(p.pid, SIGTERM);
+        EXPECT_EQ(wait_exit(p.pid, 5000), 0) << waiting[0];
+    }
 }
 
 }  // namespace

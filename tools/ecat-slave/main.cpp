@@ -86,6 +86,15 @@ int main(int argc, char** argv) {
                    "Run with SCHED_FIFO at this priority (1-99) and lock all memory")
         ->check(CLI::Range(1, 99));
     app.add_option("--cpu", options.cpu, "Pin the slave to this CPU")->check(CLI::NonNegativeNumber);
+    auto* spin =
+        app.add_option("--spin-us", options.spin_us,
+                       "Wake N us before each timed event (SYNC0, application cycle, watchdog) and "
+                       "busy-wait to it: takes the timer latency out of the cycle, for up to N us of CPU "
+                       "per event")
+            ->check(CLI::Range(1, 100000));
+    app.add_flag("--busy-poll", options.busy_poll,
+                 "Never sleep: poll the network and the clock in a loop (one CPU fully busy; use with --cpu)")
+        ->excludes(spin);
     app.add_flag("--verbose,-v", options.verbose, "Print statistics at exit");
     app.add_option("--stats-file", options.stats_file,
                    "Write the statistics as 'name value' lines to this file at exit");

@@ -92,11 +92,13 @@ Runtime::~Runtime() {
 }
 
 void Runtime::request_stop() {
+    stop_flag_.store(true, std::memory_order_relaxed);  // lock-free: safe in a signal handler
     const uint64_t one = 1;
     (void)!::write(stop_fd_, &one, sizeof one);
 }
 
 bool Runtime::stop_requested() const {
+    if (stop_flag_.load(std::memory_order_relaxed)) return true;
     pollfd p{stop_fd_, POLLIN, 0};
     return ::poll(&p, 1, 0) > 0 && (p.revents & POLLIN) != 0;
 }
@@ -107,9 +109,9 @@ void Runtime::run() {
 }
 
 bool Runtime::run_once(int timeout_ms) {
-    arm_timer();
+    if (!busy_poll_) arm_timer();
     epoll_event events[4];
-    const int n = ::epoll_wait(epoll_fd_, events, 4, timeout_ms);
+    const int n = ::epoll_wait(epoll_fd_, events, 4, busy_poll_ ? 0 : timeout_ms);
     if (n < 0) {
         if (errno == EINTR) return !stop_requested();
         throw std::runtime_error(std::string("epoll_wait: ") + std::strerror(errno));
@@ -134,7 +136,7 @@ bool Runtime::run_once(int timeout_ms) {
                 break;
         }
     }
-    ++stats_.wakeups;
+    if (n > 0 || !busy_poll_) ++stats_.wakeups;
     const bool link_event = link_.fd() < 0 || link_events != 0;
     if (link_event) {
         handle_frames();
@@ -157,12 +159,75 @@ bool Runtime::run_once(int timeout_ms) {
         armed_ns_ = 0;
     }
     if (control && firmware_ != nullptr) firmware_->on_control(clock_.now_ns());
+    if (busy_poll_) {
+        // One pass of the loop: service only when something happened or a deadline passed, so an idle pass
+        // costs one epoll_wait and a clock read.
+        const uint64_t now = clock_.now_ns();
+        note_loop_pass(now);
+        if (link_event || control || now >= next_deadline_ns()) service();
+        return !stop_flag_.load(std::memory_order_relaxed);
+    }
     if (link_event || timer || control || n == 0) service();
+    if (spin_ns_ != 0 && !spin_to_deadline()) return false;
     return true;
 }
 
-void Runtime::handle_frames() {
-    for (int i = 0; i < kMaxBurst; ++i) {
+uint64_t Runtime::next_deadline_ns() const {
+    uint64_t deadline = esc_.next_event_ns();
+    if (firmware_ != nullptr) deadline = std::min(deadline, firmware_->next_deadline_ns());
+    if (capture_ != nullptr && capture_->frames_written() != flushed_frames_)
+        deadline = std::min(deadline, capture_flush_due_ns_);
+    return deadline;
+}
+
+// Called after each wake-up: while the next deadline is at most spin_ns_ away (the timer was armed that
+// early), stay awake and service each deadline on time. Several deadlines can fall within a microsecond of
+// each other (the stack's own estimate of SYNC0 comes just before the ESC's pulse), so the loop goes on
+// after each one until the next is further than spin_ns_ away. Frames that arrive meanwhile are answered and
+// serviced as usual (in SM-synchronous mode the application cycle runs on them): spinning never delays a
+// reply. A deadline that does not move on when serviced ends the spin after a few rounds.
+void Runtime::note_loop_pass(uint64_t now) {
+    if (last_pass_ns_ != 0 && now > last_pass_ns_) {
+        const uint64_t gap = now - last_pass_ns_;
+        if (gap > 50'000) ++stats_.loop_gaps_over_50us;
+        if (gap > 1'000'000) ++stats_.loop_gaps_over_1ms;
+        stats_.loop_gap_max_ns = std::max(stats_.loop_gap_max_ns, gap);
+    }
+    last_pass_ns_ = now;
+}
+
+bool Runtime::spin_to_deadline() {
+    constexpr int kMaxServicedDeadlines = 8;
+    const uint64_t start = clock_.now_ns();
+    uint64_t now = start;
+    last_pass_ns_ = 0;
+    bool spun = false;
+    for (int serviced = 0; serviced < kMaxServicedDeadlines;) {
+        const uint64_t deadline = next_deadline_ns();
+        if (deadline == kNever || deadline > now + spin_ns_) break;
+        if (now >= deadline) {
+            service();
+            ++serviced;
+        } else {
+            spun = true;
+            if (stop_flag_.load(std::memory_order_relaxed)) return false;
+            if (handle_frames() > 0) service();
+        }
+        now = clock_.now_ns();
+        note_loop_pass(now);
+    }
+    last_pass_ns_ = 0;
+    if (spun) {
+        ++stats_.spin_waits;
+        stats_.spin_ns_total += now - start;
+    }
+    armed_ns_ = 0;  // the timer may still be armed for a deadline serviced here; it is armed afresh
+    return true;
+}
+
+int Runtime::handle_frames() {
+    int i = 0;
+    for (; i < kMaxBurst; ++i) {
         const std::size_t len = link_.receive(buffer_);
         if (len == 0) break;
         const uint64_t rx_ns = clock_.now_ns();
@@ -187,6 +252,7 @@ void Runtime::handle_frames() {
             if (reply) capture_->write(frame);
         }
     }
+    return i;
 }
 
 void Runtime::service() {
@@ -204,10 +270,8 @@ void Runtime::service() {
 }
 
 void Runtime::arm_timer() {
-    uint64_t deadline = esc_.next_event_ns();
-    if (firmware_ != nullptr) deadline = std::min(deadline, firmware_->next_deadline_ns());
-    if (capture_ != nullptr && capture_->frames_written() != flushed_frames_)
-        deadline = std::min(deadline, capture_flush_due_ns_);
+    uint64_t deadline = next_deadline_ns();
+    if (deadline != kNever && spin_ns_ != 0) deadline = deadline > spin_ns_ ? deadline - spin_ns_ : 0;
     // The timer is only ever moved earlier. A deadline that moved later (a watchdog re-triggered by every
     // process-data frame) or went away leaves the timer where it is: it then fires early once, service()
     // finds nothing due, and the timer is re-armed for the real deadline. This saves a timerfd_settime()

@@ -51,6 +51,11 @@ void write_stats(std::ostream& out, const RuntimeStats& s, const esc::EscStats& 
         << "runtime.timer_expiries " << s.timer_expiries << '\n'
         << "runtime.frame_ns_mean " << (s.frames_received ? s.frame_ns_total / s.frames_received : 0) << '\n'
         << "runtime.frame_ns_max " << s.frame_ns_max << '\n'
+        << "runtime.spin_waits " << s.spin_waits << '\n'
+        << "runtime.spin_ns_mean " << (s.spin_waits ? s.spin_ns_total / s.spin_waits : 0) << '\n'
+        << "runtime.loop_gaps_over_50us " << s.loop_gaps_over_50us << '\n'
+        << "runtime.loop_gaps_over_1ms " << s.loop_gaps_over_1ms << '\n'
+        << "runtime.loop_gap_max_ns " << s.loop_gap_max_ns << '\n'
         << "esc.frames_processed " << e.frames_processed << '\n'
         << "esc.frames_malformed " << e.frames_malformed << '\n';
     if (firmware != nullptr) firmware->report(out);
@@ -123,6 +128,8 @@ int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err)
         Runtime runtime(*link, esc, clock);
         runtime.set_firmware(firmware.get());
         runtime.set_capture(capture.get());
+        runtime.set_spin(uint64_t{options.spin_us} * 1000u);
+        runtime.set_busy_poll(options.busy_poll);
         runtime.set_link_check([&iface] { return interface_exists(iface); });
         set_signal_target(&runtime);
 
@@ -160,6 +167,12 @@ int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err)
                 << ", timer arms " << s.timer_arms << ", expiries " << s.timer_expiries << "; ESC: processed "
                 << e.frames_processed << ", ignored " << e.frames_ignored << ", malformed "
                 << e.frames_malformed << ", datagrams " << e.datagrams << '\n';
+            if (s.spin_waits > 0)
+                out << "spin waits " << s.spin_waits << ", mean " << s.spin_ns_total / s.spin_waits
+                    << " ns\n";
+            if (options.busy_poll || options.spin_us > 0)
+                out << "busy loop kept from running: " << s.loop_gaps_over_50us << " times over 50 us, "
+                    << s.loop_gaps_over_1ms << " over 1 ms, longest " << s.loop_gap_max_ns << " ns\n";
             if (firmware) firmware->report(out);
         }
         if (!options.stats_file.empty()) {

@@ -8,8 +8,18 @@
 //   frame) re-arm the timerfd (CLOCK_MONOTONIC, TFD_TIMER_ABSTIME) for min(esc.next_event_ns(), firmware
 //   deadline)
 //
+// How it waits for a timed event (a SYNC0 pulse, the application cycle, a watchdog) is a choice:
+//   default        sleeps on the timerfd to the deadline: the wake-up is as late as the platform's timer
+//                  latency (tens of microseconds on a virtual machine, docs/benchmarks.md);
+//   set_spin(N)    sleeps to N ns before the deadline, then busy-waits on the clock to it, serving frames
+//                  that come meanwhile: the event runs within a microsecond or two of its time, for at most
+//                  N ns of CPU per event;
+//   set_busy_poll  never sleeps: the link, the clock and the descriptors are polled in a loop, so frames are
+//                  answered and events run without any wake-up latency, for a whole CPU.
+//
 // One receive buffer, allocated at construction; nothing is allocated per frame or per cycle.
 // The clock must count CLOCK_MONOTONIC nanoseconds (esc::SystemClock) because the timer runs on it.
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -33,6 +43,13 @@ struct RuntimeStats {
     uint64_t timer_arms = 0;      // timerfd_settime() calls
     uint64_t frame_ns_total = 0;  // sum over frames of (reply ready to send - frame received), clock ns
     uint64_t frame_ns_max = 0;
+    uint64_t spin_waits = 0;     // busy-waits to a deadline (set_spin)
+    uint64_t spin_ns_total = 0;  // time spent in them, clock ns
+    // Busy-poll and spin loops: gaps between two consecutive passes, i.e. times the loop was kept from
+    // running (preempted, interrupted, a slow system call). Show what the platform takes from a busy loop.
+    uint64_t loop_gaps_over_50us = 0;
+    uint64_t loop_gaps_over_1ms = 0;
+    uint64_t loop_gap_max_ns = 0;
 };
 
 class Runtime {
@@ -53,6 +70,10 @@ class Runtime {
     // is still usable. If it returns false, run() ends and link_lost() is true. Not called per frame.
     void set_link_check(std::function<bool()> check) { link_check_ = std::move(check); }
     bool link_lost() const { return link_lost_; }
+    // Wake spin_ns before each timed event and busy-wait to it (0: sleep all the way, the default).
+    void set_spin(uint64_t spin_ns) { spin_ns_ = spin_ns; }
+    // Never sleep (see above). run_once() then returns after one pass, whatever its timeout.
+    void set_busy_poll(bool on) { busy_poll_ = on; }
 
     // Runs until request_stop().
     void run();
@@ -66,8 +87,11 @@ class Runtime {
     const RuntimeStats& stats() const { return stats_; }
 
   private:
-    void handle_frames();
+    int handle_frames();  // returns the number of frames received
     void service();
+    uint64_t next_deadline_ns() const;
+    bool spin_to_deadline();  // false: stop was requested meanwhile
+    void note_loop_pass(uint64_t now);
     void arm_timer();
     void close_fds();
     static constexpr uint32_t kTagLink = 1, kTagTimer = 2, kTagStop = 3, kTagControl = 4;
@@ -82,12 +106,16 @@ class Runtime {
     int timer_fd_ = -1;
     int stop_fd_ = -1;
     int epoll_fd_ = -1;
-    int control_fd_ = -1;                // the firmware's control descriptor registered with epoll, -1: none
-    uint64_t armed_ns_ = 0;              // deadline the timerfd is armed for; 0 = not armed or expired
-    uint64_t flushed_frames_ = 0;        // capture frames already pushed to the file
-    uint64_t capture_flush_due_ns_ = 0;  // earliest time of the next capture flush
-    std::vector<uint8_t> buffer_;        // the receive buffer (frame processed in place)
-    std::vector<uint8_t> in_copy_;       // the frame as received, kept for the capture
+    uint64_t spin_ns_ = 0;
+    bool busy_poll_ = false;
+    uint64_t last_pass_ns_ = 0;           // clock at the last pass of a busy loop, 0: not in one
+    std::atomic<bool> stop_flag_{false};  // set with the stop eventfd, cheap to test while spinning
+    int control_fd_ = -1;                 // the firmware's control descriptor registered with epoll, -1: none
+    uint64_t armed_ns_ = 0;               // deadline the timerfd is armed for; 0 = not armed or expired
+    uint64_t flushed_frames_ = 0;         // capture frames already pushed to the file
+    uint64_t capture_flush_due_ns_ = 0;   // earliest time of the next capture flush
+    std::vector<uint8_t> buffer_;         // the receive buffer (frame processed in place)
+    std::vector<uint8_t> in_copy_;        // the frame as received, kept for the capture
     RuntimeStats stats_;
 };
 

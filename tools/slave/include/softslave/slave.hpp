@@ -39,6 +39,8 @@ struct SlaveOptions {
     std::string stats_file;           // write the same statistics as "name value" lines here at exit
     int rt_priority = 0;              // > 0: SCHED_FIFO at this priority and all memory locked (mlockall)
     int cpu = -1;                     // >= 0: pin the slave to this CPU
+    uint32_t spin_us = 0;             // wake this early before each timed event and busy-wait to it
+    bool busy_poll = false;           // never sleep: poll the link and the clock in a loop
     EepromLoader eeprom_loader = load_eeprom_file;
     FirmwareFactory firmware_factory;  // empty: no firmware
 };
