@@ -96,5 +96,43 @@ class ProcessData(unittest.TestCase):
         self.assertEqual(problems, [], "\n".join(problems[:20]))
 
 
+class ProcessDataWithABusySlave(unittest.TestCase):
+    """The slave's other ways of waiting (`--spin-us`, `--busy-poll`) run the same cyclic sessions: OP in DC
+    and in SM-synchronous mode, every cycle answered with the expected working counter, and the slave's
+    statistics at exit show that it really spun to its deadlines / polled."""
+
+    def session(self, bus, *args):
+        r = bus.ecatctl("pd", "0", "-n", "500", "--cycle-us", "1000", *args)
+        m = STATS.search(r.stdout)
+        self.assertIsNotNone(m, r.stdout)
+        self.assertIn("state: OP\n", r.stdout)
+        self.assertEqual(tuple(int(x) for x in m.groups()[:3]), (500, 0, 0), r.stdout)
+
+    def run_bus(self, waiting):
+        bus = harness.Bus(slave_args=waiting + ["--verbose"]).__enter__()
+        self.addCleanup(bus.close)
+        if not bus.slave_supports(waiting[0]):
+            self.skipTest(f"ecat-slave has no {waiting[0]}")
+        self.session(bus, "--dc")
+        self.session(bus)
+        self.assertEqual(bus.stop_slave(), 0, bus.slave_output())
+        return bus.slave_output()
+
+    def test_spin_us(self):
+        out = self.run_bus(["--spin-us", "200"])
+        m = re.search(r"spin waits (\d+), mean (\d+) ns", out)
+        self.assertIsNotNone(m, out)
+        self.assertGreater(int(m.group(1)), 0, "SYNC0 deadlines were spun to")
+        self.assertRegex(out, r"busy loop kept from running: \d+ times over 50 us")
+
+    def test_busy_poll(self):
+        out = self.run_bus(["--busy-poll"])
+        self.assertRegex(out, r"busy loop kept from running: \d+ times over 50 us")
+        self.assertNotRegex(out, r"spin waits", "busy polling never arms a spin")
+        m = re.search(r"timer arms (\d+)", out)
+        self.assertIsNotNone(m, out)
+        self.assertEqual(int(m.group(1)), 0, "busy polling never arms the timer")
+
+
 if __name__ == "__main__":
     harness.main()
