@@ -81,10 +81,107 @@ struct Options {
     int rt_priority = 80;  // 0: no SCHED_FIFO
     int master_cpu = 0;    // -1: not pinned
     int slave_cpu = 1;
-    unsigned phase_percent = 50;  // where in the cycle (after SYNC0) the frame passes the slave
-    unsigned master_spin_us = 0;  // the master loop wakes this early and spins to its deadline
+    unsigned phase_percent = 50;    // where in the cycle (after SYNC0) the frame passes the slave
+    unsigned master_spin_us = 0;    // the master loop wakes this early and spins to its deadline
+    bool master_busy_poll = false;  // the master waits for replies by polling, not in ppoll()
+    unsigned slave_spin_us = 0;     // ecat-slave --spin-us
+    bool slave_busy_poll = false;   // ecat-slave --busy-poll
+    bool rt_throttle_off = false;   // kernel.sched_rt_runtime_us = -1 for the run (restored at the end)
+    unsigned probe_seconds = 10;    // platform stall probe before the runs (0: none)
+    bool sm_sync = false;           // SM-synchronous (0x1C32:01 = 1) instead of DC SYNC0
     bool verbose = false;
     std::string keep_logs;  // copy the slave logs here
+};
+
+// The platform's floor, measured in the same run just before each cycle time: a thread pinned to each CPU
+// the benchmark uses, at the benchmark's priority, spins on CLOCK_MONOTONIC (90 % of the time, in 18 ms
+// chunks) and records every gap between two consecutive reads. Nothing else in the guest runs at that
+// priority on those CPUs, so a long gap is the vCPU not running (the host preempted it) or an interrupt.
+// Every cycle boundary that falls into such a gap is a cycle no software in the guest could have kept:
+// `periods` counts them (gap / cycle, all CPUs together).
+struct StallProbe {
+    unsigned seconds = 0;
+    uint64_t periods = 0;    // cycle periods inside gaps, all CPUs
+    uint64_t over_20us = 0;  // gaps over 20 us
+    uint64_t longest_ns = 0;
+};
+
+StallProbe probe_stalls(const Options& o, unsigned cycle_us) {
+    StallProbe r;
+    r.seconds = o.probe_seconds;
+    if (o.probe_seconds == 0) return r;
+    std::vector<int> cpus;
+    for (int c : {o.master_cpu, o.slave_cpu})
+        if (std::find(cpus.begin(), cpus.end(), c) == cpus.end()) cpus.push_back(c);
+    std::vector<StallProbe> per(cpus.size());
+    std::vector<std::thread> threads;
+    const uint64_t period = cycle_us * 1000ull;
+    const uint64_t end = bench::now_ns() + o.probe_seconds * 1'000'000'000ull;
+    for (std::size_t i = 0; i < cpus.size(); ++i) {
+        threads.emplace_back([&p = per[i], cpu = cpus[i], end, period] {
+            if (cpu >= 0) {
+                cpu_set_t set;
+                CPU_ZERO(&set);
+                CPU_SET(cpu, &set);
+                (void)::pthread_setaffinity_np(pthread_self(), sizeof set, &set);
+            }
+            // Spins 18 ms, then sleeps 2 ms (not counted): a SCHED_FIFO loop that never sleeps would be
+            // stopped for 50 ms in every second by the kernel's RT throttling, which is not the platform.
+            constexpr uint64_t kSpinNs = 18'000'000;
+            constexpr timespec kPause{0, 2'000'000};
+            uint64_t last = bench::now_ns();
+            uint64_t chunk_end = last + kSpinNs;
+            while (last < end && !g_stop.load(std::memory_order_relaxed)) {
+                uint64_t t = bench::now_ns();
+                if (t >= chunk_end) {
+                    ::nanosleep(&kPause, nullptr);
+                    t = bench::now_ns();
+                    last = t;
+                    chunk_end = t + kSpinNs;
+                }
+                const uint64_t gap = t - last;
+                last = t;
+                if (gap < 20'000) continue;
+                ++p.over_20us;
+                p.longest_ns = std::max(p.longest_ns, gap);
+                p.periods += gap / period;
+            }
+        });
+    }
+    for (auto& t : threads)
+        t.join();
+    for (const StallProbe& p : per) {
+        r.periods += p.periods;
+        r.over_20us += p.over_20us;
+        r.longest_ns = std::max(r.longest_ns, p.longest_ns);
+    }
+    return r;
+}
+
+// kernel.sched_rt_runtime_us = -1 while it lives, the previous value afterwards. A busy-polling SCHED_FIFO
+// task on each CPU would otherwise be stopped for 50 ms of every second by the kernel's real-time throttling.
+class RtThrottleOff {
+  public:
+    RtThrottleOff() {
+        std::ifstream in(kPath);
+        if (!(in >> saved_)) return;
+        std::ofstream out(kPath);
+        active_ = static_cast<bool>(out << -1 << '\n') && static_cast<bool>(out.flush());
+    }
+    ~RtThrottleOff() {
+        if (!active_) return;
+        std::ofstream out(kPath);
+        out << saved_ << '\n';
+    }
+    RtThrottleOff(const RtThrottleOff&) = delete;
+    RtThrottleOff& operator=(const RtThrottleOff&) = delete;
+    bool active() const { return active_; }
+    long saved() const { return saved_; }
+
+  private:
+    static constexpr const char* kPath = "/proc/sys/kernel/sched_rt_runtime_us";
+    long saved_ = 0;
+    bool active_ = false;
 };
 
 // "stack.cycles 123" lines of the slave's --stats-file (or of its --verbose output).
@@ -93,7 +190,7 @@ std::map<std::string, uint64_t> read_figures(const std::string& log) {
     std::ifstream in(log);
     std::string line;
     while (std::getline(in, line)) {
-        if (line.rfind("stack.", 0) != 0) continue;
+        if (line.rfind("stack.", 0) != 0 && line.rfind("runtime.", 0) != 0) continue;
         std::istringstream ls(line);
         std::string key;
         unsigned long long v = 0;
@@ -112,6 +209,7 @@ struct Result {
     ecat::LatencyHistogram rtt;    // send to matched reply
     ecat::LatencyHistogram phase;  // |frame at the slave - target phase| (DC time, from the FRMW)
     std::string end_state;
+    StallProbe probe;  // the platform just before this run
     // Slave side (the stack.* lines of its --stats-file).
     std::map<std::string, uint64_t> slave;
 };
@@ -134,6 +232,7 @@ void run_master(const Options& o, unsigned cycle_us, Result& r) {
     master::MasterOptions mo;
     mo.timeout = std::chrono::milliseconds(100);
     mo.retries = 0;
+    mo.busy_poll = o.master_busy_poll;
     master::Master m(*link, mo);
     // The slave needs a moment to open its end.
     uint16_t n = 0;
@@ -162,7 +261,7 @@ void run_master(const Options& o, unsigned cycle_us, Result& r) {
     master::ProcessDataSession pd(m, a, sdo);
     check(pd.discover(), "reading the process-data layout");
     master::DcConfig dc;
-    dc.enable = true;
+    dc.enable = !o.sm_sync;
     dc.cycle_ns = cycle_us * 1000u;
     check(pd.configure(dc), "configuring process data and DC");
     const auto period = std::chrono::microseconds(cycle_us);
@@ -188,7 +287,7 @@ void run_master(const Options& o, unsigned cycle_us, Result& r) {
     for (uint64_t i = 0; !g_stop.load(); ++i) {
         if (counting_from != UINT64_MAX && i >= counting_from + total) break;
         const bool counted = i >= counting_from;
-        sleep_until_ns(t, std::min<uint64_t>(o.master_spin_us * 1000ull, p / 2));
+        sleep_until_ns(t, std::min<uint64_t>(o.master_spin_us * 1000ull, p));
         const uint64_t woke = bench::now_ns();
         const uint64_t late_by = woke > t ? woke - t : 0;
         if (counted) r.wake.add(late_by);
@@ -213,7 +312,7 @@ void run_master(const Options& o, unsigned cycle_us, Result& r) {
         }
         // Phase control on the DC time the FRMW brought back: where in the SYNC0 cycle the frame passed.
         int64_t correction = 0;
-        if (e != Error::Timeout && e != Error::SendFailed) {
+        if (!o.sm_sync && e != Error::Timeout && e != Error::SendFailed) {
             int64_t delta = static_cast<int64_t>((pd.reference_time() + p - target_phase) % p);
             if (delta > static_cast<int64_t>(p / 2)) delta -= static_cast<int64_t>(p);
             if (counted) r.phase.add(static_cast<uint64_t>(delta < 0 ? -delta : delta));
@@ -256,6 +355,11 @@ Result run_one(const Options& o, unsigned cycle_us, const std::filesystem::path&
     if (!o.backend.empty()) args.insert(args.end(), {"--backend", o.backend});
     if (o.rt_priority > 0) args.insert(args.end(), {"--rt-priority", std::to_string(o.rt_priority)});
     if (o.slave_cpu >= 0) args.insert(args.end(), {"--cpu", std::to_string(o.slave_cpu)});
+    if (o.slave_spin_us > 0) args.insert(args.end(), {"--spin-us", std::to_string(o.slave_spin_us)});
+    if (o.slave_busy_poll) args.push_back("--busy-poll");
+    if (o.probe_seconds > 0)
+        std::fprintf(stderr, "bench-cycle: platform stall probe for %u s ...\n", o.probe_seconds);
+    r.probe = probe_stalls(o, cycle_us);
     {
         bench::Child slave(args, log);
         try {
@@ -301,30 +405,41 @@ std::string slave_figure(const Result& r, const std::string& key, bool in_us) {
 }
 
 void print_table(const Options& o, const std::vector<Result>& results, const std::string& sched) {
-    std::printf(
-        "\nbench-cycle: %u s per cycle time, backend %s, %s; frame at %u%% of the cycle after SYNC0\n",
-        o.seconds, o.backend.empty() ? esc::default_link_backend() : o.backend.c_str(), sched.c_str(),
-        o.phase_percent);
-    std::printf("%-7s | %-9s %5s %5s %5s %6s | %-9s %8s %8s | %-22s | %-22s | %-16s\n", "", "master", "lost",
-                "wkc", "late", "missed", "slave", "exceeded", "no-outp", "SYNC0->cycle us", "master wake us",
-                "rtt us");
-    std::printf("%-7s | %-9s %5s %5s %5s %6s | %-9s %8s %8s | %6s %7s %7s | %6s %7s %7s | %7s %8s\n", "cycle",
-                "cycles", "", "err", "", "", "cycles", "", "", "p50", "p99", "max", "p50", "p99", "max",
-                "p50", "p99");
-    for (const Result& r : results) {
+    std::printf("\nbench-cycle: %u s per cycle time, backend %s, %s; ", o.seconds,
+                o.backend.empty() ? esc::default_link_backend() : o.backend.c_str(), sched.c_str());
+    if (o.sm_sync)
+        std::printf("SM-synchronous: the application cycle runs on each SM2 write\n");
+    else
+        std::printf("DC: frame at %u%% of the cycle after SYNC0\n", o.phase_percent);
+    const std::string lat = o.sm_sync ? "sm2_latency" : "sync0_latency";
+    std::printf("%-7s | %-9s %5s %5s %5s %6s | %-9s %8s %8s | %-22s | %-22s | %-16s | %s\n", "", "master",
+                "lost", "wkc", "late", "missed", "slave", "exceeded", "no-outp",
+                o.sm_sync ? "frame->cycle us" : "SYNC0->cycle us", "master wake us", "rtt us", "floor");
+    std::printf("%-7s | %-9s %5s %5s %5s %6s | %-9s %8s %8s | %6s %7s %7s | %6s %7s %7s | %7s %8s | %s\n",
+                "cycle", "cycles", "", "err", "", "", "cycles", "", "", "p50", "p99", "max", "p50", "p99",
+                "max", "p50", "p99", "stalls");
+    for (std::size_t i = 0; i < results.size(); ++i) {
+        const Result& r = results[i];
+        // The probe's lost periods scaled to the measured time: cycles no software could have kept.
+        std::string floor = "-";
+        if (r.probe.seconds > 0) {
+            char b[32];
+            std::snprintf(b, sizeof b, "%.0f",
+                          static_cast<double>(r.probe.periods) * o.seconds / r.probe.seconds);
+            floor = b;
+        }
         std::printf(
             "%4u us | %-9llu %5llu %5llu %5llu %6llu | %-9s %8s %8s | %6s %7s %7s | %6.1f %7.1f %7.1f | "
-            "%7.1f %8.1f\n",
+            "%7.1f %8.1f | %6s\n",
             r.cycle_us, static_cast<unsigned long long>(r.cycles), static_cast<unsigned long long>(r.lost),
             static_cast<unsigned long long>(r.wkc_errors), static_cast<unsigned long long>(r.late),
             static_cast<unsigned long long>(r.missed), slave_figure(r, "cycles", false).c_str(),
             slave_figure(r, "cycles_exceeded", false).c_str(),
             slave_figure(r, "sm_events_missed", false).c_str(),
-            slave_figure(r, "sync0_latency.p50_ns", true).c_str(),
-            slave_figure(r, "sync0_latency.p99_ns", true).c_str(),
-            slave_figure(r, "sync0_latency.max_ns", true).c_str(), us(r.wake.percentile_ns(0.5)),
+            slave_figure(r, lat + ".p50_ns", true).c_str(), slave_figure(r, lat + ".p99_ns", true).c_str(),
+            slave_figure(r, lat + ".max_ns", true).c_str(), us(r.wake.percentile_ns(0.5)),
             us(r.wake.percentile_ns(0.99)), us(r.wake.max_ns()), us(r.rtt.percentile_ns(0.5)),
-            us(r.rtt.percentile_ns(0.99)));
+            us(r.rtt.percentile_ns(0.99)), floor.c_str());
     }
     std::printf(
         "lost: no reply within one cycle; late: reply after the next cycle was due; missed: cycles the "
@@ -332,11 +447,28 @@ void print_table(const Options& o, const std::vector<Result>& results, const std
         "slept through;\nexceeded: SYNC0 periods without a slave cycle; no-outp: SYNC0 without new outputs "
         "(sm_events_missed);\nSYNC0->cycle: DC system time at the start of the slave's application cycle "
         "minus "
-        "its SYNC0 pulse.\n");
+        "its SYNC0 pulse;\nframe->cycle (--sm-sync): from the start of the frame that wrote SM2 (0x09F0) to "
+        "the start of "
+        "the application cycle, slave local time;\nfloor stalls: cycle periods inside the gaps of a busy "
+        "loop on each CPU (platform "
+        "probe "
+        "just before the run), scaled to the measured time.\n");
     for (const Result& r : results) {
-        std::printf("%4u us: end state %s, phase error p99 %.1f us (max %.1f)", r.cycle_us,
-                    r.end_state.empty() ? "?" : r.end_state.c_str(), us(r.phase.percentile_ns(0.99)),
-                    us(r.phase.max_ns()));
+        std::printf("%4u us: end state %s", r.cycle_us, r.end_state.empty() ? "?" : r.end_state.c_str());
+        if (!o.sm_sync)
+            std::printf(", phase error p99 %.1f us (max %.1f)", us(r.phase.percentile_ns(0.99)),
+                        us(r.phase.max_ns()));
+        if (r.probe.seconds > 0)
+            std::printf(", platform probe %u s: %llu gaps over 20 us, longest %.1f us", r.probe.seconds,
+                        static_cast<unsigned long long>(r.probe.over_20us), us(r.probe.longest_ns));
+        auto gaps = r.slave.find("runtime.loop_gaps_over_50us");
+        if (gaps != r.slave.end() && (o.slave_busy_poll || o.slave_spin_us > 0))
+            std::printf(
+                ", slave's busy loop kept from running %llu times over 50 us, %llu over 1 ms, longest %.1f "
+                "us",
+                static_cast<unsigned long long>(gaps->second),
+                static_cast<unsigned long long>(r.slave.at("runtime.loop_gaps_over_1ms")),
+                us(r.slave.at("runtime.loop_gap_max_ns")));
         if (!r.failure.empty()) std::printf(", FAILED: %s", r.failure.c_str());
         if (r.slave.empty()) std::printf(", no slave figures (ecat-slave printed no stack.* lines)");
         std::printf("\n");
@@ -349,15 +481,28 @@ void usage() {
         "usage: bench-cycle [--seconds N] [--cycles-us LIST] [--slave PATH] [--backend pcap|packet]\n"
         "                   [--rt-priority N | --no-rt] [--master-cpu N] [--slave-cpu N] "
         "[--phase PERCENT]\n"
-        "                   [--master-spin-us N] [--keep-logs DIR] [--verbose]\n"
+        "                   [--master-spin-us N] [--master-busy-poll] [--slave-spin-us N | "
+        "--slave-busy-poll]\n"
+        "                   [--spin] [--no-rt-throttle] [--probe-seconds N] [--sm-sync] [--keep-logs DIR] "
+        "[--verbose]\n"
         "  --seconds N        measured time per cycle time (default 60; 5 is a quick check)\n"
         "  --slave PATH       the slave program (default: the ecat-slave of this build)\n"
         "  --cycles-us LIST   cycle times in microseconds (default 1000,250,125)\n"
         "  --rt-priority N    SCHED_FIFO priority of master and slave (default 80), --no-rt: none\n"
         "  --master-cpu/--slave-cpu N  pin to a CPU (default 0 / 1; -1: not pinned)\n"
         "  --phase PERCENT    where the frame passes the slave, in %% of the cycle after SYNC0 (50)\n"
-        "  --master-spin-us N the master wakes N us early and spins to its deadline (default 0, at most\n"
-        "                     half the cycle); the slave's runtime always sleeps on its timer\n");
+        "  --master-spin-us N the master wakes N us early and spins to its deadline (default 0; a cycle or\n"
+        "                     more: it never sleeps)\n"
+        "  --master-busy-poll the master polls for its replies instead of sleeping in ppoll()\n"
+        "  --slave-spin-us N  ecat-slave --spin-us N: the slave wakes N us before SYNC0 and spins to it\n"
+        "  --slave-busy-poll  ecat-slave --busy-poll: the slave never sleeps\n"
+        "  --no-rt-throttle   kernel.sched_rt_runtime_us = -1 for the run, restored afterwards (busy loops\n"
+        "                     at SCHED_FIFO are otherwise stopped 50 ms in every second)\n"
+        "  --spin             all of it: neither side ever sleeps (--master-spin-us 1000000\n"
+        "                     --master-busy-poll --slave-busy-poll --no-rt-throttle)\n"
+        "  --sm-sync          SM-synchronous instead of DC: the slave's cycle runs on each SM2 write\n"
+        "  --probe-seconds N  platform stall probe before each cycle time (default 10, 0: none)\n"
+        "  default: both sides sleep on timers and in poll, as a plain SOEM loop and ecat-slave do\n");
 }
 
 bool parse_list(const std::string& s, std::vector<unsigned>& out) {
@@ -412,6 +557,23 @@ int main(int argc, char** argv) {
             o.slave_cpu = static_cast<int>(number(-1, 1023));
         } else if (a == "--master-spin-us") {
             o.master_spin_us = static_cast<unsigned>(number(0, 1'000'000));
+        } else if (a == "--master-busy-poll") {
+            o.master_busy_poll = true;
+        } else if (a == "--slave-spin-us") {
+            o.slave_spin_us = static_cast<unsigned>(number(1, 100'000));
+        } else if (a == "--slave-busy-poll") {
+            o.slave_busy_poll = true;
+        } else if (a == "--spin") {
+            o.master_spin_us = 1'000'000;
+            o.master_busy_poll = true;
+            o.slave_busy_poll = true;
+            o.rt_throttle_off = true;
+        } else if (a == "--sm-sync") {
+            o.sm_sync = true;
+        } else if (a == "--no-rt-throttle") {
+            o.rt_throttle_off = true;
+        } else if (a == "--probe-seconds") {
+            o.probe_seconds = static_cast<unsigned>(number(0, 3600));
         } else if (a == "--phase") {
             o.phase_percent = static_cast<unsigned>(number(0, 99));
         } else if (a == "--keep-logs") {
@@ -464,6 +626,23 @@ int main(int argc, char** argv) {
     sched += ", master CPU " + (o.master_cpu >= 0 ? std::to_string(o.master_cpu) : std::string("any")) +
              ", slave CPU " + (o.slave_cpu >= 0 ? std::to_string(o.slave_cpu) : std::string("any"));
     if (o.master_spin_us > 0) sched += ", master spins the last " + std::to_string(o.master_spin_us) + " us";
+    if (o.master_busy_poll) sched += ", master busy-polls for replies";
+    if (o.slave_spin_us > 0) sched += ", slave --spin-us " + std::to_string(o.slave_spin_us);
+    if (o.slave_busy_poll) sched += ", slave --busy-poll";
+    if (o.slave_spin_us > 0 && o.slave_busy_poll) {
+        std::fprintf(stderr, "bench-cycle: --slave-spin-us and --slave-busy-poll exclude each other\n");
+        return 2;
+    }
+
+    std::unique_ptr<RtThrottleOff> throttle;
+    if (o.rt_throttle_off && o.rt_priority > 0) {
+        throttle = std::make_unique<RtThrottleOff>();
+        if (throttle->active())
+            sched += ", RT throttling off (kernel.sched_rt_runtime_us -1, restored to " +
+                     std::to_string(throttle->saved()) + ")";
+        else
+            std::fprintf(stderr, "bench-cycle: could not switch RT throttling off; busy loops will stall\n");
+    }
 
     char tmpl[] = "/tmp/bench-cycle.XXXXXX";
     if (::mkdtemp(tmpl) == nullptr) {
