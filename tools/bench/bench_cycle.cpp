@@ -158,6 +158,30 @@ StallProbe probe_stalls(const Options& o, unsigned cycle_us) {
     return r;
 }
 
+// Steal time of the benchmark's CPUs (/proc/stat, 8th value of each cpuN line): the time the hypervisor ran
+// something else while these vCPUs wanted to run. Milliseconds, summed over the CPUs; -1 if unknown.
+int64_t steal_ms(const Options& o) {
+    std::ifstream in("/proc/stat");
+    std::string line;
+    const long hz = ::sysconf(_SC_CLK_TCK);
+    int64_t total = 0;
+    bool found = false;
+    while (std::getline(in, line)) {
+        if (line.rfind("cpu", 0) != 0 || line.size() < 4 || line[3] < '0' || line[3] > '9') continue;
+        std::istringstream ls(line.substr(3));
+        int cpu = -1;
+        unsigned long long v[8] = {};
+        if (!(ls >> cpu)) continue;
+        for (auto& x : v)
+            ls >> x;
+        if (!ls || (cpu != o.master_cpu && cpu != o.slave_cpu)) continue;
+        total += static_cast<int64_t>(v[7]);
+        found = true;
+    }
+    if (!found || hz <= 0) return -1;
+    return total * 1000 / hz;
+}
+
 // kernel.sched_rt_runtime_us = -1 while it lives, the previous value afterwards. A busy-polling SCHED_FIFO
 // task on each CPU would otherwise be stopped for 50 ms of every second by the kernel's real-time throttling.
 class RtThrottleOff {
@@ -209,7 +233,9 @@ struct Result {
     ecat::LatencyHistogram rtt;    // send to matched reply
     ecat::LatencyHistogram phase;  // |frame at the slave - target phase| (DC time, from the FRMW)
     std::string end_state;
-    StallProbe probe;  // the platform just before this run
+    StallProbe probe;       // the platform just before this run
+    uint64_t steal_ms = 0;  // time the host took from the benchmark's CPUs during the measured window
+    bool steal_known = false;
     // Slave side (the stack.* lines of its --stats-file).
     std::map<std::string, uint64_t> slave;
 };
@@ -283,6 +309,7 @@ void run_master(const Options& o, unsigned cycle_us, Result& r) {
     const uint64_t status_every = std::max<uint64_t>(1, 5'000'000 / p);  // AL status polls while waiting
     const uint64_t op_deadline = bench::now_ns() + 10'000'000'000ull;
     uint64_t counting_from = UINT64_MAX;
+    int64_t steal_at_start = -1;
     uint64_t t = bench::now_ns() + p;
     for (uint64_t i = 0; !g_stop.load(); ++i) {
         if (counting_from != UINT64_MAX && i >= counting_from + total) break;
@@ -335,11 +362,19 @@ void run_master(const Options& o, unsigned cycle_us, Result& r) {
                               std::string(master::al_status_code_name(st->code)).c_str());
                 throw std::runtime_error(b);
             }
-            if (st && st->state == static_cast<uint8_t>(master::AlState::Op)) counting_from = i + 1;
+            if (st && st->state == static_cast<uint8_t>(master::AlState::Op)) {
+                counting_from = i + 1;
+                steal_at_start = steal_ms(o);
+            }
             if (bench::now_ns() > op_deadline) throw std::runtime_error("OP not reached within 10 s");
         }
     }
     m.set_timeout(std::chrono::milliseconds(100));
+    const int64_t steal_at_end = steal_ms(o);
+    if (steal_at_start >= 0 && steal_at_end >= steal_at_start) {
+        r.steal_ms = static_cast<uint64_t>(steal_at_end - steal_at_start);
+        r.steal_known = true;
+    }
     r.end_state = state_text(m, a);
     (void)m.request_state(a, master::AlState::Init);
     r.ok = !g_stop.load();
@@ -458,6 +493,11 @@ void print_table(const Options& o, const std::vector<Result>& results, const std
         if (!o.sm_sync)
             std::printf(", phase error p99 %.1f us (max %.1f)", us(r.phase.percentile_ns(0.99)),
                         us(r.phase.max_ns()));
+        if (r.steal_known)
+            std::printf(", host steal on the two CPUs %llu ms (%.2f %%)",
+                        static_cast<unsigned long long>(r.steal_ms),
+                        100.0 * static_cast<double>(r.steal_ms) /
+                            (o.seconds * 1000.0 * (o.master_cpu == o.slave_cpu ? 1 : 2)));
         if (r.probe.seconds > 0)
             std::printf(", platform probe %u s: %llu gaps over 20 us, longest %.1f us", r.probe.seconds,
                         static_cast<unsigned long long>(r.probe.over_20us), us(r.probe.longest_ns));
