@@ -133,39 +133,17 @@ TEST_F(CycleTiming, Dc_NoSampleWithoutCycle) {
     EXPECT_EQ(stack->stats().sm2_latency.count(), 0u);
 }
 
-// An ESC PDI that latches 0x09F0 (local time of the last ECAT buffer change) when the test says a frame
-// wrote SM2; the soft ESC under test here does not latch it.
-class LatchingPdi : public esc::Pdi {
-  public:
-    explicit LatchingPdi(esc::Esc& e) : esc_(e) {}
-    void read(uint16_t address, std::span<uint8_t> out) override {
-        esc_.read(address, out);
-        for (std::size_t i = 0; i < out.size(); ++i) {
-            const unsigned a = address + i;
-            if (a >= 0x09F0 && a < 0x09F4) out[i] = static_cast<uint8_t>(latched >> (8 * (a - 0x09F0)));
-        }
-    }
-    void write(uint16_t address, std::span<const uint8_t> in) override { esc_.write(address, in); }
-    uint32_t latched = 0;
-
-  private:
-    esc::Esc& esc_;
-};
-
+// The soft ESC latches 0x09F0 (local time of the start of the frame that changed an SM buffer): the stack's
+// SM2-to-cycle latency is the local time at the cycle start minus that.
 TEST_F(CycleTiming, SmSync_LatencyFromBufferChangeTime) {
-    LatchingPdi pdi(*esc);
-    stack = std::make_unique<Stack>(pdi, dict, desc, app, [this] { return esc->irq(); });
-    poll();
     go_op();
     ASSERT_EQ(stack->sync_mode(), SyncMode::SmSync);
     std::vector<uint8_t> out(6), in(6);
-    const uint64_t offset = 5'000'000'000ull;  // the master's clock offset: local time = system - offset
-    master.wr<uint64_t>(0x0920, offset);
+    master.wr<uint64_t>(0x0920, 5'000'000'000ull);  // the master's clock offset: local time = system - offset
     const uint64_t before = stack->stats().sm2_latency.count();
     for (int k = 0; k < 5; ++k) {
+        clock.advance(1'000'000);  // the next cycle's frame
         exchange_pd(out, in);
-        const uint64_t local = master.rd<uint64_t>(0x0910) - offset;
-        pdi.latched = static_cast<uint32_t>(local);
         clock.advance(4'000 + 1'000 * static_cast<uint64_t>(k));  // the firmware runs 4..8 us later
         poll();
     }
@@ -178,7 +156,28 @@ TEST_F(CycleTiming, SmSync_LatencyFromBufferChangeTime) {
     EXPECT_EQ(h.count() - before, 5u);
 }
 
+// An ESC that does not latch 0x09F0 (reads 0 there, as some do): the stack takes no samples rather than
+// nonsense ones.
+class PdiWithout09F0 : public esc::Pdi {
+  public:
+    explicit PdiWithout09F0(esc::Esc& e) : esc_(e) {}
+    void read(uint16_t address, std::span<uint8_t> out) override {
+        esc_.read(address, out);
+        for (std::size_t i = 0; i < out.size(); ++i) {
+            const unsigned a = address + i;
+            if (a >= 0x09F0 && a < 0x09F4) out[i] = 0;
+        }
+    }
+    void write(uint16_t address, std::span<const uint8_t> in) override { esc_.write(address, in); }
+
+  private:
+    esc::Esc& esc_;
+};
+
 TEST_F(CycleTiming, SmSync_EscWithout0x09F0_NoSamples) {
+    PdiWithout09F0 pdi(*esc);
+    stack = std::make_unique<Stack>(pdi, dict, desc, app, [this] { return esc->irq(); });
+    poll();
     go_op();
     std::vector<uint8_t> out(6), in(6);
     for (int k = 0; k < 5; ++k) {
