@@ -82,4 +82,50 @@ TEST(RuntimeAllocation, HandlingFramesAllocatesNothing) {
     std::remove(path.c_str());
 }
 
+// The other ways of waiting (--spin-us, --busy-poll) allocate nothing either, frames and deadlines alike.
+struct TickingFirmware : softslave::Firmware {
+    void poll(uint64_t now) override {
+        ++polls;
+        next = now + 200'000;  // a cycle every 200 us
+    }
+    uint64_t next_deadline_ns() const override { return next; }
+    int polls = 0;
+    uint64_t next = 0;
+};
+
+TEST(RuntimeAllocation, SpinningAndBusyPollingAllocateNothing) {
+    for (const bool busy : {false, true}) {
+        auto links = esc::LoopbackLink::make_pair(256);
+        esc::SystemClock clock;
+        esc::Esc esc(esc::EscConfig{}, clock);
+        softslave::Runtime runtime(*links.second, esc, clock);
+        TickingFirmware fw;
+        runtime.set_firmware(&fw);
+        if (busy)
+            runtime.set_busy_poll(true);
+        else
+            runtime.set_spin(150'000);
+        const auto f = frame_with(12, 0, 0x0000, 32);  // LRW
+        ASSERT_TRUE(links.first->send(f));
+        for (int i = 0; i < 100; ++i)
+            ASSERT_TRUE(runtime.run_once(10));  // warm-up
+        std::vector<uint8_t> sink(esc::kMaxFrameSize);
+        while (links.first->receive(sink) > 0) {
+        }
+        for (int i = 0; i < 100; ++i)
+            ASSERT_TRUE(links.first->send(f));
+        const int polls_before = fw.polls;
+        const alloc_counter::Scope counting;
+        for (int i = 0; i < 100000 && (links.second->pending() > 0 || fw.polls < polls_before + 20); ++i)
+            ASSERT_TRUE(runtime.run_once(10));
+        EXPECT_EQ(counting.count(), 0u) << (busy ? "busy-poll" : "spin");
+        EXPECT_EQ(links.second->pending(), 0u);
+        EXPECT_GE(fw.polls, polls_before + 20);
+        if (!busy) {
+            EXPECT_GT(runtime.stats().spin_waits, 0u);
+        }
+        runtime.set_firmware(nullptr);
+    }
+}
+
 }  // namespace

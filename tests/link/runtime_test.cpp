@@ -197,6 +197,7 @@ TEST_F(Runtime, SpinWakesEarlyAndServicesTheDeadlineInTheSameWakeUp) {
     EXPECT_EQ(runtime.stats().timer_expiries, 1u) << "one early wake-up, the rest was spun";
     EXPECT_EQ(runtime.stats().spin_waits, 1u);
     EXPECT_GT(runtime.stats().spin_ns_total, 0u);
+    EXPECT_EQ(fw.polls, 1) << "polled at the deadline only, not at the early wake-up";
     runtime.set_firmware(nullptr);
 }
 

@@ -167,7 +167,9 @@ bool Runtime::run_once(int timeout_ms) {
         if (link_event || control || now >= next_deadline_ns()) service();
         return !stop_flag_.load(std::memory_order_relaxed);
     }
-    if (link_event || timer || control || n == 0) service();
+    // With spin_ns_ the timer fires that much before the deadline: nothing is due yet, the spin services it.
+    const bool due = timer && (spin_ns_ == 0 || clock_.now_ns() >= next_deadline_ns());
+    if (link_event || due || control || n == 0) service();
     if (spin_ns_ != 0 && !spin_to_deadline()) return false;
     return true;
 }
