@@ -5,6 +5,8 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include "alloc_counter.hpp"
@@ -36,16 +38,28 @@ std::vector<uint8_t> frame_with(uint8_t cmd, uint16_t adp, uint16_t ado, std::si
     return f;
 }
 
+// A runtime over a loopback link with a real ESC; `master` is the other end.
+struct LoopbackSlave {
+    LoopbackSlave()
+        : links(esc::LoopbackLink::make_pair(256)),
+          esc(esc::EscConfig{}, clock),
+          runtime(*links.second, esc, clock) {}
+    esc::LoopbackLink& master() { return *links.first; }
+    esc::LoopbackLink& slave_end() { return *links.second; }
+    std::pair<std::unique_ptr<esc::LoopbackLink>, std::unique_ptr<esc::LoopbackLink>> links;
+    esc::SystemClock clock;
+    esc::Esc esc;
+    softslave::Runtime runtime;
+};
+
 struct NullFirmware : softslave::Firmware {
     void poll(uint64_t) override { ++polls; }
     int polls = 0;
 };
 
 TEST(RuntimeAllocation, HandlingFramesAllocatesNothing) {
-    auto links = esc::LoopbackLink::make_pair(256);
-    esc::SystemClock clock;
-    esc::Esc esc(esc::EscConfig{}, clock);
-    softslave::Runtime runtime(*links.second, esc, clock);
+    LoopbackSlave s;
+    auto& runtime = s.runtime;
     NullFirmware fw;
     runtime.set_firmware(&fw);
     const std::string path =
@@ -63,17 +77,17 @@ TEST(RuntimeAllocation, HandlingFramesAllocatesNothing) {
     };
     // Warm up once (first-use allocations of the ESC, if any, are not per-frame).
     for (const auto& f : frames)
-        ASSERT_TRUE(links.first->send(f));
+        ASSERT_TRUE(s.master().send(f));
     ASSERT_TRUE(runtime.run_once(1000));
     std::vector<uint8_t> sink(esc::kMaxFrameSize);
-    while (links.first->receive(sink) > 0) {
+    while (s.master().receive(sink) > 0) {
     }
 
     for (int round = 0; round < 20; ++round)
         for (const auto& f : frames)
-            ASSERT_TRUE(links.first->send(f));
+            ASSERT_TRUE(s.master().send(f));
     const alloc_counter::Scope counting;
-    while (links.second->pending() > 0)
+    while (s.slave_end().pending() > 0)
         ASSERT_TRUE(runtime.run_once(1000));
     EXPECT_EQ(counting.count(), 0u) << "allocations while handling " << 20 * frames.size() << " frames";
     EXPECT_EQ(runtime.stats().frames_sent, 21 * frames.size());
@@ -95,10 +109,8 @@ struct TickingFirmware : softslave::Firmware {
 
 TEST(RuntimeAllocation, SpinningAndBusyPollingAllocateNothing) {
     for (const bool busy : {false, true}) {
-        auto links = esc::LoopbackLink::make_pair(256);
-        esc::SystemClock clock;
-        esc::Esc esc(esc::EscConfig{}, clock);
-        softslave::Runtime runtime(*links.second, esc, clock);
+        LoopbackSlave s;
+        auto& runtime = s.runtime;
         TickingFirmware fw;
         runtime.set_firmware(&fw);
         if (busy)
@@ -106,20 +118,20 @@ TEST(RuntimeAllocation, SpinningAndBusyPollingAllocateNothing) {
         else
             runtime.set_spin(150'000);
         const auto f = frame_with(12, 0, 0x0000, 32);  // LRW
-        ASSERT_TRUE(links.first->send(f));
+        ASSERT_TRUE(s.master().send(f));
         for (int i = 0; i < 100; ++i)
             ASSERT_TRUE(runtime.run_once(10));  // warm-up
         std::vector<uint8_t> sink(esc::kMaxFrameSize);
-        while (links.first->receive(sink) > 0) {
+        while (s.master().receive(sink) > 0) {
         }
         for (int i = 0; i < 100; ++i)
-            ASSERT_TRUE(links.first->send(f));
+            ASSERT_TRUE(s.master().send(f));
         const int polls_before = fw.polls;
         const alloc_counter::Scope counting;
-        for (int i = 0; i < 100000 && (links.second->pending() > 0 || fw.polls < polls_before + 20); ++i)
+        for (int i = 0; i < 100000 && (s.slave_end().pending() > 0 || fw.polls < polls_before + 20); ++i)
             ASSERT_TRUE(runtime.run_once(10));
         EXPECT_EQ(counting.count(), 0u) << (busy ? "busy-poll" : "spin");
-        EXPECT_EQ(links.second->pending(), 0u);
+        EXPECT_EQ(s.slave_end().pending(), 0u);
         EXPECT_GE(fw.polls, polls_before + 20);
         if (!busy) {
             EXPECT_GT(runtime.stats().spin_waits, 0u);
