@@ -3,9 +3,9 @@
 // sockets or privileges.
 #include <gtest/gtest.h>
 
-#include <deque>
 #include <vector>
 
+#include "../support/wire_link.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
 #include "master/master.hpp"
@@ -13,29 +13,6 @@
 using namespace master;
 
 namespace {
-
-class EscLink final : public esc::Link {
-  public:
-    explicit EscLink(esc::Esc& e) : esc_(e) {}
-    int fd() const override { return -1; }
-    std::size_t receive(std::span<uint8_t> buf) override {
-        if (replies_.empty()) return 0;
-        const auto f = std::move(replies_.front());
-        replies_.pop_front();
-        const std::size_t n = std::min(buf.size(), f.size());
-        std::copy_n(f.begin(), n, buf.begin());
-        return n;
-    }
-    bool send(std::span<const uint8_t> frame) override {
-        std::vector<uint8_t> f(frame.begin(), frame.end());
-        if (esc_.process_frame(f)) replies_.push_back(std::move(f));
-        return true;
-    }
-
-  private:
-    esc::Esc& esc_;
-    std::deque<std::vector<uint8_t>> replies_;
-};
 
 uint8_t crc8(const uint8_t* p, std::size_t n) {
     uint8_t crc = 0xFF;
@@ -80,7 +57,7 @@ constexpr std::size_t kImageEnd = (0x40 + 6) * 2;
 struct Rig {
     esc::ManualClock clock;
     esc::Esc esc{esc::EscConfig{}, clock};
-    EscLink link{esc};
+    test_support::WireLink link{[this](std::vector<uint8_t>& f) { return esc.process_frame(f); }};
     Master m{link, [] {
                  MasterOptions o;
                  o.timeout = std::chrono::milliseconds(20);
