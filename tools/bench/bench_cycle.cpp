@@ -684,14 +684,10 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "bench-cycle: could not switch RT throttling off; busy loops will stall\n");
     }
 
-    char tmpl[] = "/tmp/bench-cycle.XXXXXX";
-    if (::mkdtemp(tmpl) == nullptr) {
-        std::fprintf(stderr, "bench-cycle: mkdtemp: %s\n", std::strerror(errno));
-        return 1;
-    }
-    const std::filesystem::path dir = tmpl;
     int rc = 0;
     try {
+        const bench::TempDir tmp("bench-cycle");
+        const std::filesystem::path& dir = tmp.path();
         softslave::VethPair pair(kSlaveEnd, kMasterEnd);
         std::vector<Result> results;
         for (unsigned c : o.cycles_us) {
@@ -705,7 +701,5 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "bench-cycle: %s\n", e.what());
         rc = 1;
     }
-    std::error_code ec;
-    std::filesystem::remove_all(dir, ec);
     return rc;
 }

@@ -356,14 +356,10 @@ int main(int argc, char** argv) {
         }
     }
     if (!bench::enter_network_namespace()) return 2;
-    char tmpl[] = "/tmp/bench-foe.XXXXXX";
-    if (::mkdtemp(tmpl) == nullptr) {
-        std::fprintf(stderr, "bench-foe: mkdtemp: %s\n", std::strerror(errno));
-        return 1;
-    }
-    const std::filesystem::path dir = tmpl;
     int rc = 0;
     try {
+        const bench::TempDir tmp("bench-foe");
+        const std::filesystem::path& dir = tmp.path();
         softslave::VethPair pair(kSlaveEnd, kMasterEnd);
         std::printf("FoE write through ecat-slave over a veth pair (%u runs each; MB = 10^6 bytes)\n",
                     o.runs);
@@ -418,7 +414,5 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "bench-foe: %s\n", e.what());
         rc = 1;
     }
-    std::error_code ec;
-    std::filesystem::remove_all(dir, ec);
     return rc;
 }

@@ -35,21 +35,6 @@ namespace {
 using bench::Child;
 using bench::now_ns;
 
-// A temporary directory removed at exit.
-struct TempDir {
-    std::filesystem::path path;
-    TempDir() {
-        char tmpl[] = "/tmp/bench-sdo-XXXXXX";
-        if (::mkdtemp(tmpl) == nullptr)
-            throw std::runtime_error(std::string("mkdtemp: ") + std::strerror(errno));
-        path = tmpl;
-    }
-    ~TempDir() {
-        std::error_code ec;
-        std::filesystem::remove_all(path, ec);
-    }
-};
-
 void check(master::Error e, const char* what) {
     if (e != master::Error::Ok)
         throw std::runtime_error(std::string(what) + ": " + std::string(master::to_string(e)));
@@ -132,13 +117,14 @@ int main(int argc, char** argv) {
     if (!bench::require_root("(network namespace, veth pair, raw sockets)")) return 2;
     if (!bench::enter_network_namespace()) return 2;
     try {
-        TempDir dir;
+        bench::TempDir tmp("bench-sdo");
+        const std::filesystem::path& dir = tmp.path();
         // A device name of 255 characters (the SII string limit): 0x1008 then needs segments.
         std::string name = "bench-sdo device name ";
         while (name.size() < 255)
             name += static_cast<char>('a' + name.size() % 26);
         {
-            std::ofstream conf(dir.path / "device.conf");
+            std::ofstream conf(dir / "device.conf");
             conf << "[identity]\ndevice_name = \"" << name << "\"\n";
             if (!conf) throw std::runtime_error("cannot write the device configuration");
         }
@@ -149,9 +135,9 @@ int main(int argc, char** argv) {
                                          "--backend",
                                          backend,
                                          "--config",
-                                         (dir.path / "device.conf").string(),
+                                         (dir / "device.conf").string(),
                                          "--state-dir",
-                                         (dir.path / "state").string()};
+                                         (dir / "state").string()};
         if (verbose) args.push_back("--verbose");
         Child slave(args, verbose ? "" : "/dev/null", 2000);
 

@@ -5,6 +5,7 @@
 #include <sys/types.h>
 
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -49,5 +50,19 @@ bool require_root(const char* why);
 // in it when this program and its children exit, however they exit. Prints why and returns false if
 // refused.
 bool enter_network_namespace();
+
+// A fresh directory /tmp/<prefix>.XXXXXX, removed with everything in it when the object goes. Throws
+// std::runtime_error if it cannot be created.
+class TempDir {
+  public:
+    explicit TempDir(const std::string& prefix);
+    ~TempDir();
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    const std::filesystem::path& path() const { return path_; }
+
+  private:
+    std::filesystem::path path_;
+};
 
 }  // namespace bench
