@@ -311,8 +311,13 @@ void CoeServer::download_initiate(std::span<const uint8_t> sdo, ecat::MailboxSen
             cancel_transfer();
             return send_abort(index, sub, abort::LengthTooLow, out);
         }
-        xfer_.size_known = (cmd & kCmdSizeIndicated) != 0;
-        xfer_.size = xfer_.size_known ? wire::get32(sdo, 4) : capacity;
+        // The Complete Size field is part of every normal initiate, whatever the size indicator says. With
+        // s = 0 a master may still fill it (KickCAT sends 5..n bytes as 0x20/0x30 + Complete Size + data):
+        // a non-zero Complete Size is honoured as if s were set (SOES reads it regardless of s). Only s = 0
+        // with Complete Size 0 leaves the size open, bounded by the entry (see docs/decisions/coe.md).
+        const uint32_t complete_size = wire::get32(sdo, 4);
+        xfer_.size_known = (cmd & kCmdSizeIndicated) != 0 || complete_size != 0;
+        xfer_.size = xfer_.size_known ? complete_size : capacity;
         if (xfer_.size > capacity) {
             cancel_transfer();
             return send_abort(index, sub, abort::LengthTooHigh, out);

@@ -136,6 +136,63 @@ TEST_F(SdoServer, NormalDownloadThatFitsNeedsNoSegments) {
     EXPECT_EQ(dict.raw(0x2000, 0).size(), 5u);
 }
 
+// KickCAT sends every download of more than 4 bytes that fits one mailbox as a normal initiate with the size
+// indicator clear: 0x20 (0x30 with complete access), Complete Size, then the data (ETG.1000.6 §5.6.2.1.1:
+// with e = 0 the Complete Size field is present whatever s says). The slave must store it, not wait for
+// segments.
+TEST_F(SdoServer, NormalDownloadWithSizeBitClearButCompleteSizeIsStoredAtOnce) {
+    EXPECT_EQ(ask(sdo(0x20, 0x2000, 0, 5, {'h', 'e', 'l', 'l', 'o'})),
+              (Bytes{0x00, 0x30, 0x60, 0x00, 0x20, 0x00, 0, 0, 0, 0}));
+    EXPECT_FALSE(server.transfer_in_progress());
+    auto stored = dict.raw(0x2000, 0);
+    EXPECT_EQ(Bytes(stored.begin(), stored.end()), (Bytes{'h', 'e', 'l', 'l', 'o'}));
+}
+
+TEST_F(SdoServer, CompleteAccessDownloadWithSizeBitClearChangesTheAssignment) {
+    // Exactly KickCAT's request for 0x1C12 := {0x1600, 0x1601} with complete access.
+    Bytes req = sdo(0x30, 0x1C12, 0, 6, {0x02, 0x00, 0x00, 0x16, 0x01, 0x16});
+    EXPECT_EQ(ask(req), (Bytes{0x00, 0x30, 0x70, 0x12, 0x1C, 0x00, 0, 0, 0, 0}));
+    EXPECT_FALSE(server.transfer_in_progress());
+    EXPECT_EQ(dict.get<uint8_t>(0x1C12, 0), 2);
+    EXPECT_EQ(dict.get<uint16_t>(0x1C12, 1), 0x1600);
+    EXPECT_EQ(dict.get<uint16_t>(0x1C12, 2), 0x1601);
+}
+
+TEST_F(SdoServer, SizeBitClearCompleteSizeLargerThanTheDataPresentContinuesWithSegments) {
+    EXPECT_EQ(ask(sdo(0x20, 0x2000, 0, 10, {1, 2, 3, 4})),
+              (Bytes{0x00, 0x30, 0x60, 0x00, 0x20, 0x00, 0, 0, 0, 0}));
+    EXPECT_TRUE(server.transfer_in_progress());
+    // The Complete Size is binding: a last segment that leaves bytes missing is refused, nothing stored.
+    Bytes before(dict.raw(0x2000, 0).begin(), dict.raw(0x2000, 0).end());
+    EXPECT_EQ(ask(segment(0x07, Bytes{5, 6, 7, 8, 0, 0, 0})), abort_reply(0x2000, 0, 0x06070013));
+    EXPECT_EQ(Bytes(dict.raw(0x2000, 0).begin(), dict.raw(0x2000, 0).end()), before);
+    // Complete with the right number of bytes: stored.
+    ask(sdo(0x20, 0x2000, 0, 10, {1, 2, 3, 4}));
+    EXPECT_EQ(ask(segment(0x03, Bytes{5, 6, 7, 8, 9, 10, 0})),
+              (Bytes{0x00, 0x30, 0x20, 0, 0, 0, 0, 0, 0, 0}));
+    auto stored = dict.raw(0x2000, 0);
+    EXPECT_EQ(Bytes(stored.begin(), stored.end()), (Bytes{1, 2, 3, 4, 5, 6, 7, 8, 9, 10}));
+}
+
+TEST_F(SdoServer, SizeBitClearCompleteSizeAboveTheEntryIs06070012) {
+    EXPECT_EQ(ask(sdo(0x20, 0x2000, 0, 301, {1, 2, 3, 4})), abort_reply(0x2000, 0, 0x06070012));
+    EXPECT_FALSE(server.transfer_in_progress());
+    // Complete access: 0x1C12 holds SI0 + 2 entries = 6 bytes; 8 announced and present.
+    EXPECT_EQ(ask(sdo(0x30, 0x1C12, 0, 8, {0x02, 0x00, 0x00, 0x16, 0x01, 0x16, 0x00, 0x00})),
+              abort_reply(0x1C12, 0, 0x06070012));
+    EXPECT_EQ(dict.get<uint8_t>(0x1C12, 0), 1);
+}
+
+TEST_F(SdoServer, SizeBitClearWithCompleteSizeZeroLeavesTheSizeToTheSegments) {
+    // Nothing announced: the data present is kept and segments follow, up to the entry's capacity.
+    EXPECT_EQ(ask(sdo(0x20, 0x2000, 0, 0, {1, 2, 3})),
+              (Bytes{0x00, 0x30, 0x60, 0x00, 0x20, 0x00, 0, 0, 0, 0}));
+    EXPECT_TRUE(server.transfer_in_progress());
+    EXPECT_EQ(ask(segment(0x09, Bytes{4, 5, 6, 0, 0, 0, 0})), (Bytes{0x00, 0x30, 0x20, 0, 0, 0, 0, 0, 0, 0}));
+    auto stored = dict.raw(0x2000, 0);
+    EXPECT_EQ(Bytes(stored.begin(), stored.end()), (Bytes{1, 2, 3, 4, 5, 6}));
+}
+
 TEST_F(SdoServer, DownloadSegmentWithWrongToggleAbortsWith05030000) {
     ask(sdo(0x21, 0x2000, 0, 20, {1, 2, 3, 4}));
     EXPECT_EQ(ask(segment(0x10, Bytes(7, 0))), abort_reply(0x2000, 0, coe::abort::ToggleBit));
