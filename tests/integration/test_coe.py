@@ -43,8 +43,10 @@ class CoeAndState(unittest.TestCase):
     def test_download_then_upload(self):
         self.bus.ecatctl("download", "0", "0x1600", "1", "0x607A0020", "--type", "u32")
         self.assertEqual(self.bus.ecatctl("upload", "0", "0x1600", "1").stdout.strip(), "0x607a0020 (1618608160)")
+        # Complete access is decoded per subindex with the names and types from SDO information.
         r = self.bus.ecatctl("upload", "0", "0x1600", "0", "--complete")
-        self.assertTrue(r.stdout.startswith("0x0000:"), r.stdout)
+        self.assertTrue(r.stdout.startswith("0x1600:00 "), r.stdout)
+        self.assertRegex(r.stdout, r"(?m)^0x1600:01 .* = 0x607a0020 \(1618608160\)$")
 
     def test_abort_codes_are_reported(self):
         r = self.bus.ecatctl("upload", "0", "0x5fff", "0", check=False)

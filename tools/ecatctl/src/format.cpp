@@ -1,7 +1,10 @@
 #include "format.hpp"
 
+#include <cerrno>
 #include <charconv>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 
 namespace ecatctl {
 
@@ -30,6 +33,8 @@ std::optional<ValueType> parse_type(std::string_view name) {
     if (name == "i16" || name == "int16") return ValueType::I16;
     if (name == "i32" || name == "int32") return ValueType::I32;
     if (name == "i64" || name == "int64") return ValueType::I64;
+    if (name == "f32" || name == "real32") return ValueType::F32;
+    if (name == "f64" || name == "real64") return ValueType::F64;
     return std::nullopt;
 }
 
@@ -43,9 +48,11 @@ std::size_t type_size(ValueType t) {
             return 2;
         case ValueType::U32:
         case ValueType::I32:
+        case ValueType::F32:
             return 4;
         case ValueType::U64:
         case ValueType::I64:
+        case ValueType::F64:
             return 8;
     }
     return 0;
@@ -64,7 +71,19 @@ std::string format_value(ValueType t, std::span<const uint8_t> data) {
     for (std::size_t i = 0; i < n; ++i)
         u |= static_cast<uint64_t>(data[i]) << (8 * i);
     char buf[64];
-    if (is_signed(t)) {
+    if (t == ValueType::F32 || t == ValueType::F64) {
+        double d = 0;
+        if (t == ValueType::F32) {
+            float f = 0;
+            const auto bits = static_cast<uint32_t>(u);
+            std::memcpy(&f, &bits, sizeof f);
+            d = f;
+            std::snprintf(buf, sizeof buf, "%.9g", d);
+        } else {
+            std::memcpy(&d, &u, sizeof d);
+            std::snprintf(buf, sizeof buf, "%.17g", d);
+        }
+    } else if (is_signed(t)) {
         int64_t s = static_cast<int64_t>(u);
         if (n < 8 && (u >> (8 * n - 1)) & 1) s = static_cast<int64_t>(u | (~uint64_t{0} << (8 * n)));
         std::snprintf(buf, sizeof buf, "0x%0*llx (%lld)", static_cast<int>(2 * n),
@@ -78,6 +97,21 @@ std::string format_value(ValueType t, std::span<const uint8_t> data) {
 
 std::optional<std::vector<uint8_t>> encode_value(ValueType t, std::string_view text) {
     const std::size_t n = type_size(t);
+    if (t == ValueType::F32 || t == ValueType::F64) {
+        std::string z(text);
+        char* end = nullptr;
+        errno = 0;
+        const double d = std::strtod(z.c_str(), &end);
+        if (z.empty() || end != z.c_str() + z.size() || errno == ERANGE) return std::nullopt;
+        std::vector<uint8_t> out(n);
+        if (t == ValueType::F32) {
+            const auto f = static_cast<float>(d);
+            std::memcpy(out.data(), &f, 4);
+        } else {
+            std::memcpy(out.data(), &d, 8);
+        }
+        return out;
+    }
     const uint64_t umax = n == 8 ? ~uint64_t{0} : (uint64_t{1} << (8 * n)) - 1;
     uint64_t u = 0;
     if (!text.empty() && text[0] == '-') {

@@ -22,10 +22,11 @@ inline constexpr int kExitProtocol = 6;  // a slave answered, but not as expecte
 // Decimal, 0x-hex, 0b-binary; nullopt if not a whole number within max.
 std::optional<uint64_t> parse_number(std::string_view text, uint64_t max);
 
-enum class ValueType { U8, U16, U32, U64, I8, I16, I32, I64 };
+enum class ValueType { U8, U16, U32, U64, I8, I16, I32, I64, F32, F64 };  // F32/F64: REAL32/REAL64
 std::optional<ValueType> parse_type(std::string_view name);
 std::size_t type_size(ValueType t);
-// Little-endian bytes -> "0x1234 (4660)"; data.size() must be type_size(t).
+// Little-endian bytes -> "0x1234 (4660)" (REAL32/REAL64: the number, e.g. "1.5"); data.size() must be
+// type_size(t).
 std::string format_value(ValueType t, std::span<const uint8_t> data);
 // Text -> little-endian bytes of the type (negative numbers allowed for signed types); nullopt if out of
 // range.

@@ -14,6 +14,7 @@
 
 #include "cmd_diag.hpp"
 #include "cmd_firmware.hpp"
+#include "cmd_verbs.hpp"
 #include "common.hpp"
 #include "esc/link.hpp"
 #include "format.hpp"
@@ -426,6 +427,8 @@ int sdo_transfer(master::Master& m, const SdoArgs& s, bool upload) {
         }
         for (std::size_t i = 0; i < out.size(); i += size)
             std::printf("%s\n", format_value(*type, std::span<const uint8_t>(out).subspan(i, size)).c_str());
+    } else if (print_described_upload(sdo, static_cast<uint16_t>(*index), static_cast<uint8_t>(*sub),
+                                      s.complete, out)) {
     } else if (out.size() == 1 || out.size() == 2 || out.size() == 4 || out.size() == 8) {
         const ValueType t = out.size() == 1   ? ValueType::U8
                             : out.size() == 2 ? ValueType::U16
@@ -516,6 +519,8 @@ int process_data(master::Master& m, const PdArgs& p) {
     master::SdoClient sdo(mbx);
     master::ProcessDataSession pd(m, a, sdo);
     if (Error e = pd.discover(); e != Error::Ok) return sdo_failed(sdo, e, "reading the process-data layout");
+    std::vector<SyncView> pdo_config;  // names and types of the entries, for the decoded images at the end
+    if (Error e = read_pdo_config(sdo, pdo_config); e != Error::Ok) pdo_config.clear();
     const auto& l = pd.layout();
     std::printf("outputs: SM2 0x%04x, %u bytes; inputs: SM3 0x%04x, %u bytes\n", l.sm2_start, l.sm2_length,
                 l.sm3_start, l.sm3_length);
@@ -568,6 +573,7 @@ int process_data(master::Master& m, const PdArgs& p) {
     if (p.dc)
         std::printf("reference system time %llu ns\n", static_cast<unsigned long long>(pd.reference_time()));
     std::printf("inputs:\n%s", hex_dump(0, pd.inputs()).c_str());
+    print_pd_entries(pdo_config, pd.outputs(), pd.inputs());
     if (!p.keep) (void)m.request_state(a, master::AlState::PreOp);
     const bool clean = s.lost == before.lost && s.wkc_errors == before.wkc_errors && now && !now->error;
     return clean ? kExitOk : kExitProtocol;
@@ -759,6 +765,7 @@ int main(int argc, char** argv) {
         "5 no slave answered, 6 unexpected answer (working counter, SII, AL state)",
         "ecatctl"};
     app.require_subcommand(1);
+    app.set_version_flag("--version", "ecatctl " ECATCTL_VERSION);
     app.add_option("-i,--iface", g.iface, "Network interface (the master end of the slave's veth pair)")
         ->envname("ECATCTL_IFACE")
         ->capture_default_str();
@@ -857,7 +864,8 @@ int main(int argc, char** argv) {
     up->add_option("slave", so.slave, "Slave position (or station address with --station)")->required();
     up->add_option("index", so.index, "Object index")->required();
     up->add_option("subindex", so.sub, "Subindex")->required();
-    up->add_option("--type", so.type, "u8|u16|u32|u64|i8|i16|i32|i64|string (default: by size)");
+    up->add_option("--type", so.type,
+                   "u8|u16|u32|u64|i8|i16|i32|i64|real32|real64|string (default: from SDO information)");
     up->add_flag("-s,--station", so.station, "<slave> is a station address");
     up->add_flag("-c,--complete", so.complete, "Complete access (whole object from the subindex, 0 or 1)");
     up->callback([&] { rc = with_master(g, [&](master::Master& m) { return sdo_transfer(m, so, true); }); });
@@ -867,7 +875,7 @@ int main(int argc, char** argv) {
     down->add_option("index", so.index, "Object index")->required();
     down->add_option("subindex", so.sub, "Subindex")->required();
     down->add_option("values", so.values, "Bytes, values of --type, or text with --type string")->required();
-    down->add_option("--type", so.type, "u8|u16|u32|u64|i8|i16|i32|i64|string");
+    down->add_option("--type", so.type, "u8|u16|u32|u64|i8|i16|i32|i64|real32|real64|string");
     down->add_flag("-s,--station", so.station, "<slave> is a station address");
     down->add_flag("-c,--complete", so.complete, "Complete access");
     down->callback(
@@ -930,9 +938,22 @@ int main(int argc, char** argv) {
     add_firmware_update(
         app, [&](const auto& fn) { return with_master(g, fn); }, rc);
 
+#ifdef ECATCTL_HAVE_ESI
+    add_slaves_command(
+        app, [&](const auto& fn) { return with_master(g, fn); }, rc);
+    add_pdos_command(
+        app, [&](const auto& fn) { return with_master(g, fn); }, rc);
+    add_cstruct_command(
+        app, [&](const auto& fn) { return with_master(g, fn); }, rc);
+    add_xml_command(
+        app, [&](const auto& fn) { return with_master(g, fn); }, rc);
+#endif
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         app.exit(e);
