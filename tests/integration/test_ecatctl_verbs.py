@@ -101,6 +101,15 @@ class EcatctlVerbs(unittest.TestCase):
         self.assertEqual(len(out.splitlines()), 1, out)
         self.assertRegex(out, r"^0\s+0x[0-9a-f]{4}\s+\d+:0\s+PREOP\s+\S")
 
+    def test_slaves_selects_by_position_or_station_address(self):
+        self.ctl("scan")  # station addresses 0x1001..
+        self.assertRegex(self.ctl("slaves", "0"), r"^0\s+0x1001\s")
+        self.assertRegex(self.ctl("slaves", "-s", "0x1001"), r"^0\s+0x1001\s")
+        for args in (("slaves", "5"), ("slaves", "-s", "0x1234")):
+            r = self.bus.ecatctl(*args, check=False)
+            self.assertEqual(r.returncode, 5, args)
+            self.assertIn("no slave", r.stderr)
+
     def test_slaves_verbose_shows_what_slaveinfo_shows(self):
         out = self.ctl("slaves", "-v")
         vendor = int(self.ctl("upload", "0", "0x1018", "1").split()[0], 16)

@@ -19,6 +19,7 @@ using master::Error;
 
 struct SlavesArgs {
     std::string slave;  // empty: all
+    bool station = false;
     bool verbose = false;
 };
 
@@ -174,6 +175,20 @@ int run_slaves(master::Master& m, const SlavesArgs& s) {
         return kExitNoSlave;
     }
     uint16_t first = 0, last = static_cast<uint16_t>(*n - 1);
+    if (!s.slave.empty() && s.station) {
+        // The slave whose configured station address (0x0010) is the one given.
+        auto want = parse_number(s.slave, 0xFFFF);
+        if (!want) {
+            std::fprintf(stderr, "ecatctl: bad station address '%s'\n", s.slave.c_str());
+            return kExitUsage;
+        }
+        for (uint16_t p = 0; p < *n; ++p) {
+            auto st = m.read_reg<uint16_t>(Address::position(p), 0x0010);
+            if (st && *st == *want) return show_slave(m, p, s.verbose);
+        }
+        std::fprintf(stderr, "ecatctl: no slave has station address %s\n", s.slave.c_str());
+        return kExitNoSlave;
+    }
     if (!s.slave.empty()) {
         auto p = parse_number(s.slave, 0xFFFF);
         if (!p) {
@@ -200,7 +215,8 @@ void add_slaves_command(CLI::App& app, MasterRunner run, int& rc) {
     auto s = std::make_shared<SlavesArgs>();
     auto* c = app.add_subcommand("slaves",
                                  "List the slaves (IgH `ethercat slaves`); -v: all SOEM `slaveinfo` shows");
-    c->add_option("slave", s->slave, "Only the slave at this position");
+    c->add_option("slave", s->slave, "Only the slave at this position (or station address with --station)");
+    c->add_flag("-s,--station", s->station, "<slave> is a station address");
     c->add_flag("-v,--verbose", s->verbose,
                 "Identity, sizes, ports, DC, SMs, FMMUs, mailbox, protocols, CoE details");
     c->callback(
