@@ -21,6 +21,7 @@ TEST(EcatctlTyped, Real32AndReal64BothWays) {
     EXPECT_FALSE(encode_value(ValueType::F64, ""));
     EXPECT_EQ(parse_type("real32"), ValueType::F32);
     EXPECT_EQ(parse_type("real64"), ValueType::F64);
+    EXPECT_FALSE(parse_type("f32"));  // only the CoE names
     EXPECT_EQ(type_size(ValueType::F64), 8u);
 }
 

@@ -33,8 +33,8 @@ std::optional<ValueType> parse_type(std::string_view name) {
     if (name == "i16" || name == "int16") return ValueType::I16;
     if (name == "i32" || name == "int32") return ValueType::I32;
     if (name == "i64" || name == "int64") return ValueType::I64;
-    if (name == "f32" || name == "real32") return ValueType::F32;
-    if (name == "f64" || name == "real64") return ValueType::F64;
+    if (name == "real32") return ValueType::F32;
+    if (name == "real64") return ValueType::F64;
     return std::nullopt;
 }
 
