@@ -183,6 +183,16 @@ TEST_F(SdoServer, SizeBitClearCompleteSizeAboveTheEntryIs06070012) {
     EXPECT_EQ(dict.get<uint8_t>(0x1C12, 0), 1);
 }
 
+TEST_F(SdoServer, BytesBeyondTheCompleteSizeAreNotStored) {
+    // A master that pads its message: the Complete Size it named is what it meant, with s = 0 as with s = 1.
+    for (uint8_t cmd : {uint8_t{0x20}, uint8_t{0x21}}) {
+        EXPECT_EQ(ask(sdo(cmd, 0x2000, 0, 5, {'w', 'o', 'r', 'l', 'd', 0, 0, 0})),
+                  (Bytes{0x00, 0x30, 0x60, 0x00, 0x20, 0x00, 0, 0, 0, 0}));
+        auto stored = dict.raw(0x2000, 0);
+        EXPECT_EQ(Bytes(stored.begin(), stored.end()), (Bytes{'w', 'o', 'r', 'l', 'd'}));
+    }
+}
+
 TEST_F(SdoServer, SizeBitClearWithCompleteSizeZeroLeavesTheSizeToTheSegments) {
     // Nothing announced: the data present is kept and segments follow, up to the entry's capacity.
     EXPECT_EQ(ask(sdo(0x20, 0x2000, 0, 0, {1, 2, 3})),
