@@ -227,8 +227,11 @@ void Esc::Impl::rebuild_lookup() {
         if (act & 0x01) sm_enabled_mask = static_cast<uint16_t>(sm_enabled_mask | (1u << n));
         uint32_t area = (s.mailbox || s.length == 1) ? s.length : 3u * s.length;
         uint32_t end = s.start + area;
-        s.area_valid = end <= mem_end && !(s.start < reg::kRamBase && end > reg::kRamBase);
-        if (!s.enabled) continue;
+        // SyncManagers act on the process RAM only (ESC datasheet section I, SyncManager): an area that
+        // starts in the register space or does not fit the RAM is not served and captures no address,
+        // so the registers (the SM's own included) and the RAM stay reachable (decisions/esc.md).
+        s.area_valid = s.start >= reg::kRamBase && end <= mem_end;
+        if (!s.enabled || !s.area_valid) continue;
         // Insertion by start address.
         unsigned pos = sm_area_count;
         while (pos > 0 && sm_areas[pos - 1].start > s.start) {

@@ -1,0 +1,89 @@
+"""Regression tests of issue 14 (robustness campaign), replayed over the wire as they were found: the exact
+frames sent with a raw socket (scapy builds them), ecatctl to check that the master still gets through."""
+import socket
+import struct
+import time
+import unittest
+
+import harness
+
+APRD, APWR, FPRD, FPWR = 1, 2, 4, 5
+
+
+class EscRobustness(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.bus = harness.Bus().__enter__()
+        cls.sock = cls.bus.raw_socket()
+        cls.idx = 0
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.sock.close()
+        cls.bus.close()
+
+    # -- raw datagrams ------------------------------------------------------------------------------
+    def send(self, cmd, adp, ado, data):
+        """One datagram in one frame; returns (data, wkc) of the reply."""
+        EscRobustness.idx = (EscRobustness.idx + 1) & 0xFF
+        idx = EscRobustness.idx
+        frame = harness.ecat_frame([(cmd, idx, adp, ado, data)])
+        for _ in range(3):
+            self.sock.send(frame)
+            deadline = time.monotonic() + 0.5
+            while time.monotonic() < deadline:
+                self.sock.settimeout(max(deadline - time.monotonic(), 0.001))
+                try:
+                    reply, addr = self.sock.recvfrom(2048)
+                except socket.timeout:
+                    break
+                if addr[2] == harness.PACKET_OUTGOING:
+                    continue
+                d = harness.parse_datagrams(reply)  # ecatctl's earlier traffic may come first
+                if d and d[0][0] == cmd and d[0][1] == idx and d[0][3] == ado:
+                    return d[0][4], d[0][5]
+        self.fail(f"no answer to cmd {cmd} 0x{ado:04x}: {self.bus.slave_output()}")
+
+    def station(self):
+        data, wkc = self.send(APRD, 0, 0x0010, b"\x00\x00")
+        self.assertEqual(wkc, 1)
+        st = struct.unpack("<H", data)[0]
+        if st == 0:
+            st = 0x1001
+            self.assertEqual(self.send(APWR, 0, 0x0010, struct.pack("<H", st))[1], 1)
+        return st
+
+    def require_firmware(self):
+        """Takes the slave to PREOP (upload configures the mailbox from the SII first) with one SDO."""
+        r = self.bus.ecatctl("--timeout", "200", "upload", "0", "0x1018", "1", check=False)
+        if r.returncode != 0 and "not reached in time" in r.stderr:
+            self.skipTest("ecat-slave runs without firmware")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(r.stdout.strip(), "0x000000fb (251)")
+
+    # -- finding 1 ----------------------------------------------------------------------------------
+    def test_sm_over_the_registers_does_not_lock_the_master_out(self):
+        self.require_firmware()
+        st = self.station()
+        # SM4: start 0x0100, length 0x8000, buffered, enabled.
+        _, wkc = self.send(FPWR, st, 0x0820, bytes.fromhex("0001008020000100"))
+        self.assertEqual(wkc, 1)
+        data, wkc = self.send(FPRD, st, 0x0820, bytes(8))
+        self.assertEqual((wkc, data), (1, bytes.fromhex("0001008020000100")[:5] + data[5:6] + b"\x01\x00"))
+        data, wkc = self.send(FPRD, st, 0x0130, bytes(2))
+        self.assertEqual(wkc, 1)
+        # The master and the stack still reach every register: scan, state and SDOs work.
+        self.assertIn("PREOP", self.bus.ecatctl("scan").stdout)
+        self.assertEqual(self.bus.ecatctl("upload", "0", "0x1018", "1").stdout.strip(), "0x000000fb (251)")
+        self.bus.ecatctl("state", "0", "INIT")
+        self.assertEqual(self.bus.ecatctl("upload", "0", "0x1018", "1").stdout.strip(), "0x000000fb (251)")
+        # ... and the master can disable the SM again.
+        st = self.station()
+        self.assertEqual(self.send(FPWR, st, 0x0826, b"\x00")[1], 1)
+        self.assertEqual(self.send(FPRD, st, 0x0826, b"\x00"), (b"\x00", 1))
+        self.assertTrue(self.bus.slave_alive(), self.bus.slave_output())
+
+
+
+if __name__ == "__main__":
+    harness.main()
