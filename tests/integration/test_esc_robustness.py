@@ -84,6 +84,44 @@ class EscRobustness(unittest.TestCase):
         self.assertTrue(self.bus.slave_alive(), self.bus.slave_output())
 
 
+    # -- finding 2 ----------------------------------------------------------------------------------
+    def system_time(self, st):
+        data, wkc = self.send(FPRD, st, 0x0910, bytes(8))
+        self.assertEqual(wkc, 1)
+        return struct.unpack("<Q", data)[0]
+
+    def test_dc_speed_counter_start_zero_does_not_stop_the_clock(self):
+        st = self.station()
+        self.assertEqual(self.send(FPWR, st, 0x0930, b"\x00\x00")[1], 1)
+        try:
+            now = self.system_time(st)
+            for i in range(5):  # the local copy about 2^30 ns ahead of the "reference": slow down
+                self.assertEqual(self.send(FPWR, st, 0x0910, struct.pack("<Q", now - (1 << 30) + i * 1000000))[1], 1)
+                time.sleep(0.001)
+            # The local clock keeps its rate within the bounded correction: neither frozen nor doubled.
+            outer0 = time.monotonic()
+            t1 = self.system_time(st)
+            inner0 = time.monotonic()
+            time.sleep(0.2)
+            inner1 = time.monotonic()
+            t2 = self.system_time(st)
+            outer1 = time.monotonic()
+            self.assertGreaterEqual(t2 - t1, 0.5 * (inner1 - inner0) * 1e9, "the DC clock stopped")
+            self.assertLessEqual(t2 - t1, 1.5 * (outer1 - outer0) * 1e9, "the DC clock runs too fast")
+            # SYNC0 still comes: 1 ms cycle from 20 ms ahead; the next pulse time (0x0990) moves on.
+            self.assertEqual(self.send(FPWR, st, 0x09A0, struct.pack("<II", 1000000, 0))[1], 1)
+            start = self.system_time(st) + 20000000
+            self.assertEqual(self.send(FPWR, st, 0x0990, struct.pack("<Q", start))[1], 1)
+            self.assertEqual(self.send(FPWR, st, 0x0981, b"\x03")[1], 1)
+            time.sleep(0.2)
+            data, _ = self.send(FPRD, st, 0x0990, bytes(8))
+            self.assertGreater(struct.unpack("<Q", data)[0], start, "SYNC0 never fired")
+            self.assertTrue(self.bus.slave_alive(), self.bus.slave_output())
+        finally:
+            self.send(FPWR, st, 0x0981, b"\x00")
+            self.send(FPWR, st, 0x0930, b"\x00\x10")
+
+
 
 if __name__ == "__main__":
     harness.main()
