@@ -122,6 +122,33 @@ class EscRobustness(unittest.TestCase):
             self.send(FPWR, st, 0x0930, b"\x00\x10")
 
 
+    # -- finding 5 ----------------------------------------------------------------------------------
+    def sii_command(self, st, command, word):
+        self.assertEqual(self.send(FPWR, st, 0x0500, b"\x02")[1], 1)  # the EEPROM to the ECAT side
+        self.assertEqual(self.send(FPWR, st, 0x0500, b"\x00")[1], 1)
+        self.assertEqual(self.send(FPWR, st, 0x0502, struct.pack("<HI", command, word))[1], 1)
+        for _ in range(100):
+            data, wkc = self.send(FPRD, st, 0x0502, bytes(14))
+            self.assertEqual(wkc, 1)
+            status = struct.unpack_from("<H", data)[0]
+            if not status & 0x8000:
+                return status, data[6:14]
+            time.sleep(0.001)
+        self.fail("EEPROM interface stays busy")
+
+    def test_eeprom_read_at_the_top_word_address_does_not_wrap(self):
+        st = self.station()
+        status, word0 = self.sii_command(st, 0x0100, 0)
+        self.assertEqual(status & 0x6000, 0)
+        self.assertNotEqual(word0[:4], b"\xff\xff\xff\xff")
+        status, data = self.sii_command(st, 0x0100, 0xFFFFFFFE)
+        self.assertEqual(status & 0x2000, 0x2000, f"no acknowledge error: 0x{status:04x}")
+        self.assertEqual(data, b"\xff" * 8)
+        # The next command clears the error bits.
+        status, data = self.sii_command(st, 0x0100, 0)
+        self.assertEqual(status & 0x6000, 0)
+        self.assertEqual(data, word0)
+
 
 if __name__ == "__main__":
     harness.main()
