@@ -122,6 +122,21 @@ class EscRobustness(unittest.TestCase):
             self.send(FPWR, st, 0x0930, b"\x00\x10")
 
 
+    # -- finding 4 ----------------------------------------------------------------------------------
+    def test_esc_reset_restarts_the_firmware(self):
+        self.require_firmware()  # one SDO: the firmware's mailbox has seen this master's first counter
+        st = self.station()
+        for c in b"RES":
+            self.assertEqual(self.send(FPWR, st, 0x0040, bytes([c]))[1], 1)
+        self.assertEqual(self.send(FPRD, st, 0x0130, bytes(2))[1], 0)  # the station address is reset too
+        data, wkc = self.send(APRD, 0, 0x0130, bytes(2))
+        self.assertEqual((wkc, data[0] & 0x0F), (1, 0x01))  # the ESC is in Init
+        # The master starts over (mailbox, PREOP) and its next request (counter 1 again) is served, not
+        # dropped as a repeat.
+        self.assertEqual(self.bus.ecatctl("upload", "0", "0x1018", "1").stdout.strip(), "0x000000fb (251)")
+        self.assertIn("PREOP", self.bus.ecatctl("state", "0").stdout)
+        self.assertTrue(self.bus.slave_alive(), self.bus.slave_output())
+
     # -- finding 5 ----------------------------------------------------------------------------------
     def sii_command(self, st, command, word):
         self.assertEqual(self.send(FPWR, st, 0x0500, b"\x02")[1], 1)  # the EEPROM to the ECAT side
