@@ -509,6 +509,9 @@ bool Esc::process_frame(std::span<uint8_t> frame, uint64_t rx_time_ns) {
 }
 
 void Esc::read(uint16_t address, std::span<uint8_t> out) {
+    // An empty span is no access: nothing read, the PDI watchdog not triggered, and no memset/memcpy on
+    // the null pointer an empty span may carry.
+    if (out.empty()) return;
     std::lock_guard lock(impl_->mu);
     impl_->pdi_touch();
     std::memset(out.data(), 0, out.size());
@@ -517,6 +520,7 @@ void Esc::read(uint16_t address, std::span<uint8_t> out) {
 }
 
 void Esc::write(uint16_t address, std::span<const uint8_t> in) {
+    if (in.empty()) return;  // no access, as for read()
     std::unique_lock lock(impl_->mu);
     impl_->pdi_touch();
     impl_->phys_write(address, in.data(), nullptr, static_cast<uint32_t>(in.size()), Side::Pdi);

@@ -393,4 +393,22 @@ TEST_F(DcTest, PdiWatchdog) {
     EXPECT_EQ(fprd(*e, 0x0110, 2).u16() & 0x0002, 0x0002);
 }
 
+// Issue 14, finding 8: Esc::read/write with an empty span called memset/memcpy with a null pointer (UB,
+// reported by UBSan). An empty span is no access: nothing happens, not even a PDI watchdog trigger.
+TEST_F(DcTest, EmptyPdiAccessIsNoAccess) {
+    fpwr(*e, 0x0410, le(10, 2));   // PDI watchdog 1 ms
+    e->read_reg<uint8_t>(0x0000);  // the last real access
+    e->tick();
+    clk.advance(600'000);
+    for (const uint16_t a : {uint16_t{0x0000}, uint16_t{0x0F80}, uint16_t{0x1000}, uint16_t{0xFFFF}}) {
+        e->read(a, std::span<uint8_t>{});  // data() is nullptr
+        e->write(a, std::span<const uint8_t>{});
+    }
+    e->tick();
+    clk.advance(400'000);
+    e->tick();
+    EXPECT_EQ(fprd(*e, 0x0110, 2).u16() & 0x0002, 0);  // expired 1 ms after the last real access
+    EXPECT_EQ(fprd(*e, 0x0443, 1).data[0], 1);
+}
+
 }  // namespace
