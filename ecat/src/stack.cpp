@@ -196,6 +196,7 @@ void Stack::poll(uint64_t now_ns) {
     if (irq_ && irq_usable_ && !first_poll_ && !irq_() && now_ns < next_deadline_ns()) {
         return;  // nothing signalled and no timer due
     }
+    if (!first_poll_ && esc_was_reset()) restart_after_esc_reset(now_ns);
     uint32_t events = pdi_.read_reg<uint32_t>(reg::kAlEventRequest);
     if (first_poll_) {
         first_poll_ = false;
@@ -244,6 +245,39 @@ uint64_t Stack::next_deadline_ns() const {
         }
     }
     return t;
+}
+
+// ---- ESC reset --------------------------------------------------------------------------------------
+
+bool Stack::esc_was_reset() {
+    // The AL event mask is written only through the PDI (by this stack, at start); an ESC reset puts it
+    // back to its reset value. On a device the ESC's reset would reset the controller behind it as well.
+    return pdi_.read_reg<uint32_t>(reg::kAlEventMask) != kEventMask;
+}
+
+void Stack::restart_after_esc_reset(uint64_t now_ns) {
+    ++stats_.esc_resets;
+    // Down to Init as the ESC is: outputs lost, process data and mailbox stopped, the handlers drop their
+    // transfers; the next Init -> Pre-Op starts the mailbox with fresh counters.
+    op_pending_ = false;
+    if (state_ != AlState::Init) go(AlState::Init, now_ns);
+    error_ = false;
+    code_ = al::NoError;
+    id_loaded_ = false;
+    sync_mode_ = SyncMode::FreeRun;
+    master_wrote_sync_mode_ = false;
+    cycle_ns_ = 0;
+    outputs_seen_ = false;
+    sync0_seen_ = false;
+    sync0_deadline_ns_ = UINT64_MAX;
+    // The register set-up of the constructor, lost with the reset.
+    pdi_.write_reg<uint32_t>(reg::kAlEventMask, kEventMask);
+    for (unsigned n = 0; n < 4; ++n)
+        set_sm_pdi_deactivated(n, true);
+    write_status();
+    update_irq_usable();
+    first_poll_ = true;       // take over whatever the master requested since the reset
+    restart_pending_ = true;  // the application restarts as well (end of this poll)
 }
 
 // ---- ESM --------------------------------------------------------------------------------------------
@@ -614,7 +648,8 @@ void print_stats(std::ostream& out, const StackStats& s) {
         << "stack.sync0_events " << s.sync0_events << '\n'
         << "stack.sm_events_missed " << s.sm_events_missed << '\n'
         << "stack.cycles_exceeded " << s.cycles_exceeded << '\n'
-        << "stack.watchdog_expiries " << s.watchdog_expiries << '\n';
+        << "stack.watchdog_expiries " << s.watchdog_expiries << '\n'
+        << "stack.esc_resets " << s.esc_resets << '\n';
     s.sync0_latency.print(out, "stack.sync0_latency");
     s.sm2_latency.print(out, "stack.sm2_latency");
 }

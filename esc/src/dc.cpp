@@ -11,7 +11,12 @@ namespace esc {
 
 namespace {
 constexpr uint64_t kNever = std::numeric_limits<uint64_t>::max();
-}
+// 0x0930 below the datasheet's minimum (0x0080) acts as the minimum: the correction stays within
+// +-1/128 of the local clock's rate, so the clock never stops nor runs at twice its rate.
+constexpr uint16_t kMinSpeedCounterStart = 0x0080;
+// Rate limit of the local clock for any correction, a guard for the divisions by the speed.
+constexpr double kMaxRate = 1.0 / kMinSpeedCounterStart;
+}  // namespace
 
 // ---------------------------------------------------------------------------------------- local time
 
@@ -22,9 +27,19 @@ uint64_t Esc::Impl::local_at(uint64_t c) const {
 }
 
 uint64_t Esc::Impl::clock_at_local(uint64_t local) const {
-    const int64_t dl = static_cast<int64_t>(local - local_anchor);
-    const double dc = std::ceil(static_cast<double>(dl) / (1.0 + rate));
-    return clock_anchor + static_cast<uint64_t>(static_cast<int64_t>(dc));
+    constexpr double kTwo64 = 18446744073709551616.0;
+    const double speed = 1.0 + std::clamp(rate, -kMaxRate, kMaxRate);  // > 0: never a division by zero
+    // Saturated at both ends (a start time centuries away): no overflow, no undefined conversion.
+    if (local >= local_anchor) {
+        const double dc = std::ceil(static_cast<double>(local - local_anchor) / speed);
+        if (!(dc < kTwo64)) return kNever;
+        const uint64_t d = static_cast<uint64_t>(dc);
+        return d > kNever - clock_anchor ? kNever : clock_anchor + d;
+    }
+    const double dc = std::floor(static_cast<double>(local_anchor - local) / speed);
+    if (!(dc < kTwo64)) return 0;
+    const uint64_t d = static_cast<uint64_t>(dc);
+    return d >= clock_anchor ? 0 : clock_anchor - d;
 }
 
 void Esc::Impl::set_rate(double new_rate, uint64_t at) {
@@ -32,7 +47,7 @@ void Esc::Impl::set_rate(double new_rate, uint64_t at) {
         local_anchor = local_at(at);
         clock_anchor = at;
     }
-    rate = new_rate;
+    rate = std::clamp(new_rate, -kMaxRate, kMaxRate);
 }
 
 // ---------------------------------------------------------------------------------------- control loop
@@ -67,7 +82,8 @@ void Esc::Impl::dc_system_time_written(uint32_t received) {
     if (dc_have_prev && frame_local > dc_prev_local) {
         const double dt = static_cast<double>(frame_local - dc_prev_local);
         const uint16_t start = r16(reg::kDcSpeedStart) & 0x7FFF;
-        const double max_rate = 1.0 / std::max<uint16_t>(start, 1);  // bandwidth: 0x1000 -> 244 ppm
+        // Bandwidth: 0x1000 -> 244 ppm; at most 1/0x0080 (0x0930 = 0 is not a 100 % correction).
+        const double max_rate = 1.0 / std::max(start, kMinSpeedCounterStart);
         // PI loop. Proportional gain 2^-d1 (0x0934, default 4 -> 1/16 of the error per interval), integral
         // gain 2^-(d2-2) (0x0935, default 12 -> 1/1024): critically damped for the defaults, and kept below
         // half the proportional gain so that any register setting stays stable.
@@ -248,9 +264,11 @@ void Esc::Impl::wd_run(uint64_t now) {
 uint64_t Esc::Impl::next_event() const {
     uint64_t r = kNever;
     const uint64_t offset = r64(reg::kDcOffset);
+    const uint64_t now_clock = clock.now_ns();
+    const uint64_t now_local = local_at(now_clock);
     auto sync_at = [&](uint64_t sys) {
-        const int64_t local = static_cast<int64_t>(sys - offset);
-        return clock_at_local(static_cast<uint64_t>(std::max<int64_t>(local, 0)));
+        const uint64_t local = sys - offset;  // the event's local time
+        return local <= now_local ? now_clock : clock_at_local(local);
     };
     if (sync0_armed) r = std::min(r, sync_at(next_sync0));
     if (sync1_armed) r = std::min(r, sync_at(next_sync1));

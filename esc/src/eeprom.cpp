@@ -3,8 +3,9 @@
 
 namespace esc {
 
-uint16_t Esc::Impl::eeprom_word(uint32_t word) const {
-    const uint64_t b = static_cast<uint64_t>(word) * 2;
+uint16_t Esc::Impl::eeprom_word(uint64_t word) const {
+    if (word >= eeprom.size()) return 0xFFFF;  // beyond the image (and no overflow below)
+    const uint64_t b = word * 2;
     if (b + 1 >= eeprom.size() + 1) return 0xFFFF;  // beyond the image
     const uint8_t lo = eeprom[b];
     const uint8_t hi = b + 1 < eeprom.size() ? eeprom[b + 1] : 0xFF;
@@ -56,8 +57,13 @@ void Esc::Impl::eeprom_execute(Side) {
     uint16_t err = 0;
     switch (cmd) {
         case 1:  // read: 4 words (8-byte read size, 0x0502 bit 6)
+            // Word addresses count on past 0xFFFFFFFF (no wrap to word 0); words past the end of the EEPROM
+            // read 0xFFFF (the idle bus). A start address past the end is not acknowledged by any EEPROM:
+            // bit 13, as for a write there (decisions/esc.md).
             for (uint16_t i = 0; i < 4; ++i)
-                w16(static_cast<uint16_t>(reg::kSiiData + 2 * i), eeprom_word(addr + i));
+                w16(static_cast<uint16_t>(reg::kSiiData + 2 * i),
+                    eeprom_word(static_cast<uint64_t>(addr) + i));
+            if (static_cast<uint64_t>(addr) * 2 + 1 >= eeprom.size()) err = 0x2000;
             break;
         case 2:  // write one word
             if (!(c & 0x0001)) {

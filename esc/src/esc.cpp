@@ -227,8 +227,11 @@ void Esc::Impl::rebuild_lookup() {
         if (act & 0x01) sm_enabled_mask = static_cast<uint16_t>(sm_enabled_mask | (1u << n));
         uint32_t area = (s.mailbox || s.length == 1) ? s.length : 3u * s.length;
         uint32_t end = s.start + area;
-        s.area_valid = end <= mem_end && !(s.start < reg::kRamBase && end > reg::kRamBase);
-        if (!s.enabled) continue;
+        // SyncManagers act on the process RAM only (ESC datasheet section I, SyncManager): an area that
+        // starts in the register space or does not fit the RAM is not served and captures no address,
+        // so the registers (the SM's own included) and the RAM stay reachable (decisions/esc.md).
+        s.area_valid = s.start >= reg::kRamBase && end <= mem_end;
+        if (!s.enabled || !s.area_valid) continue;
         // Insertion by start address.
         unsigned pos = sm_area_count;
         while (pos > 0 && sm_areas[pos - 1].start > s.start) {
@@ -506,6 +509,9 @@ bool Esc::process_frame(std::span<uint8_t> frame, uint64_t rx_time_ns) {
 }
 
 void Esc::read(uint16_t address, std::span<uint8_t> out) {
+    // An empty span is no access: nothing read, the PDI watchdog not triggered, and no memset/memcpy on
+    // the null pointer an empty span may carry.
+    if (out.empty()) return;
     std::lock_guard lock(impl_->mu);
     impl_->pdi_touch();
     std::memset(out.data(), 0, out.size());
@@ -514,6 +520,7 @@ void Esc::read(uint16_t address, std::span<uint8_t> out) {
 }
 
 void Esc::write(uint16_t address, std::span<const uint8_t> in) {
+    if (in.empty()) return;  // no access, as for read()
     std::unique_lock lock(impl_->mu);
     impl_->pdi_touch();
     impl_->phys_write(address, in.data(), nullptr, static_cast<uint32_t>(in.size()), Side::Pdi);

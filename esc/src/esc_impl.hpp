@@ -301,7 +301,7 @@ struct Esc::Impl {
     bool fmmu_write(const FmmuMap& f, uint64_t b0, uint64_t b1, uint32_t la, const uint8_t* data);
 
     // EEPROM.
-    uint16_t eeprom_word(uint32_t word) const;
+    uint16_t eeprom_word(uint64_t word) const;
     void eeprom_execute(Side side);
     bool eeprom_crc_ok() const;
 

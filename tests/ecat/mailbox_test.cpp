@@ -185,6 +185,65 @@ TEST_F(MailboxTest, Counter_ResetWhenMailboxRestarts) {
     EXPECT_EQ((reply[5] >> 4) & 7, 1);
 }
 
+// Issue 14, finding 4: 'R','E','S' written to 0x0040 in Pre-Op put the ESC into Init, but the stack stayed in
+// Pre-Op with its old mailbox counter and dropped the master's next request as a repeat. An ESC reset is a
+// reset of everything behind the PDI: the stack restarts in Init, the application restarts with it.
+void esc_reset(Master& m) {
+    for (uint8_t c : {uint8_t{'R'}, uint8_t{'E'}, uint8_t{'S'}})
+        m.wr<uint8_t>(0x0040, c);
+}
+
+TEST_F(MailboxTest, EscResetRestartsTheStack) {
+    go_preop();
+    ASSERT_FALSE(roundtrip(mbx_message(0x3, 1, sdo)).empty());
+    esc_reset(master);
+    EXPECT_EQ(al_status(), 0x01);  // the ESC's reset value
+    // The interrupt line is low with the reset mask: the next timer-driven poll notices.
+    advance(Stack::kHousekeepingNs);
+    EXPECT_EQ(stack->state(), AlState::Init);
+    EXPECT_EQ(stack->stats().esc_resets, 1u);
+    EXPECT_EQ(app.restarts, 1);
+    EXPECT_EQ(coe.last_state, AlState::Init);  // the handlers dropped their transfers
+    EXPECT_EQ(esc->read_reg<uint32_t>(0x0204), Stack::kEventMask);
+    EXPECT_EQ(al_status(), 0x01);
+    // The master starts over: mailbox configured again, Pre-Op, and its counter from 1 again is executed.
+    go_preop();
+    const auto reply = roundtrip(mbx_message(0x3, 1, sdo));
+    ASSERT_FALSE(reply.empty());
+    EXPECT_EQ(coe.handled, 2);
+    EXPECT_EQ((reply[5] >> 4) & 7, 1);  // the slave's counter starts over as well
+    EXPECT_EQ(stack->mailbox().stats().duplicates, 0u);
+    // Nothing is seen as a reset while the ESC keeps the stack's set-up.
+    advance(50'000'000);
+    EXPECT_EQ(stack->stats().esc_resets, 1u);
+    EXPECT_EQ(app.restarts, 1);
+}
+
+TEST_F(MailboxTest, EscResetInSafeOpStopsProcessDataAndMailbox) {
+    go_safeop();
+    esc_reset(master);
+    advance(20'000'000);  // no master activity: the next timer-driven poll notices
+    EXPECT_EQ(stack->state(), AlState::Init);
+    EXPECT_FALSE(stack->mailbox().running());
+    EXPECT_EQ(al_status(), 0x01);
+    EXPECT_EQ(app.restarts, 1);
+    ASSERT_FALSE(app.changes.empty());
+    EXPECT_EQ(app.changes.back(), std::make_pair(AlState::SafeOp, AlState::Init));
+}
+
+TEST_F(MailboxTest, EscResetWhileTheMasterAlreadyAsksForPreOp) {
+    go_preop();
+    ASSERT_FALSE(roundtrip(mbx_message(0x3, 1, sdo)).empty());
+    esc_reset(master);
+    // The master does not wait for the firmware: mailbox and Pre-Op request right after the reset.
+    configure_mailbox();
+    request(0x02);
+    EXPECT_EQ(al_status(), 0x02) << std::hex << al_code();
+    EXPECT_EQ(stack->stats().esc_resets, 1u);
+    ASSERT_FALSE(roundtrip(mbx_message(0x3, 1, sdo)).empty());
+    EXPECT_EQ(coe.handled, 2);
+}
+
 // Toggles the repeat request bit in SM1 activate and polls until the slave acknowledges it.
 void repeat_request(Master& m, bool& toggle) {
     toggle = !toggle;

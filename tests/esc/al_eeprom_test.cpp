@@ -163,6 +163,34 @@ TEST_F(EscTest, ReadBeyondImageGivesFfff) {
     EXPECT_EQ(fprd(*e, 0x0508, 8).u64(), 0xFFFFFFFFFFFFFFFFull);
 }
 
+// Issue 14, finding 5: a read at word 0xFFFFFFFE returned words 0 and 1 in its last two words (the word
+// address wrapped). Past the end every word reads 0xFFFF and the missing acknowledge sets bit 13.
+TEST_F(EscTest, ReadAtTheTopWordAddressDoesNotWrap) {
+    fpwr(*e, 0x0502, {0x00, 0x01, 0xFE, 0xFF, 0xFF, 0xFF});
+    const uint16_t st = fprd(*e, 0x0502, 2).u16();
+    EXPECT_EQ(st & 0x8000, 0);       // done
+    EXPECT_EQ(st & 0x2000, 0x2000);  // not acknowledged
+    EXPECT_EQ(fprd(*e, 0x0508, 8).u64(), 0xFFFFFFFFFFFFFFFFull);
+    // The next command clears the error; a read inside the image works and is acknowledged.
+    fpwr(*e, 0x0502, {0x00, 0x01, 0x00, 0x00, 0x00, 0x00});
+    EXPECT_EQ(fprd(*e, 0x0502, 2).u16() & 0x6000, 0);
+    EXPECT_EQ(fprd(*e, 0x0508, 2).u16(), e->eeprom()[0] | (e->eeprom()[1] << 8));
+    // A read that starts on the last word is acknowledged; the words after it read 0xFFFF.
+    const uint32_t last = static_cast<uint32_t>(e->eeprom().size() / 2 - 1);
+    auto cmd = le(0x0100, 2);
+    auto addr = le(last, 4);
+    cmd.insert(cmd.end(), addr.begin(), addr.end());
+    fpwr(*e, 0x0502, cmd);
+    EXPECT_EQ(fprd(*e, 0x0502, 2).u16() & 0x2000, 0);
+    EXPECT_EQ(fprd(*e, 0x0508, 8).u64() >> 16, 0xFFFFFFFFFFFFull);
+    // The PDI gets the same answer.
+    fpwr(*e, 0x0500, {0x01});
+    e->write_reg<uint8_t>(0x0501, 0x01);
+    e->write(0x0502, std::vector<uint8_t>{0x00, 0x01, 0xFF, 0xFF, 0xFF, 0xFF});
+    EXPECT_EQ(e->read_reg<uint16_t>(0x0502) & 0x2000, 0x2000);
+    EXPECT_EQ(e->read_reg<uint64_t>(0x0508), 0xFFFFFFFFFFFFFFFFull);
+}
+
 TEST_F(EscTest, IghStyleWriteWithEnable) {
     std::vector<std::pair<uint16_t, uint16_t>> seen;
     e->on_eeprom_write([&](uint16_t a, uint16_t v) { seen.emplace_back(a, v); });

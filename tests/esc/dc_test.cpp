@@ -150,6 +150,64 @@ TEST_F(DcTest, NoWindUpBeforeOffsetIsSet) {
     EXPECT_EQ(e->local_time_ns() - l0, 1'000'244u);  // +244 ppm: speeding up towards the reference
 }
 
+// Issue 14, finding 2: 0x0930 = 0, then system-time writes about 2^30 ns off made the correction +-100 %:
+// the local clock froze (or ran at twice its rate), SYNC0 never came, clock_at_local divided by zero. 0x0930
+// below the datasheet minimum 0x0080 acts as 0x0080: the clock is slewed by at most 1/128, never stopped.
+TEST_F(DcTest, SpeedCounterStartZeroNeitherStopsNorDoublesTheClock) {
+    for (const int64_t off : {-(int64_t{1} << 30), int64_t{1} << 30}) {
+        EXPECT_EQ(fpwr(*e, 0x0930, {0x00, 0x00}).wkc, 1);
+        EXPECT_EQ(fprd(*e, 0x0930, 2).u16(), 0);  // stored as written
+        uint64_t ref = e->local_time_ns() + static_cast<uint64_t>(off);
+        for (int i = 0; i < 5; ++i) {
+            clk.advance(1'000'000);
+            ref += 1'000'000;
+            ASSERT_EQ(run1(*e, dg(FRMW, 0x7777, 0x0910, le(ref, 8))).wkc, 1);
+        }
+        const uint64_t l0 = e->local_time_ns();
+        clk.advance(1'000'000);
+        const uint64_t dl = e->local_time_ns() - l0;
+        EXPECT_GE(dl, 1'000'000u - 7'813u) << "offset " << off;  // 1/128 slower at most
+        EXPECT_LE(dl, 1'000'000u + 7'813u) << "offset " << off;  // 1/128 faster at most
+    }
+    // SYNC0 still comes, at the time next_event_ns() announces.
+    const uint64_t start = start_sync(1'000'000, 0, 0x03, 500'000);
+    for (int pulses = 0; pulses < 3; ++pulses) {
+        const uint64_t due = e->next_event_ns();
+        ASSERT_NE(due, UINT64_MAX);
+        ASSERT_GE(due, clk.now_ns());
+        clk.set(due);
+        e->tick();
+        EXPECT_EQ(al_event() & 0x04, 0x04u) << "pulse " << pulses;
+        e->read_reg<uint8_t>(0x098E);  // acknowledge
+    }
+    EXPECT_EQ(fprd(*e, 0x0990, 8).u64(), start + 3'000'000);
+}
+
+// Every division of the DC unit is guarded: far start times, zero cycle times and any register content
+// give a defined next event (UBSan checks the conversions).
+TEST_F(DcTest, ExtremeRegisterValuesGiveDefinedEvents) {
+    fpwr(*e, 0x0920, le(0, 8));
+    start_sync(0, 0, 0x07, static_cast<int64_t>(UINT64_MAX / 2));  // start about 292 years ahead
+    EXPECT_GT(e->next_event_ns(), clk.now_ns());
+    e->tick();
+    EXPECT_EQ(al_event() & 0x04, 0u);
+    fpwr(*e, 0x0981, {0x00});
+    fpwr(*e, 0x0920, le(UINT64_MAX - 5, 8));  // offset: system time far ahead of the local time
+    start_sync(1, 1, 0x07, 0);                // 1 ns cycles
+    clk.advance(1'000);
+    e->tick();
+    EXPECT_GE(e->next_event_ns(), clk.now_ns());
+    fpwr(*e, 0x0934, {0x0F, 0x0F});
+    fpwr(*e, 0x0930, {0xFF, 0xFF});
+    for (int i = 0; i < 3; ++i) {
+        clk.advance(1);
+        run1(*e, dg(FRMW, 0x7777, 0x0910, le(UINT64_MAX, 8)));
+    }
+    const uint64_t l0 = e->local_time_ns();
+    clk.advance(1'000'000);
+    EXPECT_GT(e->local_time_ns(), l0);
+}
+
 TEST_F(DcTest, ReferenceClockReadIsNotWritten) {
     run1(*e, dg(FRMW, 0x1001, 0x0910, le(12345, 8)));
     EXPECT_EQ(fprd(*e, 0x092C, 4).u32(), 0u);
@@ -333,6 +391,24 @@ TEST_F(DcTest, PdiWatchdog) {
     e->read_reg<uint8_t>(0x0000);
     e->tick();
     EXPECT_EQ(fprd(*e, 0x0110, 2).u16() & 0x0002, 0x0002);
+}
+
+// Issue 14, finding 8: Esc::read/write with an empty span called memset/memcpy with a null pointer (UB,
+// reported by UBSan). An empty span is no access: nothing happens, not even a PDI watchdog trigger.
+TEST_F(DcTest, EmptyPdiAccessIsNoAccess) {
+    fpwr(*e, 0x0410, le(10, 2));   // PDI watchdog 1 ms
+    e->read_reg<uint8_t>(0x0000);  // the last real access
+    e->tick();
+    clk.advance(600'000);
+    for (const uint16_t a : {uint16_t{0x0000}, uint16_t{0x0F80}, uint16_t{0x1000}, uint16_t{0xFFFF}}) {
+        e->read(a, std::span<uint8_t>{});  // data() is nullptr
+        e->write(a, std::span<const uint8_t>{});
+    }
+    e->tick();
+    clk.advance(400'000);
+    e->tick();
+    EXPECT_EQ(fprd(*e, 0x0110, 2).u16() & 0x0002, 0);  // expired 1 ms after the last real access
+    EXPECT_EQ(fprd(*e, 0x0443, 1).data[0], 1);
 }
 
 }  // namespace

@@ -194,4 +194,24 @@ TEST_F(FmmuTest, MailboxThroughFmmuObeysSmRules) {
     EXPECT_EQ(m, (std::vector<uint8_t>{1, 2, 3, 4}));
 }
 
+// Issue 14, finding 1 (FMMU side): an FMMU whose physical area runs over the registers and far past the RAM
+// maps what exists and captures nothing: physical accesses, its own registers included, are unchanged.
+TEST_F(FmmuTest, FmmuBeyondTheRamCapturesNoPhysicalAddress) {
+    fmmu(0, {0x00010000, 0x8000, 0, 7, 0x0100, 0, 0x03});
+    EXPECT_EQ(fprd(*e, 0x0100, 4).u32(), 0x0007C001u);
+    EXPECT_EQ(fprd(*e, 0x0600, 16).wkc, 1);
+    Datagram d = run1(*e, lg(LRD, 0x00010000, {0, 0, 0, 0}));
+    EXPECT_EQ(d.wkc, 1);
+    EXPECT_EQ(d.u32(), 0x0007C001u);  // DL control through the mapping
+    EXPECT_EQ(run1(*e, lg(LRD, 0x00010000 + 0x3000 - 0x0100, {0, 0})).wkc, 0);  // past the RAM end
+    EXPECT_EQ(fpwr(*e, 0x1800, {0x42}).wkc, 1);
+    EXPECT_EQ(run1(*e, lg(LRD, 0x00010000 + 0x1800 - 0x0100, {0})).data[0], 0x42);
+    // An FMMU running past 0xFFFF: nothing beyond the memory, no wrap to 0x0000.
+    fmmu(1, {0x00200000, 0x100, 0, 7, 0xFFF0, 0, 0x01});
+    EXPECT_EQ(run1(*e, lg(LRD, 0x00200000, std::vector<uint8_t>(0x100, 0))).wkc, 0);
+    // Disabled again by the master.
+    EXPECT_EQ(fpwr(*e, 0x060C, {0x00}).wkc, 1);
+    EXPECT_EQ(fprd(*e, 0x060C, 1).data[0], 0x00);
+}
+
 }  // namespace

@@ -301,3 +301,55 @@ TEST_F(SmTest, EcatBufferChangeTimeLatchesTheFrameStart) {
     EXPECT_EQ(fpwr(*e, 0x09F0, {0, 0, 0, 0}).wkc, 1);
     EXPECT_EQ(change_time(), static_cast<uint32_t>(second));
 }
+
+// Issue 14, finding 1: FPWR 0x0820 <- 00 01 00 80 20 00 01 00 (SM4: start 0x0100, length 0x8000, buffered,
+// enabled) made every address from 0x0100 up unreachable, the SM registers included. SyncManagers act on the
+// process RAM only: an SM over the register space or beyond the RAM captures nothing.
+TEST_F(SmTest, SmOverTheRegisterSpaceCapturesNoAddress) {
+    EXPECT_EQ(fpwr(*e, 0x0820, {0x00, 0x01, 0x00, 0x80, 0x20, 0x00, 0x01, 0x00}).wkc, 1);
+    e->read_reg<uint8_t>(0x0826);  // acknowledge the SM activation event
+    // The SM's own registers: readable, and the activate byte is writable (the master can disable it).
+    Datagram d = fprd(*e, 0x0820, 8);
+    EXPECT_EQ(d.wkc, 1);
+    EXPECT_EQ(d.u16(0), 0x0100);
+    EXPECT_EQ(d.u16(2), 0x8000);
+    EXPECT_EQ(d.data[6], 0x01);
+    // Registers from 0x0100 up answer from both sides.
+    EXPECT_EQ(fprd(*e, 0x0100, 4).u32(), 0x0007C001u);
+    EXPECT_EQ(fprd(*e, 0x0130, 2).wkc, 1);
+    EXPECT_EQ(fprd(*e, 0x0130, 2).u16(), 0x0001);
+    EXPECT_EQ(fpwr(*e, 0x0120, {0x02, 0x00}).wkc, 1);
+    EXPECT_EQ(al_event() & 0x01, 0x01u);
+    EXPECT_EQ(e->read_reg<uint16_t>(0x0120), 0x0002);    // the stack's PDI read of AL control
+    EXPECT_EQ(al_event() & 0x01, 0x00u);                 // ... with its side effect
+    EXPECT_EQ(e->read_reg<uint8_t>(0x0805), status(0));  // SM status through the PDI
+    EXPECT_EQ(fpwr(*e, 0x0F80, {0xA5}).wkc, 1);
+    EXPECT_EQ(fprd(*e, 0x0F80, 1).data[0], 0xA5);
+    // Process RAM outside the other SMs is plain RAM, the mailbox SM still works.
+    EXPECT_EQ(fpwr(*e, 0x1800, {0x5A}).wkc, 1);
+    EXPECT_EQ(fprd(*e, 0x1800, 1).data[0], 0x5A);
+    EXPECT_EQ(fpwr(*e, 0x1000, kMsgA).wkc, 1);
+    EXPECT_EQ(status(0) & 0x08, 0x08);
+    EXPECT_EQ(pdi_read(0x1000, 8), kMsgA);
+    // Disabled again by the master.
+    EXPECT_EQ(fpwr(*e, 0x0826, {0x00}).wkc, 1);
+    EXPECT_EQ(fprd(*e, 0x0826, 1).data[0], 0x00);
+}
+
+TEST_F(SmTest, SmAreaInsideTheRegistersOrAcrossTheRamEdgesIsNotServed) {
+    // A mailbox SM on DL control: the registers keep their register rules.
+    EXPECT_EQ(fpwr(*e, 0x0820, sm_bytes(0x0100, 16, 0x26, 1)).wkc, 1);
+    EXPECT_EQ(fprd(*e, 0x0100, 4).u32(), 0x0007C001u);
+    EXPECT_EQ(fprd(*e, 0x0100, 4).wkc, 1);
+    // Across the register/RAM boundary: user RAM and process RAM stay plain memory.
+    EXPECT_EQ(fpwr(*e, 0x0828, sm_bytes(0x0FF8, 16, 0x26, 1)).wkc, 1);
+    EXPECT_EQ(fpwr(*e, 0x0FF8, {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16}).wkc, 1);
+    EXPECT_EQ(status(5) & 0x08, 0x00);  // no mailbox was written
+    EXPECT_EQ(pdi_read(0x0FF8, 16),
+              (std::vector<uint8_t>{1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16}));
+    // Past the end of the RAM (8 KiB: 0x1000-0x2FFF): the RAM below the end stays plain.
+    EXPECT_EQ(fpwr(*e, 0x0830, sm_bytes(0x2F00, 0x100, 0x20, 1)).wkc, 1);  // 3 x 256 bytes do not fit
+    EXPECT_EQ(fpwr(*e, 0x2F00, {0x77}).wkc, 1);
+    EXPECT_EQ(fprd(*e, 0x2F00, 1).data[0], 0x77);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x2F00), 0x77);
+}

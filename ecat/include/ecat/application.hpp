@@ -21,7 +21,8 @@ class Application {
     // Outputs are no longer valid: process-data watchdog, sync loss or leaving Op (the drive's 0x6007
     // reaction). Called before on_state_change of the same event.
     virtual void on_outputs_lost() {}
-    // Bootstrap -> Init: the device restarts (e.g. loads a new firmware image). Called as the last thing
+    // Bootstrap -> Init, or an ESC reset (0x0040/0x0041, which resets everything behind the PDI): the
+    // device restarts (e.g. loads a new firmware image). Called as the last thing
     // poll() does, after AL status shows Init; the application may schedule a restart of the whole firmware
     // but must not destroy the Stack from inside this call.
     virtual void on_restart() {}

@@ -36,6 +36,7 @@ struct StackStats {
     uint64_t sm_events_missed = 0;   // DC: SYNC0 without new outputs since the last one (Op)
     uint64_t cycles_exceeded = 0;    // DC: SYNC0 periods that passed without a cycle
     uint64_t watchdog_expiries = 0;  // process-data watchdog events seen
+    uint64_t esc_resets = 0;         // ESC resets (0x0040/0x0041) the stack restarted after
     // DC: how late each application cycle started after its SYNC0 pulse, against the DC system time:
     // 0x0910 read at the cycle start minus the pulse's system time (next pulse 0x0990 - SYNC0 cycle 0x09A0).
     LatencyHistogram sync0_latency;
@@ -64,7 +65,9 @@ class Stack {
     void add_handler(MailboxHandler& handler) { mailbox_.add_handler(handler); }
 
     // Reads the AL event request register (0x0220) and reacts: AL control, SM events, SYNC0, watchdog,
-    // mailbox, process-data cycle, timers.
+    // mailbox, process-data cycle, timers. An ESC reset (0x0040/0x0041, seen through the PDI as the lost
+    // register set-up) restarts the stack as a reset of the firmware behind the ESC would: Init, fresh
+    // mailbox, transfers dropped, and Application::on_restart().
     void poll(uint64_t now_ns);
     // Time at which poll() must run again even if no frame arrives; UINT64_MAX if nothing is pending.
     uint64_t next_deadline_ns() const;
@@ -105,6 +108,8 @@ class Stack {
     uint8_t expected_control(unsigned n, uint8_t fallback) const;
     const od::SyncManagerDefault* sm_default(unsigned n) const;
 
+    bool esc_was_reset();
+    void restart_after_esc_reset(uint64_t now_ns);
     void handle_al_control(uint64_t now_ns);
     void request(od::AlState to, uint64_t now_ns);
     uint16_t check_mailbox(const od::MailboxLayout& layout, uint16_t code);

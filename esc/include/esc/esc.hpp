@@ -51,6 +51,7 @@ class Esc final : public Pdi {
     bool process_frame(std::span<uint8_t> frame, uint64_t rx_time_ns = 0);
 
     // ---- PDI side ---------------------------------------------------------------------------------
+    // An empty span is no access (no side effect, the PDI watchdog is not triggered).
     void read(uint16_t address, std::span<uint8_t> out) override;
     void write(uint16_t address, std::span<const uint8_t> in) override;
     // The PDI interrupt line: (AL event request 0x0220) & (AL event mask 0x0204) != 0.
