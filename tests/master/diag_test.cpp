@@ -83,6 +83,19 @@ TEST(DiagDecode, ValueParametersOfCoeDataTypes) {
               std::string::npos);
 }
 
+TEST(DiagDecode, ATextIdAboutAnErrorShowsTheTextThenTheErrorName) {
+    auto b = message(0x8611E800, 0x0001, 0x8020, 9, {});  // warning, no parameter, text id 0x8020
+    auto e = master::decode_diag_message(b, 6);
+    ASSERT_TRUE(e);
+    auto names = [](uint16_t code) -> std::string_view { return code == 0x8611 ? "Following error" : ""; };
+    auto texts = [](uint16_t id) -> std::string_view {
+        return id == 0x8020 ? "Fault reset refused: cause still present" : "";
+    };
+    EXPECT_EQ(master::diag_text(*e, names, texts),
+              "Fault reset refused: cause still present (Following error)");
+    EXPECT_EQ(master::diag_text(*e, names), "Following error");  // without the texts: the error's name
+}
+
 TEST(DiagDecode, AWarningNamedByItsCodeDoesNotRepeatItsCutText) {
     // What the drive stores for a warning: diag code from the error code, the name cut to 14 characters.
     std::vector<uint8_t> p{0x0E, 0x20};

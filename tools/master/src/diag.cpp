@@ -213,6 +213,19 @@ std::string_view emergency_class_name(uint16_t code) {
 }
 
 std::string diag_text(const DiagEntry& e, ErrorNameLookup lookup, TextIdLookup texts) {
+    // A text the device gives by id says more than the error it concerns (e.g. "Fault reset refused: cause
+    // still present" about a following error): the text first, the error's name after it.
+    if (e.text_id != 0 && texts != nullptr) {
+        const std::string_view t = texts(e.text_id);
+        if (!t.empty()) {
+            std::string s(t);
+            if (e.from_emergency() && e.emergency_code() != 0 && lookup != nullptr) {
+                const std::string_view n = lookup(e.emergency_code());
+                if (!n.empty()) s += " (" + std::string(n) + ")";
+            }
+            return s;
+        }
+    }
     if (e.from_emergency()) {
         const uint16_t c = e.emergency_code();
         if (c == 0x0000) return "no error (error reset)";
@@ -223,10 +236,6 @@ std::string diag_text(const DiagEntry& e, ErrorNameLookup lookup, TextIdLookup t
         return std::string(emergency_class_name(c));
     }
     if (e.text_id != 0) {
-        if (texts != nullptr) {
-            const std::string_view t = texts(e.text_id);
-            if (!t.empty()) return std::string(t);
-        }
         char b[48];
         std::snprintf(b, sizeof b, "text id 0x%04x", e.text_id);
         return b;

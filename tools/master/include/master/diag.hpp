@@ -68,7 +68,8 @@ std::string format_diag_param(const DiagParameter& p);
 using ErrorNameLookup = std::string_view (*)(uint16_t code);
 // CiA 301 error code class ("current", "voltage", ...), "" for 0x0000.
 std::string_view emergency_class_name(uint16_t code);
-// Readable text of a message: the device's error name for an emergency-derived code (else its CiA 301
+// Readable text of a message: the device's text for its text id (with the error's name after it for an
+// emergency-derived code), else the device's error name for an emergency-derived code (else its CiA 301
 // class), the ASCII parameter of a manufacturer message, "text id 0x...." otherwise.
 // texts: the device's text ids (ETG.1020 text id -> text, e.g. from its ESI DiagMessages); without it, or for
 // an id it does not know, "text id 0x....".
