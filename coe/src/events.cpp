@@ -8,11 +8,12 @@ EventReporter::EventReporter(Emergency& emergency, DiagnosisHistory* history, st
     : emergency_(emergency), history_(history), clock_(std::move(clock)) {}
 
 void EventReporter::record(uint32_t diag_code, DiagType type, std::span<const DiagParam> params,
-                           bool may_send_emergency) {
+                           bool may_send_emergency, uint16_t text_id) {
     if (history_ == nullptr) return;
     DiagMessage m;
     m.code = diag_code;
     m.type = type;
+    m.text_id = text_id;
     m.timestamp_ns = clock_ ? clock_() : 0;
     m.local_time = !clock_;
     m.params = params;
@@ -41,6 +42,12 @@ void EventReporter::clear(uint16_t error_code, uint8_t error_register) {
 }
 
 void EventReporter::diag(DiagType type, uint16_t code, std::string_view text) {
+    const uint16_t id = text_ids_ != nullptr && !text.empty() ? text_ids_(text) : 0;
+    if (id != 0) {
+        record(code == 0 ? kManufacturerDiagCode : DiagnosisHistory::from_emergency(code), type, {}, true,
+               id);
+        return;
+    }
     const DiagParam params[] = {DiagParam::ascii(text)};
     record(code == 0 ? kManufacturerDiagCode : DiagnosisHistory::from_emergency(code), type,
            text.empty() ? std::span<const DiagParam>{} : std::span<const DiagParam>(params), true);

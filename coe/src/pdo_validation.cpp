@@ -1,5 +1,10 @@
 #include "coe/pdo_validation.hpp"
 
+#include <algorithm>
+#include <array>
+#include <memory>
+#include <vector>
+
 #include "wire.hpp"
 
 namespace coe {
@@ -80,12 +85,28 @@ bool valid_pdo_for(const od::Dictionary& d, uint16_t assign, uint16_t pdo) {
     return range && d.find(pdo) != nullptr;
 }
 
+// The PDOs an assignment holds with `count` entries, entry `changed` (0: none) reading `changed_pdo`.
+od::Status rules_after(const od::Dictionary& d, uint16_t assign, uint8_t count, uint8_t changed,
+                       uint16_t changed_pdo, std::span<const od::PdoRule> rules) {
+    if (rules.empty()) return od::Status::Ok;
+    std::array<uint16_t, 255> pdos{};
+    std::size_t n = 0;
+    for (uint8_t s = 1; s <= count && s != 0; ++s)
+        pdos[n++] = s == changed ? changed_pdo : u16(d, assign, s);
+    return check_pdo_rules(assign, std::span<const uint16_t>(pdos.data(), n), rules);
+}
+
 od::Status check_assignment(const od::Dictionary& d, uint16_t assign, const od::Entry& e,
-                            std::span<const uint8_t> v, const PdoLimits& lim) {
+                            std::span<const uint8_t> v, const PdoLimits& lim,
+                            std::span<const od::PdoRule> rules) {
     if (e.subindex != 0) {
         if (v.size() != 2) return od::Status::LengthMismatch;
         uint16_t pdo = wire::get16(v, 0);
-        return pdo == 0 || valid_pdo_for(d, assign, pdo) ? od::Status::Ok : od::Status::InvalidValue;
+        if (pdo != 0 && !valid_pdo_for(d, assign, pdo)) return od::Status::InvalidValue;
+        // An entry inside the current count changes the assignment in force.
+        const uint8_t count = u8(d, assign, 0);
+        if (e.subindex <= count) return rules_after(d, assign, count, e.subindex, pdo, rules);
+        return od::Status::Ok;
     }
     if (v.size() != 1) return od::Status::LengthMismatch;
     const uint8_t n = v[0];
@@ -99,10 +120,26 @@ od::Status check_assignment(const od::Dictionary& d, uint16_t assign, const od::
             if (u16(d, assign, t) == pdo) return od::Status::InvalidValue;  // assigned twice
     }
     if (assigned_bytes(d, assign, n, 0, 0) > lim.max_sm_bytes) return od::Status::PdoLengthExceeded;
-    return od::Status::Ok;
+    return rules_after(d, assign, n, 0, 0, rules);
 }
 
 }  // namespace
+
+od::Status check_pdo_rules(uint16_t assign, std::span<const uint16_t> assigned,
+                           std::span<const od::PdoRule> rules) {
+    auto holds = [&](uint16_t pdo) {
+        return std::find(assigned.begin(), assigned.end(), pdo) != assigned.end();
+    };
+    for (const od::PdoRule& r : rules) {
+        const bool ours = assign == kRxAssign ? is_rx_mapping(r.pdo) : is_tx_mapping(r.pdo);
+        if (!ours) continue;
+        if (r.mandatory && !holds(r.pdo)) return od::Status::Incompatible;
+        if (!holds(r.pdo)) continue;
+        for (uint16_t x : r.exclude)
+            if (x != r.pdo && holds(x)) return od::Status::Incompatible;
+    }
+    return od::Status::Ok;
+}
 
 od::Status check_mapping_entry(const od::Dictionary& dict, bool rx, uint32_t value) {
     if (value == 0) return od::Status::Ok;
@@ -125,7 +162,12 @@ std::size_t mapped_bits(const od::Dictionary& dict, uint16_t pdo) {
 }
 
 void install_pdo_validators(od::Dictionary& dict, PdoLimits limits) {
+    install_pdo_validators(dict, limits, {});
+}
+
+void install_pdo_validators(od::Dictionary& dict, PdoLimits limits, std::span<const od::PdoRule> rules) {
     od::Dictionary* d = &dict;
+    auto kept = std::make_shared<const std::vector<od::PdoRule>>(rules.begin(), rules.end());
     for (const auto& obj : dict.objects()) {
         const uint16_t index = obj.index;
         if (is_rx_mapping(index) || is_tx_mapping(index)) {
@@ -133,9 +175,10 @@ void install_pdo_validators(od::Dictionary& dict, PdoLimits limits) {
                 return check_mapping(*d, index, e, v, limits);
             });
         } else if (index == kRxAssign || index == kTxAssign) {
-            dict.add_validator(index, [d, index, limits](const od::Entry& e, std::span<const uint8_t> v) {
-                return check_assignment(*d, index, e, v, limits);
-            });
+            dict.add_validator(index,
+                               [d, index, limits, kept](const od::Entry& e, std::span<const uint8_t> v) {
+                                   return check_assignment(*d, index, e, v, limits, *kept);
+                               });
         }
     }
 }

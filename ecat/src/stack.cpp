@@ -214,6 +214,8 @@ void Stack::poll(uint64_t now_ns) {
         if (!(wd & 0x0001)) {
             ++stats_.watchdog_expiries;
             if (state_ == AlState::Op) {
+                // Reported where it matters: outside Op no outputs are used, and one expires after every Op.
+                if (events_ != nullptr) events_->watchdog_expired(state_);
                 // Outputs are no longer refreshed: Safe-Op with error 0x001B (§3.8, §6.4 runtime).
                 fall_back(AlState::SafeOp, al::SmWatchdog, now_ns);
             }
@@ -305,6 +307,7 @@ void Stack::handle_al_control(uint64_t now_ns) {
 
     if (!known_state(requested)) {
         refuse(al::UnknownState);
+        if (events_ != nullptr) events_->state_refused(state_, static_cast<uint8_t>(requested), code_);
     } else if (static_cast<AlState>(requested) != state_) {
         request(static_cast<AlState>(requested), now_ns);
     }
@@ -317,6 +320,14 @@ void Stack::handle_al_control(uint64_t now_ns) {
 }
 
 void Stack::request(AlState to, uint64_t now_ns) {
+    const AlState from = state_;
+    const uint64_t refused_before = stats_.refused;
+    request_checked(to, now_ns);
+    if (events_ != nullptr && stats_.refused != refused_before)
+        events_->state_refused(from, static_cast<uint8_t>(to), code_);
+}
+
+void Stack::request_checked(AlState to, uint64_t now_ns) {
     const AlState from = state_;
     const bool boot_supported = check_bootstrap() == 0;
     if (to == AlState::Boot && from == AlState::Init && !boot_supported) {
@@ -583,6 +594,7 @@ void Stack::try_complete_op(uint64_t now_ns) {
         op_pending_ = false;
         const bool dc = sync_mode_ == SyncMode::DcSync0 || sync_mode_ == SyncMode::DcSync1;
         refuse(dc && !sync0_seen_ ? al::NoSyncError : al::SmWatchdog);
+        if (events_ != nullptr) events_->state_refused(state_, static_cast<uint8_t>(AlState::Op), code_);
         write_status();
     }
 }
@@ -609,6 +621,7 @@ void Stack::go(AlState to, uint64_t now_ns) {
     ++stats_.transitions;
     update_irq_usable();
     mailbox_.set_state(from, to);
+    if (events_ != nullptr) events_->state_changed(from, to);
     app_.on_state_change(from, to);
     if (from == AlState::Boot && to == AlState::Init)
         restart_pending_ = true;  // reported at the end of poll()
@@ -638,7 +651,20 @@ void Stack::fall_back(AlState to, uint16_t code, uint64_t now_ns) {
     op_pending_ = false;
     if (rank(to) < rank(state_)) go(to, now_ns);
     refuse(code);
+    if (events_ != nullptr) events_->local_error(state_, code);
     write_status();
+}
+
+void add_stats(StackStats& t, const StackStats& s) {
+    t.transitions += s.transitions;
+    t.refused += s.refused;
+    t.cycles += s.cycles;
+    t.sync0_events += s.sync0_events;
+    t.sm_events_missed += s.sm_events_missed;
+    t.cycles_exceeded += s.cycles_exceeded;
+    t.watchdog_expiries += s.watchdog_expiries;
+    t.sync0_latency.merge(s.sync0_latency);
+    t.sm2_latency.merge(s.sm2_latency);
 }
 
 void print_stats(std::ostream& out, const StackStats& s) {

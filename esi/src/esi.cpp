@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "esi/model.hpp"
+#include "od/diag_texts.hpp"
 #include "type_names.hpp"
 
 namespace esi {
@@ -379,14 +380,30 @@ void dictionary(xmlNodePtr profile, const od::Dictionary& dict) {
     xmlFreeNode(structured);
 }
 
+// ---- Diagnosis texts (ETG.2000 DiagMessages, the ids 0x10F3 messages carry) ---------------------------
+
+void diag_messages(xmlNodePtr profile) {
+    static const char* const kClass[] = {"information", "warning", "error"};
+    xmlNodePtr messages = child(profile, "DiagMessages");
+    for (const od::DiagText& t : od::drive_diag_texts()) {
+        xmlNodePtr m = child(messages, "DiagMessage");
+        child(m, "TextId", hex_index(t.id));
+        named(m, "MessageText", std::string(t.text));
+        child(child(m, "Flags"), "DiagClass", kClass[t.type < 3 ? t.type : 0]);
+    }
+}
+
 // ---- PDOs --------------------------------------------------------------------------------------------
 
 void pdo(xmlNodePtr device, const PdoInfo& p) {
     xmlNodePtr n = child(device, p.rx ? "RxPdo" : "TxPdo");
     if (p.fixed) attr(n, "Fixed", "1");
+    if (p.mandatory) attr(n, "Mandatory", "1");
     if (p.sm >= 0) attr(n, "Sm", std::to_string(p.sm));
     child(n, "Index", hex_index(p.index));
     named(n, "Name", p.name);
+    for (uint16_t x : p.exclude)
+        child(n, "Exclude", hex_index(x));
     for (const PdoEntryInfo& e : p.entries) {
         xmlNodePtr en = child(n, "Entry");
         child(en, "Index", hex_index(e.index));
@@ -495,6 +512,11 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
     attr(type, "RevisionNo", hex32(id.revision));
     named(device, "Name", id.device_name);
     xmlNodePtr info = child(device, "Info");
+    if (d.mailbox_request_timeout_ms != 0 || d.mailbox_response_timeout_ms != 0) {
+        xmlNodePtr timeout = child(child(info, "Mailbox"), "Timeout");
+        child(timeout, "RequestTimeout", std::to_string(d.mailbox_request_timeout_ms));
+        child(timeout, "ResponseTimeout", std::to_string(d.mailbox_response_timeout_ms));
+    }
     for (int port = 0; port < 2; ++port)
         child(child(info, "Port"), "Type", "MII");  // kPhysicalPorts
     if (kIdentificationInAlStatusCode) child(info, "IdentificationReg134", "true");
@@ -506,11 +528,16 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
         child(profile, "AddInfo", std::to_string(m.profile_add_info));
     }
     dictionary(profile, dict);
+    if (dict.find(0x10F3) != nullptr) diag_messages(profile);
 
     for (FmmuUse f : m.fmmus)
         child(device, "Fmmu", fmmu_text(f));
     for (const SmInfo& s : m.sync_managers) {
         xmlNodePtr sm = child(device, "Sm", sm_text(s.kind));
+        if (s.min_size != 0 || s.max_size != 0) {
+            attr(sm, "MinSize", std::to_string(s.min_size));
+            attr(sm, "MaxSize", std::to_string(s.max_size));
+        }
         if (s.size != 0) attr(sm, "DefaultSize", std::to_string(s.size));
         attr(sm, "StartAddress", hex_index(s.start));
         attr(sm, "ControlByte", hex(s.control));
@@ -536,6 +563,8 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
             attr(coe, "PdoUpload", boolean(d.coe_details & cd::PdoUpload));
             attr(coe, "CompleteAccess", boolean(d.coe_details & cd::CompleteAccess));
             if (m.profile_number == 402) attr(coe, "DS402Channels", "1");
+            if (kSegmentedSdo) attr(coe, "SegmentedSdo", "true");
+            if (dict.find(0x10F3) != nullptr) attr(coe, "DiagHistory", "true");
         }
         if (d.mailbox_protocols & mp::FoE) child(mbx, "FoE");
         if (d.mailbox_protocols & mp::SoE) child(mbx, "SoE");
@@ -561,6 +590,8 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
     child(eeprom, "ByteSize", std::to_string(d.eeprom_bytes));
     child(eeprom, "ConfigData", hex_bytes(m.config_data.data(), m.config_data.size()));
     child(eeprom, "BootStrap", hex_bytes(m.bootstrap.data(), m.bootstrap.size()));
+    const std::vector<uint8_t> image = device_image_bmp();
+    child(device, "ImageData16x14", hex_bytes(image.data(), image.size()));
 
     xmlChar* buf = nullptr;
     int size = 0;

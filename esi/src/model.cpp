@@ -127,11 +127,31 @@ DeviceModel derive_model(const od::DeviceDescription& d, const od::Dictionary& d
         read_mapping(dict, obj, pdo, m.warnings);
         m.pdos.push_back(std::move(pdo));
     }
+    for (const od::PdoRule& rule : d.pdo_rules) {
+        PdoInfo* found = nullptr;
+        for (auto& p : m.pdos)
+            if (p.index == rule.pdo) found = &p;
+        if (found == nullptr) {
+            m.warnings.push_back("PDO rule for " + hex4(rule.pdo) + ", which is not a mapping object");
+            continue;
+        }
+        found->mandatory = found->mandatory || rule.mandatory;
+        for (uint16_t x : rule.exclude) {
+            bool known = false;
+            for (const auto& p : m.pdos)
+                known = known || (p.index == x && p.rx == found->rx);
+            if (!known)
+                m.warnings.push_back(hex4(rule.pdo) + " excludes " + hex4(x) +
+                                     ", not a PDO of its direction");
+            else
+                found->exclude.push_back(x);
+        }
+    }
 
     // ---- SyncManagers and their default PDO assignment (0x1C10 + n) ----
     for (std::size_t n = 0; n < d.sync_managers.size(); ++n) {
         const od::SyncManagerDefault& sm = d.sync_managers[n];
-        SmInfo si{sm.kind, sm.start, sm.default_size, sm.control, sm.enable};
+        SmInfo si{sm.kind, sm.start, sm.default_size, sm.control, sm.enable, sm.min_size, sm.max_size};
         const std::string name = "SM" + std::to_string(n);
         switch (sm.kind) {
             case od::SmKind::MBoxOut:
@@ -217,6 +237,85 @@ DeviceModel derive_model(const od::DeviceDescription& d, const od::Dictionary& d
     put16(&m.bootstrap[4], d.bootstrap_mailbox.in_start);
     put16(&m.bootstrap[6], d.bootstrap_mailbox.in_size);
     return m;
+}
+
+}  // namespace esi
+
+namespace esi {
+
+std::vector<uint8_t> device_image_bmp() {
+    constexpr int kW = 16, kH = 14;
+    constexpr uint32_t kPixels = kW * kH * 3;  // 48 bytes a row: no padding needed
+    constexpr uint32_t kHeader = 14 + 40;
+    // The drawing, top row first: a servo drive (grey housing, cooling fins, status LEDs green/red) with its
+    // motor (blue, round) on the right. '.' white, 'k' dark grey, 'g' grey, 'G' green, 'R' red, 'b' blue,
+    // 'B' dark blue, 'y' yellow shaft.
+    static const char* const kArt[kH] = {
+        "................",  //
+        ".kkkkkkk........",  //
+        ".kgggggk........",  //
+        ".kgGgRgk...bbb..",  //
+        ".kgggggk..bBBBb.",  //
+        ".kkkkkkk.bBbbbBb",  //
+        ".kgggggkbbBbyybB",  //
+        ".kkkkkkk.bBbyybB",  //
+        ".kgggggk.bBbbbBb",  //
+        ".kkkkkkk..bBBBb.",  //
+        ".kgggggk...bbb..",  //
+        ".kkkkkkk........",  //
+        ".kk...kk........",  //
+        "................",  //
+    };
+    auto color = [](char c) -> std::array<uint8_t, 3> {  // B, G, R
+        switch (c) {
+            case 'k':
+                return {0x40, 0x40, 0x40};
+            case 'g':
+                return {0xA0, 0xA0, 0xA0};
+            case 'G':
+                return {0x00, 0xC0, 0x00};
+            case 'R':
+                return {0x00, 0x00, 0xE0};
+            case 'b':
+                return {0xC0, 0x60, 0x20};
+            case 'B':
+                return {0x80, 0x30, 0x10};
+            case 'y':
+                return {0x00, 0xD0, 0xF0};
+            default:
+                return {0xFF, 0xFF, 0xFF};
+        }
+    };
+    std::vector<uint8_t> b;
+    auto u16 = [&b](uint32_t v) {
+        b.push_back(static_cast<uint8_t>(v));
+        b.push_back(static_cast<uint8_t>(v >> 8));
+    };
+    auto u32 = [&u16](uint32_t v) {
+        u16(v & 0xFFFF);
+        u16(v >> 16);
+    };
+    b.push_back('B');
+    b.push_back('M');
+    u32(kHeader + kPixels);  // file size
+    u32(0);                  // reserved
+    u32(kHeader);            // pixel data offset
+    u32(40);                 // BITMAPINFOHEADER
+    u32(kW);
+    u32(kH);  // positive: bottom-up
+    u16(1);   // planes
+    u16(24);  // bits per pixel
+    u32(0);   // BI_RGB
+    u32(kPixels);
+    u32(3780);  // 96 dpi
+    u32(3780);
+    u32(0);
+    u32(0);
+    for (int y = kH - 1; y >= 0; --y)
+        for (int x = 0; x < kW; ++x)
+            for (uint8_t c : color(kArt[y][x]))
+                b.push_back(c);
+    return b;
 }
 
 }  // namespace esi

@@ -111,6 +111,7 @@ std::vector<uint8_t> build_sii(const od::DeviceDescription& d, const od::Diction
         uint16_t flags = 0;
         if (p.sm >= 0) flags |= pdo_flags::Default;
         if (p.fixed) flags |= pdo_flags::FixedContent;
+        if (p.mandatory) flags |= pdo_flags::Mandatory;
         w.u16(flags);
         for (const PdoEntryInfo& e : p.entries) {
             w.u16(e.index);

@@ -144,6 +144,10 @@ void FoeServer::handle(std::span<const uint8_t> payload, ecat::MailboxSender& ou
 }
 
 void FoeServer::start_write(uint32_t password, std::string_view name, ecat::MailboxSender& out) {
+    report_write(static_cast<uint32_t>(ErrorCode::NotDefined), "superseded by a new write request");
+    write_name_.assign(name);
+    write_bytes_ = 0;
+    write_open_ = true;
     if (state_ != od::AlState::Boot) {
         send_error(ErrorCode::BootstrapOnly, "firmware download needs the Bootstrap state", out);
         return;
@@ -285,6 +289,7 @@ void FoeServer::on_data(uint32_t packet, std::span<const uint8_t> data, ecat::Ma
         send_error(e.code, e.text, out);
         return;
     }
+    write_bytes_ += data.size();
     if (data.size() >= full) {
         ++packet_;
         send_ack(packet, out);
@@ -328,9 +333,17 @@ void FoeServer::reap_commit() {
     if (worker_result_.load() == 1) {
         result_ = Result::Done;
         ++stats_.writes_completed;
+        report_write(0, {});
     } else {
         result_ = Result::Failed;
+        report_write(static_cast<uint32_t>(error_.code), error_.text);
     }
+}
+
+void FoeServer::report_write(uint32_t code, std::string_view text) {
+    if (!write_open_) return;
+    write_open_ = false;
+    if (events_ != nullptr) events_->foe_write(write_name_, write_bytes_, code, text);
 }
 
 void FoeServer::poll(uint64_t now_ns, ecat::MailboxSender& /*out*/) {
@@ -343,19 +356,25 @@ void FoeServer::poll(uint64_t now_ns, ecat::MailboxSender& /*out*/) {
         if (p == FirmwareStore::Progress::Done) {
             result_ = Result::Done;
             ++stats_.writes_completed;
+            report_write(0, {});
         } else if (p == FirmwareStore::Progress::Failed) {
             result_ = Result::Failed;
+            report_write(static_cast<uint32_t>(error_.code), error_.text);
         }
         return;
     }
     if (phase_ != Phase::Idle && now_ns - activity_ns_ > config_.timeout_ns) {
         ++stats_.timeouts;
+        if (phase_ == Phase::Writing) report_write(static_cast<uint32_t>(ErrorCode::NotDefined), "timed out");
         cancel();
     }
 }
 
 void FoeServer::on_state_change(od::AlState /*from*/, od::AlState to) {
     state_ = to;
+    if ((phase_ == Phase::Writing || (phase_ == Phase::Storing && result_ == Result::Running)) &&
+        to != od::AlState::Boot)
+        report_write(static_cast<uint32_t>(ErrorCode::NotDefined), "abandoned: the slave left Bootstrap");
     // A download belongs to Bootstrap; nothing survives the mailbox being stopped.
     if ((phase_ == Phase::Writing || phase_ == Phase::Storing) && to != od::AlState::Boot) cancel();
     if (to == od::AlState::Init) cancel();
@@ -395,6 +414,7 @@ void FoeServer::send_busy(ecat::MailboxSender& out) {
 
 void FoeServer::send_error(ErrorCode code, std::string_view detail, ecat::MailboxSender& out) {
     ++stats_.errors_sent;
+    report_write(static_cast<uint32_t>(code), detail);
     const std::size_t room = out.max_payload() > kFoeHeader ? out.max_payload() - kFoeHeader : 0;
     uint8_t* m = tx_.data();
     m[0] = static_cast<uint8_t>(Opcode::Error);

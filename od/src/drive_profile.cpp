@@ -547,6 +547,21 @@ DeviceDescription default_drive_description() {
         {"DC", "DC-Synchronous (SYNC0)", 0x0300, 1, 0},
     };
     d.eeprom_bytes = 2048;
+    // The four RxPDOs (CSP, CSV, CST, PPM/PVM; 7.2.6-7.2.9) each map the controlword and the mode, so one
+    // of them is assigned at a time, and likewise the four TxPDOs with the statusword (7.2.10-7.2.13).
+    // None is mandatory: 0x1C12/0x1C13 may hold any one of them, or none (count 0, "PDO disabled").
+    // The mappings are writable in Pre-Op, so no PDO is Fixed. See docs/decisions/coe.md.
+    for (const uint16_t base : {uint16_t{0x1600}, uint16_t{0x1A00}})
+        for (uint16_t i = 0; i < 4; ++i) {
+            PdoRule rule;
+            rule.pdo = static_cast<uint16_t>(base + i);
+            for (uint16_t j = 0; j < 4; ++j)
+                if (j != i) rule.exclude.push_back(static_cast<uint16_t>(base + j));
+            d.pdo_rules.push_back(std::move(rule));
+        }
+    // A request leaves SM0 at the next poll; the slowest answer is a 0x1010 save (file write and fsync).
+    d.mailbox_request_timeout_ms = 100;
+    d.mailbox_response_timeout_ms = 2000;
     return d;
 }
 
@@ -564,10 +579,11 @@ void place_sync_managers(DeviceDescription& d) {
     const auto rx_bytes = static_cast<uint16_t>((default_pdo_bits(0x1600) + 7) / 8);
     const auto tx_bytes = static_cast<uint16_t>((default_pdo_bits(0x1A00) + 7) / 8);
     d.sync_managers = {
-        {SmKind::MBoxOut, m.out_start, m.out_size, 0x26, true},
-        {SmKind::MBoxIn, m.in_start, m.in_size, 0x22, true},
-        {SmKind::Outputs, static_cast<uint16_t>(sm2), rx_bytes, 0x64, true},
-        {SmKind::Inputs, static_cast<uint16_t>(sm3), tx_bytes, 0x20, true},
+        // A mailbox SyncManager must have exactly the mailbox's size (ecat/ checks it on Init -> Pre-Op).
+        {SmKind::MBoxOut, m.out_start, m.out_size, 0x26, true, m.out_size, m.out_size},
+        {SmKind::MBoxIn, m.in_start, m.in_size, 0x22, true, m.in_size, m.in_size},
+        {SmKind::Outputs, static_cast<uint16_t>(sm2), rx_bytes, 0x64, true, 0, kMaxPdoBytes},
+        {SmKind::Inputs, static_cast<uint16_t>(sm3), tx_bytes, 0x20, true, 0, kMaxPdoBytes},
     };
 }
 

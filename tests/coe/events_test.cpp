@@ -89,3 +89,17 @@ TEST(EventsWithoutHistory, EmergenciesOnly) {
 }
 
 }  // namespace
+
+TEST_F(Events, TextsWithAnIdAreStoredByIdWithoutTheText) {
+    events.set_text_ids(
+        [](std::string_view text) -> uint16_t { return text == "Homing attained" ? 0x8011 : 0; });
+    events.diag(coe::DiagType::Info, 0, "Homing attained");
+    events.diag(coe::DiagType::Warning, 0x8A80, "Negative limit");  // no id: the text as before
+    Bytes i = message(6);
+    EXPECT_EQ(le32(i, 0), coe::EventReporter::kManufacturerDiagCode);
+    EXPECT_EQ(le16(i, 4), 0x0000u);  // info, no parameter
+    EXPECT_EQ(le16(i, 6), 0x8011u);  // text id
+    Bytes w = message(7);
+    EXPECT_EQ(le16(w, 4), 0x0101u);
+    EXPECT_EQ(le16(w, 6), 0u);
+}

@@ -4,6 +4,7 @@
 #include "coe/pdo_validation.hpp"
 #include "coe/sdo_server.hpp"
 #include "coe_test_support.hpp"
+#include "od/drive_profile.hpp"
 
 using namespace coe_test;
 
@@ -127,3 +128,67 @@ TEST(PdoMappingEntry, Checks) {
 }
 
 }  // namespace
+
+// The drive's PDO rules (od::default_drive_description().pdo_rules, the ESI's Exclude): one RxPDO and one
+// TxPDO at a time, since each maps the controlword / statusword and the mode.
+class DrivePdoRules : public ::testing::Test {
+  protected:
+    od::DeviceDescription desc = od::default_drive_description();
+    od::Dictionary dict = od::make_drive_dictionary(desc);
+    coe::CoeServer server{dict, [] { return od::AlState::PreOp; }};
+    RecordingSender out;
+
+    void SetUp() override { coe::install_pdo_validators(dict, {}, desc.pdo_rules); }
+
+    uint32_t write(uint16_t index, uint8_t sub, uint32_t value, uint8_t bytes) {
+        static const uint8_t cmd[] = {0, 0x2F, 0x2B, 0x27, 0x23};
+        server.handle(sdo(cmd[bytes], index, sub, value), out);
+        EXPECT_EQ(out.messages.size(), 1u);
+        Bytes r = out.take().payload;
+        return r[2] == 0x80 ? le32(r, 6) : 0;
+    }
+};
+
+TEST_F(DrivePdoRules, TwoRxPdosThatExcludeEachOtherAreRefusedWithIncompatible) {
+    // 0x1C12 = {0x1600, 0x1601}: the controlword twice (42 output bytes). The declared default of :02 is
+    // 0x1601, so writing the count alone tries exactly that.
+    EXPECT_EQ(write(0x1C12, 0, 2, 1), 0x06040043u);
+    EXPECT_EQ(dict.get<uint8_t>(0x1C12, 0), 1u);  // unchanged
+    EXPECT_EQ(write(0x1C12, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1C12, 1, 0x1602, 2), 0u);
+    EXPECT_EQ(write(0x1C12, 2, 0x1603, 2), 0u);  // beyond the count: not in force yet
+    EXPECT_EQ(write(0x1C12, 0, 2, 1), 0x06040043u);
+    EXPECT_EQ(write(0x1C12, 0, 1, 1), 0u);
+    // Within the count, an entry replaces the PDO in force: still one PDO, accepted.
+    EXPECT_EQ(write(0x1C12, 1, 0x1601, 2), 0u);
+    EXPECT_EQ(dict.get<uint16_t>(0x1C12, 1), 0x1601u);
+}
+
+TEST_F(DrivePdoRules, TxPdosFollowTheSameRule) {
+    EXPECT_EQ(write(0x1C13, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1C13, 1, 0x1A00, 2), 0u);
+    EXPECT_EQ(write(0x1C13, 2, 0x1A03, 2), 0u);
+    EXPECT_EQ(write(0x1C13, 0, 2, 1), 0x06040043u);
+    EXPECT_EQ(write(0x1C13, 0, 1, 1), 0u);
+    // Count 0 (PDO disabled) is allowed: no PDO of the drive is Mandatory.
+    EXPECT_EQ(write(0x1C13, 0, 0, 1), 0u);
+}
+
+TEST(PdoRules, MandatoryAndExcludeChecks) {
+    std::vector<od::PdoRule> rules(3);
+    rules[0].pdo = 0x1600;
+    rules[0].mandatory = true;
+    rules[1].pdo = 0x1601;
+    rules[1].exclude = {0x1602};
+    rules[2].pdo = 0x1A00;
+    rules[2].mandatory = true;
+    const std::vector<uint16_t> ok{0x1600, 0x1601}, no_mandatory{0x1601}, excluded{0x1600, 0x1602, 0x1601};
+    EXPECT_EQ(coe::check_pdo_rules(0x1C12, ok, rules), od::Status::Ok);
+    EXPECT_EQ(coe::check_pdo_rules(0x1C12, no_mandatory, rules), od::Status::Incompatible);
+    EXPECT_EQ(coe::check_pdo_rules(0x1C12, {}, rules), od::Status::Incompatible);
+    EXPECT_EQ(coe::check_pdo_rules(0x1C12, excluded, rules), od::Status::Incompatible);
+    // 0x1C13's rules do not apply to 0x1C12 and the other way round.
+    const std::vector<uint16_t> tx{0x1A00};
+    EXPECT_EQ(coe::check_pdo_rules(0x1C13, tx, rules), od::Status::Ok);
+    EXPECT_EQ(coe::check_pdo_rules(0x1C13, {}, rules), od::Status::Incompatible);
+}

@@ -24,6 +24,9 @@
 #include "master/session.hpp"
 #include "od/drive_profile.hpp"
 #include "softdrive/device.hpp"
+#include "softdrive/eeprom_writes.hpp"
+#include "softdrive/firmware.hpp"
+#include "softslave/log.hpp"
 
 #include "../support/wire_link.hpp"
 
@@ -564,4 +567,98 @@ TEST_F(DeviceTest, LeavingOpOnRequestReactsOnlyWhileTheDriveIsEnabled) {
     drive.idle(300'000'000);
     EXPECT_EQ(drive.dict().get<uint16_t>(0x603F, 0), 0x8180);
     EXPECT_EQ(drive.dict().get<uint16_t>(0x6041, 0) & 0x004F, 0x0008);
+}
+
+// ---- What the device tells (softdrive::DeviceOptions::events) -------------------------------------------
+
+TEST_F(DeviceTest, StateChangesRefusalsSavesFaultsAndRestartsAreLoggedAndStatisticsSpanRestarts) {
+    std::ostringstream lines;
+    softslave::Log log(lines, softslave::LogLevel::Info);
+    drive.options.events = &log;
+    drive.power_on();
+    ASSERT_NO_FATAL_FAILURE(to_preop());
+    EXPECT_NE(lines.str().find("ecat-slave: AL state Init -> Pre-Op\n"), std::string::npos) << lines.str();
+
+    AlStatus st;
+    EXPECT_NE(m.request_state(a, AlState::Op, &st), Error::Ok);  // Pre-Op -> Op skips Safe-Op
+    EXPECT_NE(lines.str().find("ecat-slave: warning: refused AL state request Pre-Op -> Op: AL status code "
+                               "0x0011 (Invalid requested state change)"),
+              std::string::npos)
+        << lines.str();
+    ASSERT_EQ(m.request_state(a, AlState::PreOp, &st), Error::Ok);  // acknowledges the error
+
+    const uint8_t save[4] = {'s', 'a', 'v', 'e'};
+    ASSERT_EQ(sdo.download(0x1010, 1, save), Error::Ok) << std::hex << sdo.last_abort();
+    EXPECT_NE(lines.str().find("stored parameters saved (0x1010:1 "), std::string::npos) << lines.str();
+
+    drive.dev->raise(0x8611, 0x20, {});
+    EXPECT_NE(lines.str().find("ecat-slave: error: drive fault 0x8611: "), std::string::npos) << lines.str();
+
+    // Bootstrap and back: the firmware restarts; the statistics keep the first instance's transitions.
+    ASSERT_EQ(m.request_state(a, AlState::Init, &st), Error::Ok);
+    Mailbox boot(m, a);
+    ASSERT_EQ(boot.configure_from_sii(true), Error::Ok);
+    ASSERT_EQ(m.request_state(a, AlState::Boot, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
+    const uint64_t before = drive.dev->stack().stats().transitions;  // I->P, P->I, I->B
+    ASSERT_EQ(m.request_state(a, AlState::Init, &st), Error::Ok);
+    ASSERT_EQ(drive.dev->stats().builds, 2u);
+    EXPECT_NE(lines.str().find("ecat-slave: firmware restarted (Bootstrap -> Init)"), std::string::npos)
+        << lines.str();
+    ASSERT_NO_FATAL_FAILURE(to_preop());
+    EXPECT_EQ(drive.dev->stack().stats().transitions, 1u);              // the new instance: I->P
+    EXPECT_EQ(drive.dev->stack_stats().transitions, before + 1u + 1u);  // + B->I of the old one
+    EXPECT_GE(drive.dev->stack_stats().refused, 1u);                    // the refused P->O of the old one
+
+    // --quiet: nothing but errors.
+    log.set_level(softslave::LogLevel::Error);
+    const std::size_t size = lines.str().size();
+    ASSERT_EQ(m.request_state(a, AlState::Init, &st), Error::Ok);
+    EXPECT_EQ(lines.str().size(), size) << lines.str();
+}
+
+TEST_F(DeviceTest, MasterWrittenSiiWordsAreAnnouncedWithTheWayBack) {
+    softdrive::EepromWrites writes(dir);
+    writes.record(4, 0x0042);  // station alias
+    writes.record(8, 0x0002);  // vendor id, low word
+    ASSERT_EQ(writes.save(), "");
+    std::ostringstream lines;
+    softslave::Log log(lines, softslave::LogLevel::Warn);
+    drive.options.events = &log;
+    drive.power_on();
+    const std::string out = lines.str();
+    EXPECT_NE(out.find("2 word(s) a master wrote into the EEPROM, kept in " +
+                       (dir / softdrive::EepromWrites::kFileName).string()),
+              std::string::npos)
+        << out;
+    EXPECT_NE(out.find("--reset-sii"), std::string::npos) << out;
+    EXPECT_NE(out.find("SII vendor id 0x00000002 differs from 0x1018:01 0x000000FB"), std::string::npos)
+        << out;
+    EXPECT_NE(out.find("SII checksum (word 7)"), std::string::npos) << out;  // word 4 changed, word 7 not
+}
+
+TEST(SiiDrift, ChecksumAndIdentityAgainst1018) {
+    const auto dir = temp_dir();
+    softdrive::DeviceOptions o;
+    o.state_dir = dir;
+    std::vector<uint8_t> sii = softdrive::make_sii(o);
+    const od::Identity id = softdrive::make_description(o).identity;
+    auto drift = [&](const std::vector<uint8_t>& image) {
+        return softdrive::sii_drift(image, id.vendor_id, id.product_code, id.revision, id.serial_number);
+    };
+    EXPECT_TRUE(drift(sii).empty());
+    auto other = sii;
+    other[0x14] ^= 0x01;  // product code
+    auto d = drift(other);
+    ASSERT_EQ(d.size(), 1u);
+    EXPECT_NE(d[0].find("product code"), std::string::npos);
+    EXPECT_NE(d[0].find("0x1018:02"), std::string::npos);
+    other = sii;
+    other[14] ^= 0xFF;  // checksum
+    d = drift(other);
+    ASSERT_EQ(d.size(), 1u);
+    EXPECT_NE(d[0].find("checksum"), std::string::npos);
+    d = drift(std::vector<uint8_t>(sii.begin(), sii.begin() + 16));
+    ASSERT_EQ(d.size(), 1u);
+    EXPECT_NE(d[0].find("too short"), std::string::npos);
+    std::filesystem::remove_all(dir);
 }

@@ -560,3 +560,49 @@ TEST_F(FoeServerTest, DisturbedDownloadsNeverLeaveAHalfImage) {
     for (const auto& f : std::filesystem::directory_iterator(dir.path))
         EXPECT_NE(f.path().extension(), ".tmp");
 }
+
+// The end of every file write goes to the event sink once: stored (error 0) or the FoE error and its text.
+struct FoeEvents : ecat::EventSink {
+    struct Call {
+        std::string name;
+        uint64_t bytes;
+        uint32_t code;
+        std::string text;
+    };
+    std::vector<Call> calls;
+    void foe_write(std::string_view name, uint64_t bytes, uint32_t code, std::string_view text) override {
+        calls.push_back({std::string(name), bytes, code, std::string(text)});
+    }
+};
+
+TEST_F(FoeServerTest, EveryWriteEndIsReportedOnceWithNameSizeAndResult) {
+    FoeEvents events;
+    server.set_event_sink(&events);
+    const auto image = image_v(0x01300000, 3000);
+    ASSERT_TRUE(is_ack(download(image), static_cast<uint32_t>(image.size() / kChunk + 1)));
+    ASSERT_EQ(events.calls.size(), 1u);
+    EXPECT_EQ(events.calls[0].name, "MAXPOS");
+    EXPECT_EQ(events.calls[0].bytes, image.size());
+    EXPECT_EQ(events.calls[0].code, 0u);
+
+    // A name the device does not take: refused at the request.
+    EXPECT_EQ(error_code(exchange(request(Opcode::Write, 0, "other.bin"))), 0x8001u);
+    ASSERT_EQ(events.calls.size(), 2u);
+    EXPECT_EQ(events.calls[1].name, "other.bin");
+    EXPECT_EQ(events.calls[1].code, 0x8001u);
+    EXPECT_EQ(events.calls[1].bytes, 0u);
+
+    // Abandoned half-way by leaving Bootstrap.
+    ASSERT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS")), 0));
+    ASSERT_TRUE(is_ack(exchange(data(1, {image.data(), kChunk})), 1));
+    server.on_state_change(od::AlState::Boot, od::AlState::Init);
+    ASSERT_EQ(events.calls.size(), 3u);
+    EXPECT_EQ(events.calls[2].bytes, kChunk);
+    EXPECT_NE(events.calls[2].code, 0u);
+    EXPECT_NE(events.calls[2].text.find("Bootstrap"), std::string::npos);
+
+    // Reads are not writes: nothing reported.
+    server.on_state_change(od::AlState::Init, od::AlState::PreOp);
+    EXPECT_EQ(upload("MAXPOS"), image);
+    EXPECT_EQ(events.calls.size(), 3u);
+}

@@ -61,8 +61,8 @@ TEST(DiagDecode, ManufacturerMessageTakesItsTextFromTheAsciiParameter) {
     EXPECT_EQ(e->type, 1);
     EXPECT_TRUE(e->local_time);
     EXPECT_EQ(master::diag_text(*e), "hello");
-    EXPECT_EQ(master::format_diag_line(*e),
-              ":06  0.000000005 s (local)  warning  0x0000e000  hello  [\"hello\"]");
+    // The text once, not again as a parameter.
+    EXPECT_EQ(master::format_diag_line(*e), ":06  0.000000005 s (local)  warning  0x0000e000  hello");
 }
 
 TEST(DiagDecode, ValueParametersOfCoeDataTypes) {
@@ -76,6 +76,39 @@ TEST(DiagDecode, ValueParametersOfCoeDataTypes) {
     EXPECT_EQ(master::format_diag_param(e->params[1]), "-2");
     EXPECT_EQ(master::format_diag_param(e->params[2]), "0x07 (7)");
     EXPECT_EQ(master::diag_text(*e), "text id 0x0042");
+    // With the device's texts (its ESI DiagMessages), the whole text.
+    auto texts = [](uint16_t id) -> std::string_view { return id == 0x0042 ? "Homing attained" : ""; };
+    EXPECT_EQ(master::diag_text(*e, nullptr, texts), "Homing attained");
+    EXPECT_NE(master::format_diag_line(*e, nullptr, texts).find("Homing attained  [0x1234"),
+              std::string::npos);
+}
+
+TEST(DiagDecode, ATextIdAboutAnErrorShowsTheTextThenTheErrorName) {
+    auto b = message(0x8611E800, 0x0001, 0x8020, 9, {});  // warning, no parameter, text id 0x8020
+    auto e = master::decode_diag_message(b, 6);
+    ASSERT_TRUE(e);
+    auto names = [](uint16_t code) -> std::string_view { return code == 0x8611 ? "Following error" : ""; };
+    auto texts = [](uint16_t id) -> std::string_view {
+        return id == 0x8020 ? "Fault reset refused: cause still present" : "";
+    };
+    EXPECT_EQ(master::diag_text(*e, names, texts),
+              "Fault reset refused: cause still present (Following error)");
+    EXPECT_EQ(master::diag_text(*e, names), "Following error");  // without the texts: the error's name
+}
+
+TEST(DiagDecode, AWarningNamedByItsCodeDoesNotRepeatItsCutText) {
+    // What the drive stores for a warning: diag code from the error code, the name cut to 14 characters.
+    std::vector<uint8_t> p{0x0E, 0x20};
+    for (char c : std::string("Negative limit"))
+        p.push_back(static_cast<uint8_t>(c));
+    auto b = message(0x8A80E800, 0x0101, 0, 7, p);
+    auto e = master::decode_diag_message(b, 8);
+    ASSERT_TRUE(e);
+    auto names = [](uint16_t code) -> std::string_view {
+        return code == 0x8A80 ? "Negative limit switch" : "";
+    };
+    EXPECT_EQ(master::format_diag_line(*e, names),
+              ":08  0.000000007 s  warning  0x8a80e800  Negative limit switch");
 }
 
 TEST(DiagDecode, ShortAndCutMessages) {

@@ -1,6 +1,7 @@
 // drive-sim: runs the CiA 402 drive (drive::Drive on the real drive dictionary) without EtherCAT through a
 // scripted motion, records set-point, actual position, velocity, current and following error to CSV, and
-// renders a PNG with gnuplot. `--bench` prints the cost of one drive cycle per axis (median, p99).
+// renders a PNG with gnuplot (plot.hpp: panels on one time axis, mode and CiA 402 state strips, events).
+// `--bench` prints the cost of one drive cycle per axis (median, p99).
 //
 // Script: one command per line, `#` starts a comment. Times in ms of simulated time.
 //   at <ms> mode <1|3|6|8|9|10>         0x6060
@@ -25,6 +26,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -35,6 +37,7 @@
 #include "drive/drive.hpp"
 #include "drive/profile.hpp"
 #include "od/drive_profile.hpp"
+#include "plot.hpp"
 
 namespace {
 
@@ -142,14 +145,7 @@ bool write_object(od::Dictionary& d, const std::string& spec, const std::string&
     return true;
 }
 
-struct Sample {
-    double t_ms;
-    double setpoint;
-    int32_t demand, actual, velocity, velocity_demand, following_error;
-    int16_t current;
-    uint16_t statusword;
-    int8_t mode;
-};
+using drivesim::Sample;
 
 class Sim {
   public:
@@ -269,7 +265,9 @@ class Sim {
                 dict_.get<int32_t>(0x60F4, 0),
                 dict_.get<int16_t>(0x6078, 0),
                 dict_.get<uint16_t>(0x6041, 0),
-                dict_.get<int8_t>(0x6061, 0)};
+                dict_.get<int8_t>(0x6061, 0),
+                dict_.get<uint32_t>(0x60FD, 0),
+                dict_.get<uint16_t>(0x603F, 0)};
     }
     drive::Drive& drive() { return drive_; }
     od::Dictionary& dict() { return dict_; }
@@ -287,42 +285,12 @@ class Sim {
     bool reset_pending_ = false;
 };
 
-bool write_csv(const std::string& path, const std::vector<Sample>& s) {
-    std::ofstream f(path);
-    if (!f) return false;
-    f << "t_ms,setpoint,position_demand,position_actual,velocity_actual_rpm,velocity_demand_rpm,current_ma,"
-         "following_error,statusword,mode\n";
-    for (const Sample& x : s)
-        f << x.t_ms << ',' << x.setpoint << ',' << x.demand << ',' << x.actual << ',' << x.velocity << ','
-          << x.velocity_demand << ',' << x.current << ',' << x.following_error << ",0x" << std::hex
-          << x.statusword << std::dec << ',' << static_cast<int>(x.mode) << '\n';
-    return static_cast<bool>(f);
-}
-
-bool render_png(const std::string& csv, const std::string& png, std::string& err) {
+bool render_png(const std::string& csv, const std::string& png, const std::string& title, double end_ms,
+                const std::vector<drivesim::Event>& events, std::string& err) {
     const std::string gp = png + ".gp";
     {
         std::ofstream f(gp);
-        f << "set datafile separator ','\n"
-             "set terminal pngcairo size 1200,1000 noenhanced\n"
-             "set output '"
-          << png
-          << "'\n"
-             "set multiplot layout 4,1 title 'drive-sim'\n"
-             "set grid\nset key outside right\nset xlabel 't [ms]'\n"
-             "set ylabel 'position [inc]'\n"
-             "plot '"
-          << csv
-          << "' using 1:3 with lines title 'demand 0x6062', '' using 1:4 with lines title "
-             "'actual 0x6064'\n"
-             "set ylabel 'velocity [rpm]'\n"
-             "plot '' using 1:6 with lines title 'demand 0x606B', '' using 1:5 with lines title 'actual "
-             "0x606C'\n"
-             "set ylabel 'current [mA]'\n"
-             "plot '' using 1:7 with lines title 'actual 0x6078'\n"
-             "set ylabel 'following error [inc]'\n"
-             "plot '' using 1:8 with lines title '0x60F4'\n"
-             "unset multiplot\n";
+        f << drivesim::gnuplot_script(csv, png, title, end_ms, events);
         if (!f) return err = "cannot write " + gp, false;
     }
     const pid_t pid = fork();
@@ -455,7 +423,7 @@ int main(int argc, char** argv) {
         sim.cycle(t, dt_ns);
         samples.push_back(sim.sample(t_ms));
     }
-    if (!write_csv(csv_path, samples)) {
+    if (!drivesim::write_csv(csv_path, samples)) {
         std::cerr << "drive-sim: cannot write " << csv_path << "\n";
         return 1;
     }
@@ -465,7 +433,13 @@ int main(int argc, char** argv) {
                 sim.dict().get<uint16_t>(0x603F, 0));
     if (png_path.empty()) png_path = csv_path + ".png";
     if (png_path != "-") {
-        if (!render_png(csv_path, png_path, err)) {
+        const std::string name = script_path.empty() ? std::string("built-in demo")
+                                                     : std::filesystem::path(script_path).filename().string();
+        char cycle[32];
+        std::snprintf(cycle, sizeof cycle, "%g", cycle_us);
+        const std::vector<drivesim::Event> events = drivesim::find_events(samples);
+        if (!render_png(csv_path, png_path, "drive-sim: " + name + " (" + cycle + " us cycle)", sc.end_ms,
+                        events, err)) {
             std::cerr << "drive-sim: " << err << "\n";
             return 1;
         }

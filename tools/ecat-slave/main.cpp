@@ -8,6 +8,7 @@
 #include "esc/link.hpp"
 #include "od/device_config.hpp"
 #include "softdrive/firmware.hpp"
+#include "softslave/log.hpp"
 #include "softslave/slave.hpp"
 
 namespace {
@@ -95,7 +96,20 @@ int main(int argc, char** argv) {
     app.add_flag("--busy-poll", options.busy_poll,
                  "Never sleep: poll the network and the clock in a loop (one CPU fully busy; use with --cpu)")
         ->excludes(spin);
-    app.add_flag("--verbose,-v", options.verbose, "Print statistics at exit");
+    app.add_flag("--verbose,-v", options.verbose,
+                 "Print statistics at exit (of the whole run, across restarts)");
+    bool quiet = false, reset_sii = false;
+    std::string log_level = "info";
+    auto* quiet_flag = app.add_flag("--quiet,-q", quiet, "Log errors only (same as --log-level error)");
+    app.add_option("--log-level", log_level,
+                   "Events logged on stderr, one line each: error, warn, info (default: state changes, FoE "
+                   "writes, restarts, parameter saves) or debug (also the drive's own state changes)")
+        ->check(CLI::IsMember({"error", "warn", "warning", "info", "debug"}))
+        ->excludes(quiet_flag);
+    app.add_flag(
+        "--reset-sii", reset_sii,
+        "Forget the SII words a master wrote into the EEPROM (kept in the state directory) and serve "
+        "the SII generated from the object model");
     app.add_option("--stats-file", options.stats_file,
                    "Write the statistics as 'name value' lines to this file at exit");
     try {
@@ -116,6 +130,17 @@ int main(int argc, char** argv) {
     if (auto* config = app.get_config_ptr(); config != nullptr && config->count() > 0)
         device.config_file = config->as<std::string>();
     device.state_dir = state_dir;
+    softslave::Log log(std::cerr, quiet ? softslave::LogLevel::Error : *softslave::parse_log_level(log_level),
+                       softslave::stderr_is_terminal());
+    device.events = &log;
+    if (reset_sii) {
+        const std::filesystem::path writes = device.state_dir / softdrive::EepromWrites::kFileName;
+        std::error_code ec;
+        if (std::filesystem::remove(writes, ec))
+            log.info("removed " + writes.string() + ": serving the SII generated from the object model");
+        else if (ec)
+            log.warn("cannot remove " + writes.string() + ": " + ec.message());
+    }
     if (!control.empty()) {
         const std::filesystem::path parent = std::filesystem::absolute(control).parent_path();
         std::error_code ec;

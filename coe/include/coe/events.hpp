@@ -29,6 +29,12 @@ class EventReporter {
     // history may be null (no 0x10F3); clock may be empty (time stamp 0, flagged as local time).
     EventReporter(Emergency& emergency, DiagnosisHistory* history, std::function<uint64_t()> clock = {});
 
+    // Text ids (ETG.1020) of the device's diagnosis texts (e.g. od::diag_text_id): a diag() whose text has
+    // an id (not 0) is stored with that id and without the text parameter, so the master shows the whole
+    // text from the ESI's DiagMessages instead of what fits into one message. A plain function: no state.
+    using TextIdLookup = uint16_t (*)(std::string_view text);
+    void set_text_ids(TextIdLookup lookup) { text_ids_ = lookup; }
+
     void raise(uint16_t error_code, uint8_t error_register, std::span<const uint8_t> mfr);
     void clear(uint16_t error_code, uint8_t error_register);
     void diag(DiagType type, uint16_t code, std::string_view text);
@@ -36,14 +42,15 @@ class EventReporter {
     std::size_t active() const { return active_count_; }
 
   private:
-    void record(uint32_t diag_code, DiagType type, std::span<const DiagParam> params,
-                bool may_send_emergency);
+    void record(uint32_t diag_code, DiagType type, std::span<const DiagParam> params, bool may_send_emergency,
+                uint16_t text_id = 0);
 
     Emergency& emergency_;
     DiagnosisHistory* history_;
     std::function<uint64_t()> clock_;
     std::array<uint16_t, kMaxActive> active_{};
     std::size_t active_count_ = 0;
+    TextIdLookup text_ids_ = nullptr;
 };
 
 }  // namespace coe

@@ -6,6 +6,9 @@
 #include <cstddef>
 #include <cstdint>
 
+#include <span>
+
+#include "od/device.hpp"
 #include "od/dictionary.hpp"
 
 namespace coe {
@@ -26,5 +29,14 @@ std::size_t mapped_bits(const od::Dictionary& dict, uint16_t pdo);
 // Installs the validators on every mapping object present and on 0x1C12/0x1C13. The validators keep a
 // pointer to dict: install after the dictionary has reached its final place.
 void install_pdo_validators(od::Dictionary& dict, PdoLimits limits = {});
+// The same, and the assignments also keep the ESI's PDO rules (od::DeviceDescription::pdo_rules): a count
+// written to 0x1C12/0x1C13 (or an entry within the count) that would assign two PDOs one of which Excludes
+// the other, or leave out a Mandatory PDO of that SyncManager, is refused with
+// Incompatible (0x06040043, "general parameter incompatibility"; docs/decisions/coe.md). The rules are
+// copied.
+void install_pdo_validators(od::Dictionary& dict, PdoLimits limits, std::span<const od::PdoRule> rules);
+// The rule check alone: Ok, or Incompatible for the PDOs `assigned` to SyncManager assignment `assign`.
+od::Status check_pdo_rules(uint16_t assign, std::span<const uint16_t> assigned,
+                           std::span<const od::PdoRule> rules);
 
 }  // namespace coe

@@ -36,6 +36,15 @@ class LatencyHistogram {
         if (ns > max_) max_ = ns;
     }
     void clear() { *this = LatencyHistogram{}; }
+    // Adds every sample of another histogram (statistics of a whole run across firmware restarts).
+    void merge(const LatencyHistogram& o) {
+        for (std::size_t i = 0; i < bins_.size(); ++i)
+            bins_[i] += o.bins_[i];
+        count_ += o.count_;
+        sum_ += o.sum_;
+        if (o.count_ != 0 && o.min_ < min_) min_ = o.min_;
+        if (o.max_ > max_) max_ = o.max_;
+    }
 
     uint64_t count() const { return count_; }
     uint64_t min_ns() const { return count_ ? min_ : 0; }

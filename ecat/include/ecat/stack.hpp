@@ -15,6 +15,7 @@
 
 #include "ecat/al_status.hpp"
 #include "ecat/application.hpp"
+#include "ecat/event_sink.hpp"
 #include "ecat/latency.hpp"
 #include "ecat/mailbox.hpp"
 #include "ecat/mailbox_handler.hpp"
@@ -45,6 +46,9 @@ struct StackStats {
     // so an ESC that does not latch 0x09F0 leaves this empty rather than wrong.
     LatencyHistogram sm2_latency;
 };
+
+// Adds the counts and latency samples of `more` to `total` (a run's figures over several Stack instances).
+void add_stats(StackStats& total, const StackStats& more);
 
 // The statistics as "stack.<name> <value>" lines (latencies in ns), for logs and benchmark scripts.
 void print_stats(std::ostream& out, const StackStats& stats);
@@ -90,6 +94,8 @@ class Stack {
 
     // How long a Safe-Op -> Op request may wait for the first outputs / the first SYNC0 events.
     void set_op_wait_timeout_ns(uint64_t ns) { op_wait_timeout_ns_ = ns; }
+    // Where state changes, refused requests, local errors and watchdog expiries are reported (null: nowhere).
+    void set_event_sink(EventSink* sink) { events_ = sink; }
     // Housekeeping period for the mailbox handlers' poll() (transfer timeouts).
     static constexpr uint64_t kHousekeepingNs = 10'000'000;
     // AL event mask written at start: AL control, SYNC0, SM activation, PD watchdog, SM0..SM3.
@@ -112,6 +118,7 @@ class Stack {
     void restart_after_esc_reset(uint64_t now_ns);
     void handle_al_control(uint64_t now_ns);
     void request(od::AlState to, uint64_t now_ns);
+    void request_checked(od::AlState to, uint64_t now_ns);  // request() without the refusal report
     uint16_t check_mailbox(const od::MailboxLayout& layout, uint16_t code);
     uint16_t check_bootstrap();
     uint16_t check_pre_op_to_safe_op();
@@ -143,6 +150,7 @@ class Stack {
     od::Dictionary& dict_;
     const od::DeviceDescription& desc_;
     Application& app_;
+    EventSink* events_ = nullptr;
     IrqLine irq_;
     Mailbox mailbox_;
     ProcessData pd_;

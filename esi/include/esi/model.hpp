@@ -31,6 +31,8 @@ struct PdoInfo {
     std::string name;                   // the mapping object's name
     int sm = -1;                        // SyncManager that assigns it by default (0x1C1n), -1 = not assigned
     bool fixed = false;                 // mapping not writable in any state (PdoFixedContent / ESI Fixed)
+    bool mandatory = false;             // od::PdoRule (PdoMandatory / ESI Mandatory)
+    std::vector<uint16_t> exclude;      // od::PdoRule (ESI Exclude)
     std::vector<PdoEntryInfo> entries;  // the default mapping, in order
     uint32_t bit_size() const;
 };
@@ -41,6 +43,8 @@ struct SmInfo {
     uint16_t size = 0;  // mailbox: the mailbox size; process data: bytes of the default mapping
     uint8_t control = 0;
     bool enable = true;
+    uint16_t min_size = 0;  // ESI MinSize/MaxSize (0: not declared)
+    uint16_t max_size = 0;
 };
 
 // ESI Fmmu text / SII FMMU category byte.
@@ -56,6 +60,8 @@ constexpr bool kMailboxDataLinkLayer = true;
 // Device identification in AL status code 0x0134 on AL control bit 5 (ecat/src/stack.cpp).
 // SII General flags bit 3 (IdentALSts), ESI Info/IdentificationReg134.
 constexpr bool kIdentificationInAlStatusCode = true;
+// Segmented SDO transfers (coe/src/sdo_server.cpp, both directions). ESI Mailbox/CoE SegmentedSdo.
+constexpr bool kSegmentedSdo = true;
 constexpr uint8_t kGeneralFlags =
     (kMailboxDataLinkLayer ? 0x04 : 0) | (kIdentificationInAlStatusCode ? 0x08 : 0);
 
@@ -79,6 +85,10 @@ DeviceModel derive_model(const od::DeviceDescription& description, const od::Dic
 // The integral value of a declared number (default/min/max) as raw little-endian bits for an entry of the
 // given type and bit length: reals become their IEEE-754 bits, integers are truncated two's complement.
 std::optional<uint64_t> number_bits(const od::Number& n, od::DataType type, uint16_t bit_length);
+
+// The device's 16x14 picture as a Windows bitmap (24 bits per pixel, bottom-up rows, 726 bytes): what the
+// ESI carries as ImageData16x14 and a configuration tool shows in its tree. Drawn here, not loaded.
+std::vector<uint8_t> device_image_bmp();
 
 // CRC-8 of the SII header (polynomial 0x07, initial 0xFF, MSB first) over the given bytes.
 uint8_t sii_crc8(const uint8_t* data, std::size_t size);

@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "ecat/event_sink.hpp"
 #include "ecat/mailbox_handler.hpp"
 #include "foe/errors.hpp"
 #include "foe/store.hpp"
@@ -67,6 +68,8 @@ class FoeServer final : public ecat::MailboxHandler {
 
     // Sets the AL state without a transition (e.g. a server created while the stack is in Bootstrap).
     void set_state(od::AlState state) { state_ = state; }
+    // Where the end of each file write (stored, or why not) is reported; null: nowhere.
+    void set_event_sink(ecat::EventSink* sink) { events_ = sink; }
     // Ends any transfer (an unfinished download is deleted; a worker commit is stopped after its step).
     void abort_transfer() { cancel(); }
     bool idle() const { return phase_ == Phase::Idle; }
@@ -93,6 +96,7 @@ class FoeServer final : public ecat::MailboxHandler {
     void reap_commit();
     std::size_t full_data_size(const ecat::MailboxSender& out) const;
     bool writable(std::string_view name) const;
+    void report_write(uint32_t code, std::string_view text);  // once per write, if one is open
 
     FirmwareStore& store_;
     ServerConfig config_;
@@ -116,6 +120,10 @@ class FoeServer final : public ecat::MailboxHandler {
 
     std::vector<uint8_t> tx_;
     ServerStats stats_;
+    ecat::EventSink* events_ = nullptr;
+    std::string write_name_;  // the file of the write being reported
+    uint64_t write_bytes_ = 0;
+    bool write_open_ = false;  // a write request was seen and its end not yet reported
 
     // Commit on a worker thread (commit_in_thread): 0 running, 1 done, 2 failed.
     std::thread worker_;

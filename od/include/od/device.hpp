@@ -56,6 +56,21 @@ struct SyncManagerDefault {
     uint16_t default_size = 0;  // process-data SMs: size of the default mapping
     uint8_t control = 0;        // 0x0804 control byte
     bool enable = true;
+    // Lengths the device accepts for this SyncManager (ESI Sm MinSize/MaxSize; 0: not declared). Mailbox:
+    // the one mailbox size the state machine checks; process data: 0 .. the room left for the largest PDO
+    // set.
+    uint16_t min_size = 0;
+    uint16_t max_size = 0;
+};
+
+// What the ESI says about one PDO besides its mapping (ETG.2000 RxPdo/TxPdo): Mandatory (the master must
+// assign it to its SyncManager) and Exclude (PDOs that must not be assigned together with it). Fixed comes
+// from the mapping object's access (not writable in any state). The SDO server refuses a 0x1C12/0x1C13
+// assignment that breaks these (coe::install_pdo_validators), so the ESI and the slave cannot disagree.
+struct PdoRule {
+    uint16_t pdo = 0;  // 0x1600.. / 0x1A00..
+    bool mandatory = false;
+    std::vector<uint16_t> exclude;
 };
 
 struct DcOpMode {
@@ -83,6 +98,11 @@ struct DeviceDescription {
         0xCC00;  // SII word 1: 0x0151 = 0xCC, SYNC0/SYNC1 driven and mapped to AL event bits 2/3 (as EJ7211)
     uint16_t sync_pulse_length = 1000;  // SII word 2, 10 ns units
     uint16_t station_alias = 0;         // SII word 4
+    std::vector<PdoRule> pdo_rules;     // Mandatory / Exclude of the PDOs (empty: none)
+    // Mailbox timeouts a master should use with this device (ESI Info/Mailbox/Timeout, ms): how long the
+    // slave may take to take a request out of SM0 and to answer it (0: not declared).
+    uint32_t mailbox_request_timeout_ms = 0;
+    uint32_t mailbox_response_timeout_ms = 0;
 };
 
 }  // namespace od

@@ -3,17 +3,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <stdexcept>
 #include <system_error>
 
 #include "coe/events.hpp"
 #include "coe/pdo_validation.hpp"
+#include "drive/errors.hpp"
+#include "ecat/al_status.hpp"
 #include "esi/esi.hpp"
 #include "esi/sii.hpp"
 #include "foe/firmware.hpp"
 #include "foe/image.hpp"
 #include "od/device_config.hpp"
+#include "od/diag_texts.hpp"
 #include "od/drive_profile.hpp"
 
 namespace softdrive {
@@ -95,6 +99,20 @@ Device::Device(esc::Esc& esc, DeviceOptions options)
                   << "); serving the SII as built\n";
     }
     build();
+    if (options_.load_sii && !eeprom_writes_.empty()) {
+        // The SII served is not the generated one: say so, and how to go back (docs/decisions/device.md).
+        event(softslave::LogLevel::Warn, "the SII served carries " + std::to_string(eeprom_writes_.size()) +
+                                             " word(s) a master wrote into the EEPROM, kept in " +
+                                             eeprom_writes_.file().string() +
+                                             "; delete that file (or start with --reset-sii) to serve the "
+                                             "SII generated from the object model");
+        std::vector<uint8_t> image = esi::build_sii(parts_->desc, parts_->dict);
+        eeprom_writes_.apply(image);
+        const od::Identity& id = parts_->desc.identity;
+        for (const std::string& d :
+             sii_drift(image, id.vendor_id, id.product_code, id.revision, id.serial_number))
+            event(softslave::LogLevel::Warn, "the SII served: " + d);
+    }
     // Registered once the device exists: a constructor that throws leaves no callback behind.
     if (options_.load_sii)
         esc_.on_eeprom_write([this](uint16_t address, uint16_t value) {
@@ -114,6 +132,95 @@ void Device::save_eeprom_writes() {
     eeprom_save_ns_ = 0;
     if (const std::string error = eeprom_writes_.save(); !error.empty())
         log() << "softdrive: the EEPROM content the master wrote is not kept: " << error << '\n';
+}
+
+void Device::event(softslave::LogLevel level, const std::string& text) const {
+    if (options_.events != nullptr) options_.events->write(level, text);
+}
+
+ecat::StackStats Device::stack_stats() const {
+    ecat::StackStats total = earlier_stacks_;
+    ecat::add_stats(total, parts_->stack->stats());
+    return total;
+}
+
+namespace {
+
+const char* state_text(od::AlState s) {
+    switch (s) {
+        case od::AlState::Init:
+            return "Init";
+        case od::AlState::PreOp:
+            return "Pre-Op";
+        case od::AlState::Boot:
+            return "Bootstrap";
+        case od::AlState::SafeOp:
+            return "Safe-Op";
+        case od::AlState::Op:
+            return "Op";
+    }
+    return "?";
+}
+
+std::string requested_text(uint8_t requested) {
+    switch (requested) {
+        case 0x01:
+        case 0x02:
+        case 0x03:
+        case 0x04:
+        case 0x08:
+            return state_text(static_cast<od::AlState>(requested));
+        default:
+            return "unknown state " + std::to_string(requested);
+    }
+}
+
+std::string al_code_text(uint16_t code) {
+    char b[16];
+    std::snprintf(b, sizeof b, "0x%04X", static_cast<unsigned>(code));
+    return std::string(b) + " (" + std::string(ecat::al::name(code)) + ")";
+}
+
+std::string hex16(uint16_t v) {
+    char b[8];
+    std::snprintf(b, sizeof b, "0x%04X", static_cast<unsigned>(v));
+    return b;
+}
+
+}  // namespace
+
+// ---- ecat::EventSink --------------------------------------------------------------------------------
+
+void Device::state_changed(od::AlState from, od::AlState to) {
+    event(softslave::LogLevel::Info, std::string("AL state ") + state_text(from) + " -> " + state_text(to));
+}
+
+void Device::state_refused(od::AlState current, uint8_t requested, uint16_t code) {
+    event(softslave::LogLevel::Warn, std::string("refused AL state request ") + state_text(current) + " -> " +
+                                         requested_text(requested) + ": AL status code " +
+                                         al_code_text(code));
+}
+
+void Device::local_error(od::AlState state, uint16_t code) {
+    event(softslave::LogLevel::Warn,
+          std::string("error indication in ") + state_text(state) + ": AL status code " + al_code_text(code));
+}
+
+void Device::watchdog_expired(od::AlState state) {
+    event(softslave::LogLevel::Warn,
+          std::string("process-data watchdog expired in ") + state_text(state) + " (outputs not refreshed)");
+}
+
+void Device::foe_write(std::string_view name, uint64_t bytes, uint32_t error_code,
+                       std::string_view error_text) {
+    std::string line = "FoE write '" + std::string(name) + "', " + std::to_string(bytes) + " bytes: ";
+    if (error_code == 0) {
+        event(softslave::LogLevel::Info, line + "stored");
+        return;
+    }
+    char b[16];
+    std::snprintf(b, sizeof b, "0x%04X", static_cast<unsigned>(error_code));
+    event(softslave::LogLevel::Warn, line + "failed, FoE error " + b + " (" + std::string(error_text) + ")");
 }
 
 std::ostream& Device::log() const {
@@ -138,7 +245,7 @@ void Device::build() {
     p->firmware->apply_to(p->desc.identity);
 
     p->dict = od::make_drive_dictionary(p->desc);
-    coe::install_pdo_validators(p->dict);
+    coe::install_pdo_validators(p->dict, {}, p->desc.pdo_rules);
     if (options_.commission) {
         if (const od::Status s = drive::commission(p->dict); s != od::Status::Ok)
             log() << "softdrive: commissioning the motor parameters failed: " << od::to_string(s) << '\n';
@@ -167,11 +274,24 @@ void Device::build() {
     p->diag = std::make_unique<coe::DiagnosisHistory>(p->dict, &p->coe->emergency());
     p->events = std::make_unique<coe::EventReporter>(p->coe->emergency(), p->diag.get(),
                                                      [this] { return system_time_ns(); });
+    p->events->set_text_ids(&od::diag_text_id);  // the texts the ESI lists as DiagMessages
     p->stack->add_handler(*p->coe);
     p->stack->add_handler(p->firmware->server());
+    p->stack->set_event_sink(this);
+    p->firmware->server().set_event_sink(this);
+    // A master's 0x1010 "save" / 0x1011 "load" that the store carried out (listeners run after the write).
+    p->dict.add_listener(0x1010, [this, raw](const od::Entry& e) {
+        event(softslave::LogLevel::Info, "stored parameters saved (0x1010:" + std::to_string(e.subindex) +
+                                             " " + e.name + ") to " + raw->params->file().string());
+    });
+    p->dict.add_listener(0x1011, [this](const od::Entry& e) {
+        event(softslave::LogLevel::Info, "stored parameters restored to defaults at the next start (0x1011:" +
+                                             std::to_string(e.subindex) + " " + e.name + ")");
+    });
     p->drive = std::make_unique<drive::Drive>(p->dict, this);
 
     if (options_.load_sii) esc_.load_eeprom(image);
+    if (parts_) ecat::add_stats(earlier_stacks_, parts_->stack->stats());
     parts_ = std::move(p);
     restart_pending_ = false;
     outputs_lost_pending_ = false;
@@ -217,8 +337,15 @@ void Device::poll(uint64_t now_ns) {
         restart_pending_ = false;
         try {
             build();
+            const od::Identity& id = parts_->desc.identity;
+            char rev[16];
+            std::snprintf(rev, sizeof rev, "0x%08X", static_cast<unsigned>(id.revision));
+            event(softslave::LogLevel::Info,
+                  std::string("firmware restarted (Bootstrap -> Init): revision ") + rev +
+                      ", software version " + id.software_version);
         } catch (const std::exception& e) {
             log() << "softdrive: restart failed, the running firmware stays: " << e.what() << '\n';
+            event(softslave::LogLevel::Error, std::string("firmware restart failed: ") + e.what());
         }
         parts_->stack->poll(now_ns);
     }
@@ -297,17 +424,30 @@ void Device::on_restart() {
 // ---- drive::EventSink -------------------------------------------------------------------------------
 
 void Device::raise(uint16_t error_code, uint8_t error_register, const std::array<uint8_t, 5>& mfr) {
+    if (options_.events != nullptr && options_.events->enabled(softslave::LogLevel::Error)) {
+        const drive::ErrorInfo* info = drive::find_error(error_code);
+        event(softslave::LogLevel::Error, "drive fault " + hex16(error_code) + ": " +
+                                              (info != nullptr ? std::string(info->name) : "unknown error"));
+    }
     ++stats_.emergencies;
     ++stats_.diagnoses;
     parts_->events->raise(error_code, error_register, mfr);
 }
 
 void Device::clear(uint16_t error_code, uint8_t error_register) {
+    if (options_.events != nullptr && options_.events->enabled(softslave::LogLevel::Debug))
+        event(softslave::LogLevel::Debug, "drive error " + hex16(error_code) + " cleared");
     ++stats_.emergencies;
     parts_->events->clear(error_code, error_register);
 }
 
 void Device::diag(drive::Severity severity, uint16_t code, std::string_view text) {
+    const softslave::LogLevel level = severity == drive::Severity::Error     ? softslave::LogLevel::Error
+                                      : severity == drive::Severity::Warning ? softslave::LogLevel::Warn
+                                                                             : softslave::LogLevel::Debug;
+    if (options_.events != nullptr && options_.events->enabled(level))
+        event(level, std::string("drive") + (code != 0 ? " " + hex16(code) : std::string()) + ": " +
+                         std::string(text));
     ++stats_.diagnoses;
     parts_->events->diag(severity == drive::Severity::Error     ? coe::DiagType::Error
                          : severity == drive::Severity::Warning ? coe::DiagType::Warning

@@ -5,10 +5,12 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 
+#include "esi/model.hpp"
 #include "od/store.hpp"
 
 namespace softdrive {
@@ -105,6 +107,43 @@ void EepromWrites::apply(std::vector<uint8_t>& image) const {
         image[at] = static_cast<uint8_t>(value);
         image[at + 1] = static_cast<uint8_t>(value >> 8);
     }
+}
+
+std::vector<std::string> sii_drift(std::span<const uint8_t> image, uint32_t vendor_id, uint32_t product_code,
+                                   uint32_t revision, uint32_t serial_number) {
+    std::vector<std::string> out;
+    if (image.size() < 32) {
+        out.push_back("the image has " + std::to_string(image.size()) +
+                      " bytes, too short for the SII header and identity (32 bytes)");
+        return out;
+    }
+    auto hex = [](uint32_t v, int digits) {
+        char b[16];
+        std::snprintf(b, sizeof b, "0x%0*X", digits, static_cast<unsigned>(v));
+        return std::string(b);
+    };
+    const uint8_t crc = esi::sii_crc8(image.data(), 14);
+    if (crc != image[14])
+        out.push_back("SII checksum (word 7) is " + hex(image[14], 2) + ", words 0-6 give " + hex(crc, 2) +
+                      " (a master checks it and may refuse the slave)");
+    struct Field {
+        const char* name;
+        std::size_t at;
+        uint32_t model;
+    };
+    const Field fields[] = {{"vendor id", 0x10, vendor_id},
+                            {"product code", 0x14, product_code},
+                            {"revision", 0x18, revision},
+                            {"serial number", 0x1C, serial_number}};
+    int sub = 1;
+    for (const Field& f : fields) {
+        const uint32_t v = get32(image.data() + f.at);
+        if (v != f.model)
+            out.push_back("SII " + std::string(f.name) + " " + hex(v, 8) + " differs from 0x1018:0" +
+                          std::to_string(sub) + " " + hex(f.model, 8));
+        ++sub;
+    }
+    return out;
 }
 
 }  // namespace softdrive

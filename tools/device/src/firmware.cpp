@@ -2,6 +2,8 @@
 #include "softdrive/firmware.hpp"
 
 #include <ostream>
+#include <string>
+#include <vector>
 
 namespace softdrive {
 
@@ -12,7 +14,7 @@ DeviceFirmware::DeviceFirmware(esc::Esc& esc, DeviceOptions options,
 }
 
 void DeviceFirmware::report(std::ostream& out) const {
-    device_.stack().report(out);
+    ecat::print_stats(out, device_.stack_stats());  // every firmware instance of the run, not the last only
     const DeviceStats& s = device_.stats();
     out << "device.builds " << s.builds << '\n'
         << "device.drive_cycles " << s.cycles << '\n'
@@ -31,7 +33,17 @@ softslave::FirmwareFactory firmware_factory(DeviceOptions options, std::filesyst
 
 softslave::EepromLoader eeprom_loader(DeviceOptions options) {
     return [options = std::move(options)](const softslave::SlaveOptions& slave) {
-        if (!slave.eeprom_file.empty()) return softslave::load_eeprom_file(slave);
+        if (!slave.eeprom_file.empty()) {
+            std::vector<uint8_t> image = softslave::load_eeprom_file(slave);
+            // A user's image may say something else than the device answers over CoE (0x1018): warn.
+            if (options.events != nullptr) {
+                const od::Identity id = make_description(options).identity;
+                for (const std::string& d :
+                     sii_drift(image, id.vendor_id, id.product_code, id.revision, id.serial_number))
+                    options.events->warn("--eeprom " + slave.eeprom_file + ": " + d);
+            }
+            return image;
+        }
         return make_sii(options);
     };
 }

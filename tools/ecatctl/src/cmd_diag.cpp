@@ -15,6 +15,7 @@
 #include "master/mailbox.hpp"
 #ifdef ECATCTL_HAVE_DRIVE
 #include "drive/errors.hpp"
+#include "od/diag_texts.hpp"
 #endif
 
 namespace ecatctl {
@@ -38,6 +39,16 @@ std::string_view drive_error_name(uint16_t code) {
     (void)code;
 #endif
     return {};
+}
+
+// The drive's diagnosis texts by id (what its ESI lists as DiagMessages).
+std::string_view drive_text(uint16_t id) {
+#ifdef ECATCTL_HAVE_DRIVE
+    return od::diag_text(id);
+#else
+    (void)id;
+    return {};
+#endif
 }
 
 int report(const master::SdoClient& sdo, Error e, const char* what) {
@@ -131,7 +142,7 @@ int run_diag(master::Master& m, const DiagArgs& d) {
         }
         auto e = master::decode_diag_message(std::span<const uint8_t>(msg.data(), *n), sub);
         if (!e) continue;  // an empty slot of a ring not yet full
-        std::printf("%s\n", master::format_diag_line(*e, drive_error_name).c_str());
+        std::printf("%s\n", master::format_diag_line(*e, drive_error_name, drive_text).c_str());
         ++shown;
     }
     if (shown == 0) std::printf("%s\n", d.only_new ? "no new messages" : "no messages");

@@ -212,7 +212,20 @@ std::string_view emergency_class_name(uint16_t code) {
     }
 }
 
-std::string diag_text(const DiagEntry& e, ErrorNameLookup lookup) {
+std::string diag_text(const DiagEntry& e, ErrorNameLookup lookup, TextIdLookup texts) {
+    // A text the device gives by id says more than the error it concerns (e.g. "Fault reset refused: cause
+    // still present" about a following error): the text first, the error's name after it.
+    if (e.text_id != 0 && texts != nullptr) {
+        const std::string_view t = texts(e.text_id);
+        if (!t.empty()) {
+            std::string s(t);
+            if (e.from_emergency() && e.emergency_code() != 0 && lookup != nullptr) {
+                const std::string_view n = lookup(e.emergency_code());
+                if (!n.empty()) s += " (" + std::string(n) + ")";
+            }
+            return s;
+        }
+    }
     if (e.from_emergency()) {
         const uint16_t c = e.emergency_code();
         if (c == 0x0000) return "no error (error reset)";
@@ -260,20 +273,30 @@ std::string format_diag_flags(uint16_t flags) {
     return s;
 }
 
-std::string format_diag_line(const DiagEntry& e, ErrorNameLookup lookup) {
+std::string format_diag_line(const DiagEntry& e, ErrorNameLookup lookup, TextIdLookup texts) {
     char b[96];
     std::snprintf(b, sizeof b, ":%02u  %s%s  %-7s  0x%08x  ", e.subindex,
                   format_diag_time(e.timestamp_ns).c_str(), e.local_time ? " (local)" : "",
                   std::string(diag_type_name(e.type)).c_str(), e.code);
     std::string s = b;
-    s += diag_text(e, lookup);
-    if (!e.params.empty() || e.truncated) {
-        s += "  [";
-        for (std::size_t i = 0; i < e.params.size(); ++i) {
-            if (i) s += ", ";
-            s += format_diag_param(e.params[i]);
+    const std::string text = diag_text(e, lookup, texts);
+    s += text;
+    std::vector<std::string> shown;
+    for (const auto& p : e.params) {
+        if (p.kind() == 2 || p.kind() == 3) {
+            const std::string quoted = format_diag_param(p);
+            const std::string inner = quoted.size() >= 2 ? quoted.substr(1, quoted.size() - 2) : quoted;
+            if (!inner.empty() && text.compare(0, inner.size(), inner) == 0) continue;  // said already
         }
-        if (e.truncated) s += e.params.empty() ? "cut short" : ", cut short";
+        shown.push_back(format_diag_param(p));
+    }
+    if (!shown.empty() || e.truncated) {
+        s += "  [";
+        for (std::size_t i = 0; i < shown.size(); ++i) {
+            if (i) s += ", ";
+            s += shown[i];
+        }
+        if (e.truncated) s += shown.empty() ? "cut short" : ", cut short";
         s += "]";
     }
     return s;

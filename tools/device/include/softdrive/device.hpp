@@ -25,6 +25,7 @@
 #include "drive/drive.hpp"
 #include "drive/event_sink.hpp"
 #include "ecat/application.hpp"
+#include "ecat/event_sink.hpp"
 #include "ecat/stack.hpp"
 #include "esc/esc.hpp"
 #include "foe/server.hpp"
@@ -33,6 +34,7 @@
 #include "od/dictionary.hpp"
 #include "od/store.hpp"
 #include "softdrive/eeprom_writes.hpp"
+#include "softslave/log.hpp"
 
 namespace softdrive {
 
@@ -55,6 +57,9 @@ struct DeviceOptions {
     bool load_sii = true;         // false: the ESC serves a user's image (--eeprom), leave it alone
     bool commission = true;       // drive::commission() before the stored parameters are applied
     std::ostream* log = nullptr;  // warnings (bad parameter file, ...); null: std::cerr
+    // One line per event (state changes, refused requests, FoE writes, restarts, 0x1010 saves, watchdog,
+    // drive faults); null: events are not logged.
+    softslave::Log* events = nullptr;
 };
 
 // Where the firmware slots live inside the state directory.
@@ -76,7 +81,7 @@ struct DeviceStats {
     uint64_t diagnoses = 0;    // messages offered to the diagnosis history
 };
 
-class Device final : public ecat::Application, public drive::EventSink {
+class Device final : public ecat::Application, public drive::EventSink, public ecat::EventSink {
   public:
     // Builds the whole device; loads the SII into esc unless options.load_sii is false.
     // Throws od::ConfigError on a bad configuration file and std::runtime_error if the state directory
@@ -115,6 +120,17 @@ class Device final : public ecat::Application, public drive::EventSink {
     void clear(uint16_t error_code, uint8_t error_register) override;
     void diag(drive::Severity severity, uint16_t code, std::string_view text) override;
 
+    // ---- ecat::EventSink (ecat/ and foe/ report here; lines go to options().events) -----------------------
+    void state_changed(od::AlState from, od::AlState to) override;
+    void state_refused(od::AlState current, uint8_t requested, uint16_t al_status_code) override;
+    void local_error(od::AlState state, uint16_t al_status_code) override;
+    void watchdog_expired(od::AlState state) override;
+    void foe_write(std::string_view name, uint64_t bytes, uint32_t error_code,
+                   std::string_view error_text) override;
+
+    // The stack's statistics over the whole run: every firmware instance since the device was created.
+    ecat::StackStats stack_stats() const;
+
     // ---- the parts (valid until the next restart) ---------------------------------------------------
     const DeviceOptions& options() const { return options_; }
     const od::DeviceDescription& description() const;
@@ -145,6 +161,7 @@ class Device final : public ecat::Application, public drive::EventSink {
     void save_eeprom_writes();
     void react_to_outputs_lost();
     std::ostream& log() const;
+    void event(softslave::LogLevel level, const std::string& text) const;
 
     esc::Esc& esc_;
     DeviceOptions options_;
@@ -154,6 +171,7 @@ class Device final : public ecat::Application, public drive::EventSink {
     bool outputs_lost_pending_ = false;  // outputs ended in this poll(); reacted to when it returns
     uint64_t last_cycle_ns_ = 0;         // last drive cycle (master's or our own); 0: none since the build
     DeviceStats stats_;
+    ecat::StackStats earlier_stacks_;  // statistics of the Stacks that restarts replaced
     EepromWrites eeprom_writes_;
     bool eeprom_dirty_ = false;
     uint64_t eeprom_save_ns_ = 0;  // when the written words are saved; 0: not yet scheduled

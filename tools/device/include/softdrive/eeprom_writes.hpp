@@ -41,4 +41,10 @@ class EepromWrites {
     std::map<uint16_t, uint16_t> words_;
 };
 
+// Where an SII image disagrees with what the object model says (checksum of words 0-6 in word 7, identity
+// words 8-15 against 0x1018 vendor id, product code, revision, serial number), one sentence per difference;
+// empty if none. An image too short to hold the identity says so.
+std::vector<std::string> sii_drift(std::span<const uint8_t> image, uint32_t vendor_id, uint32_t product_code,
+                                   uint32_t revision, uint32_t serial_number);
+
 }  // namespace softdrive

@@ -68,14 +68,21 @@ std::string format_diag_param(const DiagParameter& p);
 using ErrorNameLookup = std::string_view (*)(uint16_t code);
 // CiA 301 error code class ("current", "voltage", ...), "" for 0x0000.
 std::string_view emergency_class_name(uint16_t code);
-// Readable text of a message: the device's error name for an emergency-derived code (else its CiA 301
+// Readable text of a message: the device's text for its text id (with the error's name after it for an
+// emergency-derived code), else the device's error name for an emergency-derived code (else its CiA 301
 // class), the ASCII parameter of a manufacturer message, "text id 0x...." otherwise.
-std::string diag_text(const DiagEntry& e, ErrorNameLookup lookup = nullptr);
+// texts: the device's text ids (ETG.1020 text id -> text, e.g. from its ESI DiagMessages); without it, or for
+// an id it does not know, "text id 0x....".
+using TextIdLookup = std::string_view (*)(uint16_t text_id);
+std::string diag_text(const DiagEntry& e, ErrorNameLookup lookup = nullptr, TextIdLookup texts = nullptr);
 // DC system time in ns -> "12.345678901 s".
 std::string format_diag_time(uint64_t ns);
 // "emergency, acknowledge mode, overflow, no info" ...; "none" for 0.
 std::string format_diag_flags(uint16_t flags);
 // One line: ":07  12.345678901 s  error    0x8611e800  Following error  params: ..."
-std::string format_diag_line(const DiagEntry& e, ErrorNameLookup lookup = nullptr);
+// A text parameter that the text shown already says (it was taken from it, or it is the start of the
+// device's name for the code, cut to the message's room) is not repeated among the parameters.
+std::string format_diag_line(const DiagEntry& e, ErrorNameLookup lookup = nullptr,
+                             TextIdLookup texts = nullptr);
 
 }  // namespace master

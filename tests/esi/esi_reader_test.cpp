@@ -1,0 +1,157 @@
+// The ESI loaded back with the od-free reader (esi/esi_reader.hpp) and compared with the object model it was
+// generated from: identity, every object, SyncManagers with their sizes, every PDO with its Sm, Fixed,
+// Mandatory, Exclude and entries, the CoE flags, the diagnosis texts, the mailbox timeouts, the picture.
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "esi/esi.hpp"
+#include "esi/esi_reader.hpp"
+#include "esi/model.hpp"
+#include "od/diag_texts.hpp"
+#include "test_device.hpp"
+
+namespace {
+
+class EsiReadBack : public ::testing::TestWithParam<const char*> {
+  protected:
+    esi_test::Device dev =
+        std::string(GetParam()) == "drive" ? esi_test::drive_device() : esi_test::small_device();
+    esi::EsiDevice esi = esi::read_esi(esi::build_esi(dev.description, dev.dictionary));
+    esi::DeviceModel model = esi::derive_model(dev.description, dev.dictionary);
+};
+
+TEST_P(EsiReadBack, IdentityAndObjectsMatchTheModel) {
+    const od::Identity& id = dev.description.identity;
+    EXPECT_EQ(esi.vendor_id, id.vendor_id);
+    EXPECT_EQ(esi.product_code, id.product_code);
+    EXPECT_EQ(esi.revision, id.revision);
+    EXPECT_EQ(esi.name, id.device_name);
+    std::size_t objects = 0;
+    for (const od::Object& o : dev.dictionary.objects()) {
+        if (o.entries.empty()) continue;
+        ++objects;
+        const esi::EsiObject* e = esi.object(o.index);
+        ASSERT_NE(e, nullptr) << std::hex << o.index;
+        EXPECT_EQ(e->name, o.name);
+    }
+    EXPECT_EQ(esi.objects.size(), objects);
+}
+
+TEST_P(EsiReadBack, SyncManagersCarryTheirSizes) {
+    ASSERT_EQ(esi.sync_managers.size(), model.sync_managers.size());
+    for (std::size_t i = 0; i < model.sync_managers.size(); ++i) {
+        const esi::SmInfo& m = model.sync_managers[i];
+        const esi::EsiSm& s = esi.sync_managers[i];
+        EXPECT_EQ(s.start, m.start);
+        EXPECT_EQ(s.control, m.control);
+        if (m.size != 0) {
+            EXPECT_EQ(s.default_size, m.size);
+        }
+        if (m.min_size != 0 || m.max_size != 0) {
+            EXPECT_EQ(s.min_size, m.min_size);
+            EXPECT_EQ(s.max_size, m.max_size);
+            EXPECT_LE(m.size, m.max_size);
+            EXPECT_GE(m.size, m.min_size);
+        }
+    }
+}
+
+TEST_P(EsiReadBack, PdosCarryAssignmentFixedMandatoryExcludeAndEntries) {
+    ASSERT_EQ(esi.pdos.size(), model.pdos.size());
+    for (const esi::PdoInfo& m : model.pdos) {
+        const esi::EsiPdo* p = esi.pdo(m.index);
+        ASSERT_NE(p, nullptr) << std::hex << m.index;
+        EXPECT_EQ(p->rx, m.rx);
+        EXPECT_EQ(p->sm, m.sm);
+        EXPECT_EQ(p->fixed, m.fixed);
+        EXPECT_EQ(p->mandatory, m.mandatory);
+        EXPECT_EQ(p->exclude, m.exclude);
+        ASSERT_EQ(p->entries.size(), m.entries.size());
+        for (std::size_t i = 0; i < m.entries.size(); ++i) {
+            EXPECT_EQ(p->entries[i].index, m.entries[i].index);
+            EXPECT_EQ(p->entries[i].bit_length, m.entries[i].bit_length);
+            if (m.entries[i].index != 0) {
+                EXPECT_EQ(p->entries[i].subindex, m.entries[i].subindex);
+            }
+        }
+    }
+}
+
+TEST_P(EsiReadBack, CoeFlagsSayWhatTheSlaveServes) {
+    EXPECT_TRUE(esi.coe.at("SegmentedSdo"));
+    EXPECT_EQ(esi.coe.count("DiagHistory") != 0, dev.dictionary.find(0x10F3) != nullptr);
+    EXPECT_EQ(esi.coe.at("CompleteAccess"),
+              (dev.description.coe_details & od::coe_details::CompleteAccess) != 0);
+}
+
+TEST_P(EsiReadBack, DevicePictureIsA16x14Bitmap) {
+    const std::vector<uint8_t>& b = esi.image16x14;
+    ASSERT_EQ(b.size(), 54u + 16u * 14u * 3u);
+    EXPECT_EQ(b[0], 'B');
+    EXPECT_EQ(b[1], 'M');
+    auto le32 = [&b](std::size_t at) {
+        return uint32_t{b[at]} | uint32_t{b[at + 1]} << 8 | uint32_t{b[at + 2]} << 16 |
+               uint32_t{b[at + 3]} << 24;
+    };
+    EXPECT_EQ(le32(2), b.size());
+    EXPECT_EQ(le32(18), 16u);
+    EXPECT_EQ(le32(22), 14u);
+    EXPECT_EQ(b[28], 24u);
+    std::set<uint32_t> colours;
+    for (std::size_t at = 54; at + 2 < b.size(); at += 3)
+        colours.insert(uint32_t{b[at]} | uint32_t{b[at + 1]} << 8 | uint32_t{b[at + 2]} << 16);
+    EXPECT_GE(colours.size(), 4u);  // a picture, not a blank
+}
+
+INSTANTIATE_TEST_SUITE_P(Devices, EsiReadBack, ::testing::Values("small", "drive"));
+
+TEST(EsiReadBackDrive, RxAndTxPdosExcludeEachOtherAsTheSlaveEnforces) {
+    const esi_test::Device dev = esi_test::drive_device();
+    const esi::EsiDevice esi = esi::read_esi(esi::build_esi(dev.description, dev.dictionary));
+    for (uint16_t base : {0x1600, 0x1A00})
+        for (uint16_t i = 0; i < 4; ++i) {
+            const esi::EsiPdo* p = esi.pdo(static_cast<uint16_t>(base + i));
+            ASSERT_NE(p, nullptr);
+            EXPECT_FALSE(p->fixed);  // mappable in Pre-Op
+            EXPECT_FALSE(p->mandatory);
+            std::set<uint16_t> expected;
+            for (uint16_t j = 0; j < 4; ++j)
+                if (j != i) expected.insert(static_cast<uint16_t>(base + j));
+            EXPECT_EQ(std::set<uint16_t>(p->exclude.begin(), p->exclude.end()), expected);
+        }
+    EXPECT_EQ(esi.pdo(0x1600)->sm, 2);
+    EXPECT_EQ(esi.pdo(0x1A00)->sm, 3);
+}
+
+TEST(EsiReadBackDrive, DiagMessagesCoverEveryTextIdWithTheWholeText) {
+    const esi_test::Device dev = esi_test::drive_device();
+    const esi::EsiDevice esi = esi::read_esi(esi::build_esi(dev.description, dev.dictionary));
+    ASSERT_EQ(esi.diag_messages.size(), od::drive_diag_texts().size());
+    for (const od::DiagText& t : od::drive_diag_texts()) {
+        ASSERT_EQ(esi.diag_messages.count(t.id), 1u);
+        EXPECT_EQ(esi.diag_messages.at(t.id), t.text);
+        EXPECT_EQ(od::diag_text_id(t.text), t.id);
+        EXPECT_EQ(od::diag_text(t.id), t.text);
+    }
+    EXPECT_TRUE(esi.coe.at("DiagHistory"));
+    EXPECT_EQ(esi.mailbox_request_timeout_ms, dev.description.mailbox_request_timeout_ms);
+    EXPECT_EQ(esi.mailbox_response_timeout_ms, dev.description.mailbox_response_timeout_ms);
+    EXPECT_GT(*esi.mailbox_response_timeout_ms, 0u);
+    // The mailbox SyncManagers take exactly the mailbox size, the process-data ones up to 160 bytes.
+    EXPECT_EQ(esi.sync_managers[0].min_size, dev.description.standard_mailbox.out_size);
+    EXPECT_EQ(esi.sync_managers[0].max_size, dev.description.standard_mailbox.out_size);
+    EXPECT_EQ(esi.sync_managers[2].max_size, 160u);
+}
+
+TEST(EsiReader, RefusesWhatIsNotAnEsi) {
+    EXPECT_THROW(esi::read_esi("not xml"), std::runtime_error);
+    EXPECT_THROW(esi::read_esi("<Other/>"), std::runtime_error);
+    EXPECT_THROW(esi::read_esi("<EtherCATInfo/>"), std::runtime_error);
+    EXPECT_EQ(esi::parse_hex_dec("#x1A00"), 0x1A00u);
+    EXPECT_EQ(esi::parse_hex_dec("42"), 42u);
+    EXPECT_FALSE(esi::parse_hex_dec("#x"));
+    EXPECT_FALSE(esi::parse_hex_dec("4a"));
+}
+
+}  // namespace
