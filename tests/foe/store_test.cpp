@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -259,3 +261,77 @@ TEST(FoeStore, CommitStepsAreBounded) {
         std::printf("  commit %-10s worst %.3f ms\n", k.c_str(), v);
     std::printf("  %zu commit steps for a 1 MiB image\n", steps);
 }
+
+// Issue 14, finding 3: every loader checks sizes against the bytes present before reading or reserving.
+// Crafted slot and pointer files (a header announcing more than is there or more than a slot may hold, a
+// sparse file of the announced size, FIFOs, an oversized pointer) are not images: the store opens, the
+// valid image stays active, and a download still works.
+TEST(FoeStore, CraftedSlotAndPointerFilesAreNotImages) {
+    TempDir d;
+    const auto good = image_v(0x01200000);
+    {
+        FirmwareStore s(config(d.path));
+        ASSERT_TRUE(s.open());
+        ASSERT_EQ(install(s, good).code, ErrorCode::NotDefined);
+        ASSERT_EQ(s.active_image()->slot, 0u);
+    }
+    auto header_only = [&](uint32_t payload_length) {
+        ImageHeader h =
+            decode_header(std::span<const uint8_t, kImageHeaderSize>(good.data(), kImageHeaderSize));
+        h.payload_length = payload_length;
+        std::vector<uint8_t> b(kImageHeaderSize);
+        encode_header(h, std::span<uint8_t, kImageHeaderSize>(b.data(), kImageHeaderSize));
+        return b;
+    };
+    auto write_file = [](const std::filesystem::path& p, const std::vector<uint8_t>& b) {
+        std::filesystem::remove(p);
+        std::ofstream(p, std::ios::binary)
+            .write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+    };
+    const auto slot1 = d.path / "slot1.bin";
+    const auto pointer = d.path / "active";
+    for (int variant = 0; variant < 6; ++variant) {
+        SCOPED_TRACE("variant " + std::to_string(variant));
+        std::filesystem::remove(slot1);
+        switch (variant) {
+            case 0:  // 32 bytes announcing the largest payload
+                write_file(slot1, header_only(kMaxPayload));
+                break;
+            case 1:  // sparse 2 GiB file of exactly the announced size: larger than a slot may hold
+                write_file(slot1, header_only(kMaxPayload));
+                std::filesystem::resize_file(slot1, kImageHeaderSize + uint64_t{kMaxPayload});
+                break;
+            case 2:  // a FIFO in place of the slot
+                ASSERT_EQ(::mkfifo(slot1.c_str(), 0600), 0);
+                break;
+            case 3:  // pointer to slot1 with slot1 crafted
+                write_file(slot1, header_only(0xFFFFFFFFu));
+                std::ofstream(pointer) << "slot1\n";
+                break;
+            case 4:  // an oversized (sparse) pointer file that starts like a valid one
+                std::ofstream(pointer) << "slot0\n";
+                std::filesystem::resize_file(pointer, uint64_t{1} << 32);
+                break;
+            case 5:  // a FIFO in place of the pointer
+                std::filesystem::remove(pointer);
+                ASSERT_EQ(::mkfifo(pointer.c_str(), 0600), 0);
+                break;
+        }
+        FirmwareStore s(config(d.path));
+        StoreError e;
+        ASSERT_TRUE(s.open(&e)) << e.text;  // without hanging on a FIFO; a bad pointer is repaired
+        ASSERT_TRUE(s.active_image());
+        EXPECT_EQ(s.active_image()->header.version, 0x01200000u);
+        EXPECT_FALSE(s.image(1));
+        if (variant >= 4) {
+            std::filesystem::remove(pointer);
+            std::ofstream(pointer) << "slot0\n";
+        }
+    }
+    std::filesystem::remove(slot1);
+    FirmwareStore s(config(d.path));
+    ASSERT_TRUE(s.open());
+    EXPECT_EQ(install(s, image_v(0x01300000)).code, ErrorCode::NotDefined);
+    EXPECT_EQ(s.active_image()->header.version, 0x01300000u);
+}
+
