@@ -152,14 +152,19 @@ bool FirmwareStore::open(StoreError* error) {
     for (const char* tmp : {"slot0.bin.tmp", "slot1.bin.tmp", "active.tmp"})
         std::filesystem::remove(config_.dir / tmp, ec);
 
-    slots_[0] = verify_slot(0);
-    slots_[1] = verify_slot(1);
-
+    // The pointer is the commit point of a download: it is switched only once the image is stored and
+    // verified, and the master gets the final ACK only after that. No pointer file at all means no download
+    // ever got that far: a slot file then is what remains of a first download killed between its slot rename
+    // and its pointer switch, never acknowledged, so it does not boot (the same rule as with a previous
+    // image, whose pointer keeps naming the old slot). The file stays; the next download replaces it.
     int pointed = -1;
+    bool pointer_exists = false;
     // The pointer is at most "slotN\n": a regular file of up to 16 bytes is read, anything else names no
     // slot.
     const int fd = ::open(pointer_path().c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+    if (fd < 0) pointer_exists = errno != ENOENT;
     if (fd >= 0) {
+        pointer_exists = true;
         char text[16] = {};
         struct stat st {};
         const bool regular = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
@@ -170,6 +175,11 @@ bool FirmwareStore::open(StoreError* error) {
         if (s == "slot1\n" || s == "slot1") pointed = 1;
     }
     active_.reset();
+    slots_[0].reset();
+    slots_[1].reset();
+    if (!pointer_exists) return true;
+    slots_[0] = verify_slot(0);
+    slots_[1] = verify_slot(1);
     if (pointed >= 0 && slots_[pointed]) {
         active_ = slots_[pointed];
     } else {

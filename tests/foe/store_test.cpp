@@ -335,3 +335,70 @@ TEST(FoeStore, CraftedSlotAndPointerFilesAreNotImages) {
     EXPECT_EQ(s.active_image()->header.version, 0x01300000u);
 }
 
+// Issue 14, finding 6: a first-ever update SIGKILLed after the slot rename booted the new image although the
+// master never got the final ACK (there was no pointer, and open() took any valid slot). With no previous
+// image the rule is the one with a previous image: until the pointer switch nothing new boots (here: no
+// image at all, the built-in firmware), from the switch on the new image. A child process storing the image
+// is killed with SIGKILL just before each storage step in turn.
+TEST(FoeStore, FirstUpdateKilledAtEveryStepBootsOnlyWhatWasSwitchedTo) {
+    const auto new_image = image_v(0x01300000, 200'000);
+    std::vector<StoreStep> steps;
+    {
+        TempDir d;
+        FirmwareStore s(config(d.path));
+        ASSERT_TRUE(s.open());
+        s.set_step_hook([&](StoreStep st) { steps.push_back(st); });
+        ASSERT_EQ(install(s, new_image).code, ErrorCode::NotDefined);
+    }
+    std::size_t switch_at = steps.size(), rename_slot_at = steps.size();
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+        if (steps[i] == StoreStep::RenamePointer) switch_at = i;
+        if (steps[i] == StoreStep::RenameSlot) rename_slot_at = i;
+    }
+    ASSERT_LT(rename_slot_at, switch_at);
+    ASSERT_LT(switch_at, steps.size());
+
+    for (std::size_t k = 0; k <= steps.size(); ++k) {
+        SCOPED_TRACE(
+            "killed before step " + std::to_string(k) +
+            (k < steps.size() ? " (" + std::string(to_string(steps[k])) + ")" : " (after the last)"));
+        TempDir d;
+        const pid_t child = ::fork();
+        ASSERT_GE(child, 0);
+        if (child == 0) {
+            FirmwareStore s(config(d.path));
+            if (!s.open()) ::_exit(3);
+            std::size_t count = 0;
+            s.set_step_hook([&](StoreStep) {
+                if (count++ == k) ::kill(::getpid(), SIGKILL);
+            });
+            StoreError e = install(s, new_image);
+            if (k < steps.size()) ::_exit(2);  // not killed: the step list changed
+            ::_exit(e.code == ErrorCode::NotDefined ? 0 : 4);
+        }
+        int status = 0;
+        ASSERT_EQ(::waitpid(child, &status, 0), child);
+        if (k < steps.size()) {
+            ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << status;
+        } else {
+            ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+        }
+
+        FirmwareStore s(config(d.path));
+        ASSERT_TRUE(s.open());
+        if (k <= switch_at) {
+            EXPECT_FALSE(s.active_image()) << "an image the master never got the ACK for boots";
+            EXPECT_EQ(s.find("MAXPOS_0130h_3001h_0000h_0000h.bin"), nullptr);
+        } else {
+            ASSERT_TRUE(s.active_image());
+            EXPECT_EQ(s.active_image()->header.version, 0x01300000u);
+        }
+        EXPECT_TRUE(no_temp_files(d.path));
+        // A second start decides the same, and the download can simply be repeated.
+        FirmwareStore again(config(d.path));
+        ASSERT_TRUE(again.open());
+        EXPECT_EQ(again.active_image().has_value(), k > switch_at);
+        EXPECT_EQ(install(again, new_image).code, ErrorCode::NotDefined);
+        EXPECT_EQ(again.active_image()->header.version, 0x01300000u);
+    }
+}
