@@ -288,6 +288,12 @@ std::string ParameterStore::save(const Dictionary& dict, StoreScope scope) {
     return write_atomic(bytes);
 }
 
+bool ParameterStore::remove_stale_temp() const {
+    std::filesystem::path tmp = file_;
+    tmp += ".tmp";
+    return ::unlink(tmp.c_str()) == 0;
+}
+
 std::string ParameterStore::write_atomic(const std::vector<uint8_t>& bytes) {
     std::error_code ec;
     std::filesystem::create_directories(dir_, ec);

@@ -132,3 +132,47 @@ TEST(DeviceStateFiles, OversizedSiiWritesFileIsNotRead) {
     EXPECT_TRUE(w.empty());
 }
 
+// Issue 14, finding 7: temporaries of saves killed half-way (parameters, SII words, firmware slot and
+// pointer) are removed when the device starts; the files they were to replace are untouched.
+TEST(DeviceStateFiles, StaleTemporariesAreRemovedAtTheStart) {
+    StateDir d;
+    fs::create_directories(d.path / "firmware");
+    // parameters.bin.tmp the way the campaign got it: a save SIGKILLed once its temporary was written.
+    {
+        od::Dictionary dict = od::make_drive_dictionary(od::default_drive_description());
+        od::ParameterStore store(d.path);
+        const pid_t pid = ::fork();
+        ASSERT_GE(pid, 0);
+        if (pid == 0) {
+            store.on_step = [](std::string_view step) {
+                if (step == "temp-written") ::kill(::getpid(), SIGKILL);
+            };
+            store.save(dict);
+            ::_exit(0);
+        }
+        int status = 0;
+        ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+        ASSERT_TRUE(WIFSIGNALED(status)) << status;
+    }
+    const std::vector<fs::path> stale = {
+        d.path / "parameters.bin.tmp", d.path / "sii-writes.bin.tmp", d.path / "firmware" / "slot0.bin.tmp",
+        d.path / "firmware" / "slot1.bin.tmp", d.path / "firmware" / "active.tmp"};
+    for (std::size_t i = 1; i < stale.size(); ++i)
+        std::ofstream(stale[i]) << "half written";
+    for (const auto& p : stale)
+        ASSERT_TRUE(fs::exists(p)) << p;
+
+    esc::ManualClock clock;
+    clock.set(1'000'000'000);
+    esc::Esc esc(esc::EscConfig{}, clock);
+    std::ostringstream log;
+    softdrive::DeviceOptions options;
+    options.state_dir = d.path;
+    options.log = &log;
+    softdrive::Device dev(esc, options);
+    for (const auto& p : stale)
+        EXPECT_FALSE(fs::exists(p)) << p;
+    EXPECT_NE(log.str().find("parameters.bin.tmp left by an interrupted save"), std::string::npos)
+        << log.str();
+    EXPECT_FALSE(dev.parameter_load().found);  // the temporary was never the parameter file
+}

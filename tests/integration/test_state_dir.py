@@ -61,6 +61,21 @@ class StateDirectory(unittest.TestCase):
             self.assertEqual(u32(bus, 0x6065, 0), 0x4321)
             self.assertNotIn("not used", bus.slave_output())
 
+    def test_temporaries_of_interrupted_saves_are_removed_at_the_start(self):
+        stale = [os.path.join(self.state, n) for n in ("parameters.bin.tmp", "sii-writes.bin.tmp")]
+        stale += [os.path.join(self.state, "firmware", n) for n in ("slot0.bin.tmp", "slot1.bin.tmp", "active.tmp")]
+        os.makedirs(os.path.join(self.state, "firmware"))
+        for p in stale:
+            with open(p, "wb") as f:
+                f.write(b"SECATPRM half written")
+        with harness.Bus(slave_args=["--state-dir", self.state]) as bus:
+            self.assertEqual([p for p in stale if os.path.exists(p)], [])
+            self.assertIn("left by an interrupted save", bus.slave_output())
+            # The slave runs and a save now works as usual.
+            bus.ecatctl("download", "0", "0x1010", "1", "save", "--type", "string")
+            self.assertTrue(os.path.exists(os.path.join(self.state, "parameters.bin")))
+            self.assertEqual([p for p in stale if os.path.exists(p)], [])
+
 
 if __name__ == "__main__":
     harness.main()

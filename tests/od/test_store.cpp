@@ -414,3 +414,35 @@ TEST_F(StoreTest, OversizedFileAndFifoAreReported) {
     expect_defaults(d);
 }
 
+// Issue 14, finding 7: a save SIGKILLed after its temporary file was written left parameters.bin.tmp behind
+// for good. It is removed at the next start (remove_stale_temp), and the file that loads is the old one.
+TEST_F(StoreTest, TemporaryOfASaveKilledHalfWayIsRemovedAtTheStart) {
+    Dictionary d = make_drive_dictionary(desc);
+    ParameterStore store(dir);
+    ASSERT_EQ(d.set<uint32_t>(0x6065, 0, 1111), Status::Ok);
+    ASSERT_EQ(store.save(d), "");
+    ASSERT_EQ(d.set<uint32_t>(0x6065, 0, 2222), Status::Ok);
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+        store.on_step = [](std::string_view step) {
+            if (step == "temp-written") ::kill(::getpid(), SIGKILL);
+        };
+        store.save(d);
+        ::_exit(0);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << status;
+    fs::path tmp = store.file();
+    tmp += ".tmp";
+    ASSERT_TRUE(fs::exists(tmp));  // what the campaign found
+
+    const ParameterStore at_start(dir);
+    EXPECT_TRUE(at_start.remove_stale_temp());
+    EXPECT_FALSE(fs::exists(tmp));
+    EXPECT_FALSE(at_start.remove_stale_temp());  // nothing left the second time
+    Dictionary fresh = make_drive_dictionary(desc);
+    ASSERT_TRUE(at_start.load(fresh).applied);
+    EXPECT_EQ(fresh.get<uint32_t>(0x6065, 0), 1111u);
+}

@@ -72,6 +72,12 @@ std::string EepromWrites::load() {
     return {};
 }
 
+bool EepromWrites::remove_stale_temp() const {
+    std::filesystem::path tmp = file_;
+    tmp += ".tmp";
+    return ::unlink(tmp.c_str()) == 0;
+}
+
 std::string EepromWrites::save() {
     std::vector<uint8_t> b(kMagic, kMagic + 8);
     put32(b, static_cast<uint32_t>(words_.size()));
