@@ -292,6 +292,7 @@ bool Esc::Impl::process(std::span<uint8_t> frame, uint64_t rx_clock) {
     const std::size_t hdr = off + 2;
     if (size < hdr + 2) {
         ++stats.frames_malformed;
+        ++stats.malformed_no_header;
         count_error(reg::kInvalidFrameCounter);
         count_error(reg::kProcessingUnitErrors);
         return true;
@@ -311,16 +312,19 @@ bool Esc::Impl::process(std::span<uint8_t> frame, uint64_t rx_clock) {
     const std::size_t end = p + (h & 0x07FF);
     if (end > size) {
         ok = false;
+        ++stats.malformed_length;
     } else {
         for (;;) {
             if (p + 12 > end) {
                 ok = false;
+                ++stats.malformed_datagram;
                 break;
             }
             const uint16_t lf = le16(f + p + 6);
             const uint16_t dlen = lf & 0x07FF;
             if (p + 12 + dlen > end) {
                 ok = false;
+                ++stats.malformed_datagram;
                 break;
             }
             datagram(f + p, f + p + 10, dlen);

@@ -106,17 +106,19 @@ bool FirmwareStore::sync_dir(StoreError& error) {
 
 std::optional<StoredImage> FirmwareStore::verify_slot(unsigned slot) {
     const auto path = slot_path(slot);
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    // Only a regular file is a slot (O_NONBLOCK: a FIFO in its place must not hang the start). Its size
+    // must be the one its header announces before any of the payload is read.
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (fd < 0) return std::nullopt;
     struct stat st {};
     std::optional<StoredImage> result;
     uint8_t head[kImageHeaderSize];
-    if (::fstat(fd, &st) == 0 && pread_all(fd, head, kImageHeaderSize, 0)) {
+    if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && pread_all(fd, head, kImageHeaderSize, 0)) {
         std::span<const uint8_t, kImageHeaderSize> hs(head, kImageHeaderSize);
         const ImageHeader h = decode_header(hs);
         const uint64_t size = static_cast<uint64_t>(st.st_size);
         if (check_header(h, config_.identity) == ImageError::Ok &&
-            size == kImageHeaderSize + h.payload_length) {
+            size == kImageHeaderSize + uint64_t{h.payload_length} && size <= config_.max_image_bytes) {
             uint32_t crc = header_crc(hs);
             uint64_t off = kImageHeaderSize;
             bool ok = true;
@@ -150,20 +152,34 @@ bool FirmwareStore::open(StoreError* error) {
     for (const char* tmp : {"slot0.bin.tmp", "slot1.bin.tmp", "active.tmp"})
         std::filesystem::remove(config_.dir / tmp, ec);
 
-    slots_[0] = verify_slot(0);
-    slots_[1] = verify_slot(1);
-
+    // The pointer is the commit point of a download: it is switched only once the image is stored and
+    // verified, and the master gets the final ACK only after that. No pointer file at all means no download
+    // ever got that far: a slot file then is what remains of a first download killed between its slot rename
+    // and its pointer switch, never acknowledged, so it does not boot (the same rule as with a previous
+    // image, whose pointer keeps naming the old slot). The file stays; the next download replaces it.
     int pointed = -1;
-    const int fd = ::open(pointer_path().c_str(), O_RDONLY | O_CLOEXEC);
+    bool pointer_exists = false;
+    // The pointer is at most "slotN\n": a regular file of up to 16 bytes is read, anything else names no
+    // slot.
+    const int fd = ::open(pointer_path().c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+    if (fd < 0) pointer_exists = errno != ENOENT;
     if (fd >= 0) {
+        pointer_exists = true;
         char text[16] = {};
-        const ssize_t n = ::read(fd, text, sizeof text - 1);
+        struct stat st {};
+        const bool regular = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
+        const ssize_t n = regular ? ::read(fd, text, sizeof text - 1) : -1;
         ::close(fd);
         const std::string_view s(text, n > 0 ? static_cast<std::size_t>(n) : 0);
         if (s == "slot0\n" || s == "slot0") pointed = 0;
         if (s == "slot1\n" || s == "slot1") pointed = 1;
     }
     active_.reset();
+    slots_[0].reset();
+    slots_[1].reset();
+    if (!pointer_exists) return true;
+    slots_[0] = verify_slot(0);
+    slots_[1] = verify_slot(1);
     if (pointed >= 0 && slots_[pointed]) {
         active_ = slots_[pointed];
     } else {

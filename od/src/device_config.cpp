@@ -225,9 +225,18 @@ DeviceDescription parse_device_config(std::string_view text, const std::string& 
 DeviceDescription load_device_config(const std::filesystem::path& path) {
     std::ifstream f(path, std::ios::binary);
     if (!f) throw ConfigError(path.string(), 0, "cannot open the device configuration file");
-    std::ostringstream s;
-    s << f.rdbuf();
-    return parse_device_config(s.str(), path.string());
+    // Read in pieces up to the limit, never the whole of whatever the path names (a pipe or /dev/zero
+    // would not end): a configuration is a few hundred bytes.
+    std::string text;
+    char piece[4096];
+    while (f.read(piece, sizeof piece) || f.gcount() > 0) {
+        text.append(piece, static_cast<std::size_t>(f.gcount()));
+        if (text.size() > kMaxConfigBytes)
+            throw ConfigError(
+                path.string(), 0,
+                "larger than " + std::to_string(kMaxConfigBytes) + " bytes: not a device configuration file");
+    }
+    return parse_device_config(text, path.string());
 }
 
 }  // namespace od

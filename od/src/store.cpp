@@ -101,6 +101,11 @@ std::string parse(std::span<const uint8_t> f, const Dictionary& dict, std::vecto
         return "stored for vendor " + hex32(fid.vendor) + " product " + hex32(fid.product) + " revision " +
                hex32(fid.revision) + ", this device is " + hex32(id.vendor) + "/" + hex32(id.product) + "/" +
                hex32(id.revision);
+    // Every record takes at least its 8-byte header: a count the payload cannot hold is refused before
+    // anything is reserved for it (a count of 0xFFFFFFFF with valid CRCs must not cost 100 GB).
+    if (count > body.size() / kRecordHeader)
+        return "header announces " + std::to_string(count) + " records, the " + std::to_string(body.size()) +
+               "-byte payload holds at most " + std::to_string(body.size() / kRecordHeader);
     std::size_t at = 0;
     out.reserve(count);
     for (uint32_t n = 0; n < count; ++n) {
@@ -139,7 +144,8 @@ std::string errno_text(const std::string& what, const std::filesystem::path& p) 
 // Reads a whole file. Returns false with errno_code = ENOENT if it does not exist.
 bool read_file(const std::filesystem::path& p, std::vector<uint8_t>& out, std::string& error, bool& missing) {
     missing = false;
-    const int fd = ::open(p.c_str(), O_RDONLY | O_CLOEXEC);
+    // O_NONBLOCK: a FIFO in place of the file must not hang the start (it is refused below).
+    const int fd = ::open(p.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (fd < 0) {
         missing = errno == ENOENT;
         if (!missing) error = errno_text("cannot open", p);
@@ -280,6 +286,12 @@ std::string ParameterStore::save(const Dictionary& dict, StoreScope scope) {
     const std::vector<uint8_t> bytes = serialize(dict, records);
 
     return write_atomic(bytes);
+}
+
+bool ParameterStore::remove_stale_temp() const {
+    std::filesystem::path tmp = file_;
+    tmp += ".tmp";
+    return ::unlink(tmp.c_str()) == 0;
 }
 
 std::string ParameterStore::write_atomic(const std::vector<uint8_t>& bytes) {

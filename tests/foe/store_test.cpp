@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -258,4 +260,145 @@ TEST(FoeStore, CommitStepsAreBounded) {
     for (const auto& [k, v] : worst_ms)
         std::printf("  commit %-10s worst %.3f ms\n", k.c_str(), v);
     std::printf("  %zu commit steps for a 1 MiB image\n", steps);
+}
+
+// Issue 14, finding 3: every loader checks sizes against the bytes present before reading or reserving.
+// Crafted slot and pointer files (a header announcing more than is there or more than a slot may hold, a
+// sparse file of the announced size, FIFOs, an oversized pointer) are not images: the store opens, the
+// valid image stays active, and a download still works.
+TEST(FoeStore, CraftedSlotAndPointerFilesAreNotImages) {
+    TempDir d;
+    const auto good = image_v(0x01200000);
+    {
+        FirmwareStore s(config(d.path));
+        ASSERT_TRUE(s.open());
+        ASSERT_EQ(install(s, good).code, ErrorCode::NotDefined);
+        ASSERT_EQ(s.active_image()->slot, 0u);
+    }
+    auto header_only = [&](uint32_t payload_length) {
+        ImageHeader h =
+            decode_header(std::span<const uint8_t, kImageHeaderSize>(good.data(), kImageHeaderSize));
+        h.payload_length = payload_length;
+        std::vector<uint8_t> b(kImageHeaderSize);
+        encode_header(h, std::span<uint8_t, kImageHeaderSize>(b.data(), kImageHeaderSize));
+        return b;
+    };
+    auto write_file = [](const std::filesystem::path& p, const std::vector<uint8_t>& b) {
+        std::filesystem::remove(p);
+        std::ofstream(p, std::ios::binary)
+            .write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+    };
+    const auto slot1 = d.path / "slot1.bin";
+    const auto pointer = d.path / "active";
+    for (int variant = 0; variant < 6; ++variant) {
+        SCOPED_TRACE("variant " + std::to_string(variant));
+        std::filesystem::remove(slot1);
+        switch (variant) {
+            case 0:  // 32 bytes announcing the largest payload
+                write_file(slot1, header_only(kMaxPayload));
+                break;
+            case 1:  // sparse 2 GiB file of exactly the announced size: larger than a slot may hold
+                write_file(slot1, header_only(kMaxPayload));
+                std::filesystem::resize_file(slot1, kImageHeaderSize + uint64_t{kMaxPayload});
+                break;
+            case 2:  // a FIFO in place of the slot
+                ASSERT_EQ(::mkfifo(slot1.c_str(), 0600), 0);
+                break;
+            case 3:  // pointer to slot1 with slot1 crafted
+                write_file(slot1, header_only(0xFFFFFFFFu));
+                std::ofstream(pointer) << "slot1\n";
+                break;
+            case 4:  // an oversized (sparse) pointer file that starts like a valid one
+                std::ofstream(pointer) << "slot0\n";
+                std::filesystem::resize_file(pointer, uint64_t{1} << 32);
+                break;
+            case 5:  // a FIFO in place of the pointer
+                std::filesystem::remove(pointer);
+                ASSERT_EQ(::mkfifo(pointer.c_str(), 0600), 0);
+                break;
+        }
+        FirmwareStore s(config(d.path));
+        StoreError e;
+        ASSERT_TRUE(s.open(&e)) << e.text;  // without hanging on a FIFO; a bad pointer is repaired
+        ASSERT_TRUE(s.active_image());
+        EXPECT_EQ(s.active_image()->header.version, 0x01200000u);
+        EXPECT_FALSE(s.image(1));
+        if (variant >= 4) {
+            std::filesystem::remove(pointer);
+            std::ofstream(pointer) << "slot0\n";
+        }
+    }
+    std::filesystem::remove(slot1);
+    FirmwareStore s(config(d.path));
+    ASSERT_TRUE(s.open());
+    EXPECT_EQ(install(s, image_v(0x01300000)).code, ErrorCode::NotDefined);
+    EXPECT_EQ(s.active_image()->header.version, 0x01300000u);
+}
+
+// Issue 14, finding 6: a first-ever update SIGKILLed after the slot rename booted the new image although the
+// master never got the final ACK (there was no pointer, and open() took any valid slot). With no previous
+// image the rule is the one with a previous image: until the pointer switch nothing new boots (here: no
+// image at all, the built-in firmware), from the switch on the new image. A child process storing the image
+// is killed with SIGKILL just before each storage step in turn.
+TEST(FoeStore, FirstUpdateKilledAtEveryStepBootsOnlyWhatWasSwitchedTo) {
+    const auto new_image = image_v(0x01300000, 200'000);
+    std::vector<StoreStep> steps;
+    {
+        TempDir d;
+        FirmwareStore s(config(d.path));
+        ASSERT_TRUE(s.open());
+        s.set_step_hook([&](StoreStep st) { steps.push_back(st); });
+        ASSERT_EQ(install(s, new_image).code, ErrorCode::NotDefined);
+    }
+    std::size_t switch_at = steps.size(), rename_slot_at = steps.size();
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+        if (steps[i] == StoreStep::RenamePointer) switch_at = i;
+        if (steps[i] == StoreStep::RenameSlot) rename_slot_at = i;
+    }
+    ASSERT_LT(rename_slot_at, switch_at);
+    ASSERT_LT(switch_at, steps.size());
+
+    for (std::size_t k = 0; k <= steps.size(); ++k) {
+        SCOPED_TRACE(
+            "killed before step " + std::to_string(k) +
+            (k < steps.size() ? " (" + std::string(to_string(steps[k])) + ")" : " (after the last)"));
+        TempDir d;
+        const pid_t child = ::fork();
+        ASSERT_GE(child, 0);
+        if (child == 0) {
+            FirmwareStore s(config(d.path));
+            if (!s.open()) ::_exit(3);
+            std::size_t count = 0;
+            s.set_step_hook([&](StoreStep) {
+                if (count++ == k) ::kill(::getpid(), SIGKILL);
+            });
+            StoreError e = install(s, new_image);
+            if (k < steps.size()) ::_exit(2);  // not killed: the step list changed
+            ::_exit(e.code == ErrorCode::NotDefined ? 0 : 4);
+        }
+        int status = 0;
+        ASSERT_EQ(::waitpid(child, &status, 0), child);
+        if (k < steps.size()) {
+            ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << status;
+        } else {
+            ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+        }
+
+        FirmwareStore s(config(d.path));
+        ASSERT_TRUE(s.open());
+        if (k <= switch_at) {
+            EXPECT_FALSE(s.active_image()) << "an image the master never got the ACK for boots";
+            EXPECT_EQ(s.find("MAXPOS_0130h_3001h_0000h_0000h.bin"), nullptr);
+        } else {
+            ASSERT_TRUE(s.active_image());
+            EXPECT_EQ(s.active_image()->header.version, 0x01300000u);
+        }
+        EXPECT_TRUE(no_temp_files(d.path));
+        // A second start decides the same, and the download can simply be repeated.
+        FirmwareStore again(config(d.path));
+        ASSERT_TRUE(again.open());
+        EXPECT_EQ(again.active_image().has_value(), k > switch_at);
+        EXPECT_EQ(install(again, new_image).code, ErrorCode::NotDefined);
+        EXPECT_EQ(again.active_image()->header.version, 0x01300000u);
+    }
 }

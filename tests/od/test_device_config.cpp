@@ -1,5 +1,6 @@
 // Device configuration file: the example, every key, and errors with line numbers.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -133,4 +134,27 @@ TEST(DeviceConfig, ErrorsNameTheLine) {
 
 TEST(DeviceConfig, MissingFileIsAnError) {
     EXPECT_THROW(load_device_config("/nonexistent/dir/device.conf"), ConfigError);
+}
+
+// Issue 14, finding 3 (every loader checks sizes against the bytes present): a configuration path that
+// names an endless or oversized source is an error, not an unbounded read.
+TEST(DeviceConfig, OversizedOrEndlessFileIsAnError) {
+    try {
+        load_device_config("/dev/zero");
+        ADD_FAILURE() << "/dev/zero was accepted";
+    } catch (const ConfigError& e) {
+        EXPECT_NE(std::string(e.what()).find("larger than"), std::string::npos) << e.what();
+    }
+    const auto path = std::filesystem::temp_directory_path() / ("od-config-" + std::to_string(::getpid()));
+    {
+        std::ofstream f(path);
+        f << "[identity]\nvendor_id = 0xFB\n";
+        const std::string comment = "# " + std::string(1022, 'x') + "\n";
+        while (f.tellp() <= static_cast<std::streamoff>(kMaxConfigBytes))
+            f << comment;
+    }
+    EXPECT_THROW(load_device_config(path), ConfigError);
+    std::filesystem::resize_file(path, 200);  // the same file, short: reads
+    EXPECT_EQ(load_device_config(path).identity.vendor_id, 0xFBu);
+    std::filesystem::remove(path);
 }

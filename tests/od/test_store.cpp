@@ -1,9 +1,12 @@
 // Parameter store: round trip, restore, corrupted and truncated files, foreign identity, crash between the
 // temp write and the rename, and the 0x1010/0x1011/0x2110/0x2111 wiring.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -338,4 +341,108 @@ TEST_F(StoreTest, RestoreWaitsForThePowerDisableCondition) {
     power_disabled = true;
     EXPECT_EQ(d.write(0x2111, 1, AlState::PreOp, load), Status::Ok);
     EXPECT_FALSE(fs::exists(store.file()));
+}
+
+// Issue 14, finding 3: a 40-byte parameters.bin with valid CRCs, the device's identity and a record count of
+// 0xFFFFFFFF threw std::bad_alloc from every start. Crafted headers of every kind are reported and the
+// defaults run; nothing is reserved for what the bytes present cannot hold.
+TEST_F(StoreTest, CraftedRecordCountsAreReportedNotReserved) {
+    Dictionary d = make_drive_dictionary(desc);
+    modify(d);
+    ParameterStore store(dir);
+    ASSERT_EQ(store.save(d), "");
+    const std::vector<uint8_t> good = read_all(store.file());
+    auto crafted = [&](uint32_t count, std::size_t payload_bytes) {
+        const std::size_t keep = std::min(payload_bytes, good.size() - ParameterStore::kHeaderBytes);
+        std::vector<uint8_t> b(
+            good.begin(), good.begin() + static_cast<std::ptrdiff_t>(ParameterStore::kHeaderBytes + keep));
+        auto put32 = [&](std::size_t at, uint32_t v) {
+            for (int i = 0; i < 4; ++i)
+                b[at + i] = static_cast<uint8_t>(v >> (8 * i));
+        };
+        put32(24, count);
+        put32(28, static_cast<uint32_t>(b.size() - ParameterStore::kHeaderBytes));
+        put32(32, crc32(std::span<const uint8_t>(b).subspan(ParameterStore::kHeaderBytes)));
+        put32(36, crc32(std::span<const uint8_t>(b).first(36)));
+        return b;
+    };
+    // The file as found: 40 bytes, count 0xFFFFFFFF, both CRCs right.
+    const auto found = crafted(0xFFFFFFFFu, 0);
+    ASSERT_EQ(found.size(), 40u);
+    const std::size_t real_count = good[24] | (good[25] << 8);
+    for (const auto& [count, payload] : std::vector<std::pair<uint32_t, std::size_t>>{
+             {0xFFFFFFFFu, 0},                                         // the reported file
+             {0xFFFFFFFFu, good.size()},                               // every record there, count far beyond
+             {0x20000000u, 16},                                        // 12 GiB worth of records in 16 bytes
+             {static_cast<uint32_t>(real_count + 1), good.size()}}) {  // one more than present
+        SCOPED_TRACE("count " + std::to_string(count) + ", payload " + std::to_string(payload));
+        write_all(store.file(), crafted(count, payload));
+        Dictionary fresh = make_drive_dictionary(desc);
+        ParameterStore::LoadResult r;
+        ASSERT_NO_THROW(r = store.load(fresh));
+        EXPECT_TRUE(r.found);
+        EXPECT_FALSE(r.applied);
+        EXPECT_FALSE(r.error.empty());
+        EXPECT_NE(r.error.find("defaults kept"), std::string::npos) << r.error;
+        expect_defaults(fresh);
+        // A scoped store reads the current file too: it is ignored, not fatal.
+        EXPECT_EQ(store.save(d, StoreScope::Communication), "");
+        EXPECT_EQ(store.restore_defaults(d, StoreScope::Application), "");
+    }
+    write_all(store.file(), found);
+    Dictionary fresh = make_drive_dictionary(desc);
+    EXPECT_NE(store.load(fresh).error.find("records"), std::string::npos);
+}
+
+// Neither a file far beyond any dictionary nor a FIFO in place of parameters.bin stops the start.
+TEST_F(StoreTest, OversizedFileAndFifoAreReported) {
+    Dictionary d = make_drive_dictionary(desc);
+    ParameterStore store(dir);
+    fs::create_directories(dir);
+    { std::ofstream f(store.file(), std::ios::binary); }
+    fs::resize_file(store.file(), std::uintmax_t{1} << 32);  // sparse 4 GiB
+    auto r = store.load(d);
+    EXPECT_TRUE(r.found);
+    EXPECT_FALSE(r.applied);
+    EXPECT_NE(r.error.find("too large"), std::string::npos) << r.error;
+    fs::remove(store.file());
+    ASSERT_EQ(::mkfifo(store.file().c_str(), 0600), 0);
+    r = store.load(d);  // must not block waiting for a writer
+    EXPECT_TRUE(r.found);
+    EXPECT_FALSE(r.applied);
+    EXPECT_FALSE(r.error.empty());
+    expect_defaults(d);
+}
+
+// Issue 14, finding 7: a save SIGKILLed after its temporary file was written left parameters.bin.tmp behind
+// for good. It is removed at the next start (remove_stale_temp), and the file that loads is the old one.
+TEST_F(StoreTest, TemporaryOfASaveKilledHalfWayIsRemovedAtTheStart) {
+    Dictionary d = make_drive_dictionary(desc);
+    ParameterStore store(dir);
+    ASSERT_EQ(d.set<uint32_t>(0x6065, 0, 1111), Status::Ok);
+    ASSERT_EQ(store.save(d), "");
+    ASSERT_EQ(d.set<uint32_t>(0x6065, 0, 2222), Status::Ok);
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+        store.on_step = [](std::string_view step) {
+            if (step == "temp-written") ::kill(::getpid(), SIGKILL);
+        };
+        store.save(d);
+        ::_exit(0);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << status;
+    fs::path tmp = store.file();
+    tmp += ".tmp";
+    ASSERT_TRUE(fs::exists(tmp));  // what the campaign found
+
+    const ParameterStore at_start(dir);
+    EXPECT_TRUE(at_start.remove_stale_temp());
+    EXPECT_FALSE(fs::exists(tmp));
+    EXPECT_FALSE(at_start.remove_stale_temp());  // nothing left the second time
+    Dictionary fresh = make_drive_dictionary(desc);
+    ASSERT_TRUE(at_start.load(fresh).applied);
+    EXPECT_EQ(fresh.get<uint32_t>(0x6065, 0), 1111u);
 }

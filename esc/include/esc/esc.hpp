@@ -32,6 +32,10 @@ struct EscStats {
     uint64_t frames_processed = 0;
     uint64_t frames_ignored = 0;    // not EtherCAT (wrong EtherType / type field)
     uint64_t frames_malformed = 0;  // length fields disagree with the frame, datagram past the end, ...
+    // frames_malformed by reason (they add up to it):
+    uint64_t malformed_no_header = 0;  // EtherType 0x88A4 but no room for the 2-byte EtherCAT header
+    uint64_t malformed_length = 0;     // the EtherCAT header's length runs past the end of the frame
+    uint64_t malformed_datagram = 0;   // a datagram header or its data runs past that length
     uint64_t datagrams = 0;
 };
 

@@ -32,7 +32,11 @@ class ConfigError : public std::runtime_error {
     int line_;
 };
 
-// Reads `path` on top of default_drive_description(). Throws ConfigError (file:line: message).
+// Longest configuration file load_device_config() reads (a real one is a few hundred bytes).
+constexpr std::size_t kMaxConfigBytes = 1u << 20;
+
+// Reads `path` on top of default_drive_description(). Throws ConfigError (file:line: message), also for a
+// file longer than kMaxConfigBytes (nothing beyond that is read).
 DeviceDescription load_device_config(const std::filesystem::path& path);
 
 // Same, from text; `source` names it in error messages.

@@ -63,6 +63,11 @@ class ParameterStore {
     // at the next start; the running values do not change. Returns "" or the error text.
     std::string restore_defaults(const Dictionary& dict, StoreScope scope = StoreScope::All);
 
+    // Removes parameters.bin.tmp if an interrupted save left it behind (never valid: the rename is the
+    // commit point). Called once at the start of the device, never while a save may run. Returns whether
+    // there was one.
+    bool remove_stale_temp() const;
+
     // Test hook, called inside save() after each step: "temp-written" (temp file written and synced),
     // "renamed" (rename done, directory not yet synced), "done".
     std::function<void(std::string_view step)> on_step;

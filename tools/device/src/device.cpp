@@ -93,6 +93,14 @@ struct Device::Parts {
 
 Device::Device(esc::Esc& esc, DeviceOptions options)
     : esc_(esc), options_(std::move(options)), eeprom_writes_(options_.state_dir) {
+    // Temporaries a save killed half-way left behind (parameters, SII words; the firmware store removes its
+    // own when it opens): never valid, removed before anything else reads the state directory.
+    const od::ParameterStore params(options_.state_dir);
+    if (params.remove_stale_temp())
+        log() << "softdrive: removed " << params.file().string() << ".tmp left by an interrupted save\n";
+    if (eeprom_writes_.remove_stale_temp())
+        log() << "softdrive: removed " << eeprom_writes_.file().string()
+              << ".tmp left by an interrupted save\n";
     if (options_.load_sii) {
         if (const std::string error = eeprom_writes_.load(); !error.empty())
             log() << "softdrive: " << eeprom_writes_.file().string() << " not used (" << error

@@ -2,13 +2,12 @@
 #include "softdrive/eeprom_writes.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 
 #include "esi/model.hpp"
 #include "od/store.hpp"
@@ -19,6 +18,7 @@ namespace {
 
 constexpr char kMagic[8] = {'S', 'E', 'C', 'A', 'T', 'S', 'I', 'I'};
 constexpr std::size_t kMaxWords = 65536;
+constexpr std::size_t kMaxFileBytes = 16 + 4 * kMaxWords;  // every word of a 64 Ki-word EEPROM once
 
 void put32(std::vector<uint8_t>& b, uint32_t v) {
     for (int i = 0; i < 4; ++i)
@@ -39,9 +39,29 @@ EepromWrites::EepromWrites(std::filesystem::path state_dir)
 
 std::string EepromWrites::load() {
     words_.clear();
-    std::ifstream in(file_, std::ios::binary);
-    if (!in) return {};
-    const std::vector<uint8_t> b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // The size is checked against what a valid file can hold before anything is read or reserved, and
+    // only a regular file is read (O_NONBLOCK: a FIFO in its place must not hang the start).
+    const int fd = ::open(file_.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+    if (fd < 0) return errno == ENOENT ? std::string{} : sys_error("cannot open", file_);
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        ::close(fd);
+        return "not a regular file";
+    }
+    if (static_cast<uint64_t>(st.st_size) > kMaxFileBytes) {
+        ::close(fd);
+        return "file of " + std::to_string(st.st_size) + " bytes, larger than any SII writes file";
+    }
+    std::vector<uint8_t> b(static_cast<std::size_t>(st.st_size));
+    std::size_t got = 0;
+    while (got < b.size()) {
+        const ssize_t n = ::read(fd, b.data() + got, b.size() - got);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) break;
+        got += static_cast<std::size_t>(n);
+    }
+    ::close(fd);
+    b.resize(got);
     if (b.size() < 16 || std::memcmp(b.data(), kMagic, 8) != 0) return "not an SII writes file";
     const uint32_t n = get32(b.data() + 8);
     if (n > kMaxWords || b.size() != 16 + 4 * static_cast<std::size_t>(n)) return "length does not match";
@@ -52,6 +72,12 @@ std::string EepromWrites::load() {
         words_[static_cast<uint16_t>(p[0] | p[1] << 8)] = static_cast<uint16_t>(p[2] | p[3] << 8);
     }
     return {};
+}
+
+bool EepromWrites::remove_stale_temp() const {
+    std::filesystem::path tmp = file_;
+    tmp += ".tmp";
+    return ::unlink(tmp.c_str()) == 0;
 }
 
 std::string EepromWrites::save() {

@@ -12,6 +12,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstring>
@@ -94,10 +95,12 @@ int transact(Request& req) {
                 result = errno;
                 break;
             }
-            auto* h = reinterpret_cast<nlmsghdr*>(reply);
-            int len = static_cast<int>(n);
             bool done = false;
-            for (; NLMSG_OK(h, len); h = NLMSG_NEXT(h, len)) {
+            // NLMSG_OK/NLMSG_NEXT spelled out with unsigned sizes: the macros compare the u32 nlmsg_len with
+            // an int length (clang's -Wsign-compare).
+            std::size_t left = static_cast<std::size_t>(n);
+            for (auto* h = reinterpret_cast<nlmsghdr*>(reply);
+                 left >= sizeof(nlmsghdr) && h->nlmsg_len >= sizeof(nlmsghdr) && h->nlmsg_len <= left;) {
                 if (h->nlmsg_type == NLMSG_ERROR) {
                     const auto* e = static_cast<const nlmsgerr*>(NLMSG_DATA(h));
                     result = -e->error;
@@ -108,6 +111,9 @@ int transact(Request& req) {
                     done = true;
                     break;
                 }
+                const std::size_t step = std::min<std::size_t>(NLMSG_ALIGN(h->nlmsg_len), left);
+                left -= step;
+                h = reinterpret_cast<nlmsghdr*>(reinterpret_cast<uint8_t*>(h) + step);
             }
             if (done) break;
         }

@@ -57,7 +57,12 @@ void write_stats(std::ostream& out, const RuntimeStats& s, const esc::EscStats& 
         << "runtime.loop_gaps_over_1ms " << s.loop_gaps_over_1ms << '\n'
         << "runtime.loop_gap_max_ns " << s.loop_gap_max_ns << '\n'
         << "esc.frames_processed " << e.frames_processed << '\n'
-        << "esc.frames_malformed " << e.frames_malformed << '\n';
+        << "esc.frames_malformed " << e.frames_malformed << '\n'
+        << "esc.frames_ignored " << e.frames_ignored << '\n'
+        << "esc.malformed_no_header " << e.malformed_no_header << '\n'
+        << "esc.malformed_length " << e.malformed_length << '\n'
+        << "esc.malformed_datagram " << e.malformed_datagram << '\n'
+        << "esc.datagrams " << e.datagrams << '\n';
     if (firmware != nullptr) firmware->report(out);
 }
 

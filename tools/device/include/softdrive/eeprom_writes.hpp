@@ -24,6 +24,9 @@ class EepromWrites {
     // Reads the file. No file: empty, "". A bad file: empty and the reason (the file stays until the next
     // save replaces it).
     std::string load();
+    // Removes sii-writes.bin.tmp if an interrupted save left it behind (called once at the start of the
+    // device, never while a save may run). Returns whether there was one.
+    bool remove_stale_temp() const;
     // Writes the file now (atomically); "" or the error text.
     std::string save();
 
