@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <span>
@@ -203,7 +204,8 @@ class Context {
 
     // The restore note ("" if the state found at start was restored).
     std::string restore();
-    std::vector<std::string> notes;  // printed at the end
+    std::vector<std::string> notes;                      // printed at the end
+    std::map<std::string, std::shared_ptr<void>> cache;  // what several tests of a group share
 };
 
 std::string hex(uint64_t v, int digits = 4);
