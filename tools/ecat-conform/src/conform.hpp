@@ -101,6 +101,8 @@ struct Options {
     int device = -1;  // -1: the device whose identity matches the slave
     double timeout_scale = 1.0;
     bool verbose = false;
+    std::string foe_file;       // a file name the device's FoE server knows (Bootstrap firmware)
+    uint32_t foe_password = 0;  // its password
 };
 
 // ---- the run context -------------------------------------------------------------------------------

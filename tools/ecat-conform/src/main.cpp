@@ -61,6 +61,9 @@ int main(int argc, char** argv) {
     app.add_option("--json", json, "Write the results as JSON to FILE");
     app.add_option("--timeout-scale", o.timeout_scale, "Multiply every timeout (slow slaves, busy hosts)")
         ->check(CLI::Range(0.1, 100.0));
+    app.add_option("--foe-file", o.foe_file,
+                   "A file name the device accepts over FoE in Bootstrap (enables the password test)");
+    app.add_option("--foe-password", o.foe_password, "The FoE password of that file (default 0)");
     app.add_option("--backend", backend, "Raw-socket backend: packet or pcap");
     app.add_flag("--verbose,-v", o.verbose, "Details of passed and skipped tests too");
     CLI11_PARSE(app, argc, argv);
