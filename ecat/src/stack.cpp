@@ -514,7 +514,8 @@ void Stack::check_process_data_sms(uint64_t now_ns) {
         const SmRegs r = read_sm(n);
         const bool enabled = (r.activate & reg::kSmEnable) && r.length > 0;
         if (bytes == 0) return !enabled;
-        return enabled && r.length == bytes && r.start == start_address;
+        const bool length_ok = r.length == bytes || (n == 2 && faults_.sm2_length_unchecked);
+        return enabled && length_ok && r.start == start_address;
     };
     if (!still_valid(2, sm2_buf_.size(), sm2_start_)) {
         fall_back(AlState::SafeOp, al::InvalidOutputConfig, now_ns);

@@ -4,7 +4,7 @@
 namespace foe {
 
 struct FoeFaults {
-    bool password_ignored = false;  // a write with a wrong password is accepted (no error 0x8004)
+    bool password_ignored = false;  // a write with a wrong password is accepted (no error 0x800A)
     bool any_file_name = false;     // a write to an unknown file name is accepted (no error 0x8001)
 };
 
