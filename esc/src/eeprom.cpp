@@ -57,7 +57,9 @@ void Esc::Impl::eeprom_execute(Side) {
     switch (cmd) {
         case 1:  // read: 4 words (8-byte read size, 0x0502 bit 6)
             for (uint16_t i = 0; i < 4; ++i)
-                w16(static_cast<uint16_t>(reg::kSiiData + 2 * i), eeprom_word(addr + i));
+                w16(static_cast<uint16_t>(reg::kSiiData + 2 * i),
+                    static_cast<uint16_t>(eeprom_word(addr + i) ^
+                                          (addr + i == 7 && cfg.faults.sii_checksum_wrong ? 0x00FF : 0)));
             break;
         case 2:  // write one word
             if (!(c & 0x0001)) {

@@ -48,6 +48,15 @@ struct EnvironmentOptions {
     double stop_hi = kNone;
 };
 
+// Deliberate deviations of the firmware's layers, a testing aid (softdrive/faults.hpp); none by default.
+struct DeviceFaults {
+    ecat::StackFaults stack;
+    coe::CoeFaults coe;
+    foe::FoeFaults foe;
+    drive::AxisFaults axis;
+    bool identity_mismatch = false;  // 0x1018:02 = the SII's product code + 1
+};
+
 struct DeviceOptions {
     std::filesystem::path config_file;  // device configuration (od::load_device_config); empty: defaults
     std::filesystem::path state_dir = "/var/lib/softecat";  // parameters.bin, firmware/
@@ -55,6 +64,7 @@ struct DeviceOptions {
     bool load_sii = true;         // false: the ESC serves a user's image (--eeprom), leave it alone
     bool commission = true;       // drive::commission() before the stored parameters are applied
     std::ostream* log = nullptr;  // warnings (bad parameter file, ...); null: std::cerr
+    DeviceFaults faults;          // testing aid (ecat-slave --fault); none by default
 };
 
 // Where the firmware slots live inside the state directory.
