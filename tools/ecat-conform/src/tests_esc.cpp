@@ -458,7 +458,7 @@ void add_esc_tests(Catalogue& c) {
     });
     add(
         "reg.dl_status", "DL status 0x0110: EEPROM loaded, PDI operational (bit 0)",
-        "ESC register 0x0110 (DL status)",
+        "ETG.1000.4 DL status register 0x0110",
         [](Context& ctx) {
             auto s = ctx.rd<uint16_t>(0x0110);
             if (!s) return fail("0x0110 unreadable", err(s.error()));
