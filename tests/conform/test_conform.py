@@ -52,6 +52,17 @@ def alias_images(work):
     return sii, esi
 
 
+class ConformBus(harness.Bus):
+    """A Bus whose readiness probe is ecat-conform itself (BRD): ecatctl cannot talk to a slave whose APRD
+    counts wrong or whose replies keep our source MAC, and those are faults under test."""
+
+    def ecatctl(self, *args, check=True, binary=False):
+        if "reg" in args and "read" in args and not check:
+            return subprocess.run([os.environ["ECAT_CONFORM"], "--iface", self.iface, "--filter", "esc.brd.wkc"],
+                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=60)
+        return super().ecatctl(*args, check=check, binary=binary)
+
+
 class Conform(unittest.TestCase):
     mode = "clean"
     faults = []
@@ -62,7 +73,7 @@ class Conform(unittest.TestCase):
         args = ["--eeprom", sii]
         if fault:
             args += ["--fault", fault]
-        with harness.Bus(slave_args=args) as bus:
+        with ConformBus(slave_args=args) as bus:
             out = os.path.join(work, "result.json")
             junit = os.path.join(work, "result.xml")
             t0 = time.monotonic()

@@ -272,7 +272,7 @@ Error Context::ack_error() {
     auto s = m.read_reg<uint16_t>(addr, master::reg::AlStatus);
     if (!s) return s.error();
     if (!(*s & 0x10)) return Error::Ok;
-    const auto deadline = Clock::now() + ms(2000);
+    const auto deadline = Clock::now() + ms(500);
     (void)m.write_reg<uint16_t>(addr, master::reg::AlControl, static_cast<uint16_t>((*s & 0x0F) | 0x10));
     for (;;) {
         s = m.read_reg<uint16_t>(addr, master::reg::AlStatus);

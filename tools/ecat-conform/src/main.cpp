@@ -105,6 +105,7 @@ int main(int argc, char** argv) {
     master::MasterOptions mo;
     mo.timeout = std::chrono::microseconds(static_cast<long>(20'000 * o.timeout_scale));
     mo.retries = 2;
+    mo.accept_own_source = true;  // esc.frame.source_mac checks the bit; the rest still runs
     mo.sii_timeout = std::chrono::milliseconds(static_cast<long>(100 * o.timeout_scale));
     mo.al_timeout = std::chrono::milliseconds(static_cast<long>(5000 * o.timeout_scale));
     master::Master m(*link, mo);

@@ -283,22 +283,27 @@ void add_esm_tests(Catalogue& c) {
                 return fail("executed without acknowledge", status_text(st2), "INIT+ERR");
             return pass("ignored", status_text(st2));
         });
-    add("error.ack", "Error acknowledge clears the error indication and keeps the state",
-        "ETG.1000.6 AL control (error indication acknowledge)", [](Context& ctx) {
-            if (Error e = ctx.to_init(); e != Error::Ok) return fail("cannot reach INIT", err(e));
-            master::AlStatus st = ctx.request_raw(8, ctx.ms(1000));
+    add(
+        "error.ack", "Error acknowledge (PREOP + 0x10) clears the error indication and keeps the state",
+        "ETG.1000.6 AL control (error indication acknowledge)",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_mailbox());
+            if (Error e = ctx.to_preop(); e != Error::Ok) return fail("cannot reach PREOP", err(e));
+            master::AlStatus st = ctx.request_raw(8, ctx.ms(1000));  // P -> O: refused
             if (!st.error)
-                return fail("INIT -> OP did not set the error indication", status_text(st), "INIT+ERR");
-            (void)ctx.m.write_reg<uint16_t>(ctx.addr, master::reg::AlControl, 0x11);
+                return fail("PREOP -> OP did not set the error indication", status_text(st), "PREOP+ERR");
+            (void)ctx.m.write_reg<uint16_t>(ctx.addr, master::reg::AlControl, 0x12);
             master::AlStatus st2;
             for (int i = 0; i < 200; ++i) {
                 if (auto s = ctx.m.al_status(ctx.addr)) st2 = *s;
                 if (!st2.error) break;
                 std::this_thread::sleep_for(std::chrono::milliseconds(1));
             }
-            if (st2.state != 1 || st2.error) return fail("after acknowledge", status_text(st2), "INIT");
+            ctx.in_preop = false;
+            if (st2.state != 2 || st2.error) return fail("after acknowledge", status_text(st2), "PREOP");
             return pass("acknowledged", status_text(st2));
-        });
+        },
+        "mailbox slave");
     add(
         "error.code_cleared", "AL status code 0x0000 once the error is acknowledged", kCodes,
         [](Context& ctx) {

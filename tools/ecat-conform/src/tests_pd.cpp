@@ -79,6 +79,20 @@ const MappedEntry* harmless_output(const PdoMap& m) {
 
 Outcome inputs_match(Context& ctx, uint8_t state) {
     CONFORM_NEED(ctx.need_coe());
+    if (Error x = ctx.to_init(); x != Error::Ok) return fail("cannot reach INIT", err(x));
+    CONFORM_PREOP(ctx);
+    {
+        // Fill the input SM's buffers with a pattern first (plain RAM while SM3 is off): inputs the slave
+        // never writes then show up as the pattern, not as stale values of an earlier run.
+        master::ProcessDataSession s(ctx.m, ctx.addr, *ctx.sdo);
+        if (Error x = s.discover(); x != Error::Ok) return fail("layout: " + ctx.sdo_error(x));
+        std::vector<uint8_t> pattern(3u * s.layout().sm3_length, 0xA5);
+        for (std::size_t k = 0; k < pattern.size(); k += 256) {
+            const std::size_t n = std::min<std::size_t>(256, pattern.size() - k);
+            (void)ctx.m.write(ctx.addr, static_cast<uint16_t>(s.layout().sm3_start + k),
+                              std::span<const uint8_t>(pattern.data() + k, n));
+        }
+    }
     Error e = state == 8 ? ctx.to_op() : ctx.to_safeop();
     if (e != Error::Ok) return fail("cannot reach the state: " + err(e));
     PdoMap m;
