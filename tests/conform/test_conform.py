@@ -1,7 +1,7 @@
 """ecat-conform against the soft slave over a veth pair: the clean slave passes every test, and each
 `ecat-slave --fault NAME` makes the test(s) named in faults.txt fail and no test of an unrelated group.
 
-usage: test_conform.py clean | fault NAME [NAME ...]
+usage: test_conform.py clean | noslave | dies | fault NAME [NAME ...]
 The slave serves an SII with station alias 0x1234 (and the ESI says the same), so the alias tests run too.
 """
 import json
@@ -105,6 +105,47 @@ class Conform(unittest.TestCase):
             self.assertGreaterEqual(len(res["results"]), 150)
             print(f"clean run: {len(res['results'])} tests in {elapsed:.1f} s", file=sys.stderr)
             return
+        if self.mode == "noslave":
+            # Nothing on the other end of the pair: every test fails with the reason, quickly, exit code 1.
+            uid = f"{os.getpid() % 100000}"
+            a, b = f"cfa{uid}", f"cfb{uid}"
+            subprocess.run(["ip", "link", "add", a, "type", "veth", "peer", "name", b], check=True)
+            try:
+                subprocess.run(["ip", "link", "set", a, "up"], check=True)
+                subprocess.run(["ip", "link", "set", b, "up"], check=True)
+                out = os.path.join(tempfile.mkdtemp(dir=os.environ.get("ECAT_TEST_OUT")), "r.json")
+                t0 = time.monotonic()
+                r = subprocess.run([os.environ["ECAT_CONFORM"], "--iface", a, "--json", out], stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE, text=True, timeout=120)
+                self.assertLess(time.monotonic() - t0, 60)
+            finally:
+                subprocess.run(["ip", "link", "del", a])
+            self.assertEqual(r.returncode, 1, r.stderr)
+            res = json.load(open(out))
+            self.assertGreaterEqual(len(res["results"]), 150)
+            for x in res["results"]:
+                self.assertEqual(x["status"], "FAIL")
+                self.assertIn("no slave answered", x["message"])
+            self.assertTrue(r.stdout.rstrip().endswith(f"0 passed, {len(res['results'])} failed, 0 skipped"))
+            return
+        if self.mode == "dies":
+            # The slave stops in the middle of the run: the run ends in time, the tests after it fail saying so.
+            work = tempfile.mkdtemp(prefix="ecat-conform-", dir=os.environ.get("ECAT_TEST_OUT"))
+            sii, esi = alias_images(work)
+            with ConformBus(slave_args=["--eeprom", sii]) as bus:
+                out = os.path.join(work, "r.json")
+                p = subprocess.Popen([os.environ["ECAT_CONFORM"], "--iface", bus.iface, "--esi", esi, "--json", out],
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                time.sleep(1.0)
+                bus.stop_slave()
+                stdout, _ = p.communicate(timeout=120)
+            self.assertEqual(p.returncode, 1)
+            res = json.load(open(out))
+            statuses = [x["status"] for x in res["results"]]
+            self.assertIn("PASS", statuses)
+            self.assertEqual(statuses[-1], "FAIL")
+            self.assertTrue(any("no longer answers" in x["message"] for x in res["results"]), stdout[-2000:])
+            return
         for fault in self.faults:
             with self.subTest(fault=fault):
                 self.assertIn(fault, rows, "no row in faults.txt")
@@ -121,7 +162,7 @@ class Conform(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) >= 2 and sys.argv[1] in ("clean", "fault"):
+    if len(sys.argv) >= 2 and sys.argv[1] in ("clean", "fault", "noslave", "dies"):
         Conform.mode = sys.argv[1]
         Conform.faults = sys.argv[2:]
         del sys.argv[1:]

@@ -136,10 +136,24 @@ int main(int argc, char** argv) {
         info.device = id;
         if (ctx.esi) info.device += ", ESI device \"" + ctx.esi->type_name + "\"";
         std::string group;
+        std::string lost;  // id of the test during which the slave stopped answering, "" while it answers
         for (const auto& t : chosen) {
             conform::TestResult r;
             r.test = &t;
             const auto s0 = std::chrono::steady_clock::now();
+            if (!lost.empty()) {
+                // Back (restarted, replugged)? Addresses again and carry on; else fail at once.
+                auto n = m.count_slaves();
+                if (n && *n > o.slave && m.assign_station_addresses(*n) == master::Error::Ok) {
+                    ctx.notes.push_back("the slave answered again after it was lost during " + lost);
+                    lost.clear();
+                    group.clear();
+                } else {
+                    r.outcome = conform::fail("the slave no longer answers (lost during " + lost + ")");
+                    results.push_back(r);
+                    continue;
+                }
+            }
             // Every group starts from INIT with SMs and FMMUs off, as a master's start-up does.
             if (t.group != group) {
                 group = t.group;
@@ -159,7 +173,8 @@ int main(int argc, char** argv) {
             // A slave that stopped answering (reset, crash): say so on the test that saw it.
             if (r.outcome.status == Status::Fail && !ctx.rd<uint16_t>(0x0010)) {
                 r.outcome.message += " (the slave no longer answers at its station address)";
-                (void)m.assign_station_addresses(ctx.slave_count);
+                auto n = m.count_slaves();
+                if (!n || *n <= o.slave || m.assign_station_addresses(*n) != master::Error::Ok) lost = t.id;
             }
             r.duration =
                 std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - s0);

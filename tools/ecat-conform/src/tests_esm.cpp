@@ -355,10 +355,19 @@ void add_esm_tests(Catalogue& c) {
             if (!ctx.esi->identification_reg134)
                 return skip("the ESI does not announce IdentificationReg134");
             (void)ctx.to_init();
-            auto id = ctx.m.identify(ctx.addr);
-            if (!id) return fail("no identification value", err(id.error()), "AL status bit 5");
+            (void)ctx.wr<uint16_t>(master::reg::AlControl, 0x0021);
+            bool loaded = false;
+            for (int i = 0; i < 500 && !loaded; ++i) {
+                auto s = ctx.rd<uint16_t>(master::reg::AlStatus);
+                loaded = s && (*s & 0x20);
+                if (!loaded) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));  // 0x0134 is written with the bit
+            auto id = ctx.rd<uint16_t>(0x0134);
+            (void)ctx.wr<uint16_t>(master::reg::AlControl, 0x0001);
+            if (!loaded) return fail("AL status bit 5 (identification loaded) never set", "", "bit 5 set");
             auto alias = ctx.rd<uint16_t>(0x0012);
-            return expect_eq("0x0134", hex(*id), alias ? hex(*alias) : "?");
+            return expect_eq("0x0134", id ? hex(*id) : "?", alias ? hex(*alias) : "?");
         },
         "ESI announces IdentificationReg134");
 }
