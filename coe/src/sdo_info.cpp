@@ -160,7 +160,7 @@ void CoeServer::info_error(uint32_t code, ecat::MailboxSender& out) {
     wire::put_coe_header(p, wire::Service::SdoInfo);
     p[2] = kOpError;
     wire::put32(p + kInfoHead, code);
-    send(std::span<const uint8_t>(p, kInfoHead + 4), out);
+    send(std::span<const uint8_t>(p, kInfoHead + (config_.faults.info_error_short ? 2 : 4)), out);
 }
 
 void CoeServer::info_od_list(uint16_t list_type, ecat::MailboxSender& out) {
@@ -216,7 +216,8 @@ void CoeServer::info_entry(uint16_t index, uint8_t sub, uint8_t value_info, ecat
     wire::put16(p, index);
     p[2] = sub;
     p[3] = value_info;
-    wire::put16(p + 4, static_cast<uint16_t>(e->type));
+    wire::put16(p + 4, sub > 0 && config_.faults.info_entry_wrong_type ? uint16_t{0x0005}
+                                                                       : static_cast<uint16_t>(e->type));
     wire::put16(p + 6, e->bit_length);
     wire::put16(p + 8, e->access);
     std::size_t at = 10;

@@ -98,11 +98,30 @@ void CoeServer::send_abort(uint16_t index, uint8_t sub, uint32_t code, ecat::Mai
     uint8_t* p = tx(kSdoFrame);
     // SOES sends the abort as an SDO request (service 2); masters accept it by its command byte.
     wire::put_coe_header(p, wire::Service::SdoRequest);
-    p[2] = 0x80;
+    p[2] = abort_command_;
+    abort_command_ = 0x80;
     wire::put16(p + 3, index);
     p[5] = sub;
     wire::put32(p + 6, code);
     send(std::span<const uint8_t>(p, kSdoFrame), out);
+}
+
+void CoeServer::confirm_download(uint16_t index, uint8_t sub, ecat::MailboxSender& out) {
+    uint8_t* p = tx(kSdoFrame);
+    wire::put_coe_header(p, wire::Service::SdoResponse);
+    p[2] = 0x60;
+    wire::put16(p + 3, index);
+    p[5] = sub;
+    send(std::span<const uint8_t>(p, kSdoFrame), out);
+}
+
+// The AL state a download is checked against: with the pdo_map_in_safe_op fault, the PDO mapping and
+// assignment objects are writable in Safe-Op as in Pre-Op.
+od::AlState CoeServer::write_state(uint16_t index) const {
+    const bool pdo = (index >= 0x1600 && index <= 0x17FF) || (index >= 0x1A00 && index <= 0x1BFF) ||
+                     index == 0x1C12 || index == 0x1C13;
+    if (pdo && config_.faults.pdo_map_in_safe_op && state() == od::AlState::SafeOp) return od::AlState::PreOp;
+    return state();
 }
 
 void CoeServer::cancel_transfer() {
@@ -180,7 +199,9 @@ void CoeServer::handle_sdo(std::span<const uint8_t> sdo, std::size_t frame_size,
 
 void CoeServer::upload_initiate(uint16_t index, uint8_t sub, bool ca, ecat::MailboxSender& out) {
     const od::Object* obj = dict_.find(index);
-    if (obj == nullptr) return send_abort(index, sub, abort::NoObject, out);
+    if (obj == nullptr)
+        return send_abort(index, sub,
+                          config_.faults.abort_missing_object ? abort::NoSubindex : abort::NoObject, out);
     std::size_t len = 0;
     od::Status st;
     if (ca && obj->code != od::ObjectCode::Var) {
@@ -188,6 +209,10 @@ void CoeServer::upload_initiate(uint16_t index, uint8_t sub, bool ca, ecat::Mail
         std::size_t need = ca::image_size(*obj, sub, obj->max_subindex());
         if (data_.size() < need) data_.resize(need);
         st = ca::upload(dict_, *obj, sub, state(), data_, len, scratch_);
+        if (st == od::Status::Ok && sub == 0 && len >= 2 && config_.faults.ca_no_padding) {
+            std::memmove(data_.data() + 1, data_.data() + 2, len - 2);  // subindex 0 without its pad byte
+            --len;
+        }
     } else {
         const od::Entry* e = dict_.find(index, sub);
         if (e == nullptr) return send_abort(index, sub, abort::NoSubindex, out);
@@ -200,7 +225,8 @@ void CoeServer::upload_initiate(uint16_t index, uint8_t sub, bool ca, ecat::Mail
     if (len >= 1 && len <= 4) {
         uint8_t* p = tx(kSdoFrame);
         wire::put_coe_header(p, wire::Service::SdoResponse);
-        p[2] = static_cast<uint8_t>(0x40 | ca_bit | ((4 - len) << 2) | kCmdExpedited | kCmdSizeIndicated);
+        const std::size_t unused = config_.faults.expedited_size_wrong ? 0 : 4 - len;
+        p[2] = static_cast<uint8_t>(0x40 | ca_bit | (unused << 2) | kCmdExpedited | kCmdSizeIndicated);
         wire::put16(p + 3, index);
         p[5] = sub;
         std::memcpy(p + 6, data_.data(), len);
@@ -254,7 +280,7 @@ void CoeServer::send_upload_segment(ecat::MailboxSender& out) {
     const std::size_t frame = std::max(kSegmentHead + n, kSdoFrame);
     uint8_t* p = tx(frame);
     wire::put_coe_header(p, wire::Service::SdoResponse);
-    uint8_t c = static_cast<uint8_t>(xfer_.toggle ? 0x10 : 0x00);
+    uint8_t c = static_cast<uint8_t>(xfer_.toggle && !config_.faults.upload_toggle_stuck ? 0x10 : 0x00);
     if (n < 7) c = static_cast<uint8_t>(c | ((7 - n) << 1));
     if (last) c |= kCmdLastSegment;
     p[2] = c;
@@ -273,8 +299,11 @@ void CoeServer::download_initiate(std::span<const uint8_t> sdo, ecat::MailboxSen
     const uint16_t index = wire::get16(sdo, 1);
     const uint8_t sub = sdo[3];
     bool ca = (cmd & kCmdCompleteAccess) != 0;
+    if (config_.faults.download_abort_command) abort_command_ = cmd;
     const od::Object* obj = dict_.find(index);
-    if (obj == nullptr) return send_abort(index, sub, abort::NoObject, out);
+    if (obj == nullptr)
+        return send_abort(index, sub,
+                          config_.faults.abort_missing_object ? abort::NoSubindex : abort::NoObject, out);
     const bool whole = ca && obj->code != od::ObjectCode::Var;
     std::size_t capacity = 0;
     if (whole) {
@@ -283,8 +312,14 @@ void CoeServer::download_initiate(std::span<const uint8_t> sdo, ecat::MailboxSen
     } else {
         const od::Entry* e = dict_.find(index, sub);
         if (e == nullptr) return send_abort(index, sub, abort::NoSubindex, out);
-        if (!writable_at_all(*e)) return send_abort(index, sub, abort::ReadOnly, out);
-        if (!e->writable(state())) return send_abort(index, sub, abort::WrongState, out);
+        if (!writable_at_all(*e)) {
+            if (config_.faults.read_only_write_confirmed) {
+                abort_command_ = 0x80;
+                return confirm_download(index, sub, out);
+            }
+            return send_abort(index, sub, abort::ReadOnly, out);
+        }
+        if (!e->writable(write_state(index))) return send_abort(index, sub, abort::WrongState, out);
         capacity = e->byte_size();
     }
     if (data_.size() < capacity) data_.resize(capacity);
@@ -338,6 +373,7 @@ void CoeServer::download_initiate(std::span<const uint8_t> sdo, ecat::MailboxSen
         cancel_transfer();
         if (code != 0) return send_abort(index, sub, code, out);
     }
+    abort_command_ = 0x80;
     uint8_t* p = tx(kSdoFrame);
     wire::put_coe_header(p, wire::Service::SdoResponse);
     p[2] = static_cast<uint8_t>(0x60 | (ca ? kCmdCompleteAccess : 0));
@@ -348,6 +384,7 @@ void CoeServer::download_initiate(std::span<const uint8_t> sdo, ecat::MailboxSen
 
 void CoeServer::download_segment(std::span<const uint8_t> sdo, ecat::MailboxSender& out) {
     const uint8_t cmd = sdo[0];
+    if (config_.faults.download_abort_command) abort_command_ = cmd;
     if (xfer_.kind != Transfer::Download) {
         uint16_t index = xfer_.index;
         uint8_t sub = xfer_.sub;
@@ -357,7 +394,7 @@ void CoeServer::download_segment(std::span<const uint8_t> sdo, ecat::MailboxSend
     const uint16_t index = xfer_.index;
     const uint8_t sub = xfer_.sub;
     const uint8_t toggle = (cmd & 0x10) ? 1 : 0;
-    if (toggle != xfer_.toggle) {
+    if (toggle != xfer_.toggle && !config_.faults.download_toggle_unchecked) {
         cancel_transfer();
         return send_abort(index, sub, abort::ToggleBit, out);
     }
@@ -380,6 +417,7 @@ void CoeServer::download_segment(std::span<const uint8_t> sdo, ecat::MailboxSend
         cancel_transfer();
         if (code != 0) return send_abort(index, sub, code, out);
     }
+    abort_command_ = 0x80;
     uint8_t* p = tx(kSdoFrame);
     wire::put_coe_header(p, wire::Service::SdoResponse);
     p[2] = static_cast<uint8_t>(0x20 | (toggle ? 0x10 : 0));
@@ -392,10 +430,13 @@ uint32_t CoeServer::commit_download() {
     if (xfer_.complete_access) {
         const od::Object* obj = dict_.find(xfer_.index);
         if (obj == nullptr) return abort::NoObject;
-        st = ca::download(dict_, *obj, xfer_.sub, state(), value, rollback_, scratch_);
+        st = ca::download(dict_, *obj, xfer_.sub, write_state(xfer_.index), value, rollback_, scratch_);
     } else {
-        st = dict_.write(xfer_.index, xfer_.sub, state(), value);
+        st = dict_.write(xfer_.index, xfer_.sub, write_state(xfer_.index), value);
     }
+    if (config_.faults.value_range_unchecked &&
+        (st == od::Status::ValueTooHigh || st == od::Status::ValueTooLow))
+        return 0;  // confirmed, although the value was not taken
     return abort_code(st);
 }
 

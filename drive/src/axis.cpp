@@ -157,7 +157,10 @@ void Axis::begin_stop(StopKind kind, double decel_rpm_s, int64_t) {
 
 void Axis::device_control(int64_t now_ns) {
     const uint16_t c = command.controlword;
-    const DeviceCommand dc = decode(c, cw_prev_);
+    DeviceCommand dc = decode(c, cw_prev_);
+    if ((dc == DeviceCommand::QuickStop && state_ == State::OperationEnabled && faults.quick_stop_ignored) ||
+        (dc == DeviceCommand::FaultReset && faults.fault_reset_ignored))
+        dc = DeviceCommand::None;
     if (pending_.active || state_ == State::FaultReactionActive) return;  // one command completes first
     if (dc == DeviceCommand::FaultReset && state_ != State::Fault) {
         // A fault reset outside Fault acknowledges warnings ("fault signal only" reactions).
@@ -954,7 +957,7 @@ void Axis::update_feedback() {
     }
     if (state_ == State::QuickStopActive && ramp_done_) s |= sw::TargetReached;
     f.statusword = s;
-    f.mode_display = mode_;
+    if (!faults.mode_display_stuck || f.mode_display == mode::None) f.mode_display = mode_;
     f.position_actual = report(count_ + shift_);
     f.position_demand = report(static_cast<int64_t>(std::llround(demand_pos_)) + shift_);
     f.following_error = clamp_i32(std::round(demand_pos_ - static_cast<double>(count_)));

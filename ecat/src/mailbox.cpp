@@ -188,7 +188,7 @@ void Mailbox::dispatch(std::span<const uint8_t> message) {
     }
     // A request repeated with the same non-zero counter (its reply was lost, or the master's write was
     // repeated) is not executed twice.
-    if (counter != 0 && counter == last_rx_counter_) {
+    if (counter != 0 && counter == last_rx_counter_ && !faults_.counter_ignored) {
         ++stats_.duplicates;
         return;
     }
@@ -202,7 +202,7 @@ void Mailbox::dispatch(std::span<const uint8_t> message) {
     const bool allowed = handler != nullptr && handler->available(state_) &&
                          (state_ != od::AlState::Boot || handler->type() == MailboxType::FoE);
     if (!allowed) {
-        send_error(MailboxError::UnsupportedProtocol);
+        if (!faults_.unsupported_protocol_silent) send_error(MailboxError::UnsupportedProtocol);
         return;
     }
     ++stats_.dispatched;
@@ -239,7 +239,7 @@ void Mailbox::transmit() {
 void Mailbox::serve_repeat_request() {
     const uint8_t activate = pdi_.read_reg<uint8_t>(sm1_base() + reg::kSmActivate);
     const bool request = (activate & reg::kSmRepeatRequest) != 0;
-    if (request == repeat_ack_) return;
+    if (request == repeat_ack_ || faults_.repeat_ignored) return;
     ++stats_.repeats;
     const uint8_t status = pdi_.read_reg<uint8_t>(sm1_base() + reg::kSmStatus);
     const uint8_t ack_bits = repeat_ack_ ? reg::kSmPdiRepeatAck : 0;

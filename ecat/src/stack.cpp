@@ -209,7 +209,7 @@ void Stack::poll(uint64_t now_ns) {
             (void)pdi_.read_reg<uint8_t>(reg::sm_base(n) + reg::kSmActivate);
         if (process_data_state(state_)) check_process_data_sms(now_ns);
     }
-    if (events & reg::kEvWatchdogPd) {
+    if ((events & reg::kEvWatchdogPd) && !faults_.watchdog_ignored) {
         const uint16_t wd = pdi_.read_reg<uint16_t>(reg::kWatchdogStatusPd);
         if (!(wd & 0x0001)) {
             ++stats_.watchdog_expiries;
@@ -287,7 +287,7 @@ void Stack::restart_after_esc_reset(uint64_t now_ns) {
 void Stack::handle_al_control(uint64_t now_ns) {
     const uint16_t control = pdi_.read_reg<uint16_t>(reg::kAlControl);  // clears AL event bit 0
     const unsigned requested = control & reg::kAlStateMask;
-    const bool ack = (control & reg::kAlErrorFlag) != 0;
+    const bool ack = (control & reg::kAlErrorFlag) != 0 && !faults_.error_ack_ignored;
     const bool id_request = (control & reg::kAlIdFlag) != 0;
 
     // A new request supersedes a Safe-Op -> Op still waiting for outputs / SYNC0.
@@ -330,11 +330,12 @@ void Stack::request(AlState to, uint64_t now_ns) {
 void Stack::request_checked(AlState to, uint64_t now_ns) {
     const AlState from = state_;
     const bool boot_supported = check_bootstrap() == 0;
-    if (to == AlState::Boot && from == AlState::Init && !boot_supported) {
+    if (to == AlState::Boot && from == AlState::Init && (!boot_supported || faults_.bootstrap_refused)) {
         refuse(al::BootstrapNotSupported);
         return;
     }
     if (!valid_transition(from, to)) {
+        if (faults_.invalid_request_silent) return;
         refuse(al::InvalidStateChange);
         return;
     }
@@ -419,7 +420,7 @@ uint16_t Stack::check_pre_op_to_safe_op() {
             if (enabled) return s.code;
             continue;
         }
-        if (!enabled || r.length != s.bytes) return s.code;
+        if (!enabled || (r.length != s.bytes && !(s.sm == 2 && faults_.sm2_length_unchecked))) return s.code;
         if ((r.control & reg::kSmModeMask) != reg::kSmModeBuffered) return al::InvalidSmTypes;
         const uint8_t expected = expected_control(s.sm, s.fallback_control);
         if ((r.control & reg::kSmDirMask) != (expected & reg::kSmDirMask) ||
@@ -558,7 +559,8 @@ void Stack::check_process_data_sms(uint64_t now_ns) {
         const SmRegs r = read_sm(n);
         const bool enabled = (r.activate & reg::kSmEnable) && r.length > 0;
         if (bytes == 0) return !enabled;
-        return enabled && r.length == bytes && r.start == start_address;
+        const bool length_ok = r.length == bytes || (n == 2 && faults_.sm2_length_unchecked);
+        return enabled && length_ok && r.start == start_address;
     };
     if (!still_valid(2, sm2_buf_.size(), sm2_start_)) {
         fall_back(AlState::SafeOp, al::InvalidOutputConfig, now_ns);
@@ -642,7 +644,7 @@ void Stack::update_irq_usable() {
 
 void Stack::refuse(uint16_t code) {
     error_ = true;
-    code_ = code;
+    code_ = faults_.al_code_missing ? al::NoError : code;
     id_loaded_ = false;
     ++stats_.refused;
 }
@@ -718,7 +720,7 @@ void Stack::stop_process_data() {
 }
 
 void Stack::write_inputs() {
-    if (sm3_buf_.empty()) return;
+    if (sm3_buf_.empty() || (faults_.inputs_op_only && state_ != AlState::Op)) return;
     pd_.dictionary_to_inputs(sm3_buf_);
     pdi_.write(sm3_start_, sm3_buf_);
 }
@@ -728,7 +730,8 @@ void Stack::run_cycle(uint64_t now_ns, bool fresh_outputs) {
         // Reading SM2 from its first to its last byte takes the newest buffer and releases it.
         if (fresh_outputs) pdi_.read(sm2_start_, sm2_buf_);
         // Safe-Op: outputs are ignored, the application keeps its safe values.
-        if (state_ == AlState::Op && fresh_outputs) pd_.outputs_to_dictionary(sm2_buf_);
+        if ((state_ == AlState::Op || faults_.outputs_in_safe_op) && fresh_outputs)
+            pd_.outputs_to_dictionary(sm2_buf_);
     }
     app_.on_cycle(now_ns);
     write_inputs();

@@ -145,7 +145,7 @@ void Esc::Impl::dc_activation_written(uint8_t old, uint8_t v) {
                     fire = false;  // as silicon: waits for a counter wrap, i.e. never
                 }
             }
-            if (fire) {
+            if (fire && !cfg.faults.sync0_never) {
                 sync0_armed = true;
                 next_sync0 = start;
             }

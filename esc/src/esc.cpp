@@ -288,7 +288,8 @@ bool Esc::Impl::process(std::span<uint8_t> frame, uint64_t rx_clock) {
         ++stats.frames_ignored;
         return false;
     }
-    f[6] |= 0x02;  // source MAC: locally administered bit, as every ESC processing unit sets it
+    if (!cfg.faults.source_mac_unchanged)
+        f[6] |= 0x02;  // source MAC: locally administered bit, as every ESC sets it
     const std::size_t hdr = off + 2;
     if (size < hdr + 2) {
         ++stats.frames_malformed;
@@ -425,7 +426,9 @@ void Esc::Impl::datagram(uint8_t* d, uint8_t* data, uint16_t len) {
         case kFprw:
         case kFrmw: {
             const bool match =
-                adp == r16(reg::kStationAddress) || ((r8(0x0103) & 0x01) && adp == r16(reg::kStationAlias));
+                adp == r16(reg::kStationAddress) ||
+                ((r8(0x0103) & 0x01) && !cfg.faults.alias_ignored && adp == r16(reg::kStationAlias)) ||
+                (cmd == kFprd && cfg.faults.fprd_any_address);
             if (cmd == kFrmw) {
                 op = match ? kRead : kWrite;
             } else if (match) {
@@ -483,6 +486,7 @@ void Esc::Impl::datagram(uint8_t* d, uint8_t* data, uint16_t len) {
             inc = static_cast<uint16_t>(inc + (op == kWrite ? 1 : 2));
         if (lookup_dirty) rebuild_lookup();
     }
+    if (cmd == kAprd && inc && cfg.faults.wkc_aprd) ++inc;
     if (inc) put_le16(wkc_p, static_cast<uint16_t>(le16(wkc_p) + inc));
 }
 

@@ -119,7 +119,7 @@ void Esc::Impl::reg_read(uint16_t a, uint8_t* dst, uint32_t n, Side side) {
     // Values computed at the moment of the access.
     if (a < 0x0A00 && e > reg::kDcRecvTime0) {
         if (overlaps(a, e, reg::kDcSystemTime, 8)) {
-            const uint64_t local = cur_local();
+            const uint64_t local = side == Side::Ecat && cfg.faults.dc_time_frozen ? 0 : cur_local();
             uint64_t st = local + r64(reg::kDcOffset);
             if (side == Side::Ecat) st -= r32(reg::kDcDelay);
             w64(reg::kDcSystemTime, st);

@@ -606,3 +606,37 @@ TEST_F(FoeServerTest, EveryWriteEndIsReportedOnceWithNameSizeAndResult) {
     EXPECT_EQ(upload("MAXPOS"), image);
     EXPECT_EQ(events.calls.size(), 3u);
 }
+
+// ---- Deliberate faults (foe/faults.hpp, `ecat-slave --fault`) ----------------------------------------
+
+TEST_F(FoeServerTest, FaultPasswordIgnoredAcceptsAWrongPassword) {
+    EXPECT_EQ(error_code(exchange(request(Opcode::Write, 0x1234, "MAXPOS"))), 0x800Au);  // clean: no rights
+    ServerConfig c = stepped();
+    c.faults.password_ignored = true;
+    FoeServer faulty(store, c);
+    faulty.on_state_change(od::AlState::Init, od::AlState::Boot);
+    faulty.handle(request(Opcode::Write, 0x1234, "MAXPOS"), out);
+    ASSERT_EQ(out.sent.size(), 1u);
+    EXPECT_TRUE(is_ack(out.take(), 0));
+    faulty.abort_transfer();
+    // An unknown file name is still refused.
+    faulty.handle(request(Opcode::Write, 0, "NOSUCHFILE"), out);
+    ASSERT_EQ(out.sent.size(), 1u);
+    EXPECT_EQ(error_code(out.take()), 0x8001u);
+}
+
+TEST_F(FoeServerTest, FaultAnyFileNameAcceptsAnUnknownFile) {
+    EXPECT_EQ(error_code(exchange(request(Opcode::Write, 0, "NOSUCHFILE"))), 0x8001u);  // clean: not found
+    ServerConfig c = stepped();
+    c.faults.any_file_name = true;
+    FoeServer faulty(store, c);
+    faulty.on_state_change(od::AlState::Init, od::AlState::Boot);
+    faulty.handle(request(Opcode::Write, 0, "NOSUCHFILE"), out);
+    ASSERT_EQ(out.sent.size(), 1u);
+    EXPECT_TRUE(is_ack(out.take(), 0));
+    faulty.abort_transfer();
+    // A wrong password is still refused.
+    faulty.handle(request(Opcode::Write, 0x1234, "MAXPOS"), out);
+    ASSERT_EQ(out.sent.size(), 1u);
+    EXPECT_EQ(error_code(out.take()), 0x800Au);
+}

@@ -22,6 +22,7 @@
 
 #include "esc/link_packet.hpp"
 #include "netns_util.hpp"
+#include "softdrive/faults.hpp"
 #include "softslave/netif.hpp"
 
 namespace {
@@ -149,6 +150,33 @@ TEST(EcatSlaveCli, BadOptionsExitWith2) {
     EXPECT_EQ(run({"--spin-us", "0", "--iface", "lo"}).code, 2);
 }
 
+TEST(EcatSlaveCli, FaultListPrintsEveryFaultWithItsDescriptionAndExits0) {
+    const RunResult r = run({"--fault", "list"});
+    EXPECT_EQ(r.code, 0) << r.output;
+    std::size_t lines = 0;
+    for (char c : r.output)
+        lines += c == '\n';
+    EXPECT_EQ(lines, softdrive::kFaultCount) << r.output;
+    for (const softdrive::FaultInfo& f : softdrive::fault_catalogue()) {
+        const std::size_t at = r.output.find(std::string(f.name) + " ");
+        ASSERT_NE(at, std::string::npos) << f.name << "\n" << r.output;
+        const std::size_t eol = r.output.find('\n', at);
+        EXPECT_NE(r.output.substr(at, eol - at).find(f.description), std::string::npos) << f.name;
+    }
+    EXPECT_GE(softdrive::kFaultCount, 22u);
+}
+
+TEST(EcatSlaveCli, UnknownFaultIsAUsageError) {
+    RunResult r = run({"--fault", "no-such-fault", "--iface", "lo"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.output.find("no-such-fault"), std::string::npos) << r.output;
+    r = run({"--fault", "wkc-aprd,bogus", "--iface", "lo"});  // one bad name in a list
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.output.find("'bogus'"), std::string::npos) << r.output;
+    r = run({"--fault", "wkc-aprd", "--fault", "", "--iface", "lo"});
+    EXPECT_EQ(r.code, 2) << r.output;
+}
+
 TEST(EcatSlaveCli, MissingPrivilegesExitWith2AndNameTheCapability) {
     if (!linktest::is_root()) GTEST_SKIP() << "needs root to drop to an unprivileged user";
     if (::access(ECAT_SLAVE_PATH, X_OK) != 0) GTEST_SKIP() << "binary not reachable";
@@ -184,8 +212,9 @@ void in_netns_of(pid_t pid, F&& fn) {
 }
 
 // Sends a BRD of the ESC type register from ecat1 in the namespace of `pid` and expects the slave's answer:
-// working counter 1 and the source MAC bit set.
-void expect_brd_answer(pid_t pid) {
+// working counter 1 and the source MAC bit set (first source byte 0x03; 0x01 with --fault
+// source-mac-unchanged).
+void expect_brd_answer(pid_t pid, uint8_t source_byte = 0x03) {
     std::unique_ptr<esc::PacketLink> master;
     in_netns_of(pid, [&] { master = std::make_unique<esc::PacketLink>("ecat1"); });
     // BRD of the ESC type register: the slave answers with WKC 1 and the source MAC bit set.
@@ -209,7 +238,7 @@ void expect_brd_answer(pid_t pid) {
         n = master->receive(buf);
     }
     ASSERT_EQ(n, 60u);
-    EXPECT_EQ(buf[6], 0x03);
+    EXPECT_EQ(buf[6], source_byte);
     EXPECT_EQ(buf[27], 1) << "working counter";
 }
 
@@ -254,6 +283,20 @@ TEST(EcatSlaveVeth, CreatesThePairAnswersOnItAndRemovesItOnSigterm) {
     EXPECT_EQ(data[27], 1);
     pcap_close(pc);
     std::remove(capture.c_str());
+}
+
+// A fault given on the command line reaches the ESC: the slave answers, but with the source MAC unchanged.
+TEST(EcatSlaveVeth, FaultFromTheCommandLineReachesTheEsc) {
+    if (!linktest::is_root()) GTEST_SKIP() << "needs root (CAP_NET_ADMIN, CAP_NET_RAW)";
+    Proc p = start({"--fault", "source-mac-unchanged"}, /*own_netns=*/true);
+    ASSERT_GT(p.pid, 0);
+    const std::string out = read_until(p.out, "running on", 5000);
+    ASSERT_NE(out.find("master interface: ecat1"), std::string::npos) << out;
+    EXPECT_NE(out.find("deliberate faults (testing aid): source-mac-unchanged"), std::string::npos) << out;
+    expect_brd_answer(p.pid, 0x01);
+    ::kill(p.pid, SIGTERM);
+    EXPECT_EQ(wait_exit(p.pid, 5000), 0);
+    ::close(p.out);
 }
 
 // The ways of waiting (--spin-us, --busy-poll) answer frames on a real veth pair like the default and end on

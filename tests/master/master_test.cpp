@@ -79,6 +79,19 @@ TEST(MasterExchange, NoSlaveOnTheLoopMeansTimeout) {
     EXPECT_EQ(m.count_slaves().error(), Error::Timeout);
 }
 
+TEST(MasterExchange, AcceptOwnSourceTakesAnUnchangedMacAsTheReply) {
+    fake::Bus bus(0);  // frames come back untouched, with our source MAC
+    bus.echo_own = false;
+    MasterOptions o = fast();
+    o.accept_own_source = true;  // as ecat-conform runs: a slave that leaves the MAC as sent is still heard
+    Master m(bus, o);
+    uint8_t b[2] = {};
+    Datagram d{Command::BRD, 0, 0x0000, b};
+    EXPECT_EQ(m.exchange(d), Error::Ok);
+    EXPECT_EQ(d.wkc, 0);
+    EXPECT_EQ(m.stats().timeouts, 0u);
+}
+
 TEST(MasterExchange, RejectsEmptyAndOversizedRequests) {
     fake::Bus bus(1);
     Master m(bus, fast());

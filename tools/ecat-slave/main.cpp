@@ -7,6 +7,7 @@
 
 #include "esc/link.hpp"
 #include "od/device_config.hpp"
+#include "softdrive/faults.hpp"
 #include "softdrive/firmware.hpp"
 #include "softslave/log.hpp"
 #include "softslave/slave.hpp"
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
     std::string state_dir = device.state_dir.string();
     std::string write_sii, write_esi, control;
     std::vector<double> home, stops;
+    std::vector<std::string> faults;
     CLI::App app{"Soft EtherCAT slave: a CiA 402 servo drive on a Linux network interface", "ecat-slave"};
     app.set_version_flag("--version", std::string("ecat-slave ") + SOFTECAT_VERSION);
     app.set_config("--config", "",
@@ -96,6 +98,11 @@ int main(int argc, char** argv) {
     app.add_flag("--busy-poll", options.busy_poll,
                  "Never sleep: poll the network and the clock in a loop (one CPU fully busy; use with --cpu)")
         ->excludes(spin);
+    app.add_option(
+           "--fault", faults,
+           "Testing aid for conformance tools: break one behaviour on purpose, as a faulty slave would "
+           "(repeatable or a comma-separated list; '--fault list' prints them all)")
+        ->type_name("NAME");
     app.add_flag("--verbose,-v", options.verbose,
                  "Print statistics at exit (of the whole run, across restarts)");
     bool quiet = false, reset_sii = false;
@@ -124,6 +131,25 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
         app.exit(e);
         return softslave::kExitUsage;
+    }
+    softdrive::FaultSet fault_set;
+    for (const std::string& item : faults) {
+        if (item == "list") {
+            softdrive::print_faults(std::cout);
+            return softslave::kExitOk;
+        }
+        if (const auto unknown = softdrive::add_faults(item, fault_set)) {
+            std::cerr << "ecat-slave: --fault: unknown fault '" << *unknown
+                      << "' ('ecat-slave --fault list' prints the known ones)\n";
+            return softslave::kExitUsage;
+        }
+    }
+    softdrive::apply_faults(fault_set, options.esc_faults, device.faults);
+    if (fault_set.any()) {
+        std::cerr << "ecat-slave: running with deliberate faults (testing aid):";
+        for (const auto& f : softdrive::fault_catalogue())
+            if (fault_set.test(static_cast<std::size_t>(f.fault))) std::cerr << ' ' << f.name;
+        std::cerr << '\n';
     }
     if (home.size() == 2) device.environment.home_from = home[0], device.environment.home_to = home[1];
     if (stops.size() == 2) device.environment.stop_lo = stops[0], device.environment.stop_hi = stops[1];

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "coe/emergency.hpp"
+#include "coe/faults.hpp"
 #include "ecat/mailbox_handler.hpp"
 #include "od/dictionary.hpp"
 
@@ -28,6 +29,7 @@ struct CoeConfig {
     // A segmented transfer the master leaves alone this long is dropped and answered with abort 0x05040000.
     uint64_t transfer_timeout_ns = 2'000'000'000;
     std::size_t emergency_queue = 8;
+    CoeFaults faults;  // testing aid: deliberate deviations (coe/faults.hpp), all off
 };
 
 class CoeServer final : public ecat::MailboxHandler {
@@ -83,6 +85,8 @@ class CoeServer final : public ecat::MailboxHandler {
     uint32_t commit_download();
     void send_upload_segment(ecat::MailboxSender& out);
     void send_abort(uint16_t index, uint8_t sub, uint32_t code, ecat::MailboxSender& out);
+    void confirm_download(uint16_t index, uint8_t sub, ecat::MailboxSender& out);  // faults only
+    od::AlState write_state(uint16_t index) const;
     void cancel_transfer();
 
     // SDO information
@@ -117,6 +121,7 @@ class CoeServer final : public ecat::MailboxHandler {
     std::vector<uint8_t> info_buf_;  // SDO info answer body
     InfoReply info_;
     uint64_t now_ns_ = 0;
+    uint8_t abort_command_ = 0x80;  // command byte of the next abort (0x80; faults: the request's)
 };
 
 }  // namespace coe

@@ -12,6 +12,7 @@
 
 #include "drive/environment.hpp"
 #include "drive/event_sink.hpp"
+#include "drive/faults.hpp"
 #include "drive/plant.hpp"
 #include "drive/profile.hpp"
 #include "drive/state_machine.hpp"
@@ -140,6 +141,7 @@ class Axis {
     explicit Axis(EventSink* sink = nullptr);
 
     Parameters params;
+    AxisFaults faults;  // testing aid: deliberate deviations (drive/faults.hpp), all off
     Command command;
     const Feedback& feedback() const { return fb_; }
 

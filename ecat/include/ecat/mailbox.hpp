@@ -10,6 +10,7 @@
 #include <span>
 #include <vector>
 
+#include "ecat/faults.hpp"
 #include "ecat/mailbox_handler.hpp"
 #include "esc/pdi.hpp"
 #include "od/device.hpp"
@@ -60,6 +61,8 @@ class Mailbox final : public MailboxSender {
 
     // Queues a mailbox error reply (type 0) with the given detail code.
     bool send_error(MailboxError detail);
+    // Testing aid: deliberate deviations (ecat/faults.hpp); none by default.
+    void set_faults(const MailboxFaults& faults) { faults_ = faults; }
 
   private:
     void receive();
@@ -99,6 +102,7 @@ class Mailbox final : public MailboxSender {
     // Address of the request being handled (echoed in the reply); 0 for spontaneous messages.
     uint16_t reply_address_ = 0;
     MailboxStats stats_;
+    MailboxFaults faults_;
 };
 
 }  // namespace ecat

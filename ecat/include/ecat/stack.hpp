@@ -16,6 +16,7 @@
 #include "ecat/al_status.hpp"
 #include "ecat/application.hpp"
 #include "ecat/event_sink.hpp"
+#include "ecat/faults.hpp"
 #include "ecat/latency.hpp"
 #include "ecat/mailbox.hpp"
 #include "ecat/mailbox_handler.hpp"
@@ -91,6 +92,12 @@ class Stack {
     // The outgoing mailbox, for spontaneous messages (e.g. CoE emergencies from the application).
     Mailbox& mailbox() { return mailbox_; }
     const ProcessData& process_data() const { return pd_; }
+
+    // Testing aid: deliberate deviations (ecat/faults.hpp); none by default.
+    void set_faults(const StackFaults& faults) {
+        faults_ = faults;
+        mailbox_.set_faults(faults.mailbox);
+    }
 
     // How long a Safe-Op -> Op request may wait for the first outputs / the first SYNC0 events.
     void set_op_wait_timeout_ns(uint64_t ns) { op_wait_timeout_ns_ = ns; }
@@ -197,6 +204,7 @@ class Stack {
     uint64_t last_now_ns_ = 0;
     bool first_poll_ = true;
     StackStats stats_;
+    StackFaults faults_;
 };
 
 }  // namespace ecat

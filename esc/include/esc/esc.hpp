@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "esc/clock.hpp"
+#include "esc/faults.hpp"
 #include "esc/pdi.hpp"
 
 namespace esc {
@@ -25,6 +26,7 @@ struct EscConfig {
     uint32_t process_ram_kib = 8;    // 0x0006; process RAM 0x1000 .. 0x1000 + kib*1024 - 1 (ET1100: 8 KiB)
     uint8_t port_descriptor = 0x0F;  // 0x0007: port0 MII, port1 EBUS... (single port used)
     uint16_t features = 0x01CC;      // 0x0008: DC available, 64-bit DC, ...
+    EscFaults faults;                // testing aid: deliberate deviations (esc/faults.hpp), all off
 };
 
 // Counters of what the ECAT side saw (also reflected in the error counter registers 0x0300-0x0313).

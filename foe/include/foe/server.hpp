@@ -19,6 +19,7 @@
 #include "ecat/event_sink.hpp"
 #include "ecat/mailbox_handler.hpp"
 #include "foe/errors.hpp"
+#include "foe/faults.hpp"
 #include "foe/store.hpp"
 #include "od/device.hpp"
 #include "od/types.hpp"
@@ -37,6 +38,7 @@ struct ServerConfig {
     // Run the commit steps on a worker thread instead of one per poll(): an fsync (10-20 ms on a disk)
     // then never holds up the frame loop. poll() and the repeated DATA only look at its progress.
     bool commit_in_thread = true;
+    FoeFaults faults;  // testing aid: deliberate deviations (foe/faults.hpp), all off
 
     // Sizes and device name from the device description.
     static ServerConfig from(const od::DeviceDescription& d);

@@ -246,7 +246,9 @@ void Device::build() {
     // (e.g. the state directory became unusable) leaves the old firmware running.
     auto p = std::make_unique<Parts>();
     p->desc = base_description(options_);
-    p->firmware = std::make_unique<foe::FirmwareUpdate>(options_.state_dir, p->desc);
+    foe::ServerConfig foe_config = foe::ServerConfig::from(p->desc);
+    foe_config.faults = options_.faults.foe;
+    p->firmware = std::make_unique<foe::FirmwareUpdate>(options_.state_dir, p->desc, foe_config);
     if (!p->firmware->ok())
         log() << "softdrive: firmware store " << firmware_dir(options_).string() << ": "
               << p->firmware->error().text << " (running the built-in firmware)\n";
@@ -254,6 +256,8 @@ void Device::build() {
 
     p->dict = od::make_drive_dictionary(p->desc);
     coe::install_pdo_validators(p->dict, {}, p->desc.pdo_rules);
+    if (options_.faults.identity_mismatch)
+        (void)p->dict.set<uint32_t>(0x1018, 2, p->desc.identity.product_code + 1);
     if (options_.commission) {
         if (const od::Status s = drive::commission(p->dict); s != od::Status::Ok)
             log() << "softdrive: commissioning the motor parameters failed: " << od::to_string(s) << '\n';
@@ -278,7 +282,11 @@ void Device::build() {
     }
 
     p->stack = std::make_unique<ecat::Stack>(esc_, p->dict, p->desc, *this, [this] { return esc_.irq(); });
-    p->coe = std::make_unique<coe::CoeServer>(p->dict, [raw] { return raw->stack->state(); });
+    p->stack->set_faults(options_.faults.stack);
+    coe::CoeConfig coe_config;
+    coe_config.faults = options_.faults.coe;
+    p->coe = std::make_unique<coe::CoeServer>(
+        p->dict, [raw] { return raw->stack->state(); }, coe_config);
     p->diag = std::make_unique<coe::DiagnosisHistory>(p->dict, &p->coe->emergency());
     p->events = std::make_unique<coe::EventReporter>(p->coe->emergency(), p->diag.get(),
                                                      [this] { return system_time_ns(); });
@@ -297,6 +305,7 @@ void Device::build() {
                                              std::to_string(e.subindex) + " " + e.name + ")");
     });
     p->drive = std::make_unique<drive::Drive>(p->dict, this);
+    p->drive->axis().faults = options_.faults.axis;
 
     if (options_.load_sii) esc_.load_eeprom(image);
     if (parts_) ecat::add_stats(earlier_stacks_, parts_->stack->stats());

@@ -243,8 +243,10 @@ Error Master::wait_frame(uint8_t first_index, std::span<Datagram> datagrams, Clo
             const std::span<const uint8_t> frame(rx_.data(), n);
             FrameReader reader(frame);
             // Our own frame seen again unprocessed (a loop with no slave in it) is not a reply.
-            bool match = reader.valid() && !std::equal(options_.source_mac.begin(), options_.source_mac.end(),
-                                                       reader.source_mac().begin());
+            bool match =
+                reader.valid() && (options_.accept_own_source ||
+                                   !std::equal(options_.source_mac.begin(), options_.source_mac.end(),
+                                               reader.source_mac().begin()));
             // Validate the whole chain before copying anything back.
             std::size_t i = 0;
             while (match) {

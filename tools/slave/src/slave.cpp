@@ -118,6 +118,7 @@ int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err)
 
         esc::EscConfig config;
         config.process_ram_kib = options.ram_kib;
+        config.faults = options.esc_faults;
         esc::SystemClock clock;
         esc::Esc esc(config, clock);
         bool eeprom_dirty = false;

@@ -50,6 +50,15 @@ struct EnvironmentOptions {
     double stop_hi = kNone;
 };
 
+// Deliberate deviations of the firmware's layers, a testing aid (softdrive/faults.hpp); none by default.
+struct DeviceFaults {
+    ecat::StackFaults stack;
+    coe::CoeFaults coe;
+    foe::FoeFaults foe;
+    drive::AxisFaults axis;
+    bool identity_mismatch = false;  // 0x1018:02 = the SII's product code + 1
+};
+
 struct DeviceOptions {
     std::filesystem::path config_file;  // device configuration (od::load_device_config); empty: defaults
     std::filesystem::path state_dir = "/var/lib/softecat";  // parameters.bin, firmware/
@@ -60,6 +69,7 @@ struct DeviceOptions {
     // One line per event (state changes, refused requests, FoE writes, restarts, 0x1010 saves, watchdog,
     // drive faults); null: events are not logged.
     softslave::Log* events = nullptr;
+    DeviceFaults faults;          // testing aid (ecat-slave --fault); none by default
 };
 
 // Where the firmware slots live inside the state directory.

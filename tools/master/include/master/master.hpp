@@ -94,6 +94,10 @@ struct MasterOptions {
     std::chrono::milliseconds sii_timeout{100};                 // busy polling of one SII command
     std::chrono::milliseconds al_timeout{5000};                 // reaching a requested AL state
     bool busy_poll = false;  // wait for replies by polling the link in a loop instead of sleeping in ppoll()
+    // Take frames that come back with our own source MAC as replies (a slave that does not set the locally
+    // administered bit, as a conformance tool must still talk to); an unprocessed frame then looks like a
+    // reply with its working counters unchanged.
+    bool accept_own_source = false;
 };
 
 struct MasterStats {

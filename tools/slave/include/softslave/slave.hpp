@@ -41,6 +41,7 @@ struct SlaveOptions {
     int cpu = -1;                     // >= 0: pin the slave to this CPU
     uint32_t spin_us = 0;             // wake this early before each timed event and busy-wait to it
     bool busy_poll = false;           // never sleep: poll the link and the clock in a loop
+    esc::EscFaults esc_faults;        // testing aid (ecat-slave --fault): deliberate ESC deviations, none
     EepromLoader eeprom_loader = load_eeprom_file;
     FirmwareFactory firmware_factory;  // empty: no firmware
 };

@@ -1,0 +1,218 @@
+#pragma once
+// The conformance suite's core: test cases, outcomes, the catalogue, and the run context (the master, the
+// slave under test, what its SII, CoE and ESI say). The tests themselves live in tests_<group>.cpp.
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "esc/link.hpp"
+#include "esi_reader.hpp"
+#include "master/coe.hpp"
+#include "master/mailbox.hpp"
+#include "master/master.hpp"
+#include "master/session.hpp"
+
+namespace conform {
+
+enum class Status : uint8_t { Pass, Fail, Skip, Warn };
+enum class Severity : uint8_t { Error, Warning };
+
+struct Outcome {
+    Status status = Status::Pass;
+    std::string message;  // why it failed / was skipped; what was checked when it passed
+    std::string observed;
+    std::string expected;
+};
+
+Outcome pass(std::string what = {}, std::string observed = {});
+Outcome fail(std::string message, std::string observed = {}, std::string expected = {});
+Outcome skip(std::string reason);
+// Compares and fails with both values when they differ.
+Outcome expect_eq(const std::string& what, const std::string& observed, const std::string& expected);
+
+class Context;
+
+struct TestCase {
+    std::string id;     // group.subject.aspect, stable
+    std::string group;  // esc, sii, esm, mbx, sdo, sdoinfo, pd, dc, foe, cia402
+    std::string title;
+    std::string clause;  // the standard and subject the test checks
+    Severity severity = Severity::Error;
+    std::string applies;  // when the test applies (else it is skipped), for the catalogue
+    std::function<Outcome(Context&)> run;
+};
+
+struct TestResult {
+    const TestCase* test = nullptr;
+    Outcome outcome;
+    std::chrono::microseconds duration{0};
+};
+
+using Catalogue = std::vector<TestCase>;
+// Every test of every group, in the order they run.
+Catalogue build_catalogue();
+const std::vector<std::string>& group_names();
+std::string group_title(const std::string& group);
+
+// Adders, one per tests_<group>.cpp.
+void add_esc_tests(Catalogue& c);
+void add_sii_tests(Catalogue& c);
+void add_esm_tests(Catalogue& c);
+void add_mbx_tests(Catalogue& c);
+void add_sdo_tests(Catalogue& c);
+void add_sdoinfo_tests(Catalogue& c);
+void add_pd_tests(Catalogue& c);
+void add_dc_tests(Catalogue& c);
+void add_foe_tests(Catalogue& c);
+void add_cia402_tests(Catalogue& c);
+
+// ---- SII as read back ------------------------------------------------------------------------------
+struct SiiCategory {
+    uint16_t type = 0;
+    std::size_t offset = 0;  // byte offset of the data (after the 4-byte header)
+    std::size_t length = 0;  // bytes
+};
+
+struct SiiImage {
+    std::vector<uint8_t> bytes;  // whole EEPROM as read
+    std::string error;           // why the category chain could not be walked ("" = fine)
+    std::vector<SiiCategory> categories;
+    uint16_t word(std::size_t w) const;
+    uint32_t dword(std::size_t w) const;
+    const SiiCategory* find(uint16_t type) const;
+    std::span<const uint8_t> data(const SiiCategory& c) const;
+    std::string string(uint8_t index) const;  // STRINGS category entry (1-based), "" if none
+    // The category chain walked from word 0x40: fills categories/error.
+    void parse();
+};
+
+uint8_t sii_crc8(std::span<const uint8_t> bytes);
+
+struct Options {
+    std::string iface;
+    uint16_t slave = 0;
+    std::string esi_path;
+    int device = -1;  // -1: the device whose identity matches the slave
+    double timeout_scale = 1.0;
+    bool verbose = false;
+    std::string foe_file;       // a file name the device's FoE server knows (Bootstrap firmware)
+    uint32_t foe_password = 0;  // its password
+};
+
+// ---- the run context -------------------------------------------------------------------------------
+class Context {
+  public:
+    Context(master::Master& m, const Options& o);
+    // Finds the slave, assigns station addresses, reads the SII and the ESI. "" or why the run cannot start.
+    std::string setup();
+
+    master::Master& m;
+    esc::Link* link = nullptr;  // for raw frames (source MAC, short and malformed frames)
+    Options opt;
+    uint16_t slave_count = 0;
+    uint16_t station = 0;  // configured station address of the slave under test
+    master::Address pos;   // by position
+    master::Address addr;  // by station address
+    uint8_t initial_state = 0;
+    std::optional<SiiImage> sii;
+    std::string sii_error;
+    std::optional<EsiDevice> esi;
+    std::string esi_error;  // why there is no ESI expectation
+
+    std::chrono::milliseconds ms(int base) const;  // scaled timeout
+
+    // Skip reasons ("" = applies).
+    std::string need_esi() const;
+    std::string need_sii() const;
+    std::string need_mailbox() const;
+    std::string need_coe() const;
+    std::string need_foe() const;
+    std::string need_dc() const;
+    std::string need_sdo_info() const;
+    std::string need_complete_access() const;
+    std::string need_402() const;
+    std::string need_boot() const;
+
+    // Protocols the slave announces (SII word 0x1C).
+    uint16_t protocols() const;
+    bool has_coe() const { return protocols() & 0x04; }
+    bool has_foe() const { return protocols() & 0x08; }
+
+    // ---- state ----
+    master::Result<uint8_t> state();
+    // Brings the slave to INIT (acknowledging errors), and clears all SMs and FMMUs.
+    master::Error to_init();
+    // INIT -> PREOP with the standard mailbox; sets up mbx/sdo. Idempotent when already in PREOP.
+    master::Error to_preop();
+    // Requests a state, returns the AL status reached (error indication kept, not acknowledged).
+    master::AlStatus request_raw(uint8_t state, std::chrono::milliseconds wait);
+    master::Error ack_error();
+    // PREOP -> SAFEOP with the slave's current PDO assignment (layout read over CoE), SMs and FMMUs set
+    // up by pds; dc as given. to_op: on to OP while exchanging process data.
+    master::Error to_safeop(const master::DcConfig& dc = {});
+    master::Error to_op();
+    // INIT -> BOOT with the bootstrap mailbox of the SII.
+    master::Error to_boot();
+    // Reaches a state by valid transitions (1 INIT, 2 PREOP, 3 BOOT, 4 SAFEOP, 8 OP).
+    master::Error reach(uint8_t state);
+    // Exchanges process data for `cycles` cycles of 1 ms (keeps outputs valid and the watchdog fed).
+    master::Error cycle(unsigned cycles = 1);
+    std::unique_ptr<master::ProcessDataSession> pds;
+    master::AlStatus last_status;  // of the last refused to_* call
+
+    std::unique_ptr<master::Mailbox> mbx;
+    std::unique_ptr<master::SdoClient> sdo;
+    bool in_preop = false;  // set by to_preop, cleared by to_init
+
+    // ---- mailbox helpers ----
+    // Writes a whole SM0 message (header included, padded to the SM length) as given.
+    master::Error mbx_write_raw(std::span<const uint8_t> message);
+    // Reads one message from SM1 (header included); Error::MailboxTimeout if none in time.
+    master::Error mbx_read_raw(std::vector<uint8_t>& out, std::chrono::milliseconds timeout);
+    // After raw traffic: the mailbox client restarts with counter 0 and an empty SM1.
+    void mbx_resync();
+    // One CoE request through the client's counter, the raw CoE payload of the first non-emergency answer
+    // (CoE or mailbox error message: type in mailbox_type).
+    master::Error coe_request(std::span<const uint8_t> coe, std::vector<uint8_t>& answer,
+                              uint8_t& mailbox_type);
+
+    // SDO helpers with readable errors.
+    std::string sdo_error(master::Error e) const;
+    master::Result<std::vector<uint8_t>> upload(uint16_t index, uint8_t sub, bool ca = false);
+    master::Error download(uint16_t index, uint8_t sub, std::span<const uint8_t> data, bool ca = false);
+    master::Result<uint64_t> upload_uint(uint16_t index, uint8_t sub);
+    master::Error download_uint(uint16_t index, uint8_t sub, uint64_t value, std::size_t bytes);
+
+    // Register access with the slave's station address.
+    template <typename T>
+    master::Result<T> rd(uint16_t reg) {
+        return m.read_reg<T>(addr, reg);
+    }
+    template <typename T>
+    master::Error wr(uint16_t reg, T v) {
+        return m.write_reg<T>(addr, reg, v);
+    }
+
+    // Sends a whole Ethernet frame and returns the first EtherCAT frame that comes back whose first datagram
+    // carries index `index` (empty if none within the timeout).
+    std::vector<uint8_t> raw_exchange(std::span<const uint8_t> frame, uint8_t index,
+                                      std::chrono::milliseconds timeout);
+
+    // The restore note ("" if the state found at start was restored).
+    std::string restore();
+    std::vector<std::string> notes;                      // printed at the end
+    std::map<std::string, std::shared_ptr<void>> cache;  // what several tests of a group share
+};
+
+std::string hex(uint64_t v, int digits = 4);
+std::string bytes_hex(std::span<const uint8_t> b, std::size_t max = 32);
+std::string al_code_text(uint16_t code);
+std::string state_text(uint8_t s);
+
+}  // namespace conform

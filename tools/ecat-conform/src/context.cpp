@@ -1,0 +1,540 @@
+// The run context: bus set-up, state changes, raw mailbox access, SDO helpers, SII parsing.
+#include <algorithm>
+#include <cstdio>
+#include <thread>
+
+#include "conform.hpp"
+
+namespace conform {
+
+using master::Error;
+using Clock = std::chrono::steady_clock;
+
+Outcome pass(std::string what, std::string observed) {
+    return Outcome{Status::Pass, std::move(what), std::move(observed), {}};
+}
+Outcome fail(std::string message, std::string observed, std::string expected) {
+    return Outcome{Status::Fail, std::move(message), std::move(observed), std::move(expected)};
+}
+Outcome skip(std::string reason) {
+    return Outcome{Status::Skip, std::move(reason), {}, {}};
+}
+Outcome expect_eq(const std::string& what, const std::string& observed, const std::string& expected) {
+    if (observed == expected) return pass(what, observed);
+    return fail(what + " differs", observed, expected);
+}
+
+std::string hex(uint64_t v, int digits) {
+    char b[32];
+    std::snprintf(b, sizeof b, "0x%0*llx", digits, static_cast<unsigned long long>(v));
+    return b;
+}
+std::string bytes_hex(std::span<const uint8_t> b, std::size_t max) {
+    std::string s;
+    char x[4];
+    for (std::size_t i = 0; i < b.size() && i < max; ++i) {
+        std::snprintf(x, sizeof x, "%02x", b[i]);
+        if (i) s += ' ';
+        s += x;
+    }
+    if (b.size() > max) s += " ...";
+    if (b.empty()) s = "(none)";
+    return s;
+}
+std::string al_code_text(uint16_t code) {
+    return hex(code) + " (" + std::string(master::al_status_code_name(code)) + ")";
+}
+std::string state_text(uint8_t s) {
+    std::string r(master::al_state_name(s & 0x0F));
+    if (s & 0x10) r += "+ERR";
+    return r;
+}
+
+// ---- SII -------------------------------------------------------------------------------------------
+uint8_t sii_crc8(std::span<const uint8_t> bytes) {
+    uint8_t crc = 0xFF;
+    for (uint8_t b : bytes) {
+        crc ^= b;
+        for (int i = 0; i < 8; ++i)
+            crc = static_cast<uint8_t>(crc & 0x80 ? (crc << 1) ^ 0x07 : crc << 1);
+    }
+    return crc;
+}
+
+uint16_t SiiImage::word(std::size_t w) const {
+    if (2 * w + 1 >= bytes.size()) return 0;
+    return static_cast<uint16_t>(bytes[2 * w] | (bytes[2 * w + 1] << 8));
+}
+uint32_t SiiImage::dword(std::size_t w) const {
+    return word(w) | (static_cast<uint32_t>(word(w + 1)) << 16);
+}
+const SiiCategory* SiiImage::find(uint16_t type) const {
+    for (const auto& c : categories)
+        if (c.type == type) return &c;
+    return nullptr;
+}
+std::span<const uint8_t> SiiImage::data(const SiiCategory& c) const {
+    return std::span<const uint8_t>(bytes).subspan(c.offset, c.length);
+}
+std::string SiiImage::string(uint8_t index) const {
+    const SiiCategory* c = find(10);
+    if (!c || index == 0) return {};
+    auto d = data(*c);
+    if (d.empty()) return {};
+    std::size_t p = 1;
+    for (uint8_t i = 1; i <= d[0] && p < d.size(); ++i) {
+        std::size_t n = d[p];
+        if (p + 1 + n > d.size()) return {};
+        if (i == index)
+            return std::string(d.begin() + static_cast<std::ptrdiff_t>(p + 1),
+                               d.begin() + static_cast<std::ptrdiff_t>(p + 1 + n));
+        p += 1 + n;
+    }
+    return {};
+}
+void SiiImage::parse() {
+    categories.clear();
+    error.clear();
+    std::size_t w = 0x40;
+    for (int guard = 0; guard < 1024; ++guard) {
+        if (2 * w + 2 > bytes.size()) {
+            error = "category chain runs past the EEPROM end at word " + hex(w);
+            return;
+        }
+        uint16_t type = word(w);
+        if (type == 0xFFFF) return;
+        if (2 * w + 4 > bytes.size()) {
+            error = "category header at word " + hex(w) + " cut by the EEPROM end";
+            return;
+        }
+        std::size_t len = word(w + 1);
+        if (2 * (w + 2 + len) > bytes.size()) {
+            error = "category " + std::to_string(type) + " at word " + hex(w) + " (" + std::to_string(len) +
+                    " words) runs past the EEPROM end";
+            return;
+        }
+        categories.push_back(SiiCategory{type, 2 * (w + 2), 2 * len});
+        w += 2 + len;
+    }
+    error = "more than 1024 categories, no end marker";
+}
+
+// ---- context ---------------------------------------------------------------------------------------
+Context::Context(master::Master& master, const Options& o) : m(master), opt(o) {}
+
+std::chrono::milliseconds Context::ms(int base) const {
+    return std::chrono::milliseconds(static_cast<long>(base * opt.timeout_scale + 0.5));
+}
+
+std::string Context::setup() {
+    auto n = m.count_slaves();
+    if (!n)
+        return "no slave answered on " + opt.iface + " (" + std::string(master::to_string(n.error())) + ")";
+    slave_count = *n;
+    if (opt.slave >= slave_count)
+        return "slave position " + std::to_string(opt.slave) + " not on the bus (" +
+               std::to_string(slave_count) + " slave(s))";
+    pos = master::Address::position(static_cast<uint16_t>(-static_cast<int>(opt.slave)));
+    if (Error e = m.assign_station_addresses(slave_count); e != Error::Ok)
+        return "assigning station addresses: " + std::string(master::to_string(e));
+    station = static_cast<uint16_t>(0x1001 + opt.slave);
+    addr = master::Address::station(station);
+    if (auto s = m.al_status(addr)) initial_state = s->state;
+    // The whole EEPROM, as big as word 0x3E says.
+    auto img = m.sii_read_image(addr, true);
+    if (img) {
+        SiiImage s;
+        s.bytes = std::move(*img);
+        s.parse();
+        sii = std::move(s);
+    } else {
+        sii_error = "SII read failed: " + std::string(master::to_string(img.error()));
+    }
+    if (!opt.esi_path.empty()) {
+        try {
+            EsiFile f = read_esi_file(opt.esi_path);
+            int pick = opt.device;
+            if (pick < 0) {
+                pick = 0;
+                if (sii) {
+                    for (std::size_t i = 0; i < f.devices.size(); ++i)
+                        if (f.devices[i].product_code == sii->dword(0x0A) &&
+                            f.devices[i].revision == sii->dword(0x0C)) {
+                            pick = static_cast<int>(i);
+                            break;
+                        }
+                }
+            }
+            if (pick >= static_cast<int>(f.devices.size()))
+                return opt.esi_path + ": no device " + std::to_string(pick) + " (" +
+                       std::to_string(f.devices.size()) + " in the file)";
+            esi = f.devices[static_cast<std::size_t>(pick)];
+        } catch (const std::exception& e) {
+            return std::string("ESI: ") + e.what();
+        }
+    } else {
+        esi_error = "no --esi given";
+    }
+    return {};
+}
+
+std::string Context::need_esi() const {
+    return esi ? "" : "needs the ESI (" + esi_error + ")";
+}
+std::string Context::need_sii() const {
+    return sii ? "" : sii_error;
+}
+uint16_t Context::protocols() const {
+    return sii ? sii->word(0x1C) : 0;
+}
+std::string Context::need_mailbox() const {
+    if (!sii) return sii_error;
+    if (sii->word(0x19) == 0 || sii->word(0x1B) == 0)
+        return "no standard mailbox in the SII (words 0x18-0x1B)";
+    return {};
+}
+std::string Context::need_coe() const {
+    if (auto r = need_mailbox(); !r.empty()) return r;
+    return has_coe() ? "" : "CoE not announced in SII word 0x1C";
+}
+std::string Context::need_foe() const {
+    if (auto r = need_mailbox(); !r.empty()) return r;
+    return has_foe() ? "" : "FoE not announced in SII word 0x1C";
+}
+std::string Context::need_dc() const {
+    if (esi) return esi->has_dc ? "" : "the ESI has no Dc element";
+    if (sii && sii->find(60)) return {};
+    return "no DC announced (no ESI Dc element, no SII DC category)";
+}
+std::string Context::need_sdo_info() const {
+    if (auto r = need_coe(); !r.empty()) return r;
+    if (esi) return esi->coe.sdo_info ? "" : "the ESI does not announce SdoInfo";
+    if (sii) {
+        if (const auto* g = sii->find(30); g && g->length > 5)
+            return (sii->bytes[g->offset + 5] & 0x02) ? ""
+                                                      : "SII general category: SDO information not announced";
+    }
+    return "SDO information not announced";
+}
+std::string Context::need_complete_access() const {
+    if (auto r = need_coe(); !r.empty()) return r;
+    if (esi) return esi->coe.complete_access ? "" : "the ESI does not announce CompleteAccess";
+    if (sii) {
+        if (const auto* g = sii->find(30); g && g->length > 5)
+            return (sii->bytes[g->offset + 5] & 0x20) ? ""
+                                                      : "SII general category: complete access not announced";
+    }
+    return "complete access not announced";
+}
+std::string Context::need_402() const {
+    if (auto r = need_coe(); !r.empty()) return r;
+    if (esi && esi->profile_no) return *esi->profile_no == 402 ? "" : "ESI profile is not 402";
+    return {};  // decided from 0x1000 by the tests
+}
+std::string Context::need_boot() const {
+    if (!sii) return sii_error;
+    if (sii->word(0x15) == 0 || sii->word(0x17) == 0)
+        return "no bootstrap mailbox in the SII (words 0x14-0x17)";
+    return {};
+}
+
+master::Result<uint8_t> Context::state() {
+    auto s = m.read_reg<uint16_t>(addr, master::reg::AlStatus);
+    if (!s) return s.error();
+    return static_cast<uint8_t>(*s & 0x1F);
+}
+
+master::AlStatus Context::request_raw(uint8_t st, std::chrono::milliseconds wait) {
+    master::AlStatus out;
+    (void)m.write_reg<uint16_t>(addr, master::reg::AlControl, st);
+    const auto deadline = Clock::now() + wait;
+    unsigned polls = 0;
+    for (;;) {
+        auto s = m.read_reg<uint16_t>(addr, master::reg::AlStatus);
+        if (s) {
+            out.state = static_cast<uint8_t>(*s & 0x0F);
+            out.error = *s & 0x10;
+            if (out.error || out.state == (st & 0x0F) || Clock::now() >= deadline) {
+                if (auto c = m.read_reg<uint16_t>(addr, master::reg::AlStatusCode)) out.code = *c;
+                return out;
+            }
+        } else if (Clock::now() >= deadline) {
+            out.state = 0;
+            return out;
+        }
+        // A slave busy restarting (after BOOT, say) may miss a request: ask again now and then.
+        if (++polls % 200 == 0) (void)m.write_reg<uint16_t>(addr, master::reg::AlControl, st);
+        std::this_thread::sleep_for(std::chrono::microseconds(300));
+    }
+}
+
+Error Context::ack_error() {
+    auto s = m.read_reg<uint16_t>(addr, master::reg::AlStatus);
+    if (!s) return s.error();
+    if (!(*s & 0x10)) return Error::Ok;
+    const auto deadline = Clock::now() + ms(500);
+    (void)m.write_reg<uint16_t>(addr, master::reg::AlControl, static_cast<uint16_t>((*s & 0x0F) | 0x10));
+    for (;;) {
+        s = m.read_reg<uint16_t>(addr, master::reg::AlStatus);
+        if (s && !(*s & 0x10)) return Error::Ok;
+        if (Clock::now() >= deadline) return Error::AlTimeout;
+        std::this_thread::sleep_for(std::chrono::microseconds(300));
+    }
+}
+
+Error Context::to_init() {
+    in_preop = false;
+    pds.reset();
+    sdo.reset();
+    mbx.reset();
+    const auto deadline = Clock::now() + ms(5000);
+    for (;;) {
+        (void)m.write_reg<uint16_t>(addr, master::reg::AlControl, 0x0011);
+        auto s = m.read_reg<uint16_t>(addr, master::reg::AlStatus);
+        if (s && (*s & 0x1F) == 0x01) break;
+        if (Clock::now() >= deadline) return s ? Error::AlTimeout : s.error();
+        std::this_thread::sleep_for(std::chrono::microseconds(500));
+    }
+    (void)m.write_reg<uint16_t>(addr, master::reg::AlControl, 0x0001);
+    // SMs and FMMUs off, DC SYNC off: each test starts from the same ground (as a master's INIT does).
+    uint8_t counts[2] = {};
+    if (m.read(addr, 0x0004, counts) == Error::Ok) {
+        std::vector<uint8_t> z(std::max<std::size_t>(counts[0] * 16u, counts[1] * 8u), 0);
+        if (counts[1])
+            (void)m.write(addr, master::reg::Sm0, std::span<const uint8_t>(z.data(), counts[1] * 8u));
+        if (counts[0])
+            (void)m.write(addr, master::reg::Fmmu0, std::span<const uint8_t>(z.data(), counts[0] * 16u));
+    }
+    uint8_t act = 0;
+    (void)m.write(addr, 0x0981, std::span<const uint8_t>(&act, 1));
+    return Error::Ok;
+}
+
+Error Context::to_preop() {
+    if (in_preop && mbx) {
+        auto s = state();
+        if (s && *s == 0x02) return Error::Ok;
+    }
+    if (Error e = to_init(); e != Error::Ok) return e;
+    mbx = std::make_unique<master::Mailbox>(m, addr, ms(1000));
+    if (Error e = mbx->configure_from_sii(); e != Error::Ok) return e;
+    master::AlStatus st = request_raw(0x02, ms(5000));
+    last_status = st;
+    if (st.state != 0x02 || st.error) {
+        (void)ack_error();
+        return Error::AlRefused;
+    }
+    sdo = std::make_unique<master::SdoClient>(*mbx);
+    in_preop = true;
+    return Error::Ok;
+}
+
+Error Context::mbx_write_raw(std::span<const uint8_t> message) {
+    if (!mbx) return Error::MailboxNotConfigured;
+    const auto& c = mbx->config();
+    std::vector<uint8_t> buf(c.out_size, 0);
+    std::copy_n(message.begin(), std::min<std::size_t>(message.size(), buf.size()), buf.begin());
+    const auto deadline = Clock::now() + ms(1000);
+    for (;;) {
+        master::Datagram d = master::Master::addressed(addr, true, c.out_start, buf);
+        if (Error e = m.exchange(d); e != Error::Ok) return e;
+        if (d.wkc == 1) return Error::Ok;
+        if (Clock::now() >= deadline) return Error::MailboxTimeout;
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+}
+
+Error Context::mbx_read_raw(std::vector<uint8_t>& out, std::chrono::milliseconds timeout) {
+    if (!mbx) return Error::MailboxNotConfigured;
+    const auto& c = mbx->config();
+    out.assign(c.in_size, 0);
+    const auto deadline = Clock::now() + timeout;
+    for (;;) {
+        master::Datagram d = master::Master::addressed(addr, false, c.in_start, out);
+        Error e = m.exchange(std::span<master::Datagram>(&d, 1), 0);
+        if (e == Error::Ok && d.wkc == 1) return Error::Ok;
+        if (e != Error::Ok && e != Error::Timeout) return e;
+        if (Clock::now() >= deadline) return Error::MailboxTimeout;
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+}
+
+void Context::mbx_resync() {
+    if (mbx) {
+        // Whatever a test left in SM1 goes, then the client restarts its counter at 0.
+        std::vector<uint8_t> junk;
+        for (int i = 0; i < 4 && mbx_read_raw(junk, ms(20)) == Error::Ok; ++i) {
+        }
+        (void)mbx->adopt_current();
+    }
+}
+
+Error Context::coe_request(std::span<const uint8_t> coe, std::vector<uint8_t>& answer,
+                           uint8_t& mailbox_type) {
+    if (!mbx) return Error::MailboxNotConfigured;
+    if (Error e = mbx->send(master::MailboxType::CoE, coe); e != Error::Ok) return e;
+    const auto deadline = Clock::now() + ms(1000);
+    for (;;) {
+        auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+        if (left.count() <= 0) return Error::MailboxTimeout;
+        master::MailboxMessage msg;
+        if (Error e = mbx->receive(msg, left); e != Error::Ok) return e;
+        if (msg.type == master::MailboxType::CoE && msg.payload.size() >= 2 && (msg.payload[1] >> 4) == 1)
+            continue;  // emergency
+        mailbox_type = static_cast<uint8_t>(msg.type);
+        answer.assign(msg.payload.begin(), msg.payload.end());
+        return Error::Ok;
+    }
+}
+
+std::string Context::sdo_error(Error e) const {
+    char b[96];
+    if (e == Error::SdoAbort && sdo) {
+        std::snprintf(b, sizeof b, "SDO abort 0x%08x (%s)", sdo->last_abort(),
+                      std::string(master::sdo_abort_text(sdo->last_abort())).c_str());
+        return b;
+    }
+    if (e == Error::MailboxError && sdo) {
+        std::snprintf(b, sizeof b, "mailbox error 0x%04x", sdo->last_mailbox_error());
+        return b;
+    }
+    return std::string(master::to_string(e));
+}
+
+master::Result<std::vector<uint8_t>> Context::upload(uint16_t index, uint8_t sub, bool ca) {
+    if (!sdo) return Error::MailboxNotConfigured;
+    std::vector<uint8_t> buf(8192);
+    auto r = sdo->upload(index, sub, buf, ca);
+    if (!r) return r.error();
+    buf.resize(*r);
+    return buf;
+}
+
+Error Context::download(uint16_t index, uint8_t sub, std::span<const uint8_t> data, bool ca) {
+    if (!sdo) return Error::MailboxNotConfigured;
+    return sdo->download(index, sub, data, ca);
+}
+
+master::Result<uint64_t> Context::upload_uint(uint16_t index, uint8_t sub) {
+    auto r = upload(index, sub);
+    if (!r) return r.error();
+    uint64_t v = 0;
+    for (std::size_t i = 0; i < r->size() && i < 8; ++i)
+        v |= static_cast<uint64_t>((*r)[i]) << (8 * i);
+    return v;
+}
+
+Error Context::download_uint(uint16_t index, uint8_t sub, uint64_t value, std::size_t bytes) {
+    uint8_t b[8];
+    for (std::size_t i = 0; i < 8; ++i)
+        b[i] = static_cast<uint8_t>(value >> (8 * i));
+    return download(index, sub, std::span<const uint8_t>(b, std::min<std::size_t>(bytes, 8)));
+}
+
+std::string Context::restore() {
+    const uint8_t s = initial_state & 0x0F;
+    if (s == 0x01 || s == 0) {
+        if (to_init() != Error::Ok) return "could not bring the slave back to INIT";
+        return {};
+    }
+    if (s == 0x02) {
+        if (to_preop() != Error::Ok) return "could not bring the slave back to PREOP";
+        return {};
+    }
+    (void)to_preop();
+    return "the slave was in " + state_text(initial_state) +
+           " at the start; it is left in PREOP (going back needs its master's process data)";
+}
+
+}  // namespace conform
+
+namespace conform {
+std::vector<uint8_t> Context::raw_exchange(std::span<const uint8_t> frame, uint8_t index,
+                                           std::chrono::milliseconds timeout) {
+    std::vector<uint8_t> buf(esc::kMaxFrameSize);
+    if (!link || !link->send(frame)) return {};
+    const auto deadline = Clock::now() + timeout;
+    while (Clock::now() < deadline) {
+        std::size_t n = link->receive(buf);
+        if (n == 0) {
+            std::this_thread::sleep_for(std::chrono::microseconds(50));
+            continue;
+        }
+        if (n < 17 || buf[12] != 0x88 || buf[13] != 0xA4) continue;
+        if (buf[17] != index) continue;
+        buf.resize(n);
+        return buf;
+    }
+    return {};
+}
+}  // namespace conform
+
+namespace conform {
+
+Error Context::to_safeop(const master::DcConfig& dc) {
+    if (Error e = to_preop(); e != Error::Ok) return e;
+    in_preop = false;  // the next to_preop() goes through INIT again
+    pds = std::make_unique<master::ProcessDataSession>(m, addr, *sdo);
+    if (Error e = pds->discover(); e != Error::Ok) return e;
+    if (Error e = pds->configure(dc); e != Error::Ok) return e;
+    last_status = request_raw(0x04, ms(5000));
+    if (last_status.state != 0x04 || last_status.error) {
+        (void)ack_error();
+        return Error::AlRefused;
+    }
+    return Error::Ok;
+}
+
+Error Context::to_op() {
+    auto s = state();
+    if (!s || *s != 0x04 || !pds) {
+        if (Error e = to_safeop(); e != Error::Ok) return e;
+    }
+    (void)cycle(3);
+    master::AlStatus st;
+    Error e = pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st);
+    last_status = st;
+    return e;
+}
+
+Error Context::to_boot() {
+    if (Error e = to_init(); e != Error::Ok) return e;
+    mbx = std::make_unique<master::Mailbox>(m, addr, ms(1000));
+    if (Error e = mbx->configure_from_sii(true); e != Error::Ok) return e;
+    last_status = request_raw(0x03, ms(5000));
+    if (last_status.state != 0x03 || last_status.error) {
+        (void)ack_error();
+        return Error::AlRefused;
+    }
+    return Error::Ok;
+}
+
+Error Context::reach(uint8_t st) {
+    switch (st) {
+        case 0x01:
+            return to_init();
+        case 0x02:
+            return to_preop();
+        case 0x03:
+            return to_boot();
+        case 0x04:
+            return to_safeop();
+        case 0x08:
+            return to_op();
+        default:
+            return Error::InvalidArgument;
+    }
+}
+
+Error Context::cycle(unsigned cycles) {
+    if (!pds) return Error::InvalidArgument;
+    Error first = Error::Ok;
+    for (unsigned i = 0; i < cycles; ++i) {
+        Error e = pds->cycle();
+        if (e != Error::Ok && first == Error::Ok) first = e;
+        if (i + 1 < cycles) std::this_thread::sleep_for(std::chrono::microseconds(1000));
+    }
+    return first;
+}
+
+}  // namespace conform

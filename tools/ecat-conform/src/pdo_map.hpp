@@ -1,0 +1,81 @@
+#pragma once
+// The process-data image of the current PDO assignment, entry by entry (read over CoE), for the pd and
+// cia402 groups.
+#include "sdo_util.hpp"
+
+namespace conform {
+
+struct MappedEntry {
+    uint16_t pdo = 0;
+    uint16_t index = 0;
+    uint8_t sub = 0;
+    uint8_t bits = 0;
+    std::size_t bit_offset = 0;  // within the SM's image
+};
+
+struct PdoMap {
+    std::vector<MappedEntry> outputs, inputs;
+    const MappedEntry* find_out(uint16_t i, uint8_t s = 0) const {
+        for (const auto& e : outputs)
+            if (e.index == i && e.sub == s) return &e;
+        return nullptr;
+    }
+    const MappedEntry* find_in(uint16_t i, uint8_t s = 0) const {
+        for (const auto& e : inputs)
+            if (e.index == i && e.sub == s) return &e;
+        return nullptr;
+    }
+};
+
+inline master::Error read_assign(Context& ctx, uint16_t assign, std::vector<MappedEntry>& out) {
+    out.clear();
+    auto n = ctx.upload_uint(assign, 0);
+    if (!n) return n.error();
+    std::size_t off = 0;
+    for (uint8_t i = 1; i <= *n; ++i) {
+        auto p = ctx.upload_uint(assign, i);
+        if (!p) return p.error();
+        auto m = ctx.upload_uint(static_cast<uint16_t>(*p), 0);
+        if (!m) return m.error();
+        for (uint8_t k = 1; k <= *m; ++k) {
+            auto e = ctx.upload_uint(static_cast<uint16_t>(*p), k);
+            if (!e) return e.error();
+            MappedEntry me{static_cast<uint16_t>(*p), static_cast<uint16_t>(*e >> 16),
+                           static_cast<uint8_t>(*e >> 8), static_cast<uint8_t>(*e), off};
+            off += me.bits;
+            if (me.index) out.push_back(me);
+        }
+    }
+    return master::Error::Ok;
+}
+
+inline master::Error read_map(Context& ctx, PdoMap& m) {
+    if (auto e = read_assign(ctx, 0x1C12, m.outputs); e != master::Error::Ok) return e;
+    return read_assign(ctx, 0x1C13, m.inputs);
+}
+
+inline uint64_t image_get(std::span<const uint8_t> img, const MappedEntry& e) {
+    uint64_t v = 0;
+    for (unsigned b = 0; b < e.bits; ++b) {
+        const std::size_t bit = e.bit_offset + b;
+        if (bit / 8 < img.size() && (img[bit / 8] >> (bit % 8)) & 1) v |= uint64_t{1} << b;
+    }
+    return v;
+}
+inline void image_set(std::span<uint8_t> img, const MappedEntry& e, uint64_t v) {
+    for (unsigned b = 0; b < e.bits; ++b) {
+        const std::size_t bit = e.bit_offset + b;
+        if (bit / 8 >= img.size()) return;
+        if ((v >> b) & 1)
+            img[bit / 8] = static_cast<uint8_t>(img[bit / 8] | (1u << (bit % 8)));
+        else
+            img[bit / 8] = static_cast<uint8_t>(img[bit / 8] & ~(1u << (bit % 8)));
+    }
+}
+// Outputs set to what the slave's objects hold now (so the first exchange changes nothing).
+inline void prefill_outputs(Context& ctx, const PdoMap& m) {
+    for (const auto& e : m.outputs)
+        if (auto v = ctx.upload_uint(e.index, e.sub)) image_set(ctx.pds->outputs(), e, *v);
+}
+
+}  // namespace conform

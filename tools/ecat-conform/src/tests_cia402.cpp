@@ -1,0 +1,395 @@
+// Group cia402: the drive profile (IEC 61800-7-201 / CiA 402): device control transitions through
+// controlword/statusword in process data, quick stop as 0x605A says, fault and fault reset, the modes of
+// 0x6502 accepted by 0x6060 and shown by 0x6061. The axis is held: in CSP the target follows the actual
+// position every cycle, so enabling the drive does not move it.
+#include <thread>
+
+#include "pdo_map.hpp"
+
+namespace conform {
+
+namespace {
+
+using master::Error;
+constexpr const char* kDev = "IEC 61800-7-201 (CiA 402) device control state machine";
+constexpr const char* kModes = "IEC 61800-7-201 (CiA 402) modes of operation 0x6060/0x6061/0x6502";
+
+struct DsState {
+    const char* name;
+    uint16_t mask, value;
+};
+constexpr DsState kSod{"switch on disabled", 0x4F, 0x40};
+constexpr DsState kRtso{"ready to switch on", 0x6F, 0x21};
+constexpr DsState kSo{"switched on", 0x6F, 0x23};
+constexpr DsState kOe{"operation enabled", 0x6F, 0x27};
+constexpr DsState kQsa{"quick stop active", 0x6F, 0x07};
+constexpr DsState kFault{"fault", 0x4F, 0x08};
+
+std::string sw_text(uint16_t sw) {
+    for (const DsState* s : {&kSod, &kRtso, &kSo, &kOe, &kQsa, &kFault})
+        if ((sw & s->mask) == s->value) return hex(sw) + " (" + s->name + ")";
+    return hex(sw);
+}
+
+std::string need_402_profile(Context& ctx) {
+    if (auto r = ctx.need_402(); !r.empty()) return r;
+    if (ctx.esi && ctx.esi->profile_no) return {};
+    if (ctx.to_preop() != Error::Ok) return "cannot reach PREOP";
+    auto v = ctx.upload_uint(0x1000, 0);
+    if (!v || (*v & 0xFFFF) != 402) return "device type 0x1000 is not profile 402";
+    return {};
+}
+
+struct Drive {
+    explicit Drive(Context& c) : ctx(c) {}
+    Context& ctx;
+    PdoMap map;
+    const MappedEntry *cw = nullptr, *sw = nullptr, *target = nullptr, *actual = nullptr, *mode = nullptr;
+
+    void hold() {
+        if (target && actual) image_set(ctx.pds->outputs(), *target, image_get(ctx.pds->inputs(), *actual));
+    }
+    uint16_t status() const { return static_cast<uint16_t>(image_get(ctx.pds->inputs(), *sw)); }
+
+    // "" when the drive is in OP with controlword/statusword exchanged, else why not.
+    std::string start() {
+        if (Error e = ctx.to_safeop(); e != Error::Ok) return "cannot reach SAFEOP: " + err(e);
+        if (Error e = read_map(ctx, map); e != Error::Ok) return "mapping: " + ctx.sdo_error(e);
+        cw = map.find_out(0x6040);
+        sw = map.find_in(0x6041);
+        if (!cw || !sw) return "controlword 0x6040 / statusword 0x6041 not in the process data";
+        target = map.find_out(0x607A);
+        actual = map.find_in(0x6064);
+        mode = map.find_out(0x6060);
+        prefill_outputs(ctx, map);
+        image_set(ctx.pds->outputs(), *cw, 0);
+        // Cyclic synchronous position when supported and the target can follow the actual position.
+        auto modes = ctx.upload_uint(0x6502, 0);
+        if (modes && (*modes & 0x80) && target && actual) {
+            if (mode)
+                image_set(ctx.pds->outputs(), *mode, 8);
+            else
+                (void)ctx.download_uint(0x6060, 0, 8, 1);
+        }
+        (void)ctx.cycle(3);
+        hold();
+        master::AlStatus st;
+        if (Error e = ctx.pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st,
+                                             [this] { hold(); });
+            e != Error::Ok)
+            return "cannot reach OP: " + err(e) + " (" + al_code_text(st.code) + ")";
+        run(10);
+        return {};
+    }
+    void run(unsigned n) {
+        for (unsigned i = 0; i < n; ++i) {
+            hold();
+            (void)ctx.pds->cycle();
+            std::this_thread::sleep_for(std::chrono::microseconds(1000));
+        }
+    }
+    // Sends a controlword until the statusword shows `want` (or the time is up); true when reached.
+    bool command(uint16_t c, const DsState& want, int ms = 500) {
+        image_set(ctx.pds->outputs(), *cw, c);
+        const auto deadline = std::chrono::steady_clock::now() + ctx.ms(ms);
+        while (std::chrono::steady_clock::now() < deadline) {
+            run(1);
+            if ((status() & want.mask) == want.value) return true;
+        }
+        return false;
+    }
+    // From wherever the drive is to switch on disabled (fault reset if needed), then along 2, 3, 4.
+    bool to(const DsState& want) {
+        if ((status() & kFault.mask) == kFault.value) {
+            (void)command(0x0000, kFault, 20);
+            (void)command(0x0080, kSod);
+        }
+        if (!command(0x0000, kSod)) return false;
+        if (&want == &kSod) return true;
+        if (!command(0x0006, kRtso)) return false;
+        if (&want == &kRtso) return true;
+        if (!command(0x0007, kSo)) return false;
+        if (&want == &kSo) return true;
+        return command(0x000F, kOe);
+    }
+    void finish() {
+        (void)command(0x0000, kSod, 200);
+        (void)ctx.to_init();
+    }
+};
+
+Outcome transition(Context& ctx, const DsState& from, uint16_t c, const DsState& want, const char* what) {
+    CONFORM_NEED(need_402_profile(ctx));
+    Drive d(ctx);
+    if (auto e = d.start(); !e.empty()) {
+        if (e.find("not in the process data") != std::string::npos) return skip(e);
+        return fail(e);
+    }
+    if (!d.to(from)) {
+        std::string s = sw_text(d.status());
+        d.finish();
+        return fail(std::string("cannot reach ") + from.name + " first", s, from.name);
+    }
+    const bool ok = d.command(c, want);
+    const std::string s = sw_text(d.status());
+    d.finish();
+    if (!ok) return fail(std::string(what) + ": controlword " + hex(c) + " in " + from.name, s, want.name);
+    return pass(what, s);
+}
+
+struct Mode {
+    const char* id;
+    const char* name;
+    int8_t value;
+    uint32_t bit;
+};
+constexpr Mode kModeList[] = {{"pp", "profile position", 1, 0x001},
+                              {"vl", "velocity", 2, 0x002},
+                              {"pv", "profile velocity", 3, 0x004},
+                              {"tq", "profile torque", 4, 0x008},
+                              {"hm", "homing", 6, 0x020},
+                              {"ip", "interpolated position", 7, 0x040},
+                              {"csp", "cyclic sync position", 8, 0x080},
+                              {"csv", "cyclic sync velocity", 9, 0x100},
+                              {"cst", "cyclic sync torque", 10, 0x200}};
+
+}  // namespace
+
+void add_cia402_tests(Catalogue& c) {
+    Adder add{c, "cia402"};
+    const std::string a = "profile 402";
+    add(
+        "profile", "0x1000 device type: profile 402 as the ESI's ProfileNo",
+        "IEC 61800-7-201 device type 0x1000; ETG.2000 Profile/ProfileNo",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            if (!ctx.esi->profile_no || *ctx.esi->profile_no != 402)
+                return skip("the ESI does not give profile 402");
+            CONFORM_PREOP(ctx);
+            auto v = ctx.upload_uint(0x1000, 0);
+            if (!v) return fail("0x1000: " + ctx.sdo_error(v.error()));
+            return expect_eq("0x1000 low word", dec(static_cast<long long>(*v & 0xFFFF)), "402");
+        },
+        "ESI gives profile 402");
+    add(
+        "objects", "Mandatory drive objects 0x6040, 0x6041, 0x6060, 0x6061, 0x6502 present", kDev,
+        [](Context& ctx) {
+            CONFORM_NEED(need_402_profile(ctx));
+            CONFORM_PREOP(ctx);
+            std::string missing;
+            for (uint16_t i : {0x6040, 0x6041, 0x6060, 0x6061, 0x6502})
+                if (!ctx.upload(i, 0)) missing += hex(i) + " ";
+            if (!missing.empty()) return fail("missing", missing, "none");
+            return pass();
+        },
+        a);
+    add(
+        "pdo.control_status", "Controlword in the default RxPDO and statusword in the default TxPDO",
+        "ETG.6010 CiA 402 drive profile over EtherCAT (process data)",
+        [](Context& ctx) {
+            CONFORM_NEED(need_402_profile(ctx));
+            CONFORM_PREOP(ctx);
+            PdoMap m;
+            if (Error e = read_map(ctx, m); e != Error::Ok) return fail("mapping: " + ctx.sdo_error(e));
+            return expect_eq(
+                "0x6040 out / 0x6041 in",
+                std::string(m.find_out(0x6040) ? "yes" : "no") + "/" + (m.find_in(0x6041) ? "yes" : "no"),
+                "yes/yes");
+        },
+        a, Severity::Warning);
+    for (const Mode& md : kModeList) {
+        add(
+            std::string("mode.") + md.id,
+            std::string("Mode ") + dec(md.value) + " (" + md.name +
+                ") of 0x6502 accepted by 0x6060 and shown by 0x6061",
+            kModes,
+            [md](Context& ctx) {
+                CONFORM_NEED(need_402_profile(ctx));
+                CONFORM_PREOP(ctx);
+                auto sup = ctx.upload_uint(0x6502, 0);
+                if (!sup) return fail("0x6502: " + ctx.sdo_error(sup.error()));
+                if (!(*sup & md.bit))
+                    return skip(std::string(md.name) + " not in 0x6502 (" + hex(*sup, 8) + ")");
+                auto old = ctx.upload_uint(0x6060, 0);
+                if (Error e = ctx.download_uint(0x6060, 0, static_cast<uint8_t>(md.value), 1); e != Error::Ok)
+                    return fail("0x6060 = " + dec(md.value) + ": " + ctx.sdo_error(e));
+                uint64_t shown = 0xFF;
+                for (int i = 0; i < 100; ++i) {
+                    auto v = ctx.upload(0x6061, 0);
+                    if (v && !v->empty()) shown = (*v)[0];
+                    if (shown == static_cast<uint8_t>(md.value)) break;
+                    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+                }
+                if (old) (void)ctx.download_uint(0x6060, 0, *old, 1);
+                return expect_eq("0x6061 after 0x6060 = " + dec(md.value), dec(static_cast<int8_t>(shown)),
+                                 dec(md.value));
+            },
+            "profile 402, mode in 0x6502");
+    }
+    add(
+        "mode.unsupported", "A mode not in 0x6502 is refused by 0x6060 (abort) or not shown by 0x6061",
+        kModes,
+        [](Context& ctx) {
+            CONFORM_NEED(need_402_profile(ctx));
+            CONFORM_PREOP(ctx);
+            auto sup = ctx.upload_uint(0x6502, 0);
+            if (!sup) return fail("0x6502: " + ctx.sdo_error(sup.error()));
+            int8_t bad = 0;
+            for (const Mode& md : kModeList)
+                if (!(*sup & md.bit)) {
+                    bad = md.value;
+                    break;
+                }
+            if (!bad) return skip("every standard mode is supported");
+            auto old = ctx.upload_uint(0x6060, 0);
+            Error e = ctx.download_uint(0x6060, 0, static_cast<uint8_t>(bad), 1);
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            auto shown = ctx.upload(0x6061, 0);
+            if (old) (void)ctx.download_uint(0x6060, 0, *old, 1);
+            if (e == Error::SdoAbort) return pass("refused", ctx.sdo_error(e));
+            if (shown && !shown->empty() && static_cast<int8_t>((*shown)[0]) == bad)
+                return fail("unsupported mode " + dec(bad) + " taken and shown", dec(bad), "refused");
+            return pass("not taken");
+        },
+        a, Severity::Warning);
+    add(
+        "dc.shutdown", "Transition 2: shutdown (0x0006) in switch on disabled -> ready to switch on", kDev,
+        [](Context& ctx) { return transition(ctx, kSod, 0x0006, kRtso, "transition 2"); }, a);
+    add(
+        "dc.switch_on", "Transition 3: switch on (0x0007) in ready to switch on -> switched on", kDev,
+        [](Context& ctx) { return transition(ctx, kRtso, 0x0007, kSo, "transition 3"); }, a);
+    add(
+        "dc.enable_operation", "Transition 4: enable operation (0x000F) in switched on -> operation enabled",
+        kDev, [](Context& ctx) { return transition(ctx, kSo, 0x000F, kOe, "transition 4"); }, a);
+    add(
+        "dc.disable_operation",
+        "Transition 5: disable operation (0x0007) in operation enabled -> switched on", kDev,
+        [](Context& ctx) { return transition(ctx, kOe, 0x0007, kSo, "transition 5"); }, a);
+    add(
+        "dc.switched_on_shutdown", "Transition 6: shutdown (0x0006) in switched on -> ready to switch on",
+        kDev, [](Context& ctx) { return transition(ctx, kSo, 0x0006, kRtso, "transition 6"); }, a);
+    add(
+        "dc.disable_voltage",
+        "Transition 7: disable voltage (0x0000) in ready to switch on -> switch on disabled", kDev,
+        [](Context& ctx) { return transition(ctx, kRtso, 0x0000, kSod, "transition 7"); }, a);
+    add(
+        "dc.enabled_shutdown", "Transition 8: shutdown (0x0006) in operation enabled -> ready to switch on",
+        kDev, [](Context& ctx) { return transition(ctx, kOe, 0x0006, kRtso, "transition 8"); }, a);
+    add(
+        "dc.enabled_disable_voltage",
+        "Transition 9: disable voltage (0x0000) in operation enabled -> switch on disabled", kDev,
+        [](Context& ctx) { return transition(ctx, kOe, 0x0000, kSod, "transition 9"); }, a);
+    add(
+        "dc.switched_on_disable_voltage",
+        "Transition 10: disable voltage (0x0000) in switched on -> switch on disabled", kDev,
+        [](Context& ctx) { return transition(ctx, kSo, 0x0000, kSod, "transition 10"); }, a);
+    add(
+        "dc.quick_stop", "Transition 11: quick stop (0x0002) in operation enabled, then as 0x605A says",
+        "IEC 61800-7-201 (CiA 402) transition 11, quick stop option code 0x605A",
+        [](Context& ctx) {
+            CONFORM_NEED(need_402_profile(ctx));
+            CONFORM_PREOP(ctx);
+            auto opt = ctx.upload_uint(0x605A, 0);
+            const int16_t code = opt ? static_cast<int16_t>(*opt) : 2;
+            Drive d(ctx);
+            if (auto e = d.start(); !e.empty())
+                return e.find("not in the process data") != std::string::npos ? skip(e) : fail(e);
+            if (!d.to(kOe)) {
+                std::string s = sw_text(d.status());
+                d.finish();
+                return fail("cannot reach operation enabled", s, kOe.name);
+            }
+            // 0x605A 1..4: stop, then switch on disabled; 5..8: stop and stay in quick stop active.
+            const DsState& want = (code >= 5 && code <= 8) ? kQsa : kSod;
+            bool left_oe = false;
+            image_set(ctx.pds->outputs(), *d.cw, 0x0002);
+            const auto deadline = std::chrono::steady_clock::now() + ctx.ms(1500);
+            bool ok = false;
+            while (std::chrono::steady_clock::now() < deadline) {
+                d.run(1);
+                const uint16_t s = d.status();
+                left_oe = left_oe || (s & kOe.mask) != kOe.value;
+                if ((s & want.mask) == want.value) {
+                    ok = true;
+                    break;
+                }
+            }
+            if (ok && &want == &kQsa) {
+                d.run(50);  // it stays there while the quick stop command stands
+                ok = (d.status() & kQsa.mask) == kQsa.value;
+            }
+            const std::string s = sw_text(d.status());
+            d.finish();
+            if (!ok)
+                return fail("quick stop with 0x605A = " + dec(code) +
+                                (left_oe ? "" : " (never left operation enabled)"),
+                            s, want.name);
+            return pass("0x605A = " + dec(code), s);
+        },
+        a);
+    add(
+        "dc.quick_stop_exit",
+        "Transition 12: disable voltage (0x0000) in quick stop active -> switch on disabled", kDev,
+        [](Context& ctx) {
+            CONFORM_NEED(need_402_profile(ctx));
+            CONFORM_PREOP(ctx);
+            auto opt = ctx.upload_uint(0x605A, 0);
+            if (!opt || static_cast<int16_t>(*opt) < 5 || static_cast<int16_t>(*opt) > 8)
+                return skip("0x605A does not keep the drive in quick stop active");
+            Drive d(ctx);
+            if (auto e = d.start(); !e.empty())
+                return e.find("not in the process data") != std::string::npos ? skip(e) : fail(e);
+            if (!d.to(kOe) || !d.command(0x0002, kQsa, 1500)) {
+                std::string s = sw_text(d.status());
+                d.finish();
+                return fail("cannot reach quick stop active", s, kQsa.name);
+            }
+            const bool ok = d.command(0x0000, kSod);
+            const std::string s = sw_text(d.status());
+            d.finish();
+            if (!ok) return fail("transition 12", s, kSod.name);
+            return pass("transition 12", s);
+        },
+        "profile 402, 0x605A = 5..8");
+    add(
+        "fault_reset",
+        "Fault (from a communication loss while enabled) and fault reset (0x0080 edge): transition 15",
+        "IEC 61800-7-201 (CiA 402) transitions 13-15; 0x6007 abort connection option",
+        [](Context& ctx) {
+            CONFORM_NEED(need_402_profile(ctx));
+            Drive d(ctx);
+            if (auto e = d.start(); !e.empty())
+                return e.find("not in the process data") != std::string::npos ? skip(e) : fail(e);
+            if (!d.to(kOe)) {
+                std::string s = sw_text(d.status());
+                d.finish();
+                return fail("cannot reach operation enabled", s, kOe.name);
+            }
+            // The master leaves OP while the drive is enabled: a communication loss (0x6007).
+            (void)ctx.request_raw(4, ctx.ms(1000));
+            (void)ctx.ack_error();
+            d.run(20);
+            bool faulted = false;
+            for (int i = 0; i < 50 && !faulted; ++i) {
+                d.run(2);
+                faulted = (d.status() & kFault.mask) == kFault.value;
+            }
+            if (!faulted) {
+                const std::string s = sw_text(d.status());
+                d.finish();
+                return skip("the communication loss did not fault the drive (statusword " + s + ")");
+            }
+            master::AlStatus st;
+            (void)ctx.pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st,
+                                         [&d] { d.hold(); });
+            (void)d.command(0x0000, kFault, 20);
+            const bool ok = d.command(0x0080, kSod, 1000);
+            const std::string s = sw_text(d.status());
+            d.finish();
+            if (!ok) return fail("fault reset edge did not leave fault", s, kSod.name);
+            return pass("reset", s);
+        },
+        a);
+}
+
+}  // namespace conform

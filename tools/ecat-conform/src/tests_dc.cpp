@@ -1,0 +1,278 @@
+// Group dc: distributed clocks: system time, receive-time latch, offset and delay registers, SYNC0
+// activation, SAFEOP/OP in DC mode, the sync manager parameter objects 0x1C32/0x1C33.
+#include <thread>
+
+#include "sdo_util.hpp"
+
+namespace conform {
+
+namespace {
+
+using master::Error;
+constexpr const char* kDc = "ETG.1000.4 distributed clocks; ESC datasheet DC registers 0x0900-0x09FF";
+constexpr const char* kSync =
+    "ETG.1020 synchronisation (0x1C32/0x1C33); ETG.1000.6 sync manager parameter objects";
+
+master::Result<uint64_t> rd64(Context& ctx, uint16_t reg) {
+    return ctx.rd<uint64_t>(reg);
+}
+
+uint16_t dc_assign(const Context& ctx) {
+    if (ctx.esi)
+        for (const auto& m : ctx.esi->op_modes)
+            if (m.assign_activate & 0x0300) return m.assign_activate;
+    return 0x0300;
+}
+
+Outcome dc_state(Context& ctx, bool op) {
+    CONFORM_NEED(ctx.need_dc());
+    CONFORM_NEED(ctx.need_coe());
+    master::DcConfig dc;
+    dc.enable = true;
+    dc.cycle_ns = 1'000'000;
+    dc.assign_activate = dc_assign(ctx);
+    dc.start_delay = std::chrono::milliseconds(20);
+    Error e = ctx.to_safeop(dc);
+    if (e != Error::Ok) {
+        std::string st =
+            state_text(static_cast<uint8_t>(ctx.last_status.state | (ctx.last_status.error ? 0x10 : 0))) +
+            " code " + hex(ctx.last_status.code);
+        return fail("SAFEOP in DC mode (AssignActivate " + hex(dc.assign_activate) + "): " + err(e), st,
+                    "SAFEOP");
+    }
+    if (!op) return pass("SAFEOP in DC mode");
+    (void)ctx.cycle(30);
+    master::AlStatus st;
+    Error o = ctx.pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st);
+    (void)ctx.to_init();
+    if (o != Error::Ok)
+        return fail(
+            "OP in DC mode: " + err(o),
+            state_text(static_cast<uint8_t>(st.state | (st.error ? 0x10 : 0))) + " code " + hex(st.code),
+            "OP");
+    return pass("OP in DC mode");
+}
+
+}  // namespace
+
+void add_dc_tests(Catalogue& c) {
+    Adder add{c, "dc"};
+    const std::string a = "DC announced";
+    add(
+        "system_time.advances", "System time 0x0910 advances with the time elapsed", kDc,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            auto t0 = rd64(ctx, 0x0910);
+            const auto h0 = std::chrono::steady_clock::now();
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            auto t1 = rd64(ctx, 0x0910);
+            const auto h1 = std::chrono::steady_clock::now();
+            if (!t0 || !t1) return fail("0x0910 unreadable");
+            const double dt = static_cast<double>(*t1 - *t0),
+                         dh = static_cast<double>(std::chrono::nanoseconds(h1 - h0).count());
+            if (*t1 <= *t0 || dt < 0.5 * dh || dt > 2.0 * dh)
+                return fail("system time over " + dec(static_cast<long long>(dh / 1e3)) + " us of host time",
+                            dec(static_cast<long long>(dt / 1e3)) + " us", "about the same");
+            return pass("advanced", dec(static_cast<long long>(dt / 1e3)) + " us");
+        },
+        a);
+    add(
+        "receive_time.latch", "Write to 0x0900 latches new receive times (port 0 time changes)", kDc,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            uint8_t z[4] = {};
+            (void)ctx.m.broadcast_write(0x0900, z);
+            auto a0 = ctx.rd<uint32_t>(0x0900);
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));
+            (void)ctx.m.broadcast_write(0x0900, z);
+            auto a1 = ctx.rd<uint32_t>(0x0900);
+            if (!a0 || !a1) return fail("0x0900 unreadable");
+            if (*a0 == *a1)
+                return fail("receive time port 0 unchanged by a second latch", hex(*a1, 8), "a new time");
+            return pass("latched", dec(static_cast<long long>(*a1 - *a0)) + " ns apart");
+        },
+        a);
+    add(
+        "receive_time.local", "Receive time of processing unit 0x0918 latched with port 0", kDc,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            uint8_t z[4] = {};
+            (void)ctx.m.broadcast_write(0x0900, z);
+            auto r = rd64(ctx, 0x0918);
+            auto l = rd64(ctx, 0x0910);
+            if (!r || !l) return fail("registers unreadable");
+            if (*r == 0) return fail("0x0918 is 0", "0", "a local time");
+            return pass("latched", hex(*r, 16));
+        },
+        a);
+    add(
+        "offset.rw", "System time offset 0x0920 writable and read back", kDc,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            auto old = rd64(ctx, 0x0920);
+            if (!old) return fail("0x0920 unreadable");
+            const uint64_t v = *old + 123456789ull;
+            (void)ctx.wr<uint64_t>(0x0920, v);
+            auto got = rd64(ctx, 0x0920);
+            (void)ctx.wr<uint64_t>(0x0920, *old);
+            return expect_eq("0x0920", got ? hex(*got, 16) : "?", hex(v, 16));
+        },
+        a);
+    add(
+        "offset.applied", "System time follows the offset: +1 s in 0x0920 moves 0x0910 by 1 s", kDc,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            auto old = rd64(ctx, 0x0920);
+            auto t0 = rd64(ctx, 0x0910);
+            if (!old || !t0) return fail("registers unreadable");
+            (void)ctx.wr<uint64_t>(0x0920, *old + 1'000'000'000ull);
+            auto t1 = rd64(ctx, 0x0910);
+            (void)ctx.wr<uint64_t>(0x0920, *old);
+            if (!t1) return fail("0x0910 unreadable");
+            const int64_t d = static_cast<int64_t>(*t1 - *t0);
+            if (d < 1'000'000'000 || d > 1'100'000'000)
+                return fail("0x0910 moved by", dec(d) + " ns", "1 s + the time between the reads");
+            return pass("moved", dec(d) + " ns");
+        },
+        a);
+    add(
+        "delay.rw", "System time delay 0x0928 writable and read back", kDc,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            auto old = ctx.rd<uint32_t>(0x0928);
+            if (!old) return fail("0x0928 unreadable");
+            (void)ctx.wr<uint32_t>(0x0928, 1234);
+            auto got = ctx.rd<uint32_t>(0x0928);
+            (void)ctx.wr<uint32_t>(0x0928, *old);
+            return expect_eq("0x0928", got ? dec(*got) : "?", "1234");
+        },
+        a);
+    add(
+        "delay.measurable", "Propagation delay measurable: port receive times of one latch ordered in time",
+        kDc,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            uint8_t z[4] = {};
+            (void)ctx.m.broadcast_write(0x0900, z);
+            uint8_t t[16] = {};
+            if (Error e = ctx.m.read(ctx.addr, 0x0900, t); e != Error::Ok)
+                return fail("0x0900-0x090F unreadable", err(e));
+            const uint32_t p0 = get32(t), p1 = get32(t + 4);
+            if (p1 != 0 && p1 < p0) return fail("port 1 time before port 0 time", dec(p1), ">= " + dec(p0));
+            return pass("port 0 " + dec(p0) + ", port 1 " + dec(p1));
+        },
+        a);
+    add(
+        "sync0.cycle_rw", "SYNC0 cycle time 0x09A0 writable and read back", kDc,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            (void)ctx.wr<uint8_t>(0x0981, 0);
+            (void)ctx.wr<uint32_t>(0x09A0, 1'000'000);
+            auto got = ctx.rd<uint32_t>(0x09A0);
+            return expect_eq("0x09A0", got ? dec(*got) : "?", "1000000");
+        },
+        a);
+    add(
+        "sync0.pulses", "SYNC0 activated: pulses come (0x098E status) and the next SYNC0 time advances", kDc,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            (void)ctx.to_init();
+            (void)ctx.wr<uint8_t>(0x0981, 0);
+            (void)ctx.wr<uint32_t>(0x09A0, 1'000'000);
+            auto now = rd64(ctx, 0x0910);
+            if (!now) return fail("0x0910 unreadable");
+            (void)ctx.wr<uint64_t>(0x0990, (*now / 1'000'000 + 5) * 1'000'000);
+            (void)ctx.wr<uint8_t>(0x0981, 0x03);
+            auto first = rd64(ctx, 0x0990);
+            bool pulse = false, advanced = false;
+            master::Result<uint64_t> later = Error::Timeout;
+            for (int i = 0; i < 100 && !advanced; ++i) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(1));
+                auto s = ctx.rd<uint8_t>(0x098E);
+                pulse = pulse || (s && (*s & 0x01));
+                later = rd64(ctx, 0x0990);
+                advanced = first && later && *later >= *first + 1'000'000;
+            }
+            (void)ctx.wr<uint8_t>(0x0981, 0);
+            if (!advanced)
+                return fail("next SYNC0 time 0x0990 does not advance within 100 ms (no SYNC0 pulses)",
+                            later ? hex(*later, 16) : "?", "> " + (first ? hex(*first, 16) : "?"));
+            return pass("pulses");
+        },
+        a);
+    add(
+        "safeop_dc", "PREOP -> SAFEOP in the ESI's DC op mode (SYNC0)", kDc,
+        [](Context& ctx) { return dc_state(ctx, false); }, a);
+    add(
+        "op_dc", "SAFEOP -> OP in the ESI's DC op mode with SYNC0 running", kDc,
+        [](Context& ctx) { return dc_state(ctx, true); }, a);
+    add(
+        "sync_modes.1c32", "0x1C32:04 announces DC SYNC0 (bit 2) when the ESI has a SYNC0 op mode", kSync,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            auto v = ctx.upload_uint(0x1C32, 4);
+            if (!v) return fail("0x1C32:04: " + ctx.sdo_error(v.error()));
+            if (!(*v & 0x04))
+                return fail("SYNC0 synchronisation not in the supported sync modes", hex(*v), "bit 2 set");
+            return pass("supported", hex(*v));
+        },
+        a);
+    add(
+        "sync_type.1c32", "0x1C32:01 accepts 2 (DC SYNC0) and reads it back", kSync,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            auto old = ctx.upload_uint(0x1C32, 1);
+            if (Error e = ctx.download_uint(0x1C32, 1, 2, 2); e != Error::Ok)
+                return fail("write 2: " + ctx.sdo_error(e));
+            auto got = ctx.upload_uint(0x1C32, 1);
+            if (old) (void)ctx.download_uint(0x1C32, 1, *old, 2);
+            return expect_eq("0x1C32:01", got ? dec(static_cast<long long>(*got)) : "?", "2");
+        },
+        a);
+    add(
+        "cycle_time.1c32", "0x1C32:02 cycle time written in PREOP reads back", kSync,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            auto old = ctx.upload_uint(0x1C32, 2);
+            if (Error e = ctx.download_uint(0x1C32, 2, 2'000'000, 4); e != Error::Ok)
+                return fail("write: " + ctx.sdo_error(e));
+            auto got = ctx.upload_uint(0x1C32, 2);
+            if (old) (void)ctx.download_uint(0x1C32, 2, *old, 4);
+            return expect_eq("0x1C32:02", got ? dec(static_cast<long long>(*got)) : "?", "2000000");
+        },
+        a);
+    add(
+        "min_cycle.1c32", "0x1C32:05 minimum cycle time present and not 0", kSync,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            auto v = ctx.upload_uint(0x1C32, 5);
+            if (!v) return fail("0x1C32:05: " + ctx.sdo_error(v.error()));
+            if (*v == 0) return fail("minimum cycle time", "0", "> 0");
+            return pass("min cycle", dec(static_cast<long long>(*v)) + " ns");
+        },
+        a, Severity::Warning);
+    add(
+        "sync_type.1c33", "0x1C33:01 accepts 2 (DC SYNC0)", kSync,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            auto old = ctx.upload_uint(0x1C33, 1);
+            Error e = ctx.download_uint(0x1C33, 1, 2, 2);
+            auto got = ctx.upload_uint(0x1C33, 1);
+            if (old) (void)ctx.download_uint(0x1C33, 1, *old, 2);
+            if (e != Error::Ok) return fail("write 2: " + ctx.sdo_error(e));
+            return expect_eq("0x1C33:01", got ? dec(static_cast<long long>(*got)) : "?", "2");
+        },
+        a);
+}
+
+}  // namespace conform

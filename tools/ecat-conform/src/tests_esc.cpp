@@ -1,0 +1,490 @@
+// Group esc: datagram commands and their working counters, addressing, frames, ESC registers.
+#include <thread>
+
+#include "testkit.hpp"
+
+namespace conform {
+
+namespace {
+
+using master::Command;
+using master::Datagram;
+using master::Error;
+
+constexpr const char* kCmdClause = "ETG.1000.4 datagram commands and working counter";
+constexpr const char* kRegClause = "ETG.1000.4 register access; ESC datasheet register description";
+constexpr uint16_t kEventMask = 0x0200;  // ECAT event mask: read/write from EtherCAT, no side effect
+
+struct Sent {
+    Error error = Error::Ok;
+    uint16_t wkc = 0;
+    uint16_t adp = 0;
+    std::vector<uint8_t> data;
+};
+
+Sent send(Context& ctx, Command c, uint16_t adp, uint16_t ado, std::vector<uint8_t> data) {
+    Sent s;
+    s.data = std::move(data);
+    Datagram d{c, adp, ado, s.data};
+    s.error = ctx.m.exchange(d);
+    s.wkc = d.wkc;
+    return s;
+}
+
+uint16_t my_adp(const Context& ctx) {
+    return static_cast<uint16_t>(-static_cast<int>(ctx.opt.slave));
+}
+
+Outcome check_wkc(const Sent& s, uint16_t expected, const std::string& what) {
+    if (s.error != Error::Ok) return fail(what + ": no reply", err(s.error), "a reply");
+    if (s.wkc != expected) return fail(what + ": working counter", dec(s.wkc), dec(expected));
+    return pass(what, "wkc " + dec(s.wkc));
+}
+
+std::vector<uint8_t> le16(uint16_t v) {
+    return {static_cast<uint8_t>(v), static_cast<uint8_t>(v >> 8)};
+}
+
+// Maps FMMU (last one) onto the event mask register: logical kLog..kLog+1, read and write enabled.
+constexpr uint32_t kLog = 0x00E00000;
+Error map_event_mask(Context& ctx, uint8_t fmmu) {
+    uint8_t f[16] = {};
+    put32(f, kLog);
+    put16(f + 4, 2);
+    f[6] = 0;  // start bit
+    f[7] = 7;  // stop bit
+    put16(f + 8, kEventMask);
+    f[10] = 0;
+    f[11] = 0x03;  // read + write
+    f[12] = 0x01;  // enable
+    return ctx.m.write(ctx.addr, static_cast<uint16_t>(master::reg::Fmmu0 + 16 * fmmu), f);
+}
+
+Outcome logical(Context& ctx, Command c) {
+    auto n = ctx.rd<uint8_t>(0x0004);
+    if (!n) return fail("FMMU count 0x0004 unreadable", err(n.error()));
+    if (*n == 0) return skip("the ESC has no FMMU (0x0004 = 0)");
+    auto before = ctx.rd<uint16_t>(kEventMask);
+    if (!before) return fail("event mask 0x0200 unreadable", err(before.error()));
+    const uint8_t fmmu = static_cast<uint8_t>(*n - 1);
+    if (Error e = map_event_mask(ctx, fmmu); e != Error::Ok) return fail("FMMU set-up write failed", err(e));
+    const uint16_t v = static_cast<uint16_t>(*before ^ 0x0100);
+    Sent s = send(ctx, c, static_cast<uint16_t>(kLog & 0xFFFF), static_cast<uint16_t>(kLog >> 16),
+                  c == Command::LRD ? std::vector<uint8_t>{0, 0} : le16(v));
+    auto after = ctx.rd<uint16_t>(kEventMask);
+    uint8_t off[16] = {};
+    (void)ctx.m.write(ctx.addr, static_cast<uint16_t>(master::reg::Fmmu0 + 16 * fmmu), off);
+    (void)ctx.wr<uint16_t>(kEventMask, *before);
+    const uint16_t want = c == Command::LRD ? 1 : c == Command::LWR ? 1 : 3;
+    Outcome o = check_wkc(s, want, "through an FMMU onto 0x0200");
+    if (o.status != Status::Pass) return o;
+    if (c != Command::LWR && get16(s.data.data()) != *before)
+        return fail("read data", hex(get16(s.data.data())), hex(*before));
+    if (c != Command::LRD && (!after || *after != v))
+        return fail("written value not in the register", after ? hex(*after) : err(after.error()), hex(v));
+    return o;
+}
+
+Outcome physical_rw(Context& ctx, Command c) {
+    auto before = ctx.rd<uint16_t>(kEventMask);
+    if (!before) return fail("event mask 0x0200 unreadable", err(before.error()));
+    const bool auto_inc = c == Command::APRD || c == Command::APWR || c == Command::APRW;
+    const uint16_t adp = auto_inc ? my_adp(ctx) : ctx.station;
+    const uint16_t v = static_cast<uint16_t>(*before ^ 0x0004);
+    const bool reads = c == Command::APRD || c == Command::FPRD;
+    const bool rw = c == Command::APRW || c == Command::FPRW;
+    Sent s = send(ctx, c, adp, kEventMask, reads ? std::vector<uint8_t>{0, 0} : le16(v));
+    auto after = ctx.rd<uint16_t>(kEventMask);
+    (void)ctx.wr<uint16_t>(kEventMask, *before);
+    Outcome o = check_wkc(s, rw ? 3 : 1, "on the read/write register 0x0200");
+    if (o.status != Status::Pass) return o;
+    if ((reads || rw) && get16(s.data.data()) != *before)
+        return fail("data read (before the write)", hex(get16(s.data.data())), hex(*before));
+    if (!reads && (!after || *after != v))
+        return fail("register after the write", after ? hex(*after) : err(after.error()), hex(v));
+    return o;
+}
+
+Outcome broadcast(Context& ctx, Command c) {
+    auto before = ctx.rd<uint16_t>(kEventMask);
+    if (!before) return fail("event mask 0x0200 unreadable", err(before.error()));
+    const uint16_t n = ctx.slave_count;
+    if (c == Command::BRD) {
+        Sent s = send(ctx, c, 0, 0x0000, {0, 0});
+        return check_wkc(s, n, "BRD 0x0000 over " + dec(n) + " slave(s)");
+    }
+    Sent s = send(ctx, c, 0, kEventMask, le16(*before));
+    (void)ctx.wr<uint16_t>(kEventMask, *before);
+    return check_wkc(s, static_cast<uint16_t>(c == Command::BRW ? 3 * n : n),
+                     "on 0x0200 over " + dec(n) + " slave(s)");
+}
+
+Outcome read_modify_write(Context& ctx, Command c) {
+    if (ctx.slave_count != 1)
+        return skip("needs the slave alone on the bus (other slaves would take the write)");
+    const uint16_t adp = c == Command::ARMW ? my_adp(ctx) : ctx.station;
+    auto expected = ctx.rd<uint16_t>(0x0000);
+    Sent s = send(ctx, c, adp, 0x0000, {0, 0});
+    Outcome o = check_wkc(s, 1, "addressed slave reads 0x0000");
+    if (o.status != Status::Pass) return o;
+    if (expected && get16(s.data.data()) != *expected)
+        return fail("data", hex(get16(s.data.data())), hex(*expected));
+    return o;
+}
+
+std::vector<uint8_t> frame_with(std::span<const uint8_t> datagrams, std::size_t pad_to,
+                                const master::MacAddress& src) {
+    std::vector<uint8_t> f(14, 0);
+    for (int i = 0; i < 6; ++i)
+        f[static_cast<std::size_t>(i)] = 0xFF;
+    std::copy(src.begin(), src.end(), f.begin() + 6);
+    f[12] = 0x88;
+    f[13] = 0xA4;
+    f.push_back(static_cast<uint8_t>(datagrams.size() & 0xFF));
+    f.push_back(static_cast<uint8_t>(0x10 | ((datagrams.size() >> 8) & 0x07)));
+    f.insert(f.end(), datagrams.begin(), datagrams.end());
+    if (f.size() < pad_to) f.resize(pad_to, 0);
+    return f;
+}
+
+std::vector<uint8_t> datagram(Command c, uint8_t index, uint16_t adp, uint16_t ado,
+                              std::span<const uint8_t> data, uint16_t length_field) {
+    std::vector<uint8_t> d(10, 0);
+    d[0] = static_cast<uint8_t>(c);
+    d[1] = index;
+    put16(&d[2], adp);
+    put16(&d[4], ado);
+    put16(&d[6], length_field);
+    d.insert(d.end(), data.begin(), data.end());
+    d.push_back(0);
+    d.push_back(0);
+    return d;
+}
+
+}  // namespace
+
+void add_esc_tests(Catalogue& c) {
+    Adder add{c, "esc"};
+    add("nop.wkc", "NOP: no slave acts, working counter stays 0, data unchanged", kCmdClause,
+        [](Context& ctx) {
+            Sent s = send(ctx, Command::NOP, ctx.station, 0x0000, {0xA5, 0x5A});
+            Outcome o = check_wkc(s, 0, "NOP");
+            if (o.status == Status::Pass && (s.data[0] != 0xA5 || s.data[1] != 0x5A))
+                return fail("NOP data changed", bytes_hex(s.data), "a5 5a");
+            return o;
+        });
+    for (Command cmd :
+         {Command::APRD, Command::APWR, Command::APRW, Command::FPRD, Command::FPWR, Command::FPRW}) {
+        static const char* names[] = {"", "aprd", "apwr", "aprw", "fprd", "fpwr", "fprw"};
+        const std::string n = names[static_cast<int>(cmd)];
+        const bool rw = cmd == Command::APRW || cmd == Command::FPRW;
+        std::string up = n;
+        for (auto& ch : up)
+            ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+        add(n + ".wkc",
+            up + ": working counter " + (rw ? "3" : "1") + " on a read/write register, data " +
+                (rw ? "read before write" : "as the register holds"),
+            kCmdClause, [cmd](Context& ctx) { return physical_rw(ctx, cmd); });
+    }
+    add("brd.wkc", "BRD: working counter = number of slaves", kCmdClause,
+        [](Context& ctx) { return broadcast(ctx, Command::BRD); });
+    add("bwr.wkc", "BWR: working counter = number of slaves", kCmdClause,
+        [](Context& ctx) { return broadcast(ctx, Command::BWR); });
+    add("brw.wkc", "BRW: working counter = 3 x number of slaves on a read/write register", kCmdClause,
+        [](Context& ctx) { return broadcast(ctx, Command::BRW); });
+    add("lrd.wkc", "LRD through a read FMMU: working counter 1, data of the mapped register", kCmdClause,
+        [](Context& ctx) { return logical(ctx, Command::LRD); });
+    add("lwr.wkc", "LWR through a write FMMU: working counter 1, register written", kCmdClause,
+        [](Context& ctx) { return logical(ctx, Command::LWR); });
+    add("lrw.wkc", "LRW through a read/write FMMU: working counter 3", kCmdClause,
+        [](Context& ctx) { return logical(ctx, Command::LRW); });
+    add(
+        "armw.wkc", "ARMW: the addressed slave reads (working counter 1)", kCmdClause,
+        [](Context& ctx) { return read_modify_write(ctx, Command::ARMW); }, "the slave is alone on the bus");
+    add(
+        "frmw.wkc", "FRMW: the addressed slave reads (working counter 1)", kCmdClause,
+        [](Context& ctx) { return read_modify_write(ctx, Command::FRMW); }, "the slave is alone on the bus");
+    add("aprd.adp_increment", "Auto-increment address: every slave increments ADP", kCmdClause,
+        [](Context& ctx) {
+            uint8_t b[2] = {};
+            Datagram d{Command::APRD, my_adp(ctx), 0x0000, b};
+            // The reply's ADP is not kept by Master::exchange: send a raw frame.
+            auto dg = datagram(Command::APRD, 0xA1, my_adp(ctx), 0x0000, b, 2);
+            auto reply = ctx.raw_exchange(frame_with(dg, 60, ctx.m.options().source_mac), 0xA1, ctx.ms(200));
+            if (reply.size() < 16 + 12) return fail("no reply to a raw APRD frame");
+            const uint16_t adp = get16(&reply[16 + 2]);
+            const uint16_t want = static_cast<uint16_t>(my_adp(ctx) + ctx.slave_count);
+            (void)d;
+            return expect_eq("ADP in the returned datagram", hex(adp), hex(want));
+        });
+    add("brd.adp_increment", "Broadcast: every slave increments ADP", kCmdClause, [](Context& ctx) {
+        uint8_t b[2] = {};
+        auto dg = datagram(Command::BRD, 0xA2, 0x0000, 0x0000, b, 2);
+        auto reply = ctx.raw_exchange(frame_with(dg, 60, ctx.m.options().source_mac), 0xA2, ctx.ms(200));
+        if (reply.size() < 16 + 12) return fail("no reply to a raw BRD frame");
+        return expect_eq("ADP in the returned datagram", hex(get16(&reply[18])), hex(ctx.slave_count));
+    });
+    add("fprd.no_match", "FPRD to an unused station address: working counter 0", kCmdClause,
+        [](Context& ctx) {
+            Sent s = send(ctx, Command::FPRD, 0xF00D, 0x0000, {0, 0});
+            return check_wkc(s, 0, "FPRD 0xf00d");
+        });
+    add("fpwr.no_match", "FPWR to an unused station address changes nothing", kCmdClause, [](Context& ctx) {
+        auto before = ctx.rd<uint16_t>(kEventMask);
+        if (!before) return fail("0x0200 unreadable", err(before.error()));
+        Sent s = send(ctx, Command::FPWR, 0xF00D, kEventMask, le16(static_cast<uint16_t>(*before ^ 0x0010)));
+        auto after = ctx.rd<uint16_t>(kEventMask);
+        Outcome o = check_wkc(s, 0, "FPWR 0xf00d");
+        if (o.status != Status::Pass) return o;
+        if (!after || *after != *before)
+            return fail("register changed", after ? hex(*after) : "?", hex(*before));
+        return o;
+    });
+    add("aprd.no_match", "APRD past the last slave: working counter 0", kCmdClause, [](Context& ctx) {
+        Sent s =
+            send(ctx, Command::APRD, static_cast<uint16_t>(-static_cast<int>(ctx.slave_count)), 0, {0, 0});
+        return check_wkc(s, 0, "APRD position " + dec(ctx.slave_count));
+    });
+    add("frame.source_mac", "Returned frame: source MAC with the locally administered bit set",
+        "ETG.1000.4 frame processing (source address, bit 1 of the first octet)", [](Context& ctx) {
+            uint8_t b[2] = {};
+            auto dg = datagram(Command::FPRD, 0xA3, ctx.station, 0x0000, b, 2);
+            master::MacAddress src{0x00, 0x11, 0x22, 0x33, 0x44, 0x55};
+            auto reply = ctx.raw_exchange(frame_with(dg, 60, src), 0xA3, ctx.ms(200));
+            if (reply.size() < 14) return fail("no reply");
+            std::vector<uint8_t> want(src.begin(), src.end());
+            want[0] |= 0x02;
+            return expect_eq("source MAC", bytes_hex(std::span<const uint8_t>(reply).subspan(6, 6)),
+                             bytes_hex(want));
+        });
+    add("frame.length_kept", "Returned frame has the length of the frame sent", "ETG.1000.4 frame processing",
+        [](Context& ctx) {
+            uint8_t b[2] = {};
+            auto dg = datagram(Command::FPRD, 0xA4, ctx.station, 0x0000, b, 2);
+            auto f = frame_with(dg, 60, ctx.m.options().source_mac);
+            auto reply = ctx.raw_exchange(f, 0xA4, ctx.ms(200));
+            if (reply.empty()) return fail("no reply");
+            if (reply.size() != f.size()) return fail("frame length", dec(reply.size()), dec(f.size()));
+            return check_wkc(Sent{Error::Ok, get16(&reply[16 + 12]), 0, {}}, 1, "padded minimum frame");
+        });
+    add("frame.multiple_datagrams", "Frame of several datagrams: each answered with its own working counter",
+        kCmdClause, [](Context& ctx) {
+            uint8_t a[2] = {}, b[2] = {}, d3[2] = {};
+            Datagram d[3] = {{Command::FPRD, ctx.station, 0x0000, a},
+                             {Command::FPRD, 0xF00D, 0x0000, b},
+                             {Command::BRD, 0, 0x0000, d3}};
+            if (Error e = ctx.m.exchange(d); e != Error::Ok) return fail("no reply", err(e));
+            std::string got = dec(d[0].wkc) + "/" + dec(d[1].wkc) + "/" + dec(d[2].wkc);
+            return expect_eq("working counters FPRD/FPRD(no match)/BRD", got, "1/0/" + dec(ctx.slave_count));
+        });
+    add("frame.truncated_datagram", "Datagram longer than its frame: not executed",
+        "ETG.1000.4 frame processing (frames with errors are not executed)", [](Context& ctx) {
+            auto before = ctx.rd<uint16_t>(kEventMask);
+            if (!before) return fail("0x0200 unreadable", err(before.error()));
+            auto v = le16(static_cast<uint16_t>(*before ^ 0x0020));
+            auto dg = datagram(Command::FPWR, 0xA5, ctx.station, kEventMask, v, 200);  // says 200 bytes
+            auto f = frame_with(dg, 60, ctx.m.options().source_mac);
+            auto reply = ctx.raw_exchange(f, 0xA5, ctx.ms(50));
+            auto after = ctx.rd<uint16_t>(kEventMask);
+            (void)ctx.wr<uint16_t>(kEventMask, *before);
+            if (!after) return fail("0x0200 unreadable afterwards", err(after.error()));
+            if (*after != *before) return fail("the truncated write was executed", hex(*after), hex(*before));
+            return pass("not executed", reply.empty() ? "dropped" : "returned unexecuted");
+        });
+    add(
+        "frame.short_unpadded",
+        "Frame under the Ethernet minimum: dropped or answered correctly, never garbled",
+        "ETG.1000.4 frame processing; IEEE 802.3 minimum frame size",
+        [](Context& ctx) {
+            uint8_t b[2] = {};
+            auto dg = datagram(Command::FPRD, 0xA6, ctx.station, 0x0000, b, 2);
+            auto f = frame_with(dg, 0, ctx.m.options().source_mac);
+            auto expected = ctx.rd<uint16_t>(0x0000);
+            auto reply = ctx.raw_exchange(f, 0xA6, ctx.ms(50));
+            if (reply.empty()) return pass("short frame dropped");
+            if (reply.size() < 30) return fail("reply cut short", dec(reply.size()) + " bytes", ">= 30");
+            const uint16_t wkc = get16(&reply[28]);
+            if (wkc != 1 || !expected || get16(&reply[26]) != *expected)
+                return fail("garbled reply", "wkc " + dec(wkc) + " data " + hex(get16(&reply[26])),
+                            "wkc 1 data " + (expected ? hex(*expected) : "?"));
+            return pass("answered correctly");
+        },
+        {}, Severity::Warning);
+    add("frame.bad_length_field", "EtherCAT header length past the frame end: frame not executed",
+        "ETG.1000.4 EtherCAT frame header", [](Context& ctx) {
+            auto before = ctx.rd<uint16_t>(kEventMask);
+            if (!before) return fail("0x0200 unreadable", err(before.error()));
+            auto v = le16(static_cast<uint16_t>(*before ^ 0x0040));
+            auto dg = datagram(Command::FPWR, 0xA7, ctx.station, kEventMask, v, 2);
+            auto f = frame_with(dg, 60, ctx.m.options().source_mac);
+            f[14] = 0xF0;  // length 0x7F0: far past the 60-byte frame
+            f[15] = 0x17;
+            (void)ctx.raw_exchange(f, 0xA7, ctx.ms(50));
+            auto after = ctx.rd<uint16_t>(kEventMask);
+            (void)ctx.wr<uint16_t>(kEventMask, *before);
+            if (!after) return fail("0x0200 unreadable afterwards", err(after.error()));
+            if (*after != *before)
+                return fail("the write of a malformed frame was executed", hex(*after), hex(*before));
+            return pass("not executed");
+        });
+    add("frame.wrong_type", "EtherCAT header type other than 1 (datagrams): not executed",
+        "ETG.1000.4 EtherCAT frame header (type)", [](Context& ctx) {
+            auto before = ctx.rd<uint16_t>(kEventMask);
+            if (!before) return fail("0x0200 unreadable", err(before.error()));
+            auto v = le16(static_cast<uint16_t>(*before ^ 0x0080));
+            auto dg = datagram(Command::FPWR, 0xA8, ctx.station, kEventMask, v, 2);
+            auto f = frame_with(dg, 60, ctx.m.options().source_mac);
+            f[15] = static_cast<uint8_t>((f[15] & 0x0F) | 0xE0);  // type 14
+            (void)ctx.raw_exchange(f, 0xA8, ctx.ms(50));
+            auto after = ctx.rd<uint16_t>(kEventMask);
+            (void)ctx.wr<uint16_t>(kEventMask, *before);
+            if (!after) return fail("0x0200 unreadable afterwards", err(after.error()));
+            if (*after != *before)
+                return fail("a frame of another type was executed", hex(*after), hex(*before));
+            return pass("not executed");
+        });
+
+    // ---- registers ----
+    add("reg.esc_info", "ESC information registers 0x0000-0x0009 readable in one datagram", kRegClause,
+        [](Context& ctx) {
+            uint8_t b[10] = {};
+            if (Error e = ctx.m.read(ctx.addr, 0x0000, b); e != Error::Ok)
+                return fail("FPRD 0x0000/10", err(e));
+            if (b[4] == 0 && b[5] == 0)
+                return fail("no FMMU and no SM announced", bytes_hex(b), "FMMUs/SMs > 0");
+            return pass("read", bytes_hex(b));
+        });
+    add(
+        "reg.fmmu_count", "FMMUs in 0x0004 cover the ESI's Fmmu list",
+        "ETG.2000 Device/Fmmu; ESC register 0x0004",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            auto n = ctx.rd<uint8_t>(0x0004);
+            if (!n) return fail("0x0004 unreadable", err(n.error()));
+            if (*n < ctx.esi->fmmus.size())
+                return fail("too few FMMUs", dec(*n),
+                            ">= " + dec(static_cast<long long>(ctx.esi->fmmus.size())));
+            return pass("FMMUs", dec(*n));
+        },
+        "ESI given");
+    add(
+        "reg.sm_count", "SyncManagers in 0x0005 cover the ESI's Sm list",
+        "ETG.2000 Device/Sm; ESC register 0x0005",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            auto n = ctx.rd<uint8_t>(0x0005);
+            if (!n) return fail("0x0005 unreadable", err(n.error()));
+            if (*n < ctx.esi->sms.size())
+                return fail("too few SyncManagers", dec(*n),
+                            ">= " + dec(static_cast<long long>(ctx.esi->sms.size())));
+            return pass("SMs", dec(*n));
+        },
+        "ESI given");
+    add(
+        "reg.ram_size", "Process RAM (0x0006) holds every SM of the ESI",
+        "ETG.2000 Device/Sm; ESC register 0x0006",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            auto kb = ctx.rd<uint8_t>(0x0006);
+            if (!kb) return fail("0x0006 unreadable", err(kb.error()));
+            uint32_t end = 0;
+            for (const auto& s : ctx.esi->sms)
+                end = std::max<uint32_t>(end, static_cast<uint32_t>(s.start) + 3u * s.default_size);
+            const uint32_t top = 0x1000u + 1024u * *kb;
+            if (end > top) return fail("an ESI SM (3 buffers) ends past the RAM", hex(end), "<= " + hex(top));
+            return pass("RAM", dec(*kb) + " KiB");
+        },
+        "ESI given");
+    add(
+        "reg.dc_feature", "ESC features 0x0008: DC available as the ESI's Dc element says",
+        "ETG.2000 Device/Dc; ESC register 0x0008 bit 2",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            auto f = ctx.rd<uint16_t>(0x0008);
+            if (!f) return fail("0x0008 unreadable", err(f.error()));
+            const bool dc = *f & 0x0004;
+            if (ctx.esi->has_dc && !dc)
+                return fail("the ESI has Dc but the ESC has no DC", hex(*f), "bit 2 set");
+            return pass("features", hex(*f));
+        },
+        "ESI given");
+    add("reg.station_alias", "Configured station alias 0x0012 loaded from SII word 4",
+        "ETG.1000.6 SII (configured station alias); ESC register 0x0012", [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            auto a = ctx.rd<uint16_t>(0x0012);
+            if (!a) return fail("0x0012 unreadable", err(a.error()));
+            return expect_eq("station alias", hex(*a), hex(ctx.sii->word(4)));
+        });
+    add("reg.alias_addressing", "FPRD by station alias once DL control enables alias addressing",
+        "ETG.1000.4 node addressing (station alias); ESC register 0x0100 bit 24", [](Context& ctx) {
+            auto a = ctx.rd<uint16_t>(0x0012);
+            if (!a) return fail("0x0012 unreadable", err(a.error()));
+            if (*a == 0) return skip("station alias is 0 (not set in the SII)");
+            auto dl = ctx.rd<uint8_t>(0x0103);
+            if (!dl) return fail("0x0103 unreadable", err(dl.error()));
+            (void)ctx.wr<uint8_t>(0x0103, static_cast<uint8_t>(*dl | 0x01));
+            Sent s = send(ctx, Command::FPRD, *a, 0x0000, {0, 0});
+            (void)ctx.wr<uint8_t>(0x0103, *dl);
+            return check_wkc(s, 1, "FPRD to alias " + hex(*a));
+        });
+    add("reg.station_address_rw", "Station address 0x0010 writable; FPRD follows the new address",
+        "ETG.1000.4 node addressing (configured station address)", [](Context& ctx) {
+            const uint16_t tmp = 0x7E57;
+            if (Error e = ctx.wr<uint16_t>(0x0010, tmp); e != Error::Ok) return fail("write 0x0010", err(e));
+            Sent s = send(ctx, Command::FPRD, tmp, 0x0010, {0, 0});
+            (void)ctx.m.write_reg<uint16_t>(master::Address::station(tmp), 0x0010, ctx.station);
+            (void)ctx.m.write_reg<uint16_t>(ctx.pos, 0x0010, ctx.station);
+            Outcome o = check_wkc(s, 1, "FPRD at the new address");
+            if (o.status == Status::Pass && get16(s.data.data()) != tmp)
+                return fail("0x0010 read back", hex(get16(s.data.data())), hex(tmp));
+            return o;
+        });
+    add("reg.al_status_readonly", "AL status 0x0130 cannot be written by the master",
+        "ETG.1000.6 AL status register (read-only for EtherCAT)", [](Context& ctx) {
+            auto before = ctx.rd<uint16_t>(0x0130);
+            if (!before) return fail("0x0130 unreadable", err(before.error()));
+            (void)send(ctx, Command::FPWR, ctx.station, 0x0130, le16(0x0008));
+            auto after = ctx.rd<uint16_t>(0x0130);
+            if (!after) return fail("0x0130 unreadable", err(after.error()));
+            return expect_eq("AL status after a write to it", hex(*after), hex(*before));
+        });
+    add("reg.type_readonly", "ESC type 0x0000 cannot be written by the master", kRegClause, [](Context& ctx) {
+        auto before = ctx.rd<uint16_t>(0x0000);
+        if (!before) return fail("0x0000 unreadable", err(before.error()));
+        (void)send(ctx, Command::FPWR, ctx.station, 0x0000, le16(static_cast<uint16_t>(~*before)));
+        auto after = ctx.rd<uint16_t>(0x0000);
+        if (!after) return fail("0x0000 unreadable", err(after.error()));
+        return expect_eq("0x0000 after a write to it", hex(*after), hex(*before));
+    });
+    add(
+        "reg.dl_status", "DL status 0x0110: EEPROM loaded, PDI operational (bit 0)",
+        "ETG.1000.4 DL status register 0x0110",
+        [](Context& ctx) {
+            auto s = ctx.rd<uint16_t>(0x0110);
+            if (!s) return fail("0x0110 unreadable", err(s.error()));
+            if (!(*s & 0x0001)) return fail("PDI operational bit clear", hex(*s), "bit 0 set");
+            return pass("DL status", hex(*s));
+        },
+        {}, Severity::Warning);
+    add(
+        "reg.pdi_control", "PDI control 0x0140 loaded from SII word 0", "ETG.1000.6 SII configuration area",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            auto p = ctx.rd<uint8_t>(0x0140);
+            if (!p) return fail("0x0140 unreadable", err(p.error()));
+            return expect_eq("PDI control", hex(*p, 2), hex(ctx.sii->word(0) & 0xFF, 2));
+        },
+        {}, Severity::Warning);
+    add("reg.al_control_rw", "AL control 0x0120 accepts the master's request (INIT stays INIT)",
+        "ETG.1000.6 AL control register", [](Context& ctx) {
+            Sent s = send(ctx, Command::FPWR, ctx.station, 0x0120, le16(0x0001));
+            return check_wkc(s, 1, "FPWR AL control");
+        });
+    add("reg.rw_offset_span", "A read spanning several registers (0x0000..0x00FF) counts once",
+        "ETG.1000.4 working counter (one increment per datagram)", [](Context& ctx) {
+            Sent s = send(ctx, Command::FPRD, ctx.station, 0x0000, std::vector<uint8_t>(256, 0));
+            return check_wkc(s, 1, "FPRD 256 bytes");
+        });
+}
+
+}  // namespace conform

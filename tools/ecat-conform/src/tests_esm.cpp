@@ -1,0 +1,375 @@
+// Group esm: the EtherCAT state machine: every valid transition, every invalid request with its AL status
+// code, error acknowledge, mailbox and process-data SM checks, the SM watchdog, Bootstrap, identification.
+#include <thread>
+
+#include "testkit.hpp"
+
+namespace conform {
+
+namespace {
+
+using master::Error;
+constexpr const char* kEsm = "ETG.1000.6 EtherCAT state machine (state transitions)";
+constexpr const char* kCodes = "ETG.1000.6 AL status codes";
+
+const char* short_name(uint8_t s) {
+    switch (s) {
+        case 1:
+            return "init";
+        case 2:
+            return "preop";
+        case 3:
+            return "boot";
+        case 4:
+            return "safeop";
+        case 8:
+            return "op";
+    }
+    return "?";
+}
+
+std::string status_text(const master::AlStatus& s) {
+    return state_text(static_cast<uint8_t>(s.state | (s.error ? 0x10 : 0))) + " code " + hex(s.code);
+}
+
+std::string needs_for(const Context& ctx, uint8_t a, uint8_t b) {
+    if (a == 3 || b == 3) {
+        if (auto r = ctx.need_boot(); !r.empty()) return r;
+    }
+    if (a >= 2 && a != 3) {
+        if (auto r = ctx.need_mailbox(); !r.empty()) return r;
+    }
+    if (a >= 4 || b >= 4) {
+        if (auto r = ctx.need_coe(); !r.empty()) return "the process-data layout is read over CoE: " + r;
+    }
+    return {};
+}
+
+Outcome valid(Context& ctx, uint8_t from, uint8_t to) {
+    CONFORM_NEED(needs_for(ctx, from, to));
+    if (Error e = ctx.reach(from); e != Error::Ok)
+        return fail(std::string("cannot reach ") + short_name(from) + ": " + err(e) +
+                    (e == Error::AlRefused ? " (" + status_text(ctx.last_status) + ")" : ""));
+    master::AlStatus st;
+    if (from == 2 && to == 4) {
+        ctx.pds = std::make_unique<master::ProcessDataSession>(ctx.m, ctx.addr, *ctx.sdo);
+        if (Error e = ctx.pds->discover(); e != Error::Ok)
+            return fail("process-data layout over CoE: " + ctx.sdo_error(e));
+        if (Error e = ctx.pds->configure(); e != Error::Ok)
+            return fail("process-data set-up: " + ctx.sdo_error(e));
+        st = ctx.request_raw(4, ctx.ms(5000));
+    } else if (from == 1 && (to == 2 || to == 3)) {
+        ctx.mbx = std::make_unique<master::Mailbox>(ctx.m, ctx.addr, ctx.ms(1000));
+        if (Error e = ctx.mbx->configure_from_sii(to == 3); e != Error::Ok)
+            return fail("mailbox set-up: " + err(e));
+        st = ctx.request_raw(to, ctx.ms(5000));
+        ctx.mbx.reset();
+    } else if (to == 8) {
+        (void)ctx.cycle(3);
+        (void)ctx.pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st);
+        if (auto c = ctx.rd<uint16_t>(0x0134)) st.code = *c;
+    } else {
+        st = ctx.request_raw(to, ctx.ms(5000));
+    }
+    const std::string want = state_text(to) + " code " + hex(0);
+    if (st.state != to || st.error) {
+        (void)ctx.ack_error();
+        return fail("transition refused or not completed", status_text(st), want);
+    }
+    if (to == 1) ctx.in_preop = false;
+    return pass("reached", status_text(st));
+}
+
+Outcome invalid(Context& ctx, uint8_t from, uint8_t to, uint16_t code) {
+    CONFORM_NEED(needs_for(ctx, from, from));
+    if (Error e = ctx.reach(from); e != Error::Ok)
+        return fail(
+            std::string("cannot reach ") + short_name(from) + ": " + err(e),
+            state_text(static_cast<uint8_t>(ctx.last_status.state | (ctx.last_status.error ? 0x10 : 0))) +
+                " code " + hex(ctx.last_status.code));
+    if (from == 8) (void)ctx.cycle(2);
+    master::AlStatus st = ctx.request_raw(to, ctx.ms(1000));
+    // The slave may take a moment to set the error indication.
+    for (int i = 0; i < 20 && !st.error && st.state == from; ++i) {
+        if (from == 8) (void)ctx.cycle(1);
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        st = ctx.request_raw(to, ctx.ms(1));
+    }
+    (void)ctx.ack_error();
+    ctx.in_preop = false;
+    const std::string want = state_text(static_cast<uint8_t>(from | 0x10)) + " code " + hex(code);
+    if (!st.error || st.state != from || st.code != code)
+        return fail("invalid request not refused as specified", status_text(st), want);
+    return pass("refused", status_text(st));
+}
+
+// Writes SM n's 8 register bytes (disabled first).
+Error write_sm(Context& ctx, unsigned n, uint16_t start, uint16_t len, uint8_t control, bool enable) {
+    uint8_t sm[8] = {};
+    const uint8_t off[8] = {};
+    (void)ctx.m.write(ctx.addr, static_cast<uint16_t>(master::reg::Sm0 + 8 * n), off);
+    put16(sm, start);
+    put16(sm + 2, len);
+    sm[4] = control;
+    sm[6] = enable ? 1 : 0;
+    return ctx.m.write(ctx.addr, static_cast<uint16_t>(master::reg::Sm0 + 8 * n), sm);
+}
+
+Outcome bad_mailbox(Context& ctx, int variant) {
+    CONFORM_NEED(ctx.need_mailbox());
+    if (Error e = ctx.to_init(); e != Error::Ok) return fail("cannot reach INIT", err(e));
+    const SiiImage& s = *ctx.sii;
+    uint16_t o_start = s.word(0x18), o_len = s.word(0x19), i_start = s.word(0x1A), i_len = s.word(0x1B);
+    bool o_en = true, i_en = true;
+    if (variant == 0) o_len = static_cast<uint16_t>(o_len - 2);
+    if (variant == 1) i_start = static_cast<uint16_t>(i_start + 0x10);
+    if (variant == 2) o_en = i_en = false;
+    if (variant == 3)
+        o_start = s.word(0x14), o_len = s.word(0x15), i_start = s.word(0x16), i_len = s.word(0x17);
+    (void)write_sm(ctx, 0, o_start, o_len, 0x26, o_en);
+    (void)write_sm(ctx, 1, i_start, i_len, 0x22, i_en);
+    master::AlStatus st = ctx.request_raw(2, ctx.ms(2000));
+    (void)ctx.ack_error();
+    (void)ctx.to_init();
+    const std::string want = "INIT+ERR code " + hex(0x0016);
+    if (st.state != 1 || !st.error || st.code != 0x0016)
+        return fail("PREOP with a wrong mailbox SM", status_text(st), want);
+    return pass("refused", status_text(st));
+}
+
+Outcome bad_pd_sm(Context& ctx, bool outputs, bool address) {
+    CONFORM_NEED(ctx.need_coe());
+    if (Error e = ctx.to_preop(); e != Error::Ok) return fail("cannot reach PREOP", err(e));
+    ctx.pds = std::make_unique<master::ProcessDataSession>(ctx.m, ctx.addr, *ctx.sdo);
+    if (Error e = ctx.pds->discover(); e != Error::Ok)
+        return fail("process-data layout: " + ctx.sdo_error(e));
+    if (Error e = ctx.pds->configure(); e != Error::Ok)
+        return fail("process-data set-up: " + ctx.sdo_error(e));
+    const auto& l = ctx.pds->layout();
+    if (outputs && !l.sm2_length) return skip("no outputs (SM2 length 0)");
+    if (!outputs && !l.sm3_length) return skip("no inputs (SM3 length 0)");
+    if (outputs)
+        (void)write_sm(ctx, 2, static_cast<uint16_t>(l.sm2_start + (address ? 0x40 : 0)),
+                       static_cast<uint16_t>(l.sm2_length + (address ? 0 : 1)), l.sm2_control, true);
+    else
+        (void)write_sm(ctx, 3, static_cast<uint16_t>(l.sm3_start + (address ? 0x40 : 0)),
+                       static_cast<uint16_t>(l.sm3_length + (address ? 0 : 1)), l.sm3_control, true);
+    master::AlStatus st = ctx.request_raw(4, ctx.ms(2000));
+    (void)ctx.ack_error();
+    ctx.in_preop = false;
+    const uint16_t code = outputs ? 0x001D : 0x001E;
+    const std::string want = "PREOP+ERR code " + hex(code);
+    if (st.state != 2 || !st.error || st.code != code)
+        return fail("SAFEOP with a wrong SM", status_text(st), want);
+    return pass("refused", status_text(st));
+}
+
+}  // namespace
+
+void add_esm_tests(Catalogue& c) {
+    Adder add{c, "esm"};
+    struct T {
+        uint8_t from, to;
+    };
+    for (T t : {T{1, 2}, T{2, 4}, T{4, 8}, T{8, 4}, T{4, 2}, T{2, 1}, T{8, 2}, T{8, 1}, T{4, 1}, T{1, 3},
+                T{3, 1}, T{1, 1}, T{2, 2}, T{4, 4}, T{8, 8}}) {
+        std::string id = std::string(short_name(t.from)) + "_to_" + short_name(t.to);
+        std::string applies;
+        if (t.from == 3 || t.to == 3)
+            applies = "bootstrap mailbox in the SII";
+        else if (t.from >= 4 || t.to >= 4)
+            applies = "CoE (process-data layout)";
+        add(
+            id,
+            "Valid transition " + std::string(master::al_state_name(t.from)) + " -> " +
+                std::string(master::al_state_name(t.to)) + ": reached without error, AL status code 0",
+            kEsm, [t](Context& ctx) { return valid(ctx, t.from, t.to); }, applies);
+    }
+    for (T t : {T{1, 4}, T{1, 8}, T{2, 8}, T{2, 3}, T{4, 3}, T{8, 3}, T{3, 2}, T{3, 4}, T{3, 8}}) {
+        std::string id = std::string("invalid.") + short_name(t.from) + "_to_" + short_name(t.to);
+        add(
+            id,
+            "Invalid request " + std::string(master::al_state_name(t.from)) + " -> " +
+                std::string(master::al_state_name(t.to)) + ": refused with 0x0011, state kept",
+            std::string(kEsm) + "; " + kCodes + " (0x0011)",
+            [t](Context& ctx) { return invalid(ctx, t.from, t.to, 0x0011); },
+            t.from == 3 ? "bootstrap mailbox in the SII" : "");
+    }
+    for (uint8_t s : {uint8_t{0x05}, uint8_t{0x06}, uint8_t{0x07}, uint8_t{0x09}}) {
+        add("unknown_state_" + hex(s, 2).substr(2),
+            "Unknown requested state " + hex(s, 2) + ": refused with 0x0012",
+            std::string(kCodes) + " (0x0012)", [s](Context& ctx) { return invalid(ctx, 2, s, 0x0012); });
+    }
+    add(
+        "boot.not_supported", "INIT -> BOOT without a bootstrap mailbox: refused with 0x0013",
+        std::string(kCodes) + " (0x0013)",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            if (ctx.need_boot().empty()) return skip("the SII announces a bootstrap mailbox");
+            return invalid(ctx, 1, 3, 0x0013);
+        },
+        "no bootstrap mailbox in the SII");
+    add(
+        "boot.wrong_mailbox", "INIT -> BOOT with the standard mailbox layout: refused with 0x0015",
+        std::string(kCodes) + " (0x0015)",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_boot());
+            CONFORM_NEED(ctx.need_mailbox());
+            const SiiImage& s = *ctx.sii;
+            if (s.word(0x14) == s.word(0x18) && s.word(0x15) == s.word(0x19) &&
+                s.word(0x16) == s.word(0x1A) && s.word(0x17) == s.word(0x1B))
+                return skip("bootstrap and standard mailbox have the same layout");
+            (void)ctx.to_init();
+            (void)write_sm(ctx, 0, s.word(0x18), s.word(0x19), 0x26, true);
+            (void)write_sm(ctx, 1, s.word(0x1A), s.word(0x1B), 0x22, true);
+            master::AlStatus st = ctx.request_raw(3, ctx.ms(2000));
+            (void)ctx.ack_error();
+            (void)ctx.to_init();
+            if (st.state != 1 || !st.error || st.code != 0x0015)
+                return fail("BOOT with the standard mailbox", status_text(st), "INIT+ERR code 0x0015");
+            return pass("refused", status_text(st));
+        },
+        "bootstrap mailbox differs from the standard one");
+    add(
+        "mbx.sm0_length", "INIT -> PREOP with a wrong SM0 length: refused with 0x0016",
+        std::string(kCodes) + " (0x0016)", [](Context& ctx) { return bad_mailbox(ctx, 0); }, "mailbox slave");
+    add(
+        "mbx.sm1_address", "INIT -> PREOP with a wrong SM1 start address: refused with 0x0016",
+        std::string(kCodes) + " (0x0016)", [](Context& ctx) { return bad_mailbox(ctx, 1); }, "mailbox slave");
+    add(
+        "mbx.sm_disabled", "INIT -> PREOP with the mailbox SMs not activated: refused with 0x0016",
+        std::string(kCodes) + " (0x0016)", [](Context& ctx) { return bad_mailbox(ctx, 2); }, "mailbox slave");
+    add(
+        "mbx.boot_layout_in_preop", "INIT -> PREOP with the bootstrap mailbox layout: refused with 0x0016",
+        std::string(kCodes) + " (0x0016)",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_boot());
+            const SiiImage& s = *ctx.sii;
+            if (s.word(0x14) == s.word(0x18) && s.word(0x15) == s.word(0x19) &&
+                s.word(0x16) == s.word(0x1A) && s.word(0x17) == s.word(0x1B))
+                return skip("bootstrap and standard mailbox have the same layout");
+            return bad_mailbox(ctx, 3);
+        },
+        "bootstrap mailbox differs from the standard one");
+    add(
+        "sm2.length", "PREOP -> SAFEOP with a wrong SM2 (outputs) length: refused with 0x001D",
+        std::string(kCodes) + " (0x001D)", [](Context& ctx) { return bad_pd_sm(ctx, true, false); },
+        "outputs");
+    add(
+        "sm2.address", "PREOP -> SAFEOP with a wrong SM2 (outputs) start address: refused with 0x001D",
+        std::string(kCodes) + " (0x001D)", [](Context& ctx) { return bad_pd_sm(ctx, true, true); },
+        "outputs");
+    add(
+        "sm3.length", "PREOP -> SAFEOP with a wrong SM3 (inputs) length: refused with 0x001E",
+        std::string(kCodes) + " (0x001E)", [](Context& ctx) { return bad_pd_sm(ctx, false, false); },
+        "inputs");
+    add(
+        "sm3.address", "PREOP -> SAFEOP with a wrong SM3 (inputs) start address: refused with 0x001E",
+        std::string(kCodes) + " (0x001E)", [](Context& ctx) { return bad_pd_sm(ctx, false, true); },
+        "inputs");
+    add("error.sticky", "With the error indication set, a request without acknowledge is not executed",
+        "ETG.1000.6 AL control (error indication acknowledge)", [](Context& ctx) {
+            if (Error e = ctx.to_init(); e != Error::Ok) return fail("cannot reach INIT", err(e));
+            master::AlStatus st = ctx.request_raw(8, ctx.ms(1000));  // I -> O: refused
+            if (!st.error)
+                return fail("INIT -> OP did not set the error indication", status_text(st), "INIT+ERR");
+            CONFORM_NEED(ctx.need_mailbox());
+            ctx.mbx = std::make_unique<master::Mailbox>(ctx.m, ctx.addr, ctx.ms(1000));
+            (void)ctx.mbx->configure_from_sii();
+            master::AlStatus st2 = ctx.request_raw(2, ctx.ms(100));  // no acknowledge bit
+            (void)ctx.ack_error();
+            (void)ctx.to_init();
+            if (st2.state != 1 || !st2.error)
+                return fail("executed without acknowledge", status_text(st2), "INIT+ERR");
+            return pass("ignored", status_text(st2));
+        });
+    add(
+        "error.ack", "Error acknowledge (PREOP + 0x10) clears the error indication and keeps the state",
+        "ETG.1000.6 AL control (error indication acknowledge)",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_mailbox());
+            if (Error e = ctx.to_preop(); e != Error::Ok) return fail("cannot reach PREOP", err(e));
+            master::AlStatus st = ctx.request_raw(8, ctx.ms(1000));  // P -> O: refused
+            if (!st.error)
+                return fail("PREOP -> OP did not set the error indication", status_text(st), "PREOP+ERR");
+            (void)ctx.m.write_reg<uint16_t>(ctx.addr, master::reg::AlControl, 0x12);
+            master::AlStatus st2;
+            for (int i = 0; i < 200; ++i) {
+                if (auto s = ctx.m.al_status(ctx.addr)) st2 = *s;
+                if (!st2.error) break;
+                std::this_thread::sleep_for(std::chrono::milliseconds(1));
+            }
+            ctx.in_preop = false;
+            if (st2.state != 2 || st2.error) return fail("after acknowledge", status_text(st2), "PREOP");
+            return pass("acknowledged", status_text(st2));
+        },
+        "mailbox slave");
+    add(
+        "error.code_cleared", "AL status code 0x0000 once the error is acknowledged", kCodes,
+        [](Context& ctx) {
+            if (Error e = ctx.to_init(); e != Error::Ok) return fail("cannot reach INIT", err(e));
+            (void)ctx.request_raw(8, ctx.ms(1000));
+            (void)ctx.ack_error();
+            master::AlStatus st2;
+            if (auto s = ctx.m.al_status(ctx.addr)) st2 = *s;
+            return expect_eq("AL status code", hex(st2.code), hex(0));
+        },
+        {}, Severity::Warning);
+    add(
+        "watchdog.op_to_safeop", "SM watchdog: outputs stop in OP -> SAFEOP with error 0x001B",
+        std::string(kCodes) + " (0x001B); ESC SyncManager watchdog (0x0400, 0x0420)",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            if (Error e = ctx.to_op(); e != Error::Ok)
+                return fail("cannot reach OP: " + err(e), status_text(ctx.last_status));
+            if (!ctx.pds->layout().sm2_length) return skip("no outputs: no SM watchdog");
+            auto div = ctx.rd<uint16_t>(0x0400);
+            auto wd = ctx.rd<uint16_t>(0x0420);
+            if (!div || !wd) return fail("watchdog registers unreadable");
+            if (*wd == 0) return skip("process-data watchdog disabled (0x0420 = 0)");
+            const double ms = (*div + 2.0) * 40e-9 * *wd * 1000.0;
+            const auto deadline = std::chrono::steady_clock::now() +
+                                  std::chrono::milliseconds(static_cast<long>(ms * 2 + 50)) + ctx.ms(200);
+            master::AlStatus st;
+            for (;;) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(2));
+                if (auto s = ctx.m.al_status(ctx.addr)) st = *s;
+                if (st.error || std::chrono::steady_clock::now() > deadline) break;
+            }
+            (void)ctx.ack_error();
+            const std::string want = "SAFEOP+ERR code " + hex(0x001B);
+            if (st.state != 4 || !st.error || st.code != 0x001B)
+                return fail("no watchdog reaction " + dec(static_cast<long long>(ms * 2 + 250)) +
+                                " ms after the last outputs (watchdog " + dec(static_cast<long long>(ms)) +
+                                " ms)",
+                            status_text(st), want);
+            return pass("watchdog", status_text(st));
+        },
+        "outputs and a non-zero watchdog time");
+    add(
+        "identification",
+        "Device identification: AL control bit 5 -> AL status bit 5, 0x0134 = station alias",
+        "ETG.1000.6 device identification (AL control/status bit 5); ETG.2000 Info/IdentificationReg134",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            if (!ctx.esi->identification_reg134)
+                return skip("the ESI does not announce IdentificationReg134");
+            (void)ctx.to_init();
+            (void)ctx.wr<uint16_t>(master::reg::AlControl, 0x0021);
+            bool loaded = false;
+            for (int i = 0; i < 500 && !loaded; ++i) {
+                auto s = ctx.rd<uint16_t>(master::reg::AlStatus);
+                loaded = s && (*s & 0x20);
+                if (!loaded) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));  // 0x0134 is written with the bit
+            auto id = ctx.rd<uint16_t>(0x0134);
+            (void)ctx.wr<uint16_t>(master::reg::AlControl, 0x0001);
+            if (!loaded) return fail("AL status bit 5 (identification loaded) never set", "", "bit 5 set");
+            auto alias = ctx.rd<uint16_t>(0x0012);
+            return expect_eq("0x0134", id ? hex(*id) : "?", alias ? hex(*alias) : "?");
+        },
+        "ESI announces IdentificationReg134");
+}
+
+}  // namespace conform

@@ -1,0 +1,175 @@
+// Group foe: Bootstrap and FoE: entry into BOOT with the SII's bootstrap mailbox, writes refused outside
+// Bootstrap, unknown file names and wrong passwords refused with their FoE error codes. No firmware is
+// ever written: an accepted write request is cancelled at once with an FoE error packet.
+#include "testkit.hpp"
+
+namespace conform {
+
+namespace {
+
+using master::Error;
+constexpr const char* kFoe = "ETG.1000.6 FoE (File access over EtherCAT) services and error codes";
+constexpr const char* kBoot = "ETG.1000.6 BOOT state; SII bootstrap mailbox words 0x14-0x17";
+
+struct FoeAnswer {
+    Error error = Error::Ok;
+    uint8_t opcode = 0;
+    uint32_t value = 0;
+    std::string text;
+    std::string describe() const {
+        if (error != Error::Ok) return std::string(master::to_string(error));
+        if (opcode == 5) return "ERR " + hex(value) + (text.empty() ? "" : " \"" + text + "\"");
+        if (opcode == 4) return "ACK " + dec(value);
+        return "opcode " + dec(opcode);
+    }
+};
+
+FoeAnswer foe_request(Context& ctx, uint8_t opcode, uint32_t value, const std::string& name) {
+    FoeAnswer a;
+    std::vector<uint8_t> p(6, 0);
+    p[0] = opcode;
+    put32(&p[2], value);
+    p.insert(p.end(), name.begin(), name.end());
+    if ((a.error = ctx.mbx->send(master::MailboxType::FoE, p)) != Error::Ok) return a;
+    for (;;) {
+        master::MailboxMessage m;
+        if ((a.error = ctx.mbx->receive(m, ctx.ms(1000))) != Error::Ok) return a;
+        if (m.type == master::MailboxType::Error) {
+            a.error = Error::MailboxError;
+            return a;
+        }
+        if (m.type != master::MailboxType::FoE) continue;
+        if (m.payload.size() < 6) {
+            a.error = Error::MailboxProtocol;
+            return a;
+        }
+        a.opcode = m.payload[0];
+        a.value = get32(&m.payload[2]);
+        a.text.assign(m.payload.begin() + 6, m.payload.end());
+        break;
+    }
+    if (a.opcode == 4 || a.opcode == 3) {
+        // Accepted: cancel before anything is stored.
+        std::vector<uint8_t> e(6 + 9, 0);
+        e[0] = 5;
+        put32(&e[2], 0x8000);
+        const char* t = "cancelled";
+        std::copy(t, t + 9, e.begin() + 6);
+        (void)ctx.mbx->send(master::MailboxType::FoE, e);
+    }
+    return a;
+}
+
+Outcome expect_foe_error(const FoeAnswer& a, std::initializer_list<uint32_t> codes, const std::string& what) {
+    std::string want;
+    for (auto c : codes)
+        want += (want.empty() ? "ERR " : " or ") + hex(c);
+    if (a.error != Error::Ok) return fail(what + ": no FoE answer", a.describe(), want);
+    if (a.opcode != 5) return fail(what + ": not refused", a.describe(), want);
+    for (auto c : codes)
+        if (a.value == c) return pass(what, a.describe());
+    return fail(what + ": FoE error code", a.describe(), want);
+}
+
+#define CONFORM_BOOT(ctx)                                                                                  \
+    CONFORM_NEED((ctx).need_foe());                                                                        \
+    CONFORM_NEED((ctx).need_boot());                                                                       \
+    if (Error _b = (ctx).to_boot(); _b != Error::Ok)                                                       \
+    return fail(                                                                                           \
+        "cannot enter BOOT with the SII's bootstrap mailbox: " + err(_b),                                  \
+        state_text(static_cast<uint8_t>((ctx).last_status.state | ((ctx).last_status.error ? 0x10 : 0))) + \
+            " code " + hex((ctx).last_status.code),                                                        \
+        "BOOT")
+
+}  // namespace
+
+void add_foe_tests(Catalogue& c) {
+    Adder add{c, "foe"};
+    const std::string a = "FoE and a bootstrap mailbox in the SII";
+    add(
+        "boot.enter", "INIT -> BOOT with the SII's bootstrap mailbox when FoE is announced", kBoot,
+        [](Context& ctx) {
+            CONFORM_BOOT(ctx);
+            (void)ctx.to_init();
+            return pass("BOOT reached");
+        },
+        a);
+    add(
+        "boot.mailbox_layout", "In BOOT the mailbox SMs hold the bootstrap layout and answer FoE", kBoot,
+        [](Context& ctx) {
+            CONFORM_BOOT(ctx);
+            uint8_t sm[16] = {};
+            (void)ctx.m.read(ctx.addr, master::reg::Sm0, sm);
+            const SiiImage& s = *ctx.sii;
+            std::string got = hex(get16(sm)) + "/" + dec(get16(sm + 2)) + " " + hex(get16(sm + 8)) + "/" +
+                              dec(get16(sm + 10));
+            std::string want = hex(s.word(0x14)) + "/" + dec(s.word(0x15)) + " " + hex(s.word(0x16)) + "/" +
+                               dec(s.word(0x17));
+            FoeAnswer r = foe_request(ctx, 1, ctx.opt.foe_password, "ecat-conform-probe");
+            (void)ctx.to_init();
+            if (got != want) return fail("SM0/SM1 in BOOT", got, want);
+            if (r.error != Error::Ok) return fail("no FoE answer in BOOT", r.describe(), "an FoE packet");
+            return pass("FoE answers", r.describe());
+        },
+        a);
+    add(
+        "write_outside_boot", "FoE write request in PREOP refused with an FoE error (0x8008 bootstrap only)",
+        kFoe,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_foe());
+            CONFORM_NEED(ctx.need_boot());
+            CONFORM_PREOP(ctx);
+            const std::string name = ctx.opt.foe_file.empty() ? "ecat-conform.bin" : ctx.opt.foe_file;
+            FoeAnswer r = foe_request(ctx, 2, ctx.opt.foe_password, name);
+            ctx.mbx_resync();
+            if (ctx.opt.foe_file.empty()) {
+                if (r.opcode == 5) return pass("refused", r.describe());
+                return fail("write request accepted outside Bootstrap", r.describe(), "an FoE error");
+            }
+            return expect_foe_error(r, {0x8008}, "write \"" + name + "\" in PREOP");
+        },
+        "FoE and a bootstrap mailbox");
+    add(
+        "unknown_name", "FoE write request of an unknown file name in BOOT: error 0x8001 (not found)", kFoe,
+        [](Context& ctx) {
+            CONFORM_BOOT(ctx);
+            FoeAnswer r = foe_request(ctx, 2, ctx.opt.foe_password, "ecat-conform-no-such-file.bin");
+            (void)ctx.to_init();
+            return expect_foe_error(r, {0x8001}, "unknown name");
+        },
+        a);
+    add(
+        "wrong_password", "FoE write request with a wrong password in BOOT: error 0x800A (no rights)", kFoe,
+        [](Context& ctx) {
+            if (ctx.opt.foe_file.empty()) return skip("needs --foe-file (a file name the device accepts)");
+            CONFORM_BOOT(ctx);
+            FoeAnswer r = foe_request(ctx, 2, ctx.opt.foe_password ^ 0x5A5A5A5Au, ctx.opt.foe_file);
+            (void)ctx.to_init();
+            return expect_foe_error(r, {0x800A}, "password " + hex(ctx.opt.foe_password ^ 0x5A5A5A5Au, 8));
+        },
+        "--foe-file given");
+    add(
+        "read_unknown", "FoE read request of an unknown file in BOOT: error 0x8001 (not found) or 0x800F",
+        kFoe,
+        [](Context& ctx) {
+            CONFORM_BOOT(ctx);
+            FoeAnswer r = foe_request(ctx, 1, ctx.opt.foe_password, "ecat-conform-no-such-file.bin");
+            (void)ctx.to_init();
+            return expect_foe_error(r, {0x8001, 0x800F}, "read of an unknown name");
+        },
+        a);
+    add(
+        "boot.exit", "BOOT -> INIT leaves Bootstrap; INIT -> PREOP works again", kBoot,
+        [](Context& ctx) {
+            CONFORM_BOOT(ctx);
+            master::AlStatus st = ctx.request_raw(1, ctx.ms(5000));
+            if (st.state != 1 || st.error)
+                return fail("BOOT -> INIT",
+                            state_text(static_cast<uint8_t>(st.state | (st.error ? 0x10 : 0))), "INIT");
+            if (Error e = ctx.to_preop(); e != Error::Ok) return fail("INIT -> PREOP after BOOT: " + err(e));
+            return pass("back in PREOP");
+        },
+        a);
+}
+
+}  // namespace conform

@@ -1,0 +1,250 @@
+// Group pd: process data: default PDO layout against the ESI, SAFEOP and OP with working counters, inputs
+// valid in SAFEOP, outputs applied in OP only, logical commands, a remapped assignment.
+#include <thread>
+
+#include "pdo_map.hpp"
+
+namespace conform {
+
+namespace {
+
+using master::Error;
+constexpr const char* kPd =
+    "ETG.1000.6 process data and the state machine (SAFEOP: inputs valid, outputs safe; OP: outputs applied)";
+constexpr const char* kPdEsi = "ETG.2000 RxPdo/TxPdo and Sm; ETG.1000.6 PDO assignment 0x1C12/0x1C13";
+
+std::string pdo_list(const std::vector<uint16_t>& v) {
+    std::string s;
+    for (auto x : v)
+        s += hex(x) + " ";
+    return s;
+}
+
+Outcome assign_vs_esi(Context& ctx, bool outputs) {
+    CONFORM_NEED(ctx.need_coe());
+    CONFORM_NEED(ctx.need_esi());
+    CONFORM_PREOP(ctx);
+    const uint16_t idx = outputs ? 0x1C12 : 0x1C13;
+    auto n = ctx.upload_uint(idx, 0);
+    if (!n) return fail(hex(idx) + ": " + ctx.sdo_error(n.error()));
+    std::vector<uint16_t> got, want;
+    for (uint8_t i = 1; i <= *n; ++i)
+        if (auto p = ctx.upload_uint(idx, i)) got.push_back(static_cast<uint16_t>(*p));
+    for (const auto& p : outputs ? ctx.esi->rxpdos : ctx.esi->txpdos)
+        if (p.sm == (outputs ? 2 : 3)) want.push_back(p.index);
+    return expect_eq(hex(idx) + " default assignment", pdo_list(got), pdo_list(want));
+}
+
+Outcome mapping_vs_esi(Context& ctx, bool outputs) {
+    CONFORM_NEED(ctx.need_coe());
+    CONFORM_NEED(ctx.need_esi());
+    CONFORM_PREOP(ctx);
+    std::string got, want;
+    for (const auto& p : outputs ? ctx.esi->rxpdos : ctx.esi->txpdos) {
+        auto n = ctx.upload_uint(p.index, 0);
+        if (!n) return fail(hex(p.index) + ": " + ctx.sdo_error(n.error()));
+        got += hex(p.index) + "[";
+        for (uint8_t i = 1; i <= *n; ++i)
+            if (auto e = ctx.upload_uint(p.index, i)) got += hex(*e, 8) + " ";
+        got += "] ";
+        want += hex(p.index) + "[";
+        for (const auto& e : p.entries)
+            want += hex((uint64_t{e.index} << 16) | (uint64_t{e.subindex} << 8) | e.bit_len, 8) + " ";
+        want += "] ";
+    }
+    return expect_eq("mapping objects", got, want);
+}
+
+Outcome sm_size_vs_esi(Context& ctx, bool outputs) {
+    CONFORM_NEED(ctx.need_coe());
+    CONFORM_NEED(ctx.need_esi());
+    CONFORM_PREOP(ctx);
+    master::ProcessDataSession s(ctx.m, ctx.addr, *ctx.sdo);
+    if (Error e = s.discover(); e != Error::Ok) return fail("layout: " + ctx.sdo_error(e));
+    unsigned bits = 0;
+    for (const auto& p : outputs ? ctx.esi->rxpdos : ctx.esi->txpdos)
+        if (p.sm == (outputs ? 2 : 3)) bits += p.bits();
+    const unsigned got = outputs ? s.layout().sm2_length : s.layout().sm3_length;
+    return expect_eq(std::string(outputs ? "SM2" : "SM3") + " bytes of the default assignment", dec(got),
+                     dec((bits + 7) / 8));
+}
+
+// A mapped output entry that is safe to change (not the controlword, not a mode), value via SDO readable.
+const MappedEntry* harmless_output(const PdoMap& m) {
+    for (const auto& e : m.outputs)
+        if (e.index != 0x6040 && e.index != 0x6060 && e.bits >= 8 && e.bits % 8 == 0 && e.index >= 0x2000)
+            return &e;
+    return nullptr;
+}
+
+Outcome inputs_match(Context& ctx, uint8_t state) {
+    CONFORM_NEED(ctx.need_coe());
+    if (Error x = ctx.to_init(); x != Error::Ok) return fail("cannot reach INIT", err(x));
+    CONFORM_PREOP(ctx);
+    {
+        // Fill the input SM's buffers with a pattern first (plain RAM while SM3 is off): inputs the slave
+        // never writes then show up as the pattern, not as stale values of an earlier run.
+        master::ProcessDataSession s(ctx.m, ctx.addr, *ctx.sdo);
+        if (Error x = s.discover(); x != Error::Ok) return fail("layout: " + ctx.sdo_error(x));
+        std::vector<uint8_t> pattern(3u * s.layout().sm3_length, 0xA5);
+        for (std::size_t k = 0; k < pattern.size(); k += 256) {
+            const std::size_t n = std::min<std::size_t>(256, pattern.size() - k);
+            (void)ctx.m.write(ctx.addr, static_cast<uint16_t>(s.layout().sm3_start + k),
+                              std::span<const uint8_t>(pattern.data() + k, n));
+        }
+    }
+    Error e = state == 8 ? ctx.to_op() : ctx.to_safeop();
+    if (e != Error::Ok) return fail("cannot reach the state: " + err(e));
+    PdoMap m;
+    if (Error x = read_map(ctx, m); x != Error::Ok) return fail("mapping: " + ctx.sdo_error(x));
+    (void)ctx.cycle(5);
+    unsigned compared = 0;
+    for (const auto& in : m.inputs) {
+        if (in.bits % 8) continue;
+        auto a = ctx.upload_uint(in.index, in.sub);
+        (void)ctx.cycle(2);
+        const uint64_t pd = image_get(ctx.pds->inputs(), in);
+        auto b = ctx.upload_uint(in.index, in.sub);
+        if (!a || !b || *a != *b) continue;  // changing value: not comparable
+        ++compared;
+        if (pd != *a)
+            return fail(hex(in.index) + ":" + dec(in.sub) + " in the input image differs from its object",
+                        hex(pd), hex(*a));
+    }
+    if (!compared) return skip("no input entry with a steady value to compare");
+    return pass(dec(compared) + " entries equal their objects");
+}
+
+Outcome outputs(Context& ctx, bool op) {
+    CONFORM_NEED(ctx.need_coe());
+    Error e = op ? ctx.to_op() : ctx.to_safeop();
+    if (e != Error::Ok) return fail("cannot reach the state: " + err(e));
+    PdoMap m;
+    if (Error x = read_map(ctx, m); x != Error::Ok) return fail("mapping: " + ctx.sdo_error(x));
+    const MappedEntry* o = harmless_output(m);
+    if (!o) return skip("no mapped output entry other than controlword and mode");
+    prefill_outputs(ctx, m);
+    auto before = ctx.upload_uint(o->index, o->sub);
+    if (!before) return fail("upload: " + ctx.sdo_error(before.error()));
+    const uint64_t mask = o->bits >= 64 ? ~uint64_t{0} : (uint64_t{1} << o->bits) - 1;
+    const uint64_t v = (*before + 7) & mask;
+    image_set(ctx.pds->outputs(), *o, v);
+    (void)ctx.cycle(10);
+    auto after = ctx.upload_uint(o->index, o->sub);
+    image_set(ctx.pds->outputs(), *o, *before);
+    (void)ctx.cycle(5);
+    if (!after) return fail("upload: " + ctx.sdo_error(after.error()));
+    const std::string what = hex(o->index) + ":" + dec(o->sub) + " after outputs carried " + hex(v);
+    if (op) return expect_eq(what, hex(*after), hex(v));
+    return expect_eq(what + " in SAFEOP (outputs must not be applied)", hex(*after), hex(*before));
+}
+
+Outcome cycle_wkc(Context& ctx, uint8_t state) {
+    CONFORM_NEED(ctx.need_coe());
+    Error e = state == 8 ? ctx.to_op() : ctx.to_safeop();
+    if (e != Error::Ok) return fail("cannot reach the state: " + err(e));
+    (void)ctx.cycle(3);
+    Error c = ctx.pds->cycle();
+    return expect_eq("LRW working counter", c == Error::Timeout ? "no reply" : dec(ctx.pds->last_wkc()),
+                     dec(ctx.pds->expected_wkc()));
+}
+
+Outcome logical_only(Context& ctx, master::Command cmd) {
+    CONFORM_NEED(ctx.need_coe());
+    if (Error e = ctx.to_op(); e != Error::Ok) return fail("cannot reach OP: " + err(e));
+    const auto& l = ctx.pds->layout();
+    std::vector<uint8_t> img(static_cast<std::size_t>(l.sm2_length) + l.sm3_length);
+    if (cmd == master::Command::LWR)
+        std::copy(ctx.pds->outputs().begin(), ctx.pds->outputs().end(), img.begin());
+    master::Datagram d = master::Datagram::logical(cmd, master::ProcessDataSession::kLogicalBase, img);
+    if (Error e = ctx.m.exchange(d); e != Error::Ok) return fail("no reply", err(e));
+    (void)ctx.cycle(2);
+    const bool has = cmd == master::Command::LRD ? l.sm3_length > 0 : l.sm2_length > 0;
+    return expect_eq(std::string(cmd == master::Command::LRD ? "LRD" : "LWR") + " over outputs and inputs",
+                     dec(d.wkc), has ? "1" : "0");
+}
+
+}  // namespace
+
+void add_pd_tests(Catalogue& c) {
+    Adder add{c, "pd"};
+    add(
+        "assign.rx_vs_esi", "Default RxPDO assignment 0x1C12 equals the ESI's RxPdo with Sm=2", kPdEsi,
+        [](Context& ctx) { return assign_vs_esi(ctx, true); }, "CoE and ESI");
+    add(
+        "assign.tx_vs_esi", "Default TxPDO assignment 0x1C13 equals the ESI's TxPdo with Sm=3", kPdEsi,
+        [](Context& ctx) { return assign_vs_esi(ctx, false); }, "CoE and ESI");
+    add(
+        "mapping.rx_vs_esi", "RxPDO mapping objects equal the ESI's RxPdo entries", kPdEsi,
+        [](Context& ctx) { return mapping_vs_esi(ctx, true); }, "CoE and ESI");
+    add(
+        "mapping.tx_vs_esi", "TxPDO mapping objects equal the ESI's TxPdo entries", kPdEsi,
+        [](Context& ctx) { return mapping_vs_esi(ctx, false); }, "CoE and ESI");
+    add(
+        "sm2.size_vs_esi", "SM2 size of the default assignment equals the ESI's RxPdo bit lengths", kPdEsi,
+        [](Context& ctx) { return sm_size_vs_esi(ctx, true); }, "CoE and ESI");
+    add(
+        "sm3.size_vs_esi", "SM3 size of the default assignment equals the ESI's TxPdo bit lengths", kPdEsi,
+        [](Context& ctx) { return sm_size_vs_esi(ctx, false); }, "CoE and ESI");
+    add(
+        "safeop.wkc", "SAFEOP: LRW over outputs and inputs has the exact working counter", kPd,
+        [](Context& ctx) { return cycle_wkc(ctx, 4); }, "CoE");
+    add(
+        "safeop.inputs_valid", "SAFEOP: inputs in the image equal their objects", kPd,
+        [](Context& ctx) { return inputs_match(ctx, 4); }, "CoE");
+    add(
+        "safeop.outputs_not_applied", "SAFEOP: outputs received are not applied to the objects", kPd,
+        [](Context& ctx) { return outputs(ctx, false); }, "CoE");
+    add(
+        "op.wkc", "OP: LRW over outputs and inputs has the exact working counter", kPd,
+        [](Context& ctx) { return cycle_wkc(ctx, 8); }, "CoE");
+    add(
+        "op.inputs_valid", "OP: inputs in the image equal their objects", kPd,
+        [](Context& ctx) { return inputs_match(ctx, 8); }, "CoE");
+    add(
+        "op.outputs_applied", "OP: outputs received are applied to the objects", kPd,
+        [](Context& ctx) { return outputs(ctx, true); }, "CoE");
+    add(
+        "op.lrd_wkc", "OP: LRD over the image: working counter 1 (only the inputs are readable)",
+        "ETG.1000.4 working counter of LRD",
+        [](Context& ctx) { return logical_only(ctx, master::Command::LRD); }, "CoE");
+    add(
+        "op.lwr_wkc", "OP: LWR over the image: working counter 1 (only the outputs are writable)",
+        "ETG.1000.4 working counter of LWR",
+        [](Context& ctx) { return logical_only(ctx, master::Command::LWR); }, "CoE");
+    add(
+        "remap.safeop",
+        "Another ESI RxPDO assigned in PREOP: SAFEOP with the new SM2 size and exact working counter", kPdEsi,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            if (!ctx.esi->coe.pdo_assign) return skip("the ESI does not announce PdoAssign");
+            CONFORM_PREOP(ctx);
+            auto n = ctx.upload_uint(0x1C12, 0);
+            auto first = ctx.upload_uint(0x1C12, 1);
+            if (!n || !first || *n != 1) return skip("needs exactly one assigned RxPDO");
+            const EsiPdo* other = nullptr;
+            for (const auto& p : ctx.esi->rxpdos)
+                if (p.index != *first && !p.entries.empty()) {
+                    other = &p;
+                    break;
+                }
+            if (!other) return skip("no other RxPDO in the ESI");
+            (void)ctx.download_uint(0x1C12, 0, 0, 1);
+            (void)ctx.download_uint(0x1C12, 1, other->index, 2);
+            (void)ctx.download_uint(0x1C12, 0, 1, 1);
+            Error e = ctx.to_safeop();
+            std::string got = e == Error::Ok ? dec(ctx.pds->layout().sm2_length) : "not reached: " + err(e);
+            Error cy = e == Error::Ok ? (ctx.cycle(3), ctx.pds->cycle()) : e;
+            (void)ctx.to_preop();
+            (void)ctx.download_uint(0x1C12, 0, 0, 1);
+            (void)ctx.download_uint(0x1C12, 1, *first, 2);
+            (void)ctx.download_uint(0x1C12, 0, *n, 1);
+            (void)ctx.to_init();
+            if (e != Error::Ok) return fail("SAFEOP with " + hex(other->index), got);
+            if (cy != Error::Ok) return fail("cycle with the new mapping", err(cy));
+            return expect_eq("SM2 bytes with " + hex(other->index), got, dec((other->bits() + 7) / 8));
+        },
+        "ESI announces PdoAssign");
+}
+
+}  // namespace conform

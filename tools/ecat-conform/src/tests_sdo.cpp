@@ -1,0 +1,793 @@
+// Group sdo: CoE SDO transfers (expedited, normal, segmented, complete access), the standard abort codes,
+// the object dictionary against the ESI, identity against the SII, PDO assignment/mapping rules.
+#include <thread>
+
+#include "sdo_util.hpp"
+
+namespace conform {
+
+namespace {
+
+using master::Error;
+constexpr const char* kSdo = "ETG.1000.6 CoE SDO services";
+constexpr const char* kAbort = "ETG.1000.6 CoE SDO abort codes";
+constexpr const char* kCa = "ETG.1000.6 CoE SDO complete access";
+constexpr const char* kOd = "ETG.2000 Dictionary/Objects; ETG.1000.6 CoE object dictionary";
+
+// A writable entry of 1, 2 or 4 bytes (no command objects), from the ESI.
+const EntryRef* pick_rw(Context& ctx, std::vector<EntryRef>& store, unsigned bits_min, unsigned bits_max,
+                        bool need_limits = false, bool high = true) {
+    if (!ctx.esi) return nullptr;
+    store = esi_entries(*ctx.esi);
+    for (const auto& r : store) {
+        if (command_object(r.obj->index) || !writable_in_preop(*r.e) || r.e->access != "rw") continue;
+        if (r.e->bit_size < bits_min || r.e->bit_size > bits_max || r.e->bit_size % 8) continue;
+        if (r.e->type.rfind("STRING", 0) == 0) continue;
+        if (need_limits) {
+            const unsigned bits = r.e->bit_size;
+            const bool is_signed = r.e->type == "SINT" || r.e->type == "INT" || r.e->type == "DINT";
+            const int64_t tmax = is_signed ? (int64_t{1} << (bits - 1)) - 1
+                                           : (bits >= 63 ? INT64_MAX : (int64_t{1} << bits) - 1);
+            const int64_t tmin = is_signed ? -(int64_t{1} << (bits - 1)) : 0;
+            if (high && !(r.e->max && *r.e->max < tmax)) continue;
+            if (!high && !(r.e->min && *r.e->min > tmin)) continue;
+        }
+        return &r;
+    }
+    return nullptr;
+}
+
+uint16_t missing_index(Context& ctx) {
+    for (uint16_t i = 0x5FFE; i > 0x2000; --i)
+        if (!ctx.esi || !ctx.esi->object(i)) return i;
+    return 0x5FFE;
+}
+
+Outcome identity(Context& ctx, uint8_t sub, std::size_t word) {
+    CONFORM_NEED(ctx.need_coe());
+    CONFORM_PREOP(ctx);
+    auto v = ctx.upload_uint(0x1018, sub);
+    if (!v) return fail("0x1018:" + dec(sub) + " upload: " + ctx.sdo_error(v.error()));
+    return expect_eq("0x1018:" + dec(sub) + " against SII word " + hex(word, 2), hex(*v, 8),
+                     hex(ctx.sii->dword(word), 8));
+}
+
+// Largest object (complete access) or entry that does not fit one mailbox answer: a segmented upload.
+struct Big {
+    uint16_t index = 0;
+    uint8_t sub = 0;
+    bool ca = false;
+    std::size_t bytes = 0;
+};
+std::optional<Big> big_object(Context& ctx) {
+    if (!ctx.esi || !ctx.mbx) return std::nullopt;
+    const std::size_t room = ctx.mbx->max_in_payload() > 10 ? ctx.mbx->max_in_payload() - 10 : 0;
+    for (const auto& [i, o] : ctx.esi->objects)
+        for (const auto& e : o.entries)
+            if (e.bit_size / 8u > room && e.access != "wo") return Big{i, e.subindex, false, e.bit_size / 8u};
+    if (ctx.need_complete_access().empty())
+        for (const auto& [i, o] : ctx.esi->objects)
+            if (o.object_code != 7 && o.bit_size / 8u > room) return Big{i, 0, true, o.bit_size / 8u};
+    return std::nullopt;
+}
+
+Outcome expedited_sizes(Context& ctx) {
+    CONFORM_NEED(ctx.need_coe());
+    CONFORM_PREOP(ctx);
+    std::vector<std::tuple<uint16_t, uint8_t, unsigned>> cands;
+    if (ctx.esi) {
+        for (const auto& r : esi_entries(*ctx.esi))
+            if (r.e->access != "wo" && (r.e->bit_size == 8 || r.e->bit_size == 16 || r.e->bit_size == 32) &&
+                r.e->type.rfind("STRING", 0) != 0 && cands.size() < 40)
+                cands.emplace_back(r.obj->index, r.e->subindex, r.e->bit_size / 8);
+    } else {
+        cands = {{0x1001, 0, 1}, {0x1018, 0, 1}, {0x1000, 0, 4}};
+    }
+    for (auto [i, s, n] : cands) {
+        SdoAnswer a = sdo_raw(ctx, sdo_req(0x40, i, s));
+        if (a.error != Error::Ok) return fail(hex(i) + ":" + dec(s) + " upload", a.describe());
+        if (a.is_abort()) continue;  // access rules are other tests' business
+        const uint8_t c = a.cmd();
+        if ((c & 0xE0) != 0x40 || !(c & 0x02) || !(c & 0x01))
+            return fail(hex(i) + ":" + dec(s) + ": not an expedited response with size indicated", hex(c, 2),
+                        "0x4f/0x4b/0x43");
+        const unsigned got = 4u - ((c >> 2) & 3u);
+        if (got != n)
+            return fail(hex(i) + ":" + dec(s) + ": size in the expedited response", dec(got) + " bytes",
+                        dec(n) + " bytes");
+    }
+    return pass(dec(static_cast<long long>(cands.size())) + " entries");
+}
+
+}  // namespace
+
+void add_sdo_tests(Catalogue& c) {
+    Adder add{c, "sdo"};
+    add(
+        "upload.expedited", "Expedited upload of 0x1000: response 0x43 with the 4 bytes", kSdo,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            SdoAnswer a = sdo_raw(ctx, sdo_req(0x40, 0x1000, 0));
+            if (a.error != Error::Ok || a.mailbox_type != 3) return fail("no SDO answer", a.describe());
+            if (a.cmd() != 0x43) return fail("upload response command", hex(a.cmd(), 2), "0x43");
+            if (get16(&a.p[3]) != 0x1000 || a.p[5] != 0)
+                return fail("index/subindex not echoed", bytes_hex(a.p, 6));
+            return pass("0x1000", hex(get32(&a.p[6]), 8));
+        },
+        "CoE");
+    add("upload.expedited_size", "Expedited upload responses give the entry's size (1, 2, 4 bytes)", kSdo,
+        expedited_sizes, "CoE");
+    add(
+        "upload.normal", "Normal upload of an object of 5..mailbox bytes: size indicated, data complete",
+        kSdo,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            uint16_t idx = 0x1008;
+            uint8_t sub = 0;
+            std::size_t want = 0;
+            if (ctx.esi) {
+                idx = 0;
+                for (const auto& r : esi_entries(*ctx.esi))
+                    if (r.e->access != "wo" && r.e->bit_size > 32 &&
+                        r.e->bit_size / 8u + 10 <= ctx.mbx->max_in_payload()) {
+                        idx = r.obj->index, sub = r.e->subindex, want = r.e->bit_size / 8u;
+                        break;
+                    }
+                if (!idx) return skip("no readable object of 5 bytes or more in the ESI");
+            }
+            SdoAnswer a = sdo_raw(ctx, sdo_req(0x40, idx, sub));
+            if (a.is_abort() && !ctx.esi) return skip("0x1008 not present");
+            if (a.error != Error::Ok || a.mailbox_type != 3) return fail("no SDO answer", a.describe());
+            if (a.cmd() != 0x41)
+                return fail(hex(idx) + ":" + dec(sub) + " normal upload response command", a.describe(),
+                            "0x41");
+            const uint32_t size = get32(&a.p[6]);
+            if (a.p.size() - 10 != size)
+                return fail("data length against the size field",
+                            dec(static_cast<long long>(a.p.size() - 10)), dec(size));
+            if (want && size != want)
+                return fail("size against the ESI", dec(size), dec(static_cast<long long>(want)));
+            return pass(hex(idx) + ":" + dec(sub), dec(size) + " bytes");
+        },
+        "CoE");
+    add(
+        "upload.segmented",
+        "Segmented upload of an object larger than the mailbox: complete, toggles alternate", kSdo,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_PREOP(ctx);
+            auto b = big_object(ctx);
+            if (!b) return skip("no object larger than the mailbox in the ESI");
+            auto r = ctx.upload(b->index, b->sub, b->ca);
+            if (!r)
+                return fail(hex(b->index) + (b->ca ? " (complete access)" : "") +
+                            " upload: " + ctx.sdo_error(r.error()));
+            return pass(hex(b->index), dec(static_cast<long long>(r->size())) + " bytes");
+        },
+        "ESI with an object larger than the mailbox");
+    add(
+        "upload.toggle_error", "Upload segment request with the wrong toggle bit: abort 0x05030000", kAbort,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_PREOP(ctx);
+            auto b = big_object(ctx);
+            if (!b) return skip("no object larger than the mailbox in the ESI");
+            SdoAnswer a =
+                sdo_raw(ctx, sdo_req(static_cast<uint8_t>(0x40 | (b->ca ? 0x10 : 0)), b->index, b->sub));
+            if (a.error != Error::Ok || (a.cmd() & 0xEF) != 0x41)
+                return fail("initiate upload", a.describe(), "0x41 (segmented)");
+            std::vector<uint8_t> seg = sdo_req(0x70, 0, 0);  // upload segment, toggle 1: the first must be 0
+            for (int i = 3; i < 10; ++i)
+                seg[static_cast<std::size_t>(i)] = 0;
+            SdoAnswer s = sdo_raw(ctx, seg);
+            if (!s.is_abort()) return fail("wrong toggle not aborted", s.describe(), "abort 0x05030000");
+            return expect_eq("abort code", hex(s.abort_code(), 8), hex(0x05030000, 8));
+        },
+        "ESI with an object larger than the mailbox");
+    add(
+        "upload.toggle_sequence", "Segmented upload responses alternate the toggle bit from 0", kSdo,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_PREOP(ctx);
+            auto b = big_object(ctx);
+            if (!b) return skip("no object larger than the mailbox in the ESI");
+            SdoAnswer a =
+                sdo_raw(ctx, sdo_req(static_cast<uint8_t>(0x40 | (b->ca ? 0x10 : 0)), b->index, b->sub));
+            if (a.error != Error::Ok || (a.cmd() & 0xEF) != 0x41)
+                return fail("initiate upload", a.describe(), "0x41 (segmented)");
+            std::size_t done = a.p.size() - 10;
+            const std::size_t size = get32(&a.p[6]);
+            uint8_t t = 0;
+            for (int n = 0; done < size && n < 64; ++n, t ^= 1) {
+                std::vector<uint8_t> seg(10, 0);
+                seg[1] = 0x20;
+                seg[2] = static_cast<uint8_t>(0x60 | (t << 4));
+                SdoAnswer s = sdo_raw(ctx, seg);
+                if (s.error != Error::Ok || s.mailbox_type != 3 || s.is_abort())
+                    return fail("segment " + dec(n), s.describe());
+                if (((s.cmd() >> 4) & 1) != t)
+                    return fail("toggle of segment " + dec(n), dec((s.cmd() >> 4) & 1), dec(t));
+                const std::size_t len = s.p.size() == 10 ? 7u - ((s.cmd() >> 1) & 7u) : s.p.size() - 3;
+                done += len;
+                if (s.cmd() & 1) break;
+            }
+            if (done != size)
+                return fail("bytes received", dec(static_cast<long long>(done)),
+                            dec(static_cast<long long>(size)));
+            return pass("segments", dec(static_cast<long long>(size)) + " bytes");
+        },
+        "ESI with an object larger than the mailbox");
+    add(
+        "download.expedited", "Expedited download of a writable entry (its own value): response 0x60", kSdo,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_PREOP(ctx);
+            std::vector<EntryRef> st;
+            const EntryRef* r = pick_rw(ctx, st, 8, 32);
+            if (!r) return skip("no writable 1..4-byte entry in the ESI");
+            auto v = ctx.upload_uint(r->obj->index, r->e->subindex);
+            if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
+            const unsigned n = r->e->bit_size / 8u;
+            SdoAnswer a = sdo_raw(ctx, sdo_req(static_cast<uint8_t>(0x23 | ((4 - n) << 2)), r->obj->index,
+                                               r->e->subindex, static_cast<uint32_t>(*v)));
+            if (a.cmd() != 0x60 || a.is_abort())
+                return fail(hex(r->obj->index) + ":" + dec(r->e->subindex), a.describe(), "0x60");
+            return pass(hex(r->obj->index) + ":" + dec(r->e->subindex));
+        },
+        "ESI given");
+    add(
+        "download.normal", "Normal (size-indicated) download of a writable entry: response 0x60", kSdo,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_PREOP(ctx);
+            std::vector<EntryRef> st;
+            const EntryRef* r = pick_rw(ctx, st, 8, 32);
+            if (!r) return skip("no writable 1..4-byte entry in the ESI");
+            auto v = ctx.upload(r->obj->index, r->e->subindex);
+            if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
+            auto req = sdo_req(0x21, r->obj->index, r->e->subindex, static_cast<uint32_t>(v->size()));
+            req.insert(req.end(), v->begin(), v->end());
+            SdoAnswer a = sdo_raw(ctx, req);
+            if (a.cmd() != 0x60 || a.is_abort())
+                return fail(hex(r->obj->index) + ":" + dec(r->e->subindex), a.describe(), "0x60");
+            return pass(hex(r->obj->index) + ":" + dec(r->e->subindex));
+        },
+        "ESI given");
+    add(
+        "download.segmented", "Segmented download (initiate, then a last segment): value taken", kSdo,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_PREOP(ctx);
+            std::vector<EntryRef> st;
+            const EntryRef* r = pick_rw(ctx, st, 16, 32);
+            if (!r) return skip("no writable 2..4-byte entry in the ESI");
+            auto v = ctx.upload(r->obj->index, r->e->subindex);
+            if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
+            // Initiate with the complete size and no data, then everything in one last segment.
+            SdoAnswer a =
+                sdo_raw(ctx, sdo_req(0x21, r->obj->index, r->e->subindex, static_cast<uint32_t>(v->size())));
+            if (a.cmd() != 0x60 || a.is_abort()) return fail("initiate", a.describe(), "0x60");
+            std::vector<uint8_t> seg(10, 0);
+            seg[1] = 0x20;
+            seg[2] = static_cast<uint8_t>(0x01 | ((7 - v->size()) << 1));  // toggle 0, last
+            std::copy(v->begin(), v->end(), seg.begin() + 3);
+            SdoAnswer s = sdo_raw(ctx, seg);
+            if (s.is_abort() || (s.cmd() & 0xF0) != 0x20)
+                return fail("segment", s.describe(), "0x20 (segment response, toggle 0)");
+            return pass(hex(r->obj->index) + ":" + dec(r->e->subindex));
+        },
+        "ESI given");
+    add(
+        "download.toggle_error", "Download segment with the wrong toggle bit: abort 0x05030000", kAbort,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_PREOP(ctx);
+            std::vector<EntryRef> st;
+            const EntryRef* r = pick_rw(ctx, st, 16, 32);
+            if (!r) return skip("no writable 2..4-byte entry in the ESI");
+            auto v = ctx.upload(r->obj->index, r->e->subindex);
+            if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
+            SdoAnswer a =
+                sdo_raw(ctx, sdo_req(0x21, r->obj->index, r->e->subindex, static_cast<uint32_t>(v->size())));
+            if (a.cmd() != 0x60 || a.is_abort()) return fail("initiate", a.describe(), "0x60");
+            std::vector<uint8_t> seg(10, 0);
+            seg[1] = 0x20;
+            seg[2] =
+                static_cast<uint8_t>(0x10 | 0x01 | ((7 - v->size()) << 1));  // toggle 1 on the first segment
+            std::copy(v->begin(), v->end(), seg.begin() + 3);
+            SdoAnswer s = sdo_raw(ctx, seg);
+            if (!s.is_abort()) return fail("wrong toggle taken", s.describe(), "abort 0x05030000");
+            return expect_eq("abort code", hex(s.abort_code(), 8), hex(0x05030000, 8));
+        },
+        "ESI given");
+    add(
+        "abort.missing_object", "Upload of a missing object: abort 0x06020000", kAbort,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            const uint16_t i = missing_index(ctx);
+            return expect_abort(sdo_raw(ctx, sdo_req(0x40, i, 0)), i, 0, {0x06020000}, "upload " + hex(i));
+        },
+        "CoE");
+    add(
+        "abort.missing_object_download", "Download to a missing object: abort 0x06020000", kAbort,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            const uint16_t i = missing_index(ctx);
+            return expect_abort(sdo_raw(ctx, sdo_req(0x2F, i, 0, 1)), i, 0, {0x06020000},
+                                "download " + hex(i));
+        },
+        "CoE");
+    add(
+        "abort.missing_subindex", "Upload of a missing subindex of 0x1018: abort 0x06090011", kAbort,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            auto n = ctx.upload_uint(0x1018, 0);
+            if (!n) return fail("0x1018:00 upload: " + ctx.sdo_error(n.error()));
+            const uint8_t s = static_cast<uint8_t>(*n + 1);
+            return expect_abort(sdo_raw(ctx, sdo_req(0x40, 0x1018, s)), 0x1018, s, {0x06090011},
+                                "0x1018:" + dec(s));
+        },
+        "CoE");
+    add(
+        "abort.write_read_only", "Download to the read-only 0x1018:01: abort 0x06010002", kAbort,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            auto v = ctx.upload_uint(0x1018, 1);
+            if (!v) return fail("0x1018:01 upload: " + ctx.sdo_error(v.error()));
+            return expect_abort(sdo_raw(ctx, sdo_req(0x23, 0x1018, 1, static_cast<uint32_t>(*v))), 0x1018, 1,
+                                {0x06010002}, "write 0x1018:01");
+        },
+        "CoE");
+    add(
+        "abort.command_byte_download",
+        "Abort of a failed download: command byte 0x80, index and subindex echoed", kAbort,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            SdoAnswer a = sdo_raw(ctx, sdo_req(0x23, 0x1018, 1, 0));
+            if (a.error != Error::Ok || a.mailbox_type != 3 || a.p.size() < 10)
+                return fail("no answer", a.describe());
+            if (a.cmd() != 0x80) return fail("command byte of the refusal", hex(a.cmd(), 2), "0x80");
+            if (get16(&a.p[3]) != 0x1018 || a.p[5] != 1)
+                return fail("index/subindex", bytes_hex(std::span<const uint8_t>(a.p).subspan(3, 3)),
+                            "18 10 01");
+            return pass("abort", a.describe());
+        },
+        "CoE");
+    add(
+        "abort.command_byte_upload", "Abort of a failed upload: command byte 0x80, index and subindex echoed",
+        kAbort,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            const uint16_t i = missing_index(ctx);
+            SdoAnswer a = sdo_raw(ctx, sdo_req(0x40, i, 3));
+            if (a.error != Error::Ok || a.mailbox_type != 3 || a.p.size() < 10)
+                return fail("no answer", a.describe());
+            if (a.cmd() != 0x80) return fail("command byte", hex(a.cmd(), 2), "0x80");
+            if (get16(&a.p[3]) != i || a.p[5] != 3)
+                return fail("index/subindex not echoed",
+                            bytes_hex(std::span<const uint8_t>(a.p).subspan(3, 3)));
+            return pass("abort", a.describe());
+        },
+        "CoE");
+    add(
+        "abort.unknown_command", "Request with client command specifier 7: abort 0x05040001", kAbort,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            return expect_abort(sdo_raw(ctx, sdo_req(0xE0, 0x1000, 0)), 0x1000, 0, {0x05040001},
+                                "command 0xe0");
+        },
+        "CoE");
+    add(
+        "abort.length_too_long",
+        "Download of more bytes than the entry holds: abort 0x06070012 (or 0x06070010)", kAbort,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_PREOP(ctx);
+            std::vector<EntryRef> st;
+            const EntryRef* r = pick_rw(ctx, st, 8, 16);
+            if (!r) return skip("no writable 1..2-byte entry in the ESI");
+            return expect_abort(sdo_raw(ctx, sdo_req(0x23, r->obj->index, r->e->subindex, 0)), r->obj->index,
+                                r->e->subindex, {0x06070012, 0x06070010},
+                                "4 bytes to " + dec(r->e->bit_size) + " bits");
+        },
+        "ESI given");
+    add(
+        "abort.length_too_short",
+        "Download of fewer bytes than the entry holds: abort 0x06070013 (or 0x06070010)", kAbort,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_PREOP(ctx);
+            std::vector<EntryRef> st;
+            const EntryRef* r = pick_rw(ctx, st, 32, 32);
+            if (!r) return skip("no writable 4-byte entry in the ESI");
+            return expect_abort(sdo_raw(ctx, sdo_req(0x2F, r->obj->index, r->e->subindex, 0)), r->obj->index,
+                                r->e->subindex, {0x06070013, 0x06070010}, "1 byte to 32 bits");
+        },
+        "ESI given");
+    for (bool high : {true, false}) {
+        add(
+            high ? "abort.value_too_high" : "abort.value_too_low",
+            std::string("Download above the ESI's ") + (high ? "MaxValue: abort 0x06090031 (or 0x06090030)"
+                                                             : "MinValue: abort 0x06090032 (or 0x06090030)"),
+            kAbort,
+            [high](Context& ctx) {
+                CONFORM_NEED(ctx.need_coe());
+                CONFORM_NEED(ctx.need_esi());
+                CONFORM_PREOP(ctx);
+                std::vector<EntryRef> st;
+                const EntryRef* r = pick_rw(ctx, st, 8, 32, true, high);
+                if (!r)
+                    return skip(std::string("no writable entry with a ") +
+                                (high ? "MaxValue below" : "MinValue above") + " its type's range");
+                const int64_t v = high ? *r->e->max + 1 : *r->e->min - 1;
+                const unsigned n = r->e->bit_size / 8u;
+                SdoAnswer a = sdo_raw(ctx, sdo_req(static_cast<uint8_t>(0x23 | ((4 - n) << 2)), r->obj->index,
+                                                   r->e->subindex, static_cast<uint32_t>(v)));
+                return expect_abort(a, r->obj->index, r->e->subindex,
+                                    {high ? 0x06090031u : 0x06090032u, 0x06090030u},
+                                    hex(r->obj->index) + ":" + dec(r->e->subindex) + " = " + dec(v));
+            },
+            "ESI with limits");
+    }
+    add(
+        "abort.mapping_in_safeop", "PDO assignment 0x1C12 written in SAFEOP: refused with an abort",
+        "ETG.1000.6 CoE PDO assignment (changed in PREOP only)",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            if (Error e = ctx.to_safeop(); e != Error::Ok) return fail("cannot reach SAFEOP: " + err(e));
+            auto v = ctx.upload_uint(0x1C12, 0);
+            if (!v) return fail("0x1C12:00 upload: " + ctx.sdo_error(v.error()));
+            SdoAnswer a = sdo_raw(ctx, sdo_req(0x2F, 0x1C12, 0, static_cast<uint32_t>(*v)));
+            return expect_abort(a, 0x1C12, 0, {0x08000022, 0x08000021, 0x06010002, 0x08000020},
+                                "0x1C12:00 in SAFEOP");
+        },
+        "CoE");
+    add(
+        "abort.mapping_object_in_safeop",
+        "PDO mapping object (first RxPDO) written in SAFEOP: refused with an abort",
+        "ETG.1000.6 CoE PDO mapping (changed in PREOP only)",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            if (Error e = ctx.to_safeop(); e != Error::Ok) return fail("cannot reach SAFEOP: " + err(e));
+            const auto& pdos =
+                ctx.pds->layout().rx_pdos.empty() ? ctx.pds->layout().tx_pdos : ctx.pds->layout().rx_pdos;
+            if (pdos.empty()) return skip("no PDO assigned");
+            auto v = ctx.upload_uint(pdos[0], 0);
+            if (!v) return fail(hex(pdos[0]) + ":00 upload: " + ctx.sdo_error(v.error()));
+            SdoAnswer a = sdo_raw(ctx, sdo_req(0x2F, pdos[0], 0, static_cast<uint32_t>(*v)));
+            return expect_abort(a, pdos[0], 0, {0x08000022, 0x08000021, 0x06010002, 0x08000020},
+                                hex(pdos[0]) + ":00 in SAFEOP");
+        },
+        "CoE");
+    add(
+        "abort.mapping_sub0_nonzero", "Mapping entry written while subindex 0 is not 0: abort 0x06010003",
+        "ETG.1000.6 CoE PDO mapping (subindex 0 set to 0 before entries change)",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            if (!ctx.esi->coe.pdo_config) return skip("the ESI does not announce PdoConfig");
+            CONFORM_PREOP(ctx);
+            const EsiPdo* p = nullptr;
+            for (const auto& x : ctx.esi->rxpdos)
+                if (!x.fixed && !x.entries.empty()) {
+                    p = &x;
+                    break;
+                }
+            if (!p) return skip("no configurable RxPDO");
+            auto v = ctx.upload_uint(p->index, 1);
+            auto v2 = ctx.upload_uint(p->index, 2);
+            if (!v || !v2) return fail(hex(p->index) + " upload failed");
+            // Another valid entry (subindex 2's) into subindex 1: a real change of an active mapping.
+            SdoAnswer a = sdo_raw(ctx, sdo_req(0x23, p->index, 1, static_cast<uint32_t>(*v2)));
+            if (!a.is_abort()) (void)ctx.download_uint(p->index, 1, *v, 4);
+            return expect_abort(a, p->index, 1, {0x06010003}, hex(p->index) + ":01");
+        },
+        "ESI announces PdoConfig", Severity::Warning);
+    for (auto [sub, word, name] : {std::tuple<uint8_t, std::size_t, const char*>{1, 0x08, "vendor"},
+                                   {2, 0x0A, "product"},
+                                   {3, 0x0C, "revision"},
+                                   {4, 0x0E, "serial"}}) {
+        add(
+            std::string("identity.") + name,
+            std::string("0x1018:0") + dec(sub) + " (" + name + ") equals the SII",
+            "ETG.1000.6 identity object 0x1018; SII words 0x08-0x0F",
+            [sub, word](Context& ctx) { return identity(ctx, sub, word); }, "CoE");
+    }
+    add(
+        "device_type_vs_esi", "0x1000 device type equals the ESI's default", kOd,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_PREOP(ctx);
+            const EsiObject* o = ctx.esi->object(0x1000);
+            if (!o || o->entries.empty() || o->entries[0].default_data.size() < 4)
+                return skip("no 0x1000 default in the ESI");
+            auto v = ctx.upload(0x1000, 0);
+            if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
+            return expect_eq("0x1000", bytes_hex(*v), bytes_hex(o->entries[0].default_data));
+        },
+        "ESI given");
+    add(
+        "sm_types", "0x1C00 SM communication types equal the SII SyncM types",
+        "ETG.1000.6 0x1C00 sync manager communication type",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            const SiiCategory* sm = ctx.sii->find(41);
+            if (!sm) return skip("no SII SyncM category");
+            auto n = ctx.upload_uint(0x1C00, 0);
+            if (!n) return fail("0x1C00:00 upload: " + ctx.sdo_error(n.error()));
+            std::string got, want;
+            auto d = ctx.sii->data(*sm);
+            for (std::size_t i = 0; i + 8 <= d.size() && i / 8 < *n; i += 8) {
+                auto t = ctx.upload_uint(0x1C00, static_cast<uint8_t>(i / 8 + 1));
+                got += (t ? dec(static_cast<long long>(*t)) : "?") + " ";
+                want += dec(d[i + 7]) + " ";
+            }
+            return expect_eq("types", got, want);
+        },
+        "CoE");
+    add(
+        "od.present", "Every object of the ESI answers an upload of subindex 0 (or of its only entry)", kOd,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_PREOP(ctx);
+            std::string missing;
+            for (const auto& [i, o] : ctx.esi->objects) {
+                if (!o.entries.empty() && o.entries[0].access == "wo") continue;
+                SdoAnswer a = sdo_raw(ctx, sdo_req(0x40, i, 0));
+                if (a.error != Error::Ok) return fail(hex(i) + ": " + a.describe());
+                if (a.is_abort() && (a.abort_code() == 0x06020000 || a.abort_code() == 0x06090011))
+                    missing += hex(i) + " ";
+            }
+            if (!missing.empty()) return fail("objects of the ESI missing in the slave", missing, "none");
+            return pass(dec(static_cast<long long>(ctx.esi->objects.size())) + " objects");
+        },
+        "ESI given");
+    add(
+        "od.size", "Every readable entry of the ESI uploads with its declared size", kOd,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_PREOP(ctx);
+            unsigned n = 0;
+            for (const auto& r : esi_entries(*ctx.esi)) {
+                if (r.e->access == "wo" || r.e->bit_size % 8 || r.e->bit_size == 0) continue;
+                if (r.obj->index == 0x10F3 && r.e->subindex > 5)
+                    continue;  // ETG.1020: diagnosis messages vary in length
+                auto v = ctx.upload(r.obj->index, r.e->subindex);
+                if (!v) {
+                    if (v.error() == Error::SdoAbort)
+                        continue;  // access is od.present's and the abort tests' business
+                    return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + ": " +
+                                ctx.sdo_error(v.error()));
+                }
+                ++n;
+                if (v->size() != r.e->bit_size / 8u)
+                    return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " (" + r.e->type + ") size",
+                                dec(static_cast<long long>(v->size())) + " bytes",
+                                dec(r.e->bit_size / 8u) + " bytes");
+            }
+            return pass(dec(n) + " entries");
+        },
+        "ESI given");
+    add(
+        "od.read_only", "Every read-only entry of the ESI refuses a download with 0x06010002", kOd,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_PREOP(ctx);
+            unsigned n = 0;
+            for (const auto& r : esi_entries(*ctx.esi)) {
+                if (r.e->access != "ro" || r.e->subindex == 0 || r.e->bit_size > 32 || r.e->bit_size % 8 ||
+                    r.e->bit_size == 0)
+                    continue;
+                auto v = ctx.upload_uint(r.obj->index, r.e->subindex);
+                if (!v) continue;
+                const unsigned b = r.e->bit_size / 8u;
+                SdoAnswer a = sdo_raw(ctx, sdo_req(static_cast<uint8_t>(0x23 | ((4 - b) << 2)), r.obj->index,
+                                                   r.e->subindex, static_cast<uint32_t>(*v)));
+                Outcome o = expect_abort(a, r.obj->index, r.e->subindex, {0x06010002},
+                                         hex(r.obj->index) + ":" + dec(r.e->subindex));
+                if (o.status != Status::Pass) return o;
+                if (++n >= 40) break;
+            }
+            return pass(dec(n) + " entries");
+        },
+        "ESI given");
+    add(
+        "od.defaults", "Read-only, unmapped entries hold the ESI's default value", kOd,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_PREOP(ctx);
+            unsigned n = 0;
+            for (const auto& r : esi_entries(*ctx.esi)) {
+                if (r.e->access != "ro" || !r.e->pdo_mapping.empty() || r.e->default_data.empty()) continue;
+                if (r.obj->index == 0x1018 && r.e->subindex == 4) continue;  // serial number: per device
+                if (r.obj->index == 0x1001 || r.obj->index == 0x10F3 || r.obj->index == 0x1C32 ||
+                    r.obj->index == 0x1C33)
+                    continue;
+                if (r.e->type.rfind("STRING", 0) == 0) continue;
+                auto v = ctx.upload(r.obj->index, r.e->subindex);
+                if (!v) continue;
+                ++n;
+                if (*v != r.e->default_data)
+                    return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " value", bytes_hex(*v),
+                                bytes_hex(r.e->default_data));
+            }
+            return pass(dec(n) + " entries");
+        },
+        "ESI given", Severity::Warning);
+    add(
+        "od.limits", "Entries with ESI limits hold a value within MinValue..MaxValue", kOd,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_PREOP(ctx);
+            unsigned n = 0;
+            for (const auto& r : esi_entries(*ctx.esi)) {
+                if (!r.e->min || !r.e->max || r.e->bit_size > 32 || r.e->bit_size % 8 || !r.e->bit_size)
+                    continue;
+                auto v = ctx.upload_uint(r.obj->index, r.e->subindex);
+                if (!v) continue;
+                int64_t x = static_cast<int64_t>(*v);
+                const bool is_signed = r.e->type == "SINT" || r.e->type == "INT" || r.e->type == "DINT";
+                if (is_signed) x = static_cast<int64_t>(*v << (64 - r.e->bit_size)) >> (64 - r.e->bit_size);
+                ++n;
+                if (x < *r.e->min || x > *r.e->max)
+                    return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " out of its limits", dec(x),
+                                dec(*r.e->min) + ".." + dec(*r.e->max));
+            }
+            return pass(dec(n) + " entries");
+        },
+        "ESI given", Severity::Warning);
+    add(
+        "ca.upload_padding", "Complete access upload of 0x1018 from subindex 0: subindex 0 padded to 16 bits",
+        kCa,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_complete_access());
+            CONFORM_PREOP(ctx);
+            auto n = ctx.upload_uint(0x1018, 0);
+            if (!n) return fail("0x1018:00: " + ctx.sdo_error(n.error()));
+            std::vector<uint8_t> want = {static_cast<uint8_t>(*n), 0};
+            for (uint8_t s = 1; s <= *n; ++s) {
+                auto v = ctx.upload(0x1018, s);
+                if (!v) return fail("0x1018:" + dec(s) + ": " + ctx.sdo_error(v.error()));
+                want.insert(want.end(), v->begin(), v->end());
+            }
+            auto ca = ctx.upload(0x1018, 0, true);
+            if (!ca) return fail("complete access upload: " + ctx.sdo_error(ca.error()));
+            return expect_eq("0x1018 complete", bytes_hex(*ca, 64), bytes_hex(want, 64));
+        },
+        "complete access announced");
+    add(
+        "ca.upload_from_sub1",
+        "Complete access upload of 0x1018 from subindex 1: the entries without subindex 0", kCa,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_complete_access());
+            CONFORM_PREOP(ctx);
+            auto n = ctx.upload_uint(0x1018, 0);
+            if (!n) return fail("0x1018:00: " + ctx.sdo_error(n.error()));
+            std::vector<uint8_t> want;
+            for (uint8_t s = 1; s <= *n; ++s) {
+                auto v = ctx.upload(0x1018, s);
+                if (!v) return fail("0x1018:" + dec(s) + ": " + ctx.sdo_error(v.error()));
+                want.insert(want.end(), v->begin(), v->end());
+            }
+            auto ca = ctx.upload(0x1018, 1, true);
+            if (!ca) return fail("complete access upload: " + ctx.sdo_error(ca.error()));
+            return expect_eq("0x1018 from :01", bytes_hex(*ca, 64), bytes_hex(want, 64));
+        },
+        "complete access announced");
+    add(
+        "ca.download_assign", "Complete access download of 0x1C12 with its own value in PREOP", kCa,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_complete_access());
+            CONFORM_NEED(ctx.need_esi());
+            if (!ctx.esi->coe.pdo_assign) return skip("the ESI does not announce PdoAssign");
+            CONFORM_PREOP(ctx);
+            auto ca = ctx.upload(0x1C12, 0, true);
+            if (!ca) return fail("complete access upload: " + ctx.sdo_error(ca.error()));
+            if (Error e = ctx.download(0x1C12, 0, *ca, true); e != Error::Ok)
+                return fail("complete access download: " + ctx.sdo_error(e));
+            auto again = ctx.upload(0x1C12, 0, true);
+            if (!again) return fail("upload after: " + ctx.sdo_error(again.error()));
+            return expect_eq("0x1C12", bytes_hex(*again), bytes_hex(*ca));
+        },
+        "complete access and PdoAssign announced");
+    add(
+        "ca.not_announced", "Complete access refused with 0x06010004 when not announced", kCa,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            if (ctx.need_complete_access().empty()) return skip("complete access is announced");
+            CONFORM_PREOP(ctx);
+            return expect_abort(sdo_raw(ctx, sdo_req(0x50, 0x1018, 0)), 0x1018, 0, {0x06010004},
+                                "complete access");
+        },
+        "complete access not announced");
+    add(
+        "pdo.assign_change", "PDO assignment changed in PREOP to another ESI PDO reads back; restored",
+        "ETG.1000.6 CoE PDO assignment 0x1C12",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            if (!ctx.esi->coe.pdo_assign) return skip("the ESI does not announce PdoAssign");
+            CONFORM_PREOP(ctx);
+            auto n = ctx.upload_uint(0x1C12, 0);
+            auto first = ctx.upload_uint(0x1C12, 1);
+            if (!n || !first) return fail("0x1C12 upload failed");
+            uint16_t other = 0;
+            for (const auto& p : ctx.esi->rxpdos)
+                if (p.index != *first) {
+                    other = p.index;
+                    break;
+                }
+            if (!other || *n != 1) return skip("needs one assigned RxPDO and another one in the ESI");
+            Error e1 = ctx.download_uint(0x1C12, 0, 0, 1);
+            Error e2 = ctx.download_uint(0x1C12, 1, other, 2);
+            Error e3 = ctx.download_uint(0x1C12, 0, 1, 1);
+            auto got = ctx.upload_uint(0x1C12, 1);
+            (void)ctx.download_uint(0x1C12, 0, 0, 1);
+            (void)ctx.download_uint(0x1C12, 1, *first, 2);
+            (void)ctx.download_uint(0x1C12, 0, *n, 1);
+            if (e1 != Error::Ok || e2 != Error::Ok || e3 != Error::Ok)
+                return fail("assignment refused: " + ctx.sdo_error(e1 != Error::Ok   ? e1
+                                                                   : e2 != Error::Ok ? e2
+                                                                                     : e3));
+            return expect_eq("0x1C12:01", got ? hex(*got) : "?", hex(other));
+        },
+        "ESI announces PdoAssign");
+    add(
+        "pdo.mapping_rewrite", "PDO mapping rewritten in PREOP (subindex 0 to 0, entries, count) reads back",
+        "ETG.1000.6 CoE PDO mapping",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            if (!ctx.esi->coe.pdo_config) return skip("the ESI does not announce PdoConfig");
+            CONFORM_PREOP(ctx);
+            const EsiPdo* p = nullptr;
+            for (const auto& x : ctx.esi->rxpdos)
+                if (!x.fixed && !x.entries.empty()) {
+                    p = &x;
+                    break;
+                }
+            if (!p) return skip("no configurable RxPDO");
+            auto n = ctx.upload_uint(p->index, 0);
+            if (!n) return fail("upload: " + ctx.sdo_error(n.error()));
+            std::vector<uint64_t> entries;
+            for (uint8_t s = 1; s <= *n; ++s) {
+                auto v = ctx.upload_uint(p->index, s);
+                if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
+                entries.push_back(*v);
+            }
+            Error e = ctx.download_uint(p->index, 0, 0, 1);
+            for (uint8_t s = 1; s <= *n && e == Error::Ok; ++s)
+                e = ctx.download_uint(p->index, s, entries[s - 1u], 4);
+            Error e2 = ctx.download_uint(p->index, 0, *n, 1);
+            if (e != Error::Ok || e2 != Error::Ok)
+                return fail("mapping write: " + ctx.sdo_error(e != Error::Ok ? e : e2));
+            auto again = ctx.upload_uint(p->index, 0);
+            return expect_eq(hex(p->index) + ":00", again ? dec(static_cast<long long>(*again)) : "?",
+                             dec(static_cast<long long>(*n)));
+        },
+        "ESI announces PdoConfig");
+}
+
+}  // namespace conform

@@ -1,0 +1,445 @@
+// Group sdoinfo: the SDO information service: every list type, object and entry descriptions against the
+// ESI, error replies.
+#include <set>
+
+#include "sdo_util.hpp"
+
+namespace conform {
+
+namespace {
+
+using master::Error;
+constexpr const char* kInfo = "ETG.1000.6 CoE SDO information service";
+
+struct InfoCache {
+    std::map<uint16_t, master::ObjectDescription> objects;
+    std::map<std::pair<uint16_t, uint8_t>, master::EntryDescription> entries;
+    std::string error;
+};
+
+// Object and entry descriptions of every ESI object, fetched once per run.
+InfoCache& descriptions(Context& ctx) {
+    auto& slot = ctx.cache["sdoinfo"];
+    if (slot) return *static_cast<InfoCache*>(slot.get());
+    auto c = std::make_shared<InfoCache>();
+    for (const auto& [i, o] : ctx.esi->objects) {
+        auto d = ctx.sdo->object_description(i);
+        if (!d) {
+            c->error = "object description " + hex(i) + ": " + ctx.sdo_error(d.error());
+            break;
+        }
+        c->objects[i] = *d;
+        for (const auto& e : o.entries) {
+            auto x = ctx.sdo->entry_description(i, e.subindex, 0x70);
+            if (!x) {
+                c->error =
+                    "entry description " + hex(i) + ":" + dec(e.subindex) + ": " + ctx.sdo_error(x.error());
+                break;
+            }
+            c->entries[{i, e.subindex}] = *x;
+        }
+        if (!c->error.empty()) break;
+    }
+    slot = c;
+    return *c;
+}
+
+#define CONFORM_INFO(ctx)                \
+    CONFORM_NEED((ctx).need_sdo_info()); \
+    CONFORM_NEED((ctx).need_esi());      \
+    CONFORM_PREOP(ctx);                  \
+    InfoCache& info = descriptions(ctx); \
+    if (!info.error.empty()) return fail(info.error)
+
+std::string list_text(const std::set<uint16_t>& s) {
+    std::string r;
+    for (auto i : s)
+        r += hex(i) + " ";
+    return r.empty() ? "(none)" : r;
+}
+
+Outcome list_vs_esi(Context& ctx, uint16_t type, const std::function<bool(const EsiObject&)>& in_list) {
+    CONFORM_NEED(ctx.need_sdo_info());
+    CONFORM_NEED(ctx.need_esi());
+    CONFORM_PREOP(ctx);
+    auto l = ctx.sdo->od_list(type);
+    if (!l) return fail("list type " + dec(type) + ": " + ctx.sdo_error(l.error()));
+    std::set<uint16_t> got(l->begin(), l->end()), want;
+    for (const auto& [i, o] : ctx.esi->objects)
+        if (in_list(o)) want.insert(i);
+    std::set<uint16_t> missing, extra;
+    for (auto i : want)
+        if (!got.count(i)) missing.insert(i);
+    for (auto i : got)
+        if (!want.count(i)) extra.insert(i);
+    if (missing.empty() && extra.empty()) return pass(dec(static_cast<long long>(got.size())) + " objects");
+    return fail("list differs from the ESI", "missing " + list_text(missing) + "; extra " + list_text(extra),
+                "none missing, none extra");
+}
+
+bool any_entry(const EsiObject& o, const std::function<bool(const EsiEntry&)>& f) {
+    for (const auto& e : o.entries)
+        if (f(e)) return true;
+    return false;
+}
+
+// Access bits of an entry description: 0-2 read in PREOP/SAFEOP/OP, 3-5 write in PREOP/SAFEOP/OP.
+uint16_t expected_access(const EsiEntry& e) {
+    uint16_t a = 0;
+    if (e.access == "ro" || e.access == "rw") a |= 0x07;
+    if (e.access == "rw" || e.access == "wo") {
+        const auto& w = e.write_restrictions;
+        if (w.empty()) {
+            a |= 0x38;
+        } else {
+            if (w.find("PreOP") != std::string::npos) a |= 0x08;
+            if (w.find("SafeOP") != std::string::npos) a |= 0x10;
+            if (w == "OP" || (w.size() > 3 && w.compare(w.size() - 3, 3, "_OP") == 0)) a |= 0x20;
+        }
+    }
+    return a;
+}
+
+SdoAnswer info_raw(Context& ctx, uint8_t opcode, std::vector<uint8_t> body) {
+    std::vector<uint8_t> r = {0x00, 0x80, opcode, 0, 0, 0};
+    r.insert(r.end(), body.begin(), body.end());
+    return sdo_raw(ctx, r);
+}
+
+}  // namespace
+
+void add_sdoinfo_tests(Catalogue& c) {
+    Adder add{c, "sdoinfo"};
+    const std::string a = "SDO information and ESI";
+    add(
+        "list.all", "Object list 'all objects' (type 1) equals the ESI's objects", kInfo,
+        [](Context& ctx) { return list_vs_esi(ctx, 1, [](const EsiObject&) { return true; }); }, a);
+    add(
+        "list.rxpdo", "Object list 'RxPDO-mappable' (type 2) equals the ESI's objects with PdoMapping R",
+        kInfo,
+        [](Context& ctx) {
+            return list_vs_esi(ctx, 2, [](const EsiObject& o) {
+                return any_entry(
+                    o, [](const EsiEntry& e) { return e.pdo_mapping.find('R') != std::string::npos; });
+            });
+        },
+        a);
+    add(
+        "list.txpdo", "Object list 'TxPDO-mappable' (type 3) equals the ESI's objects with PdoMapping T",
+        kInfo,
+        [](Context& ctx) {
+            return list_vs_esi(ctx, 3, [](const EsiObject& o) {
+                return any_entry(
+                    o, [](const EsiEntry& e) { return e.pdo_mapping.find('T') != std::string::npos; });
+            });
+        },
+        a);
+    add(
+        "list.backup", "Object list 'backup' (type 4) equals the ESI's objects with Backup entries", kInfo,
+        [](Context& ctx) {
+            return list_vs_esi(ctx, 4, [](const EsiObject& o) {
+                return any_entry(o, [](const EsiEntry& e) { return e.backup; });
+            });
+        },
+        a, Severity::Warning);
+    add(
+        "list.settings", "Object list 'settings' (type 5) equals the ESI's objects with Setting entries",
+        kInfo,
+        [](Context& ctx) {
+            return list_vs_esi(ctx, 5, [](const EsiObject& o) {
+                return any_entry(o, [](const EsiEntry& e) { return e.setting; });
+            });
+        },
+        a, Severity::Warning);
+    add(
+        "list.lengths", "List type 0 gives the lengths of lists 1..5", kInfo,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sdo_info());
+            CONFORM_PREOP(ctx);
+            auto l = ctx.sdo->od_list(0);
+            if (!l) return fail("list type 0: " + ctx.sdo_error(l.error()));
+            std::string got, want;
+            for (uint16_t t = 1; t <= 5; ++t) {
+                auto x = ctx.sdo->od_list(t);
+                if (!x) return fail("list type " + dec(t) + ": " + ctx.sdo_error(x.error()));
+                want += dec(static_cast<long long>(x->size())) + " ";
+                got += (t - 1u < l->size() ? dec((*l)[t - 1u]) : std::string("-")) + " ";
+            }
+            return expect_eq("lengths of lists 1..5", got, want);
+        },
+        "SDO information");
+    add(
+        "list.fragments", "A list longer than the mailbox comes in fragments counting down to 0", kInfo,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sdo_info());
+            CONFORM_PREOP(ctx);
+            SdoAnswer r = info_raw(ctx, 0x01, {0x01, 0x00});
+            if (r.error != Error::Ok || r.p.size() < 6) return fail("no answer", r.describe());
+            int n = 0;
+            uint16_t left = get16(&r.p[4]);
+            while (r.p[2] & 0x80) {
+                master::MailboxMessage msg;
+                if (Error e = ctx.mbx->receive(msg, ctx.ms(500)); e != Error::Ok)
+                    return fail("fragment " + dec(n + 1) + ": " + err(e));
+                if (msg.payload.size() < 6)
+                    return fail("fragment too short", dec(static_cast<long long>(msg.payload.size())));
+                r.p.assign(msg.payload.begin(), msg.payload.end());
+                const uint16_t now = get16(&r.p[4]);
+                if (now + 1 != left) return fail("fragments left", dec(now), dec(left - 1));
+                left = now;
+                ++n;
+            }
+            if (left != 0) return fail("last fragment: fragments left", dec(left), "0");
+            if (n == 0) return skip("the list fits one mailbox");
+            return pass(dec(n + 1) + " fragments");
+        },
+        "SDO information");
+    add(
+        "od.object_code", "Object descriptions: object code (VAR/ARRAY/RECORD) as the ESI", kInfo,
+        [](Context& ctx) {
+            CONFORM_INFO(ctx);
+            for (const auto& [i, o] : ctx.esi->objects) {
+                const uint8_t got = info.objects[i].object_code;
+                if (got == o.object_code) continue;
+                // An ARRAY with gaps in its subindices can only be written as a record-like DataType in an
+                // ESI: accepted when all entries after subindex 0 have one type.
+                bool one_type = o.entries.size() > 1;
+                for (std::size_t k = 1; k < o.entries.size(); ++k)
+                    one_type = one_type && o.entries[k].type == o.entries[1].type;
+                if (got == 8 && o.object_code == 9 && one_type) continue;
+                return fail(hex(i) + " object code", dec(got), dec(o.object_code));
+            }
+            return pass(dec(static_cast<long long>(info.objects.size())) + " objects");
+        },
+        a);
+    add(
+        "od.max_subindex", "Object descriptions: maximum subindex as the ESI", kInfo,
+        [](Context& ctx) {
+            CONFORM_INFO(ctx);
+            for (const auto& [i, o] : ctx.esi->objects)
+                if (info.objects[i].max_subindex != o.max_subindex())
+                    return fail(hex(i) + " max subindex", dec(info.objects[i].max_subindex),
+                                dec(o.max_subindex()));
+            return pass();
+        },
+        a);
+    add(
+        "od.data_type", "Object descriptions of VAR and ARRAY objects: data type as the ESI", kInfo,
+        [](Context& ctx) {
+            CONFORM_INFO(ctx);
+            for (const auto& [i, o] : ctx.esi->objects) {
+                std::string t =
+                    o.object_code == 7
+                        ? o.type
+                        : (o.object_code == 8 && o.entries.size() > 1 ? o.entries.back().type : "");
+                const uint16_t want = esi_coe_type(t);
+                if (want && info.objects[i].data_type != want)
+                    return fail(hex(i) + " data type", hex(info.objects[i].data_type),
+                                hex(want) + " (" + t + ")");
+            }
+            return pass();
+        },
+        a);
+    add(
+        "od.name", "Object descriptions: name as the ESI", kInfo,
+        [](Context& ctx) {
+            CONFORM_INFO(ctx);
+            for (const auto& [i, o] : ctx.esi->objects)
+                if (info.objects[i].name != o.name)
+                    return fail(hex(i) + " name", info.objects[i].name, o.name);
+            return pass();
+        },
+        a, Severity::Warning);
+    add(
+        "entry.data_type", "Entry descriptions: data type as the ESI", kInfo,
+        [](Context& ctx) {
+            CONFORM_INFO(ctx);
+            for (const auto& r : esi_entries(*ctx.esi)) {
+                const uint16_t want = esi_coe_type(r.e->type);
+                const auto& d = info.entries[{r.obj->index, r.e->subindex}];
+                if (want && d.data_type != want)
+                    return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " data type", hex(d.data_type),
+                                hex(want) + " (" + r.e->type + ")");
+            }
+            return pass();
+        },
+        a);
+    add(
+        "entry.bit_length", "Entry descriptions: bit length as the ESI", kInfo,
+        [](Context& ctx) {
+            CONFORM_INFO(ctx);
+            for (const auto& r : esi_entries(*ctx.esi)) {
+                const auto& d = info.entries[{r.obj->index, r.e->subindex}];
+                if (d.bit_length != r.e->bit_size)
+                    return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " bit length",
+                                dec(d.bit_length), dec(r.e->bit_size));
+            }
+            return pass();
+        },
+        a);
+    add(
+        "entry.access", "Entry descriptions: read/write access per state as the ESI's Access", kInfo,
+        [](Context& ctx) {
+            CONFORM_INFO(ctx);
+            for (const auto& r : esi_entries(*ctx.esi)) {
+                const auto& d = info.entries[{r.obj->index, r.e->subindex}];
+                const uint16_t want = expected_access(*r.e);
+                if ((d.access & 0x3F) != want)
+                    return fail(
+                        hex(r.obj->index) + ":" + dec(r.e->subindex) + " access bits (" + r.e->access +
+                            (r.e->write_restrictions.empty() ? "" : ", " + r.e->write_restrictions) + ")",
+                        hex(d.access & 0x3F, 2), hex(want, 2));
+            }
+            return pass();
+        },
+        a);
+    add(
+        "entry.pdo_mapping", "Entry descriptions: RxPDO/TxPDO mappable bits as the ESI's PdoMapping", kInfo,
+        [](Context& ctx) {
+            CONFORM_INFO(ctx);
+            for (const auto& r : esi_entries(*ctx.esi)) {
+                const auto& d = info.entries[{r.obj->index, r.e->subindex}];
+                const uint16_t want =
+                    static_cast<uint16_t>((r.e->pdo_mapping.find('R') != std::string::npos ? 0x40 : 0) |
+                                          (r.e->pdo_mapping.find('T') != std::string::npos ? 0x80 : 0));
+                if ((d.access & 0xC0) != want)
+                    return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " mapping bits",
+                                hex(d.access & 0xC0, 2), hex(want, 2));
+            }
+            return pass();
+        },
+        a);
+    add(
+        "entry.name", "Entry descriptions: name as the ESI", kInfo,
+        [](Context& ctx) {
+            CONFORM_INFO(ctx);
+            for (const auto& [i, o] : ctx.esi->objects) {
+                if (o.object_code == 7) continue;  // a VAR's entry is named after the object
+                for (const auto& e : o.entries) {
+                    if (o.object_code == 8 && e.subindex > 0)
+                        continue;  // array elements share one name in the ESI
+                    const auto& d = info.entries[{i, e.subindex}];
+                    if (d.name != e.name)
+                        return fail(hex(i) + ":" + dec(e.subindex) + " name", d.name, e.name);
+                }
+            }
+            return pass();
+        },
+        a, Severity::Warning);
+    add(
+        "entry.default", "Entry descriptions: default value (value info 0x10) as the ESI's DefaultData",
+        kInfo,
+        [](Context& ctx) {
+            CONFORM_INFO(ctx);
+            unsigned n = 0;
+            for (const auto& r : esi_entries(*ctx.esi)) {
+                const auto& d = info.entries[{r.obj->index, r.e->subindex}];
+                if (!(d.value_info & 0x10) || r.e->default_data.empty() || r.e->type.rfind("STRING", 0) == 0)
+                    continue;
+                const std::size_t off = (d.value_info & 0x08) ? 4 : 0;
+                const std::size_t len = (d.bit_length + 7u) / 8u;
+                if (d.values.size() < off + len) continue;
+                std::vector<uint8_t> v(d.values.begin() + static_cast<std::ptrdiff_t>(off),
+                                       d.values.begin() + static_cast<std::ptrdiff_t>(off + len));
+                ++n;
+                if (v != r.e->default_data)
+                    return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " default", bytes_hex(v),
+                                bytes_hex(r.e->default_data));
+            }
+            if (!n) return skip("no entry description carries a default value");
+            return pass(dec(n) + " entries");
+        },
+        a, Severity::Warning);
+    add(
+        "entry.limits",
+        "Entry descriptions: minimum/maximum (value info 0x20/0x40) as the ESI's MinValue/MaxValue", kInfo,
+        [](Context& ctx) {
+            CONFORM_INFO(ctx);
+            unsigned n = 0;
+            for (const auto& r : esi_entries(*ctx.esi)) {
+                const auto& d = info.entries[{r.obj->index, r.e->subindex}];
+                if ((d.value_info & 0x60) != 0x60 || !r.e->min || !r.e->max || d.bit_length > 32 ||
+                    d.bit_length % 8)
+                    continue;
+                const std::size_t len = d.bit_length / 8u;
+                std::size_t off = ((d.value_info & 0x08) ? 4 : 0) + ((d.value_info & 0x10) ? len : 0);
+                if (d.values.size() < off + 2 * len) continue;
+                auto val = [&](std::size_t o) {
+                    uint64_t v = 0;
+                    for (std::size_t k = 0; k < len; ++k)
+                        v |= static_cast<uint64_t>(d.values[o + k]) << (8 * k);
+                    const bool is_signed = r.e->type == "SINT" || r.e->type == "INT" || r.e->type == "DINT";
+                    if (is_signed) return static_cast<int64_t>(v << (64 - 8 * len)) >> (64 - 8 * len);
+                    return static_cast<int64_t>(v);
+                };
+                ++n;
+                if (val(off) != *r.e->min || val(off + len) != *r.e->max)
+                    return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " limits",
+                                dec(val(off)) + ".." + dec(val(off + len)),
+                                dec(*r.e->min) + ".." + dec(*r.e->max));
+            }
+            if (!n) return skip("no entry description carries limits");
+            return pass(dec(n) + " entries");
+        },
+        a, Severity::Warning);
+    add(
+        "error.missing_object", "Object description of a missing object: error reply 0x06020000", kInfo,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sdo_info());
+            CONFORM_PREOP(ctx);
+            uint16_t i = 0x5FFE;
+            while (ctx.esi && ctx.esi->object(i))
+                --i;
+            auto d = ctx.sdo->object_description(i);
+            if (d) return fail("described a missing object " + hex(i), d->name, "error 0x06020000");
+            if (d.error() != Error::SdoAbort) return fail("no error reply: " + ctx.sdo_error(d.error()));
+            return expect_eq("error code", hex(ctx.sdo->last_abort(), 8), hex(0x06020000, 8));
+        },
+        "SDO information");
+    add(
+        "error.missing_subindex", "Entry description of a missing subindex of 0x1018: error reply 0x06090011",
+        kInfo,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sdo_info());
+            CONFORM_PREOP(ctx);
+            auto n = ctx.upload_uint(0x1018, 0);
+            if (!n) return fail("0x1018:00: " + ctx.sdo_error(n.error()));
+            auto d = ctx.sdo->entry_description(0x1018, static_cast<uint8_t>(*n + 1));
+            if (d) return fail("described a missing subindex", d->name, "error 0x06090011");
+            if (d.error() != Error::SdoAbort) return fail("no error reply: " + ctx.sdo_error(d.error()));
+            return expect_eq("error code", hex(ctx.sdo->last_abort(), 8), hex(0x06090011, 8));
+        },
+        "SDO information");
+    add(
+        "error.format", "SDO information error reply: opcode 7, complete, 4-byte abort code (length 10)",
+        kInfo,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sdo_info());
+            CONFORM_PREOP(ctx);
+            uint16_t i = 0x5FFE;
+            while (ctx.esi && ctx.esi->object(i))
+                --i;
+            SdoAnswer r = info_raw(ctx, 0x03, {static_cast<uint8_t>(i), static_cast<uint8_t>(i >> 8)});
+            if (r.error != Error::Ok || r.mailbox_type != 3) return fail("no answer", r.describe());
+            if ((r.p[2] & 0x7F) != 0x07) return fail("opcode", hex(r.p[2] & 0x7F, 2), "0x07");
+            if (r.p[2] & 0x80) return fail("incomplete bit set on an error reply", hex(r.p[2], 2), "0x07");
+            return expect_eq("CoE length of the error reply", dec(static_cast<long long>(r.p.size())), "10");
+        },
+        "SDO information");
+    add(
+        "entry.sub0_type", "Entry description of subindex 0 of ARRAY/RECORD objects: UNSIGNED8, 8 bits",
+        kInfo,
+        [](Context& ctx) {
+            CONFORM_INFO(ctx);
+            for (const auto& [i, o] : ctx.esi->objects) {
+                if (o.object_code == 7) continue;
+                const auto& d = info.entries[{i, 0}];
+                if (d.data_type != 0x0005 || d.bit_length != 8)
+                    return fail(hex(i) + ":0", hex(d.data_type) + "/" + dec(d.bit_length), "0x0005/8");
+            }
+            return pass();
+        },
+        a);
+}
+
+}  // namespace conform

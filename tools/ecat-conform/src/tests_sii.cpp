@@ -1,0 +1,443 @@
+// Group sii: the EEPROM read back whole, its header, every category well-formed, and the SII compared with
+// the ESI (ETG.2000 describes how an ESI becomes the SII image).
+#include <set>
+
+#include "testkit.hpp"
+
+namespace conform {
+
+namespace {
+
+constexpr const char* kSii = "ETG.1000.6 Slave Information Interface (SII) content";
+constexpr const char* kSiiEsi = "ETG.2000 ESI to SII mapping; ETG.1000.6 SII content";
+constexpr uint16_t kStrings = 10, kGeneral = 30, kFmmu = 40, kSyncM = 41, kTxPdo = 50, kRxPdo = 51, kDc = 60;
+
+std::string esi_sm(const EsiSm& s) {
+    return hex(s.start) + "/" + dec(s.default_size) + "/" + hex(s.control, 2) + "/" + (s.enable ? "1" : "0");
+}
+
+struct SiiPdo {
+    uint16_t index = 0;
+    uint8_t sm = 0;
+    std::vector<std::string> entries;  // "idx:sub/bits"
+};
+
+// Walks a PDO category; "" or why it is malformed.
+std::string parse_pdos(std::span<const uint8_t> d, std::vector<SiiPdo>& out) {
+    std::size_t p = 0;
+    while (p + 8 <= d.size()) {
+        SiiPdo pdo;
+        pdo.index = get16(&d[p]);
+        const uint8_t n = d[p + 2];
+        pdo.sm = d[p + 3];
+        p += 8;
+        if (p + 8u * n > d.size())
+            return "PDO " + hex(pdo.index) + " announces " + dec(n) + " entries past the category end";
+        for (uint8_t i = 0; i < n; ++i, p += 8)
+            pdo.entries.push_back(hex(get16(&d[p])) + ":" + dec(d[p + 2]) + "/" + dec(d[p + 5]));
+        out.push_back(pdo);
+    }
+    if (p != d.size() && !(d.size() - p < 8 && std::all_of(d.begin() + static_cast<std::ptrdiff_t>(p),
+                                                           d.end(), [](uint8_t b) { return b == 0; })))
+        return "trailing " + dec(static_cast<long long>(d.size() - p)) + " bytes";
+    return {};
+}
+
+std::string esi_pdo_text(const std::vector<EsiPdo>& pdos) {
+    std::string s;
+    for (const auto& p : pdos) {
+        s += hex(p.index) + "[";
+        for (std::size_t i = 0; i < p.entries.size(); ++i)
+            s += (i ? " " : "") + hex(p.entries[i].index) + ":" + dec(p.entries[i].subindex) + "/" +
+                 dec(p.entries[i].bit_len);
+        s += "] ";
+    }
+    return s;
+}
+std::string sii_pdo_text(const std::vector<SiiPdo>& pdos) {
+    std::string s;
+    for (const auto& p : pdos) {
+        s += hex(p.index) + "[";
+        for (std::size_t i = 0; i < p.entries.size(); ++i)
+            s += (i ? " " : "") + p.entries[i];
+        s += "] ";
+    }
+    return s;
+}
+
+Outcome category_present(Context& ctx, uint16_t type, const char* name) {
+    CONFORM_NEED(ctx.need_sii());
+    if (!ctx.sii->error.empty()) return fail("category chain broken: " + ctx.sii->error);
+    if (!ctx.sii->find(type)) return skip(std::string("no ") + name + " category");
+    return pass();
+}
+
+Outcome pdo_category(Context& ctx, uint16_t type) {
+    Outcome o = category_present(ctx, type, type == kTxPdo ? "TXPDO" : "RXPDO");
+    if (o.status != Status::Pass) return o;
+    std::vector<SiiPdo> pdos;
+    if (auto e = parse_pdos(ctx.sii->data(*ctx.sii->find(type)), pdos); !e.empty()) return fail(e);
+    const SiiCategory* sm = ctx.sii->find(kSyncM);
+    const std::size_t sms = sm ? sm->length / 8 : 0;
+    for (const auto& p : pdos)
+        if (p.sm != 0xFF && p.sm >= sms && sms)
+            return fail("PDO " + hex(p.index) + " names SM " + dec(p.sm), dec(p.sm),
+                        "< " + dec(static_cast<long long>(sms)));
+    return pass(dec(static_cast<long long>(pdos.size())) + " PDOs");
+}
+
+Outcome pdo_vs_esi(Context& ctx, uint16_t type) {
+    CONFORM_NEED(ctx.need_esi());
+    CONFORM_NEED(ctx.need_sii());
+    const auto& esi = type == kTxPdo ? ctx.esi->txpdos : ctx.esi->rxpdos;
+    std::vector<SiiPdo> pdos;
+    if (const SiiCategory* c = ctx.sii->find(type)) parse_pdos(ctx.sii->data(*c), pdos);
+    if (esi.empty() && pdos.empty()) return skip("no PDOs of this direction in ESI or SII");
+    return expect_eq("PDOs (index[entry:sub/bits])", sii_pdo_text(pdos), esi_pdo_text(esi));
+}
+
+}  // namespace
+
+void add_sii_tests(Catalogue& c) {
+    Adder add{c, "sii"};
+    add("read.whole", "The whole EEPROM (size from word 0x3E) reads back", kSii, [](Context& ctx) {
+        CONFORM_NEED(ctx.need_sii());
+        const std::size_t want = (ctx.sii->word(0x3E) + 1u) * 128u;
+        if (ctx.sii->bytes.size() != want)
+            return fail("bytes read", dec(static_cast<long long>(ctx.sii->bytes.size())),
+                        dec(static_cast<long long>(want)));
+        return pass("read", dec(static_cast<long long>(want)) + " bytes");
+    });
+    add("read.consistent", "Reading a word twice gives the same value (header words 0..0x3F)", kSii,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            uint8_t b[128];
+            if (auto e = ctx.m.sii_read(ctx.addr, 0, b); e != master::Error::Ok)
+                return fail("second read", err(e));
+            return expect_eq("header bytes", bytes_hex(std::span<const uint8_t>(b, 128), 128),
+                             bytes_hex(std::span<const uint8_t>(ctx.sii->bytes).subspan(0, 128), 128));
+        });
+    add("header.checksum", "Checksum of words 0-6 in word 7 (CRC-8, polynomial 0x07, seed 0xFF)", kSii,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            const uint8_t crc = sii_crc8(std::span<const uint8_t>(ctx.sii->bytes).subspan(0, 14));
+            return expect_eq("word 7 low byte", hex(ctx.sii->bytes[14], 2), hex(crc, 2));
+        });
+    add(
+        "header.version", "SII version (word 0x3F) is 1", kSii,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            return expect_eq("word 0x3F", dec(ctx.sii->word(0x3F)), "1");
+        },
+        {}, Severity::Warning);
+    add(
+        "header.size_vs_esi", "EEPROM size (word 0x3E) equals the ESI's Eeprom/ByteSize", kSiiEsi,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            CONFORM_NEED(ctx.need_esi());
+            if (!ctx.esi->eeprom_bytes) return skip("the ESI gives no Eeprom/ByteSize");
+            return expect_eq("bytes", dec((ctx.sii->word(0x3E) + 1) * 128), dec(ctx.esi->eeprom_bytes));
+        },
+        "ESI given");
+    add(
+        "header.config_vs_esi", "Configuration area (words 0-6) equals the ESI's Eeprom/ConfigData", kSiiEsi,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            CONFORM_NEED(ctx.need_esi());
+            const auto& cd = ctx.esi->config_data;
+            if (cd.empty()) return skip("the ESI gives no Eeprom/ConfigData");
+            std::size_t n = std::min<std::size_t>(cd.size(), 14);
+            return expect_eq("words 0-6", bytes_hex(std::span<const uint8_t>(ctx.sii->bytes).subspan(0, n)),
+                             bytes_hex(std::span<const uint8_t>(cd).subspan(0, n)));
+        },
+        "ESI given");
+    struct Id {
+        const char* id;
+        const char* title;
+        std::size_t word;
+        uint32_t EsiDevice::*field;
+    };
+    for (const Id& x : {Id{"header.vendor_vs_esi", "Vendor ID (word 0x08) equals the ESI's Vendor/Id", 0x08,
+                           &EsiDevice::vendor_id},
+                        Id{"header.product_vs_esi", "Product code (word 0x0A) equals the ESI's ProductCode",
+                           0x0A, &EsiDevice::product_code},
+                        Id{"header.revision_vs_esi", "Revision (word 0x0C) equals the ESI's RevisionNo", 0x0C,
+                           &EsiDevice::revision}}) {
+        add(
+            x.id, x.title, kSiiEsi,
+            [x](Context& ctx) {
+                CONFORM_NEED(ctx.need_sii());
+                CONFORM_NEED(ctx.need_esi());
+                return expect_eq("identity", hex(ctx.sii->dword(x.word), 8), hex((*ctx.esi).*(x.field), 8));
+            },
+            "ESI given");
+    }
+    add(
+        "header.std_mailbox_vs_esi", "Standard mailbox (words 0x18-0x1B) equals the ESI's MBoxOut/MBoxIn Sm",
+        kSiiEsi,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            CONFORM_NEED(ctx.need_esi());
+            std::string want;
+            for (const char* t : {"MBoxOut", "MBoxIn"})
+                for (const auto& s : ctx.esi->sms)
+                    if (s.type == t) want += hex(s.start) + "/" + dec(s.default_size) + " ";
+            if (want.empty()) return skip("the ESI has no mailbox SMs");
+            std::string got = hex(ctx.sii->word(0x18)) + "/" + dec(ctx.sii->word(0x19)) + " " +
+                              hex(ctx.sii->word(0x1A)) + "/" + dec(ctx.sii->word(0x1B)) + " ";
+            return expect_eq("out/in start/size", got, want);
+        },
+        "ESI given");
+    add(
+        "header.boot_mailbox_vs_esi", "Bootstrap mailbox (words 0x14-0x17) equals the ESI's Eeprom/BootStrap",
+        kSiiEsi,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            CONFORM_NEED(ctx.need_esi());
+            if (ctx.esi->bootstrap.size() < 8) return skip("the ESI gives no Eeprom/BootStrap");
+            return expect_eq("words 0x14-0x17",
+                             bytes_hex(std::span<const uint8_t>(ctx.sii->bytes).subspan(0x28, 8)),
+                             bytes_hex(std::span<const uint8_t>(ctx.esi->bootstrap).subspan(0, 8)));
+        },
+        "ESI gives Eeprom/BootStrap");
+    add(
+        "header.protocols_vs_esi", "Mailbox protocols (word 0x1C) equal the ESI's Mailbox element", kSiiEsi,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            CONFORM_NEED(ctx.need_esi());
+            return expect_eq("word 0x1C", hex(ctx.sii->word(0x1C) & 0x3F), hex(ctx.esi->mailbox_protocols()));
+        },
+        "ESI given");
+    add(
+        "header.mailbox_sizes", "Standard mailbox sizes hold a mailbox header and a CoE SDO (>= 16 bytes)",
+        kSii,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_mailbox());
+            if (ctx.sii->word(0x19) < 16 || ctx.sii->word(0x1B) < 16)
+                return fail("mailbox too small", dec(ctx.sii->word(0x19)) + "/" + dec(ctx.sii->word(0x1B)),
+                            ">= 16/16");
+            return pass("sizes", dec(ctx.sii->word(0x19)) + "/" + dec(ctx.sii->word(0x1B)));
+        },
+        "mailbox slave");
+    add("cat.chain", "Category chain from word 0x40 ends with 0xFFFF inside the EEPROM", kSii,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            if (!ctx.sii->error.empty()) return fail(ctx.sii->error);
+            return pass(dec(static_cast<long long>(ctx.sii->categories.size())) + " categories");
+        });
+    add("cat.unique", "Each of STRINGS, General, FMMU, SyncM and DC appears at most once", kSii,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            std::map<uint16_t, int> n;
+            for (const auto& k : ctx.sii->categories)
+                ++n[k.type];
+            for (uint16_t t : {kStrings, kGeneral, kFmmu, kSyncM, kDc})
+                if (n[t] > 1) return fail("category " + dec(t) + " repeated", dec(n[t]), "1");
+            return pass();
+        });
+    add("cat.strings", "STRINGS category: count and lengths fit the category", kSii, [](Context& ctx) {
+        Outcome o = category_present(ctx, kStrings, "STRINGS");
+        if (o.status != Status::Pass) return o;
+        auto d = ctx.sii->data(*ctx.sii->find(kStrings));
+        if (d.empty()) return fail("empty STRINGS category");
+        std::size_t p = 1;
+        for (unsigned i = 0; i < d[0]; ++i) {
+            if (p >= d.size() || p + 1 + d[p] > d.size())
+                return fail("string " + dec(i + 1) + " runs past the category",
+                            dec(static_cast<long long>(p)), "< " + dec(static_cast<long long>(d.size())));
+            p += 1 + d[p];
+        }
+        return pass(dec(d[0]) + " strings");
+    });
+    add("cat.general", "General category present (mailbox slaves) and 32 bytes long", kSii, [](Context& ctx) {
+        CONFORM_NEED(ctx.need_sii());
+        const SiiCategory* g = ctx.sii->find(kGeneral);
+        if (!g) {
+            if (ctx.sii->word(0x1C)) return fail("a mailbox slave without General category");
+            return skip("no General category (no mailbox)");
+        }
+        if (g->length < 32)
+            return fail("General category length", dec(static_cast<long long>(g->length)), ">= 32 bytes");
+        return pass();
+    });
+    add("cat.string_refs", "String indices in General, PDO and DC categories name existing strings", kSii,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            const SiiCategory* s = ctx.sii->find(kStrings);
+            const unsigned count = s && s->length ? ctx.sii->bytes[s->offset] : 0;
+            auto bad = [&](unsigned i) { return i > count; };
+            if (const SiiCategory* g = ctx.sii->find(kGeneral); g && g->length >= 4) {
+                auto d = ctx.sii->data(*g);
+                for (int i : {0, 1, 2, 3})
+                    if (bad(d[static_cast<std::size_t>(i)]))
+                        return fail(
+                            "General byte " + dec(i) + " names string " + dec(d[static_cast<std::size_t>(i)]),
+                            dec(d[static_cast<std::size_t>(i)]), "<= " + dec(count));
+            }
+            for (uint16_t t : {kTxPdo, kRxPdo}) {
+                for (const auto& k : ctx.sii->categories) {
+                    if (k.type != t) continue;
+                    auto d = ctx.sii->data(k);
+                    std::size_t p = 0;
+                    while (p + 8 <= d.size()) {
+                        if (bad(d[p + 5]))
+                            return fail("PDO " + hex(get16(&d[p])) + " name index", dec(d[p + 5]),
+                                        "<= " + dec(count));
+                        const uint8_t n = d[p + 2];
+                        p += 8;
+                        for (uint8_t i = 0; i < n && p + 8 <= d.size(); ++i, p += 8)
+                            if (bad(d[p + 3]))
+                                return fail("PDO entry name index", dec(d[p + 3]), "<= " + dec(count));
+                    }
+                }
+            }
+            return pass();
+        });
+    add("cat.fmmu", "FMMU category: one usage byte per FMMU (0 unused, 1 outputs, 2 inputs, 3 SM status)",
+        kSii, [](Context& ctx) {
+            Outcome o = category_present(ctx, kFmmu, "FMMU");
+            if (o.status != Status::Pass) return o;
+            for (uint8_t b : ctx.sii->data(*ctx.sii->find(kFmmu)))
+                if (b > 3 && b != 0xFF) return fail("FMMU usage byte", hex(b, 2), "0..3 or 0xff");
+            return pass();
+        });
+    add("cat.syncm", "SyncM category: 8 bytes per SM, type 0..4, mailbox SMs as words 0x18-0x1B", kSii,
+        [](Context& ctx) {
+            Outcome o = category_present(ctx, kSyncM, "SyncM");
+            if (o.status != Status::Pass) return o;
+            auto d = ctx.sii->data(*ctx.sii->find(kSyncM));
+            if (d.size() % 8)
+                return fail("length not a multiple of 8", dec(static_cast<long long>(d.size())));
+            for (std::size_t i = 0; i < d.size(); i += 8) {
+                if (d[i + 7] > 4)
+                    return fail("SM " + dec(static_cast<long long>(i / 8)) + " type", dec(d[i + 7]), "0..4");
+                if (d[i + 7] == 1 &&
+                    (get16(&d[i]) != ctx.sii->word(0x18) || get16(&d[i + 2]) != ctx.sii->word(0x19)))
+                    return fail("mailbox-out SM differs from words 0x18/0x19",
+                                hex(get16(&d[i])) + "/" + dec(get16(&d[i + 2])),
+                                hex(ctx.sii->word(0x18)) + "/" + dec(ctx.sii->word(0x19)));
+                if (d[i + 7] == 2 &&
+                    (get16(&d[i]) != ctx.sii->word(0x1A) || get16(&d[i + 2]) != ctx.sii->word(0x1B)))
+                    return fail("mailbox-in SM differs from words 0x1A/0x1B",
+                                hex(get16(&d[i])) + "/" + dec(get16(&d[i + 2])),
+                                hex(ctx.sii->word(0x1A)) + "/" + dec(ctx.sii->word(0x1B)));
+            }
+            return pass(dec(static_cast<long long>(d.size() / 8)) + " SMs");
+        });
+    add("cat.txpdo", "TXPDO category: PDOs and entries fit, SM index valid", kSii,
+        [](Context& ctx) { return pdo_category(ctx, kTxPdo); });
+    add("cat.rxpdo", "RXPDO category: PDOs and entries fit, SM index valid", kSii,
+        [](Context& ctx) { return pdo_category(ctx, kRxPdo); });
+    add("cat.dc", "DC category: 24 bytes per op mode", kSii, [](Context& ctx) {
+        Outcome o = category_present(ctx, kDc, "DC");
+        if (o.status != Status::Pass) return o;
+        auto n = ctx.sii->find(kDc)->length;
+        if (n % 24) return fail("length not a multiple of 24", dec(static_cast<long long>(n)));
+        return pass(dec(static_cast<long long>(n / 24)) + " op modes");
+    });
+    add(
+        "esi.syncm", "SyncM category equals the ESI's Sm elements (start, size, control, enable)", kSiiEsi,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_NEED(ctx.need_sii());
+            std::string got, want;
+            if (const SiiCategory* s = ctx.sii->find(kSyncM)) {
+                auto d = ctx.sii->data(*s);
+                for (std::size_t i = 0; i + 8 <= d.size(); i += 8)
+                    got += hex(get16(&d[i])) + "/" + dec(get16(&d[i + 2])) + "/" + hex(d[i + 4], 2) + "/" +
+                           ((d[i + 6] & 1) ? "1" : "0") + " ";
+            }
+            for (const auto& s : ctx.esi->sms)
+                want += esi_sm(s) + " ";
+            return expect_eq("SMs start/size/control/enable", got, want);
+        },
+        "ESI given");
+    add(
+        "esi.fmmu", "FMMU category equals the ESI's Fmmu elements", kSiiEsi,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_NEED(ctx.need_sii());
+            std::string got, want;
+            if (const SiiCategory* f = ctx.sii->find(kFmmu))
+                for (uint8_t b : ctx.sii->data(*f))
+                    if (b != 0 && b != 0xFF) got += dec(b) + " ";
+            for (const auto& f : ctx.esi->fmmus)
+                want += (f == "Outputs" ? "1 " : f == "Inputs" ? "2 " : f == "MBoxState" ? "3 " : "? ");
+            return expect_eq("FMMU usage", got, want);
+        },
+        "ESI given");
+    add(
+        "esi.txpdo", "TXPDO category equals the ESI's TxPdo list", kSiiEsi,
+        [](Context& ctx) { return pdo_vs_esi(ctx, kTxPdo); }, "ESI given");
+    add(
+        "esi.rxpdo", "RXPDO category equals the ESI's RxPdo list", kSiiEsi,
+        [](Context& ctx) { return pdo_vs_esi(ctx, kRxPdo); }, "ESI given");
+    add(
+        "esi.dc", "DC category op modes equal the ESI's Dc/OpMode (AssignActivate, SYNC0 cycle)", kSiiEsi,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_NEED(ctx.need_sii());
+            if (!ctx.esi->has_dc) return skip("the ESI has no Dc element");
+            std::string got, want;
+            if (const SiiCategory* dc = ctx.sii->find(kDc)) {
+                auto d = ctx.sii->data(*dc);
+                for (std::size_t i = 0; i + 24 <= d.size(); i += 24)
+                    got += hex(get16(&d[i + 14])) + " ";
+            }
+            for (const auto& m : ctx.esi->op_modes)
+                want += hex(m.assign_activate) + " ";
+            return expect_eq("AssignActivate per op mode", got, want);
+        },
+        "ESI has Dc");
+    add(
+        "esi.coe_details", "General CoE details (byte 5) match the ESI's CoE attributes", kSiiEsi,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_NEED(ctx.need_sii());
+            if (!ctx.esi->coe.present) return skip("the ESI has no CoE");
+            const SiiCategory* g = ctx.sii->find(kGeneral);
+            if (!g || g->length < 6) return fail("no General category");
+            const uint8_t b = ctx.sii->bytes[g->offset + 5];
+            const auto& e = ctx.esi->coe;
+            uint8_t want = static_cast<uint8_t>(0x01 | (e.sdo_info ? 0x02 : 0) | (e.pdo_assign ? 0x04 : 0) |
+                                                (e.pdo_config ? 0x08 : 0) | (e.pdo_upload ? 0x10 : 0) |
+                                                (e.complete_access ? 0x20 : 0));
+            return expect_eq("CoE details", hex(b & 0x3F, 2), hex(want, 2));
+        },
+        "ESI has CoE");
+    add(
+        "esi.foe_details", "General FoE details (byte 6) match the ESI's FoE element", kSiiEsi,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_NEED(ctx.need_sii());
+            const SiiCategory* g = ctx.sii->find(kGeneral);
+            if (!g || g->length < 7) return skip("no General category");
+            return expect_eq("FoE enabled", dec(ctx.sii->bytes[g->offset + 6] & 1), ctx.esi->foe ? "1" : "0");
+        },
+        "ESI given");
+    add(
+        "esi.names", "General category order number and name equal the ESI's Type and Name", kSiiEsi,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_NEED(ctx.need_sii());
+            const SiiCategory* g = ctx.sii->find(kGeneral);
+            if (!g || g->length < 4) return skip("no General category");
+            auto d = ctx.sii->data(*g);
+            return expect_eq("order/name", ctx.sii->string(d[2]) + " / " + ctx.sii->string(d[3]),
+                             ctx.esi->type_name + " / " + ctx.esi->name);
+        },
+        "ESI given", Severity::Warning);
+    add(
+        "esi.group", "General category group equals the ESI's GroupType", kSiiEsi,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_NEED(ctx.need_sii());
+            const SiiCategory* g = ctx.sii->find(kGeneral);
+            if (!g || g->length < 1) return skip("no General category");
+            if (ctx.esi->group_type.empty()) return skip("the ESI has no GroupType");
+            return expect_eq("group", ctx.sii->string(ctx.sii->data(*g)[0]), ctx.esi->group_type);
+        },
+        "ESI given", Severity::Warning);
+}
+
+}  // namespace conform
