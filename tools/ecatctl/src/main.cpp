@@ -14,6 +14,7 @@
 
 #include "cmd_diag.hpp"
 #include "cmd_firmware.hpp"
+#include "cmd_state.hpp"
 #include "common.hpp"
 #include "esc/link.hpp"
 #include "format.hpp"
@@ -39,11 +40,17 @@ struct Globals {
     unsigned retries = 2;
 };
 
+// The AL status of the last refused state request, for fail() to report.
+master::AlStatus g_refusal;
+
 int fail(Error e, const std::string& what) {
-    std::cerr << "ecatctl: " << what << ": " << master::to_string(e) << "\n";
-    if (e == Error::Timeout)
-        std::cerr << "ecatctl: check that a slave is connected and running on the interface\n";
-    return exit_code(e);
+    if (e == Error::AlRefused) {
+        std::fprintf(stderr, "ecatctl: %s: refused, stays in %s, AL status code 0x%04x (%s)\n", what.c_str(),
+                     std::string(master::al_state_name(g_refusal.state)).c_str(), g_refusal.code,
+                     std::string(master::al_status_code_name(g_refusal.code)).c_str());
+        return kExitProtocol;
+    }
+    return report_error(e, what);
 }
 
 int usage(const std::string& what) {
@@ -288,54 +295,6 @@ int sii_write(master::Master& m, const SiiArgs& s) {
     return kExitOk;
 }
 
-int state(master::Master& m, const std::string& slave, bool station, const std::string& target,
-          bool identify) {
-    auto a = named_slave(slave, station);
-    if (!a) return kExitUsage;
-    if (identify) {
-        auto id = m.identify(*a);
-        if (!id) return fail(id.error(), "device identification of " + slave_text(*a));
-        std::printf("identification value 0x%04x (%u)\n", *id, *id);
-        return kExitOk;
-    }
-    if (target.empty()) {
-        auto st = m.al_status(*a);
-        if (!st) return fail(st.error(), "reading the AL status of " + slave_text(*a));
-        std::printf("%s%s", std::string(master::al_state_name(st->state)).c_str(), st->error ? " +ERR" : "");
-        if (st->error || st->code)
-            std::printf(" 0x%04x %s", st->code, std::string(master::al_status_code_name(st->code)).c_str());
-        std::printf("\n");
-        return kExitOk;
-    }
-    std::string t = target;
-    for (auto& c : t)
-        c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-    master::AlState s;
-    if (t == "INIT")
-        s = master::AlState::Init;
-    else if (t == "PREOP")
-        s = master::AlState::PreOp;
-    else if (t == "BOOT")
-        s = master::AlState::Boot;
-    else if (t == "SAFEOP")
-        s = master::AlState::SafeOp;
-    else if (t == "OP")
-        s = master::AlState::Op;
-    else
-        return usage("unknown state '" + target + "' (INIT, PREOP, BOOT, SAFEOP, OP)");
-    master::AlStatus st;
-    const Error e = m.request_state(*a, s, &st);
-    if (e == Error::AlRefused) {
-        std::fprintf(stderr, "ecatctl: %s refused %s: stays in %s, AL status code 0x%04x (%s)\n",
-                     slave_text(*a).c_str(), t.c_str(), std::string(master::al_state_name(st.state)).c_str(),
-                     st.code, std::string(master::al_status_code_name(st.code)).c_str());
-        return kExitProtocol;
-    }
-    if (e != Error::Ok) return fail(e, "requesting " + t + " from " + slave_text(*a));
-    std::printf("%s\n", std::string(master::al_state_name(st.state)).c_str());
-    return kExitOk;
-}
-
 // ---- CoE SDO -------------------------------------------------------------------------------------
 
 struct SdoArgs {
@@ -357,9 +316,7 @@ Error open_mailbox(master::Master& m, master::Mailbox& mbx, Address a) {
         if (Error e = mbx.configure_from_sii(); e != Error::Ok) return e;
         master::AlStatus final;
         const Error e = m.request_state(a, master::AlState::PreOp, &final);
-        if (e == Error::AlRefused)
-            std::fprintf(stderr, "ecatctl: INIT -> PREOP refused, AL status code 0x%04x (%s)\n", final.code,
-                         std::string(master::al_status_code_name(final.code)).c_str());
+        if (e == Error::AlRefused) g_refusal = final;  // fail() reports it, in one message
         return e;
     }
     return mbx.adopt_current();
@@ -683,9 +640,16 @@ int foe_transfer(master::Master& m, const FoeArgs& f, bool read) {
         auto d = read_file(f.file);
         if (!d) return usage("cannot read " + f.file);
         data = std::move(*d);
-        if (name.empty()) name = std::filesystem::path(f.file).filename().string();
+        // The device takes firmware under its device name (0x1008, the SII General name) or the firmware
+        // file name built from it; the local file's name means nothing to it.
+        if (name.empty()) {
+            auto device = sii_device_name(m, *a);
+            if (!device)
+                return usage(foe_names_hint(slave_text(*a) + " has no device name in its SII: give --name"));
+            name = *device;
+        }
     }
-    if (name.empty()) return usage("give the file name on the slave (--name)");
+    if (name.empty()) return usage("give the file name on the slave");
     master::Mailbox mbx(m, *a);
     auto st = m.al_status(*a);
     if (!st) return fail(st.error(), "reading the AL status of " + slave_text(*a));
@@ -706,9 +670,7 @@ int foe_transfer(master::Master& m, const FoeArgs& f, bool read) {
             return fail(e, "setting up the bootstrap mailbox");
         master::AlStatus final;
         if (Error e = m.request_state(*a, master::AlState::Boot, &final); e != Error::Ok) {
-            if (e == Error::AlRefused)
-                std::fprintf(stderr, "ecatctl: BOOT refused, AL status code 0x%04x (%s)\n", final.code,
-                             std::string(master::al_status_code_name(final.code)).c_str());
+            if (e == Error::AlRefused) g_refusal = final;
             return fail(e, "going to BOOT");
         }
         entered_boot = true;
@@ -736,7 +698,13 @@ int foe_transfer(master::Master& m, const FoeArgs& f, bool read) {
         foe.set_progress(bar.callback());
         const Error e = foe.write(name, data, static_cast<uint32_t>(*password));
         bar.finish();
-        if (e != Error::Ok)
+        if (e == Error::FoeError && foe.last_error() == 0x8001) {  // not found: say which names it takes
+            std::cerr << "ecatctl: "
+                      << foe_names_hint("writing '" + name + "': FoE error 0x8001 (" + foe.last_error_text() +
+                                        ")")
+                      << "\n";
+            rc = kExitProtocol;
+        } else if (e != Error::Ok)
             rc = foe_failed(foe, e, "writing '" + name + "'");
         else
             std::cerr << "ecatctl: " << data.size() << " bytes written to '" << name << "'\n";
@@ -826,6 +794,7 @@ int main(int argc, char** argv) {
                 return;
             }
             std::fputs(esi::decode_sii(*img).c_str(), stdout);
+            rc = sii_problems(s.input, *img) ? kExitUsage : kExitOk;  // an empty or corrupt file
             return;
         }
         rc = with_master(g, [&](master::Master& m) {
@@ -834,22 +803,13 @@ int main(int argc, char** argv) {
             auto img = m.sii_read_image(*a);
             if (!img) return fail(img.error(), "reading the SII of " + slave_text(*a));
             std::fputs(esi::decode_sii(*img).c_str(), stdout);
-            return kExitOk;
+            return sii_problems("the SII of " + slave_text(*a), *img) ? kExitProtocol : kExitOk;
         });
     });
 #endif
 
-    std::string st_slave, st_target;
-    bool st_station = false, st_identify = false;
-    auto* st = app.add_subcommand("state", "Show the AL state, or request one (with the error acknowledge)");
-    st->add_option("slave", st_slave, "Slave position (or station address with --station)")->required();
-    st->add_option("state", st_target, "INIT|PREOP|BOOT|SAFEOP|OP (omit to show the current state)");
-    st->add_flag("-s,--station", st_station, "<slave> is a station address");
-    st->add_flag("--identify", st_identify, "Device identification: AL control bit 5, value from 0x0134");
-    st->callback([&] {
-        rc = with_master(
-            g, [&](master::Master& m) { return state(m, st_slave, st_station, st_target, st_identify); });
-    });
+    add_state_command(
+        app, [&](const auto& fn) { return with_master(g, fn); }, rc);
 
     SdoArgs so;
     auto* up =
@@ -914,7 +874,8 @@ int main(int argc, char** argv) {
         [&] { rc = with_master(g, [&](master::Master& m) { return foe_transfer(m, fa, true); }); });
     auto* foe_wr = foe->add_subcommand("write", "Write a file (firmware) through BOOT, then back to INIT");
     foe_wr->add_option("file", fa.file, "Local file")->required()->check(CLI::ExistingFile);
-    foe_wr->add_option("-n,--name", fa.name, "File name on the slave (default: the local file's name)");
+    foe_wr->add_option("-n,--name", fa.name,
+                       "File name on the slave (default: the device name from its SII)");
     foe_wr->add_option("-p,--position", fa.slave, "Slave position (or station address with --station)")
         ->capture_default_str();
     foe_wr->add_flag("-s,--station", fa.station, "--position is a station address");
@@ -935,8 +896,7 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        app.exit(e);
-        return kExitUsage;
+        return report_usage_error(app, e, argc, argv);  // one line, exit 2
     }
     return rc;
 }
