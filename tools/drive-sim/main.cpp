@@ -20,6 +20,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -287,16 +288,21 @@ class Sim {
     bool reset_pending_ = false;
 };
 
-bool write_csv(const std::string& path, const std::vector<Sample>& s) {
-    std::ofstream f(path);
-    if (!f) return false;
+void write_csv_to(std::ostream& f, const std::vector<Sample>& s) {
     f << "t_ms,setpoint,position_demand,position_actual,velocity_actual_rpm,velocity_demand_rpm,current_ma,"
          "following_error,statusword,mode\n";
     for (const Sample& x : s)
         f << x.t_ms << ',' << x.setpoint << ',' << x.demand << ',' << x.actual << ',' << x.velocity << ','
           << x.velocity_demand << ',' << x.current << ',' << x.following_error << ",0x" << std::hex
           << x.statusword << std::dec << ',' << static_cast<int>(x.mode) << '\n';
-    return static_cast<bool>(f);
+}
+
+bool write_csv(const std::string& path, const std::vector<Sample>& s) {
+    errno = 0;
+    std::ofstream f(path);
+    if (!f) return false;
+    write_csv_to(f, s);
+    return static_cast<bool>(f.flush());
 }
 
 bool render_png(const std::string& csv, const std::string& png, std::string& err) {
@@ -412,7 +418,14 @@ int main(int argc, char** argv) {
     app.add_flag("--print-demo", print_demo, "print the built-in demo script and exit");
     app.add_flag("--seed-defaults", seed_defaults,
                  "start from the seed's defaults instead of the commissioned motor data (torque constant 0)");
-    CLI11_PARSE(app, argc, argv);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        std::cerr << "drive-sim: " << e.what() << " (drive-sim --help)\n";  // one line
+        return 2;  // usage error, as every program of the project
+    }
 
     const auto dt_ns = static_cast<int64_t>(std::llround(cycle_us * 1000.0));
     if (print_demo) {
@@ -429,7 +442,7 @@ int main(int argc, char** argv) {
     } else {
         std::ifstream in(script_path);
         if (!in) {
-            std::cerr << "drive-sim: cannot open " << script_path << "\n";
+            std::cerr << "drive-sim: cannot open " << script_path << ": " << std::strerror(errno) << "\n";
             return 2;
         }
         if (!parse_script(in, sc, err)) {
@@ -455,21 +468,36 @@ int main(int argc, char** argv) {
         sim.cycle(t, dt_ns);
         samples.push_back(sim.sample(t_ms));
     }
-    if (!write_csv(csv_path, samples)) {
-        std::cerr << "drive-sim: cannot write " << csv_path << "\n";
+    // "-o -": the CSV goes to standard output (and the summary to stderr); a plot then needs -p and is
+    // rendered from a temporary copy of the CSV.
+    const bool csv_stdout = csv_path == "-";
+    if (csv_stdout) {
+        write_csv_to(std::cout, samples);
+        if (!std::cout.flush()) {
+            std::cerr << "drive-sim: cannot write the CSV to standard output: " << std::strerror(errno)
+                      << "\n";
+            return 1;
+        }
+        csv_path = png_path.empty() || png_path == "-" ? "" : png_path + ".csv";
+    }
+    if (!csv_path.empty() && !write_csv(csv_path, samples)) {
+        std::cerr << "drive-sim: cannot write " << csv_path << ": " << std::strerror(errno) << "\n";
         return 1;
     }
     const Sample& last = samples.back();
-    std::printf("%zu samples -> %s; end: position %d inc, velocity %d rpm, statusword 0x%04X, error 0x%04X\n",
-                samples.size(), csv_path.c_str(), last.actual, last.velocity, last.statusword,
-                sim.dict().get<uint16_t>(0x603F, 0));
-    if (png_path.empty()) png_path = csv_path + ".png";
-    if (png_path != "-") {
+    std::fprintf(
+        csv_stdout ? stderr : stdout,
+        "%zu samples -> %s; end: position %d inc, velocity %d rpm, statusword 0x%04X, error 0x%04X\n",
+        samples.size(), csv_stdout ? "<stdout>" : csv_path.c_str(), last.actual, last.velocity,
+        last.statusword, sim.dict().get<uint16_t>(0x603F, 0));
+    if (png_path.empty() && !csv_stdout) png_path = csv_path + ".png";
+    if (!png_path.empty() && png_path != "-") {  // "-p -": no plot
         if (!render_png(csv_path, png_path, err)) {
             std::cerr << "drive-sim: " << err << "\n";
             return 1;
         }
-        std::printf("plot -> %s\n", png_path.c_str());
+        std::fprintf(csv_stdout ? stderr : stdout, "plot -> %s\n", png_path.c_str());
+        if (csv_stdout) std::remove(csv_path.c_str());  // the temporary copy
     }
     return 0;
 }
