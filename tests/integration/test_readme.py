@@ -9,7 +9,8 @@ with <placeholders> or [options] are synopses, not commands.
 Each README runs in its own network namespace, so `ecat-slave` creates its veth pair ecat0/ecat1 as the
 README says, and `ecatctl` finds ecat1 as its default interface, without touching the host's interfaces.
 The only change made to a command: `ecat-slave` gets `--state-dir` in the test's directory (not the system's
-/var/lib/softecat). Commands run in a temporary working directory, in README order, except that the commands
+/var/lib/softecat); a later `ecat-slave` start stops the one before. Commands run in a temporary working
+directory (with the repository's folders linked into it), in README order, except that the commands
 that need no slave (fwimage, drive-sim, ecat-slave --write-*) run first (the image `foe write image.bin`
 sends is the one `fwimage build ... -o image.bin` makes); a file named FILE is there for `--payload FILE`.
 """
@@ -33,6 +34,7 @@ SKIP = {
     "bash scripts/demo.sh": "the demo script itself (builds, and uses ecat0/ecat1 of the host)",
     "bash scripts/test.sh": "the whole test suite, of which this test is a part",
     "build/tools/ecat-slave/ecat-slave --iface enp3s0": "needs a real NIC",
+    "ecat-slave --iface enp3s0": "needs a real NIC",
 }
 
 # The project's programs: the names a README uses -> the environment variable with the built binary.
@@ -145,6 +147,11 @@ class Readme(unittest.TestCase):
         self.addCleanup(subprocess.run, ["ip", "netns", "del", ns])
         work = os.path.join(self.dir, f"work{READMES.index(readme)}")
         os.makedirs(work)
+        # The README's paths are relative to the repository (od/examples/...): its folders are linked into
+        # the working directory, whose files (image.bin, ...) stay the test's own.
+        for entry in os.listdir(ROOT):
+            if not entry.startswith(".") and entry != "build" and not os.path.exists(os.path.join(work, entry)):
+                os.symlink(os.path.join(ROOT, entry), os.path.join(work, entry))
         with open(os.path.join(work, "FILE"), "wb") as f:  # `fwimage build --payload FILE ...`
             f.write(bytes((i * 13 + 7) & 0xFF for i in range(40000)))
         state = os.path.join(self.dir, f"state{READMES.index(readme)}")
@@ -171,6 +178,7 @@ class Readme(unittest.TestCase):
             if os.path.basename(argv[0]) == "ecat-slave":
                 argv = argv + ["--state-dir", state]
             if os.path.basename(argv[0]) == "ecat-slave" and self.starts_slave(argv):
+                stop_slave()  # a README that starts the slave again (another configuration) replaces it
                 log = open(os.path.join(self.dir, f"slave{READMES.index(readme)}.log"), "w")
                 self.addCleanup(log.close)
                 p = subprocess.Popen(in_ns(argv), cwd=work, stdout=log, stderr=subprocess.STDOUT)
@@ -184,7 +192,7 @@ class Readme(unittest.TestCase):
             print(f"{where}: ok")
         stop_slave()
         for p in slave:
-            self.assertEqual(p.returncode, 0, f"ecat-slave of {readme} exited {p.returncode}")
+            self.assertEqual(p.returncode, 0, f"an ecat-slave of {readme} exited {p.returncode}")
 
     @staticmethod
     def starts_slave(argv):

@@ -108,5 +108,42 @@ class StateVerb(unittest.TestCase):
         self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
 
 
+ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+
+
+class SoemFirmUpdate(unittest.TestCase):
+    """What SOEM's firm_update sample sends: PREOP (standard mailbox), INIT, SM0/SM1 rewritten with the
+    bootstrap mailbox from the SII WITHOUT disabling them first (FPWR of 8 bytes each, activate bit set),
+    then BOOT. A hardware ESC ignores the writes to enabled SMs, so the slave refuses BOOT (0x0015); with a
+    device whose bootstrap mailbox equals the standard one, the same sequence reaches BOOT."""
+
+    def firm_update_sequence(self, bus, boot_mailbox):
+        self.assertEqual(bus.ecatctl("state", "0", "PREOP").stdout.strip(), "PREOP")
+        self.assertEqual(bus.ecatctl("state", "0", "INIT").stdout.strip(), "INIT")
+        (out_start, out_size), (in_start, in_size) = boot_mailbox
+        for reg, start, size, control in ((0x800, out_start, out_size, 0x26), (0x808, in_start, in_size, 0x22)):
+            b = struct.pack("<HHBBBB", start, size, control, 0, 1, 0)
+            bus.ecatctl("reg", "write", "0", hex(reg), *(hex(x) for x in b))
+        bus.ecatctl("reg", "write", "0", "0x0120", "0x03", "0x00")  # BOOT
+        for _ in range(500):
+            st = al_state(bus)
+            if st.startswith("BOOT") or "+ERR" in st:
+                return st
+        return st
+
+    def test_the_default_device_refuses_boot_like_silicon(self):
+        with harness.Bus() as bus:
+            st = self.firm_update_sequence(bus, ((0x1000, 1024), (0x1400, 1024)))
+            self.assertTrue(st.startswith("INIT +ERR 0x0015"), st)
+            # The way that works: ecatctl disables the SMs before it writes them.
+            self.assertEqual(bus.ecatctl("state", "0", "BOOT").stdout.strip(), "BOOT")
+
+    def test_a_bootstrap_mailbox_equal_to_the_standard_one_lets_it_in(self):
+        conf = os.path.join(ROOT, "od", "examples", "bootstrap-as-standard.conf")
+        with harness.Bus(slave_args=["--config", conf]) as bus:
+            st = self.firm_update_sequence(bus, ((0x1000, 128), (0x1080, 128)))
+            self.assertEqual(st, "BOOT")
+
+
 if __name__ == "__main__":
     harness.main()
