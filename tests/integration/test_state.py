@@ -88,6 +88,23 @@ class StateVerb(unittest.TestCase):
         self.assertEqual(r.returncode, 5, r.stderr)
         self.assertIn("station address 0x1005", r.stderr)
 
+    def test_every_verb_takes_the_slave_as_dash_p_or_station(self):
+        # IgH style -p N also for the verbs that take the slave as their first argument.
+        self.assertEqual(self.bus.ecatctl("state", "-p", "0", "PREOP").stdout.strip(), "PREOP")
+        self.assertEqual(self.bus.ecatctl("upload", "-p", "0", "0x1018", "1").stdout.split()[0], "0x000000fb")
+        self.assertEqual(self.bus.ecatctl("upload", "--position=0", "0x1018", "1").stdout.split()[0], "0x000000fb")
+        self.assertIn("0x0130", self.bus.ecatctl("reg", "read", "0x0130", "2", "-p", "0").stdout)
+        self.bus.ecatctl("scan")
+        for verb in (["upload", "0x1018", "1"], ["sdos", "-q"], ["diag"], ["pd", "-n", "5"]):
+            r = self.bus.ecatctl(verb[0], "--station", "0x1001", *verb[1:], check=False)
+            self.assertEqual(r.returncode, 0, f"{verb}: {r.stderr}")
+            r = self.bus.ecatctl(verb[0], "-p", "3", *verb[1:], check=False)
+            self.assertEqual(r.returncode, 5 if verb[0] in ("pd",) else r.returncode, f"{verb}: {r.stderr}")
+            self.assertNotEqual(r.returncode, 0, f"{verb}: {r.stderr}")
+            self.assertEqual(len(r.stderr.strip().splitlines()), 1, f"{verb}: {r.stderr}")
+        r = self.bus.ecatctl("pd", "-s", "0x1005", "-n", "5", check=False)
+        self.assertEqual(r.returncode, 5, r.stderr)
+
     def test_foe_write_defaults_to_the_device_name(self):
         scan = self.bus.ecatctl("scan").stdout
         m = re.search(r"^0\s+0x1001\s+\S+\s+0x([0-9a-f]{8}) 0x([0-9a-f]{8}) \S+ \S+ (\S+)", scan, re.M)

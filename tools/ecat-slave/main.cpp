@@ -122,7 +122,7 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        app.exit(e);
+        std::cerr << "ecat-slave: " << e.what() << " (ecat-slave --help)\n";  // one line
         return softslave::kExitUsage;
     }
     if (home.size() == 2) device.environment.home_from = home[0], device.environment.home_to = home[1];

@@ -63,6 +63,8 @@ int report_error(master::Error e, const std::string& what) {
     std::cerr << "ecatctl: " << what << ": " << master::to_string(e);
     if (e == master::Error::Timeout)
         std::cerr << " (check that a slave is connected and running on the interface)";
+    if (e == master::Error::WorkingCounter)
+        std::cerr << " (is there a slave at that address? `ecatctl scan` lists them)";
     std::cerr << "\n";
     return exit_code(e);
 }
@@ -157,6 +159,49 @@ int report_usage_error(const CLI::App& app, const CLI::ParseError& e, int argc, 
     }
     std::cerr << "ecatctl: " << e.what() << " (ecatctl --help)\n";
     return kExitUsage;
+}
+
+std::vector<std::string> position_option_as_argument(int argc, char** argv) {
+    std::vector<std::string> args(argv, argv + argc);
+    auto global_with_value = [](const std::string& a) {
+        return a == "-i" || a == "--iface" || a == "-b" || a == "--backend" || a == "-t" ||
+               a == "--timeout" || a == "--retries";
+    };
+    std::size_t i = 1;
+    while (i < args.size() && !args[i].empty() && args[i][0] == '-')
+        i += global_with_value(args[i]) ? 2 : 1;
+    if (i >= args.size()) return args;
+    const std::string verb = args[i];
+    std::size_t slave_at = i + 1;  // where the slave argument goes
+    if (verb == "reg") {
+        if (slave_at >= args.size() || (args[slave_at] != "read" && args[slave_at] != "write")) return args;
+        ++slave_at;
+    } else if (verb != "state" && verb != "upload" && verb != "download" && verb != "sdos" && verb != "pd" &&
+               verb != "diag") {
+        return args;  // these verbs have -p/--position as an option of their own
+    }
+    for (std::size_t k = slave_at; k < args.size(); ++k) {
+        const std::string& a = args[k];
+        if (a == "--") break;
+        std::string value;
+        std::size_t take = 0;
+        if ((a == "-p" || a == "--position") && k + 1 < args.size()) {
+            value = args[k + 1];
+            take = 2;
+        } else if (a.rfind("--position=", 0) == 0) {
+            value = a.substr(11);
+            take = 1;
+        } else if (a.size() > 2 && a.rfind("-p", 0) == 0) {
+            value = a.substr(2);
+            take = 1;
+        }
+        if (take == 0) continue;
+        args.erase(args.begin() + static_cast<std::ptrdiff_t>(k),
+                   args.begin() + static_cast<std::ptrdiff_t>(k + take));
+        args.insert(args.begin() + static_cast<std::ptrdiff_t>(slave_at), value);
+        break;
+    }
+    return args;
 }
 
 }  // namespace ecatctl

@@ -43,4 +43,9 @@ bool sii_problems(const std::string& what, const std::vector<uint8_t>& image);
 // verb); returns kExitUsage.
 int report_usage_error(const CLI::App& app, const CLI::ParseError& e, int argc, char** argv);
 
+// The slave is named the same way in every verb: `-p N` / `--position N` (as in IgH's `ethercat`), a station
+// address with `-s`/`--station`. Verbs that take the slave as their first argument (reg, state, upload,
+// download, sdos, pd, diag) also take `-p N`: this moves it to the argument's place before parsing.
+std::vector<std::string> position_option_as_argument(int argc, char** argv);
+
 }  // namespace ecatctl

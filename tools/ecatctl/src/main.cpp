@@ -3,7 +3,9 @@
 // Verbs: scan | reg read | reg write | sii read | sii write | sii decode | state | upload | download | sdos |
 // pd
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -257,7 +259,7 @@ int sii_read(master::Master& m, const SiiArgs& s) {
     std::ofstream f(s.output, std::ios::binary | std::ios::trunc);
     f.write(reinterpret_cast<const char*>(img->data()), static_cast<std::streamsize>(img->size()));
     if (!f) {
-        std::cerr << "ecatctl: cannot write " << s.output << "\n";
+        std::cerr << "ecatctl: cannot write " << s.output << ": " << std::strerror(errno) << "\n";
         return kExitFailure;
     }
     std::cerr << "ecatctl: " << img->size() << " bytes written to " << s.output << "\n";
@@ -406,6 +408,7 @@ struct PdArgs {
     std::vector<std::string> outputs;
     std::vector<std::string> steps;
     bool keep = false;
+    bool station = false;  // slave is a station address (as scan assigns them)
 };
 
 // "CYCLES:B0,B1,..." -> cycles and the output bytes sent (from the first byte) during them.
@@ -455,10 +458,13 @@ int process_data(master::Master& m, const PdArgs& p) {
     // Station addresses as scan gives them; DC's FRMW addresses the reference clock by station.
     auto n = m.count_slaves();
     if (!n) return fail(n.error(), "counting slaves (BRD 0x0000)");
-    if (*pos >= *n) return usage("no slave at position " + p.slave);
+    if (!p.station && *pos >= *n)
+        return check_slave_present(m, Address::position(static_cast<uint16_t>(*pos)));
     if (Error e = m.assign_station_addresses(*n); e != Error::Ok)
         return fail(e, "assigning station addresses");
-    const Address a = Address::station(static_cast<uint16_t>(0x1001 + *pos));
+    const Address a = Address::station(static_cast<uint16_t>(p.station ? *pos : 0x1001 + *pos));
+    if (p.station)
+        if (int rc = check_slave_present(m, a); rc != kExitOk) return rc;
     // Configuration happens in PREOP.
     auto st = m.al_status(a);
     if (!st) return fail(st.error(), "reading the AL status");
@@ -684,11 +690,13 @@ int foe_transfer(master::Master& m, const FoeArgs& f, bool read) {
         if (!file) return foe_failed(foe, file.error(), "reading '" + name + "'");
         if (f.output.empty()) {
             std::fputs(hex_dump(0, *file).c_str(), stdout);
+        } else if (f.output == "-") {  // the file itself on standard output
+            std::fwrite(file->data(), 1, file->size(), stdout);
         } else {
             std::ofstream o(f.output, std::ios::binary | std::ios::trunc);
             o.write(reinterpret_cast<const char*>(file->data()), static_cast<std::streamsize>(file->size()));
             if (!o) {
-                std::cerr << "ecatctl: cannot write " << f.output << "\n";
+                std::cerr << "ecatctl: cannot write " << f.output << ": " << std::strerror(errno) << "\n";
                 return kExitFailure;
             }
             std::cerr << "ecatctl: " << file->size() << " bytes written to " << f.output << "\n";
@@ -836,7 +844,9 @@ int main(int argc, char** argv) {
     PdArgs pa;
     auto* pdc = app.add_subcommand(
         "pd", "Bring a slave to OP and exchange process data cyclically (LRW), with optional DC");
-    pdc->add_option("slave", pa.slave, "Slave position")->capture_default_str();
+    pdc->add_option("slave", pa.slave, "Slave position (or station address with --station)")
+        ->capture_default_str();
+    pdc->add_flag("-s,--station", pa.station, "<slave> is a station address (scan assigns 0x1001..)");
     pdc->add_option("--cycle-us", pa.cycle_us, "Cycle time in microseconds")
         ->check(CLI::Range(50u, 1000000u))
         ->capture_default_str();
@@ -865,7 +875,7 @@ int main(int argc, char** argv) {
     auto* foe = app.add_subcommand("foe", "File access over EtherCAT")->require_subcommand(1);
     auto* foe_rd = foe->add_subcommand("read", "Read a file from the slave (hex dump, or -o FILE)");
     foe_rd->add_option("name", fa.name, "File name on the slave")->required();
-    foe_rd->add_option("-o,--output", fa.output, "Write the file here");
+    foe_rd->add_option("-o,--output", fa.output, "Write the file here ('-': standard output)");
     foe_rd->add_option("-p,--position", fa.slave, "Slave position (or station address with --station)")
         ->capture_default_str();
     foe_rd->add_flag("-s,--station", fa.station, "--position is a station address");
@@ -891,6 +901,14 @@ int main(int argc, char** argv) {
     add_firmware_update(
         app, [&](const auto& fn) { return with_master(g, fn); }, rc);
 
+    // `-p N` names the slave in every verb, also in those that take it as their first argument.
+    std::vector<std::string> args = position_option_as_argument(argc, argv);
+    std::vector<char*> argp;
+    for (std::string& a : args)
+        argp.push_back(a.data());
+    argc = static_cast<int>(argp.size());
+    argp.push_back(nullptr);
+    argv = argp.data();
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
