@@ -25,7 +25,9 @@ namespace od {
 class ConfigError : public std::runtime_error {
   public:
     ConfigError(const std::string& source, int line, const std::string& message)
-        : std::runtime_error(source + ":" + std::to_string(line) + ": " + message), line_(line) {}
+        : std::runtime_error(source + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " +
+                             message),
+          line_(line) {}
     int line() const { return line_; }  // 1-based; 0 if the error is not tied to a line
 
   private:
