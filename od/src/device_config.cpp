@@ -1,6 +1,8 @@
 #include "od/device_config.hpp"
 
+#include <cerrno>
 #include <charconv>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <set>
@@ -223,8 +225,12 @@ DeviceDescription parse_device_config(std::string_view text, const std::string& 
 }
 
 DeviceDescription load_device_config(const std::filesystem::path& path) {
+    errno = 0;
     std::ifstream f(path, std::ios::binary);
-    if (!f) throw ConfigError(path.string(), 0, "cannot open the device configuration file");
+    if (!f)
+        throw ConfigError(path.string(), 0,
+                          std::string("cannot open the device configuration file: ") +
+                              std::strerror(errno ? errno : ENOENT));
     // Read in pieces up to the limit, never the whole of whatever the path names (a pipe or /dev/zero
     // would not end): a configuration is a few hundred bytes.
     std::string text;

@@ -19,8 +19,8 @@
 #include "esi/sii.hpp"
 #include "test_device.hpp"
 
-#ifndef SOFTECAT_SHARED_DIR
-#error "SOFTECAT_SHARED_DIR must be defined"
+#ifndef SOFTECAT_ESI_SCHEMA
+#error "SOFTECAT_ESI_SCHEMA must be defined"
 #endif
 
 namespace {
@@ -28,7 +28,7 @@ namespace {
 using esi_test::Device;
 namespace a = od::access;
 
-const std::string kXsd = std::string(SOFTECAT_SHARED_DIR) + "/esi-schema/EtherCATInfo.xsd";
+const std::string kXsd = SOFTECAT_ESI_SCHEMA;  // esi/schema/ in the repository
 
 // ---- libxml2 helpers ----------------------------------------------------------------------------------
 

@@ -2,6 +2,7 @@
 import os
 import shutil
 import subprocess
+import tempfile
 import unittest
 
 import harness
@@ -53,6 +54,122 @@ class CliErrors(unittest.TestCase):
         self.assertEqual(run().returncode, 2)
         self.assertEqual(run("frobnicate").returncode, 2)
         self.assertEqual(run("--help").returncode, 0)
+
+    def test_unknown_command_is_named_in_one_message(self):
+        r = run("--iface", "lo", "scna")
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn("unknown command 'scna'", r.stderr)
+        self.assertIn("scan", r.stderr)  # the commands there are
+        self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
+        r = run("state")  # a known command without its slave
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertNotIn("unknown command", r.stderr)
+        self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
+
+    def test_sii_decode_of_an_empty_or_corrupt_file_fails(self):
+        d = tempfile.mkdtemp(prefix="ecat-cli-")
+        self.addCleanup(shutil.rmtree, d, True)
+        empty = os.path.join(d, "empty.bin")
+        open(empty, "wb").close()
+        r = run("sii", "decode", empty)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn("empty", r.stderr)
+        junk = os.path.join(d, "junk.bin")
+        with open(junk, "wb") as f:
+            f.write(bytes(range(7, 207)))
+        r = run("sii", "decode", junk)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn("not a valid SII image", r.stderr)
+        good = os.path.join(d, "good.bin")
+        w = subprocess.run([harness.env_path("ECAT_SLAVE"), "--write-sii", good, "--state-dir", os.path.join(d, "s")],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=60)
+        self.assertEqual(w.returncode, 0, w.stderr)
+        r = run("sii", "decode", good)
+        self.assertEqual(r.returncode, 0, r.stderr)
+
+
+def tool(name, *args, cwd=None):
+    return subprocess.run([harness.env_path(name), *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                          timeout=120, cwd=cwd)
+
+
+class ToolErrors(unittest.TestCase):
+    """fwimage and drive-sim: usage errors exit 2 with one message, '-' is standard output, failed writes
+    say why."""
+
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="ecat-tools-")
+        self.addCleanup(shutil.rmtree, self.dir, True)
+        self.payload = os.path.join(self.dir, "payload.bin")
+        with open(self.payload, "wb") as f:
+            f.write(bytes(i & 0xFF for i in range(5000)))
+
+    def assert_usage(self, r, name):
+        err = r.stderr.decode()
+        self.assertEqual(r.returncode, 2, err)
+        self.assertTrue(err.startswith(f"{name}: "), err)
+        self.assertEqual(len(err.strip().splitlines()), 1, err)
+
+    def test_fwimage_usage_errors_exit_2(self):
+        self.assert_usage(tool("FWIMAGE"), "fwimage")  # no subcommand (CLI11 said 106)
+        self.assert_usage(tool("FWIMAGE", "build", "--payload", self.payload), "fwimage")  # required missing
+        self.assert_usage(tool("FWIMAGE", "--frobnicate"), "fwimage")
+        self.assert_usage(tool("FWIMAGE", "build", "--payload", self.payload, "--version", "x", "-o", "o.bin"),
+                          "fwimage")
+        r = tool("FWIMAGE", "build", "--payload", os.path.join(self.dir, "none"), "--version", "1", "-o", "o")
+        self.assert_usage(r, "fwimage")
+        self.assertIn(b"No such file or directory", r.stderr)
+
+    def test_fwimage_build_takes_the_device_identity_by_default_or_from_an_esi(self):
+        r = tool("FWIMAGE", "build", "--payload", self.payload, "--version", "0x01300000", "-o", "image.bin",
+                 cwd=self.dir)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn(b"vendor 0x000000FB product 0x30010000", r.stdout)
+        self.assertIn(b"MAXPOS_0130h_3001h_0000h_0000h.bin", r.stdout)
+        self.assertEqual(tool("FWIMAGE", "info", "image.bin", "--product", "0x30010000", "--vendor", "0xFB",
+                              cwd=self.dir).returncode, 0)
+        # From an ESI: a device configured with another product code.
+        conf = os.path.join(self.dir, "other.conf")
+        with open(conf, "w") as f:
+            f.write("[identity]\nproduct_code = 0x30020000\ndevice_name = \"OTHER\"\n")
+        esi = os.path.join(self.dir, "other.xml")
+        w = tool("ECAT_SLAVE", "--config", conf, "--write-esi", esi, "--state-dir", os.path.join(self.dir, "s"))
+        self.assertEqual(w.returncode, 0, w.stderr)
+        for source in (["--esi", esi], ["--config", conf]):
+            r = tool("FWIMAGE", "build", "--payload", self.payload, "--version", "0x01300000", *source, "-o",
+                     "o.bin", cwd=self.dir)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn(b"product 0x30020000", r.stdout)
+            self.assertIn(b"OTHER_0130h_3002h_0000h_0000h.bin", r.stdout)
+        r = tool("FWIMAGE", "build", "--payload", self.payload, "--version", "1", "--esi", self.payload, "-o", "o")
+        self.assert_usage(r, "fwimage")
+        self.assertIn(b"payload.bin", r.stderr)
+
+    def test_fwimage_output_dash_is_stdout_and_write_failures_say_why(self):
+        r = tool("FWIMAGE", "build", "--payload", self.payload, "--version", "0x01300000", "-o", "-", cwd=self.dir)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(r.stdout[:4], b"SEFW")
+        self.assertEqual(len(r.stdout), 5000 + 32)
+        self.assertFalse(os.path.exists(os.path.join(self.dir, "-")))
+        r = tool("FWIMAGE", "build", "--payload", self.payload, "--version", "1", "-o", "/nonexistent-dir/i.bin")
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertIn(b"/nonexistent-dir/i.bin: No such file or directory", r.stderr)
+
+    def test_drive_sim_usage_errors_exit_2(self):
+        self.assert_usage(tool("DRIVE_SIM", "--frobnicate"), "drive-sim")  # CLI11 said 109
+        self.assert_usage(tool("DRIVE_SIM", "--cycle-us", "1"), "drive-sim")  # CLI11 said 105
+        r = tool("DRIVE_SIM", "-s", os.path.join(self.dir, "none.txt"))
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn(b"No such file or directory", r.stderr)
+
+    def test_drive_sim_csv_to_stdout_and_write_failures(self):
+        r = tool("DRIVE_SIM", "-o", "-", "-p", "-", cwd=self.dir)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertTrue(r.stdout.startswith(b"t_ms,"), r.stdout[:80])
+        self.assertEqual(os.listdir(self.dir), ["payload.bin"])  # nothing else written
+        r = tool("DRIVE_SIM", "-o", "/nonexistent-dir/x.csv", "-p", "-")
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertIn(b"/nonexistent-dir/x.csv: No such file or directory", r.stderr)
 
 
 if __name__ == "__main__":

@@ -318,3 +318,78 @@ TEST(EcatSlaveVeth, SpinAndBusyPollAnswerAndStopOnSigterm) {
 }
 
 }  // namespace
+
+// ---- usage errors that name the file and the line, and output files
+// ----------------------------------------
+
+namespace {
+
+std::string temp_file(const std::string& name, const std::string& content) {
+    const std::string path = state_dir() + "/" + name;
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    if (f != nullptr) {
+        std::fwrite(content.data(), 1, content.size(), f);
+        std::fclose(f);
+    }
+    return path;
+}
+
+bool has(const RunResult& r, const std::string& text) {
+    return r.output.find(text) != std::string::npos;
+}
+
+}  // namespace
+
+TEST(EcatSlaveCli, ABadEepromImageIsAUsageError) {
+    // Exists, but is no SII image: refused before any network set-up, exit 2 like every bad option.
+    const std::string odd = temp_file("odd.bin", "abc");
+    const RunResult r = run({"--eeprom", odd, "--iface", "lo"});
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_TRUE(has(r, "--eeprom")) << r.output;
+    EXPECT_TRUE(has(r, "3 bytes")) << r.output;
+    EXPECT_EQ(run({"--eeprom", temp_file("empty.bin", ""), "--iface", "lo"}).code, 2);
+}
+
+TEST(EcatSlaveCli, ConfigurationErrorsNameTheFileAndTheLine) {
+    struct Case {
+        std::string content, expect;
+    };
+    const std::vector<Case> cases = {
+        {"state-dir = /tmp/x\n[identity\nvendor_id = 1\n", ":2: section header '[identity' without ']'"},
+        {"# options\nfrobnicate = 1\n", ":2: unknown option 'frobnicate'"},
+        {"[identity]\nvendor_idx = 3\n", ":2: unknown key 'vendor_idx' in [identity]"},
+        {"[identity]\n[nonsense]\nx = 1\n", ":2: unknown section [nonsense]"},
+        {"limit-neg = -5\n\x7f\x45LF\x02\x01\x01\x00\x00\x00\n", ":2: not a text file"},
+    };
+    int n = 0;
+    for (const Case& c : cases) {
+        const std::string path = temp_file("bad" + std::to_string(n++) + ".conf", c.content);
+        const RunResult r = run({"--config", path, "--write-sii", state_dir() + "/out.sii"});
+        EXPECT_EQ(r.code, 2) << r.output;
+        EXPECT_TRUE(has(r, path + c.expect)) << "expected '" << path + c.expect << "' in: " << r.output;
+        EXPECT_FALSE(has(r, "ELF")) << "the binary content is echoed: " << r.output;
+    }
+    const RunResult missing =
+        run({"--config", state_dir() + "/none.conf", "--write-sii", state_dir() + "/o"});
+    EXPECT_EQ(missing.code, 2) << missing.output;
+    EXPECT_TRUE(has(missing, "none.conf: cannot open: No such file or directory")) << missing.output;
+    // The example configurations are accepted as they are.
+    EXPECT_EQ(run({"--config", std::string(SOFTECAT_SOURCE_DIR) + "/tools/ecat-slave/drive.conf",
+                   "--write-sii", state_dir() + "/ok.sii"})
+                  .code,
+              0);
+}
+
+TEST(EcatSlaveCli, OutputFilesTakeDashForStandardOutputAndSayWhyAWriteFails) {
+    const RunResult esi = run({"--write-esi", "-"});
+    EXPECT_EQ(esi.code, 0) << esi.output;
+    EXPECT_TRUE(has(esi, "<EtherCATInfo")) << esi.output.substr(0, 200);
+    EXPECT_FALSE(std::filesystem::exists("-"));
+    const RunResult sii = run({"--write-sii", "-"});
+    EXPECT_EQ(sii.code, 0);
+    EXPECT_GE(sii.output.size(), 128u);  // the binary image on stdout
+    const RunResult bad = run({"--write-esi", "/nonexistent-dir/device.xml"});
+    EXPECT_EQ(bad.code, 1) << bad.output;
+    EXPECT_TRUE(has(bad, "cannot write /nonexistent-dir/device.xml: No such file or directory"))
+        << bad.output;
+}

@@ -158,3 +158,37 @@ TEST(DeviceConfig, OversizedOrEndlessFileIsAnError) {
     EXPECT_EQ(load_device_config(path).identity.vendor_id, 0xFBu);
     std::filesystem::remove(path);
 }
+
+TEST(DeviceConfig, MessagesNameTheFileAndALineOnlyWhenThereIsOne) {
+    try {
+        load_device_config("/nonexistent/dir/device.conf");
+        FAIL() << "no error";
+    } catch (const ConfigError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "/nonexistent/dir/device.conf: cannot open the device configuration file: No such file or "
+                  "directory");
+        EXPECT_EQ(e.line(), 0);
+    }
+    std::string msg;
+    EXPECT_EQ(error_line("[identity]\ndevice_name = \"\"\n", &msg), 0);  // checked after the last line
+    EXPECT_EQ(msg.rfind("t.conf: ", 0), 0u) << msg;
+    EXPECT_EQ(error_line("[identity\n", &msg), 1);
+    EXPECT_EQ(msg.rfind("t.conf:1: ", 0), 0u) << msg;
+}
+
+// Each of the drive's example configurations loads (od/examples/*.conf are shown in the README).
+TEST(DeviceConfig, EveryExampleLoads) {
+    int n = 0;
+    for (const auto& f : std::filesystem::directory_iterator(OD_EXAMPLES_DIR)) {
+        if (f.path().extension() != ".conf") continue;
+        EXPECT_NO_THROW(load_device_config(f.path())) << f.path();
+        ++n;
+    }
+    EXPECT_GE(n, 2);
+    const DeviceDescription d =
+        load_device_config(std::filesystem::path(OD_EXAMPLES_DIR) / "bootstrap-as-standard.conf");
+    EXPECT_EQ(d.bootstrap_mailbox.out_start, d.standard_mailbox.out_start);
+    EXPECT_EQ(d.bootstrap_mailbox.out_size, d.standard_mailbox.out_size);
+    EXPECT_EQ(d.bootstrap_mailbox.in_start, d.standard_mailbox.in_start);
+    EXPECT_EQ(d.bootstrap_mailbox.in_size, d.standard_mailbox.in_size);
+}

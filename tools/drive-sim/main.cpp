@@ -21,6 +21,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -380,7 +381,14 @@ int main(int argc, char** argv) {
     app.add_flag("--print-demo", print_demo, "print the built-in demo script and exit");
     app.add_flag("--seed-defaults", seed_defaults,
                  "start from the seed's defaults instead of the commissioned motor data (torque constant 0)");
-    CLI11_PARSE(app, argc, argv);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        std::cerr << "drive-sim: " << e.what() << " (drive-sim --help)\n";  // one line
+        return 2;  // usage error, as every program of the project
+    }
 
     const auto dt_ns = static_cast<int64_t>(std::llround(cycle_us * 1000.0));
     if (print_demo) {
@@ -397,7 +405,7 @@ int main(int argc, char** argv) {
     } else {
         std::ifstream in(script_path);
         if (!in) {
-            std::cerr << "drive-sim: cannot open " << script_path << "\n";
+            std::cerr << "drive-sim: cannot open " << script_path << ": " << std::strerror(errno) << "\n";
             return 2;
         }
         if (!parse_script(in, sc, err)) {
@@ -423,16 +431,30 @@ int main(int argc, char** argv) {
         sim.cycle(t, dt_ns);
         samples.push_back(sim.sample(t_ms));
     }
-    if (!drivesim::write_csv(csv_path, samples)) {
-        std::cerr << "drive-sim: cannot write " << csv_path << "\n";
+    // "-o -": the CSV goes to standard output (and the summary to stderr); a plot then needs -p and is
+    // rendered from a temporary copy of the CSV.
+    const bool csv_stdout = csv_path == "-";
+    if (csv_stdout) {
+        drivesim::write_csv(std::cout, samples);
+        if (!std::cout.flush()) {
+            std::cerr << "drive-sim: cannot write the CSV to standard output: " << std::strerror(errno)
+                      << "\n";
+            return 1;
+        }
+        csv_path = png_path.empty() || png_path == "-" ? "" : png_path + ".csv";
+    }
+    if (!csv_path.empty() && !drivesim::write_csv(csv_path, samples)) {
+        std::cerr << "drive-sim: cannot write " << csv_path << ": " << std::strerror(errno) << "\n";
         return 1;
     }
     const Sample& last = samples.back();
-    std::printf("%zu samples -> %s; end: position %d inc, velocity %d rpm, statusword 0x%04X, error 0x%04X\n",
-                samples.size(), csv_path.c_str(), last.actual, last.velocity, last.statusword,
-                sim.dict().get<uint16_t>(0x603F, 0));
-    if (png_path.empty()) png_path = csv_path + ".png";
-    if (png_path != "-") {
+    std::fprintf(
+        csv_stdout ? stderr : stdout,
+        "%zu samples -> %s; end: position %d inc, velocity %d rpm, statusword 0x%04X, error 0x%04X\n",
+        samples.size(), csv_stdout ? "<stdout>" : csv_path.c_str(), last.actual, last.velocity,
+        last.statusword, sim.dict().get<uint16_t>(0x603F, 0));
+    if (png_path.empty() && !csv_stdout) png_path = csv_path + ".png";
+    if (!png_path.empty() && png_path != "-") {  // "-p -": no plot
         const std::string name = script_path.empty() ? std::string("built-in demo")
                                                      : std::filesystem::path(script_path).filename().string();
         char cycle[32];
@@ -443,7 +465,8 @@ int main(int argc, char** argv) {
             std::cerr << "drive-sim: " << err << "\n";
             return 1;
         }
-        std::printf("plot -> %s\n", png_path.c_str());
+        std::fprintf(csv_stdout ? stderr : stdout, "plot -> %s\n", png_path.c_str());
+        if (csv_stdout) std::remove(csv_path.c_str());  // the temporary copy
     }
     return 0;
 }

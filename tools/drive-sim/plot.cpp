@@ -1,6 +1,7 @@
 // drive-sim's events and plot (see plot.hpp).
 #include "plot.hpp"
 
+#include <cerrno>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -93,9 +94,7 @@ std::vector<Event> find_events(const std::vector<Sample>& s) {
     return ev;
 }
 
-bool write_csv(const std::string& path, const std::vector<Sample>& s) {
-    std::ofstream f(path);
-    if (!f) return false;
+void write_csv(std::ostream& f, const std::vector<Sample>& s) {
     f << "t_ms,setpoint,position_demand,position_actual,velocity_actual_rpm,velocity_demand_rpm,current_ma,"
          "following_error,statusword,mode,digital_inputs,error_code,state\n";
     for (const Sample& x : s)
@@ -103,6 +102,13 @@ bool write_csv(const std::string& path, const std::vector<Sample>& s) {
           << x.velocity_demand << ',' << x.current << ',' << x.following_error << ",0x" << std::hex
           << x.statusword << std::dec << ',' << static_cast<int>(x.mode) << ",0x" << std::hex << x.inputs
           << ",0x" << x.error_code << std::dec << ',' << cia402_state(x.statusword) << '\n';
+}
+
+bool write_csv(const std::string& path, const std::vector<Sample>& s) {
+    errno = 0;
+    std::ofstream f(path);
+    if (!f) return false;
+    write_csv(f, s);
     return static_cast<bool>(f.flush());
 }
 

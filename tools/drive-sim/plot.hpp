@@ -5,6 +5,7 @@
 // mode of operation and one for the CiA 402 state from the statusword, every event a dashed line across all
 // panels with its name on top, the script's name in the title.
 #include <cstdint>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -37,7 +38,9 @@ std::vector<Event> find_events(const std::vector<Sample>& samples);
 
 // CSV columns: t_ms, setpoint, position_demand, position_actual, velocity_actual_rpm, velocity_demand_rpm,
 // current_ma, following_error, statusword, mode, digital_inputs, error_code, state.
+// write_csv(path) leaves errno set when it fails.
 bool write_csv(const std::string& path, const std::vector<Sample>& samples);
+void write_csv(std::ostream& out, const std::vector<Sample>& samples);
 
 // The gnuplot script that renders csv into png.
 std::string gnuplot_script(const std::string& csv, const std::string& png, const std::string& title,

@@ -1,10 +1,15 @@
 // ecat-slave: parses the command line (and the configuration file) and hands over to
 // softslave::run_slave() with the soft drive (softdrive) as firmware.
 #include <CLI/CLI.hpp>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <string_view>
 
+#include "config_check.hpp"
 #include "esc/link.hpp"
 #include "od/device_config.hpp"
 #include "softdrive/faults.hpp"
@@ -21,16 +26,16 @@ bool device_section(const std::string& item) {
     return false;
 }
 
-bool write_text(const std::string& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out << text;
-    return static_cast<bool>(out.flush());
-}
-
-bool write_bytes(const std::string& path, const std::vector<uint8_t>& data) {
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size()));
-    return static_cast<bool>(out.flush());
+// Writes the bytes to path, or to standard output for "-"; on failure, why (strerror) in error.
+bool write_output(const std::string& path, std::string_view bytes, std::string& error) {
+    errno = 0;
+    FILE* f = path == "-" ? stdout : std::fopen(path.c_str(), "wb");
+    bool ok =
+        f != nullptr && std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size() && std::fflush(f) == 0;
+    int err = errno;
+    if (f != nullptr && f != stdout && std::fclose(f) != 0 && ok) ok = false, err = errno;
+    if (!ok) error = std::strerror(err ? err : EIO);
+    return ok;
 }
 
 }  // namespace
@@ -66,9 +71,11 @@ int main(int argc, char** argv) {
     app.add_option("--state-dir", state_dir,
                    "Directory for stored parameters and firmware images (created if missing)")
         ->capture_default_str();
-    app.add_option("--write-sii", write_sii, "Write the device's SII EEPROM image to FILE and exit")
+    app.add_option("--write-sii", write_sii,
+                   "Write the device's SII EEPROM image to FILE ('-': standard output) and exit")
         ->type_name("FILE");
-    app.add_option("--write-esi", write_esi, "Write the device's ESI (EtherCATInfo XML) to FILE and exit")
+    app.add_option("--write-esi", write_esi,
+                   "Write the device's ESI (EtherCATInfo XML) to FILE ('-': standard output) and exit")
         ->type_name("FILE");
     app.add_option("--control", control,
                    "Create a UNIX datagram socket here that changes the simulated machine at run time "
@@ -119,6 +126,13 @@ int main(int argc, char** argv) {
         "the SII generated from the object model");
     app.add_option("--stats-file", options.stats_file,
                    "Write the statistics as 'name value' lines to this file at exit");
+    // The configuration file is checked first: CLI11 would name neither the file nor the line.
+    if (auto config = ecat_slave::config_file_argument(argc, argv)) {
+        if (const std::string problem = ecat_slave::check_config_file(app, *config); !problem.empty()) {
+            std::cerr << "ecat-slave: " << problem << '\n';
+            return softslave::kExitUsage;
+        }
+    }
     try {
         app.parse(argc, argv);
         for (const std::string& extra : app.remaining())
@@ -129,7 +143,7 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        app.exit(e);
+        std::cerr << "ecat-slave: " << e.what() << " (ecat-slave --help)\n";  // one line
         return softslave::kExitUsage;
     }
     softdrive::FaultSet fault_set;
@@ -178,12 +192,16 @@ int main(int argc, char** argv) {
 
     try {
         if (!write_sii.empty() || !write_esi.empty()) {
-            if (!write_sii.empty() && !write_bytes(write_sii, softdrive::make_sii(device))) {
-                std::cerr << "ecat-slave: cannot write " << write_sii << '\n';
+            std::string why;
+            const std::vector<uint8_t> sii =
+                write_sii.empty() ? std::vector<uint8_t>{} : softdrive::make_sii(device);
+            if (!write_sii.empty() &&
+                !write_output(write_sii, {reinterpret_cast<const char*>(sii.data()), sii.size()}, why)) {
+                std::cerr << "ecat-slave: cannot write " << write_sii << ": " << why << '\n';
                 return softslave::kExitFailure;
             }
-            if (!write_esi.empty() && !write_text(write_esi, softdrive::make_esi(device))) {
-                std::cerr << "ecat-slave: cannot write " << write_esi << '\n';
+            if (!write_esi.empty() && !write_output(write_esi, softdrive::make_esi(device), why)) {
+                std::cerr << "ecat-slave: cannot write " << write_esi << ": " << why << '\n';
                 return softslave::kExitFailure;
             }
             return softslave::kExitOk;
@@ -195,6 +213,14 @@ int main(int argc, char** argv) {
     } catch (const std::exception& e) {
         std::cerr << "ecat-slave: " << e.what() << '\n';
         return softslave::kExitFailure;
+    }
+    if (!options.eeprom_file.empty()) {
+        try {  // a bad --eeprom is a usage error (exit 2), found before any network set-up
+            (void)softslave::load_eeprom_file(options);
+        } catch (const std::exception& e) {
+            std::cerr << "ecat-slave: --eeprom: " << e.what() << '\n';
+            return softslave::kExitUsage;
+        }
     }
     options.eeprom_loader = softdrive::eeprom_loader(device);
     options.firmware_factory = softdrive::firmware_factory(device, control);

@@ -1,15 +1,21 @@
-// fwimage build --payload FILE --version 0x01200000 --vendor 0xFB --product 0x30010000 -o image.bin
+// fwimage build --payload FILE --version 0x01200000 [--vendor 0xFB --product 0x30010000 | --esi FILE |
+//               --config FILE] -o image.bin        (vendor, product and name default to the drive's own)
 // fwimage info image.bin [--vendor V --product P]
+// Exit codes: 0 ok, 1 failure (an image that does not verify, a file that cannot be written), 2 usage (bad
+// options, an input file that cannot be read).
 #include <CLI/CLI.hpp>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
+#include <iostream>
 #include <iterator>
 #include <string>
 #include <vector>
 
 #include "foe/image.hpp"
+#include "identity.hpp"
 
 namespace {
 
@@ -24,10 +30,38 @@ bool parse_u32(const std::string& text, uint32_t& out) {
 }
 
 bool read_file(const std::string& path, std::vector<uint8_t>& out) {
+    errno = 0;
     std::ifstream f(path, std::ios::binary);
-    if (!f) return false;
+    if (!f) {
+        std::fprintf(stderr, "fwimage: cannot read %s: %s\n", path.c_str(),
+                     std::strerror(errno ? errno : ENOENT));
+        return false;
+    }
     out.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-    return !f.bad();
+    if (f.bad()) {
+        std::fprintf(stderr, "fwimage: cannot read %s: %s\n", path.c_str(),
+                     std::strerror(errno ? errno : EIO));
+        return false;
+    }
+    return true;
+}
+
+// The image to `path`, or to standard output for "-"; says why on failure.
+bool write_file(const std::string& path, const std::vector<uint8_t>& bytes) {
+    FILE* f = path == "-" ? stdout : std::fopen(path.c_str(), "wb");
+    if (!f) {
+        std::fprintf(stderr, "fwimage: cannot write %s: %s\n", path.c_str(), std::strerror(errno));
+        return false;
+    }
+    const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size() && std::fflush(f) == 0;
+    const int err = errno;
+    const bool closed = f == stdout || std::fclose(f) == 0;
+    if (!ok || !closed) {
+        std::fprintf(stderr, "fwimage: cannot write %s: %s\n", path.c_str(),
+                     std::strerror(err ? err : errno));
+        return false;
+    }
+    return true;
 }
 
 }  // namespace
@@ -36,16 +70,20 @@ int main(int argc, char** argv) {
     CLI::App app{"Build and inspect firmware images for the soft EtherCAT drive (FoE download)"};
     app.require_subcommand(1);
 
-    std::string payload_path, out_path, version_text, vendor_text = "0xFB", product_text, name = "MAXPOS";
+    const fwimage::DeviceIdentity defaults = fwimage::default_identity();
+    std::string payload_path, out_path, version_text, vendor_text, product_text, name, esi_path, config_path;
     auto* build = app.add_subcommand("build", "wrap a payload into a firmware image");
     build->add_option("--payload", payload_path, "payload file")->required();
     build->add_option("--version", version_text, "firmware version = revision 0x1018:03 (e.g. 0x01200000)")
         ->required();
-    build->add_option("--vendor", vendor_text, "vendor id the image is for (default 0xFB)");
-    build->add_option("--product", product_text, "product code the image is for (e.g. 0x30010000)")
-        ->required();
-    build->add_option("-o,--output", out_path, "image file to write")->required();
-    build->add_option("--name", name, "device name for the firmware file name (default MAXPOS)");
+    build->add_option("--vendor", vendor_text, "vendor id the image is for (default: the device's)");
+    build->add_option("--product", product_text, "product code the image is for (default: the device's)");
+    auto* esi_opt = build->add_option("--esi", esi_path,
+                                      "take vendor, product and name from this ESI file (first Device)");
+    build->add_option("--config", config_path, "take vendor, product and name from this device configuration")
+        ->excludes(esi_opt);
+    build->add_option("-o,--output", out_path, "image file to write ('-': standard output)")->required();
+    build->add_option("--name", name, "device name for the firmware file name (default: the device's)");
 
     std::string image_path, check_vendor, check_product;
     auto* info = app.add_subcommand("info", "print and verify an image's header");
@@ -53,47 +91,60 @@ int main(int argc, char** argv) {
     info->add_option("--vendor", check_vendor, "verify against this vendor id (default: the image's own)");
     info->add_option("--product", check_product,
                      "verify against this product code (default: the image's own)");
-    info->add_option("--name", name, "device name for the firmware file name (default MAXPOS)");
+    info->add_option("--name", name, "device name for the firmware file name (default: the device's)");
 
-    CLI11_PARSE(app, argc, argv);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        std::cerr << "fwimage: " << e.what() << " (fwimage --help)\n";  // one line
+        return 2;
+    }
 
     if (build->parsed()) {
-        foe::ImageIdentity id;
+        fwimage::DeviceIdentity device = defaults;
+        std::string error;
+        if (!esi_path.empty() || !config_path.empty()) {
+            auto from_file = esi_path.empty() ? fwimage::identity_from_config(config_path, error)
+                                              : fwimage::identity_from_esi(esi_path, error);
+            if (!from_file) {
+                std::fprintf(stderr, "fwimage: %s\n", error.c_str());
+                return 2;
+            }
+            device = *from_file;
+        }
+        foe::ImageIdentity id{device.vendor_id, device.product_code};
         uint32_t version = 0;
-        if (!parse_u32(version_text, version) || !parse_u32(vendor_text, id.vendor_id) ||
-            !parse_u32(product_text, id.product_code)) {
+        if (!parse_u32(version_text, version) ||
+            (!vendor_text.empty() && !parse_u32(vendor_text, id.vendor_id)) ||
+            (!product_text.empty() && !parse_u32(product_text, id.product_code))) {
             std::fprintf(
                 stderr,
                 "fwimage: --version, --vendor and --product take 32-bit numbers (0x... or decimal)\n");
             return 2;
         }
+        if (name.empty()) name = device.device_name;
         std::vector<uint8_t> payload;
-        if (!read_file(payload_path, payload)) {
-            std::fprintf(stderr, "fwimage: cannot read %s\n", payload_path.c_str());
-            return 1;
-        }
+        if (!read_file(payload_path, payload)) return 2;
         if (payload.size() > foe::kMaxPayload) {
-            std::fprintf(stderr, "fwimage: payload too large\n");
-            return 1;
+            std::fprintf(stderr, "fwimage: %s: payload too large (%zu bytes, at most %zu)\n",
+                         payload_path.c_str(), payload.size(), static_cast<std::size_t>(foe::kMaxPayload));
+            return 2;
         }
         const auto image = foe::build_image(payload, id, version);
-        std::ofstream f(out_path, std::ios::binary | std::ios::trunc);
-        f.write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));
-        f.close();
-        if (!f) {
-            std::fprintf(stderr, "fwimage: cannot write %s\n", out_path.c_str());
-            return 1;
-        }
-        std::printf("%s: %zu bytes, firmware file name %s\n", out_path.c_str(), image.size(),
-                    foe::firmware_file_name(name, id.product_code, version).c_str());
+        if (!write_file(out_path, image)) return 1;
+        // The summary goes to stderr when the image itself goes to standard output.
+        std::fprintf(out_path == "-" ? stderr : stdout,
+                     "%s: %zu bytes for vendor 0x%08X product 0x%08X, firmware file name %s\n",
+                     out_path == "-" ? "<stdout>" : out_path.c_str(), image.size(), id.vendor_id,
+                     id.product_code, foe::firmware_file_name(name, id.product_code, version).c_str());
         return 0;
     }
 
+    if (name.empty()) name = defaults.device_name;
     std::vector<uint8_t> bytes;
-    if (!read_file(image_path, bytes)) {
-        std::fprintf(stderr, "fwimage: cannot read %s\n", image_path.c_str());
-        return 1;
-    }
+    if (!read_file(image_path, bytes)) return 2;
     if (bytes.size() < foe::kImageHeaderSize) {
         std::printf("%s: %zu bytes: %s\n", image_path.c_str(), bytes.size(),
                     std::string(foe::to_string(foe::ImageError::TooShort)).c_str());

@@ -25,10 +25,22 @@ namespace od {
 class ConfigError : public std::runtime_error {
   public:
     ConfigError(const std::string& source, int line, const std::string& message)
-        : std::runtime_error(source + ":" + std::to_string(line) + ": " + message), line_(line) {}
+        : std::runtime_error(text(source, line, message)), line_(line) {}
     int line() const { return line_; }  // 1-based; 0 if the error is not tied to a line
 
   private:
+    // "FILE:LINE: message", or "FILE: message" when no line is to blame. Appended piece by piece: GCC 12 at
+    // -O3 misjudges ":" + std::string&& as an overlapping copy (-Werror=restrict, GCC bug 105651).
+    static std::string text(const std::string& source, int line, const std::string& message) {
+        std::string t = source;
+        if (line > 0) {
+            t += ':';
+            t += std::to_string(line);
+        }
+        t += ": ";
+        t += message;
+        return t;
+    }
     int line_;
 };
 

@@ -1,8 +1,12 @@
 #include "common.hpp"
 
 #include <cstdio>
+#include <iostream>
 
 #include "format.hpp"
+#ifdef ECATCTL_HAVE_ESI
+#include "esi/sii.hpp"
+#endif
 
 namespace ecatctl {
 
@@ -34,6 +38,170 @@ int report_sdo_failure(const master::SdoClient& sdo, master::Error e, const std:
         return kExitProtocol;
     }
     return fail(e, what);
+}
+
+std::string slave_label(master::Address a) {
+    char b[32];
+    std::snprintf(b, sizeof b, a.mode == master::Address::Mode::Station ? "station 0x%04x" : "slave %u",
+                  a.value);
+    return b;
+}
+
+std::optional<master::Address> parse_slave_address(const std::string& text, bool station) {
+    auto v = parse_number(text, 0xFFFF);
+    if (!v) return std::nullopt;
+    return station ? master::Address::station(static_cast<uint16_t>(*v))
+                   : master::Address::position(static_cast<uint16_t>(*v));
+}
+
+int usage_error(const std::string& what) {
+    std::cerr << "ecatctl: " << what << "\n";
+    return kExitUsage;
+}
+
+int report_error(master::Error e, const std::string& what) {
+    std::cerr << "ecatctl: " << what << ": " << master::to_string(e);
+    if (e == master::Error::Timeout)
+        std::cerr << " (check that a slave is connected and running on the interface)";
+    if (e == master::Error::WorkingCounter)
+        std::cerr << " (is there a slave at that address? `ecatctl scan` lists them)";
+    std::cerr << "\n";
+    return exit_code(e);
+}
+
+int check_slave_present(master::Master& m, master::Address a) {
+    if (a.mode == master::Address::Mode::Position) {
+        auto n = m.count_slaves();
+        if (!n) return report_error(n.error(), "counting slaves (BRD 0x0000)");
+        if (a.value < *n) return kExitOk;
+        std::cerr << "ecatctl: there is no slave " << a.value << ": " << *n << " slave"
+                  << (*n == 1 ? "" : "s") << " on the line"
+                  << (*n ? " (positions 0.." + std::to_string(*n - 1) + ")" : "") << "\n";
+        return kExitNoSlave;
+    }
+    uint8_t b[2];
+    const master::Error e = m.read(a, 0x0130, b);  // AL status
+    if (e == master::Error::Ok) return kExitOk;
+    if (e == master::Error::WorkingCounter) {
+        char t[120];
+        std::snprintf(t, sizeof t,
+                      "ecatctl: no slave has the station address 0x%04x (`ecatctl scan` assigns 0x1001..)\n",
+                      a.value);
+        std::cerr << t;
+        return kExitNoSlave;
+    }
+    return report_error(e, "reading the AL status of " + slave_label(a));
+}
+
+std::optional<std::string> sii_device_name(master::Master& m, master::Address a) {
+#ifdef ECATCTL_HAVE_ESI
+    auto img = m.sii_read_image(a);
+    if (!img) return std::nullopt;
+    const esi::SiiInfo info = esi::parse_sii(*img);
+    if (info.general && !info.general->name.empty()) return info.general->name;
+#else
+    (void)m;
+    (void)a;
+#endif
+    return std::nullopt;
+}
+
+std::string foe_names_hint(const std::string& prefix) {
+    return prefix +
+           ": the device takes firmware under its device name (0x1008, e.g. MAXPOS) or its firmware file "
+           "name "
+           "<name>_XXXXh_XXXXh_XXXXh_XXXXh.bin (`fwimage info FILE` prints it); --name chooses";
+}
+
+bool sii_problems(const std::string& what, const std::vector<uint8_t>& image) {
+    if (image.empty()) {
+        std::cerr << "ecatctl: " << what << " is empty: not an SII image\n";
+        return true;
+    }
+#ifdef ECATCTL_HAVE_ESI
+    const esi::SiiInfo info = esi::parse_sii(image);
+    if (info.problems.empty() && info.header_complete) return false;
+    std::cerr << "ecatctl: " << what << " is not a valid SII image: "
+              << (info.problems.empty() ? std::string("the header is incomplete") : info.problems.front());
+    if (info.problems.size() > 1)
+        std::cerr << " (and " << info.problems.size() - 1 << " more problems, above)";
+    std::cerr << "\n";
+    return true;
+#else
+    return false;
+#endif
+}
+
+int report_usage_error(const CLI::App& app, const CLI::ParseError& e, int argc, char** argv) {
+    // The first word that is not a global option or its value is the verb.
+    std::string verb;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a == "-i" || a == "--iface" || a == "-b" || a == "--backend" || a == "-t" || a == "--timeout" ||
+            a == "--retries") {
+            ++i;
+            continue;
+        }
+        if (!a.empty() && a[0] == '-') continue;
+        verb = a;
+        break;
+    }
+    const auto all = app.get_subcommands([](const CLI::App*) { return true; });
+    bool known = false;
+    std::string verbs;
+    for (const CLI::App* c : all) {
+        known = known || c->check_name(verb);
+        verbs += (verbs.empty() ? "" : ", ") + c->get_name();
+    }
+    if (!verb.empty() && !known) {
+        std::cerr << "ecatctl: unknown command '" << verb << "' (commands: " << verbs << ")\n";
+        return kExitUsage;
+    }
+    std::cerr << "ecatctl: " << e.what() << " (ecatctl --help)\n";
+    return kExitUsage;
+}
+
+std::vector<std::string> position_option_as_argument(int argc, char** argv) {
+    std::vector<std::string> args(argv, argv + argc);
+    auto global_with_value = [](const std::string& a) {
+        return a == "-i" || a == "--iface" || a == "-b" || a == "--backend" || a == "-t" ||
+               a == "--timeout" || a == "--retries";
+    };
+    std::size_t i = 1;
+    while (i < args.size() && !args[i].empty() && args[i][0] == '-')
+        i += global_with_value(args[i]) ? 2 : 1;
+    if (i >= args.size()) return args;
+    const std::string verb = args[i];
+    std::size_t slave_at = i + 1;  // where the slave argument goes
+    if (verb == "reg") {
+        if (slave_at >= args.size() || (args[slave_at] != "read" && args[slave_at] != "write")) return args;
+        ++slave_at;
+    } else if (verb != "state" && verb != "upload" && verb != "download" && verb != "sdos" && verb != "pd" &&
+               verb != "diag" && verb != "slaves" && verb != "pdos" && verb != "cstruct" && verb != "xml") {
+        return args;  // these verbs have -p/--position as an option of their own
+    }
+    for (std::size_t k = slave_at; k < args.size(); ++k) {
+        const std::string& a = args[k];
+        if (a == "--") break;
+        std::string value;
+        std::size_t take = 0;
+        if ((a == "-p" || a == "--position") && k + 1 < args.size()) {
+            value = args[k + 1];
+            take = 2;
+        } else if (a.rfind("--position=", 0) == 0) {
+            value = a.substr(11);
+            take = 1;
+        } else if (a.size() > 2 && a.rfind("-p", 0) == 0) {
+            value = a.substr(2);
+            take = 1;
+        }
+        if (take == 0) continue;
+        args.erase(args.begin() + static_cast<std::ptrdiff_t>(k),
+                   args.begin() + static_cast<std::ptrdiff_t>(k + take));
+        args.insert(args.begin() + static_cast<std::ptrdiff_t>(slave_at), value);
+        break;
+    }
+    return args;
 }
 
 }  // namespace ecatctl

@@ -3,7 +3,9 @@
 // Verbs: scan | reg read | reg write | sii read | sii write | sii decode | state | upload | download | sdos |
 // pd
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -15,6 +17,7 @@
 #include "cmd_diag.hpp"
 #include "cmd_firmware.hpp"
 #include "cmd_verbs.hpp"
+#include "cmd_state.hpp"
 #include "common.hpp"
 #include "esc/link.hpp"
 #include "format.hpp"
@@ -40,11 +43,17 @@ struct Globals {
     unsigned retries = 2;
 };
 
+// The AL status of the last refused state request, for fail() to report.
+master::AlStatus g_refusal;
+
 int fail(Error e, const std::string& what) {
-    std::cerr << "ecatctl: " << what << ": " << master::to_string(e) << "\n";
-    if (e == Error::Timeout)
-        std::cerr << "ecatctl: check that a slave is connected and running on the interface\n";
-    return exit_code(e);
+    if (e == Error::AlRefused) {
+        std::fprintf(stderr, "ecatctl: %s: refused, stays in %s, AL status code 0x%04x (%s)\n", what.c_str(),
+                     std::string(master::al_state_name(g_refusal.state)).c_str(), g_refusal.code,
+                     std::string(master::al_status_code_name(g_refusal.code)).c_str());
+        return kExitProtocol;
+    }
+    return report_error(e, what);
 }
 
 int usage(const std::string& what) {
@@ -251,7 +260,7 @@ int sii_read(master::Master& m, const SiiArgs& s) {
     std::ofstream f(s.output, std::ios::binary | std::ios::trunc);
     f.write(reinterpret_cast<const char*>(img->data()), static_cast<std::streamsize>(img->size()));
     if (!f) {
-        std::cerr << "ecatctl: cannot write " << s.output << "\n";
+        std::cerr << "ecatctl: cannot write " << s.output << ": " << std::strerror(errno) << "\n";
         return kExitFailure;
     }
     std::cerr << "ecatctl: " << img->size() << " bytes written to " << s.output << "\n";
@@ -289,54 +298,6 @@ int sii_write(master::Master& m, const SiiArgs& s) {
     return kExitOk;
 }
 
-int state(master::Master& m, const std::string& slave, bool station, const std::string& target,
-          bool identify) {
-    auto a = named_slave(slave, station);
-    if (!a) return kExitUsage;
-    if (identify) {
-        auto id = m.identify(*a);
-        if (!id) return fail(id.error(), "device identification of " + slave_text(*a));
-        std::printf("identification value 0x%04x (%u)\n", *id, *id);
-        return kExitOk;
-    }
-    if (target.empty()) {
-        auto st = m.al_status(*a);
-        if (!st) return fail(st.error(), "reading the AL status of " + slave_text(*a));
-        std::printf("%s%s", std::string(master::al_state_name(st->state)).c_str(), st->error ? " +ERR" : "");
-        if (st->error || st->code)
-            std::printf(" 0x%04x %s", st->code, std::string(master::al_status_code_name(st->code)).c_str());
-        std::printf("\n");
-        return kExitOk;
-    }
-    std::string t = target;
-    for (auto& c : t)
-        c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-    master::AlState s;
-    if (t == "INIT")
-        s = master::AlState::Init;
-    else if (t == "PREOP")
-        s = master::AlState::PreOp;
-    else if (t == "BOOT")
-        s = master::AlState::Boot;
-    else if (t == "SAFEOP")
-        s = master::AlState::SafeOp;
-    else if (t == "OP")
-        s = master::AlState::Op;
-    else
-        return usage("unknown state '" + target + "' (INIT, PREOP, BOOT, SAFEOP, OP)");
-    master::AlStatus st;
-    const Error e = m.request_state(*a, s, &st);
-    if (e == Error::AlRefused) {
-        std::fprintf(stderr, "ecatctl: %s refused %s: stays in %s, AL status code 0x%04x (%s)\n",
-                     slave_text(*a).c_str(), t.c_str(), std::string(master::al_state_name(st.state)).c_str(),
-                     st.code, std::string(master::al_status_code_name(st.code)).c_str());
-        return kExitProtocol;
-    }
-    if (e != Error::Ok) return fail(e, "requesting " + t + " from " + slave_text(*a));
-    std::printf("%s\n", std::string(master::al_state_name(st.state)).c_str());
-    return kExitOk;
-}
-
 // ---- CoE SDO -------------------------------------------------------------------------------------
 
 struct SdoArgs {
@@ -358,9 +319,7 @@ Error open_mailbox(master::Master& m, master::Mailbox& mbx, Address a) {
         if (Error e = mbx.configure_from_sii(); e != Error::Ok) return e;
         master::AlStatus final;
         const Error e = m.request_state(a, master::AlState::PreOp, &final);
-        if (e == Error::AlRefused)
-            std::fprintf(stderr, "ecatctl: INIT -> PREOP refused, AL status code 0x%04x (%s)\n", final.code,
-                         std::string(master::al_status_code_name(final.code)).c_str());
+        if (e == Error::AlRefused) g_refusal = final;  // fail() reports it, in one message
         return e;
     }
     return mbx.adopt_current();
@@ -452,6 +411,7 @@ struct PdArgs {
     std::vector<std::string> outputs;
     std::vector<std::string> steps;
     bool keep = false;
+    bool station = false;  // slave is a station address (as scan assigns them)
 };
 
 // "CYCLES:B0,B1,..." -> cycles and the output bytes sent (from the first byte) during them.
@@ -501,10 +461,13 @@ int process_data(master::Master& m, const PdArgs& p) {
     // Station addresses as scan gives them; DC's FRMW addresses the reference clock by station.
     auto n = m.count_slaves();
     if (!n) return fail(n.error(), "counting slaves (BRD 0x0000)");
-    if (*pos >= *n) return usage("no slave at position " + p.slave);
+    if (!p.station && *pos >= *n)
+        return check_slave_present(m, Address::position(static_cast<uint16_t>(*pos)));
     if (Error e = m.assign_station_addresses(*n); e != Error::Ok)
         return fail(e, "assigning station addresses");
-    const Address a = Address::station(static_cast<uint16_t>(0x1001 + *pos));
+    const Address a = Address::station(static_cast<uint16_t>(p.station ? *pos : 0x1001 + *pos));
+    if (p.station)
+        if (int rc = check_slave_present(m, a); rc != kExitOk) return rc;
     // Configuration happens in PREOP.
     auto st = m.al_status(a);
     if (!st) return fail(st.error(), "reading the AL status");
@@ -689,9 +652,16 @@ int foe_transfer(master::Master& m, const FoeArgs& f, bool read) {
         auto d = read_file(f.file);
         if (!d) return usage("cannot read " + f.file);
         data = std::move(*d);
-        if (name.empty()) name = std::filesystem::path(f.file).filename().string();
+        // The device takes firmware under its device name (0x1008, the SII General name) or the firmware
+        // file name built from it; the local file's name means nothing to it.
+        if (name.empty()) {
+            auto device = sii_device_name(m, *a);
+            if (!device)
+                return usage(foe_names_hint(slave_text(*a) + " has no device name in its SII: give --name"));
+            name = *device;
+        }
     }
-    if (name.empty()) return usage("give the file name on the slave (--name)");
+    if (name.empty()) return usage("give the file name on the slave");
     master::Mailbox mbx(m, *a);
     auto st = m.al_status(*a);
     if (!st) return fail(st.error(), "reading the AL status of " + slave_text(*a));
@@ -712,9 +682,7 @@ int foe_transfer(master::Master& m, const FoeArgs& f, bool read) {
             return fail(e, "setting up the bootstrap mailbox");
         master::AlStatus final;
         if (Error e = m.request_state(*a, master::AlState::Boot, &final); e != Error::Ok) {
-            if (e == Error::AlRefused)
-                std::fprintf(stderr, "ecatctl: BOOT refused, AL status code 0x%04x (%s)\n", final.code,
-                             std::string(master::al_status_code_name(final.code)).c_str());
+            if (e == Error::AlRefused) g_refusal = final;
             return fail(e, "going to BOOT");
         }
         entered_boot = true;
@@ -728,11 +696,13 @@ int foe_transfer(master::Master& m, const FoeArgs& f, bool read) {
         if (!file) return foe_failed(foe, file.error(), "reading '" + name + "'");
         if (f.output.empty()) {
             std::fputs(hex_dump(0, *file).c_str(), stdout);
+        } else if (f.output == "-") {  // the file itself on standard output
+            std::fwrite(file->data(), 1, file->size(), stdout);
         } else {
             std::ofstream o(f.output, std::ios::binary | std::ios::trunc);
             o.write(reinterpret_cast<const char*>(file->data()), static_cast<std::streamsize>(file->size()));
             if (!o) {
-                std::cerr << "ecatctl: cannot write " << f.output << "\n";
+                std::cerr << "ecatctl: cannot write " << f.output << ": " << std::strerror(errno) << "\n";
                 return kExitFailure;
             }
             std::cerr << "ecatctl: " << file->size() << " bytes written to " << f.output << "\n";
@@ -742,7 +712,13 @@ int foe_transfer(master::Master& m, const FoeArgs& f, bool read) {
         foe.set_progress(bar.callback());
         const Error e = foe.write(name, data, static_cast<uint32_t>(*password));
         bar.finish();
-        if (e != Error::Ok)
+        if (e == Error::FoeError && foe.last_error() == 0x8001) {  // not found: say which names it takes
+            std::cerr << "ecatctl: "
+                      << foe_names_hint("writing '" + name + "': FoE error 0x8001 (" + foe.last_error_text() +
+                                        ")")
+                      << "\n";
+            rc = kExitProtocol;
+        } else if (e != Error::Ok)
             rc = foe_failed(foe, e, "writing '" + name + "'");
         else
             std::cerr << "ecatctl: " << data.size() << " bytes written to '" << name << "'\n";
@@ -833,6 +809,7 @@ int main(int argc, char** argv) {
                 return;
             }
             std::fputs(esi::decode_sii(*img).c_str(), stdout);
+            rc = sii_problems(s.input, *img) ? kExitUsage : kExitOk;  // an empty or corrupt file
             return;
         }
         rc = with_master(g, [&](master::Master& m) {
@@ -841,22 +818,13 @@ int main(int argc, char** argv) {
             auto img = m.sii_read_image(*a);
             if (!img) return fail(img.error(), "reading the SII of " + slave_text(*a));
             std::fputs(esi::decode_sii(*img).c_str(), stdout);
-            return kExitOk;
+            return sii_problems("the SII of " + slave_text(*a), *img) ? kExitProtocol : kExitOk;
         });
     });
 #endif
 
-    std::string st_slave, st_target;
-    bool st_station = false, st_identify = false;
-    auto* st = app.add_subcommand("state", "Show the AL state, or request one (with the error acknowledge)");
-    st->add_option("slave", st_slave, "Slave position (or station address with --station)")->required();
-    st->add_option("state", st_target, "INIT|PREOP|BOOT|SAFEOP|OP (omit to show the current state)");
-    st->add_flag("-s,--station", st_station, "<slave> is a station address");
-    st->add_flag("--identify", st_identify, "Device identification: AL control bit 5, value from 0x0134");
-    st->callback([&] {
-        rc = with_master(
-            g, [&](master::Master& m) { return state(m, st_slave, st_station, st_target, st_identify); });
-    });
+    add_state_command(
+        app, [&](const auto& fn) { return with_master(g, fn); }, rc);
 
     SdoArgs so;
     auto* up =
@@ -884,7 +852,9 @@ int main(int argc, char** argv) {
     PdArgs pa;
     auto* pdc = app.add_subcommand(
         "pd", "Bring a slave to OP and exchange process data cyclically (LRW), with optional DC");
-    pdc->add_option("slave", pa.slave, "Slave position")->capture_default_str();
+    pdc->add_option("slave", pa.slave, "Slave position (or station address with --station)")
+        ->capture_default_str();
+    pdc->add_flag("-s,--station", pa.station, "<slave> is a station address (scan assigns 0x1001..)");
     pdc->add_option("--cycle-us", pa.cycle_us, "Cycle time in microseconds")
         ->check(CLI::Range(50u, 1000000u))
         ->capture_default_str();
@@ -913,7 +883,7 @@ int main(int argc, char** argv) {
     auto* foe = app.add_subcommand("foe", "File access over EtherCAT")->require_subcommand(1);
     auto* foe_rd = foe->add_subcommand("read", "Read a file from the slave (hex dump, or -o FILE)");
     foe_rd->add_option("name", fa.name, "File name on the slave")->required();
-    foe_rd->add_option("-o,--output", fa.output, "Write the file here");
+    foe_rd->add_option("-o,--output", fa.output, "Write the file here ('-': standard output)");
     foe_rd->add_option("-p,--position", fa.slave, "Slave position (or station address with --station)")
         ->capture_default_str();
     foe_rd->add_flag("-s,--station", fa.station, "--position is a station address");
@@ -922,7 +892,8 @@ int main(int argc, char** argv) {
         [&] { rc = with_master(g, [&](master::Master& m) { return foe_transfer(m, fa, true); }); });
     auto* foe_wr = foe->add_subcommand("write", "Write a file (firmware) through BOOT, then back to INIT");
     foe_wr->add_option("file", fa.file, "Local file")->required()->check(CLI::ExistingFile);
-    foe_wr->add_option("-n,--name", fa.name, "File name on the slave (default: the local file's name)");
+    foe_wr->add_option("-n,--name", fa.name,
+                       "File name on the slave (default: the device name from its SII)");
     foe_wr->add_option("-p,--position", fa.slave, "Slave position (or station address with --station)")
         ->capture_default_str();
     foe_wr->add_flag("-s,--station", fa.station, "--position is a station address");
@@ -949,6 +920,14 @@ int main(int argc, char** argv) {
         app, [&](const auto& fn) { return with_master(g, fn); }, rc);
 #endif
 
+    // `-p N` names the slave in every verb, also in those that take it as their first argument.
+    std::vector<std::string> args = position_option_as_argument(argc, argv);
+    std::vector<char*> argp;
+    for (std::string& a : args)
+        argp.push_back(a.data());
+    argc = static_cast<int>(argp.size());
+    argp.push_back(nullptr);
+    argv = argp.data();
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -956,8 +935,7 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        app.exit(e);
-        return kExitUsage;
+        return report_usage_error(app, e, argc, argv);  // one line, exit 2
     }
     return rc;
 }
