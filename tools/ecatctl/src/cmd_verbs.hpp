@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cmd_diag.hpp"  // MasterRunner
+#include "common.hpp"    // slave_label
 #include "coe_view.hpp"
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
@@ -34,8 +35,6 @@ struct SlaveArg {
     // The address, or nullopt after printing a usage error.
     std::optional<master::Address> address() const;
 };
-
-std::string slave_label(master::Address a);
 
 // A slave in INIT gets its mailbox SMs from its SII and goes to PREOP; one in PREOP or above keeps its SMs.
 master::Error open_coe_mailbox(master::Master& m, master::Mailbox& mbx, master::Address a);

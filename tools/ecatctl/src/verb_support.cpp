@@ -25,12 +25,6 @@ std::optional<Address> SlaveArg::address() const {
                    : Address::position(static_cast<uint16_t>(*v));
 }
 
-std::string slave_label(Address a) {
-    char b[32];
-    std::snprintf(b, sizeof b, a.mode == Address::Mode::Station ? "station 0x%04x" : "slave %u", a.value);
-    return b;
-}
-
 Error open_coe_mailbox(master::Master& m, master::Mailbox& mbx, Address a) {
     auto st = m.al_status(a);
     if (!st) return st.error();
