@@ -18,6 +18,7 @@
 
 #include "ecat/mailbox_handler.hpp"
 #include "foe/errors.hpp"
+#include "foe/sink.hpp"
 #include "foe/store.hpp"
 #include "od/device.hpp"
 #include "od/types.hpp"
@@ -54,7 +55,7 @@ struct ServerStats {
 
 class FoeServer final : public ecat::MailboxHandler {
   public:
-    FoeServer(FirmwareStore& store, ServerConfig config = {});
+    FoeServer(FirmwareSink& store, ServerConfig config = {});
     ~FoeServer() override;
     FoeServer(const FoeServer&) = delete;
     FoeServer& operator=(const FoeServer&) = delete;
@@ -94,7 +95,7 @@ class FoeServer final : public ecat::MailboxHandler {
     std::size_t full_data_size(const ecat::MailboxSender& out) const;
     bool writable(std::string_view name) const;
 
-    FirmwareStore& store_;
+    FirmwareSink& store_;
     ServerConfig config_;
     od::AlState state_ = od::AlState::Init;
     Phase phase_ = Phase::Idle;
