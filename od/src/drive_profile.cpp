@@ -19,7 +19,7 @@ constexpr uint16_t RO = access::RO;
 constexpr uint16_t RW = access::RW;
 constexpr uint16_t RWP = access::RW_PreOp;  // "write access only in ESM Pre-Operational"
 constexpr uint16_t TX = access::TxPdo;
-constexpr uint16_t RX = access::RxPdo;
+[[maybe_unused]] constexpr uint16_t RX = access::RxPdo;  // no entry is RxPDO-only (clang: unused)
 constexpr uint16_t TRX = access::TxPdo | access::RxPdo;
 constexpr uint16_t BK = access::Backup;
 
