@@ -3,6 +3,7 @@
 // the FoE fuzz harness. Same checks as foe::FirmwareStore: the header as soon as it is complete (device,
 // size limit), no byte past the announced length, length and CRC at finish(); the commit takes a few
 // steps, then the image is active in the other slot.
+#include <algorithm>
 #include <array>
 #include <cstring>
 #include <optional>
@@ -43,8 +44,9 @@ class MemorySink final : public foe::FirmwareSink {
         const std::size_t before = buffer_.size();
         if (before < foe::kImageHeaderSize && before + data.size() >= foe::kImageHeaderSize) {
             std::array<uint8_t, foe::kImageHeaderSize> h{};
-            std::memcpy(h.data(), buffer_.data(), before);
-            std::memcpy(h.data() + before, data.data(), foe::kImageHeaderSize - before);
+            std::copy(buffer_.begin(), buffer_.end(), h.begin());
+            std::copy_n(data.begin(), foe::kImageHeaderSize - before,
+                        h.begin() + static_cast<std::ptrdiff_t>(before));
             header_ = foe::decode_header(h);
             if (const foe::ImageError e = foe::check_header(header_, identity_); e != foe::ImageError::Ok)
                 return fail(error, foe::foe_error(e), "bad header");
