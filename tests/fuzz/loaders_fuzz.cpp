@@ -78,7 +78,7 @@ void parameters(std::vector<uint8_t> b, bool repair) {
     }
     // Known finding 3 (issue 14): a record count larger than the bytes can hold is reserved before it is
     // checked (std::bad_alloc at every start). Fixed on branch store-robust; the input is in known/loaders/.
-    if (b.size() >= kHeader && get32(b, 24) > (b.size() - kHeader) / 8 + 1) return;
+    if (known::kGated && b.size() >= kHeader && get32(b, 24) > (b.size() - kHeader) / 8 + 1) return;
     write_file(state_dir() / "parameters.bin", b);
     // A rejected file changes nothing (all or nothing); an applied one sets stored values, which the next
     // input may overwrite again: the dictionary is built once.
