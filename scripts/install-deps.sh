@@ -4,8 +4,8 @@
 set -euo pipefail
 PKGS=(build-essential cmake ninja-build pkg-config
       libpcap-dev libeigen3-dev libgtest-dev libgmock-dev libcli11-dev libxml2-dev libxml2-utils
-      iproute2 tshark python3 python3-scapy gnuplot-nox clang-format)
-PKGS+=(clang)  # .ci/run: the whole tree built with clang++ (issue 14)
+      iproute2 tshark python3 python3-scapy gnuplot-nox clang-format
+      clang libclang-rt-14-dev)  # clang + libFuzzer/sanitizer runtimes: the fuzz build (tests/fuzz) and the clang -Werror build
 missing=()
 for p in "${PKGS[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,8 +1,5 @@
 #include "foe/server.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
@@ -71,7 +68,7 @@ ServerConfig ServerConfig::from(const od::DeviceDescription& d) {
     return c;
 }
 
-FoeServer::FoeServer(FirmwareStore& store, ServerConfig config) : store_(store), config_(std::move(config)) {
+FoeServer::FoeServer(FirmwareSink& store, ServerConfig config) : store_(store), config_(std::move(config)) {
     tx_.resize(2048);
 }
 
@@ -188,9 +185,10 @@ void FoeServer::start_read(uint32_t password, std::string_view name, ecat::Mailb
                    out);
         return;
     }
-    read_fd_ = ::open(image->path.c_str(), O_RDONLY | O_CLOEXEC);
+    read_fd_ = store_.open_image(*image);
     if (read_fd_ < 0) {
-        send_error(ErrorCode::FlashError, std::strerror(errno), out);
+        send_error(ErrorCode::FlashError, std::strerror(-read_fd_), out);
+        read_fd_ = -1;
         return;
     }
     const std::size_t chunk = out.max_payload() > kFoeHeader ? out.max_payload() - kFoeHeader : 0;
@@ -213,9 +211,8 @@ void FoeServer::send_data(ecat::MailboxSender& out) {
     const std::size_t n = static_cast<std::size_t>(std::min<uint64_t>(chunk, read_size_ - read_offset_));
     std::size_t got = 0;
     while (got < n) {
-        const ssize_t r =
-            ::pread(read_fd_, tx_.data() + kFoeHeader + got, n - got, static_cast<off_t>(read_offset_ + got));
-        if (r < 0 && errno == EINTR) continue;
+        const long r =
+            store_.read_image(read_fd_, read_offset_ + got, {tx_.data() + kFoeHeader + got, n - got});
         if (r <= 0) {
             cancel();
             send_error(ErrorCode::FlashError, "image file cannot be read", out);
@@ -314,12 +311,12 @@ void FoeServer::start_commit() {
     try {
         worker_ = std::thread([this] {
             StoreError e;
-            FirmwareStore::Progress p = FirmwareStore::Progress::Running;
-            while (p == FirmwareStore::Progress::Running && !worker_stop_.load())
+            FirmwareSink::Progress p = FirmwareSink::Progress::Running;
+            while (p == FirmwareSink::Progress::Running && !worker_stop_.load())
                 p = store_.commit_step(e);
-            if (p == FirmwareStore::Progress::Running) return;  // stopped: cancel() aborts after the join
+            if (p == FirmwareSink::Progress::Running) return;  // stopped: cancel() aborts after the join
             error_ = std::move(e);
-            worker_result_.store(p == FirmwareStore::Progress::Done ? 1 : 2);
+            worker_result_.store(p == FirmwareSink::Progress::Done ? 1 : 2);
         });
     } catch (const std::system_error&) {
         // No thread to be had: the commit runs one step per poll() instead.
@@ -353,11 +350,11 @@ void FoeServer::poll(uint64_t now_ns, ecat::MailboxSender& /*out*/) {
         activity_ns_ = now_ns;
         if (worker_.joinable()) return;
         const auto p = store_.commit_step(error_);
-        if (p == FirmwareStore::Progress::Done) {
+        if (p == FirmwareSink::Progress::Done) {
             result_ = Result::Done;
             ++stats_.writes_completed;
             report_write(0, {});
-        } else if (p == FirmwareStore::Progress::Failed) {
+        } else if (p == FirmwareSink::Progress::Failed) {
             result_ = Result::Failed;
             report_write(static_cast<uint32_t>(error_.code), error_.text);
         }
@@ -389,7 +386,7 @@ void FoeServer::cancel() {
     }
     if (phase_ == Phase::Writing || (phase_ == Phase::Storing && result_ == Result::Running)) store_.abort();
     if (read_fd_ >= 0) {
-        ::close(read_fd_);
+        store_.close_image(read_fd_);
         read_fd_ = -1;
     }
     phase_ = Phase::Idle;

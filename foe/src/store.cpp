@@ -437,4 +437,23 @@ uint16_t FirmwareStore::compute_progress() const {
     return 0;
 }
 
+// ---- reading a stored image back -------------------------------------------------------------------
+
+int FirmwareStore::open_image(const StoredImage& image) {
+    const int fd = ::open(image.path.c_str(), O_RDONLY | O_CLOEXEC);
+    return fd >= 0 ? fd : -errno;
+}
+
+long FirmwareStore::read_image(int handle, uint64_t offset, std::span<uint8_t> out) {
+    for (;;) {
+        const ssize_t r = ::pread(handle, out.data(), out.size(), static_cast<off_t>(offset));
+        if (r < 0 && errno == EINTR) continue;
+        return r < 0 ? -1 : static_cast<long>(r);
+    }
+}
+
+void FirmwareStore::close_image(int handle) {
+    if (handle >= 0) ::close(handle);
+}
+
 }  // namespace foe

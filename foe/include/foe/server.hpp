@@ -20,6 +20,7 @@
 #include "ecat/mailbox_handler.hpp"
 #include "foe/errors.hpp"
 #include "foe/faults.hpp"
+#include "foe/sink.hpp"
 #include "foe/store.hpp"
 #include "od/device.hpp"
 #include "od/types.hpp"
@@ -57,7 +58,7 @@ struct ServerStats {
 
 class FoeServer final : public ecat::MailboxHandler {
   public:
-    FoeServer(FirmwareStore& store, ServerConfig config = {});
+    FoeServer(FirmwareSink& store, ServerConfig config = {});
     ~FoeServer() override;
     FoeServer(const FoeServer&) = delete;
     FoeServer& operator=(const FoeServer&) = delete;
@@ -100,7 +101,7 @@ class FoeServer final : public ecat::MailboxHandler {
     bool writable(std::string_view name) const;
     void report_write(uint32_t code, std::string_view text);  // once per write, if one is open
 
-    FirmwareStore& store_;
+    FirmwareSink& store_;
     ServerConfig config_;
     od::AlState state_ = od::AlState::Init;
     Phase phase_ = Phase::Idle;

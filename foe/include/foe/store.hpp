@@ -17,6 +17,7 @@
 
 #include "foe/errors.hpp"
 #include "foe/image.hpp"
+#include "foe/sink.hpp"
 
 namespace foe {
 
@@ -43,58 +44,50 @@ struct StoreConfig {
     std::size_t read_back_chunk = 64u << 10;
 };
 
-// A failed operation: the FoE error code and a readable detail.
-struct StoreError {
-    ErrorCode code = ErrorCode::NotDefined;
-    std::string text;
-};
+// StoreError and StoredImage: foe/sink.hpp.
 
-struct StoredImage {
-    unsigned slot = 0;
-    ImageHeader header{};
-    std::string file_name;  // firmware file name of the image (seed naming rule)
-    std::filesystem::path path;
-    uint64_t size = 0;  // header + payload
-};
-
-class FirmwareStore {
+class FirmwareStore : public FirmwareSink {
   public:
     explicit FirmwareStore(StoreConfig config);
-    ~FirmwareStore();
+    ~FirmwareStore() override;
     FirmwareStore(const FirmwareStore&) = delete;
     FirmwareStore& operator=(const FirmwareStore&) = delete;
 
     // Creates the directory if needed, removes stale temp files, reads the pointer and verifies the slots.
     // The active image is the pointed slot if it verifies, else the other slot if that verifies, else none.
     bool open(StoreError* error = nullptr);
-    const std::optional<StoredImage>& active_image() const { return active_; }
+    const std::optional<StoredImage>& active_image() const override { return active_; }
     // A valid stored image in the given slot (0 or 1), verified at open() or after the last commit.
-    const std::optional<StoredImage>& image(unsigned slot) const { return slots_[slot & 1]; }
+    const std::optional<StoredImage>& image(unsigned slot) const override { return slots_[slot & 1]; }
     // The valid image whose file name is name (the active one first), if any.
     const StoredImage* find(std::string_view name) const;
     const StoreConfig& config() const { return config_; }
 
     // ---- writing a new image --------------------------------------------------------------------------
     // Starts a new image in the inactive slot (any unfinished one is dropped first).
-    bool begin_write(StoreError& error);
+    bool begin_write(StoreError& error) override;
     // Appends received bytes. The header is checked as soon as it is complete, so an image for another
     // device is refused at its first packet; too many bytes are refused at once.
-    bool append(std::span<const uint8_t> data, StoreError& error);
+    bool append(std::span<const uint8_t> data, StoreError& error) override;
     // All bytes received: checks length and CRC and prepares the commit.
-    bool finish(StoreError& error);
-    enum class Progress : uint8_t { Running, Done, Failed };
+    bool finish(StoreError& error) override;
     // One commit step (call repeatedly, e.g. from FoeServer::poll()). Done: the new image is active.
-    Progress commit_step(StoreError& error);
+    Progress commit_step(StoreError& error) override;
     // Runs the commit to its end.
     Progress commit_all(StoreError& error);
     // Drops an unfinished image; the active one is not touched.
-    void abort();
+    void abort() override;
     bool writing() const { return phase_ == Phase::Receiving; }
     bool committing() const { return phase_ == Phase::Committing; }
     uint64_t received() const { return received_; }
     // Commit progress for FoE BUSY (done of entire). Safe to read while another thread runs commit_step().
-    uint16_t progress_done() const { return progress_.load(std::memory_order_relaxed); }
-    uint16_t progress_entire() const { return 100; }
+    uint16_t progress_done() const override { return progress_.load(std::memory_order_relaxed); }
+    uint16_t progress_entire() const override { return 100; }
+
+    // Reading a stored image back: a read-only file descriptor of its slot file.
+    int open_image(const StoredImage& image) override;
+    long read_image(int handle, uint64_t offset, std::span<uint8_t> out) override;
+    void close_image(int handle) override;
 
     // Test hook: called just before each storage step.
     void set_step_hook(std::function<void(StoreStep)> hook) { hook_ = std::move(hook); }
