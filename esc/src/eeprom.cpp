@@ -62,10 +62,10 @@ void Esc::Impl::eeprom_execute(Side) {
             // bit 13, as for a write there (decisions/esc.md).
             for (uint16_t i = 0; i < 4; ++i)
                 w16(static_cast<uint16_t>(reg::kSiiData + 2 * i),
-                    static_cast<uint16_t>(eeprom_word(static_cast<uint64_t>(addr) + i) ^
-                                          (static_cast<uint64_t>(addr) + i == 7 && cfg.faults.sii_checksum_wrong
-                                               ? 0x00FF
-                                               : 0)));
+                    static_cast<uint16_t>(
+                        eeprom_word(static_cast<uint64_t>(addr) + i) ^
+                        (static_cast<uint64_t>(addr) + i == 7 && cfg.faults.sii_checksum_wrong ? 0x00FF
+                                                                                               : 0)));
             if (static_cast<uint64_t>(addr) * 2 + 1 >= eeprom.size()) err = 0x2000;
             break;
         case 2:  // write one word

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "cmd_diag.hpp"  // MasterRunner
-#include "common.hpp"    // slave_label
 #include "coe_view.hpp"
+#include "common.hpp"  // slave_label
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"

@@ -16,8 +16,8 @@
 
 #include "cmd_diag.hpp"
 #include "cmd_firmware.hpp"
-#include "cmd_verbs.hpp"
 #include "cmd_state.hpp"
+#include "cmd_verbs.hpp"
 #include "common.hpp"
 #include "esc/link.hpp"
 #include "format.hpp"

@@ -69,7 +69,7 @@ struct DeviceOptions {
     // One line per event (state changes, refused requests, FoE writes, restarts, 0x1010 saves, watchdog,
     // drive faults); null: events are not logged.
     softslave::Log* events = nullptr;
-    DeviceFaults faults;          // testing aid (ecat-slave --fault); none by default
+    DeviceFaults faults;  // testing aid (ecat-slave --fault); none by default
 };
 
 // Where the firmware slots live inside the state directory.
