@@ -10,9 +10,9 @@ Each README runs in its own network namespace, so `ecat-slave` creates its veth 
 README says, and `ecatctl` finds ecat1 as its default interface, without touching the host's interfaces.
 The only change made to a command: `ecat-slave` gets `--state-dir` in the test's directory (not the system's
 /var/lib/softecat); a later `ecat-slave` start stops the one before. Commands run in a temporary working
-directory (with the repository's folders linked into it), in README order, except that the commands
-that need no slave (fwimage, drive-sim, ecat-slave --write-*) run first (the image `foe write image.bin`
-sends is the one `fwimage build ... -o image.bin` makes); a file named FILE is there for `--payload FILE`.
+directory (with the repository's folders linked into it), in README order, except that fwimage and drive-sim
+run first (the image `foe write image.bin` sends is the one `fwimage build ... -o image.bin` makes); a file
+named FILE is there for `--payload FILE`.
 """
 import os
 import re
@@ -47,6 +47,8 @@ PROGRAMS = {
     "fwimage": "FWIMAGE",
     "build/tools/drive-sim/drive-sim": "DRIVE_SIM",
     "drive-sim": "DRIVE_SIM",
+    "build/tools/ecat-conform/ecat-conform": "ECAT_CONFORM",
+    "ecat-conform": "ECAT_CONFORM",
 }
 
 
@@ -171,8 +173,10 @@ class Readme(unittest.TestCase):
                         p.wait()
 
         self.addCleanup(stop_slave)
-        offline = [r for r in runs if not self.needs_slave(r[2])]
-        online = [r for r in runs if self.needs_slave(r[2])]
+        # fwimage and drive-sim first (they make the files later commands use); every other command, ecat-slave
+        # --write-esi included (its ESI is of the device as the state directory holds it then), in README order.
+        offline = [r for r in runs if os.path.basename(r[2][0]) in ("fwimage", "drive-sim")]
+        online = [r for r in runs if r not in offline]
         for line, cmd, argv, background in offline + online:
             where = f"{readme}:{line}: `{cmd}`"
             if os.path.basename(argv[0]) == "ecat-slave":
@@ -188,7 +192,9 @@ class Readme(unittest.TestCase):
             self.assertFalse(background, f"{where}: only ecat-slave is started in the background")
             r = subprocess.run(in_ns(argv), cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                errors="replace", timeout=240)
-            self.assertEqual(r.returncode, 0, f"{where} exited {r.returncode}:\n{r.stdout[-1500:]}\n{r.stderr[-1500:]}")
+            failed = "\n".join(ln for ln in r.stdout.splitlines() if "FAIL" in ln)  # a report's failures
+            self.assertEqual(r.returncode, 0,
+                             f"{where} exited {r.returncode}:\n{failed}\n{r.stdout[-1500:]}\n{r.stderr[-1500:]}")
             print(f"{where}: ok")
         stop_slave()
         for p in slave:
@@ -196,10 +202,14 @@ class Readme(unittest.TestCase):
 
     @staticmethod
     def starts_slave(argv):
+        if any(a == "--fault" and b == "list" for a, b in zip(argv[1:], argv[2:])):
+            return False  # prints the faults and exits
         return not any(a in ("--help", "-h", "--version") or a.startswith("--write-") for a in argv[1:])
 
     def needs_slave(self, argv):
         name = os.path.basename(argv[0])
+        if name == "ecat-conform":
+            return not any(a in ("--list", "--help", "-h") for a in argv[1:])
         return name == "ecatctl" or (name == "ecat-slave" and self.starts_slave(argv))
 
     def wait_for_slave(self, in_ns, proc, where):
