@@ -78,9 +78,10 @@ std::vector<Event> find_events(const std::vector<Sample>& s) {
             ev.push_back({t, Event::Kind::Fault, "homing error"});
         if (rose(a.statusword, b.statusword, 0x0008)) {
             const drive::ErrorInfo* info = drive::find_error(b.error_code);
-            ev.push_back(
-                {t, Event::Kind::Fault,
-                 "fault " + hex4(b.error_code) + (info != nullptr ? " " + std::string(info->name) : "")});
+            std::string text = "fault ";
+            text.append(hex4(b.error_code));
+            if (info != nullptr) text.append(" ").append(info->name);
+            ev.push_back({t, Event::Kind::Fault, text});
         }
         if (fell(a.statusword, b.statusword, 0x0008)) ev.push_back({t, Event::Kind::Reset, "fault reset"});
         if (rose(a.statusword, b.statusword, 0x0080)) ev.push_back({t, Event::Kind::Warning, "warning"});

@@ -462,9 +462,14 @@ void Device::diag(drive::Severity severity, uint16_t code, std::string_view text
     const softslave::LogLevel level = severity == drive::Severity::Error     ? softslave::LogLevel::Error
                                       : severity == drive::Severity::Warning ? softslave::LogLevel::Warn
                                                                              : softslave::LogLevel::Debug;
-    if (options_.events != nullptr && options_.events->enabled(level))
-        event(level, std::string("drive") + (code != 0 ? " " + hex16(code) : std::string()) + ": " +
-                         std::string(text));
+    if (options_.events != nullptr && options_.events->enabled(level)) {
+        // Appended piece by piece: GCC 12's -O3 reports a false -Werror=restrict on "literal" +
+        // std::string&&.
+        std::string line = "drive";
+        if (code != 0) line.append(" ").append(hex16(code));
+        line.append(": ").append(text);
+        event(level, line);
+    }
     ++stats_.diagnoses;
     parts_->events->diag(severity == drive::Severity::Error     ? coe::DiagType::Error
                          : severity == drive::Severity::Warning ? coe::DiagType::Warning

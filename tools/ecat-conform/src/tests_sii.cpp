@@ -48,8 +48,12 @@ std::string esi_pdo_text(const std::vector<EsiPdo>& pdos) {
     for (const auto& p : pdos) {
         s += hex(p.index) + "[";
         for (std::size_t i = 0; i < p.entries.size(); ++i)
-            s += (i ? " " : "") + hex(p.entries[i].index) + ":" + dec(p.entries[i].subindex) + "/" +
-                 dec(p.entries[i].bit_len);
+            s.append(i ? " " : "")
+                .append(hex(p.entries[i].index))
+                .append(":")
+                .append(dec(p.entries[i].subindex))
+                .append("/")
+                .append(dec(p.entries[i].bit_len));
         s += "] ";
     }
     return s;
@@ -59,7 +63,7 @@ std::string sii_pdo_text(const std::vector<SiiPdo>& pdos) {
     for (const auto& p : pdos) {
         s += hex(p.index) + "[";
         for (std::size_t i = 0; i < p.entries.size(); ++i)
-            s += (i ? " " : "") + p.entries[i];
+            s.append(i ? " " : "").append(p.entries[i]);
         s += "] ";
     }
     return s;
