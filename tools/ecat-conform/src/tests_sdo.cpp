@@ -508,7 +508,8 @@ void add_sdo_tests(Catalogue& c) {
             std::string("identity.") + name,
             std::string("0x1018:0") + dec(sub) + " (" + name + ") equals the SII",
             "ETG.1000.6 identity object 0x1018; SII words 0x08-0x0F",
-            [sub, word](Context& ctx) { return identity(ctx, sub, word); }, "CoE");
+            [s = sub, w = word](Context& ctx) { return identity(ctx, s, w); },
+            "CoE");  // clang 14: no binding capture
     }
     add(
         "device_type_vs_esi", "0x1000 device type equals the ESI's default", kOd,
