@@ -355,17 +355,36 @@ void add_esm_tests(Catalogue& c) {
             if (!ctx.esi->identification_reg134)
                 return skip("the ESI does not announce IdentificationReg134");
             (void)ctx.to_init();
-            (void)ctx.wr<uint16_t>(master::reg::AlControl, 0x0021);
+            // AL control is a handshake register on an ESC without device emulation: a write that comes
+            // before the application read the previous one (the 0x0001 of to_init) is not taken (ESC
+            // datasheet, AL control 0x0120). So the request is repeated every 50 ms until the bit shows, as
+            // a master does; a write lost on a loaded host is retried the same way.
             bool loaded = false;
-            for (int i = 0; i < 500 && !loaded; ++i) {
+            std::optional<uint16_t> last;
+            master::Error werr = master::Error::Timeout;
+            const auto deadline = std::chrono::steady_clock::now() + ctx.ms(1000);
+            auto next_write = std::chrono::steady_clock::now();
+            while (!loaded && std::chrono::steady_clock::now() < deadline) {
+                if (std::chrono::steady_clock::now() >= next_write) {
+                    if (ctx.wr<uint16_t>(master::reg::AlControl, 0x0021) == master::Error::Ok)
+                        werr = master::Error::Ok;
+                    next_write = std::chrono::steady_clock::now() + std::chrono::milliseconds(50);
+                }
                 auto s = ctx.rd<uint16_t>(master::reg::AlStatus);
+                if (s) last = *s;
                 loaded = s && (*s & 0x20);
                 if (!loaded) std::this_thread::sleep_for(std::chrono::milliseconds(1));
             }
-            std::this_thread::sleep_for(std::chrono::milliseconds(2));  // 0x0134 is written with the bit
+            // The slave writes 0x0134 before it sets the bit, so 0x0134 is valid once the bit is seen.
             auto id = ctx.rd<uint16_t>(0x0134);
             (void)ctx.wr<uint16_t>(master::reg::AlControl, 0x0001);
-            if (!loaded) return fail("AL status bit 5 (identification loaded) never set", "", "bit 5 set");
+            if (werr != master::Error::Ok)
+                return fail("AL control 0x0021 was not written: " + std::string(master::to_string(werr)), "",
+                            "written");
+            if (!loaded)
+                return fail("AL status bit 5 (identification loaded) not set within " +
+                                dec(static_cast<long long>(ctx.ms(1000).count())) + " ms",
+                            last ? "AL status " + hex(*last) : "no AL status read", "bit 5 set");
             auto alias = ctx.rd<uint16_t>(0x0012);
             return expect_eq("0x0134", id ? hex(*id) : "?", alias ? hex(*alias) : "?");
         },
