@@ -4,12 +4,12 @@
 
 #include <array>
 
-#include "alloc_counter.hpp"
 #include "coe/diagnosis.hpp"
 #include "coe/events.hpp"
 #include "coe/pdo_validation.hpp"
 #include "coe/sdo_server.hpp"
 #include "coe_test_support.hpp"
+#include "support/alloc_counter.hpp"
 
 // The replacement pairs malloc with free on purpose; GCC cannot see that once gtest's new/delete are inlined.
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"

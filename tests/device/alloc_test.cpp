@@ -10,7 +10,6 @@
 #include <filesystem>
 #include <memory>
 
-#include "alloc_counter.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
 #include "master/coe.hpp"
@@ -18,6 +17,7 @@
 #include "master/master.hpp"
 #include "master/session.hpp"
 #include "softdrive/device.hpp"
+#include "support/alloc_counter.hpp"
 
 namespace {
 

@@ -28,7 +28,7 @@
 #include "softdrive/firmware.hpp"
 #include "softslave/log.hpp"
 
-#include "../support/wire_link.hpp"
+#include "support/wire_link.hpp"
 
 using namespace master;
 
@@ -135,10 +135,11 @@ uint32_t u32(const uint8_t* b) {
     return static_cast<uint32_t>(b[0] | (b[1] << 8) | (b[2] << 16) | (static_cast<uint32_t>(b[3]) << 24));
 }
 
-class DeviceTest : public ::testing::Test {
+class DeviceAssembly : public ::testing::Test {
   protected:
-    DeviceTest() : dir(temp_dir()), drive(dir), link(drive), m(link, master_options()), mbx(m, a), sdo(mbx) {}
-    ~DeviceTest() override {
+    DeviceAssembly()
+        : dir(temp_dir()), drive(dir), link(drive), m(link, master_options()), mbx(m, a), sdo(mbx) {}
+    ~DeviceAssembly() override {
         std::error_code ec;
         std::filesystem::remove_all(dir, ec);
     }
@@ -213,7 +214,7 @@ class DeviceTest : public ::testing::Test {
 
 }  // namespace
 
-TEST_F(DeviceTest, IdentityInTheSiiEqualsObject1018AndTheEsi) {
+TEST_F(DeviceAssembly, IdentityInTheSiiEqualsObject1018AndTheEsi) {
     const od::Identity& id = drive.dev->description().identity;
     EXPECT_EQ(id.vendor_id, 0x000000FBu);
     EXPECT_EQ(m.sii_read_u32(a, sii::VendorId).value(), sdo_u32(0x1018, 1));
@@ -249,7 +250,7 @@ TEST_F(DeviceTest, IdentityInTheSiiEqualsObject1018AndTheEsi) {
     EXPECT_EQ(std::string(name.begin(), name.begin() + static_cast<long>(*n)), id.device_name);
 }
 
-TEST_F(DeviceTest, ReachesOpWithTheDefaultMappingAndTheDriveMovesInCsp) {
+TEST_F(DeviceAssembly, ReachesOpWithTheDefaultMappingAndTheDriveMovesInCsp) {
     ProcessDataSession pd(m, a, sdo);
     ASSERT_NO_FATAL_FAILURE(to_op(pd));
     EXPECT_EQ(pd.layout().rx_pdos, (std::vector<uint16_t>{0x1600}));
@@ -276,7 +277,7 @@ TEST_F(DeviceTest, ReachesOpWithTheDefaultMappingAndTheDriveMovesInCsp) {
     EXPECT_GE(drive.dev->stats().cycles, 700u);
 }
 
-TEST_F(DeviceTest, WatchdogFallsBackToSafeOpAndTheDriveReactsWith6007) {
+TEST_F(DeviceAssembly, WatchdogFallsBackToSafeOpAndTheDriveReactsWith6007) {
     ProcessDataSession pd(m, a, sdo);
     ASSERT_NO_FATAL_FAILURE(to_op(pd));
     drive.frame_ns = 1'000'000;
@@ -300,7 +301,7 @@ TEST_F(DeviceTest, WatchdogFallsBackToSafeOpAndTheDriveReactsWith6007) {
     EXPECT_GT(drive.dev->stats().emergencies, emergencies_before);
 }
 
-TEST_F(DeviceTest, AProvokedFaultSendsAnEmergencyAndIsInTheDiagnosisHistory) {
+TEST_F(DeviceAssembly, AProvokedFaultSendsAnEmergencyAndIsInTheDiagnosisHistory) {
     ProcessDataSession pd(m, a, sdo);
     ASSERT_NO_FATAL_FAILURE(to_op(pd));
     drive.frame_ns = 1'000'000;
@@ -355,7 +356,7 @@ TEST_F(DeviceTest, AProvokedFaultSendsAnEmergencyAndIsInTheDiagnosisHistory) {
     EXPECT_TRUE(in_history);
 }
 
-TEST_F(DeviceTest, StoredParametersSurviveAPowerCycle) {
+TEST_F(DeviceAssembly, StoredParametersSurviveAPowerCycle) {
     // 0x6065 following error window: a backup parameter.
     const uint8_t v[4] = {0x34, 0x12, 0, 0};
     ASSERT_EQ(sdo.download(0x6065, 0, v), Error::Ok) << std::hex << sdo.last_abort();
@@ -372,7 +373,7 @@ TEST_F(DeviceTest, StoredParametersSurviveAPowerCycle) {
     EXPECT_EQ(sdo_u32(0x6065, 0), 0x1234u);
 }
 
-TEST_F(DeviceTest, ABadParameterFileIsReportedAndTheDefaultsRun) {
+TEST_F(DeviceAssembly, ABadParameterFileIsReportedAndTheDefaultsRun) {
     const uint32_t def = drive.dict().get<uint32_t>(0x6065, 0);
     {
         std::ofstream f(dir / "parameters.bin", std::ios::binary | std::ios::trunc);
@@ -385,7 +386,7 @@ TEST_F(DeviceTest, ABadParameterFileIsReportedAndTheDefaultsRun) {
     ASSERT_NO_FATAL_FAILURE(to_preop());
 }
 
-TEST_F(DeviceTest, BootstrapRestartRebuildsFromTheNewFirmwareImage) {
+TEST_F(DeviceAssembly, BootstrapRestartRebuildsFromTheNewFirmwareImage) {
     const od::Identity id = drive.dev->description().identity;
     const uint32_t version = 0x01300002;
     // A new image lands in the store (as an FoE download in Bootstrap would leave it).
@@ -417,7 +418,7 @@ TEST_F(DeviceTest, BootstrapRestartRebuildsFromTheNewFirmwareImage) {
               foe::software_version_text(version));
 }
 
-TEST_F(DeviceTest, DriveRunsOnItsOwnOutsideOp) {
+TEST_F(DeviceAssembly, DriveRunsOnItsOwnOutsideOp) {
     // In Pre-Op, without any process data, the drive's loop still runs (statusword valid, time passes).
     const uint64_t cycles = drive.dev->stats().cycles;
     drive.idle(100'000'000);
@@ -454,7 +455,7 @@ TEST(DeviceEnvironment, InputsAndSwitchesReachTheDriveAndSurviveARestart) {
     std::filesystem::remove_all(dir);
 }
 
-TEST_F(DeviceTest, EepromWordsAMasterWritesSurviveARestartAndAPowerCycle) {
+TEST_F(DeviceAssembly, EepromWordsAMasterWritesSurviveARestartAndAPowerCycle) {
     // Station alias 0x0042 in word 4, and the checksum of words 0-6 in word 7 (as a master tool writes them).
     std::array<uint8_t, 14> header{};
     for (uint16_t w = 0; w < 7; ++w) {
@@ -496,7 +497,7 @@ TEST_F(DeviceTest, EepromWordsAMasterWritesSurviveARestartAndAPowerCycle) {
     EXPECT_NE(drive.log.str().find("not used"), std::string::npos) << drive.log.str();
 }
 
-TEST_F(DeviceTest, ARestartThatCannotBuildKeepsTheRunningFirmware) {
+TEST_F(DeviceAssembly, ARestartThatCannotBuildKeepsTheRunningFirmware) {
     AlStatus st;
     ASSERT_EQ(m.request_state(a, AlState::Init, &st), Error::Ok);
     Mailbox boot(m, a);
@@ -514,7 +515,7 @@ TEST_F(DeviceTest, ARestartThatCannotBuildKeepsTheRunningFirmware) {
     std::filesystem::create_directories(dir);
 }
 
-TEST_F(DeviceTest, DcSync0OpRunsTheDriveOnEverySync0) {
+TEST_F(DeviceAssembly, DcSync0OpRunsTheDriveOnEverySync0) {
     ProcessDataSession pd(m, a, sdo);
     ASSERT_EQ(pd.discover(), Error::Ok);
     DcConfig dc;
@@ -544,7 +545,7 @@ TEST_F(DeviceTest, DcSync0OpRunsTheDriveOnEverySync0) {
     EXPECT_EQ(drive.dict().get<uint16_t>(0x1C32, 1), 2) << "0x1C32:01 says DC SYNC0";
 }
 
-TEST_F(DeviceTest, LeavingOpOnRequestReactsOnlyWhileTheDriveIsEnabled) {
+TEST_F(DeviceAssembly, LeavingOpOnRequestReactsOnlyWhileTheDriveIsEnabled) {
     ProcessDataSession pd(m, a, sdo);
     ASSERT_NO_FATAL_FAILURE(to_op(pd));
     drive.frame_ns = 1'000'000;
@@ -571,7 +572,7 @@ TEST_F(DeviceTest, LeavingOpOnRequestReactsOnlyWhileTheDriveIsEnabled) {
 
 // ---- What the device tells (softdrive::DeviceOptions::events) -------------------------------------------
 
-TEST_F(DeviceTest, StateChangesRefusalsSavesFaultsAndRestartsAreLoggedAndStatisticsSpanRestarts) {
+TEST_F(DeviceAssembly, StateChangesRefusalsSavesFaultsAndRestartsAreLoggedAndStatisticsSpanRestarts) {
     std::ostringstream lines;
     softslave::Log log(lines, softslave::LogLevel::Info);
     drive.options.events = &log;
@@ -616,7 +617,7 @@ TEST_F(DeviceTest, StateChangesRefusalsSavesFaultsAndRestartsAreLoggedAndStatist
     EXPECT_EQ(lines.str().size(), size) << lines.str();
 }
 
-TEST_F(DeviceTest, MasterWrittenSiiWordsAreAnnouncedWithTheWayBack) {
+TEST_F(DeviceAssembly, MasterWrittenSiiWordsAreAnnouncedWithTheWayBack) {
     softdrive::EepromWrites writes(dir);
     writes.record(4, 0x0042);  // station alias
     writes.record(8, 0x0002);  // vendor id, low word

@@ -19,7 +19,7 @@
 #include "softdrive/device.hpp"
 #include "softdrive/faults.hpp"
 
-#include "../support/wire_link.hpp"
+#include "support/wire_link.hpp"
 
 using namespace softdrive;
 

@@ -3,10 +3,10 @@
 
 #include <random>
 
-#include "alloc_counter.hpp"
 #include "drive/drive.hpp"
 #include "od/drive_profile.hpp"
 #include "rig.hpp"
+#include "support/alloc_counter.hpp"
 
 using namespace drive;
 using namespace drive::test;

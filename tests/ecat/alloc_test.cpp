@@ -1,8 +1,8 @@
 // Hot paths allocate nothing: the process-data cycle and a mailbox request/reply, counted with the counting
 // global operator new (tests/support/alloc_counter.hpp) while only Stack::poll() runs.
 
-#include "alloc_counter.hpp"
 #include "fixture.hpp"
+#include "support/alloc_counter.hpp"
 
 namespace ecat::test {
 namespace {

@@ -40,7 +40,7 @@ class EchoHandler : public MailboxHandler {
     std::vector<uint8_t> last;
 };
 
-class MailboxTest : public StackTest {
+class MailboxOverStack : public StackTest {
   protected:
     void SetUp() override {
         StackTest::SetUp();
@@ -65,7 +65,7 @@ class MailboxTest : public StackTest {
     const std::vector<uint8_t> sdo{0x00, 0x20, 0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0};
 };
 
-TEST_F(MailboxTest, Dispatch_ReplyInSm1) {
+TEST_F(MailboxOverStack, Dispatch_ReplyInSm1) {
     go_preop();
     const auto reply = roundtrip(mbx_message(0x3, 1, sdo));
     ASSERT_EQ(reply.size(), 128u);  // the whole SM1 is read
@@ -78,25 +78,25 @@ TEST_F(MailboxTest, Dispatch_ReplyInSm1) {
     EXPECT_EQ(reply[6 + sdo.size()], 0xEE);
 }
 
-TEST_F(MailboxTest, Sm1EmptyWithoutReply_Wkc0) {
+TEST_F(MailboxOverStack, Sm1EmptyWithoutReply_Wkc0) {
     go_preop();
     EXPECT_TRUE(mbx_read().empty());
 }
 
-TEST_F(MailboxTest, AddressEchoedInReply) {
+TEST_F(MailboxOverStack, AddressEchoedInReply) {
     go_preop();
     const auto reply = roundtrip(mbx_message(0x3, 1, sdo, 0x1001));
     ASSERT_FALSE(reply.empty());
     EXPECT_EQ(reply[2] | (reply[3] << 8), 0x1001);
 }
 
-TEST_F(MailboxTest, Error_InvalidHeader_TypeZero) {
+TEST_F(MailboxOverStack, Error_InvalidHeader_TypeZero) {
     go_preop();
     expect_error(roundtrip(mbx_message(0x0, 1, sdo)), MailboxError::InvalidHeader);
     EXPECT_EQ(coe.handled, 0);
 }
 
-TEST_F(MailboxTest, Error_InvalidSize_LengthBeyondSm0) {
+TEST_F(MailboxOverStack, Error_InvalidSize_LengthBeyondSm0) {
     go_preop();
     auto m = mbx_message(0x3, 1, sdo);
     m[0] = 123;  // 6 + 123 > 128
@@ -104,35 +104,35 @@ TEST_F(MailboxTest, Error_InvalidSize_LengthBeyondSm0) {
     EXPECT_EQ(coe.handled, 0);
 }
 
-TEST_F(MailboxTest, Error_SizeTooShort_LengthZero) {
+TEST_F(MailboxOverStack, Error_SizeTooShort_LengthZero) {
     go_preop();
     expect_error(roundtrip(mbx_message(0x3, 1, {})), MailboxError::SizeTooShort);
 }
 
-TEST_F(MailboxTest, Error_SizeTooShort_BelowCoeHeader) {
+TEST_F(MailboxOverStack, Error_SizeTooShort_BelowCoeHeader) {
     go_preop();
     const std::vector<uint8_t> one{0x00};
     expect_error(roundtrip(mbx_message(0x3, 1, one)), MailboxError::SizeTooShort);
 }
 
-TEST_F(MailboxTest, Error_InvalidChannel) {
+TEST_F(MailboxOverStack, Error_InvalidChannel) {
     go_preop();
     expect_error(roundtrip(mbx_message(0x3, 1, sdo, 0, 5)), MailboxError::InvalidChannel);
 }
 
-TEST_F(MailboxTest, Error_UnsupportedProtocol) {
+TEST_F(MailboxOverStack, Error_UnsupportedProtocol) {
     go_preop();
     expect_error(roundtrip(mbx_message(0x5, 1, sdo)), MailboxError::UnsupportedProtocol);  // SoE
 }
 
-TEST_F(MailboxTest, Error_ProtocolNotAvailableInState) {
+TEST_F(MailboxOverStack, Error_ProtocolNotAvailableInState) {
     go_preop();
     const std::vector<uint8_t> foe_req{0x01, 0, 0, 0, 0, 0, 'x'};
     expect_error(roundtrip(mbx_message(0x4, 1, foe_req)), MailboxError::UnsupportedProtocol);
     EXPECT_EQ(foe.handled, 0);
 }
 
-TEST_F(MailboxTest, Bootstrap_ServesFoeOnly) {
+TEST_F(MailboxOverStack, Bootstrap_ServesFoeOnly) {
     configure_bootstrap_mailbox();
     request(0x03);
     ASSERT_EQ(al_status(), 0x03);
@@ -145,7 +145,7 @@ TEST_F(MailboxTest, Bootstrap_ServesFoeOnly) {
     EXPECT_EQ(foe.handled, 1);
 }
 
-TEST_F(MailboxTest, Counter_RepeatedRequestNotExecutedTwice) {
+TEST_F(MailboxOverStack, Counter_RepeatedRequestNotExecutedTwice) {
     go_preop();
     ASSERT_FALSE(roundtrip(mbx_message(0x3, 3, sdo)).empty());
     EXPECT_TRUE(roundtrip(mbx_message(0x3, 3, sdo)).empty());
@@ -155,14 +155,14 @@ TEST_F(MailboxTest, Counter_RepeatedRequestNotExecutedTwice) {
     EXPECT_EQ(coe.handled, 2);
 }
 
-TEST_F(MailboxTest, Counter_ZeroAlwaysExecuted) {
+TEST_F(MailboxOverStack, Counter_ZeroAlwaysExecuted) {
     go_preop();
     roundtrip(mbx_message(0x3, 0, sdo));
     roundtrip(mbx_message(0x3, 0, sdo));
     EXPECT_EQ(coe.handled, 2);
 }
 
-TEST_F(MailboxTest, Counter_SlaveCounterWraps1To7NeverZero) {
+TEST_F(MailboxOverStack, Counter_SlaveCounterWraps1To7NeverZero) {
     go_preop();
     std::vector<int> counters;
     for (int i = 0; i < 9; ++i) {
@@ -173,7 +173,7 @@ TEST_F(MailboxTest, Counter_SlaveCounterWraps1To7NeverZero) {
     EXPECT_THAT(counters, ::testing::ElementsAre(1, 2, 3, 4, 5, 6, 7, 1, 2));
 }
 
-TEST_F(MailboxTest, Counter_ResetWhenMailboxRestarts) {
+TEST_F(MailboxOverStack, Counter_ResetWhenMailboxRestarts) {
     go_preop();
     roundtrip(mbx_message(0x3, 1, sdo));
     request(0x01);
@@ -193,7 +193,7 @@ void esc_reset(Master& m) {
         m.wr<uint8_t>(0x0040, c);
 }
 
-TEST_F(MailboxTest, EscResetRestartsTheStack) {
+TEST_F(MailboxOverStack, EscResetRestartsTheStack) {
     go_preop();
     ASSERT_FALSE(roundtrip(mbx_message(0x3, 1, sdo)).empty());
     esc_reset(master);
@@ -219,7 +219,7 @@ TEST_F(MailboxTest, EscResetRestartsTheStack) {
     EXPECT_EQ(app.restarts, 1);
 }
 
-TEST_F(MailboxTest, EscResetInSafeOpStopsProcessDataAndMailbox) {
+TEST_F(MailboxOverStack, EscResetInSafeOpStopsProcessDataAndMailbox) {
     go_safeop();
     esc_reset(master);
     advance(20'000'000);  // no master activity: the next timer-driven poll notices
@@ -231,7 +231,7 @@ TEST_F(MailboxTest, EscResetInSafeOpStopsProcessDataAndMailbox) {
     EXPECT_EQ(app.changes.back(), std::make_pair(AlState::SafeOp, AlState::Init));
 }
 
-TEST_F(MailboxTest, EscResetWhileTheMasterAlreadyAsksForPreOp) {
+TEST_F(MailboxOverStack, EscResetWhileTheMasterAlreadyAsksForPreOp) {
     go_preop();
     ASSERT_FALSE(roundtrip(mbx_message(0x3, 1, sdo)).empty());
     esc_reset(master);
@@ -250,7 +250,7 @@ void repeat_request(Master& m, bool& toggle) {
     m.wr<uint8_t>(0x080E, static_cast<uint8_t>(0x01 | (toggle ? 0x02 : 0)));
 }
 
-TEST_F(MailboxTest, Repeat_ResendsLostReply) {
+TEST_F(MailboxOverStack, Repeat_ResendsLostReply) {
     go_preop();
     const auto first = roundtrip(mbx_message(0x3, 1, sdo));  // "lost" on its way back
     ASSERT_FALSE(first.empty());
@@ -268,7 +268,7 @@ TEST_F(MailboxTest, Repeat_ResendsLostReply) {
     EXPECT_EQ(mbx_read(), first);
 }
 
-TEST_F(MailboxTest, Repeat_WithNewerMessagePending) {
+TEST_F(MailboxOverStack, Repeat_WithNewerMessagePending) {
     go_preop();
     coe.replies = 2;  // two replies: B waits in SM1 after A was read
     mbx_write(mbx_message(0x3, 1, sdo));
@@ -289,7 +289,7 @@ TEST_F(MailboxTest, Repeat_WithNewerMessagePending) {
     EXPECT_TRUE(mbx_read().empty());
 }
 
-TEST_F(MailboxTest, Queue_HoldsRepliesUntilRead) {
+TEST_F(MailboxOverStack, Queue_HoldsRepliesUntilRead) {
     go_preop();
     coe.replies = 3;
     mbx_write(mbx_message(0x3, 1, sdo));
@@ -306,7 +306,7 @@ TEST_F(MailboxTest, Queue_HoldsRepliesUntilRead) {
     EXPECT_EQ(stack->mailbox().queued(), 0u);
 }
 
-TEST_F(MailboxTest, Queue_FullRefusesWithoutBlocking) {
+TEST_F(MailboxOverStack, Queue_FullRefusesWithoutBlocking) {
     go_preop();
     coe.replies = static_cast<int>(Mailbox::kQueueCapacity) + 3;
     mbx_write(mbx_message(0x3, 1, sdo));
@@ -324,7 +324,7 @@ TEST_F(MailboxTest, Queue_FullRefusesWithoutBlocking) {
     EXPECT_EQ(coe.handled, 2);
 }
 
-TEST_F(MailboxTest, Send_TooLargeRefused) {
+TEST_F(MailboxOverStack, Send_TooLargeRefused) {
     go_preop();
     std::vector<uint8_t> big(123, 0);
     EXPECT_FALSE(stack->mailbox().send(MailboxType::CoE, big));
@@ -333,7 +333,7 @@ TEST_F(MailboxTest, Send_TooLargeRefused) {
     EXPECT_EQ(stack->mailbox().max_payload(), 122u);
 }
 
-TEST_F(MailboxTest, Send_SpontaneousMessageHasAddressZero) {
+TEST_F(MailboxOverStack, Send_SpontaneousMessageHasAddressZero) {
     go_preop();
     roundtrip(mbx_message(0x3, 1, sdo, 0x1001));  // a request with an address, answered and read
     const std::vector<uint8_t> emergency{0x00, 0x10, 0x10, 0x82, 0x11, 0, 0, 0, 0, 0};
@@ -346,12 +346,12 @@ TEST_F(MailboxTest, Send_SpontaneousMessageHasAddressZero) {
     EXPECT_EQ((m[5] >> 4) & 7, 2);
 }
 
-TEST_F(MailboxTest, Send_RefusedInInit) {
+TEST_F(MailboxOverStack, Send_RefusedInInit) {
     std::vector<uint8_t> small(4, 0);
     EXPECT_FALSE(stack->mailbox().send(MailboxType::CoE, small));
 }
 
-TEST_F(MailboxTest, Handlers_PolledAndToldStateChanges) {
+TEST_F(MailboxOverStack, Handlers_PolledAndToldStateChanges) {
     go_preop();
     const int before = coe.polls;
     advance(Stack::kHousekeepingNs);
@@ -361,7 +361,7 @@ TEST_F(MailboxTest, Handlers_PolledAndToldStateChanges) {
     EXPECT_LE(stack->next_deadline_ns(), clock.now_ns() + Stack::kHousekeepingNs);
 }
 
-TEST_F(MailboxTest, Sm0ReadToLastByte_MasterCanWriteAgain) {
+TEST_F(MailboxOverStack, Sm0ReadToLastByte_MasterCanWriteAgain) {
     go_preop();
     mbx_write(mbx_message(0x3, 1, sdo));
     poll();
@@ -372,7 +372,7 @@ TEST_F(MailboxTest, Sm0ReadToLastByte_MasterCanWriteAgain) {
     EXPECT_EQ(coe.handled, 2);
 }
 
-TEST_F(MailboxTest, SafeOpAndOp_MailboxKeepsRunning) {
+TEST_F(MailboxOverStack, SafeOpAndOp_MailboxKeepsRunning) {
     go_op();
     const auto reply = roundtrip(mbx_message(0x3, 1, sdo));
     EXPECT_FALSE(reply.empty());
@@ -385,7 +385,7 @@ TEST_F(MailboxTest, SafeOpAndOp_MailboxKeepsRunning) {
 namespace ecat::test {
 namespace {
 
-TEST_F(MailboxTest, NoPdiEventBits_MailboxStillServedAtOnce) {
+TEST_F(MailboxOverStack, NoPdiEventBits_MailboxStillServedAtOnce) {
     configure_sm(0, 0x1000, 128, 0x06, true);  // no PDI event: the interrupt line will not tell us
     configure_sm(1, 0x1080, 128, 0x02, true);
     request(0x02);

@@ -9,7 +9,7 @@ using namespace esc_test;
 
 namespace {
 
-struct EscTest : ::testing::Test {
+struct EscBasics : ::testing::Test {
     esc::ManualClock clk;
     std::optional<esc::Esc> e;
     void SetUp() override {
@@ -50,7 +50,7 @@ std::vector<uint8_t> make_image(uint16_t w0, uint16_t w1, uint16_t w2, uint16_t 
 
 // ------------------------------------------------------------------------------------------------ AL
 
-TEST_F(EscTest, AlControlRaisesEventClearedByPdiRead) {
+TEST_F(EscBasics, AlControlRaisesEventClearedByPdiRead) {
     EXPECT_FALSE(e->irq());
     EXPECT_EQ(fpwr(*e, 0x0120, {0x02, 0x00}).wkc, 1);
     EXPECT_TRUE(e->irq());
@@ -61,7 +61,7 @@ TEST_F(EscTest, AlControlRaisesEventClearedByPdiRead) {
     EXPECT_EQ(fprd(*e, 0x0220, 4).u32() & 1, 0u);
 }
 
-TEST_F(EscTest, AlControlIsAMailboxUntilPdiRead) {
+TEST_F(EscBasics, AlControlIsAMailboxUntilPdiRead) {
     fpwr(*e, 0x0120, {0x02, 0x00});
     EXPECT_EQ(fpwr(*e, 0x0120, {0x04, 0x00}).wkc, 1);  // accepted on the wire, value not taken
     EXPECT_EQ(fprd(*e, 0x0120, 2).u16(), 0x0002);
@@ -70,7 +70,7 @@ TEST_F(EscTest, AlControlIsAMailboxUntilPdiRead) {
     EXPECT_EQ(e->read_reg<uint16_t>(0x0120), 0x0004);
 }
 
-TEST_F(EscTest, AlStatusWrittenByPdiOnly) {
+TEST_F(EscBasics, AlStatusWrittenByPdiOnly) {
     e->write_reg<uint16_t>(0x0130, 0x0012);
     e->write_reg<uint16_t>(0x0134, 0x0011);
     Datagram d = fprd(*e, 0x0130, 6);
@@ -80,7 +80,7 @@ TEST_F(EscTest, AlStatusWrittenByPdiOnly) {
     EXPECT_EQ(fprd(*e, 0x0134, 2).u16(), 0x0011);
 }
 
-TEST_F(EscTest, AlStatusEventForMasterClearedByEcatRead) {
+TEST_F(EscBasics, AlStatusEventForMasterClearedByEcatRead) {
     fpwr(*e, 0x0200, {0x08, 0x00});
     e->write_reg<uint16_t>(0x0130, 0x0002);
     EXPECT_EQ(fprd(*e, 0x0210, 2).u16() & 0x08, 0x08);
@@ -88,7 +88,7 @@ TEST_F(EscTest, AlStatusEventForMasterClearedByEcatRead) {
     EXPECT_EQ(fprd(*e, 0x0210, 2).u16() & 0x08, 0x00);
 }
 
-TEST_F(EscTest, DeviceEmulationMirrorsAlControl) {
+TEST_F(EscBasics, DeviceEmulationMirrorsAlControl) {
     e->load_eeprom(make_image(0x0105, 0, 0, 0, 0));  // 0x0141 bit 0
     fpwr(*e, 0x0120, {0x02, 0x00});
     EXPECT_EQ(fprd(*e, 0x0130, 2).u16(), 0x0002);
@@ -98,7 +98,7 @@ TEST_F(EscTest, DeviceEmulationMirrorsAlControl) {
     EXPECT_EQ(fprd(*e, 0x0130, 2).u16(), 0x0004);
 }
 
-TEST_F(EscTest, IrqFollowsAlEventMask) {
+TEST_F(EscBasics, IrqFollowsAlEventMask) {
     fpwr(*e, 0x0120, {0x02, 0x00});
     EXPECT_TRUE(e->irq());
     e->write_reg<uint32_t>(0x0204, 0x00000000);
@@ -110,7 +110,7 @@ TEST_F(EscTest, IrqFollowsAlEventMask) {
 
 // ------------------------------------------------------------------------------------------------ SII
 
-TEST_F(EscTest, BareEscHasValidBuiltInImage) {
+TEST_F(EscBasics, BareEscHasValidBuiltInImage) {
     Datagram d = fprd(*e, 0x0502, 2);
     EXPECT_EQ(d.u16() & 0x1800, 0);       // no checksum error, loaded
     EXPECT_EQ(d.u16() & 0x0060, 0x0060);  // emulated EEPROM, 8-byte reads
@@ -122,7 +122,7 @@ TEST_F(EscTest, BareEscHasValidBuiltInImage) {
     EXPECT_EQ(fprd(*e, 0x0141, 1).data[0] & 0x0C, 0x0C);
 }
 
-TEST_F(EscTest, SoemStyleRead) {
+TEST_F(EscBasics, SoemStyleRead) {
     e->load_eeprom(make_image(0x0C08, 0xCC00, 0x03E8, 0, 0x0007));
     // Clear errors, then one 6-byte write: control 0x0100 + 32-bit word address 8.
     fpwr(*e, 0x0502, {0x00, 0x00});
@@ -136,7 +136,7 @@ TEST_F(EscTest, SoemStyleRead) {
     EXPECT_EQ(d.u16(4), 0x5678);
 }
 
-TEST_F(EscTest, IghStyleReadWithReadOnlyBits) {
+TEST_F(EscBasics, IghStyleReadWithReadOnlyBits) {
     e->load_eeprom(make_image(0x0C08, 0xCC00, 0x03E8, 0, 0x0007));
     EXPECT_EQ(fpwr(*e, 0x0502, {0x80, 0x01, 0x04, 0x00}).wkc, 1);  // 0x0180, word address 4
     Datagram d = fprd(*e, 0x0502, 10);
@@ -145,14 +145,14 @@ TEST_F(EscTest, IghStyleReadWithReadOnlyBits) {
     EXPECT_EQ(d.u16(6), 0x0007);      // word 4: alias
 }
 
-TEST_F(EscTest, BusyUntilEndOfFrame) {
+TEST_F(EscBasics, BusyUntilEndOfFrame) {
     auto r = run(*e, {dg(FPWR, 0x1001, 0x0502, {0x00, 0x01, 0x00, 0x00, 0x00, 0x00}),
                       dg_len(FPRD, 0x1001, 0x0502, 2)});
     EXPECT_EQ(r[1].u16() & 0x8000, 0x8000);
     EXPECT_EQ(fprd(*e, 0x0502, 2).u16() & 0x8000, 0);
 }
 
-TEST_F(EscTest, ReadBeyondImageGivesFfff) {
+TEST_F(EscBasics, ReadBeyondImageGivesFfff) {
     e->load_eeprom(make_image(0x0C08, 0, 0, 0, 0));  // 256 bytes = 128 words
     fpwr(*e, 0x0502, {0x00, 0x01, 0x7E, 0x00, 0x00, 0x00});
     Datagram d = fprd(*e, 0x0508, 8);
@@ -165,7 +165,7 @@ TEST_F(EscTest, ReadBeyondImageGivesFfff) {
 
 // Issue 14, finding 5: a read at word 0xFFFFFFFE returned words 0 and 1 in its last two words (the word
 // address wrapped). Past the end every word reads 0xFFFF and the missing acknowledge sets bit 13.
-TEST_F(EscTest, ReadAtTheTopWordAddressDoesNotWrap) {
+TEST_F(EscBasics, ReadAtTheTopWordAddressDoesNotWrap) {
     fpwr(*e, 0x0502, {0x00, 0x01, 0xFE, 0xFF, 0xFF, 0xFF});
     const uint16_t st = fprd(*e, 0x0502, 2).u16();
     EXPECT_EQ(st & 0x8000, 0);       // done
@@ -191,7 +191,7 @@ TEST_F(EscTest, ReadAtTheTopWordAddressDoesNotWrap) {
     EXPECT_EQ(e->read_reg<uint64_t>(0x0508), 0xFFFFFFFFFFFFFFFFull);
 }
 
-TEST_F(EscTest, IghStyleWriteWithEnable) {
+TEST_F(EscBasics, IghStyleWriteWithEnable) {
     std::vector<std::pair<uint16_t, uint16_t>> seen;
     e->on_eeprom_write([&](uint16_t a, uint16_t v) { seen.emplace_back(a, v); });
     EXPECT_EQ(fpwr(*e, 0x0502, {0x81, 0x02, 0x10, 0x00, 0x00, 0x00, 0xEF, 0xBE}).wkc, 1);
@@ -204,7 +204,7 @@ TEST_F(EscTest, IghStyleWriteWithEnable) {
     EXPECT_EQ(e->eeprom()[0x21], 0xBE);
 }
 
-TEST_F(EscTest, WriteWithoutEnableIsAnError) {
+TEST_F(EscBasics, WriteWithoutEnableIsAnError) {
     bool called = false;
     e->on_eeprom_write([&](uint16_t, uint16_t) { called = true; });
     fpwr(*e, 0x0508, {0x11, 0x22});                          // SOEM: data first
@@ -220,7 +220,7 @@ TEST_F(EscTest, WriteWithoutEnableIsAnError) {
     EXPECT_EQ(fprd(*e, 0x0502, 2).u16() & 0x0001, 0);  // write enable consumed
 }
 
-TEST_F(EscTest, PdiOwnedInterfaceAndForcedEcatAccess) {
+TEST_F(EscBasics, PdiOwnedInterfaceAndForcedEcatAccess) {
     fpwr(*e, 0x0500, {0x01});             // offer the interface to the PDI
     e->write_reg<uint8_t>(0x0501, 0x01);  // the PDI takes it
     fpwr(*e, 0x0502, {0x00, 0x01, 0x08, 0x00, 0x00, 0x00});
@@ -235,12 +235,12 @@ TEST_F(EscTest, PdiOwnedInterfaceAndForcedEcatAccess) {
     EXPECT_EQ(fprd(*e, 0x0508, 2).u16(), 0x000F);
 }
 
-TEST_F(EscTest, InvalidCommandSetsError) {
+TEST_F(EscBasics, InvalidCommandSetsError) {
     fpwr(*e, 0x0502, {0x00, 0x07});
     EXPECT_EQ(fprd(*e, 0x0502, 2).u16() & 0x2000, 0x2000);
 }
 
-TEST_F(EscTest, ReloadAppliesWordsButNotAlias) {
+TEST_F(EscBasics, ReloadAppliesWordsButNotAlias) {
     e->load_eeprom(make_image(0x0C08, 0x0000, 0x03E8, 0, 0x0007));
     EXPECT_EQ(e->read_reg<uint16_t>(0x0012), 0x0007);
     EXPECT_EQ(fprd(*e, 0x0150, 2).u16(), 0x0000);
@@ -265,14 +265,14 @@ TEST_F(EscTest, ReloadAppliesWordsButNotAlias) {
     EXPECT_EQ(fprd(*e, 0x0502, 2).u16() & 0xA000, 0);
 }
 
-TEST_F(EscTest, ReloadDetectsChecksumError) {
+TEST_F(EscBasics, ReloadDetectsChecksumError) {
     fpwr(*e, 0x0502, {0x01, 0x02, 0x01, 0x00, 0x00, 0x00, 0x55, 0x55});  // word 1 changed, CRC not
     fpwr(*e, 0x0502, {0x00, 0x04});
     EXPECT_EQ(fprd(*e, 0x0502, 2).u16() & 0x0800, 0x0800);
     EXPECT_EQ(fprd(*e, 0x0110, 2).u16() & 0x0001, 0);
 }
 
-TEST_F(EscTest, PowerOnLoadAndCrc) {
+TEST_F(EscBasics, PowerOnLoadAndCrc) {
     e->load_eeprom(make_image(0x0C05, 0x8800, 0x0064, 0x1234, 0x0BAD));
     EXPECT_EQ(fprd(*e, 0x0140, 2).u16(), 0x0C05);
     EXPECT_EQ(fprd(*e, 0x0150, 2).u16(), 0x8800);

@@ -36,7 +36,7 @@ std::vector<uint8_t> fmmu_bytes(const FmmuCfg& c) {
     return b;
 }
 
-struct FmmuTest : ::testing::Test {
+struct FmmuMapping : ::testing::Test {
     esc::ManualClock clk;
     std::optional<esc::Esc> e;
     void SetUp() override {
@@ -59,7 +59,7 @@ struct FmmuTest : ::testing::Test {
     }
 };
 
-TEST_F(FmmuTest, B1ExampleWriteBits) {
+TEST_F(FmmuMapping, B1ExampleWriteBits) {
     // 14 bits from logical 0x00010011.3 to 0x00010013.0 -> physical 0x0F01.1 .. 0x0F02.6.
     fmmu(0, {0x00010011, 3, 3, 0, 0x0F01, 1, 0x02});
     Datagram d = run1(*e, lg(LWR, 0x00010010, {0xFF, 0xFF, 0xFF, 0xFF, 0xFF}));
@@ -67,7 +67,7 @@ TEST_F(FmmuTest, B1ExampleWriteBits) {
     EXPECT_EQ(e->read_reg<uint32_t>(0x0F00), 0x007FFE00u);
 }
 
-TEST_F(FmmuTest, B1ExampleReadBits) {
+TEST_F(FmmuMapping, B1ExampleReadBits) {
     fmmu(0, {0x00010011, 3, 3, 0, 0x0F01, 1, 0x01});
     fpwr(*e, 0x0F00, {0xFF, 0xFF, 0xFF, 0xFF});
     Datagram d = run1(*e, lg(LRD, 0x00010010, {0x00, 0x00, 0x00, 0x00, 0x00}));
@@ -78,7 +78,7 @@ TEST_F(FmmuTest, B1ExampleReadBits) {
     EXPECT_EQ(d.data, (std::vector<uint8_t>{0xAA, 0xFD, 0xFF, 0xF1, 0x55}));
 }
 
-TEST_F(FmmuTest, ShiftedBitMappingMatchesReference) {
+TEST_F(FmmuMapping, ShiftedBitMappingMatchesReference) {
     // Random data through a mapping with a bit shift of 5: compare with a bit-by-bit model.
     const FmmuCfg c{0x00000100, 6, 2, 4, 0x1003, 7, 0x02};
     fmmu(0, c);
@@ -118,7 +118,7 @@ struct WkcCase {
     uint16_t wkc;
 };
 
-class FmmuWkc : public FmmuTest, public ::testing::WithParamInterface<WkcCase> {};
+class FmmuWkc : public FmmuMapping, public ::testing::WithParamInterface<WkcCase> {};
 
 TEST_P(FmmuWkc, PerDirection) {
     fmmu(0, {0x10000, 4, 0, 7, 0x1000, 0, 0x02});  // outputs (write)
@@ -137,7 +137,7 @@ INSTANTIATE_TEST_SUITE_P(Fmmu, FmmuWkc,
                                            WkcCase{LWR, 0x10008, 4, 1},  // two write FMMUs: counted once
                                            WkcCase{LRW, 0x20000, 8, 0}, WkcCase{LRW, 0x0FFFC, 5, 2}));
 
-TEST_F(FmmuTest, LrwReadsBeforeWriting) {
+TEST_F(FmmuMapping, LrwReadsBeforeWriting) {
     // One FMMU of type read+write: the frame returns the old memory, memory takes the frame data.
     fmmu(0, {0x0, 2, 0, 7, 0x1000, 0, 0x03});
     e->write_reg<uint16_t>(0x1000, 0x1234);
@@ -147,14 +147,14 @@ TEST_F(FmmuTest, LrwReadsBeforeWriting) {
     EXPECT_EQ(e->read_reg<uint16_t>(0x1000), 0xABCD);
 }
 
-TEST_F(FmmuTest, InactiveFmmuIgnored) {
+TEST_F(FmmuMapping, InactiveFmmuIgnored) {
     auto b = fmmu_bytes({0x0, 2, 0, 7, 0x1000, 0, 0x03});
     b[12] = 0;  // not activated
     fpwr(*e, 0x0600, b);
     EXPECT_EQ(run1(*e, lg(LRW, 0x0, {1, 2})).wkc, 0);
 }
 
-TEST_F(FmmuTest, MapsSm1StatusRegisterForMailboxPolling) {
+TEST_F(FmmuMapping, MapsSm1StatusRegisterForMailboxPolling) {
     smcfg(1, 0x1080, 8, 0x22);  // mailbox, ECAT reads
     fmmu(2, {0x00090000, 1, 0, 7, 0x080D, 0, 0x01});
     Datagram d = run1(*e, lg(LRD, 0x00090000, {0x00}));
@@ -166,7 +166,7 @@ TEST_F(FmmuTest, MapsSm1StatusRegisterForMailboxPolling) {
     EXPECT_EQ(d.data[0] & 0x08, 0x08);
 }
 
-TEST_F(FmmuTest, ProcessDataThroughBufferedSyncManagers) {
+TEST_F(FmmuMapping, ProcessDataThroughBufferedSyncManagers) {
     smcfg(2, 0x1100, 4, 0x64);  // outputs, ECAT writes, watchdog
     smcfg(3, 0x1180, 4, 0x20);  // inputs, ECAT reads
     fmmu(0, {0x0, 4, 0, 7, 0x1100, 0, 0x02});
@@ -184,7 +184,7 @@ TEST_F(FmmuTest, ProcessDataThroughBufferedSyncManagers) {
     EXPECT_EQ(d.wkc, 1);
 }
 
-TEST_F(FmmuTest, MailboxThroughFmmuObeysSmRules) {
+TEST_F(FmmuMapping, MailboxThroughFmmuObeysSmRules) {
     smcfg(0, 0x1000, 4, 0x26);  // mailbox, ECAT writes
     fmmu(0, {0x100, 4, 0, 7, 0x1000, 0, 0x02});
     EXPECT_EQ(run1(*e, lg(LWR, 0x100, {1, 2, 3, 4})).wkc, 1);
@@ -196,7 +196,7 @@ TEST_F(FmmuTest, MailboxThroughFmmuObeysSmRules) {
 
 // Issue 14, finding 1 (FMMU side): an FMMU whose physical area runs over the registers and far past the RAM
 // maps what exists and captures nothing: physical accesses, its own registers included, are unchanged.
-TEST_F(FmmuTest, FmmuBeyondTheRamCapturesNoPhysicalAddress) {
+TEST_F(FmmuMapping, FmmuBeyondTheRamCapturesNoPhysicalAddress) {
     fmmu(0, {0x00010000, 0x8000, 0, 7, 0x0100, 0, 0x03});
     EXPECT_EQ(fprd(*e, 0x0100, 4).u32(), 0x0007C001u);
     EXPECT_EQ(fprd(*e, 0x0600, 16).wkc, 1);

@@ -9,7 +9,7 @@ using namespace esc_test;
 
 namespace {
 
-struct FrameTest : ::testing::Test {
+struct FrameHandling : ::testing::Test {
     esc::ManualClock clk;
     std::optional<esc::Esc> e;
     void SetUp() override {
@@ -19,7 +19,7 @@ struct FrameTest : ::testing::Test {
     }
 };
 
-TEST_F(FrameTest, SourceMacBitSetAndLengthKept) {
+TEST_F(FrameHandling, SourceMacBitSetAndLengthKept) {
     auto f = build({dg_len(APRD, 0, 0x0130, 2)});
     ASSERT_EQ(f.size(), 60u);
     auto before = f;
@@ -36,7 +36,7 @@ TEST_F(FrameTest, SourceMacBitSetAndLengthKept) {
     EXPECT_EQ(parse(f)[0].data, (std::vector<uint8_t>{0x01, 0x00}));
 }
 
-TEST_F(FrameTest, NotEtherCatIsDropped) {
+TEST_F(FrameHandling, NotEtherCatIsDropped) {
     auto f = build({dg_len(APRD, 0, 0x0130, 2)});
     f[12] = 0x08;
     f[13] = 0x00;
@@ -48,7 +48,7 @@ TEST_F(FrameTest, NotEtherCatIsDropped) {
     EXPECT_EQ(e->stats().frames_ignored, 2u);
 }
 
-TEST_F(FrameTest, VlanTaggedFrame) {
+TEST_F(FrameHandling, VlanTaggedFrame) {
     auto f = build({dg_len(FPRD, 0x1001, 0x0010, 2)});
     const uint8_t tag[4] = {0x81, 0x00, 0x20, 0x05};
     f.insert(f.begin() + 12, tag, tag + 4);
@@ -62,7 +62,7 @@ TEST_F(FrameTest, VlanTaggedFrame) {
     EXPECT_EQ(f[20 + 12], 1);  // WKC
 }
 
-TEST_F(FrameTest, OtherEtherCatTypeForwardedUnprocessed) {
+TEST_F(FrameHandling, OtherEtherCatTypeForwardedUnprocessed) {
     auto f = build({dg_len(FPRD, 0x1001, 0x0010, 2)});
     f[15] = static_cast<uint8_t>((f[15] & 0x0F) | 0x50);  // type 5 (mailbox gateway)
     auto before = f;
@@ -71,7 +71,7 @@ TEST_F(FrameTest, OtherEtherCatTypeForwardedUnprocessed) {
     EXPECT_EQ(f, before);
 }
 
-TEST_F(FrameTest, RuntFrameOf29Bytes) {
+TEST_F(FrameHandling, RuntFrameOf29Bytes) {
     auto f = build({dg_len(FPRD, 0x1001, 0x0010, 1)}, 0);
     ASSERT_EQ(f.size(), 29u);
     EXPECT_TRUE(e->process_frame(f));
@@ -82,7 +82,7 @@ TEST_F(FrameTest, RuntFrameOf29Bytes) {
     EXPECT_EQ(d[0].wkc, 1);
 }
 
-TEST_F(FrameTest, MultipleDatagramsSeeEarlierEffects) {
+TEST_F(FrameHandling, MultipleDatagramsSeeEarlierEffects) {
     auto r = run(*e, {dg(FPWR, 0x1001, 0x1000, {0xDE, 0xAD}), dg_len(FPRD, 0x1001, 0x1000, 2),
                       dg_len(APRD, 0, 0x0010, 2), dg_len(BRD, 0, 0x0000, 1)});
     ASSERT_EQ(r.size(), 4u);
@@ -95,7 +95,7 @@ TEST_F(FrameTest, MultipleDatagramsSeeEarlierEffects) {
     EXPECT_EQ(e->stats().datagrams, 1u + 4u);  // set_station + 4
 }
 
-TEST_F(FrameTest, TruncatedDatagramStopsProcessing) {
+TEST_F(FrameHandling, TruncatedDatagramStopsProcessing) {
     auto f = build({dg(FPWR, 0x1001, 0x1000, {0x11}), dg(FPWR, 0x1001, 0x1001, {0x22, 0x33, 0x44})}, 0);
     // Cut the frame inside the second datagram and shorten the header length to match the frame.
     f.resize(f.size() - 3);
@@ -110,7 +110,7 @@ TEST_F(FrameTest, TruncatedDatagramStopsProcessing) {
     EXPECT_EQ(e->read_reg<uint8_t>(0x030C), 1);
 }
 
-TEST_F(FrameTest, HeaderLengthTooBig) {
+TEST_F(FrameHandling, HeaderLengthTooBig) {
     auto f = build({dg(FPWR, 0x1001, 0x1000, {0x11})});
     f[14] = 0xF0;
     f[15] = 0x17;  // 0x7F0 bytes: beyond the 60-byte frame
@@ -121,7 +121,7 @@ TEST_F(FrameTest, HeaderLengthTooBig) {
     EXPECT_EQ(e->stats().frames_malformed, 1u);
 }
 
-TEST_F(FrameTest, HeaderLengthTooSmall) {
+TEST_F(FrameHandling, HeaderLengthTooSmall) {
     auto f = build({dg(FPWR, 0x1001, 0x1000, {0x11, 0x22, 0x33, 0x44})});
     f[14] = 12;  // covers the datagram header but not its data
     EXPECT_TRUE(e->process_frame(f));
@@ -131,7 +131,7 @@ TEST_F(FrameTest, HeaderLengthTooSmall) {
     EXPECT_EQ(d[16 + 10 + 4], 0);
 }
 
-TEST_F(FrameTest, MoreBitPastHeaderLength) {
+TEST_F(FrameHandling, MoreBitPastHeaderLength) {
     auto f = build({dg(FPWR, 0x1001, 0x1000, {0x11})});
     f[16 + 7] |= 0x80;  // claims a next datagram but the header length ends here
     EXPECT_TRUE(e->process_frame(f));
@@ -139,7 +139,7 @@ TEST_F(FrameTest, MoreBitPastHeaderLength) {
     EXPECT_EQ(e->stats().frames_malformed, 1u);
 }
 
-TEST_F(FrameTest, TooShortForEtherCatHeader) {
+TEST_F(FrameHandling, TooShortForEtherCatHeader) {
     std::vector<uint8_t> f(15, 0);
     f[12] = 0x88;
     f[13] = 0xA4;
@@ -147,7 +147,7 @@ TEST_F(FrameTest, TooShortForEtherCatHeader) {
     EXPECT_EQ(e->stats().frames_malformed, 1u);
 }
 
-TEST_F(FrameTest, BrdOrsAcrossTwoSlaves) {
+TEST_F(FrameHandling, BrdOrsAcrossTwoSlaves) {
     esc::Esc second({}, clk);
     second.write_reg<uint16_t>(0x1000, 0x00F0);
     e->write_reg<uint16_t>(0x1000, 0x0F01);
@@ -163,7 +163,7 @@ TEST_F(FrameTest, BrdOrsAcrossTwoSlaves) {
     EXPECT_EQ(d[1].adp, 1);
 }
 
-TEST_F(FrameTest, IrqFieldOrsMaskedEcatEvents) {
+TEST_F(FrameHandling, IrqFieldOrsMaskedEcatEvents) {
     // ECAT event request after reset: bit 2 (DL status) is set; mask it in.
     fpwr(*e, 0x0200, {0x0C, 0x00});
     e->write_reg<uint16_t>(0x0130, 0x0002);  // PDI writes AL status -> ECAT event bit 3
@@ -182,7 +182,7 @@ TEST_F(FrameTest, IrqFieldOrsMaskedEcatEvents) {
     EXPECT_EQ(run1(*e, in).irq, 0x8000);
 }
 
-TEST_F(FrameTest, IndexAndCirculatingBitUntouched) {
+TEST_F(FrameHandling, IndexAndCirculatingBitUntouched) {
     Datagram in = dg_len(FPRD, 0x1001, 0x0010, 2);
     in.idx = 0x5A;
     auto f = build({in});

@@ -21,7 +21,7 @@ std::vector<uint8_t> sm_bytes(uint16_t start, uint16_t len, uint8_t ctrl, uint8_
     return b;
 }
 
-struct SmTest : ::testing::Test {
+struct SyncManagerRules : ::testing::Test {
     esc::ManualClock clk;
     std::optional<esc::Esc> e;
     void SetUp() override {
@@ -48,7 +48,7 @@ struct SmTest : ::testing::Test {
 const std::vector<uint8_t> kMsgA{1, 2, 3, 4, 5, 6, 7, 8};
 const std::vector<uint8_t> kMsgB{9, 9, 9, 9, 9, 9, 9, 9};
 
-TEST_F(SmTest, ConfigurationAndActivateInOneWriteIsTaken) {
+TEST_F(SyncManagerRules, ConfigurationAndActivateInOneWriteIsTaken) {
     Datagram d = fprd(*e, 0x0800, 8);
     EXPECT_EQ(d.u16(0), 0x1000);
     EXPECT_EQ(d.u16(2), 8);
@@ -56,7 +56,7 @@ TEST_F(SmTest, ConfigurationAndActivateInOneWriteIsTaken) {
     EXPECT_EQ(d.data[6], 0x01);
 }
 
-TEST_F(SmTest, ConfigLockedWhileEnabled) {
+TEST_F(SyncManagerRules, ConfigLockedWhileEnabled) {
     fpwr(*e, 0x0800, sm_bytes(0x1400, 16, 0x22, 1));
     Datagram d = fprd(*e, 0x0800, 8);
     EXPECT_EQ(d.u16(0), 0x1000);
@@ -74,7 +74,7 @@ TEST_F(SmTest, ConfigLockedWhileEnabled) {
     EXPECT_EQ(d.u16(2), 16);
 }
 
-TEST_F(SmTest, ActivateWriteRaisesAlEventClearedByPdiRead) {
+TEST_F(SyncManagerRules, ActivateWriteRaisesAlEventClearedByPdiRead) {
     EXPECT_EQ(al_event() & 0x10, 0u);
     fpwr(*e, 0x080E, {0x01});
     EXPECT_EQ(al_event() & 0x10, 0x10u);
@@ -82,7 +82,7 @@ TEST_F(SmTest, ActivateWriteRaisesAlEventClearedByPdiRead) {
     EXPECT_EQ(al_event() & 0x10, 0u);
 }
 
-TEST_F(SmTest, MailboxWriteFullThenBlocked) {
+TEST_F(SyncManagerRules, MailboxWriteFullThenBlocked) {
     EXPECT_EQ(fpwr(*e, 0x1000, kMsgA).wkc, 1);
     EXPECT_EQ(status(0) & 0x09, 0x09);          // full + interrupt write
     EXPECT_EQ(al_event() & 0x100, 0x100u);      // SM0 event to the PDI (control bit 5)
@@ -95,7 +95,7 @@ TEST_F(SmTest, MailboxWriteFullThenBlocked) {
     EXPECT_EQ(pdi_read(0x1000, 8), kMsgB);
 }
 
-TEST_F(SmTest, MailboxMustOpenAtStart) {
+TEST_F(SyncManagerRules, MailboxMustOpenAtStart) {
     EXPECT_EQ(fpwr(*e, 0x1002, {1, 2, 3, 4, 5, 6}).wkc, 0);
     EXPECT_EQ(fpwr(*e, 0x1000, {1, 2, 3, 4}).wkc, 1);  // opened, not complete
     EXPECT_EQ(status(0) & 0x08, 0);
@@ -105,7 +105,7 @@ TEST_F(SmTest, MailboxMustOpenAtStart) {
     EXPECT_EQ(pdi_read(0x1000, 8), kMsgA);
 }
 
-TEST_F(SmTest, MailboxCommitAtEndOfFrame) {
+TEST_F(SyncManagerRules, MailboxCommitAtEndOfFrame) {
     auto r = run(*e, {dg(FPWR, 0x1001, 0x1000, kMsgA), dg_len(FPRD, 0x1001, 0x0805, 1),
                       dg(FPWR, 0x1001, 0x1000, kMsgB)});
     EXPECT_EQ(r[0].wkc, 1);
@@ -115,7 +115,7 @@ TEST_F(SmTest, MailboxCommitAtEndOfFrame) {
     EXPECT_EQ(pdi_read(0x1000, 8), kMsgA);
 }
 
-TEST_F(SmTest, MailboxWriteInMalformedFrameIsDiscarded) {
+TEST_F(SyncManagerRules, MailboxWriteInMalformedFrameIsDiscarded) {
     auto f = build({dg(FPWR, 0x1001, 0x1000, kMsgA), dg_len(FPRD, 0x1001, 0x0000, 2)}, 0);
     f.resize(f.size() - 2);  // second datagram truncated
     const uint16_t elen = static_cast<uint16_t>(f.size() - 16);
@@ -126,7 +126,7 @@ TEST_F(SmTest, MailboxWriteInMalformedFrameIsDiscarded) {
     EXPECT_EQ(fpwr(*e, 0x1000, kMsgB).wkc, 1);  // still writable
 }
 
-TEST_F(SmTest, MailboxReadEmptyThenFull) {
+TEST_F(SyncManagerRules, MailboxReadEmptyThenFull) {
     EXPECT_EQ(fprd(*e, 0x1080, 8).wkc, 0);
     e->write(0x1080, kMsgA);
     EXPECT_EQ(status(1) & 0x09, 0x09);
@@ -141,13 +141,13 @@ TEST_F(SmTest, MailboxReadEmptyThenFull) {
     EXPECT_EQ(fprd(*e, 0x1080, 8).data, kMsgB);
 }
 
-TEST_F(SmTest, PdiCannotWriteFullMailbox) {
+TEST_F(SyncManagerRules, PdiCannotWriteFullMailbox) {
     e->write(0x1080, kMsgA);
     e->write(0x1080, kMsgB);
     EXPECT_EQ(fprd(*e, 0x1080, 8).data, kMsgA);
 }
 
-TEST_F(SmTest, RepeatRequestAndAcknowledge) {
+TEST_F(SyncManagerRules, RepeatRequestAndAcknowledge) {
     e->write(0x1080, kMsgA);
     EXPECT_EQ(fprd(*e, 0x1080, 8).wkc, 1);  // reply "lost"
     fpwr(*e, 0x080E, {0x03});               // toggle repeat request
@@ -163,7 +163,7 @@ TEST_F(SmTest, RepeatRequestAndAcknowledge) {
     EXPECT_EQ(fprd(*e, 0x080E, 1).data[0] & 0x01, 0x01);
 }
 
-TEST_F(SmTest, PdiDeactivationProtectsArea) {
+TEST_F(SyncManagerRules, PdiDeactivationProtectsArea) {
     e->write(0x1080, kMsgA);
     e->write_reg<uint8_t>(0x080F, 0x01);
     EXPECT_EQ(fprd(*e, 0x080F, 1).data[0] & 0x01, 0x01);
@@ -175,7 +175,7 @@ TEST_F(SmTest, PdiDeactivationProtectsArea) {
     EXPECT_EQ(fprd(*e, 0x1080, 8).data, kMsgB);
 }
 
-TEST_F(SmTest, DisablingByEcatResetsState) {
+TEST_F(SyncManagerRules, DisablingByEcatResetsState) {
     EXPECT_EQ(fpwr(*e, 0x1000, kMsgA).wkc, 1);
     fpwr(*e, 0x0806, {0x00});
     EXPECT_EQ(status(0) & 0x08, 0);
@@ -186,7 +186,7 @@ TEST_F(SmTest, DisablingByEcatResetsState) {
     EXPECT_EQ(pdi_read(0x1000, 8), kMsgB);
 }
 
-TEST_F(SmTest, BufferedConsumerGetsNewest) {
+TEST_F(SyncManagerRules, BufferedConsumerGetsNewest) {
     for (uint8_t v = 1; v <= 3; ++v)
         EXPECT_EQ(fpwr(*e, 0x1100, {v, v, v, v}).wkc, 1);
     EXPECT_EQ(status(2) & 0x01, 0x01);
@@ -195,7 +195,7 @@ TEST_F(SmTest, BufferedConsumerGetsNewest) {
     EXPECT_EQ(pdi_read(0x1100, 4), (std::vector<uint8_t>{3, 3, 3, 3}));  // no new data: same buffer
 }
 
-TEST_F(SmTest, BufferedThreeBufferExchange) {
+TEST_F(SyncManagerRules, BufferedThreeBufferExchange) {
     fpwr(*e, 0x1100, {1, 1, 1, 1});
     // PDI opens the buffer (reads the first half), ECAT completes a newer one meanwhile.
     EXPECT_EQ(pdi_read(0x1100, 2), (std::vector<uint8_t>{1, 1}));
@@ -206,7 +206,7 @@ TEST_F(SmTest, BufferedThreeBufferExchange) {
     EXPECT_EQ(pdi_read(0x1100, 4), (std::vector<uint8_t>{3, 3, 3, 3}));
 }
 
-TEST_F(SmTest, BufferedLastWrittenStatus) {
+TEST_F(SyncManagerRules, BufferedLastWrittenStatus) {
     EXPECT_EQ(status(2) & 0x30, 0x30);  // none written yet
     fpwr(*e, 0x1100, {1, 1, 1, 1});
     const uint8_t first = (status(2) >> 4) & 3;
@@ -215,7 +215,7 @@ TEST_F(SmTest, BufferedLastWrittenStatus) {
     EXPECT_NE((status(2) >> 4) & 3, first);
 }
 
-TEST_F(SmTest, BufferedOpenAtStartOnly) {
+TEST_F(SyncManagerRules, BufferedOpenAtStartOnly) {
     EXPECT_EQ(fpwr(*e, 0x1102, {7, 7}).wkc, 0);
     EXPECT_EQ(fpwr(*e, 0x1104, {7, 7}).wkc, 0);  // buffers 2/3 are not directly accessible
     EXPECT_EQ(fpwr(*e, 0x1100, {5, 5}).wkc, 1);
@@ -223,7 +223,7 @@ TEST_F(SmTest, BufferedOpenAtStartOnly) {
     EXPECT_EQ(pdi_read(0x1100, 4), (std::vector<uint8_t>{5, 5, 6, 6}));
 }
 
-TEST_F(SmTest, BufferedInputsAlwaysReadable) {
+TEST_F(SyncManagerRules, BufferedInputsAlwaysReadable) {
     Datagram d = fprd(*e, 0x1180, 4);
     EXPECT_EQ(d.wkc, 1);
     e->write(0x1180, std::vector<uint8_t>{4, 3, 2, 1});
@@ -232,7 +232,7 @@ TEST_F(SmTest, BufferedInputsAlwaysReadable) {
     EXPECT_EQ(fpwr(*e, 0x1180, {0, 0, 0, 0}).wkc, 0);  // wrong direction
 }
 
-TEST_F(SmTest, EcatEventsForSmWhenEnabled) {
+TEST_F(SyncManagerRules, EcatEventsForSmWhenEnabled) {
     // SM1 with ECAT event enable (control bit 4): master sees the mailbox full via 0x0210 bit 5.
     fpwr(*e, 0x080E, {0x00});
     fpwr(*e, 0x0808, sm_bytes(0x1080, 8, 0x32, 1));
@@ -243,7 +243,7 @@ TEST_F(SmTest, EcatEventsForSmWhenEnabled) {
     EXPECT_EQ(fprd(*e, 0x0210, 2).u16() & 0x0020, 0x0000);
 }
 
-TEST_F(SmTest, ProcessDataWatchdog) {
+TEST_F(SyncManagerRules, ProcessDataWatchdog) {
     fpwr(*e, 0x0420, le(10, 2));  // 10 x 100 us = 1 ms
     e->tick();                    // arms the PDI watchdog (100 ms) after the PDI accesses of SetUp
     EXPECT_EQ(fpwr(*e, 0x1100, {1, 2, 3, 4}).wkc, 1);
@@ -266,7 +266,7 @@ TEST_F(SmTest, ProcessDataWatchdog) {
     EXPECT_EQ(fprd(*e, 0x0442, 2).u16(), 0);
 }
 
-TEST_F(SmTest, InputsDoNotTriggerWatchdog) {
+TEST_F(SyncManagerRules, InputsDoNotTriggerWatchdog) {
     fpwr(*e, 0x0420, le(10, 2));
     e->write(0x1180, std::vector<uint8_t>{1, 2, 3, 4});
     fprd(*e, 0x1180, 4);
@@ -279,7 +279,7 @@ TEST_F(SmTest, InputsDoNotTriggerWatchdog) {
 
 // 0x09F0 (ECAT buffer change event time): local time of the beginning of a frame that completed an ECAT-side
 // buffer access; frames that leave the buffers alone, a partial access or a malformed frame do not move it.
-TEST_F(SmTest, EcatBufferChangeTimeLatchesTheFrameStart) {
+TEST_F(SyncManagerRules, EcatBufferChangeTimeLatchesTheFrameStart) {
     auto change_time = [&] { return e->read_reg<uint32_t>(0x09F0); };
     EXPECT_EQ(change_time(), 0u);
     clk.set(5'000'000);
@@ -305,7 +305,7 @@ TEST_F(SmTest, EcatBufferChangeTimeLatchesTheFrameStart) {
 // Issue 14, finding 1: FPWR 0x0820 <- 00 01 00 80 20 00 01 00 (SM4: start 0x0100, length 0x8000, buffered,
 // enabled) made every address from 0x0100 up unreachable, the SM registers included. SyncManagers act on the
 // process RAM only: an SM over the register space or beyond the RAM captures nothing.
-TEST_F(SmTest, SmOverTheRegisterSpaceCapturesNoAddress) {
+TEST_F(SyncManagerRules, SmOverTheRegisterSpaceCapturesNoAddress) {
     EXPECT_EQ(fpwr(*e, 0x0820, {0x00, 0x01, 0x00, 0x80, 0x20, 0x00, 0x01, 0x00}).wkc, 1);
     e->read_reg<uint8_t>(0x0826);  // acknowledge the SM activation event
     // The SM's own registers: readable, and the activate byte is writable (the master can disable it).
@@ -336,7 +336,7 @@ TEST_F(SmTest, SmOverTheRegisterSpaceCapturesNoAddress) {
     EXPECT_EQ(fprd(*e, 0x0826, 1).data[0], 0x00);
 }
 
-TEST_F(SmTest, SmAreaInsideTheRegistersOrAcrossTheRamEdgesIsNotServed) {
+TEST_F(SyncManagerRules, SmAreaInsideTheRegistersOrAcrossTheRamEdgesIsNotServed) {
     // A mailbox SM on DL control: the registers keep their register rules.
     EXPECT_EQ(fpwr(*e, 0x0820, sm_bytes(0x0100, 16, 0x26, 1)).wkc, 1);
     EXPECT_EQ(fprd(*e, 0x0100, 4).u32(), 0x0007C001u);

@@ -7,9 +7,9 @@
 #include <chrono>
 #include <thread>
 
-#include "alloc_counter.hpp"
 #include "foe/server.hpp"
 #include "foe_test_support.hpp"
+#include "support/alloc_counter.hpp"
 
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 

@@ -133,9 +133,9 @@ Bytes image_v(uint32_t version, std::size_t size = 1000) {
 
 }  // namespace
 
-using FoeServerTest = Fixture;
+using FoeServerSession = Fixture;
 
-TEST_F(FoeServerTest, FullWriteInBootstrapThenReadBack) {
+TEST_F(FoeServerSession, FullWriteInBootstrapThenReadBack) {
     const auto image = image_v(0x01300000, 5000);
     const Bytes answer = download(image);
     EXPECT_TRUE(is_ack(answer, static_cast<uint32_t>(image.size() / kChunk + 1)));
@@ -151,14 +151,14 @@ TEST_F(FoeServerTest, FullWriteInBootstrapThenReadBack) {
     EXPECT_EQ(upload("maxpos_0130H_3001h_0000h_0000h.BIN"), image);
 }
 
-TEST_F(FoeServerTest, PreviousImageStaysReadableByItsName) {
+TEST_F(FoeServerSession, PreviousImageStaysReadableByItsName) {
     ASSERT_TRUE(is_ack(download(image_v(0x01200000)), 9));
     ASSERT_TRUE(is_ack(download(image_v(0x01300000)), 9));
     EXPECT_EQ(upload("MAXPOS_0120h_3001h_0000h_0000h.bin"), image_v(0x01200000));
     EXPECT_EQ(upload("MAXPOS"), image_v(0x01300000));
 }
 
-TEST_F(FoeServerTest, ReadWithoutImageOrUnknownNameIsNotFound) {
+TEST_F(FoeServerSession, ReadWithoutImageOrUnknownNameIsNotFound) {
     Bytes err;
     EXPECT_TRUE(upload("MAXPOS", &err).empty());
     EXPECT_EQ(error_code(err), 0x8001u);
@@ -168,7 +168,7 @@ TEST_F(FoeServerTest, ReadWithoutImageOrUnknownNameIsNotFound) {
     EXPECT_EQ(error_code(err), 0x8001u);
 }
 
-TEST_F(FoeServerTest, WrongPasswordIsNoRights) {
+TEST_F(FoeServerSession, WrongPasswordIsNoRights) {
     const Bytes r = exchange(request(Opcode::Write, 0x1234, "MAXPOS"));
     EXPECT_EQ(error_code(r), 0x800Au);
     EXPECT_EQ(error_string(r).rfind("No rights", 0), 0u);
@@ -178,7 +178,7 @@ TEST_F(FoeServerTest, WrongPasswordIsNoRights) {
     EXPECT_EQ(error_code(err), 0x800Au);
 }
 
-TEST_F(FoeServerTest, ConfiguredPasswordIsRequired) {
+TEST_F(FoeServerSession, ConfiguredPasswordIsRequired) {
     ServerConfig c = stepped();
     c.password = 0x12345678;
     FoeServer s(store, c);
@@ -189,7 +189,7 @@ TEST_F(FoeServerTest, ConfiguredPasswordIsRequired) {
     EXPECT_TRUE(is_ack(out.take(), 0));
 }
 
-TEST_F(FoeServerTest, ImageForAnotherProductIsRefusedAtItsFirstPacket) {
+TEST_F(FoeServerSession, ImageForAnotherProductIsRefusedAtItsFirstPacket) {
     ASSERT_TRUE(is_ack(download(image_v(0x01200000)), 9));
     const auto other = build_image(foe_test::payload_bytes(3000, 5), {0xFB, 0x30020000}, 0x01300000);
     ASSERT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS")), 0));
@@ -203,7 +203,7 @@ TEST_F(FoeServerTest, ImageForAnotherProductIsRefusedAtItsFirstPacket) {
     EXPECT_EQ(active_version(), 0x01200000u);
 }
 
-TEST_F(FoeServerTest, CorruptedImageIsInvalidChecksum) {
+TEST_F(FoeServerSession, CorruptedImageIsInvalidChecksum) {
     ASSERT_TRUE(is_ack(download(image_v(0x01200000)), 9));
     auto bad = image_v(0x01300000, 2000);
     bad[1500] ^= 0x10;
@@ -216,7 +216,7 @@ TEST_F(FoeServerTest, CorruptedImageIsInvalidChecksum) {
     EXPECT_EQ(active_version(), 0x01200000u);
 }
 
-TEST_F(FoeServerTest, TransferCutOffThenNewRequestStartsClean) {
+TEST_F(FoeServerSession, TransferCutOffThenNewRequestStartsClean) {
     ASSERT_TRUE(is_ack(download(image_v(0x01200000)), 9));
     const auto image = image_v(0x01300000, 4000);
     ASSERT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS")), 0));
@@ -234,7 +234,7 @@ TEST_F(FoeServerTest, TransferCutOffThenNewRequestStartsClean) {
     EXPECT_EQ(active_version(), 0x01300000u);
 }
 
-TEST_F(FoeServerTest, StaleTransferTimesOut) {
+TEST_F(FoeServerSession, StaleTransferTimesOut) {
     const auto image = image_v(0x01300000, 4000);
     ASSERT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS")), 0));
     ASSERT_TRUE(is_ack(exchange(data(1, {image.data(), kChunk})), 1));
@@ -247,7 +247,7 @@ TEST_F(FoeServerTest, StaleTransferTimesOut) {
     EXPECT_FALSE(store.active_image());
 }
 
-TEST_F(FoeServerTest, PathLikeAndMalformedNamesAreRefused) {
+TEST_F(FoeServerSession, PathLikeAndMalformedNamesAreRefused) {
     for (std::string name :
          {std::string("../MAXPOS"), std::string("/MAXPOS"), std::string("a/b"), std::string("a\\b"),
           std::string("C:MAXPOS"), std::string(".."), std::string("MAX\0POS", 7), std::string("MAX\x01POS"),
@@ -267,7 +267,7 @@ TEST_F(FoeServerTest, PathLikeAndMalformedNamesAreRefused) {
     EXPECT_EQ(error_code(exchange(request(Opcode::Write, 0, "MAXPOS_0130h_3001h_0000h.bin"))), 0x8001u);
 }
 
-TEST_F(FoeServerTest, WriteOutsideBootstrapIsBootstrapOnly) {
+TEST_F(FoeServerSession, WriteOutsideBootstrapIsBootstrapOnly) {
     for (od::AlState s : {od::AlState::PreOp, od::AlState::SafeOp, od::AlState::Op}) {
         server.on_state_change(od::AlState::Init, s);
         const Bytes r = exchange(request(Opcode::Write, 0, "MAXPOS"));
@@ -279,7 +279,7 @@ TEST_F(FoeServerTest, WriteOutsideBootstrapIsBootstrapOnly) {
     EXPECT_TRUE(server.available(od::AlState::PreOp));
 }
 
-TEST_F(FoeServerTest, LeavingBootstrapDropsTheDownload) {
+TEST_F(FoeServerSession, LeavingBootstrapDropsTheDownload) {
     const auto image = image_v(0x01300000, 4000);
     ASSERT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS")), 0));
     ASSERT_TRUE(is_ack(exchange(data(1, {image.data(), kChunk})), 1));
@@ -288,7 +288,7 @@ TEST_F(FoeServerTest, LeavingBootstrapDropsTheDownload) {
     EXPECT_FALSE(store.writing());
 }
 
-TEST_F(FoeServerTest, PacketNumberWrong) {
+TEST_F(FoeServerSession, PacketNumberWrong) {
     const auto image = image_v(0x01300000, 4000);
     ASSERT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS")), 0));
     ASSERT_TRUE(is_ack(exchange(data(1, {image.data(), kChunk})), 1));
@@ -306,7 +306,7 @@ TEST_F(FoeServerTest, PacketNumberWrong) {
     EXPECT_EQ(error_code(exchange(request(Opcode::Ack, 2))), 0x8005u);
 }
 
-TEST_F(FoeServerTest, BusyWhileStoring) {
+TEST_F(FoeServerSession, BusyWhileStoring) {
     const auto image = image_v(0x01300000, 500'000);  // several read-back steps
     ASSERT_TRUE(is_ack(exchange(request(Opcode::Write, 0, "MAXPOS")), 0));
     uint32_t packet = 1;
@@ -338,7 +338,7 @@ TEST_F(FoeServerTest, BusyWhileStoring) {
     EXPECT_TRUE(server.idle());
 }
 
-TEST_F(FoeServerTest, FileLengthMultipleOfThePacketSize) {
+TEST_F(FoeServerSession, FileLengthMultipleOfThePacketSize) {
     // 3 full packets exactly: the master ends with an empty DATA.
     const auto image = image_v(0x01300000, 3 * kChunk - kImageHeaderSize);
     ASSERT_EQ(image.size(), 3 * kChunk);
@@ -367,7 +367,7 @@ TEST_F(FoeServerTest, FileLengthMultipleOfThePacketSize) {
     EXPECT_TRUE(server.idle());
 }
 
-TEST_F(FoeServerTest, ConfiguredSm0SizeDecidesTheEndOfFile) {
+TEST_F(FoeServerSession, ConfiguredSm0SizeDecidesTheEndOfFile) {
     // The master's mailbox (SM0) is larger than the reply mailbox: packets of 500 bytes are full ones.
     ServerConfig c = stepped();
     c.bootstrap_data_size = 500;
@@ -388,7 +388,7 @@ TEST_F(FoeServerTest, ConfiguredSm0SizeDecidesTheEndOfFile) {
     EXPECT_EQ(ServerConfig::from(d).device_name, "MAXPOS");
 }
 
-TEST_F(FoeServerTest, UnexpectedPacketsAreIllegal) {
+TEST_F(FoeServerSession, UnexpectedPacketsAreIllegal) {
     Bytes r = exchange(Bytes{0x09, 0, 0, 0, 0, 0});
     EXPECT_EQ(error_code(r), 0x8004u);
     EXPECT_EQ(error_string(r).rfind("Illegal", 0), 0u);
@@ -404,7 +404,7 @@ TEST_F(FoeServerTest, UnexpectedPacketsAreIllegal) {
     EXPECT_FALSE(store.writing());
 }
 
-TEST_F(FoeServerTest, ErrorTextIsCutToTheMailbox) {
+TEST_F(FoeServerSession, ErrorTextIsCutToTheMailbox) {
     out.max = 14;
     const Bytes r = exchange(request(Opcode::Write, 0, "../x"));
     EXPECT_EQ(r.size(), 14u);
@@ -412,7 +412,7 @@ TEST_F(FoeServerTest, ErrorTextIsCutToTheMailbox) {
     EXPECT_EQ(error_string(r), "Access d");
 }
 
-TEST_F(FoeServerTest, RandomPacketsNeverCrash) {
+TEST_F(FoeServerSession, RandomPacketsNeverCrash) {
     ASSERT_TRUE(is_ack(download(image_v(0x01200000)), 9));
     uint32_t x = 12345;
     auto next = [&] {
@@ -432,7 +432,7 @@ TEST_F(FoeServerTest, RandomPacketsNeverCrash) {
     EXPECT_EQ(active_version(), 0x01200000u);
 }
 
-TEST_F(FoeServerTest, CommitOnAWorkerThread) {
+TEST_F(FoeServerSession, CommitOnAWorkerThread) {
     ServerConfig c;
     ASSERT_TRUE(c.commit_in_thread);
     FoeServer s(store, c);
@@ -462,7 +462,7 @@ TEST_F(FoeServerTest, CommitOnAWorkerThread) {
     EXPECT_EQ(s.stats().writes_completed, 1u);
 }
 
-TEST_F(FoeServerTest, NewRequestStopsAWorkerCommit) {
+TEST_F(FoeServerSession, NewRequestStopsAWorkerCommit) {
     ASSERT_TRUE(is_ack(download(image_v(0x01200000)), 9));
     ServerConfig c;
     FoeServer s(store, c);
@@ -490,7 +490,7 @@ TEST_F(FoeServerTest, NewRequestStopsAWorkerCommit) {
 // Downloads disturbed at random (wrong packet numbers, short packets, bit flips, aborts, new requests,
 // state changes, timeouts): one answer per request at most, and whatever happened, the store reopens with
 // one of the complete images active.
-TEST_F(FoeServerTest, DisturbedDownloadsNeverLeaveAHalfImage) {
+TEST_F(FoeServerSession, DisturbedDownloadsNeverLeaveAHalfImage) {
     const Bytes v1 = image_v(0x01200000, 600), v2 = image_v(0x01300000, 900);
     ASSERT_TRUE(is_ack(download(v1), 6));
     uint32_t x = 777;
@@ -575,7 +575,7 @@ struct FoeEvents : ecat::EventSink {
     }
 };
 
-TEST_F(FoeServerTest, EveryWriteEndIsReportedOnceWithNameSizeAndResult) {
+TEST_F(FoeServerSession, EveryWriteEndIsReportedOnceWithNameSizeAndResult) {
     FoeEvents events;
     server.set_event_sink(&events);
     const auto image = image_v(0x01300000, 3000);
@@ -609,7 +609,7 @@ TEST_F(FoeServerTest, EveryWriteEndIsReportedOnceWithNameSizeAndResult) {
 
 // ---- Deliberate faults (foe/faults.hpp, `ecat-slave --fault`) ----------------------------------------
 
-TEST_F(FoeServerTest, FaultPasswordIgnoredAcceptsAWrongPassword) {
+TEST_F(FoeServerSession, FaultPasswordIgnoredAcceptsAWrongPassword) {
     EXPECT_EQ(error_code(exchange(request(Opcode::Write, 0x1234, "MAXPOS"))), 0x800Au);  // clean: no rights
     ServerConfig c = stepped();
     c.faults.password_ignored = true;
@@ -625,7 +625,7 @@ TEST_F(FoeServerTest, FaultPasswordIgnoredAcceptsAWrongPassword) {
     EXPECT_EQ(error_code(out.take()), 0x8001u);
 }
 
-TEST_F(FoeServerTest, FaultAnyFileNameAcceptsAnUnknownFile) {
+TEST_F(FoeServerSession, FaultAnyFileNameAcceptsAnUnknownFile) {
     EXPECT_EQ(error_code(exchange(request(Opcode::Write, 0, "NOSUCHFILE"))), 0x8001u);  // clean: not found
     ServerConfig c = stepped();
     c.faults.any_file_name = true;

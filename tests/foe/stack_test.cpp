@@ -22,7 +22,7 @@
 #include "master/master.hpp"
 #include "od/drive_profile.hpp"
 
-#include "../support/wire_link.hpp"
+#include "support/wire_link.hpp"
 
 namespace {
 

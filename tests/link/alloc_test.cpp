@@ -9,11 +9,11 @@
 #include <utility>
 #include <vector>
 
-#include "alloc_counter.hpp"
 #include "esc/esc.hpp"
 #include "esc/link_capture.hpp"
 #include "esc/link_loopback.hpp"
 #include "softslave/runtime.hpp"
+#include "support/alloc_counter.hpp"
 
 namespace {
 

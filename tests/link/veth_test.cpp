@@ -196,14 +196,14 @@ INSTANTIATE_TEST_SUITE_P(Backends, VethLink, ::testing::Values(std::string("pcap
                              return param_info.param;
                          });
 
-class VethPairTest : public ::testing::Test {
+class VethPairs : public ::testing::Test {
   protected:
     void SetUp() override {
         if (!linktest::is_root()) GTEST_SKIP() << "needs root (CAP_NET_ADMIN)";
     }
 };
 
-TEST_F(VethPairTest, CreatesUpPairWithoutIpv6AndRemovesItAgain) {
+TEST_F(VethPairs, CreatesUpPairWithoutIpv6AndRemovesItAgain) {
     in_new_netns([] {
         {
             softslave::VethPair pair("ecat0", "ecat1");
@@ -224,7 +224,7 @@ TEST_F(VethPairTest, CreatesUpPairWithoutIpv6AndRemovesItAgain) {
     });
 }
 
-TEST_F(VethPairTest, RemovesAStalePairLeftByAKilledRun) {
+TEST_F(VethPairs, RemovesAStalePairLeftByAKilledRun) {
     in_new_netns([] {
         softslave::create_veth("ecat0", "ecat1");  // as if a previous run was killed
         {
@@ -236,7 +236,7 @@ TEST_F(VethPairTest, RemovesAStalePairLeftByAKilledRun) {
     });
 }
 
-TEST_F(VethPairTest, APairOwnedByARunningSlaveIsNotTakenAsStale) {
+TEST_F(VethPairs, APairOwnedByARunningSlaveIsNotTakenAsStale) {
     in_new_netns([] {
         softslave::VethPair first("ecat0", "ecat1");
         try {
@@ -250,7 +250,7 @@ TEST_F(VethPairTest, APairOwnedByARunningSlaveIsNotTakenAsStale) {
     });
 }
 
-TEST_F(VethPairTest, CreatingAnExistingPairFailsClearly) {
+TEST_F(VethPairs, CreatingAnExistingPairFailsClearly) {
     in_new_netns([] {
         softslave::create_veth("x0", "x1");
         EXPECT_THROW(softslave::create_veth("x0", "x1"), esc::LinkError);

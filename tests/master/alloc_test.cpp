@@ -5,7 +5,6 @@
 
 #include <array>
 
-#include "alloc_counter.hpp"
 #include "coe/sdo_server.hpp"
 #include "ecat/application.hpp"
 #include "ecat/stack.hpp"
@@ -17,6 +16,7 @@
 #include "master/master.hpp"
 #include "master/session.hpp"
 #include "od/drive_profile.hpp"
+#include "support/alloc_counter.hpp"
 
 using namespace master;
 

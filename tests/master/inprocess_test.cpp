@@ -5,10 +5,10 @@
 
 #include <vector>
 
-#include "../support/wire_link.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
 #include "master/master.hpp"
+#include "support/wire_link.hpp"
 
 using namespace master;
 

@@ -25,7 +25,7 @@
 #include "master/session.hpp"
 #include "od/drive_profile.hpp"
 
-#include "../support/wire_link.hpp"
+#include "support/wire_link.hpp"
 
 using namespace master;
 

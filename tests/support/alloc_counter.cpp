@@ -1,5 +1,5 @@
 // The counting replacement of the global operator new/delete (see alloc_counter.hpp).
-#include "alloc_counter.hpp"
+#include "support/alloc_counter.hpp"
 
 #include <atomic>
 #include <cstdlib>

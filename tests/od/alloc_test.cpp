@@ -2,8 +2,8 @@
 // listeners), set, Ref<T>, lookup.
 #include <gtest/gtest.h>
 
-#include "alloc_counter.hpp"
 #include "od/drive_profile.hpp"
+#include "support/alloc_counter.hpp"
 
 TEST(OdAlloc, AccessPathsAllocateNothing) {
     od::Dictionary d = od::make_drive_dictionary(od::default_drive_description());

@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-class StoreTest : public ::testing::Test {
+class StoredParameters : public ::testing::Test {
   protected:
     void SetUp() override {
         char tmpl[] = "/tmp/od-store-XXXXXX";
@@ -72,7 +72,7 @@ TEST(Crc32, KnownVector) {
     EXPECT_EQ(crc32(std::span(reinterpret_cast<const uint8_t*>(s), 9)), 0xCBF43926u);
 }
 
-TEST_F(StoreTest, NoFileKeepsDefaults) {
+TEST_F(StoredParameters, NoFileKeepsDefaults) {
     Dictionary d = make_drive_dictionary(desc);
     ParameterStore store(dir);
     const auto r = store.load(d);
@@ -82,7 +82,7 @@ TEST_F(StoreTest, NoFileKeepsDefaults) {
     expect_defaults(d);
 }
 
-TEST_F(StoreTest, RoundTripRestoresEveryBackupEntry) {
+TEST_F(StoredParameters, RoundTripRestoresEveryBackupEntry) {
     Dictionary d = make_drive_dictionary(desc);
     modify(d);
     ASSERT_EQ(d.set<int8_t>(0x6060, 0, 9), Status::Ok);  // not a Backup entry: not stored
@@ -104,7 +104,7 @@ TEST_F(StoreTest, RoundTripRestoresEveryBackupEntry) {
     EXPECT_EQ(fresh.get<int8_t>(0x6060, 0), 8);
 }
 
-TEST_F(StoreTest, RestoreDefaultsDropsTheStoredSet) {
+TEST_F(StoredParameters, RestoreDefaultsDropsTheStoredSet) {
     Dictionary d = make_drive_dictionary(desc);
     modify(d);
     ParameterStore store(dir);
@@ -118,7 +118,7 @@ TEST_F(StoreTest, RestoreDefaultsDropsTheStoredSet) {
     EXPECT_EQ(store.restore_defaults(d), "");  // nothing stored: still fine
 }
 
-TEST_F(StoreTest, ScopedStoreAndRestore) {
+TEST_F(StoredParameters, ScopedStoreAndRestore) {
     Dictionary d = make_drive_dictionary(desc);
     modify(d);
     ParameterStore store(dir);
@@ -138,7 +138,7 @@ TEST_F(StoreTest, ScopedStoreAndRestore) {
     EXPECT_EQ(c.get<uint32_t>(0x6065, 0), 4321u);
 }
 
-TEST_F(StoreTest, FlippedByteAnywhereKeepsDefaults) {
+TEST_F(StoredParameters, FlippedByteAnywhereKeepsDefaults) {
     Dictionary d = make_drive_dictionary(desc);
     modify(d);
     ParameterStore store(dir);
@@ -158,7 +158,7 @@ TEST_F(StoreTest, FlippedByteAnywhereKeepsDefaults) {
     }
 }
 
-TEST_F(StoreTest, TruncatedAtEveryLengthKeepsDefaults) {
+TEST_F(StoredParameters, TruncatedAtEveryLengthKeepsDefaults) {
     Dictionary d = make_drive_dictionary(desc);
     modify(d);
     ParameterStore store(dir);
@@ -179,7 +179,7 @@ TEST_F(StoreTest, TruncatedAtEveryLengthKeepsDefaults) {
     EXPECT_TRUE(store.load(fresh).applied);
 }
 
-TEST_F(StoreTest, ValidCrcButInvalidContentIsRejectedWhole) {
+TEST_F(StoredParameters, ValidCrcButInvalidContentIsRejectedWhole) {
     // A file that is well-formed but holds an out-of-range value must not apply the entries before it.
     Dictionary d = make_drive_dictionary(desc);
     modify(d);
@@ -212,7 +212,7 @@ TEST_F(StoreTest, ValidCrcButInvalidContentIsRejectedWhole) {
     expect_defaults(fresh);  // 0x1600, 0x1C12 come before 0x605A in the file and are not applied either
 }
 
-TEST_F(StoreTest, MismatchedIdentityIsRejected) {
+TEST_F(StoredParameters, MismatchedIdentityIsRejected) {
     Dictionary d = make_drive_dictionary(desc);
     modify(d);
     ParameterStore store(dir);
@@ -235,7 +235,7 @@ TEST_F(StoreTest, MismatchedIdentityIsRejected) {
     EXPECT_TRUE(store.load(s).applied);
 }
 
-TEST_F(StoreTest, CrashBetweenTempWriteAndRenameKeepsTheOldFile) {
+TEST_F(StoredParameters, CrashBetweenTempWriteAndRenameKeepsTheOldFile) {
     Dictionary d = make_drive_dictionary(desc);
     ParameterStore store(dir);
     ASSERT_EQ(d.set<uint32_t>(0x6065, 0, 1111), Status::Ok);
@@ -272,7 +272,7 @@ TEST_F(StoreTest, CrashBetweenTempWriteAndRenameKeepsTheOldFile) {
     }
 }
 
-TEST_F(StoreTest, UnwritableDirectoryReportsAnError) {
+TEST_F(StoredParameters, UnwritableDirectoryReportsAnError) {
     Dictionary d = make_drive_dictionary(desc);
     fs::create_directories(dir.parent_path());
     write_all(dir, {1, 2, 3});  // "state" is a file, not a directory
@@ -280,7 +280,7 @@ TEST_F(StoreTest, UnwritableDirectoryReportsAnError) {
     EXPECT_FALSE(store.save(d).empty());
 }
 
-TEST_F(StoreTest, SdoStoreAndRestoreObjects) {
+TEST_F(StoredParameters, SdoStoreAndRestoreObjects) {
     Dictionary d = make_drive_dictionary(desc);
     ParameterStore store(dir);
     attach_store(d, store);
@@ -318,7 +318,7 @@ TEST_F(StoreTest, SdoStoreAndRestoreObjects) {
     EXPECT_EQ(d.get<uint32_t>(0x1011, 1), 1u);
 }
 
-TEST_F(StoreTest, SdoStoreFailureIsAHardwareErrorAndShowsInTheState) {
+TEST_F(StoredParameters, SdoStoreFailureIsAHardwareErrorAndShowsInTheState) {
     Dictionary d = make_drive_dictionary(desc);
     fs::create_directories(dir.parent_path());
     write_all(dir, {1});  // cannot create the state directory
@@ -329,7 +329,7 @@ TEST_F(StoreTest, SdoStoreFailureIsAHardwareErrorAndShowsInTheState) {
     EXPECT_EQ(d.get<uint32_t>(0x2110, 1), 2u);  // bit 1: error during store
 }
 
-TEST_F(StoreTest, RestoreWaitsForThePowerDisableCondition) {
+TEST_F(StoredParameters, RestoreWaitsForThePowerDisableCondition) {
     Dictionary d = make_drive_dictionary(desc);
     ParameterStore store(dir);
     bool power_disabled = false;
@@ -346,7 +346,7 @@ TEST_F(StoreTest, RestoreWaitsForThePowerDisableCondition) {
 // Issue 14, finding 3: a 40-byte parameters.bin with valid CRCs, the device's identity and a record count of
 // 0xFFFFFFFF threw std::bad_alloc from every start. Crafted headers of every kind are reported and the
 // defaults run; nothing is reserved for what the bytes present cannot hold.
-TEST_F(StoreTest, CraftedRecordCountsAreReportedNotReserved) {
+TEST_F(StoredParameters, CraftedRecordCountsAreReportedNotReserved) {
     Dictionary d = make_drive_dictionary(desc);
     modify(d);
     ParameterStore store(dir);
@@ -395,7 +395,7 @@ TEST_F(StoreTest, CraftedRecordCountsAreReportedNotReserved) {
 }
 
 // Neither a file far beyond any dictionary nor a FIFO in place of parameters.bin stops the start.
-TEST_F(StoreTest, OversizedFileAndFifoAreReported) {
+TEST_F(StoredParameters, OversizedFileAndFifoAreReported) {
     Dictionary d = make_drive_dictionary(desc);
     ParameterStore store(dir);
     fs::create_directories(dir);
@@ -416,7 +416,7 @@ TEST_F(StoreTest, OversizedFileAndFifoAreReported) {
 
 // Issue 14, finding 7: a save SIGKILLed after its temporary file was written left parameters.bin.tmp behind
 // for good. It is removed at the next start (remove_stale_temp), and the file that loads is the old one.
-TEST_F(StoreTest, TemporaryOfASaveKilledHalfWayIsRemovedAtTheStart) {
+TEST_F(StoredParameters, TemporaryOfASaveKilledHalfWayIsRemovedAtTheStart) {
     Dictionary d = make_drive_dictionary(desc);
     ParameterStore store(dir);
     ASSERT_EQ(d.set<uint32_t>(0x6065, 0, 1111), Status::Ok);
