@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "esi/wire/sii.hpp"
+
 namespace esi {
 namespace {
 
@@ -105,13 +107,7 @@ std::optional<uint64_t> number_bits(const od::Number& n, od::DataType type, uint
 }
 
 uint8_t sii_crc8(const uint8_t* data, std::size_t size) {
-    uint8_t crc = 0xFF;
-    for (std::size_t i = 0; i < size; ++i) {
-        crc ^= data[i];
-        for (int b = 0; b < 8; ++b)
-            crc = (crc & 0x80) ? static_cast<uint8_t>((crc << 1) ^ 0x07) : (crc << 1);
-    }
-    return crc;
+    return sii::crc8(data, size);
 }
 
 DeviceModel derive_model(const od::DeviceDescription& d, const od::Dictionary& dict) {

@@ -3,36 +3,16 @@
 #include <array>
 #include <cstdio>
 
+#include "util/crc.hpp"
+#include "util/le.hpp"
+
 namespace foe {
 namespace {
 
-constexpr std::array<uint32_t, 256> make_table() {
-    std::array<uint32_t, 256> t{};
-    for (uint32_t i = 0; i < 256; ++i) {
-        uint32_t c = i;
-        for (int k = 0; k < 8; ++k)
-            c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-        t[i] = c;
-    }
-    return t;
-}
-constexpr auto kTable = make_table();
-
-void put32(uint8_t* p, uint32_t v) {
-    for (int i = 0; i < 4; ++i)
-        p[i] = static_cast<uint8_t>(v >> (8 * i));
-}
-void put16(uint8_t* p, uint16_t v) {
-    p[0] = static_cast<uint8_t>(v);
-    p[1] = static_cast<uint8_t>(v >> 8);
-}
-uint32_t get32(const uint8_t* p) {
-    return static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 |
-           static_cast<uint32_t>(p[2]) << 16 | static_cast<uint32_t>(p[3]) << 24;
-}
-uint16_t get16(const uint8_t* p) {
-    return static_cast<uint16_t>(p[0] | p[1] << 8);
-}
+using util::get16;
+using util::get32;
+using util::put16;
+using util::put32;
 
 std::string hex32(uint32_t v) {
     char b[16];
@@ -43,10 +23,7 @@ std::string hex32(uint32_t v) {
 }  // namespace
 
 uint32_t crc32(std::span<const uint8_t> data, uint32_t crc) {
-    crc = ~crc;
-    for (uint8_t b : data)
-        crc = kTable[(crc ^ b) & 0xFF] ^ (crc >> 8);
-    return ~crc;
+    return util::crc32(data, crc);
 }
 
 std::string_view to_string(ImageError e) {

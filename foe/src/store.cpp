@@ -7,6 +7,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include "util/atomic_file.hpp"
+
 namespace foe {
 namespace {
 
@@ -93,15 +95,9 @@ bool FirmwareStore::fail(StoreError& error, ErrorCode code, std::string text) {
 }
 
 bool FirmwareStore::sync_dir(StoreError& error) {
-    const int d = ::open(config_.dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (d < 0) {
-        error = {ErrorCode::FlashError, errno_text("open directory")};
-        return false;
-    }
-    const bool ok = ::fsync(d) == 0;
-    if (!ok) error = {ErrorCode::FlashError, errno_text("fsync directory")};
-    ::close(d);
-    return ok;
+    if (util::sync_directory(config_.dir)) return true;
+    error = {ErrorCode::FlashError, errno_text("fsync directory")};
+    return false;
 }
 
 std::optional<StoredImage> FirmwareStore::verify_slot(unsigned slot) {

@@ -11,6 +11,9 @@
 #include <vector>
 
 #include "od/drive_profile.hpp"
+#include "util/atomic_file.hpp"
+#include "util/crc.hpp"
+#include "util/le.hpp"
 
 namespace od {
 namespace {
@@ -19,36 +22,13 @@ constexpr char kMagic[8] = {'S', 'E', 'C', 'A', 'T', 'P', 'R', 'M'};
 constexpr std::size_t kMaxFileBytes = 1u << 20;  // far above any dictionary; bounds what a bad file costs
 constexpr std::size_t kRecordHeader = 8;
 
-constexpr std::array<uint32_t, 256> make_crc_table() {
-    std::array<uint32_t, 256> t{};
-    for (uint32_t i = 0; i < 256; ++i) {
-        uint32_t c = i;
-        for (int k = 0; k < 8; ++k)
-            c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-        t[i] = c;
-    }
-    return t;
-}
-constexpr std::array<uint32_t, 256> kCrcTable = make_crc_table();
+using util::append16;
+using util::append32;
+using util::get16;
+using util::get32;
 
-void put16(std::vector<uint8_t>& b, uint16_t v) {
-    b.push_back(static_cast<uint8_t>(v));
-    b.push_back(static_cast<uint8_t>(v >> 8));
-}
-void put32(std::vector<uint8_t>& b, uint32_t v) {
-    for (int i = 0; i < 4; ++i)
-        b.push_back(static_cast<uint8_t>(v >> (8 * i)));
-}
 void set32(std::vector<uint8_t>& b, std::size_t at, uint32_t v) {
-    for (int i = 0; i < 4; ++i)
-        b[at + i] = static_cast<uint8_t>(v >> (8 * i));
-}
-uint16_t get16(std::span<const uint8_t> b, std::size_t at) {
-    return static_cast<uint16_t>(b[at] | (b[at + 1] << 8));
-}
-uint32_t get32(std::span<const uint8_t> b, std::size_t at) {
-    return uint32_t{b[at]} | (uint32_t{b[at + 1]} << 8) | (uint32_t{b[at + 2]} << 16) |
-           (uint32_t{b[at + 3]} << 24);
+    util::put32(b.data() + at, v);
 }
 
 struct Ident {
@@ -176,20 +156,13 @@ bool read_file(const std::filesystem::path& p, std::vector<uint8_t>& out, std::s
 }
 
 bool sync_dir(const std::filesystem::path& dir) {
-    const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (fd < 0) return false;
-    const bool ok = ::fsync(fd) == 0;
-    ::close(fd);
-    return ok;
+    return util::sync_directory(dir);
 }
 
 }  // namespace
 
 uint32_t crc32(std::span<const uint8_t> data, uint32_t crc) {
-    uint32_t c = crc ^ 0xFFFFFFFFu;
-    for (uint8_t b : data)
-        c = kCrcTable[(c ^ b) & 0xFFu] ^ (c >> 8);
-    return c ^ 0xFFFFFFFFu;
+    return util::crc32(data, crc);
 }
 
 bool in_scope(StoreScope scope, uint16_t index) {
@@ -234,22 +207,22 @@ namespace {
 std::vector<uint8_t> serialize(const Dictionary& dict, const std::vector<Record>& records) {
     std::vector<uint8_t> b(kMagic, kMagic + sizeof kMagic);
     const Ident id = identity_of(dict);
-    put16(b, ParameterStore::kFormatVersion);
-    put16(b, static_cast<uint16_t>(ParameterStore::kHeaderBytes));
-    put32(b, id.vendor);
-    put32(b, id.product);
-    put32(b, id.revision);
-    put32(b, static_cast<uint32_t>(records.size()));
-    put32(b, 0);  // payload bytes
-    put32(b, 0);  // payload CRC
-    put32(b, 0);  // header CRC
+    append16(b, ParameterStore::kFormatVersion);
+    append16(b, static_cast<uint16_t>(ParameterStore::kHeaderBytes));
+    append32(b, id.vendor);
+    append32(b, id.product);
+    append32(b, id.revision);
+    append32(b, static_cast<uint32_t>(records.size()));
+    append32(b, 0);  // payload bytes
+    append32(b, 0);  // payload CRC
+    append32(b, 0);  // header CRC
     for (const Record& r : records) {
         const Entry* e = dict.find(r.index, r.sub);
-        put16(b, r.index);
+        append16(b, r.index);
         b.push_back(r.sub);
         b.push_back(0);
-        put16(b, static_cast<uint16_t>(e->type));
-        put16(b, static_cast<uint16_t>(r.value.size()));
+        append16(b, static_cast<uint16_t>(e->type));
+        append16(b, static_cast<uint16_t>(r.value.size()));
         b.insert(b.end(), r.value.begin(), r.value.end());
     }
     const auto payload = std::span<const uint8_t>(b).subspan(ParameterStore::kHeaderBytes);
@@ -289,48 +262,11 @@ std::string ParameterStore::save(const Dictionary& dict, StoreScope scope) {
 }
 
 bool ParameterStore::remove_stale_temp() const {
-    std::filesystem::path tmp = file_;
-    tmp += ".tmp";
-    return ::unlink(tmp.c_str()) == 0;
+    return util::remove_stale_temp(file_);
 }
 
 std::string ParameterStore::write_atomic(const std::vector<uint8_t>& bytes) {
-    std::error_code ec;
-    std::filesystem::create_directories(dir_, ec);
-    if (ec) return "cannot create " + dir_.string() + ": " + ec.message();
-    std::filesystem::path tmp = file_;
-    tmp += ".tmp";
-    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) return errno_text("cannot create", tmp);
-    std::size_t done = 0;
-    while (done < bytes.size()) {
-        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            const std::string err = errno_text("cannot write", tmp);
-            ::close(fd);
-            ::unlink(tmp.c_str());
-            return err;
-        }
-        done += static_cast<std::size_t>(n);
-    }
-    if (::fsync(fd) != 0) {
-        const std::string err = errno_text("cannot sync", tmp);
-        ::close(fd);
-        ::unlink(tmp.c_str());
-        return err;
-    }
-    ::close(fd);
-    if (on_step) on_step("temp-written");
-    if (::rename(tmp.c_str(), file_.c_str()) != 0) {
-        const std::string err = errno_text("cannot rename onto", file_);
-        ::unlink(tmp.c_str());
-        return err;
-    }
-    if (on_step) on_step("renamed");
-    if (!sync_dir(dir_)) return errno_text("cannot sync directory", dir_);
-    if (on_step) on_step("done");
-    return {};
+    return util::write_file_atomic(file_, bytes, on_step);
 }
 
 std::string ParameterStore::restore_defaults(const Dictionary& dict, StoreScope scope) {

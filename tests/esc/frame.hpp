@@ -5,26 +5,30 @@
 #include <vector>
 
 #include "esc/esc.hpp"
+#include "esc/wire/frame_builder.hpp"
+#include "util/le.hpp"
 
 namespace esc_test {
 
-enum Cmd : uint8_t {
-    NOP = 0,
-    APRD = 1,
-    APWR = 2,
-    APRW = 3,
-    FPRD = 4,
-    FPWR = 5,
-    FPRW = 6,
-    BRD = 7,
-    BWR = 8,
-    BRW = 9,
-    LRD = 10,
-    LWR = 11,
-    LRW = 12,
-    ARMW = 13,
-    FRMW = 14,
-};
+// Datagram commands as the raw command byte the tests put into a frame (esc/wire/datagram.hpp).
+constexpr uint8_t command_byte(esc::Command c) {
+    return static_cast<uint8_t>(c);
+}
+constexpr uint8_t NOP = command_byte(esc::Command::NOP);
+constexpr uint8_t APRD = command_byte(esc::Command::APRD);
+constexpr uint8_t APWR = command_byte(esc::Command::APWR);
+constexpr uint8_t APRW = command_byte(esc::Command::APRW);
+constexpr uint8_t FPRD = command_byte(esc::Command::FPRD);
+constexpr uint8_t FPWR = command_byte(esc::Command::FPWR);
+constexpr uint8_t FPRW = command_byte(esc::Command::FPRW);
+constexpr uint8_t BRD = command_byte(esc::Command::BRD);
+constexpr uint8_t BWR = command_byte(esc::Command::BWR);
+constexpr uint8_t BRW = command_byte(esc::Command::BRW);
+constexpr uint8_t LRD = command_byte(esc::Command::LRD);
+constexpr uint8_t LWR = command_byte(esc::Command::LWR);
+constexpr uint8_t LRW = command_byte(esc::Command::LRW);
+constexpr uint8_t ARMW = command_byte(esc::Command::ARMW);
+constexpr uint8_t FRMW = command_byte(esc::Command::FRMW);
 
 struct Datagram {
     uint8_t cmd = 0;
@@ -46,10 +50,7 @@ struct Datagram {
 };
 
 inline std::vector<uint8_t> le(uint64_t v, std::size_t n) {
-    std::vector<uint8_t> b(n);
-    for (std::size_t i = 0; i < n; ++i)
-        b[i] = static_cast<uint8_t>(v >> (8 * i));
-    return b;
+    return util::le_bytes(v, n);
 }
 
 inline Datagram dg(uint8_t cmd, uint16_t adp, uint16_t ado, std::vector<uint8_t> data) {
@@ -70,59 +71,28 @@ inline Datagram lg(uint8_t cmd, uint32_t la, std::vector<uint8_t> data) {
 // Ethernet II (broadcast destination, master source 01:01:01:01:01:01), EtherType 0x88A4, type 1 header,
 // datagrams chained with the M bit, padded with zeros up to min_len.
 inline std::vector<uint8_t> build(const std::vector<Datagram>& dgs, std::size_t min_len = 60) {
-    std::vector<uint8_t> f(12, 0xFF);
-    for (int i = 6; i < 12; ++i)
-        f[i] = 0x01;
-    f.push_back(0x88);
-    f.push_back(0xA4);
-    std::size_t total = 0;
+    esc::wire::FrameBuilder b;
     for (const auto& d : dgs)
-        total += 12 + d.data.size();
-    f.push_back(static_cast<uint8_t>(total));
-    f.push_back(static_cast<uint8_t>(0x10 | ((total >> 8) & 0x07)));
-    for (std::size_t k = 0; k < dgs.size(); ++k) {
-        const Datagram& d = dgs[k];
-        const uint16_t lf = static_cast<uint16_t>(d.data.size() | (k + 1 < dgs.size() ? 0x8000 : 0));
-        const uint8_t h[10] = {d.cmd,
-                               d.idx,
-                               static_cast<uint8_t>(d.adp),
-                               static_cast<uint8_t>(d.adp >> 8),
-                               static_cast<uint8_t>(d.ado),
-                               static_cast<uint8_t>(d.ado >> 8),
-                               static_cast<uint8_t>(lf),
-                               static_cast<uint8_t>(lf >> 8),
-                               static_cast<uint8_t>(d.irq),
-                               static_cast<uint8_t>(d.irq >> 8)};
-        f.insert(f.end(), h, h + 10);
-        f.insert(f.end(), d.data.begin(), d.data.end());
-        f.push_back(static_cast<uint8_t>(d.wkc));
-        f.push_back(static_cast<uint8_t>(d.wkc >> 8));
-    }
-    if (f.size() < min_len) f.resize(min_len, 0);
-    return f;
+        b.add(d.cmd, d.idx, d.adp, d.ado, d.data, d.irq, d.wkc);
+    return b.build(min_len);
 }
 
 // Parses the datagrams of a (returned) frame; stops at the first inconsistency.
 inline std::vector<Datagram> parse(const std::vector<uint8_t>& f) {
     std::vector<Datagram> out;
-    std::size_t p = 16;
-    if (f.size() < p) return out;
-    const std::size_t end = p + ((f[14] | (f[15] << 8)) & 0x07FF);
-    while (p + 12 <= end && end <= f.size()) {
+    esc::wire::DatagramReader r(f, false, false);
+    esc::wire::DatagramView v;
+    while (r.next(v)) {
         Datagram d;
-        d.cmd = f[p];
-        d.idx = f[p + 1];
-        d.adp = static_cast<uint16_t>(f[p + 2] | (f[p + 3] << 8));
-        d.ado = static_cast<uint16_t>(f[p + 4] | (f[p + 5] << 8));
-        d.flags = static_cast<uint16_t>(f[p + 6] | (f[p + 7] << 8));
-        d.irq = static_cast<uint16_t>(f[p + 8] | (f[p + 9] << 8));
-        const std::size_t len = d.flags & 0x07FF;
-        if (p + 12 + len > end) break;
-        d.data.assign(f.begin() + static_cast<long>(p + 10), f.begin() + static_cast<long>(p + 10 + len));
-        d.wkc = static_cast<uint16_t>(f[p + 10 + len] | (f[p + 11 + len] << 8));
+        d.cmd = v.command;
+        d.idx = v.index;
+        d.adp = v.adp;
+        d.ado = v.ado;
+        d.flags = v.length_flags;
+        d.irq = v.irq;
+        d.data.assign(v.data.begin(), v.data.end());
+        d.wkc = v.wkc;
         out.push_back(d);
-        p += 12 + len;
-        if (!(d.flags & 0x8000)) break;
     }
     return out;
 }

@@ -11,6 +11,9 @@
 
 #include "esi/model.hpp"
 #include "od/store.hpp"
+#include "util/atomic_file.hpp"
+#include "util/crc.hpp"
+#include "util/le.hpp"
 
 namespace softdrive {
 
@@ -20,13 +23,9 @@ constexpr char kMagic[8] = {'S', 'E', 'C', 'A', 'T', 'S', 'I', 'I'};
 constexpr std::size_t kMaxWords = 65536;
 constexpr std::size_t kMaxFileBytes = 16 + 4 * kMaxWords;  // every word of a 64 Ki-word EEPROM once
 
+using util::get32;
 void put32(std::vector<uint8_t>& b, uint32_t v) {
-    for (int i = 0; i < 4; ++i)
-        b.push_back(static_cast<uint8_t>(v >> (8 * i)));
-}
-uint32_t get32(const uint8_t* p) {
-    return static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 |
-           static_cast<uint32_t>(p[2]) << 16 | static_cast<uint32_t>(p[3]) << 24;
+    util::append32(b, v);
 }
 std::string sys_error(const std::string& what, const std::filesystem::path& p) {
     return what + " " + p.string() + ": " + std::strerror(errno);
@@ -65,7 +64,7 @@ std::string EepromWrites::load() {
     if (b.size() < 16 || std::memcmp(b.data(), kMagic, 8) != 0) return "not an SII writes file";
     const uint32_t n = get32(b.data() + 8);
     if (n > kMaxWords || b.size() != 16 + 4 * static_cast<std::size_t>(n)) return "length does not match";
-    if (od::crc32(std::span<const uint8_t>(b.data(), b.size() - 4)) != get32(b.data() + b.size() - 4))
+    if (util::crc32(std::span<const uint8_t>(b.data(), b.size() - 4)) != get32(b.data() + b.size() - 4))
         return "checksum mismatch";
     for (uint32_t i = 0; i < n; ++i) {
         const uint8_t* p = b.data() + 12 + 4 * i;
@@ -75,55 +74,18 @@ std::string EepromWrites::load() {
 }
 
 bool EepromWrites::remove_stale_temp() const {
-    std::filesystem::path tmp = file_;
-    tmp += ".tmp";
-    return ::unlink(tmp.c_str()) == 0;
+    return util::remove_stale_temp(file_);
 }
 
 std::string EepromWrites::save() {
     std::vector<uint8_t> b(kMagic, kMagic + 8);
     put32(b, static_cast<uint32_t>(words_.size()));
     for (const auto& [address, value] : words_) {
-        b.push_back(static_cast<uint8_t>(address));
-        b.push_back(static_cast<uint8_t>(address >> 8));
-        b.push_back(static_cast<uint8_t>(value));
-        b.push_back(static_cast<uint8_t>(value >> 8));
+        util::append16(b, address);
+        util::append16(b, value);
     }
-    put32(b, od::crc32(b));
-
-    std::filesystem::path tmp = file_;
-    tmp += ".tmp";
-    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) return sys_error("cannot create", tmp);
-    std::size_t done = 0;
-    while (done < b.size()) {
-        const ssize_t n = ::write(fd, b.data() + done, b.size() - done);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            const std::string e = sys_error("cannot write", tmp);
-            ::close(fd);
-            ::unlink(tmp.c_str());
-            return e;
-        }
-        done += static_cast<std::size_t>(n);
-    }
-    if (::fsync(fd) != 0) {
-        const std::string e = sys_error("cannot sync", tmp);
-        ::close(fd);
-        ::unlink(tmp.c_str());
-        return e;
-    }
-    ::close(fd);
-    if (::rename(tmp.c_str(), file_.c_str()) != 0) {
-        const std::string e = sys_error("cannot rename onto", file_);
-        ::unlink(tmp.c_str());
-        return e;
-    }
-    const int dfd = ::open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (dfd < 0) return sys_error("cannot open", dir_);
-    const bool synced = ::fsync(dfd) == 0;
-    ::close(dfd);
-    return synced ? std::string{} : sys_error("cannot sync", dir_);
+    put32(b, util::crc32(b));
+    return util::write_file_atomic(file_, b);
 }
 
 void EepromWrites::apply(std::vector<uint8_t>& image) const {

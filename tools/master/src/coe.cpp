@@ -4,36 +4,30 @@
 #include <algorithm>
 #include <cstring>
 
+#include "coe/wire/sdo.hpp"
+#include "util/le.hpp"
+
 namespace master {
 
 using Clock = std::chrono::steady_clock;
 
 namespace {
-constexpr uint8_t kServiceEmergency = 1;
-constexpr uint8_t kServiceSdoRequest = 2;
-constexpr uint8_t kServiceSdoResponse = 3;
-constexpr uint8_t kServiceSdoInfo = 8;
-constexpr uint8_t kInfoError = 0x07;
-constexpr uint8_t kInfoIncomplete = 0x80;
-constexpr uint32_t kAbortToggle = 0x05030000;
-constexpr uint32_t kAbortCommand = 0x05040001;
-constexpr uint32_t kAbortOutOfMemory = 0x05040005;
-constexpr uint32_t kAbortGeneral = 0x08000000;
+using util::get16;
+using util::get32;
+using util::put16;
+using util::put32;
+// The CoE vocabulary (coe/wire/sdo.hpp).
+constexpr uint8_t kServiceEmergency = static_cast<uint8_t>(coe::Service::Emergency);
+constexpr uint8_t kServiceSdoRequest = static_cast<uint8_t>(coe::Service::SdoRequest);
+constexpr uint8_t kServiceSdoResponse = static_cast<uint8_t>(coe::Service::SdoResponse);
+constexpr uint8_t kServiceSdoInfo = static_cast<uint8_t>(coe::Service::SdoInfo);
+constexpr uint8_t kInfoError = coe::info::kError;
+constexpr uint8_t kInfoIncomplete = coe::info::kIncomplete;
+constexpr uint32_t kAbortToggle = coe::abort::ToggleBit;
+constexpr uint32_t kAbortCommand = coe::abort::UnknownCommand;
+constexpr uint32_t kAbortOutOfMemory = coe::abort::OutOfMemory;
+constexpr uint32_t kAbortGeneral = coe::abort::General;
 
-uint16_t get16(const uint8_t* p) {
-    return static_cast<uint16_t>(p[0] | (p[1] << 8));
-}
-uint32_t get32(const uint8_t* p) {
-    return static_cast<uint32_t>(p[0] | (p[1] << 8) | (p[2] << 16) | (static_cast<uint32_t>(p[3]) << 24));
-}
-void put16(uint8_t* p, uint16_t v) {
-    p[0] = static_cast<uint8_t>(v);
-    p[1] = static_cast<uint8_t>(v >> 8);
-}
-void put32(uint8_t* p, uint32_t v) {
-    for (int i = 0; i < 4; ++i)
-        p[i] = static_cast<uint8_t>(v >> (8 * i));
-}
 // CoE header + SDO command + index + subindex.
 void sdo_head(uint8_t* p, uint8_t cmd, uint16_t index, uint8_t sub) {
     put16(p, static_cast<uint16_t>(kServiceSdoRequest << 12));
@@ -44,74 +38,8 @@ void sdo_head(uint8_t* p, uint8_t cmd, uint16_t index, uint8_t sub) {
 }  // namespace
 
 std::string_view sdo_abort_text(uint32_t code) {
-    switch (code) {
-        case 0x05030000:
-            return "Toggle bit not changed";
-        case 0x05040000:
-            return "SDO protocol timeout";
-        case 0x05040001:
-            return "Client/server command specifier not valid or unknown";
-        case 0x05040005:
-            return "Out of memory";
-        case 0x06010000:
-            return "Unsupported access to an object";
-        case 0x06010001:
-            return "Attempt to read a write-only object";
-        case 0x06010002:
-            return "Attempt to write a read-only object";
-        case 0x06010003:
-            return "Subindex cannot be written, SI0 must be 0 for write access";
-        case 0x06010004:
-            return "SDO complete access not supported";
-        case 0x06010005:
-            return "Object length exceeds mailbox size";
-        case 0x06010006:
-            return "Object mapped to RxPDO, SDO download blocked";
-        case 0x06020000:
-            return "Object does not exist in the object dictionary";
-        case 0x06040041:
-            return "Object cannot be mapped into the PDO";
-        case 0x06040042:
-            return "Number and length of mapped objects would exceed PDO length";
-        case 0x06040043:
-            return "General parameter incompatibility";
-        case 0x06040047:
-            return "General internal incompatibility in the device";
-        case 0x06060000:
-            return "Access failed due to a hardware error";
-        case 0x06070010:
-            return "Data type does not match, length of service parameter does not match";
-        case 0x06070012:
-            return "Data type does not match, length too high";
-        case 0x06070013:
-            return "Data type does not match, length too low";
-        case 0x06090011:
-            return "Subindex does not exist";
-        case 0x06090030:
-            return "Value range of parameter exceeded";
-        case 0x06090031:
-            return "Value written too high";
-        case 0x06090032:
-            return "Value written too low";
-        case 0x06090036:
-            return "Maximum value is less than minimum value";
-        case 0x060A0023:
-            return "Resource not available";
-        case 0x08000000:
-            return "General error";
-        case 0x08000020:
-            return "Data cannot be transferred or stored to the application";
-        case 0x08000021:
-            return "Data cannot be transferred or stored because of local control";
-        case 0x08000022:
-            return "Data cannot be transferred or stored because of the present device state";
-        case 0x08000023:
-            return "Object dictionary not present";
-        case 0x08000024:
-            return "No data available";
-        default:
-            return "unknown abort code";
-    }
+    const std::string_view text = coe::abort::text(code);
+    return text.empty() ? "unknown abort code" : text;
 }
 
 SdoClient::SdoClient(Mailbox& mailbox)
@@ -337,7 +265,7 @@ Result<std::vector<uint16_t>> SdoClient::od_list(uint16_t list_type) {
     uint8_t body[2];
     put16(body, list_type);
     std::vector<uint8_t> a;
-    if (Error e = info(0x01, body, a); e != Error::Ok) return e;
+    if (Error e = info(coe::info::kOdListReq, body, a); e != Error::Ok) return e;
     if (a.size() < 2 || get16(a.data()) != list_type) return Error::MailboxProtocol;
     std::vector<uint16_t> out;
     for (std::size_t i = 2; i + 1 < a.size(); i += 2)
@@ -349,7 +277,7 @@ Result<ObjectDescription> SdoClient::object_description(uint16_t index) {
     uint8_t body[2];
     put16(body, index);
     std::vector<uint8_t> a;
-    if (Error e = info(0x03, body, a); e != Error::Ok) return e;
+    if (Error e = info(coe::info::kObjDescReq, body, a); e != Error::Ok) return e;
     if (a.size() < 6 || get16(a.data()) != index) return Error::MailboxProtocol;
     ObjectDescription d;
     d.index = index;
@@ -366,7 +294,7 @@ Result<EntryDescription> SdoClient::entry_description(uint16_t index, uint8_t su
     body[2] = sub;
     body[3] = value_info;
     std::vector<uint8_t> a;
-    if (Error e = info(0x05, body, a); e != Error::Ok) return e;
+    if (Error e = info(coe::info::kEntryDescReq, body, a); e != Error::Ok) return e;
     if (a.size() < 10 || get16(a.data()) != index || a[2] != sub) return Error::MailboxProtocol;
     EntryDescription d;
     d.index = index;

@@ -2,19 +2,14 @@
 
 #include <cstdio>
 
+#include "util/le.hpp"
+
 namespace master {
 
 namespace {
-
-uint16_t le16(const uint8_t* p) {
-    return static_cast<uint16_t>(p[0] | (p[1] << 8));
-}
-uint32_t le32(const uint8_t* p) {
-    return static_cast<uint32_t>(le16(p)) | (static_cast<uint32_t>(le16(p + 2)) << 16);
-}
-uint64_t le64(const uint8_t* p) {
-    return static_cast<uint64_t>(le32(p)) | (static_cast<uint64_t>(le32(p + 4)) << 32);
-}
+using util::get16;
+using util::get32;
+using util::get64;
 
 constexpr std::size_t kHead = 16;
 
@@ -71,12 +66,12 @@ std::optional<DiagEntry> decode_diag_message(std::span<const uint8_t> bytes, uin
     if (bytes.size() < kHead) return std::nullopt;
     DiagEntry e;
     e.subindex = subindex;
-    e.code = le32(bytes.data());
-    const uint16_t flags = le16(bytes.data() + 4);
+    e.code = get32(bytes.data());
+    const uint16_t flags = get16(bytes.data() + 4);
     e.type = static_cast<uint8_t>(flags & 0x0F);
     e.local_time = (flags & 0x10) != 0;
-    e.text_id = le16(bytes.data() + 6);
-    e.timestamp_ns = le64(bytes.data() + 8);
+    e.text_id = get16(bytes.data() + 6);
+    e.timestamp_ns = get64(bytes.data() + 8);
     // An erased slot (all zero) is no message.
     bool all_zero = true;
     for (uint8_t b : bytes.first(kHead))
@@ -90,7 +85,7 @@ std::optional<DiagEntry> decode_diag_message(std::span<const uint8_t> bytes, uin
             break;
         }
         DiagParameter p;
-        p.flags = le16(bytes.data() + at);
+        p.flags = get16(bytes.data() + at);
         const std::size_t len = p.kind() == 0 ? diag_value_size(p.flags & 0x0FFF) : (p.flags & 0x0FFFu);
         if ((p.kind() == 0 && len == 0) || p.kind() > 3 || at + 2 + len > bytes.size()) {
             e.truncated = true;  // unknown data type or kind: the rest cannot be delimited
@@ -172,7 +167,7 @@ std::string format_diag_param(const DiagParameter& p) {
         case 3:
             s = "\"";
             for (std::size_t i = 0; i + 1 < p.data.size(); i += 2) {
-                const uint16_t c = le16(p.data.data() + i);
+                const uint16_t c = get16(p.data.data() + i);
                 if (c == 0) break;
                 s += (c >= 0x20 && c < 0x7F) ? static_cast<char>(c) : '?';
             }

@@ -3,15 +3,23 @@
 
 #include "master/foe.hpp"
 
+#include "foe/wire/foe.hpp"
+#include "util/le.hpp"
+
 namespace master {
 
 namespace {
-constexpr uint8_t kRead = 1, kWrite = 2, kData = 3, kAck = 4, kErr = 5, kBusy = 6;
-constexpr uint32_t kErrIllegal = 0x8004;
-constexpr uint32_t kErrPacketNumber = 0x8005;
-uint32_t get32(const uint8_t* p) {
-    return static_cast<uint32_t>(p[0] | (p[1] << 8) | (p[2] << 16) | (static_cast<uint32_t>(p[3]) << 24));
-}
+using util::get32;
+// The FoE vocabulary (foe/wire/foe.hpp).
+constexpr uint8_t kRead = static_cast<uint8_t>(foe::Opcode::Read),
+                  kWrite = static_cast<uint8_t>(foe::Opcode::Write),
+                  kData = static_cast<uint8_t>(foe::Opcode::Data),
+                  kAck = static_cast<uint8_t>(foe::Opcode::Ack),
+                  kErr = static_cast<uint8_t>(foe::Opcode::Error),
+                  kBusy = static_cast<uint8_t>(foe::Opcode::Busy);
+constexpr uint32_t kErrIllegal = static_cast<uint32_t>(foe::ErrorCode::Illegal);
+constexpr uint32_t kErrPacketNumber = static_cast<uint32_t>(foe::ErrorCode::PacketNumberWrong);
+constexpr uint32_t kErrDiskFull = static_cast<uint32_t>(foe::ErrorCode::DiskFull);
 }  // namespace
 
 FoeClient::FoeClient(Mailbox& mailbox) : mbx_(mailbox) {}
@@ -73,7 +81,7 @@ Result<std::vector<uint8_t>> FoeClient::read(std::string_view name, uint32_t pas
             return Error::MailboxProtocol;
         }
         if (file.size() + data.size() > max_size) {
-            (void)send(kErr, 0x8003, {});  // disk full
+            (void)send(kErr, kErrDiskFull, {});
             return Error::BufferTooSmall;
         }
         file.insert(file.end(), data.begin(), data.end());

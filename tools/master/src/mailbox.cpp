@@ -4,19 +4,16 @@
 #include <algorithm>
 #include <thread>
 
+#include "util/le.hpp"
+
 namespace master {
 
 using Clock = std::chrono::steady_clock;
 
 namespace {
+using util::get16;
+using util::put16;
 constexpr auto kPoll = std::chrono::microseconds(200);
-uint16_t get16(const uint8_t* p) {
-    return static_cast<uint16_t>(p[0] | (p[1] << 8));
-}
-void put16(uint8_t* p, uint16_t v) {
-    p[0] = static_cast<uint8_t>(v);
-    p[1] = static_cast<uint8_t>(v >> 8);
-}
 }  // namespace
 
 Mailbox::Mailbox(Master& master, Address slave, std::chrono::milliseconds timeout)

@@ -6,32 +6,18 @@
 #include <algorithm>
 #include <thread>
 
+#include "util/le.hpp"
+
 namespace master {
 
 using Clock = std::chrono::steady_clock;
 
 namespace {
-uint16_t get16(const uint8_t* p) {
-    return static_cast<uint16_t>(p[0] | (p[1] << 8));
-}
-void put16(uint8_t* p, uint16_t v) {
-    p[0] = static_cast<uint8_t>(v);
-    p[1] = static_cast<uint8_t>(v >> 8);
-}
-void put32(uint8_t* p, uint32_t v) {
-    for (int i = 0; i < 4; ++i)
-        p[i] = static_cast<uint8_t>(v >> (8 * i));
-}
-void put64(uint8_t* p, uint64_t v) {
-    for (int i = 0; i < 8; ++i)
-        p[i] = static_cast<uint8_t>(v >> (8 * i));
-}
-uint64_t get64(const uint8_t* p) {
-    uint64_t v = 0;
-    for (int i = 0; i < 8; ++i)
-        v |= static_cast<uint64_t>(p[i]) << (8 * i);
-    return v;
-}
+using util::get16;
+using util::get64;
+using util::put16;
+using util::put32;
+using util::put64;
 // EtherCAT system time: ns since 2000-01-01 (§11.1).
 uint64_t master_system_time() {
     timespec ts{};

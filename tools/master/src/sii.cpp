@@ -7,18 +7,17 @@
 
 #include "master/master.hpp"
 
+#include "util/le.hpp"
+
 namespace master {
 
 using Clock = std::chrono::steady_clock;
 
 namespace {
+using util::put32;
 constexpr std::size_t kMaxImageWords = 32768;  // 64 KiB: bound of the category walk (decisions/master.md)
 constexpr unsigned kNackRetries = 5;
 
-void put32(uint8_t* p, uint32_t v) {
-    for (int i = 0; i < 4; ++i)
-        p[i] = static_cast<uint8_t>(v >> (8 * i));
-}
 }  // namespace
 
 Error Master::sii_take(Address a) {

@@ -8,35 +8,21 @@
 #include <optional>
 #include <span>
 
+#include "esc/wire/datagram.hpp"
+
 namespace master {
 
-constexpr uint16_t kEtherType = 0x88A4;
-constexpr std::size_t kEthernetHeaderSize = 14;
-constexpr std::size_t kEcatHeaderSize = 2;
-constexpr std::size_t kDatagramHeaderSize = 10;
-constexpr std::size_t kDatagramOverhead = kDatagramHeaderSize + 2;  // header + working counter
-constexpr std::size_t kMinFrameSize = 60;                           // without FCS
-constexpr std::size_t kMaxFrameSize = 1514;                         // without FCS
-constexpr std::size_t kMaxDatagramsLength = 1498;                   // the 11-bit length field's room in 1500
-constexpr std::size_t kMaxDatagramData = kMaxDatagramsLength - kDatagramOverhead;  // 1486
-
-enum class Command : uint8_t {
-    NOP = 0,
-    APRD = 1,
-    APWR = 2,
-    APRW = 3,
-    FPRD = 4,
-    FPWR = 5,
-    FPRW = 6,
-    BRD = 7,
-    BWR = 8,
-    BRW = 9,
-    LRD = 10,
-    LWR = 11,
-    LRW = 12,
-    ARMW = 13,
-    FRMW = 14,
-};
+// Frame layout and the datagram commands: the ESC wire vocabulary (esc/wire/datagram.hpp).
+using esc::wire::kDatagramHeaderSize;
+using esc::wire::kDatagramOverhead;
+using esc::wire::kEcatHeaderSize;
+using esc::wire::kEthernetHeaderSize;
+using esc::wire::kEtherType;
+using esc::wire::kMaxDatagramData;
+using esc::wire::kMaxDatagramsLength;
+using esc::wire::kMaxFrameSize;
+using esc::wire::kMinFrameSize;
+using Command = esc::Command;
 
 // One datagram of a request. data is both the payload sent and, after the exchange, the payload
 // returned; wkc and irq are filled from the reply.
@@ -89,10 +75,8 @@ class FrameReader {
 
   private:
     std::span<const uint8_t> frame_;
-    std::size_t pos_ = 0;
-    std::size_t end_ = 0;
+    esc::wire::DatagramReader reader_;
     bool valid_ = false;
-    bool done_ = false;
 };
 
 }  // namespace master

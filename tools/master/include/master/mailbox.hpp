@@ -8,19 +8,12 @@
 #include <span>
 #include <vector>
 
+#include "ecat/wire/mailbox.hpp"
 #include "master/master.hpp"
 
 namespace master {
 
-enum class MailboxType : uint8_t {
-    Error = 0x0,
-    AoE = 0x1,
-    EoE = 0x2,
-    CoE = 0x3,
-    FoE = 0x4,
-    SoE = 0x5,
-    VoE = 0xF
-};
+using MailboxType = ecat::MailboxType;  // the mailbox vocabulary (ecat/wire/mailbox.hpp)
 
 struct MailboxConfig {
     uint16_t out_start = 0;  // SM0

@@ -10,7 +10,10 @@
 #include <span>
 #include <vector>
 
+#include "ecat/wire/al.hpp"
 #include "esc/link.hpp"
+#include "esc/wire/registers.hpp"
+#include "esi/wire/sii.hpp"
 #include "master/error.hpp"
 #include "master/frame.hpp"
 
@@ -25,54 +28,45 @@ struct Address {
     static Address station(uint16_t s) { return {Mode::Station, s}; }
 };
 
+// ESC registers the master uses, under its names (values: esc/wire/registers.hpp).
 namespace reg {
-constexpr uint16_t Type = 0x0000;
-constexpr uint16_t StationAddress = 0x0010;
-constexpr uint16_t StationAlias = 0x0012;
-constexpr uint16_t DlStatus = 0x0110;
-constexpr uint16_t AlControl = 0x0120;
-constexpr uint16_t AlStatus = 0x0130;
-constexpr uint16_t AlStatusCode = 0x0134;
-constexpr uint16_t SiiConfig = 0x0500;
-constexpr uint16_t SiiControl = 0x0502;
-constexpr uint16_t SiiAddress = 0x0504;
-constexpr uint16_t SiiData = 0x0508;
-constexpr uint16_t Fmmu0 = 0x0600;
-constexpr uint16_t Sm0 = 0x0800;
-constexpr uint16_t DcSystemTime = 0x0910;
+constexpr uint16_t Type = esc::reg::kType;
+constexpr uint16_t StationAddress = esc::reg::kStationAddress;
+constexpr uint16_t StationAlias = esc::reg::kStationAlias;
+constexpr uint16_t DlStatus = esc::reg::kDlStatus;
+constexpr uint16_t AlControl = esc::reg::kAlControl;
+constexpr uint16_t AlStatus = esc::reg::kAlStatus;
+constexpr uint16_t AlStatusCode = esc::reg::kAlStatusCode;
+constexpr uint16_t SiiConfig = esc::reg::kSiiConfig;
+constexpr uint16_t SiiControl = esc::reg::kSiiControl;
+constexpr uint16_t SiiAddress = esc::reg::kSiiAddress;
+constexpr uint16_t SiiData = esc::reg::kSiiData;
+constexpr uint16_t Fmmu0 = esc::reg::kFmmu;
+constexpr uint16_t Sm0 = esc::reg::kSm;
+constexpr uint16_t DcSystemTime = esc::reg::kDcSystemTime;
 }  // namespace reg
 
-// SII word addresses of the fixed header (ethercat-protocol.md §7.1).
+// SII word addresses of the fixed header (esi/wire/sii.hpp) and the 0x0502 control/status bits
+// (esc/wire/registers.hpp), under the master's names.
 namespace sii {
-constexpr uint16_t VendorId = 0x0008;
-constexpr uint16_t ProductCode = 0x000A;
-constexpr uint16_t Revision = 0x000C;
-constexpr uint16_t SerialNumber = 0x000E;
-constexpr uint16_t BootMailboxOut = 0x0014;
-constexpr uint16_t StdMailboxOut = 0x0018;
-constexpr uint16_t StdMailboxIn = 0x001A;
-constexpr uint16_t MailboxProtocols = 0x001C;
-constexpr uint16_t EepromSize = 0x003E;
-constexpr uint16_t FirstCategory = 0x0040;
-constexpr uint16_t CategoryEnd = 0xFFFF;
-// 0x0502 control/status bits.
-constexpr uint16_t CtlWriteEnable = 0x0001;
-constexpr uint16_t CtlReadSize8 = 0x0040;
-constexpr uint16_t CmdRead = 0x0100;
-constexpr uint16_t CmdWrite = 0x0200;
-constexpr uint16_t CmdReload = 0x0400;
-constexpr uint16_t CmdMask = 0x0700;
-constexpr uint16_t ErrChecksum = 0x0800;
-constexpr uint16_t ErrNotLoaded = 0x1000;
-constexpr uint16_t ErrAck = 0x2000;
-constexpr uint16_t ErrWriteEnable = 0x4000;
-constexpr uint16_t ErrMask = 0x7800;
-constexpr uint16_t Busy = 0x8000;
+constexpr uint16_t VendorId = esi::sii::word::VendorId;
+constexpr uint16_t ProductCode = esi::sii::word::ProductCode;
+constexpr uint16_t Revision = esi::sii::word::Revision;
+constexpr uint16_t SerialNumber = esi::sii::word::SerialNumber;
+constexpr uint16_t BootMailboxOut = esi::sii::word::BootMailboxOut;
+constexpr uint16_t StdMailboxOut = esi::sii::word::StdMailboxOut;
+constexpr uint16_t StdMailboxIn = esi::sii::word::StdMailboxIn;
+constexpr uint16_t MailboxProtocols = esi::sii::word::MailboxProtocols;
+constexpr uint16_t EepromSize = esi::sii::word::EepromSize;
+constexpr uint16_t FirstCategory = esi::sii::word::FirstCategory;
+constexpr uint16_t CategoryEnd = esi::sii::category::End;
+using namespace esc::reg::sii;
 }  // namespace sii
 
-enum class AlState : uint8_t { Init = 0x01, PreOp = 0x02, Boot = 0x03, SafeOp = 0x04, Op = 0x08 };
-constexpr uint16_t kAlErrorAck = 0x0010;  // AL control bit 4 / AL status bit 4 (error indication)
-constexpr uint16_t kAlIdentify = 0x0020;  // AL control bit 5 / AL status bit 5
+using AlState = ecat::AlState;
+constexpr uint16_t kAlErrorAck =
+    esc::reg::kAlErrorFlag;  // AL control bit 4 / AL status bit 4 (error indication)
+constexpr uint16_t kAlIdentify = esc::reg::kAlIdFlag;  // AL control bit 5 / AL status bit 5
 
 struct AlStatus {
     uint8_t state = 0;   // bits 3:0 of 0x0130
