@@ -1,5 +1,5 @@
-// Physical memory of the ESC: routing of an access over registers, SyncManager areas and process RAM,
-// and the register read/write rules of both sides (ECAT, PDI).
+// Access to the ESC's memory: routing of an access over registers, SyncManager areas and process RAM, and
+// the register read/write rules of both sides (ECAT, PDI), which hand the unit registers to their units.
 #include <algorithm>
 #include <cstring>
 
@@ -7,22 +7,12 @@
 
 namespace esc {
 
-namespace {
-const SmArea* first_area(const std::array<SmArea, 16>& areas, uint8_t count, uint32_t p, uint32_t end) {
-    for (uint8_t k = 0; k < count; ++k) {
-        const SmArea& s = areas[k];
-        if (s.end > p && s.start < end) return &s;
-    }
-    return nullptr;
-}
-}  // namespace
-
 bool Esc::Impl::phys_read(uint32_t a, uint8_t* dst, uint8_t* ok, uint32_t n, Side side) {
     const uint32_t end = a + n;
     bool any = false;
     uint32_t p = a;
     while (p < end) {
-        const SmArea* hit = first_area(sm_areas, sm_area_count, p, end);
+        const SmArea* hit = sm.first_area(p, end);
         const uint32_t seg_end = hit ? std::max(p, hit->start) : end;
         if (p < seg_end) {
             if (p < reg::kRamBase) {
@@ -32,9 +22,9 @@ bool Esc::Impl::phys_read(uint32_t a, uint8_t* dst, uint8_t* ok, uint32_t n, Sid
                 any = true;
                 p = q;
             }
-            if (p < seg_end && p < mem_end) {
-                const uint32_t q = std::min(seg_end, mem_end);
-                std::memcpy(dst + (p - a), &ram[p - reg::kRamBase], q - p);
+            if (p < seg_end && p < mem.ram_end) {
+                const uint32_t q = std::min(seg_end, mem.ram_end);
+                std::memcpy(dst + (p - a), &mem.ram[p - reg::kRamBase], q - p);
                 if (ok) std::memset(ok + (p - a), 1, q - p);
                 any = true;
                 p = q;
@@ -43,9 +33,9 @@ bool Esc::Impl::phys_read(uint32_t a, uint8_t* dst, uint8_t* ok, uint32_t n, Sid
         }
         if (hit && p < end) {
             const uint32_t q = std::min(end, hit->end);
-            if (sm_access(hit->sm, p - hit->start, dst + (p - a), nullptr, nullptr, q - p, false, side)) {
+            if (sm.access(hit->sm, p - hit->start, dst + (p - a), nullptr, nullptr, q - p, false, side)) {
                 any = true;
-                if (ok) std::memset(ok + (p - a), 1, std::min(q, hit->start + sm[hit->sm].length) - p);
+                if (ok) std::memset(ok + (p - a), 1, std::min(q, hit->start + sm.length(hit->sm)) - p);
             }
             p = q;
         }
@@ -58,9 +48,9 @@ bool Esc::Impl::phys_write(uint32_t a, const uint8_t* src, const uint8_t* bm, ui
     bool any = false;
     uint32_t p = a;
     const bool esc_protected =
-        side == Side::Ecat && (regs[reg::kEscWriteProtect] & 0x01) && !frame_esc_write_enable;
+        side == Side::Ecat && (mem.regs[reg::kEscWriteProtect] & 0x01) && !frame_esc_write_enable;
     while (p < end) {
-        const SmArea* hit = first_area(sm_areas, sm_area_count, p, end);
+        const SmArea* hit = sm.first_area(p, end);
         const uint32_t seg_end = hit ? std::max(p, hit->start) : end;
         if (p < seg_end) {
             if (p < reg::kRamBase) {
@@ -70,10 +60,10 @@ bool Esc::Impl::phys_write(uint32_t a, const uint8_t* src, const uint8_t* bm, ui
                     any = true;
                 p = q;
             }
-            if (p < seg_end && p < mem_end) {
-                const uint32_t q = std::min(seg_end, mem_end);
+            if (p < seg_end && p < mem.ram_end) {
+                const uint32_t q = std::min(seg_end, mem.ram_end);
                 if (!esc_protected) {
-                    uint8_t* m = &ram[p - reg::kRamBase];
+                    uint8_t* m = &mem.ram[p - reg::kRamBase];
                     const uint8_t* s = src + (p - a);
                     if (bm) {
                         const uint8_t* mk = bm + (p - a);
@@ -90,7 +80,7 @@ bool Esc::Impl::phys_write(uint32_t a, const uint8_t* src, const uint8_t* bm, ui
         }
         if (hit && p < end) {
             const uint32_t q = std::min(end, hit->end);
-            if (!esc_protected && sm_access(hit->sm, p - hit->start, nullptr, src + (p - a),
+            if (!esc_protected && sm.access(hit->sm, p - hit->start, nullptr, src + (p - a),
                                             bm ? bm + (p - a) : nullptr, q - p, true, side))
                 any = true;
             p = q;
@@ -104,7 +94,7 @@ uint64_t Esc::Impl::merged(uint16_t r, unsigned size, uint16_t a, uint16_t e, co
     uint64_t v = 0;
     for (unsigned i = 0; i < size; ++i) {
         const uint16_t addr = static_cast<uint16_t>(r + i);
-        uint8_t b = regs[addr];
+        uint8_t b = mem.regs[addr];
         if (addr >= a && addr < e) {
             const uint8_t m = bm ? bm[addr - a] : 0xFF;
             b = static_cast<uint8_t>((b & ~m) | (src[addr - a] & m));
@@ -117,53 +107,31 @@ uint64_t Esc::Impl::merged(uint16_t r, unsigned size, uint16_t a, uint16_t e, co
 void Esc::Impl::reg_read(uint16_t a, uint8_t* dst, uint32_t n, Side side) {
     const uint16_t e = static_cast<uint16_t>(a + n);
     // Values computed at the moment of the access.
-    if (a < 0x0A00 && e > reg::kDcRecvTime0) {
-        if (overlaps(a, e, reg::kDcSystemTime, 8)) {
-            const uint64_t local = side == Side::Ecat && cfg.faults.dc_time_frozen ? 0 : cur_local();
-            uint64_t st = local + r64(reg::kDcOffset);
-            if (side == Side::Ecat) st -= r32(reg::kDcDelay);
-            w64(reg::kDcSystemTime, st);
-        }
-        if (overlaps(a, e, reg::kDcSync0Status, 2)) {
-            const uint16_t pulse = r16(reg::kDcPulseLength);
-            const uint64_t sys = cur_local() + r64(reg::kDcOffset);
-            const uint64_t len = static_cast<uint64_t>(pulse) * 10;
-            const bool s0 = pulse == 0 ? sync0_ack : (last_sync0 != 0 && sys < last_sync0 + len);
-            const bool s1 = pulse == 0 ? sync1_ack : (last_sync1 != 0 && sys < last_sync1 + len);
-            w8(reg::kDcSync0Status, s0 ? 1 : 0);
-            w8(reg::kDcSync1Status, s1 ? 1 : 0);
-        }
-    }
-    std::memcpy(dst, &regs[a], n);
+    if (a < 0x0A00 && e > reg::kDcRecvTime0) dc.before_read(a, e, side);
+    std::memcpy(dst, &mem.regs[a], n);
     if (side == Side::Ecat) {
-        if (overlaps(a, e, reg::kDlStatus, 2)) clear_ecat_event(ecev::kDlStatus);
-        if (overlaps(a, e, reg::kAlStatus, 2)) clear_ecat_event(ecev::kAlStatus);
+        if (overlaps(a, e, reg::kDlStatus, 2)) mem.clear_ecat_event(ecev::kDlStatus);
+        if (overlaps(a, e, reg::kAlStatus, 2)) mem.clear_ecat_event(ecev::kAlStatus);
         return;
     }
-    if (overlaps(a, e, reg::kAlControl, 2)) clear_al_event(alev::kAlControl);
-    if (overlaps(a, e, reg::kSm, 8u * sm_count)) {
-        for (unsigned k = 0; k < sm_count; ++k)
+    if (overlaps(a, e, reg::kAlControl, 2)) mem.clear_al_event(alev::kAlControl);
+    if (overlaps(a, e, reg::kSm, 8u * cfg.sm_count)) {
+        for (unsigned k = 0; k < cfg.sm_count; ++k)
             if (overlaps(a, e, static_cast<uint16_t>(reg::kSm + 8 * k + 6), 1))
-                clear_al_event(alev::kSmActivation);
+                mem.clear_al_event(alev::kSmActivation);
     }
-    if (overlaps(a, e, reg::kWdStatusPd, 2)) clear_al_event(alev::kWatchdogPd);
-    if (overlaps(a, e, reg::kDcSync0Status, 1)) {
-        clear_al_event(alev::kSync0);
-        sync0_ack = false;
-    }
-    if (overlaps(a, e, reg::kDcSync1Status, 1)) {
-        clear_al_event(alev::kSync1);
-        sync1_ack = false;
-    }
-    if (overlaps(a, e, reg::kDcLatch0Status, 0x22)) clear_al_event(alev::kDcLatch);
+    if (overlaps(a, e, reg::kWdStatusPd, 2)) mem.clear_al_event(alev::kWatchdogPd);
+    dc.after_pdi_read(a, e);
+    if (overlaps(a, e, reg::kDcLatch0Status, 0x22)) mem.clear_al_event(alev::kDcLatch);
 }
 
 bool Esc::Impl::reg_write(uint16_t a, const uint8_t* src, const uint8_t* bm, uint32_t n, Side side) {
     const uint8_t* kind = side == Side::Ecat ? ecat_kind.data() : pdi_kind.data();
     const uint8_t* wmask = side == Side::Ecat ? ecat_wmask.data() : pdi_wmask.data();
-    const bool reg_prot = side == Side::Ecat && (regs[reg::kRegWriteProtect] & 0x01) && !frame_write_enable;
+    const bool reg_prot =
+        side == Side::Ecat && (mem.regs[reg::kRegWriteProtect] & 0x01) && !frame_write_enable;
     const bool esc_prot =
-        side == Side::Ecat && (regs[reg::kEscWriteProtect] & 0x01) && !frame_esc_write_enable;
+        side == Side::Ecat && (mem.regs[reg::kEscWriteProtect] & 0x01) && !frame_esc_write_enable;
     bool any = false;
     bool special = false;
     for (uint32_t i = 0; i < n; ++i) {
@@ -174,7 +142,7 @@ bool Esc::Impl::reg_write(uint16_t a, const uint8_t* src, const uint8_t* bm, uin
         any = true;
         if (kind[addr] == kPlain) {
             const uint8_t m = static_cast<uint8_t>(wmask[addr] & (bm ? bm[i] : 0xFF));
-            regs[addr] = static_cast<uint8_t>((regs[addr] & ~m) | (src[i] & m));
+            mem.regs[addr] = static_cast<uint8_t>((mem.regs[addr] & ~m) | (src[i] & m));
         } else if (kind[addr] == kSpecial) {
             special = true;
         }
@@ -210,100 +178,103 @@ void Esc::Impl::reg_special_write(uint16_t a, uint16_t e, const uint8_t* src, co
     if (side == Side::Ecat) {
         if (hit(reg::kRegWriteEnable, 1)) {
             frame_write_enable = M(reg::kRegWriteEnable, 1) & 0x01;
-            regs[reg::kRegWriteEnable] = frame_write_enable ? 1 : 0;
+            mem.regs[reg::kRegWriteEnable] = frame_write_enable ? 1 : 0;
         }
         if (hit(reg::kEscWriteEnable, 1)) {
             frame_esc_write_enable = M(reg::kEscWriteEnable, 1) & 0x01;
-            regs[reg::kEscWriteEnable] = frame_esc_write_enable ? 1 : 0;
+            mem.regs[reg::kEscWriteEnable] = frame_esc_write_enable ? 1 : 0;
         }
         if (a >= reg::kUserRam) return;  // nothing special above
         if (hit(reg::kEscResetEcat, 1)) {
-            regs[reg::kEscResetEcat] = static_cast<uint8_t>(M(reg::kEscResetEcat, 1));
+            mem.regs[reg::kEscResetEcat] = static_cast<uint8_t>(M(reg::kEscResetEcat, 1));
             reset_written_this_frame = true;
         }
         if (hit(reg::kAlControl, 2)) {
             const uint16_t v = static_cast<uint16_t>(M(reg::kAlControl, 2) & 0x003F);
-            const bool emulation = r8(reg::kEscConfig) & 0x01;
+            const bool emulation = mem.r8(reg::kEscConfig) & 0x01;
             // Device emulation off: AL control is a mailbox, blocked until the PDI read the last value.
-            if (emulation || !(r32(reg::kAlEvent) & alev::kAlControl)) {
-                w16(reg::kAlControl, v);
-                set_al_event(alev::kAlControl);
+            if (emulation || !(mem.r32(reg::kAlEvent) & alev::kAlControl)) {
+                mem.w16(reg::kAlControl, v);
+                mem.set_al_event(alev::kAlControl);
                 if (emulation) {
-                    const uint16_t st = static_cast<uint16_t>((r16(reg::kAlStatus) & ~0x001F) | (v & 0x000F));
-                    w16(reg::kAlStatus, st);
-                    set_ecat_event(ecev::kAlStatus);
+                    const uint16_t st =
+                        static_cast<uint16_t>((mem.r16(reg::kAlStatus) & ~0x001F) | (v & 0x000F));
+                    mem.w16(reg::kAlStatus, st);
+                    mem.set_ecat_event(ecev::kAlStatus);
                 }
             }
         }
         if (hit(0x0300, 0x14)) {
             for (uint16_t x = std::max<uint16_t>(a, 0x0300); x < std::min<uint16_t>(e, 0x0314); ++x)
-                regs[x] = 0;
+                mem.regs[x] = 0;
         }
         if (hit(reg::kWdCounterPd, 2)) {
-            regs[reg::kWdCounterPd] = 0;
-            regs[reg::kWdCounterPdi] = 0;
+            mem.regs[reg::kWdCounterPd] = 0;
+            mem.regs[reg::kWdCounterPdi] = 0;
         }
         if (hit(reg::kSiiConfig, 1)) {
             const uint8_t v = static_cast<uint8_t>(M(reg::kSiiConfig, 1) & 0x03);
-            w8(reg::kSiiConfig, v);
+            mem.w8(reg::kSiiConfig, v);
             // Force ECAT access: takes the interface back from the PDI.
-            if (v & 0x02) w8(reg::kSiiPdiAccess, static_cast<uint8_t>(r8(reg::kSiiPdiAccess) & ~0x01));
+            if (v & 0x02)
+                mem.w8(reg::kSiiPdiAccess, static_cast<uint8_t>(mem.r8(reg::kSiiPdiAccess) & ~0x01));
         }
-        const bool pdi_owns_sii = (r8(reg::kSiiConfig) & 0x01) && (r8(reg::kSiiPdiAccess) & 0x01);
-        const bool sii_busy = r16(reg::kSiiControl) & 0x8000;
+        const bool pdi_owns_sii = (mem.r8(reg::kSiiConfig) & 0x01) && (mem.r8(reg::kSiiPdiAccess) & 0x01);
+        const bool sii_busy = mem.r16(reg::kSiiControl) & 0x8000;
         if (hit(reg::kSiiAddress, 12) && !pdi_owns_sii && !sii_busy) {
             for (uint16_t x = std::max<uint16_t>(a, reg::kSiiAddress); x < std::min<uint16_t>(e, 0x0510); ++x)
-                regs[x] = static_cast<uint8_t>(M(x, 1));
+                mem.regs[x] = static_cast<uint8_t>(M(x, 1));
         }
         if (hit(reg::kSiiControl, 2) && !pdi_owns_sii && !sii_busy) {
             // Only bit 0 (write enable) and bits 10:8 (command) are writable; IgH sets read-only bits.
             const uint16_t v = static_cast<uint16_t>(M(reg::kSiiControl, 2));
-            uint16_t c = static_cast<uint16_t>((r16(reg::kSiiControl) & ~0x0701) | (v & 0x0701));
+            uint16_t c = static_cast<uint16_t>((mem.r16(reg::kSiiControl) & ~0x0701) | (v & 0x0701));
             if (((v >> 8) & 0x07) == 0) {
                 c = static_cast<uint16_t>(c & ~0x6000);  // command 000 clears the error bits
             } else {
                 c = static_cast<uint16_t>(c | 0x8000);  // busy until the end of the frame
-                eeprom_pending = true;
+                sii.request();
             }
-            w16(reg::kSiiControl, c);
+            mem.w16(reg::kSiiControl, c);
         }
-        if (hit(reg::kFmmu, 16u * fmmu_count)) {
+        if (hit(reg::kFmmu, 16u * cfg.fmmu_count)) {
             static constexpr uint8_t kMask[13] = {0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0x07,
                                                   0x07, 0xFF, 0xFF, 0x07, 0x03, 0x01};
             const uint16_t lo = std::max<uint16_t>(a, reg::kFmmu);
-            const uint16_t hi = std::min<uint16_t>(e, static_cast<uint16_t>(reg::kFmmu + 16u * fmmu_count));
+            const uint16_t hi =
+                std::min<uint16_t>(e, static_cast<uint16_t>(reg::kFmmu + 16u * cfg.fmmu_count));
             for (uint16_t x = lo; x < hi; ++x) {
                 const unsigned off = (x - reg::kFmmu) % 16;
                 if (off > 0x0C) continue;
                 const uint8_t m = static_cast<uint8_t>(kMask[off] & (bm ? bm[x - a] : 0xFF));
-                regs[x] = static_cast<uint8_t>((regs[x] & ~m) | (src[x - a] & m));
+                mem.regs[x] = static_cast<uint8_t>((mem.regs[x] & ~m) | (src[x - a] & m));
             }
             lookup_dirty = true;
         }
-        if (hit(reg::kSm, 8u * sm_count)) {
+        if (hit(reg::kSm, 8u * cfg.sm_count)) {
             const uint16_t lo = std::max<uint16_t>(a, reg::kSm);
-            const uint16_t hi = std::min<uint16_t>(e, static_cast<uint16_t>(reg::kSm + 8u * sm_count));
+            const uint16_t hi = std::min<uint16_t>(e, static_cast<uint16_t>(reg::kSm + 8u * cfg.sm_count));
             for (uint16_t x = lo; x < hi; ++x) {
                 const unsigned n = (x - reg::kSm) / 8;
                 const unsigned off = (x - reg::kSm) % 8;
                 if (off <= 4) {
                     // Start, length, control: writable only while the SM was disabled before this datagram.
-                    if (sm_lock_mask & (1u << n)) continue;
+                    if (sm.locked(n)) continue;
                     const uint8_t m = bm ? bm[x - a] : 0xFF;
-                    regs[x] = static_cast<uint8_t>((regs[x] & ~m) | (src[x - a] & m));
+                    mem.regs[x] = static_cast<uint8_t>((mem.regs[x] & ~m) | (src[x - a] & m));
                     lookup_dirty = true;
                 } else if (off == 6) {
-                    sm_activate_written(n, static_cast<uint8_t>(M(x, 1)));
+                    if (sm.activate_written(n, static_cast<uint8_t>(M(x, 1)))) lookup_dirty = true;
                 }
             }
         }
         if (a >= 0x0A00 || e <= reg::kDcRecvTime0) return;
-        if (hit(reg::kDcRecvTime0, 4)) dc_latch_pending = true;
+        if (hit(reg::kDcRecvTime0, 4)) dc.receive_time_written();
         if (covers(reg::kDcSystemTime, 4))
-            dc_system_time_written(static_cast<uint32_t>(M(reg::kDcSystemTime, 4)));
+            dc.system_time_written(static_cast<uint32_t>(M(reg::kDcSystemTime, 4)));
         if (hit(reg::kDcSpeedStart, 2)) {
-            w16(reg::kDcSpeedStart, static_cast<uint16_t>(M(reg::kDcSpeedStart, 2) & 0x7FFF));
-            dc_reset_filters();
+            mem.w16(reg::kDcSpeedStart, static_cast<uint16_t>(M(reg::kDcSpeedStart, 2) & 0x7FFF));
+            dc.reset_filters();
         }
     }
 
@@ -319,58 +290,58 @@ void Esc::Impl::reg_special_write(uint16_t a, uint16_t e, const uint8_t* src, co
             }
             if (reset_progress_pdi == 3) {
                 reset_registers();
-                load_eeprom_words(true);
+                sii.load_words(true);
                 return;
             }
-            regs[reg::kEscResetPdi] = reset_progress_pdi;
+            mem.regs[reg::kEscResetPdi] = reset_progress_pdi;
         }
-        if (hit(reg::kAlStatus, 2) && !(r8(reg::kEscConfig) & 0x01)) {
-            w16(reg::kAlStatus, static_cast<uint16_t>(M(reg::kAlStatus, 2) & 0x003F));
-            set_ecat_event(ecev::kAlStatus);
+        if (hit(reg::kAlStatus, 2) && !(mem.r8(reg::kEscConfig) & 0x01)) {
+            mem.w16(reg::kAlStatus, static_cast<uint16_t>(M(reg::kAlStatus, 2) & 0x003F));
+            mem.set_ecat_event(ecev::kAlStatus);
         }
-        const bool pdi_owns_sii = (r8(reg::kSiiConfig) & 0x01) && (r8(reg::kSiiPdiAccess) & 0x01);
-        if (hit(reg::kSiiControl, 14) && pdi_owns_sii && !(r16(reg::kSiiControl) & 0x8000)) {
+        const bool pdi_owns_sii = (mem.r8(reg::kSiiConfig) & 0x01) && (mem.r8(reg::kSiiPdiAccess) & 0x01);
+        if (hit(reg::kSiiControl, 14) && pdi_owns_sii && !(mem.r16(reg::kSiiControl) & 0x8000)) {
             for (uint16_t x = std::max<uint16_t>(a, reg::kSiiAddress); x < std::min<uint16_t>(e, 0x0510); ++x)
-                regs[x] = static_cast<uint8_t>(M(x, 1));
+                mem.regs[x] = static_cast<uint8_t>(M(x, 1));
             if (hit(reg::kSiiControl, 2)) {
                 const uint16_t v = static_cast<uint16_t>(M(reg::kSiiControl, 2));
-                uint16_t c = static_cast<uint16_t>((r16(reg::kSiiControl) & ~0x2701) | (v & 0x2701));
-                w16(reg::kSiiControl, c);
-                if ((v >> 8) & 0x07) eeprom_execute(Side::Pdi);
+                uint16_t c = static_cast<uint16_t>((mem.r16(reg::kSiiControl) & ~0x2701) | (v & 0x2701));
+                mem.w16(reg::kSiiControl, c);
+                if ((v >> 8) & 0x07) sii.execute();
             }
         }
-        if (hit(reg::kSm, 8u * sm_count)) {
-            for (unsigned n = 0; n < sm_count; ++n) {
+        if (hit(reg::kSm, 8u * cfg.sm_count)) {
+            for (unsigned n = 0; n < cfg.sm_count; ++n) {
                 const uint16_t x = static_cast<uint16_t>(reg::kSm + 8 * n + 7);
-                if (hit(x, 1)) sm_pdi_control_written(n, static_cast<uint8_t>(M(x, 1)));
+                if (hit(x, 1)) sm.pdi_control_written(n, static_cast<uint8_t>(M(x, 1)));
             }
         }
         if (a >= 0x0A00 || e <= reg::kDcRecvTime0) return;
     }
 
     // ---- DC SYNC/latch configuration: writable by the side that owns the unit (0x0980).
-    const uint8_t owner = r8(reg::kDcCyclicControl);
+    const uint8_t owner = mem.r8(reg::kDcCyclicControl);
     const bool sync_mine = (side == Side::Pdi) == ((owner & 0x01) != 0);
     if (sync_mine) {
-        if (hit(reg::kDcStartTime, 8) && !(r8(reg::kDcActivation) & 0x01)) {
-            w64(reg::kDcStartTime, M(reg::kDcStartTime, 8));
-            dc_start_time_written(!hit(0x0994, 4));
+        if (hit(reg::kDcStartTime, 8) && !(mem.r8(reg::kDcActivation) & 0x01)) {
+            mem.w64(reg::kDcStartTime, M(reg::kDcStartTime, 8));
+            dc.start_time_written(!hit(0x0994, 4));
         }
         if (hit(reg::kDcSync0Cycle, 8)) {
-            w32(reg::kDcSync0Cycle, static_cast<uint32_t>(M(reg::kDcSync0Cycle, 4)));
-            w32(reg::kDcSync1Cycle, static_cast<uint32_t>(M(reg::kDcSync1Cycle, 4)));
+            mem.w32(reg::kDcSync0Cycle, static_cast<uint32_t>(M(reg::kDcSync0Cycle, 4)));
+            mem.w32(reg::kDcSync1Cycle, static_cast<uint32_t>(M(reg::kDcSync1Cycle, 4)));
         }
         if (hit(reg::kDcActivation, 1)) {
-            const uint8_t old = r8(reg::kDcActivation);
+            const uint8_t old = mem.r8(reg::kDcActivation);
             const uint8_t v = static_cast<uint8_t>(M(reg::kDcActivation, 1));
-            w8(reg::kDcActivation, v);
-            dc_activation_written(old, v);
+            mem.w8(reg::kDcActivation, v);
+            dc.activation_written(old, v);
         }
     }
     if (hit(reg::kDcLatch0Control, 1) && (side == Side::Pdi) == ((owner & 0x10) != 0))
-        w8(reg::kDcLatch0Control, static_cast<uint8_t>(M(reg::kDcLatch0Control, 1) & 0x03));
+        mem.w8(reg::kDcLatch0Control, static_cast<uint8_t>(M(reg::kDcLatch0Control, 1) & 0x03));
     if (hit(reg::kDcLatch1Control, 1) && (side == Side::Pdi) == ((owner & 0x20) != 0))
-        w8(reg::kDcLatch1Control, static_cast<uint8_t>(M(reg::kDcLatch1Control, 1) & 0x03));
+        mem.w8(reg::kDcLatch1Control, static_cast<uint8_t>(M(reg::kDcLatch1Control, 1) & 0x03));
 }
 
 }  // namespace esc
