@@ -2,40 +2,18 @@
 #include <algorithm>
 #include <cstring>
 
+#include "esc/wire/datagram.hpp"
 #include "esc_impl.hpp"
+#include "util/le.hpp"
 
 namespace esc {
 
 namespace {
 
-constexpr uint16_t kEtherTypeEcat = 0x88A4;
-constexpr uint16_t kEtherTypeVlan = 0x8100;
-
-enum Cmd : uint8_t {
-    kNop = 0,
-    kAprd = 1,
-    kApwr = 2,
-    kAprw = 3,
-    kFprd = 4,
-    kFpwr = 5,
-    kFprw = 6,
-    kBrd = 7,
-    kBwr = 8,
-    kBrw = 9,
-    kLrd = 10,
-    kLwr = 11,
-    kLrw = 12,
-    kArmw = 13,
-    kFrmw = 14,
-};
-
-uint16_t le16(const uint8_t* p) {
-    return static_cast<uint16_t>(p[0] | (p[1] << 8));
-}
-void put_le16(uint8_t* p, uint16_t v) {
-    p[0] = static_cast<uint8_t>(v);
-    p[1] = static_cast<uint8_t>(v >> 8);
-}
+using wire::kEtherTypeVlan;
+constexpr uint16_t kEtherTypeEcat = wire::kEtherType;
+using util::get16;
+using util::put16;
 
 }  // namespace
 
@@ -209,7 +187,7 @@ bool Esc::Impl::process(std::span<uint8_t> frame, uint64_t rx_clock) {
         mem.count_error(reg::kProcessingUnitErrors);
         return true;
     }
-    const uint16_t h = le16(f + hdr);
+    const uint16_t h = get16(f + hdr);
     if ((h >> 12) != 1) {
         ++stats.frames_ignored;  // EtherCAT frame of another type: forwarded unprocessed
         return true;
@@ -232,7 +210,7 @@ bool Esc::Impl::process(std::span<uint8_t> frame, uint64_t rx_clock) {
                 ++stats.malformed_datagram;
                 break;
             }
-            const uint16_t lf = le16(f + p + 6);
+            const uint16_t lf = get16(f + p + 6);
             const uint16_t dlen = lf & 0x07FF;
             if (p + 12 + dlen > end) {
                 ok = false;
@@ -284,58 +262,59 @@ void Esc::Impl::end_of_frame(bool ok) {
 }
 
 void Esc::Impl::datagram(uint8_t* d, uint8_t* data, uint16_t len) {
-    const uint8_t cmd = d[0];
-    if (cmd == kNop || cmd > kFrmw) return;  // not for a slave: untouched
-    const uint16_t adp = le16(d + 2);
-    const uint16_t ado = le16(d + 4);
+    if (d[0] == static_cast<uint8_t>(Command::NOP) || d[0] > static_cast<uint8_t>(Command::FRMW))
+        return;  // not for a slave: untouched
+    const Command cmd = static_cast<Command>(d[0]);
+    const uint16_t adp = get16(d + 2);
+    const uint16_t ado = get16(d + 4);
     uint8_t* wkc_p = data + len;
-    put_le16(d + 8,
-             static_cast<uint16_t>(le16(d + 8) | (mem.r16(reg::kEcatEvent) & mem.r16(reg::kEcatEventMask))));
+    put16(d + 8,
+          static_cast<uint16_t>(get16(d + 8) | (mem.r16(reg::kEcatEvent) & mem.r16(reg::kEcatEventMask))));
 
     enum Op : uint8_t { kNone, kRead, kWrite, kReadWrite };
     Op op = kNone;
     bool or_read = false;
     switch (cmd) {
-        case kAprd:
-        case kApwr:
-        case kAprw:
-            if (adp == 0) op = cmd == kAprd ? kRead : cmd == kApwr ? kWrite : kReadWrite;
-            put_le16(d + 2, static_cast<uint16_t>(adp + 1));
+        case Command::APRD:
+        case Command::APWR:
+        case Command::APRW:
+            if (adp == 0) op = cmd == Command::APRD ? kRead : cmd == Command::APWR ? kWrite : kReadWrite;
+            put16(d + 2, static_cast<uint16_t>(adp + 1));
             break;
-        case kFprd:
-        case kFpwr:
-        case kFprw:
-        case kFrmw: {
+        case Command::FPRD:
+        case Command::FPWR:
+        case Command::FPRW:
+        case Command::FRMW: {
             const bool match = adp == mem.r16(reg::kStationAddress) ||
                                ((mem.r8(0x0103) & 0x01) && !cfg.faults.alias_ignored &&
                                 adp == mem.r16(reg::kStationAlias)) ||
-                               (cmd == kFprd && cfg.faults.fprd_any_address);
-            if (cmd == kFrmw) {
+                               (cmd == Command::FPRD && cfg.faults.fprd_any_address);
+            if (cmd == Command::FRMW) {
                 op = match ? kRead : kWrite;
             } else if (match) {
-                op = cmd == kFprd ? kRead : cmd == kFpwr ? kWrite : kReadWrite;
+                op = cmd == Command::FPRD ? kRead : cmd == Command::FPWR ? kWrite : kReadWrite;
             }
             break;
         }
-        case kBrd:
-        case kBwr:
-        case kBrw:
-            op = cmd == kBrd ? kRead : cmd == kBwr ? kWrite : kReadWrite;
-            or_read = cmd != kBwr;
-            put_le16(d + 2, static_cast<uint16_t>(adp + 1));
+        case Command::BRD:
+        case Command::BWR:
+        case Command::BRW:
+            op = cmd == Command::BRD ? kRead : cmd == Command::BWR ? kWrite : kReadWrite;
+            or_read = cmd != Command::BWR;
+            put16(d + 2, static_cast<uint16_t>(adp + 1));
             break;
-        case kArmw:
+        case Command::ARMW:
             op = adp == 0 ? kRead : kWrite;
-            put_le16(d + 2, static_cast<uint16_t>(adp + 1));
+            put16(d + 2, static_cast<uint16_t>(adp + 1));
             break;
-        case kLrd:
-        case kLwr:
-        case kLrw: {
+        case Command::LRD:
+        case Command::LWR:
+        case Command::LRW: {
             const uint32_t la = static_cast<uint32_t>(adp) | (static_cast<uint32_t>(ado) << 16);
             sm.set_lock_mask(sm.enabled_mask());
             const uint16_t inc = fmmu.logical(cmd, la, data, len);
             if (lookup_dirty) rebuild_lookup();
-            if (inc) put_le16(wkc_p, static_cast<uint16_t>(le16(wkc_p) + inc));
+            if (inc) put16(wkc_p, static_cast<uint16_t>(get16(wkc_p) + inc));
             return;
         }
         default:
@@ -368,8 +347,8 @@ void Esc::Impl::datagram(uint8_t* d, uint8_t* data, uint16_t len) {
             inc = static_cast<uint16_t>(inc + (op == kWrite ? 1 : 2));
         if (lookup_dirty) rebuild_lookup();
     }
-    if (cmd == kAprd && inc && cfg.faults.wkc_aprd) ++inc;
-    if (inc) put_le16(wkc_p, static_cast<uint16_t>(le16(wkc_p) + inc));
+    if (cmd == Command::APRD && inc && cfg.faults.wkc_aprd) ++inc;
+    if (inc) put16(wkc_p, static_cast<uint16_t>(get16(wkc_p) + inc));
 }
 
 // ==================================================================================================

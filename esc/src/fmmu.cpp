@@ -36,12 +36,12 @@ void Fmmus::rebuild() {
     }
 }
 
-uint16_t Fmmus::logical(uint8_t cmd, uint32_t la, uint8_t* data, uint16_t len) {
+uint16_t Fmmus::logical(Command cmd, uint32_t la, uint8_t* data, uint16_t len) {
     if (len == 0) return 0;
     const uint64_t b0 = static_cast<uint64_t>(la) * 8;
     const uint64_t b1 = b0 + static_cast<uint64_t>(len) * 8;
-    const bool do_read = cmd != 11;   // LRD (10), LRW (12)
-    const bool do_write = cmd != 10;  // LWR (11), LRW (12)
+    const bool do_read = cmd != Command::LWR;   // LRD, LRW
+    const bool do_write = cmd != Command::LRD;  // LWR, LRW
     const uint8_t* wsrc = data;
     if (do_read && do_write) {
         std::memcpy(lrw_src.data(), data, len);  // writes take the incoming data, reads happen first
@@ -65,8 +65,8 @@ uint16_t Fmmus::logical(uint8_t cmd, uint32_t la, uint8_t* data, uint16_t len) {
             if (i0 < i1 && write(f, i0, i1, la, wsrc)) any_w = true;
         }
     }
-    if (cmd == 10) return any_r ? 1 : 0;
-    if (cmd == 11) return any_w ? 1 : 0;
+    if (cmd == Command::LRD) return any_r ? 1 : 0;
+    if (cmd == Command::LWR) return any_w ? 1 : 0;
     return static_cast<uint16_t>((any_r ? 1 : 0) + (any_w ? 2 : 0));
 }
 

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 
+#include "esc/wire/datagram.hpp"
 #include "memory.hpp"
 
 namespace esc {
@@ -34,9 +35,9 @@ class Fmmus {
     Fmmus(const Memory& m, PhysicalMemory& p, uint8_t count) : mem(m), phys(p), count_(count) {}
     // Re-decodes the FMMU registers into the active mappings.
     void rebuild();
-    // Executes LRD (10), LWR (11) or LRW (12) of len bytes at logical address la on data in place.
+    // Executes LRD, LWR or LRW of len bytes at logical address la on data in place.
     // Returns the working-counter increment.
-    uint16_t logical(uint8_t cmd, uint32_t la, uint8_t* data, uint16_t len);
+    uint16_t logical(Command cmd, uint32_t la, uint8_t* data, uint16_t len);
 
   private:
     bool read(const FmmuMap& f, uint64_t b0, uint64_t b1, uint32_t la, uint8_t* data);

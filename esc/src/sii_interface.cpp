@@ -4,6 +4,9 @@
 
 #include <algorithm>
 
+#include "esi/wire/sii.hpp"
+#include "util/le.hpp"
+
 namespace esc {
 
 namespace {
@@ -13,14 +16,11 @@ namespace {
 std::vector<uint8_t> default_eeprom() {
     std::vector<uint8_t> img(2048, 0xFF);
     std::fill(img.begin(), img.begin() + 0x80, 0x00);
-    auto put = [&](unsigned word, uint16_t v) {
-        img[2 * word] = static_cast<uint8_t>(v);
-        img[2 * word + 1] = static_cast<uint8_t>(v >> 8);
-    };
+    auto put = [&](unsigned word, uint16_t v) { util::put16(&img[2 * word], v); };
     put(0x00, 0x0C80);  // 0x0140 PDI control 0x80, 0x0141 ESC config: SYNC out unit + latch in unit
     put(0x01, 0xCC00);  // 0x0150 0x00, 0x0151: SYNC0/SYNC1 outputs, mapped to AL event bits 2/3
     put(0x02, 0x03E8);  // SYNC pulse length 1000 x 10 ns
-    put(0x07, sii_crc8(img.data(), 14));
+    put(0x07, esi::sii::crc8(img.data(), 14));
     put(0x3E, 0x000F);  // 16 Kbit - 1
     put(0x3F, 0x0001);  // version
     put(0x40, 0xFFFF);  // end of categories
@@ -28,16 +28,6 @@ std::vector<uint8_t> default_eeprom() {
 }
 
 }  // namespace
-
-uint8_t sii_crc8(const uint8_t* data, std::size_t n) {
-    uint8_t crc = 0xFF;
-    for (std::size_t i = 0; i < n; ++i) {
-        crc ^= data[i];
-        for (int b = 0; b < 8; ++b)
-            crc = static_cast<uint8_t>((crc & 0x80) ? (crc << 1) ^ 0x07 : (crc << 1));
-    }
-    return crc;
-}
 
 SiiInterface::SiiInterface(Memory& m, const EscFaults& f) : mem(m), faults(f), eeprom(default_eeprom()) {}
 
@@ -76,7 +66,7 @@ bool SiiInterface::crc_ok() const {
     if (eeprom.size() < 16) return false;
     const uint16_t w7 = word(7);
     if (w7 == 0x88A4) return true;  // checksum check disabled (B1, debug value)
-    return (w7 & 0xFF) == sii_crc8(eeprom.data(), 14);
+    return (w7 & 0xFF) == esi::sii::crc8(eeprom.data(), 14);
 }
 
 void SiiInterface::load_words(bool power_on) {
@@ -135,8 +125,7 @@ void SiiInterface::execute() {
                 err = 0x2000;  // no acknowledge beyond the device
             } else {
                 const uint16_t v = mem.r16(reg::kSiiData);
-                eeprom[addr * 2] = static_cast<uint8_t>(v);
-                eeprom[addr * 2 + 1] = static_cast<uint8_t>(v >> 8);
+                util::put16(&eeprom[addr * 2], v);
                 if (write_count < writes.size())
                     writes[write_count++] = EepromWrite{static_cast<uint16_t>(addr), v};
             }

@@ -13,8 +13,6 @@
 
 namespace esc {
 
-uint8_t sii_crc8(const uint8_t* data, std::size_t n);
-
 class SiiInterface {
   public:
     SiiInterface(Memory& m, const EscFaults& f);
