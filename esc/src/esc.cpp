@@ -2,91 +2,38 @@
 #include <algorithm>
 #include <cstring>
 
+#include "esc/wire/datagram.hpp"
 #include "esc_impl.hpp"
+#include "util/le.hpp"
 
 namespace esc {
 
 namespace {
 
-constexpr uint16_t kEtherTypeEcat = 0x88A4;
-constexpr uint16_t kEtherTypeVlan = 0x8100;
-
-enum Cmd : uint8_t {
-    kNop = 0,
-    kAprd = 1,
-    kApwr = 2,
-    kAprw = 3,
-    kFprd = 4,
-    kFpwr = 5,
-    kFprw = 6,
-    kBrd = 7,
-    kBwr = 8,
-    kBrw = 9,
-    kLrd = 10,
-    kLwr = 11,
-    kLrw = 12,
-    kArmw = 13,
-    kFrmw = 14,
-};
-
-uint16_t le16(const uint8_t* p) {
-    return static_cast<uint16_t>(p[0] | (p[1] << 8));
-}
-void put_le16(uint8_t* p, uint16_t v) {
-    p[0] = static_cast<uint8_t>(v);
-    p[1] = static_cast<uint8_t>(v >> 8);
-}
-
-// The built-in SII image of a bare ESC: a valid header (PDI "on-chip bus", DC SYNC/latch units on, SYNC0/1
-// mapped to the AL event register, 10 us pulses), identity zero, no categories, 2 KiB (16 Kbit).
-std::vector<uint8_t> default_eeprom() {
-    std::vector<uint8_t> img(2048, 0xFF);
-    std::fill(img.begin(), img.begin() + 0x80, 0x00);
-    auto put = [&](unsigned word, uint16_t v) {
-        img[2 * word] = static_cast<uint8_t>(v);
-        img[2 * word + 1] = static_cast<uint8_t>(v >> 8);
-    };
-    put(0x00, 0x0C80);  // 0x0140 PDI control 0x80, 0x0141 ESC config: SYNC out unit + latch in unit
-    put(0x01, 0xCC00);  // 0x0150 0x00, 0x0151: SYNC0/SYNC1 outputs, mapped to AL event bits 2/3
-    put(0x02, 0x03E8);  // SYNC pulse length 1000 x 10 ns
-    put(0x07, sii_crc8(img.data(), 14));
-    put(0x3E, 0x000F);  // 16 Kbit - 1
-    put(0x3F, 0x0001);  // version
-    put(0x40, 0xFFFF);  // end of categories
-    return img;
-}
+using wire::kEtherTypeVlan;
+constexpr uint16_t kEtherTypeEcat = wire::kEtherType;
+using util::get16;
+using util::put16;
 
 }  // namespace
-
-uint8_t sii_crc8(const uint8_t* data, std::size_t n) {
-    uint8_t crc = 0xFF;
-    for (std::size_t i = 0; i < n; ++i) {
-        crc ^= data[i];
-        for (int b = 0; b < 8; ++b)
-            crc = static_cast<uint8_t>((crc & 0x80) ? (crc << 1) ^ 0x07 : (crc << 1));
-    }
-    return crc;
-}
 
 // ==================================================================================================
 // Construction and reset
 // ==================================================================================================
 
-Esc::Impl::Impl(const EscConfig& c, const Clock& clk) : cfg(c), clock(clk) {
-    uint32_t kib = std::min<uint32_t>(c.process_ram_kib, 60);  // RAM must end below 0x10000
-    cfg.process_ram_kib = kib;
-    ram.assign(kib * 1024, 0);
-    mem_end = reg::kRamBase + kib * 1024;
-    fmmu_count = std::min<uint8_t>(c.fmmu_count, 16);
-    sm_count = std::min<uint8_t>(c.sm_count, 16);
-    cfg.fmmu_count = fmmu_count;
-    cfg.sm_count = sm_count;
-    clock_anchor = clock.now_ns();
-    local_anchor = clock_anchor;
+namespace {
+EscConfig clamped(EscConfig c) {
+    c.process_ram_kib = std::min<uint32_t>(c.process_ram_kib, 60);  // RAM must end below 0x10000
+    c.fmmu_count = std::min<uint8_t>(c.fmmu_count, 16);
+    c.sm_count = std::min<uint8_t>(c.sm_count, 16);
+    return c;
+}
+}  // namespace
+
+Esc::Impl::Impl(const EscConfig& c, const Clock& clk) : cfg(clamped(c)), mem(cfg.process_ram_kib), time(clk) {
     init_tables();
-    eeprom = default_eeprom();
     reset_registers();
-    load_eeprom_words(true);
+    sii.load_words(true);
 }
 
 void Esc::Impl::init_tables() {
@@ -124,9 +71,9 @@ void Esc::Impl::init_tables() {
     ecat(0x0510, 1, kPlain, 0x01);         // MII: inert, stored
     ecat(0x0512, 4, kPlain);
     ecat(0x0516, 1, kPlain, 0x01);
-    for (unsigned n = 0; n < fmmu_count; ++n)
+    for (unsigned n = 0; n < cfg.fmmu_count; ++n)
         ecat(static_cast<uint16_t>(reg::kFmmu + 16 * n), 13, kSpecial);
-    for (unsigned n = 0; n < sm_count; ++n) {
+    for (unsigned n = 0; n < cfg.sm_count; ++n) {
         uint16_t b = static_cast<uint16_t>(reg::kSm + 8 * n);
         ecat(b, 5, kSpecial);
         ecat(static_cast<uint16_t>(b + 6), 1, kSpecial);
@@ -153,7 +100,7 @@ void Esc::Impl::init_tables() {
     pdi(reg::kAlEventMask, 4, kPlain);
     pdi(reg::kSiiPdiAccess, 1, kPlain, 0x01);
     pdi(reg::kSiiControl, 14, kSpecial);
-    for (unsigned n = 0; n < sm_count; ++n)
+    for (unsigned n = 0; n < cfg.sm_count; ++n)
         pdi(static_cast<uint16_t>(reg::kSm + 8 * n + 7), 1, kSpecial);
     pdi(reg::kDcActivation, 1, kSpecial);
     pdi(reg::kDcStartTime, 8, kSpecial);
@@ -163,104 +110,46 @@ void Esc::Impl::init_tables() {
 }
 
 void Esc::Impl::reset_registers() {
-    regs.fill(0);
-    w8(0x0000, cfg.type);
-    w8(0x0001, cfg.revision);
-    w16(0x0002, cfg.build);
-    w8(0x0004, fmmu_count);
-    w8(0x0005, sm_count);
-    w8(0x0006, static_cast<uint8_t>(cfg.process_ram_kib));
-    w8(0x0007, cfg.port_descriptor);
-    w16(0x0008, cfg.features);
-    w32(reg::kDlControl, 0x0007C001);
+    mem.regs.fill(0);
+    mem.w8(0x0000, cfg.type);
+    mem.w8(0x0001, cfg.revision);
+    mem.w16(0x0002, cfg.build);
+    mem.w8(0x0004, cfg.fmmu_count);
+    mem.w8(0x0005, cfg.sm_count);
+    mem.w8(0x0006, static_cast<uint8_t>(cfg.process_ram_kib));
+    mem.w8(0x0007, cfg.port_descriptor);
+    mem.w16(0x0008, cfg.features);
+    mem.w32(reg::kDlControl, 0x0007C001);
     // Single port: link + communication on port 0, loop of port 0 open, ports 1-3 closed, PDI watchdog
     // reloaded. Bit 0 (EEPROM loaded) is set by the EEPROM load.
-    w16(reg::kDlStatus, 0x5612);
-    w16(reg::kAlControl, 0x0001);
-    w16(reg::kAlStatus, 0x0001);
-    w32(reg::kAlEventMask, 0x00FFFF2F);
-    w16(reg::kEcatEvent, ecev::kDlStatus);
-    w32(reg::kAlEvent, 0);
-    w16(reg::kWdDivider, 0x09C2);
-    w16(reg::kWdTimePdi, 0x03E8);
-    w16(reg::kWdTimePd, 0x03E8);
-    w16(reg::kWdStatusPd, 0x0001);
-    uint16_t sii = 0x0060 | 0x1000;  // emulated EEPROM, 8-byte reads, not loaded yet
-    if (eeprom.size() > 2048) sii |= 0x0080;
-    w16(reg::kSiiControl, sii);
-    w16(reg::kDcSpeedStart, 0x1000);
-    w8(reg::kDcFilterDiff, 4);
-    w8(reg::kDcFilterSpeed, 12);
+    mem.w16(reg::kDlStatus, 0x5612);
+    mem.w16(reg::kAlControl, 0x0001);
+    mem.w16(reg::kAlStatus, 0x0001);
+    mem.w32(reg::kAlEventMask, 0x00FFFF2F);
+    mem.w16(reg::kEcatEvent, ecev::kDlStatus);
+    mem.w32(reg::kAlEvent, 0);
+    mem.w16(reg::kWdDivider, 0x09C2);
+    mem.w16(reg::kWdTimePdi, 0x03E8);
+    mem.w16(reg::kWdTimePd, 0x03E8);
+    mem.w16(reg::kWdStatusPd, 0x0001);
+    uint16_t sii_control = 0x0060 | 0x1000;  // emulated EEPROM, 8-byte reads, not loaded yet
+    if (sii.image().size() > 2048) sii_control |= 0x0080;
+    mem.w16(reg::kSiiControl, sii_control);
+    mem.w16(reg::kDcSpeedStart, 0x1000);
+    mem.w8(reg::kDcFilterDiff, 4);
+    mem.w8(reg::kDcFilterSpeed, 12);
 
-    for (unsigned n = 0; n < 16; ++n) {
-        sm[n] = SyncManager{};
-        if (n < sm_count) sm_update_status(n);
-    }
-    sm_pending_mask = 0;
+    sm.reset();
     rebuild_lookup();
-
-    sync_running = sync0_armed = sync1_armed = false;
-    sync0_ack = sync1_ack = false;
-    rate_integral = 0.0;
-    set_rate(0.0, clock.now_ns());
-    dc_have_prev = false;
-    dc_filter_primed = false;
-    dc_diff_filtered = 0.0;
-    pd_wd_armed = pdi_wd_armed = pdi_touched = false;
+    dc.reset();
+    wd.reset();
     reset_progress_ecat = reset_progress_pdi = 0;
 }
 
 void Esc::Impl::rebuild_lookup() {
     lookup_dirty = false;
-    sm_enabled_mask = 0;
-    sm_area_count = 0;
-    for (unsigned n = 0; n < sm_count; ++n) {
-        uint16_t b = static_cast<uint16_t>(reg::kSm + 8 * n);
-        SyncManager& s = sm[n];
-        s.start = r16(b);
-        s.length = r16(b + 2);
-        s.control = r8(b + 4);
-        uint8_t act = r8(b + 6);
-        s.mailbox = (s.control & 0x03) == 0x02;
-        s.ecat_writes = ((s.control >> 2) & 0x03) == 0x01;
-        s.enabled = (act & 0x01) && s.length > 0;
-        if (act & 0x01) sm_enabled_mask = static_cast<uint16_t>(sm_enabled_mask | (1u << n));
-        uint32_t area = (s.mailbox || s.length == 1) ? s.length : 3u * s.length;
-        uint32_t end = s.start + area;
-        // SyncManagers act on the process RAM only (ESC datasheet section I, SyncManager): an area that
-        // starts in the register space or does not fit the RAM is not served and captures no address,
-        // so the registers (the SM's own included) and the RAM stay reachable (decisions/esc.md).
-        s.area_valid = s.start >= reg::kRamBase && end <= mem_end;
-        if (!s.enabled || !s.area_valid) continue;
-        // Insertion by start address.
-        unsigned pos = sm_area_count;
-        while (pos > 0 && sm_areas[pos - 1].start > s.start) {
-            sm_areas[pos] = sm_areas[pos - 1];
-            --pos;
-        }
-        sm_areas[pos] = SmArea{s.start, end, static_cast<uint8_t>(n)};
-        ++sm_area_count;
-    }
-    fmmu_active = 0;
-    for (unsigned n = 0; n < fmmu_count; ++n) {
-        uint16_t b = static_cast<uint16_t>(reg::kFmmu + 16 * n);
-        uint32_t la = r32(b);
-        uint16_t len = r16(b + 4);
-        uint8_t lstart = r8(b + 6) & 0x07;
-        uint8_t lstop = r8(b + 7) & 0x07;
-        uint16_t pa = r16(b + 8);
-        uint8_t pstart = r8(b + 0x0A) & 0x07;
-        uint8_t type = r8(b + 0x0B) & 0x03;
-        if (!(r8(b + 0x0C) & 0x01) || len == 0 || type == 0) continue;
-        FmmuMap f;
-        f.lbit_start = static_cast<uint64_t>(la) * 8 + lstart;
-        f.lbit_end = (static_cast<uint64_t>(la) + len - 1) * 8 + lstop + 1;
-        if (f.lbit_end <= f.lbit_start) continue;
-        f.pbit_start = static_cast<uint64_t>(pa) * 8 + pstart;
-        f.read = type & 0x01;
-        f.write = type & 0x02;
-        fmmu_map[fmmu_active++] = f;
-    }
+    sm.rebuild();
+    fmmu.rebuild();
 }
 
 // ==================================================================================================
@@ -294,19 +183,19 @@ bool Esc::Impl::process(std::span<uint8_t> frame, uint64_t rx_clock) {
     if (size < hdr + 2) {
         ++stats.frames_malformed;
         ++stats.malformed_no_header;
-        count_error(reg::kInvalidFrameCounter);
-        count_error(reg::kProcessingUnitErrors);
+        mem.count_error(reg::kInvalidFrameCounter);
+        mem.count_error(reg::kProcessingUnitErrors);
         return true;
     }
-    const uint16_t h = le16(f + hdr);
+    const uint16_t h = get16(f + hdr);
     if ((h >> 12) != 1) {
         ++stats.frames_ignored;  // EtherCAT frame of another type: forwarded unprocessed
         return true;
     }
     ++stats.frames_processed;
-    frame_clock = rx_clock != 0 ? rx_clock : clock.now_ns();
-    frame_local = local_at(frame_clock);
-    in_frame = true;
+    time.frame_clock = rx_clock != 0 ? rx_clock : time.clock.now_ns();
+    time.frame_local = dc.local_at(time.frame_clock);
+    time.in_frame = true;
 
     bool ok = true;
     std::size_t p = hdr + 2;
@@ -321,7 +210,7 @@ bool Esc::Impl::process(std::span<uint8_t> frame, uint64_t rx_clock) {
                 ++stats.malformed_datagram;
                 break;
             }
-            const uint16_t lf = le16(f + p + 6);
+            const uint16_t lf = get16(f + p + 6);
             const uint16_t dlen = lf & 0x07FF;
             if (p + 12 + dlen > end) {
                 ok = false;
@@ -336,59 +225,28 @@ bool Esc::Impl::process(std::span<uint8_t> frame, uint64_t rx_clock) {
     }
     if (!ok) {
         ++stats.frames_malformed;
-        count_error(reg::kInvalidFrameCounter);
-        count_error(reg::kProcessingUnitErrors);
+        mem.count_error(reg::kInvalidFrameCounter);
+        mem.count_error(reg::kProcessingUnitErrors);
     }
     end_of_frame(ok);
-    in_frame = false;
+    time.in_frame = false;
     return true;
 }
 
 void Esc::Impl::end_of_frame(bool ok) {
     // SyncManager buffer changes of ECAT accesses take effect at the end of a correct frame. 0x09F0 latches
     // the local time of the beginning of a frame that changed at least one buffer (docs/decisions/esc.md).
-    uint16_t pend = sm_pending_mask;
-    sm_pending_mask = 0;
-    bool buffer_changed = false;
-    for (unsigned n = 0; pend != 0; ++n, pend = static_cast<uint16_t>(pend >> 1)) {
-        if (!(pend & 1)) continue;
-        SyncManager& s = sm[n];
-        if (!s.pending) continue;
-        s.pending = false;
-        if (ok) {
-            sm_commit(n, s.pending_write, Side::Ecat);
-            buffer_changed = true;
-        } else {
-            (s.pending_write ? s.prod_open : s.cons_open) = false;
-            sm_update_status(n);
-        }
-    }
-    if (buffer_changed) w32(reg::kDcEcatBufferChange, static_cast<uint32_t>(frame_local));
-    if (dc_latch_pending) {
-        dc_latch_pending = false;
-        if (ok) {
-            const uint32_t t32 = static_cast<uint32_t>(frame_local);
-            for (uint16_t port = 0; port < 4; ++port)
-                w32(static_cast<uint16_t>(reg::kDcRecvTime0 + 4 * port), t32);
-            w64(reg::kDcRecvTimePu, frame_local);
-        }
-    }
-    if (eeprom_pending) {
-        eeprom_pending = false;
-        if (ok) {
-            eeprom_execute(Side::Ecat);
-        } else {
-            w16(reg::kSiiControl, static_cast<uint16_t>(r16(reg::kSiiControl) & ~0x8000));
-        }
-    }
+    if (sm.end_of_frame(ok)) mem.w32(reg::kDcEcatBufferChange, static_cast<uint32_t>(time.frame_local));
+    dc.end_of_frame(ok);
+    sii.end_of_frame(ok);
     frame_write_enable = false;
     frame_esc_write_enable = false;
-    regs[reg::kRegWriteEnable] = 0;
-    regs[reg::kEscWriteEnable] = 0;
+    mem.regs[reg::kRegWriteEnable] = 0;
+    mem.regs[reg::kEscWriteEnable] = 0;
     if (reset_written_this_frame) {
         reset_written_this_frame = false;
         static constexpr uint8_t kSeq[3] = {0x52, 0x45, 0x53};
-        const uint8_t v = regs[reg::kEscResetEcat];
+        const uint8_t v = mem.regs[reg::kEscResetEcat];
         if (ok && v == kSeq[reset_progress_ecat]) {
             ++reset_progress_ecat;
         } else {
@@ -396,64 +254,67 @@ void Esc::Impl::end_of_frame(bool ok) {
         }
         if (reset_progress_ecat == 3) {
             reset_registers();
-            load_eeprom_words(true);
+            sii.load_words(true);
         } else {
-            regs[reg::kEscResetEcat] = reset_progress_ecat;
+            mem.regs[reg::kEscResetEcat] = reset_progress_ecat;
         }
     }
 }
 
 void Esc::Impl::datagram(uint8_t* d, uint8_t* data, uint16_t len) {
-    const uint8_t cmd = d[0];
-    if (cmd == kNop || cmd > kFrmw) return;  // not for a slave: untouched
-    const uint16_t adp = le16(d + 2);
-    const uint16_t ado = le16(d + 4);
+    if (d[0] == static_cast<uint8_t>(Command::NOP) || d[0] > static_cast<uint8_t>(Command::FRMW))
+        return;  // not for a slave: untouched
+    const Command cmd = static_cast<Command>(d[0]);
+    const uint16_t adp = get16(d + 2);
+    const uint16_t ado = get16(d + 4);
     uint8_t* wkc_p = data + len;
-    put_le16(d + 8, static_cast<uint16_t>(le16(d + 8) | (r16(reg::kEcatEvent) & r16(reg::kEcatEventMask))));
+    put16(d + 8,
+          static_cast<uint16_t>(get16(d + 8) | (mem.r16(reg::kEcatEvent) & mem.r16(reg::kEcatEventMask))));
 
     enum Op : uint8_t { kNone, kRead, kWrite, kReadWrite };
     Op op = kNone;
     bool or_read = false;
     switch (cmd) {
-        case kAprd:
-        case kApwr:
-        case kAprw:
-            if (adp == 0) op = cmd == kAprd ? kRead : cmd == kApwr ? kWrite : kReadWrite;
-            put_le16(d + 2, static_cast<uint16_t>(adp + 1));
+        case Command::APRD:
+        case Command::APWR:
+        case Command::APRW:
+            if (adp == 0) op = cmd == Command::APRD ? kRead : cmd == Command::APWR ? kWrite : kReadWrite;
+            put16(d + 2, static_cast<uint16_t>(adp + 1));
             break;
-        case kFprd:
-        case kFpwr:
-        case kFprw:
-        case kFrmw: {
-            const bool match =
-                adp == r16(reg::kStationAddress) ||
-                ((r8(0x0103) & 0x01) && !cfg.faults.alias_ignored && adp == r16(reg::kStationAlias)) ||
-                (cmd == kFprd && cfg.faults.fprd_any_address);
-            if (cmd == kFrmw) {
+        case Command::FPRD:
+        case Command::FPWR:
+        case Command::FPRW:
+        case Command::FRMW: {
+            const bool match = adp == mem.r16(reg::kStationAddress) ||
+                               ((mem.r8(0x0103) & 0x01) && !cfg.faults.alias_ignored &&
+                                adp == mem.r16(reg::kStationAlias)) ||
+                               (cmd == Command::FPRD && cfg.faults.fprd_any_address);
+            if (cmd == Command::FRMW) {
                 op = match ? kRead : kWrite;
             } else if (match) {
-                op = cmd == kFprd ? kRead : cmd == kFpwr ? kWrite : kReadWrite;
+                op = cmd == Command::FPRD ? kRead : cmd == Command::FPWR ? kWrite : kReadWrite;
             }
             break;
         }
-        case kBrd:
-        case kBwr:
-        case kBrw:
-            op = cmd == kBrd ? kRead : cmd == kBwr ? kWrite : kReadWrite;
-            or_read = cmd != kBwr;
-            put_le16(d + 2, static_cast<uint16_t>(adp + 1));
+        case Command::BRD:
+        case Command::BWR:
+        case Command::BRW:
+            op = cmd == Command::BRD ? kRead : cmd == Command::BWR ? kWrite : kReadWrite;
+            or_read = cmd != Command::BWR;
+            put16(d + 2, static_cast<uint16_t>(adp + 1));
             break;
-        case kArmw:
+        case Command::ARMW:
             op = adp == 0 ? kRead : kWrite;
-            put_le16(d + 2, static_cast<uint16_t>(adp + 1));
+            put16(d + 2, static_cast<uint16_t>(adp + 1));
             break;
-        case kLrd:
-        case kLwr:
-        case kLrw: {
+        case Command::LRD:
+        case Command::LWR:
+        case Command::LRW: {
             const uint32_t la = static_cast<uint32_t>(adp) | (static_cast<uint32_t>(ado) << 16);
-            const uint16_t inc = logical(cmd, la, data, len);
+            sm.set_lock_mask(sm.enabled_mask());
+            const uint16_t inc = fmmu.logical(cmd, la, data, len);
             if (lookup_dirty) rebuild_lookup();
-            if (inc) put_le16(wkc_p, static_cast<uint16_t>(le16(wkc_p) + inc));
+            if (inc) put16(wkc_p, static_cast<uint16_t>(get16(wkc_p) + inc));
             return;
         }
         default:
@@ -461,7 +322,7 @@ void Esc::Impl::datagram(uint8_t* d, uint8_t* data, uint16_t len) {
     }
     if (op == kNone) return;
 
-    const uint16_t lock_before = sm_enabled_mask;
+    const uint16_t lock_before = sm.enabled_mask();
     uint16_t inc = 0;
     const uint8_t* wsrc = data;
     if (op == kReadWrite) {
@@ -481,13 +342,13 @@ void Esc::Impl::datagram(uint8_t* d, uint8_t* data, uint16_t len) {
         if (any) inc = 1;
     }
     if (op == kWrite || op == kReadWrite) {
-        sm_lock_mask = lock_before;
+        sm.set_lock_mask(lock_before);
         if (phys_write(ado, wsrc, nullptr, len, Side::Ecat))
             inc = static_cast<uint16_t>(inc + (op == kWrite ? 1 : 2));
         if (lookup_dirty) rebuild_lookup();
     }
-    if (cmd == kAprd && inc && cfg.faults.wkc_aprd) ++inc;
-    if (inc) put_le16(wkc_p, static_cast<uint16_t>(le16(wkc_p) + inc));
+    if (cmd == Command::APRD && inc && cfg.faults.wkc_aprd) ++inc;
+    if (inc) put16(wkc_p, static_cast<uint16_t>(get16(wkc_p) + inc));
 }
 
 // ==================================================================================================
@@ -497,22 +358,10 @@ void Esc::Impl::datagram(uint8_t* d, uint8_t* data, uint16_t len) {
 Esc::Esc(const EscConfig& config, const Clock& clock) : impl_(std::make_unique<Impl>(config, clock)) {}
 Esc::~Esc() = default;
 
-void Esc::Impl::flush_callbacks(std::unique_lock<std::mutex>& lock) {
-    if (eeprom_write_count == 0) return;
-    const std::array<EepromWrite, 4> w = eeprom_writes;
-    const uint8_t n = eeprom_write_count;
-    eeprom_write_count = 0;
-    auto cb = on_eeprom_write;
-    lock.unlock();
-    if (cb)
-        for (uint8_t i = 0; i < n; ++i)
-            cb(w[i].address, w[i].value);
-}
-
 bool Esc::process_frame(std::span<uint8_t> frame, uint64_t rx_time_ns) {
     std::unique_lock lock(impl_->mu);
     const bool r = impl_->process(frame, rx_time_ns);
-    impl_->flush_callbacks(lock);
+    impl_->sii.flush_callbacks(lock);
     return r;
 }
 
@@ -521,7 +370,7 @@ void Esc::read(uint16_t address, std::span<uint8_t> out) {
     // the null pointer an empty span may carry.
     if (out.empty()) return;
     std::lock_guard lock(impl_->mu);
-    impl_->pdi_touch();
+    impl_->wd.pdi_touch();
     std::memset(out.data(), 0, out.size());
     impl_->phys_read(address, out.data(), nullptr, static_cast<uint32_t>(out.size()), Side::Pdi);
     if (impl_->lookup_dirty) impl_->rebuild_lookup();
@@ -530,22 +379,26 @@ void Esc::read(uint16_t address, std::span<uint8_t> out) {
 void Esc::write(uint16_t address, std::span<const uint8_t> in) {
     if (in.empty()) return;  // no access, as for read()
     std::unique_lock lock(impl_->mu);
-    impl_->pdi_touch();
+    impl_->wd.pdi_touch();
     impl_->phys_write(address, in.data(), nullptr, static_cast<uint32_t>(in.size()), Side::Pdi);
     if (impl_->lookup_dirty) impl_->rebuild_lookup();
-    impl_->flush_callbacks(lock);
+    impl_->sii.flush_callbacks(lock);
 }
 
 bool Esc::irq() const {
     std::lock_guard lock(impl_->mu);
-    return (impl_->r32(reg::kAlEvent) & impl_->r32(reg::kAlEventMask)) != 0;
+    return (impl_->mem.r32(reg::kAlEvent) & impl_->mem.r32(reg::kAlEventMask)) != 0;
 }
 
 void Esc::tick() {
     std::lock_guard lock(impl_->mu);
-    const uint64_t now = impl_->clock.now_ns();
-    impl_->wd_run(now);
-    impl_->dc_run(now);
+    const uint64_t now = impl_->time.clock.now_ns();
+    impl_->wd.run(now);
+    impl_->dc.run(now);
+}
+
+uint64_t Esc::Impl::next_event() const {
+    return std::min(dc.next_event(), wd.next_event());
 }
 
 uint64_t Esc::next_event_ns() const {
@@ -555,26 +408,26 @@ uint64_t Esc::next_event_ns() const {
 
 uint64_t Esc::local_time_ns() const {
     std::lock_guard lock(impl_->mu);
-    return impl_->local_at(impl_->clock.now_ns());
+    return impl_->dc.local_at(impl_->time.clock.now_ns());
 }
 
 void Esc::load_eeprom(std::span<const uint8_t> image) {
     std::lock_guard lock(impl_->mu);
-    impl_->eeprom.assign(image.begin(), image.end());
-    uint16_t c = impl_->r16(reg::kSiiControl);
-    c = static_cast<uint16_t>(impl_->eeprom.size() > 2048 ? (c | 0x0080) : (c & ~0x0080));
-    impl_->w16(reg::kSiiControl, c);
-    impl_->load_eeprom_words(true);
+    impl_->sii.set_image(image.data(), image.size());
+    uint16_t c = impl_->mem.r16(reg::kSiiControl);
+    c = static_cast<uint16_t>(impl_->sii.image().size() > 2048 ? (c | 0x0080) : (c & ~0x0080));
+    impl_->mem.w16(reg::kSiiControl, c);
+    impl_->sii.load_words(true);
 }
 
 std::span<const uint8_t> Esc::eeprom() const {
     std::lock_guard lock(impl_->mu);
-    return impl_->eeprom;
+    return impl_->sii.image();
 }
 
 void Esc::on_eeprom_write(std::function<void(uint16_t, uint16_t)> callback) {
     std::lock_guard lock(impl_->mu);
-    impl_->on_eeprom_write = std::move(callback);
+    impl_->sii.on_write(std::move(callback));
 }
 
 EscStats Esc::stats() const {

@@ -1,13 +1,14 @@
-// SyncManagers: mailbox (1-buffer) and buffered (3-buffer) modes, both directions, both sides.
+// SyncManager unit (sync_manager.hpp): mailbox (1-buffer) and buffered (3-buffer) modes, both directions,
+// both sides.
 #include <algorithm>
 #include <cstring>
 #include <utility>
 
-#include "esc_impl.hpp"
+#include "sync_manager.hpp"
 
 namespace esc {
 
-void Esc::Impl::sm_reset_state(unsigned n) {
+void SyncManagers::reset_state(unsigned n) {
     SyncManager& s = sm[n];
     s.full = s.prod_open = s.cons_open = false;
     s.irq_write = s.irq_read = false;
@@ -17,38 +18,38 @@ void Esc::Impl::sm_reset_state(unsigned n) {
     s.next = 1;
     s.free = 2;
     s.next_valid = false;
-    sm_pending_mask = static_cast<uint16_t>(sm_pending_mask & ~(1u << n));
-    sm_update_status(n);
+    pending_mask_ = static_cast<uint16_t>(pending_mask_ & ~(1u << n));
+    update_status(n);
 }
 
-void Esc::Impl::sm_update_status(unsigned n) {
+void SyncManagers::update_status(unsigned n) {
     SyncManager& s = sm[n];
     const uint8_t st = static_cast<uint8_t>((s.irq_write ? 0x01 : 0) | (s.irq_read ? 0x02 : 0) |
                                             (s.full ? 0x08 : 0) | ((s.last_written & 0x03) << 4) |
                                             (s.cons_open ? 0x40 : 0) | (s.prod_open ? 0x80 : 0));
-    regs[reg::kSm + 8 * n + 5] = st;
+    mem.regs[reg::kSm + 8 * n + 5] = st;
     // Events: the PDI is interested in what ECAT did and vice versa.
-    const uint8_t ctrl = r8(static_cast<uint16_t>(reg::kSm + 8 * n + 4));
-    const bool active = (r8(static_cast<uint16_t>(reg::kSm + 8 * n + 6)) & 0x01) && !s.pdi_disabled;
+    const uint8_t ctrl = mem.r8(static_cast<uint16_t>(reg::kSm + 8 * n + 4));
+    const bool active = (mem.r8(static_cast<uint16_t>(reg::kSm + 8 * n + 6)) & 0x01) && !s.pdi_disabled;
     const bool al = active && (ctrl & 0x20) && (s.ecat_writes ? s.irq_write : s.irq_read);
     const uint32_t albit = alev::kSm0 << n;
     if (al) {
-        set_al_event(albit);
+        mem.set_al_event(albit);
     } else {
-        clear_al_event(albit);
+        mem.clear_al_event(albit);
     }
     if (n < 8) {
         const bool ec = active && (ctrl & 0x10) && (s.ecat_writes ? s.irq_read : s.irq_write);
         const uint16_t ecbit = static_cast<uint16_t>(ecev::kSm0 << n);
         if (ec) {
-            set_ecat_event(ecbit);
+            mem.set_ecat_event(ecbit);
         } else {
-            clear_ecat_event(ecbit);
+            mem.clear_ecat_event(ecbit);
         }
     }
 }
 
-void Esc::Impl::sm_commit(unsigned n, bool write, Side side) {
+void SyncManagers::commit(unsigned n, bool write, Side side) {
     SyncManager& s = sm[n];
     if (write) {
         s.prod_open = false;
@@ -60,16 +61,16 @@ void Esc::Impl::sm_commit(unsigned n, bool write, Side side) {
             s.last_written = s.next;
         }
         s.irq_write = true;
-        if (side == Side::Ecat && (s.control & 0x40)) wd_pd_trigger();
+        if (side == Side::Ecat && (s.control & 0x40)) wd.pd_trigger();
     } else {
         s.cons_open = false;
         if (s.mailbox) s.full = false;
         s.irq_read = true;
     }
-    sm_update_status(n);
+    update_status(n);
 }
 
-bool Esc::Impl::sm_access(unsigned n, uint32_t off, uint8_t* dst, const uint8_t* src, const uint8_t* bm,
+bool SyncManagers::access(unsigned n, uint32_t off, uint8_t* dst, const uint8_t* src, const uint8_t* bm,
                           uint32_t cnt, bool write, Side side) {
     SyncManager& s = sm[n];
     if (!s.area_valid || s.pdi_disabled) return false;
@@ -91,16 +92,16 @@ bool Esc::Impl::sm_access(unsigned n, uint32_t off, uint8_t* dst, const uint8_t*
     };
 
     if (len == 1) {  // single byte: transparent, only interrupt and watchdog
-        copy(mem(s.start));
+        copy(mem.at(s.start));
         if (write) {
             s.irq_write = true;
             s.irq_read = false;
-            if (side == Side::Ecat && (s.control & 0x40)) wd_pd_trigger();
+            if (side == Side::Ecat && (s.control & 0x40)) wd.pd_trigger();
         } else {
             s.irq_read = true;
             s.irq_write = false;
         }
-        sm_update_status(n);
+        update_status(n);
         return true;
     }
     if (s.pending) return false;  // closed in this frame: the end address cannot be accessed twice
@@ -121,42 +122,111 @@ bool Esc::Impl::sm_access(unsigned n, uint32_t off, uint8_t* dst, const uint8_t*
         }
     }
     const uint32_t buf = s.mailbox ? 0 : static_cast<uint32_t>(write ? s.free : s.user) * len;
-    copy(mem(s.start + buf + off));
+    copy(mem.at(s.start + buf + off));
     if (off + cnt == len) {
         if (side == Side::Ecat) {
             s.pending = true;
             s.pending_write = write;
-            sm_pending_mask = static_cast<uint16_t>(sm_pending_mask | (1u << n));
+            pending_mask_ = static_cast<uint16_t>(pending_mask_ | (1u << n));
         } else {
-            sm_commit(n, write, side);
+            commit(n, write, side);
             return true;
         }
     }
-    sm_update_status(n);
+    update_status(n);
     return true;
 }
 
-void Esc::Impl::sm_activate_written(unsigned n, uint8_t value) {
+bool SyncManagers::activate_written(unsigned n, uint8_t value) {
     const uint16_t a = static_cast<uint16_t>(reg::kSm + 8 * n + 6);
-    const uint8_t old = regs[a];
+    const uint8_t old = mem.regs[a];
     const uint8_t v = static_cast<uint8_t>(value & 0xC3);
-    regs[a] = v;
-    set_al_event(alev::kSmActivation);
+    mem.regs[a] = v;
+    mem.set_al_event(alev::kSmActivation);
     if ((old ^ v) & 0x01) {
-        lookup_dirty = true;
-        sm_reset_state(n);
+        reset_state(n);
+        return true;
     }
+    return false;
 }
 
-void Esc::Impl::sm_pdi_control_written(unsigned n, uint8_t value) {
+void SyncManagers::pdi_control_written(unsigned n, uint8_t value) {
     const uint16_t a = static_cast<uint16_t>(reg::kSm + 8 * n + 7);
     SyncManager& s = sm[n];
     const bool deact = value & 0x01;
-    regs[a] = static_cast<uint8_t>(value & 0x03);
+    mem.regs[a] = static_cast<uint8_t>(value & 0x03);
     if (deact != s.pdi_disabled) {
         s.pdi_disabled = deact;
-        sm_reset_state(n);
+        reset_state(n);
     }
+}
+
+void SyncManagers::reset() {
+    for (unsigned n = 0; n < 16; ++n) {
+        sm[n] = SyncManager{};
+        if (n < count_) update_status(n);
+    }
+    pending_mask_ = 0;
+}
+
+void SyncManagers::rebuild() {
+    enabled_mask_ = 0;
+    area_count_ = 0;
+    for (unsigned n = 0; n < count_; ++n) {
+        uint16_t b = static_cast<uint16_t>(reg::kSm + 8 * n);
+        SyncManager& s = sm[n];
+        s.start = mem.r16(b);
+        s.length = mem.r16(b + 2);
+        s.control = mem.r8(b + 4);
+        uint8_t act = mem.r8(b + 6);
+        s.mailbox = (s.control & 0x03) == 0x02;
+        s.ecat_writes = ((s.control >> 2) & 0x03) == 0x01;
+        s.enabled = (act & 0x01) && s.length > 0;
+        if (act & 0x01) enabled_mask_ = static_cast<uint16_t>(enabled_mask_ | (1u << n));
+        uint32_t area = (s.mailbox || s.length == 1) ? s.length : 3u * s.length;
+        uint32_t end = s.start + area;
+        // SyncManagers act on the process RAM only (ESC datasheet section I, SyncManager): an area that
+        // starts in the register space or does not fit the RAM is not served and captures no address,
+        // so the registers (the SM's own included) and the RAM stay reachable (decisions/esc.md).
+        s.area_valid = s.start >= reg::kRamBase && end <= mem.ram_end;
+        if (!s.enabled || !s.area_valid) continue;
+        // Insertion by start address.
+        unsigned pos = area_count_;
+        while (pos > 0 && areas_[pos - 1].start > s.start) {
+            areas_[pos] = areas_[pos - 1];
+            --pos;
+        }
+        areas_[pos] = SmArea{s.start, end, static_cast<uint8_t>(n)};
+        ++area_count_;
+    }
+}
+
+const SmArea* SyncManagers::first_area(uint32_t p, uint32_t end) const {
+    for (uint8_t k = 0; k < area_count_; ++k) {
+        const SmArea& s = areas_[k];
+        if (s.end > p && s.start < end) return &s;
+    }
+    return nullptr;
+}
+
+bool SyncManagers::end_of_frame(bool ok) {
+    uint16_t pend = pending_mask_;
+    pending_mask_ = 0;
+    bool buffer_changed = false;
+    for (unsigned n = 0; pend != 0; ++n, pend = static_cast<uint16_t>(pend >> 1)) {
+        if (!(pend & 1)) continue;
+        SyncManager& s = sm[n];
+        if (!s.pending) continue;
+        s.pending = false;
+        if (ok) {
+            commit(n, s.pending_write, Side::Ecat);
+            buffer_changed = true;
+        } else {
+            (s.pending_write ? s.prod_open : s.cons_open) = false;
+            update_status(n);
+        }
+    }
+    return buffer_changed;
 }
 
 }  // namespace esc

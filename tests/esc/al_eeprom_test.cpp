@@ -1,4 +1,5 @@
-// AL control/status handshake and events (§3.5, §3.6), SII EEPROM interface and power-on load (§3.9, §7.1).
+// AL control/status handshake and events (ESC datasheet section II, 0x0120-0x0134, 0x0200-0x0220), SII EEPROM
+// interface and power-on load (ESC datasheet section I, SII EEPROM interface; SII header words: ETG.2010).
 #include <gtest/gtest.h>
 
 #include <optional>

@@ -1,4 +1,5 @@
-// Datagram commands and working counters (protocol reference §2.1, §2.2).
+// Datagram commands and working counters (ETG.1000.4, datagram commands; ESC datasheet section I, frame
+// processing).
 #include <gtest/gtest.h>
 
 #include <optional>

@@ -1,5 +1,5 @@
-// Distributed clocks (§3.13, §11): receive-time latch, system time, offset/delay, drift loop, SYNC0/SYNC1,
-// plus the PDI watchdog.
+// Distributed clocks (ESC datasheet section I, distributed clocks; section II, 0x0900-0x09FF): receive-time
+// latch, system time, offset/delay, drift loop, SYNC0/SYNC1, plus the PDI watchdog.
 #include <gtest/gtest.h>
 
 #include <cstdlib>

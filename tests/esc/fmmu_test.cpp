@@ -1,4 +1,5 @@
-// FMMU logical addressing (§3.11, §5): bit mapping, read/write/both types, WKC, register and SM targets.
+// FMMU logical addressing (ESC datasheet section I, FMMU; ETG.1000.4 logical addressing): bit mapping,
+// read/write/both types, WKC, register and SM targets.
 #include <gtest/gtest.h>
 
 #include <optional>

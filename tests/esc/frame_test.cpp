@@ -1,4 +1,5 @@
-// Frame level: Ethernet/EtherCAT headers, datagram chains, malformed frames, runts, source MAC (§1, §13).
+// Frame level (ETG.1000.4 frame structure; ESC datasheet section I, frame processing): Ethernet/EtherCAT
+// headers, datagram chains, malformed frames, runts, source MAC.
 #include <gtest/gtest.h>
 
 #include <optional>

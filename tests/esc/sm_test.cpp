@@ -1,5 +1,5 @@
-// SyncManagers (§3.12, §4): mailbox and buffered modes, both sides, events, lock rule (E3), repeat, PDI
-// control.
+// SyncManagers (ESC datasheet section I, SyncManager): mailbox and buffered modes, both sides, events, lock
+// rule (E3), repeat, PDI control.
 #include <gtest/gtest.h>
 
 #include <optional>

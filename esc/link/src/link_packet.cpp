@@ -13,11 +13,13 @@
 #include <cerrno>
 #include <cstring>
 
+#include "esc/wire/datagram.hpp"
+
 namespace esc {
 
 namespace {
 
-constexpr uint16_t kEtherTypeEcat = 0x88A4;
+constexpr uint16_t kEtherTypeEcat = wire::kEtherType;
 // Ring geometry: 2 KiB slots (TPACKET2 header + sockaddr_ll + a 1518-byte frame fit), 8 slots per 16 KiB
 // block, 16 blocks: 128 frames may wait before the kernel drops.
 constexpr std::size_t kSlotSize = 2048;
