@@ -1,5 +1,5 @@
 #pragma once
-// SDO abort codes (ETG.1000.6 / CiA 301, reference §9.3) and the one mapping from od::Status.
+// SDO abort codes (ETG.1000.6 / CiA 301 SDO abort codes) and the one mapping from od::Status.
 #include <cstdint>
 
 #include "od/types.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// FoE opcodes and error codes (ethercat-protocol.md §10.1, §10.2; ETG.1000.6, SSC ecatfoe.h).
+// FoE opcodes and error codes (ETG.1000.6, FoE).
 #include <cstdint>
 #include <string_view>
 
