@@ -3,7 +3,7 @@
 # Used by both README commands and by .ci/run. Idempotent; quiet when all is present.
 set -euo pipefail
 PKGS=(build-essential cmake ninja-build pkg-config
-      libpcap-dev libeigen3-dev libgtest-dev libgmock-dev libcli11-dev libxml2-dev libxml2-utils
+      libpcap-dev zlib1g-dev libeigen3-dev libgtest-dev libgmock-dev libcli11-dev libxml2-dev libxml2-utils
       iproute2 tshark python3 python3-scapy gnuplot-nox clang-format
       clang libclang-rt-14-dev)  # clang + libFuzzer/sanitizer runtimes: the fuzz build (tests/fuzz) and the clang -Werror build
 missing=()

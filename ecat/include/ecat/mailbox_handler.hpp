@@ -6,35 +6,10 @@
 #include <cstdint>
 #include <span>
 
+#include "ecat/wire/mailbox.hpp"
 #include "od/types.hpp"
 
 namespace ecat {
-
-// Mailbox types (header byte 5, bits 3:0).
-enum class MailboxType : uint8_t {
-    Error = 0x0,
-    AoE = 0x1,
-    EoE = 0x2,
-    CoE = 0x3,
-    FoE = 0x4,
-    SoE = 0x5,
-    VoE = 0xF
-};
-
-// Mailbox error codes (mailbox type 0 reply, ETG.1000.4).
-enum class MailboxError : uint16_t {
-    Syntax = 0x0001,
-    UnsupportedProtocol = 0x0002,
-    InvalidChannel = 0x0003,
-    ServiceNotSupported = 0x0004,
-    InvalidHeader = 0x0005,
-    SizeTooShort = 0x0006,
-    NoMoreMemory = 0x0007,
-    InvalidSize = 0x0008,
-    ServiceInWork = 0x0009,
-};
-
-constexpr std::size_t kMailboxHeaderSize = 6;
 
 // The outgoing side of the mailbox, as a protocol handler sees it.
 class MailboxSender {

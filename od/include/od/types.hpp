@@ -3,6 +3,8 @@
 #include <cstdint>
 #include <string_view>
 
+#include "ecat/wire/al.hpp"
+
 namespace od {
 
 // CANopen / ETG.1000.6 data type codes.
@@ -28,8 +30,8 @@ enum class DataType : uint16_t {
 
 enum class ObjectCode : uint8_t { Var = 0x07, Array = 0x08, Record = 0x09 };
 
-// EtherCAT AL states, for state-dependent access ("rw only in Pre-Op").
-enum class AlState : uint8_t { Init = 0x01, PreOp = 0x02, Boot = 0x03, SafeOp = 0x04, Op = 0x08 };
+// EtherCAT AL states, for state-dependent access ("rw only in Pre-Op"): the AL vocabulary's (ecat/wire/al.hpp).
+using AlState = ecat::AlState;
 
 // Access and flag bits exactly as the SDO information "entry description" ObjectAccess word (ETG.1000.6):
 namespace access {
