@@ -16,7 +16,7 @@ Cycle::Cycle(StackContext& ctx, StateMachine& esm, SyncControl& sync, IrqLine ir
 }
 
 void Cycle::set_up_registers() {
-    ctx_.pdi.write_reg<uint32_t>(reg::kAlEventMask, kEventMask);
+    ctx_.pdi.write_reg<uint32_t>(esc::reg::kAlEventMask, kEventMask);
 }
 
 // ---- poll -------------------------------------------------------------------------------------------
@@ -28,20 +28,20 @@ void Cycle::poll(uint64_t now_ns) {
         return;  // nothing signalled and no timer due
     }
     if (!first_poll_ && esc_was_reset()) restart_after_esc_reset(now_ns);
-    uint32_t events = pdi.read_reg<uint32_t>(reg::kAlEventRequest);
+    uint32_t events = pdi.read_reg<uint32_t>(esc::reg::kAlEvent);
     if (first_poll_) {
         first_poll_ = false;
-        events |= reg::kEvAlControl;  // take over whatever the master requested before we started
+        events |= esc::alev::kAlControl;  // take over whatever the master requested before we started
     }
-    if (events & reg::kEvAlControl) esm_.handle_al_control(now_ns);
-    if (events & reg::kEvSmActivation) {
+    if (events & esc::alev::kAlControl) esm_.handle_al_control(now_ns);
+    if (events & esc::alev::kSmActivation) {
         // Reading the activation registers acknowledges the event; the mailbox checks the repeat bit.
         for (unsigned n = 0; n < 4; ++n)
-            (void)pdi.read_reg<uint8_t>(reg::sm_base(n) + reg::kSmActivate);
+            (void)pdi.read_reg<uint8_t>(esc::reg::sm_base(n) + esc::reg::kSmActivate);
         if (process_data_state(esm_.state())) esm_.check_process_data_sms(now_ns);
     }
-    if ((events & reg::kEvWatchdogPd) && !ctx_.faults.watchdog_ignored) {
-        const uint16_t wd = pdi.read_reg<uint16_t>(reg::kWatchdogStatusPd);
+    if ((events & esc::alev::kWatchdogPd) && !ctx_.faults.watchdog_ignored) {
+        const uint16_t wd = pdi.read_reg<uint16_t>(esc::reg::kWdStatusPd);
         if (!(wd & 0x0001)) {
             ++ctx_.stats.watchdog_expiries;
             if (esm_.state() == AlState::Op) {
@@ -77,7 +77,7 @@ uint64_t Cycle::next_deadline_ns() const {
 bool Cycle::esc_was_reset() {
     // The AL event mask is written only through the PDI (by this stack, at start); an ESC reset puts it
     // back to its reset value. On a device the ESC's reset would reset the controller behind it as well.
-    return ctx_.pdi.read_reg<uint32_t>(reg::kAlEventMask) != kEventMask;
+    return ctx_.pdi.read_reg<uint32_t>(esc::reg::kAlEventMask) != kEventMask;
 }
 
 void Cycle::restart_after_esc_reset(uint64_t now_ns) {
@@ -159,8 +159,8 @@ void Cycle::process_data_events(uint32_t events, uint64_t now_ns) {
     const bool has_outputs = !sm2_buf_.empty();
     bool new_outputs = false;
     if (has_outputs) {
-        const uint8_t st = pdi.read_reg<uint8_t>(reg::sm_base(2) + reg::kSmStatus);
-        new_outputs = (st & reg::kSmStatusIrqWrite) != 0 || (events & reg::ev_sm(2)) != 0;
+        const uint8_t st = pdi.read_reg<uint8_t>(esc::reg::sm_base(2) + esc::reg::kSmStatus);
+        new_outputs = (st & esc::reg::kSmStatusIrqWrite) != 0 || (events & esc::alev::sm(2)) != 0;
         if (new_outputs) outputs_seen_ = true;
     }
     switch (sync_.mode()) {
@@ -173,8 +173,9 @@ void Cycle::process_data_events(uint32_t events, uint64_t now_ns) {
                 }
             } else if (!sm3_buf_.empty()) {
                 // Inputs only: a new cycle each time the master has read the inputs.
-                const uint8_t st = pdi.read_reg<uint8_t>(reg::sm_base(3) + reg::kSmStatus);
-                if ((st & reg::kSmStatusIrqRead) || (events & reg::ev_sm(3))) run_cycle(now_ns, false);
+                const uint8_t st = pdi.read_reg<uint8_t>(esc::reg::sm_base(3) + esc::reg::kSmStatus);
+                if ((st & esc::reg::kSmStatusIrqRead) || (events & esc::alev::sm(3)))
+                    run_cycle(now_ns, false);
             }
             break;
         case SyncMode::FreeRun:

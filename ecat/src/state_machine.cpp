@@ -8,8 +8,9 @@ namespace {
 
 using od::AlState;
 
+// One of the AL states of the AL vocabulary (bits 3:0 of AL control).
 bool known_state(unsigned s) {
-    return s == 1 || s == 2 || s == 3 || s == 4 || s == 8;
+    return al_state_name(static_cast<uint8_t>(s)) != "UNKNOWN";
 }
 
 // The ESM transition table (ETG.1000.6, EtherCAT State Machine): true if from -> to is a defined transition.
@@ -51,10 +52,10 @@ int rank(AlState s) {
 
 void StateMachine::write_status() {
     uint16_t status = static_cast<uint16_t>(state_);
-    if (error_) status |= reg::kAlErrorFlag;
-    if (id_loaded_ && !error_) status |= reg::kAlIdFlag;
-    ctx_.pdi.write_reg<uint16_t>(reg::kAlStatusCode, (id_loaded_ && !error_) ? id_value_ : code_);
-    ctx_.pdi.write_reg<uint16_t>(reg::kAlStatus, status);
+    if (error_) status |= esc::reg::kAlErrorFlag;
+    if (id_loaded_ && !error_) status |= esc::reg::kAlIdFlag;
+    ctx_.pdi.write_reg<uint16_t>(esc::reg::kAlStatusCode, (id_loaded_ && !error_) ? id_value_ : code_);
+    ctx_.pdi.write_reg<uint16_t>(esc::reg::kAlStatus, status);
 }
 
 bool StateMachine::take_restart() {
@@ -81,10 +82,10 @@ void StateMachine::reset_to_init(uint64_t now_ns) {
 }
 
 void StateMachine::handle_al_control(uint64_t now_ns) {
-    const uint16_t control = ctx_.pdi.read_reg<uint16_t>(reg::kAlControl);  // clears AL event bit 0
-    const unsigned requested = control & reg::kAlStateMask;
-    const bool ack = (control & reg::kAlErrorFlag) != 0 && !ctx_.faults.error_ack_ignored;
-    const bool id_request = (control & reg::kAlIdFlag) != 0;
+    const uint16_t control = ctx_.pdi.read_reg<uint16_t>(esc::reg::kAlControl);  // clears AL event bit 0
+    const unsigned requested = control & esc::reg::kAlStateMask;
+    const bool ack = (control & esc::reg::kAlErrorFlag) != 0 && !ctx_.faults.error_ack_ignored;
+    const bool id_request = (control & esc::reg::kAlIdFlag) != 0;
 
     // A new request supersedes a Safe-Op -> Op still waiting for outputs / SYNC0.
     op_pending_ = false;
@@ -112,7 +113,7 @@ void StateMachine::handle_al_control(uint64_t now_ns) {
     // Device identification (ETG.1000.6, AL control/status): the ID value (station alias 0x0012) in
     // 0x0134 and AL status bit 5, only while no error is pending.
     id_loaded_ = id_request && !error_;
-    if (id_loaded_) id_value_ = ctx_.pdi.read_reg<uint16_t>(reg::kStationAlias);
+    if (id_loaded_) id_value_ = ctx_.pdi.read_reg<uint16_t>(esc::reg::kStationAlias);
     write_status();
 }
 
@@ -177,14 +178,16 @@ uint16_t StateMachine::check_mailbox(const od::MailboxLayout& layout, uint16_t c
     const SmRegs sm0 = read_sm(ctx_.pdi, 0);
     const SmRegs sm1 = read_sm(ctx_.pdi, 1);
     // Mode and direction must match; event-enable and watchdog bits are the master's choice.
-    const uint8_t c0 = static_cast<uint8_t>(expected_control(0, 0x26) & (reg::kSmModeMask | reg::kSmDirMask));
-    const uint8_t c1 = static_cast<uint8_t>(expected_control(1, 0x22) & (reg::kSmModeMask | reg::kSmDirMask));
+    const uint8_t c0 =
+        static_cast<uint8_t>(expected_control(0, 0x26) & (esc::reg::kSmModeMask | esc::reg::kSmDirMask));
+    const uint8_t c1 =
+        static_cast<uint8_t>(expected_control(1, 0x22) & (esc::reg::kSmModeMask | esc::reg::kSmDirMask));
     const bool ok0 = sm0.start == layout.out_start && sm0.length == layout.out_size &&
-                     (sm0.control & (reg::kSmModeMask | reg::kSmDirMask)) == c0 &&
-                     (sm0.activate & reg::kSmEnable);
+                     (sm0.control & (esc::reg::kSmModeMask | esc::reg::kSmDirMask)) == c0 &&
+                     (sm0.activate & esc::reg::kSmEnable);
     const bool ok1 = sm1.start == layout.in_start && sm1.length == layout.in_size &&
-                     (sm1.control & (reg::kSmModeMask | reg::kSmDirMask)) == c1 &&
-                     (sm1.activate & reg::kSmEnable);
+                     (sm1.control & (esc::reg::kSmModeMask | esc::reg::kSmDirMask)) == c1 &&
+                     (sm1.activate & esc::reg::kSmEnable);
     // The two mailboxes must not overlap.
     const bool apart = sm0.start + sm0.length <= sm1.start || sm1.start + sm1.length <= sm0.start;
     return ok0 && ok1 && apart ? al::NoError : code;
@@ -208,24 +211,24 @@ uint16_t StateMachine::check_pre_op_to_safe_op() {
         uint16_t code;
         uint8_t fallback_control;
     };
-    const Side sides[2] = {{2, pd.rx_bytes(), reg::kSmDirWrite, al::InvalidOutputConfig, 0x64},
-                           {3, pd.tx_bytes(), reg::kSmDirRead, al::InvalidInputConfig, 0x20}};
+    const Side sides[2] = {{2, pd.rx_bytes(), esc::reg::kSmDirWrite, al::InvalidOutputConfig, 0x64},
+                           {3, pd.tx_bytes(), esc::reg::kSmDirRead, al::InvalidInputConfig, 0x20}};
     SmRegs regs[4];
     for (unsigned n = 0; n < 4; ++n)
         regs[n] = read_sm(ctx_.pdi, n);
     for (const Side& s : sides) {
         const SmRegs& r = regs[s.sm];
-        const bool enabled = (r.activate & reg::kSmEnable) && r.length > 0;
+        const bool enabled = (r.activate & esc::reg::kSmEnable) && r.length > 0;
         if (s.bytes == 0) {
             if (enabled) return s.code;
             continue;
         }
         if (!enabled || (r.length != s.bytes && !(s.sm == 2 && ctx_.faults.sm2_length_unchecked)))
             return s.code;
-        if ((r.control & reg::kSmModeMask) != reg::kSmModeBuffered) return al::InvalidSmTypes;
+        if ((r.control & esc::reg::kSmModeMask) != esc::reg::kSmModeBuffered) return al::InvalidSmTypes;
         const uint8_t expected = expected_control(s.sm, s.fallback_control);
-        if ((r.control & reg::kSmDirMask) != (expected & reg::kSmDirMask) ||
-            (r.control & reg::kSmDirMask) != s.dir)
+        if ((r.control & esc::reg::kSmDirMask) != (expected & esc::reg::kSmDirMask) ||
+            (r.control & esc::reg::kSmDirMask) != s.dir)
             return s.code;
         const od::SyncManagerDefault* d = sm_default(s.sm);
         if (d != nullptr && d->start != 0 && r.start != d->start) return s.code;
@@ -239,8 +242,8 @@ uint16_t StateMachine::check_pre_op_to_safe_op() {
     std::size_t count = 0;
     for (unsigned n = 0; n < 4; ++n) {
         const SmRegs& r = regs[n];
-        if (!(r.activate & reg::kSmEnable) || r.length == 0) continue;
-        const uint32_t factor = (r.control & reg::kSmModeMask) == reg::kSmModeBuffered ? 3 : 1;
+        if (!(r.activate & esc::reg::kSmEnable) || r.length == 0) continue;
+        const uint32_t factor = (r.control & esc::reg::kSmModeMask) == esc::reg::kSmModeBuffered ? 3 : 1;
         areas[count++] = {r.start, r.start + factor * r.length};
     }
     for (std::size_t i = 0; i < count; ++i)
@@ -256,10 +259,10 @@ uint16_t StateMachine::check_watchdog() {
     esc::Pdi& pdi = ctx_.pdi;
     if (ctx_.pd.rx_bytes() == 0) return al::NoError;
     const SmRegs sm2 = read_sm(pdi, 2);
-    if (!(sm2.control & reg::kSmWatchdogEnable)) return al::NoError;
-    const uint16_t time = pdi.read_reg<uint16_t>(reg::kWatchdogTimePd);
+    if (!(sm2.control & esc::reg::kSmWatchdogEnable)) return al::NoError;
+    const uint16_t time = pdi.read_reg<uint16_t>(esc::reg::kWdTimePd);
     if (time == 0) return al::NoError;  // watchdog off
-    const uint16_t divider = pdi.read_reg<uint16_t>(reg::kWatchdogDivider);
+    const uint16_t divider = pdi.read_reg<uint16_t>(esc::reg::kWdDivider);
     const uint64_t timeout_ns = (static_cast<uint64_t>(divider) + 2) * 40 * time;
     // A watchdog shorter than one cycle would expire between two correct output updates.
     if (sync_.cycle_ns() != 0 && timeout_ns < sync_.cycle_ns()) return al::InvalidWatchdogConfig;
@@ -271,7 +274,7 @@ void StateMachine::check_process_data_sms(uint64_t now_ns) {
     // with (ETG.1000.6 AL status codes 0x001D / 0x001E, Op or Safe-Op -> Safe-Op with error).
     auto still_valid = [this](unsigned n, std::size_t bytes, uint16_t start_address) {
         const SmRegs r = read_sm(ctx_.pdi, n);
-        const bool enabled = (r.activate & reg::kSmEnable) && r.length > 0;
+        const bool enabled = (r.activate & esc::reg::kSmEnable) && r.length > 0;
         if (bytes == 0) return !enabled;
         const bool length_ok = r.length == bytes || (n == 2 && ctx_.faults.sm2_length_unchecked);
         return enabled && length_ok && r.start == start_address;
@@ -288,9 +291,9 @@ bool StateMachine::op_conditions_met() {
     if (ctx_.pd.rx_bytes() > 0) {
         if (!cycle_.outputs_seen()) return false;
         // Outputs seen once but since stopped: the process-data watchdog says they are stale.
-        const bool watched = (read_sm(pdi, 2).control & reg::kSmWatchdogEnable) &&
-                             pdi.read_reg<uint16_t>(reg::kWatchdogTimePd) != 0;
-        if (watched && !(pdi.read_reg<uint16_t>(reg::kWatchdogStatusPd) & 0x0001)) return false;
+        const bool watched = (read_sm(pdi, 2).control & esc::reg::kSmWatchdogEnable) &&
+                             pdi.read_reg<uint16_t>(esc::reg::kWdTimePd) != 0;
+        if (watched && !(pdi.read_reg<uint16_t>(esc::reg::kWdStatusPd) & 0x0001)) return false;
     }
     if (sync_.dc() && !sync_.sync0_seen()) return false;
     return true;

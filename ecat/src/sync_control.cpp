@@ -83,13 +83,13 @@ void SyncControl::init_objects() {
 uint16_t SyncControl::configure() {
     esc::Pdi& pdi = ctx_.pdi;
     const ProcessData& pd = ctx_.pd;
-    const uint8_t activation = pdi.read_reg<uint8_t>(reg::kDcActivation);
-    const uint32_t sync0_cycle = pdi.read_reg<uint32_t>(reg::kDcSync0CycleTime);
+    const uint8_t activation = pdi.read_reg<uint8_t>(esc::reg::kDcActivation);
+    const uint32_t sync0_cycle = pdi.read_reg<uint32_t>(esc::reg::kDcSync0Cycle);
     const uint16_t supported = static_cast<uint16_t>(get_u(kSmOutputParams, kSiSyncModesSupported, 0x0007));
     const uint32_t min_cycle = static_cast<uint32_t>(get_u(kSmOutputParams, kSiMinCycleTime, 0));
-    const bool cyclic = activation & reg::kDcActCyclic;
-    const bool sync0 = cyclic && (activation & reg::kDcActSync0);
-    const bool sync1 = cyclic && (activation & reg::kDcActSync1);
+    const bool cyclic = activation & esc::reg::kDcActCyclic;
+    const bool sync0 = cyclic && (activation & esc::reg::kDcActSync0);
+    const bool sync1 = cyclic && (activation & esc::reg::kDcActSync1);
     const bool has_pd = pd.rx_bytes() > 0 || pd.tx_bytes() > 0;
 
     if (sync1 && !sync0) return al::InvalidDcSyncConfig;  // SYNC1 only together with SYNC0
@@ -148,7 +148,7 @@ uint16_t SyncControl::configure() {
             if (sync0_cycle == 0) return al::DcInvalidSyncCycleTime;
             // Start time already past when activated (0x0984 bit 2): SYNC0 would not come (ESC datasheet,
             // Distributed Clocks, activation status).
-            if (pdi.read_reg<uint8_t>(reg::kDcActivationStatus) & 0x04) return al::InvalidDcSyncConfig;
+            if (pdi.read_reg<uint8_t>(esc::reg::kDcActivationStatus) & 0x04) return al::InvalidDcSyncConfig;
             if (min_cycle != 0 && sync0_cycle < min_cycle) return al::DcSync0CycleTime;
             cycle = sync0_cycle;
             break;
@@ -180,9 +180,9 @@ void SyncControl::start(uint64_t now_ns) {
     sync0_seen_ = false;
     last_sync0_ns_ = now_ns;
     next_cycle_ns_ = now_ns + cycle_ns_;
-    next_sync0_sys_ = ctx_.pdi.read_reg<uint64_t>(reg::kDcStartTime);
+    next_sync0_sys_ = ctx_.pdi.read_reg<uint64_t>(esc::reg::kDcStartTime);
     sync0_deadline_ns_ = UINT64_MAX;
-    last_sm_change_time_ = ctx_.pdi.read_reg<uint32_t>(reg::kDcEcatBufferChangeTime);
+    last_sm_change_time_ = ctx_.pdi.read_reg<uint32_t>(esc::reg::kDcEcatBufferChange);
     for (int i = 0; i < 2; ++i) {
         if (sm_missed_[i].valid()) sm_missed_[i].set(0);
         if (cycle_exceeded_[i].valid()) cycle_exceeded_[i].set(0);
@@ -222,7 +222,7 @@ uint64_t SyncControl::next_deadline_ns(bool op) const {
 // longer than a period: such a sample is not taken (cycles_exceeded counts periods without a cycle).
 void SyncControl::sample_sync0_latency(uint64_t sys, uint64_t next_sync0, bool running) {
     if (!running) return;
-    const uint32_t period = ctx_.pdi.read_reg<uint32_t>(reg::kDcSync0CycleTime);
+    const uint32_t period = ctx_.pdi.read_reg<uint32_t>(esc::reg::kDcSync0Cycle);
     if (period == 0 || next_sync0 < period) return;
     const uint64_t pulse = next_sync0 - period;
     if (sys < pulse || sys - pulse >= period) return;
@@ -233,11 +233,11 @@ void SyncControl::sample_sync0_latency(uint64_t sys, uint64_t next_sync0, bool r
 // system time copy minus the offset. Differences are taken modulo 2^32 (valid up to 4.29 s).
 void SyncControl::sample_sm2_latency() {
     esc::Pdi& pdi = ctx_.pdi;
-    const uint32_t changed = pdi.read_reg<uint32_t>(reg::kDcEcatBufferChangeTime);
+    const uint32_t changed = pdi.read_reg<uint32_t>(esc::reg::kDcEcatBufferChange);
     if (changed == last_sm_change_time_) return;  // not latched by this ESC, or no new event
     last_sm_change_time_ = changed;
-    const uint64_t sys = pdi.read_reg<uint64_t>(reg::kDcSystemTime);
-    const uint64_t offset = pdi.read_reg<uint64_t>(reg::kDcSystemTimeOffset);
+    const uint64_t sys = pdi.read_reg<uint64_t>(esc::reg::kDcSystemTime);
+    const uint64_t offset = pdi.read_reg<uint64_t>(esc::reg::kDcOffset);
     const auto local = static_cast<uint32_t>(sys - offset);
     ctx_.stats.sm2_latency.add(static_cast<uint32_t>(local - changed));
 }
@@ -249,21 +249,21 @@ SyncControl::Sync0 SyncControl::sync0_events(uint32_t events, uint64_t now_ns, b
     // SYNC0 is seen as the AL event (when 0x0151 maps it) and, in any case, as the "next SYNC0" time 0x0990
     // moving on; the latter also says how many periods passed since the last look.
     uint64_t periods = 0;
-    if (events & reg::kEvSync0) {
-        (void)pdi.read_reg<uint8_t>(reg::kDcSync0Status);  // acknowledges the SYNC0 event
+    if (events & esc::alev::kSync0) {
+        (void)pdi.read_reg<uint8_t>(esc::reg::kDcSync0Status);  // acknowledges the SYNC0 event
         periods = 1;
     }
     // 0x0990 is the next pulse only while SYNC0 runs; otherwise it is whatever the master wrote.
-    const uint8_t activation = pdi.read_reg<uint8_t>(reg::kDcActivation);
-    const bool running =
-        (activation & (reg::kDcActCyclic | reg::kDcActSync0)) == (reg::kDcActCyclic | reg::kDcActSync0);
-    const uint64_t next = running ? pdi.read_reg<uint64_t>(reg::kDcStartTime) : next_sync0_sys_;
+    const uint8_t activation = pdi.read_reg<uint8_t>(esc::reg::kDcActivation);
+    const bool running = (activation & (esc::reg::kDcActCyclic | esc::reg::kDcActSync0)) ==
+                         (esc::reg::kDcActCyclic | esc::reg::kDcActSync0);
+    const uint64_t next = running ? pdi.read_reg<uint64_t>(esc::reg::kDcStartTime) : next_sync0_sys_;
     if (next != next_sync0_sys_) {
         if (cycle_ns_ > 0 && next > next_sync0_sys_) periods = (next - next_sync0_sys_) / cycle_ns_;
         if (periods == 0) periods = 1;
         next_sync0_sys_ = next;
     }
-    const uint64_t sys = pdi.read_reg<uint64_t>(reg::kDcSystemTime);  // local copy of system time
+    const uint64_t sys = pdi.read_reg<uint64_t>(esc::reg::kDcSystemTime);  // local copy of system time
     sync0_deadline_ns_ = running && next > sys ? now_ns + (next - sys) : UINT64_MAX;
     if (periods > 0) {
         ++stats.sync0_events;

@@ -5,15 +5,15 @@
 #include <cstdint>
 #include <iosfwd>
 
-#include "ecat/al_status.hpp"
 #include "ecat/application.hpp"
 #include "ecat/event_sink.hpp"
 #include "ecat/faults.hpp"
 #include "ecat/latency.hpp"
 #include "ecat/mailbox.hpp"
 #include "ecat/process_data.hpp"
-#include "ecat/registers.hpp"
+#include "ecat/wire/al.hpp"
 #include "esc/pdi.hpp"
+#include "esc/wire/registers.hpp"
 #include "od/device.hpp"
 #include "od/dictionary.hpp"
 
@@ -72,7 +72,7 @@ struct SmRegs {
 
 inline SmRegs read_sm(esc::Pdi& pdi, unsigned n) {
     uint8_t b[8];
-    pdi.read(reg::sm_base(n), b);
+    pdi.read(esc::reg::sm_base(n), b);
     SmRegs r;
     r.start = static_cast<uint16_t>(b[0] | (b[1] << 8));
     r.length = static_cast<uint16_t>(b[2] | (b[3] << 8));
@@ -85,10 +85,10 @@ inline SmRegs read_sm(esc::Pdi& pdi, unsigned n) {
 
 // Sets or clears "deactivate SyncManager" in the PDI control register of SM n.
 inline void set_sm_pdi_deactivated(esc::Pdi& pdi, unsigned n, bool deactivated) {
-    uint8_t v = pdi.read_reg<uint8_t>(reg::sm_base(n) + reg::kSmPdiControl);
-    v = deactivated ? static_cast<uint8_t>(v | reg::kSmPdiDeactivate)
-                    : static_cast<uint8_t>(v & ~reg::kSmPdiDeactivate);
-    pdi.write_reg<uint8_t>(reg::sm_base(n) + reg::kSmPdiControl, v);
+    uint8_t v = pdi.read_reg<uint8_t>(esc::reg::sm_base(n) + esc::reg::kSmPdiControl);
+    v = deactivated ? static_cast<uint8_t>(v | esc::reg::kSmPdiDeactivate)
+                    : static_cast<uint8_t>(v & ~esc::reg::kSmPdiDeactivate);
+    pdi.write_reg<uint8_t>(esc::reg::sm_base(n) + esc::reg::kSmPdiControl, v);
 }
 
 }  // namespace ecat
