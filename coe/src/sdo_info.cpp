@@ -1,4 +1,4 @@
-// SDO information service (CoE service 8, reference §9.4).
+// SDO information service (CoE service 8, ETG.1000.6 SDO Information).
 #include <algorithm>
 #include <cfloat>
 #include <cmath>

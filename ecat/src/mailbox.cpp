@@ -19,7 +19,8 @@ void put_le16(uint8_t* p, uint16_t v) {
     p[1] = static_cast<uint8_t>(v >> 8);
 }
 
-// Smallest protocol header after the mailbox header; a shorter request is "size too short" (§8.3).
+// Smallest protocol header after the mailbox header; a shorter request is "size too short" (ETG.1000.6,
+// mailbox error reply).
 std::size_t min_protocol_length(uint8_t type) {
     switch (static_cast<MailboxType>(type)) {
         case MailboxType::CoE:
@@ -169,7 +170,8 @@ void Mailbox::dispatch(std::span<const uint8_t> message) {
         ~ResetAddress() { a = 0; }
     } reset{reply_address_};
 
-    // Header checks (ethercat-protocol.md §8.1, §8.3; decisions in docs/decisions/ecat.md).
+    // Header checks (ETG.1000.4 mailbox header, ETG.1000.6 mailbox error reply; decisions in
+    // docs/decisions/ecat.md).
     if (type == static_cast<uint8_t>(MailboxType::Error)) {
         send_error(MailboxError::InvalidHeader);
         return;
@@ -198,7 +200,8 @@ void Mailbox::dispatch(std::span<const uint8_t> message) {
     for (std::size_t i = 0; i < handler_count_; ++i) {
         if (static_cast<uint8_t>(handlers_[i]->type()) == type) handler = handlers_[i];
     }
-    // Bootstrap serves FoE only (§10.4); otherwise the handler says where it is available.
+    // Bootstrap serves FoE only (ETG.1000.6, Bootstrap state); otherwise the handler says where it is
+    // available.
     const bool allowed = handler != nullptr && handler->available(state_) &&
                          (state_ != od::AlState::Boot || handler->type() == MailboxType::FoE);
     if (!allowed) {

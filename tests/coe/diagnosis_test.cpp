@@ -1,4 +1,4 @@
-// Diagnosis history 0x10F3 (ETG.1020; seed 001 §7.2.5, digest §4.1).
+// Diagnosis history 0x10F3 (ETG.1020 Diagnosis History; MAXPOS firmware specification §7.2.5).
 #include <gtest/gtest.h>
 
 #include "coe/diagnosis.hpp"

@@ -1,4 +1,4 @@
-// The CoE server on od's real drive dictionary (seed 001 chapter 7).
+// The CoE server on od's real drive dictionary (MAXPOS firmware specification, chapter 7).
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -75,7 +75,8 @@ TEST_F(DriveDictionary, RemapAndCompleteAccessDownloadOfThePdoObjects) {
 }
 
 TEST_F(DriveDictionary, WholeArrayDownloadWithZerosPastTheCount) {
-    // 0x1C12 entries only take 0x1600..0x1603 (seed 001 §7.2.15); zeros past the count are not an error.
+    // 0x1C12 entries only take 0x1600..0x1603 (MAXPOS firmware specification §7.2.15); zeros past the count
+    // are not an error.
     Bytes req = sdo(0x31, 0x1C12, 0, 10, {0x01, 0x00, 0x01, 0x16, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00});
     EXPECT_EQ(ask(req), (Bytes{0x00, 0x30, 0x70, 0x12, 0x1C, 0x00, 0, 0, 0, 0}));
     EXPECT_EQ(dict.get<uint8_t>(0x1C12, 0), 1);

@@ -1,4 +1,4 @@
-// Emergency (CoE service 1, reference §9.5; seed digest 000 "EMCY = code + error register + 5 bytes").
+// Emergency (CoE service 1, ETG.1000.6 Emergency: error code + error register + 5 bytes).
 #include <gtest/gtest.h>
 
 #include <array>
@@ -23,7 +23,8 @@ TEST(Emergency, EncodingIsCoeHeaderCodeRegisterAndFiveBytes) {
 TEST(Emergency, RaiseAndClearMaintainTheErrorRegister) {
     od::Dictionary dict = make_test_dictionary();
     coe::Emergency e(&dict);
-    e.raise(0x2310, 0x03);  // overcurrent: generic + current (seed 001 Table 8-141: 00000010 -> as given)
+    e.raise(0x2310, 0x03);  // overcurrent: generic + current (MAXPOS firmware specification Table 8-141:
+                            // 00000010 -> as given)
     EXPECT_EQ(dict.get<uint8_t>(0x1001, 0), 0x03);
     e.raise(0x8611, 0x80);  // following error: motion bit only, no generic bit forced
     EXPECT_EQ(dict.get<uint8_t>(0x1001, 0), 0x83);

@@ -1,4 +1,5 @@
-// PDO mapping and assignment checks (seed 001 §7.2.6-16, digest §5.3/5.4; ETG.1000.6 mapping entry format).
+// PDO mapping and assignment checks (MAXPOS firmware specification §7.2.6-16; ETG.1000.6 mapping entry
+// format).
 #include <gtest/gtest.h>
 
 #include "coe/pdo_validation.hpp"
@@ -30,7 +31,7 @@ class PdoChecks : public ::testing::Test {
 };
 
 TEST_F(PdoChecks, MasterRemapSequenceIsAccepted) {
-    // zub MACS sequence [004 §6.4.3], in Pre-Op.
+    // zub MACS sequence (EPOS4 Application Notes §6.4.3), in Pre-Op.
     EXPECT_EQ(write(0x1C12, 0, 0, 1), 0u);
     EXPECT_EQ(write(0x1C13, 0, 0, 1), 0u);
     EXPECT_EQ(write(0x1A00, 0, 0, 1), 0u);

@@ -1,4 +1,4 @@
-// SDO server (ETG.1000.6 §5.6.2, reference §9.2/§9.3): byte-level requests and the replies they must get.
+// SDO server (ETG.1000.6 §5.6.2): byte-level requests and the replies they must get.
 #include <gtest/gtest.h>
 
 #include <numeric>
@@ -39,14 +39,14 @@ class SdoServer : public ::testing::Test {
 // ---- Expedited ------------------------------------------------------------------------------------------
 
 TEST_F(SdoServer, ExpeditedUploadOf4ByteEntryAnswers43) {
-    // Reference §9.2 worked example: read 0x1018:01.
+    // Worked example: read 0x1018:01.
     EXPECT_EQ(ask(sdo(0x40, 0x1018, 1)), (Bytes{0x00, 0x30, 0x43, 0x18, 0x10, 0x01, 0xFB, 0x00, 0x00, 0x00}));
 }
 
 TEST_F(SdoServer, ExpeditedUploadOf2And1ByteEntriesAnswer4BAnd4F) {
     EXPECT_EQ(ask(sdo(0x40, 0x6041, 0)), (Bytes{0x00, 0x30, 0x4B, 0x41, 0x60, 0x00, 0x50, 0x02, 0x00, 0x00}));
     EXPECT_EQ(ask(sdo(0x40, 0x6060, 0)), (Bytes{0x00, 0x30, 0x4F, 0x60, 0x60, 0x00, 0x08, 0x00, 0x00, 0x00}));
-    // Seed 004 §5.4: read 0x6064 -> 43 64 60 00 CA 04 00 00 (= 1226).
+    // EPOS4 Application Notes §5.4: read 0x6064 -> 43 64 60 00 CA 04 00 00 (= 1226).
     EXPECT_EQ(ask(sdo(0x40, 0x6064, 0)), (Bytes{0x00, 0x30, 0x43, 0x64, 0x60, 0x00, 0xCA, 0x04, 0x00, 0x00}));
 }
 
@@ -60,7 +60,7 @@ TEST_F(SdoServer, ExpeditedDownloadWithSizeIndicated) {
 }
 
 TEST_F(SdoServer, ExpeditedDownloadWithoutSizeTakesTheEntrySize) {
-    // Seed 004 §5.4: write 0x6040 = 0x000F as 22 40 60 00 0F 00 00 00.
+    // EPOS4 Application Notes §5.4: write 0x6040 = 0x000F as 22 40 60 00 0F 00 00 00.
     EXPECT_EQ(ask(sdo(0x22, 0x6040, 0, 0x000F)), (Bytes{0x00, 0x30, 0x60, 0x40, 0x60, 0x00, 0, 0, 0, 0}));
     EXPECT_EQ(dict.get<uint16_t>(0x6040, 0), 0x000F);
 }
@@ -259,7 +259,7 @@ TEST_F(SdoServer, AbortObjectDoesNotExist06020000) {
 }
 
 TEST_F(SdoServer, AbortSubindexDoesNotExist06090011) {
-    // Seed 004 §5.4.2: abort bytes 4..7 = 11 00 09 06.
+    // EPOS4 Application Notes §5.4.2: abort bytes 4..7 = 11 00 09 06.
     EXPECT_EQ(ask(sdo(0x40, 0x1018, 7)), (Bytes{0x00, 0x20, 0x80, 0x18, 0x10, 0x07, 0x11, 0x00, 0x09, 0x06}));
 }
 

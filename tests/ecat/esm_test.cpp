@@ -1,5 +1,6 @@
-// EtherCAT state machine: one test per row of the ETG transition table (ethercat-protocol.md §6.2), the AL
-// status codes of §6.3 for the checks of §6.4, error indication / acknowledge and device identification.
+// EtherCAT state machine: one test per row of the ESM transition table (ETG.1000.6, EtherCAT State Machine),
+// the AL status codes (ETG.1000.6) for the checks of each transition, error indication / acknowledge and
+// device identification.
 #include "fixture.hpp"
 
 namespace ecat::test {

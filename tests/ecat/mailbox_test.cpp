@@ -1,5 +1,6 @@
-// Mailbox: header checks and error replies (ethercat-protocol.md §8), counters, repeat request (§4.4),
-// queue, Bootstrap protocol restriction, handler dispatch.
+// Mailbox: header checks and error replies (ETG.1000.4 mailbox, ETG.1000.6 mailbox error reply), counters,
+// repeat request (ESC datasheet, SyncManager mailbox repeat), queue, Bootstrap protocol restriction, handler
+// dispatch.
 #include <gmock/gmock.h>
 
 #include "fixture.hpp"

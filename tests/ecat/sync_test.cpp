@@ -10,8 +10,8 @@ constexpr uint16_t kErr = 0x10;
 
 class Sync : public StackTest {
   protected:
-    // DC SYNC0 as masters set it up (ethercat-protocol.md §11.2 step 8): cycle time, start time in the near
-    // future (system time), then activation.
+    // DC SYNC0 as masters set it up (ETG.1020 Synchronization, DC start-up): cycle time, start time in the
+    // near future (system time), then activation.
     void enable_dc(uint32_t cycle_ns, uint8_t activation = 0x03, uint64_t start_delay_ns = 1'000'000) {
         master.wr<uint8_t>(0x0980, 0);
         master.wr<uint32_t>(0x09A0, cycle_ns);

@@ -1,6 +1,7 @@
 #pragma once
-// Diagnosis history, object 0x10F3 (ETG.1020; seed 001 §7.2.5, digest §4.1). The drive glue adds messages;
-// they live in the dictionary entries 0x10F3:06.. (a ring), so the master reads them by SDO like any object.
+// Diagnosis history, object 0x10F3 (ETG.1020 Diagnosis History; MAXPOS firmware specification §7.2.5). The
+// drive glue adds messages; they live in the dictionary entries 0x10F3:06.. (a ring), so the master reads
+// them by SDO like any object.
 //
 //   :01 maximum messages   :02 newest message (subindex, 0 = none)   :03 newest acknowledged (write: 0 clears
 //   all, 6..5+max acknowledges up to that message, 1..5 -> 0x06090032, above -> 0x06090031)

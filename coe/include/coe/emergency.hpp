@@ -1,5 +1,5 @@
 #pragma once
-// CoE emergency (service 1, reference §9.5): the drive glue raises and clears errors here; the error
+// CoE emergency (service 1, ETG.1000.6 Emergency): the drive glue raises and clears errors here; the error
 // register 0x1001 follows the active errors; messages wait in a bounded queue until CoeServer::poll()
 // sends them through the mailbox.
 #include <array>
@@ -22,9 +22,9 @@ class Emergency {
     explicit Emergency(od::Dictionary* dict = nullptr, std::size_t capacity = 8);
 
     // An error occurred: remember it as active, OR its register bits into 0x1001 (the bits the error table
-    // gives: seed 001 Table 8-141 sets e.g. only the motion bit for 0x8611, so no generic bit is forced) and
-    // queue an emergency carrying the new register value.
-    // mfr: up to 5 manufacturer-specific bytes (more are cut, fewer are zero-padded).
+    // gives: the MAXPOS firmware specification, Table 8-141, sets e.g. only the motion bit for 0x8611, so no
+    // generic bit is forced) and queue an emergency carrying the new register value. mfr: up to 5
+    // manufacturer-specific bytes (more are cut, fewer are zero-padded).
     void raise(uint16_t error_code, uint8_t register_bits, std::span<const uint8_t> mfr = {});
     // The error went away: recompute 0x1001; when no error is left, queue the "no error" emergency
     // (code 0x0000). Clearing an error that is not active does nothing.

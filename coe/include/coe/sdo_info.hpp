@@ -1,5 +1,5 @@
 #pragma once
-// SDO information service helpers (reference §9.4) shared with the ESI/SII side.
+// SDO information service helpers (ETG.1000.6 SDO Information) shared with the ESI/SII side.
 #include <cstdint>
 #include <string_view>
 

@@ -1,5 +1,5 @@
 #pragma once
-// The CoE mailbox protocol (ETG.1000.6, reference §9): SDO server (expedited, normal, segmented, complete
+// The CoE mailbox protocol (ETG.1000.6, CoE): SDO server (expedited, normal, segmented, complete
 // access), SDO information service and the emergency sender, on top of the object model.
 //
 // Requests arrive through ecat::MailboxHandler::handle() as mailbox payloads (CoE header first). Every

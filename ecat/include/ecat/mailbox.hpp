@@ -1,9 +1,10 @@
 #pragma once
-// The mailbox layer (ethercat-protocol.md §4.3, §4.4, §8): SM0 (master -> slave) is read to its last byte
-// whenever it is full, the 6-byte header is checked, counters are de-duplicated, the payload is dispatched
-// to the registered MailboxHandler; replies wait in a fixed-capacity queue and are written into SM1 (whole
-// SM1 length, so the last byte completes the buffer) whenever SM1 is empty. The last message read by the
-// master is kept for the repeat request/acknowledge handshake. Nothing is allocated per message.
+// The mailbox layer (ETG.1000.4 mailbox; ESC datasheet, SyncManager mailbox mode and repeat): SM0 (master ->
+// slave) is read to its last byte whenever it is full, the 6-byte header is checked, counters are
+// de-duplicated, the payload is dispatched to the registered MailboxHandler; replies wait in a fixed-capacity
+// queue and are written into SM1 (whole SM1 length, so the last byte completes the buffer) whenever SM1 is
+// empty. The last message read by the master is kept for the repeat request/acknowledge handshake. Nothing is
+// allocated per message.
 #include <array>
 #include <cstddef>
 #include <cstdint>

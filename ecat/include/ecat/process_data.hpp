@@ -1,7 +1,8 @@
 #pragma once
-// Process-data copy plan (ethercat-protocol.md §9.6): built from the PDO assignment (0x1C12 outputs/SM2,
-// 0x1C13 inputs/SM3) and the mapping objects (0x16xx / 0x1Axx) when the slave enters Safe-Op, then used every
-// cycle to copy bit-exactly between the SM buffers and the dictionary's value storage, allocating nothing.
+// Process-data copy plan (ETG.1000.6, PDO mapping and SyncManager PDO assignment objects): built from the PDO
+// assignment (0x1C12 outputs/SM2, 0x1C13 inputs/SM3) and the mapping objects (0x16xx / 0x1Axx) when the slave
+// enters Safe-Op, then used every cycle to copy bit-exactly between the SM buffers and the dictionary's value
+// storage, allocating nothing.
 #include <cstddef>
 #include <cstdint>
 #include <span>

@@ -88,10 +88,12 @@ VerifyResult verify_image(std::span<const uint8_t> bytes, const ImageIdentity& i
 // Error with a readable detail (e.g. "image is for product 0x30020000, this device is 0x30010000").
 std::string describe(const VerifyResult& r, const ImageIdentity& identity);
 
-// 0x100A text as the seed writes it: the software version word as 4 hex digits and 'h' ("0120h").
+// 0x100A text as the MAXPOS firmware specification writes it: the software version word as 4 hex digits and
+// 'h' ("0120h").
 std::string software_version_text(uint32_t version);
-// Firmware file name per seed 001 §9.2 / seed 000 §15: <device>_<SW>h_<HW>h_<AppNo>h_<AppVer>h.bin,
-// e.g. MAXPOS_0120h_3001h_0000h_0000h.bin for product 0x30010000, version 0x01200000.
+// Firmware file name per MAXPOS firmware specification §9.2 / EPOS Firmware Specification §15:
+// <device>_<SW>h_<HW>h_<AppNo>h_<AppVer>h.bin, e.g. MAXPOS_0120h_3001h_0000h_0000h.bin for product
+// 0x30010000, version 0x01200000.
 std::string firmware_file_name(std::string_view device_name, uint32_t product_code, uint32_t version);
 // Sets what the running image decides: revision (0x1018:03, SII) and software version text (0x100A).
 void apply_version(od::Identity& identity, uint32_t version);

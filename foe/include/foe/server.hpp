@@ -1,12 +1,13 @@
 #pragma once
-// FoE server (ethercat-protocol.md §10): firmware download into a FirmwareStore (Bootstrap only) and upload
+// FoE server (ETG.1000.6, FoE): firmware download into a FirmwareStore (Bootstrap only) and upload
 // of the stored images. An ecat::MailboxHandler for mailbox type FoE: it sees the bytes after the mailbox
 // header and answers through the MailboxSender.
 //
-// Files: "<device>" (e.g. "MAXPOS", the FoE target as seed 004 §4.8.3 names it for EPOS4) and
-// "<device>_<SW>h_<HW>h_<AppNo>h_<AppVer>h.bin" (seed 001 §9.2) are writable in Bootstrap; the written image
-// decides its version, the name only selects the firmware. Readable in every mailbox state: "<device>"
-// (the active image) and the file name of each stored valid image (active and previous slot).
+// Files: "<device>" (e.g. "MAXPOS", the FoE target as the EPOS4 Application Notes §4.8.3 name it for EPOS4)
+// and "<device>_<SW>h_<HW>h_<AppNo>h_<AppVer>h.bin" (MAXPOS firmware specification §9.2) are writable in
+// Bootstrap; the written image decides its version, the name only selects the firmware. Readable in every
+// mailbox state: "<device>" (the active image) and the file name of each stored valid image (active and
+// previous slot).
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -29,7 +30,7 @@ namespace foe {
 
 struct ServerConfig {
     std::string device_name = "MAXPOS";
-    uint32_t password = 0;                    // seed 004 §4.8.3: password 0
+    uint32_t password = 0;                    // EPOS4 Application Notes §4.8.3: password 0
     uint64_t timeout_ns = 10'000'000'000ull;  // an idle transfer is dropped after this
     // Largest DATA payload the master sends (SM0 length - 12), per mailbox; a shorter DATA ends the file.
     // 0: take the largest payload the reply mailbox allows (SM1 length - 12).

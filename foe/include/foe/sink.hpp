@@ -24,7 +24,7 @@ struct StoreError {
 struct StoredImage {
     unsigned slot = 0;
     ImageHeader header{};
-    std::string file_name;  // firmware file name of the image (seed naming rule)
+    std::string file_name;  // firmware file name of the image (MAXPOS firmware specification §9.2)
     std::filesystem::path path;
     uint64_t size = 0;  // header + payload
 };

@@ -39,7 +39,7 @@ std::string_view to_string(StoreStep s);
 struct StoreConfig {
     std::filesystem::path dir;
     ImageIdentity identity;
-    std::string device_name = "MAXPOS";    // file name prefix (seed 001 §9.2)
+    std::string device_name = "MAXPOS";    // file name prefix (MAXPOS firmware specification §9.2)
     uint64_t max_image_bytes = 64u << 20;  // larger images are refused with "disk full"
     std::size_t read_back_chunk = 64u << 10;
 };

@@ -1,0 +1,78 @@
+#pragma once
+// The cycle of ecat::Stack: the poll loop (AL event request 0x0220 and its dispatch to the state machine,
+// the mailbox and the process data), the ESC-reset restart, the process-data watchdog, and the process data
+// exchange itself (SM2 outputs into the dictionary, the application cycle, inputs out through SM3) at the
+// moments SyncControl says. It owns the process-data images (sized at Safe-Op, never per frame) and the
+// interrupt-line bookkeeping.
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "ecat/stack_context.hpp"
+
+namespace ecat {
+
+class StateMachine;
+class SyncControl;
+
+class Cycle {
+  public:
+    using IrqLine = std::function<bool()>;
+
+    // Housekeeping period for the mailbox handlers' poll() (transfer timeouts).
+    static constexpr uint64_t kHousekeepingNs = 10'000'000;
+    // AL event mask written at start: AL control, SYNC0, SM activation, PD watchdog, SM0..SM3.
+    static constexpr uint32_t kEventMask = 0x00000F55;
+
+    Cycle(StackContext& ctx, StateMachine& esm, SyncControl& sync, IrqLine irq);
+    Cycle(const Cycle&) = delete;
+    Cycle& operator=(const Cycle&) = delete;
+
+    // The register set-up of a fresh start (and after an ESC reset): event mask, SMs deactivated on the PDI.
+    void set_up_registers();
+
+    void poll(uint64_t now_ns);
+    uint64_t next_deadline_ns() const;
+    uint64_t last_now_ns() const { return last_now_ns_; }
+
+    // Process data, started at Safe-Op entry and stopped when leaving the process-data states.
+    void set_sm_starts(uint16_t sm2, uint16_t sm3) {
+        sm2_start_ = sm2;
+        sm3_start_ = sm3;
+    }
+    void start_process_data(uint64_t now_ns);
+    void stop_process_data();
+    std::size_t output_bytes() const { return sm2_buf_.size(); }
+    std::size_t input_bytes() const { return sm3_buf_.size(); }
+    uint16_t sm2_start() const { return sm2_start_; }
+    uint16_t sm3_start() const { return sm3_start_; }
+    bool outputs_seen() const { return outputs_seen_; }
+
+    // Whether the interrupt line covers every SM event the stack waits on (SM control bit 5 set).
+    void update_irq_usable();
+
+  private:
+    bool esc_was_reset();
+    void restart_after_esc_reset(uint64_t now_ns);
+    void process_data_events(uint32_t events, uint64_t now_ns);
+    void run_cycle(uint64_t now_ns, bool fresh_outputs);
+    void write_inputs();
+
+    StackContext& ctx_;
+    StateMachine& esm_;
+    SyncControl& sync_;
+    IrqLine irq_;
+
+    std::vector<uint8_t> sm2_buf_;
+    std::vector<uint8_t> sm3_buf_;
+    uint16_t sm2_start_ = 0;
+    uint16_t sm3_start_ = 0;
+    bool outputs_seen_ = false;
+
+    bool irq_usable_ = true;
+    uint64_t housekeeping_at_ns_ = 0;
+    uint64_t last_now_ns_ = 0;
+    bool first_poll_ = true;
+};
+
+}  // namespace ecat

@@ -1,0 +1,94 @@
+#pragma once
+// What the three parts of ecat::Stack (StateMachine, SyncControl, Cycle) share: the collaborators the Stack
+// was built with, its statistics and faults, and the SyncManager register block as read through the PDI.
+// Internal to the stack; applications use ecat/stack.hpp.
+#include <cstdint>
+#include <iosfwd>
+
+#include "ecat/application.hpp"
+#include "ecat/event_sink.hpp"
+#include "ecat/faults.hpp"
+#include "ecat/latency.hpp"
+#include "ecat/mailbox.hpp"
+#include "ecat/process_data.hpp"
+#include "ecat/wire/al.hpp"
+#include "esc/pdi.hpp"
+#include "esc/wire/registers.hpp"
+#include "od/device.hpp"
+#include "od/dictionary.hpp"
+
+namespace ecat {
+
+struct StackStats {
+    uint64_t transitions = 0;  // successful AL state changes
+    uint64_t refused = 0;      // refused requests (error flag set)
+    uint64_t cycles = 0;       // application cycles run
+    uint64_t sync0_events = 0;
+    uint64_t sm_events_missed = 0;   // DC: SYNC0 without new outputs since the last one (Op)
+    uint64_t cycles_exceeded = 0;    // DC: SYNC0 periods that passed without a cycle
+    uint64_t watchdog_expiries = 0;  // process-data watchdog events seen
+    uint64_t esc_resets = 0;         // ESC resets (0x0040/0x0041) the stack restarted after
+    // DC: how late each application cycle started after its SYNC0 pulse, against the DC system time:
+    // 0x0910 read at the cycle start minus the pulse's system time (next pulse 0x0990 - SYNC0 cycle 0x09A0).
+    LatencyHistogram sync0_latency;
+    // SM-synchronous: from the ECAT-side SM buffer change (0x09F0, local time, 32 bit) to the cycle start
+    // (local time = 0x0910 - offset 0x0920). Only samples where 0x09F0 changed since the last cycle count,
+    // so an ESC that does not latch 0x09F0 leaves this empty rather than wrong.
+    LatencyHistogram sm2_latency;
+};
+
+// Adds the counts and latency samples of `more` to `total` (a run's figures over several Stack instances).
+void add_stats(StackStats& total, const StackStats& more);
+
+// The statistics as "stack.<name> <value>" lines (latencies in ns), for logs and benchmark scripts.
+void print_stats(std::ostream& out, const StackStats& stats);
+
+struct StackContext {
+    esc::Pdi& pdi;
+    od::Dictionary& dict;
+    const od::DeviceDescription& desc;
+    Application& app;
+    Mailbox& mailbox;
+    ProcessData& pd;
+    StackStats& stats;
+    const StackFaults& faults;
+    EventSink* events = nullptr;
+};
+
+// States in which process data (SM2/SM3) runs.
+constexpr bool process_data_state(od::AlState s) {
+    return s == od::AlState::SafeOp || s == od::AlState::Op;
+}
+
+// One SyncManager's register block (ESC datasheet, SyncManager registers 0x0800 + 8n).
+struct SmRegs {
+    uint16_t start = 0;
+    uint16_t length = 0;
+    uint8_t control = 0;
+    uint8_t status = 0;
+    uint8_t activate = 0;
+    uint8_t pdi_control = 0;
+};
+
+inline SmRegs read_sm(esc::Pdi& pdi, unsigned n) {
+    uint8_t b[8];
+    pdi.read(esc::reg::sm_base(n), b);
+    SmRegs r;
+    r.start = static_cast<uint16_t>(b[0] | (b[1] << 8));
+    r.length = static_cast<uint16_t>(b[2] | (b[3] << 8));
+    r.control = b[4];
+    r.status = b[5];
+    r.activate = b[6];
+    r.pdi_control = b[7];
+    return r;
+}
+
+// Sets or clears "deactivate SyncManager" in the PDI control register of SM n.
+inline void set_sm_pdi_deactivated(esc::Pdi& pdi, unsigned n, bool deactivated) {
+    uint8_t v = pdi.read_reg<uint8_t>(esc::reg::sm_base(n) + esc::reg::kSmPdiControl);
+    v = deactivated ? static_cast<uint8_t>(v | esc::reg::kSmPdiDeactivate)
+                    : static_cast<uint8_t>(v & ~esc::reg::kSmPdiDeactivate);
+    pdi.write_reg<uint8_t>(esc::reg::sm_base(n) + esc::reg::kSmPdiControl, v);
+}
+
+}  // namespace ecat

@@ -1,0 +1,205 @@
+#include "ecat/cycle.hpp"
+
+#include <algorithm>
+
+#include "ecat/state_machine.hpp"
+#include "ecat/sync_control.hpp"
+
+namespace ecat {
+
+using od::AlState;
+
+Cycle::Cycle(StackContext& ctx, StateMachine& esm, SyncControl& sync, IrqLine irq)
+    : ctx_(ctx), esm_(esm), sync_(sync), irq_(std::move(irq)) {
+    sm2_buf_.reserve(1024);
+    sm3_buf_.reserve(1024);
+}
+
+void Cycle::set_up_registers() {
+    ctx_.pdi.write_reg<uint32_t>(esc::reg::kAlEventMask, kEventMask);
+}
+
+// ---- poll -------------------------------------------------------------------------------------------
+
+void Cycle::poll(uint64_t now_ns) {
+    esc::Pdi& pdi = ctx_.pdi;
+    last_now_ns_ = now_ns;
+    if (irq_ && irq_usable_ && !first_poll_ && !irq_() && now_ns < next_deadline_ns()) {
+        return;  // nothing signalled and no timer due
+    }
+    if (!first_poll_ && esc_was_reset()) restart_after_esc_reset(now_ns);
+    uint32_t events = pdi.read_reg<uint32_t>(esc::reg::kAlEvent);
+    if (first_poll_) {
+        first_poll_ = false;
+        events |= esc::alev::kAlControl;  // take over whatever the master requested before we started
+    }
+    if (events & esc::alev::kAlControl) esm_.handle_al_control(now_ns);
+    if (events & esc::alev::kSmActivation) {
+        // Reading the activation registers acknowledges the event; the mailbox checks the repeat bit.
+        for (unsigned n = 0; n < 4; ++n)
+            (void)pdi.read_reg<uint8_t>(esc::reg::sm_base(n) + esc::reg::kSmActivate);
+        if (process_data_state(esm_.state())) esm_.check_process_data_sms(now_ns);
+    }
+    if ((events & esc::alev::kWatchdogPd) && !ctx_.faults.watchdog_ignored) {
+        const uint16_t wd = pdi.read_reg<uint16_t>(esc::reg::kWdStatusPd);
+        if (!(wd & 0x0001)) {
+            ++ctx_.stats.watchdog_expiries;
+            if (esm_.state() == AlState::Op) {
+                // Reported where it matters: outside Op no outputs are used, and one expires after every Op.
+                if (ctx_.events != nullptr) ctx_.events->watchdog_expired(esm_.state());
+                // Outputs are no longer refreshed: Safe-Op with error 0x001B (ETG.1000.6, process-data
+                // watchdog; ESC datasheet, watchdog).
+                esm_.fall_back(AlState::SafeOp, al::SmWatchdog, now_ns);
+            }
+        }
+    }
+    if (process_data_state(esm_.state())) process_data_events(events, now_ns);
+    if (esm_.op_pending()) esm_.try_complete_op(now_ns);
+    if (ctx_.mailbox.running()) {
+        ctx_.mailbox.poll(now_ns);
+        housekeeping_at_ns_ = now_ns + kHousekeepingNs;
+    }
+    // Last: AL status already says Init, so the application may restart the device from here.
+    if (esm_.take_restart()) ctx_.app.on_restart();
+}
+
+uint64_t Cycle::next_deadline_ns() const {
+    uint64_t t = UINT64_MAX;
+    if (ctx_.mailbox.running()) t = std::min(t, housekeeping_at_ns_);
+    if (esm_.op_pending()) t = std::min(t, esm_.op_deadline_ns());
+    if (process_data_state(esm_.state()))
+        t = std::min(t, sync_.next_deadline_ns(esm_.state() == AlState::Op));
+    return t;
+}
+
+// ---- ESC reset --------------------------------------------------------------------------------------
+
+bool Cycle::esc_was_reset() {
+    // The AL event mask is written only through the PDI (by this stack, at start); an ESC reset puts it
+    // back to its reset value. On a device the ESC's reset would reset the controller behind it as well.
+    return ctx_.pdi.read_reg<uint32_t>(esc::reg::kAlEventMask) != kEventMask;
+}
+
+void Cycle::restart_after_esc_reset(uint64_t now_ns) {
+    ++ctx_.stats.esc_resets;
+    // Down to Init as the ESC is: outputs lost, process data and mailbox stopped, the handlers drop their
+    // transfers; the next Init -> Pre-Op starts the mailbox with fresh counters.
+    esm_.reset_to_init(now_ns);
+    sync_.reset();
+    outputs_seen_ = false;
+    // The register set-up of the constructor, lost with the reset.
+    set_up_registers();
+    for (unsigned n = 0; n < 4; ++n)
+        set_sm_pdi_deactivated(ctx_.pdi, n, true);
+    esm_.write_status();
+    update_irq_usable();
+    first_poll_ = true;      // take over whatever the master requested since the reset
+    esm_.request_restart();  // the application restarts as well (end of this poll)
+}
+
+void Cycle::update_irq_usable() {
+    constexpr uint8_t kPdiEvent = 0x20;
+    esc::Pdi& pdi = ctx_.pdi;
+    bool usable = true;
+    if (ctx_.mailbox.running()) {
+        usable = usable && (read_sm(pdi, 0).control & kPdiEvent) && (read_sm(pdi, 1).control & kPdiEvent);
+    }
+    if (process_data_state(esm_.state())) {
+        if (!sm2_buf_.empty()) usable = usable && (read_sm(pdi, 2).control & kPdiEvent);
+        if (!sm3_buf_.empty()) usable = usable && (read_sm(pdi, 3).control & kPdiEvent);
+    }
+    irq_usable_ = usable;
+}
+
+// ---- Process data -----------------------------------------------------------------------------------
+
+void Cycle::start_process_data(uint64_t now_ns) {
+    ProcessData& pd = ctx_.pd;
+    sm2_buf_.assign(pd.rx_bytes(), 0);
+    sm3_buf_.assign(pd.tx_bytes(), 0);
+    outputs_seen_ = false;
+    sync_.start(now_ns);
+    if (pd.rx_bytes() > 0) set_sm_pdi_deactivated(ctx_.pdi, 2, false);
+    if (pd.tx_bytes() > 0) {
+        set_sm_pdi_deactivated(ctx_.pdi, 3, false);
+        write_inputs();  // valid inputs from the first Safe-Op frame on
+    }
+}
+
+void Cycle::stop_process_data() {
+    set_sm_pdi_deactivated(ctx_.pdi, 2, true);
+    set_sm_pdi_deactivated(ctx_.pdi, 3, true);
+    ctx_.pd.clear();
+    sm2_buf_.clear();
+    sm3_buf_.clear();
+    outputs_seen_ = false;
+}
+
+void Cycle::write_inputs() {
+    if (sm3_buf_.empty() || (ctx_.faults.inputs_op_only && esm_.state() != AlState::Op)) return;
+    ctx_.pd.dictionary_to_inputs(sm3_buf_);
+    ctx_.pdi.write(sm3_start_, sm3_buf_);
+}
+
+void Cycle::run_cycle(uint64_t now_ns, bool fresh_outputs) {
+    if (!sm2_buf_.empty()) {
+        // Reading SM2 from its first to its last byte takes the newest buffer and releases it.
+        if (fresh_outputs) ctx_.pdi.read(sm2_start_, sm2_buf_);
+        // Safe-Op: outputs are ignored, the application keeps its safe values.
+        if ((esm_.state() == AlState::Op || ctx_.faults.outputs_in_safe_op) && fresh_outputs)
+            ctx_.pd.outputs_to_dictionary(sm2_buf_);
+    }
+    ctx_.app.on_cycle(now_ns);
+    write_inputs();
+    ++ctx_.stats.cycles;
+}
+
+void Cycle::process_data_events(uint32_t events, uint64_t now_ns) {
+    esc::Pdi& pdi = ctx_.pdi;
+    const bool has_outputs = !sm2_buf_.empty();
+    bool new_outputs = false;
+    if (has_outputs) {
+        const uint8_t st = pdi.read_reg<uint8_t>(esc::reg::sm_base(2) + esc::reg::kSmStatus);
+        new_outputs = (st & esc::reg::kSmStatusIrqWrite) != 0 || (events & esc::alev::sm(2)) != 0;
+        if (new_outputs) outputs_seen_ = true;
+    }
+    switch (sync_.mode()) {
+        case SyncMode::SmSync:
+        case SyncMode::SmSync2:
+            if (has_outputs) {
+                if (new_outputs) {
+                    sync_.sample_sm2_latency();
+                    run_cycle(now_ns, true);
+                }
+            } else if (!sm3_buf_.empty()) {
+                // Inputs only: a new cycle each time the master has read the inputs.
+                const uint8_t st = pdi.read_reg<uint8_t>(esc::reg::sm_base(3) + esc::reg::kSmStatus);
+                if ((st & esc::reg::kSmStatusIrqRead) || (events & esc::alev::sm(3)))
+                    run_cycle(now_ns, false);
+            }
+            break;
+        case SyncMode::FreeRun:
+            if (sync_.free_run_due(now_ns)) {
+                run_cycle(now_ns, new_outputs);
+                sync_.free_run_advance(now_ns);
+            }
+            break;
+        case SyncMode::DcSync0:
+        case SyncMode::DcSync1: {
+            const bool op = esm_.state() == AlState::Op;
+            switch (sync_.sync0_events(events, now_ns, op, has_outputs, new_outputs)) {
+                case SyncControl::Sync0::RunCycle:
+                    run_cycle(now_ns, new_outputs);
+                    break;
+                case SyncControl::Sync0::Lost:
+                    esm_.fall_back(AlState::SafeOp, al::FatalSyncError, now_ns);
+                    break;
+                case SyncControl::Sync0::None:
+                    break;
+            }
+            break;
+        }
+    }
+}
+
+}  // namespace ecat

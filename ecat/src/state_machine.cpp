@@ -1,0 +1,363 @@
+#include "ecat/state_machine.hpp"
+
+#include "ecat/cycle.hpp"
+#include "ecat/sync_control.hpp"
+
+namespace ecat {
+namespace {
+
+using od::AlState;
+
+// One of the AL states of the AL vocabulary (bits 3:0 of AL control).
+bool known_state(unsigned s) {
+    return al_state_name(static_cast<uint8_t>(s)) != "UNKNOWN";
+}
+
+// The ESM transition table (ETG.1000.6, EtherCAT State Machine): true if from -> to is a defined transition.
+bool valid_transition(AlState from, AlState to) {
+    if (from == to) return true;
+    switch (from) {
+        case AlState::Init:
+            return to == AlState::PreOp || to == AlState::Boot;
+        case AlState::PreOp:
+            return to == AlState::Init || to == AlState::SafeOp;
+        case AlState::Boot:
+            return to == AlState::Init;
+        case AlState::SafeOp:
+            return to == AlState::Init || to == AlState::PreOp || to == AlState::Op;
+        case AlState::Op:
+            return to == AlState::Init || to == AlState::PreOp || to == AlState::SafeOp;
+    }
+    return false;
+}
+
+// Rank for "lower than": Boot counts with Init (both below Pre-Op).
+int rank(AlState s) {
+    switch (s) {
+        case AlState::Init:
+            return 0;
+        case AlState::Boot:
+            return 0;
+        case AlState::PreOp:
+            return 1;
+        case AlState::SafeOp:
+            return 2;
+        case AlState::Op:
+            return 3;
+    }
+    return 0;
+}
+
+}  // namespace
+
+void StateMachine::write_status() {
+    uint16_t status = static_cast<uint16_t>(state_);
+    if (error_) status |= esc::reg::kAlErrorFlag;
+    if (id_loaded_ && !error_) status |= esc::reg::kAlIdFlag;
+    ctx_.pdi.write_reg<uint16_t>(esc::reg::kAlStatusCode, (id_loaded_ && !error_) ? id_value_ : code_);
+    ctx_.pdi.write_reg<uint16_t>(esc::reg::kAlStatus, status);
+}
+
+bool StateMachine::take_restart() {
+    const bool pending = restart_pending_;
+    restart_pending_ = false;
+    return pending;
+}
+
+const od::SyncManagerDefault* StateMachine::sm_default(unsigned n) const {
+    return n < ctx_.desc.sync_managers.size() ? &ctx_.desc.sync_managers[n] : nullptr;
+}
+
+uint8_t StateMachine::expected_control(unsigned n, uint8_t fallback) const {
+    const od::SyncManagerDefault* d = sm_default(n);
+    return d != nullptr ? d->control : fallback;
+}
+
+void StateMachine::reset_to_init(uint64_t now_ns) {
+    op_pending_ = false;
+    if (state_ != AlState::Init) go(AlState::Init, now_ns);
+    error_ = false;
+    code_ = al::NoError;
+    id_loaded_ = false;
+}
+
+void StateMachine::handle_al_control(uint64_t now_ns) {
+    const uint16_t control = ctx_.pdi.read_reg<uint16_t>(esc::reg::kAlControl);  // clears AL event bit 0
+    const unsigned requested = control & esc::reg::kAlStateMask;
+    const bool ack = (control & esc::reg::kAlErrorFlag) != 0 && !ctx_.faults.error_ack_ignored;
+    const bool id_request = (control & esc::reg::kAlIdFlag) != 0;
+
+    // A new request supersedes a Safe-Op -> Op still waiting for outputs / SYNC0.
+    op_pending_ = false;
+
+    if (error_) {
+        // While the error indication is set, only a request with the acknowledge bit (or a request for
+        // Init, as SOES does) is taken; everything else is ignored (ETG.1000.6, ESM error handling).
+        if (!ack && requested != static_cast<unsigned>(AlState::Init)) {
+            id_loaded_ = false;
+            write_status();
+            return;
+        }
+        error_ = false;
+        code_ = al::NoError;
+    }
+
+    if (!known_state(requested)) {
+        refuse(al::UnknownState);
+        if (ctx_.events != nullptr)
+            ctx_.events->state_refused(state_, static_cast<uint8_t>(requested), code_);
+    } else if (static_cast<AlState>(requested) != state_) {
+        request(static_cast<AlState>(requested), now_ns);
+    }
+
+    // Device identification (ETG.1000.6, AL control/status): the ID value (station alias 0x0012) in
+    // 0x0134 and AL status bit 5, only while no error is pending.
+    id_loaded_ = id_request && !error_;
+    if (id_loaded_) id_value_ = ctx_.pdi.read_reg<uint16_t>(esc::reg::kStationAlias);
+    write_status();
+}
+
+void StateMachine::request(AlState to, uint64_t now_ns) {
+    const AlState from = state_;
+    const uint64_t refused_before = ctx_.stats.refused;
+    request_checked(to, now_ns);
+    if (ctx_.events != nullptr && ctx_.stats.refused != refused_before)
+        ctx_.events->state_refused(from, static_cast<uint8_t>(to), code_);
+}
+
+void StateMachine::request_checked(AlState to, uint64_t now_ns) {
+    const AlState from = state_;
+    const bool boot_supported = check_bootstrap() == 0;
+    if (to == AlState::Boot && from == AlState::Init && (!boot_supported || ctx_.faults.bootstrap_refused)) {
+        refuse(al::BootstrapNotSupported);
+        return;
+    }
+    if (!valid_transition(from, to)) {
+        if (ctx_.faults.invalid_request_silent) return;
+        refuse(al::InvalidStateChange);
+        return;
+    }
+    uint16_t code = al::NoError;
+    const bool upward = rank(to) > rank(from) || (from == AlState::Init && to == AlState::Boot);
+    if (upward) {
+        if (from == AlState::Init && to == AlState::PreOp) {
+            code = check_mailbox(ctx_.desc.standard_mailbox, al::InvalidMailboxConfigPreOp);
+        } else if (from == AlState::Init && to == AlState::Boot) {
+            code = check_mailbox(ctx_.desc.bootstrap_mailbox, al::InvalidMailboxConfigBoot);
+        } else if (from == AlState::PreOp && to == AlState::SafeOp) {
+            code = check_pre_op_to_safe_op();
+        }
+    }
+    // Going down always succeeds (ETG.1000.6, ESM); the application vetoes only transitions up.
+    if (code == al::NoError && upward) code = ctx_.app.check_transition(from, to);
+    if (code != al::NoError) {
+        if (from == AlState::PreOp && to == AlState::SafeOp) ctx_.pd.clear();
+        refuse(code);
+        return;
+    }
+    if (from == AlState::SafeOp && to == AlState::Op && !op_conditions_met()) {
+        // Wait (in Safe-Op, no error) for the first outputs and, in DC mode, for SYNC0 (ETG.1000.6,
+        // Safe-Op to Op; ETG.1020 Synchronization).
+        op_pending_ = true;
+        op_deadline_ns_ = now_ns + op_wait_timeout_ns_;
+        return;
+    }
+    go(to, now_ns);
+}
+
+uint16_t StateMachine::check_bootstrap() const {
+    const od::DeviceDescription& desc = ctx_.desc;
+    const bool foe = (desc.mailbox_protocols & od::mailbox_protocol::FoE) != 0;
+    const bool sized = desc.bootstrap_mailbox.out_size > kMailboxHeaderSize &&
+                       desc.bootstrap_mailbox.in_size > kMailboxHeaderSize;
+    return foe && sized ? al::NoError : al::BootstrapNotSupported;
+}
+
+uint16_t StateMachine::check_mailbox(const od::MailboxLayout& layout, uint16_t code) {
+    if (layout.out_size == 0 && layout.in_size == 0) return al::NoError;  // device without mailbox
+    const SmRegs sm0 = read_sm(ctx_.pdi, 0);
+    const SmRegs sm1 = read_sm(ctx_.pdi, 1);
+    // Mode and direction must match; event-enable and watchdog bits are the master's choice.
+    const uint8_t c0 =
+        static_cast<uint8_t>(expected_control(0, 0x26) & (esc::reg::kSmModeMask | esc::reg::kSmDirMask));
+    const uint8_t c1 =
+        static_cast<uint8_t>(expected_control(1, 0x22) & (esc::reg::kSmModeMask | esc::reg::kSmDirMask));
+    const bool ok0 = sm0.start == layout.out_start && sm0.length == layout.out_size &&
+                     (sm0.control & (esc::reg::kSmModeMask | esc::reg::kSmDirMask)) == c0 &&
+                     (sm0.activate & esc::reg::kSmEnable);
+    const bool ok1 = sm1.start == layout.in_start && sm1.length == layout.in_size &&
+                     (sm1.control & (esc::reg::kSmModeMask | esc::reg::kSmDirMask)) == c1 &&
+                     (sm1.activate & esc::reg::kSmEnable);
+    // The two mailboxes must not overlap.
+    const bool apart = sm0.start + sm0.length <= sm1.start || sm1.start + sm1.length <= sm0.start;
+    return ok0 && ok1 && apart ? al::NoError : code;
+}
+
+uint16_t StateMachine::check_pre_op_to_safe_op() {
+    const od::DeviceDescription& desc = ctx_.desc;
+    ProcessData& pd = ctx_.pd;
+    // SM types as described (0x1C00).
+    for (unsigned n = 0; n < desc.sync_managers.size() && n < 4; ++n) {
+        const uint64_t kind = sync_.sm_type(n, static_cast<uint64_t>(desc.sync_managers[n].kind));
+        if (kind != static_cast<uint64_t>(desc.sync_managers[n].kind)) return al::InvalidSmTypes;
+    }
+    // Take over the PDO assignment and mapping.
+    if (const uint16_t code = pd.build(); code != 0) return code;
+
+    struct Side {
+        unsigned sm;
+        std::size_t bytes;
+        uint8_t dir;
+        uint16_t code;
+        uint8_t fallback_control;
+    };
+    const Side sides[2] = {{2, pd.rx_bytes(), esc::reg::kSmDirWrite, al::InvalidOutputConfig, 0x64},
+                           {3, pd.tx_bytes(), esc::reg::kSmDirRead, al::InvalidInputConfig, 0x20}};
+    SmRegs regs[4];
+    for (unsigned n = 0; n < 4; ++n)
+        regs[n] = read_sm(ctx_.pdi, n);
+    for (const Side& s : sides) {
+        const SmRegs& r = regs[s.sm];
+        const bool enabled = (r.activate & esc::reg::kSmEnable) && r.length > 0;
+        if (s.bytes == 0) {
+            if (enabled) return s.code;
+            continue;
+        }
+        if (!enabled || (r.length != s.bytes && !(s.sm == 2 && ctx_.faults.sm2_length_unchecked)))
+            return s.code;
+        if ((r.control & esc::reg::kSmModeMask) != esc::reg::kSmModeBuffered) return al::InvalidSmTypes;
+        const uint8_t expected = expected_control(s.sm, s.fallback_control);
+        if ((r.control & esc::reg::kSmDirMask) != (expected & esc::reg::kSmDirMask) ||
+            (r.control & esc::reg::kSmDirMask) != s.dir)
+            return s.code;
+        const od::SyncManagerDefault* d = sm_default(s.sm);
+        if (d != nullptr && d->start != 0 && r.start != d->start) return s.code;
+    }
+    // No overlap of the active SM areas (a buffered SM occupies three times its length: ESC datasheet,
+    // SyncManager, 3-buffer mode).
+    struct Area {
+        uint32_t begin, end;
+    };
+    Area areas[4];
+    std::size_t count = 0;
+    for (unsigned n = 0; n < 4; ++n) {
+        const SmRegs& r = regs[n];
+        if (!(r.activate & esc::reg::kSmEnable) || r.length == 0) continue;
+        const uint32_t factor = (r.control & esc::reg::kSmModeMask) == esc::reg::kSmModeBuffered ? 3 : 1;
+        areas[count++] = {r.start, r.start + factor * r.length};
+    }
+    for (std::size_t i = 0; i < count; ++i)
+        for (std::size_t j = i + 1; j < count; ++j)
+            if (areas[i].begin < areas[j].end && areas[j].begin < areas[i].end) return al::InvalidSmConfig;
+
+    cycle_.set_sm_starts(regs[2].start, regs[3].start);
+    if (const uint16_t code = sync_.configure(); code != 0) return code;
+    return check_watchdog();
+}
+
+uint16_t StateMachine::check_watchdog() {
+    esc::Pdi& pdi = ctx_.pdi;
+    if (ctx_.pd.rx_bytes() == 0) return al::NoError;
+    const SmRegs sm2 = read_sm(pdi, 2);
+    if (!(sm2.control & esc::reg::kSmWatchdogEnable)) return al::NoError;
+    const uint16_t time = pdi.read_reg<uint16_t>(esc::reg::kWdTimePd);
+    if (time == 0) return al::NoError;  // watchdog off
+    const uint16_t divider = pdi.read_reg<uint16_t>(esc::reg::kWdDivider);
+    const uint64_t timeout_ns = (static_cast<uint64_t>(divider) + 2) * 40 * time;
+    // A watchdog shorter than one cycle would expire between two correct output updates.
+    if (sync_.cycle_ns() != 0 && timeout_ns < sync_.cycle_ns()) return al::InvalidWatchdogConfig;
+    return al::NoError;
+}
+
+void StateMachine::check_process_data_sms(uint64_t now_ns) {
+    // The master changed an SM while process data runs: SM2/SM3 must still be what Safe-Op was entered
+    // with (ETG.1000.6 AL status codes 0x001D / 0x001E, Op or Safe-Op -> Safe-Op with error).
+    auto still_valid = [this](unsigned n, std::size_t bytes, uint16_t start_address) {
+        const SmRegs r = read_sm(ctx_.pdi, n);
+        const bool enabled = (r.activate & esc::reg::kSmEnable) && r.length > 0;
+        if (bytes == 0) return !enabled;
+        const bool length_ok = r.length == bytes || (n == 2 && ctx_.faults.sm2_length_unchecked);
+        return enabled && length_ok && r.start == start_address;
+    };
+    if (!still_valid(2, cycle_.output_bytes(), cycle_.sm2_start())) {
+        fall_back(AlState::SafeOp, al::InvalidOutputConfig, now_ns);
+    } else if (!still_valid(3, cycle_.input_bytes(), cycle_.sm3_start())) {
+        fall_back(AlState::SafeOp, al::InvalidInputConfig, now_ns);
+    }
+}
+
+bool StateMachine::op_conditions_met() {
+    esc::Pdi& pdi = ctx_.pdi;
+    if (ctx_.pd.rx_bytes() > 0) {
+        if (!cycle_.outputs_seen()) return false;
+        // Outputs seen once but since stopped: the process-data watchdog says they are stale.
+        const bool watched = (read_sm(pdi, 2).control & esc::reg::kSmWatchdogEnable) &&
+                             pdi.read_reg<uint16_t>(esc::reg::kWdTimePd) != 0;
+        if (watched && !(pdi.read_reg<uint16_t>(esc::reg::kWdStatusPd) & 0x0001)) return false;
+    }
+    if (sync_.dc() && !sync_.sync0_seen()) return false;
+    return true;
+}
+
+void StateMachine::try_complete_op(uint64_t now_ns) {
+    if (state_ != AlState::SafeOp) {
+        op_pending_ = false;
+        return;
+    }
+    if (op_conditions_met()) {
+        op_pending_ = false;
+        go(AlState::Op, now_ns);
+        write_status();
+        return;
+    }
+    if (now_ns >= op_deadline_ns_) {
+        op_pending_ = false;
+        refuse(sync_.dc() && !sync_.sync0_seen() ? al::NoSyncError : al::SmWatchdog);
+        if (ctx_.events != nullptr)
+            ctx_.events->state_refused(state_, static_cast<uint8_t>(AlState::Op), code_);
+        write_status();
+    }
+}
+
+void StateMachine::go(AlState to, uint64_t now_ns) {
+    const AlState from = state_;
+    if (from == to) return;
+    // Downward: stop outputs, inputs, mailbox as the target state requires.
+    if (from == AlState::Op) ctx_.app.on_outputs_lost();
+    if (process_data_state(from) && !process_data_state(to)) cycle_.stop_process_data();
+    if (from != AlState::Init && (to == AlState::Init)) ctx_.mailbox.stop();
+    // Upward: start the mailbox (standard or bootstrap layout), the process data.
+    if (from == AlState::Init && to == AlState::PreOp) {
+        sync_.pre_op_entered();
+        ctx_.mailbox.start(ctx_.desc.standard_mailbox, AlState::PreOp);
+    }
+    if (from == AlState::Init && to == AlState::Boot)
+        ctx_.mailbox.start(ctx_.desc.bootstrap_mailbox, AlState::Boot);
+    if (from == AlState::PreOp && to == AlState::SafeOp) cycle_.start_process_data(now_ns);
+    if (to == AlState::Op) sync_.op_entered();
+    state_ = to;
+    ++ctx_.stats.transitions;
+    cycle_.update_irq_usable();
+    ctx_.mailbox.set_state(from, to);
+    if (ctx_.events != nullptr) ctx_.events->state_changed(from, to);
+    ctx_.app.on_state_change(from, to);
+    if (from == AlState::Boot && to == AlState::Init)
+        restart_pending_ = true;  // reported at the end of poll()
+}
+
+void StateMachine::refuse(uint16_t code) {
+    error_ = true;
+    code_ = ctx_.faults.al_code_missing ? al::NoError : code;
+    id_loaded_ = false;
+    ++ctx_.stats.refused;
+}
+
+void StateMachine::fall_back(AlState to, uint16_t code, uint64_t now_ns) {
+    op_pending_ = false;
+    if (rank(to) < rank(state_)) go(to, now_ns);
+    refuse(code);
+    if (ctx_.events != nullptr) ctx_.events->local_error(state_, code);
+    write_status();
+}
+
+}  // namespace ecat
