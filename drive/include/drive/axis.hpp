@@ -10,25 +10,20 @@
 #include <cstdint>
 #include <limits>
 
+#include "drive/controller.hpp"
+#include "drive/device_control.hpp"
 #include "drive/environment.hpp"
 #include "drive/event_sink.hpp"
 #include "drive/faults.hpp"
+#include "drive/homing.hpp"
 #include "drive/plant.hpp"
 #include "drive/profile.hpp"
+#include "drive/setpoint.hpp"
 #include "drive/state_machine.hpp"
+#include "drive/supervisor.hpp"
+#include "drive/touch_probe.hpp"
 
 namespace drive {
-
-namespace mode {
-constexpr int8_t None = 0;
-constexpr int8_t ProfilePosition = 1;
-constexpr int8_t ProfileVelocity = 3;
-constexpr int8_t Homing = 6;
-constexpr int8_t CyclicSyncPosition = 8;
-constexpr int8_t CyclicSyncVelocity = 9;
-constexpr int8_t CyclicSyncTorque = 10;
-bool supported(int8_t m);
-}  // namespace mode
 
 // Configuration objects (defaults = seed 001 defaults, except where noted).
 struct Parameters {
@@ -158,14 +153,14 @@ class Axis {
     // Raise an error from outside (e.g. the communication side); reaction per its class.
     void raise_error(uint16_t code);
 
-    State state() const { return state_; }
-    int8_t active_mode() const { return mode_; }
-    bool power_on() const { return power_; }
-    bool referenced() const { return referenced_; }
-    bool i2t_limiting() const { return i2t_active_; }
-    double thermal_load() const { return thermal_; }  // I2t state, 1.0 = limit
+    State state() const { return dc_.state; }
+    int8_t active_mode() const { return sp_.mode; }
+    bool power_on() const { return dc_.power; }
+    bool referenced() const { return home_.referenced; }
+    bool i2t_limiting() const { return ctl_.i2t_active; }
+    double thermal_load() const { return ctl_.thermal; }  // I2t state, 1.0 = limit
     const Plant& plant() const { return plant_; }
-    double position_demand_inc() const { return demand_pos_ + shift_; }  // reported frame, unrounded
+    double position_demand_inc() const { return sp_.demand_pos + shift_; }  // reported frame, unrounded
     double raw_position_inc() const;   // exact simulated position in raw increments (after polarity)
     double phys_position_inc() const;  // the same before polarity: the frame of the Environment
     int64_t home_shift() const { return shift_; }
@@ -174,18 +169,6 @@ class Axis {
     bool error_active(uint16_t code) const;
 
   private:
-    enum class Control : uint8_t { Position, Velocity, Torque };
-    enum class StopKind : uint8_t { None, Ramp, Disable };
-    enum class HomingStatus : uint8_t { Idle, InProgress, Done, Error, Interrupted };
-    enum class HomingPhase : uint8_t { Search, Backoff, ToIndex, Offset, Stopping, Finished };
-
-    struct Pending {  // a transition waiting for the drive to stop
-        bool active = false;
-        State to = State::SwitchOnDisabled;
-        int number = -1;
-        int64_t since_ns = 0;
-    };
-
     void derive();
     void device_control(int64_t now_ns);
     void enter(State s, int number);
@@ -205,8 +188,6 @@ class Axis {
     void tp_latch(bool rising, double raw_pos);
     void on_index(double raw_pos);
     void supervise(int64_t now_ns, int64_t dt_ns);
-    void standstill(int64_t dt_ns);
-    void touch_probe_config();
     void homing_start();
     void homing_tick(double h);
     void homing_finish_ok();
@@ -227,98 +208,33 @@ class Axis {
     Environment env_;
     MotorModel motor_;
     Plant plant_;
-    Profile profile_;
     Feedback fb_;
+
+    // the parts, each owning its state
+    DeviceControl dc_;
+    SetpointGenerator sp_;
+    Controller ctl_;
+    Supervisor sup_;
+    TouchProbe tp_;
+    Homing home_;
 
     // configuration derived from params
     int32_t res_ = 2000;
     double pol_ = 1.0;  // 0x3000:04 bit 0: -1 = inverse polarity
-    double km_ctrl_ = 0, j_ctrl_ = 1e-5, r_ctrl_ = 0;
-    double kv_ = 0, kiv_ = 0, kpp_ = 0;     // velocity PI (A s/rad, A/rad), position P (1/s)
-    double kpi_ = 0, kii_ = 0, kff_i_ = 0;  // current PI
     double km_plant_ = -1;
     bool plant_dirty_ = true;
-
-    // device control
-    State state_ = State::NotReadyToSwitchOn;
-    bool power_ = false;
-    uint16_t cw_prev_ = 0;  // controlword of the previous cycle (mode bits)
-    Pending pending_;
-    StopKind stop_ = StopKind::None;
-    double stop_decel_ = 0;  // inc/s^2
-    bool ramp_done_ = false;
-    bool fra_ = false;  // fault reaction running
-    bool fra_power_off_ = false;
     int64_t now_ns_ = 0;
 
-    // errors
-    std::array<uint16_t, 8> active_{};
-    std::array<uint16_t, 8> warnings_{};
-    uint16_t last_error_ = 0;
-    uint8_t error_register_ = 0;
-
-    // modes
-    int8_t mode_ = mode::None;
-    bool halted_ = false;
-    // PPM
-    bool ppm_moving_ = false, ppm_buffered_ = false, ppm_ack_ = false;
-    double ppm_target_ = 0, ppm_next_target_ = 0;
-    bool ppm_next_rel_ = false;
-    int32_t ppm_next_raw_ = 0;
-    bool ppm_limited_ = false;
-    // CSP interpolation (raw increments)
-    double ip_from_ = 0, ip_to_ = 0;
-    int64_t ip_t0_ = 0, ip_period_ = 0;
-    bool csp_limit_violation_ = false;
-    // demand (raw increments, inc/s, inc/s^2) and control
-    Control control_ = Control::Position;
-    double demand_pos_ = 0, demand_vel_ = 0, demand_acc_ = 0;
-    double vel_ref_ = 0;      // rad/s, output of the position loop / CSV input
-    double vel_ff_ = 0;       // rad/s
-    double torque_ff_a_ = 0;  // A (current feed-forward)
-    double cur_ref_ = 0;      // A
-    double vel_int_ = 0, cur_int_ = 0;
-    double voltage_ = 0;
-    // observer
-    double obs_pos_ = 0, obs_vel_ = 0;  // rad, rad/s (raw frame)
-    double obs_load_ = 0;               // Nm, estimated load + friction torque
-    double vel_avg_rpm_ = 0, cur_avg_a_ = 0;
-    // encoder
+    // encoder and inputs
     int64_t count_ = 0;  // raw encoder count
     int64_t shift_ = 0;  // reported = raw + shift
     int64_t index_count_ = 0;
     double prev_raw_pos_ = 0;
     uint64_t func_ = 0;  // 0x60FD-style function bits, bit 26 = touch probe input, bits 32..37 = pins
     uint16_t pins_ = 0;
-    // I2t
-    double thermal_ = 0;
-    bool i2t_active_ = false;
     // timing
     int64_t tick_ = 0;
     int64_t residual_ns_ = 0;
-    // supervision
-    double ferr_time_ms_ = 0;
-    double still_ms_ = 0;
-    bool still_ = false;
-    // touch probe
-    uint16_t tp_prev_fn_ = 0;
-    uint16_t tp_status_ = 0;
-    int32_t tp_pos_ = 0, tp_neg_ = 0;
-    uint16_t tp_pos_cnt_ = 0, tp_neg_cnt_ = 0;
-    // homing
-    HomingStatus hstat_ = HomingStatus::Idle;
-    HomingPhase hphase_ = HomingPhase::Finished;
-    int hdir_ = 1;        // current search direction
-    bool hedge_ = false;  // the awaited event happened
-    double href_ = 0;     // reference point (raw inc)
-    double hevent_pos_ = 0;
-    int hbit_ = -1;        // function bit awaited (-1 none)
-    bool hrise_ = true;    // awaited edge direction
-    bool hindex_ = false;  // index seen in ToIndex
-    int hsettle_ = 0;      // position ticks at constant search speed (current-threshold methods)
-    double hsearch_origin_ = 0;
-    bool referenced_ = false;
-    int8_t hmethod_ = 0;
 };
 
 }  // namespace drive
