@@ -43,7 +43,8 @@ void Axis::homing_start() {
     const bool neg = func_ & ((1ull << 0) | (1ull << 24));
     const bool pos = func_ & ((1ull << 1) | (1ull << 25));
     const bool home = func_ & (1ull << 2);
-    if (uses_index(m) && !(params.encoder_type & 0x1)) {
+    // Only the methods of 0x60E3 (declared once in od/drive_objects.hpp, also the 0x6098 validator's).
+    if (!od::contains(od::kHomingMethods, m) || (uses_index(m) && !(params.encoder_type & 0x1))) {
         homing_fail();
         return;
     }

@@ -14,8 +14,7 @@ namespace drive {
 using namespace detail;
 
 bool mode::supported(int8_t m) {
-    return m == ProfilePosition || m == ProfileVelocity || m == Homing || m == CyclicSyncPosition ||
-           m == CyclicSyncVelocity || m == CyclicSyncTorque;
+    return od::contains(od::kModesOfOperation, m);
 }
 
 void Axis::switch_mode(int8_t m) {

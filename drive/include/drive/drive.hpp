@@ -12,6 +12,7 @@
 #include "drive/axis.hpp"
 #include "drive/event_sink.hpp"
 #include "od/dictionary.hpp"
+#include "od/drive_objects.hpp"
 
 namespace drive {
 
@@ -42,6 +43,8 @@ class Drive {
     // How many (index, subindex) pairs the drive found in the dictionary, and how many it had to run without.
     std::size_t bound() const { return bound_; }
     std::size_t missing() const { return missing_; }
+    // Whether the drive found and bound this entry (one of the od/drive_objects.hpp handles).
+    bool binds(uint16_t index, uint8_t sub) const;
 
   private:
     struct Link {
@@ -49,12 +52,14 @@ class Drive {
         od::Ref<uint16_t> r16;
         od::Ref<uint32_t> r32;
         uint8_t* field;
+        uint16_t index;
+        uint8_t sub;
         uint8_t size;
     };
     template <typename T>
-    void in(uint16_t index, uint8_t sub, T& field);
+    void in(const od::Obj<T>& object, T& field);
     template <typename T>
-    void out(uint16_t index, uint8_t sub, const T& field);
+    void out(const od::Obj<T>& object, const T& field);
     bool locate(uint16_t index, uint8_t sub, std::size_t size, Link& link);
     static void load(const Link& l);
     static void store(Link l);
@@ -64,7 +69,7 @@ class Drive {
     std::vector<Link> inputs_;   // dictionary -> axis (parameters, commands)
     std::vector<Link> outputs_;  // axis -> dictionary (feedback)
     Feedback fb_copy_;
-    int32_t resolution_ = 0;
+    uint32_t resolution_ = 0;
     std::size_t bound_ = 0, missing_ = 0;
     // Read by the validators (the mailbox side); shared so a validator outliving the Drive stays safe.
     std::shared_ptr<std::atomic<bool>> powered_ = std::make_shared<std::atomic<bool>>(false);

@@ -6,17 +6,19 @@
 #include <cstdint>
 
 #include "drive/profile.hpp"
+#include "od/drive_objects.hpp"
 
 namespace drive {
 
+// Modes of operation 0x6060; the set is declared once in od/drive_objects.hpp (also the 0x6060 validator's).
 namespace mode {
 constexpr int8_t None = 0;
-constexpr int8_t ProfilePosition = 1;
-constexpr int8_t ProfileVelocity = 3;
-constexpr int8_t Homing = 6;
-constexpr int8_t CyclicSyncPosition = 8;
-constexpr int8_t CyclicSyncVelocity = 9;
-constexpr int8_t CyclicSyncTorque = 10;
+constexpr int8_t ProfilePosition = od::modes::ProfilePosition;
+constexpr int8_t ProfileVelocity = od::modes::ProfileVelocity;
+constexpr int8_t Homing = od::modes::Homing;
+constexpr int8_t CyclicSyncPosition = od::modes::CyclicSyncPosition;
+constexpr int8_t CyclicSyncVelocity = od::modes::CyclicSyncVelocity;
+constexpr int8_t CyclicSyncTorque = od::modes::CyclicSyncTorque;
 bool supported(int8_t m);
 }  // namespace mode
 

@@ -50,6 +50,24 @@ constexpr uint8_t CompleteAccess = 0x20;
 
 enum class SmKind : uint8_t { MBoxOut = 1, MBoxIn = 2, Outputs = 3, Inputs = 4 };
 
+// The SyncManager control byte (ESC register 0x0804; ETG.1000.4, ESC datasheet section "SyncManager") each
+// kind gets: mailbox out 0x26 (mailbox mode, ECAT writes, PDI interrupt), mailbox in 0x22 (mailbox mode, ECAT
+// reads, PDI interrupt), outputs 0x64 (3-buffer mode, ECAT writes, PDI interrupt, watchdog trigger), inputs
+// 0x20 (3-buffer mode, ECAT reads, PDI interrupt).
+constexpr uint8_t default_sm_control(SmKind k) {
+    switch (k) {
+        case SmKind::MBoxOut:
+            return 0x26;
+        case SmKind::MBoxIn:
+            return 0x22;
+        case SmKind::Outputs:
+            return 0x64;
+        case SmKind::Inputs:
+            return 0x20;
+    }
+    return 0;
+}
+
 struct SyncManagerDefault {
     SmKind kind = SmKind::MBoxOut;
     uint16_t start = 0;

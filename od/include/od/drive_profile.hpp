@@ -12,8 +12,8 @@ namespace od {
 DeviceDescription default_drive_description();
 
 // Places SM0/SM1 on the standard mailbox and SM2/SM3 after it (3 buffers of the largest PDO set each),
-// keeping control bytes 0x26/0x22/0x64/0x20 and the default process-data sizes. Throws std::out_of_range
-// if the process-data areas would not fit below 0x10000.
+// with the control bytes of od::default_sm_control and the default process-data sizes. Throws
+// std::out_of_range if the process-data areas would not fit below 0x10000.
 void place_sync_managers(DeviceDescription& description);
 
 // Every object and subindex of the drive, defaults as the seed gives them, identity from `description`.
