@@ -61,7 +61,8 @@ void Axis::derive() {
         static_cast<int32_t>(std::clamp<uint64_t>(4ull * params.encoder_pulses, 4ull, 1ull << 30));
     const double pol = (params.axis_misc & 0x1) ? -1.0 : 1.0;
     if (res != res_ || pol != pol_) {
-        // A new resolution or polarity invalidates the position and the reference [001 §7.2.22].
+        // A new resolution or polarity invalidates the position and the reference (MAXPOS firmware
+        // specification §7.2.22).
         const double phys_angle = plant_.angle();
         res_ = res;
         pol_ = pol;
@@ -140,7 +141,8 @@ void Axis::plant_step(int64_t t_ns, double u) {
 }
 
 void Axis::on_edge(int bit, bool rising, double raw_pos) {
-    // Touch-probe source [001 §7.2.84]: b3..2 = 00 TP1 input (function 26), 10 = 0x60D0:01.
+    // Touch-probe source (MAXPOS firmware specification §7.2.84): b3..2 = 00 TP1 input (function 26), 10 =
+    // 0x60D0:01.
     const uint16_t src = (command.touch_probe_function >> 2) & 0x3;
     int tp_bit = -1;
     if (src == 0) tp_bit = 26;

@@ -100,7 +100,8 @@ void Axis::device_control(int64_t now_ns) {
                 dc_.pending = {true, t.to, t.number, now_ns};
                 break;
             case 11:
-                // 0x605A = 6 (the only value seed 001 allows): quick-stop ramp, stay in Quick Stop Active.
+                // 0x605A = 6 (the only value the MAXPOS firmware specification allows): quick-stop ramp, stay
+                // in Quick Stop Active.
                 begin_stop(StopKind::Ramp, params.quick_stop_deceleration, now_ns);
                 enter(State::QuickStopActive, 11);
                 break;

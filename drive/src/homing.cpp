@@ -1,6 +1,7 @@
-// Homing mode (6) [001 §4.5, digest §2.3]: the methods of 0x60E3, run as a small phase machine on top of the
-// profile generator. Edges and index pulses are latched in the plant sub-steps (on_edge/on_index) at the
-// position where they really happened, so the reference point does not depend on the cycle time.
+// Homing mode (6) (IEC 61800-7-201 homing mode; MAXPOS firmware specification §4.5, §7.2.75-7.2.77; EPOS4
+// Application Notes §7.3): the methods of 0x60E3, run as a small phase machine on top of the profile
+// generator. Edges and index pulses are latched in the plant sub-steps (on_edge/on_index) at the position
+// where they really happened, so the reference point does not depend on the cycle time.
 #include <cmath>
 
 #include "drive/axis.hpp"
@@ -29,7 +30,7 @@ int offset_sign(int m) {
 }  // namespace
 
 void Axis::homing_start() {
-    // Homing clears touch-probe states and latched values [001 §4.5].
+    // Homing clears touch-probe states and latched values (MAXPOS firmware specification §4.5).
     tp_.clear_for_homing();
     home_.method = params.homing_method;
     home_.referenced = false;
@@ -112,7 +113,8 @@ void Axis::homing_tick(double h) {
         sp_.profile.step_velocity(0.0, acc, acc, h);
         return;
     }
-    if (sp_.halted) {  // halt in homing: stop with the homing acceleration [001 Table 4-29]
+    if (sp_.halted) {  // halt in homing: stop with the homing acceleration (MAXPOS firmware specification
+                       // Table 4-29)
         if (sp_.profile.step_velocity(0.0, acc, acc, h)) {
             home_.status = HomingStatus::Interrupted;
             home_.phase = HomingPhase::Finished;

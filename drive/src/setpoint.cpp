@@ -77,7 +77,7 @@ void Axis::mode_commands(int64_t now_ns, int64_t dt_ns) {
             } else if (rise4 && !dc_.power && params.homing_method == 37 && dc_.state != State::Fault &&
                        dc_.state != State::FaultReactionActive) {
                 // Method 37 while disabled: no offset move, the actual position becomes the home position
-                // [001 §4.5.3.11].
+                // (MAXPOS firmware specification §4.5.3.11).
                 home_.method = 37;
                 home_.ref = static_cast<double>(count_);
                 shift_ = static_cast<int64_t>(params.home_position) - count_;

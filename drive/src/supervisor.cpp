@@ -133,7 +133,7 @@ void Axis::supervise(int64_t now_ns, int64_t dt_ns) {
     const bool enabled = dc_.state == State::OperationEnabled && dc_.power && !dc_.pending.active;
     const bool homing = sp_.mode == mode::Homing && home_.status == HomingStatus::InProgress;
     if (enabled) {
-        // Following error [001 §4.6]: position-controlled modes.
+        // Following error (MAXPOS firmware specification §4.6): position-controlled modes.
         const bool pos_mode = sp_.mode == mode::CyclicSyncPosition || sp_.mode == mode::ProfilePosition ||
                               sp_.mode == mode::Homing;
         const double ferr = std::abs(sp_.demand_pos - static_cast<double>(count_));

@@ -1,6 +1,6 @@
 // The MAXPOS object dictionary, declared as data: one line per object header or entry, in the order and
-// with the values of seed 001 (maxon «MAXPOS Firmware Specification», chapter 7, § numbers in the comments).
-// Where the seed is inconsistent the choice is written down in docs/decisions/od.md.
+// with the values of the MAXPOS firmware specification (maxon), chapter 7 (its § numbers in the comments).
+// Where the specification is inconsistent the choice is written down in docs/decisions/od.md.
 #include "od/drive_profile.hpp"
 
 #include <algorithm>
@@ -63,9 +63,9 @@ constexpr Line kTable[] = {
 {VAR, 0x1008, 0, VSTR, RO,        "$device_name", "",    "",          "",      "Manufacturer Device Name"},           // 7.2.3
 {VAR, 0x1009, 0, VSTR, RO,        "$hardware_version", "", "",        "",      "Manufacturer Hardware Version"},      // CiA 301 (decisions)
 {VAR, 0x100A, 0, VSTR, RO,        "$software_version", "", "",        "",      "Manufacturer Software Version"},      // CiA 301 (decisions)
-{ARR, 0x1010, 0, U32,  RO,        "",           "",      "",          "",      "Store Parameters"},                   // CiA 301, [004 §7.11]
+{ARR, 0x1010, 0, U32,  RO,        "",           "",      "",          "",      "Store Parameters"},                   // CiA 301, EPOS4 Application Notes §7.11
 {SUB, 0x1010, 1, U32,  RW,        "0x00000001", "",      "",          "",      "Save all Parameters"},
-{ARR, 0x1011, 0, U32,  RO,        "",           "",      "",          "",      "Restore Default Parameters"},         // CiA 301, [004 §7.11]
+{ARR, 0x1011, 0, U32,  RO,        "",           "",      "",          "",      "Restore Default Parameters"},         // CiA 301, EPOS4 Application Notes §7.11
 {SUB, 0x1011, 1, U32,  RWP,       "0x00000001", "",      "",          "",      "Restore all Default Parameters"},
 {REC, 0x1018, 0, IDENT, RO,       "",           "",      "",          "",      "Identity Object"},                    // 7.2.4
 {SUB, 0x1018, 1, U32,  RO,        "$vendor_id", "",      "",          "",      "Vendor ID"},
@@ -428,7 +428,7 @@ constexpr Line kTable[] = {
 };
 // clang-format on
 
-// Value sets where the seed lists the only accepted values; anything else is "value range exceeded".
+// Value sets where the specification lists the only accepted values; anything else is "value range exceeded".
 struct ValueSet {
     uint16_t index;
     uint8_t sub;

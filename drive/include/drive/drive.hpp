@@ -17,16 +17,17 @@
 namespace drive {
 
 // Writes the parameters a commissioning tool would have stored for the simulated motor into the dictionary:
-// torque constant 0x3001:05 (the seed default 0 refuses to enable with 0x8331), and a position/velocity
-// tuning 0x30A1 matched to the motor and load (20 Hz bandwidth, critical damping, 50 ms reset time, the
-// model's inertia and viscous friction). Device-side writes, range-checked; returns the first failure or Ok.
+// torque constant 0x3001:05 (the default 0 of the MAXPOS firmware specification refuses to enable with
+// 0x8331), and a position/velocity tuning 0x30A1 matched to the motor and load (20 Hz bandwidth, critical
+// damping, 50 ms reset time, the model's inertia and viscous friction). Device-side writes, range-checked;
+// returns the first failure or Ok.
 od::Status commission(od::Dictionary& dictionary, const MotorModel& motor = MotorModel{});
 
 class Drive {
   public:
-    // Also registers validators on the objects seed 001 lets a master write only in "Power Disable"
-    // (0x3000, 0x3001:03, the sensor records, 0x60A8..0x60AA, 0x6402): such writes answer WrongState
-    // (SDO abort 0x08000022) while the power stage is on.
+    // Also registers validators on the objects the MAXPOS firmware specification lets a master write only in
+    // "Power Disable" (0x3000, 0x3001:03, the sensor records, 0x60A8..0x60AA, 0x6402): such writes answer
+    // WrongState (SDO abort 0x08000022) while the power stage is on.
     explicit Drive(od::Dictionary& dictionary, EventSink* sink = nullptr);
     Drive(const Drive&) = delete;
     Drive& operator=(const Drive&) = delete;

@@ -10,7 +10,7 @@ namespace od {
 
 struct Identity {
     uint32_t vendor_id = 0x000000FB;  // maxon motor ag
-    uint32_t product_code = 0;        // seed 001 §7.2.4.3
+    uint32_t product_code = 0;        // MAXPOS firmware specification §7.2.4.3
     uint32_t revision = 0;            // high word software version, low word application version
     uint32_t serial_number = 0;
     std::string vendor_name = "maxon motor ag";

@@ -31,7 +31,7 @@ struct Obj {
     T def;  // the default the dictionary declares
 };
 
-// X(name, index, subindex, C++ type, default, role)
+// X(name, index, subindex, C++ type, default, role); § numbers: the MAXPOS firmware specification.
 // clang-format off
 #define OD_DRIVE_OBJECTS(X) \
     /* motor, sensor, axis configuration (MAXPOS firmware specification §7.2.22-7.2.24, §7.2.100) */ \
