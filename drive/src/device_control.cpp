@@ -78,9 +78,7 @@ void Axis::device_control(int64_t now_ns) {
                 sp_.demand_pos = static_cast<double>(count_);
                 sp_.demand_vel = sp_.demand_acc = 0;
                 sp_.profile.reset(sp_.demand_pos, 0);
-                sp_.ip_from = sp_.ip_to = sp_.demand_pos;
-                sp_.ip_period = 0;
-                sp_.ppm_moving = sp_.ppm_buffered = false;
+                sp_.hold(sp_.demand_pos);
                 enter(State::OperationEnabled, 4);
                 break;
             }
@@ -112,9 +110,7 @@ void Axis::device_control(int64_t now_ns) {
                 dc_.stop = StopKind::None;
                 sp_.demand_pos = sp_.profile.position();
                 sp_.demand_vel = 0;
-                sp_.ip_from = sp_.ip_to = sp_.demand_pos;
-                sp_.ip_period = 0;
-                sp_.ppm_moving = sp_.ppm_buffered = false;
+                sp_.hold(sp_.demand_pos);
                 enter(State::OperationEnabled, 16);
                 break;
             default:

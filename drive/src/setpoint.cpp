@@ -24,9 +24,8 @@ void Axis::switch_mode(int8_t m) {
     sp_.mode = m;
     const double from = dc_.power ? sp_.demand_pos : static_cast<double>(count_);
     sp_.profile.reset(from, dc_.power ? sp_.demand_vel : 0.0);
-    sp_.ip_from = sp_.ip_to = from;
-    sp_.ip_period = 0;
-    sp_.ppm_moving = sp_.ppm_buffered = sp_.ppm_ack = false;
+    sp_.hold(from);
+    sp_.ppm_ack = false;
     ctl_.vel_ref = dc_.power ? ctl_.vel_ref : 0.0;
     if (m == mode::Homing && home_.status != HomingStatus::Done) home_.status = HomingStatus::Idle;
 }

@@ -1,6 +1,9 @@
 #pragma once
-// One servo axis without any object dictionary: CiA 402 device control, the operating modes, homing, touch
-// probe, error handling, the cascaded control loops and the simulated machine. Drive (drive.hpp) copies the
+// One servo axis that runs without an object dictionary (its defaults are the dictionary's, declared once in
+// od/drive_objects.hpp), composed of value types that each own their state: device control
+// (device_control.hpp), the set-point generator (setpoint.hpp), the cascaded loops and observer
+// (controller.hpp), supervision and errors (supervisor.hpp), the touch probe (touch_probe.hpp) and homing
+// (homing.hpp), plus the simulated machine (plant.hpp, environment.hpp). Drive (drive.hpp) copies the
 // dictionary's values into `Parameters`/`Command` before each cycle and the `Feedback` back after it; tests
 // can drive an Axis directly.
 //
@@ -183,30 +186,39 @@ class Axis {
     bool error_active(uint16_t code) const;
 
   private:
+    // Axis runs its parts against each other; each group below lives in the .cpp named after the part.
+    // axis.cpp: configuration, the cycle, the machine (plant, inputs, encoder) and the feedback
     void derive();
+    void plant_step(int64_t t_ns, double u);
+    void on_edge(int bit, bool rising, double raw_pos);
+    void on_index(double raw_pos);
+    void update_feedback();
+    // device_control.cpp
     void device_control(int64_t now_ns);
     void enter(State s, int number);
     void begin_stop(StopKind kind, double decel_rpm_s, int64_t now_ns);
     void check_pending(int64_t now_ns);
+    // supervisor.cpp
     void fault(uint16_t code, int64_t now_ns);
     void fault_reset();
     bool cause_present(uint16_t code) const;
+    void supervise(int64_t now_ns, int64_t dt_ns);
+    // setpoint.cpp
     void mode_commands(int64_t now_ns, int64_t dt_ns);
     void switch_mode(int8_t m);
     void trajectory_tick(int64_t t_ns);
+    // controller.cpp
     void position_tick();
     void velocity_tick();
     void current_tick(int64_t t_ns);
-    void plant_step(int64_t t_ns, double u);
-    void on_edge(int bit, bool rising, double raw_pos);
+    // touch_probe.cpp
     void tp_latch(bool rising, double raw_pos);
-    void on_index(double raw_pos);
-    void supervise(int64_t now_ns, int64_t dt_ns);
+    // homing.cpp
     void homing_start();
     void homing_tick(double h);
     void homing_finish_ok();
     void homing_fail();
-    void update_feedback();
+    // helpers (axis.cpp)
     uint64_t functions(uint16_t pins) const;
     int32_t clamp_i32(double v) const;
     bool range_on() const;
