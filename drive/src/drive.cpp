@@ -24,6 +24,8 @@ bool Drive::locate(uint16_t index, uint8_t sub, std::size_t size, Link& link) {
         return false;
     }
     link.size = static_cast<uint8_t>(size);
+    link.index = index;
+    link.sub = sub;
     ++bound_;
     return true;
 }
@@ -58,123 +60,146 @@ void Drive::store(Link l) {
 }
 
 template <typename T>
-void Drive::in(uint16_t index, uint8_t sub, T& field) {
+void Drive::in(const od::Obj<T>& h, T& field) {
     static_assert(sizeof(T) == 1 || sizeof(T) == 2 || sizeof(T) == 4);
     Link l{};
     l.field = reinterpret_cast<uint8_t*>(&field);
-    if (locate(index, sub, sizeof(T), l)) inputs_.push_back(l);
+    if (locate(h.index, h.sub, sizeof(T), l)) inputs_.push_back(l);
 }
 
 template <typename T>
-void Drive::out(uint16_t index, uint8_t sub, const T& field) {
+void Drive::out(const od::Obj<T>& h, const T& field) {
     static_assert(sizeof(T) == 1 || sizeof(T) == 2 || sizeof(T) == 4);
     Link l{};
     l.field = reinterpret_cast<uint8_t*>(const_cast<T*>(&field));
-    if (locate(index, sub, sizeof(T), l)) outputs_.push_back(l);
+    if (locate(h.index, h.sub, sizeof(T), l)) outputs_.push_back(l);
+}
+
+bool Drive::binds(uint16_t index, uint8_t sub) const {
+    for (const auto* links : {&inputs_, &outputs_})
+        for (const Link& l : *links)
+            if (l.index == index && l.sub == sub) return true;
+    return false;
 }
 
 Drive::Drive(od::Dictionary& dictionary, EventSink* sink) : dict_(dictionary), axis_(sink) {
+    namespace obj = od::obj;
     Parameters& p = axis_.params;
     Command& c = axis_.command;
     // Configuration
-    in(0x3001, 1, p.nominal_current);
-    in(0x3001, 2, p.output_current_limit);
-    in(0x3001, 3, p.pole_pairs);
-    in(0x3001, 4, p.thermal_time_constant);
-    in(0x3001, 5, p.torque_constant);
-    in(0x6402, 0, p.motor_type);
-    in(0x3010, 1, p.encoder_pulses);
-    in(0x3010, 2, p.encoder_type);
-    in(0x3000, 4, p.axis_misc);
-    in(0x30A0, 1, p.current_p);
-    in(0x30A0, 2, p.current_i);
-    in(0x30A0, 3, p.current_ff);
-    in(0x30A1, 1, p.bandwidth);
-    in(0x30A1, 2, p.damping);
-    in(0x30A1, 3, p.reset_time);
-    in(0x30A1, 4, p.inertia);
-    in(0x30A1, 5, p.friction);
-    in(0x6007, 0, p.abort_connection);
-    in(0x605A, 0, p.quick_stop);
-    in(0x605B, 0, p.shutdown);
-    in(0x605C, 0, p.disable_operation);
-    in(0x605D, 0, p.halt);
-    in(0x605E, 0, p.fault_reaction);
-    in(0x6065, 0, p.following_error_window);
-    in(0x6066, 0, p.following_error_timeout);
-    in(0x607D, 1, p.sw_limit_min);
-    in(0x607D, 2, p.sw_limit_max);
-    in(0x607B, 1, p.range_min);
-    in(0x607B, 2, p.range_max);
-    in(0x607F, 0, p.max_profile_velocity);
-    in(0x6080, 0, p.max_motor_speed);
-    in(0x6081, 0, p.profile_velocity);
-    in(0x6083, 0, p.profile_acceleration);
-    in(0x6084, 0, p.profile_deceleration);
-    in(0x6085, 0, p.quick_stop_deceleration);
-    in(0x60C5, 0, p.max_acceleration);
-    in(0x6098, 0, p.homing_method);
-    in(0x6099, 1, p.homing_speed_switch);
-    in(0x6099, 2, p.homing_speed_zero);
-    in(0x609A, 0, p.homing_acceleration);
-    in(0x30B0, 0, p.home_position);
-    in(0x30B1, 0, p.home_offset_move);
-    in(0x30B2, 0, p.homing_current_threshold);
-    in(0x60C2, 1, p.interpolation_value);
-    in(0x60C2, 2, p.interpolation_index);
-    in(0x30E0, 1, p.standstill_window);
-    in(0x30E0, 2, p.standstill_time);
-    in(0x30E0, 3, p.standstill_timeout);
-    in(0x3141, 2, p.input_polarity);
-    for (uint8_t i = 0; i < 6; ++i)
-        in(0x3142, static_cast<uint8_t>(i + 1), p.input_function[i]);
-    in(0x60D0, 1, p.touch_probe_source);
+    in(obj::MotorNominalCurrent, p.nominal_current);
+    in(obj::MotorOutputCurrentLimit, p.output_current_limit);
+    in(obj::MotorPolePairs, p.pole_pairs);
+    in(obj::MotorThermalTimeConstant, p.thermal_time_constant);
+    in(obj::MotorTorqueConstant, p.torque_constant);
+    in(obj::MotorType, p.motor_type);
+    in(obj::EncoderPulses, p.encoder_pulses);
+    in(obj::EncoderType, p.encoder_type);
+    in(obj::AxisConfigurationMisc, p.axis_misc);
+    in(obj::CurrentPGain, p.current_p);
+    in(obj::CurrentIGain, p.current_i);
+    in(obj::CurrentFfGain, p.current_ff);
+    in(obj::PositionBandwidth, p.bandwidth);
+    in(obj::PositionDamping, p.damping);
+    in(obj::PositionResetTime, p.reset_time);
+    in(obj::Inertia, p.inertia);
+    in(obj::Friction, p.friction);
+    in(obj::AbortConnectionOptionCode, p.abort_connection);
+    in(obj::QuickStopOptionCode, p.quick_stop);
+    in(obj::ShutdownOptionCode, p.shutdown);
+    in(obj::DisableOperationOptionCode, p.disable_operation);
+    in(obj::HaltOptionCode, p.halt);
+    in(obj::FaultReactionOptionCode, p.fault_reaction);
+    in(obj::FollowingErrorWindow, p.following_error_window);
+    in(obj::FollowingErrorTimeout, p.following_error_timeout);
+    in(obj::SoftwarePositionLimitMin, p.sw_limit_min);
+    in(obj::SoftwarePositionLimitMax, p.sw_limit_max);
+    in(obj::PositionRangeLimitMin, p.range_min);
+    in(obj::PositionRangeLimitMax, p.range_max);
+    in(obj::MaxProfileVelocity, p.max_profile_velocity);
+    in(obj::MaxMotorSpeed, p.max_motor_speed);
+    in(obj::ProfileVelocity, p.profile_velocity);
+    in(obj::ProfileAcceleration, p.profile_acceleration);
+    in(obj::ProfileDeceleration, p.profile_deceleration);
+    in(obj::QuickStopDeceleration, p.quick_stop_deceleration);
+    in(obj::MaxAcceleration, p.max_acceleration);
+    in(obj::HomingMethod, p.homing_method);
+    in(obj::HomingSpeedSwitchSearch, p.homing_speed_switch);
+    in(obj::HomingSpeedZeroSearch, p.homing_speed_zero);
+    in(obj::HomingAcceleration, p.homing_acceleration);
+    in(obj::HomePosition, p.home_position);
+    in(obj::HomeOffsetMoveDistance, p.home_offset_move);
+    in(obj::HomingCurrentThreshold, p.homing_current_threshold);
+    in(obj::InterpolationTimePeriodValue, p.interpolation_value);
+    in(obj::InterpolationTimeIndex, p.interpolation_index);
+    in(obj::StandstillWindow, p.standstill_window);
+    in(obj::StandstillWindowTime, p.standstill_time);
+    in(obj::StandstillWindowTimeout, p.standstill_timeout);
+    in(obj::DigitalInputPolarity, p.input_polarity);
+    in(obj::DigitalInput1Configuration, p.input_function[0]);
+    in(obj::DigitalInput2Configuration, p.input_function[1]);
+    in(obj::DigitalInput3Configuration, p.input_function[2]);
+    in(obj::DigitalInput4Configuration, p.input_function[3]);
+    in(obj::DigitalInput5Configuration, p.input_function[4]);
+    in(obj::DigitalInput6Configuration, p.input_function[5]);
+    in(obj::TouchProbe1Source, p.touch_probe_source);
     // Commands (RxPDO objects)
-    in(0x6040, 0, c.controlword);
-    in(0x6060, 0, c.mode);
-    in(0x607A, 0, c.target_position);
-    in(0x60FF, 0, c.target_velocity);
-    in(0x6071, 0, c.target_torque);
-    in(0x60B0, 0, c.position_offset);
-    in(0x60B1, 0, c.velocity_offset);
-    in(0x60B2, 0, c.torque_offset);
-    in(0x60B8, 0, c.touch_probe_function);
+    in(obj::Controlword, c.controlword);
+    in(obj::ModesOfOperation, c.mode);
+    in(obj::TargetPosition, c.target_position);
+    in(obj::TargetVelocity, c.target_velocity);
+    in(obj::TargetTorque, c.target_torque);
+    in(obj::PositionOffset, c.position_offset);
+    in(obj::VelocityOffset, c.velocity_offset);
+    in(obj::TorqueOffset, c.torque_offset);
+    in(obj::TouchProbeFunction, c.touch_probe_function);
     // Feedback (TxPDO objects and other computed values)
     Feedback& f = fb_copy_;
-    out(0x6041, 0, f.statusword);
-    out(0x6061, 0, f.mode_display);
-    out(0x6062, 0, f.position_demand);
-    out(0x6064, 0, f.position_actual);
-    out(0x60E4, 1, f.position_actual);
-    out(0x606B, 0, f.velocity_demand);
-    out(0x606C, 0, f.velocity_actual);
-    out(0x60E5, 1, f.velocity_actual);
-    out(0x60E5, 9, f.velocity_averaged);
-    out(0x30D5, 0, f.velocity_averaged);
-    out(0x6077, 0, f.torque_actual);
-    out(0x6078, 0, f.current_actual);
-    out(0x30D0, 0, f.current_demand);
-    out(0x30D1, 0, f.current_averaged);
-    out(0x60F4, 0, f.following_error);
-    out(0x6076, 0, f.motor_rated_torque);
-    out(0x60FD, 0, f.digital_inputs);
-    out(0x3141, 1, f.input_logic_state);
-    out(0x3010, 4, f.index_position);
-    out(0x60B9, 0, f.touch_probe_status);
-    out(0x60BA, 0, f.touch_probe_pos);
-    out(0x60BB, 0, f.touch_probe_neg);
-    out(0x60D5, 0, f.touch_probe_pos_count);
-    out(0x60D6, 0, f.touch_probe_neg_count);
-    out(0x603F, 0, f.error_code);
-    out(0x1001, 0, f.error_register);
-    out(0x3000, 5, resolution_);
+    out(obj::Statusword, f.statusword);
+    out(obj::ModesOfOperationDisplay, f.mode_display);
+    out(obj::PositionDemandValue, f.position_demand);
+    out(obj::PositionActualValue, f.position_actual);
+    out(obj::PositionActualValueSensor1, f.position_actual);
+    out(obj::VelocityDemandValue, f.velocity_demand);
+    out(obj::VelocityActualValue, f.velocity_actual);
+    out(obj::VelocityActualValueSensor1, f.velocity_actual);
+    out(obj::VelocityActualAveragedSensor1, f.velocity_averaged);
+    out(obj::VelocityActualValueAveraged, f.velocity_averaged);
+    out(obj::TorqueActualValue, f.torque_actual);
+    out(obj::CurrentActualValue, f.current_actual);
+    out(obj::CurrentDemandValue, f.current_demand);
+    out(obj::CurrentActualValueAveraged, f.current_averaged);
+    out(obj::FollowingErrorActualValue, f.following_error);
+    out(obj::MotorRatedTorque, f.motor_rated_torque);
+    out(obj::DigitalInputs, f.digital_inputs);
+    out(obj::DigitalInputLogicState, f.input_logic_state);
+    out(obj::EncoderIndexPosition, f.index_position);
+    out(obj::TouchProbeStatus, f.touch_probe_status);
+    out(obj::TouchProbePosition1Positive, f.touch_probe_pos);
+    out(obj::TouchProbePosition1Negative, f.touch_probe_neg);
+    out(obj::TouchProbe1PositiveEdgeCounter, f.touch_probe_pos_count);
+    out(obj::TouchProbe1NegativeEdgeCounter, f.touch_probe_neg_count);
+    out(obj::ErrorCode, f.error_code);
+    out(obj::ErrorRegister, f.error_register);
+    out(obj::MainSensorResolution, resolution_);
 
-    const uint16_t power_disable_only[] = {0x3000, 0x3001, 0x3010, 0x3011, 0x3012, 0x3014,
-                                           0x301A, 0x3020, 0x60A8, 0x60A9, 0x60AA, 0x6402};
+    const uint16_t power_disable_only[] = {obj::AxisConfiguration,
+                                           obj::MotorData,
+                                           obj::DigitalIncrementalEncoder1,
+                                           obj::AnalogIncrementalEncoder,
+                                           obj::SsiAbsoluteEncoder,
+                                           obj::BissAbsoluteEncoder,
+                                           obj::DigitalHallSensor,
+                                           obj::DigitalIncrementalEncoder2,
+                                           obj::SiUnitPosition,
+                                           obj::SiUnitVelocity,
+                                           obj::SiUnitAcceleration,
+                                           obj::MotorType.index};
     for (uint16_t index : power_disable_only) {
         if (!dict_.find(index)) continue;
         dict_.add_validator(index, [flag = powered_](const od::Entry& e, std::span<const uint8_t>) {
-            if (e.index == 0x3001 && e.subindex != 3) return od::Status::Ok;  // only the pole pairs
+            if (e.index == obj::MotorData && e.subindex != obj::MotorPolePairs.sub)
+                return od::Status::Ok;  // only the pole pairs
             return flag->load(std::memory_order_relaxed) ? od::Status::WrongState : od::Status::Ok;
         });
     }
@@ -187,19 +212,19 @@ Drive::~Drive() {
 od::Status commission(od::Dictionary& d, const MotorModel& m) {
     const double j = m.rotor_inertia + m.load_inertia;
     const struct {
-        uint16_t index;
-        uint8_t sub;
+        od::Obj<uint32_t> obj;
         uint32_t value;
     } rows[] = {
-        {0x3001, 5, static_cast<uint32_t>(std::lround(m.torque_constant * 1e6))},  // uNm/A
-        {0x30A1, 1, 20000},                                                        // 20 Hz
-        {0x30A1, 2, 1000},                                                         // critical damping
-        {0x30A1, 3, 50000},                                                        // 50 ms
-        {0x30A1, 4, static_cast<uint32_t>(std::lround(j * 1e10))},                 // mg cm^2
-        {0x30A1, 5, static_cast<uint32_t>(std::lround(m.viscous_friction * 1e9 * 6.283185307179586 / 60.0))},
+        {od::obj::MotorTorqueConstant, static_cast<uint32_t>(std::lround(m.torque_constant * 1e6))},  // uNm/A
+        {od::obj::PositionBandwidth, 20000},                                                          // 20 Hz
+        {od::obj::PositionDamping, 1000},                                  // critical damping
+        {od::obj::PositionResetTime, 50000},                               // 50 ms
+        {od::obj::Inertia, static_cast<uint32_t>(std::lround(j * 1e10))},  // mg cm^2
+        {od::obj::Friction,
+         static_cast<uint32_t>(std::lround(m.viscous_friction * 1e9 * 6.283185307179586 / 60.0))},
     };
     for (const auto& r : rows) {
-        const od::Status s = d.set<uint32_t>(r.index, r.sub, r.value);
+        const od::Status s = d.set<uint32_t>(r.obj.index, r.obj.sub, r.value);
         if (s != od::Status::Ok) return s;
     }
     return od::Status::Ok;
@@ -210,7 +235,7 @@ void Drive::cycle(int64_t now_ns, int64_t dt_ns) {
         load(l);
     axis_.cycle(now_ns, dt_ns);
     fb_copy_ = axis_.feedback();
-    resolution_ = axis_.increments_per_rev();
+    resolution_ = static_cast<uint32_t>(axis_.increments_per_rev());
     for (const Link& l : outputs_)
         store(l);
     powered_->store(axis_.power_on(), std::memory_order_relaxed);

@@ -4,9 +4,9 @@
 
 namespace drive {
 namespace {
-// Error-register bits [001 §7.2.2]: b0 generic, b1 current, b2 voltage, b3 temperature, b4 communication,
-// b5 device profile, b7 motion. Where the overview table and the detail pages disagree (marked (!) in the
-// digest) the detail page wins; see docs/decisions/drive.md.
+// Error-register bits (MAXPOS firmware specification §7.2.2): b0 generic, b1 current, b2 voltage, b3
+// temperature, b4 communication, b5 device profile, b7 motion. Where the overview table and the detail pages
+// disagree the detail page wins; see docs/decisions/drive.md.
 constexpr uint8_t kGeneric = 0x01, kCurrent = 0x02, kVoltage = 0x04, kTemperature = 0x08, kComm = 0x10,
                   kProfile = 0x20, kMotion = 0x80;
 using R = Reaction;

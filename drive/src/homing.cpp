@@ -1,6 +1,7 @@
-// Homing mode (6) [001 §4.5, digest §2.3]: the methods of 0x60E3, run as a small phase machine on top of the
-// profile generator. Edges and index pulses are latched in the plant sub-steps (on_edge/on_index) at the
-// position where they really happened, so the reference point does not depend on the cycle time.
+// Homing mode (6) (IEC 61800-7-201 homing mode; MAXPOS firmware specification §4.5, §7.2.75-7.2.77; EPOS4
+// Application Notes §7.3): the methods of 0x60E3, run as a small phase machine on top of the profile
+// generator. Edges and index pulses are latched in the plant sub-steps (on_edge/on_index) at the position
+// where they really happened, so the reference point does not depend on the cycle time.
 #include <cmath>
 
 #include "drive/axis.hpp"
@@ -29,57 +30,56 @@ int offset_sign(int m) {
 }  // namespace
 
 void Axis::homing_start() {
-    // Homing clears touch-probe states and latched values [001 §4.5].
-    tp_status_ &= 0x1;
-    tp_pos_ = tp_neg_ = 0;
-    tp_pos_cnt_ = tp_neg_cnt_ = 0;
-    hmethod_ = params.homing_method;
-    referenced_ = false;
-    hstat_ = HomingStatus::InProgress;
-    hedge_ = hindex_ = false;
-    hsettle_ = 0;
-    hbit_ = -1;
-    hrise_ = true;
-    profile_.reset(demand_pos_, demand_vel_);
-    const int m = hmethod_;
+    // Homing clears touch-probe states and latched values (MAXPOS firmware specification §4.5).
+    tp_.clear_for_homing();
+    home_.method = params.homing_method;
+    home_.referenced = false;
+    home_.status = HomingStatus::InProgress;
+    home_.edge = home_.index = false;
+    home_.settle = 0;
+    home_.bit = -1;
+    home_.rise = true;
+    sp_.profile.reset(sp_.demand_pos, sp_.demand_vel);
+    const int m = home_.method;
     const bool neg = func_ & ((1ull << 0) | (1ull << 24));
     const bool pos = func_ & ((1ull << 1) | (1ull << 25));
     const bool home = func_ & (1ull << 2);
-    if (uses_index(m) && !(params.encoder_type & 0x1)) {
+    // Only the methods of 0x60E3 (declared once in od/drive_objects.hpp, also the 0x6098 validator's).
+    if (!od::contains(od::kHomingMethods, m) || (uses_index(m) && !(params.encoder_type & 0x1))) {
         homing_fail();
         return;
     }
     if (limit_method(m)) {
         const bool negative = (m == 1 || m == 17);
-        hbit_ = negative ? 0 : 1;
-        hdir_ = negative ? -1 : 1;
+        home_.bit = negative ? 0 : 1;
+        home_.dir = negative ? -1 : 1;
         if (negative ? neg : pos) {  // already on the switch: only back off
-            hdir_ = -hdir_;
-            hrise_ = false;
-            hphase_ = HomingPhase::Backoff;
+            home_.dir = -home_.dir;
+            home_.rise = false;
+            home_.phase = HomingPhase::Backoff;
         } else {
-            hphase_ = HomingPhase::Search;
+            home_.phase = HomingPhase::Search;
         }
     } else if (home_method(m)) {
-        hbit_ = 2;
-        hdir_ = (m == 7 || m == 23) ? 1 : -1;
+        home_.bit = 2;
+        home_.dir = (m == 7 || m == 23) ? 1 : -1;
         if (home) {  // starts on the switch: go the other way to its edge
-            hdir_ = -hdir_;
-            hrise_ = false;
-            hphase_ = HomingPhase::Backoff;
+            home_.dir = -home_.dir;
+            home_.rise = false;
+            home_.phase = HomingPhase::Backoff;
         } else {
-            hphase_ = HomingPhase::Search;
+            home_.phase = HomingPhase::Search;
         }
     } else if (m == 33 || m == 34) {
-        hdir_ = m == 33 ? -1 : 1;
-        hsearch_origin_ = static_cast<double>(count_);
-        hphase_ = HomingPhase::ToIndex;
+        home_.dir = m == 33 ? -1 : 1;
+        home_.search_origin = static_cast<double>(count_);
+        home_.phase = HomingPhase::ToIndex;
     } else if (m == 37) {
-        href_ = static_cast<double>(count_);
-        hphase_ = HomingPhase::Offset;
+        home_.ref = static_cast<double>(count_);
+        home_.phase = HomingPhase::Offset;
     } else if (current_method(m)) {
-        hdir_ = (m == -1 || m == -3) ? 1 : -1;
-        hphase_ = HomingPhase::Search;
+        home_.dir = (m == -1 || m == -3) ? 1 : -1;
+        home_.phase = HomingPhase::Search;
     } else {
         homing_fail();
         return;
@@ -88,20 +88,20 @@ void Axis::homing_start() {
 }
 
 void Axis::homing_fail() {
-    hstat_ = HomingStatus::Error;
-    hphase_ = HomingPhase::Stopping;
-    referenced_ = false;
+    home_.status = HomingStatus::Error;
+    home_.phase = HomingPhase::Stopping;
+    home_.referenced = false;
     sink_->diag(Severity::Warning, 0, "Homing error");
 }
 
 void Axis::homing_finish_ok() {
     const double target =
-        std::floor(href_ + offset_sign(hmethod_) * static_cast<double>(params.home_offset_move));
+        std::floor(home_.ref + offset_sign(home_.method) * static_cast<double>(params.home_offset_move));
     shift_ = static_cast<int64_t>(params.home_position) - static_cast<int64_t>(target);
-    profile_.reset(target, 0);
-    hstat_ = HomingStatus::Done;
-    hphase_ = HomingPhase::Finished;
-    referenced_ = true;
+    sp_.profile.reset(target, 0);
+    home_.status = HomingStatus::Done;
+    home_.phase = HomingPhase::Finished;
+    home_.referenced = true;
     sink_->diag(Severity::Info, 0, "Homing attained");
 }
 
@@ -109,86 +109,87 @@ void Axis::homing_tick(double h) {
     const double fast = rpm_to_inc_s(params.homing_speed_switch);
     const double slow = rpm_to_inc_s(params.homing_speed_zero);
     const double acc = decel_limit(params.homing_acceleration);
-    if (hstat_ != HomingStatus::InProgress) {
-        profile_.step_velocity(0.0, acc, acc, h);
+    if (home_.status != HomingStatus::InProgress) {
+        sp_.profile.step_velocity(0.0, acc, acc, h);
         return;
     }
-    if (halted_) {  // halt in homing: stop with the homing acceleration [001 Table 4-29]
-        if (profile_.step_velocity(0.0, acc, acc, h)) {
-            hstat_ = HomingStatus::Interrupted;
-            hphase_ = HomingPhase::Finished;
+    if (sp_.halted) {  // halt in homing: stop with the homing acceleration (MAXPOS firmware specification
+                       // Table 4-29)
+        if (sp_.profile.step_velocity(0.0, acc, acc, h)) {
+            home_.status = HomingStatus::Interrupted;
+            home_.phase = HomingPhase::Finished;
         }
         return;
     }
-    const int m = hmethod_;
+    const int m = home_.method;
     const double threshold = params.homing_current_threshold * 1e-3;
     const double current = std::abs(plant_.current());
     const bool neg = func_ & ((1ull << 0) | (1ull << 24));
     const bool pos = func_ & ((1ull << 1) | (1ull << 25));
-    switch (hphase_) {
+    switch (home_.phase) {
         case HomingPhase::Search:
-            profile_.step_velocity(hdir_ * fast, acc, acc, h);
+            sp_.profile.step_velocity(home_.dir * fast, acc, acc, h);
             // A limit switch that is not the target of the search ends homing with an error.
-            if (limit_method(m) && ((hbit_ == 0 && pos) || (hbit_ == 1 && neg))) return homing_fail();
-            if (home_method(m) && ((hdir_ < 0 && neg) || (hdir_ > 0 && pos))) return homing_fail();
+            if (limit_method(m) && ((home_.bit == 0 && pos) || (home_.bit == 1 && neg))) return homing_fail();
+            if (home_method(m) && ((home_.dir < 0 && neg) || (home_.dir > 0 && pos))) return homing_fail();
             if (current_method(m)) {
                 // Only at constant speed: the acceleration current must not look like the stop.
-                hsettle_ = profile_.velocity() == hdir_ * fast ? hsettle_ + 1 : 0;
-                if (current > threshold && hsettle_ > 20) {
+                home_.settle = sp_.profile.velocity() == home_.dir * fast ? home_.settle + 1 : 0;
+                if (current > threshold && home_.settle > 20) {
                     if (m == -3 || m == -4) {
-                        href_ = static_cast<double>(count_);
-                        hphase_ = HomingPhase::Offset;
+                        home_.ref = static_cast<double>(count_);
+                        home_.phase = HomingPhase::Offset;
                     } else {
-                        hdir_ = -hdir_;
-                        hphase_ = HomingPhase::Backoff;
+                        home_.dir = -home_.dir;
+                        home_.phase = HomingPhase::Backoff;
                     }
                 }
-            } else if (hedge_) {
-                hedge_ = false;
-                hdir_ = -hdir_;
-                hrise_ = false;
-                hphase_ = HomingPhase::Backoff;
+            } else if (home_.edge) {
+                home_.edge = false;
+                home_.dir = -home_.dir;
+                home_.rise = false;
+                home_.phase = HomingPhase::Backoff;
             }
             break;
         case HomingPhase::Backoff:
-            profile_.step_velocity(hdir_ * slow, acc, acc, h);
+            sp_.profile.step_velocity(home_.dir * slow, acc, acc, h);
             if (current_method(m)) {
-                const double v = profile_.velocity();
-                if (current < threshold && ((hdir_ > 0 && v > 0) || (hdir_ < 0 && v < 0))) {
-                    hsearch_origin_ = static_cast<double>(count_);
-                    hindex_ = false;
-                    hphase_ = HomingPhase::ToIndex;
+                const double v = sp_.profile.velocity();
+                if (current < threshold && ((home_.dir > 0 && v > 0) || (home_.dir < 0 && v < 0))) {
+                    home_.search_origin = static_cast<double>(count_);
+                    home_.index = false;
+                    home_.phase = HomingPhase::ToIndex;
                 }
-            } else if (hedge_) {
-                hedge_ = false;
+            } else if (home_.edge) {
+                home_.edge = false;
                 if (m == 17 || m == 18 || m == 23 || m == 27) {
-                    href_ = hevent_pos_;
-                    hphase_ = HomingPhase::Offset;
+                    home_.ref = home_.event_pos;
+                    home_.phase = HomingPhase::Offset;
                 } else {
-                    hsearch_origin_ = hevent_pos_;
-                    hindex_ = false;
-                    hphase_ = HomingPhase::ToIndex;
+                    home_.search_origin = home_.event_pos;
+                    home_.index = false;
+                    home_.phase = HomingPhase::ToIndex;
                 }
             }
             break;
         case HomingPhase::ToIndex:
-            profile_.step_velocity(hdir_ * slow, acc, acc, h);
-            if (hindex_) {
-                href_ = hevent_pos_;
-                hphase_ = HomingPhase::Offset;
-            } else if (std::abs(static_cast<double>(count_) - hsearch_origin_) > 2.0 * res_) {
+            sp_.profile.step_velocity(home_.dir * slow, acc, acc, h);
+            if (home_.index) {
+                home_.ref = home_.event_pos;
+                home_.phase = HomingPhase::Offset;
+            } else if (std::abs(static_cast<double>(count_) - home_.search_origin) > 2.0 * res_) {
                 return homing_fail();  // no index within two turns
             }
             break;
         case HomingPhase::Offset: {
             const double target =
-                std::floor(href_ + offset_sign(m) * static_cast<double>(params.home_offset_move));
-            if (profile_.step_position(target, fast, acc, acc, h)) homing_finish_ok();
+                std::floor(home_.ref + offset_sign(m) * static_cast<double>(params.home_offset_move));
+            if (sp_.profile.step_position(target, fast, acc, acc, h)) homing_finish_ok();
             break;
         }
         case HomingPhase::Stopping:
         case HomingPhase::Finished:
-            profile_.step_velocity(0.0, acc, acc, h);
+            sp_.profile.step_velocity(0.0, acc, acc, h);
             break;
     }
 }

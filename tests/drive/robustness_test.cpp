@@ -20,7 +20,7 @@ TEST(Robustness, RandomParametersAndCommandsStayFinite) {
         NullEventSink sink;
         Axis ax(&sink);
         Parameters& p = ax.params;
-        // Anywhere inside the seed's value ranges (the dictionary enforces those).
+        // Anywhere inside the specification's value ranges (the dictionary enforces those).
         p.nominal_current = static_cast<uint16_t>(pick(0, 5000));
         p.output_current_limit = static_cast<uint16_t>(pick(0, 15000));
         p.thermal_time_constant = static_cast<uint16_t>(pick(1, 10000));

@@ -1,4 +1,5 @@
-// CiA 402 controlword decoding and the transition table [001 Tables 3-5..3-7].
+// CiA 402 controlword decoding and the transition table (IEC 61800-7-201 §6.2.2; MAXPOS firmware
+// specification Tables 3-5..3-7).
 #include <gtest/gtest.h>
 
 #include "drive/state_machine.hpp"
@@ -13,7 +14,7 @@ TEST(Controlword, DecodesTable3_7Patterns) {
     EXPECT_EQ(decode(0x0000, 0), DeviceCommand::DisableVoltage);
     EXPECT_EQ(decode(0x000D, 0), DeviceCommand::DisableVoltage);  // 0xxx xx0x
     EXPECT_EQ(decode(0x0002, 0), DeviceCommand::QuickStop);
-    EXPECT_EQ(decode(0x000B, 0), DeviceCommand::QuickStop);        // [004] uses 0x000B
+    EXPECT_EQ(decode(0x000B, 0), DeviceCommand::QuickStop);        // the EPOS4 Application Notes use 0x000B
     EXPECT_EQ(decode(0x001F, 0), DeviceCommand::EnableOperation);  // mode bits do not matter
 }
 

@@ -1,4 +1,4 @@
-// The drive's dictionary against seed 001 chapter 7 (reference/seed-od-table.md), and the device description.
+// The drive's dictionary against the MAXPOS firmware specification chapter 7, and the device description.
 #include <gtest/gtest.h>
 
 #include <map>
@@ -13,10 +13,11 @@ namespace {
 
 struct Expected {
     uint16_t index;
-    std::vector<uint8_t> subs;  // every subindex the seed table lists (besides sub 0 of ARRAY/RECORD)
+    std::vector<uint8_t>
+        subs;  // every subindex the specification's object table lists (besides sub 0 of ARRAY/RECORD)
 };
 
-// Hand-copied from seed-od-table.md table A (keeps the test hermetic).
+// Copied by hand from the specification's object table (chapter 7), so the test is hermetic.
 const std::vector<Expected> kSeedTable = {
     {0x1000, {0}},
     {0x1001, {0}},

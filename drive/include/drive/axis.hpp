@@ -1,105 +1,117 @@
 #pragma once
-// One servo axis without any object dictionary: CiA 402 device control, the operating modes, homing, touch
-// probe, error handling, the cascaded control loops and the simulated machine. Drive (drive.hpp) copies the
+// One servo axis that runs without an object dictionary (its defaults are the dictionary's, declared once in
+// od/drive_objects.hpp), composed of value types that each own their state: device control
+// (device_control.hpp), the set-point generator (setpoint.hpp), the cascaded loops and observer
+// (controller.hpp), supervision and errors (supervisor.hpp), the touch probe (touch_probe.hpp) and homing
+// (homing.hpp), plus the simulated machine (plant.hpp, environment.hpp). Drive (drive.hpp) copies the
 // dictionary's values into `Parameters`/`Command` before each cycle and the `Feedback` back after it; tests
 // can drive an Axis directly.
 //
-// Units at this interface are the device units of seed 001 §3.3: position inc, velocity rpm, acceleration
-// rpm/s, torque per mille of the motor rated torque, current mA.
+// Units at this interface are the device units of the MAXPOS firmware specification §3.3: position inc,
+// velocity rpm, acceleration rpm/s, torque per mille of the motor rated torque, current mA.
 #include <array>
 #include <cstdint>
 #include <limits>
 
+#include "drive/controller.hpp"
+#include "drive/device_control.hpp"
 #include "drive/environment.hpp"
 #include "drive/event_sink.hpp"
 #include "drive/faults.hpp"
+#include "drive/homing.hpp"
 #include "drive/plant.hpp"
 #include "drive/profile.hpp"
+#include "drive/setpoint.hpp"
 #include "drive/state_machine.hpp"
+#include "drive/supervisor.hpp"
+#include "drive/touch_probe.hpp"
+#include "od/drive_objects.hpp"
 
 namespace drive {
 
-namespace mode {
-constexpr int8_t None = 0;
-constexpr int8_t ProfilePosition = 1;
-constexpr int8_t ProfileVelocity = 3;
-constexpr int8_t Homing = 6;
-constexpr int8_t CyclicSyncPosition = 8;
-constexpr int8_t CyclicSyncVelocity = 9;
-constexpr int8_t CyclicSyncTorque = 10;
-bool supported(int8_t m);
-}  // namespace mode
-
-// Configuration objects (defaults = seed 001 defaults, except where noted).
+// Configuration objects. Defaults: the dictionary's, declared once in od/drive_objects.hpp (the MAXPOS
+// firmware specification's defaults, except where docs/decisions/od.md notes otherwise).
 struct Parameters {
     // Motor data 0x3001, 0x6402
-    uint16_t nominal_current = 5000;        // :01 mA
-    uint16_t output_current_limit = 15000;  // :02 mA
-    uint8_t pole_pairs = 1;                 // :03
-    uint16_t thermal_time_constant = 40;    // :04 in 100 ms
-    uint32_t torque_constant = 0;           // :05 uNm/A (0 -> 0x8331 on enable)
-    uint16_t motor_type = 10;               // 0x6402
+    uint16_t nominal_current = od::obj::MotorNominalCurrent.def;             // :01 mA
+    uint16_t output_current_limit = od::obj::MotorOutputCurrentLimit.def;    // :02 mA
+    uint8_t pole_pairs = od::obj::MotorPolePairs.def;                        // :03
+    uint16_t thermal_time_constant = od::obj::MotorThermalTimeConstant.def;  // :04 in 100 ms
+    uint32_t torque_constant = od::obj::MotorTorqueConstant.def;  // :05 uNm/A (0 -> 0x8331 on enable)
+    uint16_t motor_type = od::obj::MotorType.def;                 // 0x6402
     // Encoder 0x3010
-    uint32_t encoder_pulses = 500;   // :01 pulses/rev, inc/rev = 4 x
-    uint16_t encoder_type = 0x0001;  // :02 bit0 index present
-    uint32_t axis_misc = 0;          // 0x3000:04 bit0 polarity: 1 = inverse
+    uint32_t encoder_pulses = od::obj::EncoderPulses.def;     // :01 pulses/rev, inc/rev = 4 x
+    uint16_t encoder_type = od::obj::EncoderType.def;         // :02 bit0 index present
+    uint32_t axis_misc = od::obj::AxisConfigurationMisc.def;  // 0x3000:04 bit0 polarity: 1 = inverse
     // Current loop 0x30A0 (2^-16 V/A; I gain per 40 us current-loop sample, see decisions)
-    uint32_t current_p = 32768, current_i = 4096, current_ff = 0;
+    uint32_t current_p = od::obj::CurrentPGain.def, current_i = od::obj::CurrentIGain.def,
+             current_ff = od::obj::CurrentFfGain.def;
     // Position (and velocity) loop 0x30A1
-    uint32_t bandwidth = 4000;      // :01 0.001 Hz
-    uint32_t damping = 1000;        // :02 per mille of critical
-    uint32_t reset_time = 1000000;  // :03 us
-    uint32_t inertia = 100000;      // :04 mg cm^2
-    uint32_t friction = 0;          // :05 nNm/rpm (viscous)
-    // Option codes
-    int16_t abort_connection = 3, quick_stop = 6, shutdown = 0, disable_operation = 1, halt = 2,
-            fault_reaction = 2;
+    uint32_t bandwidth = od::obj::PositionBandwidth.def;   // :01 0.001 Hz
+    uint32_t damping = od::obj::PositionDamping.def;       // :02 per mille of critical
+    uint32_t reset_time = od::obj::PositionResetTime.def;  // :03 us
+    uint32_t inertia = od::obj::Inertia.def;               // :04 mg cm^2
+    uint32_t friction = od::obj::Friction.def;             // :05 nNm/rpm (viscous)
+    // Option codes 0x6007, 0x605A..0x605E
+    int16_t abort_connection = od::obj::AbortConnectionOptionCode.def;
+    int16_t quick_stop = od::obj::QuickStopOptionCode.def;
+    int16_t shutdown = od::obj::ShutdownOptionCode.def;
+    int16_t disable_operation = od::obj::DisableOperationOptionCode.def;
+    int16_t halt = od::obj::HaltOptionCode.def;
+    int16_t fault_reaction = od::obj::FaultReactionOptionCode.def;
     // Motion limits and profile
-    uint32_t following_error_window = 2000;                      // 0x6065 inc; 0xFFFFFFFF = off
-    uint16_t following_error_timeout = 0;                        // 0x6066 ms
-    int32_t sw_limit_min = std::numeric_limits<int32_t>::min();  // 0x607D:01
-    int32_t sw_limit_max = std::numeric_limits<int32_t>::max();  // 0x607D:02
-    int32_t range_min = std::numeric_limits<int32_t>::min();     // 0x607B:01 (-2^31 = off)
-    int32_t range_max = std::numeric_limits<int32_t>::max();     // 0x607B:02
-    uint32_t max_profile_velocity = 200000;                      // 0x607F rpm
-    uint32_t max_motor_speed = 200000;                           // 0x6080 rpm
-    uint32_t profile_velocity = 1000;                            // 0x6081 rpm
-    uint32_t profile_acceleration = 10000;                       // 0x6083 rpm/s
-    uint32_t profile_deceleration = 10000;                       // 0x6084 rpm/s
-    uint32_t quick_stop_deceleration = 15000;                    // 0x6085 rpm/s
-    uint32_t max_acceleration = 0xFFFFFFFF;                      // 0x60C5 rpm/s
+    uint32_t following_error_window = od::obj::FollowingErrorWindow.def;    // 0x6065 inc; 0xFFFFFFFF = off
+    uint16_t following_error_timeout = od::obj::FollowingErrorTimeout.def;  // 0x6066 ms
+    int32_t sw_limit_min = od::obj::SoftwarePositionLimitMin.def;           // 0x607D:01
+    int32_t sw_limit_max = od::obj::SoftwarePositionLimitMax.def;           // 0x607D:02
+    int32_t range_min = od::obj::PositionRangeLimitMin.def;                 // 0x607B:01 (-2^31 = off)
+    int32_t range_max = od::obj::PositionRangeLimitMax.def;                 // 0x607B:02
+    uint32_t max_profile_velocity = od::obj::MaxProfileVelocity.def;        // 0x607F rpm
+    uint32_t max_motor_speed = od::obj::MaxMotorSpeed.def;                  // 0x6080 rpm
+    uint32_t profile_velocity = od::obj::ProfileVelocity.def;               // 0x6081 rpm
+    uint32_t profile_acceleration = od::obj::ProfileAcceleration.def;       // 0x6083 rpm/s
+    uint32_t profile_deceleration = od::obj::ProfileDeceleration.def;       // 0x6084 rpm/s
+    uint32_t quick_stop_deceleration = od::obj::QuickStopDeceleration.def;  // 0x6085 rpm/s
+    uint32_t max_acceleration = od::obj::MaxAcceleration.def;               // 0x60C5 rpm/s
     // Homing
-    int8_t homing_method = 37;                // 0x6098
-    uint32_t homing_speed_switch = 100;       // 0x6099:01 rpm
-    uint32_t homing_speed_zero = 10;          // 0x6099:02 rpm
-    uint32_t homing_acceleration = 1000;      // 0x609A rpm/s
-    int32_t home_position = 0;                // 0x30B0 inc
-    int32_t home_offset_move = 0;             // 0x30B1 inc
-    uint16_t homing_current_threshold = 500;  // 0x30B2 mA
+    int8_t homing_method = od::obj::HomingMethod.def;                         // 0x6098
+    uint32_t homing_speed_switch = od::obj::HomingSpeedSwitchSearch.def;      // 0x6099:01 rpm
+    uint32_t homing_speed_zero = od::obj::HomingSpeedZeroSearch.def;          // 0x6099:02 rpm
+    uint32_t homing_acceleration = od::obj::HomingAcceleration.def;           // 0x609A rpm/s
+    int32_t home_position = od::obj::HomePosition.def;                        // 0x30B0 inc
+    int32_t home_offset_move = od::obj::HomeOffsetMoveDistance.def;           // 0x30B1 inc
+    uint16_t homing_current_threshold = od::obj::HomingCurrentThreshold.def;  // 0x30B2 mA
     // Interpolation 0x60C2 (value x 10^index s); 0 = no interpolation
-    uint8_t interpolation_value = 1;
-    int8_t interpolation_index = -3;
+    uint8_t interpolation_value = od::obj::InterpolationTimePeriodValue.def;
+    int8_t interpolation_index = od::obj::InterpolationTimeIndex.def;
     // Standstill 0x30E0
-    uint32_t standstill_window = 30;     // rpm; 0xFFFFFFFF = detection off
-    uint16_t standstill_time = 50;       // ms
-    uint16_t standstill_timeout = 1000;  // ms; 0xFFFF = no timeout
+    uint32_t standstill_window = od::obj::StandstillWindow.def;          // rpm; 0xFFFFFFFF = detection off
+    uint16_t standstill_time = od::obj::StandstillWindowTime.def;        // ms
+    uint16_t standstill_timeout = od::obj::StandstillWindowTimeout.def;  // ms; 0xFFFF = no timeout
     // Digital inputs 0x3141:02, 0x3142:01..06
-    uint16_t input_polarity = 0;
-    std::array<uint8_t, 6> input_function{0, 1, 2, 19, 20, 21};
-    int16_t touch_probe_source = 5;  // 0x60D0:01
+    uint16_t input_polarity = od::obj::DigitalInputPolarity.def;
+    std::array<uint8_t, 6> input_function{
+        od::obj::DigitalInput1Configuration.def, od::obj::DigitalInput2Configuration.def,
+        od::obj::DigitalInput3Configuration.def, od::obj::DigitalInput4Configuration.def,
+        od::obj::DigitalInput5Configuration.def, od::obj::DigitalInput6Configuration.def};
+    int16_t touch_probe_source = od::obj::TouchProbe1Source.def;  // 0x60D0:01
+
+    bool operator==(const Parameters&) const = default;
 };
 
 // Process-data outputs of the master (RxPDO objects).
 struct Command {
-    uint16_t controlword = 0;                // 0x6040
-    int8_t mode = mode::CyclicSyncPosition;  // 0x6060
-    int32_t target_position = 0;             // 0x607A
-    int32_t target_velocity = 0;             // 0x60FF
-    int16_t target_torque = 0;               // 0x6071
-    int32_t position_offset = 0;             // 0x60B0
-    int32_t velocity_offset = 0;             // 0x60B1
-    int16_t torque_offset = 0;               // 0x60B2
-    uint16_t touch_probe_function = 0;       // 0x60B8
+    uint16_t controlword = od::obj::Controlword.def;                  // 0x6040
+    int8_t mode = od::obj::ModesOfOperation.def;                      // 0x6060
+    int32_t target_position = od::obj::TargetPosition.def;            // 0x607A
+    int32_t target_velocity = od::obj::TargetVelocity.def;            // 0x60FF
+    int16_t target_torque = od::obj::TargetTorque.def;                // 0x6071
+    int32_t position_offset = od::obj::PositionOffset.def;            // 0x60B0
+    int32_t velocity_offset = od::obj::VelocityOffset.def;            // 0x60B1
+    int16_t torque_offset = od::obj::TorqueOffset.def;                // 0x60B2
+    uint16_t touch_probe_function = od::obj::TouchProbeFunction.def;  // 0x60B8
+
+    bool operator==(const Command&) const = default;
 };
 
 // Process-data inputs and other values the drive computes.
@@ -158,14 +170,14 @@ class Axis {
     // Raise an error from outside (e.g. the communication side); reaction per its class.
     void raise_error(uint16_t code);
 
-    State state() const { return state_; }
-    int8_t active_mode() const { return mode_; }
-    bool power_on() const { return power_; }
-    bool referenced() const { return referenced_; }
-    bool i2t_limiting() const { return i2t_active_; }
-    double thermal_load() const { return thermal_; }  // I2t state, 1.0 = limit
+    State state() const { return dc_.state; }
+    int8_t active_mode() const { return sp_.mode; }
+    bool power_on() const { return dc_.power; }
+    bool referenced() const { return home_.referenced; }
+    bool i2t_limiting() const { return ctl_.i2t_active; }
+    double thermal_load() const { return ctl_.thermal; }  // I2t state, 1.0 = limit
     const Plant& plant() const { return plant_; }
-    double position_demand_inc() const { return demand_pos_ + shift_; }  // reported frame, unrounded
+    double position_demand_inc() const { return sp_.demand_pos + shift_; }  // reported frame, unrounded
     double raw_position_inc() const;   // exact simulated position in raw increments (after polarity)
     double phys_position_inc() const;  // the same before polarity: the frame of the Environment
     int64_t home_shift() const { return shift_; }
@@ -174,44 +186,39 @@ class Axis {
     bool error_active(uint16_t code) const;
 
   private:
-    enum class Control : uint8_t { Position, Velocity, Torque };
-    enum class StopKind : uint8_t { None, Ramp, Disable };
-    enum class HomingStatus : uint8_t { Idle, InProgress, Done, Error, Interrupted };
-    enum class HomingPhase : uint8_t { Search, Backoff, ToIndex, Offset, Stopping, Finished };
-
-    struct Pending {  // a transition waiting for the drive to stop
-        bool active = false;
-        State to = State::SwitchOnDisabled;
-        int number = -1;
-        int64_t since_ns = 0;
-    };
-
+    // Axis runs its parts against each other; each group below lives in the .cpp named after the part.
+    // axis.cpp: configuration, the cycle, the machine (plant, inputs, encoder) and the feedback
     void derive();
+    void plant_step(int64_t t_ns, double u);
+    void on_edge(int bit, bool rising, double raw_pos);
+    void on_index(double raw_pos);
+    void update_feedback();
+    // device_control.cpp
     void device_control(int64_t now_ns);
     void enter(State s, int number);
     void begin_stop(StopKind kind, double decel_rpm_s, int64_t now_ns);
     void check_pending(int64_t now_ns);
+    // supervisor.cpp
     void fault(uint16_t code, int64_t now_ns);
     void fault_reset();
     bool cause_present(uint16_t code) const;
+    void supervise(int64_t now_ns, int64_t dt_ns);
+    // setpoint.cpp
     void mode_commands(int64_t now_ns, int64_t dt_ns);
     void switch_mode(int8_t m);
     void trajectory_tick(int64_t t_ns);
+    // controller.cpp
     void position_tick();
     void velocity_tick();
     void current_tick(int64_t t_ns);
-    void plant_step(int64_t t_ns, double u);
-    void on_edge(int bit, bool rising, double raw_pos);
+    // touch_probe.cpp
     void tp_latch(bool rising, double raw_pos);
-    void on_index(double raw_pos);
-    void supervise(int64_t now_ns, int64_t dt_ns);
-    void standstill(int64_t dt_ns);
-    void touch_probe_config();
+    // homing.cpp
     void homing_start();
     void homing_tick(double h);
     void homing_finish_ok();
     void homing_fail();
-    void update_feedback();
+    // helpers (axis.cpp)
     uint64_t functions(uint16_t pins) const;
     int32_t clamp_i32(double v) const;
     bool range_on() const;
@@ -227,98 +234,33 @@ class Axis {
     Environment env_;
     MotorModel motor_;
     Plant plant_;
-    Profile profile_;
     Feedback fb_;
+
+    // the parts, each owning its state
+    DeviceControl dc_;
+    SetpointGenerator sp_;
+    Controller ctl_;
+    Supervisor sup_;
+    TouchProbe tp_;
+    Homing home_;
 
     // configuration derived from params
     int32_t res_ = 2000;
     double pol_ = 1.0;  // 0x3000:04 bit 0: -1 = inverse polarity
-    double km_ctrl_ = 0, j_ctrl_ = 1e-5, r_ctrl_ = 0;
-    double kv_ = 0, kiv_ = 0, kpp_ = 0;     // velocity PI (A s/rad, A/rad), position P (1/s)
-    double kpi_ = 0, kii_ = 0, kff_i_ = 0;  // current PI
     double km_plant_ = -1;
     bool plant_dirty_ = true;
-
-    // device control
-    State state_ = State::NotReadyToSwitchOn;
-    bool power_ = false;
-    uint16_t cw_prev_ = 0;  // controlword of the previous cycle (mode bits)
-    Pending pending_;
-    StopKind stop_ = StopKind::None;
-    double stop_decel_ = 0;  // inc/s^2
-    bool ramp_done_ = false;
-    bool fra_ = false;  // fault reaction running
-    bool fra_power_off_ = false;
     int64_t now_ns_ = 0;
 
-    // errors
-    std::array<uint16_t, 8> active_{};
-    std::array<uint16_t, 8> warnings_{};
-    uint16_t last_error_ = 0;
-    uint8_t error_register_ = 0;
-
-    // modes
-    int8_t mode_ = mode::None;
-    bool halted_ = false;
-    // PPM
-    bool ppm_moving_ = false, ppm_buffered_ = false, ppm_ack_ = false;
-    double ppm_target_ = 0, ppm_next_target_ = 0;
-    bool ppm_next_rel_ = false;
-    int32_t ppm_next_raw_ = 0;
-    bool ppm_limited_ = false;
-    // CSP interpolation (raw increments)
-    double ip_from_ = 0, ip_to_ = 0;
-    int64_t ip_t0_ = 0, ip_period_ = 0;
-    bool csp_limit_violation_ = false;
-    // demand (raw increments, inc/s, inc/s^2) and control
-    Control control_ = Control::Position;
-    double demand_pos_ = 0, demand_vel_ = 0, demand_acc_ = 0;
-    double vel_ref_ = 0;      // rad/s, output of the position loop / CSV input
-    double vel_ff_ = 0;       // rad/s
-    double torque_ff_a_ = 0;  // A (current feed-forward)
-    double cur_ref_ = 0;      // A
-    double vel_int_ = 0, cur_int_ = 0;
-    double voltage_ = 0;
-    // observer
-    double obs_pos_ = 0, obs_vel_ = 0;  // rad, rad/s (raw frame)
-    double obs_load_ = 0;               // Nm, estimated load + friction torque
-    double vel_avg_rpm_ = 0, cur_avg_a_ = 0;
-    // encoder
+    // encoder and inputs
     int64_t count_ = 0;  // raw encoder count
     int64_t shift_ = 0;  // reported = raw + shift
     int64_t index_count_ = 0;
     double prev_raw_pos_ = 0;
     uint64_t func_ = 0;  // 0x60FD-style function bits, bit 26 = touch probe input, bits 32..37 = pins
     uint16_t pins_ = 0;
-    // I2t
-    double thermal_ = 0;
-    bool i2t_active_ = false;
     // timing
     int64_t tick_ = 0;
     int64_t residual_ns_ = 0;
-    // supervision
-    double ferr_time_ms_ = 0;
-    double still_ms_ = 0;
-    bool still_ = false;
-    // touch probe
-    uint16_t tp_prev_fn_ = 0;
-    uint16_t tp_status_ = 0;
-    int32_t tp_pos_ = 0, tp_neg_ = 0;
-    uint16_t tp_pos_cnt_ = 0, tp_neg_cnt_ = 0;
-    // homing
-    HomingStatus hstat_ = HomingStatus::Idle;
-    HomingPhase hphase_ = HomingPhase::Finished;
-    int hdir_ = 1;        // current search direction
-    bool hedge_ = false;  // the awaited event happened
-    double href_ = 0;     // reference point (raw inc)
-    double hevent_pos_ = 0;
-    int hbit_ = -1;        // function bit awaited (-1 none)
-    bool hrise_ = true;    // awaited edge direction
-    bool hindex_ = false;  // index seen in ToIndex
-    int hsettle_ = 0;      // position ticks at constant search speed (current-threshold methods)
-    double hsearch_origin_ = 0;
-    bool referenced_ = false;
-    int8_t hmethod_ = 0;
 };
 
 }  // namespace drive

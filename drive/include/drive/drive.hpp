@@ -12,20 +12,22 @@
 #include "drive/axis.hpp"
 #include "drive/event_sink.hpp"
 #include "od/dictionary.hpp"
+#include "od/drive_objects.hpp"
 
 namespace drive {
 
 // Writes the parameters a commissioning tool would have stored for the simulated motor into the dictionary:
-// torque constant 0x3001:05 (the seed default 0 refuses to enable with 0x8331), and a position/velocity
-// tuning 0x30A1 matched to the motor and load (20 Hz bandwidth, critical damping, 50 ms reset time, the
-// model's inertia and viscous friction). Device-side writes, range-checked; returns the first failure or Ok.
+// torque constant 0x3001:05 (the default 0 of the MAXPOS firmware specification refuses to enable with
+// 0x8331), and a position/velocity tuning 0x30A1 matched to the motor and load (20 Hz bandwidth, critical
+// damping, 50 ms reset time, the model's inertia and viscous friction). Device-side writes, range-checked;
+// returns the first failure or Ok.
 od::Status commission(od::Dictionary& dictionary, const MotorModel& motor = MotorModel{});
 
 class Drive {
   public:
-    // Also registers validators on the objects seed 001 lets a master write only in "Power Disable"
-    // (0x3000, 0x3001:03, the sensor records, 0x60A8..0x60AA, 0x6402): such writes answer WrongState
-    // (SDO abort 0x08000022) while the power stage is on.
+    // Also registers validators on the objects the MAXPOS firmware specification lets a master write only in
+    // "Power Disable" (0x3000, 0x3001:03, the sensor records, 0x60A8..0x60AA, 0x6402): such writes answer
+    // WrongState (SDO abort 0x08000022) while the power stage is on.
     explicit Drive(od::Dictionary& dictionary, EventSink* sink = nullptr);
     Drive(const Drive&) = delete;
     Drive& operator=(const Drive&) = delete;
@@ -42,6 +44,8 @@ class Drive {
     // How many (index, subindex) pairs the drive found in the dictionary, and how many it had to run without.
     std::size_t bound() const { return bound_; }
     std::size_t missing() const { return missing_; }
+    // Whether the drive found and bound this entry (one of the od/drive_objects.hpp handles).
+    bool binds(uint16_t index, uint8_t sub) const;
 
   private:
     struct Link {
@@ -49,12 +53,14 @@ class Drive {
         od::Ref<uint16_t> r16;
         od::Ref<uint32_t> r32;
         uint8_t* field;
+        uint16_t index;
+        uint8_t sub;
         uint8_t size;
     };
     template <typename T>
-    void in(uint16_t index, uint8_t sub, T& field);
+    void in(const od::Obj<T>& object, T& field);
     template <typename T>
-    void out(uint16_t index, uint8_t sub, const T& field);
+    void out(const od::Obj<T>& object, const T& field);
     bool locate(uint16_t index, uint8_t sub, std::size_t size, Link& link);
     static void load(const Link& l);
     static void store(Link l);
@@ -64,7 +70,7 @@ class Drive {
     std::vector<Link> inputs_;   // dictionary -> axis (parameters, commands)
     std::vector<Link> outputs_;  // axis -> dictionary (feedback)
     Feedback fb_copy_;
-    int32_t resolution_ = 0;
+    uint32_t resolution_ = 0;
     std::size_t bound_ = 0, missing_ = 0;
     // Read by the validators (the mailbox side); shared so a validator outliving the Drive stays safe.
     std::shared_ptr<std::atomic<bool>> powered_ = std::make_shared<std::atomic<bool>>(false);

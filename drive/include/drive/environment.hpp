@@ -43,7 +43,8 @@ class Environment {
     // A pin the user drives directly (pins no switch is wired to). Takes effect at the given time (ns on the
     // drive's clock), so an edge can fall between two drive cycles; now_ns <= 0 = immediately.
     void set_input(int pin, bool level, int64_t at_ns = 0);
-    // STO inputs: DigIN5/6 are STO-IN1/2 [001 §5]; both must be high for the power stage. Default high.
+    // STO inputs: DigIN5/6 are STO-IN1/2 (MAXPOS firmware specification §5); both must be high for the power
+    // stage. Default high.
     void set_sto(bool released) {
         set_input(5, released);
         set_input(6, released);

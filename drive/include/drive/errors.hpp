@@ -1,5 +1,6 @@
 #pragma once
-// The drive's error table [001 §8.1, Table 8-141]: code, error-register bits and reaction class.
+// The drive's error table (MAXPOS firmware specification §8.1, Table 8-141): code, error-register bits and
+// reaction class.
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -7,8 +8,8 @@
 
 namespace drive {
 
-// Reaction classes of seed 001 §8.1: d = power stage off at once; f = per fault reaction option code 0x605E;
-// a = per abort connection option code 0x6007.
+// Reaction classes of the MAXPOS firmware specification §8.1: d = power stage off at once; f = per fault
+// reaction option code 0x605E; a = per abort connection option code 0x6007.
 enum class Reaction : uint8_t { Disable, FaultReactionCode, AbortConnectionCode };
 
 namespace error_code {

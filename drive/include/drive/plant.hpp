@@ -11,7 +11,7 @@ namespace drive {
 
 // Physical data of the simulated motor and load. Values the object dictionary carries (torque constant,
 // current limits, pole pairs, thermal time constant) come from there; these are the ones it does not have.
-// Defaults: maxon EC-4pole 30 with load, the EPOS4 tuning example 2 [004 §2.4].
+// Defaults: maxon EC-4pole 30 with load, the EPOS4 tuning example 2 (EPOS4 Application Notes §2.4).
 struct MotorModel {
     double resistance = 0.836;           // ohm, terminal resistance
     double inductance = 0.118e-3;        // H

@@ -1,6 +1,7 @@
 #pragma once
-// CiA 402 device control [001 §3.2, Tables 3-5..3-7]: states, controlword commands, transitions 0..16 and the
-// statusword state bits. Pure functions; the Axis executes the actions (ramps, standstill gating).
+// CiA 402 device control (IEC 61800-7-201 §6.2.2; MAXPOS firmware specification §3.2, Tables 3-5..3-7):
+// states, controlword commands, transitions 0..16 and the statusword state bits. Pure functions; the Axis
+// executes the actions (ramps, standstill gating).
 #include <cstdint>
 
 namespace drive {
@@ -47,7 +48,8 @@ constexpr uint16_t VoltageEnabled = 1u << 4;
 constexpr uint16_t QuickStop = 1u << 5;
 constexpr uint16_t SwitchOnDisabled = 1u << 6;
 constexpr uint16_t Warning = 1u << 7;
-constexpr uint16_t Reserved8 = 1u << 8;  // "reserved (1)" in seed 001: offset current measured (EPOS)
+constexpr uint16_t Reserved8 =
+    1u << 8;  // "reserved (1)" in the MAXPOS firmware specification: offset current measured (EPOS)
 constexpr uint16_t Remote = 1u << 9;
 constexpr uint16_t TargetReached = 1u << 10;
 constexpr uint16_t InternalLimit = 1u << 11;
@@ -67,8 +69,8 @@ struct Transition {
 // Transitions 2..12, 15, 16 (13/14 are driven by faults, 0/1 by start-up).
 Transition next(State from, DeviceCommand c);
 
-// Statusword bits 0..6 for a state [001 Table 3-5]. power_on only matters in Fault Reaction Active
-// (x001 1111 while a ramp runs with the power stage on, x000 1111 once it is off).
+// Statusword bits 0..6 for a state (MAXPOS firmware specification Table 3-5). power_on only matters in Fault
+// Reaction Active (x001 1111 while a ramp runs with the power stage on, x000 1111 once it is off).
 uint16_t state_bits(State s, bool power_on = true);
 const char* to_string(State s);
 

@@ -10,7 +10,7 @@ namespace od {
 
 struct Identity {
     uint32_t vendor_id = 0x000000FB;  // maxon motor ag
-    uint32_t product_code = 0;        // seed 001 §7.2.4.3
+    uint32_t product_code = 0;        // MAXPOS firmware specification §7.2.4.3
     uint32_t revision = 0;            // high word software version, low word application version
     uint32_t serial_number = 0;
     std::string vendor_name = "maxon motor ag";
@@ -49,6 +49,24 @@ constexpr uint8_t CompleteAccess = 0x20;
 }  // namespace coe_details
 
 enum class SmKind : uint8_t { MBoxOut = 1, MBoxIn = 2, Outputs = 3, Inputs = 4 };
+
+// The SyncManager control byte (ESC register 0x0804; ETG.1000.4, ESC datasheet section "SyncManager") each
+// kind gets: mailbox out 0x26 (mailbox mode, ECAT writes, PDI interrupt), mailbox in 0x22 (mailbox mode, ECAT
+// reads, PDI interrupt), outputs 0x64 (3-buffer mode, ECAT writes, PDI interrupt, watchdog trigger), inputs
+// 0x20 (3-buffer mode, ECAT reads, PDI interrupt).
+constexpr uint8_t default_sm_control(SmKind k) {
+    switch (k) {
+        case SmKind::MBoxOut:
+            return 0x26;
+        case SmKind::MBoxIn:
+            return 0x22;
+        case SmKind::Outputs:
+            return 0x64;
+        case SmKind::Inputs:
+            return 0x20;
+    }
+    return 0;
+}
 
 struct SyncManagerDefault {
     SmKind kind = SmKind::MBoxOut;

@@ -1,5 +1,5 @@
 #pragma once
-// The drive's object dictionary as seed 001 (maxon MAXPOS firmware specification, chapter 7) declares it,
+// The drive's object dictionary as the MAXPOS firmware specification (maxon), chapter 7, declares it,
 // and the device description (identity, mailboxes, SyncManagers, DC modes) that goes with it.
 // 0x1018, 0x1008, 0x1009, 0x100A and 0x2100 take their values from DeviceDescription::identity, so the SII,
 // the ESI and CoE always agree.
@@ -8,18 +8,19 @@
 
 namespace od {
 
-// The MAXPOS 50/5 with firmware 0120h, as the seeds give or imply it (see docs/decisions/od.md).
+// The MAXPOS 50/5 with firmware 0120h, as the MAXPOS firmware specification gives or implies it (see
+// docs/decisions/od.md).
 DeviceDescription default_drive_description();
 
 // Places SM0/SM1 on the standard mailbox and SM2/SM3 after it (3 buffers of the largest PDO set each),
-// keeping control bytes 0x26/0x22/0x64/0x20 and the default process-data sizes. Throws std::out_of_range
-// if the process-data areas would not fit below 0x10000.
+// with the control bytes of od::default_sm_control and the default process-data sizes. Throws
+// std::out_of_range if the process-data areas would not fit below 0x10000.
 void place_sync_managers(DeviceDescription& description);
 
-// Every object and subindex of the drive, defaults as the seed gives them, identity from `description`.
-// Validators wired here: the value lists the seed gives (sync modes of 0x1C32/0x1C33, 0x3000:02/03,
-// modes of operation 0x6060, homing methods 0x6098, motor type 0x6402) answer InvalidValue otherwise.
-// The dictionary is returned by value; Ref<T> handles taken afterwards stay valid across moves.
+// Every object and subindex of the drive, defaults as the specification gives them, identity from
+// `description`. Validators wired here: the value lists the specification gives (sync modes of 0x1C32/0x1C33,
+// 0x3000:02/03, modes of operation 0x6060, homing methods 0x6098, motor type 0x6402) answer InvalidValue
+// otherwise. The dictionary is returned by value; Ref<T> handles taken afterwards stay valid across moves.
 Dictionary make_drive_dictionary(const DeviceDescription& description);
 
 // Signatures of the store (0x1010 / 0x2110) and restore (0x1011 / 0x2111) objects.

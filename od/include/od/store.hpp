@@ -84,8 +84,8 @@ class ParameterStore {
 // with Status::CannotStore (SDO abort 0x08000020); a failed file operation with Status::HardwareError.
 // On read, 0x1010:01/0x1011:01 show CiA 301's capability bit 0 (= 1), 0x2110/0x2111 the state of the
 // last command (bit 0 done, bit 1 error). Both `dict` and `store` must outlive the wiring and stay put.
-// `restore_allowed`, if given, is asked before a restore (seed 001 §7.2.21: only with every axis in
-// "Power Disable"); a non-Ok answer fails the write with that status and nothing is restored.
+// `restore_allowed`, if given, is asked before a restore (MAXPOS firmware specification §7.2.21: only with
+// every axis in "Power Disable"); a non-Ok answer fails the write with that status and nothing is restored.
 void attach_store(Dictionary& dict, ParameterStore& store, std::function<Status()> restore_allowed = {});
 
 }  // namespace od

@@ -1,0 +1,41 @@
+#pragma once
+// The cascaded loops of one axis (position P 2.5 kHz, velocity PI 5 kHz, current PI 25 kHz), the velocity
+// observer and the I2t model, with the gains derived from 0x30A0/0x30A1 (docs/decisions/drive.md "Control
+// loops"). Angles and speeds in rad and rad/s of the raw frame, currents in A.
+#include <cstdint>
+
+namespace drive {
+
+struct Parameters;
+
+struct Controller {
+    // gains derived from the parameters
+    double km = 0, j = 1e-5, r = 0;      // torque constant (0 = not configured), inertia, viscous friction
+    double kv = 0, kiv = 0, kpp = 0;     // velocity PI (A s/rad, A/rad), position P (1/s)
+    double kpi = 0, kii = 0, kff_i = 0;  // current PI
+    // loop state
+    double vel_ref = 0;      // rad/s, output of the position loop / CSV input
+    double vel_ff = 0;       // rad/s
+    double torque_ff_a = 0;  // A (current feed-forward)
+    double cur_ref = 0;      // A
+    double vel_int = 0, cur_int = 0;
+    double voltage = 0;
+    // observer
+    double obs_pos = 0, obs_vel = 0;  // rad, rad/s (raw frame)
+    double obs_load = 0;              // Nm, estimated load + friction torque
+    double vel_avg_rpm = 0, cur_avg_a = 0;
+    // I2t
+    double thermal = 0;
+    bool i2t_active = false;
+
+    // Gains by pole placement from 0x30A1 and 0x30A0; `km_plant` stands in when 0x3001:05 is 0.
+    void tune(const Parameters& p, double km_plant);
+    // One current-loop sample of the observer (measured angle, measured current), the I2t model and the
+    // averaged values; `km_plant` stands in for an unconfigured torque constant.
+    void observe(double meas_rad, double i_meas, double km_plant, const Parameters& p);
+    // The estimates diverged (absurd gains): true if any is not finite.
+    bool diverged() const;
+    void reset_estimates(double pos_rad);
+};
+
+}  // namespace drive

@@ -1,0 +1,131 @@
+// The control loops, the observer and the I2t model (Controller).
+#include "drive/controller.hpp"
+
+#include "drive/axis.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "axis_internal.hpp"
+
+namespace drive {
+
+using namespace detail;
+
+void Axis::position_tick() {
+    if (!dc_.power || sp_.control != Control::Position) return;
+    const double e = inc_to_rad(sp_.demand_pos - static_cast<double>(count_));
+    const bool internal_ff = sp_.mode != mode::CyclicSyncPosition || dc_.stop != StopKind::None;
+    const double w_ff = internal_ff ? inc_to_rad(sp_.demand_vel) : ctl_.vel_ff;
+    ctl_.vel_ref = ctl_.kpp * e + w_ff;
+    if (internal_ff) {
+        // Feed-forward of inertia and viscous friction (0x30A1:04/05) in the profile modes.
+        const double km = ctl_.km > 0 ? ctl_.km : plant_.torque_constant();
+        ctl_.torque_ff_a = (ctl_.j * inc_to_rad(sp_.demand_acc) + ctl_.r * inc_to_rad(sp_.demand_vel)) / km;
+    }
+}
+
+void Axis::velocity_tick() {
+    if (!dc_.power) {
+        ctl_.vel_int = 0;
+        ctl_.cur_ref = 0;
+        return;
+    }
+    if (sp_.control == Control::Torque) {
+        ctl_.vel_int = 0;
+    } else {
+        const double e = ctl_.vel_ref - ctl_.obs_vel;
+        ctl_.vel_int += ctl_.kiv * e * kVelH;
+        ctl_.cur_ref = ctl_.kv * e + ctl_.vel_int + ctl_.torque_ff_a;
+    }
+    const double limit = (ctl_.i2t_active ? params.nominal_current : params.output_current_limit) * 1e-3;
+    if (ctl_.cur_ref > limit || ctl_.cur_ref < -limit) {
+        const double c = std::clamp(ctl_.cur_ref, -limit, limit);
+        // Anti-windup: the integrator takes back what the limit cut off.
+        if (sp_.control != Control::Torque)
+            ctl_.vel_int = std::clamp(ctl_.vel_int - (ctl_.cur_ref - c), -limit, limit);
+        ctl_.cur_ref = c;
+    }
+}
+
+void Axis::current_tick(int64_t t_ns) {
+    double u = 0;
+    const double km = plant_.torque_constant();
+    if (dc_.power) {
+        const double limit = (ctl_.i2t_active ? params.nominal_current : params.output_current_limit) * 1e-3;
+        if (sp_.control == Control::Torque) ctl_.cur_ref = std::clamp(ctl_.cur_ref, -limit, limit);
+        const double e = ctl_.cur_ref - i_meas();
+        ctl_.cur_int += ctl_.kii * e * kTick;
+        // Back-EMF decoupling with the estimated speed, plus the 0x30A0:03 feed-forward.
+        const double unclamped = ctl_.kpi * e + ctl_.cur_int + km * ctl_.obs_vel + ctl_.kff_i * ctl_.cur_ref;
+        const double vs = motor_.supply_voltage;
+        u = std::clamp(unclamped, -vs, vs);
+        if (u != unclamped) ctl_.cur_int -= (unclamped - u);
+    } else {
+        ctl_.cur_int = 0;
+    }
+    ctl_.voltage = u;
+    for (int k = 0; k < kPlantStepsPerTick; ++k)
+        plant_step(t_ns + static_cast<int64_t>((k + 1) * kCurrentTickNs / kPlantStepsPerTick), u);
+
+    ctl_.observe(inc_to_rad(static_cast<double>(count_) + 0.5), i_meas(), km, params);
+}
+
+void Controller::observe(double meas_rad, double i_meas, double km_plant, const Parameters& p) {
+    // Velocity observer on the encoder count (EPOS4 style, EPOS4 Application Notes §2.3.2): model-based
+    // prediction with the controller's inertia and torque constant, corrected by the position error.
+    // A load-torque state removes the bias friction would otherwise leave in the speed estimate; the three
+    // observer poles sit at -kObserverHz.
+    const double wo = kTwoPi * kObserverHz;
+    const double err = meas_rad - obs_pos;
+    const double kmc = km > 0 ? km : km_plant;
+    obs_pos += kTick * (obs_vel + 3.0 * wo * err);
+    obs_vel += kTick * ((kmc * i_meas - obs_load - r * obs_vel) / j + 3.0 * wo * wo * err);
+    obs_load -= kTick * j * wo * wo * wo * err;
+
+    // I2t: normalized winding temperature rise, 1.0 = the level continuous nominal current reaches.
+    const double tau = std::max<double>(p.thermal_time_constant, 1.0) * 0.1;
+    const double in = std::max<double>(p.nominal_current, 1.0) * 1e-3;
+    const double ratio = i_meas / in;
+    thermal += kTick / tau * (ratio * ratio - thermal);
+    if (thermal >= 1.0)
+        i2t_active = true;
+    else if (thermal < 0.98)
+        i2t_active = false;
+
+    const double rpm = obs_vel * 60.0 / kTwoPi;
+    vel_avg_rpm += kAvgAlpha * (rpm - vel_avg_rpm);
+    cur_avg_a += kAvgAlpha * (i_meas - cur_avg_a);
+}
+
+void Controller::tune(const Parameters& p, double km_plant) {
+    // 0x30A1: bandwidth, damping, reset time, inertia, friction -> cascade gains by pole placement
+    // (docs/decisions/drive.md "Control loops").
+    km = p.torque_constant * 1e-6;
+    const double k = km > 0 ? km : km_plant;
+    j = std::max<double>(p.inertia, 1.0) * 1e-10;
+    r = p.friction * 1e-9 * 60.0 / kTwoPi;
+    const double wb = kTwoPi * std::max<double>(p.bandwidth, 1.0) * 1e-3;
+    const double zeta = std::max<double>(p.damping, 1.0) * 1e-3;
+    const double ti = std::max<double>(p.reset_time, 100.0) * 1e-6;
+    kv = 2.0 * zeta * wb * j / k;
+    kiv = kv / ti;
+    kpp = wb / (2.0 * zeta);
+    // 0x30A0: 2^-16 V/A; the I gain integrates once per current-loop sample.
+    kpi = p.current_p / 65536.0;
+    kii = p.current_i / 65536.0 / kTick;
+    kff_i = p.current_ff / 65536.0;
+}
+
+bool Controller::diverged() const {
+    return !std::isfinite(obs_vel) || !std::isfinite(obs_pos) || !std::isfinite(obs_load) ||
+           !std::isfinite(vel_int) || !std::isfinite(cur_int) || !std::isfinite(cur_ref);
+}
+
+void Controller::reset_estimates(double pos_rad) {
+    obs_pos = pos_rad;
+    obs_vel = obs_load = vel_int = cur_int = cur_ref = vel_ref = 0;
+}
+
+}  // namespace drive
