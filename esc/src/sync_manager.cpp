@@ -209,7 +209,7 @@ const SmArea* SyncManagers::first_area(uint32_t p, uint32_t end) const {
     return nullptr;
 }
 
-bool SyncManagers::end_of_frame(bool ok) {
+bool SyncManagers::commit_pending(bool ok) {
     uint16_t pend = pending_mask_;
     pending_mask_ = 0;
     bool buffer_changed = false;

@@ -58,7 +58,7 @@ class SyncManagers {
     void pdi_control_written(unsigned n, uint8_t value);
     // End of an ECAT frame: buffer closes of the frame take effect if it was correct. Returns true if a
     // buffer changed.
-    bool end_of_frame(bool ok);
+    bool end_of_frame(bool ok) { return pending_mask_ != 0 && commit_pending(ok); }
 
     // Lock rule E3: start, length and control of an SM enabled before the current datagram are read-only.
     uint16_t enabled_mask() const { return enabled_mask_; }
@@ -66,6 +66,7 @@ class SyncManagers {
     bool locked(unsigned n) const { return lock_mask_ & (1u << n); }
 
   private:
+    bool commit_pending(bool ok);
     void reset_state(unsigned n);
     void commit(unsigned n, bool write, Side side);
     void update_status(unsigned n);
