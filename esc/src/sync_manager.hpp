@@ -47,7 +47,13 @@ class SyncManagers {
     // Re-decodes the configuration registers and the sorted list of enabled areas.
     void rebuild();
     // First enabled SM area overlapping [p, end), or nullptr.
-    const SmArea* first_area(uint32_t p, uint32_t end) const;
+    const SmArea* first_area(uint32_t p, uint32_t end) const {
+        for (uint8_t k = 0; k < area_count_; ++k) {
+            const SmArea& s = areas_[k];
+            if (s.end > p && s.start < end) return &s;
+        }
+        return nullptr;
+    }
     uint16_t length(unsigned n) const { return sm[n].length; }
     // Access of cnt bytes at offset off of SM n's area. Returns false if not accessible (direction, state).
     bool access(unsigned n, uint32_t off, uint8_t* dst, const uint8_t* src, const uint8_t* bm, uint32_t cnt,
