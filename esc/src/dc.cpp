@@ -262,8 +262,7 @@ void DistributedClocks::after_pdi_read(uint16_t a, uint16_t e) {
     }
 }
 
-void DistributedClocks::end_of_frame(bool ok) {
-    if (!latch_pending) return;
+void DistributedClocks::latch(bool ok) {
     latch_pending = false;
     if (!ok) return;
     const uint32_t t32 = static_cast<uint32_t>(time.frame_local);

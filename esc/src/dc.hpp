@@ -34,7 +34,9 @@ class DistributedClocks {
     void activation_written(uint8_t old_value, uint8_t value);
     void start_time_written(bool only_low32);
     // End of an ECAT frame: the receive-time latch of a correct frame.
-    void end_of_frame(bool ok);
+    void end_of_frame(bool ok) {
+        if (latch_pending) latch(ok);
+    }
 
     // SYNC0/SYNC1 generation up to now_clock.
     void run(uint64_t now_clock);
@@ -42,6 +44,7 @@ class DistributedClocks {
     uint64_t next_event() const;
 
   private:
+    void latch(bool ok);
     void set_rate(double new_rate, uint64_t at_clock);
     void fire_sync0(uint64_t t);
     void fire_sync1(uint64_t t);

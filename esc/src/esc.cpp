@@ -312,7 +312,7 @@ void Esc::Impl::datagram(uint8_t* d, uint8_t* data, uint16_t len) {
         case Command::LRW: {
             const uint32_t la = static_cast<uint32_t>(adp) | (static_cast<uint32_t>(ado) << 16);
             sm.set_lock_mask(sm.enabled_mask());
-            const uint16_t inc = fmmu.logical(cmd, la, data, len);
+            const uint16_t inc = fmmu.logical(*this, cmd, la, data, len);
             if (lookup_dirty) rebuild_lookup();
             if (inc) put16(wkc_p, static_cast<uint16_t>(get16(wkc_p) + inc));
             return;

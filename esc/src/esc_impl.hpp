@@ -20,7 +20,7 @@
 
 namespace esc {
 
-struct Esc::Impl final : PhysicalMemory {
+struct Esc::Impl final {
     Impl(const EscConfig& c, const Clock& clk);
 
     // ---------------------------------------------------------------- configuration
@@ -35,7 +35,7 @@ struct Esc::Impl final : PhysicalMemory {
     FrameTime time;
     Watchdogs wd{mem, time};
     SyncManagers sm{mem, wd, cfg.sm_count};
-    Fmmus fmmu{mem, *this, cfg.fmmu_count};
+    Fmmus fmmu{mem, cfg.fmmu_count};
     DistributedClocks dc{mem, time, cfg.faults};
     SiiInterface sii{mem, cfg.faults};
     bool lookup_dirty = false;  // SM / FMMU configuration written: rebuild their decoded state
@@ -65,8 +65,8 @@ struct Esc::Impl final : PhysicalMemory {
     // Physical memory access (whole address space: registers, RAM, SM areas). Return true if any byte
     // was accessible. read: inaccessible bytes of dst are left untouched, ok[] (optional) marks accessible
     // bytes. write: bm (optional) is a per-byte bit mask of the bits to write.
-    bool phys_read(uint32_t a, uint8_t* dst, uint8_t* ok, uint32_t n, Side side) override;
-    bool phys_write(uint32_t a, const uint8_t* src, const uint8_t* bm, uint32_t n, Side side) override;
+    bool phys_read(uint32_t a, uint8_t* dst, uint8_t* ok, uint32_t n, Side side);
+    bool phys_write(uint32_t a, const uint8_t* src, const uint8_t* bm, uint32_t n, Side side);
     void reg_read(uint16_t a, uint8_t* dst, uint32_t n, Side side);
     bool reg_write(uint16_t a, const uint8_t* src, const uint8_t* bm, uint32_t n, Side side);
     void reg_special_write(uint16_t a, uint16_t e, const uint8_t* src, const uint8_t* bm, Side side);

@@ -31,8 +31,7 @@ std::vector<uint8_t> default_eeprom() {
 
 SiiInterface::SiiInterface(Memory& m, const EscFaults& f) : mem(m), faults(f), eeprom(default_eeprom()) {}
 
-void SiiInterface::end_of_frame(bool ok) {
-    if (!pending) return;
+void SiiInterface::run_pending(bool ok) {
     pending = false;
     if (ok) {
         execute();
@@ -41,8 +40,7 @@ void SiiInterface::end_of_frame(bool ok) {
     }
 }
 
-void SiiInterface::flush_callbacks(std::unique_lock<std::mutex>& lock) {
-    if (write_count == 0) return;
+void SiiInterface::flush(std::unique_lock<std::mutex>& lock) {
     const std::array<EepromWrite, 4> w = writes;
     const uint8_t n = write_count;
     write_count = 0;

@@ -29,11 +29,17 @@ class SiiInterface {
     // Runs the command in 0x0502 bits 10:8 (at the end of the frame for ECAT, at once for the PDI).
     void execute();
     // End of an ECAT frame: runs the requested command if the frame was correct, else drops it.
-    void end_of_frame(bool ok);
+    void end_of_frame(bool ok) {
+        if (pending) run_pending(ok);
+    }
     // Calls the write callback for the words written since the last flush, outside the lock.
-    void flush_callbacks(std::unique_lock<std::mutex>& lock);
+    void flush_callbacks(std::unique_lock<std::mutex>& lock) {
+        if (write_count != 0) flush(lock);
+    }
 
   private:
+    void run_pending(bool ok);
+    void flush(std::unique_lock<std::mutex>& lock);
     uint16_t word(uint64_t word) const;
     bool crc_ok() const;
 

@@ -201,15 +201,7 @@ void SyncManagers::rebuild() {
     }
 }
 
-const SmArea* SyncManagers::first_area(uint32_t p, uint32_t end) const {
-    for (uint8_t k = 0; k < area_count_; ++k) {
-        const SmArea& s = areas_[k];
-        if (s.end > p && s.start < end) return &s;
-    }
-    return nullptr;
-}
-
-bool SyncManagers::end_of_frame(bool ok) {
+bool SyncManagers::commit_pending(bool ok) {
     uint16_t pend = pending_mask_;
     pending_mask_ = 0;
     bool buffer_changed = false;

@@ -47,7 +47,13 @@ class SyncManagers {
     // Re-decodes the configuration registers and the sorted list of enabled areas.
     void rebuild();
     // First enabled SM area overlapping [p, end), or nullptr.
-    const SmArea* first_area(uint32_t p, uint32_t end) const;
+    const SmArea* first_area(uint32_t p, uint32_t end) const {
+        for (uint8_t k = 0; k < area_count_; ++k) {
+            const SmArea& s = areas_[k];
+            if (s.end > p && s.start < end) return &s;
+        }
+        return nullptr;
+    }
     uint16_t length(unsigned n) const { return sm[n].length; }
     // Access of cnt bytes at offset off of SM n's area. Returns false if not accessible (direction, state).
     bool access(unsigned n, uint32_t off, uint8_t* dst, const uint8_t* src, const uint8_t* bm, uint32_t cnt,
@@ -58,7 +64,7 @@ class SyncManagers {
     void pdi_control_written(unsigned n, uint8_t value);
     // End of an ECAT frame: buffer closes of the frame take effect if it was correct. Returns true if a
     // buffer changed.
-    bool end_of_frame(bool ok);
+    bool end_of_frame(bool ok) { return pending_mask_ != 0 && commit_pending(ok); }
 
     // Lock rule E3: start, length and control of an SM enabled before the current datagram are read-only.
     uint16_t enabled_mask() const { return enabled_mask_; }
@@ -66,6 +72,7 @@ class SyncManagers {
     bool locked(unsigned n) const { return lock_mask_ & (1u << n); }
 
   private:
+    bool commit_pending(bool ok);
     void reset_state(unsigned n);
     void commit(unsigned n, bool write, Side side);
     void update_status(unsigned n);
