@@ -11,13 +11,13 @@
 #include <memory>
 
 #include "alloc_counter.hpp"
+#include "device/device.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
-#include "device/device.hpp"
 
 namespace {
 

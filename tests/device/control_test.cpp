@@ -10,10 +10,10 @@
 #include <filesystem>
 #include <memory>
 
-#include "esc/clock.hpp"
-#include "esc/esc.hpp"
 #include "device/control.hpp"
 #include "device/device.hpp"
+#include "esc/clock.hpp"
+#include "esc/esc.hpp"
 
 namespace {
 

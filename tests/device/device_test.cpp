@@ -14,6 +14,9 @@
 #include <string>
 #include <vector>
 
+#include "device/device.hpp"
+#include "device/eeprom_writes.hpp"
+#include "device/firmware.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
 #include "esi/sii.hpp"
@@ -23,9 +26,6 @@
 #include "master/master.hpp"
 #include "master/session.hpp"
 #include "od/drive_profile.hpp"
-#include "device/device.hpp"
-#include "device/eeprom_writes.hpp"
-#include "device/firmware.hpp"
 #include "slave/log.hpp"
 
 #include "../support/wire_link.hpp"
@@ -292,7 +292,8 @@ TEST_F(DeviceTest, WatchdogFallsBackToSafeOpAndTheDriveReactsWith6007) {
     EXPECT_EQ(st->state, 0x04);
     EXPECT_TRUE(st->error);
     EXPECT_EQ(st->code, 0x001B);
-    // 0x6007 = 3 (seed default): quick-stop ramp, then Fault with 0x8180; the drive kept running on its own.
+    // 0x6007 = 3 (MAXPOS firmware specification default): quick-stop ramp, then Fault with 0x8180; the drive
+    // kept running on its own.
     EXPECT_EQ(drive.dict().get<int16_t>(0x6007, 0), 3);
     EXPECT_EQ(drive.dict().get<uint16_t>(0x603F, 0), 0x8180);
     const uint16_t sw = drive.dict().get<uint16_t>(0x6041, 0);

@@ -11,13 +11,13 @@
 #include <sstream>
 #include <type_traits>
 
+#include "device/device.hpp"
+#include "device/faults.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
-#include "device/device.hpp"
-#include "device/faults.hpp"
 
 #include "../support/wire_link.hpp"
 

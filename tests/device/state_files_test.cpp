@@ -14,12 +14,12 @@
 #include <string_view>
 #include <vector>
 
+#include "device/device.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
 #include "foe/image.hpp"
 #include "od/drive_profile.hpp"
 #include "od/store.hpp"
-#include "device/device.hpp"
 
 namespace fs = std::filesystem;
 

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "device/eeprom_writes.hpp"
 #include "esi/sii.hpp"
 #include "foe/store.hpp"
 #include "fuzz_support.hpp"
@@ -22,7 +23,6 @@
 #include "od/device_config.hpp"
 #include "od/drive_profile.hpp"
 #include "od/store.hpp"
-#include "device/eeprom_writes.hpp"
 
 namespace fuzz::loaders {
 namespace {

@@ -20,9 +20,9 @@
 #include <thread>
 #include <vector>
 
+#include "device/faults.hpp"
 #include "esc/link_packet.hpp"
 #include "netns_util.hpp"
-#include "device/faults.hpp"
 #include "slave/netif.hpp"
 
 namespace {

@@ -10,10 +10,10 @@
 #include <string_view>
 
 #include "config_check.hpp"
-#include "esc/link.hpp"
-#include "od/device_config.hpp"
 #include "device/faults.hpp"
 #include "device/firmware.hpp"
+#include "esc/link.hpp"
+#include "od/device_config.hpp"
 #include "slave/log.hpp"
 #include "slave/slave.hpp"
 
@@ -171,7 +171,7 @@ int main(int argc, char** argv) {
         device.config_file = config->as<std::string>();
     device.state_dir = state_dir;
     slave::Log log(std::cerr, quiet ? slave::LogLevel::Error : *slave::parse_log_level(log_level),
-                       slave::stderr_is_terminal());
+                   slave::stderr_is_terminal());
     device.events = &log;
     if (reset_sii) {
         const std::filesystem::path writes = device.state_dir / device::EepromWrites::kFileName;

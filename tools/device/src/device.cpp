@@ -110,10 +110,10 @@ Device::Device(esc::Esc& esc, DeviceOptions options)
     if (options_.load_sii && !eeprom_writes_.empty()) {
         // The SII served is not the generated one: say so, and how to go back (docs/decisions/device.md).
         event(slave::LogLevel::Warn, "the SII served carries " + std::to_string(eeprom_writes_.size()) +
-                                             " word(s) a master wrote into the EEPROM, kept in " +
-                                             eeprom_writes_.file().string() +
-                                             "; delete that file (or start with --reset-sii) to serve the "
-                                             "SII generated from the object model");
+                                         " word(s) a master wrote into the EEPROM, kept in " +
+                                         eeprom_writes_.file().string() +
+                                         "; delete that file (or start with --reset-sii) to serve the "
+                                         "SII generated from the object model");
         std::vector<uint8_t> image = esi::build_sii(parts_->desc, parts_->dict);
         eeprom_writes_.apply(image);
         const od::Identity& id = parts_->desc.identity;
@@ -205,8 +205,7 @@ void Device::state_changed(od::AlState from, od::AlState to) {
 
 void Device::state_refused(od::AlState current, uint8_t requested, uint16_t code) {
     event(slave::LogLevel::Warn, std::string("refused AL state request ") + state_text(current) + " -> " +
-                                         requested_text(requested) + ": AL status code " +
-                                         al_code_text(code));
+                                     requested_text(requested) + ": AL status code " + al_code_text(code));
 }
 
 void Device::local_error(od::AlState state, uint16_t code) {
@@ -269,7 +268,8 @@ void Device::build() {
               << p->load.error << "); running with the defaults\n";
     Parts* raw = p.get();
     od::attach_store(p->dict, *p->params, [raw] {
-        // Seed 001 §7.2.21: restoring defaults only with the axis in "Power Disable" (not switched on).
+        // MAXPOS firmware specification §7.2.21: restoring defaults only with the axis in "Power Disable"
+        // (not switched on).
         const od::Entry* e = raw->dict.find(0x6041, 0);
         if (e == nullptr) return od::Status::Ok;
         return (raw->dict.get<uint16_t>(0x6041, 0) & 0x0002) != 0 ? od::Status::WrongState : od::Status::Ok;
@@ -297,12 +297,12 @@ void Device::build() {
     p->firmware->server().set_event_sink(this);
     // A master's 0x1010 "save" / 0x1011 "load" that the store carried out (listeners run after the write).
     p->dict.add_listener(0x1010, [this, raw](const od::Entry& e) {
-        event(slave::LogLevel::Info, "stored parameters saved (0x1010:" + std::to_string(e.subindex) +
-                                             " " + e.name + ") to " + raw->params->file().string());
+        event(slave::LogLevel::Info, "stored parameters saved (0x1010:" + std::to_string(e.subindex) + " " +
+                                         e.name + ") to " + raw->params->file().string());
     });
     p->dict.add_listener(0x1011, [this](const od::Entry& e) {
         event(slave::LogLevel::Info, "stored parameters restored to defaults at the next start (0x1011:" +
-                                             std::to_string(e.subindex) + " " + e.name + ")");
+                                         std::to_string(e.subindex) + " " + e.name + ")");
     });
     p->drive = std::make_unique<drive::Drive>(p->dict, this);
     p->drive->axis().faults = options_.faults.axis;
@@ -357,9 +357,8 @@ void Device::poll(uint64_t now_ns) {
             const od::Identity& id = parts_->desc.identity;
             char rev[16];
             std::snprintf(rev, sizeof rev, "0x%08X", static_cast<unsigned>(id.revision));
-            event(slave::LogLevel::Info,
-                  std::string("firmware restarted (Bootstrap -> Init): revision ") + rev +
-                      ", software version " + id.software_version);
+            event(slave::LogLevel::Info, std::string("firmware restarted (Bootstrap -> Init): revision ") +
+                                             rev + ", software version " + id.software_version);
         } catch (const std::exception& e) {
             log() << "softdrive: restart failed, the running firmware stays: " << e.what() << '\n';
             event(slave::LogLevel::Error, std::string("firmware restart failed: ") + e.what());
@@ -444,7 +443,7 @@ void Device::raise(uint16_t error_code, uint8_t error_register, const std::array
     if (options_.events != nullptr && options_.events->enabled(slave::LogLevel::Error)) {
         const drive::ErrorInfo* info = drive::find_error(error_code);
         event(slave::LogLevel::Error, "drive fault " + hex16(error_code) + ": " +
-                                              (info != nullptr ? std::string(info->name) : "unknown error"));
+                                          (info != nullptr ? std::string(info->name) : "unknown error"));
     }
     ++stats_.emergencies;
     ++stats_.diagnoses;
@@ -460,8 +459,8 @@ void Device::clear(uint16_t error_code, uint8_t error_register) {
 
 void Device::diag(drive::Severity severity, uint16_t code, std::string_view text) {
     const slave::LogLevel level = severity == drive::Severity::Error     ? slave::LogLevel::Error
-                                      : severity == drive::Severity::Warning ? slave::LogLevel::Warn
-                                                                             : slave::LogLevel::Debug;
+                                  : severity == drive::Severity::Warning ? slave::LogLevel::Warn
+                                                                         : slave::LogLevel::Debug;
     if (options_.events != nullptr && options_.events->enabled(level)) {
         // Appended piece by piece: GCC 12's -O3 reports a false -Werror=restrict on "literal" +
         // std::string&&.

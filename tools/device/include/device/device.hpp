@@ -22,6 +22,7 @@
 
 #include "coe/diagnosis.hpp"
 #include "coe/sdo_server.hpp"
+#include "device/eeprom_writes.hpp"
 #include "drive/drive.hpp"
 #include "drive/event_sink.hpp"
 #include "ecat/application.hpp"
@@ -33,7 +34,6 @@
 #include "od/device.hpp"
 #include "od/dictionary.hpp"
 #include "od/store.hpp"
-#include "device/eeprom_writes.hpp"
 #include "slave/log.hpp"
 
 namespace device {

@@ -42,7 +42,7 @@ constexpr uint16_t Sm0 = 0x0800;
 constexpr uint16_t DcSystemTime = 0x0910;
 }  // namespace reg
 
-// SII word addresses of the fixed header (ethercat-protocol.md §7.1).
+// SII word addresses of the fixed header (ETG.2010).
 namespace sii {
 constexpr uint16_t VendorId = 0x0008;
 constexpr uint16_t ProductCode = 0x000A;
@@ -84,7 +84,7 @@ struct AlStatus {
 std::string_view to_string(AlState s);
 // "INIT", "PREOP", ... or "0x0?" for a state code that is not one of the five.
 std::string_view al_state_name(uint8_t state);
-// Name of an AL status code (ethercat-protocol.md §6.3), "unknown" if not in the table.
+// Name of an AL status code (ETG.1000.6 AL status codes), "unknown" if not in the table.
 std::string_view al_status_code_name(uint16_t code);
 
 struct MasterOptions {
@@ -178,9 +178,9 @@ class Master {
     // is acknowledged (AL control = actual state | 0x10) and Error::AlRefused is returned; `final`
     // then holds the refused status with its AL status code.
     Error request_state(Address a, AlState state, AlStatus* final = nullptr);
-    // Device identification (§6.2): AL control bit 5 set with the current state; once AL status bit 5
-    // says the value is loaded, 0x0134 holds it (the station alias or ID selector). The request bit is
-    // cleared again afterwards. Error::AlRefused if an error indication is pending.
+    // Device identification (ETG.1000.6 AL control): AL control bit 5 set with the current state; once AL
+    // status bit 5 says the value is loaded, 0x0134 holds it (the station alias or ID selector). The request
+    // bit is cleared again afterwards. Error::AlRefused if an error indication is pending.
     Result<uint16_t> identify(Address a);
     // Same on every slave at once (BWR 0x0120), then each of the given station addresses is polled.
     Error request_state_all(AlState state, std::span<const uint16_t> stations);
