@@ -1,47 +1,46 @@
 #pragma once
-// ESI (IEC 61131-3 style) names of the CoE data types, shared by the ESI writer and the SII decoder.
+// ESI (IEC 61131-3 style) names of the CoE data types, shared by the ESI writer and the SII decoder;
+// by CoE data type code (ETG.1000.6 Table 64, the values of od::DataType) so the od-free decoder can use it.
 #include <cstdint>
-
-#include "od/types.hpp"
 
 namespace esi::detail {
 
 // nullptr for codes without a scalar ESI name (strings get "STRING(n)" etc. from the caller).
 inline const char* base_type_name(uint16_t code) {
-    switch (static_cast<od::DataType>(code)) {
-        case od::DataType::Boolean:
+    switch (code) {
+        case 0x0001:  // Boolean
             return "BOOL";
-        case od::DataType::Integer8:
+        case 0x0002:  // Integer8
             return "SINT";
-        case od::DataType::Integer16:
+        case 0x0003:  // Integer16
             return "INT";
-        case od::DataType::Integer32:
+        case 0x0004:  // Integer32
             return "DINT";
-        case od::DataType::Unsigned8:
+        case 0x0005:  // Unsigned8
             return "USINT";
-        case od::DataType::Unsigned16:
+        case 0x0006:  // Unsigned16
             return "UINT";
-        case od::DataType::Unsigned32:
+        case 0x0007:  // Unsigned32
             return "UDINT";
-        case od::DataType::Real32:
+        case 0x0008:  // Real32
             return "REAL";
-        case od::DataType::Real64:
+        case 0x0011:  // Real64
             return "LREAL";
-        case od::DataType::Integer64:
+        case 0x0015:  // Integer64
             return "LINT";
-        case od::DataType::Unsigned64:
+        case 0x001B:  // Unsigned64
             return "ULINT";
-        case od::DataType::VisibleString:
+        case 0x0009:  // VisibleString
             return "STRING";
-        case od::DataType::OctetString:
+        case 0x000A:  // OctetString
             return "OCTET_STRING";
-        case od::DataType::UnicodeString:
+        case 0x000B:  // UnicodeString
             return "UNICODE_STRING";
-        case od::DataType::PdoMapping:
+        case 0x0021:  // PdoMapping
             return "PDO_MAPPING";
-        case od::DataType::Identity:
+        case 0x0023:  // Identity
             return "IDENTITY";
-        case od::DataType::SyncManagerParameter:
+        case 0x0029:  // SyncManagerParameter
             return "SYNC_PAR";
     }
     return nullptr;

@@ -181,9 +181,4 @@ std::string firmware_file_name(std::string_view device_name, uint32_t product_co
     return std::string(device_name) + b;
 }
 
-void apply_version(od::Identity& identity, uint32_t version) {
-    identity.revision = version;
-    identity.software_version = software_version_text(version);
-}
-
 }  // namespace foe

@@ -10,13 +10,15 @@
 #include <filesystem>
 #include <memory>
 
+#include "support/alloc_counter.hpp"
+#include "device/device.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
-#include "softdrive/device.hpp"
+
 #include "support/alloc_counter.hpp"
 
 namespace {
@@ -24,7 +26,7 @@ namespace {
 // A link that hands each frame to the ESC and runs the Device, with fixed buffers (allocates nothing).
 class FixedLink final : public esc::Link {
   public:
-    FixedLink(esc::ManualClock& clock, esc::Esc& esc, softdrive::Device& dev)
+    FixedLink(esc::ManualClock& clock, esc::Esc& esc, device::Device& dev)
         : clock_(clock), esc_(esc), dev_(dev) {}
     int fd() const override { return -1; }
     std::size_t receive(std::span<uint8_t> buf) override {
@@ -49,7 +51,7 @@ class FixedLink final : public esc::Link {
   private:
     esc::ManualClock& clock_;
     esc::Esc& esc_;
-    softdrive::Device& dev_;
+    device::Device& dev_;
     std::array<uint8_t, 1600> frame_{};
     std::size_t len_ = 0;
 };
@@ -62,9 +64,9 @@ TEST(DeviceAllocation, ProcessDataCyclesInOpAllocateNothing) {
     esc::ManualClock clock;
     clock.set(1'000'000'000);
     esc::Esc esc(esc::EscConfig{}, clock);
-    softdrive::DeviceOptions options;
+    device::DeviceOptions options;
     options.state_dir = dir;
-    auto dev = std::make_unique<softdrive::Device>(esc, options);
+    auto dev = std::make_unique<device::Device>(esc, options);
     FixedLink link(clock, esc, *dev);
     master::MasterOptions mo;
     mo.timeout = std::chrono::milliseconds(5);

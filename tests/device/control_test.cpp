@@ -10,10 +10,10 @@
 #include <filesystem>
 #include <memory>
 
+#include "device/control.hpp"
+#include "device/device.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
-#include "softdrive/control.hpp"
-#include "softdrive/device.hpp"
 
 namespace {
 
@@ -21,15 +21,15 @@ struct Rig {
     std::filesystem::path dir;
     esc::ManualClock clock;
     std::unique_ptr<esc::Esc> esc;
-    std::unique_ptr<softdrive::Device> dev;
+    std::unique_ptr<device::Device> dev;
     Rig() {
         char pattern[] = "/tmp/softdrive-ctl-XXXXXX";
         dir = ::mkdtemp(pattern);
         clock.set(1'000'000'000);
         esc = std::make_unique<esc::Esc>(esc::EscConfig{}, clock);
-        softdrive::DeviceOptions o;
+        device::DeviceOptions o;
         o.state_dir = dir;
-        dev = std::make_unique<softdrive::Device>(*esc, o);
+        dev = std::make_unique<device::Device>(*esc, o);
         dev->poll(clock.now_ns());
     }
     ~Rig() {
@@ -46,7 +46,7 @@ struct Rig {
     }
 };
 
-using softdrive::ControlSocket;
+using device::ControlSocket;
 
 }  // namespace
 

@@ -1,4 +1,4 @@
-// The composed soft drive (softdrive::Device) against the master library, in process: each frame the master
+// The composed soft drive (device::Device) against the master library, in process: each frame the master
 // sends goes through esc::Esc::process_frame(), then the ESC's time-driven parts and the Device run, as the
 // slave runtime does. The ESC and the Device run on a manual clock that moves on with every frame.
 #include <gtest/gtest.h>
@@ -14,6 +14,9 @@
 #include <string>
 #include <vector>
 
+#include "device/device.hpp"
+#include "device/eeprom_writes.hpp"
+#include "device/firmware.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
 #include "esi/sii.hpp"
@@ -23,10 +26,7 @@
 #include "master/master.hpp"
 #include "master/session.hpp"
 #include "od/drive_profile.hpp"
-#include "softdrive/device.hpp"
-#include "softdrive/eeprom_writes.hpp"
-#include "softdrive/firmware.hpp"
-#include "softslave/log.hpp"
+#include "slave/log.hpp"
 
 #include "support/wire_link.hpp"
 
@@ -45,10 +45,10 @@ std::filesystem::path temp_dir() {
 // One soft drive "powered" on a manual clock.
 struct Drive {
     esc::ManualClock clock;
-    softdrive::DeviceOptions options;
+    device::DeviceOptions options;
     std::ostringstream log;
     std::unique_ptr<esc::Esc> esc;
-    std::unique_ptr<softdrive::Device> dev;
+    std::unique_ptr<device::Device> dev;
     uint64_t frame_ns = 20'000;  // slave time that passes with each frame
 
     explicit Drive(const std::filesystem::path& state_dir) {
@@ -61,7 +61,7 @@ struct Drive {
     void power_on() {
         dev.reset();
         esc = std::make_unique<esc::Esc>(esc::EscConfig{}, clock);
-        dev = std::make_unique<softdrive::Device>(*esc, options);
+        dev = std::make_unique<device::Device>(*esc, options);
         service();
     }
     void service() {
@@ -225,7 +225,7 @@ TEST_F(DeviceAssembly, IdentityInTheSiiEqualsObject1018AndTheEsi) {
     EXPECT_EQ(sdo_u32(0x1018, 3), id.revision);
 
     // The ESI of the same configuration names the same device.
-    const std::string esi = softdrive::make_esi(drive.options);
+    const std::string esi = device::make_esi(drive.options);
     auto hex = [](uint32_t v) {
         char b[16];
         std::snprintf(b, sizeof b, "#x%08x", v);
@@ -239,7 +239,7 @@ TEST_F(DeviceAssembly, IdentityInTheSiiEqualsObject1018AndTheEsi) {
     // And the image the slave serves is the one make_sii() writes.
     const auto served = m.sii_read_image(a);
     ASSERT_TRUE(served.ok());
-    const auto built = softdrive::make_sii(drive.options);
+    const auto built = device::make_sii(drive.options);
     ASSERT_LE(served->size(), built.size());
     EXPECT_TRUE(std::equal(served->begin(), served->end(), built.begin()));
 
@@ -293,7 +293,8 @@ TEST_F(DeviceAssembly, WatchdogFallsBackToSafeOpAndTheDriveReactsWith6007) {
     EXPECT_EQ(st->state, 0x04);
     EXPECT_TRUE(st->error);
     EXPECT_EQ(st->code, 0x001B);
-    // 0x6007 = 3 (seed default): quick-stop ramp, then Fault with 0x8180; the drive kept running on its own.
+    // 0x6007 = 3 (MAXPOS firmware specification default): quick-stop ramp, then Fault with 0x8180; the drive
+    // kept running on its own.
     EXPECT_EQ(drive.dict().get<int16_t>(0x6007, 0), 3);
     EXPECT_EQ(drive.dict().get<uint16_t>(0x603F, 0), 0x8180);
     const uint16_t sw = drive.dict().get<uint16_t>(0x6041, 0);
@@ -429,7 +430,7 @@ TEST_F(DeviceAssembly, DriveRunsOnItsOwnOutsideOp) {
 TEST(DeviceEnvironment, InputsAndSwitchesReachTheDriveAndSurviveARestart) {
     const auto dir = temp_dir();
     Drive d(dir);
-    softdrive::EnvironmentOptions env;
+    device::EnvironmentOptions env;
     env.negative_limit = -1000;
     env.positive_limit = -5;  // the axis (at 0) stands on the positive limit switch
     d.dev->set_environment(env);
@@ -474,10 +475,10 @@ TEST_F(DeviceAssembly, EepromWordsAMasterWritesSurviveARestartAndAPowerCycle) {
     EXPECT_EQ(drive.dev->eeprom_writes().size(), 2u);
     // Saved once the writes have settled.
     drive.idle(300'000'000);
-    EXPECT_TRUE(std::filesystem::exists(dir / softdrive::EepromWrites::kFileName));
+    EXPECT_TRUE(std::filesystem::exists(dir / device::EepromWrites::kFileName));
 
     // The served image, --write-sii and a power cycle all keep the words; the alias register loads from it.
-    EXPECT_EQ(softdrive::make_sii(drive.options)[8], 0x42);
+    EXPECT_EQ(device::make_sii(drive.options)[8], 0x42);
     drive.power_on();
     EXPECT_EQ(esi::parse_sii(drive.esc->eeprom()).station_alias, 0x0042);
     EXPECT_TRUE(esi::parse_sii(drive.esc->eeprom()).crc_ok);
@@ -487,7 +488,7 @@ TEST_F(DeviceAssembly, EepromWordsAMasterWritesSurviveARestartAndAPowerCycle) {
 
     // A damaged file is reported and the SII is served as built.
     {
-        std::fstream f(dir / softdrive::EepromWrites::kFileName,
+        std::fstream f(dir / device::EepromWrites::kFileName,
                        std::ios::in | std::ios::out | std::ios::binary);
         f.seekp(12);
         f.put('\x55');
@@ -570,11 +571,11 @@ TEST_F(DeviceAssembly, LeavingOpOnRequestReactsOnlyWhileTheDriveIsEnabled) {
     EXPECT_EQ(drive.dict().get<uint16_t>(0x6041, 0) & 0x004F, 0x0008);
 }
 
-// ---- What the device tells (softdrive::DeviceOptions::events) -------------------------------------------
+// ---- What the device tells (device::DeviceOptions::events) -------------------------------------------
 
 TEST_F(DeviceAssembly, StateChangesRefusalsSavesFaultsAndRestartsAreLoggedAndStatisticsSpanRestarts) {
     std::ostringstream lines;
-    softslave::Log log(lines, softslave::LogLevel::Info);
+    slave::Log log(lines, slave::LogLevel::Info);
     drive.options.events = &log;
     drive.power_on();
     ASSERT_NO_FATAL_FAILURE(to_preop());
@@ -611,24 +612,24 @@ TEST_F(DeviceAssembly, StateChangesRefusalsSavesFaultsAndRestartsAreLoggedAndSta
     EXPECT_GE(drive.dev->stack_stats().refused, 1u);                    // the refused P->O of the old one
 
     // --quiet: nothing but errors.
-    log.set_level(softslave::LogLevel::Error);
+    log.set_level(slave::LogLevel::Error);
     const std::size_t size = lines.str().size();
     ASSERT_EQ(m.request_state(a, AlState::Init, &st), Error::Ok);
     EXPECT_EQ(lines.str().size(), size) << lines.str();
 }
 
 TEST_F(DeviceAssembly, MasterWrittenSiiWordsAreAnnouncedWithTheWayBack) {
-    softdrive::EepromWrites writes(dir);
+    device::EepromWrites writes(dir);
     writes.record(4, 0x0042);  // station alias
     writes.record(8, 0x0002);  // vendor id, low word
     ASSERT_EQ(writes.save(), "");
     std::ostringstream lines;
-    softslave::Log log(lines, softslave::LogLevel::Warn);
+    slave::Log log(lines, slave::LogLevel::Warn);
     drive.options.events = &log;
     drive.power_on();
     const std::string out = lines.str();
     EXPECT_NE(out.find("2 word(s) a master wrote into the EEPROM, kept in " +
-                       (dir / softdrive::EepromWrites::kFileName).string()),
+                       (dir / device::EepromWrites::kFileName).string()),
               std::string::npos)
         << out;
     EXPECT_NE(out.find("--reset-sii"), std::string::npos) << out;
@@ -639,12 +640,12 @@ TEST_F(DeviceAssembly, MasterWrittenSiiWordsAreAnnouncedWithTheWayBack) {
 
 TEST(SiiDrift, ChecksumAndIdentityAgainst1018) {
     const auto dir = temp_dir();
-    softdrive::DeviceOptions o;
+    device::DeviceOptions o;
     o.state_dir = dir;
-    std::vector<uint8_t> sii = softdrive::make_sii(o);
-    const od::Identity id = softdrive::make_description(o).identity;
+    std::vector<uint8_t> sii = device::make_sii(o);
+    const od::Identity id = device::make_description(o).identity;
     auto drift = [&](const std::vector<uint8_t>& image) {
-        return softdrive::sii_drift(image, id.vendor_id, id.product_code, id.revision, id.serial_number);
+        return device::sii_drift(image, id.vendor_id, id.product_code, id.revision, id.serial_number);
     };
     EXPECT_TRUE(drift(sii).empty());
     auto other = sii;

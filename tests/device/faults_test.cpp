@@ -1,4 +1,4 @@
-// The fault registry of `ecat-slave --fault` (softdrive/faults.hpp): names, parsing, one flag per fault, and
+// The fault registry of `ecat-slave --fault` (device/faults.hpp): names, parsing, one flag per fault, and
 // faults of every layer reaching the composed drive, seen from the master library in process.
 #include <gtest/gtest.h>
 
@@ -11,17 +11,17 @@
 #include <sstream>
 #include <type_traits>
 
+#include "device/device.hpp"
+#include "device/faults.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
-#include "softdrive/device.hpp"
-#include "softdrive/faults.hpp"
 
 #include "support/wire_link.hpp"
 
-using namespace softdrive;
+using namespace device;
 
 namespace {
 

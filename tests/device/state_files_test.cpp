@@ -14,12 +14,12 @@
 #include <string_view>
 #include <vector>
 
+#include "device/device.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
 #include "foe/image.hpp"
 #include "od/drive_profile.hpp"
 #include "od/store.hpp"
-#include "softdrive/device.hpp"
 
 namespace fs = std::filesystem;
 
@@ -79,7 +79,7 @@ TEST(DeviceStateFiles, CraftedFilesAreReportedAndTheDefaultsRun) {
     const od::DeviceDescription desc = od::default_drive_description();
     write_file(d.path / "parameters.bin", parameters_with_count(desc.identity, 0xFFFFFFFFu));
     ASSERT_EQ(fs::file_size(d.path / "parameters.bin"), 40u);
-    write_file(d.path / softdrive::EepromWrites::kFileName, sii_writes_with_count(0xFFFFFFFFu));
+    write_file(d.path / device::EepromWrites::kFileName, sii_writes_with_count(0xFFFFFFFFu));
     fs::create_directories(d.path / "firmware");
     {
         foe::ImageHeader h;
@@ -99,16 +99,16 @@ TEST(DeviceStateFiles, CraftedFilesAreReportedAndTheDefaultsRun) {
     clock.set(1'000'000'000);
     esc::Esc esc(esc::EscConfig{}, clock);
     std::ostringstream log;
-    softdrive::DeviceOptions options;
+    device::DeviceOptions options;
     options.state_dir = d.path;
     options.log = &log;
-    std::unique_ptr<softdrive::Device> dev;
-    ASSERT_NO_THROW(dev = std::make_unique<softdrive::Device>(esc, options)) << log.str();
+    std::unique_ptr<device::Device> dev;
+    ASSERT_NO_THROW(dev = std::make_unique<device::Device>(esc, options)) << log.str();
     // Reported ...
     EXPECT_TRUE(dev->parameter_load().found);
     EXPECT_FALSE(dev->parameter_load().applied);
     EXPECT_NE(log.str().find("stored parameters"), std::string::npos) << log.str();
-    EXPECT_NE(log.str().find(softdrive::EepromWrites::kFileName), std::string::npos) << log.str();
+    EXPECT_NE(log.str().find(device::EepromWrites::kFileName), std::string::npos) << log.str();
     // ... and the defaults run: the dictionary's stored parameters, the built-in firmware, the SII as built.
     const od::Dictionary defaults = od::make_drive_dictionary(desc);
     EXPECT_EQ(dev->dictionary().get<uint32_t>(0x6065, 0), defaults.get<uint32_t>(0x6065, 0));
@@ -120,14 +120,14 @@ TEST(DeviceStateFiles, CraftedFilesAreReportedAndTheDefaultsRun) {
 
 TEST(DeviceStateFiles, OversizedSiiWritesFileIsNotRead) {
     StateDir d;
-    write_file(d.path / softdrive::EepromWrites::kFileName, sii_writes_with_count(2));
-    fs::resize_file(d.path / softdrive::EepromWrites::kFileName, uint64_t{1} << 32);  // sparse 4 GiB
-    softdrive::EepromWrites w(d.path);
+    write_file(d.path / device::EepromWrites::kFileName, sii_writes_with_count(2));
+    fs::resize_file(d.path / device::EepromWrites::kFileName, uint64_t{1} << 32);  // sparse 4 GiB
+    device::EepromWrites w(d.path);
     const std::string error = w.load();
     EXPECT_NE(error.find("larger than"), std::string::npos) << error;
     EXPECT_TRUE(w.empty());
-    fs::remove(d.path / softdrive::EepromWrites::kFileName);
-    ASSERT_EQ(::mkfifo((d.path / softdrive::EepromWrites::kFileName).c_str(), 0600), 0);
+    fs::remove(d.path / device::EepromWrites::kFileName);
+    ASSERT_EQ(::mkfifo((d.path / device::EepromWrites::kFileName).c_str(), 0600), 0);
     EXPECT_FALSE(w.load().empty());  // refused without waiting for a writer
     EXPECT_TRUE(w.empty());
 }
@@ -166,10 +166,10 @@ TEST(DeviceStateFiles, StaleTemporariesAreRemovedAtTheStart) {
     clock.set(1'000'000'000);
     esc::Esc esc(esc::EscConfig{}, clock);
     std::ostringstream log;
-    softdrive::DeviceOptions options;
+    device::DeviceOptions options;
     options.state_dir = d.path;
     options.log = &log;
-    softdrive::Device dev(esc, options);
+    device::Device dev(esc, options);
     for (const auto& p : stale)
         EXPECT_FALSE(fs::exists(p)) << p;
     EXPECT_NE(log.str().find("parameters.bin.tmp left by an interrupted save"), std::string::npos)

@@ -39,10 +39,10 @@ TEST_P(EsiReadBack, IdentityAndObjectsMatchTheModel) {
 }
 
 TEST_P(EsiReadBack, SyncManagersCarryTheirSizes) {
-    ASSERT_EQ(esi.sync_managers.size(), model.sync_managers.size());
+    ASSERT_EQ(esi.sms.size(), model.sync_managers.size());
     for (std::size_t i = 0; i < model.sync_managers.size(); ++i) {
         const esi::SmInfo& m = model.sync_managers[i];
-        const esi::EsiSm& s = esi.sync_managers[i];
+        const esi::EsiSm& s = esi.sms[i];
         EXPECT_EQ(s.start, m.start);
         EXPECT_EQ(s.control, m.control);
         if (m.size != 0) {
@@ -58,7 +58,7 @@ TEST_P(EsiReadBack, SyncManagersCarryTheirSizes) {
 }
 
 TEST_P(EsiReadBack, PdosCarryAssignmentFixedMandatoryExcludeAndEntries) {
-    ASSERT_EQ(esi.pdos.size(), model.pdos.size());
+    ASSERT_EQ(esi.rxpdos.size() + esi.txpdos.size(), model.pdos.size());
     for (const esi::PdoInfo& m : model.pdos) {
         const esi::EsiPdo* p = esi.pdo(m.index);
         ASSERT_NE(p, nullptr) << std::hex << m.index;
@@ -70,7 +70,7 @@ TEST_P(EsiReadBack, PdosCarryAssignmentFixedMandatoryExcludeAndEntries) {
         ASSERT_EQ(p->entries.size(), m.entries.size());
         for (std::size_t i = 0; i < m.entries.size(); ++i) {
             EXPECT_EQ(p->entries[i].index, m.entries[i].index);
-            EXPECT_EQ(p->entries[i].bit_length, m.entries[i].bit_length);
+            EXPECT_EQ(p->entries[i].bit_len, m.entries[i].bit_length);
             if (m.entries[i].index != 0) {
                 EXPECT_EQ(p->entries[i].subindex, m.entries[i].subindex);
             }
@@ -79,9 +79,9 @@ TEST_P(EsiReadBack, PdosCarryAssignmentFixedMandatoryExcludeAndEntries) {
 }
 
 TEST_P(EsiReadBack, CoeFlagsSayWhatTheSlaveServes) {
-    EXPECT_TRUE(esi.coe.at("SegmentedSdo"));
-    EXPECT_EQ(esi.coe.count("DiagHistory") != 0, dev.dictionary.find(0x10F3) != nullptr);
-    EXPECT_EQ(esi.coe.at("CompleteAccess"),
+    EXPECT_TRUE(esi.coe_attributes.at("SegmentedSdo"));
+    EXPECT_EQ(esi.coe_attributes.count("DiagHistory") != 0, dev.dictionary.find(0x10F3) != nullptr);
+    EXPECT_EQ(esi.coe_attributes.at("CompleteAccess"),
               (dev.description.coe_details & od::coe_details::CompleteAccess) != 0);
 }
 
@@ -134,24 +134,24 @@ TEST(EsiReadBackDrive, DiagMessagesCoverEveryTextIdWithTheWholeText) {
         EXPECT_EQ(od::diag_text_id(t.text), t.id);
         EXPECT_EQ(od::diag_text(t.id), t.text);
     }
-    EXPECT_TRUE(esi.coe.at("DiagHistory"));
+    EXPECT_TRUE(esi.coe_attributes.at("DiagHistory"));
     EXPECT_EQ(esi.mailbox_request_timeout_ms, dev.description.mailbox_request_timeout_ms);
     EXPECT_EQ(esi.mailbox_response_timeout_ms, dev.description.mailbox_response_timeout_ms);
     EXPECT_GT(*esi.mailbox_response_timeout_ms, 0u);
     // The mailbox SyncManagers take exactly the mailbox size, the process-data ones up to 160 bytes.
-    EXPECT_EQ(esi.sync_managers[0].min_size, dev.description.standard_mailbox.out_size);
-    EXPECT_EQ(esi.sync_managers[0].max_size, dev.description.standard_mailbox.out_size);
-    EXPECT_EQ(esi.sync_managers[2].max_size, 160u);
+    EXPECT_EQ(esi.sms[0].min_size, dev.description.standard_mailbox.out_size);
+    EXPECT_EQ(esi.sms[0].max_size, dev.description.standard_mailbox.out_size);
+    EXPECT_EQ(esi.sms[2].max_size, 160u);
 }
 
 TEST(EsiReader, RefusesWhatIsNotAnEsi) {
     EXPECT_THROW(esi::read_esi("not xml"), std::runtime_error);
     EXPECT_THROW(esi::read_esi("<Other/>"), std::runtime_error);
     EXPECT_THROW(esi::read_esi("<EtherCATInfo/>"), std::runtime_error);
-    EXPECT_EQ(esi::parse_hex_dec("#x1A00"), 0x1A00u);
-    EXPECT_EQ(esi::parse_hex_dec("42"), 42u);
-    EXPECT_FALSE(esi::parse_hex_dec("#x"));
-    EXPECT_FALSE(esi::parse_hex_dec("4a"));
+    EXPECT_EQ(esi::parse_esi_number("#x1A00"), 0x1A00);
+    EXPECT_EQ(esi::parse_esi_number("42"), 42);
+    EXPECT_FALSE(esi::parse_esi_number("#x"));
+    EXPECT_FALSE(esi::parse_esi_number("4a"));
 }
 
 }  // namespace

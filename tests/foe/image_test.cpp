@@ -4,6 +4,7 @@
 
 #include "foe/image.hpp"
 #include "foe_test_support.hpp"
+#include "od/device.hpp"  // od::Identity (foe/image.hpp is od-free)
 
 using namespace foe;
 using foe_test::kMaxpos;

@@ -2,7 +2,7 @@
 // the real code. The first byte picks the loader and whether the harness repairs lengths and CRCs first
 // (so that mutations get past the checksums to the parsing behind them):
 //   0  parameters.bin    od::ParameterStore::load on the drive's dictionary (od/src/store.cpp)
-//   1  sii-writes.bin    softdrive::EepromWrites::load, then apply onto the SII (tools/device)
+//   1  sii-writes.bin    device::EepromWrites::load, then apply onto the SII (tools/device)
 //   2  firmware/         foe::FirmwareStore::open: the slot pointer "active" and both slot images, input =
 //                        three records (16-bit length + bytes): pointer, slot0.bin, slot1.bin
 //   3  device config     od::load_device_config of the file (tools/ecat-slave --config)
@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "device/eeprom_writes.hpp"
 #include "esi/sii.hpp"
 #include "foe/store.hpp"
 #include "fuzz_support.hpp"
@@ -22,7 +23,6 @@
 #include "od/device_config.hpp"
 #include "od/drive_profile.hpp"
 #include "od/store.hpp"
-#include "softdrive/eeprom_writes.hpp"
 
 namespace fuzz::loaders {
 namespace {
@@ -92,7 +92,7 @@ void eeprom_writes(std::vector<uint8_t> b, bool repair) {
         put32(b, b.size() - 4, od::crc32(std::span<const uint8_t>(b).first(b.size() - 4)));
     }
     write_file(state_dir() / "sii-writes.bin", b);
-    softdrive::EepromWrites w(state_dir());
+    device::EepromWrites w(state_dir());
     const std::string error = w.load();
     FUZZ_CHECK(error.empty() || w.empty());
     static const std::vector<uint8_t> sii = esi::build_sii(description(), dictionary());

@@ -46,7 +46,7 @@ const Prototype& prototype() {
     return p;
 }
 
-// The firmware around the drive: runs a drive cycle for each stack cycle, as softdrive::Device does.
+// The firmware around the drive: runs a drive cycle for each stack cycle, as device::Device does.
 class DriveApp final : public ecat::Application, public drive::EventSink {
   public:
     void attach(drive::Drive* d, coe::EventReporter* e) {

@@ -12,7 +12,7 @@
 #include "esc/esc.hpp"
 #include "esc/link_capture.hpp"
 #include "esc/link_loopback.hpp"
-#include "softslave/runtime.hpp"
+#include "slave/runtime.hpp"
 #include "support/alloc_counter.hpp"
 
 namespace {
@@ -49,10 +49,10 @@ struct LoopbackSlave {
     std::pair<std::unique_ptr<esc::LoopbackLink>, std::unique_ptr<esc::LoopbackLink>> links;
     esc::SystemClock clock;
     esc::Esc esc;
-    softslave::Runtime runtime;
+    slave::Runtime runtime;
 };
 
-struct NullFirmware : softslave::Firmware {
+struct NullFirmware : slave::Firmware {
     void poll(uint64_t) override { ++polls; }
     int polls = 0;
 };
@@ -97,7 +97,7 @@ TEST(RuntimeAllocation, HandlingFramesAllocatesNothing) {
 }
 
 // The other ways of waiting (--spin-us, --busy-poll) allocate nothing either, frames and deadlines alike.
-struct TickingFirmware : softslave::Firmware {
+struct TickingFirmware : slave::Firmware {
     void poll(uint64_t now) override {
         ++polls;
         next = now + 200'000;  // a cycle every 200 us

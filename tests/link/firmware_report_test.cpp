@@ -1,4 +1,4 @@
-// softslave::Firmware::report(): the hook through which run_slave() prints the firmware's statistics at
+// slave::Firmware::report(): the hook through which run_slave() prints the firmware's statistics at
 // exit (--verbose, SlaveOptions::stats_file); FirmwareAdapter forwards it when the target has one.
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <ostream>
 #include <sstream>
 
-#include "softslave/firmware.hpp"
+#include "slave/firmware.hpp"
 
 namespace {
 
@@ -24,8 +24,8 @@ struct WithoutReport {
 
 TEST(FirmwareReport, AdapterForwardsReportOfItsTarget) {
     WithReport target;
-    softslave::FirmwareAdapter<WithReport> adapter(target);
-    const softslave::Firmware& fw = adapter;
+    slave::FirmwareAdapter<WithReport> adapter(target);
+    const slave::Firmware& fw = adapter;
     std::ostringstream out;
     fw.report(out);
     EXPECT_EQ(out.str(), "stack.cycles 42\n");
@@ -37,9 +37,9 @@ TEST(FirmwareReport, AdapterForwardsReportOfItsTarget) {
 
 TEST(FirmwareReport, TargetWithoutReportPrintsNothing) {
     WithoutReport target;
-    softslave::FirmwareAdapter<WithoutReport> adapter(target);
+    slave::FirmwareAdapter<WithoutReport> adapter(target);
     std::ostringstream out;
-    static_cast<const softslave::Firmware&>(adapter).report(out);
+    static_cast<const slave::Firmware&>(adapter).report(out);
     EXPECT_TRUE(out.str().empty());
 }
 

@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "esc/link.hpp"
-#include "softslave/netif.hpp"
+#include "slave/netif.hpp"
 
 namespace {
 
@@ -35,9 +35,9 @@ TEST(OpenLink, DefaultBackendIsOneOfTheTwo) {
 }
 
 TEST(VethPeerName, IncrementsATrailingNumberOrAppendsASuffix) {
-    EXPECT_EQ(softslave::veth_peer_name("ecat0"), "ecat1");
-    EXPECT_EQ(softslave::veth_peer_name("veth9"), "veth10");
-    EXPECT_EQ(softslave::veth_peer_name("slave"), "slave-m");
+    EXPECT_EQ(slave::veth_peer_name("ecat0"), "ecat1");
+    EXPECT_EQ(slave::veth_peer_name("veth9"), "veth10");
+    EXPECT_EQ(slave::veth_peer_name("slave"), "slave-m");
 }
 
 }  // namespace

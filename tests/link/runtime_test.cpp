@@ -17,8 +17,8 @@
 #include "esc/link_capture.hpp"
 #include "esc/link_loopback.hpp"
 #include "netns_util.hpp"
-#include "softslave/netif.hpp"
-#include "softslave/runtime.hpp"
+#include "slave/netif.hpp"
+#include "slave/runtime.hpp"
 
 namespace {
 
@@ -40,7 +40,7 @@ std::vector<uint8_t> brd_type_frame(std::size_t total = 60) {
 }
 constexpr std::size_t kWkcOffset = 16 + 10 + 1;
 
-struct RecordingFirmware : softslave::Firmware {
+struct RecordingFirmware : slave::Firmware {
     explicit RecordingFirmware(esc::LoopbackLink& master_end) : master(master_end) {}
     void poll(uint64_t now_ns) override {
         ++polls;
@@ -69,7 +69,7 @@ struct Fixture : ::testing::Test {
     esc::SystemClock clock;
     std::pair<std::unique_ptr<esc::LoopbackLink>, std::unique_ptr<esc::LoopbackLink>> links;
     esc::Esc esc;
-    softslave::Runtime runtime;
+    slave::Runtime runtime;
 };
 
 using Runtime = Fixture;
@@ -145,7 +145,7 @@ TEST_F(Runtime, TheTimerWakesTheFirmwareAtItsDeadlineWithoutFrames) {
 }
 
 TEST_F(Runtime, TheTimerMovesEarlierAtOnceButLaterOnlyAfterFiring) {
-    struct Movable : softslave::Firmware {
+    struct Movable : slave::Firmware {
         void poll(uint64_t now_ns) override { last = now_ns; }
         uint64_t next_deadline_ns() const override { return deadline; }
         uint64_t deadline = UINT64_MAX;
@@ -285,7 +285,7 @@ TEST_F(Runtime, FirmwareAdapterDrivesAnyObjectWithPollAndDeadline) {
         uint64_t deadline = 0;
     } stack;
     stack.deadline = clock.now_ns() + 5'000'000;
-    softslave::FirmwareAdapter<Stackish> adapter(stack);
+    slave::FirmwareAdapter<Stackish> adapter(stack);
     EXPECT_EQ(adapter.next_deadline_ns(), stack.deadline);
     runtime.set_firmware(&adapter);
     const uint64_t start = clock.now_ns();
@@ -308,16 +308,16 @@ TEST_F(Runtime, RequestStopEndsRunFromAnotherThread) {
 }
 
 TEST_F(Runtime, SigtermEndsRun) {
-    softslave::install_stop_signals();
-    softslave::set_signal_target(&runtime);
+    slave::install_stop_signals();
+    slave::set_signal_target(&runtime);
     std::thread killer([] {
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
         ::kill(::getpid(), SIGTERM);
     });
     runtime.run();
     killer.join();
-    softslave::set_signal_target(nullptr);
-    EXPECT_TRUE(softslave::stop_signalled());
+    slave::set_signal_target(nullptr);
+    EXPECT_TRUE(slave::stop_signalled());
 }
 
 TEST_F(Runtime, CapturedFramesReachTheFileWithinTheFlushIntervalWithoutMoreTraffic) {
@@ -381,24 +381,24 @@ TEST_P(RuntimeOnVeth, StopsWhenTheInterfaceIsRemoved) {
     std::unique_ptr<esc::Link> link;
     int ns = -1;
     linktest::in_new_netns([&] {
-        softslave::create_veth("s0", "m0");
-        softslave::set_interface_up("s0");
-        softslave::set_interface_up("m0");
+        slave::create_veth("s0", "m0");
+        slave::set_interface_up("s0");
+        slave::set_interface_up("m0");
         link = esc::open_link("s0", GetParam());
         ns = ::open("/proc/thread-self/ns/net", O_RDONLY | O_CLOEXEC);
     });
     ASSERT_GE(ns, 0);
     esc::SystemClock clock;
     esc::Esc esc(esc::EscConfig{}, clock);
-    softslave::Runtime runtime(*link, esc, clock);
+    slave::Runtime runtime(*link, esc, clock);
     bool exists = true;
     runtime.set_link_check([&] {
-        linktest::in_netns(ns, [&] { exists = softslave::interface_exists("s0"); });
+        linktest::in_netns(ns, [&] { exists = slave::interface_exists("s0"); });
         return exists;
     });
     EXPECT_TRUE(runtime.run_once(50));  // nothing happens: still running
     EXPECT_FALSE(runtime.link_lost());
-    linktest::in_netns(ns, [] { softslave::delete_interface("s0"); });
+    linktest::in_netns(ns, [] { slave::delete_interface("s0"); });
     bool running = true;
     for (int i = 0; i < 20 && running; ++i)
         running = runtime.run_once(100);

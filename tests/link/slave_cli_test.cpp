@@ -20,10 +20,10 @@
 #include <thread>
 #include <vector>
 
+#include "device/faults.hpp"
 #include "esc/link_packet.hpp"
 #include "netns_util.hpp"
-#include "softdrive/faults.hpp"
-#include "softslave/netif.hpp"
+#include "slave/netif.hpp"
 
 namespace {
 
@@ -68,7 +68,7 @@ Proc start(const std::vector<std::string>& args, bool own_netns = false, bool st
         if (own_netns && ::unshare(CLONE_NEWNET) != 0) ::_exit(125);
         if (stale_pair) {
             try {
-                softslave::create_veth("ecat0", "ecat1");
+                slave::create_veth("ecat0", "ecat1");
             } catch (...) {
                 ::_exit(124);
             }
@@ -156,14 +156,14 @@ TEST(EcatSlaveCli, FaultListPrintsEveryFaultWithItsDescriptionAndExits0) {
     std::size_t lines = 0;
     for (char c : r.output)
         lines += c == '\n';
-    EXPECT_EQ(lines, softdrive::kFaultCount) << r.output;
-    for (const softdrive::FaultInfo& f : softdrive::fault_catalogue()) {
+    EXPECT_EQ(lines, device::kFaultCount) << r.output;
+    for (const device::FaultInfo& f : device::fault_catalogue()) {
         const std::size_t at = r.output.find(std::string(f.name) + " ");
         ASSERT_NE(at, std::string::npos) << f.name << "\n" << r.output;
         const std::size_t eol = r.output.find('\n', at);
         EXPECT_NE(r.output.substr(at, eol - at).find(f.description), std::string::npos) << f.name;
     }
-    EXPECT_GE(softdrive::kFaultCount, 22u);
+    EXPECT_GE(device::kFaultCount, 22u);
 }
 
 TEST(EcatSlaveCli, UnknownFaultIsAUsageError) {
@@ -189,7 +189,7 @@ TEST(EcatSlaveCli, MissingPrivilegesExitWith2AndNameTheCapability) {
     const RunResult r = run({"--veth-name", "nopriv0"}, /*unprivileged=*/true);
     EXPECT_EQ(r.code, 2) << r.output;
     EXPECT_NE(r.output.find("CAP_NET_ADMIN"), std::string::npos) << r.output;
-    EXPECT_FALSE(softslave::interface_exists("nopriv0"));
+    EXPECT_FALSE(slave::interface_exists("nopriv0"));
 }
 
 // Joins the network namespace of pid on a helper thread, runs fn there.
@@ -253,7 +253,7 @@ TEST(EcatSlaveVeth, CreatesThePairAnswersOnItAndRemovesItOnSigterm) {
     expect_brd_answer(p.pid);
 
     bool exists_before = false, exists_after = true;
-    in_netns_of(p.pid, [&] { exists_before = softslave::interface_exists("ecat0"); });
+    in_netns_of(p.pid, [&] { exists_before = slave::interface_exists("ecat0"); });
     // Keep a handle on the namespace so it outlives the slave and we can look inside afterwards.
     const int ns = ::open(("/proc/" + std::to_string(p.pid) + "/ns/net").c_str(), O_RDONLY | O_CLOEXEC);
     ASSERT_GE(ns, 0);
@@ -261,7 +261,7 @@ TEST(EcatSlaveVeth, CreatesThePairAnswersOnItAndRemovesItOnSigterm) {
     EXPECT_EQ(wait_exit(p.pid, 5000), 0);
     std::thread t([&] {
         if (::setns(ns, CLONE_NEWNET) == 0)
-            exists_after = softslave::interface_exists("ecat0") || softslave::interface_exists("ecat1");
+            exists_after = slave::interface_exists("ecat0") || slave::interface_exists("ecat1");
     });
     t.join();
     ::close(ns);

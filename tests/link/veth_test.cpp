@@ -17,7 +17,7 @@
 #include "esc/link_packet.hpp"
 #include "esc/link_pcap.hpp"
 #include "netns_util.hpp"
-#include "softslave/netif.hpp"
+#include "slave/netif.hpp"
 
 namespace {
 
@@ -62,11 +62,11 @@ struct Pair {
 Pair make_pair(const std::string& backend) {
     Pair p;
     in_new_netns([&] {
-        softslave::create_veth("s0", "m0");
-        softslave::disable_ipv6("s0");
-        softslave::disable_ipv6("m0");
-        softslave::set_interface_up("s0");
-        softslave::set_interface_up("m0");
+        slave::create_veth("s0", "m0");
+        slave::disable_ipv6("s0");
+        slave::disable_ipv6("m0");
+        slave::set_interface_up("s0");
+        slave::set_interface_up("m0");
         p.slave = esc::open_link("s0", backend);
         p.master = std::make_unique<esc::PacketLink>("m0");
     });
@@ -131,9 +131,9 @@ TEST_P(VethLink, FramesAnotherSocketSendsOutOfTheSameInterfaceAreNotReceived) {
     std::unique_ptr<esc::Link> slave, master;
     int other = -1;
     in_new_netns([&] {
-        softslave::create_veth("s0", "m0");
-        softslave::set_interface_up("s0");
-        softslave::set_interface_up("m0");
+        slave::create_veth("s0", "m0");
+        slave::set_interface_up("s0");
+        slave::set_interface_up("m0");
         slave = esc::open_link("s0", GetParam());
         master = std::make_unique<esc::PacketLink>("m0");
         other = plain_packet_socket("s0");
@@ -173,7 +173,7 @@ TEST_P(VethLink, UnicastToAnotherMacIsReceived) {
 
 TEST_P(VethLink, DownAndMissingInterfacesAreClearErrors) {
     in_new_netns([&] {
-        softslave::create_veth("s0", "m0");
+        slave::create_veth("s0", "m0");
         try {
             esc::open_link("s0", GetParam());
             ADD_FAILURE() << "opening a down interface must fail";
@@ -187,7 +187,7 @@ TEST_P(VethLink, DownAndMissingInterfacesAreClearErrors) {
         } catch (const esc::LinkError& e) {
             EXPECT_EQ(e.kind(), esc::LinkError::Kind::NoSuchInterface) << e.what();
         }
-        softslave::delete_interface("s0");
+        slave::delete_interface("s0");
     });
 }
 
@@ -206,9 +206,9 @@ class VethPairs : public ::testing::Test {
 TEST_F(VethPairs, CreatesUpPairWithoutIpv6AndRemovesItAgain) {
     in_new_netns([] {
         {
-            softslave::VethPair pair("ecat0", "ecat1");
-            EXPECT_TRUE(softslave::interface_exists("ecat0"));
-            EXPECT_TRUE(softslave::interface_exists("ecat1"));
+            slave::VethPair pair("ecat0", "ecat1");
+            EXPECT_TRUE(slave::interface_exists("ecat0"));
+            EXPECT_TRUE(slave::interface_exists("ecat1"));
             EXPECT_NO_THROW(esc::check_interface("ecat0"));  // up
             EXPECT_NO_THROW(esc::check_interface("ecat1"));
             for (const char* name : {"ecat0", "ecat1"}) {
@@ -219,44 +219,44 @@ TEST_F(VethPairs, CreatesUpPairWithoutIpv6AndRemovesItAgain) {
                 }
             }
         }
-        EXPECT_FALSE(softslave::interface_exists("ecat0"));
-        EXPECT_FALSE(softslave::interface_exists("ecat1"));
+        EXPECT_FALSE(slave::interface_exists("ecat0"));
+        EXPECT_FALSE(slave::interface_exists("ecat1"));
     });
 }
 
 TEST_F(VethPairs, RemovesAStalePairLeftByAKilledRun) {
     in_new_netns([] {
-        softslave::create_veth("ecat0", "ecat1");  // as if a previous run was killed
+        slave::create_veth("ecat0", "ecat1");  // as if a previous run was killed
         {
-            softslave::VethPair pair("ecat0", "ecat1");
-            EXPECT_TRUE(softslave::interface_exists("ecat0"));
+            slave::VethPair pair("ecat0", "ecat1");
+            EXPECT_TRUE(slave::interface_exists("ecat0"));
         }
-        EXPECT_FALSE(softslave::interface_exists("ecat0"));
-        EXPECT_FALSE(softslave::interface_exists("ecat1"));
+        EXPECT_FALSE(slave::interface_exists("ecat0"));
+        EXPECT_FALSE(slave::interface_exists("ecat1"));
     });
 }
 
 TEST_F(VethPairs, APairOwnedByARunningSlaveIsNotTakenAsStale) {
     in_new_netns([] {
-        softslave::VethPair first("ecat0", "ecat1");
+        slave::VethPair first("ecat0", "ecat1");
         try {
-            softslave::VethPair second("ecat0", "ecat1");
+            slave::VethPair second("ecat0", "ecat1");
             ADD_FAILURE() << "a second owner must be refused";
         } catch (const esc::LinkError& e) {
             EXPECT_EQ(e.kind(), esc::LinkError::Kind::BadArgument);
             EXPECT_NE(std::string(e.what()).find("in use"), std::string::npos) << e.what();
         }
-        EXPECT_TRUE(softslave::interface_exists("ecat0")) << "the first owner's pair must survive";
+        EXPECT_TRUE(slave::interface_exists("ecat0")) << "the first owner's pair must survive";
     });
 }
 
 TEST_F(VethPairs, CreatingAnExistingPairFailsClearly) {
     in_new_netns([] {
-        softslave::create_veth("x0", "x1");
-        EXPECT_THROW(softslave::create_veth("x0", "x1"), esc::LinkError);
-        softslave::delete_interface("x0");
-        EXPECT_FALSE(softslave::interface_exists("x1"));
-        EXPECT_NO_THROW(softslave::delete_interface("x0"));  // already gone: nothing to do
+        slave::create_veth("x0", "x1");
+        EXPECT_THROW(slave::create_veth("x0", "x1"), esc::LinkError);
+        slave::delete_interface("x0");
+        EXPECT_FALSE(slave::interface_exists("x1"));
+        EXPECT_NO_THROW(slave::delete_interface("x0"));  // already gone: nothing to do
     });
 }
 

@@ -1,4 +1,4 @@
-// AL state requests with the error-acknowledge handshake (ethercat-protocol.md §6).
+// AL state requests with the error-acknowledge handshake (ETG.1000.6 AL state machine).
 #include <gtest/gtest.h>
 
 #include "fake_bus.hpp"

@@ -59,7 +59,7 @@ TEST(EcatctlFormat, HexDumpSixteenPerLine) {
 }
 
 TEST(EcatctlFormat, SiiCrcCheckValue) {
-    // ethercat-protocol.md §7.1 CRC-8: poly 0x07, init 0xFF, no reflection, no final XOR. Its check
+    // ETG.2010 SII CRC-8: poly 0x07, init 0xFF, no reflection, no final XOR. Its check
     // value over "123456789" is 0xFB (the same polynomial with init 0x00, CRC-8/SMBUS, gives 0xF4).
     const uint8_t check[] = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
     EXPECT_EQ(sii_crc(check), 0xFB);

@@ -1,4 +1,4 @@
-// Frame encoding and parsing (ethercat-protocol.md §1).
+// Frame encoding and parsing (ETG.1000.4 frame and datagram layout).
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -17,7 +17,7 @@ TEST(Frame, SingleDatagramIsPaddedTo60AndLaidOutAsSpecified) {
     std::array<uint8_t, kMaxFrameSize> out{};
     const std::size_t n = encode_frame(std::span<const Datagram>(&d, 1), 0x00, kMac, out);
     ASSERT_EQ(n, 60u);
-    // §1.5 worked example: 0E 10 | 01 00 00 00 30 01 02 00 00 00 | 00 00 | 00 00
+    // Worked example (APRD of AL status at position 0): 0E 10 | 01 00 00 00 30 01 02 00 00 00 | 00 00 | 00 00
     const std::vector<uint8_t> expect = {0x0E, 0x10, 0x01, 0x00, 0x00, 0x00, 0x30, 0x01,
                                          0x02, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00};
     EXPECT_EQ(std::vector<uint8_t>(out.begin() + 14, out.begin() + 30), expect);

@@ -1,4 +1,5 @@
-// SII EEPROM access (ethercat-protocol.md §3.9): read sizes, busy, not-acknowledged, category chain, write.
+// SII EEPROM access (ESC datasheet section II, 0x0500-0x050F): read sizes, busy, not-acknowledged, category
+// chain, write.
 #include <gtest/gtest.h>
 
 #include "fake_bus.hpp"

@@ -44,7 +44,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
-#include "softslave/netif.hpp"
+#include "slave/netif.hpp"
 
 namespace {
 
@@ -688,7 +688,7 @@ int main(int argc, char** argv) {
     try {
         const bench::TempDir tmp("bench-cycle");
         const std::filesystem::path& dir = tmp.path();
-        softslave::VethPair pair(kSlaveEnd, kMasterEnd);
+        slave::VethPair pair(kSlaveEnd, kMasterEnd);
         std::vector<Result> results;
         for (unsigned c : o.cycles_us) {
             if (g_stop.load()) break;

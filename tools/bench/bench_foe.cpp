@@ -36,7 +36,7 @@
 #include "master/foe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
-#include "softslave/netif.hpp"
+#include "slave/netif.hpp"
 
 namespace {
 
@@ -360,7 +360,7 @@ int main(int argc, char** argv) {
     try {
         const bench::TempDir tmp("bench-foe");
         const std::filesystem::path& dir = tmp.path();
-        softslave::VethPair pair(kSlaveEnd, kMasterEnd);
+        slave::VethPair pair(kSlaveEnd, kMasterEnd);
         std::printf("FoE write through ecat-slave over a veth pair (%u runs each; MB = 10^6 bytes)\n",
                     o.runs);
         std::printf("%-8s %-10s %-24s %-22s %-24s %s\n", "mailbox", "image", "data phase s / MB/s (med)",

@@ -18,7 +18,7 @@
 #include "esc/link_packet.hpp"
 #include "frame.hpp"
 #include "harness.hpp"
-#include "softslave/netif.hpp"
+#include "slave/netif.hpp"
 #include "stats.hpp"
 
 namespace {
@@ -68,7 +68,7 @@ void measure(esc::Link& link, std::vector<uint8_t>& frame, std::vector<uint8_t>&
 // the slave are restarted for each block) so that both see the same load on average.
 int run_same_pair(std::size_t frames, const std::string& backend, const std::string& slave_path,
                   const std::string& echo_path, bool verbose) {
-    softslave::VethPair pair("rtt-s0", "rtt-m0");
+    slave::VethPair pair("rtt-s0", "rtt-m0");
     esc::PacketLink master("rtt-m0");
     std::vector<uint8_t> rx(esc::kMaxFrameSize);
     const uint16_t station = 0x1001;
@@ -160,8 +160,8 @@ int main(int argc, char** argv) {
     if (!bench::enter_network_namespace()) return 2;
     try {
         if (same_pair) return run_same_pair(frames, backend, slave_path, echo_path, verbose);
-        softslave::VethPair echo_pair("rtt-s0", "rtt-m0");
-        softslave::VethPair slave_pair("rtt-s1", "rtt-m1");
+        slave::VethPair echo_pair("rtt-s0", "rtt-m0");
+        slave::VethPair slave_pair("rtt-s1", "rtt-m1");
         // (a) on pair 0, (b) on pair 1. With --compare-backends: (a) echo over pcap, (b) echo over packet.
         const std::string backend_a = compare_backends ? std::string("pcap") : backend;
         Child echo({echo_path, "--iface", "rtt-s0", "--backend", backend_a}, verbose ? "" : "/dev/null",

@@ -27,7 +27,7 @@
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
-#include "softslave/netif.hpp"
+#include "slave/netif.hpp"
 #include "stats.hpp"
 
 namespace {
@@ -128,7 +128,7 @@ int main(int argc, char** argv) {
             conf << "[identity]\ndevice_name = \"" << name << "\"\n";
             if (!conf) throw std::runtime_error("cannot write the device configuration");
         }
-        softslave::VethPair pair("sdo-s0", "sdo-m0");
+        slave::VethPair pair("sdo-s0", "sdo-m0");
         std::vector<std::string> args = {slave_path,
                                          "--iface",
                                          "sdo-s0",

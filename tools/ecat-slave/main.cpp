@@ -1,5 +1,5 @@
 // ecat-slave: parses the command line (and the configuration file) and hands over to
-// softslave::run_slave() with the soft drive (softdrive) as firmware.
+// slave::run_slave() with the soft drive (tools/device) as firmware.
 #include <CLI/CLI.hpp>
 #include <cerrno>
 #include <cstdio>
@@ -10,12 +10,12 @@
 #include <string_view>
 
 #include "config_check.hpp"
+#include "device/faults.hpp"
+#include "device/firmware.hpp"
 #include "esc/link.hpp"
 #include "od/device_config.hpp"
-#include "softdrive/faults.hpp"
-#include "softdrive/firmware.hpp"
-#include "softslave/log.hpp"
-#include "softslave/slave.hpp"
+#include "slave/log.hpp"
+#include "slave/slave.hpp"
 
 namespace {
 
@@ -41,8 +41,8 @@ bool write_output(const std::string& path, std::string_view bytes, std::string& 
 }  // namespace
 
 int main(int argc, char** argv) {
-    softslave::SlaveOptions options;
-    softdrive::DeviceOptions device;
+    slave::SlaveOptions options;
+    device::DeviceOptions device;
     std::string state_dir = device.state_dir.string();
     std::string write_sii, write_esi, control;
     std::vector<double> home, stops;
@@ -130,7 +130,7 @@ int main(int argc, char** argv) {
     if (auto config = ecat_slave::config_file_argument(argc, argv)) {
         if (const std::string problem = ecat_slave::check_config_file(app, *config); !problem.empty()) {
             std::cerr << "ecat-slave: " << problem << '\n';
-            return softslave::kExitUsage;
+            return slave::kExitUsage;
         }
     }
     try {
@@ -144,24 +144,24 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         std::cerr << "ecat-slave: " << e.what() << " (ecat-slave --help)\n";  // one line
-        return softslave::kExitUsage;
+        return slave::kExitUsage;
     }
-    softdrive::FaultSet fault_set;
+    device::FaultSet fault_set;
     for (const std::string& item : faults) {
         if (item == "list") {
-            softdrive::print_faults(std::cout);
-            return softslave::kExitOk;
+            device::print_faults(std::cout);
+            return slave::kExitOk;
         }
-        if (const auto unknown = softdrive::add_faults(item, fault_set)) {
+        if (const auto unknown = device::add_faults(item, fault_set)) {
             std::cerr << "ecat-slave: --fault: unknown fault '" << *unknown
                       << "' ('ecat-slave --fault list' prints the known ones)\n";
-            return softslave::kExitUsage;
+            return slave::kExitUsage;
         }
     }
-    softdrive::apply_faults(fault_set, options.esc_faults, device.faults);
+    device::apply_faults(fault_set, options.esc_faults, device.faults);
     if (fault_set.any()) {
         std::cerr << "ecat-slave: running with deliberate faults (testing aid):";
-        for (const auto& f : softdrive::fault_catalogue())
+        for (const auto& f : device::fault_catalogue())
             if (fault_set.test(static_cast<std::size_t>(f.fault))) std::cerr << ' ' << f.name;
         std::cerr << '\n';
     }
@@ -170,11 +170,11 @@ int main(int argc, char** argv) {
     if (auto* config = app.get_config_ptr(); config != nullptr && config->count() > 0)
         device.config_file = config->as<std::string>();
     device.state_dir = state_dir;
-    softslave::Log log(std::cerr, quiet ? softslave::LogLevel::Error : *softslave::parse_log_level(log_level),
-                       softslave::stderr_is_terminal());
+    slave::Log log(std::cerr, quiet ? slave::LogLevel::Error : *slave::parse_log_level(log_level),
+                   slave::stderr_is_terminal());
     device.events = &log;
     if (reset_sii) {
-        const std::filesystem::path writes = device.state_dir / softdrive::EepromWrites::kFileName;
+        const std::filesystem::path writes = device.state_dir / device::EepromWrites::kFileName;
         std::error_code ec;
         if (std::filesystem::remove(writes, ec))
             log.info("removed " + writes.string() + ": serving the SII generated from the object model");
@@ -186,7 +186,7 @@ int main(int argc, char** argv) {
         std::error_code ec;
         if (!std::filesystem::is_directory(parent, ec)) {
             std::cerr << "ecat-slave: --control: directory " << parent.string() << " does not exist\n";
-            return softslave::kExitUsage;
+            return slave::kExitUsage;
         }
     }
 
@@ -194,35 +194,35 @@ int main(int argc, char** argv) {
         if (!write_sii.empty() || !write_esi.empty()) {
             std::string why;
             const std::vector<uint8_t> sii =
-                write_sii.empty() ? std::vector<uint8_t>{} : softdrive::make_sii(device);
+                write_sii.empty() ? std::vector<uint8_t>{} : device::make_sii(device);
             if (!write_sii.empty() &&
                 !write_output(write_sii, {reinterpret_cast<const char*>(sii.data()), sii.size()}, why)) {
                 std::cerr << "ecat-slave: cannot write " << write_sii << ": " << why << '\n';
-                return softslave::kExitFailure;
+                return slave::kExitFailure;
             }
-            if (!write_esi.empty() && !write_output(write_esi, softdrive::make_esi(device), why)) {
+            if (!write_esi.empty() && !write_output(write_esi, device::make_esi(device), why)) {
                 std::cerr << "ecat-slave: cannot write " << write_esi << ": " << why << '\n';
-                return softslave::kExitFailure;
+                return slave::kExitFailure;
             }
-            return softslave::kExitOk;
+            return slave::kExitOk;
         }
-        (void)softdrive::make_description(device);  // a bad configuration is a usage error, before any setup
+        (void)device::make_description(device);  // a bad configuration is a usage error, before any setup
     } catch (const od::ConfigError& e) {
         std::cerr << "ecat-slave: " << e.what() << '\n';
-        return softslave::kExitUsage;
+        return slave::kExitUsage;
     } catch (const std::exception& e) {
         std::cerr << "ecat-slave: " << e.what() << '\n';
-        return softslave::kExitFailure;
+        return slave::kExitFailure;
     }
     if (!options.eeprom_file.empty()) {
         try {  // a bad --eeprom is a usage error (exit 2), found before any network set-up
-            (void)softslave::load_eeprom_file(options);
+            (void)slave::load_eeprom_file(options);
         } catch (const std::exception& e) {
             std::cerr << "ecat-slave: --eeprom: " << e.what() << '\n';
-            return softslave::kExitUsage;
+            return slave::kExitUsage;
         }
     }
-    options.eeprom_loader = softdrive::eeprom_loader(device);
-    options.firmware_factory = softdrive::firmware_factory(device, control);
-    return softslave::run_slave(options, std::cout, std::cerr);
+    options.eeprom_loader = device::eeprom_loader(device);
+    options.firmware_factory = device::firmware_factory(device, control);
+    return slave::run_slave(options, std::cout, std::cerr);
 }

@@ -66,7 +66,7 @@ class Stack {
     uint16_t status_code() const { return esm_.code(); }
     SyncMode sync_mode() const { return sync_.mode(); }
     const StackStats& stats() const { return stats_; }
-    // print_stats() of stats(); the runtime prints it at exit (softslave::FirmwareAdapter forwards it).
+    // print_stats() of stats(); the runtime prints it at exit (slave::FirmwareAdapter forwards it).
     void report(std::ostream& out) const { print_stats(out, stats_); }
     const Mailbox& mailbox() const { return mailbox_; }
     // The outgoing mailbox, for spontaneous messages (e.g. CoE emergencies from the application).

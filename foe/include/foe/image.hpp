@@ -20,7 +20,6 @@
 #include <vector>
 
 #include "foe/errors.hpp"
-#include "od/device.hpp"
 
 namespace foe {
 
@@ -33,7 +32,11 @@ constexpr uint32_t kMaxPayload = 0x7FFFFFFF;
 struct ImageIdentity {
     uint32_t vendor_id = 0;
     uint32_t product_code = 0;
-    static ImageIdentity from(const od::Identity& id) { return {id.vendor_id, id.product_code}; }
+    // From any identity with vendor_id and product_code (od::Identity): the image format stays od-free.
+    template <class Identity>
+    static ImageIdentity from(const Identity& id) {
+        return {id.vendor_id, id.product_code};
+    }
 };
 
 struct ImageHeader {
@@ -96,6 +99,11 @@ std::string software_version_text(uint32_t version);
 // 0x30010000, version 0x01200000.
 std::string firmware_file_name(std::string_view device_name, uint32_t product_code, uint32_t version);
 // Sets what the running image decides: revision (0x1018:03, SII) and software version text (0x100A).
-void apply_version(od::Identity& identity, uint32_t version);
+// Identity is od::Identity (template so that the image format stays od-free).
+template <class Identity>
+void apply_version(Identity& identity, uint32_t version) {
+    identity.revision = version;
+    identity.software_version = software_version_text(version);
+}
 
 }  // namespace foe

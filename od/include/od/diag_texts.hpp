@@ -7,13 +7,9 @@
 #include <span>
 #include <string_view>
 
-namespace od {
+#include "od/diag_text_table.hpp"
 
-struct DiagText {
-    uint16_t id = 0;
-    uint8_t type = 0;  // ETG.1020 message type: 0 info, 1 warning, 2 error
-    std::string_view text;
-};
+namespace od {
 
 // Every text the drive (drive/) emits as a diagnosis message without an error code: the CiA 402 states it
 // enters, homing progress, a refused fault reset.

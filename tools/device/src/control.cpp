@@ -1,5 +1,5 @@
-// The soft drive's control socket (see softdrive/control.hpp).
-#include "softdrive/control.hpp"
+// The soft drive's control socket (see device/control.hpp).
+#include "device/control.hpp"
 
 #include <sys/socket.h>
 #include <sys/un.h>
@@ -12,9 +12,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "softdrive/device.hpp"
+#include "device/device.hpp"
 
-namespace softdrive {
+namespace device {
 
 namespace {
 
@@ -175,4 +175,4 @@ std::string ControlSocket::apply(Device& device, std::string_view line) {
            "' (input, sto, limit-neg, limit-pos, home, stops, status)";
 }
 
-}  // namespace softdrive
+}  // namespace device

@@ -1,5 +1,5 @@
-// softdrive::Device: the soft drive's firmware composed from od, ecat, coe, foe, drive and esi.
-#include "softdrive/device.hpp"
+// device::Device: the soft drive's firmware composed from od, ecat, coe, foe, drive and esi.
+#include "device/device.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -20,7 +20,7 @@
 #include "od/diag_texts.hpp"
 #include "od/drive_profile.hpp"
 
-namespace softdrive {
+namespace device {
 
 namespace {
 
@@ -109,17 +109,17 @@ Device::Device(esc::Esc& esc, DeviceOptions options)
     build();
     if (options_.load_sii && !eeprom_writes_.empty()) {
         // The SII served is not the generated one: say so, and how to go back (docs/decisions/device.md).
-        event(softslave::LogLevel::Warn, "the SII served carries " + std::to_string(eeprom_writes_.size()) +
-                                             " word(s) a master wrote into the EEPROM, kept in " +
-                                             eeprom_writes_.file().string() +
-                                             "; delete that file (or start with --reset-sii) to serve the "
-                                             "SII generated from the object model");
+        event(slave::LogLevel::Warn, "the SII served carries " + std::to_string(eeprom_writes_.size()) +
+                                         " word(s) a master wrote into the EEPROM, kept in " +
+                                         eeprom_writes_.file().string() +
+                                         "; delete that file (or start with --reset-sii) to serve the "
+                                         "SII generated from the object model");
         std::vector<uint8_t> image = esi::build_sii(parts_->desc, parts_->dict);
         eeprom_writes_.apply(image);
         const od::Identity& id = parts_->desc.identity;
         for (const std::string& d :
              sii_drift(image, id.vendor_id, id.product_code, id.revision, id.serial_number))
-            event(softslave::LogLevel::Warn, "the SII served: " + d);
+            event(slave::LogLevel::Warn, "the SII served: " + d);
     }
     // Registered once the device exists: a constructor that throws leaves no callback behind.
     if (options_.load_sii)
@@ -142,7 +142,7 @@ void Device::save_eeprom_writes() {
         log() << "softdrive: the EEPROM content the master wrote is not kept: " << error << '\n';
 }
 
-void Device::event(softslave::LogLevel level, const std::string& text) const {
+void Device::event(slave::LogLevel level, const std::string& text) const {
     if (options_.events != nullptr) options_.events->write(level, text);
 }
 
@@ -200,22 +200,21 @@ std::string hex16(uint16_t v) {
 // ---- ecat::EventSink --------------------------------------------------------------------------------
 
 void Device::state_changed(od::AlState from, od::AlState to) {
-    event(softslave::LogLevel::Info, std::string("AL state ") + state_text(from) + " -> " + state_text(to));
+    event(slave::LogLevel::Info, std::string("AL state ") + state_text(from) + " -> " + state_text(to));
 }
 
 void Device::state_refused(od::AlState current, uint8_t requested, uint16_t code) {
-    event(softslave::LogLevel::Warn, std::string("refused AL state request ") + state_text(current) + " -> " +
-                                         requested_text(requested) + ": AL status code " +
-                                         al_code_text(code));
+    event(slave::LogLevel::Warn, std::string("refused AL state request ") + state_text(current) + " -> " +
+                                     requested_text(requested) + ": AL status code " + al_code_text(code));
 }
 
 void Device::local_error(od::AlState state, uint16_t code) {
-    event(softslave::LogLevel::Warn,
+    event(slave::LogLevel::Warn,
           std::string("error indication in ") + state_text(state) + ": AL status code " + al_code_text(code));
 }
 
 void Device::watchdog_expired(od::AlState state) {
-    event(softslave::LogLevel::Warn,
+    event(slave::LogLevel::Warn,
           std::string("process-data watchdog expired in ") + state_text(state) + " (outputs not refreshed)");
 }
 
@@ -223,12 +222,12 @@ void Device::foe_write(std::string_view name, uint64_t bytes, uint32_t error_cod
                        std::string_view error_text) {
     std::string line = "FoE write '" + std::string(name) + "', " + std::to_string(bytes) + " bytes: ";
     if (error_code == 0) {
-        event(softslave::LogLevel::Info, line + "stored");
+        event(slave::LogLevel::Info, line + "stored");
         return;
     }
     char b[16];
     std::snprintf(b, sizeof b, "0x%04X", static_cast<unsigned>(error_code));
-    event(softslave::LogLevel::Warn, line + "failed, FoE error " + b + " (" + std::string(error_text) + ")");
+    event(slave::LogLevel::Warn, line + "failed, FoE error " + b + " (" + std::string(error_text) + ")");
 }
 
 std::ostream& Device::log() const {
@@ -269,7 +268,8 @@ void Device::build() {
               << p->load.error << "); running with the defaults\n";
     Parts* raw = p.get();
     od::attach_store(p->dict, *p->params, [raw] {
-        // Seed 001 §7.2.21: restoring defaults only with the axis in "Power Disable" (not switched on).
+        // MAXPOS firmware specification §7.2.21: restoring defaults only with the axis in "Power Disable"
+        // (not switched on).
         const od::Entry* e = raw->dict.find(0x6041, 0);
         if (e == nullptr) return od::Status::Ok;
         return (raw->dict.get<uint16_t>(0x6041, 0) & 0x0002) != 0 ? od::Status::WrongState : od::Status::Ok;
@@ -297,12 +297,12 @@ void Device::build() {
     p->firmware->server().set_event_sink(this);
     // A master's 0x1010 "save" / 0x1011 "load" that the store carried out (listeners run after the write).
     p->dict.add_listener(0x1010, [this, raw](const od::Entry& e) {
-        event(softslave::LogLevel::Info, "stored parameters saved (0x1010:" + std::to_string(e.subindex) +
-                                             " " + e.name + ") to " + raw->params->file().string());
+        event(slave::LogLevel::Info, "stored parameters saved (0x1010:" + std::to_string(e.subindex) + " " +
+                                         e.name + ") to " + raw->params->file().string());
     });
     p->dict.add_listener(0x1011, [this](const od::Entry& e) {
-        event(softslave::LogLevel::Info, "stored parameters restored to defaults at the next start (0x1011:" +
-                                             std::to_string(e.subindex) + " " + e.name + ")");
+        event(slave::LogLevel::Info, "stored parameters restored to defaults at the next start (0x1011:" +
+                                         std::to_string(e.subindex) + " " + e.name + ")");
     });
     p->drive = std::make_unique<drive::Drive>(p->dict, this);
     p->drive->axis().faults = options_.faults.axis;
@@ -357,12 +357,11 @@ void Device::poll(uint64_t now_ns) {
             const od::Identity& id = parts_->desc.identity;
             char rev[16];
             std::snprintf(rev, sizeof rev, "0x%08X", static_cast<unsigned>(id.revision));
-            event(softslave::LogLevel::Info,
-                  std::string("firmware restarted (Bootstrap -> Init): revision ") + rev +
-                      ", software version " + id.software_version);
+            event(slave::LogLevel::Info, std::string("firmware restarted (Bootstrap -> Init): revision ") +
+                                             rev + ", software version " + id.software_version);
         } catch (const std::exception& e) {
             log() << "softdrive: restart failed, the running firmware stays: " << e.what() << '\n';
-            event(softslave::LogLevel::Error, std::string("firmware restart failed: ") + e.what());
+            event(slave::LogLevel::Error, std::string("firmware restart failed: ") + e.what());
         }
         parts_->stack->poll(now_ns);
     }
@@ -441,10 +440,10 @@ void Device::on_restart() {
 // ---- drive::EventSink -------------------------------------------------------------------------------
 
 void Device::raise(uint16_t error_code, uint8_t error_register, const std::array<uint8_t, 5>& mfr) {
-    if (options_.events != nullptr && options_.events->enabled(softslave::LogLevel::Error)) {
+    if (options_.events != nullptr && options_.events->enabled(slave::LogLevel::Error)) {
         const drive::ErrorInfo* info = drive::find_error(error_code);
-        event(softslave::LogLevel::Error, "drive fault " + hex16(error_code) + ": " +
-                                              (info != nullptr ? std::string(info->name) : "unknown error"));
+        event(slave::LogLevel::Error, "drive fault " + hex16(error_code) + ": " +
+                                          (info != nullptr ? std::string(info->name) : "unknown error"));
     }
     ++stats_.emergencies;
     ++stats_.diagnoses;
@@ -452,16 +451,16 @@ void Device::raise(uint16_t error_code, uint8_t error_register, const std::array
 }
 
 void Device::clear(uint16_t error_code, uint8_t error_register) {
-    if (options_.events != nullptr && options_.events->enabled(softslave::LogLevel::Debug))
-        event(softslave::LogLevel::Debug, "drive error " + hex16(error_code) + " cleared");
+    if (options_.events != nullptr && options_.events->enabled(slave::LogLevel::Debug))
+        event(slave::LogLevel::Debug, "drive error " + hex16(error_code) + " cleared");
     ++stats_.emergencies;
     parts_->events->clear(error_code, error_register);
 }
 
 void Device::diag(drive::Severity severity, uint16_t code, std::string_view text) {
-    const softslave::LogLevel level = severity == drive::Severity::Error     ? softslave::LogLevel::Error
-                                      : severity == drive::Severity::Warning ? softslave::LogLevel::Warn
-                                                                             : softslave::LogLevel::Debug;
+    const slave::LogLevel level = severity == drive::Severity::Error     ? slave::LogLevel::Error
+                                  : severity == drive::Severity::Warning ? slave::LogLevel::Warn
+                                                                         : slave::LogLevel::Debug;
     if (options_.events != nullptr && options_.events->enabled(level)) {
         // Appended piece by piece: GCC 12's -O3 reports a false -Werror=restrict on "literal" +
         // std::string&&.
@@ -513,4 +512,4 @@ const od::ParameterStore::LoadResult& Device::parameter_load() const {
     return parts_->load;
 }
 
-}  // namespace softdrive
+}  // namespace device

@@ -1,5 +1,5 @@
-// Master-written SII words kept across restarts (see softdrive/eeprom_writes.hpp).
-#include "softdrive/eeprom_writes.hpp"
+// Master-written SII words kept across restarts (see device/eeprom_writes.hpp).
+#include "device/eeprom_writes.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -15,7 +15,7 @@
 #include "util/crc.hpp"
 #include "util/le.hpp"
 
-namespace softdrive {
+namespace device {
 
 namespace {
 
@@ -134,4 +134,4 @@ std::vector<std::string> sii_drift(std::span<const uint8_t> image, uint32_t vend
     return out;
 }
 
-}  // namespace softdrive
+}  // namespace device

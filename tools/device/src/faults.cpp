@@ -1,13 +1,13 @@
-// The fault registry of `ecat-slave --fault` (softdrive/faults.hpp, docs/decisions/faults.md).
-#include "softdrive/faults.hpp"
+// The fault registry of `ecat-slave --fault` (device/faults.hpp, docs/decisions/faults.md).
+#include "device/faults.hpp"
 
 #include <array>
 #include <iomanip>
 #include <ostream>
 
-#include "softdrive/device.hpp"
+#include "device/device.hpp"
 
-namespace softdrive {
+namespace device {
 
 namespace {
 
@@ -223,4 +223,4 @@ void apply_faults(const FaultSet& set, esc::EscFaults& esc, DeviceFaults& device
     flag(F::ModeDisplayStuck, device.axis.mode_display_stuck);
 }
 
-}  // namespace softdrive
+}  // namespace device

@@ -1,11 +1,11 @@
-// The soft drive as the runtime's firmware (see softdrive/firmware.hpp).
-#include "softdrive/firmware.hpp"
+// The soft drive as the runtime's firmware (see device/firmware.hpp).
+#include "device/firmware.hpp"
 
 #include <ostream>
 #include <string>
 #include <vector>
 
-namespace softdrive {
+namespace device {
 
 DeviceFirmware::DeviceFirmware(esc::Esc& esc, DeviceOptions options,
                                const std::filesystem::path& control_path)
@@ -22,19 +22,19 @@ void DeviceFirmware::report(std::ostream& out) const {
         << "device.diagnosis_events " << s.diagnoses << '\n';
 }
 
-softslave::FirmwareFactory firmware_factory(DeviceOptions options, std::filesystem::path control_path) {
+slave::FirmwareFactory firmware_factory(DeviceOptions options, std::filesystem::path control_path) {
     return [options = std::move(options), control_path = std::move(control_path)](
-               esc::Esc& esc, const softslave::SlaveOptions& slave) -> std::unique_ptr<softslave::Firmware> {
+               esc::Esc& esc, const slave::SlaveOptions& slave) -> std::unique_ptr<slave::Firmware> {
         DeviceOptions o = options;
         o.load_sii = slave.eeprom_file.empty();
         return std::make_unique<DeviceFirmware>(esc, std::move(o), control_path);
     };
 }
 
-softslave::EepromLoader eeprom_loader(DeviceOptions options) {
-    return [options = std::move(options)](const softslave::SlaveOptions& slave) {
+slave::EepromLoader eeprom_loader(DeviceOptions options) {
+    return [options = std::move(options)](const slave::SlaveOptions& slave) {
         if (!slave.eeprom_file.empty()) {
-            std::vector<uint8_t> image = softslave::load_eeprom_file(slave);
+            std::vector<uint8_t> image = slave::load_eeprom_file(slave);
             // A user's image may say something else than the device answers over CoE (0x1018): warn.
             if (options.events != nullptr) {
                 const od::Identity id = make_description(options).identity;
@@ -48,4 +48,4 @@ softslave::EepromLoader eeprom_loader(DeviceOptions options) {
     };
 }
 
-}  // namespace softdrive
+}  // namespace device

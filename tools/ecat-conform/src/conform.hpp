@@ -12,13 +12,29 @@
 #include <vector>
 
 #include "esc/link.hpp"
-#include "esi_reader.hpp"
+#include "esi/esi_reader.hpp"
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
 
 namespace conform {
+
+// The ESI reader is the project's one od-free reader (esi/esi_reader.hpp, target esi_reader).
+using esi::esi_basic_bits;
+using esi::esi_coe_type;
+using esi::EsiCoe;
+using esi::EsiDevice;
+using esi::EsiEntry;
+using esi::EsiFile;
+using esi::EsiObject;
+using esi::EsiOpMode;
+using esi::EsiPdo;
+using esi::EsiPdoEntry;
+using esi::EsiSm;
+using esi::parse_esi_number;
+using esi::read_esi_file;
+using esi::read_esi_text;
 
 enum class Status : uint8_t { Pass, Fail, Skip, Warn };
 enum class Severity : uint8_t { Error, Warning };

@@ -1,7 +1,7 @@
 // ecatctl diag [slave] [--oldest-first] [--new] [--ack]: the diagnosis history 0x10F3 (ETG.1020) read over
 // CoE SDO and printed as text: the header subindices, the flags, then one line per message with its time
 // stamp (DC system time), type, diag code, text and parameters. Texts of emergency-derived codes come from
-// the drive's error table (drive::find_error) when ecatctl is built with the drive library.
+// the drive's error table (drive/error_codes.hpp, od-free; ecatctl does not link the drive).
 #include "cmd_diag.hpp"
 
 #include <cstdio>
@@ -9,14 +9,12 @@
 #include <string>
 #include <vector>
 
+#include "drive/error_codes.hpp"
 #include "format.hpp"
 #include "master/coe.hpp"
 #include "master/diag.hpp"
 #include "master/mailbox.hpp"
-#ifdef ECATCTL_HAVE_DRIVE
-#include "drive/errors.hpp"
-#include "od/diag_texts.hpp"
-#endif
+#include "od/diag_text_table.hpp"
 
 namespace ecatctl {
 
@@ -33,22 +31,13 @@ struct DiagArgs {
 };
 
 std::string_view drive_error_name(uint16_t code) {
-#ifdef ECATCTL_HAVE_DRIVE
-    if (const drive::ErrorInfo* e = drive::find_error(code)) return e->name;
-#else
-    (void)code;
-#endif
+    if (const drive::ErrorInfo* e = drive::find_error_code(code)) return e->name;
     return {};
 }
 
 // The drive's diagnosis texts by id (what its ESI lists as DiagMessages).
 std::string_view drive_text(uint16_t id) {
-#ifdef ECATCTL_HAVE_DRIVE
-    return od::diag_text(id);
-#else
-    (void)id;
-    return {};
-#endif
+    return od::diag_text_of(id);
 }
 
 int report(const master::SdoClient& sdo, Error e, const char* what) {

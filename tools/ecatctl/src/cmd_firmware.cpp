@@ -1,10 +1,11 @@
-// ecatctl firmware-update FILE: the seed's firmware update over FoE (seed-digest-ethercat-drive.md §8.1,
-// seed 004 §4.2-4.9) as a master runs it, with every step checked and every failure named:
+// ecatctl firmware-update FILE: the firmware update over FoE of the EPOS4 Application Notes §4.2-4.9 as a
+// master runs it, with every step checked and every failure named:
 //   1. identity and revision from the SII and from 0x1018 / 0x100A / 0x1008 (CoE, in PREOP); the drive
-//      must not be switched on (seed step 1: device control "Disabled");
+//      must not be switched on (step 1 of the procedure: device control "Disabled");
 //   2. the image header must be for this vendor and product (checked here, before anything is sent);
 //   3. ESC -> Bootstrap (INIT first, the bootstrap mailbox from SII words 0x14-0x17);
-//   4. FoE write of the image to the device's name (seed: file `EPOS4` for EPOS4, i.e. 0x1008), password;
+//   4. FoE write of the image to the device's name (the application notes: file `EPOS4` for EPOS4, i.e.
+//   0x1008), password;
 //   5. ESC -> Init: the device resets (B->I "reset device after a successful firmware download");
 //   6. wait for the restart (AL status answers INIT again, the SII header reads back);
 //   7. the revision in the SII, 0x1018:03 and 0x100A must be the image's version.
@@ -371,7 +372,7 @@ int firmware_update(master::Master& m, const Args& args, const Image& img) {
     if (coe.have_statusword && (coe.statusword & 0x0002) != 0 && !args.force) {
         std::fprintf(stderr,
                      "ecatctl: the drive is switched on (statusword 0x%04x): disable it before an update "
-                     "(seed step 1), or use --force\n",
+                     "(step 1 of the update procedure), or use --force\n",
                      coe.statusword);
         return kExitFailure;
     }
@@ -454,7 +455,7 @@ int firmware_update(master::Master& m, const Args& args, const Image& img) {
         ok = false;
     }
     if (after.id.vendor != head.vendor_id || after.id.product != head.product_code) {
-        // Seed step 6 checks 0x1018:02 (hardware version and application number) as well.
+        // Step 6 of the procedure checks 0x1018:02 (hardware version and application number) as well.
         std::fprintf(stderr,
                      "ecatctl: 0x1018 reports vendor 0x%08x product 0x%08x, the image is for 0x%08x 0x%08x\n",
                      after.id.vendor, after.id.product, head.vendor_id, head.product_code);

@@ -1,5 +1,5 @@
 #pragma once
-// ecatctl firmware-update (the seed's FoE update procedure, seed-digest-ethercat-drive.md §8.1) and the
+// ecatctl firmware-update (the FoE update procedure of the EPOS4 Application Notes §4.2-4.9) and the
 // progress bar of FoE transfers (also used by `foe write`).
 #include <chrono>
 #include <cstddef>

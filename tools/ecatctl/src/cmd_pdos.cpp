@@ -5,7 +5,7 @@
 
 #include "cmd_verbs.hpp"
 #include "coe_view.hpp"
-#include "esi/sii.hpp"
+#include "esi/sii_reader.hpp"
 #include "format.hpp"
 
 namespace ecatctl {

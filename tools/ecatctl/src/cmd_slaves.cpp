@@ -7,7 +7,7 @@
 #include <string>
 
 #include "cmd_verbs.hpp"
-#include "esi/sii.hpp"
+#include "esi/sii_reader.hpp"
 #include "format.hpp"
 
 namespace ecatctl {

@@ -3,10 +3,8 @@
 #include <cstdio>
 #include <iostream>
 
+#include "esi/sii_reader.hpp"
 #include "format.hpp"
-#ifdef ECATCTL_HAVE_ESI
-#include "esi/sii.hpp"
-#endif
 
 namespace ecatctl {
 
@@ -94,15 +92,10 @@ int check_slave_present(master::Master& m, master::Address a) {
 }
 
 std::optional<std::string> sii_device_name(master::Master& m, master::Address a) {
-#ifdef ECATCTL_HAVE_ESI
     auto img = m.sii_read_image(a);
     if (!img) return std::nullopt;
     const esi::SiiInfo info = esi::parse_sii(*img);
     if (info.general && !info.general->name.empty()) return info.general->name;
-#else
-    (void)m;
-    (void)a;
-#endif
     return std::nullopt;
 }
 
@@ -118,7 +111,6 @@ bool sii_problems(const std::string& what, const std::vector<uint8_t>& image) {
         std::cerr << "ecatctl: " << what << " is empty: not an SII image\n";
         return true;
     }
-#ifdef ECATCTL_HAVE_ESI
     const esi::SiiInfo info = esi::parse_sii(image);
     if (info.problems.empty() && info.header_complete) return false;
     std::cerr << "ecatctl: " << what << " is not a valid SII image: "
@@ -127,9 +119,6 @@ bool sii_problems(const std::string& what, const std::vector<uint8_t>& image) {
         std::cerr << " (and " << info.problems.size() - 1 << " more problems, above)";
     std::cerr << "\n";
     return true;
-#else
-    return false;
-#endif
 }
 
 int report_usage_error(const CLI::App& app, const CLI::ParseError& e, int argc, char** argv) {

@@ -1,4 +1,4 @@
-// CoE SDO client (ethercat-protocol.md §9.2 transfers, §9.3 abort codes, §9.5 emergencies).
+// CoE SDO client (ETG.1000.6 CoE: SDO transfers, abort codes, emergencies).
 #include "master/coe.hpp"
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// FoE client (ethercat-protocol.md §10.1 packets, §10.3 transfer flow).
+// FoE client (ETG.1000.6 FoE: packets and transfer flow).
 #include <algorithm>
 
 #include "master/foe.hpp"

@@ -1,4 +1,5 @@
-// Master side of the mailbox (ethercat-protocol.md §4.3 mailbox SMs, §4.4 repeat, §8 header/counter).
+// Master side of the mailbox (mailbox SMs and repeat: ESC datasheet section I §8.2, §8.6; header and counter:
+// ETG.1000.4 mailbox, ESC datasheet section I Table 24).
 #include "master/mailbox.hpp"
 
 #include <algorithm>
@@ -47,7 +48,8 @@ Error Mailbox::configure(const MailboxConfig& c) {
     put16(sm + 10, c.in_size);
     sm[12] = kSm1ControlDefault;
     sm[14] = 0x01;
-    // Disable both first: start, length and control are taken only while an SM is disabled (§4.1).
+    // Disable both first: start, length and control are taken only while an SM is disabled (ESC datasheet
+    // section I §8).
     const uint8_t off[16] = {};
     if (Error e = m_.write(slave_, reg::Sm0, off); e != Error::Ok) return e;
     if (Error e = m_.write(slave_, reg::Sm0, sm); e != Error::Ok) return e;
@@ -75,7 +77,7 @@ Error Mailbox::adopt_current() {
     rx_.assign(c.in_size, 0);
     // The slave remembers the counter of the last request it took, which another master process may
     // have sent; a first request with that counter would be dropped as a repeat. Counter 0 ("not
-    // used", §8.1) is never a repeat, and 1, 2, ... follow it.
+    // used", ETG.1000.4 mailbox header) is never a repeat, and 1, 2, ... follow it.
     counter_ = 0;
     send_zero_ = true;
     drain();  // an answer an earlier process abandoned is not ours
@@ -83,14 +85,14 @@ Error Mailbox::adopt_current() {
 }
 
 uint8_t Mailbox::next_counter() {
-    counter_ = static_cast<uint8_t>(counter_ % 7 + 1);  // 1..7, never 0 (§8.1)
+    counter_ = static_cast<uint8_t>(counter_ % 7 + 1);  // 1..7, never 0 (ETG.1000.4 mailbox header)
     return counter_;
 }
 
 Error Mailbox::send(MailboxType type, std::span<const uint8_t> payload) {
     if (!config_.valid()) return Error::MailboxNotConfigured;
     if (payload.empty() || payload.size() > max_out_payload()) return Error::InvalidArgument;
-    // The whole SM0 length is written so that its last byte closes the buffer (§4.3).
+    // The whole SM0 length is written so that its last byte closes the buffer (ESC datasheet section I §8.2).
     std::fill(tx_.begin(), tx_.end(), 0);
     put16(tx_.data(), static_cast<uint16_t>(payload.size()));
     put16(tx_.data() + 2, 0);
@@ -102,7 +104,8 @@ Error Mailbox::send(MailboxType type, std::span<const uint8_t> payload) {
     const auto deadline = Clock::now() + timeout_;
     for (;;) {
         Datagram d = Master::addressed(slave_, true, config_.out_start, tx_);
-        // Retries are safe here: a repeated write carries the same counter and the slave drops it (§8.1).
+        // Retries are safe here: a repeated write carries the same counter and the slave drops it (ETG.1000.4
+        // mailbox header).
         if (Error e = m_.exchange(d); e != Error::Ok) return e;
         if (d.wkc == 1) return Error::Ok;
         if (Clock::now() >= deadline) return Error::MailboxTimeout;  // SM0 stays full

@@ -235,8 +235,8 @@ Result<AlStatus> Master::al_status(Address a) {
 
 namespace {
 
-// AL control behaves like a mailbox on firmware-driven slaves (ethercat-protocol.md §3.5): a write
-// before the firmware read the previous one may be refused (WKC 0). Keep trying until the deadline.
+// AL control behaves like a mailbox on firmware-driven slaves (ESC datasheet section II, AL control 0x0120):
+// a write before the firmware read the previous one may be refused (WKC 0). Keep trying until the deadline.
 Error write_al_control(Master& m, Address a, uint16_t value, Clock::time_point deadline) {
     for (;;) {
         const Error e = m.write_reg<uint16_t>(a, reg::AlControl, value);

@@ -18,7 +18,7 @@ using util::get64;
 using util::put16;
 using util::put32;
 using util::put64;
-// EtherCAT system time: ns since 2000-01-01 (§11.1).
+// EtherCAT system time: ns since 2000-01-01 (ESC datasheet section I §9).
 uint64_t master_system_time() {
     timespec ts{};
     clock_gettime(CLOCK_REALTIME, &ts);
@@ -113,7 +113,8 @@ Error ProcessDataSession::configure(const DcConfig& dc) {
         if (Error e = sdo_.download(0x1C32, 2, cyc); e != Error::Ok) return e;
         (void)sdo_.download(0x1C33, 2, cyc);  // some slaves derive it from 0x1C32 and refuse the write
     }
-    // SM2/SM3: disabled first, then start, length, control and activate in one write (§4.1).
+    // SM2/SM3: disabled first, then start, length, control and activate in one write (ESC datasheet section I
+    // §8).
     uint8_t sm[16] = {};
     const uint8_t off[16] = {};
     if (Error e = m_.write(slave_, static_cast<uint16_t>(reg::Sm0 + 16), off); e != Error::Ok) return e;
@@ -126,7 +127,8 @@ Error ProcessDataSession::configure(const DcConfig& dc) {
     sm[12] = layout_.sm3_control;
     sm[14] = layout_.sm3_length ? 1 : 0;
     if (Error e = m_.write(slave_, static_cast<uint16_t>(reg::Sm0 + 16), sm); e != Error::Ok) return e;
-    // FMMU0: outputs (write), FMMU1: inputs (read), logically back to back from kLogicalBase (§3.11, §5).
+    // FMMU0: outputs (write), FMMU1: inputs (read), logically back to back from kLogicalBase (ESC datasheet
+    // section I §7).
     uint8_t fm[32] = {};
     auto fmmu = [](uint8_t* f, uint32_t logical, uint16_t length, uint16_t physical, uint8_t type) {
         put32(f, logical);
@@ -153,8 +155,8 @@ Error ProcessDataSession::configure(const DcConfig& dc) {
 
 Error ProcessDataSession::configure_dc(const DcConfig& dc) {
     // Latch receive times with a broadcast write to 0x0900, read the slave's local time of that frame
-    // (0x0918) and make its system time the master's: offset = master time - local time (§11.2).
-    // A single slave is the reference clock: propagation delay 0, no drift compensation.
+    // (0x0918) and make its system time the master's: offset = master time - local time (ESC datasheet
+    // section I §9.1). A single slave is the reference clock: propagation delay 0, no drift compensation.
     const uint8_t latch[4] = {};
     const uint64_t master_now = master_system_time();
     auto w = m_.broadcast_write(0x0900, latch);

@@ -1,4 +1,4 @@
-// SII EEPROM access through the ESC's EEPROM interface (0x0500-0x050F), ethercat-protocol.md §3.9.
+// SII EEPROM access through the ESC's EEPROM interface (0x0500-0x050F, ESC datasheet section II).
 // Works with both read sizes (4 and 8 bytes, 0x0502 bit 6), waits while busy or while the command bits
 // are still set (as IgH), clears stale error bits before a command (as SOEM) and repeats a command the
 // interface reports as not acknowledged (bit 13).

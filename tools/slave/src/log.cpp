@@ -1,11 +1,11 @@
-// The slave's console log (see softslave/log.hpp).
-#include "softslave/log.hpp"
+// The slave's console log (see slave/log.hpp).
+#include "slave/log.hpp"
 
 #include <unistd.h>
 
 #include <ostream>
 
-namespace softslave {
+namespace slave {
 
 std::optional<LogLevel> parse_log_level(std::string_view t) {
     if (t == "error") return LogLevel::Error;
@@ -47,4 +47,4 @@ bool stderr_is_terminal() {
     return ::isatty(STDERR_FILENO) == 1;
 }
 
-}  // namespace softslave
+}  // namespace slave

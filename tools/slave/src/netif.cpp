@@ -1,5 +1,5 @@
-// rtnetlink plumbing. See softslave/netif.hpp.
-#include "softslave/netif.hpp"
+// rtnetlink plumbing. See slave/netif.hpp.
+#include "slave/netif.hpp"
 
 #include <fcntl.h>
 #include <linux/if_link.h>
@@ -17,7 +17,7 @@
 #include <cerrno>
 #include <cstring>
 
-namespace softslave {
+namespace slave {
 
 namespace {
 
@@ -294,4 +294,4 @@ VethPair::~VethPair() {
     release_lock();
 }
 
-}  // namespace softslave
+}  // namespace slave

@@ -1,5 +1,5 @@
-// The slave runtime event loop. See softslave/runtime.hpp.
-#include "softslave/runtime.hpp"
+// The slave runtime event loop. See slave/runtime.hpp.
+#include "slave/runtime.hpp"
 
 #include <poll.h>
 #include <sys/epoll.h>
@@ -17,7 +17,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace softslave {
+namespace slave {
 
 namespace {
 
@@ -307,4 +307,4 @@ bool stop_signalled() {
     return g_stop_signalled != 0;
 }
 
-}  // namespace softslave
+}  // namespace slave

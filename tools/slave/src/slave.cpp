@@ -1,5 +1,5 @@
-// run_slave(): the ecat-slave program minus its command line. See softslave/slave.hpp.
-#include "softslave/slave.hpp"
+// run_slave(): the ecat-slave program minus its command line. See slave/slave.hpp.
+#include "slave/slave.hpp"
 
 #include <sched.h>
 #include <sys/mman.h>
@@ -14,10 +14,10 @@
 
 #include "esc/link.hpp"
 #include "esc/link_capture.hpp"
-#include "softslave/netif.hpp"
-#include "softslave/runtime.hpp"
+#include "slave/netif.hpp"
+#include "slave/runtime.hpp"
 
-namespace softslave {
+namespace slave {
 
 std::vector<uint8_t> load_eeprom_file(const SlaveOptions& options) {
     if (options.eeprom_file.empty()) return {};
@@ -197,4 +197,4 @@ int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err)
     }
 }
 
-}  // namespace softslave
+}  // namespace slave

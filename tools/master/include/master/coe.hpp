@@ -1,5 +1,5 @@
 #pragma once
-// CoE SDO client (ethercat-protocol.md §9.2): upload and download, expedited, normal and segmented,
+// CoE SDO client (ETG.1000.6 CoE): upload and download, expedited, normal and segmented,
 // with or without complete access, over a configured Mailbox. Emergencies that arrive while waiting are
 // kept (the last one) and counted. Buffers are allocated at construction.
 #include <array>
@@ -18,7 +18,7 @@ struct EmergencyMessage {
     std::array<uint8_t, 5> data{};
 };
 
-// SDO information service (§9.4).
+// SDO information service (ETG.1000.6).
 struct ObjectDescription {
     uint16_t index = 0;
     uint16_t data_type = 0;
@@ -43,7 +43,7 @@ class SdoClient {
     explicit SdoClient(Mailbox& mailbox);
 
     // Reads index:sub into out; returns the number of bytes the slave sent. complete_access: the whole
-    // object from sub (0 or 1), subindex 0 then occupying 16 bits (§9.2).
+    // object from sub (0 or 1), subindex 0 then occupying 16 bits (ETG.1000.6 complete access).
     Result<std::size_t> upload(uint16_t index, uint8_t sub, std::span<uint8_t> out,
                                bool complete_access = false);
     Error download(uint16_t index, uint8_t sub, std::span<const uint8_t> data, bool complete_access = false);
@@ -57,7 +57,7 @@ class SdoClient {
 
     // Abort code of the last Error::SdoAbort (from the slave, or sent by us when we gave up).
     uint32_t last_abort() const { return last_abort_; }
-    // Detail code of the last Error::MailboxError (ethercat-protocol.md §8.3).
+    // Detail code of the last Error::MailboxError (ETG.1000.6 mailbox error reply).
     uint16_t last_mailbox_error() const { return last_mailbox_error_; }
     uint64_t emergencies() const { return emergencies_; }
     const EmergencyMessage& last_emergency() const { return last_emergency_; }
@@ -78,7 +78,7 @@ class SdoClient {
     EmergencyMessage last_emergency_;
 };
 
-// Text of an SDO abort code (§9.3), "unknown abort code" if not in the table.
+// Text of an SDO abort code (ETG.1000.6), "unknown abort code" if not in the table.
 std::string_view sdo_abort_text(uint32_t code);
 
 }  // namespace master

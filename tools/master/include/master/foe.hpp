@@ -1,5 +1,5 @@
 #pragma once
-// FoE client (ethercat-protocol.md §10): read and write a file over a configured Mailbox. A DATA packet
+// FoE client (ETG.1000.6 FoE): read and write a file over a configured Mailbox. A DATA packet
 // shorter than the largest one ends the file (an empty one when the length is a multiple of it); BUSY
 // answers to a DATA packet make the client send that packet again.
 #include <cstdint>

@@ -1,8 +1,8 @@
 #pragma once
-// The master's side of the EtherCAT mailbox (ethercat-protocol.md §4.3, §4.4, §8): SM0 (master -> slave)
-// and SM1 (slave -> master) set up from the SII, the 6-byte header with the 1..7 counter, the full-length
-// SM writes and reads the ESC requires, and the repeat request when a read reply is lost.
-// Buffers are allocated once, at configure(); send/receive allocate nothing.
+// The master's side of the EtherCAT mailbox (ESC datasheet section I §8.2, §8.6; ETG.1000.4 mailbox header):
+// SM0 (master -> slave) and SM1 (slave -> master) set up from the SII, the 6-byte header with the 1..7
+// counter, the full-length SM writes and reads the ESC requires, and the repeat request when a read reply is
+// lost. Buffers are allocated once, at configure(); send/receive allocate nothing.
 #include <chrono>
 #include <cstdint>
 #include <span>

@@ -46,7 +46,7 @@ constexpr uint16_t Sm0 = esc::reg::kSm;
 constexpr uint16_t DcSystemTime = esc::reg::kDcSystemTime;
 }  // namespace reg
 
-// SII word addresses of the fixed header (esi/wire/sii.hpp) and the 0x0502 control/status bits
+// SII word addresses of the fixed header (ETG.2010; esi/wire/sii.hpp) and the 0x0502 control/status bits
 // (esc/wire/registers.hpp), under the master's names.
 namespace sii {
 constexpr uint16_t VendorId = esi::sii::word::VendorId;
@@ -78,7 +78,7 @@ struct AlStatus {
 std::string_view to_string(AlState s);
 // "INIT", "PREOP", ... or "0x0?" for a state code that is not one of the five.
 std::string_view al_state_name(uint8_t state);
-// Name of an AL status code (ethercat-protocol.md §6.3), "unknown" if not in the table.
+// Name of an AL status code (ETG.1000.6 AL status codes), "unknown" if not in the table.
 std::string_view al_status_code_name(uint16_t code);
 
 struct MasterOptions {
@@ -172,9 +172,9 @@ class Master {
     // is acknowledged (AL control = actual state | 0x10) and Error::AlRefused is returned; `final`
     // then holds the refused status with its AL status code.
     Error request_state(Address a, AlState state, AlStatus* final = nullptr);
-    // Device identification (§6.2): AL control bit 5 set with the current state; once AL status bit 5
-    // says the value is loaded, 0x0134 holds it (the station alias or ID selector). The request bit is
-    // cleared again afterwards. Error::AlRefused if an error indication is pending.
+    // Device identification (ETG.1000.6 AL control): AL control bit 5 set with the current state; once AL
+    // status bit 5 says the value is loaded, 0x0134 holds it (the station alias or ID selector). The request
+    // bit is cleared again afterwards. Error::AlRefused if an error indication is pending.
     Result<uint16_t> identify(Address a);
     // Same on every slave at once (BWR 0x0120), then each of the given station addresses is polled.
     Error request_state_all(AlState state, std::span<const uint16_t> stations);

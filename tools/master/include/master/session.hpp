@@ -1,9 +1,10 @@
 #pragma once
-// A cyclic process-data session with one slave (ethercat-protocol.md §4.2, §5, §6, §11): discovers the
-// process-data layout (SM2/SM3 from the SII SyncM category, sizes from the PDO assignment 0x1C12/0x1C13
-// and the mapping objects over CoE), sets up SM2/SM3 and two FMMUs, optionally distributed clocks with
-// SYNC0, and exchanges outputs and inputs with one LRW per cycle (plus an FRMW of the reference clock's
-// system time when DC is on). cycle() allocates nothing.
+// A cyclic process-data session with one slave (buffered SMs and FMMUs: ESC datasheet section I §8.1, §7; AL
+// states: ETG.1000.6; distributed clocks: ESC datasheet section I §9): discovers the process-data layout
+// (SM2/SM3 from the SII SyncM category, sizes from the PDO assignment 0x1C12/0x1C13 and the mapping objects
+// over CoE), sets up SM2/SM3 and two FMMUs, optionally distributed clocks with SYNC0, and exchanges outputs
+// and inputs with one LRW per cycle (plus an FRMW of the reference clock's system time when DC is on).
+// cycle() allocates nothing.
 #include <chrono>
 #include <cstdint>
 #include <functional>

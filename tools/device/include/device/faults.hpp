@@ -14,7 +14,7 @@
 
 #include "esc/faults.hpp"
 
-namespace softdrive {
+namespace device {
 
 struct DeviceFaults;
 
@@ -85,4 +85,4 @@ void print_faults(std::ostream& out);
 // Sets the layers' flags of every fault in set (flags of faults not in set are left alone).
 void apply_faults(const FaultSet& set, esc::EscFaults& esc, DeviceFaults& device);
 
-}  // namespace softdrive
+}  // namespace device

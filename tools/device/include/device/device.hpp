@@ -22,6 +22,7 @@
 
 #include "coe/diagnosis.hpp"
 #include "coe/sdo_server.hpp"
+#include "device/eeprom_writes.hpp"
 #include "drive/drive.hpp"
 #include "drive/event_sink.hpp"
 #include "ecat/application.hpp"
@@ -33,10 +34,9 @@
 #include "od/device.hpp"
 #include "od/dictionary.hpp"
 #include "od/store.hpp"
-#include "softdrive/eeprom_writes.hpp"
-#include "softslave/log.hpp"
+#include "slave/log.hpp"
 
-namespace softdrive {
+namespace device {
 
 // The simulated machine around the motor (drive::Environment), positions in raw encoder increments.
 // NaN: not fitted.
@@ -50,7 +50,7 @@ struct EnvironmentOptions {
     double stop_hi = kNone;
 };
 
-// Deliberate deviations of the firmware's layers, a testing aid (softdrive/faults.hpp); none by default.
+// Deliberate deviations of the firmware's layers, a testing aid (device/faults.hpp); none by default.
 struct DeviceFaults {
     ecat::StackFaults stack;
     coe::CoeFaults coe;
@@ -68,7 +68,7 @@ struct DeviceOptions {
     std::ostream* log = nullptr;  // warnings (bad parameter file, ...); null: std::cerr
     // One line per event (state changes, refused requests, FoE writes, restarts, 0x1010 saves, watchdog,
     // drive faults); null: events are not logged.
-    softslave::Log* events = nullptr;
+    slave::Log* events = nullptr;
     DeviceFaults faults;  // testing aid (ecat-slave --fault); none by default
 };
 
@@ -107,7 +107,7 @@ class Device final : public ecat::Application, public drive::EventSink, public e
     // Longest time one drive cycle simulates: after a longer pause the machine does not catch up.
     static constexpr int64_t kMaxCycleStepNs = 100'000'000;
 
-    // Firmware entry points (softslave::Firmware through an adapter).
+    // Firmware entry points (slave::Firmware through an adapter).
     void poll(uint64_t now_ns);
     uint64_t next_deadline_ns() const;
 
@@ -171,7 +171,7 @@ class Device final : public ecat::Application, public drive::EventSink, public e
     void save_eeprom_writes();
     void react_to_outputs_lost();
     std::ostream& log() const;
-    void event(softslave::LogLevel level, const std::string& text) const;
+    void event(slave::LogLevel level, const std::string& text) const;
 
     esc::Esc& esc_;
     DeviceOptions options_;
@@ -187,4 +187,4 @@ class Device final : public ecat::Application, public drive::EventSink, public e
     uint64_t eeprom_save_ns_ = 0;  // when the written words are saved; 0: not yet scheduled
 };
 
-}  // namespace softdrive
+}  // namespace device

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-namespace softdrive {
+namespace device {
 
 class EepromWrites {
   public:
@@ -50,4 +50,4 @@ class EepromWrites {
 std::vector<std::string> sii_drift(std::span<const uint8_t> image, uint32_t vendor_id, uint32_t product_code,
                                    uint32_t revision, uint32_t serial_number);
 
-}  // namespace softdrive
+}  // namespace device

@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "esc/esc.hpp"
-#include "softslave/firmware.hpp"
+#include "slave/firmware.hpp"
 
-namespace softslave {
+namespace slave {
 
 struct SlaveOptions;
 
@@ -54,4 +54,4 @@ inline constexpr int kExitUsage = 2;    // bad options, missing interface, missi
 // Runs the slave until SIGINT/SIGTERM. Messages go to out (status) and err (errors).
 int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err);
 
-}  // namespace softslave
+}  // namespace slave

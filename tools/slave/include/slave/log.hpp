@@ -7,7 +7,7 @@
 #include <optional>
 #include <string_view>
 
-namespace softslave {
+namespace slave {
 
 enum class LogLevel : uint8_t { Error = 0, Warn = 1, Info = 2, Debug = 3 };
 
@@ -43,4 +43,4 @@ class Log {
 // Whether stderr is a terminal (colour) and not redirected, e.g. to the journal.
 bool stderr_is_terminal();
 
-}  // namespace softslave
+}  // namespace slave

@@ -28,9 +28,9 @@
 #include "esc/esc.hpp"
 #include "esc/link.hpp"
 #include "esc/link_capture.hpp"
-#include "softslave/firmware.hpp"
+#include "slave/firmware.hpp"
 
-namespace softslave {
+namespace slave {
 
 struct RuntimeStats {
     uint64_t frames_received = 0;
@@ -126,4 +126,4 @@ void install_stop_signals();
 void set_signal_target(Runtime* runtime);
 bool stop_signalled();
 
-}  // namespace softslave
+}  // namespace slave

@@ -7,7 +7,7 @@
 #include <iosfwd>
 #include <limits>
 
-namespace softslave {
+namespace slave {
 
 class Firmware {
   public:
@@ -43,4 +43,4 @@ class FirmwareAdapter final : public Firmware {
     T& target_;
 };
 
-}  // namespace softslave
+}  // namespace slave

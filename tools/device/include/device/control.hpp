@@ -18,7 +18,7 @@
 #include <string_view>
 #include <vector>
 
-namespace softdrive {
+namespace device {
 
 class Device;
 
@@ -44,4 +44,4 @@ class ControlSocket {
     std::vector<char> buffer_;
 };
 
-}  // namespace softdrive
+}  // namespace device

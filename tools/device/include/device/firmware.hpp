@@ -1,18 +1,18 @@
 #pragma once
 // The soft drive as the slave runtime's firmware: a Device (plus an optional control socket) behind the
-// softslave::Firmware interface, and the factory/loader that plug it into softslave::SlaveOptions.
+// slave::Firmware interface, and the factory/loader that plug it into slave::SlaveOptions.
 #include <cstdint>
 #include <filesystem>
 #include <memory>
 
-#include "softdrive/control.hpp"
-#include "softdrive/device.hpp"
-#include "softslave/firmware.hpp"
-#include "softslave/slave.hpp"
+#include "device/control.hpp"
+#include "device/device.hpp"
+#include "slave/firmware.hpp"
+#include "slave/slave.hpp"
 
-namespace softdrive {
+namespace device {
 
-class DeviceFirmware final : public softslave::Firmware {
+class DeviceFirmware final : public slave::Firmware {
   public:
     // control_path: where to create the control socket; empty: none.
     DeviceFirmware(esc::Esc& esc, DeviceOptions options, const std::filesystem::path& control_path = {});
@@ -36,8 +36,8 @@ class DeviceFirmware final : public softslave::Firmware {
 
 // SlaveOptions::firmware_factory for the soft drive. options.load_sii is set from whether the slave
 // serves a user's image (SlaveOptions::eeprom_file).
-softslave::FirmwareFactory firmware_factory(DeviceOptions options, std::filesystem::path control_path = {});
+slave::FirmwareFactory firmware_factory(DeviceOptions options, std::filesystem::path control_path = {});
 // SlaveOptions::eeprom_loader: the user's --eeprom file if one is given, else the SII built from the model.
-softslave::EepromLoader eeprom_loader(DeviceOptions options);
+slave::EepromLoader eeprom_loader(DeviceOptions options);
 
-}  // namespace softdrive
+}  // namespace device

@@ -7,7 +7,7 @@
 
 #include "esc/link.hpp"
 
-namespace softslave {
+namespace slave {
 
 bool interface_exists(const std::string& name);
 // Creates the veth pair a <-> b (both down).
@@ -46,4 +46,4 @@ class VethPair {
 // otherwise "-m" is appended (ecat -> ecat-m).
 std::string veth_peer_name(const std::string& slave_end);
 
-}  // namespace softslave
+}  // namespace slave

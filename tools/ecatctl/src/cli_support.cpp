@@ -1,0 +1,89 @@
+// Helpers the commands of main.cpp share: failures and usage errors, naming the slave, the mailbox.
+#include <CLI/CLI.hpp>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "format.hpp"
+#include "master/coe.hpp"
+#include "master/foe.hpp"
+#include "master/mailbox.hpp"
+#include "master/master.hpp"
+#include "master/session.hpp"
+
+namespace ecatctl {
+
+using master::Address;
+using master::Error;
+
+master::AlStatus g_refusal;
+
+int fail(Error e, const std::string& what) {
+    if (e == Error::AlRefused) {
+        std::fprintf(stderr, "ecatctl: %s: refused, stays in %s, AL status code 0x%04x (%s)\n", what.c_str(),
+                     std::string(master::al_state_name(g_refusal.state)).c_str(), g_refusal.code,
+                     std::string(master::al_status_code_name(g_refusal.code)).c_str());
+        return kExitProtocol;
+    }
+    return report_error(e, what);
+}
+
+int usage(const std::string& what) {
+    std::cerr << "ecatctl: " << what << "\n";
+    return kExitUsage;
+}
+
+std::optional<Address> parse_slave(const std::string& text, bool station) {
+    auto v = parse_number(text, 0xFFFF);
+    if (!v) return std::nullopt;
+    return station ? Address::station(static_cast<uint16_t>(*v))
+                   : Address::position(static_cast<uint16_t>(*v));
+}
+
+// The slave a command names; a bad one is reported as a usage error (exit kExitUsage) and gives nullopt.
+std::optional<Address> named_slave(const std::string& text, bool station) {
+    auto a = parse_slave(text, station);
+    if (!a) usage("bad slave '" + text + "'");
+    return a;
+}
+
+std::string slave_text(Address a) {
+    char b[32];
+    std::snprintf(b, sizeof b, a.mode == Address::Mode::Station ? "station 0x%04x" : "slave %u", a.value);
+    return b;
+}
+
+std::optional<std::vector<uint8_t>> read_file(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) return std::nullopt;
+    return std::vector<uint8_t>(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+// A slave in INIT gets its mailbox SMs from its SII and is taken to PREOP; one already in PREOP or above
+// keeps the SMs it has.
+Error open_mailbox(master::Master& m, master::Mailbox& mbx, Address a) {
+    auto st = m.al_status(a);
+    if (!st) return st.error();
+    if (st->state == static_cast<uint8_t>(master::AlState::Init)) {
+        if (Error e = mbx.configure_from_sii(); e != Error::Ok) return e;
+        master::AlStatus final;
+        const Error e = m.request_state(a, master::AlState::PreOp, &final);
+        if (e == Error::AlRefused) g_refusal = final;  // fail() reports it, in one message
+        return e;
+    }
+    return mbx.adopt_current();
+}
+
+int sdo_failed(const master::SdoClient& sdo, Error e, const std::string& what) {
+    return report_sdo_failure(sdo, e, what, fail);
+}
+
+}  // namespace ecatctl

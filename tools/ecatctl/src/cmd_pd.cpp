@@ -1,0 +1,195 @@
+// `ecatctl pd`: bring a slave to OP and exchange process data cyclically (LRW), with optional DC.
+#include <CLI/CLI.hpp>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cmd_verbs.hpp"
+#include "coe_view.hpp"
+#include "commands.hpp"
+#include "common.hpp"
+#include "format.hpp"
+#include "master/coe.hpp"
+#include "master/foe.hpp"
+#include "master/mailbox.hpp"
+#include "master/master.hpp"
+#include "master/session.hpp"
+
+namespace ecatctl {
+
+namespace {
+
+using master::Address;
+using master::Error;
+
+struct PdArgs {
+    std::string slave = "0";
+    unsigned cycle_us = 1000;
+    uint64_t count = 1000;
+    bool dc = false;
+    std::string state = "OP";
+    std::vector<std::string> outputs;
+    std::vector<std::string> steps;
+    bool keep = false;
+    bool station = false;  // slave is a station address (as scan assigns them)
+};
+
+// "CYCLES:B0,B1,..." -> cycles and the output bytes sent (from the first byte) during them.
+struct Step {
+    uint64_t cycles = 0;
+    std::vector<uint8_t> bytes;
+};
+std::optional<Step> parse_step(const std::string& text) {
+    const auto colon = text.find(':');
+    if (colon == std::string::npos) return std::nullopt;
+    auto n = parse_number(text.substr(0, colon), 10'000'000);
+    if (!n) return std::nullopt;
+    Step st;
+    st.cycles = *n;
+    std::string rest = text.substr(colon + 1);
+    std::size_t pos = 0;
+    while (pos <= rest.size()) {
+        const auto comma = rest.find(',', pos);
+        const std::string item =
+            rest.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+        if (item.empty()) return std::nullopt;
+        const bool hex_digits = item.find_first_not_of("0123456789abcdefABCDEF") == std::string::npos;
+        auto b = parse_number(hex_digits && item.size() <= 2 ? "0x" + item : item, 0xFF);
+        if (!b) return std::nullopt;
+        st.bytes.push_back(static_cast<uint8_t>(*b));
+        if (comma == std::string::npos) break;
+        pos = comma + 1;
+    }
+    return st;
+}
+
+int process_data(master::Master& m, const PdArgs& p) {
+    auto pos = parse_number(p.slave, 0xFFFF);
+    if (!pos) return usage("bad slave '" + p.slave + "'");
+    std::string t = p.state;
+    for (auto& c : t)
+        c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    if (t != "OP" && t != "SAFEOP") return usage("--state must be SAFEOP or OP");
+    for (const std::string& text : p.steps)
+        if (!parse_step(text)) return usage("bad --step '" + text + "' (CYCLES:BYTE,BYTE,... e.g. 50:06,00)");
+    std::vector<uint8_t> out_bytes;
+    for (const std::string& v : p.outputs) {
+        auto b = parse_number(v, 0xFF);
+        if (!b) return usage("bad output byte '" + v + "'");
+        out_bytes.push_back(static_cast<uint8_t>(*b));
+    }
+    // Station addresses as scan gives them; DC's FRMW addresses the reference clock by station.
+    auto n = m.count_slaves();
+    if (!n) return fail(n.error(), "counting slaves (BRD 0x0000)");
+    if (!p.station && *pos >= *n)
+        return check_slave_present(m, Address::position(static_cast<uint16_t>(*pos)));
+    if (Error e = m.assign_station_addresses(*n); e != Error::Ok)
+        return fail(e, "assigning station addresses");
+    const Address a = Address::station(static_cast<uint16_t>(p.station ? *pos : 0x1001 + *pos));
+    if (p.station)
+        if (int rc = check_slave_present(m, a); rc != kExitOk) return rc;
+    // Configuration happens in PREOP.
+    auto st = m.al_status(a);
+    if (!st) return fail(st.error(), "reading the AL status");
+    const auto init = static_cast<uint8_t>(master::AlState::Init);
+    const auto preop = static_cast<uint8_t>(master::AlState::PreOp);
+    if (st->state != init && (st->state != preop || st->error)) {
+        if (Error e = m.request_state(a, master::AlState::PreOp); e != Error::Ok)
+            return fail(e, "going to PREOP");
+    }
+    master::Mailbox mbx(m, a);
+    if (Error e = open_mailbox(m, mbx, a); e != Error::Ok) return fail(e, "opening the mailbox");
+    master::SdoClient sdo(mbx);
+    master::ProcessDataSession pd(m, a, sdo);
+    if (Error e = pd.discover(); e != Error::Ok) return sdo_failed(sdo, e, "reading the process-data layout");
+    std::vector<SyncView> pdo_config;  // names and types of the entries, for the decoded images at the end
+    if (Error e = read_pdo_config(sdo, pdo_config); e != Error::Ok) pdo_config.clear();
+    const auto& l = pd.layout();
+    std::printf("outputs: SM2 0x%04x, %u bytes; inputs: SM3 0x%04x, %u bytes\n", l.sm2_start, l.sm2_length,
+                l.sm3_start, l.sm3_length);
+    master::DcConfig dc;
+    dc.enable = p.dc;
+    dc.cycle_ns = p.cycle_us * 1000u;
+    if (Error e = pd.configure(dc); e != Error::Ok) return sdo_failed(sdo, e, "configuring process data");
+    const auto period = std::chrono::microseconds(p.cycle_us);
+    auto fill = [&] {
+        auto o = pd.outputs();
+        std::copy_n(out_bytes.begin(), std::min(out_bytes.size(), o.size()), o.begin());
+    };
+    master::AlStatus final;
+    auto go = [&](master::AlState s, const char* name) {
+        const Error e = pd.request_state(s, period, &final, fill);
+        if (e == Error::AlRefused) {
+            std::fprintf(stderr, "ecatctl: %s refused: AL status code 0x%04x (%s)\n", name, final.code,
+                         std::string(master::al_status_code_name(final.code)).c_str());
+            return kExitProtocol;
+        }
+        return e == Error::Ok ? kExitOk : fail(e, std::string("requesting ") + name);
+    };
+    if (int rc = go(master::AlState::SafeOp, "SAFEOP"); rc != kExitOk) return rc;
+    if (t == "OP")
+        if (int rc = go(master::AlState::Op, "OP"); rc != kExitOk) return rc;
+    const master::CycleStats before = pd.stats();
+    const std::vector<uint8_t> final_outputs = out_bytes;
+    for (const std::string& text : p.steps) {
+        auto step = parse_step(text);  // validated before anything was sent
+        out_bytes = step->bytes;
+        pd.run(step->cycles, period, fill);
+    }
+    if (!p.outputs.empty() || p.steps.empty()) out_bytes = final_outputs;  // else the last step's bytes stay
+    pd.run(p.count, period, fill);
+    const auto& s = pd.stats();
+    const uint64_t cycles = s.cycles - before.cycles;
+    const uint64_t ok = cycles - (s.lost - before.lost);
+    const double avg =
+        ok ? static_cast<double>((s.rtt_sum - before.rtt_sum).count()) / 1000.0 / static_cast<double>(ok) : 0;
+    auto now = m.al_status(a);
+    std::printf("state: %s%s\n", now ? std::string(master::al_state_name(now->state)).c_str() : "?",
+                now && now->error ? " +ERR" : "");
+    std::printf(
+        "cycles %llu, lost %llu, wkc errors %llu (expected wkc %u), rtt min %.1f us, avg %.1f us, max %.1f "
+        "us\n",
+        static_cast<unsigned long long>(cycles), static_cast<unsigned long long>(s.lost - before.lost),
+        static_cast<unsigned long long>(s.wkc_errors - before.wkc_errors), pd.expected_wkc(),
+        static_cast<double>(s.rtt_min.count()) / 1000.0, avg,
+        static_cast<double>(s.rtt_max.count()) / 1000.0);
+    if (p.dc)
+        std::printf("reference system time %llu ns\n", static_cast<unsigned long long>(pd.reference_time()));
+    std::printf("inputs:\n%s", hex_dump(0, pd.inputs()).c_str());
+    print_pd_entries(pdo_config, pd.outputs(), pd.inputs());
+    if (!p.keep) (void)m.request_state(a, master::AlState::PreOp);
+    const bool clean = s.lost == before.lost && s.wkc_errors == before.wkc_errors && now && !now->error;
+    return clean ? kExitOk : kExitProtocol;
+}
+
+}  // namespace
+
+void add_pd_command(CLI::App& app, MasterRunner run, int& rc) {
+    auto pa = std::make_shared<PdArgs>();
+    auto* pdc = app.add_subcommand(
+        "pd", "Bring a slave to OP and exchange process data cyclically (LRW), with optional DC");
+    pdc->add_option("slave", pa->slave, "Slave position (or station address with --station)")
+        ->capture_default_str();
+    pdc->add_flag("-s,--station", pa->station, "<slave> is a station address (scan assigns 0x1001..)");
+    pdc->add_option("--cycle-us", pa->cycle_us, "Cycle time in microseconds")
+        ->check(CLI::Range(50u, 1000000u))
+        ->capture_default_str();
+    pdc->add_option("-n,--count", pa->count, "Cycles to run once the state is reached")
+        ->capture_default_str();
+    pdc->add_flag("--dc", pa->dc, "Distributed clocks: SYNC0 at the cycle time, sync mode DC SYNC0");
+    pdc->add_option("--state", pa->state, "SAFEOP or OP")->capture_default_str();
+    pdc->add_option("--outputs", pa->outputs, "Output bytes sent every cycle (from the first byte)");
+    pdc->add_option("--step", pa->steps,
+                    "CYCLES:BYTES before the --count cycles, in order; bytes in hex, comma-separated "
+                    "(e.g. --step 50:06,00 --step 50:0f,00)");
+    pdc->add_flag("--keep", pa->keep, "Leave the slave in the state reached (default: back to PREOP)");
+    pdc->callback([pa, run, &rc] { rc = run([&](master::Master& m) { return process_data(m, *pa); }); });
+}
+
+}  // namespace ecatctl

@@ -1,0 +1,50 @@
+#pragma once
+// The ecatctl commands main.cpp wires, one file each, and the helpers they share (cli_support.cpp):
+//   scan                     cmd_scan.cpp     sii read|write|decode  cmd_sii.cpp
+//   reg read|write           cmd_reg.cpp      upload|download        cmd_sdo.cpp
+//   pd                       cmd_pd.cpp       sdos                   cmd_sdos.cpp
+//   foe read|write           cmd_foe.cpp      state                  cmd_state.cpp
+//   diag                     cmd_diag.cpp     firmware-update        cmd_firmware.cpp
+//   slaves, pdos, cstruct, xml (the IgH/SOEM-style verbs)          cmd_verbs.hpp
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cmd_diag.hpp"  // MasterRunner
+#include "master/coe.hpp"
+#include "master/mailbox.hpp"
+#include "master/master.hpp"
+
+namespace ecatctl {
+
+void add_scan_command(CLI::App& app, MasterRunner run, int& rc);
+void add_reg_command(CLI::App& app, MasterRunner run, int& rc);
+void add_sii_command(CLI::App& app, MasterRunner run, int& rc);
+void add_sdo_commands(CLI::App& app, MasterRunner run, int& rc);  // upload, download
+void add_pd_command(CLI::App& app, MasterRunner run, int& rc);
+void add_sdos_command(CLI::App& app, MasterRunner run, int& rc);
+void add_foe_command(CLI::App& app, MasterRunner run, int& rc);
+
+// ---- cli_support.cpp -----------------------------------------------------------------------------
+
+// The AL status of the last refused state request, for fail() to report.
+extern master::AlStatus g_refusal;
+// "ecatctl: <what>: <error>" (a refused state request with its AL status code); returns the exit code.
+int fail(master::Error e, const std::string& what);
+// "ecatctl: <what>"; returns kExitUsage.
+int usage(const std::string& what);
+std::optional<master::Address> parse_slave(const std::string& text, bool station);
+// The slave a command names; a bad one is reported as a usage error (exit kExitUsage) and gives nullopt.
+std::optional<master::Address> named_slave(const std::string& text, bool station);
+// "slave 3" or "station 0x1001".
+std::string slave_text(master::Address a);
+std::optional<std::vector<uint8_t>> read_file(const std::string& path);
+// A slave in INIT gets its mailbox SMs from its SII and is taken to PREOP; one already in PREOP or above
+// keeps the SMs it has.
+master::Error open_mailbox(master::Master& m, master::Mailbox& mbx, master::Address a);
+// The end of a failed SDO transfer (abort code and text, mailbox error, or fail()).
+int sdo_failed(const master::SdoClient& sdo, master::Error e, const std::string& what);
+
+}  // namespace ecatctl
