@@ -15,20 +15,20 @@ namespace coe {
 
 namespace {
 
-constexpr uint8_t kOpOdListReq = 0x01;
-constexpr uint8_t kOpOdListResp = 0x02;
-constexpr uint8_t kOpObjDescReq = 0x03;
-constexpr uint8_t kOpObjDescResp = 0x04;
-constexpr uint8_t kOpEntryDescReq = 0x05;
-constexpr uint8_t kOpEntryDescResp = 0x06;
-constexpr uint8_t kOpError = 0x07;
-constexpr uint8_t kIncomplete = 0x80;
-constexpr std::size_t kInfoHead = 6;  // CoE header 2 + opcode 1 + reserved 1 + fragments left 2
-
-constexpr uint8_t kValueInfoUnit = 0x08;
-constexpr uint8_t kValueInfoDefault = 0x10;
-constexpr uint8_t kValueInfoMin = 0x20;
-constexpr uint8_t kValueInfoMax = 0x40;
+// SDO information opcodes and value info bits: the CoE vocabulary (coe/wire/sdo.hpp).
+constexpr uint8_t kOpOdListReq = info::kOdListReq;
+constexpr uint8_t kOpOdListResp = info::kOdListResp;
+constexpr uint8_t kOpObjDescReq = info::kObjDescReq;
+constexpr uint8_t kOpObjDescResp = info::kObjDescResp;
+constexpr uint8_t kOpEntryDescReq = info::kEntryDescReq;
+constexpr uint8_t kOpEntryDescResp = info::kEntryDescResp;
+constexpr uint8_t kOpError = info::kError;
+using info::kIncomplete;
+using info::kValueInfoDefault;
+using info::kValueInfoMax;
+using info::kValueInfoMin;
+using info::kValueInfoUnit;
+constexpr std::size_t kInfoHead = info::kHead;
 
 std::size_t value_size(const od::Entry& e) {
     return e.byte_size();

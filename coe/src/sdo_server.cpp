@@ -11,20 +11,19 @@ namespace coe {
 
 namespace {
 
-// SDO command specifiers (bits 7:5 of the command byte).
-constexpr uint8_t kCcsDownloadSegment = 0;
-constexpr uint8_t kCcsDownloadInitiate = 1;
-constexpr uint8_t kCcsUploadInitiate = 2;
-constexpr uint8_t kCcsUploadSegment = 3;
-constexpr uint8_t kCcsAbort = 4;
+// SDO command specifiers, command byte bits and sizes: the CoE vocabulary (coe/wire/sdo.hpp).
+using sdo::kCcsAbort;
+using sdo::kCcsDownloadInitiate;
+using sdo::kCcsDownloadSegment;
+using sdo::kCcsUploadInitiate;
+using sdo::kCcsUploadSegment;
+using sdo::kCmdCompleteAccess;
+using sdo::kCmdExpedited;
+using sdo::kCmdLastSegment;
+using sdo::kCmdSizeIndicated;
+using sdo::kSdoFrame;
+using sdo::kSegmentHead;
 
-constexpr uint8_t kCmdCompleteAccess = 0x10;  // initiate: complete access; segments: toggle
-constexpr uint8_t kCmdExpedited = 0x02;
-constexpr uint8_t kCmdSizeIndicated = 0x01;
-constexpr uint8_t kCmdLastSegment = 0x01;
-
-constexpr std::size_t kSdoFrame = 10;    // CoE header 2 + command 1 + index 2 + subindex 1 + data 4
-constexpr std::size_t kSegmentHead = 3;  // CoE header 2 + command 1
 constexpr std::size_t kMinMessage = 64;  // initial size of the message buffers
 
 bool writable_at_all(const od::Entry& e) {

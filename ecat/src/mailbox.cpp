@@ -5,19 +5,15 @@
 
 #include "ecat/registers.hpp"
 
+#include "util/le.hpp"
+
 namespace ecat {
 namespace {
+using util::get16;
+using util::put16;
 
 constexpr uint8_t kSm0 = 0;
 constexpr uint8_t kSm1 = 1;
-
-uint16_t le16(const uint8_t* p) {
-    return static_cast<uint16_t>(p[0] | (p[1] << 8));
-}
-void put_le16(uint8_t* p, uint16_t v) {
-    p[0] = static_cast<uint8_t>(v);
-    p[1] = static_cast<uint8_t>(v >> 8);
-}
 
 // Smallest protocol header after the mailbox header; a shorter request is "size too short" (ETG.1000.6,
 // mailbox error reply).
@@ -113,8 +109,8 @@ bool Mailbox::send(MailboxType type, std::span<const uint8_t> payload) {
     }
     const std::size_t index = (head_ + count_) % kQueueCapacity;
     uint8_t* m = slot(index);
-    put_le16(m, static_cast<uint16_t>(payload.size()));
-    put_le16(m + 2, reply_address_);
+    put16(m, static_cast<uint16_t>(payload.size()));
+    put16(m + 2, reply_address_);
     m[4] = 0;                                  // channel 0, priority 0
     m[5] = static_cast<uint8_t>(type) & 0x0F;  // counter assigned when first written into SM1
     if (!payload.empty()) std::memcpy(m + kMailboxHeaderSize, payload.data(), payload.size());
@@ -125,8 +121,8 @@ bool Mailbox::send(MailboxType type, std::span<const uint8_t> payload) {
 
 bool Mailbox::send_error(MailboxError detail) {
     uint8_t body[4];
-    put_le16(body, 0x0001);  // mailbox command error
-    put_le16(body + 2, static_cast<uint16_t>(detail));
+    put16(body, 0x0001);  // mailbox command error
+    put16(body + 2, static_cast<uint16_t>(detail));
     const bool ok = send(MailboxType::Error, body);
     if (ok) ++stats_.errors_sent;
     return ok;
@@ -158,8 +154,8 @@ void Mailbox::receive() {
 
 void Mailbox::dispatch(std::span<const uint8_t> message) {
     if (message.size() < kMailboxHeaderSize) return;
-    const uint16_t length = le16(message.data());
-    const uint16_t address = le16(message.data() + 2);
+    const uint16_t length = get16(message.data());
+    const uint16_t address = get16(message.data() + 2);
     const uint8_t channel = message[4] & 0x3F;
     const uint8_t type = message[5] & 0x0F;
     const uint8_t counter = (message[5] >> 4) & 0x07;

@@ -5,19 +5,14 @@
 #include <cstring>
 #include <system_error>
 
+#include "util/le.hpp"
+
 namespace foe {
 namespace {
+using util::get32;
+using util::put32;
 
-constexpr std::size_t kFoeHeader = 6;
-
-uint32_t le32(const uint8_t* p) {
-    return static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 |
-           static_cast<uint32_t>(p[2]) << 16 | static_cast<uint32_t>(p[3]) << 24;
-}
-void put32(uint8_t* p, uint32_t v) {
-    for (int i = 0; i < 4; ++i)
-        p[i] = static_cast<uint8_t>(v >> (8 * i));
-}
+constexpr std::size_t kFoeHeader = kFoeHeaderSize;  // foe/wire/foe.hpp
 
 char lower(char c) {
     return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c;
@@ -106,7 +101,7 @@ void FoeServer::handle(std::span<const uint8_t> payload, ecat::MailboxSender& ou
         return;
     }
     const uint8_t opcode = payload[0];
-    const uint32_t value = le32(payload.data() + 2);
+    const uint32_t value = get32(payload.data() + 2);
     const auto rest = payload.subspan(kFoeHeader);
     switch (static_cast<Opcode>(opcode)) {
         case Opcode::Read:

@@ -4,6 +4,7 @@
 #include <thread>
 
 #include "conform.hpp"
+#include "esi/wire/sii.hpp"
 
 namespace conform {
 
@@ -52,13 +53,7 @@ std::string state_text(uint8_t s) {
 
 // ---- SII -------------------------------------------------------------------------------------------
 uint8_t sii_crc8(std::span<const uint8_t> bytes) {
-    uint8_t crc = 0xFF;
-    for (uint8_t b : bytes) {
-        crc ^= b;
-        for (int i = 0; i < 8; ++i)
-            crc = static_cast<uint8_t>(crc & 0x80 ? (crc << 1) ^ 0x07 : crc << 1);
-    }
-    return crc;
+    return esi::sii::crc8(bytes.data(), bytes.size());
 }
 
 uint16_t SiiImage::word(std::size_t w) const {
