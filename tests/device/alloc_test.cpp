@@ -10,7 +10,6 @@
 #include <filesystem>
 #include <memory>
 
-#include "support/alloc_counter.hpp"
 #include "device/device.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
@@ -18,6 +17,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
+#include "support/alloc_counter.hpp"
 
 #include "support/alloc_counter.hpp"
 
