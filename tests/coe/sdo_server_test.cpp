@@ -358,7 +358,7 @@ TEST_F(SdoServer, ValidatorResultsReachTheMasterAsTheirAbortCodes) {
 // ---- Complete access ------------------------------------------------------------------------------------
 
 TEST_F(SdoServer, CompleteAccessUploadOf1C12PadsSubindex0To16Bits) {
-    // architecture-lessons: 0x1C12 with one PDO reads 01 00 | 00 16.
+    // ETG.1000.6 complete access: subindex 0 travels as 16 bits, so 0x1C12 with one PDO reads 01 00 | 00 16.
     EXPECT_EQ(ask(sdo(0x50, 0x1C12, 0)), (Bytes{0x00, 0x30, 0x53, 0x12, 0x1C, 0x00, 0x01, 0x00, 0x00, 0x16}));
 }
 

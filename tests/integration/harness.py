@@ -40,7 +40,7 @@ def sii_crc(data14):
 
 def build_sii(vendor=0x000000FB, product=0x30010000, revision=0x01200000, serial=0x00001234,
               name="Soft slave", size=2048, mailbox=(0x1000, 128, 0x1080, 128), alias=0):
-    """An SII image (ethercat-protocol.md §7): header with CRC, STRINGS, GENERAL, SyncM, end; padded
+    """An SII image (ETG.2010 SII layout): header with CRC, STRINGS, GENERAL, SyncM, end; padded
     with 0xFF to `size` bytes as an erased EEPROM."""
     w = [0] * 0x40
     w[0] = 0x0C05  # PDI SPI, DC sync/latch units on

@@ -135,7 +135,7 @@ class SdoAbortsThroughEcatctl(unittest.TestCase):
         self.assert_abort(0x08000020, "download", "0", "0x1010", "1", "0x12345678", "--type", "u32")
 
     def test_not_in_this_state(self):
-        # Mapping entries are writable in PREOP only (seed 001: RW in Pre-Operational).
+        # Mapping entries are writable in PREOP only (MAXPOS firmware specification: RW in Pre-Operational).
         r = self.bus.ecatctl("pd", "0", "--state", "SAFEOP", "-n", "10", "--keep", check=False)
         if r.returncode != 0:
             self.skipTest(f"SAFEOP not reached: {r.stderr.strip()}")

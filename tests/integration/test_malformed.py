@@ -1,5 +1,5 @@
 """Frames crafted with scapy that a real master would never send: the slave survives each one and
-answers the next good frame (ethercat-protocol.md §1)."""
+answers the next good frame (ETG.1000.4 frame structure)."""
 import struct
 import unittest
 

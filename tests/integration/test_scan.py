@@ -43,7 +43,7 @@ class Scan(unittest.TestCase):
             _, _, state, vendor, product, _revision, _serial, name = rows[0]
             self.assertTrue(name, "no device name from the SII")
             self.assertEqual(int(vendor, 16), 0x000000FB)  # maxon motor ag
-            self.assertEqual(int(product, 16), 0x30010000)  # MAXPOS 50/5 (seed 001 §7.2.4.3)
+            self.assertEqual(int(product, 16), 0x30010000)  # MAXPOS 50/5 (MAXPOS firmware specification §7.2.4.3)
             self.assertRegex(state, r"^(INIT|PREOP|SAFEOP|OP|BOOT)")
 
     def test_both_link_backends_on_the_master_side(self):
