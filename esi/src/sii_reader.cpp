@@ -15,17 +15,6 @@ namespace esi {
 
 namespace {
 
-// CRC-8 of the SII header words 0-6 (polynomial x^8 + x^2 + x + 1, initial value 0xFF; ETG.2010).
-uint8_t header_crc8(const uint8_t* data, std::size_t size) {
-    uint8_t crc = 0xFF;
-    for (std::size_t i = 0; i < size; ++i) {
-        crc ^= data[i];
-        for (int b = 0; b < 8; ++b)
-            crc = (crc & 0x80) ? static_cast<uint8_t>((crc << 1) ^ 0x07) : static_cast<uint8_t>(crc << 1);
-    }
-    return crc;
-}
-
 // Bounds-checked little-endian reader over one span; reads past the end give 0 and set short_read.
 struct Reader {
     std::span<const uint8_t> s;
@@ -189,7 +178,7 @@ SiiInfo parse_sii(std::span<const uint8_t> image) {
     info.extended_pdi_config = r.u16(6);
     info.station_alias = r.u16(8);
     info.checksum_word = r.u16(14);
-    if (r.has(0, 14)) info.crc_computed = header_crc8(image.data(), 14);
+    if (r.has(0, sii::kCrcBytes)) info.crc_computed = sii::crc8(image.data(), sii::kCrcBytes);
     info.crc_disabled = r.has(14, 2) && info.checksum_word == kSiiChecksumDisabled;
     info.crc_ok = r.has(14, 2) && (info.crc_disabled || (info.checksum_word & 0xFF) == info.crc_computed);
     if (r.has(14, 2) && !info.crc_ok)

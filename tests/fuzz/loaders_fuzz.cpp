@@ -23,6 +23,7 @@
 #include "od/device_config.hpp"
 #include "od/drive_profile.hpp"
 #include "od/store.hpp"
+#include "util/le.hpp"
 
 namespace fuzz::loaders {
 namespace {
@@ -50,14 +51,8 @@ void write_file(const std::filesystem::path& p, std::span<const uint8_t> bytes) 
     std::ofstream f(p, std::ios::binary | std::ios::trunc);
     f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
 }
-void put32(std::vector<uint8_t>& b, std::size_t at, uint32_t v) {
-    for (int i = 0; i < 4; ++i)
-        b[at + static_cast<std::size_t>(i)] = static_cast<uint8_t>(v >> (8 * i));
-}
-uint32_t get32(const std::vector<uint8_t>& b, std::size_t at) {
-    return static_cast<uint32_t>(b[at] | b[at + 1] << 8 | b[at + 2] << 16 |
-                                 static_cast<uint32_t>(b[at + 3]) << 24);
-}
+using util::get32;
+using util::put32;
 
 const od::DeviceDescription& description() {
     static const od::DeviceDescription d = od::default_drive_description();

@@ -23,6 +23,7 @@
 #include "master/frame.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
+#include "util/le.hpp"
 
 namespace fuzz::master_reply {
 namespace {
@@ -67,7 +68,7 @@ class ReplyLink final : public esc::Link {
     void echo(bool new_data, uint8_t wkc) {
         std::size_t at = 16;
         for (int n = 0; n < 255 && at + 12 <= reply_.size(); ++n) {
-            const unsigned lf = reply_[at + 6] | reply_[at + 7] << 8;
+            const unsigned lf = util::get16(&reply_[at + 6]);
             const std::size_t len = lf & 0x07FF;
             if (at + 10 + len + 2 > reply_.size()) break;
             if (new_data) {

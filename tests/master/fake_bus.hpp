@@ -13,16 +13,13 @@
 #include <vector>
 
 #include "esc/link.hpp"
+#include "util/le.hpp"
 
 namespace fake {
 
-inline uint16_t get16(const uint8_t* p) {
-    return static_cast<uint16_t>(p[0] | (p[1] << 8));
-}
-inline void put16(uint8_t* p, uint16_t v) {
-    p[0] = static_cast<uint8_t>(v);
-    p[1] = static_cast<uint8_t>(v >> 8);
-}
+// Little-endian access: the project's helpers (util/le.hpp).
+using util::get16;
+using util::put16;
 
 struct Slave {
     std::vector<uint8_t> mem = std::vector<uint8_t>(0x2000, 0);

@@ -37,6 +37,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "slave/netif.hpp"
+#include "util/le.hpp"
 
 namespace {
 
@@ -110,7 +111,7 @@ bool wait_for_slave(master::Master& m) {
     const auto deadline = Clock::now() + std::chrono::seconds(10);
     while (Clock::now() < deadline) {
         uint8_t b[1];
-        if (m.read(kSlave, 0x0000, b) == Error::Ok) return true;
+        if (m.read(kSlave, esc::reg::kType, b) == Error::Ok) return true;
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     return false;
@@ -162,8 +163,7 @@ void measure_throughput(const Options& o, unsigned size, const std::filesystem::
         r.failure = std::string("SII identity: ") + err(e);
         return;
     }
-    const foe::ImageIdentity who{static_cast<uint32_t>(id[0] | id[1] << 8 | id[2] << 16 | id[3] << 24),
-                                 static_cast<uint32_t>(id[4] | id[5] << 8 | id[6] << 16 | id[7] << 24)};
+    const foe::ImageIdentity who{util::get32(id), util::get32(id + 4)};
     std::vector<uint8_t> payload(o.bytes > foe::kImageHeaderSize ? o.bytes - foe::kImageHeaderSize : 1);
     for (std::size_t i = 0; i < payload.size(); ++i)
         payload[i] = static_cast<uint8_t>(i * 7 + (i >> 9));
@@ -255,8 +255,7 @@ void measure_update(const Options& o, const std::filesystem::path& dir, UpdateTi
             r.failure = std::string("SII identity: ") + err(e);
             return;
         }
-        who = {static_cast<uint32_t>(id[0] | id[1] << 8 | id[2] << 16 | id[3] << 24),
-               static_cast<uint32_t>(id[4] | id[5] << 8 | id[6] << 16 | id[7] << 24)};
+        who = {util::get32(id), util::get32(id + 4)};
     }
     std::vector<uint8_t> payload(o.update_bytes - foe::kImageHeaderSize);
     for (std::size_t i = 0; i < payload.size(); ++i)

@@ -149,7 +149,7 @@ int main(int argc, char** argv) {
         uint8_t al[2];
         bool up = false;
         for (int i = 0; i < 100 && !up; ++i) {
-            up = m.read(a, 0x0130, al) == master::Error::Ok;
+            up = m.read(a, esc::reg::kAlStatus, al) == master::Error::Ok;
             if (!up) std::this_thread::sleep_for(std::chrono::milliseconds(50));
         }
         if (!up) throw std::runtime_error("ecat-slave does not answer");
@@ -175,7 +175,7 @@ int main(int argc, char** argv) {
         std::size_t failed = 0;
         auto frame_rtt = [&] {
             const uint64_t t0 = now_ns();
-            if (m.read(a, 0x0130, al) == master::Error::Ok) return now_ns() - t0;
+            if (m.read(a, esc::reg::kAlStatus, al) == master::Error::Ok) return now_ns() - t0;
             ++failed;
             return uint64_t{0};
         };

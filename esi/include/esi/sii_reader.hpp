@@ -8,36 +8,16 @@
 #include <string>
 #include <vector>
 
+#include "esi/wire/sii.hpp"
+
 namespace esi {
 
-// Category type codes.
-namespace category {
-constexpr uint16_t Nop = 0;
-constexpr uint16_t Strings = 10;
-constexpr uint16_t DataTypes = 20;
-constexpr uint16_t General = 30;
-constexpr uint16_t Fmmu = 40;
-constexpr uint16_t SyncM = 41;
-constexpr uint16_t FmmuX = 42;
-constexpr uint16_t SyncUnit = 43;
-constexpr uint16_t TxPdo = 50;
-constexpr uint16_t RxPdo = 51;
-constexpr uint16_t Dc = 60;
-constexpr uint16_t End = 0xFFFF;
-}  // namespace category
-
-// PDO flags word (TxPDO/RxPDO category, bytes 6-7).
-namespace pdo_flags {
-constexpr uint16_t Mandatory = 0x0001;
-constexpr uint16_t Default = 0x0002;  // assigned by default (ESI Sm attribute given)
-constexpr uint16_t FixedContent = 0x0010;
-constexpr uint16_t VirtualContent = 0x0020;
-constexpr uint16_t OverwrittenByModule = 0x0800;
-}  // namespace pdo_flags
-
-constexpr uint16_t kSiiChecksumDisabled =
-    0x88A4;  // word 7 value that disables the check (ESC datasheet section I, SII EEPROM content)
-constexpr std::size_t kSiiFirstCategoryWord = 0x40;
+// Category codes, PDO flags, the checksum-disabled word and the first category word are the SII wire
+// vocabulary (esi/wire/sii.hpp); these names are kept for the reader's users.
+namespace category = sii::category;
+namespace pdo_flags = sii::pdo_flags;
+constexpr uint16_t kSiiChecksumDisabled = sii::kChecksumDisabled;
+constexpr std::size_t kSiiFirstCategoryWord = sii::word::FirstCategory;
 
 // Mailbox protocols word (word 0x1C) bits.
 namespace mailbox_protocol {

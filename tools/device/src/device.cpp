@@ -12,6 +12,7 @@
 #include "coe/pdo_validation.hpp"
 #include "drive/errors.hpp"
 #include "ecat/al_status.hpp"
+#include "esc/wire/registers.hpp"
 #include "esi/esi.hpp"
 #include "esi/sii.hpp"
 #include "foe/firmware.hpp"
@@ -396,7 +397,7 @@ void Device::run_drive(uint64_t now_ns) {
 
 uint64_t Device::system_time_ns() {
     uint8_t b[8] = {};
-    esc_.read(0x0910, b);
+    esc_.read(esc::reg::kDcSystemTime, b);
     uint64_t v = 0;
     for (int i = 7; i >= 0; --i)
         v = (v << 8) | b[i];

@@ -68,7 +68,7 @@ std::string EepromWrites::load() {
         return "checksum mismatch";
     for (uint32_t i = 0; i < n; ++i) {
         const uint8_t* p = b.data() + 12 + 4 * i;
-        words_[static_cast<uint16_t>(p[0] | p[1] << 8)] = static_cast<uint16_t>(p[2] | p[3] << 8);
+        words_[util::get16(p)] = util::get16(p + 2);
     }
     return {};
 }
@@ -92,8 +92,7 @@ void EepromWrites::apply(std::vector<uint8_t>& image) const {
     for (const auto& [address, value] : words_) {
         const std::size_t at = 2 * static_cast<std::size_t>(address);
         if (at + 1 >= image.size()) continue;
-        image[at] = static_cast<uint8_t>(value);
-        image[at + 1] = static_cast<uint8_t>(value >> 8);
+        util::put16(image.data() + at, value);
     }
 }
 

@@ -5,6 +5,7 @@
 
 #include "conform.hpp"
 #include "esi/wire/sii.hpp"
+#include "util/le.hpp"
 
 namespace conform {
 
@@ -58,7 +59,7 @@ uint8_t sii_crc8(std::span<const uint8_t> bytes) {
 
 uint16_t SiiImage::word(std::size_t w) const {
     if (2 * w + 1 >= bytes.size()) return 0;
-    return static_cast<uint16_t>(bytes[2 * w] | (bytes[2 * w + 1] << 8));
+    return util::get16(bytes.data() + 2 * w);
 }
 uint32_t SiiImage::dword(std::size_t w) const {
     return word(w) | (static_cast<uint32_t>(word(w + 1)) << 16);
@@ -301,7 +302,7 @@ Error Context::to_init() {
             (void)m.write(addr, master::reg::Fmmu0, std::span<const uint8_t>(z.data(), counts[0] * 16u));
     }
     uint8_t act = 0;
-    (void)m.write(addr, 0x0981, std::span<const uint8_t>(&act, 1));
+    (void)m.write(addr, esc::reg::kDcActivation, std::span<const uint8_t>(&act, 1));
     return Error::Ok;
 }
 

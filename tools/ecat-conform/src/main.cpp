@@ -171,7 +171,7 @@ int main(int argc, char** argv) {
             if (r.outcome.status == Status::Fail && t.severity == conform::Severity::Warning)
                 r.outcome.status = Status::Warn;
             // A slave that stopped answering (reset, crash): say so on the test that saw it.
-            if (r.outcome.status == Status::Fail && !ctx.rd<uint16_t>(0x0010)) {
+            if (r.outcome.status == Status::Fail && !ctx.rd<uint16_t>(esc::reg::kStationAddress)) {
                 r.outcome.message += " (the slave no longer answers at its station address)";
                 auto n = m.count_slaves();
                 if (!n || *n <= o.slave || m.assign_station_addresses(*n) != master::Error::Ok) lost = t.id;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "conform.hpp"
+#include "util/le.hpp"
 
 namespace conform {
 
@@ -20,20 +21,12 @@ struct Adder {
     }
 };
 
-inline uint16_t get16(const uint8_t* p) {
-    return static_cast<uint16_t>(p[0] | (p[1] << 8));
-}
-inline uint32_t get32(const uint8_t* p) {
-    return static_cast<uint32_t>(p[0] | (p[1] << 8) | (p[2] << 16) | (static_cast<uint32_t>(p[3]) << 24));
-}
-inline void put16(uint8_t* p, uint16_t v) {
-    p[0] = static_cast<uint8_t>(v);
-    p[1] = static_cast<uint8_t>(v >> 8);
-}
-inline void put32(uint8_t* p, uint32_t v) {
-    for (int i = 0; i < 4; ++i)
-        p[i] = static_cast<uint8_t>(v >> (8 * i));
-}
+// Little-endian access: the project's one set of helpers (util/le.hpp).
+using util::get16;
+using util::get32;
+using util::put16;
+using util::put32;
+
 inline std::string dec(long long v) {
     return std::to_string(v);
 }

@@ -62,10 +62,10 @@ void add_dc_tests(Catalogue& c) {
         "system_time.advances", "System time 0x0910 advances with the time elapsed", kDc,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_dc());
-            auto t0 = rd64(ctx, 0x0910);
+            auto t0 = rd64(ctx, esc::reg::kDcSystemTime);
             const auto h0 = std::chrono::steady_clock::now();
             std::this_thread::sleep_for(std::chrono::milliseconds(20));
-            auto t1 = rd64(ctx, 0x0910);
+            auto t1 = rd64(ctx, esc::reg::kDcSystemTime);
             const auto h1 = std::chrono::steady_clock::now();
             if (!t0 || !t1) return fail("0x0910 unreadable");
             const double dt = static_cast<double>(*t1 - *t0),
@@ -81,11 +81,11 @@ void add_dc_tests(Catalogue& c) {
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_dc());
             uint8_t z[4] = {};
-            (void)ctx.m.broadcast_write(0x0900, z);
-            auto a0 = ctx.rd<uint32_t>(0x0900);
+            (void)ctx.m.broadcast_write(esc::reg::kDcRecvTime0, z);
+            auto a0 = ctx.rd<uint32_t>(esc::reg::kDcRecvTime0);
             std::this_thread::sleep_for(std::chrono::milliseconds(2));
-            (void)ctx.m.broadcast_write(0x0900, z);
-            auto a1 = ctx.rd<uint32_t>(0x0900);
+            (void)ctx.m.broadcast_write(esc::reg::kDcRecvTime0, z);
+            auto a1 = ctx.rd<uint32_t>(esc::reg::kDcRecvTime0);
             if (!a0 || !a1) return fail("0x0900 unreadable");
             if (*a0 == *a1)
                 return fail("receive time port 0 unchanged by a second latch", hex(*a1, 8), "a new time");
@@ -97,9 +97,9 @@ void add_dc_tests(Catalogue& c) {
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_dc());
             uint8_t z[4] = {};
-            (void)ctx.m.broadcast_write(0x0900, z);
-            auto r = rd64(ctx, 0x0918);
-            auto l = rd64(ctx, 0x0910);
+            (void)ctx.m.broadcast_write(esc::reg::kDcRecvTime0, z);
+            auto r = rd64(ctx, esc::reg::kDcRecvTimePu);
+            auto l = rd64(ctx, esc::reg::kDcSystemTime);
             if (!r || !l) return fail("registers unreadable");
             if (*r == 0) return fail("0x0918 is 0", "0", "a local time");
             return pass("latched", hex(*r, 16));
@@ -109,12 +109,12 @@ void add_dc_tests(Catalogue& c) {
         "offset.rw", "System time offset 0x0920 writable and read back", kDc,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_dc());
-            auto old = rd64(ctx, 0x0920);
+            auto old = rd64(ctx, esc::reg::kDcOffset);
             if (!old) return fail("0x0920 unreadable");
             const uint64_t v = *old + 123456789ull;
-            (void)ctx.wr<uint64_t>(0x0920, v);
-            auto got = rd64(ctx, 0x0920);
-            (void)ctx.wr<uint64_t>(0x0920, *old);
+            (void)ctx.wr<uint64_t>(esc::reg::kDcOffset, v);
+            auto got = rd64(ctx, esc::reg::kDcOffset);
+            (void)ctx.wr<uint64_t>(esc::reg::kDcOffset, *old);
             return expect_eq("0x0920", got ? hex(*got, 16) : "?", hex(v, 16));
         },
         a);
@@ -122,12 +122,12 @@ void add_dc_tests(Catalogue& c) {
         "offset.applied", "System time follows the offset: +1 s in 0x0920 moves 0x0910 by 1 s", kDc,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_dc());
-            auto old = rd64(ctx, 0x0920);
-            auto t0 = rd64(ctx, 0x0910);
+            auto old = rd64(ctx, esc::reg::kDcOffset);
+            auto t0 = rd64(ctx, esc::reg::kDcSystemTime);
             if (!old || !t0) return fail("registers unreadable");
-            (void)ctx.wr<uint64_t>(0x0920, *old + 1'000'000'000ull);
-            auto t1 = rd64(ctx, 0x0910);
-            (void)ctx.wr<uint64_t>(0x0920, *old);
+            (void)ctx.wr<uint64_t>(esc::reg::kDcOffset, *old + 1'000'000'000ull);
+            auto t1 = rd64(ctx, esc::reg::kDcSystemTime);
+            (void)ctx.wr<uint64_t>(esc::reg::kDcOffset, *old);
             if (!t1) return fail("0x0910 unreadable");
             const int64_t d = static_cast<int64_t>(*t1 - *t0);
             if (d < 1'000'000'000 || d > 1'100'000'000)
@@ -139,11 +139,11 @@ void add_dc_tests(Catalogue& c) {
         "delay.rw", "System time delay 0x0928 writable and read back", kDc,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_dc());
-            auto old = ctx.rd<uint32_t>(0x0928);
+            auto old = ctx.rd<uint32_t>(esc::reg::kDcDelay);
             if (!old) return fail("0x0928 unreadable");
-            (void)ctx.wr<uint32_t>(0x0928, 1234);
-            auto got = ctx.rd<uint32_t>(0x0928);
-            (void)ctx.wr<uint32_t>(0x0928, *old);
+            (void)ctx.wr<uint32_t>(esc::reg::kDcDelay, 1234);
+            auto got = ctx.rd<uint32_t>(esc::reg::kDcDelay);
+            (void)ctx.wr<uint32_t>(esc::reg::kDcDelay, *old);
             return expect_eq("0x0928", got ? dec(*got) : "?", "1234");
         },
         a);
@@ -153,9 +153,9 @@ void add_dc_tests(Catalogue& c) {
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_dc());
             uint8_t z[4] = {};
-            (void)ctx.m.broadcast_write(0x0900, z);
+            (void)ctx.m.broadcast_write(esc::reg::kDcRecvTime0, z);
             uint8_t t[16] = {};
-            if (Error e = ctx.m.read(ctx.addr, 0x0900, t); e != Error::Ok)
+            if (Error e = ctx.m.read(ctx.addr, esc::reg::kDcRecvTime0, t); e != Error::Ok)
                 return fail("0x0900-0x090F unreadable", err(e));
             const uint32_t p0 = get32(t), p1 = get32(t + 4);
             if (p1 != 0 && p1 < p0) return fail("port 1 time before port 0 time", dec(p1), ">= " + dec(p0));
@@ -166,9 +166,9 @@ void add_dc_tests(Catalogue& c) {
         "sync0.cycle_rw", "SYNC0 cycle time 0x09A0 writable and read back", kDc,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_dc());
-            (void)ctx.wr<uint8_t>(0x0981, 0);
-            (void)ctx.wr<uint32_t>(0x09A0, 1'000'000);
-            auto got = ctx.rd<uint32_t>(0x09A0);
+            (void)ctx.wr<uint8_t>(esc::reg::kDcActivation, 0);
+            (void)ctx.wr<uint32_t>(esc::reg::kDcSync0Cycle, 1'000'000);
+            auto got = ctx.rd<uint32_t>(esc::reg::kDcSync0Cycle);
             return expect_eq("0x09A0", got ? dec(*got) : "?", "1000000");
         },
         a);
@@ -177,23 +177,23 @@ void add_dc_tests(Catalogue& c) {
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_dc());
             (void)ctx.to_init();
-            (void)ctx.wr<uint8_t>(0x0981, 0);
-            (void)ctx.wr<uint32_t>(0x09A0, 1'000'000);
-            auto now = rd64(ctx, 0x0910);
+            (void)ctx.wr<uint8_t>(esc::reg::kDcActivation, 0);
+            (void)ctx.wr<uint32_t>(esc::reg::kDcSync0Cycle, 1'000'000);
+            auto now = rd64(ctx, esc::reg::kDcSystemTime);
             if (!now) return fail("0x0910 unreadable");
-            (void)ctx.wr<uint64_t>(0x0990, (*now / 1'000'000 + 5) * 1'000'000);
-            (void)ctx.wr<uint8_t>(0x0981, 0x03);
-            auto first = rd64(ctx, 0x0990);
+            (void)ctx.wr<uint64_t>(esc::reg::kDcStartTime, (*now / 1'000'000 + 5) * 1'000'000);
+            (void)ctx.wr<uint8_t>(esc::reg::kDcActivation, 0x03);
+            auto first = rd64(ctx, esc::reg::kDcStartTime);
             bool pulse = false, advanced = false;
             master::Result<uint64_t> later = Error::Timeout;
             for (int i = 0; i < 100 && !advanced; ++i) {
                 std::this_thread::sleep_for(std::chrono::milliseconds(1));
                 auto s = ctx.rd<uint8_t>(0x098E);
                 pulse = pulse || (s && (*s & 0x01));
-                later = rd64(ctx, 0x0990);
+                later = rd64(ctx, esc::reg::kDcStartTime);
                 advanced = first && later && *later >= *first + 1'000'000;
             }
-            (void)ctx.wr<uint8_t>(0x0981, 0);
+            (void)ctx.wr<uint8_t>(esc::reg::kDcActivation, 0);
             if (!advanced)
                 return fail("next SYNC0 time 0x0990 does not advance within 100 ms (no SYNC0 pulses)",
                             later ? hex(*later, 16) : "?", "> " + (first ? hex(*first, 16) : "?"));

@@ -124,7 +124,7 @@ Outcome read_modify_write(Context& ctx, Command c) {
     if (ctx.slave_count != 1)
         return skip("needs the slave alone on the bus (other slaves would take the write)");
     const uint16_t adp = c == Command::ARMW ? my_adp(ctx) : ctx.station;
-    auto expected = ctx.rd<uint16_t>(0x0000);
+    auto expected = ctx.rd<uint16_t>(esc::reg::kType);
     Sent s = send(ctx, c, adp, 0x0000, {0, 0});
     Outcome o = check_wkc(s, 1, "addressed slave reads 0x0000");
     if (o.status != Status::Pass) return o;
@@ -299,7 +299,7 @@ void add_esc_tests(Catalogue& c) {
             uint8_t b[2] = {};
             auto dg = datagram(Command::FPRD, 0xA6, ctx.station, 0x0000, b, 2);
             auto f = frame_with(dg, 0, ctx.m.options().source_mac);
-            auto expected = ctx.rd<uint16_t>(0x0000);
+            auto expected = ctx.rd<uint16_t>(esc::reg::kType);
             auto reply = ctx.raw_exchange(f, 0xA6, ctx.ms(50));
             if (reply.empty()) return pass("short frame dropped");
             if (reply.size() < 30) return fail("reply cut short", dec(reply.size()) + " bytes", ">= 30");
@@ -348,7 +348,7 @@ void add_esc_tests(Catalogue& c) {
     add("reg.esc_info", "ESC information registers 0x0000-0x0009 readable in one datagram", kRegClause,
         [](Context& ctx) {
             uint8_t b[10] = {};
-            if (Error e = ctx.m.read(ctx.addr, 0x0000, b); e != Error::Ok)
+            if (Error e = ctx.m.read(ctx.addr, esc::reg::kType, b); e != Error::Ok)
                 return fail("FPRD 0x0000/10", err(e));
             if (b[4] == 0 && b[5] == 0)
                 return fail("no FMMU and no SM announced", bytes_hex(b), "FMMUs/SMs > 0");
@@ -411,13 +411,13 @@ void add_esc_tests(Catalogue& c) {
     add("reg.station_alias", "Configured station alias 0x0012 loaded from SII word 4",
         "ETG.1000.6 SII (configured station alias); ESC register 0x0012", [](Context& ctx) {
             CONFORM_NEED(ctx.need_sii());
-            auto a = ctx.rd<uint16_t>(0x0012);
+            auto a = ctx.rd<uint16_t>(esc::reg::kStationAlias);
             if (!a) return fail("0x0012 unreadable", err(a.error()));
             return expect_eq("station alias", hex(*a), hex(ctx.sii->word(4)));
         });
     add("reg.alias_addressing", "FPRD by station alias once DL control enables alias addressing",
         "ETG.1000.4 node addressing (station alias); ESC register 0x0100 bit 24", [](Context& ctx) {
-            auto a = ctx.rd<uint16_t>(0x0012);
+            auto a = ctx.rd<uint16_t>(esc::reg::kStationAlias);
             if (!a) return fail("0x0012 unreadable", err(a.error()));
             if (*a == 0) return skip("station alias is 0 (not set in the SII)");
             auto dl = ctx.rd<uint8_t>(0x0103);
@@ -430,7 +430,8 @@ void add_esc_tests(Catalogue& c) {
     add("reg.station_address_rw", "Station address 0x0010 writable; FPRD follows the new address",
         "ETG.1000.4 node addressing (configured station address)", [](Context& ctx) {
             const uint16_t tmp = 0x7E57;
-            if (Error e = ctx.wr<uint16_t>(0x0010, tmp); e != Error::Ok) return fail("write 0x0010", err(e));
+            if (Error e = ctx.wr<uint16_t>(esc::reg::kStationAddress, tmp); e != Error::Ok)
+                return fail("write 0x0010", err(e));
             Sent s = send(ctx, Command::FPRD, tmp, 0x0010, {0, 0});
             (void)ctx.m.write_reg<uint16_t>(master::Address::station(tmp), 0x0010, ctx.station);
             (void)ctx.m.write_reg<uint16_t>(ctx.pos, 0x0010, ctx.station);
@@ -441,18 +442,18 @@ void add_esc_tests(Catalogue& c) {
         });
     add("reg.al_status_readonly", "AL status 0x0130 cannot be written by the master",
         "ETG.1000.6 AL status register (read-only for EtherCAT)", [](Context& ctx) {
-            auto before = ctx.rd<uint16_t>(0x0130);
+            auto before = ctx.rd<uint16_t>(esc::reg::kAlStatus);
             if (!before) return fail("0x0130 unreadable", err(before.error()));
             (void)send(ctx, Command::FPWR, ctx.station, 0x0130, le16(0x0008));
-            auto after = ctx.rd<uint16_t>(0x0130);
+            auto after = ctx.rd<uint16_t>(esc::reg::kAlStatus);
             if (!after) return fail("0x0130 unreadable", err(after.error()));
             return expect_eq("AL status after a write to it", hex(*after), hex(*before));
         });
     add("reg.type_readonly", "ESC type 0x0000 cannot be written by the master", kRegClause, [](Context& ctx) {
-        auto before = ctx.rd<uint16_t>(0x0000);
+        auto before = ctx.rd<uint16_t>(esc::reg::kType);
         if (!before) return fail("0x0000 unreadable", err(before.error()));
         (void)send(ctx, Command::FPWR, ctx.station, 0x0000, le16(static_cast<uint16_t>(~*before)));
-        auto after = ctx.rd<uint16_t>(0x0000);
+        auto after = ctx.rd<uint16_t>(esc::reg::kType);
         if (!after) return fail("0x0000 unreadable", err(after.error()));
         return expect_eq("0x0000 after a write to it", hex(*after), hex(*before));
     });
@@ -460,7 +461,7 @@ void add_esc_tests(Catalogue& c) {
         "reg.dl_status", "DL status 0x0110: EEPROM loaded, PDI operational (bit 0)",
         "ETG.1000.4 DL status register 0x0110",
         [](Context& ctx) {
-            auto s = ctx.rd<uint16_t>(0x0110);
+            auto s = ctx.rd<uint16_t>(esc::reg::kDlStatus);
             if (!s) return fail("0x0110 unreadable", err(s.error()));
             if (!(*s & 0x0001)) return fail("PDI operational bit clear", hex(*s), "bit 0 set");
             return pass("DL status", hex(*s));
@@ -470,7 +471,7 @@ void add_esc_tests(Catalogue& c) {
         "reg.pdi_control", "PDI control 0x0140 loaded from SII word 0", "ETG.1000.6 SII configuration area",
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_sii());
-            auto p = ctx.rd<uint8_t>(0x0140);
+            auto p = ctx.rd<uint8_t>(esc::reg::kPdiControl);
             if (!p) return fail("0x0140 unreadable", err(p.error()));
             return expect_eq("PDI control", hex(*p, 2), hex(ctx.sii->word(0) & 0xFF, 2));
         },

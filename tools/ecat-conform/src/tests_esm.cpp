@@ -67,7 +67,7 @@ Outcome valid(Context& ctx, uint8_t from, uint8_t to) {
     } else if (to == 8) {
         (void)ctx.cycle(3);
         (void)ctx.pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st);
-        if (auto c = ctx.rd<uint16_t>(0x0134)) st.code = *c;
+        if (auto c = ctx.rd<uint16_t>(esc::reg::kAlStatusCode)) st.code = *c;
     } else {
         st = ctx.request_raw(to, ctx.ms(5000));
     }
@@ -323,8 +323,8 @@ void add_esm_tests(Catalogue& c) {
             if (Error e = ctx.to_op(); e != Error::Ok)
                 return fail("cannot reach OP: " + err(e), status_text(ctx.last_status));
             if (!ctx.pds->layout().sm2_length) return skip("no outputs: no SM watchdog");
-            auto div = ctx.rd<uint16_t>(0x0400);
-            auto wd = ctx.rd<uint16_t>(0x0420);
+            auto div = ctx.rd<uint16_t>(esc::reg::kWdDivider);
+            auto wd = ctx.rd<uint16_t>(esc::reg::kWdTimePd);
             if (!div || !wd) return fail("watchdog registers unreadable");
             if (*wd == 0) return skip("process-data watchdog disabled (0x0420 = 0)");
             const double ms = (*div + 2.0) * 40e-9 * *wd * 1000.0;
@@ -376,7 +376,7 @@ void add_esm_tests(Catalogue& c) {
                 if (!loaded) std::this_thread::sleep_for(std::chrono::milliseconds(1));
             }
             // The slave writes 0x0134 before it sets the bit, so 0x0134 is valid once the bit is seen.
-            auto id = ctx.rd<uint16_t>(0x0134);
+            auto id = ctx.rd<uint16_t>(esc::reg::kAlStatusCode);
             (void)ctx.wr<uint16_t>(master::reg::AlControl, 0x0001);
             if (werr != master::Error::Ok)
                 return fail("AL control 0x0021 was not written: " + std::string(master::to_string(werr)), "",
@@ -385,7 +385,7 @@ void add_esm_tests(Catalogue& c) {
                 return fail("AL status bit 5 (identification loaded) not set within " +
                                 dec(static_cast<long long>(ctx.ms(1000).count())) + " ms",
                             last ? "AL status " + hex(*last) : "no AL status read", "bit 5 set");
-            auto alias = ctx.rd<uint16_t>(0x0012);
+            auto alias = ctx.rd<uint16_t>(esc::reg::kStationAlias);
             return expect_eq("0x0134", id ? hex(*id) : "?", alias ? hex(*alias) : "?");
         },
         "ESI announces IdentificationReg134");

@@ -30,6 +30,7 @@
 #include "format.hpp"
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
+#include "util/le.hpp"
 
 namespace ecatctl {
 
@@ -161,14 +162,10 @@ int fail(Error e, const std::string& what) {
     return exit_code(e);
 }
 
-uint32_t le32(const uint8_t* p) {
-    return static_cast<uint32_t>(p[0] | (p[1] << 8) | (p[2] << 16) | (static_cast<uint32_t>(p[3]) << 24));
-}
-
 Error read_sii_identity(master::Master& m, Address a, Identity& id) {
     uint8_t b[16];
     if (Error e = m.sii_read(a, master::sii::VendorId, b); e != Error::Ok) return e;
-    id = Identity{le32(b), le32(b + 4), le32(b + 8), le32(b + 12)};
+    id = Identity{util::get32(b), util::get32(b + 4), util::get32(b + 8), util::get32(b + 12)};
     return Error::Ok;
 }
 
@@ -218,7 +215,7 @@ int read_coe_identity(master::Master& m, Address a, CoeIdentity& out) {
     for (uint8_t sub = 1; sub <= 4; ++sub) {
         auto n = sdo.upload(0x1018, sub, std::span<uint8_t>(b, 4));
         if (!n) return sdo_failed(sdo, n.error(), "reading 0x1018:0" + std::to_string(sub));
-        *fields[sub - 1] = le32(b);
+        *fields[sub - 1] = util::get32(b);
     }
     auto text = [&](uint16_t index, std::string& s) -> int {
         auto n = sdo.upload(index, 0, b);
@@ -235,7 +232,7 @@ int read_coe_identity(master::Master& m, Address a, CoeIdentity& out) {
     if (int rc = text(0x1008, out.name); rc != kExitOk) return rc;
     if (int rc = text(0x100A, out.version); rc != kExitOk) return rc;
     if (auto n = sdo.upload(0x6041, 0, std::span<uint8_t>(b, 2))) {
-        out.statusword = static_cast<uint16_t>(b[0] | (b[1] << 8));
+        out.statusword = util::get16(b);
         out.have_statusword = true;
     }
     return kExitOk;

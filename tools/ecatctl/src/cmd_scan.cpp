@@ -19,6 +19,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
+#include "util/le.hpp"
 
 namespace ecatctl {
 
@@ -62,10 +63,7 @@ int scan(master::Master& m) {
             rc = exit_code(e);
             continue;
         }
-        auto u32 = [&](int k) {
-            return static_cast<unsigned>(id[4 * k] | (id[4 * k + 1] << 8) | (id[4 * k + 2] << 16) |
-                                         (static_cast<unsigned>(id[4 * k + 3]) << 24));
-        };
+        auto u32 = [&](int k) { return static_cast<unsigned>(util::get32(&id[4 * k])); };
         std::string name;
         // The device name from the SII General category (through the STRINGS category).
         if (auto img = m.sii_read_image(a)) {

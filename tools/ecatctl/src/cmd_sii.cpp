@@ -19,6 +19,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
+#include "util/le.hpp"
 
 namespace ecatctl {
 
@@ -66,9 +67,9 @@ int sii_write(master::Master& m, const SiiArgs& s) {
     if (!img) return usage("cannot read " + s.input);
     if (img->size() < 16 || img->size() % 2 != 0 || img->size() > 65536)
         return usage(s.input + ": an SII image is an even number of bytes, 16 to 65536");
-    const uint16_t w7 = static_cast<uint16_t>((*img)[14] | ((*img)[15] << 8));
-    const uint8_t crc = sii_crc(std::span<const uint8_t>(img->data(), 14));
-    if (w7 != 0x88A4 && (w7 & 0xFF) != crc && !s.force) {
+    const uint16_t w7 = util::get16(img->data() + 2 * esi::sii::word::Checksum);
+    const uint8_t crc = esi::sii::crc8(img->data(), esi::sii::kCrcBytes);
+    if (w7 != esi::sii::kChecksumDisabled && (w7 & 0xFF) != crc && !s.force) {
         char b[96];
         std::snprintf(b, sizeof b, "%s: checksum word 7 is 0x%04x, CRC of words 0-6 is 0x%02x (use --force)",
                       s.input.c_str(), w7, crc);
@@ -76,7 +77,7 @@ int sii_write(master::Master& m, const SiiArgs& s) {
     }
     const std::size_t words = img->size() / 2;
     for (std::size_t w = 0; w < words; ++w) {
-        const uint16_t v = static_cast<uint16_t>((*img)[2 * w] | ((*img)[2 * w + 1] << 8));
+        const uint16_t v = util::get16(img->data() + 2 * w);
         if (Error e = m.sii_write_word(*a, static_cast<uint32_t>(w), v); e != Error::Ok)
             return fail(e, "writing SII word " + std::to_string(w) + " of " + slave_text(*a));
     }

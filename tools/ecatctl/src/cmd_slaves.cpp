@@ -9,6 +9,7 @@
 #include "cmd_verbs.hpp"
 #include "esi/sii_reader.hpp"
 #include "format.hpp"
+#include "util/le.hpp"
 
 namespace ecatctl {
 
@@ -22,13 +23,6 @@ struct SlavesArgs {
     bool station = false;
     bool verbose = false;
 };
-
-uint16_t le16(const uint8_t* p) {
-    return static_cast<uint16_t>(p[0] | (p[1] << 8));
-}
-uint32_t le32(const uint8_t* p) {
-    return static_cast<uint32_t>(p[0] | (p[1] << 8) | (p[2] << 16) | (static_cast<uint32_t>(p[3]) << 24));
-}
 
 std::string protocols_text(uint16_t p) {
     static const std::pair<uint16_t, const char*> kNames[] = {{0x01, "AoE"}, {0x02, "EoE"}, {0x04, "CoE"},
@@ -64,10 +58,10 @@ unsigned default_pdo_bits(const std::vector<esi::SiiPdo>& pdos) {
 int show_slave(master::Master& m, uint16_t pos, bool verbose) {
     const Address a = Address::position(pos);
     uint8_t info[10] = {};
-    if (Error e = m.read(a, 0x0000, info); e != Error::Ok)
+    if (Error e = m.read(a, esc::reg::kType, info); e != Error::Ok)
         return report_error(nullptr, e, "reading slave " + std::to_string(pos));
     uint8_t addr[4] = {};
-    (void)m.read(a, 0x0010, addr);
+    (void)m.read(a, esc::reg::kStationAddress, addr);
     auto st = m.al_status(a);
     std::string state = st ? std::string(master::al_state_name(st->state)) + (st->error ? "+ERR" : "") : "?";
     esi::SiiInfo sii;
@@ -78,12 +72,12 @@ int show_slave(master::Master& m, uint16_t pos, bool verbose) {
     }
     const std::string name = sii.general ? sii.general->name : std::string();
     if (!verbose) {
-        std::printf("%-3u 0x%04x %5u:%-3u %-8s %s\n", pos, le16(addr), le16(addr + 2), pos, state.c_str(),
-                    name.c_str());
+        std::printf("%-3u 0x%04x %5u:%-3u %-8s %s\n", pos, util::get16(addr), util::get16(addr + 2), pos,
+                    state.c_str(), name.c_str());
         return kExitOk;
     }
     std::printf("Slave %u: %s\n", pos, name.empty() ? "(no name in the SII)" : name.c_str());
-    std::printf("  Station address 0x%04x, alias %u\n", le16(addr), le16(addr + 2));
+    std::printf("  Station address 0x%04x, alias %u\n", util::get16(addr), util::get16(addr + 2));
     if (st)
         std::printf("  State %s, AL status code 0x%04x (%s)\n", state.c_str(), st->code,
                     std::string(master::al_status_code_name(st->code)).c_str());
@@ -94,15 +88,15 @@ int show_slave(master::Master& m, uint16_t pos, bool verbose) {
         std::printf("  Output size: %u bits (%u bytes), input size: %u bits (%u bytes) (default PDOs, SII)\n",
                     out_bits, (out_bits + 7) / 8, in_bits, (in_bits + 7) / 8);
     }
-    const uint16_t features = le16(info + 8);
+    const uint16_t features = util::get16(info + 8);
     std::printf(
         "  ESC type 0x%02x, revision %u, build %u; %u FMMUs, %u SMs, %u KiB process RAM, features 0x%04x\n",
-        info[0], info[1], le16(info + 2), info[4], info[5], info[6], features);
+        info[0], info[1], util::get16(info + 2), info[4], info[5], info[6], features);
     // Ports: descriptor 0x0007 (2 bits each), DL status 0x0110 (link bits 4..7, communication bits
     // 9,11,13,15).
     uint8_t dl[2] = {};
-    (void)m.read(a, 0x0110, dl);
-    const uint16_t dls = le16(dl);
+    (void)m.read(a, esc::reg::kDlStatus, dl);
+    const uint16_t dls = util::get16(dl);
     std::printf("  Ports:");
     unsigned active = 0;
     for (unsigned p = 0; p < 4; ++p) {
@@ -117,31 +111,32 @@ int show_slave(master::Master& m, uint16_t pos, bool verbose) {
     // DC: features bit 2 (DC), bit 3 (64-bit system time); receive times latched by a write to 0x0900.
     if (features & 0x0004) {
         uint8_t latch[4] = {};
-        (void)m.broadcast_write(0x0900, latch);
+        (void)m.broadcast_write(esc::reg::kDcRecvTime0, latch);
         uint8_t rt[16] = {}, delay[4] = {}, offset[8] = {};
-        (void)m.read(a, 0x0900, rt);
-        (void)m.read(a, 0x0928, delay);
-        (void)m.read(a, 0x0920, offset);
+        (void)m.read(a, esc::reg::kDcRecvTime0, rt);
+        (void)m.read(a, esc::reg::kDcDelay, delay);
+        (void)m.read(a, esc::reg::kDcOffset, offset);
         std::printf("  DC: yes, %s system time; system time delay %u ns, offset %lld ns\n",
-                    (features & 0x0008) ? "64-bit" : "32-bit", le32(delay),
-                    static_cast<long long>(static_cast<uint64_t>(le32(offset)) |
-                                           (static_cast<uint64_t>(le32(offset + 4)) << 32)));
-        std::printf("  DC receive times: port 0 %u, port 1 %u, port 2 %u, port 3 %u ns\n", le32(rt),
-                    le32(rt + 4), le32(rt + 8), le32(rt + 12));
+                    (features & 0x0008) ? "64-bit" : "32-bit", util::get32(delay),
+                    static_cast<long long>(static_cast<uint64_t>(util::get32(offset)) |
+                                           (static_cast<uint64_t>(util::get32(offset + 4)) << 32)));
+        std::printf("  DC receive times: port 0 %u, port 1 %u, port 2 %u, port 3 %u ns\n", util::get32(rt),
+                    util::get32(rt + 4), util::get32(rt + 8), util::get32(rt + 12));
     } else {
         std::printf("  DC: no\n");
     }
     for (unsigned i = 0; i < info[5] && i < 16; ++i) {
         uint8_t sm[8] = {};
-        if (m.read(a, static_cast<uint16_t>(0x0800 + 8 * i), sm) != Error::Ok) break;
+        if (m.read(a, static_cast<uint16_t>(esc::reg::kSm + 8 * i), sm) != Error::Ok) break;
         const uint8_t type = i < sii.sync_managers.size() ? sii.sync_managers[i].type : 0;
-        std::printf("  SM%u A:%04x L:%4u F:%08x Type:%u\n", i, le16(sm), le16(sm + 2), le32(sm + 4), type);
+        std::printf("  SM%u A:%04x L:%4u F:%08x Type:%u\n", i, util::get16(sm), util::get16(sm + 2),
+                    util::get32(sm + 4), type);
     }
     for (unsigned i = 0; i < info[4] && i < 16; ++i) {
         uint8_t f[16] = {};
-        if (m.read(a, static_cast<uint16_t>(0x0600 + 16 * i), f) != Error::Ok) break;
-        std::printf("  FMMU%u Ls:%08x Ll:%4u Lsb:%u Leb:%u Ps:%04x Psb:%u Ty:%02x Act:%02x\n", i, le32(f),
-                    le16(f + 4), f[6], f[7], le16(f + 8), f[10], f[11], f[12]);
+        if (m.read(a, static_cast<uint16_t>(esc::reg::kFmmu + 16 * i), f) != Error::Ok) break;
+        std::printf("  FMMU%u Ls:%08x Ll:%4u Lsb:%u Leb:%u Ps:%04x Psb:%u Ty:%02x Act:%02x\n", i,
+                    util::get32(f), util::get16(f + 4), f[6], f[7], util::get16(f + 8), f[10], f[11], f[12]);
     }
     if (have_sii) {
         const auto& mb = sii.standard_mailbox;

@@ -14,6 +14,7 @@
 #include "coe_view.hpp"
 #include "esi/sii_reader.hpp"
 #include "format.hpp"
+#include "util/le.hpp"
 
 namespace ecatctl {
 
@@ -117,7 +118,7 @@ Error read_mapping(master::SdoClient& sdo, uint16_t index, PdoView& pv) {
         auto m = sdo.upload(index, static_cast<uint8_t>(k), v);
         if (!m) return m.error();
         PdoEntryView e;
-        e.index = static_cast<uint16_t>(v[2] | (v[3] << 8));
+        e.index = util::get16(v + 2);
         e.subindex = v[1];
         e.bit_length = v[0];
         if (e.index != 0)

@@ -78,7 +78,7 @@ int check_slave_present(master::Master& m, master::Address a) {
         return kExitNoSlave;
     }
     uint8_t b[2];
-    const master::Error e = m.read(a, 0x0130, b);  // AL status
+    const master::Error e = m.read(a, esc::reg::kAlStatus, b);  // AL status
     if (e == master::Error::Ok) return kExitOk;
     if (e == master::Error::WorkingCounter) {
         char t[120];

@@ -1,5 +1,7 @@
 #include "format.hpp"
 
+#include "esi/wire/sii.hpp"
+
 #include <cerrno>
 #include <charconv>
 #include <cstdio>
@@ -149,13 +151,7 @@ std::string hex_dump(uint32_t base, std::span<const uint8_t> data) {
 }
 
 uint8_t sii_crc(std::span<const uint8_t> first14) {
-    uint8_t crc = 0xFF;
-    for (uint8_t byte : first14) {
-        crc ^= byte;
-        for (int b = 0; b < 8; ++b)
-            crc = static_cast<uint8_t>((crc & 0x80) ? (crc << 1) ^ 0x07 : crc << 1);
-    }
-    return crc;
+    return esi::sii::crc8(first14.data(), first14.size());
 }
 
 }  // namespace ecatctl

@@ -7,6 +7,8 @@
 #include <cstring>
 #include <thread>
 
+#include "util/le.hpp"
+
 namespace master {
 
 using Clock = std::chrono::steady_clock;
@@ -229,7 +231,7 @@ Result<AlStatus> Master::al_status(Address a) {
     s.state = b[0] & 0x0F;
     s.error = (b[0] & kAlErrorAck) != 0;
     s.id_loaded = (b[0] & kAlIdentify) != 0;
-    s.code = static_cast<uint16_t>(b[4] | (b[5] << 8));
+    s.code = util::get16(b + 4);
     return s;
 }
 

@@ -148,7 +148,7 @@ Error ProcessDataSession::configure(const DcConfig& dc) {
     if (dc.enable) return configure_dc(dc);
     // Not DC: SYNC0 left running by an earlier session would contradict sync mode 1 (AL code 0x0030).
     const uint8_t zero2[2] = {};
-    if (Error e = m_.write(slave_, 0x0980, zero2); e != Error::Ok) return e;
+    if (Error e = m_.write(slave_, esc::reg::kDcCyclicControl, zero2); e != Error::Ok) return e;
     dc_ = false;
     return Error::Ok;
 }
@@ -159,24 +159,25 @@ Error ProcessDataSession::configure_dc(const DcConfig& dc) {
     // section I §9.1). A single slave is the reference clock: propagation delay 0, no drift compensation.
     const uint8_t latch[4] = {};
     const uint64_t master_now = master_system_time();
-    auto w = m_.broadcast_write(0x0900, latch);
+    auto w = m_.broadcast_write(esc::reg::kDcRecvTime0, latch);
     if (!w) return w.error();
     uint8_t t[8];
-    if (Error e = m_.read(slave_, 0x0918, t); e != Error::Ok) return e;
+    if (Error e = m_.read(slave_, esc::reg::kDcRecvTimePu, t); e != Error::Ok) return e;
     uint8_t off[8];
     put64(off, master_now - get64(t));
-    if (Error e = m_.write(slave_, 0x0920, off); e != Error::Ok) return e;
+    if (Error e = m_.write(slave_, esc::reg::kDcOffset, off); e != Error::Ok) return e;
     const uint8_t zero4[4] = {};
-    if (Error e = m_.write(slave_, 0x0928, zero4); e != Error::Ok) return e;
+    if (Error e = m_.write(slave_, esc::reg::kDcDelay, zero4); e != Error::Ok) return e;
     uint8_t speed[2];
-    if (Error e = m_.read(slave_, 0x0930, speed); e != Error::Ok) return e;
-    if (Error e = m_.write(slave_, 0x0930, speed); e != Error::Ok) return e;  // resets the filters
+    if (Error e = m_.read(slave_, esc::reg::kDcSpeedStart, speed); e != Error::Ok) return e;
+    if (Error e = m_.write(slave_, esc::reg::kDcSpeedStart, speed); e != Error::Ok)
+        return e;  // resets the filters
     // SYNC0: deactivate, cycle time, start time on the cycle grid in the near future, activate.
     const uint8_t zero2[2] = {};
-    if (Error e = m_.write(slave_, 0x0980, zero2); e != Error::Ok) return e;
+    if (Error e = m_.write(slave_, esc::reg::kDcCyclicControl, zero2); e != Error::Ok) return e;
     uint8_t cyc[4];
     put32(cyc, dc.cycle_ns);
-    if (Error e = m_.write(slave_, 0x09A0, cyc); e != Error::Ok) return e;
+    if (Error e = m_.write(slave_, esc::reg::kDcSync0Cycle, cyc); e != Error::Ok) return e;
     uint8_t now[8];
     if (Error e = m_.read(slave_, reg::DcSystemTime, now); e != Error::Ok) return e;
     const uint64_t delay = static_cast<uint64_t>(std::chrono::nanoseconds(dc.start_delay).count());
@@ -185,10 +186,10 @@ Error ProcessDataSession::configure_dc(const DcConfig& dc) {
     start = static_cast<uint64_t>(static_cast<int64_t>(start) + dc.shift_ns);
     uint8_t st[8];
     put64(st, start);
-    if (Error e = m_.write(slave_, 0x0990, st); e != Error::Ok) return e;
+    if (Error e = m_.write(slave_, esc::reg::kDcStartTime, st); e != Error::Ok) return e;
     uint8_t aa[2];
     put16(aa, dc.assign_activate);
-    if (Error e = m_.write(slave_, 0x0980, aa); e != Error::Ok) return e;
+    if (Error e = m_.write(slave_, esc::reg::kDcCyclicControl, aa); e != Error::Ok) return e;
     // From now on every cycle carries an FRMW of the reference clock's system time.
     dg_[1] = Datagram{Command::FRMW, slave_.value, reg::DcSystemTime, time_};
     dc_ = slave_.mode == Address::Mode::Station;

@@ -39,7 +39,7 @@ Error Master::sii_wait(Address a, uint16_t& status, std::span<uint8_t> data_out)
     for (;;) {
         uint8_t b[14];  // 0x0502 control/status, 0x0504 address, 0x0508 data (up to 8 bytes)
         if (Error e = read(a, reg::SiiControl, b); e != Error::Ok) return e;
-        status = static_cast<uint16_t>(b[0] | (b[1] << 8));
+        status = util::get16(b);
         if (!(status & sii::Busy) && !(status & sii::CmdMask)) {
             std::copy_n(b + 6, std::min<std::size_t>(data_out.size(), 8), data_out.begin());
             return Error::Ok;
@@ -110,13 +110,13 @@ Error Master::sii_read(Address a, uint32_t word, std::span<uint8_t> out) {
 Result<uint16_t> Master::sii_read_word(Address a, uint32_t word) {
     uint8_t b[2];
     if (Error e = sii_read(a, word, b); e != Error::Ok) return e;
-    return static_cast<uint16_t>(b[0] | (b[1] << 8));
+    return util::get16(b);
 }
 
 Result<uint32_t> Master::sii_read_u32(Address a, uint32_t word) {
     uint8_t b[4];
     if (Error e = sii_read(a, word, b); e != Error::Ok) return e;
-    return static_cast<uint32_t>(b[0] | (b[1] << 8) | (b[2] << 16) | (static_cast<uint32_t>(b[3]) << 24));
+    return util::get32(b);
 }
 
 Result<std::vector<uint8_t>> Master::sii_read_image(Address a, bool whole_eeprom) {
@@ -133,9 +133,7 @@ Result<std::vector<uint8_t>> Master::sii_read_image(Address a, bool whole_eeprom
         }
         return Error::Ok;
     };
-    auto word_at = [&](std::size_t w) {
-        return static_cast<uint16_t>(image[2 * w] | (image[2 * w + 1] << 8));
-    };
+    auto word_at = [&](std::size_t w) { return util::get16(image.data() + 2 * w); };
 
     if (Error e = ensure(sii::FirstCategory); e != Error::Ok) return e;
     if (whole_eeprom) {
