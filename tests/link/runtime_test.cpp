@@ -16,6 +16,7 @@
 #include "esc/esc.hpp"
 #include "esc/link_capture.hpp"
 #include "esc/link_loopback.hpp"
+#include "esc/wire/frame_builder.hpp"
 #include "netns_util.hpp"
 #include "slave/netif.hpp"
 #include "slave/runtime.hpp"
@@ -24,19 +25,7 @@ namespace {
 
 // BRD of the ESC type register (0x0000, 1 byte): every ESC answers with WKC 1.
 std::vector<uint8_t> brd_type_frame(std::size_t total = 60) {
-    std::vector<uint8_t> f(total, 0);
-    for (int i = 0; i < 6; ++i)
-        f[static_cast<std::size_t>(i)] = 0xFF;
-    for (int i = 6; i < 12; ++i)
-        f[static_cast<std::size_t>(i)] = 0x01;
-    f[12] = 0x88;
-    f[13] = 0xA4;
-    f[14] = 13;  // 10 header + 1 data + 2 WKC
-    f[15] = 0x10;
-    f[16] = 7;  // BRD
-    f[17] = 0x42;
-    f[22] = 1;  // length 1
-    return f;
+    return esc::wire::FrameBuilder().add_zero(esc::Command::BRD, 0x42, 0, 0x0000, 1).build(total);
 }
 constexpr std::size_t kWkcOffset = 16 + 10 + 1;
 

@@ -22,6 +22,7 @@
 
 #include "device/faults.hpp"
 #include "esc/link_packet.hpp"
+#include "esc/wire/frame_builder.hpp"
 #include "netns_util.hpp"
 #include "slave/netif.hpp"
 
@@ -218,17 +219,7 @@ void expect_brd_answer(pid_t pid, uint8_t source_byte = 0x03) {
     std::unique_ptr<esc::PacketLink> master;
     in_netns_of(pid, [&] { master = std::make_unique<esc::PacketLink>("ecat1"); });
     // BRD of the ESC type register: the slave answers with WKC 1 and the source MAC bit set.
-    std::vector<uint8_t> f(60, 0);
-    for (int i = 0; i < 6; ++i)
-        f[static_cast<std::size_t>(i)] = 0xFF;
-    for (int i = 6; i < 12; ++i)
-        f[static_cast<std::size_t>(i)] = 0x01;
-    f[12] = 0x88;
-    f[13] = 0xA4;
-    f[14] = 13;
-    f[15] = 0x10;
-    f[16] = 7;
-    f[22] = 1;
+    const auto f = esc::wire::FrameBuilder().add_zero(esc::Command::BRD, 0, 0, 0x0000, 1).build();
     ASSERT_TRUE(master->send(f));
     std::array<uint8_t, esc::kMaxFrameSize> buf{};
     std::size_t n = 0;
