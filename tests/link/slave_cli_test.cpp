@@ -10,8 +10,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <pcap/pcap.h>
-
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -24,6 +22,7 @@
 #include "esc/link_packet.hpp"
 #include "esc/wire/frame_builder.hpp"
 #include "netns_util.hpp"
+#include "pcap_records.hpp"
 #include "slave/netif.hpp"
 
 namespace {
@@ -261,18 +260,13 @@ TEST(EcatSlaveVeth, CreatesThePairAnswersOnItAndRemovesItOnSigterm) {
     EXPECT_FALSE(exists_after) << "the veth pair must be gone after SIGTERM";
 
     // The capture holds the frame as received and the reply.
-    char errbuf[PCAP_ERRBUF_SIZE];
-    pcap_t* pc = pcap_open_offline(capture.c_str(), errbuf);
-    ASSERT_NE(pc, nullptr) << errbuf;
-    pcap_pkthdr* hdr = nullptr;
-    const u_char* data = nullptr;
-    ASSERT_EQ(pcap_next_ex(pc, &hdr, &data), 1);
-    EXPECT_EQ(hdr->caplen, 60u);
-    EXPECT_EQ(data[6], 0x01);
-    ASSERT_EQ(pcap_next_ex(pc, &hdr, &data), 1);
-    EXPECT_EQ(data[6], 0x03);
-    EXPECT_EQ(data[27], 1);
-    pcap_close(pc);
+    const auto cap = linktest::read_pcap(capture);
+    ASSERT_TRUE(cap.opened) << cap.error;
+    ASSERT_GE(cap.records.size(), 2u);
+    EXPECT_EQ(cap.records[0].size(), 60u);
+    EXPECT_EQ(cap.records[0][6], 0x01);
+    EXPECT_EQ(cap.records[1][6], 0x03);
+    EXPECT_EQ(cap.records[1][27], 1);
     std::remove(capture.c_str());
 }
 
