@@ -28,6 +28,7 @@
 #include "od/drive_profile.hpp"
 #include "slave/log.hpp"
 
+#include "support/temp_dir.hpp"
 #include "support/wire_link.hpp"
 
 using namespace master;
@@ -35,11 +36,7 @@ using namespace master;
 namespace {
 
 std::filesystem::path temp_dir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "softdrive-test-XXXXXX").string();
-    std::vector<char> buf(pattern.begin(), pattern.end());
-    buf.push_back('\0');
-    if (::mkdtemp(buf.data()) == nullptr) throw std::runtime_error("mkdtemp");
-    return buf.data();
+    return test_support::make_temp_dir("softdrive-test-");
 }
 
 // One soft drive "powered" on a manual clock.
@@ -79,21 +76,14 @@ struct Drive {
 };
 
 // The master's link to this slave: each frame through the ESC, then the firmware, as the runtime does.
-class DriveLink final : public esc::Link {
-  public:
+struct DriveLink final : test_support::WireLink {
     explicit DriveLink(Drive& d)
-        : wire_([&d](std::vector<uint8_t>& f) {
+        : WireLink([&d](std::vector<uint8_t>& f) {
               d.clock.advance(d.frame_ns);
               const bool back = d.esc->process_frame(f);
               d.service();
               return back;
           }) {}
-    int fd() const override { return wire_.fd(); }
-    std::size_t receive(std::span<uint8_t> buf) override { return wire_.receive(buf); }
-    bool send(std::span<const uint8_t> frame) override { return wire_.send(frame); }
-
-  private:
-    test_support::WireLink wire_;
 };
 
 MasterOptions master_options() {

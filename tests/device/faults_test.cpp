@@ -19,6 +19,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 
+#include "support/temp_dir.hpp"
 #include "support/wire_link.hpp"
 
 using namespace device;
@@ -100,11 +101,7 @@ TEST(FaultRegistry, ListsAreParsed) {
 // ---- The composed drive with faults, from the master library ------------------------------------------
 
 std::filesystem::path temp_dir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "softdrive-faults-XXXXXX").string();
-    std::vector<char> buf(pattern.begin(), pattern.end());
-    buf.push_back('\0');
-    if (::mkdtemp(buf.data()) == nullptr) throw std::runtime_error("mkdtemp");
-    return buf.data();
+    return test_support::make_temp_dir("softdrive-faults-");
 }
 
 struct FaultyDrive {

@@ -9,22 +9,15 @@
 
 #include "ecat/mailbox_handler.hpp"
 #include "foe/image.hpp"
+#include "support/temp_dir.hpp"
 
 namespace foe_test {
 
 constexpr foe::ImageIdentity kMaxpos{0x000000FB, 0x30010000};
 
-// A fresh directory under /tmp, removed with the object.
-struct TempDir {
-    std::filesystem::path path;
-    TempDir() {
-        char tmpl[] = "/tmp/foe_test_XXXXXX";
-        path = ::mkdtemp(tmpl);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        std::filesystem::remove_all(path, ec);
-    }
+// A fresh temporary directory, removed with the object.
+struct TempDir : test_support::TempDir {
+    TempDir() : test_support::TempDir("foe_test_") {}
 };
 
 // Collects what a handler sends.

@@ -75,22 +75,15 @@ struct Slave {
 };
 
 // The master's link to this slave: each frame through the ESC, then the firmware, as the runtime does.
-class SlaveLink final : public esc::Link {
-  public:
+struct SlaveLink final : test_support::WireLink {
     explicit SlaveLink(Slave& s)
-        : wire_([&s](std::vector<uint8_t>& f) {
+        : WireLink([&s](std::vector<uint8_t>& f) {
               s.clock.advance(50'000);
               const bool back = s.esc->process_frame(f);
               s.esc->tick();
               s.stack->poll(s.clock.now_ns());
               return back;
           }) {}
-    int fd() const override { return wire_.fd(); }
-    std::size_t receive(std::span<uint8_t> buf) override { return wire_.receive(buf); }
-    bool send(std::span<const uint8_t> frame) override { return wire_.send(frame); }
-
-  private:
-    test_support::WireLink wire_;
 };
 
 Bytes foe_packet(uint8_t op, uint32_t value, std::span<const uint8_t> tail = {}) {

@@ -83,23 +83,15 @@ struct Slave {
 };
 
 // The master's link to this slave: each frame through the ESC, then the firmware, as the runtime does.
-class SlaveLink final : public esc::Link {
-  public:
+struct SlaveLink final : test_support::WireLink {
     explicit SlaveLink(Slave& s)
-        : wire_([&s](std::vector<uint8_t>& f) {
+        : WireLink([&s](std::vector<uint8_t>& f) {
               if (!s.real_time) s.clock.advance(20'000);
               const bool back = s.esc->process_frame(f);
               s.esc->tick();
               s.stack->poll(s.clk().now_ns());  // firmware after the reply, as the runtime does
               return back;
           }) {}
-    int fd() const override { return wire_.fd(); }
-    std::size_t receive(std::span<uint8_t> buf) override { return wire_.receive(buf); }
-    bool send(std::span<const uint8_t> frame) override { return wire_.send(frame); }
-    void drop_next() { wire_.drop_next(); }
-
-  private:
-    test_support::WireLink wire_;
 };
 
 MasterOptions options() {
