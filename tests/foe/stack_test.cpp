@@ -86,17 +86,7 @@ struct SlaveLink final : test_support::WireLink {
           }) {}
 };
 
-Bytes foe_packet(uint8_t op, uint32_t value, std::span<const uint8_t> tail = {}) {
-    Bytes m = {op,
-               0,
-               static_cast<uint8_t>(value),
-               static_cast<uint8_t>(value >> 8),
-               static_cast<uint8_t>(value >> 16),
-               static_cast<uint8_t>(value >> 24)};
-    for (auto c : tail)
-        m.push_back(static_cast<uint8_t>(c));  // (vector::insert here trips GCC 12's -Warray-bounds at -O2)
-    return m;
-}
+using foe_test::foe_packet;
 std::span<const uint8_t> text(std::string_view s) {
     return {reinterpret_cast<const uint8_t*>(s.data()), s.size()};
 }
