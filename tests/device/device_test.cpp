@@ -28,6 +28,7 @@
 #include "od/drive_profile.hpp"
 #include "slave/log.hpp"
 
+#include "support/master_bring_up.hpp"
 #include "support/temp_dir.hpp"
 #include "support/wire_link.hpp"
 
@@ -135,13 +136,7 @@ class DeviceAssembly : public ::testing::Test {
     }
     void SetUp() override { ASSERT_NO_FATAL_FAILURE(to_preop()); }
 
-    void to_preop() {
-        ASSERT_EQ(m.count_slaves().value(), 1);
-        ASSERT_EQ(m.assign_station_addresses(1), Error::Ok);
-        ASSERT_EQ(mbx.configure_from_sii(), Error::Ok);
-        AlStatus st;
-        ASSERT_EQ(m.request_state(a, AlState::PreOp, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
-    }
+    void to_preop() { ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(m, mbx, a)); }
 
     uint32_t sdo_u32(uint16_t index, uint8_t sub) {
         uint8_t b[4] = {};

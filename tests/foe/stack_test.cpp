@@ -22,6 +22,7 @@
 #include "master/master.hpp"
 #include "od/drive_profile.hpp"
 
+#include "support/master_bring_up.hpp"
 #include "support/wire_link.hpp"
 
 namespace {
@@ -100,10 +101,7 @@ class FoeOverTheStack : public ::testing::Test {
         o.al_timeout = std::chrono::milliseconds(500);
         return o;
     }
-    void SetUp() override {
-        ASSERT_EQ(m.count_slaves().value(), 1);
-        ASSERT_EQ(m.assign_station_addresses(1), master::Error::Ok);
-    }
+    void SetUp() override { ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m)); }
     // Init -> Bootstrap with the bootstrap mailbox from the description (SII words 0x14-0x17).
     void enter_bootstrap() {
         const auto& b = slave.desc.bootstrap_mailbox;
