@@ -88,10 +88,7 @@ struct DriveLink final : test_support::WireLink {
 };
 
 MasterOptions master_options() {
-    MasterOptions o;
-    o.timeout = std::chrono::milliseconds(5);
-    o.al_timeout = std::chrono::milliseconds(500);
-    return o;
+    return test_support::in_process_master_options();
 }
 
 // Byte offset of index:sub in the process image of the PDOs assigned in `assign` (0x1C12 / 0x1C13).

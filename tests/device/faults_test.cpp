@@ -133,10 +133,7 @@ struct FaultyDrive {
             service();
             return back;
         });
-        master::MasterOptions mo;
-        mo.timeout = std::chrono::milliseconds(5);
-        mo.al_timeout = std::chrono::milliseconds(500);
-        m = std::make_unique<master::Master>(*link, mo);
+        m = std::make_unique<master::Master>(*link, test_support::in_process_master_options());
         mbx = std::make_unique<master::Mailbox>(*m, a);
         sdo = std::make_unique<master::SdoClient>(*mbx);
     }

@@ -95,12 +95,7 @@ std::span<const uint8_t> text(std::string_view s) {
 class FoeOverTheStack : public ::testing::Test {
   protected:
     FoeOverTheStack() : link(slave), m(link, options()), mbx(m, a) {}
-    static master::MasterOptions options() {
-        master::MasterOptions o;
-        o.timeout = std::chrono::milliseconds(5);
-        o.al_timeout = std::chrono::milliseconds(500);
-        return o;
-    }
+    static master::MasterOptions options() { return test_support::in_process_master_options(); }
     void SetUp() override { ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m)); }
     // Init -> Bootstrap with the bootstrap mailbox from the description (SII words 0x14-0x17).
     void enter_bootstrap() {

@@ -96,10 +96,7 @@ struct SlaveLink final : test_support::WireLink {
 };
 
 MasterOptions options() {
-    MasterOptions o;
-    o.timeout = std::chrono::milliseconds(5);
-    o.al_timeout = std::chrono::milliseconds(500);
-    return o;
+    return test_support::in_process_master_options();
 }
 
 class WithSlave : public ::testing::TestWithParam<uint16_t> {

@@ -4,12 +4,22 @@
 // Call through ASSERT_NO_FATAL_FAILURE(...) so a failed step stops the test.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <ios>
 
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 
 namespace test_support {
+
+// Master options for an in-process slave: it answers at once, so short frame timeouts; AL state changes
+// still get half a second.
+inline master::MasterOptions in_process_master_options() {
+    master::MasterOptions o;
+    o.timeout = std::chrono::milliseconds(5);
+    o.al_timeout = std::chrono::milliseconds(500);
+    return o;
+}
 
 // The one slave on the bus counted and given its station address.
 inline void one_slave_addressed(master::Master& m) {
