@@ -10,6 +10,7 @@
 #include "coe/sdo_server.hpp"
 #include "coe_test_support.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/fixed_sender.hpp"
 
 // The replacement pairs malloc with free on purpose; GCC cannot see that once gtest's new/delete are inlined.
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
@@ -18,21 +19,7 @@ using namespace coe_test;
 
 namespace {
 
-// A sender with fixed storage (the recording sender's deque would allocate).
-class FixedSender final : public ecat::MailboxSender {
-  public:
-    bool send(ecat::MailboxType, std::span<const uint8_t> payload) override {
-        if (payload.size() > max_payload()) return false;
-        last_len = payload.size();
-        std::copy(payload.begin(), payload.end(), last.begin());
-        ++count;
-        return true;
-    }
-    std::size_t max_payload() const override { return 58; }
-    std::array<uint8_t, 128> last{};
-    std::size_t last_len = 0;
-    std::size_t count = 0;
-};
+using test_support::FixedSender;
 
 void one_round(coe::CoeServer& server, coe::DiagnosisHistory& diag, FixedSender& out) {
     auto req = [&](const Bytes& b) { server.handle(b, out); };
@@ -71,7 +58,7 @@ TEST(CoeAllocation, ServingRequestsAllocatesNothingOnceWarm) {
     coe::install_pdo_validators(dict);
     coe::CoeServer server(dict, [] { return od::AlState::PreOp; });
     coe::DiagnosisHistory diag(dict, &server.emergency());
-    FixedSender out;
+    FixedSender out(58);
     one_round(server, diag, out);  // warm-up: buffers reach their working size
     ASSERT_EQ(dict.set_raw(0x2000, 0, big), od::Status::Ok);
     const std::size_t before = out.count;

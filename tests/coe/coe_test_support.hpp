@@ -10,6 +10,7 @@
 #include "coe/sdo_server.hpp"
 #include "ecat/mailbox_handler.hpp"
 #include "od/dictionary.hpp"
+#include "util/le.hpp"
 
 namespace coe_test {
 
@@ -44,15 +45,14 @@ class RecordingSender final : public ecat::MailboxSender {
 };
 
 inline void put_le(Bytes& b, uint64_t v, std::size_t n) {
-    for (std::size_t i = 0; i < n; ++i)
-        b.push_back(static_cast<uint8_t>(v >> (8 * i)));
+    const Bytes le = util::le_bytes(v, n);
+    b.insert(b.end(), le.begin(), le.end());
 }
 inline uint32_t le32(const Bytes& b, std::size_t at) {
-    return static_cast<uint32_t>(b[at] | (b[at + 1] << 8) | (b[at + 2] << 16)) |
-           (static_cast<uint32_t>(b[at + 3]) << 24);
+    return util::get32(b, at);
 }
 inline uint16_t le16(const Bytes& b, std::size_t at) {
-    return static_cast<uint16_t>(b[at] | (b[at + 1] << 8));
+    return util::get16(b, at);
 }
 
 // An SDO request (CoE payload): CoE header 0x2000, command, index, subindex, 4 data bytes, extra bytes.

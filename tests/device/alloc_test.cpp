@@ -18,6 +18,7 @@
 #include "master/master.hpp"
 #include "master/session.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/master_bring_up.hpp"
 
 #include "support/alloc_counter.hpp"
 
@@ -72,11 +73,8 @@ TEST(DeviceAllocation, ProcessDataCyclesInOpAllocateNothing) {
     mo.timeout = std::chrono::milliseconds(5);
     master::Master m(link, mo);
     const auto a = master::Address::station(0x1001);
-    ASSERT_EQ(m.count_slaves().value(), 1);
-    ASSERT_EQ(m.assign_station_addresses(1), master::Error::Ok);
     master::Mailbox mbx(m, a);
-    ASSERT_EQ(mbx.configure_from_sii(), master::Error::Ok);
-    ASSERT_EQ(m.request_state(a, master::AlState::PreOp), master::Error::Ok);
+    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(m, mbx, a));
     master::SdoClient sdo(mbx);
     master::ProcessDataSession pd(m, a, sdo);
     ASSERT_EQ(pd.discover(), master::Error::Ok);

@@ -28,6 +28,8 @@
 #include "od/drive_profile.hpp"
 #include "slave/log.hpp"
 
+#include "support/master_bring_up.hpp"
+#include "support/temp_dir.hpp"
 #include "support/wire_link.hpp"
 
 using namespace master;
@@ -35,11 +37,7 @@ using namespace master;
 namespace {
 
 std::filesystem::path temp_dir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "softdrive-test-XXXXXX").string();
-    std::vector<char> buf(pattern.begin(), pattern.end());
-    buf.push_back('\0');
-    if (::mkdtemp(buf.data()) == nullptr) throw std::runtime_error("mkdtemp");
-    return buf.data();
+    return test_support::make_temp_dir("softdrive-test-");
 }
 
 // One soft drive "powered" on a manual clock.
@@ -79,28 +77,18 @@ struct Drive {
 };
 
 // The master's link to this slave: each frame through the ESC, then the firmware, as the runtime does.
-class DriveLink final : public esc::Link {
-  public:
+struct DriveLink final : test_support::WireLink {
     explicit DriveLink(Drive& d)
-        : wire_([&d](std::vector<uint8_t>& f) {
+        : WireLink([&d](std::vector<uint8_t>& f) {
               d.clock.advance(d.frame_ns);
               const bool back = d.esc->process_frame(f);
               d.service();
               return back;
           }) {}
-    int fd() const override { return wire_.fd(); }
-    std::size_t receive(std::span<uint8_t> buf) override { return wire_.receive(buf); }
-    bool send(std::span<const uint8_t> frame) override { return wire_.send(frame); }
-
-  private:
-    test_support::WireLink wire_;
 };
 
 MasterOptions master_options() {
-    MasterOptions o;
-    o.timeout = std::chrono::milliseconds(5);
-    o.al_timeout = std::chrono::milliseconds(500);
-    return o;
+    return test_support::in_process_master_options();
 }
 
 // Byte offset of index:sub in the process image of the PDOs assigned in `assign` (0x1C12 / 0x1C13).
@@ -145,13 +133,7 @@ class DeviceAssembly : public ::testing::Test {
     }
     void SetUp() override { ASSERT_NO_FATAL_FAILURE(to_preop()); }
 
-    void to_preop() {
-        ASSERT_EQ(m.count_slaves().value(), 1);
-        ASSERT_EQ(m.assign_station_addresses(1), Error::Ok);
-        ASSERT_EQ(mbx.configure_from_sii(), Error::Ok);
-        AlStatus st;
-        ASSERT_EQ(m.request_state(a, AlState::PreOp, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
-    }
+    void to_preop() { ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(m, mbx, a)); }
 
     uint32_t sdo_u32(uint16_t index, uint8_t sub) {
         uint8_t b[4] = {};

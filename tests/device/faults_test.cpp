@@ -19,6 +19,8 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 
+#include "support/master_bring_up.hpp"
+#include "support/temp_dir.hpp"
 #include "support/wire_link.hpp"
 
 using namespace device;
@@ -100,11 +102,7 @@ TEST(FaultRegistry, ListsAreParsed) {
 // ---- The composed drive with faults, from the master library ------------------------------------------
 
 std::filesystem::path temp_dir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "softdrive-faults-XXXXXX").string();
-    std::vector<char> buf(pattern.begin(), pattern.end());
-    buf.push_back('\0');
-    if (::mkdtemp(buf.data()) == nullptr) throw std::runtime_error("mkdtemp");
-    return buf.data();
+    return test_support::make_temp_dir("softdrive-faults-");
 }
 
 struct FaultyDrive {
@@ -135,10 +133,7 @@ struct FaultyDrive {
             service();
             return back;
         });
-        master::MasterOptions mo;
-        mo.timeout = std::chrono::milliseconds(5);
-        mo.al_timeout = std::chrono::milliseconds(500);
-        m = std::make_unique<master::Master>(*link, mo);
+        m = std::make_unique<master::Master>(*link, test_support::in_process_master_options());
         mbx = std::make_unique<master::Mailbox>(*m, a);
         sdo = std::make_unique<master::SdoClient>(*mbx);
     }
@@ -157,13 +152,7 @@ struct FaultyDrive {
             service();
         }
     }
-    void to_preop() {
-        ASSERT_EQ(m->count_slaves().value(), 1);
-        ASSERT_EQ(m->assign_station_addresses(1), master::Error::Ok);
-        ASSERT_EQ(mbx->configure_from_sii(), master::Error::Ok);
-        master::AlStatus st;
-        ASSERT_EQ(m->request_state(a, master::AlState::PreOp, &st), master::Error::Ok) << std::hex << st.code;
-    }
+    void to_preop() { ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(*m, *mbx, a)); }
     uint32_t sdo_u32(uint16_t index, uint8_t sub) {
         uint8_t b[4] = {};
         EXPECT_TRUE(sdo->upload(index, sub, b).ok());
@@ -192,10 +181,8 @@ TEST(DeviceFaults, IdentityMismatch) {
 
 TEST(DeviceFaults, SiiChecksumThroughTheEsc) {
     FaultyDrive clean({}), faulty(only(Fault::SiiChecksum));
-    for (FaultyDrive* d : {&clean, &faulty}) {
-        ASSERT_EQ(d->m->count_slaves().value(), 1);
-        ASSERT_EQ(d->m->assign_station_addresses(1), master::Error::Ok);
-    }
+    for (FaultyDrive* d : {&clean, &faulty})
+        ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(*d->m));
     const uint16_t right = clean.m->sii_read_word(clean.a, 7).value();
     EXPECT_EQ(faulty.m->sii_read_word(faulty.a, 7).value(), right ^ 0x00FF);
     EXPECT_EQ(faulty.m->sii_read_word(faulty.a, 8).value(), clean.m->sii_read_word(clean.a, 8).value());
@@ -205,8 +192,7 @@ TEST(DeviceFaults, SiiChecksumThroughTheEsc) {
 TEST(DeviceFaults, BootstrapRefusedThroughTheStack) {
     FaultyDrive clean({}), faulty(only(Fault::BootstrapRefused));
     for (FaultyDrive* d : {&clean, &faulty}) {
-        ASSERT_EQ(d->m->count_slaves().value(), 1);
-        ASSERT_EQ(d->m->assign_station_addresses(1), master::Error::Ok);
+        ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(*d->m));
         ASSERT_EQ(d->mbx->configure_from_sii(/*bootstrap=*/true), master::Error::Ok);
     }
     master::AlStatus st;

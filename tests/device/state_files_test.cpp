@@ -20,21 +20,14 @@
 #include "foe/image.hpp"
 #include "od/drive_profile.hpp"
 #include "od/store.hpp"
+#include "support/temp_dir.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct StateDir {
-    fs::path path;
-    StateDir() {
-        char tmpl[] = "/tmp/softdrive-state-XXXXXX";
-        path = ::mkdtemp(tmpl);
-    }
-    ~StateDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
+struct StateDir : test_support::TempDir {
+    StateDir() : TempDir("softdrive-state-") {}
 };
 
 void put32(std::vector<uint8_t>& b, std::size_t at, uint32_t v) {

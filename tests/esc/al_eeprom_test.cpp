@@ -4,42 +4,26 @@
 
 #include <optional>
 
-#include "frame.hpp"
+#include "esc_fixture.hpp"
 
 using namespace esc_test;
 
 namespace {
 
-struct EscBasics : ::testing::Test {
-    esc::ManualClock clk;
-    std::optional<esc::Esc> e;
-    void SetUp() override {
-        clk.set(1'000'000);
-        e.emplace(esc::EscConfig{}, clk);
-        set_station(*e, 0x1001);
-    }
-};
+struct EscBasics : EscFixture<> {};
 
 // A valid SII image: header with CRC, identity, a string category.
 std::vector<uint8_t> make_image(uint16_t w0, uint16_t w1, uint16_t w2, uint16_t w3, uint16_t alias,
                                 bool good_crc = true) {
     std::vector<uint8_t> img(256, 0xFF);
     std::fill(img.begin(), img.begin() + 0x80, 0);
-    auto put = [&](unsigned w, uint16_t v) {
-        img[2 * w] = static_cast<uint8_t>(v);
-        img[2 * w + 1] = static_cast<uint8_t>(v >> 8);
-    };
+    auto put = [&](unsigned w, uint16_t v) { util::put16(img.data() + 2 * w, v); };
     put(0, w0);
     put(1, w1);
     put(2, w2);
     put(3, w3);
     put(4, alias);
-    uint8_t crc = 0xFF;
-    for (int i = 0; i < 14; ++i) {
-        crc ^= img[i];
-        for (int b = 0; b < 8; ++b)
-            crc = static_cast<uint8_t>((crc & 0x80) ? (crc << 1) ^ 0x07 : (crc << 1));
-    }
+    const uint8_t crc = esi::sii::crc8(img.data(), 14);
     put(7, good_crc ? crc : static_cast<uint8_t>(crc ^ 0x5A));
     put(8, 0x1234);  // vendor id low word
     put(0x0A, 0x5678);
@@ -248,7 +232,7 @@ TEST_F(EscBasics, ReloadAppliesWordsButNotAlias) {
     // Change word 1 and word 4 via writes, fix the CRC (word 7), then reload with 0x0400.
     auto img = make_image(0x0C08, 0xCC11, 0x03E8, 0, 0x0009);
     auto wr = [&](uint16_t w) {
-        const uint16_t v = static_cast<uint16_t>(img[2 * w] | (img[2 * w + 1] << 8));
+        const uint16_t v = util::get16(img.data() + 2 * w);
         fpwr(*e, 0x0502,
              {0x01, 0x02, static_cast<uint8_t>(w), 0x00, 0x00, 0x00, static_cast<uint8_t>(v),
               static_cast<uint8_t>(v >> 8)});

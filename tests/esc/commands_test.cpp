@@ -5,7 +5,7 @@
 #include <optional>
 #include <string>
 
-#include "frame.hpp"
+#include "esc_fixture.hpp"
 
 using namespace esc_test;
 
@@ -69,15 +69,7 @@ INSTANTIATE_TEST_SUITE_P(
                       CommandCase{"EXT_0xFF", 0xFF, 0, kIn, kIn, 0, 0, kMem}),
     [](const auto& p) { return p.param.name; });
 
-struct Fixture : ::testing::Test {
-    esc::ManualClock clk;
-    std::optional<esc::Esc> e;
-    void SetUp() override {
-        clk.set(1'000'000);
-        e.emplace(esc::EscConfig{}, clk);
-        set_station(*e, 0x1001);
-    }
-};
+using Fixture = EscFixture<>;
 
 using Addressing = Fixture;
 

@@ -5,7 +5,7 @@
 #include <cstdlib>
 #include <optional>
 
-#include "frame.hpp"
+#include "esc_fixture.hpp"
 
 using namespace esc_test;
 
@@ -13,13 +13,9 @@ namespace {
 
 constexpr uint64_t kT0 = 1'000'000'000;  // clock at construction (local time starts equal to it)
 
-struct DistributedClocks : ::testing::Test {
-    esc::ManualClock clk;
-    std::optional<esc::Esc> e;
+struct DistributedClocks : EscFixture<kT0> {
     void SetUp() override {
-        clk.set(kT0);
-        e.emplace(esc::EscConfig{}, clk);
-        set_station(*e, 0x1001);
+        EscFixture::SetUp();
         fpwr(*e, 0x0410, {0x00, 0x00});  // PDI watchdog off: next_event_ns() only shows DC events
     }
     uint32_t al_event() { return e->read_reg<uint32_t>(0x0220); }
@@ -329,13 +325,7 @@ TEST_F(DistributedClocks, SyncNotMappedToAlEvent) {
     img[3] = 0x00;  // word 1: 0x0151 = 0 (SYNC0/1 not mapped)
     img[4] = 0x00;
     img[5] = 0x00;  // word 2: pulse length 0 = acknowledge mode
-    uint8_t crc = 0xFF;
-    for (int i = 0; i < 14; ++i) {
-        crc ^= img[i];
-        for (int b = 0; b < 8; ++b)
-            crc = static_cast<uint8_t>((crc & 0x80) ? (crc << 1) ^ 0x07 : (crc << 1));
-    }
-    img[14] = crc;
+    fix_sii_header_crc(img);
     e->load_eeprom(img);
     const uint64_t start = start_sync(1'000'000, 0, 0x03);
     clk.set(start + 50'000);
@@ -350,13 +340,7 @@ TEST_F(DistributedClocks, SyncNotMappedToAlEvent) {
 TEST_F(DistributedClocks, SyncUnitDisabledInEscConfig) {
     std::vector<uint8_t> img(e->eeprom().begin(), e->eeprom().end());
     img[1] = 0x00;  // 0x0141 = 0: SYNC out unit off
-    uint8_t crc = 0xFF;
-    for (int i = 0; i < 14; ++i) {
-        crc ^= img[i];
-        for (int b = 0; b < 8; ++b)
-            crc = static_cast<uint8_t>((crc & 0x80) ? (crc << 1) ^ 0x07 : (crc << 1));
-    }
-    img[14] = crc;
+    fix_sii_header_crc(img);
     e->load_eeprom(img);
     const uint64_t start = start_sync(1'000'000, 0, 0x03);
     clk.set(start + 1);

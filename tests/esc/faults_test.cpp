@@ -4,6 +4,7 @@
 
 #include <optional>
 
+#include "esi/wire/sii.hpp"
 #include "frame.hpp"
 
 using namespace esc_test;
@@ -11,17 +12,6 @@ using namespace esc_test;
 namespace {
 
 constexpr uint64_t kT0 = 1'000'000'000;
-
-// SII word 7: CRC-8 (polynomial 0x07, initial 0xFF) of words 0-6.
-uint8_t sii_crc(const uint8_t* p) {
-    uint8_t crc = 0xFF;
-    for (int i = 0; i < 14; ++i) {
-        crc ^= p[i];
-        for (int b = 0; b < 8; ++b)
-            crc = static_cast<uint8_t>((crc & 0x80) ? (crc << 1) ^ 0x07 : (crc << 1));
-    }
-    return crc;
-}
 
 struct Escs {
     esc::ManualClock clk;
@@ -103,7 +93,7 @@ TEST(EscFaults, SiiChecksum) {
         return fprd(x, 0x0508, 8).u16(6);
     };
     const uint16_t right = word7(*e.clean);
-    EXPECT_EQ(right & 0xFF, sii_crc(e.clean->eeprom().data()));
+    EXPECT_EQ(right & 0xFF, esi::sii::crc8(e.clean->eeprom().data(), 14));
     EXPECT_EQ(word7(*e.faulty), right ^ 0x00FF);
     // The ESC itself loaded its configuration: no checksum error, EEPROM loaded.
     EXPECT_EQ(fprd(*e.faulty, 0x0502, 2).u16() & 0x0800, 0);

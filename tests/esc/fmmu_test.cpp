@@ -5,7 +5,7 @@
 #include <optional>
 #include <random>
 
-#include "frame.hpp"
+#include "esc_fixture.hpp"
 
 using namespace esc_test;
 
@@ -37,14 +37,7 @@ std::vector<uint8_t> fmmu_bytes(const FmmuCfg& c) {
     return b;
 }
 
-struct FmmuMapping : ::testing::Test {
-    esc::ManualClock clk;
-    std::optional<esc::Esc> e;
-    void SetUp() override {
-        clk.set(1'000'000);
-        e.emplace(esc::EscConfig{}, clk);
-        set_station(*e, 0x1001);
-    }
+struct FmmuMapping : EscFixture<> {
     void fmmu(unsigned n, const FmmuCfg& c) {
         ASSERT_EQ(fpwr(*e, static_cast<uint16_t>(0x0600 + 16 * n), fmmu_bytes(c)).wkc, 1);
     }

@@ -4,21 +4,13 @@
 
 #include <optional>
 
-#include "frame.hpp"
+#include "esc_fixture.hpp"
 
 using namespace esc_test;
 
 namespace {
 
-struct FrameHandling : ::testing::Test {
-    esc::ManualClock clk;
-    std::optional<esc::Esc> e;
-    void SetUp() override {
-        clk.set(5'000'000);
-        e.emplace(esc::EscConfig{}, clk);
-        set_station(*e, 0x1001);
-    }
-};
+struct FrameHandling : EscFixture<5'000'000> {};
 
 TEST_F(FrameHandling, SourceMacBitSetAndLengthKept) {
     auto f = build({dg_len(APRD, 0, 0x0130, 2)});

@@ -4,7 +4,7 @@
 
 #include <optional>
 
-#include "frame.hpp"
+#include "esc_fixture.hpp"
 
 using namespace esc_test;
 
@@ -21,13 +21,9 @@ std::vector<uint8_t> sm_bytes(uint16_t start, uint16_t len, uint8_t ctrl, uint8_
     return b;
 }
 
-struct SyncManagerRules : ::testing::Test {
-    esc::ManualClock clk;
-    std::optional<esc::Esc> e;
+struct SyncManagerRules : EscFixture<> {
     void SetUp() override {
-        clk.set(1'000'000);
-        e.emplace(esc::EscConfig{}, clk);
-        set_station(*e, 0x1001);
+        EscFixture::SetUp();
         // SOEM style: clear all SMs, then start/length/control + activate in one write each.
         ASSERT_EQ(run1(*e, dg(BWR, 0, 0x0800, std::vector<uint8_t>(32, 0))).wkc, 1);
         ASSERT_EQ(fpwr(*e, 0x0800, sm_bytes(0x1000, 8, 0x26, 1)).wkc, 1);  // mailbox out

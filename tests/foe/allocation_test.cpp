@@ -10,31 +10,18 @@
 #include "foe/server.hpp"
 #include "foe_test_support.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/fixed_sender.hpp"
+#include "util/le.hpp"
 
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 
 namespace {
 
-class FixedSender final : public ecat::MailboxSender {
-  public:
-    bool send(ecat::MailboxType, std::span<const uint8_t> payload) override {
-        if (payload.size() > max_payload()) return false;
-        last_len = payload.size();
-        std::copy(payload.begin(), payload.end(), last.begin());
-        return true;
-    }
-    std::size_t max_payload() const override { return 128 - 6; }
-    std::array<uint8_t, 128> last{};
-    std::size_t last_len = 0;
-};
+using test_support::FixedSender;
 
 std::array<uint8_t, 128> packet(uint8_t op, uint32_t value, std::span<const uint8_t> tail, std::size_t& len) {
-    std::array<uint8_t, 128> m{op,
-                               0,
-                               static_cast<uint8_t>(value),
-                               static_cast<uint8_t>(value >> 8),
-                               static_cast<uint8_t>(value >> 16),
-                               static_cast<uint8_t>(value >> 24)};
+    std::array<uint8_t, 128> m{op, 0};
+    util::put32(m.data() + 2, value);
     std::copy(tail.begin(), tail.end(), m.begin() + 6);
     len = 6 + tail.size();
     return m;
@@ -51,7 +38,7 @@ TEST(FoeAllocation, DataAckAndIdlePollAllocateNothing) {
     ASSERT_TRUE(store.open());
     foe::FoeServer server(store);
     server.set_state(od::AlState::Boot);
-    FixedSender out;
+    FixedSender out(128 - 6);
     const std::size_t chunk = 116;
     const auto image =
         foe::build_image(foe_test::payload_bytes(100 * chunk, 1), foe_test::kMaxpos, 0x01300000);

@@ -9,22 +9,16 @@
 
 #include "ecat/mailbox_handler.hpp"
 #include "foe/image.hpp"
+#include "support/temp_dir.hpp"
+#include "util/le.hpp"
 
 namespace foe_test {
 
 constexpr foe::ImageIdentity kMaxpos{0x000000FB, 0x30010000};
 
-// A fresh directory under /tmp, removed with the object.
-struct TempDir {
-    std::filesystem::path path;
-    TempDir() {
-        char tmpl[] = "/tmp/foe_test_XXXXXX";
-        path = ::mkdtemp(tmpl);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        std::filesystem::remove_all(path, ec);
-    }
+// A fresh temporary directory, removed with the object.
+struct TempDir : test_support::TempDir {
+    TempDir() : test_support::TempDir("foe_test_") {}
 };
 
 // Collects what a handler sends.
@@ -56,8 +50,17 @@ inline std::vector<uint8_t> payload_bytes(std::size_t n, uint32_t seed) {
 }
 
 inline uint32_t le32(const std::vector<uint8_t>& m, std::size_t at) {
-    return static_cast<uint32_t>(m[at]) | static_cast<uint32_t>(m[at + 1]) << 8 |
-           static_cast<uint32_t>(m[at + 2]) << 16 | static_cast<uint32_t>(m[at + 3]) << 24;
+    return util::get32(m, at);
+}
+
+// A FoE packet (ETG.1000.6 FoE header: opcode, reserved byte, 32-bit packet number / password / error code)
+// followed by tail.
+inline std::vector<uint8_t> foe_packet(uint8_t op, uint32_t value, std::span<const uint8_t> tail = {}) {
+    std::vector<uint8_t> m{op, 0};
+    util::append32(m, value);
+    for (auto c : tail)
+        m.push_back(c);  // (vector::insert here trips GCC 12's -Warray-bounds at -O2)
+    return m;
 }
 
 }  // namespace foe_test

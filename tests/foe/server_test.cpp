@@ -18,12 +18,8 @@ namespace {
 using Bytes = std::vector<uint8_t>;
 
 Bytes request(Opcode op, uint32_t value, std::string_view tail = {}) {
-    Bytes m = {static_cast<uint8_t>(op),          0,
-               static_cast<uint8_t>(value),       static_cast<uint8_t>(value >> 8),
-               static_cast<uint8_t>(value >> 16), static_cast<uint8_t>(value >> 24)};
-    for (auto c : tail)
-        m.push_back(static_cast<uint8_t>(c));  // (vector::insert here trips GCC 12's -Warray-bounds at -O2)
-    return m;
+    return foe_test::foe_packet(static_cast<uint8_t>(op), value,
+                                {reinterpret_cast<const uint8_t*>(tail.data()), tail.size()});
 }
 Bytes data(uint32_t packet, std::span<const uint8_t> bytes) {
     Bytes m = request(Opcode::Data, packet);

@@ -22,6 +22,7 @@
 #include "master/master.hpp"
 #include "od/drive_profile.hpp"
 
+#include "support/master_bring_up.hpp"
 #include "support/wire_link.hpp"
 
 namespace {
@@ -75,35 +76,18 @@ struct Slave {
 };
 
 // The master's link to this slave: each frame through the ESC, then the firmware, as the runtime does.
-class SlaveLink final : public esc::Link {
-  public:
+struct SlaveLink final : test_support::WireLink {
     explicit SlaveLink(Slave& s)
-        : wire_([&s](std::vector<uint8_t>& f) {
+        : WireLink([&s](std::vector<uint8_t>& f) {
               s.clock.advance(50'000);
               const bool back = s.esc->process_frame(f);
               s.esc->tick();
               s.stack->poll(s.clock.now_ns());
               return back;
           }) {}
-    int fd() const override { return wire_.fd(); }
-    std::size_t receive(std::span<uint8_t> buf) override { return wire_.receive(buf); }
-    bool send(std::span<const uint8_t> frame) override { return wire_.send(frame); }
-
-  private:
-    test_support::WireLink wire_;
 };
 
-Bytes foe_packet(uint8_t op, uint32_t value, std::span<const uint8_t> tail = {}) {
-    Bytes m = {op,
-               0,
-               static_cast<uint8_t>(value),
-               static_cast<uint8_t>(value >> 8),
-               static_cast<uint8_t>(value >> 16),
-               static_cast<uint8_t>(value >> 24)};
-    for (auto c : tail)
-        m.push_back(static_cast<uint8_t>(c));  // (vector::insert here trips GCC 12's -Warray-bounds at -O2)
-    return m;
-}
+using foe_test::foe_packet;
 std::span<const uint8_t> text(std::string_view s) {
     return {reinterpret_cast<const uint8_t*>(s.data()), s.size()};
 }
@@ -111,16 +95,8 @@ std::span<const uint8_t> text(std::string_view s) {
 class FoeOverTheStack : public ::testing::Test {
   protected:
     FoeOverTheStack() : link(slave), m(link, options()), mbx(m, a) {}
-    static master::MasterOptions options() {
-        master::MasterOptions o;
-        o.timeout = std::chrono::milliseconds(5);
-        o.al_timeout = std::chrono::milliseconds(500);
-        return o;
-    }
-    void SetUp() override {
-        ASSERT_EQ(m.count_slaves().value(), 1);
-        ASSERT_EQ(m.assign_station_addresses(1), master::Error::Ok);
-    }
+    static master::MasterOptions options() { return test_support::in_process_master_options(); }
+    void SetUp() override { ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m)); }
     // Init -> Bootstrap with the bootstrap mailbox from the description (SII words 0x14-0x17).
     void enter_bootstrap() {
         const auto& b = slave.desc.bootstrap_mailbox;

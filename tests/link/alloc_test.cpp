@@ -12,30 +12,15 @@
 #include "esc/esc.hpp"
 #include "esc/link_capture.hpp"
 #include "esc/link_loopback.hpp"
+#include "esc/wire/frame_builder.hpp"
 #include "slave/runtime.hpp"
 #include "support/alloc_counter.hpp"
 
 namespace {
 
+// One datagram of len zero bytes (index 0), padded to the minimum frame size.
 std::vector<uint8_t> frame_with(uint8_t cmd, uint16_t adp, uint16_t ado, std::size_t len) {
-    std::vector<uint8_t> f(std::max<std::size_t>(60, 16 + 12 + len), 0);
-    for (int i = 0; i < 6; ++i)
-        f[static_cast<std::size_t>(i)] = 0xFF;
-    for (int i = 6; i < 12; ++i)
-        f[static_cast<std::size_t>(i)] = 0x01;
-    f[12] = 0x88;
-    f[13] = 0xA4;
-    const std::size_t dl = 12 + len;
-    f[14] = static_cast<uint8_t>(dl);
-    f[15] = static_cast<uint8_t>(0x10 | (dl >> 8));
-    f[16] = cmd;
-    f[18] = static_cast<uint8_t>(adp);
-    f[19] = static_cast<uint8_t>(adp >> 8);
-    f[20] = static_cast<uint8_t>(ado);
-    f[21] = static_cast<uint8_t>(ado >> 8);
-    f[22] = static_cast<uint8_t>(len);
-    f[23] = static_cast<uint8_t>(len >> 8);
-    return f;
+    return esc::wire::FrameBuilder().add_zero(cmd, 0, adp, ado, len).build();
 }
 
 // A runtime over a loopback link with a real ESC; `master` is the other end.

@@ -11,12 +11,12 @@
 #include <thread>
 #include <vector>
 
-#include <pcap/pcap.h>
-
 #include "esc/esc.hpp"
 #include "esc/link_capture.hpp"
 #include "esc/link_loopback.hpp"
+#include "esc/wire/frame_builder.hpp"
 #include "netns_util.hpp"
+#include "pcap_records.hpp"
 #include "slave/netif.hpp"
 #include "slave/runtime.hpp"
 
@@ -24,19 +24,7 @@ namespace {
 
 // BRD of the ESC type register (0x0000, 1 byte): every ESC answers with WKC 1.
 std::vector<uint8_t> brd_type_frame(std::size_t total = 60) {
-    std::vector<uint8_t> f(total, 0);
-    for (int i = 0; i < 6; ++i)
-        f[static_cast<std::size_t>(i)] = 0xFF;
-    for (int i = 6; i < 12; ++i)
-        f[static_cast<std::size_t>(i)] = 0x01;
-    f[12] = 0x88;
-    f[13] = 0xA4;
-    f[14] = 13;  // 10 header + 1 data + 2 WKC
-    f[15] = 0x10;
-    f[16] = 7;  // BRD
-    f[17] = 0x42;
-    f[22] = 1;  // length 1
-    return f;
+    return esc::wire::FrameBuilder().add_zero(esc::Command::BRD, 0x42, 0, 0x0000, 1).build(total);
 }
 constexpr std::size_t kWkcOffset = 16 + 10 + 1;
 
@@ -353,20 +341,14 @@ TEST_F(Runtime, CaptureRecordsTheFrameAsReceivedAndAsSent) {
         ASSERT_TRUE(runtime.run_once(1000));
         runtime.set_capture(nullptr);
     }
-    char errbuf[PCAP_ERRBUF_SIZE];
-    pcap_t* p = pcap_open_offline(path.c_str(), errbuf);
-    ASSERT_NE(p, nullptr) << errbuf;
-    pcap_pkthdr* hdr = nullptr;
-    const u_char* data = nullptr;
-    ASSERT_EQ(pcap_next_ex(p, &hdr, &data), 1);
-    EXPECT_EQ(hdr->caplen, 60u);
-    EXPECT_EQ(data[6], 0x01) << "first record: the frame as it came in";
-    EXPECT_EQ(data[kWkcOffset], 0);
-    ASSERT_EQ(pcap_next_ex(p, &hdr, &data), 1);
-    EXPECT_EQ(data[6], 0x03) << "second record: the reply";
-    EXPECT_EQ(data[kWkcOffset], 1);
-    EXPECT_NE(pcap_next_ex(p, &hdr, &data), 1);
-    pcap_close(p);
+    const auto cap = linktest::read_pcap(path);
+    ASSERT_TRUE(cap.opened) << cap.error;
+    ASSERT_EQ(cap.records.size(), 2u) << "the frame as it came in and the reply";
+    EXPECT_EQ(cap.records[0].size(), 60u);
+    EXPECT_EQ(cap.records[0][6], 0x01) << "first record: the frame as it came in";
+    EXPECT_EQ(cap.records[0][kWkcOffset], 0);
+    EXPECT_EQ(cap.records[1][6], 0x03) << "second record: the reply";
+    EXPECT_EQ(cap.records[1][kWkcOffset], 1);
     std::remove(path.c_str());
 }
 

@@ -10,8 +10,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <pcap/pcap.h>
-
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -22,7 +20,9 @@
 
 #include "device/faults.hpp"
 #include "esc/link_packet.hpp"
+#include "esc/wire/frame_builder.hpp"
 #include "netns_util.hpp"
+#include "pcap_records.hpp"
 #include "slave/netif.hpp"
 
 namespace {
@@ -218,17 +218,7 @@ void expect_brd_answer(pid_t pid, uint8_t source_byte = 0x03) {
     std::unique_ptr<esc::PacketLink> master;
     in_netns_of(pid, [&] { master = std::make_unique<esc::PacketLink>("ecat1"); });
     // BRD of the ESC type register: the slave answers with WKC 1 and the source MAC bit set.
-    std::vector<uint8_t> f(60, 0);
-    for (int i = 0; i < 6; ++i)
-        f[static_cast<std::size_t>(i)] = 0xFF;
-    for (int i = 6; i < 12; ++i)
-        f[static_cast<std::size_t>(i)] = 0x01;
-    f[12] = 0x88;
-    f[13] = 0xA4;
-    f[14] = 13;
-    f[15] = 0x10;
-    f[16] = 7;
-    f[22] = 1;
+    const auto f = esc::wire::FrameBuilder().add_zero(esc::Command::BRD, 0, 0, 0x0000, 1).build();
     ASSERT_TRUE(master->send(f));
     std::array<uint8_t, esc::kMaxFrameSize> buf{};
     std::size_t n = 0;
@@ -270,18 +260,13 @@ TEST(EcatSlaveVeth, CreatesThePairAnswersOnItAndRemovesItOnSigterm) {
     EXPECT_FALSE(exists_after) << "the veth pair must be gone after SIGTERM";
 
     // The capture holds the frame as received and the reply.
-    char errbuf[PCAP_ERRBUF_SIZE];
-    pcap_t* pc = pcap_open_offline(capture.c_str(), errbuf);
-    ASSERT_NE(pc, nullptr) << errbuf;
-    pcap_pkthdr* hdr = nullptr;
-    const u_char* data = nullptr;
-    ASSERT_EQ(pcap_next_ex(pc, &hdr, &data), 1);
-    EXPECT_EQ(hdr->caplen, 60u);
-    EXPECT_EQ(data[6], 0x01);
-    ASSERT_EQ(pcap_next_ex(pc, &hdr, &data), 1);
-    EXPECT_EQ(data[6], 0x03);
-    EXPECT_EQ(data[27], 1);
-    pcap_close(pc);
+    const auto cap = linktest::read_pcap(capture);
+    ASSERT_TRUE(cap.opened) << cap.error;
+    ASSERT_GE(cap.records.size(), 2u);
+    EXPECT_EQ(cap.records[0].size(), 60u);
+    EXPECT_EQ(cap.records[0][6], 0x01);
+    EXPECT_EQ(cap.records[1][6], 0x03);
+    EXPECT_EQ(cap.records[1][27], 1);
     std::remove(capture.c_str());
 }
 

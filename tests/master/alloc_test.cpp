@@ -17,6 +17,7 @@
 #include "master/session.hpp"
 #include "od/drive_profile.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/master_bring_up.hpp"
 
 using namespace master;
 
@@ -70,11 +71,8 @@ TEST(MasterAllocations, CyclesAndMailboxMessagesAllocateNothing) {
     o.timeout = std::chrono::milliseconds(20);
     Master m(link, o);
     const Address a = Address::station(0x1001);
-    ASSERT_EQ(m.count_slaves().value(), 1);
-    ASSERT_EQ(m.assign_station_addresses(1), Error::Ok);
     Mailbox mbx(m, a);
-    ASSERT_EQ(mbx.configure_from_sii(), Error::Ok);
-    ASSERT_EQ(m.request_state(a, AlState::PreOp), Error::Ok);
+    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(m, mbx, a));
     SdoClient sdo(mbx);
     ProcessDataSession pd(m, a, sdo);
     ASSERT_EQ(pd.discover(), Error::Ok);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "master/diag.hpp"
+#include "util/le.hpp"
 
 namespace {
 
@@ -16,14 +17,10 @@ using master::DiagHeader;
 std::vector<uint8_t> message(uint32_t code, uint16_t flags, uint16_t text, uint64_t ts,
                              std::vector<uint8_t> params = {}) {
     std::vector<uint8_t> b;
-    for (int i = 0; i < 4; ++i)
-        b.push_back(static_cast<uint8_t>(code >> (8 * i)));
-    b.push_back(static_cast<uint8_t>(flags));
-    b.push_back(static_cast<uint8_t>(flags >> 8));
-    b.push_back(static_cast<uint8_t>(text));
-    b.push_back(static_cast<uint8_t>(text >> 8));
-    for (int i = 0; i < 8; ++i)
-        b.push_back(static_cast<uint8_t>(ts >> (8 * i)));
+    util::append32(b, code);
+    util::append16(b, flags);
+    util::append16(b, text);
+    util::append64(b, ts);
     b.insert(b.end(), params.begin(), params.end());
     return b;
 }

@@ -7,22 +7,14 @@
 
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
+#include "esi/wire/sii.hpp"
 #include "master/master.hpp"
 #include "support/wire_link.hpp"
+#include "util/le.hpp"
 
 using namespace master;
 
 namespace {
-
-uint8_t crc8(const uint8_t* p, std::size_t n) {
-    uint8_t crc = 0xFF;
-    for (std::size_t i = 0; i < n; ++i) {
-        crc ^= p[i];
-        for (int b = 0; b < 8; ++b)
-            crc = static_cast<uint8_t>((crc & 0x80) ? (crc << 1) ^ 0x07 : crc << 1);
-    }
-    return crc;
-}
 
 // Header + one STRINGS category + end, 2 KiB. esc_config goes to word 0 high byte (0x0141).
 std::vector<uint8_t> image(uint8_t esc_config = 0x0C) {
@@ -43,11 +35,9 @@ std::vector<uint8_t> image(uint8_t esc_config = 0x0C) {
     w[0x3F] = 1;
     w.insert(w.end(), {10, 3, 0x4101, 0x4242, 0x0042, 0xFFFF});
     std::vector<uint8_t> b;
-    for (uint16_t x : w) {
-        b.push_back(static_cast<uint8_t>(x));
-        b.push_back(static_cast<uint8_t>(x >> 8));
-    }
-    b[14] = crc8(b.data(), 14);
+    for (uint16_t x : w)
+        util::append16(b, x);
+    b[14] = esi::sii::crc8(b.data(), 14);
     b.resize(2048, 0xFF);
     return b;
 }

@@ -4,6 +4,7 @@
 
 #include "fake_bus.hpp"
 #include "master/master.hpp"
+#include "util/le.hpp"
 
 using namespace master;
 
@@ -36,10 +37,8 @@ std::vector<uint16_t> sample_image() {
 
 std::vector<uint8_t> bytes(const std::vector<uint16_t>& w, std::size_t words) {
     std::vector<uint8_t> b;
-    for (std::size_t i = 0; i < words; ++i) {
-        b.push_back(static_cast<uint8_t>(w[i]));
-        b.push_back(static_cast<uint8_t>(w[i] >> 8));
-    }
+    for (std::size_t i = 0; i < words; ++i)
+        util::append16(b, w[i]);
     return b;
 }
 }  // namespace

@@ -25,6 +25,7 @@
 #include "master/session.hpp"
 #include "od/drive_profile.hpp"
 
+#include "support/master_bring_up.hpp"
 #include "support/wire_link.hpp"
 
 using namespace master;
@@ -83,43 +84,26 @@ struct Slave {
 };
 
 // The master's link to this slave: each frame through the ESC, then the firmware, as the runtime does.
-class SlaveLink final : public esc::Link {
-  public:
+struct SlaveLink final : test_support::WireLink {
     explicit SlaveLink(Slave& s)
-        : wire_([&s](std::vector<uint8_t>& f) {
+        : WireLink([&s](std::vector<uint8_t>& f) {
               if (!s.real_time) s.clock.advance(20'000);
               const bool back = s.esc->process_frame(f);
               s.esc->tick();
               s.stack->poll(s.clk().now_ns());  // firmware after the reply, as the runtime does
               return back;
           }) {}
-    int fd() const override { return wire_.fd(); }
-    std::size_t receive(std::span<uint8_t> buf) override { return wire_.receive(buf); }
-    bool send(std::span<const uint8_t> frame) override { return wire_.send(frame); }
-    void drop_next() { wire_.drop_next(); }
-
-  private:
-    test_support::WireLink wire_;
 };
 
 MasterOptions options() {
-    MasterOptions o;
-    o.timeout = std::chrono::milliseconds(5);
-    o.al_timeout = std::chrono::milliseconds(500);
-    return o;
+    return test_support::in_process_master_options();
 }
 
 class WithSlave : public ::testing::TestWithParam<uint16_t> {
   protected:
     WithSlave()
         : slave(GetParam()), link(slave), m(link, options()), mbx(m, Address::station(0x1001)), sdo(mbx) {}
-    void SetUp() override {
-        ASSERT_EQ(m.count_slaves().value(), 1);
-        ASSERT_EQ(m.assign_station_addresses(1), Error::Ok);
-        ASSERT_EQ(mbx.configure_from_sii(), Error::Ok);
-        AlStatus st;
-        ASSERT_EQ(m.request_state(a, AlState::PreOp, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
-    }
+    void SetUp() override { ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(m, mbx, a)); }
     Slave slave;
     SlaveLink link;
     Master m;
@@ -350,11 +334,8 @@ TEST(ProcessDataDc, Sync0RunsAndTheSlaveReachesOpInDcMode) {
     SlaveLink link(slave);
     Master m(link, options());
     const Address a = Address::station(0x1001);
-    ASSERT_EQ(m.count_slaves().value(), 1);
-    ASSERT_EQ(m.assign_station_addresses(1), Error::Ok);
     Mailbox mbx(m, a);
-    ASSERT_EQ(mbx.configure_from_sii(), Error::Ok);
-    ASSERT_EQ(m.request_state(a, AlState::PreOp), Error::Ok);
+    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(m, mbx, a));
     SdoClient sdo(mbx);
     ProcessDataSession pd(m, a, sdo);
     ASSERT_EQ(pd.discover(), Error::Ok);
@@ -391,12 +372,9 @@ TEST(FoeWithSlave, FirmwareWrittenInBootstrapIsReadBack) {
     SlaveLink link(slave);
     Master m(link, options());
     const Address a = Address::station(0x1001);
-    ASSERT_EQ(m.count_slaves().value(), 1);
-    ASSERT_EQ(m.assign_station_addresses(1), Error::Ok);
     // Outside Bootstrap a firmware write is refused with an FoE error.
     Mailbox std_mbx(m, a);
-    ASSERT_EQ(std_mbx.configure_from_sii(), Error::Ok);
-    ASSERT_EQ(m.request_state(a, AlState::PreOp), Error::Ok);
+    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(m, std_mbx, a));
     FoeClient refused(std_mbx);
     const std::vector<uint8_t> payload(3000, 0x5A);
     const auto image = foe::build_image(payload, foe::ImageIdentity::from(slave.desc.identity), 0x01300000);

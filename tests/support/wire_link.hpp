@@ -2,6 +2,7 @@
 // A master's esc::Link wired straight to an in-process slave: send() hands the frame to the slave's
 // `deliver` function (ESC processing, then whatever firmware work the test runs after a reply), and a frame
 // the slave sends back is queued for receive(). drop_next() loses the next reply, as a broken cable would.
+// A test names its link by deriving from it with the deliver function of its slave.
 #include <algorithm>
 #include <cstdint>
 #include <deque>
@@ -14,7 +15,7 @@
 
 namespace test_support {
 
-class WireLink final : public esc::Link {
+class WireLink : public esc::Link {
   public:
     // Processes the frame in place; returns true if it goes back to the master.
     using Deliver = std::function<bool(std::vector<uint8_t>& frame)>;

@@ -1,0 +1,31 @@
+#pragma once
+// The ESC the tests of tests/esc start from: a manual clock set to StartNs, the default EscConfig and station
+// address 0x1001 (set through ECAT, see frame.hpp). Fixtures derive from it and add their own set-up.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "esi/wire/sii.hpp"
+#include "frame.hpp"
+
+namespace esc_test {
+
+template <uint64_t StartNs = 1'000'000>
+struct EscFixture : ::testing::Test {
+    esc::ManualClock clk;
+    std::optional<esc::Esc> e;
+    void SetUp() override {
+        clk.set(StartNs);
+        e.emplace(esc::EscConfig{}, clk);
+        set_station(*e, 0x1001);
+    }
+};
+
+// Rewrites the SII header checksum (word 7, low byte) after a test changed words 0..6 (ETG.2010).
+inline void fix_sii_header_crc(std::vector<uint8_t>& img) {
+    img[14] = esi::sii::crc8(img.data(), 14);
+}
+
+}  // namespace esc_test
