@@ -19,25 +19,10 @@ namespace pdo_flags = sii::pdo_flags;
 constexpr uint16_t kSiiChecksumDisabled = sii::kChecksumDisabled;
 constexpr std::size_t kSiiFirstCategoryWord = sii::word::FirstCategory;
 
-// Mailbox protocols word (word 0x1C) bits.
-namespace mailbox_protocol {
-constexpr uint16_t AoE = 0x0001;
-constexpr uint16_t EoE = 0x0002;
-constexpr uint16_t CoE = 0x0004;
-constexpr uint16_t FoE = 0x0008;
-constexpr uint16_t SoE = 0x0010;
-constexpr uint16_t VoE = 0x0020;
-}  // namespace mailbox_protocol
-
-// CoE details bits (General category).
-namespace coe_details {
-constexpr uint8_t Sdo = 0x01;
-constexpr uint8_t SdoInfo = 0x02;
-constexpr uint8_t PdoAssign = 0x04;
-constexpr uint8_t PdoConfig = 0x08;
-constexpr uint8_t PdoUpload = 0x10;
-constexpr uint8_t CompleteAccess = 0x20;
-}  // namespace coe_details
+// Mailbox protocol bits (SII word 0x1C, the ESI) and CoE details bits (SII General category): the SII
+// vocabulary's (esi/wire/sii.hpp).
+namespace mailbox_protocol = sii::mailbox_protocol;
+namespace coe_details = sii::coe_details;
 
 // A mailbox's two sync managers as the SII header words 0x14-0x1B give them.
 struct SiiMailbox {

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "esi/wire/sii.hpp"
+
 namespace od {
 
 struct Identity {
@@ -28,25 +30,10 @@ struct MailboxLayout {
     uint16_t in_size = 128;
 };
 
-// Mailbox protocol bits as in SII word 0x1C and the ESI.
-namespace mailbox_protocol {
-constexpr uint16_t AoE = 0x0001;
-constexpr uint16_t EoE = 0x0002;
-constexpr uint16_t CoE = 0x0004;
-constexpr uint16_t FoE = 0x0008;
-constexpr uint16_t SoE = 0x0010;
-constexpr uint16_t VoE = 0x0020;
-}  // namespace mailbox_protocol
-
-// CoE details bits as in the SII General category.
-namespace coe_details {
-constexpr uint8_t Sdo = 0x01;
-constexpr uint8_t SdoInfo = 0x02;
-constexpr uint8_t PdoAssign = 0x04;
-constexpr uint8_t PdoConfig = 0x08;
-constexpr uint8_t PdoUpload = 0x10;
-constexpr uint8_t CompleteAccess = 0x20;
-}  // namespace coe_details
+// Mailbox protocol bits (SII word 0x1C, the ESI) and CoE details bits (SII General category): the SII
+// vocabulary's (esi/wire/sii.hpp).
+namespace mailbox_protocol = esi::sii::mailbox_protocol;
+namespace coe_details = esi::sii::coe_details;
 
 enum class SmKind : uint8_t { MBoxOut = 1, MBoxIn = 2, Outputs = 3, Inputs = 4 };
 

@@ -70,4 +70,24 @@ constexpr uint8_t crc8(const uint8_t* data, std::size_t size) {
     return crc;
 }
 
+// Mailbox protocols word (word 0x1C) bits, also the ESI's Mailbox element (ETG.2010, ETG.2000).
+namespace mailbox_protocol {
+constexpr uint16_t AoE = 0x0001;
+constexpr uint16_t EoE = 0x0002;
+constexpr uint16_t CoE = 0x0004;
+constexpr uint16_t FoE = 0x0008;
+constexpr uint16_t SoE = 0x0010;
+constexpr uint16_t VoE = 0x0020;
+}  // namespace mailbox_protocol
+
+// CoE details bits of the General category (ETG.2010).
+namespace coe_details {
+constexpr uint8_t Sdo = 0x01;
+constexpr uint8_t SdoInfo = 0x02;
+constexpr uint8_t PdoAssign = 0x04;
+constexpr uint8_t PdoConfig = 0x08;
+constexpr uint8_t PdoUpload = 0x10;
+constexpr uint8_t CompleteAccess = 0x20;
+}  // namespace coe_details
+
 }  // namespace esi::sii
