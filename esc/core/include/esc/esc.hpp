@@ -18,15 +18,32 @@
 namespace esc {
 
 struct EscConfig {
-    uint8_t type = 0x04;             // 0x0000 ESC type (0x04: "IP core" style emulated ESC)
-    uint8_t revision = 0x01;         // 0x0001
-    uint16_t build = 0x0001;         // 0x0002
-    uint8_t fmmu_count = 8;          // 0x0004
-    uint8_t sm_count = 8;            // 0x0005
-    uint32_t process_ram_kib = 8;    // 0x0006; process RAM 0x1000 .. 0x1000 + kib*1024 - 1 (ET1100: 8 KiB)
-    uint8_t port_descriptor = 0x0F;  // 0x0007: port0 MII, port1 EBUS... (single port used)
-    uint16_t features = 0x01CC;      // 0x0008: DC available, 64-bit DC, ...
-    EscFaults faults;                // testing aid: deliberate deviations (esc/faults.hpp), all off
+    uint8_t type = 0x04;           // 0x0000 ESC type (0x04: "IP core" style emulated ESC)
+    uint8_t revision = 0x01;       // 0x0001
+    uint16_t build = 0x0001;       // 0x0002
+    uint8_t fmmu_count = 8;        // 0x0004
+    uint8_t sm_count = 8;          // 0x0005
+    uint32_t process_ram_kib = 8;  // 0x0006; process RAM 0x1000 .. 0x1000 + kib*1024 - 1 (ET1100: 8 KiB)
+    // 0x0007, 2 bits per port (00 not implemented, 01 not configured, 10 EBUS, 11 MII): which of the
+    // ports 0-3 exist. 0x0F: ports 0 and 1 (MII), the IN/OUT pair of a drive; 0xFF: a four-port junction.
+    uint8_t port_descriptor = 0x0F;
+    uint16_t features = 0x01CC;  // 0x0008: DC available, 64-bit DC, ...
+    EscFaults faults;            // testing aid: deliberate deviations (esc/faults.hpp), all off
+    // The ESC's own oscillator against the Clock it is given: DC local time = Clock time * (1 + drift) +
+    // offset before any correction by the DC control loop. Gives a master's drift compensation and offset
+    // calculation something real to do on a segment of soft slaves. 0/0: the Clock itself.
+    double clock_drift_ppm = 0.0;
+    int64_t clock_offset_ns = 0;
+};
+
+inline constexpr int kPortCount = 4;  // ports 0..3
+
+// A frame's integrity as it travels along a segment (what a bad FCS does on a real line): the first ESC
+// that receives a frame with crc_bad counts it as invalid at its port (0x0300 + 2p) and marks it; every
+// later ESC counts a forwarded RX error at its port (0x0308 + p). Neither processes it.
+struct FrameCheck {
+    bool crc_bad = false;  // the frame's FCS is wrong (corrupted on the cable)
+    bool marked = false;   // an earlier ESC detected it already
 };
 
 // Counters of what the ECAT side saw (also reflected in the error counter registers 0x0300-0x0313).
@@ -51,9 +68,10 @@ class Esc final : public Pdi {
     // ---- ECAT side --------------------------------------------------------------------------------
     // Processes one whole Ethernet frame (destination MAC first, no FCS) in place, as the ESC's
     // processing unit does: datagrams executed in order, working counters incremented, ADP incremented,
-    // source MAC bit 1 set. rx_time_ns is the local time the frame's first bit arrived (DC receive-time
+    // source MAC bit 1 set. rx_time_ns is the Clock time the frame's first bit arrived (DC receive-time
     // latch); pass 0 to use the clock's current time. Returns true if the frame is to be sent back out
-    // (an EtherCAT frame, processed or not), false if it is to be dropped.
+    // (an EtherCAT frame, processed or not), false if it is to be dropped. This is receive() at port 0 for
+    // an ESC alone on its wire: true when the frame leaves through port 0 again.
     bool process_frame(std::span<uint8_t> frame, uint64_t rx_time_ns = 0);
 
     // ---- PDI side ---------------------------------------------------------------------------------
@@ -80,6 +98,28 @@ class Esc final : public Pdi {
     void on_eeprom_write(std::function<void(uint16_t word_address, uint16_t value)> callback);
 
     EscStats stats() const;
+
+    // ---- Ports (ESC datasheet section I, "Frame processing" / "Loop control"; ETG.1000.4 DL control and
+    // DL status) ------------------------------------------------------------------------------------
+    // A frame received at `port` at Clock time rx_clock_ns (0: now) travels through the ESC in the fixed
+    // order 0 -> 3 -> 1 -> 2 -> 0, the EtherCAT processing unit sitting behind the receive side of port 0.
+    // A port that is closed (no link with loop "auto", or DL control 0x0101 "closed"/"auto close" after a
+    // link loss) loops the frame back internally to its own receive side. receive() runs the frame through
+    // the processing unit where it passes it and returns the next port that is open, i.e. where the frame
+    // leaves the ESC; that can be `port` itself (all others closed). Returns -1 if the frame is destroyed:
+    // received at a closed or non-existent port, or circulating a second time (the circulating bit of the
+    // first datagram set on its way through the processing unit while port 0 is closed, ETG.1000.4).
+    // Receive-time latches: a write to 0x0900 arms them; port 0 (0x0900) latches that frame's arrival at
+    // port 0, ports 1-3 (0x0904/0x0908/0x090C) the arrival of the next frame received at that port.
+    int receive(std::span<uint8_t> frame, int port, uint64_t rx_clock_ns = 0);
+    int receive(std::span<uint8_t> frame, int port, uint64_t rx_clock_ns, FrameCheck& check);
+    // Physical link of a port (cable plugged, the peer powered). A change updates DL status 0x0110, raises
+    // the DL status event; a loss counts in the lost-link counter 0x0310 + port. No effect on a port the
+    // port descriptor does not implement. After construction port 0 has a link, ports 1-3 have none.
+    void set_link(int port, bool up);
+    bool link(int port) const;
+    // A frame sent towards `port` leaves the ESC there (the port exists, has a link and its loop is open).
+    bool port_open(int port) const;
 
   private:
     struct Impl;
