@@ -70,21 +70,11 @@ void Ports::update() {
     uint8_t open = 0;
     for (int p = 0; p < 4; ++p) {
         if (!exists(p)) continue;  // a port that is not implemented is always closed
-        bool o = false;
-        switch ((loop >> (2 * p)) & 0x03) {
-            case 0x00:
-                o = link(p);
-                break;  // auto
-            case 0x01:
-                o = link(p) && !((auto_closed_ >> p) & 1u);
-                break;  // auto close
-            case 0x02:
-                o = true;
-                break;  // always open
-            default:
-                o = false;
-                break;  // always closed
-        }
+        // 00 auto: open with a link; 01 auto close: also not while waiting for its reopening; 10 always open;
+        // 11 always closed.
+        const unsigned mode = (loop >> (2 * p)) & 0x03u;
+        const bool waiting = (auto_closed_ >> p) & 1u;
+        const bool o = mode == 0x02 || (mode == 0x00 && link(p)) || (mode == 0x01 && link(p) && !waiting);
         if (o) open = static_cast<uint8_t>(open | (1u << p));
     }
     // Port 0's loop is open when every port is closed, automatically or by the master (ESC datasheet
