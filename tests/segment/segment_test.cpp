@@ -209,6 +209,45 @@ TEST_F(SegmentTest, LongerCableAndHeldReply) {
     EXPECT_EQ(after, before + 500);
 }
 
+TEST_F(SegmentTest, CableDelayPerConnection) {
+    add();
+    add();
+    add();
+    seg->connect(0, 1, 1, 0, 100);  // a 20 m cable
+    seg->connect(1, 1, 2, 0, 0);    // a device right behind the other
+    arm_latches();
+    const esc::SegmentTiming t = seg->timing();
+    EXPECT_EQ(pdi32(1, esc::reg::kDcRecvTime0) - pdi32(0, esc::reg::kDcRecvTime0),
+              t.processing_delay_ns + 100);
+    EXPECT_EQ(pdi32(2, esc::reg::kDcRecvTime0) - pdi32(1, esc::reg::kDcRecvTime0), t.processing_delay_ns);
+    // Timing given to the segment.
+    esc::SegmentTiming slow;
+    slow.processing_delay_ns = 1000;
+    slow.cable_delay_ns = 50;
+    Rig other;
+    other.seg = std::make_unique<esc::Segment>(slow);
+    other.line(2);
+    other.arm_latches();
+    EXPECT_EQ(other.pdi32(1, esc::reg::kDcRecvTime0) - other.pdi32(0, esc::reg::kDcRecvTime0), 1050u);
+}
+
+TEST_F(SegmentTest, GarbageFramesAreDroppedNotProcessed) {
+    line(3);
+    std::vector<uint8_t> tiny(10, 0xAB);
+    EXPECT_EQ(walk(tiny).kind, Kind::Dropped);
+    std::vector<uint8_t> empty;
+    EXPECT_EQ(walk(empty).kind, Kind::Dropped);
+    std::vector<uint8_t> not_ecat(60, 0);
+    not_ecat[12] = 0x08;  // IPv4
+    EXPECT_EQ(walk(not_ecat).kind, Kind::Dropped);
+    // A truncated EtherCAT frame: its length field runs past the end.
+    std::vector<uint8_t> f = FrameBuilder().add_zero(Command::BRD, 0, 0, esc::reg::kType, 2).build();
+    f[esc::wire::kEthernetHeaderSize] = 0xFF;
+    f[esc::wire::kEthernetHeaderSize + 1] = 0x17;
+    seg->walk(f, kT0);  // whatever the ESCs make of it, nothing breaks
+    EXPECT_EQ(brd_count(), 3);
+}
+
 // ---- trees ----------------------------------------------------------------------------------------
 
 TEST_F(SegmentTest, TreeOrderAndCount) {
@@ -481,6 +520,12 @@ TEST_F(SegmentTest, ExternalPortWalkAndResume) {
     // The external port is a port in use.
     EXPECT_THROW(seg->connect(2, 1, 0, 1), std::invalid_argument);
     EXPECT_THROW(seg->set_external(1, 1, [](std::span<const uint8_t>) {}), std::invalid_argument);
+    // No callback: the port no longer leads out (no link, the ESC loops back).
+    seg->set_external(2, 1, nullptr);
+    EXPECT_FALSE(seg->esc(2).link(1));
+    EXPECT_EQ(brd_count(), 3);
+    EXPECT_EQ(sent, 2);
+    EXPECT_EQ(seg->resume(back, kT0).kind, Kind::Dropped);
 }
 
 TEST_F(SegmentTest, ExternalPortInTheMiddle) {
