@@ -192,6 +192,9 @@ void Esc::Impl::rebuild_lookup() {
 int Esc::Impl::receive(std::span<uint8_t> frame, int port, uint64_t rx_clock, FrameCheck* check) {
     // A frame received at a closed or non-existent port is destroyed.
     if (static_cast<unsigned>(port) >= static_cast<unsigned>(kPortCount) || !ports.loop_open(port)) {
+        // A correct frame at an auto-close port waiting with its link back opens it, after the frame.
+        if (static_cast<unsigned>(port) < static_cast<unsigned>(kPortCount) && !(check && check->crc_bad))
+            ports.valid_frame_at_closed_port(port);
         ++stats.frames_destroyed;
         return -1;
     }
@@ -213,9 +216,11 @@ int Esc::Impl::receive(std::span<uint8_t> frame, int port, uint64_t rx_clock, Fr
     if (port != 0) {
         if (!ports.via_closed_port0(port))
             return ports.exit_after(port);  // does not pass the processing unit
-        // Looped back at the closed port 0 into the processing unit: the circulating bit is set on the
-        // first pass; a frame that comes by with it already set is destroyed (ETG.1000.4).
-        if (uint8_t* lw = first_length_word(frame)) {
+        // Looped back at the closed port 0 into the processing unit: with port 0 closed by its link state
+        // the circulating bit is set on the first pass; a frame that comes by with it already set is
+        // destroyed (ETG.1000.4; ESC datasheet section I, circulating frames).
+        uint8_t* lw = ports.port0_closed_automatically() ? first_length_word(frame) : nullptr;
+        if (lw) {
             if (lw[1] & 0x40) {
                 ++stats.frames_destroyed;
                 return -1;

@@ -56,29 +56,32 @@ void Ports::dl_control_written() {
     update();
 }
 
+bool Ports::valid_frame_at_closed_port(int p) {
+    const uint8_t bit = static_cast<uint8_t>(1u << p);
+    if (!(auto_closed_ & bit) || !link(p) || ((mem_.r8(kDlControlLoop) >> (2 * p)) & 0x03) != 0x01)
+        return false;
+    auto_closed_ = static_cast<uint8_t>(auto_closed_ & ~bit);
+    update();
+    return true;
+}
+
 void Ports::update() {
     const uint8_t loop = mem_.r8(kDlControlLoop);
     uint8_t open = 0;
     for (int p = 0; p < 4; ++p) {
         if (!exists(p)) continue;  // a port that is not implemented is always closed
-        bool o = false;
-        switch ((loop >> (2 * p)) & 0x03) {
-            case 0x00:
-                o = link(p);
-                break;  // auto
-            case 0x01:
-                o = link(p) && !((auto_closed_ >> p) & 1u);
-                break;  // auto close
-            case 0x02:
-                o = true;
-                break;  // always open
-            default:
-                o = false;
-                break;  // always closed
-        }
+        // 00 auto: open with a link; 01 auto close: also not while waiting for its reopening; 10 always open;
+        // 11 always closed.
+        const unsigned mode = (loop >> (2 * p)) & 0x03u;
+        const bool waiting = (auto_closed_ >> p) & 1u;
+        const bool o = mode == 0x02 || (mode == 0x00 && link(p)) || (mode == 0x01 && link(p) && !waiting);
         if (o) open = static_cast<uint8_t>(open | (1u << p));
     }
+    // Port 0's loop is open when every port is closed, automatically or by the master (ESC datasheet
+    // section I, special functions of port 0): the ESC stays reachable from port 0.
+    if (open == 0 && exists(0)) open = 0x01;
     open_mask_ = open;
+    port0_auto_closed_ = !(open & 0x01) && (loop & 0x03) != 0x03;
 
     for (int p = 0; p < 4; ++p) {
         int q = kNext[p];

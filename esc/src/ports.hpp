@@ -31,11 +31,18 @@ class Ports {
     // looped back at a closed port 0 and so passes the processing unit. Valid for a p whose loop is open.
     int exit_after(int p) const { return exit_[static_cast<unsigned>(p)]; }
     bool via_closed_port0(int p) const { return via0_[static_cast<unsigned>(p)]; }
+    // Port 0 is closed by its link state (loop setting auto or auto close), not by the master (always
+    // closed): only then does the circulating-frame prevention act (ESC datasheet section I, circulating
+    // frames / special functions of port 0).
+    bool port0_closed_automatically() const { return port0_auto_closed_; }
 
     // Physical link change. Returns false if nothing changed (same state or no such port).
     bool set_link(int p, bool up);
     // The master wrote DL control 0x0101 (loop settings): auto-close ports with a link reopen.
     void dl_control_written();
+    // A frame with a correct FCS arrived at port p while its loop was closed: an auto-close port waiting for
+    // its reopening (link back) opens after it. Returns true if the port opened.
+    bool valid_frame_at_closed_port(int p);
 
   private:
     void update();
@@ -47,6 +54,7 @@ class Ports {
     uint8_t open_mask_ = 0;
     std::array<int8_t, 4> exit_{};
     std::array<bool, 4> via0_{};
+    bool port0_auto_closed_ = false;
 };
 
 }  // namespace esc

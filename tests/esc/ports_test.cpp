@@ -151,6 +151,55 @@ TEST(PortsJunction, OrderIsZeroThreeOneTwo) {
     EXPECT_EQ(e.read_reg<uint32_t>(0x0310), 0x01000100u);
 }
 
+// Random link changes, loop settings and entry ports on a junction: receive() returns -1 or a port whose loop
+// is open, never processes a frame entering at a closed port, and DL status always matches
+// link()/port_open().
+TEST(PortsJunction, RandomLinksAndLoopSettingsKeepTheInvariants) {
+    esc::ManualClock clk;
+    clk.set(kT0);
+    esc::EscConfig c;
+    c.port_descriptor = 0xFF;
+    esc::Esc e(c, clk);
+    set_station(e, 0x1001);
+    uint32_t s = 12345;
+    auto rnd = [&](uint32_t n) {
+        s = s * 1103515245u + 12345u;
+        return (s >> 8) % n;
+    };
+    for (int i = 0; i < 5000; ++i) {
+        switch (rnd(4)) {
+            case 0:
+                e.set_link(static_cast<int>(rnd(4)), rnd(2) == 0);
+                break;
+            case 1:
+                if (e.port_open(0)) fpwr(e, 0x0101, {static_cast<uint8_t>(rnd(256))});
+                break;
+            default:
+                break;
+        }
+        const int port = static_cast<int>(rnd(6)) - 1;
+        auto f = build({dg_len(BRD, 0, 0x0000, 1)});
+        const bool open_before = port >= 0 && port < 4 && (dl_status(e) & (1u << (8 + 2 * port))) == 0;
+        const int out = e.receive(f, port, clk.now_ns());
+        if (!open_before) {
+            EXPECT_EQ(out, -1) << i;
+            EXPECT_EQ(parse(f).at(0).wkc, 0) << i;
+        } else if (out >= 0) {
+            EXPECT_EQ(dl_status(e) & (1u << (8 + 2 * out)), 0u) << i;  // leaves through an open loop
+        }
+        const uint16_t dl = dl_status(e);
+        for (int p = 0; p < 4; ++p) {
+            EXPECT_EQ(((dl >> (4 + p)) & 1u) != 0, e.link(p)) << i;
+            EXPECT_EQ(((dl >> (9 + 2 * p)) & 1u) != 0, e.port_open(p)) << i;
+        }
+        if (!e.port_open(0) && rnd(8) == 0) {  // the master gets its way back
+            e.set_link(0, true);
+            run1(e, dg(BWR, 0, 0x0101, {0x00}));
+        }
+        clk.advance(1000);
+    }
+}
+
 TEST(PortsLine, BroadcastCountsEveryEscAndAutoIncrementAddressesThem) {
     Line line(3);
     auto r = line.run({dg_len(BRD, 0, 0x0000, 1)});
@@ -219,9 +268,36 @@ TEST_F(Ports, LoopSettingsOpenAndClosed) {
     EXPECT_FALSE(e->port_open(1));              // no link
     EXPECT_EQ(dl_status(*e) & 0x0F00, 0x0200);  // loop 1 open, no communication there
     EXPECT_EQ(e->receive(f, 0), 1);
-    // 11 on port 0 destroys everything the master sends.
-    EXPECT_EQ(fpwr(*e, 0x0101, {0x03}).wkc, 1);
+    // 11 on port 0 with port 1 open destroys everything the master sends.
+    EXPECT_EQ(fpwr(*e, 0x0101, {0x0B}).wkc, 1);
+    EXPECT_EQ(dl_status(*e) & 0x0F00, 0x0100);  // port 0 closed, port 1 open without a link
     auto g = build({dg_len(BRD, 0, 0x0000, 1)});
+    EXPECT_FALSE(e->process_frame(g));
+    EXPECT_EQ(parse(g).at(0).wkc, 0);
+    // A frame looped back at a port 0 closed by the master gets no circulating bit.
+    auto h = build({dg_len(BRD, 0, 0x0000, 1)});
+    EXPECT_EQ(e->receive(h, 1), 1);
+    EXPECT_EQ(first_flags(h) & 0x4000, 0);
+    EXPECT_EQ(parse(h).at(0).wkc, 1);
+}
+
+TEST_F(Ports, PortZeroOpensWhenEveryPortIsClosed) {
+    // Port 0 closed by the master and nothing else open: port 0's loop is open all the same.
+    EXPECT_EQ(fpwr(*e, 0x0101, {0x03}).wkc, 1);
+    EXPECT_EQ(dl_status(*e) & 0x0300, 0x0200);
+    auto f = build({dg_len(BRD, 0, 0x0000, 1)});
+    EXPECT_TRUE(e->process_frame(f));
+    EXPECT_EQ(parse(f).at(0).wkc, 1);
+    // Port 0 without a link and port 1 closed: still open (no communication), frames still answered.
+    EXPECT_EQ(fpwr(*e, 0x0101, {0x00}).wkc, 1);
+    e->set_link(0, false);
+    EXPECT_EQ(dl_status(*e) & 0x0310, 0x0000);
+    EXPECT_FALSE(e->port_open(0));
+    auto g = build({dg_len(BRD, 0, 0x0000, 1)});
+    EXPECT_TRUE(e->process_frame(g));
+    // Once port 1 opens, port 0 (no link) closes.
+    e->set_link(1, true);
+    EXPECT_EQ(dl_status(*e) & 0x0F00, 0x0900);
     EXPECT_FALSE(e->process_frame(g));
 }
 
@@ -241,9 +317,36 @@ TEST_F(Ports, AutoCloseReopensOnlyWhenDlControlIsWritten) {
     EXPECT_EQ(fpwr(*e, 0x0101, {0x04}).wkc, 1);
     e->set_link(1, true);
     EXPECT_FALSE(e->port_open(1));
-    // Back to auto: open with the link.
-    EXPECT_EQ(fpwr(*e, 0x0101, {0x00}).wkc, 1);
+    // Fallback: a correct frame received at the waiting port opens it after the frame (which is destroyed);
+    // one with a bad FCS does not.
+    auto f = build({dg_len(BRD, 0, 0x0000, 1)});
+    esc::FrameCheck bad;
+    bad.crc_bad = true;
+    EXPECT_EQ(e->receive(f, 1, 0, bad), -1);
+    EXPECT_FALSE(e->port_open(1));
+    EXPECT_EQ(e->receive(f, 1), -1);
     EXPECT_TRUE(e->port_open(1));
+    EXPECT_EQ(e->receive(f, 1), 0);
+    // Back to auto: open with the link.
+    e->set_link(1, false);
+    EXPECT_EQ(fpwr(*e, 0x0101, {0x00}).wkc, 1);
+    e->set_link(1, true);
+    EXPECT_TRUE(e->port_open(1));
+}
+
+TEST_F(Ports, AutoClosePortZeroReopensWithTheMastersNextFrame) {
+    e->set_link(1, true);
+    EXPECT_EQ(fpwr(*e, 0x0101, {0x01}).wkc, 1);  // port 0: auto close
+    e->set_link(0, false);
+    e->set_link(0, true);
+    EXPECT_FALSE(e->port_open(0));  // waiting; port 1 is open so port 0 stays closed
+    auto f = build({dg_len(BRD, 0, 0x0000, 1)});
+    EXPECT_FALSE(e->process_frame(f));  // destroyed, but reopens the port
+    EXPECT_EQ(parse(f).at(0).wkc, 0);
+    EXPECT_TRUE(e->port_open(0));
+    auto g = build({dg_len(BRD, 0, 0x0000, 1)});
+    EXPECT_EQ(e->receive(g, 0), 1);
+    EXPECT_EQ(parse(g).at(0).wkc, 1);
 }
 
 TEST_F(Ports, DlStatusPortBitsLeaveEepromAndWatchdogBitsAlone) {
