@@ -293,3 +293,61 @@ TEST(SegmentRuntime, DropAndCorruptAreCountedPerHop) {
 }
 
 }  // namespace
+
+namespace {
+
+// The line continues on an out link (--out-iface): a second, lone ESC behind it answers as the next process
+// or a hardware device would; the master counts both. Without a carrier the external port loops back.
+TEST(SegmentRuntime, TheLineContinuesOnTheOutLink) {
+    test_support::TempDir dir("segment-out-");
+    esc::SystemClock clock;
+    auto in = esc::LoopbackLink::make_pair(64);
+    auto out = esc::LoopbackLink::make_pair(64);
+    device::LineOptions o;
+    o.topology = slave::line_topology(2);
+    o.base.state_dir = dir.path;
+    std::ostringstream warnings, log_text;
+    o.base.log = &warnings;
+    slave::Log log(log_text);
+    o.log = &log;
+    esc::LoopbackLink& out_end = *out.first;
+    device::Line line(clock, std::move(o), [&out_end](std::span<const uint8_t> f) { (void)out_end.send(f); });
+    slave::Runtime runtime(*in.second, line.segment(), clock, out.first.get());
+    runtime.set_firmware(&line);
+    bool carrier = true;
+    runtime.set_carrier_check([&carrier] { return carrier; }, &log, "out0");
+    esc::Esc next(esc::EscConfig{}, clock);  // the device behind the out link
+
+    auto brd_wkc = [&]() -> int {
+        const auto f = brd_type_frame();
+        EXPECT_TRUE(in.first->send(f));
+        std::array<uint8_t, esc::kMaxFrameSize> buf{};
+        for (int i = 0; i < 200; ++i) {
+            EXPECT_TRUE(runtime.run_once(10));
+            // The far side: what came out of OUT goes through the next ESC and back.
+            std::array<uint8_t, esc::kMaxFrameSize> far{};
+            while (const std::size_t n = out.second->receive(far)) {
+                std::span<uint8_t> frame(far.data(), n);
+                if (next.process_frame(frame)) (void)out.second->send(frame);
+            }
+            if (const std::size_t n = in.first->receive(buf); n > 0) return buf[kWkcOffset];
+        }
+        return -1;
+    };
+    EXPECT_EQ(brd_wkc(), 3) << "two ESCs here and one behind the out link";
+    EXPECT_GT(runtime.stats().frames_external, 0u);
+    EXPECT_GT(runtime.stats().frames_resumed, 0u);
+
+    carrier = false;  // the peer went away: polled within kCarrierPollNs
+    for (int i = 0; i < 2000 && runtime.stats().carrier_changes == 0; ++i)
+        ASSERT_TRUE(runtime.run_once(10));
+    ASSERT_EQ(runtime.stats().carrier_changes, 1u);
+    EXPECT_EQ(brd_wkc(), 2) << "no carrier: the last device's port 1 loops back";
+    EXPECT_NE(log_text.str().find("out link out0: no carrier"), std::string::npos) << log_text.str();
+    carrier = true;
+    for (int i = 0; i < 2000 && runtime.stats().carrier_changes == 1; ++i)
+        ASSERT_TRUE(runtime.run_once(10));
+    EXPECT_EQ(brd_wkc(), 3);
+}
+
+}  // namespace

@@ -256,7 +256,9 @@ bool Runtime::spin_to_deadline() {
         } else {
             spun = true;
             if (stop_flag_.load(std::memory_order_relaxed)) return false;
-            if (handle_frames() > 0) service();
+            int frames = handle_frames();
+            if (out_ != nullptr) frames += handle_out_frames();
+            if (frames > 0) service();
         }
         now = clock_.now_ns();
         note_loop_pass(now);
