@@ -145,7 +145,7 @@ bool Runtime::run_once(int timeout_ms) {
     uint32_t link_events = 0;
     bool timer = false;
     bool control = false;
-    bool out_event = false;
+    uint32_t out_events = 0;
     for (int i = 0; i < n; ++i) {
         switch (events[i].data.u32) {
             case kTagStop:
@@ -160,7 +160,7 @@ bool Runtime::run_once(int timeout_ms) {
                 control = true;
                 break;
             case kTagOut:
-                out_event = true;
+                out_events = events[i].events;
                 break;
             default:
                 break;
@@ -168,9 +168,17 @@ bool Runtime::run_once(int timeout_ms) {
     }
     if (n > 0 || !busy_poll_) ++stats_.wakeups;
     bool link_event = link_.fd() < 0 || link_events != 0;
-    if (out_ != nullptr && (out_event || out_->fd() < 0)) {
+    if (out_ != nullptr && (out_events != 0 || out_->fd() < 0)) {
         handle_out_frames();  // frames coming back from the rest of the line first: they are older
         link_event = true;
+        if (out_events & EPOLLERR) {
+            // As for the link: a pending error (the out interface lost its carrier or went down) would keep
+            // the descriptor ready; reading it clears it. The carrier poll closes the port meanwhile.
+            int err = 0;
+            socklen_t len = sizeof err;
+            (void)::getsockopt(out_->fd(), SOL_SOCKET, SO_ERROR, &err, &len);
+            ++stats_.link_errors;
+        }
     }
     if (link_event) {
         handle_frames();
