@@ -3,6 +3,7 @@
 #include "master/session.hpp"
 
 #include <algorithm>
+#include <iterator>
 #include <thread>
 
 #include "util/le.hpp"
@@ -128,6 +129,11 @@ uint16_t ProcessDataSession::expected_wkc(std::size_t k) const {
 
 uint16_t ProcessDataSession::expected_wkc() const {
     uint16_t sum = 0;
+    if (!chunks_.empty()) {  // a slave split over two frames counts in both
+        for (const Chunk& c : chunks_)
+            sum = static_cast<uint16_t>(sum + c.expected_wkc);
+        return sum;
+    }
     for (std::size_t k = 0; k < slaves_.size(); ++k)
         sum = static_cast<uint16_t>(sum + expected_wkc(k));
     return sum;
@@ -147,17 +153,30 @@ Error ProcessDataSession::configure(const DcConfig& dc) {
     for (Slave& s : slaves_)
         if (Error e = configure(s, dc); e != Error::Ok) return e;
     image_.assign(static_cast<std::size_t>(out_bytes_) + in_bytes_, 0);
-    // One LRW per frame, as many frames as the image needs; each knows its share of the working counter.
+    // One LRW per frame, as many frames as the image needs, split where one slave's outputs or inputs end
+    // (so that each slave counts once); each frame knows its share of the working counter.
+    std::vector<std::size_t> ends;
+    for (const Slave& s : slaves_) {
+        ends.push_back(s.out_offset + s.layout.sm2_length);
+        ends.push_back(out_bytes_ + s.in_offset + s.layout.sm3_length);
+    }
+    std::sort(ends.begin(), ends.end());
     chunks_.clear();
-    for (std::size_t at = 0; at < image_.size(); at += kMaxChunk) {
+    for (std::size_t at = 0, len = 0; at < image_.size(); at += len) {
+        len = std::min(kMaxChunk, image_.size() - at);
+        if (at + len < image_.size()) {
+            auto it = std::upper_bound(ends.begin(), ends.end(), at + len);
+            if (it != ends.begin() && *std::prev(it) > at) len = *std::prev(it) - at;
+        }
         Chunk c;
-        const uint32_t len = static_cast<uint32_t>(std::min(kMaxChunk, image_.size() - at));
         const uint32_t pos = static_cast<uint32_t>(at);
         c.lrw =
             Datagram::logical(Command::LRW, kLogicalBase + pos, std::span<uint8_t>(image_.data() + at, len));
         for (const Slave& s : slaves_) {
-            if (overlaps(pos, len, s.out_offset, s.layout.sm2_length)) c.expected_wkc += 2;
-            if (overlaps(pos, len, out_bytes_ + s.in_offset, s.layout.sm3_length)) c.expected_wkc += 1;
+            if (overlaps(pos, static_cast<uint32_t>(len), s.out_offset, s.layout.sm2_length))
+                c.expected_wkc += 2;
+            if (overlaps(pos, static_cast<uint32_t>(len), out_bytes_ + s.in_offset, s.layout.sm3_length))
+                c.expected_wkc += 1;
         }
         chunks_.push_back(c);
     }

@@ -84,6 +84,8 @@ class ProcessDataSession {
     uint16_t expected_wkc() const;
     uint16_t expected_wkc(std::size_t k) const;  // this slave's share: 2 with outputs + 1 with inputs
     uint16_t last_wkc() const { return last_wkc_; }
+    // Frames per cycle: 1 unless the image is larger than one frame's LRW can carry.
+    std::size_t frames_per_cycle() const { return chunks_.size(); }
     uint64_t reference_time() const { return ref_time_; }  // DC system time read in the last cycle
     const CycleStats& stats() const { return stats_; }
     // The slaves as the DC measurement saw them (topology, delays, offsets); empty without dc.measure.
