@@ -9,10 +9,10 @@
 //
 // Prints per N: the processing time of one frame through the whole segment (from the runtime's receive()
 // of the frame to its send() of the reply; median/p99), the CPU time of the slave thread per cycle as % of
-// one core (CLOCK_THREAD_CPUTIME_ID of that thread over the measured window), missed cycles (the master
-// loop woke a whole period late), lost frames and working-counter errors, the round trip of the cyclic
-// frame and of the bare echo (median/p99 and their ratios) and the allocations per cycle of the whole
-// process during the measured window (a counting global operator new). Asserts nothing. Needs root.
+// one core at 1 kHz (CLOCK_THREAD_CPUTIME_ID of that thread over the measured window, per cycle), missed
+// cycles (the master loop woke a whole period late), lost frames and working-counter errors, the round trip
+// of the cyclic frame and of the bare echo (median/p99 and their ratios) and the allocations per cycle of the
+// whole process during the measured window (a counting global operator new). Asserts nothing. Needs root.
 #include <poll.h>
 #include <pthread.h>
 #include <sched.h>
@@ -119,7 +119,7 @@ struct DriveIo {
 struct Figures {
     std::size_t drives = 0;
     bench::Summary walk, rtt, echo;
-    double cpu_percent = 0, cpu_us_per_cycle = 0, allocs_per_cycle = 0;
+    double cpu_percent = 0, cpu_wall_percent = 0, cpu_us_per_cycle = 0, allocs_per_cycle = 0;
     uint64_t cycles = 0, missed = 0, lost = 0, wkc_errors = 0, enabled = 0;
     std::size_t frames_per_cycle = 0;
 };
@@ -370,8 +370,11 @@ int main(int argc, char** argv) {
         bench::print("  round trip, bare echo", f.echo, "us", 1000.0);
         std::printf("  ratio cyclic/echo: median %.3f  p99 %.3f\n",
                     f.rtt.median / std::max(1.0, f.echo.median), f.rtt.p99 / std::max(1.0, f.echo.p99));
-        std::printf("  slave thread CPU: %.1f %% of one core, %.1f us per cycle (%.2f us per drive)\n",
-                    f.cpu_percent, f.cpu_us_per_cycle, f.cpu_us_per_cycle / static_cast<double>(f.drives));
+        std::printf(
+            "  slave thread CPU: %.1f us per cycle (%.2f us per drive) = %.1f %% of one core at 1 kHz "
+            "(%.1f %% of the wall time)\n",
+            f.cpu_us_per_cycle, f.cpu_us_per_cycle / static_cast<double>(f.drives), f.cpu_percent,
+            f.cpu_wall_percent);
         std::printf("  missed cycles %llu, lost frames %llu, wkc errors %llu, allocations per cycle %.3f\n",
                     static_cast<unsigned long long>(f.missed), static_cast<unsigned long long>(f.lost),
                     static_cast<unsigned long long>(f.wkc_errors), f.allocs_per_cycle);
