@@ -58,6 +58,22 @@ struct Line {
             if (k > 0) seg.connect(k - 1, 1, k, 0);
         }
     }
+    // The line scanned and one process-data session over all of it, every slave with `layout` (null, after
+    // a failed assertion, if the scan failed).
+    std::vector<SlaveInfo> bus;
+    std::unique_ptr<ProcessDataSession> session(const ProcessDataLayout& layout) {
+        auto scanned = scan_bus(m, {.first_station = 0x1001, .identity = false});
+        EXPECT_TRUE(scanned.ok()) << to_string(scanned.error());
+        if (!scanned) return nullptr;
+        bus = *scanned;
+        std::vector<Address> a;
+        for (const SlaveInfo& s : bus)
+            a.push_back(Address::station(s.station));
+        auto pd = std::make_unique<ProcessDataSession>(m, a);
+        for (std::size_t k = 0; k < pd->size(); ++k)
+            pd->set_layout(k, layout);
+        return pd;
+    }
     // The ESC at a master position (processing order).
     esc::Esc& at(std::size_t position) { return seg.esc(seg.order()[position]); }
 };
@@ -187,11 +203,9 @@ TEST(MasterOnSegment, DcDelaysInATree) {
 TEST(MasterOnSegment, OneLrwOverEverySlaveWithTheSumOfTheirWorkingCounters) {
     Line l;
     l.line(5);
-    auto bus = scan_bus(l.m);
-    ASSERT_TRUE(bus.ok());
-    const auto addr = stations(*bus);
-    ProcessDataSession pd(l.m, addr);
-    set_layouts(pd, small_layout());
+    auto session = l.session(small_layout());
+    ASSERT_TRUE(session);
+    ProcessDataSession& pd = *session;
     ASSERT_EQ(pd.configure(), Error::Ok);
     EXPECT_EQ(pd.expected_wkc(), 5 * 3);
     EXPECT_EQ(pd.outputs().size(), 5u * 4);
@@ -222,10 +236,9 @@ TEST(MasterOnSegment, OneLrwOverEverySlaveWithTheSumOfTheirWorkingCounters) {
 TEST(MasterOnSegment, ImageLargerThanOneFrameIsSplitAndStillAddsUp) {
     Line l;
     l.line(100);
-    auto bus = scan_bus(l.m, {.first_station = 0x1001, .identity = false});
-    ASSERT_TRUE(bus.ok());
-    ProcessDataSession pd(l.m, stations(*bus));
-    set_layouts(pd, big_layout());
+    auto session = l.session(big_layout());
+    ASSERT_TRUE(session);
+    ProcessDataSession& pd = *session;
     ASSERT_EQ(pd.configure(), Error::Ok);
     EXPECT_GT(pd.frames_per_cycle(), 1u);
     EXPECT_EQ(pd.expected_wkc(), 300);
@@ -236,10 +249,9 @@ TEST(MasterOnSegment, ImageLargerThanOneFrameIsSplitAndStillAddsUp) {
 TEST(MasterOnSegment, DcSessionStartsSync0EverywhereAtTheSameTime) {
     Line l;
     l.line(4);
-    auto bus = scan_bus(l.m);
-    ASSERT_TRUE(bus.ok());
-    ProcessDataSession pd(l.m, stations(*bus));
-    set_layouts(pd, small_layout());
+    auto session = l.session(small_layout());
+    ASSERT_TRUE(session);
+    ProcessDataSession& pd = *session;
     DcConfig dc;
     dc.enable = true;
     dc.cycle_ns = 1'000'000;
@@ -262,10 +274,9 @@ TEST(MasterOnSegment, DcSessionStartsSync0EverywhereAtTheSameTime) {
 TEST(MasterOnSegment, PulledCableGivesAWorkingCounterErrorAndRecovers) {
     Line l;
     l.line(5);
-    auto bus = scan_bus(l.m);
-    ASSERT_TRUE(bus.ok());
-    ProcessDataSession pd(l.m, stations(*bus));
-    set_layouts(pd, small_layout());
+    auto session = l.session(small_layout());
+    ASSERT_TRUE(session);
+    ProcessDataSession& pd = *session;
     ASSERT_EQ(pd.configure(), Error::Ok);
     ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(100)), Error::Ok);
     ASSERT_EQ(pd.cycle(), Error::Ok);
