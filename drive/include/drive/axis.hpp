@@ -220,6 +220,8 @@ class Axis {
     void homing_fail();
     // helpers (axis.cpp)
     uint64_t functions(uint16_t pins) const;
+    uint64_t functions_now(uint16_t pins);  // functions() remembered for the last pins within one cycle
+    void prepare_steps(int64_t from_ns, int64_t to_ns);
     int32_t clamp_i32(double v) const;
     bool range_on() const;
     int32_t report(int64_t v) const;                           // a position as the dictionary shows it
@@ -258,6 +260,16 @@ class Axis {
     double prev_raw_pos_ = 0;
     uint64_t func_ = 0;  // 0x60FD-style function bits, bit 26 = touch probe input, bits 32..37 = pins
     uint16_t pins_ = 0;
+    // per-cycle caches of the 10 us machine steps (prepare_steps; same values as computing them each step)
+    bool fn_valid_ = false;  // functions_now(): fn_pins_ -> fn_value_ under this cycle's parameters
+    uint16_t fn_pins_ = 0;
+    uint64_t fn_value_ = 0;
+    bool pins_fixed_ = false;  // the environment's pins cannot change during this cycle's steps
+    uint16_t fixed_pins_ = 0;
+    bool index_on_ = false;  // encoder index (0x3010:02 bit 0)
+    double index_p0_ = 0;    // where the index sits within a turn, inc
+    double index_k_ = 0;     // floor((prev_raw_pos_ - p0) / res): the turn the last step ended in
+    double index_lo_ = 0, index_hi_ = 0;  // raw - p0 strictly inside this turn: no division needed
     // timing
     int64_t tick_ = 0;
     int64_t residual_ns_ = 0;
