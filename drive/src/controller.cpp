@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "axis_internal.hpp"
+#include "machine_step.hpp"
 
 namespace drive {
 
