@@ -5,8 +5,8 @@
 #include <limits>
 
 #include "axis_internal.hpp"
-#include "machine_step.hpp"
 #include "drive/errors.hpp"
+#include "machine_step.hpp"
 
 namespace drive {
 
@@ -19,7 +19,7 @@ double Axis::raw_position_inc() const {
 }
 
 double Axis::phys_position_inc() const {
-    return plant_.angle() * res_ / kTwoPi;
+    return plant_.angle() * inc_per_rad_;
 }
 
 bool Axis::error_active(uint16_t code) const {
@@ -66,6 +66,8 @@ void Axis::derive() {
         // specification §7.2.22).
         const double phys_angle = plant_.angle();
         res_ = res;
+        rad_per_inc_ = kTwoPi / res_;
+        inc_per_rad_ = res_ / kTwoPi;
         pol_ = pol;
         count_ = static_cast<int64_t>(std::floor(pol_ * phys_angle * res_ / kTwoPi));
         prev_raw_pos_ = phys_angle * res_ / kTwoPi;
@@ -112,6 +114,27 @@ void Axis::prepare_steps(int64_t from_ns, int64_t to_ns) {
         index_p0_ = motor_.index_angle / kTwoPi * res_;
         index_k_ = std::floor((prev_raw_pos_ - index_p0_) / res_);
         index_bounds(index_k_, res_, index_lo_, index_hi_);
+    }
+}
+
+void Axis::edges(double prev, double raw, int64_t t_ns, uint64_t changed) {
+    const int64_t t0 = t_ns - kCurrentTickNs / kPlantStepsPerTick;
+    for (int bit = 0; bit < 64; ++bit) {
+        const uint64_t m = 1ull << bit;
+        if (!(changed & m)) continue;
+        // Where between the two samples did it switch? Bisection on the straight line between them.
+        double lo = 0, hi = 1;
+        const bool before = func_ & m;
+        for (int it = 0; it < 20; ++it) {
+            const double mid = 0.5 * (lo + hi);
+            const double pos = prev + (raw - prev) * mid;
+            const int64_t t = t0 + static_cast<int64_t>((t_ns - t0) * mid);
+            if (static_cast<bool>(functions_now(env_.pins(pos, t)) & m) == before)
+                lo = mid;
+            else
+                hi = mid;
+        }
+        on_edge(bit, !before, pol_ * (prev + (raw - prev) * hi));
     }
 }
 

@@ -1,8 +1,9 @@
 #pragma once
-// The 10 us machine step (Axis::plant_step) and what it needs, inline: the current loop (controller.cpp) runs
-// four of them per 40 us sample, 100 per 1 ms cycle, and one piece of code for the sample keeps the state in
-// registers (docs/decisions/drive.md "Cost of a cycle"). axis.cpp has the rest of the machine (on_edge,
-// on_index) and prepare_steps(), which sets up the per-cycle values used here.
+// What the machine does after each 10 us plant step (Axis::machine_step: input edges, encoder index), inline:
+// the current loop (controller.cpp) runs four steps per 40 us sample, 100 per 1 ms cycle, and one piece of
+// code for the sample keeps the plant state in registers (docs/decisions/drive.md "Cost of a cycle").
+// axis.cpp has the rest of the machine (on_edge, on_index) and prepare_steps(), which sets up the per-cycle
+// values used here.
 #include <cmath>
 #include <cstdint>
 
@@ -38,35 +39,17 @@ inline uint64_t Axis::functions_now(uint16_t pins) {
     return fn_value_;
 }
 
-inline void Axis::plant_step(int64_t t_ns, double u) {
+inline void Axis::machine_step(double raw, int64_t t_ns) {
     const double prev = prev_raw_pos_;
-    plant_.step(pol_ * u, dc_.power);        // polarity: the motor turns the other way
-    const double raw = plant_.angle() * res_ / detail::kTwoPi;  // physical positions (phys_position_inc())
-    const uint16_t p = pins_fixed_ ? fixed_pins_ : env_.pins(raw, t_ns);
-    const uint64_t f = functions_now(p);
-    const uint64_t changed = f ^ func_;
-    if (changed) {
-        const int64_t t0 = t_ns - kCurrentTickNs / kPlantStepsPerTick;
-        for (int bit = 0; bit < 64; ++bit) {
-            const uint64_t m = 1ull << bit;
-            if (!(changed & m)) continue;
-            // Where between the two samples did it switch? Bisection on the straight line between them.
-            double lo = 0, hi = 1;
-            const bool before = func_ & m;
-            for (int it = 0; it < 20; ++it) {
-                const double mid = 0.5 * (lo + hi);
-                const double pos = prev + (raw - prev) * mid;
-                const int64_t t = t0 + static_cast<int64_t>((t_ns - t0) * mid);
-                if (static_cast<bool>(functions_now(env_.pins(pos, t)) & m) == before)
-                    lo = mid;
-                else
-                    hi = mid;
-            }
-            on_edge(bit, !before, pol_ * (prev + (raw - prev) * hi));
-        }
+    // Inputs: nothing to do while the pins and their functions cannot change during the cycle.
+    if (!pins_fixed_ || !fn_valid_) {
+        const uint16_t p = pins_fixed_ ? fixed_pins_ : env_.pins(raw, t_ns);
+        const uint64_t f = functions_now(p);
+        const uint64_t changed = f ^ func_;
+        if (changed) edges(prev, raw, t_ns, changed);  // rare: out of line (axis.cpp)
+        func_ = f;
+        pins_ = p;
     }
-    func_ = f;
-    pins_ = p;
     // Encoder index: once per revolution at the configured angle (only with a 3-channel encoder).
     if (index_on_) {
         const double d = raw - index_p0_;
@@ -78,7 +61,6 @@ inline void Axis::plant_step(int64_t t_ns, double u) {
             detail::index_bounds(k1, res_, index_lo_, index_hi_);
         }
     }
-    count_ = static_cast<int64_t>(std::floor(pol_ * raw));
     prev_raw_pos_ = raw;
 }
 

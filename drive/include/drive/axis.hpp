@@ -189,7 +189,8 @@ class Axis {
     // Axis runs its parts against each other; each group below lives in the .cpp named after the part.
     // axis.cpp: configuration, the cycle, the machine (plant, inputs, encoder) and the feedback
     void derive();
-    void plant_step(int64_t t_ns, double u);
+    void machine_step(double raw, int64_t t_ns);  // after a plant step: inputs, encoder index
+    void edges(double prev, double raw, int64_t t_ns, uint64_t changed);  // input edges within a step
     void on_edge(int bit, bool rising, double raw_pos);
     void on_index(double raw_pos);
     void update_feedback();
@@ -228,7 +229,7 @@ class Axis {
     double unwrap(int32_t target, double near_raw) const;      // modulo target -> raw increments
     double i_meas() const { return pol_ * plant_.current(); }  // current in the axis' direction
     double rpm_to_inc_s(double rpm) const { return rpm * res_ / 60.0; }
-    double inc_to_rad(double inc) const { return inc * 6.283185307179586 / res_; }
+    double inc_to_rad(double inc) const { return inc * rad_per_inc_; }
     double decel_limit(double d) const;
 
     EventSink* sink_;
@@ -248,6 +249,9 @@ class Axis {
 
     // configuration derived from params
     int32_t res_ = 2000;
+    // 2 pi / res_ and res_ / 2 pi: multiplications instead of divisions in the current loop's feedback chain
+    double rad_per_inc_ = 6.283185307179586 / 2000;
+    double inc_per_rad_ = 2000 / 6.283185307179586;
     double pol_ = 1.0;  // 0x3000:04 bit 0: -1 = inverse polarity
     double km_plant_ = -1;
     bool plant_dirty_ = true;

@@ -15,6 +15,7 @@ struct Controller {
     double kpi = 0, kii = 0, kff_i = 0;  // current PI
     // constants of observe() that only change with the parameters (set by tune())
     double obs_load_gain = 0;   // kTick j wo^3
+    double inv_j = 1e5;         // 1 / j
     double i2t_rate = 0;        // kTick / thermal time constant
     double i2t_nominal = 1e-3;  // A
     // loop state
