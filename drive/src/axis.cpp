@@ -6,6 +6,7 @@
 
 #include "axis_internal.hpp"
 #include "drive/errors.hpp"
+#include "machine_step.hpp"
 
 namespace drive {
 
@@ -18,7 +19,7 @@ double Axis::raw_position_inc() const {
 }
 
 double Axis::phys_position_inc() const {
-    return plant_.angle() * res_ / kTwoPi;
+    return plant_.angle() * inc_per_rad_;
 }
 
 bool Axis::error_active(uint16_t code) const {
@@ -65,6 +66,8 @@ void Axis::derive() {
         // specification §7.2.22).
         const double phys_angle = plant_.angle();
         res_ = res;
+        rad_per_inc_ = kTwoPi / res_;
+        inc_per_rad_ = res_ / kTwoPi;
         pol_ = pol;
         count_ = static_cast<int64_t>(std::floor(pol_ * phys_angle * res_ / kTwoPi));
         prev_raw_pos_ = phys_angle * res_ / kTwoPi;
@@ -101,43 +104,38 @@ uint64_t Axis::functions(uint16_t pins) const {
     return f;
 }
 
-void Axis::plant_step(int64_t t_ns, double u) {
-    const double prev = prev_raw_pos_;
-    plant_.step(pol_ * u, dc_.power);        // polarity: the motor turns the other way
-    const double raw = phys_position_inc();  // the machine sees physical positions
-    const uint16_t p = env_.pins(raw, t_ns);
-    const uint64_t f = functions(p);
-    const uint64_t changed = f ^ func_;
-    if (changed) {
-        const int64_t t0 = t_ns - kCurrentTickNs / kPlantStepsPerTick;
-        for (int bit = 0; bit < 64; ++bit) {
-            const uint64_t m = 1ull << bit;
-            if (!(changed & m)) continue;
-            // Where between the two samples did it switch? Bisection on the straight line between them.
-            double lo = 0, hi = 1;
-            const bool before = func_ & m;
-            for (int it = 0; it < 20; ++it) {
-                const double mid = 0.5 * (lo + hi);
-                const double pos = prev + (raw - prev) * mid;
-                const int64_t t = t0 + static_cast<int64_t>((t_ns - t0) * mid);
-                if (static_cast<bool>(functions(env_.pins(pos, t)) & m) == before)
-                    lo = mid;
-                else
-                    hi = mid;
-            }
-            on_edge(bit, !before, pol_ * (prev + (raw - prev) * hi));
+void Axis::prepare_steps(int64_t from_ns, int64_t to_ns) {
+    // Everything here is constant for the cycle (parameters, environment, resolution): computed once instead
+    // of in each of the 100 machine steps of a 1 ms cycle.
+    fn_valid_ = false;
+    pins_fixed_ = env_.constant_over(from_ns, to_ns, fixed_pins_);
+    index_on_ = (params.encoder_type & 0x0001) != 0;
+    if (index_on_) {
+        index_p0_ = motor_.index_angle / kTwoPi * res_;
+        index_k_ = std::floor((prev_raw_pos_ - index_p0_) / res_);
+        index_bounds(index_k_, res_, index_lo_, index_hi_);
+    }
+}
+
+void Axis::edges(double prev, double raw, int64_t t_ns, uint64_t changed) {
+    const int64_t t0 = t_ns - kCurrentTickNs / kPlantStepsPerTick;
+    for (int bit = 0; bit < 64; ++bit) {
+        const uint64_t m = 1ull << bit;
+        if (!(changed & m)) continue;
+        // Where between the two samples did it switch? Bisection on the straight line between them.
+        double lo = 0, hi = 1;
+        const bool before = func_ & m;
+        for (int it = 0; it < 20; ++it) {
+            const double mid = 0.5 * (lo + hi);
+            const double pos = prev + (raw - prev) * mid;
+            const int64_t t = t0 + static_cast<int64_t>((t_ns - t0) * mid);
+            if (static_cast<bool>(functions_now(env_.pins(pos, t)) & m) == before)
+                lo = mid;
+            else
+                hi = mid;
         }
+        on_edge(bit, !before, pol_ * (prev + (raw - prev) * hi));
     }
-    func_ = f;
-    pins_ = p;
-    // Encoder index: once per revolution at the configured angle (only with a 3-channel encoder).
-    if (params.encoder_type & 0x0001) {
-        const double p0 = motor_.index_angle / kTwoPi * res_;
-        const double k0 = std::floor((prev - p0) / res_), k1 = std::floor((raw - p0) / res_);
-        if (k0 != k1) on_index(pol_ * (p0 + std::max(k0, k1) * res_));
-    }
-    count_ = static_cast<int64_t>(std::floor(pol_ * raw));
-    prev_raw_pos_ = raw;
 }
 
 void Axis::on_edge(int bit, bool rising, double raw_pos) {
@@ -203,6 +201,7 @@ void Axis::cycle(int64_t now_ns, int64_t dt_ns) {
         const int64_t total = residual_ns_ + dt_ns;
         const int64_t ticks = total / kCurrentTickNs;
         residual_ns_ = total % kCurrentTickNs;
+        prepare_steps(now_ns, now_ns + ticks * kCurrentTickNs);
         for (int64_t k = 0; k < ticks; ++k) {
             const int64_t t = now_ns + k * kCurrentTickNs;
             if (tick_ % kPositionDivider == 0) {

@@ -49,4 +49,13 @@ uint16_t Environment::pins(double position, int64_t t_ns) const {
     return p;
 }
 
+bool Environment::constant_over(int64_t from_ns, int64_t to_ns, uint16_t& level) const {
+    for (const Switch& s : switches_)
+        if (s.present && s.pin >= 1 && s.pin <= kPins) return false;
+    for (const Manual& m : manual_)
+        if (m.pending && m.at > from_ns && m.at <= to_ns) return false;
+    level = pins(0.0, from_ns);
+    return true;
+}
+
 }  // namespace drive

@@ -61,41 +61,4 @@ void Plant::configure(const MotorModel& model, double torque_constant, double h)
     gamma_mech_ = em.block<2, 1>(0, 2);
 }
 
-void Plant::step(double u, bool power_on, double load_torque) {
-    const double w0 = x_(1);
-    const double motor_torque = power_on ? km_ * x_(0) : 0.0;
-    // Coulomb friction: opposes motion; at rest it holds as long as the driving torque is below it.
-    double friction;
-    if (w0 != 0.0) {
-        friction = w0 > 0 ? -coulomb_ : coulomb_;
-    } else {
-        const double drive = motor_torque + load_torque;
-        friction = std::abs(drive) <= coulomb_ ? -drive : (drive > 0 ? -coulomb_ : coulomb_);
-    }
-    const double torque = load_torque + friction;
-    if (power_on) {
-        x_ = phi_ * x_ + gamma_u_ * u + gamma_t_ * torque;
-    } else {
-        // Open winding: no current path (the power stage is off), current ends at once.
-        Eigen::Vector2d m(x_(1), x_(2));
-        m = phi_mech_ * m + gamma_mech_ * torque;
-        x_ << 0.0, m(0), m(1);
-    }
-    // Friction cannot reverse the motion within one step: stop at the zero crossing instead.
-    if (w0 != 0.0 && (x_(1) > 0) != (w0 > 0)) {
-        const double drive = (power_on ? km_ * x_(0) : 0.0) + load_torque;
-        if (std::abs(drive) <= coulomb_) x_(1) = 0.0;
-    }
-    at_stop_ = false;
-    if (x_(2) >= hi_) {
-        x_(2) = hi_;
-        if (x_(1) > 0) x_(1) = 0.0;
-        at_stop_ = true;
-    } else if (x_(2) <= lo_) {
-        x_(2) = lo_;
-        if (x_(1) < 0) x_(1) = 0.0;
-        at_stop_ = true;
-    }
-}
-
 }  // namespace drive

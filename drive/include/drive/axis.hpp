@@ -189,7 +189,8 @@ class Axis {
     // Axis runs its parts against each other; each group below lives in the .cpp named after the part.
     // axis.cpp: configuration, the cycle, the machine (plant, inputs, encoder) and the feedback
     void derive();
-    void plant_step(int64_t t_ns, double u);
+    void machine_step(double raw, int64_t t_ns);  // after a plant step: inputs, encoder index
+    void edges(double prev, double raw, int64_t t_ns, uint64_t changed);  // input edges within a step
     void on_edge(int bit, bool rising, double raw_pos);
     void on_index(double raw_pos);
     void update_feedback();
@@ -220,13 +221,15 @@ class Axis {
     void homing_fail();
     // helpers (axis.cpp)
     uint64_t functions(uint16_t pins) const;
+    uint64_t functions_now(uint16_t pins);  // functions() remembered for the last pins within one cycle
+    void prepare_steps(int64_t from_ns, int64_t to_ns);
     int32_t clamp_i32(double v) const;
     bool range_on() const;
     int32_t report(int64_t v) const;                           // a position as the dictionary shows it
     double unwrap(int32_t target, double near_raw) const;      // modulo target -> raw increments
     double i_meas() const { return pol_ * plant_.current(); }  // current in the axis' direction
     double rpm_to_inc_s(double rpm) const { return rpm * res_ / 60.0; }
-    double inc_to_rad(double inc) const { return inc * 6.283185307179586 / res_; }
+    double inc_to_rad(double inc) const { return inc * rad_per_inc_; }
     double decel_limit(double d) const;
 
     EventSink* sink_;
@@ -246,6 +249,9 @@ class Axis {
 
     // configuration derived from params
     int32_t res_ = 2000;
+    // 2 pi / res_ and res_ / 2 pi: multiplications instead of divisions in the current loop's feedback chain
+    double rad_per_inc_ = 6.283185307179586 / 2000;
+    double inc_per_rad_ = 2000 / 6.283185307179586;
     double pol_ = 1.0;  // 0x3000:04 bit 0: -1 = inverse polarity
     double km_plant_ = -1;
     bool plant_dirty_ = true;
@@ -258,6 +264,16 @@ class Axis {
     double prev_raw_pos_ = 0;
     uint64_t func_ = 0;  // 0x60FD-style function bits, bit 26 = touch probe input, bits 32..37 = pins
     uint16_t pins_ = 0;
+    // per-cycle caches of the 10 us machine steps (prepare_steps; same values as computing them each step)
+    bool fn_valid_ = false;  // functions_now(): fn_pins_ -> fn_value_ under this cycle's parameters
+    uint16_t fn_pins_ = 0;
+    uint64_t fn_value_ = 0;
+    bool pins_fixed_ = false;  // the environment's pins cannot change during this cycle's steps
+    uint16_t fixed_pins_ = 0;
+    bool index_on_ = false;  // encoder index (0x3010:02 bit 0)
+    double index_p0_ = 0;    // where the index sits within a turn, inc
+    double index_k_ = 0;     // floor((prev_raw_pos_ - p0) / res): the turn the last step ended in
+    double index_lo_ = 0, index_hi_ = 0;  // raw - p0 strictly inside this turn: no division needed
     // timing
     int64_t tick_ = 0;
     int64_t residual_ns_ = 0;

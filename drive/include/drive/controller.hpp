@@ -13,6 +13,11 @@ struct Controller {
     double km = 0, j = 1e-5, r = 0;      // torque constant (0 = not configured), inertia, viscous friction
     double kv = 0, kiv = 0, kpp = 0;     // velocity PI (A s/rad, A/rad), position P (1/s)
     double kpi = 0, kii = 0, kff_i = 0;  // current PI
+    // constants of observe() that only change with the parameters (set by tune())
+    double obs_load_gain = 0;   // kTick j wo^3
+    double inv_j = 1e5;         // 1 / j
+    double i2t_rate = 0;        // kTick / thermal time constant
+    double i2t_nominal = 1e-3;  // A
     // loop state
     double vel_ref = 0;      // rad/s, output of the position loop / CSV input
     double vel_ff = 0;       // rad/s
@@ -32,7 +37,7 @@ struct Controller {
     void tune(const Parameters& p, double km_plant);
     // One current-loop sample of the observer (measured angle, measured current), the I2t model and the
     // averaged values; `km_plant` stands in for an unconfigured torque constant.
-    void observe(double meas_rad, double i_meas, double km_plant, const Parameters& p);
+    void observe(double meas_rad, double i_meas, double km_plant);
     // The estimates diverged (absurd gains): true if any is not finite.
     bool diverged() const;
     void reset_estimates(double pos_rad);

@@ -52,6 +52,10 @@ class Environment {
 
     // Pin levels (bit n-1 = DigIN n) at a raw position and time.
     uint16_t pins(double position, int64_t t_ns) const;
+    // True when the pins cannot change for any position and any time in [from_ns, to_ns] (no switch wired,
+    // no timed input change due after from_ns and at or before to_ns); `level` is then their value. Lets the
+    // drive skip pins() in its 10 us machine steps.
+    bool constant_over(int64_t from_ns, int64_t to_ns, uint16_t& level) const;
 
   private:
     std::array<Switch, 3> switches_{};  // neg, pos, home

@@ -5,6 +5,7 @@
 // step; Coulomb friction, stiction and the stops are applied per step. Nothing here allocates after
 // configure().
 #include <Eigen/Dense>
+#include <cmath>
 #include <limits>
 
 namespace drive {
@@ -30,7 +31,19 @@ class Plant {
     void configure(const MotorModel& m, double torque_constant, double h);
     // One integration step with winding voltage u (V) and external load torque (Nm, positive = positive
     // direction). With power off the winding is open: the current decays to zero and no torque is made.
-    void step(double u, bool power_on, double load_torque = 0.0);
+    inline void step(double u, bool power_on, double load_torque = 0.0);
+    // The same step on a copy of the state the caller holds (in registers: the drive runs 100 steps per 1 ms
+    // cycle, docs/decisions/drive.md "Cost of a cycle"); returns whether the step ended at a stop. Hand the
+    // state back with set_state().
+    struct State {
+        double current, velocity, angle;
+    };
+    State state() const { return {x_(0), x_(1), x_(2)}; }
+    void set_state(const State& s, bool at_stop) {
+        x_ << s.current, s.velocity, s.angle;
+        at_stop_ = at_stop;
+    }
+    inline bool advance(State& s, double u, bool power_on, double load_torque = 0.0) const;
 
     double current() const { return x_(0); }
     double velocity() const { return x_(1); }
@@ -59,6 +72,57 @@ class Plant {
     double hi_ = std::numeric_limits<double>::infinity();
     bool at_stop_ = false;
 };
+
+inline void Plant::step(double u, bool power_on, double load_torque) {
+    State s{x_(0), x_(1), x_(2)};
+    at_stop_ = advance(s, u, power_on, load_torque);
+    x_ << s.current, s.velocity, s.angle;
+}
+
+inline bool Plant::advance(State& s, double u, bool power_on, double load_torque) const {
+    const double w0 = s.velocity;
+    const double motor_torque = power_on ? km_ * s.current : 0.0;
+    // Coulomb friction: opposes motion; at rest it holds as long as the driving torque is below it.
+    double friction;
+    if (w0 != 0.0) {
+        friction = w0 > 0 ? -coulomb_ : coulomb_;
+    } else {
+        const double drive = motor_torque + load_torque;
+        friction = std::abs(drive) <= coulomb_ ? -drive : (drive > 0 ? -coulomb_ : coulomb_);
+    }
+    const double torque = load_torque + friction;
+    const double x0 = s.current, x1 = s.velocity, x2 = s.angle;
+    if (power_on) {
+        // x = phi x + gamma_u u + gamma_t torque, summed as a tree (the input terms do not wait for x)
+        const double f0 = gamma_u_(0) * u + gamma_t_(0) * torque;
+        const double f1 = gamma_u_(1) * u + gamma_t_(1) * torque;
+        const double f2 = gamma_u_(2) * u + gamma_t_(2) * torque;
+        s.current = (phi_(0, 0) * x0 + phi_(0, 1) * x1) + (phi_(0, 2) * x2 + f0);
+        s.velocity = (phi_(1, 0) * x0 + phi_(1, 1) * x1) + (phi_(1, 2) * x2 + f1);
+        s.angle = (phi_(2, 0) * x0 + phi_(2, 1) * x1) + (phi_(2, 2) * x2 + f2);
+    } else {
+        // Open winding: no current path (the power stage is off), current ends at once.
+        s.current = 0.0;
+        s.velocity = phi_mech_(0, 0) * x1 + phi_mech_(0, 1) * x2 + gamma_mech_(0) * torque;
+        s.angle = phi_mech_(1, 0) * x1 + phi_mech_(1, 1) * x2 + gamma_mech_(1) * torque;
+    }
+    // Friction cannot reverse the motion within one step: stop at the zero crossing instead.
+    if (w0 != 0.0 && (s.velocity > 0) != (w0 > 0)) {
+        const double drive = (power_on ? km_ * s.current : 0.0) + load_torque;
+        if (std::abs(drive) <= coulomb_) s.velocity = 0.0;
+    }
+    if (s.angle >= hi_) {
+        s.angle = hi_;
+        if (s.velocity > 0) s.velocity = 0.0;
+        return true;
+    }
+    if (s.angle <= lo_) {
+        s.angle = lo_;
+        if (s.velocity < 0) s.velocity = 0.0;
+        return true;
+    }
+    return false;
+}
 
 // exp(M) for a small dense matrix (scaling and squaring with a Taylor series); used to discretize the plant.
 Eigen::MatrixXd expm(const Eigen::MatrixXd& m);
