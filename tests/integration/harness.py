@@ -517,6 +517,9 @@ class MiniMaster:
         for st in self.stations():
             self.fpwr(st, 0x0990, struct.pack("<Q", start))
             self.fpwr(st, 0x0980, struct.pack("<H", 0x0300))
+        # Cycle until SYNC0 runs (it starts 100 ms from now) before any state request: a drive entering SAFEOP
+        # starts its SYNC0 supervision, and in OP SYNC0 must arrive (else AL status 0x002C).
+        self.run(150)
 
     # -- cycles ------------------------------------------------------------------------------------------------
     def request(self, state, stations=None):
@@ -526,9 +529,10 @@ class MiniMaster:
     def al_code(self, station):
         return struct.unpack("<H", self.fprd(station, 0x0134, 2))[0]
 
-    def run(self, cycles, period_ns=1_000_000, until=None):
+    def run(self, cycles, period_ns=1_000_000, until=None, timeout=0.05):
         """Cycles at period_ns: LRW of the whole image (+ FRMW with DC, + FPRD 0x0130 of each slave). Stops early
-        when until(states) is true. Returns a dict of counters; self.states holds the last AL states read."""
+        when until(states) is true. A reply later than `timeout` counts as lost (a loaded machine delays replies by
+        milliseconds now and then; tests that lose frames on purpose use a shorter one). Returns a dict of counters; self.states holds the last AL states read."""
         dgs = [(LRW, 0x0000, 0x0001, bytes(self.image))]  # logical address 0x00010000
         if self.dc:
             dgs.append((FRMW, 0x1001, 0x0910, bytes(8)))
@@ -537,7 +541,7 @@ class MiniMaster:
         nxt = time.monotonic_ns()
         for _ in range(cycles):
             nxt += period_ns
-            r = self.txrx(dgs, timeout=0.005)
+            r = self.txrx(dgs, timeout=timeout)
             stats["cycles"] += 1
             if r is None:
                 stats["lost"] += 1

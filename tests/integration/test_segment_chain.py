@@ -104,7 +104,10 @@ class ChainedProcesses(unittest.TestCase):
         self.addCleanup(m.close)
         self.assertEqual(self.wait_count(m, n), n, bus.slave_output())
         out = m.scan()
-        self.assertEqual([r[6] for r in scan_rows(out)], serials, out)
+        rows = scan_rows(out)
+        self.assertEqual([r[1] for r in rows], [0x1001 + k for k in range(n)], out)
+        # B's drives come after A's, in B's order (A's single drive has the program's default serial number).
+        self.assertEqual([r[6] for r in rows][len(rows) - len(serials):], serials, out)
         m.discover()
         m.configure(dc=True)
         delays = [d[0] for d in m.delays]
@@ -121,7 +124,7 @@ class ChainedProcesses(unittest.TestCase):
 
     def test_two_processes_one_line(self):
         with Chain() as bus:
-            m = self.line_to_op(bus, 2, [0, 0])  # two single drives: the default serial number each
+            m = self.line_to_op(bus, 2, [])
             # B's interface loses its carrier: A closes port 1 and answers alone, as a hardware ESC does.
             bus.ns_ip("link", "set", bus.in_b, "down")
             self.assertEqual(self.wait_count(m, 1), 1, bus.slave_output())
@@ -130,7 +133,7 @@ class ChainedProcesses(unittest.TestCase):
 
     def test_one_plus_two(self):
         with Chain(args_b=["--slaves", "2"]) as bus:
-            self.line_to_op(bus, 3, [0, 1, 2])
+            self.line_to_op(bus, 3, [1, 2])
 
 
 if __name__ == "__main__":

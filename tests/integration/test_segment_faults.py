@@ -143,7 +143,7 @@ class SegmentFaults(unittest.TestCase):
         before = [self.configuration(pos) for pos in range(3)]
         m.to_op(dc=True)
         self.control("drop 1 0.05")  # the cable into drive 2
-        s = m.run(10000)
+        s = m.run(10000, timeout=0.01)
         self.control("clear")
         # Lost frames seen by the master (no reply); what came back had the full working counter.
         self.assertGreater(s["lost"], 100, s)
