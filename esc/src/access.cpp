@@ -204,6 +204,10 @@ void Esc::Impl::reg_special_write(uint16_t a, uint16_t e, const uint8_t* src, co
                 }
             }
         }
+        if (hit(kDlControlLoop, 1)) {
+            mem.w8(kDlControlLoop, static_cast<uint8_t>(M(kDlControlLoop, 1)));
+            ports.dl_control_written();
+        }
         if (hit(0x0300, 0x14)) {
             for (uint16_t x = std::max<uint16_t>(a, 0x0300); x < std::min<uint16_t>(e, 0x0314); ++x)
                 mem.regs[x] = 0;

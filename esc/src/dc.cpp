@@ -22,13 +22,14 @@ constexpr double kMaxRate = 1.0 / kMinSpeedCounterStart;
 
 uint64_t DistributedClocks::local_at(uint64_t c) const {
     const int64_t dt = static_cast<int64_t>(c - clock_anchor);
-    const int64_t corr = static_cast<int64_t>(std::llround(static_cast<double>(dt) * rate));
+    const int64_t corr = static_cast<int64_t>(std::llround(static_cast<double>(dt) * speed_m1));
     return local_anchor + static_cast<uint64_t>(dt + corr);
 }
 
 uint64_t DistributedClocks::clock_at_local(uint64_t local) const {
     constexpr double kTwo64 = 18446744073709551616.0;
-    const double speed = 1.0 + std::clamp(rate, -kMaxRate, kMaxRate);  // > 0: never a division by zero
+    // > 0: never a division by zero (the drift is clamped to +-1/128 at construction too).
+    const double speed = (1.0 + drift) * (1.0 + std::clamp(rate, -kMaxRate, kMaxRate));
     // Saturated at both ends (a start time centuries away): no overflow, no undefined conversion.
     if (local >= local_anchor) {
         const double dc = std::ceil(static_cast<double>(local - local_anchor) / speed);
@@ -48,6 +49,7 @@ void DistributedClocks::set_rate(double new_rate, uint64_t at) {
         clock_anchor = at;
     }
     rate = std::clamp(new_rate, -kMaxRate, kMaxRate);
+    speed_m1 = (1.0 + drift) * (1.0 + rate) - 1.0;
 }
 
 // ---------------------------------------------------------------------------------------- control loop
@@ -215,13 +217,22 @@ void DistributedClocks::run(uint64_t now_clock) {
 
 // ---------------------------------------------------------------------------------------- construction
 
-DistributedClocks::DistributedClocks(Memory& m, FrameTime& t, const EscFaults& f)
-    : mem(m), time(t), faults(f) {
+DistributedClocks::DistributedClocks(Memory& m, FrameTime& t, const EscConfig& cfg)
+    : mem(m),
+      time(t),
+      faults(cfg.faults),
+      drift(std::isfinite(cfg.clock_drift_ppm) ? std::clamp(cfg.clock_drift_ppm * 1e-6, -kMaxRate, kMaxRate)
+                                               : 0.0) {
+    // Local time = Clock time * (1 + drift) + offset (modulo 2^64, as the 64-bit DC counter wraps).
     clock_anchor = time.clock.now_ns();
-    local_anchor = clock_anchor;
+    const int64_t skew = static_cast<int64_t>(std::llround(static_cast<double>(clock_anchor) * drift));
+    local_anchor = clock_anchor + static_cast<uint64_t>(skew) + static_cast<uint64_t>(cfg.clock_offset_ns);
+    speed_m1 = drift;
 }
 
 void DistributedClocks::reset() {
+    latch_pending = false;
+    port_armed = 0;
     sync_running = sync0_armed = sync1_armed = false;
     sync0_ack = sync1_ack = false;
     rate_integral = 0.0;
@@ -265,10 +276,11 @@ void DistributedClocks::after_pdi_read(uint16_t a, uint16_t e) {
 void DistributedClocks::latch(bool ok) {
     latch_pending = false;
     if (!ok) return;
-    const uint32_t t32 = static_cast<uint32_t>(time.frame_local);
-    for (uint16_t port = 0; port < 4; ++port)
-        mem.w32(static_cast<uint16_t>(reg::kDcRecvTime0 + 4 * port), t32);
+    // Port 0: this frame's arrival (the processing unit sits behind port 0's receive side). Ports 1-3: the
+    // next frame each of them receives (Ports / Esc::receive call port_received()).
+    mem.w32(reg::kDcRecvTime0, static_cast<uint32_t>(time.frame_local));
     mem.w64(reg::kDcRecvTimePu, time.frame_local);
+    port_armed = 0x0E;
 }
 
 uint64_t DistributedClocks::next_event() const {

@@ -4,6 +4,7 @@
 // registers 0x0900-0x09FF).
 #include <cstdint>
 
+#include "esc/esc.hpp"
 #include "esc/faults.hpp"
 #include "frame_time.hpp"
 #include "memory.hpp"
@@ -12,7 +13,9 @@ namespace esc {
 
 class DistributedClocks {
   public:
-    DistributedClocks(Memory& m, FrameTime& t, const EscFaults& f);
+    // The ESC's oscillator: EscConfig::clock_drift_ppm / clock_offset_ns (local time = Clock time *
+    // (1 + drift) + offset before the control loop's correction).
+    DistributedClocks(Memory& m, FrameTime& t, const EscConfig& cfg);
     // Power-on / ESC reset state (registers already reset).
     void reset();
 
@@ -33,6 +36,15 @@ class DistributedClocks {
     // Writes of the side that owns the SYNC unit (0x0980).
     void activation_written(uint8_t old_value, uint8_t value);
     void start_time_written(bool only_low32);
+    // A frame was received at port 1-3 at Clock time clock_ns: latches 0x0904/0x0908/0x090C once per arming.
+    bool port_latch_armed() const { return port_armed != 0; }
+    void port_received(int port, uint64_t clock_ns) {
+        const uint8_t bit = static_cast<uint8_t>(1u << port);
+        if (!(port_armed & bit)) return;
+        port_armed = static_cast<uint8_t>(port_armed & ~bit);
+        mem.w32(static_cast<uint16_t>(reg::kDcRecvTime0 + 4 * port),
+                static_cast<uint32_t>(local_at(clock_ns)));
+    }
     // End of an ECAT frame: the receive-time latch of a correct frame.
     void end_of_frame(bool ok) {
         if (latch_pending) latch(ok);
@@ -53,10 +65,13 @@ class DistributedClocks {
     Memory& mem;
     FrameTime& time;
     const EscFaults& faults;
+    const double drift;          // the oscillator's fractional deviation (50 ppm: 5e-5)
     bool latch_pending = false;  // 0x0900 written in this frame
+    uint8_t port_armed = 0;      // ports 1-3 whose receive time latches with the next frame they receive
     uint64_t clock_anchor = 0;   // Clock time where the local time mapping was last re-anchored
     uint64_t local_anchor = 0;   // local time at clock_anchor
     double rate = 0.0;           // fractional rate correction of the local time (-1e-4 = 100 ppm slower)
+    double speed_m1 = 0.0;       // (1 + drift) * (1 + rate) - 1: the local clock's speed against the Clock
     double rate_integral = 0.0;
     bool have_prev = false;
     uint64_t prev_local = 0;

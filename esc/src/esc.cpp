@@ -15,6 +15,35 @@ constexpr uint16_t kEtherTypeEcat = wire::kEtherType;
 using util::get16;
 using util::put16;
 
+// Error counters (ESC datasheet section II, 0x0300-0x0313), per port p.
+constexpr uint16_t invalid_frame_counter(int p) {
+    return static_cast<uint16_t>(0x0300 + 2 * p);
+}
+constexpr uint16_t rx_error_counter(int p) {
+    return static_cast<uint16_t>(0x0301 + 2 * p);
+}
+constexpr uint16_t forwarded_rx_error_counter(int p) {
+    return static_cast<uint16_t>(0x0308 + p);
+}
+
+// The first datagram's length word (bit 14: circulating frame, ETG.1000.4) of an EtherCAT frame (type 1),
+// nullptr if the frame has none.
+uint8_t* first_length_word(std::span<uint8_t> frame) {
+    const std::size_t size = frame.size();
+    if (size < 14) return nullptr;
+    uint8_t* f = frame.data();
+    std::size_t off = 12;
+    uint16_t type = static_cast<uint16_t>((f[12] << 8) | f[13]);
+    if (type == kEtherTypeVlan) {
+        if (size < 18) return nullptr;
+        type = static_cast<uint16_t>((f[16] << 8) | f[17]);
+        off = 16;
+    }
+    const std::size_t word = off + 2 + 2 + 6;  // EtherCAT header, then the datagram's cmd/idx/adp/ado
+    if (type != kEtherTypeEcat || size < word + 2 || (get16(f + off + 2) >> 12) != 1) return nullptr;
+    return f + word;
+}
+
 }  // namespace
 
 // ==================================================================================================
@@ -56,7 +85,9 @@ void Esc::Impl::init_tables() {
     ecat(reg::kEscWriteEnable, 1, kSpecial, 0x01);
     ecat(reg::kEscWriteProtect, 1, kPlain, 0x01);
     ecat(reg::kEscResetEcat, 1, kSpecial);
-    ecat(reg::kDlControl, 4, kPlain);
+    ecat(reg::kDlControl, 1, kPlain);
+    ecat(kDlControlLoop, 1, kSpecial);  // loop settings: the port unit recomputes the loops
+    ecat(0x0102, 2, kPlain);
     ecat(0x0108, 2, kPlain);  // physical read/write offset (stored, not applied: see decisions)
     ecat(reg::kAlControl, 2, kSpecial);
     ecat(reg::kEcatEventMask, 2, kPlain);
@@ -119,10 +150,11 @@ void Esc::Impl::reset_registers() {
     mem.w8(0x0006, static_cast<uint8_t>(cfg.process_ram_kib));
     mem.w8(0x0007, cfg.port_descriptor);
     mem.w16(0x0008, cfg.features);
-    mem.w32(reg::kDlControl, 0x0007C001);
-    // Single port: link + communication on port 0, loop of port 0 open, ports 1-3 closed, PDI watchdog
-    // reloaded. Bit 0 (EEPROM loaded) is set by the EEPROM load.
-    mem.w16(reg::kDlStatus, 0x5612);
+    // DL control: EtherCAT forwarding rule, every port's loop "auto" (open while it has a link), RX FIFO 7.
+    mem.w32(reg::kDlControl, 0x00070001);
+    // DL status: PDI watchdog reloaded; bit 0 (EEPROM loaded) is set by the EEPROM load, bits 4-15 (links,
+    // loops, communication) by the port unit below. A lone ESC with a link on port 0 only: 0x5612.
+    mem.w16(reg::kDlStatus, 0x0002);
     mem.w16(reg::kAlControl, 0x0001);
     mem.w16(reg::kAlStatus, 0x0001);
     mem.w32(reg::kAlEventMask, 0x00FFFF2F);
@@ -143,6 +175,7 @@ void Esc::Impl::reset_registers() {
     rebuild_lookup();
     dc.reset();
     wd.reset();
+    ports.reset();
     reset_progress_ecat = reset_progress_pdi = 0;
 }
 
@@ -155,6 +188,47 @@ void Esc::Impl::rebuild_lookup() {
 // ==================================================================================================
 // Frame processing
 // ==================================================================================================
+
+int Esc::Impl::receive(std::span<uint8_t> frame, int port, uint64_t rx_clock, FrameCheck* check) {
+    // A frame received at a closed or non-existent port is destroyed.
+    if (static_cast<unsigned>(port) >= static_cast<unsigned>(kPortCount) || !ports.loop_open(port)) {
+        ++stats.frames_destroyed;
+        return -1;
+    }
+    if (port != 0 && dc.port_latch_armed())
+        dc.port_received(port, rx_clock != 0 ? rx_clock : time.clock.now_ns());
+    if (check && check->crc_bad) {
+        // Forwarded, never processed. The first ESC that sees the bad FCS counts an invalid frame (and the
+        // PHY's RX error) and marks the frame; the ones after it count a forwarded RX error.
+        ++stats.frames_bad_fcs;
+        if (!check->marked) {
+            mem.count_error(invalid_frame_counter(port));
+            mem.count_error(rx_error_counter(port));
+            check->marked = true;
+        } else {
+            mem.count_error(forwarded_rx_error_counter(port));
+        }
+        return ports.exit_after(port);
+    }
+    if (port != 0) {
+        if (!ports.via_closed_port0(port))
+            return ports.exit_after(port);  // does not pass the processing unit
+        // Looped back at the closed port 0 into the processing unit: the circulating bit is set on the
+        // first pass; a frame that comes by with it already set is destroyed (ETG.1000.4).
+        if (uint8_t* lw = first_length_word(frame)) {
+            if (lw[1] & 0x40) {
+                ++stats.frames_destroyed;
+                return -1;
+            }
+            lw[1] = static_cast<uint8_t>(lw[1] | 0x40);
+        }
+    }
+    if (!process(frame, rx_clock)) {
+        ++stats.frames_destroyed;
+        return -1;
+    }
+    return ports.exit_after(port);
+}
 
 bool Esc::Impl::process(std::span<uint8_t> frame, uint64_t rx_clock) {
     const std::size_t size = frame.size();
@@ -360,9 +434,40 @@ Esc::~Esc() = default;
 
 bool Esc::process_frame(std::span<uint8_t> frame, uint64_t rx_time_ns) {
     std::unique_lock lock(impl_->mu);
-    const bool r = impl_->process(frame, rx_time_ns);
+    const int r = impl_->receive(frame, 0, rx_time_ns, nullptr);
+    impl_->sii.flush_callbacks(lock);
+    return r == 0;
+}
+
+int Esc::receive(std::span<uint8_t> frame, int port, uint64_t rx_clock_ns) {
+    std::unique_lock lock(impl_->mu);
+    const int r = impl_->receive(frame, port, rx_clock_ns, nullptr);
     impl_->sii.flush_callbacks(lock);
     return r;
+}
+
+int Esc::receive(std::span<uint8_t> frame, int port, uint64_t rx_clock_ns, FrameCheck& check) {
+    std::unique_lock lock(impl_->mu);
+    const int r = impl_->receive(frame, port, rx_clock_ns, &check);
+    impl_->sii.flush_callbacks(lock);
+    return r;
+}
+
+void Esc::set_link(int port, bool up) {
+    std::lock_guard lock(impl_->mu);
+    impl_->ports.set_link(port, up);
+}
+
+bool Esc::link(int port) const {
+    if (static_cast<unsigned>(port) >= static_cast<unsigned>(kPortCount)) return false;
+    std::lock_guard lock(impl_->mu);
+    return impl_->ports.link(port);
+}
+
+bool Esc::port_open(int port) const {
+    if (static_cast<unsigned>(port) >= static_cast<unsigned>(kPortCount)) return false;
+    std::lock_guard lock(impl_->mu);
+    return impl_->ports.port_open(port);
 }
 
 void Esc::read(uint16_t address, std::span<uint8_t> out) {

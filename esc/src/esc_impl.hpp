@@ -2,9 +2,10 @@
 // Internal state of the emulated ESC. Not a public header: only esc/src/*.cpp include it.
 // Esc::Impl composes the units, each owning its state: memory (registers + process RAM, memory.hpp),
 // SyncManagers (sync_manager.hpp), FMMUs (fmmu.hpp), distributed clocks (dc.hpp), SII EEPROM interface
-// (sii_interface.hpp), watchdogs (watchdog.hpp). Impl itself keeps what spans units: frame and datagram
-// processing (esc.cpp), the register access rules of both sides and the routing of physical accesses over
-// registers, SyncManager areas and RAM (access.cpp), AL control, the write enables and the ESC reset.
+// (sii_interface.hpp), watchdogs (watchdog.hpp), ports (ports.hpp). Impl itself keeps what spans units: frame
+// and datagram processing (esc.cpp), the register access rules of both sides and the routing of physical
+// accesses over registers, SyncManager areas and RAM (access.cpp), AL control, the write enables and the ESC
+// reset.
 #include <array>
 #include <cstdint>
 #include <mutex>
@@ -14,6 +15,7 @@
 #include "fmmu.hpp"
 #include "frame_time.hpp"
 #include "memory.hpp"
+#include "ports.hpp"
 #include "sii_interface.hpp"
 #include "sync_manager.hpp"
 #include "watchdog.hpp"
@@ -36,7 +38,8 @@ struct Esc::Impl final {
     Watchdogs wd{mem, time};
     SyncManagers sm{mem, wd, cfg.sm_count};
     Fmmus fmmu{mem, cfg.fmmu_count};
-    DistributedClocks dc{mem, time, cfg.faults};
+    DistributedClocks dc{mem, time, cfg};
+    Ports ports{mem, cfg.port_descriptor};
     SiiInterface sii{mem, cfg.faults};
     bool lookup_dirty = false;  // SM / FMMU configuration written: rebuild their decoded state
 
@@ -58,6 +61,7 @@ struct Esc::Impl final {
     void rebuild_lookup();
 
     // Frame processing.
+    int receive(std::span<uint8_t> frame, int port, uint64_t rx_clock, FrameCheck* check);
     bool process(std::span<uint8_t> frame, uint64_t rx_clock);
     void end_of_frame(bool ok);
     void datagram(uint8_t* hdr, uint8_t* data, uint16_t len);

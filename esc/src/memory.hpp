@@ -20,6 +20,9 @@ enum RegKind : uint8_t {
     kSpecial,  // stored by a handler after the byte loop
 };
 
+// DL control byte 1: the loop setting of each port (2 bits per port; ports.hpp).
+constexpr uint16_t kDlControlLoop = 0x0101;
+
 // True if [a, e) overlaps the register [ra, ra + size).
 inline bool overlaps(uint16_t a, uint16_t e, uint16_t ra, unsigned size) {
     return a < ra + size && ra < e;

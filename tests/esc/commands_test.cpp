@@ -120,8 +120,8 @@ TEST_F(Addressing, ReadOnlyRegistersIgnoreEcatWrites) {
 }
 
 TEST_F(Addressing, ResetValues) {
-    EXPECT_EQ(fprd(*e, 0x0100, 4).u32(), 0x0007C001u);
-    EXPECT_EQ(fprd(*e, 0x0110, 2).u16(), 0x5613);  // single port, EEPROM loaded
+    EXPECT_EQ(fprd(*e, 0x0100, 4).u32(), 0x00070001u);  // every port's loop "auto"
+    EXPECT_EQ(fprd(*e, 0x0110, 2).u16(), 0x5613);       // single port, EEPROM loaded
     EXPECT_EQ(fprd(*e, 0x0120, 2).u16(), 0x0001);
     EXPECT_EQ(fprd(*e, 0x0130, 2).u16(), 0x0001);
     EXPECT_EQ(fprd(*e, 0x0204, 4).u32(), 0x00FFFF2Fu);

@@ -37,8 +37,10 @@ TEST_F(DistributedClocks, ReceiveTimeLatch) {
     EXPECT_EQ(r[0].wkc, 1);
     EXPECT_EQ(r[1].u32(), 0u);  // not readable in the same frame
     Datagram d = fprd(*e, 0x0900, 16);
-    for (int p = 0; p < 4; ++p)
-        EXPECT_EQ(d.u32(4 * p), static_cast<uint32_t>(kT0 + 5'000'123)) << "port " << p;
+    EXPECT_EQ(d.u32(0), static_cast<uint32_t>(kT0 + 5'000'123));
+    // Ports 1-3 latch the next frame they receive; a lone ESC receives nothing there (ports_test.cpp).
+    for (int p = 1; p < 4; ++p)
+        EXPECT_EQ(d.u32(4 * p), 0u) << "port " << p;
     EXPECT_EQ(fprd(*e, 0x0918, 8).u64(), kT0 + 5'000'123);
 }
 
@@ -87,6 +89,34 @@ TEST_F(DistributedClocks, DriftLoopChangesLocalClockRate) {
     const uint64_t l2 = e->local_time_ns();
     clk.advance(1'000'050);
     EXPECT_EQ(e->local_time_ns() - l2, 1'000'050u);
+}
+
+// EscConfig::clock_drift_ppm: the ESC's own oscillator runs 50 ppm fast (and 30 us off) against the Clock the
+// master's reference runs on. The FRMW-distributed system time converges as for a drift-free ESC, and the
+// loop's drift estimate 0x0932 cancels the configured drift.
+TEST(DistributedClocksDrift, ConfiguredDriftIsCompensatedByTheLoop) {
+    for (double ppm : {0.0, 50.0, -100.0, 100.0}) {
+        esc::ManualClock clk;
+        clk.set(kT0);
+        esc::EscConfig c;
+        c.clock_drift_ppm = ppm;
+        c.clock_offset_ns = ppm == 0.0 ? 0 : 30'000;
+        esc::Esc e(c, clk);
+        set_station(e, 0x1001);
+        // Offset as a master computes it: reference time minus this ESC's local time.
+        const uint64_t local = e.local_time_ns();
+        fpwr(e, 0x0920, le(clk.now_ns() - local, 8));
+        fpwr(e, 0x0930, {0x00, 0x10});
+        for (int i = 0; i < 3000; ++i) {
+            clk.advance(1'000'000);
+            ASSERT_EQ(run1(e, dg(FRMW, 0x7777, 0x0910, le(clk.now_ns(), 8))).wkc, 1) << ppm;
+        }
+        EXPECT_LT(fprd(e, 0x092C, 4).u32() & 0x7FFFFFFF, 50u) << ppm;
+        EXPECT_NEAR(static_cast<int16_t>(fprd(e, 0x0932, 2).u16()), -10.0 * ppm, 25) << ppm;
+        // System time = the reference's.
+        const uint64_t sys = fprd(e, 0x0910, 8).u64();
+        EXPECT_LT(std::llabs(static_cast<long long>(sys - clk.now_ns())), 100) << ppm;
+    }
 }
 
 TEST_F(DistributedClocks, DriftLoopFollowsSlowerOscillator) {

@@ -192,11 +192,11 @@ TEST_F(FmmuMapping, MailboxThroughFmmuObeysSmRules) {
 // maps what exists and captures nothing: physical accesses, its own registers included, are unchanged.
 TEST_F(FmmuMapping, FmmuBeyondTheRamCapturesNoPhysicalAddress) {
     fmmu(0, {0x00010000, 0x8000, 0, 7, 0x0100, 0, 0x03});
-    EXPECT_EQ(fprd(*e, 0x0100, 4).u32(), 0x0007C001u);
+    EXPECT_EQ(fprd(*e, 0x0100, 4).u32(), 0x00070001u);
     EXPECT_EQ(fprd(*e, 0x0600, 16).wkc, 1);
     Datagram d = run1(*e, lg(LRD, 0x00010000, {0, 0, 0, 0}));
     EXPECT_EQ(d.wkc, 1);
-    EXPECT_EQ(d.u32(), 0x0007C001u);  // DL control through the mapping
+    EXPECT_EQ(d.u32(), 0x00070001u);  // DL control through the mapping
     EXPECT_EQ(run1(*e, lg(LRD, 0x00010000 + 0x3000 - 0x0100, {0, 0})).wkc, 0);  // past the RAM end
     EXPECT_EQ(fpwr(*e, 0x1800, {0x42}).wkc, 1);
     EXPECT_EQ(run1(*e, lg(LRD, 0x00010000 + 0x1800 - 0x0100, {0})).data[0], 0x42);

@@ -311,7 +311,7 @@ TEST_F(SyncManagerRules, SmOverTheRegisterSpaceCapturesNoAddress) {
     EXPECT_EQ(d.u16(2), 0x8000);
     EXPECT_EQ(d.data[6], 0x01);
     // Registers from 0x0100 up answer from both sides.
-    EXPECT_EQ(fprd(*e, 0x0100, 4).u32(), 0x0007C001u);
+    EXPECT_EQ(fprd(*e, 0x0100, 4).u32(), 0x00070001u);
     EXPECT_EQ(fprd(*e, 0x0130, 2).wkc, 1);
     EXPECT_EQ(fprd(*e, 0x0130, 2).u16(), 0x0001);
     EXPECT_EQ(fpwr(*e, 0x0120, {0x02, 0x00}).wkc, 1);
@@ -335,7 +335,7 @@ TEST_F(SyncManagerRules, SmOverTheRegisterSpaceCapturesNoAddress) {
 TEST_F(SyncManagerRules, SmAreaInsideTheRegistersOrAcrossTheRamEdgesIsNotServed) {
     // A mailbox SM on DL control: the registers keep their register rules.
     EXPECT_EQ(fpwr(*e, 0x0820, sm_bytes(0x0100, 16, 0x26, 1)).wkc, 1);
-    EXPECT_EQ(fprd(*e, 0x0100, 4).u32(), 0x0007C001u);
+    EXPECT_EQ(fprd(*e, 0x0100, 4).u32(), 0x00070001u);
     EXPECT_EQ(fprd(*e, 0x0100, 4).wkc, 1);
     // Across the register/RAM boundary: user RAM and process RAM stay plain memory.
     EXPECT_EQ(fpwr(*e, 0x0828, sm_bytes(0x0FF8, 16, 0x26, 1)).wkc, 1);

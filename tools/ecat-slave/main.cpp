@@ -12,10 +12,12 @@
 #include "config_check.hpp"
 #include "device/faults.hpp"
 #include "device/firmware.hpp"
+#include "device/line.hpp"
 #include "esc/link.hpp"
 #include "od/device_config.hpp"
 #include "slave/log.hpp"
 #include "slave/slave.hpp"
+#include "slave/topology.hpp"
 
 namespace {
 
@@ -126,6 +128,25 @@ int main(int argc, char** argv) {
         "the SII generated from the object model");
     app.add_option("--stats-file", options.stats_file,
                    "Write the statistics as 'name value' lines to this file at exit");
+    int slaves = 1;
+    std::string topology_file;
+    auto* slaves_opt =
+        app.add_option(
+               "--slaves", slaves,
+               "Serve N drives in a line (device k's port 1 to device k+1's port 0), serial numbers 1..N, "
+               "state directories <state-dir>/drive<k> when N > 1")
+            ->check(CLI::Range(1, 1000));
+    app.add_option(
+           "--topology", topology_file,
+           "Serve the devices of this topology file (docs/segment.md): names, config files, where each "
+           "is plugged in, clocks and cables")
+        ->check(CLI::ExistingFile)
+        ->excludes(slaves_opt)
+        ->type_name("FILE");
+    app.add_option("--out-iface", options.out_iface,
+                   "Port 1 of the last device (or the topology's 'external' port) leads to this interface: "
+                   "the line continues there; no carrier closes the port")
+        ->type_name("OUT");
     // The configuration file is checked first: CLI11 would name neither the file nor the line.
     if (auto config = ecat_slave::config_file_argument(argc, argv)) {
         if (const std::string problem = ecat_slave::check_config_file(app, *config); !problem.empty()) {
@@ -222,7 +243,55 @@ int main(int argc, char** argv) {
             return slave::kExitUsage;
         }
     }
-    options.eeprom_loader = device::eeprom_loader(device);
-    options.firmware_factory = device::firmware_factory(device, control);
+    const bool segment_mode = slaves > 1 || !topology_file.empty() || !options.out_iface.empty();
+    if (slaves_opt->count() > 0 && !segment_mode) device.serial_number = 1;  // --slaves 1: serial number 1
+    if (!segment_mode) {
+        options.eeprom_loader = device::eeprom_loader(device);
+        options.firmware_factory = device::firmware_factory(device, control);
+        return slave::run_slave(options, std::cout, std::cerr);
+    }
+    if (!options.eeprom_file.empty()) {
+        std::cerr << "ecat-slave: --eeprom serves one image: not with --slaves, --topology or --out-iface\n";
+        return slave::kExitUsage;
+    }
+    device::LineOptions line;
+    try {
+        line.topology =
+            topology_file.empty() ? slave::line_topology(slaves) : slave::load_topology(topology_file);
+    } catch (const slave::TopologyError& e) {
+        std::cerr << "ecat-slave: " << e.what() << '\n';
+        return slave::kExitUsage;
+    }
+    if (topology_file.empty() && slaves == 1) line.topology.devices[0].state_dir = device.state_dir.string();
+    for (slave::TopologyDevice& d : line.topology.devices) {
+        if (d.state_dir.empty()) d.state_dir = (device.state_dir / d.name).string();
+        // Each device's configuration is loaded now: a bad one is a usage error naming the topology line.
+        device::DeviceOptions o = device;
+        if (!d.config.empty()) o.config_file = d.config;
+        o.state_dir = d.state_dir;
+        try {
+            (void)device::make_description(o);
+        } catch (const std::exception& e) {
+            std::cerr << "ecat-slave: " << (d.line > 0 ? line.topology.where(d.line) : std::string())
+                      << "device " << d.name << ": " << e.what() << '\n';
+            return slave::kExitUsage;
+        }
+        if (reset_sii) {
+            const std::filesystem::path writes =
+                std::filesystem::path(d.state_dir) / device::EepromWrites::kFileName;
+            std::error_code ec;
+            if (std::filesystem::remove(writes, ec)) log.info("removed " + writes.string());
+        }
+    }
+    line.base = device;
+    line.esc.process_ram_kib = options.ram_kib;
+    line.esc.faults = options.esc_faults;
+    line.control_path = control;
+    line.log = &log;
+    options.log = &log;
+    options.segment_factory = [&line](const esc::Clock& clock, const slave::SlaveOptions&,
+                                      slave::ExternalSend send) -> std::unique_ptr<slave::SegmentFirmware> {
+        return std::make_unique<device::Line>(clock, line, std::move(send));
+    };
     return slave::run_slave(options, std::cout, std::cerr);
 }

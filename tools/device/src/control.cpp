@@ -97,6 +97,10 @@ ControlSocket::~ControlSocket() {
 }
 
 void ControlSocket::service(Device& device, uint64_t /*now_ns*/) {
+    service([&device](std::string_view line) { return apply(device, line); });
+}
+
+void ControlSocket::service(const std::function<std::string(std::string_view)>& apply_line) {
     for (int i = 0; i < 64; ++i) {  // bounded: a flood cannot starve the event loop
         sockaddr_un from{};
         socklen_t from_len = sizeof from;
@@ -107,7 +111,7 @@ void ControlSocket::service(Device& device, uint64_t /*now_ns*/) {
         std::string_view text(buffer_.data(), static_cast<std::size_t>(n));
         while (!text.empty()) {
             const std::size_t nl = text.find('\n');
-            const std::string answer = apply(device, text.substr(0, nl));
+            const std::string answer = apply_line(text.substr(0, nl));
             if (!answer.empty()) reply += answer + '\n';
             text = nl == std::string_view::npos ? std::string_view{} : text.substr(nl + 1);
         }

@@ -34,8 +34,10 @@ foe::StoreConfig store_config(const DeviceOptions& options, const od::DeviceDesc
 }
 
 od::DeviceDescription base_description(const DeviceOptions& options) {
-    return options.config_file.empty() ? od::default_drive_description()
-                                       : od::load_device_config(options.config_file);
+    od::DeviceDescription d = options.config_file.empty() ? od::default_drive_description()
+                                                          : od::load_device_config(options.config_file);
+    if (options.serial_number) d.identity.serial_number = *options.serial_number;
+    return d;
 }
 
 // The description with the version of the active image of an opened store.

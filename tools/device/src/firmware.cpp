@@ -14,8 +14,12 @@ DeviceFirmware::DeviceFirmware(esc::Esc& esc, DeviceOptions options,
 }
 
 void DeviceFirmware::report(std::ostream& out) const {
-    ecat::print_stats(out, device_.stack_stats());  // every firmware instance of the run, not the last only
-    const DeviceStats& s = device_.stats();
+    report_device(out, device_);
+}
+
+void report_device(std::ostream& out, const Device& device) {
+    ecat::print_stats(out, device.stack_stats());  // every firmware instance of the run, not the last only
+    const DeviceStats& s = device.stats();
     out << "device.builds " << s.builds << '\n'
         << "device.drive_cycles " << s.cycles << '\n'
         << "device.error_events " << s.emergencies << '\n'

@@ -34,8 +34,34 @@ void on_stop_signal(int) {
 
 }  // namespace
 
+Runtime::Runtime(esc::Link& link, esc::Segment& segment, const esc::Clock& clock, esc::Link* out)
+    : Runtime(link, segment.esc(0), clock) {
+    esc_ = nullptr;
+    segment_ = &segment;
+    out_ = out;
+    hold_buffer_.resize(kHoldSlots * esc::kMaxFrameSize);
+    hold_slots_.resize(kHoldSlots);
+    if (out_ != nullptr && out_->fd() >= 0) add_watch(out_->fd(), kTagOut);
+}
+
+void Runtime::add_watch(int fd, uint32_t tag) {
+    epoll_event ev{};
+    ev.events = EPOLLIN;
+    ev.data.u32 = tag;
+    if (::epoll_ctl(epoll_fd_, EPOLL_CTL_ADD, fd, &ev) != 0)
+        throw std::runtime_error(std::string("epoll_ctl: ") + std::strerror(errno));
+}
+
+void Runtime::set_carrier_check(std::function<bool()> check, Log* log, std::string name) {
+    carrier_check_ = std::move(check);
+    carrier_log_ = log;
+    carrier_name_ = std::move(name);
+    carrier_due_ns_ = 0;
+    carrier_state_ = -1;
+}
+
 Runtime::Runtime(esc::Link& link, esc::Esc& esc, const esc::Clock& clock)
-    : link_(link), esc_(esc), clock_(clock), buffer_(esc::kMaxFrameSize), in_copy_(esc::kMaxFrameSize) {
+    : link_(link), esc_(&esc), clock_(clock), buffer_(esc::kMaxFrameSize), in_copy_(esc::kMaxFrameSize) {
     timer_fd_ = ::timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC);
     if (timer_fd_ < 0) throw std::runtime_error(std::string("timerfd_create: ") + std::strerror(errno));
     stop_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
@@ -110,8 +136,8 @@ void Runtime::run() {
 
 bool Runtime::run_once(int timeout_ms) {
     if (!busy_poll_) arm_timer();
-    epoll_event events[4];
-    const int n = ::epoll_wait(epoll_fd_, events, 4, busy_poll_ ? 0 : timeout_ms);
+    epoll_event events[5];
+    const int n = ::epoll_wait(epoll_fd_, events, 5, busy_poll_ ? 0 : timeout_ms);
     if (n < 0) {
         if (errno == EINTR) return !stop_requested();
         throw std::runtime_error(std::string("epoll_wait: ") + std::strerror(errno));
@@ -119,6 +145,7 @@ bool Runtime::run_once(int timeout_ms) {
     uint32_t link_events = 0;
     bool timer = false;
     bool control = false;
+    bool out_event = false;
     for (int i = 0; i < n; ++i) {
         switch (events[i].data.u32) {
             case kTagStop:
@@ -132,12 +159,19 @@ bool Runtime::run_once(int timeout_ms) {
             case kTagControl:
                 control = true;
                 break;
+            case kTagOut:
+                out_event = true;
+                break;
             default:
                 break;
         }
     }
     if (n > 0 || !busy_poll_) ++stats_.wakeups;
-    const bool link_event = link_.fd() < 0 || link_events != 0;
+    bool link_event = link_.fd() < 0 || link_events != 0;
+    if (out_ != nullptr && (out_event || out_->fd() < 0)) {
+        handle_out_frames();  // frames coming back from the rest of the line first: they are older
+        link_event = true;
+    }
     if (link_event) {
         handle_frames();
         if (link_events & EPOLLERR) {
@@ -175,7 +209,16 @@ bool Runtime::run_once(int timeout_ms) {
 }
 
 uint64_t Runtime::next_deadline_ns() const {
-    uint64_t deadline = esc_.next_event_ns();
+    uint64_t deadline = kNever;
+    if (esc_ != nullptr) {
+        deadline = esc_->next_event_ns();
+    } else {
+        const int count = static_cast<int>(segment_->size());
+        for (int k = 0; k < count; ++k)
+            if (segment_->powered(k)) deadline = std::min(deadline, segment_->esc(k).next_event_ns());
+        if (hold_count_ != 0) deadline = std::min(deadline, hold_slots_[hold_head_].due_ns);
+        if (carrier_check_) deadline = std::min(deadline, carrier_due_ns_);
+    }
     if (firmware_ != nullptr) deadline = std::min(deadline, firmware_->next_deadline_ns());
     if (capture_ != nullptr && capture_->frames_written() != flushed_frames_)
         deadline = std::min(deadline, capture_flush_due_ns_);
@@ -213,7 +256,9 @@ bool Runtime::spin_to_deadline() {
         } else {
             spun = true;
             if (stop_flag_.load(std::memory_order_relaxed)) return false;
-            if (handle_frames() > 0) service();
+            int frames = handle_frames();
+            if (out_ != nullptr) frames += handle_out_frames();
+            if (frames > 0) service();
         }
         now = clock_.now_ns();
         note_loop_pass(now);
@@ -228,6 +273,7 @@ bool Runtime::spin_to_deadline() {
 }
 
 int Runtime::handle_frames() {
+    if (segment_ != nullptr) return handle_segment_frames();
     int i = 0;
     for (; i < kMaxBurst; ++i) {
         const std::size_t len = link_.receive(buffer_);
@@ -236,7 +282,7 @@ int Runtime::handle_frames() {
         ++stats_.frames_received;
         std::span<uint8_t> frame(buffer_.data(), len);
         if (capture_ != nullptr) std::memcpy(in_copy_.data(), buffer_.data(), len);
-        const bool reply = esc_.process_frame(frame, rx_ns);
+        const bool reply = esc_->process_frame(frame, rx_ns);
         const uint64_t done_ns = clock_.now_ns() - rx_ns;
         stats_.frame_ns_total += done_ns;
         stats_.frame_ns_max = std::max(stats_.frame_ns_max, done_ns);
@@ -257,9 +303,115 @@ int Runtime::handle_frames() {
     return i;
 }
 
+// Segment mode: each frame from the master is walked through the segment.
+int Runtime::handle_segment_frames() {
+    int i = 0;
+    for (; i < kMaxBurst; ++i) {
+        const std::size_t len = link_.receive(buffer_);
+        if (len == 0) break;
+        const uint64_t rx_ns = clock_.now_ns();
+        ++stats_.frames_received;
+        std::span<uint8_t> frame(buffer_.data(), len);
+        if (capture_ != nullptr) std::memcpy(in_copy_.data(), buffer_.data(), len);
+        const esc::Segment::Result result = segment_->walk(frame, rx_ns);
+        const uint64_t done = clock_.now_ns();
+        stats_.frame_ns_total += done - rx_ns;
+        stats_.frame_ns_max = std::max(stats_.frame_ns_max, done - rx_ns);
+        segment_result(result, frame, done);
+        if (capture_ != nullptr) {
+            capture_->write(std::span<const uint8_t>(in_copy_.data(), len));
+            if (result.kind == esc::Segment::Result::Kind::Reply) capture_->write(frame);
+        }
+    }
+    return i;
+}
+
+// Frames that come back on the out link (from the devices behind the external port).
+int Runtime::handle_out_frames() {
+    int i = 0;
+    for (; i < kMaxBurst; ++i) {
+        const std::size_t len = out_->receive(buffer_);
+        if (len == 0) break;
+        const uint64_t rx_ns = clock_.now_ns();
+        ++stats_.frames_resumed;
+        std::span<uint8_t> frame(buffer_.data(), len);
+        const esc::Segment::Result result = segment_->resume(frame, rx_ns);
+        segment_result(result, frame, clock_.now_ns());
+        if (capture_ != nullptr && result.kind == esc::Segment::Result::Kind::Reply) capture_->write(frame);
+    }
+    return i;
+}
+
+void Runtime::segment_result(const esc::Segment::Result& result, std::span<uint8_t> frame, uint64_t now) {
+    using Kind = esc::Segment::Result::Kind;
+    if (result.kind == Kind::External) {
+        ++stats_.frames_external;
+        return;
+    }
+    if (result.kind != Kind::Reply) {
+        ++stats_.frames_dropped;
+        return;
+    }
+    if (result.hold_ns != 0 || hold_count_ != 0) {  // behind held replies too: a cable keeps the order
+        if (hold_count_ < kHoldSlots) {
+            const std::size_t slot = (hold_head_ + hold_count_) % kHoldSlots;
+            std::memcpy(hold_buffer_.data() + slot * esc::kMaxFrameSize, frame.data(), frame.size());
+            hold_slots_[slot] = HeldFrame{now + result.hold_ns, frame.size()};
+            ++hold_count_;
+            ++stats_.frames_held;
+            return;
+        }
+        ++stats_.hold_overflows;
+    }
+    if (link_.send(frame))
+        ++stats_.frames_sent;
+    else
+        ++stats_.send_errors;
+}
+
+void Runtime::release_held(uint64_t now) {
+    while (hold_count_ != 0 && hold_slots_[hold_head_].due_ns <= now) {
+        const HeldFrame& h = hold_slots_[hold_head_];
+        if (link_.send(
+                std::span<const uint8_t>(hold_buffer_.data() + hold_head_ * esc::kMaxFrameSize, h.length)))
+            ++stats_.frames_sent;
+        else
+            ++stats_.send_errors;
+        hold_head_ = (hold_head_ + 1) % kHoldSlots;
+        --hold_count_;
+    }
+}
+
+void Runtime::poll_carrier(uint64_t now) {
+    if (now < carrier_due_ns_) return;
+    carrier_due_ns_ = now + kCarrierPollNs;
+    const int up = carrier_check_() ? 1 : 0;
+    if (up == carrier_state_) return;
+    const bool first = carrier_state_ < 0;
+    carrier_state_ = up;
+    segment_->set_external_link(up != 0);
+    if (!first) ++stats_.carrier_changes;
+    if (carrier_log_ != nullptr && (!first || up == 0)) {
+        const std::string what = up != 0 ? "carrier on, the external port is open"
+                                         : "no carrier, the external port is closed (frames loop back)";
+        carrier_log_->write(up != 0 ? LogLevel::Info : LogLevel::Warn,
+                            "out link " + carrier_name_ + ": " + what);
+    }
+}
+
 void Runtime::service() {
-    esc_.tick();
-    const uint64_t now = clock_.now_ns();
+    uint64_t now;
+    if (esc_ != nullptr) {
+        esc_->tick();
+        now = clock_.now_ns();
+    } else {
+        const int count = static_cast<int>(segment_->size());
+        for (int k = 0; k < count; ++k)
+            if (segment_->powered(k)) segment_->esc(k).tick();
+        now = clock_.now_ns();
+        if (hold_count_ != 0) release_held(now);
+        if (carrier_check_) poll_carrier(now);
+    }
     if (firmware_ != nullptr) firmware_->poll(now);
     // Capture: pushed to the file at most every kCaptureFlushNs, so a reader (or a SIGKILL) sees frames
     // that are at most that old, without a write() per frame.

@@ -1,8 +1,12 @@
 // run_slave(): the ecat-slave program minus its command line. See slave/slave.hpp.
 #include "slave/slave.hpp"
 
+#include <net/if.h>
 #include <sched.h>
+#include <sys/ioctl.h>
 #include <sys/mman.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
@@ -63,7 +67,113 @@ void write_stats(std::ostream& out, const RuntimeStats& s, const esc::EscStats& 
         << "esc.malformed_length " << e.malformed_length << '\n'
         << "esc.malformed_datagram " << e.malformed_datagram << '\n'
         << "esc.datagrams " << e.datagrams << '\n';
+    if (s.frames_external != 0 || s.frames_resumed != 0 || s.frames_held != 0 || s.carrier_changes != 0 ||
+        s.hold_overflows != 0)
+        out << "runtime.frames_external " << s.frames_external << '\n'
+            << "runtime.frames_resumed " << s.frames_resumed << '\n'
+            << "runtime.frames_held " << s.frames_held << '\n'
+            << "runtime.hold_overflows " << s.hold_overflows << '\n'
+            << "runtime.out_send_errors " << s.out_send_errors << '\n'
+            << "runtime.carrier_changes " << s.carrier_changes << '\n';
     if (firmware != nullptr) firmware->report(out);
+}
+
+void print_summary(std::ostream& out, const SlaveOptions& options, const RuntimeStats& s,
+                   const esc::EscStats& e, const Firmware* firmware) {
+    if (s.frames_received > 0)
+        out << "frame processing (received to reply ready): mean " << s.frame_ns_total / s.frames_received
+            << " ns, max " << s.frame_ns_max << " ns\n";
+    out << "frames received " << s.frames_received << ", sent " << s.frames_sent << ", dropped "
+        << s.frames_dropped << ", send errors " << s.send_errors << ", link errors " << s.link_errors
+        << ", timer arms " << s.timer_arms << ", expiries " << s.timer_expiries << "; ESC: processed "
+        << e.frames_processed << ", ignored " << e.frames_ignored << ", malformed " << e.frames_malformed
+        << ", datagrams " << e.datagrams << '\n';
+    if (s.spin_waits > 0)
+        out << "spin waits " << s.spin_waits << ", mean " << s.spin_ns_total / s.spin_waits << " ns\n";
+    if (options.busy_poll || options.spin_us > 0)
+        out << "busy loop kept from running: " << s.loop_gaps_over_50us << " times over 50 us, "
+            << s.loop_gaps_over_1ms << " over 1 ms, longest " << s.loop_gap_max_ns << " ns\n";
+    if (firmware != nullptr) firmware->report(out);
+}
+
+// Whether the interface is up with a carrier (IFF_RUNNING: the kernel's operational state, which follows
+// the carrier of a NIC and the peer of a veth). Asked through ioctl so it is the caller's network namespace.
+bool interface_running(int sock, const std::string& name) {
+    ifreq req{};
+    if (name.size() >= sizeof req.ifr_name) return false;
+    std::memcpy(req.ifr_name, name.c_str(), name.size() + 1);
+    if (::ioctl(sock, SIOCGIFFLAGS, &req) != 0) return false;
+    return (req.ifr_flags & IFF_UP) != 0 && (req.ifr_flags & IFF_RUNNING) != 0;
+}
+
+// The runtime loop common to both modes, until a signal or a lost link. Returns the exit code.
+int run_loop(Runtime& runtime, const std::string& iface, std::ostream& err) {
+    set_signal_target(&runtime);
+    try {
+        runtime.run();
+    } catch (...) {
+        set_signal_target(nullptr);
+        throw;
+    }
+    set_signal_target(nullptr);
+    if (runtime.link_lost()) {
+        err << "ecat-slave: network interface '" << iface << "' disappeared\n";
+        return kExitFailure;
+    }
+    return kExitOk;
+}
+
+// Segment mode: the devices of options.segment_factory behind the link, the external port on out_iface.
+int run_segment(const SlaveOptions& options, esc::Link& link, esc::PcapWriter* capture,
+                const std::string& iface, const VethPair* veth, std::ostream& out, std::ostream& err) {
+    esc::SystemClock clock;
+    std::unique_ptr<esc::Link> out_link;
+    if (!options.out_iface.empty()) out_link = esc::open_link(options.out_iface, options.backend);
+    RuntimeStats* stats = nullptr;  // the runtime's, once it exists (the send callback counts its errors)
+    ExternalSend send;
+    if (out_link)
+        send = [&out_link, &stats](std::span<const uint8_t> frame) {
+            if (!out_link->send(frame) && stats != nullptr) ++stats->out_send_errors;
+        };
+    std::unique_ptr<SegmentFirmware> segment = options.segment_factory(clock, options, send);
+    Runtime runtime(link, segment->segment(), clock, out_link.get());
+    stats = &runtime.stats();
+    runtime.set_firmware(segment.get());
+    runtime.set_capture(capture);
+    runtime.set_spin(uint64_t{options.spin_us} * 1000u);
+    runtime.set_busy_poll(options.busy_poll);
+    runtime.set_link_check([&iface] { return interface_exists(iface); });
+    int sock = -1;
+    if (out_link) {
+        sock = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+        if (sock < 0) sock = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+        const std::string name = options.out_iface;
+        runtime.set_carrier_check([sock, name] { return interface_running(sock, name); }, options.log, name);
+    }
+    if (veth) out << "master interface: " << veth->master_end() << '\n';
+    out << "ecat-slave: running " << segment->segment().size() << " devices on " << link.describe()
+        << (out_link ? ", external port on " + out_link->describe() : std::string())
+        << (capture ? ", capturing to " + options.capture_file : std::string()) << '\n';
+    out.flush();
+    int code = kExitOk;
+    try {
+        code = run_loop(runtime, iface, err);
+    } catch (...) {
+        if (sock >= 0) ::close(sock);
+        throw;
+    }
+    if (sock >= 0) ::close(sock);
+    if (capture != nullptr) capture->flush();
+    if (code != kExitOk) return code;
+    const esc::EscStats e = segment->segment().esc(0).stats();
+    if (options.verbose) print_summary(out, options, runtime.stats(), e, segment.get());
+    if (!options.stats_file.empty()) {
+        std::ofstream file(options.stats_file, std::ios::trunc);
+        write_stats(file, runtime.stats(), e, segment.get());
+        if (!file.flush()) err << "ecat-slave: warning: could not write " << options.stats_file << '\n';
+    }
+    out << "ecat-slave: stopped\n";
+    return kExitOk;
 }
 
 // Real-time setup. Returns an error message, empty on success.
@@ -101,8 +211,9 @@ int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err)
     }
     install_stop_signals();
     try {
-        std::vector<uint8_t> image =
-            options.eeprom_loader ? options.eeprom_loader(options) : std::vector<uint8_t>{};
+        std::vector<uint8_t> image = options.eeprom_loader && !options.segment_factory
+                                         ? options.eeprom_loader(options)
+                                         : std::vector<uint8_t>{};
 
         std::optional<VethPair> veth;
         std::string iface = options.iface;
@@ -115,6 +226,8 @@ int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err)
         auto link = esc::open_link(iface, options.backend);
         std::unique_ptr<esc::PcapWriter> capture;
         if (!options.capture_file.empty()) capture = std::make_unique<esc::PcapWriter>(options.capture_file);
+        if (options.segment_factory)
+            return run_segment(options, *link, capture.get(), iface, veth ? &*veth : nullptr, out, err);
 
         esc::EscConfig config;
         config.process_ram_kib = options.ram_kib;
@@ -162,25 +275,7 @@ int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err)
                 err << "ecat-slave: warning: could not write the EEPROM image back to " << options.eeprom_file
                     << '\n';
         }
-        if (options.verbose) {
-            const RuntimeStats& s = runtime.stats();
-            const esc::EscStats e = esc.stats();
-            if (s.frames_received > 0)
-                out << "frame processing (received to reply ready): mean "
-                    << s.frame_ns_total / s.frames_received << " ns, max " << s.frame_ns_max << " ns\n";
-            out << "frames received " << s.frames_received << ", sent " << s.frames_sent << ", dropped "
-                << s.frames_dropped << ", send errors " << s.send_errors << ", link errors " << s.link_errors
-                << ", timer arms " << s.timer_arms << ", expiries " << s.timer_expiries << "; ESC: processed "
-                << e.frames_processed << ", ignored " << e.frames_ignored << ", malformed "
-                << e.frames_malformed << ", datagrams " << e.datagrams << '\n';
-            if (s.spin_waits > 0)
-                out << "spin waits " << s.spin_waits << ", mean " << s.spin_ns_total / s.spin_waits
-                    << " ns\n";
-            if (options.busy_poll || options.spin_us > 0)
-                out << "busy loop kept from running: " << s.loop_gaps_over_50us << " times over 50 us, "
-                    << s.loop_gaps_over_1ms << " over 1 ms, longest " << s.loop_gap_max_ns << " ns\n";
-            if (firmware) firmware->report(out);
-        }
+        if (options.verbose) print_summary(out, options, runtime.stats(), esc.stats(), firmware.get());
         if (!options.stats_file.empty()) {
             std::ofstream stats(options.stats_file, std::ios::trunc);
             write_stats(stats, runtime.stats(), esc.stats(), firmware.get());

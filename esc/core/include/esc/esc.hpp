@@ -56,6 +56,11 @@ struct EscStats {
     uint64_t malformed_length = 0;     // the EtherCAT header's length runs past the end of the frame
     uint64_t malformed_datagram = 0;   // a datagram header or its data runs past that length
     uint64_t datagrams = 0;
+    // receive(): frames destroyed (received at a closed or non-existent port, circulating a second time,
+    // or not EtherCAT at the processing unit, which frames_ignored counts as well) and frames with a bad
+    // FCS (FrameCheck::crc_bad), forwarded unprocessed.
+    uint64_t frames_destroyed = 0;
+    uint64_t frames_bad_fcs = 0;
 };
 
 class Esc final : public Pdi {

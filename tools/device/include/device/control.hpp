@@ -14,6 +14,7 @@
 // line ("ok ..." or "error: ..."); `echo 'input 4 on' | nc -uU -w0 PATH` works without one.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -34,6 +35,8 @@ class ControlSocket {
     const std::filesystem::path& path() const { return path_; }
     // Reads every waiting datagram, applies its lines to device, answers senders that have an address.
     void service(Device& device, uint64_t now_ns);
+    // The same with another interpreter of the lines (a segment's, device/line.hpp).
+    void service(const std::function<std::string(std::string_view)>& apply);
 
     // Applies one command line; returns the answer ("ok ..." or "error: ..."); "" for an empty line.
     static std::string apply(Device& device, std::string_view line);

@@ -17,6 +17,7 @@
 #include <iosfwd>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -70,6 +71,9 @@ struct DeviceOptions {
     // drive faults); null: events are not logged.
     slave::Log* events = nullptr;
     DeviceFaults faults;  // testing aid (ecat-slave --fault); none by default
+    // Serial number of this unit (0x1018:04 and the SII's serial word), instead of the configuration's: the
+    // drives of one segment (ecat-slave --slaves N) are numbered 1..N. Unset: the configuration's.
+    std::optional<uint32_t> serial_number;
 };
 
 // Where the firmware slots live inside the state directory.

@@ -34,6 +34,9 @@ class DeviceFirmware final : public slave::Firmware {
     std::unique_ptr<ControlSocket> control_;
 };
 
+// What DeviceFirmware::report() writes for a device ("name value" lines).
+void report_device(std::ostream& out, const Device& device);
+
 // SlaveOptions::firmware_factory for the soft drive. options.load_sii is set from whether the slave
 // serves a user's image (SlaveOptions::eeprom_file).
 slave::FirmwareFactory firmware_factory(DeviceOptions options, std::filesystem::path control_path = {});

@@ -25,6 +25,8 @@ class Log {
     void set_level(LogLevel level) { level_ = level; }
     LogLevel level() const { return level_; }
     bool enabled(LogLevel level) const { return level <= level_; }
+    std::ostream& stream() const { return out_; }
+    bool colour() const { return colour_; }
 
     // Writes one line (and flushes it) if the level is enabled.
     void write(LogLevel level, std::string_view text);

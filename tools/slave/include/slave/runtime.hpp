@@ -19,6 +19,14 @@
 //
 // One receive buffer, allocated at construction; nothing is allocated per frame or per cycle.
 // The clock must count CLOCK_MONOTONIC nanoseconds (esc::SystemClock) because the timer runs on it.
+//
+// A segment of devices (ecat-slave --slaves N, --topology, --out-iface) runs the same loop over an
+// esc::Segment instead of one Esc: a frame from the link is walked through the segment (Segment::walk);
+// a reply goes back out on the link, held back HopFaults::hold_ns in a preallocated queue when a hop is
+// delayed; a frame the segment sent out of its external port (the `out` link) comes back on that link and
+// finishes its walk (Segment::resume). The carrier of the out link is polled every kCarrierPollNs and given
+// to Segment::set_external_link() (no carrier: the port is closed and loops back). The timers of every ESC
+// of the segment are ticked after each burst; the firmware (all the devices' firmware in one) runs after it.
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -28,7 +36,9 @@
 #include "esc/esc.hpp"
 #include "esc/link.hpp"
 #include "esc/link_capture.hpp"
+#include "esc/segment.hpp"
 #include "slave/firmware.hpp"
+#include "slave/log.hpp"
 
 namespace slave {
 
@@ -50,6 +60,13 @@ struct RuntimeStats {
     uint64_t loop_gaps_over_50us = 0;
     uint64_t loop_gaps_over_1ms = 0;
     uint64_t loop_gap_max_ns = 0;
+    // Segment mode only:
+    uint64_t frames_external = 0;  // walks that left through the external port (sent on the out link)
+    uint64_t frames_resumed = 0;   // frames received on the out link (Segment::resume)
+    uint64_t frames_held = 0;      // replies held back by a delayed hop
+    uint64_t hold_overflows = 0;   // replies sent at once because the hold queue was full
+    uint64_t out_send_errors = 0;  // not used by the Runtime itself: the external send callback counts here
+    uint64_t carrier_changes = 0;  // carrier of the out link gained or lost
 };
 
 class Runtime {
@@ -58,7 +75,15 @@ class Runtime {
     // Longest time a captured frame stays in the capture's buffer before it is written to the file.
     static constexpr uint64_t kCaptureFlushNs = 200'000'000;
 
+    // Replies held back by a delayed hop (HopFaults::hold_ns): at most this many at once.
+    static constexpr std::size_t kHoldSlots = 256;
+    // How often the out link's carrier is polled (segment mode with an out link).
+    static constexpr uint64_t kCarrierPollNs = 100'000'000;
+
     Runtime(esc::Link& link, esc::Esc& esc, const esc::Clock& clock);
+    // Segment mode: frames from `link` are walked through `segment`; `out` (may be null) is the link of
+    // the segment's external port, whose send callback the owner set (Segment::set_external).
+    Runtime(esc::Link& link, esc::Segment& segment, const esc::Clock& clock, esc::Link* out = nullptr);
     ~Runtime();
     Runtime(const Runtime&) = delete;
     Runtime& operator=(const Runtime&) = delete;
@@ -70,6 +95,9 @@ class Runtime {
     // is still usable. If it returns false, run() ends and link_lost() is true. Not called per frame.
     void set_link_check(std::function<bool()> check) { link_check_ = std::move(check); }
     bool link_lost() const { return link_lost_; }
+    // Segment mode with an out link: whether the out interface has a carrier, polled every kCarrierPollNs
+    // (not per frame); each change is given to Segment::set_external_link() and logged to `log`.
+    void set_carrier_check(std::function<bool()> check, Log* log = nullptr, std::string name = {});
     // Wake spin_ns before each timed event and busy-wait to it (0: sleep all the way, the default).
     void set_spin(uint64_t spin_ns) { spin_ns_ = spin_ns; }
     // Never sleep (see above). run_once() then returns after one pass, whatever its timeout.
@@ -85,19 +113,30 @@ class Runtime {
     bool stop_requested() const;
 
     const RuntimeStats& stats() const { return stats_; }
+    RuntimeStats& stats() { return stats_; }
+    // Replies waiting in the hold queue.
+    std::size_t held() const { return hold_count_; }
 
   private:
     int handle_frames();  // returns the number of frames received
+    int handle_segment_frames();
+    int handle_out_frames();
+    void segment_result(const esc::Segment::Result& result, std::span<uint8_t> frame, uint64_t now);
+    void release_held(uint64_t now);
+    void poll_carrier(uint64_t now);
+    void add_watch(int fd, uint32_t tag);
     void service();
     uint64_t next_deadline_ns() const;
     bool spin_to_deadline();  // false: stop was requested meanwhile
     void note_loop_pass(uint64_t now);
     void arm_timer();
     void close_fds();
-    static constexpr uint32_t kTagLink = 1, kTagTimer = 2, kTagStop = 3, kTagControl = 4;
+    static constexpr uint32_t kTagLink = 1, kTagTimer = 2, kTagStop = 3, kTagControl = 4, kTagOut = 5;
 
     esc::Link& link_;
-    esc::Esc& esc_;
+    esc::Esc* esc_ = nullptr;          // one ESC alone on its wire, or
+    esc::Segment* segment_ = nullptr;  // a segment of them
+    esc::Link* out_ = nullptr;         // the segment's external port, may be null
     const esc::Clock& clock_;
     Firmware* firmware_ = nullptr;
     esc::PcapWriter* capture_ = nullptr;
@@ -117,6 +156,21 @@ class Runtime {
     std::vector<uint8_t> buffer_;         // the receive buffer (frame processed in place)
     std::vector<uint8_t> in_copy_;        // the frame as received, kept for the capture
     RuntimeStats stats_;
+    // Hold queue (segment mode): a ring of kHoldSlots frames, released in order when due.
+    struct HeldFrame {
+        uint64_t due_ns = 0;
+        std::size_t length = 0;
+    };
+    std::vector<uint8_t> hold_buffer_;  // kHoldSlots * kMaxFrameSize, allocated at construction
+    std::vector<HeldFrame> hold_slots_;
+    std::size_t hold_head_ = 0;
+    std::size_t hold_count_ = 0;
+    // Carrier of the out link.
+    std::function<bool()> carrier_check_;
+    Log* carrier_log_ = nullptr;
+    std::string carrier_name_;
+    uint64_t carrier_due_ns_ = 0;
+    int carrier_state_ = -1;  // -1: not polled yet, 0: no carrier, 1: carrier
 };
 
 // SIGINT / SIGTERM handling: install_stop_signals() makes both signals set a flag (stop_signalled()) and

@@ -6,11 +6,14 @@
 #include <functional>
 #include <iosfwd>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "esc/esc.hpp"
+#include "esc/segment.hpp"
 #include "slave/firmware.hpp"
+#include "slave/log.hpp"
 
 namespace slave {
 
@@ -21,6 +24,18 @@ struct SlaveOptions;
 using EepromLoader = std::function<std::vector<uint8_t>(const SlaveOptions&)>;
 // Creates the firmware that runs behind the ESC's PDI; may return nullptr (ESC only, no state machine).
 using FirmwareFactory = std::function<std::unique_ptr<Firmware>(esc::Esc&, const SlaveOptions&)>;
+
+// A segment of devices (ecat-slave --slaves N / --topology): the esc::Segment with every device's ESC and
+// the firmware of all of them in one (device::Line). run_slave() walks frames through segment().
+class SegmentFirmware : public Firmware {
+  public:
+    virtual esc::Segment& segment() = 0;
+};
+// Sends a frame out of the segment's external port (on the --out-iface link); empty when there is none.
+using ExternalSend = std::function<void(std::span<const uint8_t>)>;
+// Builds the segment on the runtime's clock; the factory wires `send` to the external port, if given.
+using SegmentFactory = std::function<std::unique_ptr<SegmentFirmware>(const esc::Clock&, const SlaveOptions&,
+                                                                      ExternalSend send)>;
 
 // Reads options.eeprom_file (empty name: returns an empty image). Throws std::runtime_error on an
 // unreadable file or an image that is empty, of odd length or larger than 64 KiB words.
@@ -44,6 +59,10 @@ struct SlaveOptions {
     esc::EscFaults esc_faults;        // testing aid (ecat-slave --fault): deliberate ESC deviations, none
     EepromLoader eeprom_loader = load_eeprom_file;
     FirmwareFactory firmware_factory;  // empty: no firmware
+    // A segment of devices instead of one ESC with firmware_factory (eeprom_loader is then not used).
+    SegmentFactory segment_factory;
+    std::string out_iface;  // segment mode: the external port leads to this interface
+    Log* log = nullptr;     // events of the runtime (carrier of out_iface); null: not logged
 };
 
 // Exit codes of run_slave() (and of ecat-slave).

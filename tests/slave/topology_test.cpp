@@ -1,0 +1,149 @@
+// The topology file parser (tools/slave, slave/topology.hpp).
+#include "slave/topology.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace {
+
+slave::Topology parse(const std::string& text) {
+    return slave::parse_topology(text, "line.topo", "/etc/softecat");
+}
+
+// The message of the TopologyError the text raises ("" if it parses).
+std::string error_of(const std::string& text) {
+    try {
+        (void)parse(text);
+    } catch (const slave::TopologyError& e) {
+        return e.what();
+    }
+    return {};
+}
+
+TEST(Topology, ALineByDefault) {
+    const auto t = parse(
+        "# three drives\n"
+        "timing processing-ns=400 forwarding-ns=300 cable-ns=15\n"
+        "device a config=a.conf serial=7\n"
+        "device b drift-ppm=-12.5 offset-ns=-3000 cable-ns=50\n"
+        "\n"
+        "device c state-dir=/tmp/c  # comment\n");
+    ASSERT_EQ(t.devices.size(), 3u);
+    EXPECT_EQ(t.timing.processing_delay_ns, 400u);
+    EXPECT_EQ(t.timing.forwarding_delay_ns, 300u);
+    EXPECT_EQ(t.timing.cable_delay_ns, 15u);
+    EXPECT_EQ(t.devices[0].name, "a");
+    EXPECT_EQ(t.devices[0].parent, -1);
+    EXPECT_EQ(t.devices[0].config, "/etc/softecat/a.conf") << "relative to the topology file's folder";
+    EXPECT_EQ(t.devices[0].serial, 7u);
+    EXPECT_EQ(t.devices[1].parent, 0);
+    EXPECT_EQ(t.devices[1].parent_port, 1);
+    EXPECT_EQ(t.devices[1].port, 0);
+    EXPECT_DOUBLE_EQ(t.devices[1].drift_ppm, -12.5);
+    EXPECT_EQ(t.devices[1].offset_ns, -3000);
+    EXPECT_EQ(t.devices[1].cable_ns, 50);
+    EXPECT_FALSE(t.devices[1].serial.has_value());
+    EXPECT_EQ(t.devices[2].parent, 1);
+    EXPECT_EQ(t.devices[2].state_dir, "/tmp/c");
+    EXPECT_EQ(t.devices[2].line, 6);
+    EXPECT_EQ(t.devices[2].port_descriptor(), 0x0F);
+    EXPECT_EQ(t.external_device, -1);
+}
+
+TEST(Topology, ATreeWithAJunction) {
+    const auto t = parse(
+        "device j ports=4\n"
+        "device a at=j:1\n"
+        "device b at=j:3 port=0\n"
+        "device c at=j:2\n"
+        "device d at=c:1\n"
+        "external d:1\n");
+    ASSERT_EQ(t.devices.size(), 5u);
+    EXPECT_EQ(t.devices[0].port_descriptor(), 0xFF);
+    EXPECT_EQ(t.devices[2].parent, 0);
+    EXPECT_EQ(t.devices[2].parent_port, 3);
+    EXPECT_EQ(t.devices[3].parent_port, 2);
+    EXPECT_EQ(t.devices[4].parent, 3);
+    EXPECT_EQ(t.external_device, 4);
+    EXPECT_EQ(t.external_port, 1);
+    EXPECT_EQ(t.find("c"), 3);
+    EXPECT_EQ(t.find("4"), 4);
+    EXPECT_EQ(t.find("5"), -1);
+    EXPECT_EQ(t.find("nope"), -1);
+}
+
+TEST(Topology, ForwardReferencesAreResolved) {
+    const auto t = parse("device root ports=4\ndevice x at=y:1\ndevice y at=root:3\n");
+    EXPECT_EQ(t.devices[1].parent, 2);
+    EXPECT_EQ(t.devices[2].parent, 0);
+}
+
+TEST(Topology, ErrorsNameFileAndLine) {
+    EXPECT_EQ(error_of("device a\ndevice b colour=red\n"),
+              "line.topo:2: unknown key 'colour' (device takes config, at, port, ports, serial, drift-ppm, "
+              "offset-ns, cable-ns, state-dir)");
+    EXPECT_EQ(error_of("device a\n\ndevice b at=zz:1\n"), "line.topo:3: at=zz:1: unknown device 'zz'");
+    EXPECT_EQ(error_of("device a\ndevice b at=a:1\ndevice c at=a:1\n"),
+              "line.topo:3: at=a:1: port 1 of 'a' used twice (also at line 2)");
+    EXPECT_EQ(error_of("device a\ndevice b serial=12x\n"),
+              "line.topo:2: bad number '12x' for serial (expected an integer 0..4294967295)");
+    EXPECT_EQ(error_of("device a\ndevice b drift-ppm=fast\n"),
+              "line.topo:2: bad number 'fast' for drift-ppm (expected -1000..1000)");
+    EXPECT_EQ(error_of("timing cable-ns=-1\n"),
+              "line.topo:1: bad number '-1' for cable-ns (expected an integer 0..100000000)");
+    EXPECT_EQ(error_of("wire a b\n"), "line.topo:1: unknown statement 'wire' (timing, device, external)");
+}
+
+TEST(Topology, ALoopIsRefused) {
+    const std::string e = error_of("device r ports=4\ndevice a at=b:1\ndevice b at=a:1\n");
+    EXPECT_EQ(e.rfind("line.topo:2: device 'a' is part of a loop", 0), 0u) << e;
+    EXPECT_EQ(error_of("device r\ndevice a at=a:1\n"),
+              "line.topo:2: at=: device 'a' plugged into itself (a loop)");
+    EXPECT_EQ(error_of("device r at=r:1\n"),
+              "line.topo:1: the first device is the root (its port 0 faces the master); it takes no at=");
+}
+
+TEST(Topology, PortsMustExistAndBeFree) {
+    EXPECT_EQ(error_of("device a\ndevice b at=a:2\n"),
+              "line.topo:2: at=a:2: device 'a' has only ports 0..1 (ports=4 for a junction)");
+    EXPECT_EQ(error_of("device a\ndevice b at=a:0\n"),
+              "line.topo:2: at=a:0: port 0 of 'a' used twice (also at line 1)")
+        << "the root's port 0 faces the master";
+    EXPECT_EQ(error_of("device a\ndevice b port=1\ndevice c at=b:1\n"),
+              "line.topo:3: at=b:1: port 1 of 'b' used twice (also at line 2)");
+    EXPECT_EQ(error_of("device a\ndevice b\nexternal a:1\n"),
+              "line.topo:3: external: port 1 of 'a' used twice (also at line 2)");
+    EXPECT_EQ(error_of("device a\ndevice b port=5\n"),
+              "line.topo:2: bad number '5' for port (expected an integer 0..3)");
+    EXPECT_EQ(error_of("device a ports=3\n"), "line.topo:1: ports=3: an ESC has 2 or 4 ports");
+}
+
+TEST(Topology, NamesAreUnique) {
+    EXPECT_EQ(error_of("device a\ndevice a\n"), "line.topo:2: device 'a' declared twice (first at line 1)");
+    EXPECT_EQ(error_of("device 3\n"),
+              "line.topo:1: device name '3' must not be a number (numbers are device indexes)");
+    EXPECT_EQ(error_of("# nothing\n"), "line.topo:1: no device declared");
+}
+
+TEST(Topology, LineOfDrives) {
+    const auto t = slave::line_topology(4);
+    ASSERT_EQ(t.devices.size(), 4u);
+    EXPECT_EQ(t.devices[0].name, "drive1");
+    EXPECT_EQ(t.devices[0].parent, -1);
+    EXPECT_EQ(t.devices[3].name, "drive4");
+    EXPECT_EQ(t.devices[3].serial, 4u);
+    EXPECT_EQ(t.devices[3].parent, 2);
+    EXPECT_EQ(t.devices[3].parent_port, 1);
+}
+
+TEST(Topology, MissingFile) {
+    try {
+        (void)slave::load_topology("/nonexistent/x.topo");
+        FAIL() << "no error";
+    } catch (const slave::TopologyError& e) {
+        EXPECT_EQ(std::string(e.what()).rfind("/nonexistent/x.topo: cannot read", 0), 0u) << e.what();
+    }
+}
+
+}  // namespace

@@ -1,0 +1,74 @@
+#pragma once
+// The topology file of a segment of soft slaves (`ecat-slave --topology FILE`): which devices there are,
+// where each is plugged in, their clocks and cables. One statement per line, '#' starts a comment:
+//
+//   timing processing-ns=320 forwarding-ns=280 cable-ns=10
+//   device NAME [config=FILE] [at=PARENT:PORT] [port=P] [ports=2|4] [serial=N] [drift-ppm=X] [offset-ns=N]
+//          [cable-ns=N] [state-dir=DIR]
+//   external DEVICE:PORT
+//
+// config= and state-dir= are relative to the topology file's folder. at= defaults to the previous device's
+// port 1 (a line); the first device is the root (its port 0 faces the master). port= is the device's own
+// port facing upstream (default 0). ports=4 makes a four-port (junction-capable) ESC. `external` names the
+// port that leads to --out-iface (default: port 1 of the last device).
+//
+// Errors are reported as "FILE:LINE: message" (TopologyError), for an unknown key or statement, an
+// unknown device, a port used twice or missing on the ESC, a loop, a bad number or a duplicate name.
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "esc/segment.hpp"
+
+namespace slave {
+
+class TopologyError : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+struct TopologyDevice {
+    std::string name;
+    std::string config;   // device configuration file (resolved), empty: the built-in drive
+    int parent = -1;      // index of the upstream device, -1: the root (faces the master)
+    int parent_port = 1;  // port of the parent this device is plugged into
+    int port = 0;         // this device's own port facing upstream
+    int ports = 2;        // 2: ports 0 and 1 (port descriptor 0x0F), 4: ports 0-3 (0xFF)
+    std::optional<uint32_t> serial;
+    double drift_ppm = 0.0;
+    int64_t offset_ns = 0;
+    int64_t cable_ns = -1;  // the cable into this device; < 0: the timing's cable delay
+    std::string state_dir;  // resolved; empty: <state-dir>/NAME
+    int line = 0;           // where it is declared (for messages about it)
+
+    uint8_t port_descriptor() const { return ports == 4 ? 0xFF : 0x0F; }
+};
+
+struct Topology {
+    std::string file;  // as given, for messages
+    esc::SegmentTiming timing;
+    std::vector<TopologyDevice> devices;
+    int external_device = -1;  // -1: port 1 of the last device (when --out-iface is given)
+    int external_port = 1;
+    int external_line = 0;
+
+    // Index of the device named `name`, or of the index written as a number; -1 if none.
+    int find(std::string_view name_or_index) const;
+    int find_name(std::string_view name) const;
+    // "FILE:LINE: message" for a device's line.
+    std::string where(int line) const;
+};
+
+// Parses the text of a topology file. file names it in messages; base_dir resolves relative paths.
+// Throws TopologyError.
+Topology parse_topology(std::string_view text, const std::string& file, const std::string& base_dir);
+// Reads and parses a file. Throws TopologyError (also when the file cannot be read).
+Topology load_topology(const std::string& file);
+// The line of N drives that `--slaves N` means: drive1..driveN, serial numbers 1..N, each plugged into
+// the previous one's port 1; state directories are left empty (the caller decides).
+Topology line_topology(int count);
+
+}  // namespace slave
