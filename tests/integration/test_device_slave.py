@@ -14,7 +14,8 @@ import zlib
 
 import harness
 
-ROW = re.compile(r"^(\d+)\s+0x([0-9a-f]{4})\s+(\S+)\s+0x([0-9a-f]{8}) 0x([0-9a-f]{8}) 0x([0-9a-f]{8}) 0x([0-9a-f]{8})(?: +(\S.*))?$",
+ROW = re.compile(r"^(\d+)\s+0x([0-9a-f]{4})\s+(\S+)\s+0x([0-9a-f]{8}) 0x([0-9a-f]{8}) 0x([0-9a-f]{8}) 0x([0-9a-f]{8})"
+                 r"(?: +(?:-|-?\d+))?(?: +(\S.*))?$",  # then the DC delay in ns (- without DC) and the name
                  re.M)
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCHEMA = os.path.normpath(os.path.join(HERE, "..", "..", "esi", "schema", "EtherCATInfo.xsd"))

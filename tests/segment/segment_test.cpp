@@ -209,6 +209,45 @@ TEST_F(SegmentTest, LongerCableAndHeldReply) {
     EXPECT_EQ(after, before + 500);
 }
 
+TEST_F(SegmentTest, CableDelayPerConnection) {
+    add();
+    add();
+    add();
+    seg->connect(0, 1, 1, 0, 100);  // a 20 m cable
+    seg->connect(1, 1, 2, 0, 0);    // a device right behind the other
+    arm_latches();
+    const esc::SegmentTiming t = seg->timing();
+    EXPECT_EQ(pdi32(1, esc::reg::kDcRecvTime0) - pdi32(0, esc::reg::kDcRecvTime0),
+              t.processing_delay_ns + 100);
+    EXPECT_EQ(pdi32(2, esc::reg::kDcRecvTime0) - pdi32(1, esc::reg::kDcRecvTime0), t.processing_delay_ns);
+    // Timing given to the segment.
+    esc::SegmentTiming slow;
+    slow.processing_delay_ns = 1000;
+    slow.cable_delay_ns = 50;
+    Rig other;
+    other.seg = std::make_unique<esc::Segment>(slow);
+    other.line(2);
+    other.arm_latches();
+    EXPECT_EQ(other.pdi32(1, esc::reg::kDcRecvTime0) - other.pdi32(0, esc::reg::kDcRecvTime0), 1050u);
+}
+
+TEST_F(SegmentTest, GarbageFramesAreDroppedNotProcessed) {
+    line(3);
+    std::vector<uint8_t> tiny(10, 0xAB);
+    EXPECT_EQ(walk(tiny).kind, Kind::Dropped);
+    std::vector<uint8_t> empty;
+    EXPECT_EQ(walk(empty).kind, Kind::Dropped);
+    std::vector<uint8_t> not_ecat(60, 0);
+    not_ecat[12] = 0x08;  // IPv4
+    EXPECT_EQ(walk(not_ecat).kind, Kind::Dropped);
+    // A truncated EtherCAT frame: its length field runs past the end.
+    std::vector<uint8_t> f = FrameBuilder().add_zero(Command::BRD, 0, 0, esc::reg::kType, 2).build();
+    f[esc::wire::kEthernetHeaderSize] = 0xFF;
+    f[esc::wire::kEthernetHeaderSize + 1] = 0x17;
+    seg->walk(f, kT0);  // whatever the ESCs make of it, nothing breaks
+    EXPECT_EQ(brd_count(), 3);
+}
+
 // ---- trees ----------------------------------------------------------------------------------------
 
 TEST_F(SegmentTest, TreeOrderAndCount) {
@@ -370,6 +409,68 @@ TEST_F(SegmentTest, CorruptedFrameCountsOnlyBeforeTheHop) {
     EXPECT_EQ(pdi8(2, kInvalidFrameCounter + 0), 1);  // counters keep their count
 }
 
+TEST_F(SegmentTest, LostLinksCountedOncePerLoss) {
+    // Wiring in any order counts no lost link; a pulled cable counts one at each end; a powered-off
+    // neighbour one more.
+    add();  // 0
+    add();  // 1
+    add();  // 2
+    seg->connect(1, 1, 2, 0);
+    seg->connect(0, 1, 1, 0);
+    constexpr uint16_t kLostLink = 0x0310;
+    for (int d = 0; d < 3; ++d)
+        for (int p = 0; p < 2; ++p)
+            EXPECT_EQ(pdi8(d, kLostLink + p), 0) << "device " << d << " port " << p;
+    seg->set_cable(1, 1, false);
+    EXPECT_EQ(pdi8(1, kLostLink + 1), 1);
+    EXPECT_EQ(pdi8(2, kLostLink + 0), 1);
+    seg->set_cable(1, 1, false);  // already pulled: nothing more
+    EXPECT_EQ(pdi8(1, kLostLink + 1), 1);
+    seg->set_cable(1, 1, true);
+    EXPECT_EQ(pdi8(1, kLostLink + 1), 1);
+    seg->set_power(2, false);
+    EXPECT_EQ(pdi8(1, kLostLink + 1), 2);
+    EXPECT_EQ(pdi8(0, kLostLink + 1), 0);
+    seg->set_power(2, true);
+    EXPECT_EQ(brd_count(), 3);
+}
+
+TEST_F(SegmentTest, LoopControlFromTheMaster) {
+    line(4);
+    // DL control 0x0101 of device 1: port 1 "always closed" (bits 3:2 = 11): the line ends there.
+    ASSERT_EQ(apwr16(1, esc::reg::kDlControl, 0x0C00), 1);
+    EXPECT_EQ(brd_count(), 2);
+    EXPECT_EQ(seg->order(), (std::vector<int>{0, 1}));
+    ASSERT_EQ(apwr16(1, esc::reg::kDlControl, 0x0000), 1);  // back to auto
+    EXPECT_EQ(brd_count(), 4);
+    // Port 1 of device 2 "always open" and its cable pulled: the frame is sent into the void and lost.
+    ASSERT_EQ(apwr16(2, esc::reg::kDlControl, 0x0800), 1);
+    seg->set_cable(2, 1, false);
+    EXPECT_EQ(brd_count(), -1);
+    EXPECT_EQ(seg->hop_stats(3).dropped, 1u);
+    seg->set_cable(2, 1, true);
+    EXPECT_EQ(brd_count(), 4);
+}
+
+TEST_F(SegmentTest, DevicePluggedInThroughPortOne) {
+    // A device plugged in with its port 1 (port 0 free): the frame reaches its processing unit looped back at
+    // the closed port 0, which sets the circulating bit; a second such device destroys the frame
+    // (ETG.1000.4), so a frame never circulates for ever.
+    add(0xFF);  // 0: junction
+    add(0xFF);  // 1: plugged in through its port 1
+    seg->connect(0, 1, 1, 1);
+    EXPECT_EQ(seg->upstream_port(1), 1);
+    EXPECT_FALSE(seg->esc(1).link(0));
+    EXPECT_EQ(seg->order(), (std::vector<int>{0, 1}));
+    std::vector<uint8_t> f = FrameBuilder().add_zero(Command::BRD, 0, 0, esc::reg::kType, 2).build();
+    ASSERT_EQ(walk(f).kind, Kind::Reply);
+    EXPECT_EQ(datagram_wkc(f, 0), 2);
+    EXPECT_NE(f[esc::wire::kFrameHeaderSize + esc::wire::kDgLengthFlags + 1] & 0x40, 0);  // circulating
+    add();  // 2: below device 1, also through its port 1
+    seg->connect(1, 2, 2, 1);
+    EXPECT_EQ(brd_count(), -1);
+}
+
 TEST_F(SegmentTest, HopFaultsRejectBadFractions) {
     line(2);
     esc::HopFaults f;
@@ -419,6 +520,12 @@ TEST_F(SegmentTest, ExternalPortWalkAndResume) {
     // The external port is a port in use.
     EXPECT_THROW(seg->connect(2, 1, 0, 1), std::invalid_argument);
     EXPECT_THROW(seg->set_external(1, 1, [](std::span<const uint8_t>) {}), std::invalid_argument);
+    // No callback: the port no longer leads out (no link, the ESC loops back).
+    seg->set_external(2, 1, nullptr);
+    EXPECT_FALSE(seg->esc(2).link(1));
+    EXPECT_EQ(brd_count(), 3);
+    EXPECT_EQ(sent, 2);
+    EXPECT_EQ(seg->resume(back, kT0).kind, Kind::Dropped);
 }
 
 TEST_F(SegmentTest, ExternalPortInTheMiddle) {

@@ -38,6 +38,7 @@ struct PdArgs {
     std::vector<std::string> steps;
     bool keep = false;
     bool station = false;  // slave is a station address (as scan assigns them)
+    bool all = false;      // every slave on the line in one session (cmd_pd_all.cpp)
 };
 
 // "CYCLES:B0,B1,..." -> cycles and the output bytes sent (from the first byte) during them.
@@ -71,7 +72,7 @@ std::optional<Step> parse_step(const std::string& text) {
 
 int process_data(master::Master& m, const PdArgs& p) {
     auto pos = parse_number(p.slave, 0xFFFF);
-    if (!pos) return usage("bad slave '" + p.slave + "'");
+    if (!pos && !p.all) return usage("bad slave '" + p.slave + "'");
     std::string t = p.state;
     for (auto& c : t)
         c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
@@ -83,6 +84,20 @@ int process_data(master::Master& m, const PdArgs& p) {
         auto b = parse_number(v, 0xFF);
         if (!b) return usage("bad output byte '" + v + "'");
         out_bytes.push_back(static_cast<uint8_t>(*b));
+    }
+    if (p.all) {
+        PdAllArgs all;
+        all.cycle_us = p.cycle_us;
+        all.count = p.count;
+        all.dc = p.dc;
+        all.op = t == "OP";
+        all.outputs = out_bytes;
+        for (const std::string& text : p.steps) {
+            auto step = parse_step(text);
+            all.steps.emplace_back(step->cycles, step->bytes);
+        }
+        all.keep = p.keep;
+        return process_data_all(m, all);
     }
     // Station addresses as scan gives them; DC's FRMW addresses the reference clock by station.
     auto n = m.count_slaves();
@@ -177,6 +192,9 @@ void add_pd_command(CLI::App& app, MasterRunner run, int& rc) {
     pdc->add_option("slave", pa->slave, "Slave position (or station address with --station)")
         ->capture_default_str();
     pdc->add_flag("-s,--station", pa->station, "<slave> is a station address (scan assigns 0x1001..)");
+    pdc->add_flag("-a,--all", pa->all,
+                  "Every slave on the line in one session: one LRW per cycle, the working counter checked "
+                  "against the sum of the slaves' shares, the state of each slave listed (<slave> ignored)");
     pdc->add_option("--cycle-us", pa->cycle_us, "Cycle time in microseconds")
         ->check(CLI::Range(50u, 1000000u))
         ->capture_default_str();

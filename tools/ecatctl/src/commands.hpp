@@ -2,7 +2,8 @@
 // The ecatctl commands main.cpp wires, one file each, and the helpers they share (cli_support.cpp):
 //   scan                     cmd_scan.cpp     sii read|write|decode  cmd_sii.cpp
 //   reg read|write           cmd_reg.cpp      upload|download        cmd_sdo.cpp
-//   pd                       cmd_pd.cpp       sdos                   cmd_sdos.cpp
+//   pd [--all]               cmd_pd.cpp, cmd_pd_all.cpp
+//                                  sdos                   cmd_sdos.cpp
 //   foe read|write           cmd_foe.cpp      state                  cmd_state.cpp
 //   diag                     cmd_diag.cpp     firmware-update        cmd_firmware.cpp
 //   slaves, pdos, cstruct, xml (the IgH/SOEM-style verbs)          cmd_verbs.hpp
@@ -10,6 +11,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cmd_diag.hpp"  // MasterRunner
@@ -26,6 +28,18 @@ void add_sdo_commands(CLI::App& app, MasterRunner run, int& rc);  // upload, dow
 void add_pd_command(CLI::App& app, MasterRunner run, int& rc);
 void add_sdos_command(CLI::App& app, MasterRunner run, int& rc);
 void add_foe_command(CLI::App& app, MasterRunner run, int& rc);
+
+// `pd --all` (cmd_pd_all.cpp): every slave on the line in one process-data session.
+struct PdAllArgs {
+    unsigned cycle_us = 1000;
+    uint64_t count = 1000;
+    bool dc = false;
+    bool op = true;                // else SAFEOP
+    std::vector<uint8_t> outputs;  // sent to every slave (from its first output byte)
+    std::vector<std::pair<uint64_t, std::vector<uint8_t>>> steps;
+    bool keep = false;
+};
+int process_data_all(master::Master& m, const PdAllArgs& p);
 
 // ---- cli_support.cpp -----------------------------------------------------------------------------
 

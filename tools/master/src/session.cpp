@@ -1,9 +1,9 @@
-// Cyclic process data with one slave: layout discovery, SM/FMMU set-up, DC/SYNC0, LRW cycles.
+// Cyclic process data with one slave or a line of them: layout discovery, SM/FMMU set-up, DC/SYNC0, LRW
+// cycles.
 #include "master/session.hpp"
 
-#include <time.h>
-
 #include <algorithm>
+#include <iterator>
 #include <thread>
 
 #include "util/le.hpp"
@@ -18,38 +18,47 @@ using util::get64;
 using util::put16;
 using util::put32;
 using util::put64;
-// EtherCAT system time: ns since 2000-01-01 (ESC datasheet section I §9).
-uint64_t master_system_time() {
-    timespec ts{};
-    clock_gettime(CLOCK_REALTIME, &ts);
-    constexpr uint64_t k2000 = 946'684'800ull;
-    return (static_cast<uint64_t>(ts.tv_sec) - k2000) * 1'000'000'000ull + static_cast<uint64_t>(ts.tv_nsec);
-}
 void sleep_until(Clock::time_point t) {
     std::this_thread::sleep_until(t);
 }
+// Room for the LRW of one frame when the FRMW of DC (8 bytes) rides along.
+constexpr std::size_t kMaxChunk = kMaxDatagramData - (kDatagramOverhead + 8);
+// AL status reads per frame in read_states(): 6 bytes (0x0130..0x0135) each.
+constexpr std::size_t kStatesPerFrame = 60;
+bool overlaps(uint32_t a, uint32_t a_len, uint32_t b, uint32_t b_len) {
+    return a_len && b_len && a < b + b_len && b < a + a_len;
+}
 }  // namespace
 
-ProcessDataSession::ProcessDataSession(Master& master, Address slave, SdoClient& sdo)
-    : m_(master), slave_(slave), sdo_(sdo) {}
+ProcessDataSession::ProcessDataSession(Master& master, Address slave, SdoClient& sdo) : m_(master) {
+    slaves_.push_back(Slave{slave, &sdo, {}, 0, 0});
+}
 
-Error ProcessDataSession::pdo_bytes(uint16_t assign_index, std::vector<uint16_t>& pdos, uint16_t& bytes) {
+ProcessDataSession::ProcessDataSession(Master& master, std::span<const Address> slaves,
+                                       std::span<SdoClient* const> sdos)
+    : m_(master) {
+    for (std::size_t k = 0; k < slaves.size(); ++k)
+        slaves_.push_back(Slave{slaves[k], k < sdos.size() ? sdos[k] : nullptr, {}, 0, 0});
+}
+
+Error ProcessDataSession::pdo_bytes(SdoClient& sdo, uint16_t assign_index, std::vector<uint16_t>& pdos,
+                                    uint16_t& bytes) {
     pdos.clear();
     uint32_t bits = 0;
     uint8_t b[4] = {};
-    auto n = sdo_.upload(assign_index, 0, b);
+    auto n = sdo.upload(assign_index, 0, b);
     if (!n) return n.error();
     const uint8_t count = b[0];
     for (uint8_t i = 1; i <= count; ++i) {
-        auto r = sdo_.upload(assign_index, i, b);
+        auto r = sdo.upload(assign_index, i, b);
         if (!r) return r.error();
         const uint16_t pdo = get16(b);
         pdos.push_back(pdo);
-        auto c = sdo_.upload(pdo, 0, b);
+        auto c = sdo.upload(pdo, 0, b);
         if (!c) return c.error();
         const uint8_t entries = b[0];
         for (uint8_t e = 1; e <= entries; ++e) {
-            auto x = sdo_.upload(pdo, e, b);
+            auto x = sdo.upload(pdo, e, b);
             if (!x) return x.error();
             bits += b[0];  // low byte of index<<16 | sub<<8 | bit length
         }
@@ -59,8 +68,17 @@ Error ProcessDataSession::pdo_bytes(uint16_t assign_index, std::vector<uint16_t>
 }
 
 Error ProcessDataSession::discover() {
+    for (Slave& s : slaves_) {
+        if (!s.sdo) continue;  // its layout comes from set_layout()
+        if (Error e = discover(s); e != Error::Ok) return e;
+    }
+    return Error::Ok;
+}
+
+Error ProcessDataSession::discover(Slave& slave) {
     // SM2/SM3 start and control from the SII SyncM category (41).
-    auto img = m_.sii_read_image(slave_);
+    ProcessDataLayout& layout = slave.layout;
+    auto img = m_.sii_read_image(slave.address);
     if (!img) return img.error();
     const auto& s = *img;
     bool found = false;
@@ -74,12 +92,12 @@ Error ProcessDataSession::discover() {
                 const uint8_t* sm = &s[data + 8 * k];
                 const uint8_t kind = sm[7];
                 if (kind == 3) {
-                    layout_.sm2_start = get16(sm);
-                    layout_.sm2_control = sm[4];
+                    layout.sm2_start = get16(sm);
+                    layout.sm2_control = sm[4];
                     found = true;
                 } else if (kind == 4) {
-                    layout_.sm3_start = get16(sm);
-                    layout_.sm3_control = sm[4];
+                    layout.sm3_start = get16(sm);
+                    layout.sm3_control = sm[4];
                     found = true;
                 }
             }
@@ -87,47 +105,126 @@ Error ProcessDataSession::discover() {
         w += 2 + len;
     }
     if (!found) return Error::SiiFormat;
-    if (Error e = pdo_bytes(0x1C12, layout_.rx_pdos, layout_.sm2_length); e != Error::Ok) return e;
-    if (Error e = pdo_bytes(0x1C13, layout_.tx_pdos, layout_.sm3_length); e != Error::Ok) return e;
-    image_.assign(static_cast<std::size_t>(layout_.sm2_length) + layout_.sm3_length, 0);
+    if (Error e = pdo_bytes(*slave.sdo, 0x1C12, layout.rx_pdos, layout.sm2_length); e != Error::Ok) return e;
+    if (Error e = pdo_bytes(*slave.sdo, 0x1C13, layout.tx_pdos, layout.sm3_length); e != Error::Ok) return e;
     return Error::Ok;
 }
 
+std::span<uint8_t> ProcessDataSession::outputs(std::size_t k) {
+    const Slave& s = slaves_[k];
+    if (image_.empty()) return {};
+    return {image_.data() + s.out_offset, s.layout.sm2_length};
+}
+
+std::span<const uint8_t> ProcessDataSession::inputs(std::size_t k) const {
+    const Slave& s = slaves_[k];
+    if (image_.empty()) return {};
+    return {image_.data() + out_bytes_ + s.in_offset, s.layout.sm3_length};
+}
+
+uint16_t ProcessDataSession::expected_wkc(std::size_t k) const {
+    const ProcessDataLayout& l = slaves_[k].layout;
+    return static_cast<uint16_t>((l.sm2_length ? 2 : 0) + (l.sm3_length ? 1 : 0));
+}
+
 uint16_t ProcessDataSession::expected_wkc() const {
-    return static_cast<uint16_t>((layout_.sm2_length ? 2 : 0) + (layout_.sm3_length ? 1 : 0));
+    uint16_t sum = 0;
+    if (!chunks_.empty()) {  // a slave split over two frames counts in both
+        for (const Chunk& c : chunks_)
+            sum = static_cast<uint16_t>(sum + c.expected_wkc);
+        return sum;
+    }
+    for (std::size_t k = 0; k < slaves_.size(); ++k)
+        sum = static_cast<uint16_t>(sum + expected_wkc(k));
+    return sum;
 }
 
 Error ProcessDataSession::configure(const DcConfig& dc) {
-    if (image_.empty() && layout_.sm2_length + layout_.sm3_length == 0) return Error::InvalidArgument;
-    // Sync mode first: the slave checks it against 0x0981 on PREOP -> SAFEOP.
-    const uint8_t mode_out[2] = {static_cast<uint8_t>(dc.enable ? 2 : 1), 0};
-    if (Error e = sdo_.download(0x1C32, 1, mode_out); e != Error::Ok) return e;
-    const uint8_t mode_in[2] = {static_cast<uint8_t>(dc.enable ? 2 : (layout_.sm2_length ? 0x22 : 1)), 0};
-    if (Error e = sdo_.download(0x1C33, 1, mode_in); e != Error::Ok) {
-        const uint8_t plain[2] = {static_cast<uint8_t>(dc.enable ? 2 : 1), 0};
-        if (sdo_.download(0x1C33, 1, plain) != Error::Ok) return e;
+    if (slaves_.empty()) return Error::InvalidArgument;
+    // The image: every slave's outputs back to back, then every slave's inputs.
+    out_bytes_ = in_bytes_ = 0;
+    for (Slave& s : slaves_) {
+        s.out_offset = out_bytes_;
+        s.in_offset = in_bytes_;
+        out_bytes_ += s.layout.sm2_length;
+        in_bytes_ += s.layout.sm3_length;
     }
-    if (dc.enable) {
-        uint8_t cyc[4];
-        put32(cyc, dc.cycle_ns);
-        if (Error e = sdo_.download(0x1C32, 2, cyc); e != Error::Ok) return e;
-        (void)sdo_.download(0x1C33, 2, cyc);  // some slaves derive it from 0x1C32 and refuse the write
+    if (out_bytes_ + in_bytes_ == 0) return Error::InvalidArgument;
+    for (Slave& s : slaves_)
+        if (Error e = configure(s, dc); e != Error::Ok) return e;
+    image_.assign(static_cast<std::size_t>(out_bytes_) + in_bytes_, 0);
+    // One LRW per frame, as many frames as the image needs, split where one slave's outputs or inputs end
+    // (so that each slave counts once); each frame knows its share of the working counter.
+    std::vector<std::size_t> ends;
+    for (const Slave& s : slaves_) {
+        ends.push_back(s.out_offset + s.layout.sm2_length);
+        ends.push_back(out_bytes_ + s.in_offset + s.layout.sm3_length);
+    }
+    std::sort(ends.begin(), ends.end());
+    chunks_.clear();
+    for (std::size_t at = 0, len = 0; at < image_.size(); at += len) {
+        len = std::min(kMaxChunk, image_.size() - at);
+        if (at + len < image_.size()) {
+            auto it = std::upper_bound(ends.begin(), ends.end(), at + len);
+            if (it != ends.begin() && *std::prev(it) > at) len = *std::prev(it) - at;
+        }
+        Chunk c;
+        const uint32_t pos = static_cast<uint32_t>(at);
+        c.lrw =
+            Datagram::logical(Command::LRW, kLogicalBase + pos, std::span<uint8_t>(image_.data() + at, len));
+        for (const Slave& s : slaves_) {
+            if (overlaps(pos, static_cast<uint32_t>(len), s.out_offset, s.layout.sm2_length))
+                c.expected_wkc += 2;
+            if (overlaps(pos, static_cast<uint32_t>(len), out_bytes_ + s.in_offset, s.layout.sm3_length))
+                c.expected_wkc += 1;
+        }
+        chunks_.push_back(c);
+    }
+    states_.assign(slaves_.size(), AlStatus{});
+    state_buf_.assign(kStatesPerFrame * 6, 0);
+    if (dc.enable) return configure_dc(dc);
+    // Not DC: SYNC0 left running by an earlier session would contradict sync mode 1 (AL code 0x0030).
+    const uint8_t zero2[2] = {};
+    for (const Slave& s : slaves_)
+        if (Error e = m_.write(s.address, esc::reg::kDcCyclicControl, zero2); e != Error::Ok) return e;
+    dc_ = false;
+    return Error::Ok;
+}
+
+Error ProcessDataSession::configure(Slave& slave, const DcConfig& dc) {
+    const ProcessDataLayout& layout = slave.layout;
+    const Address a = slave.address;
+    if (SdoClient* sdo = slave.sdo) {
+        // Sync mode first: the slave checks it against 0x0981 on PREOP -> SAFEOP.
+        const uint8_t mode_out[2] = {static_cast<uint8_t>(dc.enable ? 2 : 1), 0};
+        if (Error e = sdo->download(0x1C32, 1, mode_out); e != Error::Ok) return e;
+        const uint8_t mode_in[2] = {static_cast<uint8_t>(dc.enable ? 2 : (layout.sm2_length ? 0x22 : 1)), 0};
+        if (Error e = sdo->download(0x1C33, 1, mode_in); e != Error::Ok) {
+            const uint8_t plain[2] = {static_cast<uint8_t>(dc.enable ? 2 : 1), 0};
+            if (sdo->download(0x1C33, 1, plain) != Error::Ok) return e;
+        }
+        if (dc.enable) {
+            uint8_t cyc[4];
+            put32(cyc, dc.cycle_ns);
+            if (Error e = sdo->download(0x1C32, 2, cyc); e != Error::Ok) return e;
+            (void)sdo->download(0x1C33, 2, cyc);  // some slaves derive it from 0x1C32 and refuse the write
+        }
     }
     // SM2/SM3: disabled first, then start, length, control and activate in one write (ESC datasheet section I
     // §8).
     uint8_t sm[16] = {};
     const uint8_t off[16] = {};
-    if (Error e = m_.write(slave_, static_cast<uint16_t>(reg::Sm0 + 16), off); e != Error::Ok) return e;
-    put16(sm + 0, layout_.sm2_start);
-    put16(sm + 2, layout_.sm2_length);
-    sm[4] = layout_.sm2_control;
-    sm[6] = layout_.sm2_length ? 1 : 0;
-    put16(sm + 8, layout_.sm3_start);
-    put16(sm + 10, layout_.sm3_length);
-    sm[12] = layout_.sm3_control;
-    sm[14] = layout_.sm3_length ? 1 : 0;
-    if (Error e = m_.write(slave_, static_cast<uint16_t>(reg::Sm0 + 16), sm); e != Error::Ok) return e;
-    // FMMU0: outputs (write), FMMU1: inputs (read), logically back to back from kLogicalBase (ESC datasheet
+    if (Error e = m_.write(a, static_cast<uint16_t>(reg::Sm0 + 16), off); e != Error::Ok) return e;
+    put16(sm + 0, layout.sm2_start);
+    put16(sm + 2, layout.sm2_length);
+    sm[4] = layout.sm2_control;
+    sm[6] = layout.sm2_length ? 1 : 0;
+    put16(sm + 8, layout.sm3_start);
+    put16(sm + 10, layout.sm3_length);
+    sm[12] = layout.sm3_control;
+    sm[14] = layout.sm3_length ? 1 : 0;
+    if (Error e = m_.write(a, static_cast<uint16_t>(reg::Sm0 + 16), sm); e != Error::Ok) return e;
+    // FMMU0: outputs (write), FMMU1: inputs (read), at this slave's places in the image (ESC datasheet
     // section I §7).
     uint8_t fm[32] = {};
     auto fmmu = [](uint8_t* f, uint32_t logical, uint16_t length, uint16_t physical, uint8_t type) {
@@ -140,78 +237,92 @@ Error ProcessDataSession::configure(const DcConfig& dc) {
         f[11] = type;
         f[12] = length ? 1 : 0;
     };
-    fmmu(fm, kLogicalBase, layout_.sm2_length, layout_.sm2_start, 0x02);
-    fmmu(fm + 16, kLogicalBase + layout_.sm2_length, layout_.sm3_length, layout_.sm3_start, 0x01);
-    if (Error e = m_.write(slave_, reg::Fmmu0, fm); e != Error::Ok) return e;
-    image_.assign(static_cast<std::size_t>(layout_.sm2_length) + layout_.sm3_length, 0);
-    lrw_ = Datagram::logical(Command::LRW, kLogicalBase, image_);
-    if (dc.enable) return configure_dc(dc);
-    // Not DC: SYNC0 left running by an earlier session would contradict sync mode 1 (AL code 0x0030).
-    const uint8_t zero2[2] = {};
-    if (Error e = m_.write(slave_, esc::reg::kDcCyclicControl, zero2); e != Error::Ok) return e;
-    dc_ = false;
-    return Error::Ok;
+    fmmu(fm, kLogicalBase + slave.out_offset, layout.sm2_length, layout.sm2_start, 0x02);
+    fmmu(fm + 16, kLogicalBase + out_bytes_ + slave.in_offset, layout.sm3_length, layout.sm3_start, 0x01);
+    return m_.write(a, reg::Fmmu0, fm);
 }
 
 Error ProcessDataSession::configure_dc(const DcConfig& dc) {
-    // Latch receive times with a broadcast write to 0x0900, read the slave's local time of that frame
-    // (0x0918) and make its system time the master's: offset = master time - local time (ESC datasheet
-    // section I §9.1). A single slave is the reference clock: propagation delay 0, no drift compensation.
-    const uint8_t latch[4] = {};
-    const uint64_t master_now = master_system_time();
-    auto w = m_.broadcast_write(esc::reg::kDcRecvTime0, latch);
-    if (!w) return w.error();
-    uint8_t t[8];
-    if (Error e = m_.read(slave_, esc::reg::kDcRecvTimePu, t); e != Error::Ok) return e;
-    uint8_t off[8];
-    put64(off, master_now - get64(t));
-    if (Error e = m_.write(slave_, esc::reg::kDcOffset, off); e != Error::Ok) return e;
-    const uint8_t zero4[4] = {};
-    if (Error e = m_.write(slave_, esc::reg::kDcDelay, zero4); e != Error::Ok) return e;
-    uint8_t speed[2];
-    if (Error e = m_.read(slave_, esc::reg::kDcSpeedStart, speed); e != Error::Ok) return e;
-    if (Error e = m_.write(slave_, esc::reg::kDcSpeedStart, speed); e != Error::Ok)
-        return e;  // resets the filters
-    // SYNC0: deactivate, cycle time, start time on the cycle grid in the near future, activate.
+    // Delays and offsets (bus.hpp): the first DC slave is the reference clock, its system time the master's.
+    reference_ = slaves_.front().address.value;
+    if (dc.measure) {
+        dc_slaves_.clear();
+        for (std::size_t k = 0; k < slaves_.size(); ++k) {
+            SlaveInfo info;
+            info.position = static_cast<uint16_t>(k);
+            info.station = slaves_[k].address.value;
+            auto features = m_.read_reg<uint16_t>(slaves_[k].address, 0x0008);
+            if (!features) return features.error();
+            info.has_dc = (*features & 0x0004) != 0;
+            dc_slaves_.push_back(info);
+        }
+        if (Error e = read_ports(m_, dc_slaves_); e != Error::Ok) return e;
+        if (Error e = master::configure_dc(m_, dc_slaves_, dc.measure_options); e != Error::Ok) return e;
+        const int ref = reference_clock(dc_slaves_);
+        if (ref < 0) return Error::InvalidArgument;
+        reference_ = dc_slaves_[static_cast<std::size_t>(ref)].station;
+    }
+    // SYNC0 on every slave: deactivate, cycle time; then one start time on the cycle grid in the near future
+    // (the reference clock's system time, which all others now share), and activate.
     const uint8_t zero2[2] = {};
-    if (Error e = m_.write(slave_, esc::reg::kDcCyclicControl, zero2); e != Error::Ok) return e;
     uint8_t cyc[4];
     put32(cyc, dc.cycle_ns);
-    if (Error e = m_.write(slave_, esc::reg::kDcSync0Cycle, cyc); e != Error::Ok) return e;
+    for (const Slave& s : slaves_) {
+        if (Error e = m_.write(s.address, esc::reg::kDcCyclicControl, zero2); e != Error::Ok) return e;
+        if (Error e = m_.write(s.address, esc::reg::kDcSync0Cycle, cyc); e != Error::Ok) return e;
+    }
     uint8_t now[8];
-    if (Error e = m_.read(slave_, reg::DcSystemTime, now); e != Error::Ok) return e;
+    if (Error e = m_.read(Address::station(reference_), reg::DcSystemTime, now); e != Error::Ok) return e;
     const uint64_t delay = static_cast<uint64_t>(std::chrono::nanoseconds(dc.start_delay).count());
     uint64_t start = get64(now) + delay;
     if (dc.cycle_ns) start = (start / dc.cycle_ns + 1) * dc.cycle_ns;
     start = static_cast<uint64_t>(static_cast<int64_t>(start) + dc.shift_ns);
     uint8_t st[8];
     put64(st, start);
-    if (Error e = m_.write(slave_, esc::reg::kDcStartTime, st); e != Error::Ok) return e;
     uint8_t aa[2];
     put16(aa, dc.assign_activate);
-    if (Error e = m_.write(slave_, esc::reg::kDcCyclicControl, aa); e != Error::Ok) return e;
+    for (const Slave& s : slaves_) {
+        if (Error e = m_.write(s.address, esc::reg::kDcStartTime, st); e != Error::Ok) return e;
+        if (Error e = m_.write(s.address, esc::reg::kDcCyclicControl, aa); e != Error::Ok) return e;
+    }
     // From now on every cycle carries an FRMW of the reference clock's system time.
-    dg_[1] = Datagram{Command::FRMW, slave_.value, reg::DcSystemTime, time_};
-    dc_ = slave_.mode == Address::Mode::Station;
+    frame_[1] = Datagram{Command::FRMW, reference_, reg::DcSystemTime, time_};
+    dc_ = true;
+    for (const Slave& s : slaves_)
+        if (s.address.mode != Address::Mode::Station) dc_ = false;
     return Error::Ok;
 }
 
 Error ProcessDataSession::cycle() {
     if (image_.empty()) return Error::InvalidArgument;
     const auto t0 = Clock::now();
-    const Error e = m_.exchange(std::span<Datagram>(dg_, dc_ ? 2 : 1), 0);
     ++stats_.cycles;
-    if (e == Error::Timeout) {
-        ++stats_.lost;
-        return e;
+    uint16_t wkc = 0;
+    bool lost = false;
+    for (std::size_t k = 0; k < chunks_.size(); ++k) {
+        Chunk& c = chunks_[k];
+        frame_[0] = c.lrw;
+        const std::size_t n = (k == 0 && dc_) ? 2 : 1;
+        const Error e = m_.exchange(std::span<Datagram>(frame_, n), 0);
+        if (e == Error::Timeout) {
+            lost = true;
+            continue;
+        }
+        if (e != Error::Ok) return e;
+        c.lrw.wkc = frame_[0].wkc;
+        wkc = static_cast<uint16_t>(wkc + frame_[0].wkc);
+        if (n == 2) ref_time_ = get64(time_.data());
     }
-    if (e != Error::Ok) return e;
+    last_wkc_ = wkc;
+    if (lost) {
+        ++stats_.lost;
+        return Error::Timeout;
+    }
     const auto rtt = std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0);
     stats_.rtt_min = std::min(stats_.rtt_min, rtt);
     stats_.rtt_max = std::max(stats_.rtt_max, rtt);
     stats_.rtt_sum += rtt;
-    if (dc_) ref_time_ = get64(time_.data());
-    if (lrw_.wkc != expected_wkc()) {
+    if (wkc != expected_wkc()) {
         ++stats_.wkc_errors;
         return Error::WorkingCounter;
     }
@@ -232,19 +343,82 @@ Error ProcessDataSession::run(uint64_t count, std::chrono::microseconds period,
     return first;
 }
 
+Error ProcessDataSession::read_states(std::span<AlStatus> out) {
+    if (out.size() < slaves_.size()) return Error::InvalidArgument;
+    if (state_buf_.size() < kStatesPerFrame * 6) state_buf_.assign(kStatesPerFrame * 6, 0);
+    std::array<Datagram, kStatesPerFrame> dg;
+    for (std::size_t first = 0; first < slaves_.size(); first += kStatesPerFrame) {
+        const std::size_t n = std::min(kStatesPerFrame, slaves_.size() - first);
+        std::fill(state_buf_.begin(), state_buf_.end(), 0);
+        for (std::size_t i = 0; i < n; ++i)
+            dg[i] = Master::addressed(slaves_[first + i].address, false, reg::AlStatus,
+                                      std::span<uint8_t>(state_buf_.data() + 6 * i, 6));
+        if (Error e = m_.exchange(std::span<Datagram>(dg.data(), n)); e != Error::Ok) return e;
+        for (std::size_t i = 0; i < n; ++i) {
+            const uint8_t* b = state_buf_.data() + 6 * i;
+            AlStatus s;
+            if (dg[i].wkc == 1) {
+                s.state = b[0] & 0x0F;
+                s.error = (b[0] & kAlErrorAck) != 0;
+                s.id_loaded = (b[0] & kAlIdentify) != 0;
+                s.code = get16(b + 4);
+            }
+            out[first + i] = s;
+        }
+    }
+    return Error::Ok;
+}
+
+// AL control of the session's slaves: one slave by its address, several with one BWR (every slave on the
+// line, as a master bringing up its whole line does).
+Error ProcessDataSession::write_al_control(AlState state, bool acknowledge, uint8_t current) {
+    if (slaves_.size() == 1) {
+        const uint16_t v =
+            acknowledge ? static_cast<uint16_t>(current | kAlErrorAck) : static_cast<uint8_t>(state);
+        return m_.write_reg<uint16_t>(slaves_.front().address, reg::AlControl, v);
+    }
+    const uint8_t v[2] = {static_cast<uint8_t>(state), 0};
+    auto w = m_.broadcast_write(reg::AlControl, v);
+    if (!w) return w.error();
+    return *w == 0 ? Error::WorkingCounter : Error::Ok;
+}
+
+Error ProcessDataSession::states_reached(AlState state, AlStatus* final, bool& done) {
+    done = false;
+    if (Error e = read_states(states_); e != Error::Ok) return e;
+    if (slaves_.size() == 1 && states_.front().state == 0) return Error::WorkingCounter;  // it did not answer
+    bool all = true;
+    for (std::size_t k = 0; k < slaves_.size(); ++k) {
+        const AlStatus& st = states_[k];
+        if (st.error) {
+            if (final) *final = st;
+            (void)m_.write_reg<uint16_t>(slaves_[k].address, reg::AlControl,
+                                         static_cast<uint16_t>(st.state | kAlErrorAck));
+            return Error::AlRefused;
+        }
+        if (st.state != static_cast<uint8_t>(state)) {
+            if (all && final) *final = st;
+            all = false;
+        }
+    }
+    if (all && final && !slaves_.empty()) *final = states_.front();
+    done = all;
+    return Error::Ok;
+}
+
 Error ProcessDataSession::request_state(AlState state, std::chrono::microseconds period, AlStatus* final,
                                         const std::function<void()>& each_cycle) {
     const auto deadline = Clock::now() + m_.options().al_timeout;
-    auto st = m_.al_status(slave_);
-    if (!st) return st.error();
-    if (st->error) {
-        if (Error e = m_.write_reg<uint16_t>(slave_, reg::AlControl,
-                                             static_cast<uint16_t>(st->state | kAlErrorAck));
+    if (states_.size() != slaves_.size()) states_.assign(slaves_.size(), AlStatus{});
+    if (Error e = read_states(states_); e != Error::Ok) return e;
+    for (std::size_t k = 0; k < slaves_.size(); ++k) {
+        if (!states_[k].error) continue;
+        if (Error e = m_.write_reg<uint16_t>(slaves_[k].address, reg::AlControl,
+                                             static_cast<uint16_t>(states_[k].state | kAlErrorAck));
             e != Error::Ok)
             return e;
     }
-    if (Error e = m_.write_reg<uint16_t>(slave_, reg::AlControl, static_cast<uint8_t>(state)); e != Error::Ok)
-        return e;
+    if (Error e = write_al_control(state, false, 0); e != Error::Ok) return e;
     auto next = Clock::now();
     const auto poll_every =
         std::max<int64_t>(1, std::chrono::milliseconds(5) / std::max(period, std::chrono::microseconds(1)));
@@ -252,15 +426,9 @@ Error ProcessDataSession::request_state(AlState state, std::chrono::microseconds
         if (each_cycle) each_cycle();
         (void)cycle();
         if (i % poll_every == 0) {
-            st = m_.al_status(slave_);
-            if (!st) return st.error();
-            if (final) *final = *st;
-            if (st->error) {
-                (void)m_.write_reg<uint16_t>(slave_, reg::AlControl,
-                                             static_cast<uint16_t>(st->state | kAlErrorAck));
-                return Error::AlRefused;
-            }
-            if (st->state == static_cast<uint8_t>(state)) return Error::Ok;
+            bool done = false;
+            if (Error e = states_reached(state, final, done); e != Error::Ok) return e;
+            if (done) return Error::Ok;
             if (Clock::now() >= deadline) return Error::AlTimeout;
         }
         next += period;

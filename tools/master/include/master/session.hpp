@@ -1,16 +1,20 @@
 #pragma once
-// A cyclic process-data session with one slave (buffered SMs and FMMUs: ESC datasheet section I §8.1, §7; AL
-// states: ETG.1000.6; distributed clocks: ESC datasheet section I §9): discovers the process-data layout
-// (SM2/SM3 from the SII SyncM category, sizes from the PDO assignment 0x1C12/0x1C13 and the mapping objects
-// over CoE), sets up SM2/SM3 and two FMMUs, optionally distributed clocks with SYNC0, and exchanges outputs
-// and inputs with one LRW per cycle (plus an FRMW of the reference clock's system time when DC is on).
-// cycle() allocates nothing.
+// A cyclic process-data session with one slave or a whole line of them (buffered SMs and FMMUs: ESC datasheet
+// section I §8.1, §7; AL states: ETG.1000.6; distributed clocks: ESC datasheet section I §9, ETG.1020):
+// discovers each slave's process-data layout (SM2/SM3 from the SII SyncM category, sizes from the PDO
+// assignment 0x1C12/0x1C13 and the mapping objects over CoE), sets up its SM2/SM3 and two FMMUs into one
+// logical image (the outputs of all slaves back to back, then their inputs), optionally distributed clocks
+// (delays and offsets measured over the line, SYNC0 on every slave with the same start time), and exchanges
+// outputs and inputs with one LRW per cycle (split over several frames only when the image does not fit one),
+// plus an FRMW of the reference clock's system time when DC is on. Expected working counter: the sum over the
+// slaves of 2 (outputs written) + 1 (inputs read). cycle() allocates nothing.
 #include <chrono>
 #include <cstdint>
 #include <functional>
 #include <span>
 #include <vector>
 
+#include "master/bus.hpp"
 #include "master/coe.hpp"
 #include "master/master.hpp"
 
@@ -30,6 +34,11 @@ struct DcConfig {
     int32_t shift_ns = 0;                        // SYNC0 start offset within the cycle
     uint16_t assign_activate = 0x0300;           // 0x0980/0x0981 word: cyclic unit + SYNC0
     std::chrono::milliseconds start_delay{100};  // first SYNC0 this far in the future (IgH, SOEM)
+    // Measure delays and offsets over the session's slaves (bus.hpp configure_dc; for more than one slave
+    // they must be the whole line in position order). false: the caller did it already (configure_dc on
+    // the scan of the bus) and the session only sets SYNC0 up.
+    bool measure = true;
+    DcMeasureOptions measure_options;
 };
 
 struct CycleStats {
@@ -45,28 +54,45 @@ class ProcessDataSession {
   public:
     static constexpr uint32_t kLogicalBase = 0x00010000;
 
-    // slave must be a station address (the FRMW of DC needs one); sdo must run over its mailbox.
+    // One slave. slave must be a station address (the FRMW of DC needs one); sdo must run over its mailbox.
     ProcessDataSession(Master& master, Address slave, SdoClient& sdo);
+    // Several slaves (station addresses) in one image, in this order. sdos: one per slave, or empty; a
+    // slave without an SDO client (nullptr) gets its layout from set_layout() and no sync-mode objects.
+    ProcessDataSession(Master& master, std::span<const Address> slaves,
+                       std::span<SdoClient* const> sdos = {});
 
-    // Reads the layout (SII + CoE). The slave must be in PREOP.
+    std::size_t size() const { return slaves_.size(); }
+    Address address(std::size_t k) const { return slaves_[k].address; }
+
+    // Reads each slave's layout (SII + CoE). The slaves must be in PREOP.
     Error discover();
-    const ProcessDataLayout& layout() const { return layout_; }
-    // Sync mode objects (0x1C32:01, 0x1C33:01): DC SYNC0 (2) with dc.enable, else SM-synchronous (1).
-    // Then SM2/SM3, FMMU0 (outputs, write) and FMMU1 (inputs, read); with dc.enable also the clock
-    // offset and SYNC0 (0x0980/0x09A0/0x0990/0x0981).
+    const ProcessDataLayout& layout(std::size_t k = 0) const { return slaves_[k].layout; }
+    void set_layout(std::size_t k, const ProcessDataLayout& layout) { slaves_[k].layout = layout; }
+    // For each slave: sync mode objects (0x1C32:01, 0x1C33:01): DC SYNC0 (2) with dc.enable, else
+    // SM-synchronous (1); SM2/SM3, FMMU0 (outputs, write) and FMMU1 (inputs, read). With dc.enable also the
+    // delays and offsets (dc.measure) and SYNC0 (0x0980/0x09A0/0x0990/0x0981) with one start time for all.
     Error configure(const DcConfig& dc = {});
 
     // One process-data exchange: outputs() go out, inputs() come back. Returns Error::WorkingCounter if
     // the LRW's working counter is not expected_wkc() (the data is still copied).
     Error cycle();
-    std::span<uint8_t> outputs() { return {image_.data(), layout_.sm2_length}; }
-    std::span<const uint8_t> inputs() const {
-        return {image_.data() + layout_.sm2_length, layout_.sm3_length};
-    }
+    // All slaves' outputs (inputs) back to back, in slave order; or those of slave k.
+    std::span<uint8_t> outputs() { return {image_.data(), out_bytes_}; }
+    std::span<const uint8_t> inputs() const { return {image_.data() + out_bytes_, in_bytes_}; }
+    std::span<uint8_t> outputs(std::size_t k);
+    std::span<const uint8_t> inputs(std::size_t k) const;
     uint16_t expected_wkc() const;
-    uint16_t last_wkc() const { return lrw_.wkc; }
+    uint16_t expected_wkc(std::size_t k) const;  // this slave's share: 2 with outputs + 1 with inputs
+    uint16_t last_wkc() const { return last_wkc_; }
+    // Frames per cycle: 1 unless the image is larger than one frame's LRW can carry.
+    std::size_t frames_per_cycle() const { return chunks_.size(); }
     uint64_t reference_time() const { return ref_time_; }  // DC system time read in the last cycle
     const CycleStats& stats() const { return stats_; }
+    // The slaves as the DC measurement saw them (topology, delays, offsets); empty without dc.measure.
+    std::span<const SlaveInfo> dc_slaves() const { return dc_slaves_; }
+    // AL status of every slave, read in as few frames as fit (after a working-counter error: who is gone or
+    // not in the state). A slave that does not answer gets state 0.
+    Error read_states(std::span<AlStatus> out);
 
     // Requests a state while cycling every `period` (SAFEOP -> OP needs valid outputs arriving);
     // each_cycle runs before every exchange (fill outputs). Returns like Master::request_state.
@@ -76,20 +102,39 @@ class ProcessDataSession {
     Error run(uint64_t count, std::chrono::microseconds period, const std::function<void()>& each_cycle = {});
 
   private:
-    Error pdo_bytes(uint16_t assign_index, std::vector<uint16_t>& pdos, uint16_t& bytes);
+    struct Slave {
+        Address address;
+        SdoClient* sdo = nullptr;
+        ProcessDataLayout layout;
+        uint32_t out_offset = 0, in_offset = 0;  // in the image
+    };
+    // One frame of the cycle: an LRW over part of the image (the FRMW of DC rides in the first).
+    struct Chunk {
+        Datagram lrw;
+        uint16_t expected_wkc = 0;
+    };
+    Error discover(Slave& s);
+    Error pdo_bytes(SdoClient& sdo, uint16_t assign_index, std::vector<uint16_t>& pdos, uint16_t& bytes);
+    Error configure(Slave& s, const DcConfig& dc);
     Error configure_dc(const DcConfig& dc);
+    Error write_al_control(AlState state, bool acknowledge, uint8_t current);
+    Error states_reached(AlState state, AlStatus* final, bool& done);
 
     Master& m_;
-    Address slave_;
-    SdoClient& sdo_;
-    ProcessDataLayout layout_;
+    std::vector<Slave> slaves_;
+    uint32_t out_bytes_ = 0, in_bytes_ = 0;
     bool dc_ = false;
+    uint16_t reference_ = 0;  // station address of the reference clock
     std::vector<uint8_t> image_;
+    std::vector<Chunk> chunks_;
     std::array<uint8_t, 8> time_{};
-    Datagram dg_[2];
-    Datagram& lrw_ = dg_[0];
+    Datagram frame_[2];
+    uint16_t last_wkc_ = 0;
     uint64_t ref_time_ = 0;
     CycleStats stats_;
+    std::vector<SlaveInfo> dc_slaves_;
+    std::vector<AlStatus> states_;
+    std::vector<uint8_t> state_buf_;
 };
 
 }  // namespace master

@@ -1,0 +1,133 @@
+// `ecatctl pd --all`: every slave on the line to OP in one process-data session (one LRW per cycle over all
+// slaves' SM2/SM3, expected working counter = the sum of their shares), with optional DC (delays and offsets
+// measured over the line, SYNC0 on every slave with one start time).
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "format.hpp"
+#include "master/bus.hpp"
+#include "master/coe.hpp"
+#include "master/mailbox.hpp"
+#include "master/master.hpp"
+#include "master/session.hpp"
+
+namespace ecatctl {
+
+using master::Address;
+using master::Error;
+
+int process_data_all(master::Master& m, const PdAllArgs& p) {
+    auto bus = master::scan_bus(m, {.first_station = 0x1001, .identity = false});
+    if (!bus) return fail(bus.error(), "scanning the line");
+    if (bus->empty()) {
+        std::cerr << "ecatctl: no slave answered\n";
+        return kExitNoSlave;
+    }
+    const std::size_t n = bus->size();
+    std::vector<Address> addresses;
+    std::vector<std::unique_ptr<master::Mailbox>> mailboxes;
+    std::vector<std::unique_ptr<master::SdoClient>> clients;
+    std::vector<master::SdoClient*> sdos;
+    for (const master::SlaveInfo& s : *bus) {
+        const Address a = Address::station(s.station);
+        addresses.push_back(a);
+        // Configuration happens in PREOP.
+        if (s.al.state != static_cast<uint8_t>(master::AlState::Init) &&
+            (s.al.state != static_cast<uint8_t>(master::AlState::PreOp) || s.al.error)) {
+            if (Error e = m.request_state(a, master::AlState::PreOp); e != Error::Ok)
+                return fail(e, "taking " + slave_text(a) + " to PREOP");
+        }
+        mailboxes.push_back(std::make_unique<master::Mailbox>(m, a));
+        if (Error e = open_mailbox(m, *mailboxes.back(), a); e != Error::Ok)
+            return fail(e, "opening the mailbox of " + slave_text(a));
+        clients.push_back(std::make_unique<master::SdoClient>(*mailboxes.back()));
+        sdos.push_back(clients.back().get());
+    }
+    master::ProcessDataSession pd(m, addresses, sdos);
+    if (Error e = pd.discover(); e != Error::Ok) return fail(e, "reading the process-data layouts");
+    master::DcConfig dc;
+    dc.enable = p.dc;
+    dc.cycle_ns = p.cycle_us * 1000u;
+    // Every slave's SYNC0 gets its start time before the first one is due.
+    dc.start_delay = std::max(dc.start_delay, std::chrono::milliseconds(10 + 2 * static_cast<int64_t>(n)));
+    if (Error e = pd.configure(dc); e != Error::Ok) return fail(e, "configuring process data");
+    std::printf("%zu slaves, outputs %zu bytes, inputs %zu bytes, expected wkc %u\n", n, pd.outputs().size(),
+                pd.inputs().size(), pd.expected_wkc());
+    const auto period = std::chrono::microseconds(p.cycle_us);
+    std::vector<uint8_t> out_bytes = p.outputs;
+    auto fill = [&] {
+        for (std::size_t k = 0; k < pd.size(); ++k) {
+            auto o = pd.outputs(k);
+            std::copy_n(out_bytes.begin(), std::min(out_bytes.size(), o.size()), o.begin());
+        }
+    };
+    master::AlStatus final;
+    auto go = [&](master::AlState s, const char* name) {
+        const Error e = pd.request_state(s, period, &final, fill);
+        if (e == Error::AlRefused) {
+            std::fprintf(stderr, "ecatctl: %s refused: AL status code 0x%04x (%s)\n", name, final.code,
+                         std::string(master::al_status_code_name(final.code)).c_str());
+            return kExitProtocol;
+        }
+        return e == Error::Ok ? kExitOk : fail(e, std::string("requesting ") + name);
+    };
+    if (int rc = go(master::AlState::SafeOp, "SAFEOP"); rc != kExitOk) return rc;
+    if (p.op)
+        if (int rc = go(master::AlState::Op, "OP"); rc != kExitOk) return rc;
+    const master::CycleStats before = pd.stats();
+    for (const auto& [cycles, bytes] : p.steps) {
+        out_bytes = bytes;
+        pd.run(cycles, period, fill);
+    }
+    if (!p.outputs.empty() || p.steps.empty()) out_bytes = p.outputs;
+    pd.run(p.count, period, fill);
+    const auto& s = pd.stats();
+    const uint64_t cycles = s.cycles - before.cycles;
+    const uint64_t ok = cycles - (s.lost - before.lost);
+    const double avg =
+        ok ? static_cast<double>((s.rtt_sum - before.rtt_sum).count()) / 1000.0 / static_cast<double>(ok) : 0;
+    // Per slave: its state now and its share of the working counter; a slave that is gone or not in the
+    // state is what a working-counter error means.
+    std::vector<master::AlStatus> states(n);
+    const Error read = pd.read_states(states);
+    const uint8_t want = static_cast<uint8_t>(p.op ? master::AlState::Op : master::AlState::SafeOp);
+    bool all_there = read == Error::Ok;
+    std::printf("%-4s %-7s %-10s %-4s %-7s %-7s", "pos", "station", "state", "wkc", "out", "in");
+    std::printf(p.dc ? " %s\n" : "\n", "delay/ns");
+    for (std::size_t k = 0; k < n; ++k) {
+        const master::AlStatus& st = states[k];
+        std::string state = st.state ? std::string(master::al_state_name(st.state)) : "gone";
+        if (st.error) state += "+ERR";
+        if (st.state != want || st.error) all_there = false;
+        std::printf("%-4zu 0x%04x  %-10s %-4u %-7zu %-7zu", k, addresses[k].value, state.c_str(),
+                    pd.expected_wkc(k), pd.outputs(k).size(), pd.inputs(k).size());
+        if (p.dc && k < pd.dc_slaves().size())
+            std::printf(" %lld\n", static_cast<long long>(pd.dc_slaves()[k].delay_ns));
+        else
+            std::printf("\n");
+    }
+    std::printf(
+        "cycles %llu, lost %llu, wkc errors %llu (expected wkc %u, last %u), rtt min %.1f us, avg %.1f us, "
+        "max %.1f us\n",
+        static_cast<unsigned long long>(cycles), static_cast<unsigned long long>(s.lost - before.lost),
+        static_cast<unsigned long long>(s.wkc_errors - before.wkc_errors), pd.expected_wkc(), pd.last_wkc(),
+        static_cast<double>(s.rtt_min.count()) / 1000.0, avg,
+        static_cast<double>(s.rtt_max.count()) / 1000.0);
+    if (p.dc)
+        std::printf("reference system time %llu ns\n", static_cast<unsigned long long>(pd.reference_time()));
+    if (!p.keep) {
+        std::vector<uint16_t> stations;
+        for (const Address& a : addresses)
+            stations.push_back(a.value);
+        (void)m.request_state_all(master::AlState::PreOp, stations);
+    }
+    const bool clean = s.lost == before.lost && s.wkc_errors == before.wkc_errors && all_there;
+    return clean ? kExitOk : kExitProtocol;
+}
+
+}  // namespace ecatctl
