@@ -89,16 +89,38 @@ class Line(unittest.TestCase):
                 self.assertEqual(m.fprd(st, 0x0981, 1), b"\x03")
             delays_read = [int.from_bytes(m.fprd(st, 0x0928, 4), "little") for st in m.stations()]
             self.assertEqual(delays_read, [d & 0xFFFFFFFF for d in delays])
-            # ecatctl's own scan, if it lists DC delays (the master library's measurement), agrees on the order.
+            # ecatctl's own scan lists the DC delays of the master library's measurement: the same order.
             scan = bus.ecatctl("scan").stdout
             self.assertEqual([r[2] for r in scan_rows(scan)], ["OP"] * 3, scan)
             d = scan_delays(scan)
-            if d is not None and None not in d:
-                self.assertTrue(d[0] < d[1] < d[2], scan)
+            self.assertIsNotNone(d, scan)
+            self.assertTrue(d[0] < d[1] < d[2], scan)
             # State directories per drive: <state-dir>/drive<k>.
             bus.ecatctl("download", "1", "0x1010", "1", "save", "--type", "string")
             self.assertTrue(os.path.exists(os.path.join(bus.dir, "state", "drive2", "parameters.bin")),
                             os.listdir(os.path.join(bus.dir, "state")))
+
+
+    def test_ecatctl_pd_all_with_dc(self):
+        """The project's own master (ecatctl pd --all) on the same line: one session over all drives."""
+        require_segment(self)
+        with harness.Bus(slave_args=["--slaves", "3"]) as bus:
+            if "--all" not in bus.ecatctl("pd", "--help").stdout:
+                self.skipTest("ecatctl pd has no --all")
+            r = bus.ecatctl("pd", "--all", "--dc", "-n", "2000", "--cycle-us", "1000", check=False)
+            m = re.search(r"cycles (\d+), lost (\d+), wkc errors (\d+) \(expected wkc (\d+)", r.stdout)
+            self.assertIsNotNone(m, r.stdout + r.stderr)
+            cycles, lost, wkc_errors, expected = (int(x) for x in m.groups())
+            self.assertEqual((cycles, wkc_errors, expected), (2000, 0, 9), r.stdout)
+            self.assertLessEqual(lost, 20, r.stdout)
+            rows = re.findall(r"^(\d+)\s+0x([0-9a-f]{4})\s+(\S+)\s+(\d+)\s+(\d+)\s+(\d+)\s+(-?\d+)$", r.stdout, re.M)
+            self.assertEqual([row[2] for row in rows], ["OP"] * 3, r.stdout)
+            delays = [int(row[6]) for row in rows]
+            self.assertTrue(delays[0] < delays[1] < delays[2], r.stdout)
+            scan = bus.ecatctl("scan").stdout
+            d = scan_delays(scan)
+            self.assertIsNotNone(d, scan)
+            self.assertTrue(d[0] < d[1] < d[2], scan)
 
 
 TREE = """# a junction (four ports) with a drive on each of ports 1, 2 and 3
