@@ -4,7 +4,8 @@ import unittest
 
 import harness
 
-ROW = re.compile(r"^(\d+)\s+0x([0-9a-f]{4})\s+(\S+)\s+0x([0-9a-f]{8}) 0x([0-9a-f]{8}) 0x([0-9a-f]{8}) 0x([0-9a-f]{8}) ?(.*)$",
+ROW = re.compile(r"^(\d+)\s+0x([0-9a-f]{4})\s+(\S+)\s+0x([0-9a-f]{8}) 0x([0-9a-f]{8}) 0x([0-9a-f]{8}) 0x([0-9a-f]{8})"
+                 r"(?: +(?:-|-?\d+))? *(.*)$",  # then the DC delay in ns (- without DC) and the name
                  re.M)
 
 

@@ -107,7 +107,8 @@ class StateVerb(unittest.TestCase):
 
     def test_foe_write_defaults_to_the_device_name(self):
         scan = self.bus.ecatctl("scan").stdout
-        m = re.search(r"^0\s+0x1001\s+\S+\s+0x([0-9a-f]{8}) 0x([0-9a-f]{8}) \S+ \S+ (\S+)", scan, re.M)
+        # identity, then the DC delay column (ns, or -), then the name
+        m = re.search(r"^0\s+0x1001\s+\S+\s+0x([0-9a-f]{8}) 0x([0-9a-f]{8}) \S+ \S+ +(?:-|-?\d+) +(\S+)", scan, re.M)
         self.assertIsNotNone(m, scan)
         vendor, product, name = int(m.group(1), 16), int(m.group(2), 16), m.group(3)
         payload = bytes(i & 0xFF for i in range(3000))

@@ -17,43 +17,12 @@
 #include "master/session.hpp"
 #include "od/drive_profile.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/fixed_link.hpp"
 #include "support/master_bring_up.hpp"
 
 using namespace master;
 
-namespace {
-
-// One frame in flight, in a fixed buffer: the ESC answers in place, then the firmware runs.
-class FixedLink final : public esc::Link {
-  public:
-    FixedLink(esc::Esc& e, ecat::Stack& s, esc::ManualClock& c) : esc_(e), stack_(s), clock_(c) {}
-    int fd() const override { return -1; }
-    std::size_t receive(std::span<uint8_t> buf) override {
-        if (len_ == 0) return 0;
-        const std::size_t n = std::min(buf.size(), len_);
-        std::copy_n(frame_.begin(), n, buf.begin());
-        len_ = 0;
-        return n;
-    }
-    bool send(std::span<const uint8_t> f) override {
-        if (f.size() > frame_.size()) return false;
-        std::copy(f.begin(), f.end(), frame_.begin());
-        clock_.advance(20'000);
-        len_ = esc_.process_frame(std::span<uint8_t>(frame_.data(), f.size())) ? f.size() : 0;
-        esc_.tick();
-        stack_.poll(clock_.now_ns());
-        return true;
-    }
-
-  private:
-    esc::Esc& esc_;
-    ecat::Stack& stack_;
-    esc::ManualClock& clock_;
-    std::array<uint8_t, 2048> frame_{};
-    std::size_t len_ = 0;
-};
-
-}  // namespace
+namespace {}  // namespace
 
 TEST(MasterAllocations, CyclesAndMailboxMessagesAllocateNothing) {
     esc::ManualClock clock;
@@ -66,7 +35,13 @@ TEST(MasterAllocations, CyclesAndMailboxMessagesAllocateNothing) {
     ecat::Stack stack(esc, dict, desc, app);
     coe::CoeServer coe(dict, [&] { return stack.state(); });
     stack.add_handler(coe);
-    FixedLink link(esc, stack, clock);
+    test_support::FixedLink link([&](std::span<uint8_t> f) {
+        clock.advance(20'000);
+        const bool back = esc.process_frame(f);
+        esc.tick();
+        stack.poll(clock.now_ns());
+        return back;
+    });
     MasterOptions o;
     o.timeout = std::chrono::milliseconds(20);
     Master m(link, o);

@@ -9,6 +9,7 @@
 #include "esc/esc.hpp"
 #include "esi/wire/sii.hpp"
 #include "master/master.hpp"
+#include "support/sii_image.hpp"
 #include "support/wire_link.hpp"
 #include "util/le.hpp"
 
@@ -16,33 +17,11 @@ using namespace master;
 
 namespace {
 
-// Header + one STRINGS category + end, 2 KiB. esc_config goes to word 0 high byte (0x0141).
 std::vector<uint8_t> image(uint8_t esc_config = 0x0C) {
-    std::vector<uint16_t> w(0x40, 0);
-    w[0] = static_cast<uint16_t>(0x05 | (esc_config << 8));
-    w[8] = 0x00FB;
-    w[10] = 0x0000;
-    w[11] = 0x3001;
-    w[12] = 0x0000;
-    w[13] = 0x0120;
-    w[14] = 0x4321;
-    w[0x18] = 0x1000;
-    w[0x19] = 128;
-    w[0x1A] = 0x1080;
-    w[0x1B] = 128;
-    w[0x1C] = 0x0004;
-    w[0x3E] = 0x000F;
-    w[0x3F] = 1;
-    w.insert(w.end(), {10, 3, 0x4101, 0x4242, 0x0042, 0xFFFF});
-    std::vector<uint8_t> b;
-    for (uint16_t x : w)
-        util::append16(b, x);
-    b[14] = esi::sii::crc8(b.data(), 14);
-    b.resize(2048, 0xFF);
-    return b;
+    return test_support::small_sii_image(esc_config);
 }
 
-constexpr std::size_t kImageEnd = (0x40 + 6) * 2;
+constexpr std::size_t kImageEnd = test_support::kSmallSiiImageEnd;
 
 struct Rig {
     esc::ManualClock clock;

@@ -18,7 +18,9 @@
 #include "master/master.hpp"
 #include "master/session.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/fixed_link.hpp"
 #include "support/master_bring_up.hpp"
+#include "support/sii_image.hpp"
 #include "support/wire_link.hpp"
 #include "util/le.hpp"
 
@@ -26,31 +28,8 @@ using namespace master;
 
 namespace {
 
-constexpr uint32_t kVendor = 0x000000FB;
+constexpr uint32_t kVendor = 0x000000FB;  // test_support::small_sii_image's identity
 constexpr uint32_t kProduct = 0x30010000;
-
-// SII image: header with identity and the given serial, ESC config 0x0D (device emulation), no categories.
-std::vector<uint8_t> image(uint32_t serial) {
-    std::vector<uint16_t> w(0x40, 0);
-    w[0] = 0x0D05;  // PDI control 0x05, ESC config 0x0D (device emulation)
-    w[8] = static_cast<uint16_t>(kVendor);
-    w[9] = static_cast<uint16_t>(kVendor >> 16);
-    w[10] = static_cast<uint16_t>(kProduct);
-    w[11] = static_cast<uint16_t>(kProduct >> 16);
-    w[12] = 0x0000;
-    w[13] = 0x0120;
-    w[14] = static_cast<uint16_t>(serial);
-    w[15] = static_cast<uint16_t>(serial >> 16);
-    w[0x3E] = 0x000F;
-    w[0x3F] = 1;
-    w.push_back(0xFFFF);
-    std::vector<uint8_t> b;
-    for (uint16_t x : w)
-        util::append16(b, x);
-    b[14] = esi::sii::crc8(b.data(), 14);
-    b.resize(2048, 0xFF);
-    return b;
-}
 
 // A segment of ESCs and a master whose link walks every frame through it.
 struct Line {
@@ -70,7 +49,7 @@ struct Line {
         // Every device's local clock is somewhere else, as after power-on.
         cfg.clock_offset_ns = static_cast<int64_t>(escs.size() + 1) * 1'234'567'891;
         escs.push_back(std::make_unique<esc::Esc>(cfg, clock));
-        escs.back()->load_eeprom(image(static_cast<uint32_t>(escs.size())));
+        escs.back()->load_eeprom(test_support::small_sii_image(0x0D, static_cast<uint32_t>(escs.size())));
         return seg.add(*escs.back());
     }
     void line(int n) {
@@ -79,35 +58,24 @@ struct Line {
             if (k > 0) seg.connect(k - 1, 1, k, 0);
         }
     }
+    // The line scanned and one process-data session over all of it, every slave with `layout` (null, after
+    // a failed assertion, if the scan failed).
+    std::vector<SlaveInfo> bus;
+    std::unique_ptr<ProcessDataSession> session(const ProcessDataLayout& layout) {
+        auto scanned = scan_bus(m, {.first_station = 0x1001, .identity = false});
+        EXPECT_TRUE(scanned.ok()) << to_string(scanned.error());
+        if (!scanned) return nullptr;
+        bus = *scanned;
+        std::vector<Address> a;
+        for (const SlaveInfo& s : bus)
+            a.push_back(Address::station(s.station));
+        auto pd = std::make_unique<ProcessDataSession>(m, a);
+        for (std::size_t k = 0; k < pd->size(); ++k)
+            pd->set_layout(k, layout);
+        return pd;
+    }
     // The ESC at a master position (processing order).
     esc::Esc& at(std::size_t position) { return seg.esc(seg.order()[position]); }
-};
-
-// One frame in flight in a fixed buffer, walked through the segment in place: nothing allocated per frame.
-class FixedSegmentLink final : public esc::Link {
-  public:
-    FixedSegmentLink(esc::Segment& s, esc::ManualClock& c) : seg_(s), clock_(c) {}
-    int fd() const override { return -1; }
-    std::size_t receive(std::span<uint8_t> buf) override {
-        const std::size_t n = std::min(buf.size(), len_);
-        std::copy_n(frame_.begin(), n, buf.begin());
-        len_ = 0;
-        return n;
-    }
-    bool send(std::span<const uint8_t> f) override {
-        if (f.size() > frame_.size()) return false;
-        std::copy(f.begin(), f.end(), frame_.begin());
-        clock_.advance(20'000);
-        const auto r = seg_.walk(std::span<uint8_t>(frame_.data(), f.size()), clock_.now_ns());
-        len_ = r.kind == esc::Segment::Result::Kind::Reply ? f.size() : 0;
-        return true;
-    }
-
-  private:
-    esc::Segment& seg_;
-    esc::ManualClock& clock_;
-    std::array<uint8_t, 2048> frame_{};
-    std::size_t len_ = 0;
 };
 
 // The layout of a small drive: 4 output bytes in SM2, 6 input bytes in SM3.
@@ -118,6 +86,19 @@ ProcessDataLayout small_layout() {
     l.sm3_start = 0x1180;
     l.sm3_length = 6;
     return l;
+}
+
+// A larger drive: 12 output bytes, 20 input bytes (a hundred of them need more than one frame).
+ProcessDataLayout big_layout() {
+    ProcessDataLayout l = small_layout();
+    l.sm2_length = 12;
+    l.sm3_length = 20;
+    return l;
+}
+
+void set_layouts(ProcessDataSession& pd, const ProcessDataLayout& layout) {
+    for (std::size_t k = 0; k < pd.size(); ++k)
+        pd.set_layout(k, layout);
 }
 
 std::vector<Address> stations(const std::vector<SlaveInfo>& bus) {
@@ -222,12 +203,9 @@ TEST(MasterOnSegment, DcDelaysInATree) {
 TEST(MasterOnSegment, OneLrwOverEverySlaveWithTheSumOfTheirWorkingCounters) {
     Line l;
     l.line(5);
-    auto bus = scan_bus(l.m);
-    ASSERT_TRUE(bus.ok());
-    const auto addr = stations(*bus);
-    ProcessDataSession pd(l.m, addr);
-    for (std::size_t k = 0; k < pd.size(); ++k)
-        pd.set_layout(k, small_layout());
+    auto session = l.session(small_layout());
+    ASSERT_TRUE(session);
+    ProcessDataSession& pd = *session;
     ASSERT_EQ(pd.configure(), Error::Ok);
     EXPECT_EQ(pd.expected_wkc(), 5 * 3);
     EXPECT_EQ(pd.outputs().size(), 5u * 4);
@@ -258,14 +236,9 @@ TEST(MasterOnSegment, OneLrwOverEverySlaveWithTheSumOfTheirWorkingCounters) {
 TEST(MasterOnSegment, ImageLargerThanOneFrameIsSplitAndStillAddsUp) {
     Line l;
     l.line(100);
-    auto bus = scan_bus(l.m, {.first_station = 0x1001, .identity = false});
-    ASSERT_TRUE(bus.ok());
-    ProcessDataSession pd(l.m, stations(*bus));
-    ProcessDataLayout big = small_layout();
-    big.sm2_length = 12;
-    big.sm3_length = 20;
-    for (std::size_t k = 0; k < pd.size(); ++k)
-        pd.set_layout(k, big);
+    auto session = l.session(big_layout());
+    ASSERT_TRUE(session);
+    ProcessDataSession& pd = *session;
     ASSERT_EQ(pd.configure(), Error::Ok);
     EXPECT_GT(pd.frames_per_cycle(), 1u);
     EXPECT_EQ(pd.expected_wkc(), 300);
@@ -276,11 +249,9 @@ TEST(MasterOnSegment, ImageLargerThanOneFrameIsSplitAndStillAddsUp) {
 TEST(MasterOnSegment, DcSessionStartsSync0EverywhereAtTheSameTime) {
     Line l;
     l.line(4);
-    auto bus = scan_bus(l.m);
-    ASSERT_TRUE(bus.ok());
-    ProcessDataSession pd(l.m, stations(*bus));
-    for (std::size_t k = 0; k < pd.size(); ++k)
-        pd.set_layout(k, small_layout());
+    auto session = l.session(small_layout());
+    ASSERT_TRUE(session);
+    ProcessDataSession& pd = *session;
     DcConfig dc;
     dc.enable = true;
     dc.cycle_ns = 1'000'000;
@@ -303,11 +274,9 @@ TEST(MasterOnSegment, DcSessionStartsSync0EverywhereAtTheSameTime) {
 TEST(MasterOnSegment, PulledCableGivesAWorkingCounterErrorAndRecovers) {
     Line l;
     l.line(5);
-    auto bus = scan_bus(l.m);
-    ASSERT_TRUE(bus.ok());
-    ProcessDataSession pd(l.m, stations(*bus));
-    for (std::size_t k = 0; k < pd.size(); ++k)
-        pd.set_layout(k, small_layout());
+    auto session = l.session(small_layout());
+    ASSERT_TRUE(session);
+    ProcessDataSession& pd = *session;
     ASSERT_EQ(pd.configure(), Error::Ok);
     ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(100)), Error::Ok);
     ASSERT_EQ(pd.cycle(), Error::Ok);
@@ -334,16 +303,15 @@ TEST(MasterOnSegment, PulledCableGivesAWorkingCounterErrorAndRecovers) {
 TEST(MasterOnSegment, CyclesOverAHundredSlavesWithDcAllocateNothing) {
     Line l;
     l.line(100);
-    FixedSegmentLink link(l.seg, l.clock);
+    test_support::FixedLink link([&](std::span<uint8_t> f) {
+        l.clock.advance(20'000);
+        return l.seg.walk(f, l.clock.now_ns()).kind == esc::Segment::Result::Kind::Reply;
+    });
     Master m(link, test_support::in_process_master_options());
     auto bus = scan_bus(m, {.first_station = 0x1001, .identity = false});
     ASSERT_TRUE(bus.ok());
     ProcessDataSession pd(m, stations(*bus));
-    ProcessDataLayout big = small_layout();
-    big.sm2_length = 12;
-    big.sm3_length = 20;
-    for (std::size_t k = 0; k < pd.size(); ++k)
-        pd.set_layout(k, big);
+    set_layouts(pd, big_layout());
     DcConfig dc;
     dc.enable = true;
     ASSERT_EQ(pd.configure(dc), Error::Ok);

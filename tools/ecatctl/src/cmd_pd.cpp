@@ -70,6 +70,54 @@ std::optional<Step> parse_step(const std::string& text) {
     return st;
 }
 
+}  // namespace
+
+int pd_to_state(master::ProcessDataSession& pd, bool op, std::chrono::microseconds period,
+                const std::function<void()>& fill) {
+    master::AlStatus final;
+    auto go = [&](master::AlState s, const char* name) {
+        const Error e = pd.request_state(s, period, &final, fill);
+        if (e == Error::AlRefused) {
+            std::fprintf(stderr, "ecatctl: %s refused: AL status code 0x%04x (%s)\n", name, final.code,
+                         std::string(master::al_status_code_name(final.code)).c_str());
+            return kExitProtocol;
+        }
+        return e == Error::Ok ? kExitOk : fail(e, std::string("requesting ") + name);
+    };
+    if (int rc = go(master::AlState::SafeOp, "SAFEOP"); rc != kExitOk) return rc;
+    return op ? go(master::AlState::Op, "OP") : kExitOk;
+}
+
+void pd_run(master::ProcessDataSession& pd, const std::vector<PdStep>& steps, uint64_t count,
+            std::chrono::microseconds period, std::vector<uint8_t>& out_bytes,
+            const std::function<void()>& fill) {
+    const std::vector<uint8_t> final_outputs = out_bytes;
+    for (const auto& [cycles, bytes] : steps) {
+        out_bytes = bytes;
+        pd.run(cycles, period, fill);
+    }
+    if (!final_outputs.empty() || steps.empty())
+        out_bytes = final_outputs;  // else the last step's bytes stay
+    pd.run(count, period, fill);
+}
+
+void print_pd_cycles(const master::ProcessDataSession& pd, const master::CycleStats& before) {
+    const auto& s = pd.stats();
+    const uint64_t cycles = s.cycles - before.cycles;
+    const uint64_t ok = cycles - (s.lost - before.lost);
+    const double avg =
+        ok ? static_cast<double>((s.rtt_sum - before.rtt_sum).count()) / 1000.0 / static_cast<double>(ok) : 0;
+    std::printf(
+        "cycles %llu, lost %llu, wkc errors %llu (expected wkc %u), rtt min %.1f us, avg %.1f us, max %.1f "
+        "us\n",
+        static_cast<unsigned long long>(cycles), static_cast<unsigned long long>(s.lost - before.lost),
+        static_cast<unsigned long long>(s.wkc_errors - before.wkc_errors), pd.expected_wkc(),
+        static_cast<double>(s.rtt_min.count()) / 1000.0, avg,
+        static_cast<double>(s.rtt_max.count()) / 1000.0);
+}
+
+namespace {
+
 int process_data(master::Master& m, const PdArgs& p) {
     auto pos = parse_number(p.slave, 0xFFFF);
     if (!pos && !p.all) return usage("bad slave '" + p.slave + "'");
@@ -93,7 +141,7 @@ int process_data(master::Master& m, const PdArgs& p) {
         all.op = t == "OP";
         all.outputs = out_bytes;
         for (const std::string& text : p.steps) {
-            auto step = parse_step(text);
+            auto step = parse_step(text);  // validated above
             all.steps.emplace_back(step->cycles, step->bytes);
         }
         all.keep = p.keep;
@@ -137,43 +185,19 @@ int process_data(master::Master& m, const PdArgs& p) {
         auto o = pd.outputs();
         std::copy_n(out_bytes.begin(), std::min(out_bytes.size(), o.size()), o.begin());
     };
-    master::AlStatus final;
-    auto go = [&](master::AlState s, const char* name) {
-        const Error e = pd.request_state(s, period, &final, fill);
-        if (e == Error::AlRefused) {
-            std::fprintf(stderr, "ecatctl: %s refused: AL status code 0x%04x (%s)\n", name, final.code,
-                         std::string(master::al_status_code_name(final.code)).c_str());
-            return kExitProtocol;
-        }
-        return e == Error::Ok ? kExitOk : fail(e, std::string("requesting ") + name);
-    };
-    if (int rc = go(master::AlState::SafeOp, "SAFEOP"); rc != kExitOk) return rc;
-    if (t == "OP")
-        if (int rc = go(master::AlState::Op, "OP"); rc != kExitOk) return rc;
+    if (int rc = pd_to_state(pd, t == "OP", period, fill); rc != kExitOk) return rc;
     const master::CycleStats before = pd.stats();
-    const std::vector<uint8_t> final_outputs = out_bytes;
+    std::vector<PdStep> steps;
     for (const std::string& text : p.steps) {
         auto step = parse_step(text);  // validated before anything was sent
-        out_bytes = step->bytes;
-        pd.run(step->cycles, period, fill);
+        steps.emplace_back(step->cycles, step->bytes);
     }
-    if (!p.outputs.empty() || p.steps.empty()) out_bytes = final_outputs;  // else the last step's bytes stay
-    pd.run(p.count, period, fill);
+    pd_run(pd, steps, p.count, period, out_bytes, fill);
     const auto& s = pd.stats();
-    const uint64_t cycles = s.cycles - before.cycles;
-    const uint64_t ok = cycles - (s.lost - before.lost);
-    const double avg =
-        ok ? static_cast<double>((s.rtt_sum - before.rtt_sum).count()) / 1000.0 / static_cast<double>(ok) : 0;
     auto now = m.al_status(a);
     std::printf("state: %s%s\n", now ? std::string(master::al_state_name(now->state)).c_str() : "?",
                 now && now->error ? " +ERR" : "");
-    std::printf(
-        "cycles %llu, lost %llu, wkc errors %llu (expected wkc %u), rtt min %.1f us, avg %.1f us, max %.1f "
-        "us\n",
-        static_cast<unsigned long long>(cycles), static_cast<unsigned long long>(s.lost - before.lost),
-        static_cast<unsigned long long>(s.wkc_errors - before.wkc_errors), pd.expected_wkc(),
-        static_cast<double>(s.rtt_min.count()) / 1000.0, avg,
-        static_cast<double>(s.rtt_max.count()) / 1000.0);
+    print_pd_cycles(pd, before);
     if (p.dc)
         std::printf("reference system time %llu ns\n", static_cast<unsigned long long>(pd.reference_time()));
     std::printf("inputs:\n%s", hex_dump(0, pd.inputs()).c_str());

@@ -30,25 +30,21 @@ int process_data_all(master::Master& m, const PdAllArgs& p) {
     }
     const std::size_t n = bus->size();
     std::vector<Address> addresses;
-    std::vector<std::unique_ptr<master::Mailbox>> mailboxes;
-    std::vector<std::unique_ptr<master::SdoClient>> clients;
-    std::vector<master::SdoClient*> sdos;
-    for (const master::SlaveInfo& s : *bus) {
-        const Address a = Address::station(s.station);
-        addresses.push_back(a);
+    for (const master::SlaveInfo& s : *bus)
+        addresses.push_back(Address::station(s.station));
+    master::SdoClients sdos;
+    const Error opened = sdos.open(m, addresses, [&](master::Mailbox& mbx, Address a) {
+        const master::SlaveInfo& s = (*bus)[a.value - 0x1001u];
         // Configuration happens in PREOP.
         if (s.al.state != static_cast<uint8_t>(master::AlState::Init) &&
             (s.al.state != static_cast<uint8_t>(master::AlState::PreOp) || s.al.error)) {
-            if (Error e = m.request_state(a, master::AlState::PreOp); e != Error::Ok)
-                return fail(e, "taking " + slave_text(a) + " to PREOP");
+            if (Error e = m.request_state(a, master::AlState::PreOp); e != Error::Ok) return e;
         }
-        mailboxes.push_back(std::make_unique<master::Mailbox>(m, a));
-        if (Error e = open_mailbox(m, *mailboxes.back(), a); e != Error::Ok)
-            return fail(e, "opening the mailbox of " + slave_text(a));
-        clients.push_back(std::make_unique<master::SdoClient>(*mailboxes.back()));
-        sdos.push_back(clients.back().get());
-    }
-    master::ProcessDataSession pd(m, addresses, sdos);
+        return open_mailbox(m, mbx, a);
+    });
+    if (opened != Error::Ok)
+        return fail(opened, "opening the mailbox of " + slave_text(addresses[sdos.failed()]));
+    master::ProcessDataSession pd(m, addresses, sdos.clients());
     if (Error e = pd.discover(); e != Error::Ok) return fail(e, "reading the process-data layouts");
     master::DcConfig dc;
     dc.enable = p.dc;
@@ -66,31 +62,10 @@ int process_data_all(master::Master& m, const PdAllArgs& p) {
             std::copy_n(out_bytes.begin(), std::min(out_bytes.size(), o.size()), o.begin());
         }
     };
-    master::AlStatus final;
-    auto go = [&](master::AlState s, const char* name) {
-        const Error e = pd.request_state(s, period, &final, fill);
-        if (e == Error::AlRefused) {
-            std::fprintf(stderr, "ecatctl: %s refused: AL status code 0x%04x (%s)\n", name, final.code,
-                         std::string(master::al_status_code_name(final.code)).c_str());
-            return kExitProtocol;
-        }
-        return e == Error::Ok ? kExitOk : fail(e, std::string("requesting ") + name);
-    };
-    if (int rc = go(master::AlState::SafeOp, "SAFEOP"); rc != kExitOk) return rc;
-    if (p.op)
-        if (int rc = go(master::AlState::Op, "OP"); rc != kExitOk) return rc;
+    if (int rc = pd_to_state(pd, p.op, period, fill); rc != kExitOk) return rc;
     const master::CycleStats before = pd.stats();
-    for (const auto& [cycles, bytes] : p.steps) {
-        out_bytes = bytes;
-        pd.run(cycles, period, fill);
-    }
-    if (!p.outputs.empty() || p.steps.empty()) out_bytes = p.outputs;
-    pd.run(p.count, period, fill);
+    pd_run(pd, p.steps, p.count, period, out_bytes, fill);
     const auto& s = pd.stats();
-    const uint64_t cycles = s.cycles - before.cycles;
-    const uint64_t ok = cycles - (s.lost - before.lost);
-    const double avg =
-        ok ? static_cast<double>((s.rtt_sum - before.rtt_sum).count()) / 1000.0 / static_cast<double>(ok) : 0;
     // Per slave: its state now and its share of the working counter; a slave that is gone or not in the
     // state is what a working-counter error means.
     std::vector<master::AlStatus> states(n);
@@ -111,13 +86,7 @@ int process_data_all(master::Master& m, const PdAllArgs& p) {
         else
             std::printf("\n");
     }
-    std::printf(
-        "cycles %llu, lost %llu, wkc errors %llu (expected wkc %u, last %u), rtt min %.1f us, avg %.1f us, "
-        "max %.1f us\n",
-        static_cast<unsigned long long>(cycles), static_cast<unsigned long long>(s.lost - before.lost),
-        static_cast<unsigned long long>(s.wkc_errors - before.wkc_errors), pd.expected_wkc(), pd.last_wkc(),
-        static_cast<double>(s.rtt_min.count()) / 1000.0, avg,
-        static_cast<double>(s.rtt_max.count()) / 1000.0);
+    print_pd_cycles(pd, before);
     if (p.dc)
         std::printf("reference system time %llu ns\n", static_cast<unsigned long long>(pd.reference_time()));
     if (!p.keep) {

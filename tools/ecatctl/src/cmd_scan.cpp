@@ -76,9 +76,13 @@ int scan(master::Master& m, bool dc) {
             const esi::SiiInfo info = esi::parse_sii(*img);
             if (info.general) name = info.general->name;
         }
-        std::printf("%-4u 0x%04x  %-10s 0x%08x 0x%08x 0x%08x 0x%08x %-9s %s\n", s.position, s.station,
-                    state.c_str(), s.vendor_id, s.product_code, s.revision, s.serial, delay.c_str(),
-                    name.c_str());
+        char row[256];
+        std::snprintf(row, sizeof row, "%-4u 0x%04x  %-10s 0x%08x 0x%08x 0x%08x 0x%08x %-9s %s", s.position,
+                      s.station, state.c_str(), s.vendor_id, s.product_code, s.revision, s.serial,
+                      delay.c_str(), name.c_str());
+        std::string line = row;
+        line.erase(line.find_last_not_of(' ') + 1);  // no trailing blanks when there is no name
+        std::printf("%s\n", line.c_str());
     }
     return rc;
 }

@@ -8,7 +8,9 @@
 //   diag                     cmd_diag.cpp     firmware-update        cmd_firmware.cpp
 //   slaves, pdos, cstruct, xml (the IgH/SOEM-style verbs)          cmd_verbs.hpp
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -18,6 +20,7 @@
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
+#include "master/session.hpp"
 
 namespace ecatctl {
 
@@ -36,10 +39,19 @@ struct PdAllArgs {
     bool dc = false;
     bool op = true;                // else SAFEOP
     std::vector<uint8_t> outputs;  // sent to every slave (from its first output byte)
-    std::vector<std::pair<uint64_t, std::vector<uint8_t>>> steps;
+    std::vector<std::pair<uint64_t, std::vector<uint8_t>>> steps;  // --step: cycles and output bytes
     bool keep = false;
 };
 int process_data_all(master::Master& m, const PdAllArgs& p);
+// What both forms of pd share (cmd_pd.cpp): SAFEOP then (op) OP while cycling, a refusal reported with its
+// AL status code; the --step cycles then `count` cycles with out_bytes; the cycle statistics line.
+using PdStep = std::pair<uint64_t, std::vector<uint8_t>>;
+int pd_to_state(master::ProcessDataSession& pd, bool op, std::chrono::microseconds period,
+                const std::function<void()>& fill);
+void pd_run(master::ProcessDataSession& pd, const std::vector<PdStep>& steps, uint64_t count,
+            std::chrono::microseconds period, std::vector<uint8_t>& out_bytes,
+            const std::function<void()>& fill);
+void print_pd_cycles(const master::ProcessDataSession& pd, const master::CycleStats& before);
 
 // ---- cli_support.cpp -----------------------------------------------------------------------------
 

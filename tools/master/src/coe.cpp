@@ -315,4 +315,16 @@ Result<EntryDescription> SdoClient::entry_description(uint16_t index, uint8_t su
     return d;
 }
 
+Error SdoClients::open(Master& master, std::span<const Address> slaves,
+                       const std::function<Error(Mailbox&, Address)>& open_each) {
+    for (std::size_t k = 0; k < slaves.size(); ++k) {
+        mailboxes_.push_back(std::make_unique<Mailbox>(master, slaves[k]));
+        failed_ = k;
+        if (Error e = open_each(*mailboxes_.back(), slaves[k]); e != Error::Ok) return e;
+        clients_.push_back(std::make_unique<SdoClient>(*mailboxes_.back()));
+        pointers_.push_back(clients_.back().get());
+    }
+    return Error::Ok;
+}
+
 }  // namespace master

@@ -98,6 +98,39 @@ Error Master::exchange(std::span<Datagram> datagrams, unsigned retries) {
     return Error::Timeout;
 }
 
+Error Master::exchange_frames(std::span<const std::span<Datagram>> frames) {
+    constexpr std::size_t kMaxFrames = 64;
+    if (frames.empty() || frames.size() > kMaxFrames) return Error::InvalidArgument;
+    std::array<uint8_t, kMaxFrames> first{};
+    const auto sent_at = Clock::now();
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+        const std::span<Datagram> d = frames[k];
+        if (d.empty() || d.size() > 255) return Error::InvalidArgument;
+        first[k] = next_index_;
+        next_index_ = static_cast<uint8_t>(next_index_ + d.size());
+        const std::size_t n = encode_frame(d, first[k], options_.source_mac, tx_);
+        if (n == 0) return Error::InvalidArgument;
+        if (!link_.send(std::span<const uint8_t>(tx_.data(), n))) return Error::SendFailed;
+        ++stats_.frames_sent;
+    }
+    Error result = Error::Ok;
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+        const Error e = wait_frame(first[k], frames[k], sent_at + options_.timeout);
+        if (e == Error::Timeout) {
+            ++stats_.timeouts;
+            result = Error::Timeout;
+            continue;
+        }
+        if (e != Error::Ok) return e;
+    }
+    if (result == Error::Ok) {
+        const auto rtt = std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - sent_at);
+        stats_.last_round_trip = rtt;
+        stats_.max_round_trip = std::max(stats_.max_round_trip, rtt);
+    }
+    return result;
+}
+
 Error Master::wait_frame(uint8_t first_index, std::span<Datagram> datagrams, Clock::time_point deadline) {
     for (;;) {
         const std::size_t n = link_.receive(rx_);

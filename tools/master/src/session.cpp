@@ -170,7 +170,7 @@ Error ProcessDataSession::configure(const DcConfig& dc) {
         }
         Chunk c;
         const uint32_t pos = static_cast<uint32_t>(at);
-        c.lrw =
+        c.dg[0] =
             Datagram::logical(Command::LRW, kLogicalBase + pos, std::span<uint8_t>(image_.data() + at, len));
         for (const Slave& s : slaves_) {
             if (overlaps(pos, static_cast<uint32_t>(len), s.out_offset, s.layout.sm2_length))
@@ -180,6 +180,9 @@ Error ProcessDataSession::configure(const DcConfig& dc) {
         }
         chunks_.push_back(c);
     }
+    frames_.clear();
+    for (Chunk& c : chunks_)
+        frames_.emplace_back(c.dg, c.count);
     states_.assign(slaves_.size(), AlStatus{});
     state_buf_.assign(kStatesPerFrame * 6, 0);
     if (dc.enable) return configure_dc(dc);
@@ -285,11 +288,15 @@ Error ProcessDataSession::configure_dc(const DcConfig& dc) {
         if (Error e = m_.write(s.address, esc::reg::kDcStartTime, st); e != Error::Ok) return e;
         if (Error e = m_.write(s.address, esc::reg::kDcCyclicControl, aa); e != Error::Ok) return e;
     }
-    // From now on every cycle carries an FRMW of the reference clock's system time.
-    frame_[1] = Datagram{Command::FRMW, reference_, reg::DcSystemTime, time_};
+    // From now on every cycle carries an FRMW of the reference clock's system time (in its first frame).
     dc_ = true;
     for (const Slave& s : slaves_)
         if (s.address.mode != Address::Mode::Station) dc_ = false;
+    if (dc_ && !chunks_.empty()) {
+        chunks_.front().dg[1] = Datagram{Command::FRMW, reference_, reg::DcSystemTime, time_};
+        chunks_.front().count = 2;
+        frames_.front() = std::span<Datagram>(chunks_.front().dg, 2);
+    }
     return Error::Ok;
 }
 
@@ -297,22 +304,15 @@ Error ProcessDataSession::cycle() {
     if (image_.empty()) return Error::InvalidArgument;
     const auto t0 = Clock::now();
     ++stats_.cycles;
+    for (Chunk& c : chunks_)
+        c.dg[0].wkc = 0;  // a frame that does not come back counts nothing
+    const Error e = m_.exchange_frames(frames_);
+    if (e != Error::Ok && e != Error::Timeout) return e;
+    const bool lost = e == Error::Timeout;
     uint16_t wkc = 0;
-    bool lost = false;
-    for (std::size_t k = 0; k < chunks_.size(); ++k) {
-        Chunk& c = chunks_[k];
-        frame_[0] = c.lrw;
-        const std::size_t n = (k == 0 && dc_) ? 2 : 1;
-        const Error e = m_.exchange(std::span<Datagram>(frame_, n), 0);
-        if (e == Error::Timeout) {
-            lost = true;
-            continue;
-        }
-        if (e != Error::Ok) return e;
-        c.lrw.wkc = frame_[0].wkc;
-        wkc = static_cast<uint16_t>(wkc + frame_[0].wkc);
-        if (n == 2) ref_time_ = get64(time_.data());
-    }
+    for (const Chunk& c : chunks_)
+        wkc = static_cast<uint16_t>(wkc + c.dg[0].wkc);
+    if (!lost && chunks_.front().count == 2) ref_time_ = get64(time_.data());
     last_wkc_ = wkc;
     if (lost) {
         ++stats_.lost;

@@ -4,6 +4,8 @@
 // kept (the last one) and counted. Buffers are allocated at construction.
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -80,5 +82,22 @@ class SdoClient {
 
 // Text of an SDO abort code (ETG.1000.6), "unknown abort code" if not in the table.
 std::string_view sdo_abort_text(uint32_t code);
+
+// A mailbox and an SDO client for each of several slaves (a line in one process-data session). open_each
+// gets each mailbox going (SM0/SM1 from the SII, the slave to PREOP, ...); the first failure stops it and
+// failed() names the slave (index into `slaves`).
+class SdoClients {
+  public:
+    Error open(Master& master, std::span<const Address> slaves,
+               const std::function<Error(Mailbox&, Address)>& open_each);
+    std::span<SdoClient* const> clients() const { return pointers_; }
+    std::size_t failed() const { return failed_; }
+
+  private:
+    std::vector<std::unique_ptr<Mailbox>> mailboxes_;
+    std::vector<std::unique_ptr<SdoClient>> clients_;
+    std::vector<SdoClient*> pointers_;
+    std::size_t failed_ = 0;
+};
 
 }  // namespace master

@@ -120,6 +120,10 @@ class Master {
     // blindly, such as the read of a mailbox whose reply may have been lost).
     Error exchange(std::span<Datagram> datagrams, unsigned retries);
     Error exchange(Datagram& datagram) { return exchange(std::span<Datagram>(&datagram, 1)); }
+    // Several frames at once (a process-data image larger than one frame): all sent back to back, then
+    // their replies collected in the same order, without retries. Every frame whose reply came is filled;
+    // Error::Timeout if any reply is missing. Allocates nothing.
+    Error exchange_frames(std::span<const std::span<Datagram>> frames);
 
     // ---- Registers -------------------------------------------------------------------------------
     // APRD/FPRD and APWR/FPWR; the working counter must be 1.

@@ -5,9 +5,9 @@
 // assignment 0x1C12/0x1C13 and the mapping objects over CoE), sets up its SM2/SM3 and two FMMUs into one
 // logical image (the outputs of all slaves back to back, then their inputs), optionally distributed clocks
 // (delays and offsets measured over the line, SYNC0 on every slave with the same start time), and exchanges
-// outputs and inputs with one LRW per cycle (split over several frames only when the image does not fit one),
-// plus an FRMW of the reference clock's system time when DC is on. Expected working counter: the sum over the
-// slaves of 2 (outputs written) + 1 (inputs read). cycle() allocates nothing.
+// outputs and inputs with one LRW per cycle (split over several frames, sent back to back, only when the
+// image does not fit one), plus an FRMW of the reference clock's system time when DC is on. Expected working
+// counter: the sum over the slaves of 2 (outputs written) + 1 (inputs read). cycle() allocates nothing.
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -110,7 +110,8 @@ class ProcessDataSession {
     };
     // One frame of the cycle: an LRW over part of the image (the FRMW of DC rides in the first).
     struct Chunk {
-        Datagram lrw;
+        Datagram dg[2];  // the LRW, then the FRMW in the first frame with DC
+        std::size_t count = 1;
         uint16_t expected_wkc = 0;
     };
     Error discover(Slave& s);
@@ -127,8 +128,8 @@ class ProcessDataSession {
     uint16_t reference_ = 0;  // station address of the reference clock
     std::vector<uint8_t> image_;
     std::vector<Chunk> chunks_;
+    std::vector<std::span<Datagram>> frames_;  // the datagrams of each chunk, for Master::exchange_frames
     std::array<uint8_t, 8> time_{};
-    Datagram frame_[2];
     uint16_t last_wkc_ = 0;
     uint64_t ref_time_ = 0;
     CycleStats stats_;

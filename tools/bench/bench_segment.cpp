@@ -1,0 +1,390 @@
+// bench-segment: a segment of N soft drives in ONE process, driven by a master thread at 1 kHz with DC.
+// For each N (default 1, 10, 100): a veth pair in a private network namespace; on one end the slave
+// runtime (slave::Runtime over a device::Line of N drives, the segment of ecat-slave --slaves N) in its own
+// thread; on the other the master library: the whole line scanned, DC delays and offsets measured, every
+// drive's SM2/SM3 in one LRW image, SYNC0 on all at one start time, all to OP, every drive in CSP (mode 8,
+// controlword 6 -> 7 -> 15, a target position ramp). Then --seconds of cycles at 1 kHz, and afterwards the
+// same cyclic frame against a bare echo on the same veth pair (the slave thread replaced by one that sends
+// each frame straight back).
+//
+// Prints per N: the processing time of one frame through the whole segment (from the runtime's receive()
+// of the frame to its send() of the reply; median/p99), the CPU time of the slave thread per cycle as % of
+// one core at 1 kHz (CLOCK_THREAD_CPUTIME_ID of that thread over the measured window, per cycle), missed
+// cycles (the master loop woke a whole period late), lost frames and working-counter errors, the round trip
+// of the cyclic frame and of the bare echo (median/p99 and their ratios) and the allocations per cycle of the
+// whole process during the measured window (a counting global operator new). Asserts nothing. Needs root.
+#include <poll.h>
+#include <pthread.h>
+#include <sched.h>
+#include <time.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "device/line.hpp"
+#include "esc/clock.hpp"
+#include "esc/link.hpp"
+#include "harness.hpp"
+#include "master/bus.hpp"
+#include "master/coe.hpp"
+#include "master/mailbox.hpp"
+#include "master/master.hpp"
+#include "master/session.hpp"
+#include "slave/netif.hpp"
+#include "slave/runtime.hpp"
+#include "slave/topology.hpp"
+#include "stats.hpp"
+#include "support/alloc_counter.hpp"
+#include "util/le.hpp"
+
+namespace {
+
+using master::Address;
+using master::Error;
+
+constexpr const char* kSlaveEnd = "seg-s0";
+constexpr const char* kMasterEnd = "seg-m0";
+constexpr auto kPeriod = std::chrono::microseconds(1000);
+
+// The slave's link with a stopwatch: the time from receive() handing a frame to the runtime until the
+// runtime send()s the reply is the frame's way through the segment. Samples go to a preallocated ring.
+class TimedLink final : public esc::Link {
+  public:
+    explicit TimedLink(esc::Link& inner, std::size_t capacity) : inner_(inner), samples_(capacity) {}
+    int fd() const override { return inner_.fd(); }
+    std::size_t receive(std::span<uint8_t> buf) override {
+        const std::size_t n = inner_.receive(buf);
+        if (n) received_at_ = bench::now_ns();
+        return n;
+    }
+    bool send(std::span<const uint8_t> frame) override {
+        if (received_at_ && recording_.load(std::memory_order_relaxed) && count_ < samples_.size())
+            samples_[count_++] = bench::now_ns() - received_at_;
+        received_at_ = 0;
+        return inner_.send(frame);
+    }
+    std::string describe() const override { return inner_.describe(); }
+    void record(bool on) { recording_.store(on); }
+    std::vector<uint64_t> samples() const { return {samples_.begin(), samples_.begin() + count_}; }
+
+  private:
+    esc::Link& inner_;
+    std::vector<uint64_t> samples_;
+    std::size_t count_ = 0;
+    uint64_t received_at_ = 0;
+    std::atomic<bool> recording_{false};
+};
+
+uint64_t thread_cpu_ns(clockid_t id) {
+    timespec ts{};
+    clock_gettime(id, &ts);
+    return static_cast<uint64_t>(ts.tv_sec) * 1'000'000'000ull + static_cast<uint64_t>(ts.tv_nsec);
+}
+
+// Byte offset of object (index, sub) in the PDOs the assignment object lists, -1 if it is not mapped.
+int pdo_offset(master::SdoClient& sdo, uint16_t assign, uint16_t index, uint8_t sub) {
+    uint8_t b[4] = {};
+    if (!sdo.upload(assign, 0, b)) return -1;
+    const uint8_t pdos = b[0];
+    uint32_t bits = 0;
+    for (uint8_t p = 1; p <= pdos; ++p) {
+        if (!sdo.upload(assign, p, b)) return -1;
+        const uint16_t pdo = util::get16(b);
+        if (!sdo.upload(pdo, 0, b)) return -1;
+        const uint8_t entries = b[0];
+        for (uint8_t e = 1; e <= entries; ++e) {
+            if (!sdo.upload(pdo, e, b)) return -1;
+            const uint32_t entry = util::get32(b);
+            if ((entry >> 16) == index && ((entry >> 8) & 0xFF) == sub) return static_cast<int>(bits / 8);
+            bits += entry & 0xFF;
+        }
+    }
+    return -1;
+}
+
+struct DriveIo {
+    int cw = -1, mode = -1, target = -1;  // outputs
+    int sw = -1, pos = -1;                // inputs
+};
+
+struct Figures {
+    std::size_t drives = 0;
+    bench::Summary walk, rtt, echo;
+    double cpu_percent = 0, cpu_wall_percent = 0, cpu_us_per_cycle = 0, allocs_per_cycle = 0;
+    uint64_t cycles = 0, missed = 0, lost = 0, wkc_errors = 0, enabled = 0;
+    std::size_t frames_per_cycle = 0;
+};
+
+void sleep_until_ns(uint64_t t) {
+    timespec ts{static_cast<time_t>(t / 1'000'000'000ull), static_cast<long>(t % 1'000'000'000ull)};
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+    }
+}
+
+// Cycles at 1 kHz on an absolute-time grid; each_cycle fills the outputs. Round trips into rtt (reserved).
+template <typename Fill>
+void run_cycles(master::ProcessDataSession& pd, uint64_t cycles, std::vector<uint64_t>& rtt, uint64_t& missed,
+                Fill fill) {
+    const uint64_t period = static_cast<uint64_t>(std::chrono::nanoseconds(kPeriod).count());
+    uint64_t next = bench::now_ns();
+    for (uint64_t i = 0; i < cycles; ++i) {
+        const uint64_t t0 = bench::now_ns();
+        if (t0 >= next + period) {
+            ++missed;
+            next = t0;  // start again from now
+        }
+        fill(i);
+        (void)pd.cycle();
+        const uint64_t t1 = bench::now_ns();
+        if (rtt.size() < rtt.capacity()) rtt.push_back(t1 - t0);
+        next += period;
+        sleep_until_ns(next);
+    }
+}
+
+Figures run_segment(std::size_t drives, double seconds, const std::string& backend) {
+    Figures f;
+    f.drives = drives;
+    const uint64_t cycles = static_cast<uint64_t>(seconds * 1000.0);
+    slave::VethPair pair(kSlaveEnd, kMasterEnd);
+    bench::TempDir dir("bench-segment");
+
+    // ---- the slave side: N drives in a Runtime, in its own thread ---------------------------------------
+    esc::SystemClock clock;
+    device::LineOptions lo;
+    lo.topology = slave::line_topology(static_cast<int>(drives));
+    for (slave::TopologyDevice& d : lo.topology.devices)
+        d.state_dir = (dir.path() / d.name).string();
+    lo.base.state_dir = dir.path();
+    auto slave_link = esc::open_link(kSlaveEnd, backend);
+    TimedLink timed(*slave_link, cycles + 1000);
+    auto line = std::make_unique<device::Line>(clock, lo);
+    auto runtime = std::make_unique<slave::Runtime>(timed, line->segment(), clock);
+    runtime->set_firmware(line.get());
+    std::thread slave_thread([&] { runtime->run(); });
+    clockid_t slave_cpu{};
+    pthread_getcpuclockid(slave_thread.native_handle(), &slave_cpu);
+
+    // ---- the master side ---------------------------------------------------------------------------------
+    auto master_link = esc::open_link(kMasterEnd, backend);
+    master::MasterOptions mo;
+    mo.timeout = std::chrono::milliseconds(50);
+    mo.al_timeout = std::chrono::milliseconds(10'000);
+    master::Master m(*master_link, mo);
+    auto fail = [&](const std::string& what, Error e) {
+        runtime->request_stop();
+        slave_thread.join();
+        throw std::runtime_error(what + ": " + std::string(master::to_string(e)));
+    };
+    auto bus = master::scan_bus(m, {.first_station = 0x1001, .identity = false});
+    if (!bus) fail("scan", bus.error());
+    if (bus->size() != drives)
+        fail("scan found " + std::to_string(bus->size()) + " slaves", Error::WorkingCounter);
+    std::vector<Address> addresses;
+    for (const master::SlaveInfo& s : *bus)
+        addresses.push_back(Address::station(s.station));
+    master::SdoClients clients;
+    const Error opened = clients.open(m, addresses, [&](master::Mailbox& mbx, Address a) {
+        if (Error e = mbx.configure_from_sii(); e != Error::Ok) return e;
+        return m.request_state(a, master::AlState::PreOp);
+    });
+    if (opened != Error::Ok) fail("mailbox / PREOP of drive " + std::to_string(clients.failed() + 1), opened);
+    const auto sdos = clients.clients();
+    DriveIo io;  // every drive has the default mapping: the first one's offsets hold for all
+    io.cw = pdo_offset(*sdos[0], 0x1C12, 0x6040, 0);
+    io.mode = pdo_offset(*sdos[0], 0x1C12, 0x6060, 0);
+    io.target = pdo_offset(*sdos[0], 0x1C12, 0x607A, 0);
+    io.sw = pdo_offset(*sdos[0], 0x1C13, 0x6041, 0);
+    io.pos = pdo_offset(*sdos[0], 0x1C13, 0x6064, 0);
+    if (io.cw < 0 || io.target < 0 || io.sw < 0 || io.pos < 0)
+        fail("CSP objects not mapped", Error::InvalidArgument);
+    if (io.mode < 0)
+        for (master::SdoClient* sdo : sdos) {
+            const uint8_t csp[1] = {8};
+            if (Error e = sdo->download(0x6060, 0, csp); e != Error::Ok) fail("0x6060 = 8", e);
+        }
+    master::ProcessDataSession pd(m, addresses, sdos);
+    if (Error e = pd.discover(); e != Error::Ok) fail("discover", e);
+    master::DcConfig dc;
+    dc.enable = true;
+    dc.cycle_ns = 1'000'000;
+    dc.start_delay = std::chrono::milliseconds(100 + 5 * static_cast<int64_t>(drives));
+    dc.measure_options.drift_frames = 1000;
+    if (Error e = pd.configure(dc); e != Error::Ok) fail("configure", e);
+    f.frames_per_cycle = pd.frames_per_cycle();
+
+    std::vector<int32_t> target(drives, 0);
+    uint16_t controlword = 0;
+    auto fill = [&](uint64_t) {
+        for (std::size_t k = 0; k < drives; ++k) {
+            const auto o = pd.outputs(k);
+            util::put16(o.data() + io.cw, controlword);
+            if (io.mode >= 0) o[static_cast<std::size_t>(io.mode)] = 8;
+            util::put32(o.data() + io.target, static_cast<uint32_t>(target[k]));
+        }
+    };
+    auto hold = [&] {  // target = actual position
+        for (std::size_t k = 0; k < drives; ++k)
+            target[k] = static_cast<int32_t>(util::get32(pd.inputs(k).data() + io.pos));
+    };
+    auto fill_state = [&] { fill(0); };
+    if (Error e = pd.request_state(master::AlState::SafeOp, kPeriod, nullptr, fill_state); e != Error::Ok)
+        fail("SAFEOP", e);
+    if (Error e = pd.request_state(master::AlState::Op, kPeriod, nullptr, fill_state); e != Error::Ok)
+        fail("OP", e);
+    // CiA 402 enable: shutdown, switch on, enable operation, holding the actual position.
+    std::vector<uint64_t> scratch;
+    scratch.reserve(1000);
+    uint64_t ignored = 0;
+    for (uint16_t cw : {0x0006, 0x0007, 0x000F}) {
+        controlword = cw;
+        run_cycles(pd, 100, scratch, ignored, [&](uint64_t) {
+            hold();
+            fill(0);
+        });
+    }
+
+    // ---- the measured window: a position ramp on every drive ---------------------------------------------
+    std::vector<uint64_t> rtt;
+    rtt.reserve(cycles);
+    const master::CycleStats before = pd.stats();
+    timed.record(true);
+    const uint64_t cpu0 = thread_cpu_ns(slave_cpu);
+    const uint64_t wall0 = bench::now_ns();
+    const alloc_counter::Scope allocs;
+    run_cycles(pd, cycles, rtt, f.missed, [&](uint64_t) {
+        for (int32_t& t : target)
+            t += 20;  // 20 increments per ms
+        fill(0);
+    });
+    const uint64_t alloc_count = allocs.count();
+    const uint64_t wall = bench::now_ns() - wall0;
+    const uint64_t cpu = thread_cpu_ns(slave_cpu) - cpu0;
+    timed.record(false);
+    const master::CycleStats after = pd.stats();
+    f.cycles = after.cycles - before.cycles;
+    f.lost = after.lost - before.lost;
+    f.wkc_errors = after.wkc_errors - before.wkc_errors;
+    for (std::size_t k = 0; k < drives; ++k)
+        if ((util::get16(pd.inputs(k).data() + io.sw) & 0x006F) == 0x0027) ++f.enabled;
+    f.cpu_percent = 100.0 * static_cast<double>(cpu) / static_cast<double>(wall);
+    f.cpu_us_per_cycle =
+        static_cast<double>(cpu) / 1000.0 / static_cast<double>(std::max<uint64_t>(1, f.cycles));
+    f.allocs_per_cycle =
+        static_cast<double>(alloc_count) / static_cast<double>(std::max<uint64_t>(1, f.cycles));
+    f.rtt = bench::summarize(rtt);
+
+    // ---- the bare echo on the same veth pair, same frames -----------------------------------------------
+    runtime->request_stop();
+    slave_thread.join();
+    runtime.reset();
+    f.walk = bench::summarize(timed.samples());
+    std::atomic<bool> echo_stop{false};
+    std::thread echo([&] {
+        std::vector<uint8_t> buf(esc::kMaxFrameSize);
+        while (!echo_stop.load(std::memory_order_relaxed)) {
+            const std::size_t n = slave_link->receive(buf);
+            if (n == 0) {
+                pollfd p{slave_link->fd(), POLLIN, 0};
+                (void)::poll(&p, 1, 10);
+                continue;
+            }
+            if (n >= 12) buf[6] |= 0x02;  // as an ESC marks the frame processed
+            slave_link->send(std::span<const uint8_t>(buf.data(), n));
+        }
+    });
+    std::vector<uint64_t> echo_rtt;
+    echo_rtt.reserve(cycles);
+    uint64_t echo_missed = 0;
+    run_cycles(pd, cycles, echo_rtt, echo_missed, [&](uint64_t) { fill(0); });
+    echo_stop.store(true);
+    echo.join();
+    f.echo = bench::summarize(echo_rtt);
+    return f;
+}
+
+void usage() {
+    std::fprintf(stderr, "usage: bench-segment [--seconds S] [--drives N[,N...]] [--backend pcap|packet]\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    double seconds = 5.0;
+    std::vector<std::size_t> counts = {1, 10, 100};
+    std::string backend = esc::default_link_backend();
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto next = [&] { return bench::option_value(argc, argv, i, usage); };
+        if (a == "--seconds") {
+            seconds = std::max(0.1, std::atof(next().c_str()));
+        } else if (a == "--drives") {
+            counts.clear();
+            const std::string list = next();
+            for (std::size_t pos = 0; pos < list.size();) {
+                const std::size_t comma = std::min(list.find(',', pos), list.size());
+                const unsigned long n = std::strtoul(list.substr(pos, comma - pos).c_str(), nullptr, 10);
+                if (n == 0 || n > 1000) {
+                    usage();
+                    return 2;
+                }
+                counts.push_back(n);
+                pos = comma + 1;
+            }
+        } else if (a == "--backend") {
+            backend = next();
+        } else {
+            usage();
+            return 2;
+        }
+    }
+    if (!bench::require_root("(network namespace, veth pair, raw sockets)")) return 2;
+    if (!bench::enter_network_namespace()) return 2;
+    std::printf(
+        "bench-segment: %zu drive line(s), 1 kHz DC, CSP ramp, %.1f s per configuration, backend %s, %u "
+        "CPUs\n",
+        counts.size(), seconds, backend.c_str(), std::thread::hardware_concurrency());
+    std::vector<Figures> all;
+    for (std::size_t n : counts) {
+        try {
+            all.push_back(run_segment(n, seconds, backend));
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "bench-segment: %zu drives: %s\n", n, e.what());
+            return 1;
+        }
+        const Figures& f = all.back();
+        std::printf("\n%zu drive%s (%zu frame%s per cycle), %llu cycles, %llu enabled in CSP\n", f.drives,
+                    f.drives == 1 ? "" : "s", f.frames_per_cycle, f.frames_per_cycle == 1 ? "" : "s",
+                    static_cast<unsigned long long>(f.cycles), static_cast<unsigned long long>(f.enabled));
+        bench::print("  frame through segment", f.walk, "us", 1000.0);
+        bench::print("  round trip, cyclic", f.rtt, "us", 1000.0);
+        bench::print("  round trip, bare echo", f.echo, "us", 1000.0);
+        std::printf("  ratio cyclic/echo: median %.3f  p99 %.3f\n",
+                    f.rtt.median / std::max(1.0, f.echo.median), f.rtt.p99 / std::max(1.0, f.echo.p99));
+        std::printf(
+            "  slave thread CPU: %.1f us per cycle (%.2f us per drive) = %.1f %% of one core at 1 kHz "
+            "(%.1f %% of the wall time)\n",
+            f.cpu_us_per_cycle, f.cpu_us_per_cycle / static_cast<double>(f.drives), f.cpu_percent,
+            f.cpu_wall_percent);
+        std::printf("  missed cycles %llu, lost frames %llu, wkc errors %llu, allocations per cycle %.3f\n",
+                    static_cast<unsigned long long>(f.missed), static_cast<unsigned long long>(f.lost),
+                    static_cast<unsigned long long>(f.wkc_errors), f.allocs_per_cycle);
+    }
+    std::printf("\n%-7s %-22s %-10s %-8s %-22s %-8s\n", "drives", "segment med/p99 us", "cpu %core", "missed",
+                "rtt ratio med/p99", "allocs");
+    for (const Figures& f : all)
+        std::printf("%-7zu %8.2f / %-11.2f %-10.1f %-8llu %8.3f / %-11.3f %-8.3f\n", f.drives,
+                    f.walk.median / 1000.0, f.walk.p99 / 1000.0, f.cpu_percent,
+                    static_cast<unsigned long long>(f.missed), f.rtt.median / std::max(1.0, f.echo.median),
+                    f.rtt.p99 / std::max(1.0, f.echo.p99), f.allocs_per_cycle);
+    return 0;
+}
