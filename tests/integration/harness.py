@@ -6,6 +6,7 @@ links and processes when it ends, even when the test fails. Paths of the binarie
 environment (ECAT_SLAVE, ECATCTL), set by tests/integration/CMakeLists.txt.
 """
 import itertools
+import re
 import os
 import shutil
 import signal
@@ -307,3 +308,281 @@ def main():
     if res.testsRun > 0 and len(res.skipped) == res.testsRun:
         sys.exit(SKIP)
     sys.exit(0)
+
+
+# -- a segment of soft slaves (issue 13) -------------------------------------------------------------------------
+# A small cyclic master in python for the tests of a line of drives (tests/integration/test_segment*.py): the
+# registers it uses are those of the ESC datasheet section I (SM §8, FMMU §7, DC §9) and ETG.1000.4/.6; the
+# process-data layout and the CoE writes come from ecatctl. Station addresses 0x1001.. as `ecatctl scan` assigns.
+APRD, APWR, FPRD, FPWR, BRD, BWR, LRW, FRMW = 1, 2, 4, 5, 7, 8, 12, 14
+AL_NAMES = {1: "INIT", 2: "PREOP", 3: "BOOT", 4: "SAFEOP", 8: "OP"}
+LAYOUT = re.compile(r"outputs: SM2 0x([0-9a-f]+), (\d+) bytes; inputs: SM3 0x([0-9a-f]+), (\d+) bytes")
+DC_EPOCH_NS = 946684800 * 10**9  # EtherCAT system time counts from 2000-01-01
+
+
+def control(path, line, timeout=5.0):
+    """One command on ecat-slave's control socket (a UNIX datagram socket); returns the reply text."""
+    me = f"{path}.{os.getpid()}.{next(_counter)}.me"
+    s = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+    try:
+        s.bind(me)
+        s.settimeout(timeout)
+        s.sendto(line.encode() + b"\n", path)
+        return s.recv(65536).decode()
+    finally:
+        s.close()
+        try:
+            os.unlink(me)
+        except OSError:
+            pass
+
+
+def read_stats(path):
+    """key value lines of a --stats-file."""
+    out = {}
+    with open(path) as f:
+        for line in f:
+            parts = line.split()
+            if len(parts) >= 2:
+                out[parts[0]] = parts[1]
+    return out
+
+
+class MiniMaster:
+    """Process data for every slave of the line in one LRW per cycle (plus FRMW of the reference clock's system
+    time with DC, and an FPRD of each slave's AL status), DC set up from the port receive times of a line."""
+
+    def __init__(self, bus, timeout=0.02):
+        self.bus = bus
+        self.sock = bus.raw_socket()
+        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 20)
+        self.timeout = timeout
+        self.idx = 0
+        self.count = 0
+        self.layouts = []
+        self.dc = False
+        self.delays = []
+        self.states = []
+        self.expected_wkc = 0
+
+    def close(self):
+        self.sock.close()
+
+    # -- frames ------------------------------------------------------------------------------------------------
+    def txrx(self, datagrams, timeout=None):
+        """datagrams: [(cmd, adp, ado, data)]; returns [(data, wkc)] or None when no reply came."""
+        self.idx = (self.idx + 1) & 0xFF
+        idx = self.idx
+        body = b""
+        for i, (cmd, adp, ado, data) in enumerate(datagrams):
+            more = 0x8000 if i + 1 < len(datagrams) else 0
+            body += struct.pack("<BBHHHH", cmd, idx, adp, ado, len(data) | more, 0) + data + b"\x00\x00"
+        frame = b"\xff" * 6 + b"\x01" * 6 + b"\x88\xa4" + struct.pack("<H", len(body) | 0x1000) + body
+        if len(frame) < 60:
+            frame += b"\x00" * (60 - len(frame))
+        self.drain()
+        self.sock.send(frame)
+        deadline = time.monotonic() + (self.timeout if timeout is None else timeout)
+        while True:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return None
+            self.sock.settimeout(left)
+            try:
+                data, addr = self.sock.recvfrom(4096)
+            except socket.timeout:
+                return None
+            if addr[2] == PACKET_OUTGOING or len(data) < 28 or data[12:14] != b"\x88\xa4" or data[17] != idx:
+                continue
+            if data[6:12] == b"\x01" * 6:
+                continue  # not passed through a slave (an ESC sets bit 1 of the first source address byte)
+            dgs = parse_datagrams(data)
+            if [(d[0], len(d[4])) for d in dgs] != [(d[0], len(d[3])) for d in datagrams]:
+                continue  # a reply to another master's frame (ecatctl) that used the same index
+            return [(d[4], d[5]) for d in dgs]
+
+    def drain(self):
+        """Drops what is queued (replies to ecatctl's frames, late replies)."""
+        self.sock.setblocking(False)
+        try:
+            while True:
+                self.sock.recv(4096)
+        except (BlockingIOError, socket.timeout):
+            pass
+        finally:
+            self.sock.setblocking(True)
+
+    def one(self, cmd, adp, ado, data, tries=5):
+        for _ in range(tries):
+            r = self.txrx([(cmd, adp, ado, data)])
+            if r is not None:
+                return r[0]
+        raise AssertionError(f"no reply to command {cmd} 0x{adp:04x}:0x{ado:04x} ({self.bus.slave_output()[-2000:]})")
+
+    def fprd(self, station, ado, n):
+        data, wkc = self.one(FPRD, station, ado, bytes(n))
+        if wkc != 1:
+            raise AssertionError(f"FPRD 0x{station:04x}:0x{ado:04x} wkc {wkc}")
+        return data
+
+    def fpwr(self, station, ado, data):
+        _, wkc = self.one(FPWR, station, ado, data)
+        if wkc != 1:
+            raise AssertionError(f"FPWR 0x{station:04x}:0x{ado:04x} wkc {wkc}")
+
+    def count_slaves(self):
+        return self.one(BRD, 0, 0, b"\x00")[1]
+
+    def stations(self):
+        return [0x1001 + i for i in range(self.count)]
+
+    # -- set-up ------------------------------------------------------------------------------------------------
+    def scan(self):
+        """ecatctl scan (station addresses 0x1001..); returns its rows as {pos: line} and sets the count."""
+        out = self.bus.ecatctl("scan").stdout
+        self.count = int(out.split()[0])
+        return out
+
+    def discover(self):
+        """The process-data layout of each slave from `ecatctl pd <pos> -n 1 --state SAFEOP` (back to PREOP)."""
+        self.layouts = []
+        for pos in range(self.count):
+            r = self.bus.ecatctl("pd", str(pos), "-n", "1", "--state", "SAFEOP")
+            m = LAYOUT.search(r.stdout)
+            if m is None:
+                raise AssertionError(r.stdout)
+            self.layouts.append((int(m.group(1), 16), int(m.group(2)), int(m.group(3), 16), int(m.group(4))))
+
+    def dc_measure(self):
+        """Latches the receive times at every port (BWR 0x0900) and computes the propagation delay of each slave
+        of a line from the round trips behind port 1 (ESC datasheet section I §9.1.3); returns
+        [(delay_ns, port_times, dl_status, local_time)]."""
+        self.one(BWR, 0, 0x0900, bytes(4))
+        rows = []
+        for st in self.stations():
+            times = struct.unpack("<4I", self.fprd(st, 0x0900, 16))
+            dl = struct.unpack("<H", self.fprd(st, 0x0110, 2))[0]
+            local = struct.unpack("<Q", self.fprd(st, 0x0918, 8))[0]
+            rows.append([times, dl, local])
+        out = []
+        prev_delay, prev_rt = 0, 0
+        for k, (times, dl, local) in enumerate(rows):
+            rt = (times[1] - times[0]) & 0xFFFFFFFF if dl & (1 << 11) else 0  # port 1 communicating
+            delay = 0 if k == 0 else prev_delay + (prev_rt - rt) // 2
+            out.append((delay, times, dl, local))
+            prev_delay, prev_rt = delay, rt
+        return out
+
+    def configure(self, dc=True, cycle_ns=1_000_000):
+        """Sync mode over CoE (ecatctl), SM2/SM3 and FMMUs of every slave (logically one after the other), and with
+        dc the clock offsets and delays of a line and SYNC0 on the same grid in every slave."""
+        self.dc = dc
+        mode = "2" if dc else "1"
+        for pos in range(self.count):
+            self.bus.ecatctl("download", str(pos), "0x1c32", "1", mode, "--type", "u16")
+            self.bus.ecatctl("download", str(pos), "0x1c33", "1", mode if dc else "34", "--type", "u16",
+                             check=False)
+            if dc:
+                self.bus.ecatctl("download", str(pos), "0x1c32", "2", str(cycle_ns), "--type", "u32")
+        logical = 0x10000
+        self.expected_wkc = 0
+        self.image = 0
+        for st, (o_start, o_len, i_start, i_len) in zip(self.stations(), self.layouts):
+            self.fpwr(st, 0x0810, bytes(16))
+            sm = struct.pack("<HHBBBB", o_start, o_len, 0x64, 0, 1 if o_len else 0, 0)
+            sm += struct.pack("<HHBBBB", i_start, i_len, 0x20, 0, 1 if i_len else 0, 0)
+            self.fpwr(st, 0x0810, sm)
+            fm = struct.pack("<IHBBHBBBxxx", logical, o_len, 0, 7, o_start, 0, 2, 1 if o_len else 0)
+            fm += struct.pack("<IHBBHBBBxxx", logical + o_len, i_len, 0, 7, i_start, 0, 1, 1 if i_len else 0)
+            self.fpwr(st, 0x0600, fm)
+            logical += o_len + i_len
+            self.expected_wkc += (2 if o_len else 0) + (1 if i_len else 0)
+        self.image = logical - 0x10000
+        if not dc:
+            for st in self.stations():
+                self.fpwr(st, 0x0980, bytes(2))
+            return
+        self.delays = self.dc_measure()
+        now = time.time_ns() - DC_EPOCH_NS
+        for st, (delay, _times, _dl, local) in zip(self.stations(), self.delays):
+            self.fpwr(st, 0x0920, struct.pack("<Q", (now + delay - local) & 0xFFFFFFFFFFFFFFFF))
+            self.fpwr(st, 0x0928, struct.pack("<I", delay & 0xFFFFFFFF))
+        for _ in range(200):  # drift compensation: the reference clock's time to all others
+            self.txrx([(FRMW, 0x1001, 0x0910, bytes(8))])
+        for st in self.stations():
+            self.fpwr(st, 0x0980, bytes(2))
+            self.fpwr(st, 0x09A0, struct.pack("<I", cycle_ns))
+        t = struct.unpack("<Q", self.fprd(0x1001, 0x0910, 8))[0]
+        start = ((t + 100_000_000) // cycle_ns + 1) * cycle_ns
+        for st in self.stations():
+            self.fpwr(st, 0x0990, struct.pack("<Q", start))
+            self.fpwr(st, 0x0980, struct.pack("<H", 0x0300))
+        # Cycle until SYNC0 runs (it starts 100 ms from now) before any state request: a drive entering SAFEOP
+        # starts its SYNC0 supervision, and in OP SYNC0 must arrive (else AL status 0x002C).
+        self.run(150)
+
+    # -- cycles ------------------------------------------------------------------------------------------------
+    def request(self, state, stations=None):
+        for st in stations or self.stations():
+            self.fpwr(st, 0x0120, struct.pack("<H", state))
+
+    def al_code(self, station):
+        return struct.unpack("<H", self.fprd(station, 0x0134, 2))[0]
+
+    def run(self, cycles, period_ns=1_000_000, until=None, timeout=0.05):
+        """Cycles at period_ns: LRW of the whole image (+ FRMW with DC, + FPRD 0x0130 of each slave). Stops early
+        when until(states) is true. A reply later than `timeout` counts as lost (a loaded machine delays replies by
+        milliseconds now and then; tests that lose frames on purpose use a shorter one). Returns a dict of counters; self.states holds the last AL states read."""
+        dgs = [(LRW, 0x0000, 0x0001, bytes(self.image))]  # logical address 0x00010000
+        if self.dc:
+            dgs.append((FRMW, 0x1001, 0x0910, bytes(8)))
+        dgs += [(FPRD, st, 0x0130, bytes(2)) for st in self.stations()]
+        stats = {"cycles": 0, "lost": 0, "wkc_errors": 0, "wkc_min": 1 << 30, "wkc_max": 0}
+        nxt = time.monotonic_ns()
+        for _ in range(cycles):
+            nxt += period_ns
+            r = self.txrx(dgs, timeout=timeout)
+            stats["cycles"] += 1
+            if r is None:
+                stats["lost"] += 1
+            else:
+                wkc = r[0][1]
+                stats["wkc_min"] = min(stats["wkc_min"], wkc)
+                stats["wkc_max"] = max(stats["wkc_max"], wkc)
+                if wkc != self.expected_wkc:
+                    stats["wkc_errors"] += 1
+                first = 2 if self.dc else 1
+                self.states = [struct.unpack("<H", d)[0] if w == 1 else None for d, w in r[first:]]
+                if until is not None and until(self.states):
+                    break
+            left = nxt - time.monotonic_ns()
+            if left > 0:
+                time.sleep(left / 1e9)
+            elif left < -50 * period_ns:
+                nxt = time.monotonic_ns()  # far behind (a loaded machine): no burst to catch up
+        return stats
+
+    def go(self, state, max_cycles=5000):
+        """Requests `state` of every slave while cycling; raises with the AL status codes if not reached."""
+        self.request(state)
+        self.run(max_cycles, until=lambda s: all(x == state for x in s) and len(s) == self.count)
+        if not (len(self.states) == self.count and all(x == state for x in self.states)):
+            codes = [(hex(x) if x is not None else None,
+                      hex(self.al_code(st)) if x is not None and x & 0x10 else "") for st, x in
+                     zip(self.stations(), self.states)]
+            raise AssertionError(f"{AL_NAMES.get(state)} not reached: {codes}\n{self.bus.slave_output()[-3000:]}")
+
+    def to_op(self, dc=True):
+        self.scan()
+        self.discover()
+        self.configure(dc=dc)
+        self.go(4)
+        self.go(8)
+
+    def recover(self, max_cycles=5000):
+        """What a master does after errors: acknowledges SAFEOP+ERR and requests OP again, while cycling."""
+        self.run(5)
+        for st, s in zip(self.stations(), self.states):
+            if s is not None and s & 0x10:
+                self.fpwr(st, 0x0120, struct.pack("<H", (s & 0x0F) | 0x10))
+        self.go(8, max_cycles)
