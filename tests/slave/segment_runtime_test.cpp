@@ -6,6 +6,7 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <sstream>
@@ -249,7 +250,9 @@ TEST(SegmentRuntime, ADelayedHopHoldsTheReply) {
     EXPECT_EQ(bus.master_end().pending(), 0u);
     EXPECT_EQ(bus.runtime->stats().frames_held, 1u);
     std::array<uint8_t, esc::kMaxFrameSize> buf{};
-    for (int i = 0; i < 100 && bus.master_end().pending() == 0; ++i)
+    // run_once() also returns for the drives' own 10 ms cycles: wait by the clock, not by passes.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (bus.master_end().pending() == 0 && std::chrono::steady_clock::now() < deadline)
         ASSERT_TRUE(bus.runtime->run_once(100));
     ASSERT_EQ(bus.master_end().receive(buf), f.size());
     EXPECT_EQ(buf[kWkcOffset], 3) << "BRD through three ESCs";
@@ -339,13 +342,15 @@ TEST(SegmentRuntime, TheLineContinuesOnTheOutLink) {
     EXPECT_GT(runtime.stats().frames_resumed, 0u);
 
     carrier = false;  // the peer went away: polled within kCarrierPollNs
-    for (int i = 0; i < 2000 && runtime.stats().carrier_changes == 0; ++i)
+    for (auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+         runtime.stats().carrier_changes == 0 && std::chrono::steady_clock::now() < until;)
         ASSERT_TRUE(runtime.run_once(10));
     ASSERT_EQ(runtime.stats().carrier_changes, 1u);
     EXPECT_EQ(brd_wkc(), 2) << "no carrier: the last device's port 1 loops back";
     EXPECT_NE(log_text.str().find("out link out0: no carrier"), std::string::npos) << log_text.str();
     carrier = true;
-    for (int i = 0; i < 2000 && runtime.stats().carrier_changes == 1; ++i)
+    for (auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+         runtime.stats().carrier_changes == 1 && std::chrono::steady_clock::now() < until;)
         ASSERT_TRUE(runtime.run_once(10));
     EXPECT_EQ(brd_wkc(), 3);
 }
