@@ -283,10 +283,10 @@ void DistributedClocks::latch(bool ok) {
     port_armed = 0x0E;
 }
 
-uint64_t DistributedClocks::next_event() const {
+uint64_t DistributedClocks::next_event(uint64_t now_clock) const {
     uint64_t r = kNever;
+    if (!sync0_armed && !sync1_armed) return r;
     const uint64_t offset = mem.r64(reg::kDcOffset);
-    const uint64_t now_clock = time.clock.now_ns();
     const uint64_t now_local = local_at(now_clock);
     auto sync_at = [&](uint64_t sys) {
         const uint64_t local = sys - offset;  // the event's local time

@@ -53,7 +53,7 @@ class DistributedClocks {
     // SYNC0/SYNC1 generation up to now_clock.
     void run(uint64_t now_clock);
     // Clock time of the next SYNC pulse; UINT64_MAX if none.
-    uint64_t next_event() const;
+    uint64_t next_event(uint64_t now_clock) const;
 
   private:
     void latch(bool ok);

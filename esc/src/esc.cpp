@@ -501,19 +501,30 @@ bool Esc::irq() const {
 }
 
 void Esc::tick() {
-    std::lock_guard lock(impl_->mu);
-    const uint64_t now = impl_->time.clock.now_ns();
-    impl_->wd.run(now);
-    impl_->dc.run(now);
+    tick(impl_->time.clock.now_ns());
 }
 
-uint64_t Esc::Impl::next_event() const {
-    return std::min(dc.next_event(), wd.next_event());
+void Esc::tick(uint64_t now_clock) {
+    std::lock_guard lock(impl_->mu);
+    impl_->wd.run(now_clock);
+    impl_->dc.run(now_clock);
+}
+
+uint64_t Esc::Impl::next_event(uint64_t now_clock) const {
+    return std::min(dc.next_event(now_clock), wd.next_event(now_clock));
 }
 
 uint64_t Esc::next_event_ns() const {
+    return next_event_ns(impl_->time.clock.now_ns());
+}
+
+uint64_t Esc::next_event_ns(uint64_t now_clock) const {
     std::lock_guard lock(impl_->mu);
-    return impl_->next_event();
+    return impl_->next_event(now_clock);
+}
+
+const Clock& Esc::clock() const {
+    return impl_->time.clock;
 }
 
 uint64_t Esc::local_time_ns() const {

@@ -77,7 +77,7 @@ struct Esc::Impl final {
     uint64_t merged(uint16_t reg_addr, unsigned size, uint16_t a, uint16_t e, const uint8_t* src,
                     const uint8_t* bm) const;
 
-    uint64_t next_event() const;
+    uint64_t next_event(uint64_t now_clock) const;
 };
 
 }  // namespace esc

@@ -56,7 +56,7 @@ void Watchdogs::run(uint64_t now) {
     }
 }
 
-uint64_t Watchdogs::next_event() const {
+uint64_t Watchdogs::next_event(uint64_t now_clock) const {
     uint64_t r = std::numeric_limits<uint64_t>::max();
     const uint64_t inc = increment_ns();
     const uint64_t tpd = mem.r16(reg::kWdTimePd) * inc;
@@ -64,7 +64,7 @@ uint64_t Watchdogs::next_event() const {
     const uint64_t tpdi = mem.r16(reg::kWdTimePdi) * inc;
     if (tpdi) {
         if (pdi_touched && !pdi_armed) {
-            r = std::min(r, time.clock.now_ns());  // start the PDI watchdog
+            r = std::min(r, now_clock);  // start the PDI watchdog
         } else if (pdi_armed) {
             r = std::min(r, pdi_last + tpdi);
         }

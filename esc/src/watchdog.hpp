@@ -20,7 +20,7 @@ class Watchdogs {
     void pdi_touch() { pdi_touched = true; }
     void run(uint64_t now_clock);
     // Clock time at which run() has something to do next; UINT64_MAX if nothing.
-    uint64_t next_event() const;
+    uint64_t next_event(uint64_t now_clock) const;
 
   private:
     Memory& mem;

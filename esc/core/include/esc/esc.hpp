@@ -89,8 +89,13 @@ class Esc final : public Pdi {
     // ---- Time -------------------------------------------------------------------------------------
     // Runs the time-driven parts (process-data and PDI watchdogs, SYNC0/SYNC1 generation) up to now.
     void tick();
-    // Local time (ns) at which tick() has something to do next; UINT64_MAX if nothing is pending.
+    // Clock time (ns) at which tick() has something to do next; UINT64_MAX if nothing is pending.
     uint64_t next_event_ns() const;
+    // The same with the Clock's current time given (now_clock = clock().now_ns(), read once by a caller that
+    // serves many ESCs on one clock, e.g. a segment).
+    void tick(uint64_t now_clock);
+    uint64_t next_event_ns(uint64_t now_clock) const;
+    const Clock& clock() const;
     // Local clock of this ESC (DC local time, 0x0900 base), in ns.
     uint64_t local_time_ns() const;
 
