@@ -118,8 +118,8 @@ TEST_F(Runtime, NonEtherCatFramesAreNotSentBack) {
 
 TEST_F(Runtime, TheTimerWakesTheFirmwareAtItsDeadlineWithoutFrames) {
     RecordingFirmware fw(master());
-    runtime.set_firmware(&fw);
     fw.deadline = clock.now_ns() + 20'000'000;  // 20 ms
+    runtime.set_firmware(&fw);
     const uint64_t start = clock.now_ns();
     int rounds = 0;
     while (!fw.deadline_hit && rounds < 100) {
@@ -170,13 +170,41 @@ TEST_F(Runtime, TheTimerMovesEarlierAtOnceButLaterOnlyAfterFiring) {
     runtime.set_firmware(nullptr);
 }
 
+// Deadlines that come within Runtime::kChainNs of each other (the SYNC0 pulses of a line of ESCs) are
+// served by one wake-up: after the first, the runtime waits for the next awake instead of sleeping again.
+TEST_F(Runtime, DeadlinesMicrosecondsApartAreServedByOneWakeUp) {
+    struct TwoDeadlines : slave::Firmware {
+        void poll(uint64_t now_ns) override {
+            ++polls;
+            while (next < 2 && now_ns >= at[next])
+                ++next;
+        }
+        uint64_t next_deadline_ns() const override { return next < 2 ? at[next] : UINT64_MAX; }
+        uint64_t at[2] = {UINT64_MAX, UINT64_MAX};
+        int next = 0;
+        int polls = 0;
+    } fw;
+    runtime.set_firmware(&fw);
+    ASSERT_TRUE(runtime.run_once(0));        // the first service: nothing due yet
+    fw.at[0] = clock.now_ns() + 20'000'000;  // 20 ms
+    fw.at[1] = fw.at[0] + 5'000;             // 5 us later
+    ASSERT_TRUE(runtime.run_once(0));        // takes the new deadlines
+    const uint64_t expiries = runtime.stats().timer_expiries;
+    for (int i = 0; i < 100 && fw.next < 2; ++i)
+        ASSERT_TRUE(runtime.run_once(2000));
+    EXPECT_EQ(fw.next, 2);
+    EXPECT_EQ(runtime.stats().timer_expiries, expiries + 1) << "one wake-up for both";
+    EXPECT_GE(clock.now_ns(), fw.at[1]);
+    runtime.set_firmware(nullptr);
+}
+
 // --spin-us: the timer is armed spin_ns before the deadline and the runtime busy-waits the rest; the deadline
 // is serviced by that same wake-up, at or after its time, and the wait is counted.
 TEST_F(Runtime, SpinWakesEarlyAndServicesTheDeadlineInTheSameWakeUp) {
     RecordingFirmware fw(master());
-    runtime.set_firmware(&fw);
     runtime.set_spin(30'000'000);               // 30 ms
     fw.deadline = clock.now_ns() + 60'000'000;  // 60 ms: the timer is armed for 30 ms
+    runtime.set_firmware(&fw);
     int rounds = 0;
     while (!fw.deadline_hit && rounds < 100) {
         ASSERT_TRUE(runtime.run_once(2000));

@@ -265,6 +265,29 @@ TEST(SegmentRuntime, ADelayedHopHoldsTheReply) {
     EXPECT_EQ(bus.runtime->stats().frames_held, 1u);
 }
 
+// Frames that come in one burst are walked one after the other and their replies leave together, in the
+// order of the frames, once the burst is done: a master that sent several frames is woken once for them.
+TEST(SegmentRuntime, TheRepliesOfABurstLeaveTogetherInOrder) {
+    SegmentBus bus(3);
+    std::vector<std::vector<uint8_t>> sent;
+    for (uint8_t index = 0x10; index < 0x15; ++index) {
+        sent.push_back(esc::wire::FrameBuilder().add_zero(esc::Command::BRD, index, 0, 0x0000, 1).build(60));
+        ASSERT_TRUE(bus.master_end().send(sent.back()));
+    }
+    const uint64_t batches = bus.runtime->stats().reply_batches;
+    ASSERT_TRUE(bus.runtime->run_once(100));
+    EXPECT_EQ(bus.runtime->stats().frames_received, 5u);
+    EXPECT_EQ(bus.runtime->stats().frames_sent, 5u);
+    EXPECT_EQ(bus.runtime->stats().reply_batches, batches + 1) << "one batch for the burst";
+    ASSERT_EQ(bus.master_end().pending(), 5u);
+    std::array<uint8_t, esc::kMaxFrameSize> buf{};
+    for (const auto& f : sent) {
+        ASSERT_EQ(bus.master_end().receive(buf), f.size());
+        EXPECT_EQ(buf[16 + 1], f[16 + 1]) << "the replies in the order of the frames";
+        EXPECT_EQ(buf[kWkcOffset], 3);
+    }
+}
+
 TEST(SegmentRuntime, DropAndCorruptAreCountedPerHop) {
     SegmentBus bus(3);
     EXPECT_EQ(bus.line->apply("drop 1 1"), "ok drop hop 1 1");

@@ -131,8 +131,14 @@ void Line::event(slave::LogLevel level, const std::string& text) const {
 }
 
 void Line::poll(uint64_t now_ns) {
-    for (const auto& u : units_)
-        if (u->device) u->device->poll(now_ns);
+    // Each device gets the time it is polled at: a pass over many devices takes a while, and a device that
+    // compares its ESC's registers (read now) with a stale time would misjudge when its next SYNC0 comes.
+    bool first = true;
+    for (const auto& u : units_) {
+        if (!u->device) continue;
+        u->device->poll(first ? now_ns : std::max(now_ns, clock_.now_ns()));
+        first = false;
+    }
 }
 
 uint64_t Line::next_deadline_ns() const {

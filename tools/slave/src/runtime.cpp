@@ -41,6 +41,9 @@ Runtime::Runtime(esc::Link& link, esc::Segment& segment, const esc::Clock& clock
     out_ = out;
     hold_buffer_.resize(kHoldSlots * esc::kMaxFrameSize);
     hold_slots_.resize(kHoldSlots);
+    reply_buffer_.resize(kMaxBurst * esc::kMaxFrameSize);
+    reply_lengths_.resize(kMaxBurst);
+    deadline_ns_ = compute_deadline_ns(clock_.now_ns());
     if (out_ != nullptr && out_->fd() >= 0) add_watch(out_->fd(), kTagOut);
 }
 
@@ -58,6 +61,7 @@ void Runtime::set_carrier_check(std::function<bool()> check, Log* log, std::stri
     carrier_name_ = std::move(name);
     carrier_due_ns_ = 0;
     carrier_state_ = -1;
+    deadline_ns_ = 0;  // the first carrier poll is due at once
 }
 
 Runtime::Runtime(esc::Link& link, esc::Esc& esc, const esc::Clock& clock)
@@ -71,6 +75,7 @@ Runtime::Runtime(esc::Link& link, esc::Esc& esc, const esc::Clock& clock)
         close_fds();
         throw std::runtime_error(std::string("eventfd/epoll_create1: ") + std::strerror(err));
     }
+    deadline_ns_ = compute_deadline_ns(clock_.now_ns());
     // Registered once: an epoll wait costs the same however many descriptors it watches, unlike poll().
     const struct {
         int fd;
@@ -102,6 +107,7 @@ void Runtime::set_firmware(Firmware* firmware) {
         control_fd_ = -1;
     }
     firmware_ = firmware;
+    deadline_ns_ = compute_deadline_ns(clock_.now_ns());
     const int fd = firmware != nullptr ? firmware->control_fd() : -1;
     if (fd < 0) return;
     epoll_event ev{};
@@ -212,18 +218,31 @@ bool Runtime::run_once(int timeout_ms) {
     // With spin_ns_ the timer fires that much before the deadline: nothing is due yet, the spin services it.
     const bool due = timer && (spin_ns_ == 0 || clock_.now_ns() >= next_deadline_ns());
     if (link_event || due || control || n == 0) service();
-    if (spin_ns_ != 0 && !spin_to_deadline()) return false;
+    // A deadline that comes within kChainNs of this service is waited for awake, also without set_spin():
+    // the SYNC0 pulses of a line of ESCs come within a few microseconds of each other, and a sleep and a
+    // wake-up for each would cost more than the wait.
+    if (!spin_to_deadline(spin_ns_ != 0 ? spin_ns_ : kChainNs)) return false;
+    arm_timer();  // for the deadline service() found (no system call when it did not move earlier)
     return true;
 }
 
+// Every path that changes what is due (frames, control commands, timers) ends in service(), which computes
+// the deadline afresh; until then it stands. With many ESCs this saves a walk over all of them per pass.
 uint64_t Runtime::next_deadline_ns() const {
+    return deadline_ns_;
+}
+
+uint64_t Runtime::compute_deadline_ns(uint64_t now) const {
     uint64_t deadline = kNever;
     if (esc_ != nullptr) {
         deadline = esc_->next_event_ns();
     } else {
         const int count = static_cast<int>(segment_->size());
-        for (int k = 0; k < count; ++k)
-            if (segment_->powered(k)) deadline = std::min(deadline, segment_->esc(k).next_event_ns());
+        for (int k = 0; k < count; ++k) {
+            if (!segment_->powered(k)) continue;
+            const esc::Esc& e = segment_->esc(k);
+            deadline = std::min(deadline, &e.clock() == &clock_ ? e.next_event_ns(now) : e.next_event_ns());
+        }
         if (hold_count_ != 0) deadline = std::min(deadline, hold_slots_[hold_head_].due_ns);
         if (carrier_check_) deadline = std::min(deadline, carrier_due_ns_);
     }
@@ -249,15 +268,16 @@ void Runtime::note_loop_pass(uint64_t now) {
     last_pass_ns_ = now;
 }
 
-bool Runtime::spin_to_deadline() {
+bool Runtime::spin_to_deadline(uint64_t window_ns) {
     constexpr int kMaxServicedDeadlines = 8;
     const uint64_t start = clock_.now_ns();
     uint64_t now = start;
     last_pass_ns_ = 0;
     bool spun = false;
-    for (int serviced = 0; serviced < kMaxServicedDeadlines;) {
+    int serviced = 0;
+    while (serviced < kMaxServicedDeadlines) {
         const uint64_t deadline = next_deadline_ns();
-        if (deadline == kNever || deadline > now + spin_ns_) break;
+        if (deadline == kNever || deadline > now + window_ns) break;
         if (now >= deadline) {
             service();
             ++serviced;
@@ -276,7 +296,8 @@ bool Runtime::spin_to_deadline() {
         ++stats_.spin_waits;
         stats_.spin_ns_total += now - start;
     }
-    armed_ns_ = 0;  // the timer may still be armed for a deadline serviced here; it is armed afresh
+    // The timer may still be armed for a deadline serviced here: it is armed afresh.
+    if (spun || serviced > 0 || spin_ns_ != 0) armed_ns_ = 0;
     return true;
 }
 
@@ -292,6 +313,7 @@ int Runtime::handle_frames() {
         if (capture_ != nullptr) std::memcpy(in_copy_.data(), buffer_.data(), len);
         const bool reply = esc_->process_frame(frame, rx_ns);
         const uint64_t done_ns = clock_.now_ns() - rx_ns;
+        log_frame_time(done_ns);
         stats_.frame_ns_total += done_ns;
         stats_.frame_ns_max = std::max(stats_.frame_ns_max, done_ns);
         if (reply) {
@@ -319,10 +341,12 @@ int Runtime::handle_segment_frames() {
         if (len == 0) break;
         const uint64_t rx_ns = clock_.now_ns();
         ++stats_.frames_received;
+        if (reply_count_ != 0 && rx_ns - reply_first_ns_ >= kReplyCoalesceNs) flush_replies();
         std::span<uint8_t> frame(buffer_.data(), len);
         if (capture_ != nullptr) std::memcpy(in_copy_.data(), buffer_.data(), len);
         const esc::Segment::Result result = segment_->walk(frame, rx_ns);
         const uint64_t done = clock_.now_ns();
+        log_frame_time(done - rx_ns);
         stats_.frame_ns_total += done - rx_ns;
         stats_.frame_ns_max = std::max(stats_.frame_ns_max, done - rx_ns);
         segment_result(result, frame, done);
@@ -331,7 +355,16 @@ int Runtime::handle_segment_frames() {
             if (result.kind == esc::Segment::Result::Kind::Reply) capture_->write(frame);
         }
     }
+    flush_replies();
     return i;
+}
+
+void Runtime::log_frame_time(uint64_t ns) {
+    if (frame_log_ == nullptr || !frame_log_->on.load(std::memory_order_relaxed)) return;
+    const std::size_t k = frame_log_->count.load(std::memory_order_relaxed);
+    if (k >= frame_log_->ns.size()) return;
+    frame_log_->ns[k] = ns;
+    frame_log_->count.store(k + 1, std::memory_order_release);
 }
 
 // Frames that come back on the out link (from the devices behind the external port).
@@ -347,6 +380,7 @@ int Runtime::handle_out_frames() {
         segment_result(result, frame, clock_.now_ns());
         if (capture_ != nullptr && result.kind == esc::Segment::Result::Kind::Reply) capture_->write(frame);
     }
+    flush_replies();
     return i;
 }
 
@@ -361,6 +395,7 @@ void Runtime::segment_result(const esc::Segment::Result& result, std::span<uint8
         return;
     }
     if (result.hold_ns != 0 || hold_count_ != 0) {  // behind held replies too: a cable keeps the order
+        flush_replies();                            // and the replies before it go first
         if (hold_count_ < kHoldSlots) {
             const std::size_t slot = (hold_head_ + hold_count_) % kHoldSlots;
             std::memcpy(hold_buffer_.data() + slot * esc::kMaxFrameSize, frame.data(), frame.size());
@@ -370,11 +405,34 @@ void Runtime::segment_result(const esc::Segment::Result& result, std::span<uint8
             return;
         }
         ++stats_.hold_overflows;
+        send_reply(frame, now);
+        flush_replies();
+        return;
     }
-    if (link_.send(frame))
-        ++stats_.frames_sent;
-    else
-        ++stats_.send_errors;
+    send_reply(frame, now);
+}
+
+// A reply joins the burst's batch; the batch goes out when the burst is done (flush_replies() at the end of
+// handle_segment_frames/handle_out_frames) or once its oldest reply has waited kReplyCoalesceNs.
+void Runtime::send_reply(std::span<const uint8_t> frame, uint64_t now) {
+    if (reply_count_ == reply_lengths_.size()) flush_replies();
+    if (reply_count_ == 0) reply_first_ns_ = now;
+    std::memcpy(reply_buffer_.data() + reply_count_ * esc::kMaxFrameSize, frame.data(), frame.size());
+    reply_lengths_[reply_count_++] = frame.size();
+    if (now - reply_first_ns_ >= kReplyCoalesceNs) flush_replies();
+}
+
+void Runtime::flush_replies() {
+    if (reply_count_ == 0) return;
+    for (std::size_t k = 0; k < reply_count_; ++k) {
+        if (link_.send(
+                std::span<const uint8_t>(reply_buffer_.data() + k * esc::kMaxFrameSize, reply_lengths_[k])))
+            ++stats_.frames_sent;
+        else
+            ++stats_.send_errors;
+    }
+    reply_count_ = 0;
+    ++stats_.reply_batches;
 }
 
 void Runtime::release_held(uint64_t now) {
@@ -413,10 +471,17 @@ void Runtime::service() {
         esc_->tick();
         now = clock_.now_ns();
     } else {
-        const int count = static_cast<int>(segment_->size());
-        for (int k = 0; k < count; ++k)
-            if (segment_->powered(k)) segment_->esc(k).tick();
+        // One clock read for the segment: its ESCs count the runtime's clock (each with its own drift).
         now = clock_.now_ns();
+        const int count = static_cast<int>(segment_->size());
+        for (int k = 0; k < count; ++k) {
+            if (!segment_->powered(k)) continue;
+            esc::Esc& e = segment_->esc(k);
+            if (&e.clock() == &clock_)
+                e.tick(now);
+            else
+                e.tick();
+        }
         if (hold_count_ != 0) release_held(now);
         if (carrier_check_) poll_carrier(now);
     }
@@ -429,6 +494,8 @@ void Runtime::service() {
         flushed_frames_ = capture_->frames_written();
         capture_flush_due_ns_ = now + kCaptureFlushNs;
     }
+    // `now` may be a little old by here: an event found due at it is due at once, which is what it is.
+    deadline_ns_ = compute_deadline_ns(now);
 }
 
 void Runtime::arm_timer() {

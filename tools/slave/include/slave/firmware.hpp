@@ -15,6 +15,7 @@ class Firmware {
     // Does whatever is due at now_ns (reads the ESC through its PDI, answers mailboxes, runs the drive).
     virtual void poll(uint64_t now_ns) = 0;
     // Monotonic time (ns) at which poll() must run again even if no frame arrives; UINT64_MAX if never.
+    // The runtime asks after each poll() (and when the firmware is set): the answer may change only there.
     virtual uint64_t next_deadline_ns() const { return std::numeric_limits<uint64_t>::max(); }
     // An extra descriptor the runtime watches with the link, for input that is not EtherCAT (e.g. a control
     // socket that toggles the simulated machine's inputs); -1: none. Read once, when the firmware is set.

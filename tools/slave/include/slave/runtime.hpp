@@ -10,7 +10,9 @@
 //
 // How it waits for a timed event (a SYNC0 pulse, the application cycle, a watchdog) is a choice:
 //   default        sleeps on the timerfd to the deadline: the wake-up is as late as the platform's timer
-//                  latency (tens of microseconds on a virtual machine, docs/benchmarks.md);
+//                  latency (tens of microseconds on a virtual machine, docs/benchmarks.md); a deadline
+//                  that comes within kChainNs after a service is waited for awake (the SYNC0 pulses of a
+//                  line of drives come microseconds apart: one wake-up serves them all);
 //   set_spin(N)    sleeps to N ns before the deadline, then busy-waits on the clock to it, serving frames
 //                  that come meanwhile: the event runs within a microsecond or two of its time, for at most
 //                  N ns of CPU per event;
@@ -27,6 +29,9 @@
 // finishes its walk (Segment::resume). The carrier of the out link is polled every kCarrierPollNs and given
 // to Segment::set_external_link() (no carrier: the port is closed and loops back). The timers of every ESC
 // of the segment are ticked after each burst; the firmware (all the devices' firmware in one) runs after it.
+// Replies of one burst are coalesced: they go out together when the burst has been walked, or as soon as
+// the oldest has waited kReplyCoalesceNs (docs/decisions/segment.md "Replies of a burst"), so a master that
+// sent several frames is woken once for them instead of once per reply.
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -67,6 +72,16 @@ struct RuntimeStats {
     uint64_t hold_overflows = 0;   // replies sent at once because the hold queue was full
     uint64_t out_send_errors = 0;  // not used by the Runtime itself: the external send callback counts here
     uint64_t carrier_changes = 0;  // carrier of the out link gained or lost
+    uint64_t reply_batches = 0;    // coalesced replies sent together (a batch of one counts too)
+};
+
+// Optional record of each frame's processing time (receive to reply ready, clock ns), for benchmarks: a
+// buffer the caller allocates; the runtime fills it while `on` is set and stops when it is full.
+struct FrameTimeLog {
+    explicit FrameTimeLog(std::size_t capacity) : ns(capacity) {}
+    std::vector<uint64_t> ns;
+    std::atomic<std::size_t> count{0};
+    std::atomic<bool> on{false};
 };
 
 class Runtime {
@@ -77,6 +92,11 @@ class Runtime {
 
     // Replies held back by a delayed hop (HopFaults::hold_ns): at most this many at once.
     static constexpr std::size_t kHoldSlots = 256;
+    // Longest time the first reply of a burst waits for the others (segment mode): well below the time a
+    // full frame takes on a 100 Mbit/s wire (123 us), so replies never come later than on real cables.
+    static constexpr uint64_t kReplyCoalesceNs = 100'000;
+    // A deadline this close after a service is waited for awake instead of asleep (see run_once()).
+    static constexpr uint64_t kChainNs = 20'000;
     // How often the out link's carrier is polled (segment mode with an out link).
     static constexpr uint64_t kCarrierPollNs = 100'000'000;
 
@@ -91,6 +111,7 @@ class Runtime {
     // Also watches the firmware's control_fd(), if it has one.
     void set_firmware(Firmware* firmware);
     void set_capture(esc::PcapWriter* capture) { capture_ = capture; }
+    void set_frame_time_log(FrameTimeLog* log) { frame_log_ = log; }
     // Called when poll() reports an error on the link (interface down or removed); returns whether the link
     // is still usable. If it returns false, run() ends and link_lost() is true. Not called per frame.
     void set_link_check(std::function<bool()> check) { link_check_ = std::move(check); }
@@ -123,11 +144,15 @@ class Runtime {
     int handle_out_frames();
     void segment_result(const esc::Segment::Result& result, std::span<uint8_t> frame, uint64_t now);
     void release_held(uint64_t now);
+    void send_reply(std::span<const uint8_t> frame, uint64_t now);
+    void flush_replies();
+    void log_frame_time(uint64_t ns);
     void poll_carrier(uint64_t now);
     void add_watch(int fd, uint32_t tag);
     void service();
-    uint64_t next_deadline_ns() const;
-    bool spin_to_deadline();  // false: stop was requested meanwhile
+    uint64_t next_deadline_ns() const;  // as computed at the end of the last service()
+    uint64_t compute_deadline_ns(uint64_t now) const;
+    bool spin_to_deadline(uint64_t window_ns);  // false: stop was requested meanwhile
     void note_loop_pass(uint64_t now);
     void arm_timer();
     void close_fds();
@@ -140,6 +165,7 @@ class Runtime {
     const esc::Clock& clock_;
     Firmware* firmware_ = nullptr;
     esc::PcapWriter* capture_ = nullptr;
+    FrameTimeLog* frame_log_ = nullptr;
     std::function<bool()> link_check_;
     bool link_lost_ = false;
     int timer_fd_ = -1;
@@ -150,6 +176,7 @@ class Runtime {
     uint64_t last_pass_ns_ = 0;           // clock at the last pass of a busy loop, 0: not in one
     std::atomic<bool> stop_flag_{false};  // set with the stop eventfd, cheap to test while spinning
     int control_fd_ = -1;                 // the firmware's control descriptor registered with epoll, -1: none
+    uint64_t deadline_ns_ = 0;            // next deadline, computed by service() (and when the parts change)
     uint64_t armed_ns_ = 0;               // deadline the timerfd is armed for; 0 = not armed or expired
     uint64_t flushed_frames_ = 0;         // capture frames already pushed to the file
     uint64_t capture_flush_due_ns_ = 0;   // earliest time of the next capture flush
@@ -165,6 +192,11 @@ class Runtime {
     std::vector<HeldFrame> hold_slots_;
     std::size_t hold_head_ = 0;
     std::size_t hold_count_ = 0;
+    // Replies of the current burst (segment mode), sent together by flush_replies().
+    std::vector<uint8_t> reply_buffer_;  // kMaxBurst * kMaxFrameSize, allocated at construction
+    std::vector<std::size_t> reply_lengths_;
+    std::size_t reply_count_ = 0;
+    uint64_t reply_first_ns_ = 0;  // when the oldest waiting reply was ready
     // Carrier of the out link.
     std::function<bool()> carrier_check_;
     Log* carrier_log_ = nullptr;
