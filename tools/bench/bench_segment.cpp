@@ -3,16 +3,20 @@
 // runtime (slave::Runtime over a device::Line of N drives, the segment of ecat-slave --slaves N) in its own
 // thread; on the other the master library: the whole line scanned, DC delays and offsets measured, every
 // drive's SM2/SM3 in one LRW image, SYNC0 on all at one start time, all to OP, every drive in CSP (mode 8,
-// controlword 6 -> 7 -> 15, a target position ramp). Then --seconds of cycles at 1 kHz, and afterwards the
-// same cyclic frame against a bare echo on the same veth pair (the slave thread replaced by one that sends
-// each frame straight back).
+// controlword 6 -> 7 -> 15, a target position ramp). Then --seconds of cycles at 1 kHz in blocks of 20,
+// alternating with as many cycles of a bare echo in the runtime's place (TimedLink answers each frame itself,
+// in the runtime's thread and wake-up path, unprocessed), so the cyclic frame and its baseline are measured
+// side by side on the same veth pair and the same busy or idle machine. Afterwards the same frames against an
+// echo in a thread of its own (poll(), no runtime), as a second baseline.
 //
-// Prints per N: the processing time of one frame through the whole segment (from the runtime's receive()
-// of the frame to its send() of the reply; median/p99), the CPU time of the slave thread per cycle as % of
-// one core at 1 kHz (CLOCK_THREAD_CPUTIME_ID of that thread over the measured window, per cycle), missed
-// cycles (the master loop woke a whole period late), lost frames and working-counter errors, the round trip
-// of the cyclic frame and of the bare echo (median/p99 and their ratios) and the allocations per cycle of the
-// whole process during the measured window (a counting global operator new). Asserts nothing. Needs root.
+// Prints per N: the processing time of one frame through the whole segment (the runtime's walk, from the
+// frame's receive to its reply being ready) and its latency in the slave (receive to send, with the wait
+// for the other replies of a burst), the CPU time of the slave thread per cycle as % of one core at 1 kHz
+// (CLOCK_THREAD_CPUTIME_ID of that thread over the cyclic blocks), the runtime's wake-ups and timer arms per
+// cycle, missed cycles (the master loop woke a whole period late), lost frames and working-counter errors of
+// the cyclic blocks, the round trips of the cyclic frame and of the echoes (median/p99 and their ratios) and
+// the allocations per cycle of the whole process during the measured window (a counting global operator
+// new). Asserts nothing. Needs root.
 #include <poll.h>
 #include <pthread.h>
 #include <sched.h>
@@ -55,33 +59,66 @@ constexpr const char* kSlaveEnd = "seg-s0";
 constexpr const char* kMasterEnd = "seg-m0";
 constexpr auto kPeriod = std::chrono::microseconds(1000);
 
-// The slave's link with a stopwatch: the time from receive() handing a frame to the runtime until the
-// runtime send()s the reply is the frame's way through the segment. Samples go to a preallocated ring.
+// The slave's link with a stopwatch and an echo switch.
+// Stopwatch: a frame's receive() time is kept under its first datagram's index; when the reply with that
+// index is sent, send - receive is the frame's latency through the slave: its walk through the segment and,
+// in a burst, the wait for the burst's other replies (slave::Runtime coalesces them).
+// Echo: while set, receive() sends each frame straight back (processed, as an ESC marks it) and hands nothing
+// to the runtime: a bare echo in the runtime's own thread and wake-up path. Blocks of echo and of cyclic
+// operation alternate, so both baselines see the same machine at the same time.
 class TimedLink final : public esc::Link {
   public:
     explicit TimedLink(esc::Link& inner, std::size_t capacity) : inner_(inner), samples_(capacity) {}
     int fd() const override { return inner_.fd(); }
     std::size_t receive(std::span<uint8_t> buf) override {
-        const std::size_t n = inner_.receive(buf);
-        if (n) received_at_ = bench::now_ns();
-        return n;
+        for (;;) {
+            const std::size_t n = inner_.receive(buf);
+            if (n == 0) return 0;
+            if (echo_.load(std::memory_order_relaxed)) {
+                if (n >= 12) buf[6] |= 0x02;  // source MAC: locally administered, as an ESC's port 0 sets it
+                (void)inner_.send(std::span<const uint8_t>(buf.data(), n));
+                continue;
+            }
+            if (n > kIndexOffset) {
+                Pending& p = pending_[next_++ % kPending];
+                p = Pending{bench::now_ns(), buf[kIndexOffset], true};
+            }
+            return n;
+        }
     }
     bool send(std::span<const uint8_t> frame) override {
-        if (received_at_ && recording_.load(std::memory_order_relaxed) && count_ < samples_.size())
-            samples_[count_++] = bench::now_ns() - received_at_;
-        received_at_ = 0;
+        if (frame.size() > kIndexOffset) {
+            Pending* oldest = nullptr;
+            for (Pending& p : pending_)
+                if (p.valid && p.index == frame[kIndexOffset] && (!oldest || p.at < oldest->at)) oldest = &p;
+            if (oldest != nullptr) {
+                oldest->valid = false;
+                if (recording_.load(std::memory_order_relaxed) && count_ < samples_.size())
+                    samples_[count_++] = bench::now_ns() - oldest->at;
+            }
+        }
         return inner_.send(frame);
     }
     std::string describe() const override { return inner_.describe(); }
     void record(bool on) { recording_.store(on); }
+    void echo(bool on) { echo_.store(on); }
     std::vector<uint64_t> samples() const { return {samples_.begin(), samples_.begin() + count_}; }
 
   private:
+    static constexpr std::size_t kIndexOffset = 14 + 2 + 1;  // Ethernet header, EtherCAT header, command
+    static constexpr std::size_t kPending = 16;
+    struct Pending {
+        uint64_t at = 0;
+        uint8_t index = 0;
+        bool valid = false;
+    };
     esc::Link& inner_;
     std::vector<uint64_t> samples_;
     std::size_t count_ = 0;
-    uint64_t received_at_ = 0;
+    Pending pending_[kPending];
+    std::size_t next_ = 0;
     std::atomic<bool> recording_{false};
+    std::atomic<bool> echo_{false};
 };
 
 uint64_t thread_cpu_ns(clockid_t id) {
@@ -118,8 +155,9 @@ struct DriveIo {
 
 struct Figures {
     std::size_t drives = 0;
-    bench::Summary walk, rtt, echo;
-    double cpu_percent = 0, cpu_wall_percent = 0, cpu_us_per_cycle = 0, allocs_per_cycle = 0;
+    bench::Summary walk, latency, rtt, echo, echo_thread;
+    double cpu_percent = 0, cpu_us_per_cycle = 0, allocs_per_cycle = 0;
+    double wakeups_per_cycle = 0, timer_arms_per_cycle = 0, frames_per_wakeup = 0, replies_per_batch = 0;
     uint64_t cycles = 0, missed = 0, lost = 0, wkc_errors = 0, enabled = 0;
     std::size_t frames_per_cycle = 0;
 };
@@ -170,7 +208,27 @@ Figures run_segment(std::size_t drives, double seconds, const std::string& backe
     auto line = std::make_unique<device::Line>(clock, lo);
     auto runtime = std::make_unique<slave::Runtime>(timed, line->segment(), clock);
     runtime->set_firmware(line.get());
-    std::thread slave_thread([&] { runtime->run(); });
+    slave::FrameTimeLog walk_log(cycles * 8 + 1000);
+    runtime->set_frame_time_log(&walk_log);
+    // The runtime's statistics are copied by its own thread on request (snapshot()), never read across.
+    std::atomic<int> snap_state{0};
+    slave::RuntimeStats snap;
+    std::thread slave_thread([&] {
+        pthread_setname_np(pthread_self(), "segment-slave");  // for perf and top
+        while (runtime->run_once(2)) {
+            if (snap_state.load(std::memory_order_acquire) == 1) {
+                snap = runtime->stats();
+                snap_state.store(2, std::memory_order_release);
+            }
+        }
+    });
+    auto snapshot = [&] {
+        snap_state.store(1, std::memory_order_release);
+        while (snap_state.load(std::memory_order_acquire) != 2)
+            std::this_thread::sleep_for(std::chrono::microseconds(100));
+        snap_state.store(0);
+        return snap;
+    };
     clockid_t slave_cpu{};
     pthread_getcpuclockid(slave_thread.native_handle(), &slave_cpu);
 
@@ -253,41 +311,66 @@ Figures run_segment(std::size_t drives, double seconds, const std::string& backe
         });
     }
 
-    // ---- the measured window: a position ramp on every drive ---------------------------------------------
-    std::vector<uint64_t> rtt;
+    // ---- the measured window: a position ramp on every drive, in blocks of cyclic operation that alternate
+    // with blocks of the bare echo in the runtime's place (TimedLink)
+    // ------------------------------------------
+    constexpr uint64_t kBlock = 20;  // cycles; well inside the process-data watchdog (100 ms)
+    std::vector<uint64_t> rtt, echo_rtt;
     rtt.reserve(cycles);
-    const master::CycleStats before = pd.stats();
-    timed.record(true);
-    const uint64_t cpu0 = thread_cpu_ns(slave_cpu);
-    const uint64_t wall0 = bench::now_ns();
+    echo_rtt.reserve(cycles);
+    uint64_t cpu = 0, echo_missed = 0;
+    const slave::RuntimeStats rs0 = snapshot();
     const alloc_counter::Scope allocs;
-    run_cycles(pd, cycles, rtt, f.missed, [&](uint64_t) {
-        for (int32_t& t : target)
-            t += 20;  // 20 increments per ms
-        fill(0);
-    });
+    walk_log.on.store(true);
+    for (uint64_t done = 0; done < cycles; done += kBlock) {
+        const uint64_t n = std::min(kBlock, cycles - done);
+        timed.echo(true);
+        run_cycles(pd, n, echo_rtt, echo_missed, [&](uint64_t) { fill(0); });
+        timed.echo(false);
+        const master::CycleStats before = pd.stats();
+        timed.record(true);
+        const uint64_t cpu0 = thread_cpu_ns(slave_cpu);
+        run_cycles(pd, n, rtt, f.missed, [&](uint64_t) {
+            for (int32_t& t : target)
+                t += 20;  // 20 increments per ms
+            fill(0);
+        });
+        cpu += thread_cpu_ns(slave_cpu) - cpu0;
+        timed.record(false);
+        const master::CycleStats after = pd.stats();
+        f.cycles += after.cycles - before.cycles;
+        f.lost += after.lost - before.lost;
+        f.wkc_errors += after.wkc_errors - before.wkc_errors;
+    }
+    walk_log.on.store(false);
     const uint64_t alloc_count = allocs.count();
-    const uint64_t wall = bench::now_ns() - wall0;
-    const uint64_t cpu = thread_cpu_ns(slave_cpu) - cpu0;
-    timed.record(false);
-    const master::CycleStats after = pd.stats();
-    f.cycles = after.cycles - before.cycles;
-    f.lost = after.lost - before.lost;
-    f.wkc_errors = after.wkc_errors - before.wkc_errors;
+    const slave::RuntimeStats rs1 = snapshot();
     for (std::size_t k = 0; k < drives; ++k)
         if ((util::get16(pd.inputs(k).data() + io.sw) & 0x006F) == 0x0027) ++f.enabled;
-    f.cpu_percent = 100.0 * static_cast<double>(cpu) / static_cast<double>(wall);
+    // CPU and allocations over the cyclic blocks; the runtime's counters over the whole window (both kinds of
+    // block: its timers run in the echo blocks as well).
+    const double window_cycles = static_cast<double>(2 * cycles);
     f.cpu_us_per_cycle =
         static_cast<double>(cpu) / 1000.0 / static_cast<double>(std::max<uint64_t>(1, f.cycles));
-    f.allocs_per_cycle =
-        static_cast<double>(alloc_count) / static_cast<double>(std::max<uint64_t>(1, f.cycles));
+    f.cpu_percent = f.cpu_us_per_cycle / 10.0;  // of the 1000 us period
+    f.allocs_per_cycle = static_cast<double>(alloc_count) / window_cycles;
+    f.wakeups_per_cycle = static_cast<double>(rs1.wakeups - rs0.wakeups) / window_cycles;
+    f.timer_arms_per_cycle = static_cast<double>(rs1.timer_arms - rs0.timer_arms) / window_cycles;
+    f.frames_per_wakeup = static_cast<double>(rs1.frames_received - rs0.frames_received) /
+                          static_cast<double>(std::max<uint64_t>(1, rs1.wakeups - rs0.wakeups));
+    f.replies_per_batch = static_cast<double>(rs1.frames_sent - rs0.frames_sent) /
+                          static_cast<double>(std::max<uint64_t>(1, rs1.reply_batches - rs0.reply_batches));
     f.rtt = bench::summarize(rtt);
+    f.echo = bench::summarize(echo_rtt);
+    f.latency = bench::summarize(timed.samples());
+    f.walk = bench::summarize(
+        std::vector<uint64_t>(walk_log.ns.begin(), walk_log.ns.begin() + walk_log.count.load()));
 
-    // ---- the bare echo on the same veth pair, same frames -----------------------------------------------
+    // ---- the bare echo in a thread of its own (poll(), no runtime), after the slave stopped
+    // ----------------
     runtime->request_stop();
     slave_thread.join();
     runtime.reset();
-    f.walk = bench::summarize(timed.samples());
     std::atomic<bool> echo_stop{false};
     std::thread echo([&] {
         std::vector<uint8_t> buf(esc::kMaxFrameSize);
@@ -302,13 +385,13 @@ Figures run_segment(std::size_t drives, double seconds, const std::string& backe
             slave_link->send(std::span<const uint8_t>(buf.data(), n));
         }
     });
-    std::vector<uint64_t> echo_rtt;
-    echo_rtt.reserve(cycles);
-    uint64_t echo_missed = 0;
-    run_cycles(pd, cycles, echo_rtt, echo_missed, [&](uint64_t) { fill(0); });
+    std::vector<uint64_t> thread_rtt;
+    thread_rtt.reserve(cycles);
+    uint64_t thread_missed = 0;
+    run_cycles(pd, cycles, thread_rtt, thread_missed, [&](uint64_t) { fill(0); });
     echo_stop.store(true);
     echo.join();
-    f.echo = bench::summarize(echo_rtt);
+    f.echo_thread = bench::summarize(thread_rtt);
     return f;
 }
 
@@ -366,15 +449,22 @@ int main(int argc, char** argv) {
                     f.drives == 1 ? "" : "s", f.frames_per_cycle, f.frames_per_cycle == 1 ? "" : "s",
                     static_cast<unsigned long long>(f.cycles), static_cast<unsigned long long>(f.enabled));
         bench::print("  frame through segment", f.walk, "us", 1000.0);
+        bench::print("  frame latency in slave", f.latency, "us", 1000.0);
         bench::print("  round trip, cyclic", f.rtt, "us", 1000.0);
         bench::print("  round trip, bare echo", f.echo, "us", 1000.0);
-        std::printf("  ratio cyclic/echo: median %.3f  p99 %.3f\n",
-                    f.rtt.median / std::max(1.0, f.echo.median), f.rtt.p99 / std::max(1.0, f.echo.p99));
+        bench::print("  round trip, echo thread", f.echo_thread, "us", 1000.0);
         std::printf(
-            "  slave thread CPU: %.1f us per cycle (%.2f us per drive) = %.1f %% of one core at 1 kHz "
-            "(%.1f %% of the wall time)\n",
-            f.cpu_us_per_cycle, f.cpu_us_per_cycle / static_cast<double>(f.drives), f.cpu_percent,
-            f.cpu_wall_percent);
+            "  ratio cyclic/echo: median %.3f  p99 %.3f   (against the echo thread run after it: %.3f / "
+            "%.3f)\n",
+            f.rtt.median / std::max(1.0, f.echo.median), f.rtt.p99 / std::max(1.0, f.echo.p99),
+            f.rtt.median / std::max(1.0, f.echo_thread.median), f.rtt.p99 / std::max(1.0, f.echo_thread.p99));
+        std::printf(
+            "  slave thread CPU: %.1f us per cycle (%.2f us per drive) = %.1f %% of one core at 1 kHz\n",
+            f.cpu_us_per_cycle, f.cpu_us_per_cycle / static_cast<double>(f.drives), f.cpu_percent);
+        std::printf(
+            "  slave wake-ups per cycle %.2f, timer arms per cycle %.2f, frames per wake-up %.2f, "
+            "replies per batch %.2f\n",
+            f.wakeups_per_cycle, f.timer_arms_per_cycle, f.frames_per_wakeup, f.replies_per_batch);
         std::printf("  missed cycles %llu, lost frames %llu, wkc errors %llu, allocations per cycle %.3f\n",
                     static_cast<unsigned long long>(f.missed), static_cast<unsigned long long>(f.lost),
                     static_cast<unsigned long long>(f.wkc_errors), f.allocs_per_cycle);
