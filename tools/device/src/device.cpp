@@ -370,8 +370,7 @@ void Device::poll(uint64_t now_ns) {
     }
     // The drive's own loop: it runs when no master cycle drives it (outside Op), as the controller of a
     // hardware drive never stops; the first run right after a build sets the statusword.
-    if (last_cycle_ns_ == 0 ||
-        (parts_->stack->state() != od::AlState::Op && now_ns >= last_cycle_ns_ + kFreeRunNs))
+    if (last_cycle_ns_ == 0 || (parts_->stack->state() != od::AlState::Op && now_ns >= free_run_due_ns()))
         run_drive(now_ns);
     if (eeprom_dirty_) {
         if (eeprom_save_ns_ == 0)
@@ -385,7 +384,7 @@ uint64_t Device::next_deadline_ns() const {
     uint64_t next = parts_->stack->next_deadline_ns();
     if (eeprom_dirty_ && eeprom_save_ns_ != 0) next = std::min(next, eeprom_save_ns_);
     if (parts_->stack->state() == od::AlState::Op || last_cycle_ns_ == 0) return next;
-    return std::min(next, last_cycle_ns_ + kFreeRunNs);
+    return std::min(next, free_run_due_ns());
 }
 
 void Device::run_drive(uint64_t now_ns) {

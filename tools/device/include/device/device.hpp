@@ -106,7 +106,9 @@ class Device final : public ecat::Application, public drive::EventSink, public e
     Device& operator=(const Device&) = delete;
 
     // Outside Op, the drive runs on its own every kFreeRunNs when no master cycle ran it (the controller of
-    // a hardware drive never stops: a fault reaction ramps down after the master is gone).
+    // a hardware drive never stops: a fault reaction ramps down after the master is gone). Its cycles fall
+    // on the grid of multiples of kFreeRunNs of the clock, so the drives of a line run theirs in the same
+    // wake-up of the runtime instead of one wake-up each.
     static constexpr uint64_t kFreeRunNs = 10'000'000;
     // Longest time one drive cycle simulates: after a longer pause the machine does not catch up.
     static constexpr int64_t kMaxCycleStepNs = 100'000'000;
@@ -183,7 +185,8 @@ class Device final : public ecat::Application, public drive::EventSink, public e
     std::array<int8_t, 6> inputs_{-1, -1, -1, -1, -1, -1};  // user-set pin levels, -1: untouched
     bool restart_pending_ = false;
     bool outputs_lost_pending_ = false;  // outputs ended in this poll(); reacted to when it returns
-    uint64_t last_cycle_ns_ = 0;         // last drive cycle (master's or our own); 0: none since the build
+    uint64_t free_run_due_ns() const { return (last_cycle_ns_ / kFreeRunNs + 1) * kFreeRunNs; }
+    uint64_t last_cycle_ns_ = 0;  // last drive cycle (master's or our own); 0: none since the build
     DeviceStats stats_;
     ecat::StackStats earlier_stacks_;  // statistics of the Stacks that restarts replaced
     EepromWrites eeprom_writes_;
