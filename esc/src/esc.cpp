@@ -228,14 +228,14 @@ int Esc::Impl::receive(std::span<uint8_t> frame, int port, uint64_t rx_clock, Fr
             lw[1] = static_cast<uint8_t>(lw[1] | 0x40);
         }
     }
-    if (!process(frame, rx_clock)) {
+    if (!process(frame, port, rx_clock)) {
         ++stats.frames_destroyed;
         return -1;
     }
     return ports.exit_after(port);
 }
 
-bool Esc::Impl::process(std::span<uint8_t> frame, uint64_t rx_clock) {
+bool Esc::Impl::process(std::span<uint8_t> frame, int port, uint64_t rx_clock) {
     const std::size_t size = frame.size();
     if (size < 14) {
         ++stats.frames_ignored;
@@ -253,8 +253,10 @@ bool Esc::Impl::process(std::span<uint8_t> frame, uint64_t rx_clock) {
         off = 16;
     }
     if (type != kEtherTypeEcat) {
+        // DL control 0x0100 bit 0, the forwarding rule (ESC datasheet, DL control): 1 (the reset value)
+        // destroys non-EtherCAT frames, 0 forwards them unchanged.
         ++stats.frames_ignored;
-        return false;
+        return (mem.r8(reg::kDlControl) & 0x01) == 0;
     }
     if (!cfg.faults.source_mac_unchanged)
         f[6] |= 0x02;  // source MAC: locally administered bit, as every ESC sets it
@@ -262,7 +264,7 @@ bool Esc::Impl::process(std::span<uint8_t> frame, uint64_t rx_clock) {
     if (size < hdr + 2) {
         ++stats.frames_malformed;
         ++stats.malformed_no_header;
-        mem.count_error(reg::kInvalidFrameCounter);
+        mem.count_error(invalid_frame_counter(port));  // the port it came in at
         mem.count_error(reg::kProcessingUnitErrors);
         return true;
     }
@@ -304,7 +306,7 @@ bool Esc::Impl::process(std::span<uint8_t> frame, uint64_t rx_clock) {
     }
     if (!ok) {
         ++stats.frames_malformed;
-        mem.count_error(reg::kInvalidFrameCounter);
+        mem.count_error(invalid_frame_counter(port));  // the port it came in at
         mem.count_error(reg::kProcessingUnitErrors);
     }
     end_of_frame(ok);

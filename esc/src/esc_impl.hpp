@@ -62,7 +62,7 @@ struct Esc::Impl final {
 
     // Frame processing.
     int receive(std::span<uint8_t> frame, int port, uint64_t rx_clock, FrameCheck* check);
-    bool process(std::span<uint8_t> frame, uint64_t rx_clock);
+    bool process(std::span<uint8_t> frame, int port, uint64_t rx_clock);
     void end_of_frame(bool ok);
     void datagram(uint8_t* hdr, uint8_t* data, uint16_t len);
 

@@ -451,3 +451,42 @@ TEST(PortsClock, DriftAndOffsetShapeTheLocalTime) {
 }
 
 }  // namespace
+
+// DL control 0x0100 bit 0, the forwarding rule: 1 (reset value) destroys non-EtherCAT frames, 0 forwards
+// them unchanged, through the port after the processing unit.
+TEST_F(Ports, ForwardingRuleDestroysOrForwardsNonEtherCatFrames) {
+    auto ip = build({dg_len(BRD, 0, 0x0000, 1)});
+    ip[12] = 0x08;  // EtherType 0x0800
+    ip[13] = 0x00;
+    auto f = ip;
+    EXPECT_EQ(e->receive(f, 0), -1) << "destroyed by default";
+    EXPECT_EQ(fpwr(*e, 0x0100, {0x00}).wkc, 1);
+    f = ip;
+    EXPECT_EQ(e->receive(f, 0), 0) << "forwarded: a lone ESC sends it back";
+    EXPECT_EQ(f, ip) << "unchanged, source MAC included";
+    e->set_link(1, true);
+    f = ip;
+    EXPECT_EQ(e->receive(f, 0), 1) << "on to the next device";
+    EXPECT_EQ(f, ip);
+    EXPECT_EQ(fpwr(*e, 0x0100, {0x01}).wkc, 1);
+    f = ip;
+    EXPECT_EQ(e->receive(f, 0), -1);
+}
+
+// A malformed EtherCAT frame counts as an invalid frame at the port it was received at, also when it reaches
+// the processing unit through a port 0 the master closed.
+TEST_F(Ports, MalformedFrameCountsAtThePortItCameIn) {
+    auto bad = build({dg_len(BRD, 0, 0x0000, 1)});
+    bad[14] = 0xFF;  // EtherCAT header length 0x7FF: beyond the frame
+    bad[15] = static_cast<uint8_t>((bad[15] & 0xF8) | 0x07);
+    auto f = bad;
+    (void)e->receive(f, 0);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x0300), 1);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x0302), 0);
+    e->set_link(1, true);
+    EXPECT_EQ(fpwr(*e, 0x0101, {0x0B}).wkc, 1);  // port 0 closed, port 1 open
+    f = bad;
+    (void)e->receive(f, 1);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x0300), 1);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x0302), 1);
+}
