@@ -262,7 +262,11 @@ int main(int argc, char** argv) {
         std::cerr << "ecat-slave: " << e.what() << '\n';
         return slave::kExitUsage;
     }
-    if (topology_file.empty() && slaves == 1) line.topology.devices[0].state_dir = device.state_dir.string();
+    if (topology_file.empty() && slaves == 1) {
+        line.topology.devices[0].state_dir = device.state_dir.string();
+        // One drive with --out-iface only: the serial number of its configuration, as without --out-iface.
+        if (slaves_opt->count() == 0) line.topology.devices[0].serial = 0;
+    }
     for (slave::TopologyDevice& d : line.topology.devices) {
         if (d.state_dir.empty()) d.state_dir = (device.state_dir / d.name).string();
         // Each device's configuration is loaded now: a bad one is a usage error naming the topology line.
