@@ -201,6 +201,12 @@ TEST(SegmentRuntime, APowerCycledDriveComesBackInInitWithItsStoredParameters) {
     std::ostringstream report;
     bus.line->report(report);
     EXPECT_NE(report.str().find("segment.device1.power_cycles 1\n"), std::string::npos) << report.str();
+    // Every device's own statistics, under its prefix: each of the three went through Init -> Pre-Op.
+    for (int k = 0; k < 3; ++k)
+        EXPECT_NE(report.str().find("segment.device" + std::to_string(k) + ".stack.transitions "),
+                  std::string::npos)
+            << k << report.str();
+    EXPECT_EQ(report.str().find("segment.device1.stack.transitions 0\n"), std::string::npos) << report.str();
 }
 
 // A power cut in the middle of an FoE download or of the commit of a new image loses nothing stored: the

@@ -345,6 +345,15 @@ void Line::report(std::ostream& out) const {
             << "segment.device" << k << ".frames_processed " << u.esc->stats().frames_processed << '\n';
         if (u.device) out << "segment.device" << k << ".drive_cycles " << u.device->stats().cycles << '\n';
     }
+    // Every device's own figures (ecat.*, device.*) under its prefix: segment.device<k>.ecat.frames ...
+    for (std::size_t k = 0; k < units_.size(); ++k) {
+        if (!units_[k]->device) continue;
+        std::ostringstream own;
+        report_device(own, *units_[k]->device);
+        std::istringstream lines(own.str());
+        for (std::string line; std::getline(lines, line);)
+            out << "segment.device" << k << '.' << line << '\n';
+    }
 }
 
 }  // namespace device

@@ -66,7 +66,8 @@ class Line final : public slave::SegmentFirmware {
     uint64_t next_deadline_ns() const override;
     int control_fd() const override { return control_ ? control_->fd() : -1; }
     void on_control(uint64_t now_ns) override;
-    // Device 0's figures as a single drive reports them (ecat.*, device.*), then segment.* lines.
+    // Device 0's figures as a single drive reports them (ecat.*, device.*), then segment.* lines, then every
+    // device's ecat.* and device.* lines prefixed segment.device<k>.
     void report(std::ostream& out) const override;
     esc::Segment& segment() override { return segment_; }
 
