@@ -74,10 +74,21 @@ void Axis::velocity_tick() {
     Plant::State x = plant_.state();
     bool at_stop = plant_.at_stop();
     const double u_motor = pol_ * u;  // polarity: the motor turns the other way
-    for (int k = 0; k < kPlantStepsPerTick; ++k) {
-        at_stop = plant_.advance(x, u_motor, dc_.power);
-        machine_step(x.angle * inc_per_rad_,
-                     t_ns + static_cast<int64_t>((k + 1) * kCurrentTickNs / kPlantStepsPerTick));
+    // With power on the four steps come from the state at once while the friction sign holds and no stop
+    // is near (Plant::advance_held); otherwise, one after the other.
+    static_assert(kPlantStepsPerTick == Plant::kHeldSteps);
+    double angles[Plant::kHeldSteps];
+    if (dc_.power && plant_.advance_held(x, u_motor, angles)) {
+        at_stop = false;
+        for (int k = 0; k < kPlantStepsPerTick; ++k)
+            machine_step(angles[k] * inc_per_rad_,
+                         t_ns + static_cast<int64_t>((k + 1) * kCurrentTickNs / kPlantStepsPerTick));
+    } else {
+        for (int k = 0; k < kPlantStepsPerTick; ++k) {
+            at_stop = plant_.advance(x, u_motor, dc_.power);
+            machine_step(x.angle * inc_per_rad_,
+                         t_ns + static_cast<int64_t>((k + 1) * kCurrentTickNs / kPlantStepsPerTick));
+        }
     }
     plant_.set_state(x, at_stop);
     count_ = static_cast<int64_t>(std::floor(pol_ * prev_raw_pos_));

@@ -51,6 +51,14 @@ void Plant::configure(const MotorModel& model, double torque_constant, double h)
     phi_ = e.block<3, 3>(0, 0);
     gamma_u_ = e.block<3, 1>(0, 3);
     gamma_t_ = e.block<3, 1>(0, 4);
+    // advance_held(): the same augmented system over k steps gives [Phi^k | G_k | T_k] in one exponential.
+    for (int k = 1; k <= kHeldSteps; ++k) {
+        const Eigen::MatrixXd ek = k == 1 ? e : expm(aug * (h * k));
+        auto row = [&](int r) { return HeldRow{ek(r, 0), ek(r, 1), ek(r, 2), ek(r, 3), ek(r, 4)}; };
+        held_w_[k - 1] = row(1);
+        held_a_[k - 1] = row(2);
+        if (k == kHeldSteps) held_i_ = row(0);
+    }
     // Power off: mechanics alone, [omega, theta].
     Eigen::MatrixXd mech = Eigen::MatrixXd::Zero(3, 3);
     mech(0, 0) = -b / j_;
