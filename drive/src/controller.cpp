@@ -91,7 +91,7 @@ void Axis::velocity_tick() {
         }
     }
     plant_.set_state(x, at_stop);
-    count_ = static_cast<int64_t>(std::floor(pol_ * prev_raw_pos_));
+    count_ = floor_to_int(pol_ * prev_raw_pos_);
 
     ctl_.observe(inc_to_rad(static_cast<double>(count_) + 0.5), i_meas(), km);
 }
