@@ -77,15 +77,21 @@ class Plant {
     Eigen::Matrix2d phi_mech_ = Eigen::Matrix2d::Identity();  // power off: [omega, theta] only
     Eigen::Vector2d gamma_mech_ = Eigen::Vector2d::Zero();
     Eigen::Vector3d x_ = Eigen::Vector3d::Zero();
-    // advance_held(): one row of [Phi^k | G_k | T_k] for k = 1..kHeldSteps (velocity and angle), and the
-    // current's row for the last step.
+    // advance_held(): the rows of [Phi^k | G_k | T_k] for k = 1..kHeldSteps, velocity and angle side by side
+    // (the two are computed as one pair: GCC/Clang vector extension, SSE2 on x86-64), and the current's row
+    // for the last step.
+    typedef double Pair __attribute__((vector_size(16)));
+    typedef long long PairMask __attribute__((vector_size(16)));
+    template <typename T>
     struct HeldRow {
-        double p0 = 0, p1 = 0, p2 = 0, gu = 0, gt = 0;
-        double apply(double x0, double x1, double x2, double u, double tau) const {
+        T p0{}, p1{}, p2{}, gu{}, gt{};
+        T apply(double x0, double x1, double x2, double u, double tau) const {
+            // Grouped as advance() groups one step (the input terms apart from the state).
             return (p0 * x0 + p1 * x1) + (p2 * x2 + (gu * u + gt * tau));
         }
     };
-    HeldRow held_w_[kHeldSteps], held_a_[kHeldSteps], held_i_;
+    HeldRow<Pair> held_[kHeldSteps];
+    HeldRow<double> held_i_;
     double km_ = 0.0, j_ = 1.0, coulomb_ = 0.0, h_ = 1e-5, l_ = 1e-3, r_ = 1.0;
     double lo_ = -std::numeric_limits<double>::infinity();
     double hi_ = std::numeric_limits<double>::infinity();
@@ -149,19 +155,20 @@ inline bool Plant::advance_held(State& s, double u, double (&angles)[kHeldSteps]
     if (!(sg * w0 > 0)) return false;  // at rest (stiction decides) or NaN
     const double tau = -sg * coulomb_;
     const double x0 = s.current, x1 = w0, x2 = s.angle;
-    double w[kHeldSteps];
+    // Strictly inside: the velocity on w0's side of zero (and finite), the angle between the stops.
+    const Pair lower = {sg > 0 ? 0.0 : -INFINITY, lo_}, upper = {sg > 0 ? INFINITY : 0.0, hi_};
+    PairMask ok = {-1, -1};
+    Pair wa{};
     for (int k = 0; k < kHeldSteps; ++k) {
-        w[k] = held_w_[k].apply(x0, x1, x2, u, tau);
-        angles[k] = held_a_[k].apply(x0, x1, x2, u, tau);
+        wa = held_[k].apply(x0, x1, x2, u, tau);
+        angles[k] = wa[1];
+        ok &= (wa > lower) & (wa < upper);
     }
     // Non-short-circuit tests: the branch is taken almost always one way.
-    bool ok = true;
-    for (int k = 0; k < kHeldSteps; ++k)
-        ok &= (sg * w[k] > 0) & (angles[k] > lo_) & (angles[k] < hi_);
-    if (!ok) return false;
+    if (!(ok[0] & ok[1])) return false;
     s.current = held_i_.apply(x0, x1, x2, u, tau);
-    s.velocity = w[kHeldSteps - 1];
-    s.angle = angles[kHeldSteps - 1];
+    s.velocity = wa[0];
+    s.angle = wa[1];
     return true;
 }
 
