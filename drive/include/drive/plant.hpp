@@ -81,7 +81,6 @@ class Plant {
     // (the two are computed as one pair: GCC/Clang vector extension, SSE2 on x86-64), and the current's row
     // for the last step.
     typedef double Pair __attribute__((vector_size(16)));
-    typedef long long PairMask __attribute__((vector_size(16)));
     template <typename T>
     struct HeldRow {
         T p0{}, p1{}, p2{}, gu{}, gt{};
@@ -155,17 +154,22 @@ inline bool Plant::advance_held(State& s, double u, double (&angles)[kHeldSteps]
     if (!(sg * w0 > 0)) return false;  // at rest (stiction decides) or NaN
     const double tau = -sg * coulomb_;
     const double x0 = s.current, x1 = w0, x2 = s.angle;
-    // Strictly inside: the velocity on w0's side of zero (and finite), the angle between the stops.
-    const Pair lower = {sg > 0 ? 0.0 : -INFINITY, lo_}, upper = {sg > 0 ? INFINITY : 0.0, hi_};
-    PairMask ok = {-1, -1};
-    Pair wa{};
-    for (int k = 0; k < kHeldSteps; ++k) {
+    // Strictly inside: the velocity on w0's side of zero (and finite), the angle between the stops. Tested on
+    // the smallest and largest of the steps (packed min/max) and their sum, which is NaN when any step is.
+    Pair wa = held_[0].apply(x0, x1, x2, u, tau);
+    angles[0] = wa[1];
+    Pair mn = wa, mx = wa, sum = wa;
+#pragma GCC unroll 4
+    for (int k = 1; k < kHeldSteps; ++k) {
         wa = held_[k].apply(x0, x1, x2, u, tau);
         angles[k] = wa[1];
-        ok &= (wa > lower) & (wa < upper);
+        mn = wa < mn ? wa : mn;
+        mx = wa > mx ? wa : mx;
+        sum += wa;
     }
-    // Non-short-circuit tests: the branch is taken almost always one way.
-    if (!(ok[0] & ok[1])) return false;
+    const bool inside = (sg > 0 ? mn[0] > 0 && mx[0] < INFINITY : mx[0] < 0 && mn[0] > -INFINITY) &&
+                        mn[1] > lo_ && mx[1] < hi_ && sum[0] == sum[0] && sum[1] == sum[1];
+    if (!inside) return false;
     s.current = held_i_.apply(x0, x1, x2, u, tau);
     s.velocity = wa[0];
     s.angle = wa[1];
