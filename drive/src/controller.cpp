@@ -116,7 +116,8 @@ void Controller::observe(double meas_rad, double i_meas, double km_plant) {
     else if (thermal < 0.98)
         i2t_active = false;
 
-    const double rpm = obs_vel * 60.0 / kTwoPi;
+    // One multiplication: a division here held back every sample (docs/decisions/drive.md "Cost of a cycle").
+    const double rpm = obs_vel * (60.0 / kTwoPi);
     vel_avg_rpm += kAvgAlpha * (rpm - vel_avg_rpm);
     cur_avg_a += kAvgAlpha * (i_meas - cur_avg_a);
 }
