@@ -123,6 +123,11 @@ void Controller::observe(double meas_rad, double i_meas, double km_plant) {
 }
 
 void Controller::tune(const Parameters& p, double km_plant) {
+    const TuneInputs in{p.torque_constant, p.inertia,   p.friction,  p.bandwidth,  p.damping,
+                        p.reset_time,      p.current_p, p.current_i, p.current_ff, p.thermal_time_constant,
+                        p.nominal_current, km_plant,    true};
+    if (in == tuned) return;
+    tuned = in;
     // 0x30A1: bandwidth, damping, reset time, inertia, friction -> cascade gains by pole placement
     // (docs/decisions/drive.md "Control loops").
     km = p.torque_constant * 1e-6;
