@@ -74,13 +74,24 @@ void Axis::velocity_tick() {
     Plant::State x = plant_.state();
     bool at_stop = plant_.at_stop();
     const double u_motor = pol_ * u;  // polarity: the motor turns the other way
-    for (int k = 0; k < kPlantStepsPerTick; ++k) {
-        at_stop = plant_.advance(x, u_motor, dc_.power);
-        machine_step(x.angle * inc_per_rad_,
-                     t_ns + static_cast<int64_t>((k + 1) * kCurrentTickNs / kPlantStepsPerTick));
+    // With power on the four steps come from the state at once while the friction sign holds and no stop
+    // is near (Plant::advance_held); otherwise, one after the other.
+    static_assert(kPlantStepsPerTick == Plant::kHeldSteps);
+    double angles[Plant::kHeldSteps];
+    if (dc_.power && plant_.advance_held(x, u_motor, angles)) {
+        at_stop = false;
+        for (int k = 0; k < kPlantStepsPerTick; ++k)
+            machine_step(angles[k] * inc_per_rad_,
+                         t_ns + static_cast<int64_t>((k + 1) * kCurrentTickNs / kPlantStepsPerTick));
+    } else {
+        for (int k = 0; k < kPlantStepsPerTick; ++k) {
+            at_stop = plant_.advance(x, u_motor, dc_.power);
+            machine_step(x.angle * inc_per_rad_,
+                         t_ns + static_cast<int64_t>((k + 1) * kCurrentTickNs / kPlantStepsPerTick));
+        }
     }
     plant_.set_state(x, at_stop);
-    count_ = static_cast<int64_t>(std::floor(pol_ * prev_raw_pos_));
+    count_ = floor_to_int(pol_ * prev_raw_pos_);
 
     ctl_.observe(inc_to_rad(static_cast<double>(count_) + 0.5), i_meas(), km);
 }
@@ -105,12 +116,18 @@ void Controller::observe(double meas_rad, double i_meas, double km_plant) {
     else if (thermal < 0.98)
         i2t_active = false;
 
-    const double rpm = obs_vel * 60.0 / kTwoPi;
+    // One multiplication: a division here held back every sample (docs/decisions/drive.md "Cost of a cycle").
+    const double rpm = obs_vel * (60.0 / kTwoPi);
     vel_avg_rpm += kAvgAlpha * (rpm - vel_avg_rpm);
     cur_avg_a += kAvgAlpha * (i_meas - cur_avg_a);
 }
 
 void Controller::tune(const Parameters& p, double km_plant) {
+    const TuneInputs in{p.torque_constant, p.inertia,   p.friction,  p.bandwidth,  p.damping,
+                        p.reset_time,      p.current_p, p.current_i, p.current_ff, p.thermal_time_constant,
+                        p.nominal_current, km_plant,    true};
+    if (in == tuned) return;
+    tuned = in;
     // 0x30A1: bandwidth, damping, reset time, inertia, friction -> cascade gains by pole placement
     // (docs/decisions/drive.md "Control loops").
     km = p.torque_constant * 1e-6;

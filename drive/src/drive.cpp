@@ -30,33 +30,44 @@ bool Drive::locate(uint16_t index, uint8_t sub, std::size_t size, Link& link) {
     return true;
 }
 
-void Drive::load(const Link& l) {
-    if (l.size == 1) {
-        const uint8_t v = l.r8.get();
-        std::memcpy(l.field, &v, 1);
-    } else if (l.size == 2) {
-        const uint16_t v = l.r16.get();
-        std::memcpy(l.field, &v, 2);
-    } else {
-        const uint32_t v = l.r32.get();
-        std::memcpy(l.field, &v, 4);
+template <typename T>
+void Drive::load(const std::vector<Link>& links) {
+    for (const Link& l : links) {
+        T v;
+        if constexpr (sizeof(T) == 1)
+            v = l.r8.get();
+        else if constexpr (sizeof(T) == 2)
+            v = l.r16.get();
+        else
+            v = l.r32.get();
+        std::memcpy(l.field, &v, sizeof(T));
     }
 }
 
-void Drive::store(Link l) {
-    if (l.size == 1) {
-        uint8_t v;
-        std::memcpy(&v, l.field, 1);
-        l.r8.set(v);
-    } else if (l.size == 2) {
-        uint16_t v;
-        std::memcpy(&v, l.field, 2);
-        l.r16.set(v);
-    } else {
-        uint32_t v;
-        std::memcpy(&v, l.field, 4);
-        l.r32.set(v);
+template <typename T>
+void Drive::store(const std::vector<Link>& links) {
+    for (Link l : links) {
+        T v;
+        std::memcpy(&v, l.field, sizeof(T));
+        if constexpr (sizeof(T) == 1)
+            l.r8.set(v);
+        else if constexpr (sizeof(T) == 2)
+            l.r16.set(v);
+        else
+            l.r32.set(v);
     }
+}
+
+void Drive::load_inputs() {
+    load<uint8_t>(inputs_[0]);
+    load<uint16_t>(inputs_[1]);
+    load<uint32_t>(inputs_[2]);
+}
+
+void Drive::store_outputs() {
+    store<uint8_t>(outputs_[0]);
+    store<uint16_t>(outputs_[1]);
+    store<uint32_t>(outputs_[2]);
 }
 
 template <typename T>
@@ -64,7 +75,7 @@ void Drive::in(const od::Obj<T>& h, T& field) {
     static_assert(sizeof(T) == 1 || sizeof(T) == 2 || sizeof(T) == 4);
     Link l{};
     l.field = reinterpret_cast<uint8_t*>(&field);
-    if (locate(h.index, h.sub, sizeof(T), l)) inputs_.push_back(l);
+    if (locate(h.index, h.sub, sizeof(T), l)) inputs_[group(sizeof(T))].push_back(l);
 }
 
 template <typename T>
@@ -72,13 +83,14 @@ void Drive::out(const od::Obj<T>& h, const T& field) {
     static_assert(sizeof(T) == 1 || sizeof(T) == 2 || sizeof(T) == 4);
     Link l{};
     l.field = reinterpret_cast<uint8_t*>(const_cast<T*>(&field));
-    if (locate(h.index, h.sub, sizeof(T), l)) outputs_.push_back(l);
+    if (locate(h.index, h.sub, sizeof(T), l)) outputs_[group(sizeof(T))].push_back(l);
 }
 
 bool Drive::binds(uint16_t index, uint8_t sub) const {
-    for (const auto* links : {&inputs_, &outputs_})
-        for (const Link& l : *links)
-            if (l.index == index && l.sub == sub) return true;
+    for (const auto* groups : {&inputs_, &outputs_})
+        for (const auto& links : *groups)
+            for (const Link& l : links)
+                if (l.index == index && l.sub == sub) return true;
     return false;
 }
 
@@ -231,21 +243,18 @@ od::Status commission(od::Dictionary& d, const MotorModel& m) {
 }
 
 void Drive::cycle(int64_t now_ns, int64_t dt_ns) {
-    for (const Link& l : inputs_)
-        load(l);
+    load_inputs();
     axis_.cycle(now_ns, dt_ns);
     fb_copy_ = axis_.feedback();
     resolution_ = static_cast<uint32_t>(axis_.increments_per_rev());
-    for (const Link& l : outputs_)
-        store(l);
+    store_outputs();
     powered_->store(axis_.power_on(), std::memory_order_relaxed);
 }
 
 void Drive::connection_lost() {
     axis_.connection_lost();
     fb_copy_ = axis_.feedback();
-    for (const Link& l : outputs_)
-        store(l);
+    store_outputs();
 }
 
 }  // namespace drive

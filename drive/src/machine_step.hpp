@@ -28,6 +28,15 @@ inline void index_bounds(double k, double res, double& lo, double& hi) {
     }
 }
 
+// static_cast<int64_t>(std::floor(x)), the same value for every x (NaN and out of range included, as x86
+// converts them), without the call to libm's floor the baseline x86-64 target makes: the count is taken
+// once per current-loop sample, on the sample's latency chain (docs/decisions/drive.md "Cost of a cycle").
+inline int64_t floor_to_int(double x) {
+    int64_t i = static_cast<int64_t>(x < 0x1p63 && x >= -0x1p63 ? x : std::floor(x));
+    if (static_cast<double>(i) > x) --i;
+    return i;
+}
+
 }  // namespace detail
 
 inline uint64_t Axis::functions_now(uint16_t pins) {

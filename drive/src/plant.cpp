@@ -51,6 +51,13 @@ void Plant::configure(const MotorModel& model, double torque_constant, double h)
     phi_ = e.block<3, 3>(0, 0);
     gamma_u_ = e.block<3, 1>(0, 3);
     gamma_t_ = e.block<3, 1>(0, 4);
+    // advance_held(): the same augmented system over k steps gives [Phi^k | G_k | T_k] in one exponential.
+    for (int k = 1; k <= kHeldSteps; ++k) {
+        const Eigen::MatrixXd ek = k == 1 ? e : expm(aug * (h * k));
+        auto pair = [&](int c) { return Pair{ek(1, c), ek(2, c)}; };  // velocity, angle
+        held_[k - 1] = {pair(0), pair(1), pair(2), pair(3), pair(4)};
+        if (k == kHeldSteps) held_i_ = {ek(0, 0), ek(0, 1), ek(0, 2), ek(0, 3), ek(0, 4)};
+    }
     // Power off: mechanics alone, [omega, theta].
     Eigen::MatrixXd mech = Eigen::MatrixXd::Zero(3, 3);
     mech(0, 0) = -b / j_;

@@ -33,8 +33,18 @@ struct Controller {
     double thermal = 0;
     bool i2t_active = false;
 
-    // Gains by pole placement from 0x30A1 and 0x30A0; `km_plant` stands in when 0x3001:05 is 0.
+    // Gains by pole placement from 0x30A1 and 0x30A0; `km_plant` stands in when 0x3001:05 is 0. Called every
+    // cycle; recomputes only when one of its inputs changed.
     void tune(const Parameters& p, double km_plant);
+    // The inputs tune() last computed from (0x3001:01/:04/:05, 0x30A0:01-03, 0x30A1:01-05, km_plant).
+    struct TuneInputs {
+        uint32_t torque_constant = 0, inertia = 0, friction = 0, bandwidth = 0, damping = 0, reset_time = 0,
+                 current_p = 0, current_i = 0, current_ff = 0;
+        uint16_t thermal_time_constant = 0, nominal_current = 0;
+        double km_plant = 0;
+        bool valid = false;
+        bool operator==(const TuneInputs&) const = default;
+    } tuned;
     // One current-loop sample of the observer (measured angle, measured current), the I2t model and the
     // averaged values; `km_plant` stands in for an unconfigured torque constant.
     void observe(double meas_rad, double i_meas, double km_plant);

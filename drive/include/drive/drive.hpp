@@ -62,13 +62,19 @@ class Drive {
     template <typename T>
     void out(const od::Obj<T>& object, const T& field);
     bool locate(uint16_t index, uint8_t sub, std::size_t size, Link& link);
-    static void load(const Link& l);
-    static void store(Link l);
+    // The copies of a cycle, one loop per entry size (no test of the size per entry).
+    template <typename T>
+    static void load(const std::vector<Link>& links);
+    template <typename T>
+    static void store(const std::vector<Link>& links);
+    void load_inputs();
+    void store_outputs();
+    static std::size_t group(std::size_t size) { return size == 1 ? 0 : size == 2 ? 1 : 2; }
 
     od::Dictionary& dict_;
     Axis axis_;
-    std::vector<Link> inputs_;   // dictionary -> axis (parameters, commands)
-    std::vector<Link> outputs_;  // axis -> dictionary (feedback)
+    std::vector<Link> inputs_[3];   // dictionary -> axis (parameters, commands), by size: 1, 2, 4 bytes
+    std::vector<Link> outputs_[3];  // axis -> dictionary (feedback), by size
     Feedback fb_copy_;
     uint32_t resolution_ = 0;
     std::size_t bound_ = 0, missing_ = 0;

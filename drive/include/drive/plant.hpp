@@ -44,6 +44,16 @@ class Plant {
         at_stop_ = at_stop;
     }
     inline bool advance(State& s, double u, bool power_on, double load_torque = 0.0) const;
+    // kHeldSteps steps with power on, voltage u held and no load torque, all computed from s at once (no
+    // chain from step to step): x_k = Phi^k x0 + G_k u + T_k tau with the Coulomb term tau = -sign(w0)
+    // coulomb constant. That is what advance() gives (up to rounding in the last bits) as long as the
+    // velocity keeps its sign and no stop is reached, so the result is taken only when every step's velocity
+    // is nonzero with the sign of s.velocity and every step's angle lies strictly between the stops: then s
+    // becomes the last step's state, angles[] gets each step's angle, and the steps ended away from a stop.
+    // Otherwise (at rest, a zero crossing, a stop, NaN) it returns false with s untouched and the caller runs
+    // advance() kHeldSteps times. docs/decisions/drive.md "Cost of a cycle".
+    static constexpr int kHeldSteps = 4;
+    inline bool advance_held(State& s, double u, double (&angles)[kHeldSteps]) const;
 
     double current() const { return x_(0); }
     double velocity() const { return x_(1); }
@@ -67,6 +77,20 @@ class Plant {
     Eigen::Matrix2d phi_mech_ = Eigen::Matrix2d::Identity();  // power off: [omega, theta] only
     Eigen::Vector2d gamma_mech_ = Eigen::Vector2d::Zero();
     Eigen::Vector3d x_ = Eigen::Vector3d::Zero();
+    // advance_held(): the rows of [Phi^k | G_k | T_k] for k = 1..kHeldSteps, velocity and angle side by side
+    // (the two are computed as one pair: GCC/Clang vector extension, SSE2 on x86-64), and the current's row
+    // for the last step.
+    typedef double Pair __attribute__((vector_size(16)));
+    template <typename T>
+    struct HeldRow {
+        T p0{}, p1{}, p2{}, gu{}, gt{};
+        T apply(double x0, double x1, double x2, double u, double tau) const {
+            // Grouped as advance() groups one step (the input terms apart from the state).
+            return (p0 * x0 + p1 * x1) + (p2 * x2 + (gu * u + gt * tau));
+        }
+    };
+    HeldRow<Pair> held_[kHeldSteps];
+    HeldRow<double> held_i_;
     double km_ = 0.0, j_ = 1.0, coulomb_ = 0.0, h_ = 1e-5, l_ = 1e-3, r_ = 1.0;
     double lo_ = -std::numeric_limits<double>::infinity();
     double hi_ = std::numeric_limits<double>::infinity();
@@ -122,6 +146,34 @@ inline bool Plant::advance(State& s, double u, bool power_on, double load_torque
         return true;
     }
     return false;
+}
+
+inline bool Plant::advance_held(State& s, double u, double (&angles)[kHeldSteps]) const {
+    const double w0 = s.velocity;
+    const double sg = w0 > 0 ? 1.0 : -1.0;
+    if (!(sg * w0 > 0)) return false;  // at rest (stiction decides) or NaN
+    const double tau = -sg * coulomb_;
+    const double x0 = s.current, x1 = w0, x2 = s.angle;
+    // Strictly inside: the velocity on w0's side of zero (and finite), the angle between the stops. Tested on
+    // the smallest and largest of the steps (packed min/max) and their sum, which is NaN when any step is.
+    Pair wa = held_[0].apply(x0, x1, x2, u, tau);
+    angles[0] = wa[1];
+    Pair mn = wa, mx = wa, sum = wa;
+#pragma GCC unroll 4
+    for (int k = 1; k < kHeldSteps; ++k) {
+        wa = held_[k].apply(x0, x1, x2, u, tau);
+        angles[k] = wa[1];
+        mn = wa < mn ? wa : mn;
+        mx = wa > mx ? wa : mx;
+        sum += wa;
+    }
+    const bool inside = (sg > 0 ? mn[0] > 0 && mx[0] < INFINITY : mx[0] < 0 && mn[0] > -INFINITY) &&
+                        mn[1] > lo_ && mx[1] < hi_ && sum[0] == sum[0] && sum[1] == sum[1];
+    if (!inside) return false;
+    s.current = held_i_.apply(x0, x1, x2, u, tau);
+    s.velocity = wa[0];
+    s.angle = wa[1];
+    return true;
 }
 
 // exp(M) for a small dense matrix (scaling and squaring with a Taylor series); used to discretize the plant.
