@@ -277,13 +277,16 @@ SyncControl::Sync0 SyncControl::sync0_events(uint32_t events, uint64_t now_ns, b
         // A new activation (ETG.1020, DC start-up: 0x0981 cleared, start time, 0x0981 set): forget the
         // previous one. SYNC0 is judged from its start time on; periods before it are no cycles missed.
         sync0_seen_ = false;
-        if (first_pending) {
-            next_sync0_sys_ = next;
-            last_sync0_ns_ = now_ns + (next > sys ? next - sys : 0);  // the loss is measured from the start
-        } else {
-            // Activated and already pulsed between two looks: the pulse is the first of this activation.
-            next_sync0_sys_ = next;
+        next_sync0_sys_ = next;
+        // Activated since the last look and already pulsed: that pulse is the first of this activation. A
+        // 0x0990 more than a period ahead is still the start time (an ESC that does not show the pending
+        // bit).
+        const bool pulsed = !first_pending && (cycle_ns_ == 0 || next <= sys + cycle_ns_);
+        if (pulsed) {
             periods = 1;
+        } else {
+            periods = 0;
+            last_sync0_ns_ = now_ns + (next > sys ? next - sys : 0);  // the loss is measured from the start
         }
     }
     was_running_ = running;
