@@ -18,6 +18,8 @@ constexpr uint8_t kSiCycleExceeded = 0x0C;
 constexpr uint8_t kSiSyncError = 0x20;
 
 constexpr uint64_t kDefaultFreeRunCycleNs = 1'000'000;
+// 0x0984 bit 0: first SYNC0 pulse pending (ESC datasheet, Distributed Clocks, activation status).
+constexpr uint8_t kActFirstSync0Pending = 0x01;
 
 }  // namespace
 
@@ -181,6 +183,10 @@ void SyncControl::start(uint64_t now_ns) {
     last_sync0_ns_ = now_ns;
     next_cycle_ns_ = now_ns + cycle_ns_;
     next_sync0_sys_ = ctx_.pdi.read_reg<uint64_t>(esc::reg::kDcStartTime);
+    // The activation found here is this session's (configure() checked it); not a new one at the first look.
+    const uint8_t activation = ctx_.pdi.read_reg<uint8_t>(esc::reg::kDcActivation);
+    was_running_ = (activation & (esc::reg::kDcActCyclic | esc::reg::kDcActSync0)) ==
+                   (esc::reg::kDcActCyclic | esc::reg::kDcActSync0);
     sync0_deadline_ns_ = UINT64_MAX;
     last_sm_change_time_ = ctx_.pdi.read_reg<uint32_t>(esc::reg::kDcEcatBufferChange);
     for (int i = 0; i < 2; ++i) {
@@ -195,6 +201,7 @@ void SyncControl::reset() {
     master_wrote_sync_mode_ = false;
     cycle_ns_ = 0;
     sync0_seen_ = false;
+    was_running_ = false;
     sync0_deadline_ns_ = UINT64_MAX;
 }
 
@@ -249,21 +256,45 @@ SyncControl::Sync0 SyncControl::sync0_events(uint32_t events, uint64_t now_ns, b
     // SYNC0 is seen as the AL event (when 0x0151 maps it) and, in any case, as the "next SYNC0" time 0x0990
     // moving on; the latter also says how many periods passed since the last look.
     uint64_t periods = 0;
-    if (events & esc::alev::kSync0) {
-        (void)pdi.read_reg<uint8_t>(esc::reg::kDcSync0Status);  // acknowledges the SYNC0 event
-        periods = 1;
-    }
     // 0x0990 is the next pulse only while SYNC0 runs; otherwise it is whatever the master wrote.
     const uint8_t activation = pdi.read_reg<uint8_t>(esc::reg::kDcActivation);
     const bool running = (activation & (esc::reg::kDcActCyclic | esc::reg::kDcActSync0)) ==
                          (esc::reg::kDcActCyclic | esc::reg::kDcActSync0);
+    // 0x0984 bit 0: the first SYNC0 pulse of this activation is still pending (ESC datasheet, Distributed
+    // Clocks, activation status). Until it comes, 0x0990 holds the programmed start time, and whatever was
+    // seen before belongs to an earlier activation: a SYNC0 event still latched in 0x0220 bit 2 (it stays set
+    // until 0x098E is read, also across a deactivation of 0x0981, so a session that ended in Pre-Op leaves
+    // one behind) or the 0x0990 of the pulses before.
+    const bool first_pending =
+        running && (pdi.read_reg<uint8_t>(esc::reg::kDcActivationStatus) & kActFirstSync0Pending) != 0;
+    if (events & esc::alev::kSync0) {
+        (void)pdi.read_reg<uint8_t>(esc::reg::kDcSync0Status);  // acknowledges the SYNC0 event
+        if (!first_pending) periods = 1;
+    }
     const uint64_t next = running ? pdi.read_reg<uint64_t>(esc::reg::kDcStartTime) : next_sync0_sys_;
+    const uint64_t sys = pdi.read_reg<uint64_t>(esc::reg::kDcSystemTime);  // local copy of system time
+    if (first_pending || (running && !was_running_)) {
+        // A new activation (ETG.1020, DC start-up: 0x0981 cleared, start time, 0x0981 set): forget the
+        // previous one. SYNC0 is judged from its start time on; periods before it are no cycles missed.
+        sync0_seen_ = false;
+        next_sync0_sys_ = next;
+        // Activated since the last look and already pulsed: that pulse is the first of this activation. A
+        // 0x0990 more than a period ahead is still the start time (an ESC that does not show the pending
+        // bit).
+        const bool pulsed = !first_pending && (cycle_ns_ == 0 || next <= sys + cycle_ns_);
+        if (pulsed) {
+            periods = 1;
+        } else {
+            periods = 0;
+            last_sync0_ns_ = now_ns + (next > sys ? next - sys : 0);  // the loss is measured from the start
+        }
+    }
+    was_running_ = running;
     if (next != next_sync0_sys_) {
         if (cycle_ns_ > 0 && next > next_sync0_sys_) periods = (next - next_sync0_sys_) / cycle_ns_;
         if (periods == 0) periods = 1;
         next_sync0_sys_ = next;
     }
-    const uint64_t sys = pdi.read_reg<uint64_t>(esc::reg::kDcSystemTime);  // local copy of system time
     sync0_deadline_ns_ = running && next > sys ? now_ns + (next - sys) : UINT64_MAX;
     if (periods > 0) {
         ++stats.sync0_events;

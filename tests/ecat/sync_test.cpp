@@ -19,6 +19,12 @@ class Sync : public StackTest {
         master.wr<uint64_t>(0x0990, now_sys + start_delay_ns);
         master.wr<uint8_t>(0x0981, activation);
     }
+    // A new DC session on a running SYNC0, as masters do it: 0x0980/0x0981 cleared (the start time is
+    // writable only while 0x0981 bit 0 is clear: ESC datasheet, Distributed Clocks), then set up again.
+    void restart_dc(uint32_t cycle_ns, uint64_t start_delay_ns) {
+        master.wr<uint16_t>(0x0980, 0);
+        enable_dc(cycle_ns, 0x03, start_delay_ns);
+    }
     void safeop_dc(uint32_t cycle_ns) {
         go_preop();
         configure_process_data(6, 6);
@@ -196,6 +202,77 @@ TEST_F(Sync, Dc_StartTimeRewrittenWhileStopped_NoSpuriousCycle) {
     poll();
     poll();
     EXPECT_EQ(app.cycles, before);
+}
+
+// Two DC sessions in a row, as `ecatctl pd --dc` twice does: the first ends in Pre-Op with SYNC0 still
+// running (its event latched in 0x0220 bit 2, unacknowledged outside the process-data states); the second
+// deactivates 0x0981, programs a start time 100 ms away and activates again. The pulses of the first
+// activation say nothing of the second: Op waits for the new first SYNC0, and no sync error follows (a drive
+// may be started and stopped any number of times).
+TEST_F(Sync, Dc_SecondSessionWaitsForItsOwnStartTime) {
+    safeop_dc(1'000'000);
+    run_for(3'000'000, 250'000, true);
+    request(0x08);
+    ASSERT_EQ(al_status(), 0x08);
+    run_for(5'000'000, 250'000, true);
+    request(0x02);
+    ASSERT_EQ(al_status(), 0x02);
+    run_for(5'000'000, 1'000'000, false);  // Pre-Op: SYNC0 goes on, nobody acknowledges it
+
+    configure_process_data(6, 6);
+    restart_dc(1'000'000, 100'000'000);
+    request(0x04);
+    ASSERT_EQ(al_status(), 0x04) << std::hex << al_code();
+    std::vector<uint8_t> out(6), in(6);
+    exchange_pd(out, in);
+    poll();
+    request(0x08);
+    EXPECT_EQ(al_status(), 0x04);  // waiting for the first SYNC0 of this activation, no error
+    run_for(50'000'000, 500'000, true);
+    EXPECT_EQ(al_status(), 0x04) << std::hex << al_code();
+    run_for(60'000'000, 500'000, true);
+    EXPECT_EQ(al_status(), 0x08) << std::hex << al_code();
+    run_for(30'000'000, 500'000, true);
+    EXPECT_EQ(al_status(), 0x08) << std::hex << al_code();
+    EXPECT_EQ(stack->stats().cycles_exceeded, 0u);
+}
+
+// SYNC0 deactivated and activated again with a later start time while in Safe-Op (a master that sets SYNC0 up
+// after Safe-Op): the jump of 0x0990 is a new activation, not periods without a cycle, and Op waits for it.
+TEST_F(Sync, Dc_ReactivatedInSafeOp_WaitsForNewStart) {
+    safeop_dc(1'000'000);
+    run_for(3'000'000, 250'000, true);
+    const uint64_t exceeded = stack->stats().cycles_exceeded;
+    restart_dc(1'000'000, 40'000'000);
+    std::vector<uint8_t> out(6), in(6);
+    exchange_pd(out, in);
+    poll();
+    request(0x08);
+    run_for(20'000'000, 500'000, true);
+    EXPECT_EQ(al_status(), 0x04) << std::hex << al_code();
+    run_for(30'000'000, 500'000, true);
+    EXPECT_EQ(al_status(), 0x08) << std::hex << al_code();
+    run_for(20'000'000, 500'000, true);
+    EXPECT_EQ(al_status(), 0x08) << std::hex << al_code();
+    EXPECT_EQ(stack->stats().cycles_exceeded, exceeded);
+}
+
+// SYNC0 activated again in Op with a start time in the future: judged from that start time on; if the new
+// activation never delivers a pulse, the loss is still fatal (0x002C).
+TEST_F(Sync, Dc_ReactivatedInOp_JudgedFromNewStart_LossStillFatal) {
+    safeop_dc(1'000'000);
+    run_for(3'000'000, 250'000, true);
+    request(0x08);
+    ASSERT_EQ(al_status(), 0x08);
+    restart_dc(1'000'000, 30'000'000);
+    run_for(25'000'000, 500'000, true);
+    EXPECT_EQ(al_status(), 0x08) << std::hex << al_code();  // before the new start: nothing to judge
+    run_for(20'000'000, 500'000, true);
+    EXPECT_EQ(al_status(), 0x08) << std::hex << al_code();  // pulses of the new activation came
+    master.wr<uint8_t>(0x0981, 0);                          // and stop
+    run_for(20'000'000, 1'000'000, true);
+    EXPECT_EQ(al_status(), 0x04 | kErr);
+    EXPECT_EQ(al_code(), 0x002C);
 }
 
 TEST_F(Sync, Dc_Sync0CycleBelowMinimum_0x0036) {

@@ -68,7 +68,8 @@ class SyncControl {
     uint64_t last_sync0_ns_ = 0;
     uint64_t next_sync0_sys_ = 0;              // 0x0990 as last read (system time of the next SYNC0)
     uint64_t sync0_deadline_ns_ = UINT64_MAX;  // when the next SYNC0 is due, in poll() time
-    bool sync0_seen_ = false;
+    bool sync0_seen_ = false;                  // a SYNC0 pulse of the current activation came
+    bool was_running_ = false;                 // SYNC0 activated (0x0981 cyclic + SYNC0) at the last look
     od::Ref<uint16_t> sm_missed_[2];
     od::Ref<uint16_t> cycle_exceeded_[2];
     od::Ref<uint8_t> sync_error_[2];
