@@ -8,10 +8,9 @@
 // reset.
 #include <array>
 #include <cstdint>
-#include <mutex>
-
 #include "dc.hpp"
 #include "esc/esc.hpp"
+#include "esc_lock.hpp"
 #include "fmmu.hpp"
 #include "frame_time.hpp"
 #include "memory.hpp"
@@ -27,7 +26,7 @@ struct Esc::Impl final {
 
     // ---------------------------------------------------------------- configuration
     EscConfig cfg;  // counts and RAM size clamped to what the address space holds
-    mutable std::mutex mu;
+    mutable EscLock mu{cfg.thread_safe};
     // Handling class and write mask of each register byte, per side (RegKind).
     std::array<uint8_t, 0x1000> ecat_kind{}, pdi_kind{};
     std::array<uint8_t, 0x1000> ecat_wmask{}, pdi_wmask{};

@@ -40,7 +40,7 @@ void SiiInterface::run_pending(bool ok) {
     }
 }
 
-void SiiInterface::flush(std::unique_lock<std::mutex>& lock) {
+void SiiInterface::flush(std::unique_lock<EscLock>& lock) {
     const std::array<EepromWrite, 4> w = writes;
     const uint8_t n = write_count;
     write_count = 0;

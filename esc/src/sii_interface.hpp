@@ -5,10 +5,10 @@
 #include <array>
 #include <cstdint>
 #include <functional>
-#include <mutex>
 #include <vector>
 
 #include "esc/faults.hpp"
+#include "esc_lock.hpp"
 #include "memory.hpp"
 
 namespace esc {
@@ -33,13 +33,13 @@ class SiiInterface {
         if (pending) run_pending(ok);
     }
     // Calls the write callback for the words written since the last flush, outside the lock.
-    void flush_callbacks(std::unique_lock<std::mutex>& lock) {
+    void flush_callbacks(std::unique_lock<EscLock>& lock) {
         if (write_count != 0) flush(lock);
     }
 
   private:
     void run_pending(bool ok);
-    void flush(std::unique_lock<std::mutex>& lock);
+    void flush(std::unique_lock<EscLock>& lock);
     uint16_t word(uint64_t word) const;
     bool crc_ok() const;
 

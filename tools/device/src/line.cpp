@@ -106,6 +106,7 @@ Line::Line(const esc::Clock& clock, LineOptions options, slave::ExternalSend sen
         u->esc_config.port_descriptor = d.port_descriptor();
         u->esc_config.clock_drift_ppm = d.drift_ppm;
         u->esc_config.clock_offset_ns = d.offset_ns;
+        u->esc_config.thread_safe = false;  // the runtime's thread serves every ESC of the line
         u->esc = std::make_unique<esc::Esc>(u->esc_config, clock_);
         u->device = std::make_unique<Device>(*u->esc, u->options);
         segment_.add(*u->esc);

@@ -232,6 +232,7 @@ int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err)
         esc::EscConfig config;
         config.process_ram_kib = options.ram_kib;
         config.faults = options.esc_faults;
+        config.thread_safe = false;  // the runtime below is the only thread that calls it
         esc::SystemClock clock;
         esc::Esc esc(config, clock);
         bool eeprom_dirty = false;

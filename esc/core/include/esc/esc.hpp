@@ -34,6 +34,10 @@ struct EscConfig {
     // calculation something real to do on a segment of soft slaves. 0/0: the Clock itself.
     double clock_drift_ppm = 0.0;
     int64_t clock_offset_ns = 0;
+    // true: every call takes the ESC's lock, for an owner that calls it from several threads. false: the
+    // owner calls it from one thread only (frames, PDI and timers served in turn by one runtime, as
+    // ecat-slave does), and the lock, taken several times per drive and cycle, is left out.
+    bool thread_safe = true;
 };
 
 inline constexpr int kPortCount = 4;  // ports 0..3
