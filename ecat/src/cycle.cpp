@@ -24,9 +24,7 @@ void Cycle::set_up_registers() {
 void Cycle::poll(uint64_t now_ns) {
     esc::Pdi& pdi = ctx_.pdi;
     last_now_ns_ = now_ns;
-    if (irq_ && irq_usable_ && !first_poll_ && !irq_() && now_ns < next_deadline_ns()) {
-        return;  // nothing signalled and no timer due
-    }
+    if (quiet(now_ns)) return;  // nothing signalled and no timer due
     if (!first_poll_ && esc_was_reset()) restart_after_esc_reset(now_ns);
     uint32_t events = pdi.read_reg<uint32_t>(esc::reg::kAlEvent);
     if (first_poll_) {
@@ -61,6 +59,10 @@ void Cycle::poll(uint64_t now_ns) {
     }
     // Last: AL status already says Init, so the application may restart the device from here.
     if (esm_.take_restart()) ctx_.app.on_restart();
+}
+
+bool Cycle::quiet(uint64_t now_ns) const {
+    return irq_ && irq_usable_ && !first_poll_ && !irq_() && now_ns < next_deadline_ns();
 }
 
 uint64_t Cycle::next_deadline_ns() const {

@@ -617,5 +617,22 @@ TEST_F(Esm, LocalError_FallsBack) {
     EXPECT_EQ(app.outputs_lost, 1);
 }
 
+// ---- quiet(): what a caller with many stacks may skip ------------------------------------------------
+
+TEST_F(Esm, QuietUntilTheMasterWritesAlControlOrTheHousekeepingIsDue) {
+    EXPECT_TRUE(stack->quiet(clock.now_ns()));  // first poll done, nothing signalled, no deadline
+    configure_mailbox();
+    master.wr<uint16_t>(0x0120, 0x02);  // AL control: the event raises the interrupt line
+    EXPECT_FALSE(stack->quiet(clock.now_ns()));
+    poll();
+    ASSERT_EQ(al_status(), 0x02);
+    EXPECT_TRUE(stack->quiet(clock.now_ns()));  // event acknowledged by the poll
+    // In Pre-Op the mailbox handlers' housekeeping comes due.
+    const uint64_t due = stack->next_deadline_ns();
+    ASSERT_NE(due, UINT64_MAX);
+    EXPECT_TRUE(stack->quiet(due - 1));
+    EXPECT_FALSE(stack->quiet(due));
+}
+
 }  // namespace
 }  // namespace ecat::test

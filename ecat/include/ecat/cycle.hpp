@@ -32,6 +32,8 @@ class Cycle {
     void set_up_registers();
 
     void poll(uint64_t now_ns);
+    // True if poll(now_ns) would return at once: the interrupt line is usable and low, and no deadline due.
+    bool quiet(uint64_t now_ns) const;
     uint64_t next_deadline_ns() const;
     uint64_t last_now_ns() const { return last_now_ns_; }
 

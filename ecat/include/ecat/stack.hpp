@@ -52,6 +52,9 @@ class Stack {
     // register set-up) restarts the stack as a reset of the firmware behind the ESC would: Init, fresh
     // mailbox, transfers dropped, and Application::on_restart().
     void poll(uint64_t now_ns) { cycle_.poll(now_ns); }
+    // True if poll(now_ns) would return at once without a register read beyond the interrupt line: nothing
+    // signalled, no deadline due. Lets a caller with many stacks skip those with nothing to do.
+    bool quiet(uint64_t now_ns) const { return cycle_.quiet(now_ns); }
     // Time at which poll() must run again even if no frame arrives; UINT64_MAX if nothing is pending.
     uint64_t next_deadline_ns() const { return cycle_.next_deadline_ns(); }
 

@@ -380,6 +380,13 @@ void Device::poll(uint64_t now_ns) {
     }
 }
 
+bool Device::quiet(uint64_t now_ns) const {
+    if (restart_pending_ || outputs_lost_pending_ || last_cycle_ns_ == 0) return false;
+    if (!parts_->stack->quiet(now_ns)) return false;
+    if (eeprom_dirty_ && (eeprom_save_ns_ == 0 || now_ns >= eeprom_save_ns_)) return false;
+    return parts_->stack->state() == od::AlState::Op || now_ns < free_run_due_ns();
+}
+
 uint64_t Device::next_deadline_ns() const {
     uint64_t next = parts_->stack->next_deadline_ns();
     if (eeprom_dirty_ && eeprom_save_ns_ != 0) next = std::min(next, eeprom_save_ns_);

@@ -132,13 +132,22 @@ void Line::event(slave::LogLevel level, const std::string& text) const {
 }
 
 void Line::poll(uint64_t now_ns) {
-    // Each device gets the time it is polled at: a pass over many devices takes a while, and a device that
-    // compares its ESC's registers (read now) with a stale time would misjudge when its next SYNC0 comes.
-    bool first = true;
+    // Each device polled gets the time it is polled at: a pass over many devices takes a while, and a device
+    // that compares its ESC's registers (read now) with a stale time would misjudge when its next SYNC0
+    // comes. A quiet device (interrupt line low, no deadline due) is skipped without reading the clock: most
+    // are, on each pass. One whose deadline falls due while the pass goes on is skipped as well; its
+    // deadline, now past, brings the runtime straight back to serve it.
+    uint64_t now = now_ns;
+    bool fresh = true;  // now_ns is still the time: no device examined yet
     for (const auto& u : units_) {
         if (!u->device) continue;
-        u->device->poll(first ? now_ns : std::max(now_ns, clock_.now_ns()));
-        first = false;
+        if (u->device->quiet(now)) {
+            fresh = false;
+            continue;
+        }
+        if (!fresh) now = std::max(now, clock_.now_ns());
+        u->device->poll(now);
+        fresh = false;
     }
 }
 

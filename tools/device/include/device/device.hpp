@@ -115,6 +115,9 @@ class Device final : public ecat::Application, public drive::EventSink, public e
 
     // Firmware entry points (slave::Firmware through an adapter).
     void poll(uint64_t now_ns);
+    // True if poll(now_ns) would do nothing: the stack is quiet, no restart or reaction pending, no
+    // free-running drive cycle or EEPROM save due. A line polls only the devices that are not.
+    bool quiet(uint64_t now_ns) const;
     uint64_t next_deadline_ns() const;
 
     // The machine at run time: a digital input pin 1..6 (not wired to a switch). Kept across restarts.
