@@ -158,6 +158,7 @@ struct Figures {
     bench::Summary walk, latency, rtt, echo, echo_thread;
     double cpu_percent = 0, cpu_us_per_cycle = 0, allocs_per_cycle = 0;
     double wakeups_per_cycle = 0, timer_arms_per_cycle = 0, frames_per_wakeup = 0, replies_per_batch = 0;
+    double spin_us_per_cycle = 0;  // awake waiting for a deadline microseconds away (kChainNs)
     uint64_t cycles = 0, missed = 0, lost = 0, wkc_errors = 0, enabled = 0;
     std::size_t frames_per_cycle = 0;
 };
@@ -356,6 +357,7 @@ Figures run_segment(std::size_t drives, double seconds, const std::string& backe
     f.allocs_per_cycle = static_cast<double>(alloc_count) / window_cycles;
     f.wakeups_per_cycle = static_cast<double>(rs1.wakeups - rs0.wakeups) / window_cycles;
     f.timer_arms_per_cycle = static_cast<double>(rs1.timer_arms - rs0.timer_arms) / window_cycles;
+    f.spin_us_per_cycle = static_cast<double>(rs1.spin_ns_total - rs0.spin_ns_total) / 1000.0 / window_cycles;
     f.frames_per_wakeup = static_cast<double>(rs1.frames_received - rs0.frames_received) /
                           static_cast<double>(std::max<uint64_t>(1, rs1.wakeups - rs0.wakeups));
     f.replies_per_batch = static_cast<double>(rs1.frames_sent - rs0.frames_sent) /
@@ -463,8 +465,9 @@ int main(int argc, char** argv) {
             f.cpu_us_per_cycle, f.cpu_us_per_cycle / static_cast<double>(f.drives), f.cpu_percent);
         std::printf(
             "  slave wake-ups per cycle %.2f, timer arms per cycle %.2f, frames per wake-up %.2f, "
-            "replies per batch %.2f\n",
-            f.wakeups_per_cycle, f.timer_arms_per_cycle, f.frames_per_wakeup, f.replies_per_batch);
+            "replies per batch %.2f, awake waiting for deadlines %.1f us per cycle\n",
+            f.wakeups_per_cycle, f.timer_arms_per_cycle, f.frames_per_wakeup, f.replies_per_batch,
+            f.spin_us_per_cycle);
         std::printf("  missed cycles %llu, lost frames %llu, wkc errors %llu, allocations per cycle %.3f\n",
                     static_cast<unsigned long long>(f.missed), static_cast<unsigned long long>(f.lost),
                     static_cast<unsigned long long>(f.wkc_errors), f.allocs_per_cycle);
