@@ -194,6 +194,28 @@ void esc_reset(Master& m) {
         m.wr<uint8_t>(0x0040, c);
 }
 
+// SM1's "read by the master" event stays set until the next message is written: it is not in the AL event
+// mask, so it does not hold the interrupt line high once the last reply was fetched. A reply still waiting
+// for SM1 keeps the stack from being quiet instead.
+TEST_F(MailboxOverStack, QuietOnceTheLastReplyWasFetched_NotWhileRepliesWait) {
+    go_preop();
+    ASSERT_FALSE(roundtrip(mbx_message(0x3, 1, sdo)).empty());
+    EXPECT_NE(esc->read_reg<uint32_t>(0x0220) & 0x0200, 0u);  // SM1 event pending
+    EXPECT_TRUE(stack->quiet(clock.now_ns()));
+    coe.replies = 2;
+    mbx_write(mbx_message(0x3, 2, sdo));
+    poll();  // the first reply in SM1, the second queued behind it
+    EXPECT_EQ(stack->mailbox().queued(), 1u);
+    EXPECT_FALSE(stack->quiet(clock.now_ns()));
+    ASSERT_FALSE(mbx_read().empty());
+    EXPECT_FALSE(stack->quiet(clock.now_ns()));
+    poll();  // SM1 is free: the second goes out
+    EXPECT_EQ(stack->mailbox().queued(), 0u);
+    EXPECT_TRUE(stack->quiet(clock.now_ns()));
+    EXPECT_FALSE(mbx_read().empty());
+    EXPECT_TRUE(stack->quiet(clock.now_ns()));
+}
+
 TEST_F(MailboxOverStack, EscResetRestartsTheStack) {
     go_preop();
     ASSERT_FALSE(roundtrip(mbx_message(0x3, 1, sdo)).empty());

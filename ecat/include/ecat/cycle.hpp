@@ -21,8 +21,11 @@ class Cycle {
 
     // Housekeeping period for the mailbox handlers' poll() (transfer timeouts).
     static constexpr uint64_t kHousekeepingNs = 10'000'000;
-    // AL event mask written at start: AL control, SYNC0, SM activation, PD watchdog, SM0..SM3.
-    static constexpr uint32_t kEventMask = 0x00000F55;
+    // AL event mask written at start: AL control, SYNC0, SM activation, PD watchdog, SM0, SM2, SM3. Not SM1:
+    // its event ("buffer read by the master") stays set until the PDI writes the next message (ESC
+    // datasheet, SM status 0x0805 bit 1), so after the last reply it would hold the interrupt line high for
+    // good and every pass would poll the stack. While messages wait for SM1, quiet() is false anyway.
+    static constexpr uint32_t kEventMask = 0x00000D55;
 
     Cycle(StackContext& ctx, StateMachine& esm, SyncControl& sync, IrqLine irq);
     Cycle(const Cycle&) = delete;
@@ -32,7 +35,8 @@ class Cycle {
     void set_up_registers();
 
     void poll(uint64_t now_ns);
-    // True if poll(now_ns) would return at once: the interrupt line is usable and low, and no deadline due.
+    // True if poll(now_ns) would return at once: the interrupt line is usable and low, no mailbox message
+    // waits to be sent, and no deadline is due.
     bool quiet(uint64_t now_ns) const;
     uint64_t next_deadline_ns() const;
     uint64_t last_now_ns() const { return last_now_ns_; }
