@@ -1,4 +1,4 @@
-// FoE through the whole slave: a master (tools/master) drives esc::Esc + ecat::Stack with the FoE server
+// FoE through the whole slave: a master (tools/lib/master) drives esc::Esc + ecat::Stack with the FoE server
 // and the CoE server registered, on the drive's description: Init -> Bootstrap with the bootstrap mailbox,
 // firmware download with BUSY handling as SOEM/IgH do it, Bootstrap -> Init restarts the device on the new
 // image, then upload in Pre-Op and a refused write outside Bootstrap.

@@ -2,7 +2,7 @@
 // the real code. The first byte picks the loader and whether the harness repairs lengths and CRCs first
 // (so that mutations get past the checksums to the parsing behind them):
 //   0  parameters.bin    od::ParameterStore::load on the drive's dictionary (od/src/store.cpp)
-//   1  sii-writes.bin    device::EepromWrites::load, then apply onto the SII (tools/device)
+//   1  sii-writes.bin    device::EepromWrites::load, then apply onto the SII (tools/lib/device)
 //   2  firmware/         foe::FirmwareStore::open: the slot pointer "active" and both slot images, input =
 //                        three records (16-bit length + bytes): pointer, slot0.bin, slot1.bin
 //   3  device config     od::load_device_config of the file (tools/ecat-slave --config)

@@ -1,4 +1,4 @@
-// (8) The master library's parsing of what comes back (tools/master): frame and datagram parsing, the
+// (8) The master library's parsing of what comes back (tools/lib/master): frame and datagram parsing, the
 // SII reader, the mailbox, CoE (SDO upload/download, segmented, SDO information, emergencies) and FoE
 // (read, write, busy, errors), diagnosis messages. The master talks to a link that answers each frame it
 // sends from the input: a control byte, then

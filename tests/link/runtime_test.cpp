@@ -1,4 +1,4 @@
-// The slave runtime (tools/slave) over a LoopbackLink with a real esc::Esc.
+// The slave runtime (tools/lib/slave) over a LoopbackLink with a real esc::Esc.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -1,4 +1,4 @@
-// The topology file parser (tools/slave, slave/topology.hpp).
+// The topology file parser (tools/lib/slave, slave/topology.hpp).
 #include "slave/topology.hpp"
 
 #include <gtest/gtest.h>

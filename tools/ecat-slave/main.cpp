@@ -1,5 +1,5 @@
 // ecat-slave: parses the command line (and the configuration file) and hands over to
-// slave::run_slave() with the soft drive (tools/device) as firmware.
+// slave::run_slave() with the soft drive (tools/lib/device) as firmware.
 #include <CLI/CLI.hpp>
 #include <cerrno>
 #include <cstdio>

@@ -1,7 +1,7 @@
 #pragma once
 // The CoE vocabulary (ETG.1000.6 §5.6.2, CiA 301): the CoE header and its services, the SDO command
 // specifiers, the SDO abort codes with their texts and the SDO information opcodes. SDO server (coe/) and
-// SDO client (tools/master) both take them from here.
+// SDO client (tools/lib/master) both take them from here.
 #include <cstddef>
 #include <cstdint>
 #include <string_view>

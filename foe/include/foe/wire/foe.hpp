@@ -1,6 +1,6 @@
 #pragma once
 // The FoE vocabulary (ETG.1000.6 §5.8): opcodes, the 6-byte FoE header and the error codes with the texts
-// sent in an ERR packet. FoE server (foe/) and FoE client (tools/master) both take them from here.
+// sent in an ERR packet. FoE server (foe/) and FoE client (tools/lib/master) both take them from here.
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
