@@ -1,4 +1,5 @@
 #include "od/dictionary.hpp"
+#include "util/strfmt.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -137,9 +138,8 @@ Status check_value(const Entry& e, std::span<const uint8_t> v) {
 }
 
 [[noreturn]] void declaration_error(const Entry& e, const std::string& what) {
-    char where[16];
-    std::snprintf(where, sizeof where, "0x%04X:%02X", e.index, e.subindex);
-    throw std::logic_error("od: entry " + std::string(where) + " (" + e.name + "): " + what);
+    throw std::logic_error(
+        util::strprintf("od: entry 0x%04X:%02X (%s): ", e.index, e.subindex, e.name.c_str()) + what);
 }
 
 // Encodes a declared default into n little-endian bytes of the entry's type.
@@ -262,9 +262,7 @@ void Dictionary::add(Object object) {
     auto& im = *impl_;
     const std::size_t pos = im.position(object.index);
     if (pos != im.objects.size()) {
-        char buf[8];
-        std::snprintf(buf, sizeof buf, "%04X", object.index);
-        throw std::logic_error(std::string("od: duplicate object 0x") + buf);
+        throw std::logic_error(util::strprintf("od: duplicate object 0x%04X", object.index));
     }
     std::sort(object.entries.begin(), object.entries.end(),
               [](const Entry& a, const Entry& b) { return a.subindex < b.subindex; });

@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "od/drive_objects.hpp"
+#include "util/strfmt.hpp"
 
 namespace od {
 namespace {
@@ -487,9 +488,8 @@ Number parse_number(std::string_view s, DataType t, uint16_t index) {
     uint64_t u = 0;
     auto [p, ec] = std::from_chars(d.data(), d.data() + d.size(), u, base);
     if (ec != std::errc() || p != d.data() + d.size()) {
-        char b[8];
-        std::snprintf(b, sizeof b, "%04X", index);
-        throw std::logic_error("od: bad number '" + std::string(s) + "' at 0x" + b);
+        throw std::logic_error("od: bad number '" + std::string(s) + "' at " +
+                               util::strprintf("0x%04X", index));
     }
     if (neg) return -static_cast<int64_t>(u);
     if (is_signed(t)) return static_cast<int64_t>(u);

@@ -14,6 +14,7 @@
 #include "util/atomic_file.hpp"
 #include "util/crc.hpp"
 #include "util/le.hpp"
+#include "util/strfmt.hpp"
 
 namespace od {
 namespace {
@@ -97,8 +98,7 @@ std::string parse(std::span<const uint8_t> f, const Dictionary& dict, std::vecto
         if (body.size() - at < len) return "record " + std::to_string(n) + " truncated";
         r.value = body.subspan(at, len);
         at += len;
-        char where[16];
-        std::snprintf(where, sizeof where, "0x%04X:%02X", r.index, r.sub);
+        const std::string where = util::strprintf("0x%04X:%02X", r.index, r.sub);
         const Entry* e = dict.find(r.index, r.sub);
         if (!e) return std::string("entry ") + where + " does not exist";
         if (!e->backup()) return std::string("entry ") + where + " is not a stored parameter";

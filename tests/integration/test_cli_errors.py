@@ -172,5 +172,49 @@ class ToolErrors(unittest.TestCase):
         self.assertIn(b"/nonexistent-dir/x.csv: No such file or directory", r.stderr)
 
 
+class LongPaths(unittest.TestCase):
+    """A message names a file by its whole path, however long (a fixed char array once cut
+    `ecatctl: /tmp/.../bad.bin: chec` in a clone under a long path). Each program, given a bad file under a
+    directory path of about 400 characters, names that file whole."""
+
+    def setUp(self):
+        base = tempfile.mkdtemp(prefix="ecat-long-")
+        self.addCleanup(shutil.rmtree, base, True)
+        self.dir = os.path.join(base, *(["a-rather-long-directory-name-" + "x" * 20] * 8))
+        os.makedirs(self.dir)
+        self.assertGreater(len(self.dir), 400)
+
+    def file(self, name, data):
+        path = os.path.join(self.dir, name)
+        with open(path, "wb") as f:
+            f.write(data)
+        return path
+
+    def assert_named(self, r, path):
+        text = [t if isinstance(t, str) else t.decode(errors="replace") for t in (r.stdout, r.stderr)]
+        self.assertNotEqual(r.returncode, 0, text[1])
+        self.assertIn(path, "\n".join(text))  # fwimage info reports on standard output
+
+    def test_sii_write_with_a_bad_checksum(self):
+        img = bytearray(128)
+        img[14:16] = b"\x34\x12"  # word 7: not the CRC of words 0-6, not "disabled"
+        bad = self.file("bad.bin", bytes(img))
+        r = run("--iface", "lo", "sii", "write", bad)
+        self.assert_named(r, bad)
+        self.assertIn("use --force", r.stderr)
+
+    def test_bad_files_of_every_program(self):
+        junk = self.file("junk.bin", bytes(range(7, 207)))
+        conf = self.file("bad.conf", b"[identity]\nvendor_id = nonsense\n")
+        self.assert_named(run("sii", "decode", junk), junk)
+        self.assert_named(tool("FWIMAGE", "info", junk), junk)
+        self.assert_named(tool("ECAT_SLAVE", "--config", conf, "--write-esi", "-", "--state-dir",
+                               os.path.join(self.dir, "state")), conf)
+        self.assert_named(tool("FWIMAGE", "build", "--payload", junk, "--version", "1", "--esi", junk, "-o", "o"),
+                          junk)
+        self.assert_named(tool("DRIVE_SIM", "-s", os.path.join(self.dir, "none.txt")),
+                          os.path.join(self.dir, "none.txt"))
+
+
 if __name__ == "__main__":
     harness.main()

@@ -17,6 +17,7 @@
 #include "util/atomic_file.hpp"
 #include "util/crc.hpp"
 #include "util/le.hpp"
+#include "util/strfmt.hpp"
 
 namespace {
 
@@ -159,4 +160,14 @@ TEST(FrameBuilder, ChainsDatagramsAndReadsThemBack) {
     EXPECT_FALSE(r.malformed());
     EXPECT_EQ(esc::wire::datagram_wkc(f, 1), 0);
     EXPECT_EQ(esc::wire::datagram_wkc(f, 2), -1);
+}
+
+// A message carries a path of any length whole (a fixed char array cut "ecatctl: /tmp/<long path>/bad.bin:
+// chec").
+TEST(Strprintf, KeepsTextOfAnyLength) {
+    const std::string path = "/tmp/" + std::string(300, 'd') + "/bad.bin";
+    const std::string text = util::strprintf("%s: checksum word 7 is 0x%04x", path.c_str(), 0x12u);
+    EXPECT_EQ(text, path + ": checksum word 7 is 0x0012");
+    EXPECT_EQ(util::strprintf("%s", ""), "");
+    EXPECT_EQ(util::strprintf("%d", -7), "-7");
 }

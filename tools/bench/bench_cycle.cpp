@@ -45,6 +45,7 @@
 #include "master/master.hpp"
 #include "master/session.hpp"
 #include "slave/netif.hpp"
+#include "util/strfmt.hpp"
 
 namespace {
 
@@ -245,9 +246,7 @@ std::string state_text(master::Master& m, Address a) {
     if (!st) return std::string("? (") + std::string(master::to_string(st.error())) + ")";
     std::string s(master::al_state_name(st->state));
     if (st->error) {
-        char b[32];
-        std::snprintf(b, sizeof b, "+ERR 0x%04x", st->code);
-        s += b;
+        s += util::strprintf("+ERR 0x%04x", st->code);
     }
     return s;
 }
@@ -279,9 +278,8 @@ void run_master(const Options& o, unsigned cycle_us, Result& r) {
     check(mbx.configure_from_sii(), "mailbox from SII");
     master::AlStatus final{};
     if (Error e = m.request_state(a, master::AlState::PreOp, &final); e != Error::Ok) {
-        char b[64];
-        std::snprintf(b, sizeof b, " (AL status code 0x%04x)", final.code);
-        throw std::runtime_error("INIT -> PREOP: " + std::string(master::to_string(e)) + b);
+        throw std::runtime_error("INIT -> PREOP: " + std::string(master::to_string(e)) +
+                                 util::strprintf(" (AL status code 0x%04x)", final.code));
     }
     master::SdoClient sdo(mbx);
     master::ProcessDataSession pd(m, a, sdo);
@@ -292,10 +290,8 @@ void run_master(const Options& o, unsigned cycle_us, Result& r) {
     check(pd.configure(dc), "configuring process data and DC");
     const auto period = std::chrono::microseconds(cycle_us);
     if (Error e = pd.request_state(master::AlState::SafeOp, period, &final); e != Error::Ok) {
-        char b[96];
-        std::snprintf(b, sizeof b, "requesting SAFEOP: %s (AL status code 0x%04x)",
-                      std::string(master::to_string(e)).c_str(), final.code);
-        throw std::runtime_error(b);
+        throw std::runtime_error(util::strprintf("requesting SAFEOP: %s (AL status code 0x%04x)",
+                                                 std::string(master::to_string(e)).c_str(), final.code));
     }
 
     // The cyclic loop: first the phase is locked (Safe-Op), then OP is requested between cycles (as masters
@@ -357,10 +353,9 @@ void run_master(const Options& o, unsigned cycle_us, Result& r) {
         } else if (i > kLock && (i - kLock) % status_every == 0) {
             auto st = m.al_status(a);
             if (st && st->error) {
-                char b[80];
-                std::snprintf(b, sizeof b, "OP refused: AL status code 0x%04x (%s)", st->code,
-                              std::string(master::al_status_code_name(st->code)).c_str());
-                throw std::runtime_error(b);
+                throw std::runtime_error(
+                    util::strprintf("OP refused: AL status code 0x%04x (%s)", st->code,
+                                    std::string(master::al_status_code_name(st->code)).c_str()));
             }
             if (st && st->state == static_cast<uint8_t>(master::AlState::Op)) {
                 counting_from = i + 1;

@@ -38,6 +38,7 @@
 #include "master/master.hpp"
 #include "slave/netif.hpp"
 #include "util/le.hpp"
+#include "util/strfmt.hpp"
 
 namespace {
 
@@ -82,11 +83,9 @@ void write_text(const std::filesystem::path& p, const std::string& text) {
 // The slave's device configuration: the default model with this bootstrap mailbox (SM0 at 0x1000, SM1 after
 // it, both of `size` bytes).
 std::string device_config(unsigned size) {
-    char b[256];
-    std::snprintf(b, sizeof b,
-                  "[bootstrap_mailbox]\nout_start = 0x1000\nout_size = %u\nin_start = 0x%04x\nin_size = %u\n",
-                  size, 0x1000 + ((size + 0xFF) & ~0xFFu), size);
-    return b;
+    return util::strprintf(
+        "[bootstrap_mailbox]\nout_start = 0x1000\nout_size = %u\nin_start = 0x%04x\nin_size = %u\n", size,
+        0x1000 + ((size + 0xFF) & ~0xFFu), size);
 }
 
 struct Stats {

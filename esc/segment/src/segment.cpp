@@ -5,6 +5,7 @@
 // (the topology is a tree and each ESC decides where the frame goes next through Esc::receive()), so a walk
 // needs no stack of its own and resume() restarts it at the external port. Nothing is allocated per frame.
 #include "esc/segment.hpp"
+#include "util/strfmt.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -85,11 +86,11 @@ struct Segment::Impl {
             throw std::invalid_argument(std::string("Segment::") + fn + ": " + where(d, p) +
                                         ": port out of range 0.." + std::to_string(kPortCount - 1));
         if (!devs[d].implements(p)) {
-            char desc[8];
-            std::snprintf(desc, sizeof desc, "0x%02X", devs[d].descriptor);
-            throw std::invalid_argument(std::string("Segment::") + fn + ": " + where(d, p) +
-                                        ": the ESC does not implement this port (port descriptor " + desc +
-                                        ")");
+            throw std::invalid_argument(
+                std::string("Segment::") + fn + ": " + where(d, p) +
+                util::strprintf(": the ESC does not implement this port (port descriptor "
+                                "0x%02X)",
+                                devs[d].descriptor));
         }
     }
     void check_hop(int hop, const char* fn) const {

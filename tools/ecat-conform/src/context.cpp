@@ -6,6 +6,7 @@
 #include "conform.hpp"
 #include "esi/wire/sii.hpp"
 #include "util/le.hpp"
+#include "util/strfmt.hpp"
 
 namespace conform {
 
@@ -384,16 +385,11 @@ Error Context::coe_request(std::span<const uint8_t> coe, std::vector<uint8_t>& a
 }
 
 std::string Context::sdo_error(Error e) const {
-    char b[96];
-    if (e == Error::SdoAbort && sdo) {
-        std::snprintf(b, sizeof b, "SDO abort 0x%08x (%s)", sdo->last_abort(),
-                      std::string(master::sdo_abort_text(sdo->last_abort())).c_str());
-        return b;
-    }
-    if (e == Error::MailboxError && sdo) {
-        std::snprintf(b, sizeof b, "mailbox error 0x%04x", sdo->last_mailbox_error());
-        return b;
-    }
+    if (e == Error::SdoAbort && sdo)
+        return util::strprintf("SDO abort 0x%08x (%s)", sdo->last_abort(),
+                               std::string(master::sdo_abort_text(sdo->last_abort())).c_str());
+    if (e == Error::MailboxError && sdo)
+        return util::strprintf("mailbox error 0x%04x", sdo->last_mailbox_error());
     return std::string(master::to_string(e));
 }
 

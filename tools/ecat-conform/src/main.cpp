@@ -13,6 +13,7 @@
 #include "conform.hpp"
 #include "esc/link.hpp"
 #include "report.hpp"
+#include "util/strfmt.hpp"
 
 namespace {
 
@@ -126,14 +127,12 @@ int main(int argc, char** argv) {
             results.push_back(r);
         }
     } else {
-        char id[160];
         if (ctx.sii)
-            std::snprintf(id, sizeof id, "slave %u of %u, vendor 0x%08x product 0x%08x revision 0x%08x%s",
-                          o.slave, ctx.slave_count, ctx.sii->dword(0x08), ctx.sii->dword(0x0A),
-                          ctx.sii->dword(0x0C), ctx.esi ? "" : " (no ESI)");
+            info.device = util::strprintf(
+                "slave %u of %u, vendor 0x%08x product 0x%08x revision 0x%08x%s", o.slave, ctx.slave_count,
+                ctx.sii->dword(0x08), ctx.sii->dword(0x0A), ctx.sii->dword(0x0C), ctx.esi ? "" : " (no ESI)");
         else
-            std::snprintf(id, sizeof id, "slave %u of %u (SII unreadable)", o.slave, ctx.slave_count);
-        info.device = id;
+            info.device = util::strprintf("slave %u of %u (SII unreadable)", o.slave, ctx.slave_count);
         if (ctx.esi) info.device += ", ESI device \"" + ctx.esi->type_name + "\"";
         std::string group;
         std::string lost;  // id of the test during which the slave stopped answering, "" while it answers

@@ -18,6 +18,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
+#include "util/strfmt.hpp"
 
 namespace ecatctl {
 
@@ -56,9 +57,8 @@ std::optional<Address> named_slave(const std::string& text, bool station) {
 }
 
 std::string slave_text(Address a) {
-    char b[32];
-    std::snprintf(b, sizeof b, a.mode == Address::Mode::Station ? "station 0x%04x" : "slave %u", a.value);
-    return b;
+    return a.mode == Address::Mode::Station ? util::strprintf("station 0x%04x", a.value)
+                                            : util::strprintf("slave %u", a.value);
 }
 
 std::optional<std::vector<uint8_t>> read_file(const std::string& path) {

@@ -15,6 +15,7 @@
 #include "master/diag.hpp"
 #include "master/mailbox.hpp"
 #include "od/diag_text_table.hpp"
+#include "util/strfmt.hpp"
 
 namespace ecatctl {
 
@@ -125,9 +126,7 @@ int run_diag(master::Master& m, const DiagArgs& d) {
     for (uint8_t sub : order) {
         auto n = sdo.upload(master::kDiagIndex, sub, msg);
         if (!n) {
-            char what[40];
-            std::snprintf(what, sizeof what, "reading 0x10F3:%02x", sub);
-            return report(sdo, n.error(), what);
+            return report(sdo, n.error(), util::strprintf("reading 0x10F3:%02x", sub).c_str());
         }
         auto e = master::decode_diag_message(std::span<const uint8_t>(msg.data(), *n), sub);
         if (!e) continue;  // an empty slot of a ring not yet full

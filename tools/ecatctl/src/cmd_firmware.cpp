@@ -31,6 +31,7 @@
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "util/le.hpp"
+#include "util/strfmt.hpp"
 
 namespace ecatctl {
 
@@ -220,9 +221,7 @@ int read_coe_identity(master::Master& m, Address a, CoeIdentity& out) {
     auto text = [&](uint16_t index, std::string& s) -> int {
         auto n = sdo.upload(index, 0, b);
         if (!n) {
-            char w[32];
-            std::snprintf(w, sizeof w, "reading 0x%04X", index);
-            return sdo_failed(sdo, n.error(), w);
+            return sdo_failed(sdo, n.error(), util::strprintf("reading 0x%04X", index));
         }
         s.assign(reinterpret_cast<const char*>(b), *n);
         while (!s.empty() && s.back() == '\0')

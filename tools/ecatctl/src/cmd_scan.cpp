@@ -22,6 +22,7 @@
 #include "master/master.hpp"
 #include "master/session.hpp"
 #include "util/le.hpp"
+#include "util/strfmt.hpp"
 
 namespace ecatctl {
 
@@ -64,9 +65,7 @@ int scan(master::Master& m, bool dc) {
         }
         std::string state = std::string(master::al_state_name(s.al.state));
         if (s.al.error) {
-            char b[32];
-            std::snprintf(b, sizeof b, "+ERR(0x%04x)", s.al.code);
-            state += b;
+            state += util::strprintf("+ERR(0x%04x)", s.al.code);
         }
         std::string delay = "-";
         if (dc_ok && s.has_dc) delay = std::to_string(s.delay_ns);
@@ -76,11 +75,9 @@ int scan(master::Master& m, bool dc) {
             const esi::SiiInfo info = esi::parse_sii(*img);
             if (info.general) name = info.general->name;
         }
-        char row[256];
-        std::snprintf(row, sizeof row, "%-4u 0x%04x  %-10s 0x%08x 0x%08x 0x%08x 0x%08x %-9s %s", s.position,
-                      s.station, state.c_str(), s.vendor_id, s.product_code, s.revision, s.serial,
-                      delay.c_str(), name.c_str());
-        std::string line = row;
+        std::string line = util::strprintf("%-4u 0x%04x  %-10s 0x%08x 0x%08x 0x%08x 0x%08x %-9s %s",
+                                           s.position, s.station, state.c_str(), s.vendor_id, s.product_code,
+                                           s.revision, s.serial, delay.c_str(), name.c_str());
         line.erase(line.find_last_not_of(' ') + 1);  // no trailing blanks when there is no name
         std::printf("%s\n", line.c_str());
     }

@@ -19,6 +19,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
+#include "util/strfmt.hpp"
 
 namespace ecatctl {
 
@@ -69,9 +70,8 @@ int sdo_transfer(master::Master& m, const SdoArgs& s, bool upload) {
     if (Error e = open_mailbox(m, mbx, *a); e != Error::Ok)
         return fail(e, "opening the mailbox of " + slave_text(*a));
     master::SdoClient sdo(mbx);
-    char what[64];
-    std::snprintf(what, sizeof what, "%s 0x%04x:%02x", upload ? "upload of" : "download to",
-                  static_cast<unsigned>(*index), static_cast<unsigned>(*sub));
+    const std::string what = util::strprintf("%s 0x%04x:%02x", upload ? "upload of" : "download to",
+                                             static_cast<unsigned>(*index), static_cast<unsigned>(*sub));
     if (!upload) {
         const Error e =
             sdo.download(static_cast<uint16_t>(*index), static_cast<uint8_t>(*sub), data, s.complete);

@@ -20,6 +20,7 @@
 #include "master/master.hpp"
 #include "master/session.hpp"
 #include "util/le.hpp"
+#include "util/strfmt.hpp"
 
 namespace ecatctl {
 
@@ -70,10 +71,9 @@ int sii_write(master::Master& m, const SiiArgs& s) {
     const uint16_t w7 = util::get16(img->data() + 2 * esi::sii::word::Checksum);
     const uint8_t crc = esi::sii::crc8(img->data(), esi::sii::kCrcBytes);
     if (w7 != esi::sii::kChecksumDisabled && (w7 & 0xFF) != crc && !s.force) {
-        char b[96];
-        std::snprintf(b, sizeof b, "%s: checksum word 7 is 0x%04x, CRC of words 0-6 is 0x%02x (use --force)",
-                      s.input.c_str(), w7, crc);
-        return usage(b);
+        return usage(
+            util::strprintf("%s: checksum word 7 is 0x%04x, CRC of words 0-6 is 0x%02x (use --force)",
+                            s.input.c_str(), w7, crc));
     }
     const std::size_t words = img->size() / 2;
     for (std::size_t w = 0; w < words; ++w) {

@@ -5,6 +5,7 @@
 
 #include "esi/sii_reader.hpp"
 #include "format.hpp"
+#include "util/strfmt.hpp"
 
 namespace ecatctl {
 
@@ -39,10 +40,8 @@ int report_sdo_failure(const master::SdoClient& sdo, master::Error e, const std:
 }
 
 std::string slave_label(master::Address a) {
-    char b[32];
-    std::snprintf(b, sizeof b, a.mode == master::Address::Mode::Station ? "station 0x%04x" : "slave %u",
-                  a.value);
-    return b;
+    return a.mode == master::Address::Mode::Station ? util::strprintf("station 0x%04x", a.value)
+                                                    : util::strprintf("slave %u", a.value);
 }
 
 std::optional<master::Address> parse_slave_address(const std::string& text, bool station) {
@@ -81,11 +80,8 @@ int check_slave_present(master::Master& m, master::Address a) {
     const master::Error e = m.read(a, esc::reg::kAlStatus, b);  // AL status
     if (e == master::Error::Ok) return kExitOk;
     if (e == master::Error::WorkingCounter) {
-        char t[120];
-        std::snprintf(t, sizeof t,
-                      "ecatctl: no slave has the station address 0x%04x (`ecatctl scan` assigns 0x1001..)\n",
-                      a.value);
-        std::cerr << t;
+        std::cerr << util::strprintf(
+            "ecatctl: no slave has the station address 0x%04x (`ecatctl scan` assigns 0x1001..)\n", a.value);
         return kExitNoSlave;
     }
     return report_error(e, "reading the AL status of " + slave_label(a));

@@ -20,6 +20,7 @@
 #include "od/device_config.hpp"
 #include "od/diag_texts.hpp"
 #include "od/drive_profile.hpp"
+#include "util/strfmt.hpp"
 
 namespace device {
 
@@ -187,9 +188,8 @@ std::string requested_text(uint8_t requested) {
 }
 
 std::string al_code_text(uint16_t code) {
-    char b[16];
-    std::snprintf(b, sizeof b, "0x%04X", static_cast<unsigned>(code));
-    return std::string(b) + " (" + std::string(ecat::al::name(code)) + ")";
+    return util::strprintf("0x%04X (%s)", static_cast<unsigned>(code),
+                           std::string(ecat::al::name(code)).c_str());
 }
 
 std::string hex16(uint16_t v) {
@@ -228,9 +228,9 @@ void Device::foe_write(std::string_view name, uint64_t bytes, uint32_t error_cod
         event(slave::LogLevel::Info, line + "stored");
         return;
     }
-    char b[16];
-    std::snprintf(b, sizeof b, "0x%04X", static_cast<unsigned>(error_code));
-    event(slave::LogLevel::Warn, line + "failed, FoE error " + b + " (" + std::string(error_text) + ")");
+    event(slave::LogLevel::Warn,
+          line + util::strprintf("failed, FoE error 0x%04X (%s)", static_cast<unsigned>(error_code),
+                                 std::string(error_text).c_str()));
 }
 
 std::ostream& Device::log() const {
@@ -358,10 +358,10 @@ void Device::poll(uint64_t now_ns) {
         try {
             build();
             const od::Identity& id = parts_->desc.identity;
-            char rev[16];
-            std::snprintf(rev, sizeof rev, "0x%08X", static_cast<unsigned>(id.revision));
-            event(slave::LogLevel::Info, std::string("firmware restarted (Bootstrap -> Init): revision ") +
-                                             rev + ", software version " + id.software_version);
+            event(slave::LogLevel::Info,
+                  util::strprintf(
+                      "firmware restarted (Bootstrap -> Init): revision 0x%08X, software version %s",
+                      static_cast<unsigned>(id.revision), id.software_version.c_str()));
         } catch (const std::exception& e) {
             log() << "softdrive: restart failed, the running firmware stays: " << e.what() << '\n';
             event(slave::LogLevel::Error, std::string("firmware restart failed: ") + e.what());

@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "util/le.hpp"
+#include "util/strfmt.hpp"
 
 namespace master {
 
@@ -134,7 +135,6 @@ std::string_view diag_type_name(uint8_t type) {
 
 std::string format_diag_param(const DiagParameter& p) {
     std::string s;
-    char b[64];
     switch (p.kind()) {
         case 0: {
             const uint16_t t = p.flags & 0x0FFF;
@@ -143,19 +143,15 @@ std::string format_diag_param(const DiagParameter& p) {
                 const unsigned bits = static_cast<unsigned>(p.data.size() * 8);
                 int64_t sv = static_cast<int64_t>(v);
                 if (bits < 64 && (v >> (bits - 1)) & 1) sv = static_cast<int64_t>(v | (~uint64_t{0} << bits));
-                std::snprintf(b, sizeof b, "%lld", static_cast<long long>(sv));
-            } else {
-                std::snprintf(b, sizeof b, "0x%0*llx (%llu)", static_cast<int>(p.data.size() * 2),
-                              static_cast<unsigned long long>(v), static_cast<unsigned long long>(v));
+                return util::strprintf("%lld", static_cast<long long>(sv));
             }
-            return b;
+            return util::strprintf("0x%0*llx (%llu)", static_cast<int>(p.data.size() * 2),
+                                   static_cast<unsigned long long>(v), static_cast<unsigned long long>(v));
         }
         case 1:
             s = "bytes";
-            for (uint8_t x : p.data) {
-                std::snprintf(b, sizeof b, " %02x", x);
-                s += b;
-            }
+            for (uint8_t x : p.data)
+                s += util::strprintf(" %02x", x);
             return s;
         case 2:
             s = "\"";
@@ -231,9 +227,7 @@ std::string diag_text(const DiagEntry& e, ErrorNameLookup lookup, TextIdLookup t
         return std::string(emergency_class_name(c));
     }
     if (e.text_id != 0) {
-        char b[48];
-        std::snprintf(b, sizeof b, "text id 0x%04x", e.text_id);
-        return b;
+        return util::strprintf("text id 0x%04x", e.text_id);
     }
     for (const auto& p : e.params) {
         if (p.kind() == 2 || p.kind() == 3) {
@@ -246,10 +240,8 @@ std::string diag_text(const DiagEntry& e, ErrorNameLookup lookup, TextIdLookup t
 }
 
 std::string format_diag_time(uint64_t ns) {
-    char b[48];
-    std::snprintf(b, sizeof b, "%llu.%09llu s", static_cast<unsigned long long>(ns / 1000000000u),
-                  static_cast<unsigned long long>(ns % 1000000000u));
-    return b;
+    return util::strprintf("%llu.%09llu s", static_cast<unsigned long long>(ns / 1000000000u),
+                           static_cast<unsigned long long>(ns % 1000000000u));
 }
 
 std::string format_diag_flags(uint16_t flags) {
@@ -269,11 +261,9 @@ std::string format_diag_flags(uint16_t flags) {
 }
 
 std::string format_diag_line(const DiagEntry& e, ErrorNameLookup lookup, TextIdLookup texts) {
-    char b[96];
-    std::snprintf(b, sizeof b, ":%02u  %s%s  %-7s  0x%08x  ", e.subindex,
-                  format_diag_time(e.timestamp_ns).c_str(), e.local_time ? " (local)" : "",
-                  std::string(diag_type_name(e.type)).c_str(), e.code);
-    std::string s = b;
+    std::string s =
+        util::strprintf(":%02u  %s%s  %-7s  0x%08x  ", e.subindex, format_diag_time(e.timestamp_ns).c_str(),
+                        e.local_time ? " (local)" : "", std::string(diag_type_name(e.type)).c_str(), e.code);
     const std::string text = diag_text(e, lookup, texts);
     s += text;
     std::vector<std::string> shown;
