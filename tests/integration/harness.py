@@ -216,8 +216,54 @@ class Bus:
 PACKET_OUTGOING = 4
 
 
+def datagram_keys(frame):
+    """(command, index, address offset, length) of each datagram of an EtherCAT frame, as far as it parses (a
+    malformed frame gives the datagrams before the point where it breaks off). A slave changes the address
+    position of auto-increment commands, the data and the working counter, never these: they identify the
+    request a reply answers."""
+    keys = []
+    if len(frame) < 16 or frame[12:14] != b"\x88\xa4":
+        return keys
+    end = min(len(frame), 16 + (struct.unpack_from("<H", frame, 14)[0] & 0x7FF))
+    pos = 16
+    while pos + 10 <= end:
+        cmd, idx, _adp, ado, lf = struct.unpack_from("<BBHHH", frame, pos)
+        keys.append((cmd, idx, ado, lf & 0x7FF))
+        pos += 12 + (lf & 0x7FF)
+        if not lf & 0x8000:
+            break
+    return keys
+
+
+def is_reply_to(request, reply):
+    """True if reply is the request come back through the slaves: an EtherCAT frame whose source address has
+    bit 1 of its first byte set by an ESC (when the request's had not) and whose datagrams carry the request's
+    commands, indices, offsets and lengths (ETG.1000.4: the master matches a reply to its request by the
+    index). A reply to an earlier request, or to another master's frame, is not."""
+    if len(reply) < 16 or reply[12:14] != b"\x88\xa4":
+        return False
+    if not request[6] & 0x02 and not reply[6] & 0x02:
+        return False
+    return datagram_keys(reply) == datagram_keys(request)
+
+
+def drain(sock):
+    """Drops every frame queued on the socket (late replies, another master's traffic)."""
+    sock.setblocking(False)
+    try:
+        while True:
+            sock.recv(4096)
+    except (BlockingIOError, socket.timeout):
+        pass
+    finally:
+        sock.setblocking(True)
+
+
 def exchange(sock, frame, timeout=0.5):
-    """Sends a frame and returns the first EtherCAT frame that comes back in (not our own), or None."""
+    """Sends a frame and returns the reply to it (is_reply_to), or None when none came within timeout.
+    Frames queued before are dropped and replies to other requests skipped, so a late reply to an earlier
+    request is never taken for this one's."""
+    drain(sock)
     sock.send(frame)
     deadline = time.monotonic() + timeout
     while True:
@@ -226,10 +272,10 @@ def exchange(sock, frame, timeout=0.5):
             return None
         sock.settimeout(left)
         try:
-            data, addr = sock.recvfrom(2048)
+            data, addr = sock.recvfrom(4096)
         except socket.timeout:
             return None
-        if addr[2] == PACKET_OUTGOING:
+        if addr[2] == PACKET_OUTGOING or not is_reply_to(frame, data):
             continue
         return data
 
@@ -392,25 +438,13 @@ class MiniMaster:
                 data, addr = self.sock.recvfrom(4096)
             except socket.timeout:
                 return None
-            if addr[2] == PACKET_OUTGOING or len(data) < 28 or data[12:14] != b"\x88\xa4" or data[17] != idx:
-                continue
-            if data[6:12] == b"\x01" * 6:
-                continue  # not passed through a slave (an ESC sets bit 1 of the first source address byte)
-            dgs = parse_datagrams(data)
-            if [(d[0], len(d[4])) for d in dgs] != [(d[0], len(d[3])) for d in datagrams]:
-                continue  # a reply to another master's frame (ecatctl) that used the same index
-            return [(d[4], d[5]) for d in dgs]
+            if addr[2] == PACKET_OUTGOING or not is_reply_to(frame, data):
+                continue  # our own frame, a late reply, or a reply to another master's frame (ecatctl)
+            return [(d[4], d[5]) for d in parse_datagrams(data)]
 
     def drain(self):
         """Drops what is queued (replies to ecatctl's frames, late replies)."""
-        self.sock.setblocking(False)
-        try:
-            while True:
-                self.sock.recv(4096)
-        except (BlockingIOError, socket.timeout):
-            pass
-        finally:
-            self.sock.setblocking(True)
+        drain(self.sock)
 
     def one(self, cmd, adp, ado, data, tries=5):
         for _ in range(tries):

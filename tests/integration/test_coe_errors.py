@@ -169,34 +169,13 @@ class RawMailbox:
     def close(self):
         self.sock.close()
 
-    def flush(self):
-        """Drops frames queued on the socket (ecatctl's traffic between our exchanges)."""
-        self.sock.setblocking(False)
-        try:
-            while True:
-                self.sock.recv(2048)
-        except BlockingIOError:
-            pass
-        finally:
-            self.sock.setblocking(True)
-
     def datagram(self, cmd, ado, data):
-        self.flush()
         for _ in range(5):
             self.idx = (self.idx + 1) & 0xFF
-            self.sock.send(harness.ecat_frame([(cmd, self.idx, STATION, ado, data)]))
-            deadline = time.monotonic() + 0.5
-            while time.monotonic() < deadline:
-                self.sock.settimeout(max(0.001, deadline - time.monotonic()))
-                try:
-                    frame, addr = self.sock.recvfrom(2048)
-                except OSError:
-                    break
-                if addr[2] == harness.PACKET_OUTGOING:
-                    continue
-                d = harness.parse_datagrams(frame)
-                if d and d[0][1] == self.idx and d[0][0] == cmd:
-                    return d[0][4], d[0][5]
+            reply = harness.exchange(self.sock, harness.ecat_frame([(cmd, self.idx, STATION, ado, data)]))
+            if reply is not None:
+                d = harness.parse_datagrams(reply)[0]
+                return d[4], d[5]
         raise AssertionError("no reply to a datagram")
 
     def read(self, ado, n):
