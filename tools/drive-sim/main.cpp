@@ -363,6 +363,7 @@ int bench(int axes, int cycles, int64_t dt_ns) {
 
 int main(int argc, char** argv) {
     CLI::App app{"drive-sim: the CiA 402 drive without EtherCAT, through a scripted motion"};
+    app.set_version_flag("--version", std::string("drive-sim ") + SOFTECAT_VERSION);
     std::string script_path, csv_path = "drive-sim.csv", png_path;
     double cycle_us = 1000;
     bool do_bench = false, print_demo = false, seed_defaults = false;
@@ -383,7 +384,7 @@ int main(int argc, char** argv) {
                  "start from the seed's defaults instead of the commissioned motor data (torque constant 0)");
     try {
         app.parse(argc, argv);
-    } catch (const CLI::CallForHelp& e) {
+    } catch (const CLI::Success& e) {  // --help, --version
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         std::cerr << "drive-sim: " << e.what() << " (drive-sim --help)\n";  // one line

@@ -68,6 +68,7 @@ bool write_file(const std::string& path, const std::vector<uint8_t>& bytes) {
 
 int main(int argc, char** argv) {
     CLI::App app{"Build and inspect firmware images for the soft EtherCAT drive (FoE download)"};
+    app.set_version_flag("--version", std::string("fwimage ") + SOFTECAT_VERSION);
     app.require_subcommand(1);
 
     const fwimage::DeviceIdentity defaults = fwimage::default_identity();
@@ -95,7 +96,7 @@ int main(int argc, char** argv) {
 
     try {
         app.parse(argc, argv);
-    } catch (const CLI::CallForHelp& e) {
+    } catch (const CLI::Success& e) {  // --help, --version
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         std::cerr << "fwimage: " << e.what() << " (fwimage --help)\n";  // one line

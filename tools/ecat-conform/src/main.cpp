@@ -44,6 +44,7 @@ bool selected(const conform::TestCase& t, const std::set<std::string>& groups, c
 int main(int argc, char** argv) {
     CLI::App app{
         "ecat-conform: EtherCAT slave conformance tests (ETG.1000, ETG.2000, ETG.1020, ETG.5001, CiA 402)"};
+    app.set_version_flag("--version", std::string("ecat-conform ") + SOFTECAT_VERSION);
     conform::Options o;
     std::string groups_arg, filter, junit, json, backend;
     bool list = false, markdown = false;
