@@ -4,7 +4,7 @@
 set -euo pipefail
 PKGS=(build-essential cmake ninja-build pkg-config
       libpcap-dev zlib1g-dev libeigen3-dev libgtest-dev libgmock-dev libcli11-dev libxml2-dev libxml2-utils
-      iproute2 tshark python3 python3-scapy gnuplot-nox clang-format
+      iproute2 tshark python3 python3-scapy python3-yaml gnuplot-nox clang-format help2man dpkg-dev file
       clang libclang-rt-14-dev)  # clang + libFuzzer/sanitizer runtimes: the fuzz build (tests/fuzz) and the clang -Werror build
 missing=()
 for p in "${PKGS[@]}"; do
