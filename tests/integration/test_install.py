@@ -4,6 +4,7 @@ installed ecat-slave, run as an unprivileged user with those capabilities only (
 an interface a master scans; without them it cannot start. (The .deb built from the same rules is installed and
 removed by .ci/run.)"""
 import configparser
+import gzip
 import os
 import re
 import shutil
@@ -46,15 +47,17 @@ class Install(unittest.TestCase):
                                timeout=30)
             self.assertEqual(r.returncode, 0, f"{p} --version: {r.stderr}")
             self.assertRegex(r.stdout, rf"^{p} \d+\.\d+\.\d+", p)
-            with open(self.path("share", "man", "man1", f"{p}.1")) as f:
+            with gzip.open(self.path("share", "man", "man1", f"{p}.1.gz"), "rt") as f:
                 page = f.read()
             self.assertIn(".SH NAME", page, p)
             self.assertIn("\\-\\-help", page, f"{p}.1 lists no options")
-            r = subprocess.run(["man", "-l", "-P", "cat", self.path("share", "man", "man1", f"{p}.1")],
+            self.assertTrue(os.path.isfile(self.path("share", "bash-completion", "completions", p)), p)
+            if not shutil.which("man"):
+                continue
+            r = subprocess.run(["man", "-l", "-P", "cat", self.path("share", "man", "man1", f"{p}.1.gz")],
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=60,
                                env=dict(os.environ, MANWIDTH="80"))
             self.assertEqual(r.returncode, 0, r.stderr)
-            self.assertTrue(os.path.isfile(self.path("share", "bash-completion", "completions", p)), p)
 
     def complete(self, line):
         """What bash completion offers for the last word of line, with the installed programs on PATH."""
