@@ -79,7 +79,8 @@ class Install(unittest.TestCase):
         self.assertIn("--payload", self.complete("fwimage build --pay"))
 
     def test_examples_and_schema(self):
-        for f in ("device.conf", "bootstrap-as-standard.conf", "drive.conf", os.path.join("drive-sim", "homing.txt")):
+        for f in ("device.conf", "bootstrap-as-standard.conf", "drive.conf", os.path.join("drive-sim", "homing.txt"),
+                  os.path.join("segment", "tree.topo"), os.path.join("segment", "axis-b.conf")):
             self.assertTrue(os.path.isfile(self.path("share", "doc", "softecat", "examples", f)), f)
         schema = self.path("share", "softecat", "schema", "EtherCATInfo.xsd")
         self.assertTrue(os.path.isfile(schema))
