@@ -63,12 +63,8 @@ fi
 
 if [ -S "$work/control.sock" ]; then
   echo; echo "== the simulated machine, through the control socket (--control): 'status'"
-  python3 - "$work/control.sock" "$work/me.sock" <<'EOF' || true
-import socket, sys
-s = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
-s.bind(sys.argv[2]); s.settimeout(2)
-s.sendto(b"status\n", sys.argv[1]); print("   " + s.recv(256).decode().strip())
-EOF
+  echo "\$ ecat-slave --control $work/control.sock --send status"
+  "$slave" --control "$work/control.sock" --send status || true
 fi
 
 kill "$pid" 2>/dev/null || true

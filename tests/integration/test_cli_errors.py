@@ -216,5 +216,76 @@ class LongPaths(unittest.TestCase):
                           os.path.join(self.dir, "none.txt"))
 
 
+class ControlClient(unittest.TestCase):
+    """`ecat-slave --control PATH --send LINE`, the project's own client of the control socket, against a stand-in
+    server (the real one answers it in test_readme, through docs/segment.md): the answer printed whole, exit 0 on
+    ok, 1 on an error answer or none, 2 without a socket there."""
+
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="ecat-ctl-")
+        self.addCleanup(shutil.rmtree, self.dir, True)
+        self.path = os.path.join(self.dir, "control.sock")
+
+    def serve(self, answer):
+        """A datagram server that answers each datagram with answer (None: never answers); returns what it got."""
+        import socket
+        import threading
+        srv = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+        srv.bind(self.path)
+        self.addCleanup(srv.close)
+        got = []
+
+        def loop():
+            srv.settimeout(10)
+            try:
+                data, addr = srv.recvfrom(65536)
+            except OSError:
+                return
+            got.append(data)
+            if answer is not None:
+                srv.sendto(answer, addr)
+        t = threading.Thread(target=loop)
+        t.start()
+        self.addCleanup(t.join)
+        return got
+
+    def send(self, *lines, path=None):
+        args = ["--control", path or self.path]
+        for line in lines:
+            args += ["--send", line]
+        return tool("ECAT_SLAVE", *args)
+
+    def test_ok_answer_is_printed_and_exit_0(self):
+        got = self.serve(b"ok segment 2 devices\ndevice 0 drive1 power on\nok state INIT\n")
+        r = self.send("segment", "status")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(r.stdout, b"ok segment 2 devices\ndevice 0 drive1 power on\nok state INIT\n")
+        self.assertEqual(got, [b"segment\nstatus\n"])  # one datagram, one line each
+        self.assertEqual(sorted(os.listdir(self.dir)), ["control.sock"], "the answer socket is removed")
+
+    def test_error_answer_exits_1(self):
+        self.serve(b"error: unknown command 'x'\n")
+        r = self.send("x")
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertIn(b"error: unknown command", r.stdout)
+
+    def test_no_answer_exits_1(self):
+        self.serve(None)
+        r = self.send("status")
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertIn(b"no answer", r.stderr)
+
+    def test_no_socket_or_no_path(self):
+        r = self.send("status")
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn(self.path.encode(), r.stderr)
+        long_path = os.path.join(self.dir, "x" * 200, "control.sock")
+        r = self.send("status", path=long_path)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn(long_path.encode(), r.stderr)  # named whole, with the limit
+        r = tool("ECAT_SLAVE", "--send", "status")
+        self.assertEqual(r.returncode, 2, r.stderr)
+
+
 if __name__ == "__main__":
     harness.main()

@@ -181,7 +181,7 @@ class Readme(unittest.TestCase):
         runs, _ = self.parse(READMES[1])
         self.assertTrue(any(r[3] for r in runs), "tools/ecatctl/README.md starts the slave in the background")
         runs, _ = self.parse(os.path.join("docs", "segment.md"))
-        chain = [r for r in runs if r[3]]
+        chain = [r for r in runs if r[3] and "--iface" in r[2]]
         self.assertEqual(len(chain), 2, "docs/segment.md chains two processes")
         self.assertEqual(chain[0][4], chain[1][4], "in one block")
         self.assertTrue(any(r[2][0].endswith("/ip") for r in runs), "its ip lines are run")
@@ -283,7 +283,8 @@ class Readme(unittest.TestCase):
     def starts_slave(argv):
         if any(a == "--fault" and b == "list" for a, b in zip(argv[1:], argv[2:])):
             return False  # prints the faults and exits
-        return not any(a in ("--help", "-h", "--version") or a.startswith("--write-") for a in argv[1:])
+        return not any(a in ("--help", "-h", "--version", "--send") or a.startswith(("--write-", "--send="))
+                       for a in argv[1:])
 
     def wait_for_slave(self, in_ns, proc, argv, where):
         """Until the slave serves its interface: a packet socket of its own is open (ecat-slave opens it once

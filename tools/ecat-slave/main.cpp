@@ -15,6 +15,7 @@
 #include "device/line.hpp"
 #include "esc/link.hpp"
 #include "od/device_config.hpp"
+#include "send_control.hpp"
 #include "slave/log.hpp"
 #include "slave/slave.hpp"
 #include "slave/topology.hpp"
@@ -47,6 +48,7 @@ int main(int argc, char** argv) {
     device::DeviceOptions device;
     std::string state_dir = device.state_dir.string();
     std::string write_sii, write_esi, control;
+    std::vector<std::string> send_lines;
     std::vector<double> home, stops;
     std::vector<std::string> faults;
     CLI::App app{"Soft EtherCAT slave: a CiA 402 servo drive on a Linux network interface", "ecat-slave"};
@@ -82,8 +84,14 @@ int main(int argc, char** argv) {
     app.add_option("--control", control,
                    "Create a UNIX datagram socket here that changes the simulated machine at run time "
                    "(lines like 'input 4 on', 'sto off', 'limit-pos 50000', 'status'; "
-                   "e.g. echo 'input 4 on' | nc -uUN -w0 PATH)")
+                   "e.g. ecat-slave --control PATH --send 'input 4 on')")
         ->type_name("PATH");
+    app.add_option(
+           "--send", send_lines,
+           "With --control PATH: send this command line to the ecat-slave running with that control socket, "
+           "print its answer and exit (0: ok, 1: error or no answer, 2: no such socket); repeatable")
+        ->type_name("LINE")
+        ->needs("--control");
     auto* env = app.add_option_group("Simulated machine", "Positions in raw encoder increments");
     env->add_option("--limit-neg", device.environment.negative_limit,
                     "Negative limit switch (DigIN1), active at and below this position");
@@ -167,6 +175,7 @@ int main(int argc, char** argv) {
         std::cerr << "ecat-slave: " << e.what() << " (ecat-slave --help)\n";  // one line
         return slave::kExitUsage;
     }
+    if (!send_lines.empty()) return ecat_slave::send_control(control, send_lines, std::cout, std::cerr);
     device::FaultSet fault_set;
     for (const std::string& item : faults) {
         if (item == "list") {
