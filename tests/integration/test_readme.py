@@ -149,6 +149,7 @@ class Readme(unittest.TestCase):
         with open(os.path.join(ROOT, readme)) as f:
             text = f.read()
         runs, others = [], []
+        raw_lines = text.splitlines()
         for line, cmd, block in readme_blocks(text, inline=readme in READMES):
             try:
                 words = shlex.split(cmd)
@@ -169,7 +170,9 @@ class Readme(unittest.TestCase):
             if "|" in words or ">" in words or ";" in words:
                 self.fail(f"{readme}:{line}: `{cmd}`: pipes and redirections are not run by this test")
             argv = ([self.bins[PROGRAMS[words[0]]]] if words[0] in PROGRAMS else [shutil.which(words[0])]) + words[1:]
-            runs.append((line, cmd, argv, background, block))
+            # A comment that says how many slaves the command shows (`ecatctl scan   # 2 slaves`) is checked.
+            said = re.search(r"#\s*(\d+) slaves?\b", raw_lines[line - 1]) if cmd in raw_lines[line - 1] else None
+            runs.append((line, cmd, argv, background, block, int(said.group(1)) if said else None))
         return runs, others
 
     def test_readme_commands_are_found(self):
@@ -185,6 +188,7 @@ class Readme(unittest.TestCase):
         self.assertEqual(len(chain), 2, "docs/segment.md chains two processes")
         self.assertEqual(chain[0][4], chain[1][4], "in one block")
         self.assertTrue(any(r[2][0].endswith("/ip") for r in runs), "its ip lines are run")
+        self.assertEqual([r[5] for r in runs if r[5] is not None], [2, 2], "its '# 2 slaves' comments are checked")
         self.assertIn(os.path.join("docs", "ci.md"), DOCS)
         self.assertTrue(is_synopsis("ecat-slave --slaves N") and not is_synopsis("fwimage build --payload FILE"))
 
@@ -236,7 +240,7 @@ class Readme(unittest.TestCase):
         # --write-esi included (its ESI is of the device as the state directory holds it then), in README order.
         offline = [r for r in runs if os.path.basename(r[2][0]) in ("fwimage", "drive-sim")]
         online = [r for r in runs if r not in offline]
-        for line, cmd, argv, background, block in offline + online:
+        for line, cmd, argv, background, block, slaves_said in offline + online:
             where = f"{readme}:{line}: `{cmd}`"
             if os.path.basename(argv[0]) == "ecat-slave":
                 argv = self.own_state_dir(argv, os.path.join(state, f"line{line}"))
@@ -258,6 +262,8 @@ class Readme(unittest.TestCase):
             failed = "\n".join(ln for ln in r.stdout.splitlines() if "FAIL" in ln)  # a report's failures
             self.assertEqual(r.returncode, 0,
                              f"{where} exited {r.returncode}:\n{failed}\n{r.stdout[-1500:]}\n{r.stderr[-1500:]}")
+            if slaves_said is not None:
+                self.assertRegex(r.stdout, rf"(?m)^{slaves_said} slaves?$", f"{where}: the page says so")
             print(f"{where}: ok")
         stop_slaves()
         for p, *_ in slaves:
