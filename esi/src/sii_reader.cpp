@@ -3,10 +3,10 @@
 #include "esi/sii_reader.hpp"
 
 #include <algorithm>
-#include <cstdarg>
 #include <cstdio>
 
 #include "type_names.hpp"
+#include "util/strfmt.hpp"
 
 namespace esi {
 // ---------------------------------------------------------------------------------------------------
@@ -31,19 +31,7 @@ struct Reader {
     uint32_t u32(std::size_t off) { return u16(off) | (static_cast<uint32_t>(u16(off + 2)) << 16); }
 };
 
-std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
-std::string format(const char* fmt, ...) {
-    va_list ap;
-    va_start(ap, fmt);
-    va_list ap2;
-    va_copy(ap2, ap);
-    const int n = std::vsnprintf(nullptr, 0, fmt, ap);
-    va_end(ap);
-    std::string out(n > 0 ? static_cast<std::size_t>(n) : 0, '\0');
-    if (n > 0) std::vsnprintf(out.data(), out.size() + 1, fmt, ap2);
-    va_end(ap2);
-    return out;
-}
+using util::strprintf;
 
 void parse_strings(std::span<const uint8_t> body, SiiInfo& info) {
     Reader r{body};
@@ -51,12 +39,12 @@ void parse_strings(std::span<const uint8_t> body, SiiInfo& info) {
     std::size_t off = 1;
     for (unsigned i = 0; i < count; ++i) {
         if (!r.has(off, 1)) {
-            info.problems.push_back(format("STRINGS: %u strings declared, data ends after %u", count, i));
+            info.problems.push_back(strprintf("STRINGS: %u strings declared, data ends after %u", count, i));
             return;
         }
         const uint8_t len = r.u8(off);
         if (!r.has(off + 1, len)) {
-            info.problems.push_back(format("STRINGS: string %u runs past the category", i + 1));
+            info.problems.push_back(strprintf("STRINGS: string %u runs past the category", i + 1));
             return;
         }
         info.strings.emplace_back(reinterpret_cast<const char*>(body.data() + off + 1), len);
@@ -65,7 +53,7 @@ void parse_strings(std::span<const uint8_t> body, SiiInfo& info) {
 }
 
 void parse_general(std::span<const uint8_t> body, SiiInfo& info) {
-    if (body.size() < 32) info.problems.push_back(format("GENERAL: %zu bytes, expected 32", body.size()));
+    if (body.size() < 32) info.problems.push_back(strprintf("GENERAL: %zu bytes, expected 32", body.size()));
     Reader r{body};
     SiiGeneral g;
     g.group_idx = r.u8(0);
@@ -88,7 +76,7 @@ void parse_general(std::span<const uint8_t> body, SiiInfo& info) {
 
 void parse_syncm(std::span<const uint8_t> body, SiiInfo& info) {
     if (body.size() % 8)
-        info.problems.push_back(format("SYNCM: %zu bytes, not a multiple of 8", body.size()));
+        info.problems.push_back(strprintf("SYNCM: %zu bytes, not a multiple of 8", body.size()));
     Reader r{body};
     for (std::size_t off = 0; r.has(off, 8); off += 8) {
         SiiSyncManager sm;
@@ -107,7 +95,7 @@ void parse_pdos(std::span<const uint8_t> body, std::vector<SiiPdo>& out, const c
     std::size_t off = 0;
     while (off < body.size()) {
         if (!r.has(off, 8)) {
-            info.problems.push_back(format("%s: %zu stray bytes at the end", what, body.size() - off));
+            info.problems.push_back(strprintf("%s: %zu stray bytes at the end", what, body.size() - off));
             return;
         }
         SiiPdo p;
@@ -120,7 +108,7 @@ void parse_pdos(std::span<const uint8_t> body, std::vector<SiiPdo>& out, const c
         off += 8;
         for (unsigned i = 0; i < n; ++i) {
             if (!r.has(off, 8)) {
-                info.problems.push_back(format(
+                info.problems.push_back(strprintf(
                     "%s: PDO 0x%04X declares %u entries, the category ends after %u", what, p.index, n, i));
                 out.push_back(std::move(p));
                 return;
@@ -140,7 +128,8 @@ void parse_pdos(std::span<const uint8_t> body, std::vector<SiiPdo>& out, const c
 }
 
 void parse_dc(std::span<const uint8_t> body, SiiInfo& info) {
-    if (body.size() % 24) info.problems.push_back(format("DC: %zu bytes, not a multiple of 24", body.size()));
+    if (body.size() % 24)
+        info.problems.push_back(strprintf("DC: %zu bytes, not a multiple of 24", body.size()));
     Reader r{body};
     for (std::size_t off = 0; r.has(off, 24); off += 24) {
         SiiDcMode m;
@@ -169,7 +158,7 @@ SiiInfo parse_sii(std::span<const uint8_t> image) {
     Reader r{image};
     info.header_complete = image.size() >= kSiiFirstCategoryWord * 2;
     if (!info.header_complete)
-        info.problems.push_back(format("image has %zu bytes, the header alone needs 128", image.size()));
+        info.problems.push_back(strprintf("image has %zu bytes, the header alone needs 128", image.size()));
 
     info.pdi_control = r.u8(0);
     info.esc_config = r.u8(1);
@@ -182,8 +171,8 @@ SiiInfo parse_sii(std::span<const uint8_t> image) {
     info.crc_disabled = r.has(14, 2) && info.checksum_word == kSiiChecksumDisabled;
     info.crc_ok = r.has(14, 2) && (info.crc_disabled || (info.checksum_word & 0xFF) == info.crc_computed);
     if (r.has(14, 2) && !info.crc_ok)
-        info.problems.push_back(format("checksum word 7 = 0x%04X, CRC-8 of words 0-6 is 0x%02X",
-                                       info.checksum_word, info.crc_computed));
+        info.problems.push_back(strprintf("checksum word 7 = 0x%04X, CRC-8 of words 0-6 is 0x%02X",
+                                          info.checksum_word, info.crc_computed));
     info.vendor_id = r.u32(0x08 * 2);
     info.product_code = r.u32(0x0A * 2);
     info.revision = r.u32(0x0C * 2);
@@ -205,7 +194,7 @@ SiiInfo parse_sii(std::span<const uint8_t> image) {
         }
         if (word + 1 >= words) {
             info.problems.push_back(
-                format("category %u at word 0x%04zX: the image ends inside its header", type, word));
+                strprintf("category %u at word 0x%04zX: the image ends inside its header", type, word));
             break;
         }
         SiiCategory c;
@@ -218,8 +207,8 @@ SiiInfo parse_sii(std::span<const uint8_t> image) {
             c.truncated = true;
             bytes = image.size() > start ? image.size() - start : 0;
             info.problems.push_back(
-                format("category %u at word 0x%04zX: %u words declared, the image ends after %zu", type, word,
-                       c.word_length, bytes / 2));
+                strprintf("category %u at word 0x%04zX: %u words declared, the image ends after %zu", type,
+                          word, c.word_length, bytes / 2));
         }
         info.categories.push_back(c);
         const auto body = image.subspan(std::min(start, image.size()), bytes);
@@ -257,7 +246,7 @@ SiiInfo parse_sii(std::span<const uint8_t> image) {
     auto check = [&](uint8_t idx, const char* what) {
         if (idx > info.strings.size())
             info.problems.push_back(
-                format("%s refers to string %u, the table has %zu", what, idx, info.strings.size()));
+                strprintf("%s refers to string %u, the table has %zu", what, idx, info.strings.size()));
         return info.string_at(idx);
     };
     if (info.general) {
@@ -292,7 +281,7 @@ std::string printable(const std::string& in) {
     for (char ch : in) {
         const auto c = static_cast<unsigned char>(ch);
         if (c < 0x20 || c == 0x7F || c == '"' || c == '\\')
-            out += format("\\x%02X", c);
+            out += strprintf("\\x%02X", c);
         else
             out += ch;
     }
@@ -375,31 +364,32 @@ std::string bit_names(uint16_t bits, std::initializer_list<std::pair<uint16_t, c
 
 void hexdump(std::string& out, std::span<const uint8_t> bytes, std::size_t base) {
     for (std::size_t i = 0; i < bytes.size(); i += 16) {
-        out += format("    %04zX:", base + i);
+        out += strprintf("    %04zX:", base + i);
         for (std::size_t j = i; j < std::min(i + 16, bytes.size()); ++j)
-            out += format(" %02X", bytes[j]);
+            out += strprintf(" %02X", bytes[j]);
         out += '\n';
     }
 }
 
 void decode_pdos(std::string& out, const std::vector<SiiPdo>& pdos) {
     for (const auto& p : pdos) {
-        out += format("    PDO 0x%04X \"%s\" entries %zu, SM %s, flags 0x%04X (%s)\n", p.index,
-                      printable(p.name).c_str(), p.entries.size(),
-                      p.sm == 0xFF ? "none" : std::to_string(p.sm).c_str(), p.flags,
-                      bit_names(p.flags, {{pdo_flags::Mandatory, "mandatory"},
-                                          {pdo_flags::Default, "default"},
-                                          {pdo_flags::FixedContent, "fixed"},
-                                          {pdo_flags::VirtualContent, "virtual"},
-                                          {pdo_flags::OverwrittenByModule, "overwritten-by-module"}})
-                          .c_str());
+        out += strprintf("    PDO 0x%04X \"%s\" entries %zu, SM %s, flags 0x%04X (%s)\n", p.index,
+                         printable(p.name).c_str(), p.entries.size(),
+                         p.sm == 0xFF ? "none" : std::to_string(p.sm).c_str(), p.flags,
+                         bit_names(p.flags, {{pdo_flags::Mandatory, "mandatory"},
+                                             {pdo_flags::Default, "default"},
+                                             {pdo_flags::FixedContent, "fixed"},
+                                             {pdo_flags::VirtualContent, "virtual"},
+                                             {pdo_flags::OverwrittenByModule, "overwritten-by-module"}})
+                             .c_str());
         for (const auto& e : p.entries) {
             const char* tn = detail::base_type_name(e.data_type);
             if (e.index == 0)
-                out += format("      gap %u bits\n", e.bit_length);
+                out += strprintf("      gap %u bits\n", e.bit_length);
             else
-                out += format("      0x%04X:%02X %2u bits %-6s \"%s\"\n", e.index, e.subindex, e.bit_length,
-                              tn ? tn : format("0x%02X", e.data_type).c_str(), printable(e.name).c_str());
+                out +=
+                    strprintf("      0x%04X:%02X %2u bits %-6s \"%s\"\n", e.index, e.subindex, e.bit_length,
+                              tn ? tn : strprintf("0x%02X", e.data_type).c_str(), printable(e.name).c_str());
         }
     }
 }
@@ -409,50 +399,51 @@ void decode_pdos(std::string& out, const std::vector<SiiPdo>& pdos) {
 std::string decode_sii(std::span<const uint8_t> image) {
     const SiiInfo info = parse_sii(image);
     std::string out;
-    out += format("SII image: %zu bytes\n", image.size());
-    out += format("  PDI control 0x%02X, ESC configuration 0x%02X, PDI configuration 0x%04X\n",
-                  info.pdi_control, info.esc_config, info.pdi_config);
-    out += format("  SYNC pulse length %u (x10 ns), extended PDI configuration 0x%04X, station alias %u\n",
-                  info.sync_pulse_length, info.extended_pdi_config, info.station_alias);
-    out += format("  checksum 0x%04X: %s\n", info.checksum_word,
+    out += strprintf("SII image: %zu bytes\n", image.size());
+    out += strprintf("  PDI control 0x%02X, ESC configuration 0x%02X, PDI configuration 0x%04X\n",
+                     info.pdi_control, info.esc_config, info.pdi_config);
+    out += strprintf("  SYNC pulse length %u (x10 ns), extended PDI configuration 0x%04X, station alias %u\n",
+                     info.sync_pulse_length, info.extended_pdi_config, info.station_alias);
+    out +=
+        strprintf("  checksum 0x%04X: %s\n", info.checksum_word,
                   info.crc_disabled ? "check disabled (0x88A4)"
                   : info.crc_ok     ? "ok"
-                                : format("BAD (CRC-8 of words 0-6 is 0x%02X)", info.crc_computed).c_str());
-    out += format("  vendor 0x%08X, product 0x%08X, revision 0x%08X, serial 0x%08X\n", info.vendor_id,
-                  info.product_code, info.revision, info.serial_number);
-    out += format("  bootstrap mailbox: out 0x%04X/%u, in 0x%04X/%u\n", info.bootstrap_mailbox.out_start,
-                  info.bootstrap_mailbox.out_size, info.bootstrap_mailbox.in_start,
-                  info.bootstrap_mailbox.in_size);
-    out +=
-        format("  standard mailbox:  out 0x%04X/%u, in 0x%04X/%u\n", info.standard_mailbox.out_start,
-               info.standard_mailbox.out_size, info.standard_mailbox.in_start, info.standard_mailbox.in_size);
-    out += format("  mailbox protocols 0x%04X (%s)\n", info.mailbox_protocols,
-                  bit_names(info.mailbox_protocols, {{mailbox_protocol::AoE, "AoE"},
-                                                     {mailbox_protocol::EoE, "EoE"},
-                                                     {mailbox_protocol::CoE, "CoE"},
-                                                     {mailbox_protocol::FoE, "FoE"},
-                                                     {mailbox_protocol::SoE, "SoE"},
-                                                     {mailbox_protocol::VoE, "VoE"}})
-                      .c_str());
-    out += format("  EEPROM size word 0x%04X (%zu bytes), version %u\n", info.eeprom_size_word,
-                  info.eeprom_bytes(), info.version);
+                                : strprintf("BAD (CRC-8 of words 0-6 is 0x%02X)", info.crc_computed).c_str());
+    out += strprintf("  vendor 0x%08X, product 0x%08X, revision 0x%08X, serial 0x%08X\n", info.vendor_id,
+                     info.product_code, info.revision, info.serial_number);
+    out += strprintf("  bootstrap mailbox: out 0x%04X/%u, in 0x%04X/%u\n", info.bootstrap_mailbox.out_start,
+                     info.bootstrap_mailbox.out_size, info.bootstrap_mailbox.in_start,
+                     info.bootstrap_mailbox.in_size);
+    out += strprintf("  standard mailbox:  out 0x%04X/%u, in 0x%04X/%u\n", info.standard_mailbox.out_start,
+                     info.standard_mailbox.out_size, info.standard_mailbox.in_start,
+                     info.standard_mailbox.in_size);
+    out += strprintf("  mailbox protocols 0x%04X (%s)\n", info.mailbox_protocols,
+                     bit_names(info.mailbox_protocols, {{mailbox_protocol::AoE, "AoE"},
+                                                        {mailbox_protocol::EoE, "EoE"},
+                                                        {mailbox_protocol::CoE, "CoE"},
+                                                        {mailbox_protocol::FoE, "FoE"},
+                                                        {mailbox_protocol::SoE, "SoE"},
+                                                        {mailbox_protocol::VoE, "VoE"}})
+                         .c_str());
+    out += strprintf("  EEPROM size word 0x%04X (%zu bytes), version %u\n", info.eeprom_size_word,
+                     info.eeprom_bytes(), info.version);
 
     for (const SiiCategory& c : info.categories) {
-        out += format("category %u %s at word 0x%04zX, %u words%s\n", c.type, category_name(c.type),
-                      c.word_offset, c.word_length, c.truncated ? " (TRUNCATED)" : "");
+        out += strprintf("category %u %s at word 0x%04zX, %u words%s\n", c.type, category_name(c.type),
+                         c.word_offset, c.word_length, c.truncated ? " (TRUNCATED)" : "");
         switch (c.type) {
             case category::Strings:
                 for (std::size_t i = 0; i < info.strings.size(); ++i)
-                    out += format("    %3zu \"%s\"\n", i + 1, printable(info.strings[i]).c_str());
+                    out += strprintf("    %3zu \"%s\"\n", i + 1, printable(info.strings[i]).c_str());
                 break;
             case category::General:
                 if (info.general) {
                     const auto& g = *info.general;
-                    out += format("    group %u \"%s\", image %u \"%s\", order %u \"%s\", name %u \"%s\"\n",
-                                  g.group_idx, printable(g.group).c_str(), g.image_idx,
-                                  printable(g.image).c_str(), g.order_idx, printable(g.order).c_str(),
-                                  g.name_idx, printable(g.name).c_str());
-                    out += format(
+                    out += strprintf(
+                        "    group %u \"%s\", image %u \"%s\", order %u \"%s\", name %u \"%s\"\n",
+                        g.group_idx, printable(g.group).c_str(), g.image_idx, printable(g.image).c_str(),
+                        g.order_idx, printable(g.order).c_str(), g.name_idx, printable(g.name).c_str());
+                    out += strprintf(
                         "    CoE details 0x%02X (%s), FoE 0x%02X, EoE 0x%02X, SoE channels %u, DS402 "
                         "channels %u\n",
                         g.coe_details,
@@ -464,7 +455,7 @@ std::string decode_sii(std::span<const uint8_t> image) {
                                                   {coe_details::CompleteAccess, "CompleteAccess"}})
                             .c_str(),
                         g.foe_details, g.eoe_details, g.soe_channels, g.ds402_channels);
-                    out += format(
+                    out += strprintf(
                         "    SysmanClass %u, flags 0x%02X, EBus current %d mA, ports 0x%04X, "
                         "identification address 0x%04X\n",
                         g.sysman_class, g.flags, g.ebus_current_ma, g.physical_ports,
@@ -473,14 +464,14 @@ std::string decode_sii(std::span<const uint8_t> image) {
                 break;
             case category::Fmmu:
                 for (std::size_t i = 0; i < info.fmmus.size(); ++i)
-                    out += format("    FMMU%zu 0x%02X %s\n", i, info.fmmus[i], fmmu_name(info.fmmus[i]));
+                    out += strprintf("    FMMU%zu 0x%02X %s\n", i, info.fmmus[i], fmmu_name(info.fmmus[i]));
                 break;
             case category::SyncM:
                 for (std::size_t i = 0; i < info.sync_managers.size(); ++i) {
                     const auto& s = info.sync_managers[i];
-                    out +=
-                        format("    SM%zu start 0x%04X length %u control 0x%02X enable 0x%02X type %u %s\n",
-                               i, s.start, s.length, s.control, s.enable, s.type, sm_type_name(s.type));
+                    out += strprintf(
+                        "    SM%zu start 0x%04X length %u control 0x%02X enable 0x%02X type %u %s\n", i,
+                        s.start, s.length, s.control, s.enable, s.type, sm_type_name(s.type));
                 }
                 break;
             case category::TxPdo:
@@ -491,7 +482,7 @@ std::string decode_sii(std::span<const uint8_t> image) {
                 break;
             case category::Dc:
                 for (const auto& m : info.dc_modes)
-                    out += format(
+                    out += strprintf(
                         "    \"%s\" (%s): AssignActivate 0x%04X, SYNC0 cycle %u factor %d shift %d, "
                         "SYNC1 factor %d shift %d\n",
                         printable(m.name).c_str(), printable(m.description).c_str(), m.assign_activate,
