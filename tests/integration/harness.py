@@ -30,6 +30,13 @@ def env_path(name):
     return p
 
 
+def socket_dir():
+    """A short private folder for UNIX sockets (a control socket and its clients): the kernel limits their paths
+    to 107 bytes (sockaddr_un), so they never go under ECAT_TEST_OUT, which is as long as the path of the clone
+    the tests run in. The caller removes it (shutil.rmtree)."""
+    return tempfile.mkdtemp(prefix="ecat-sock-", dir="/tmp")
+
+
 def sii_crc(data14):
     crc = 0xFF
     for b in data14:
@@ -91,6 +98,7 @@ class Bus:
         self.iface = f"em{uid}"        # master end, here
         self.slave_iface = f"es{uid}"  # slave end, in the namespace
         self.dir = tempfile.mkdtemp(prefix=f"ecat-it-{uid}-", dir=out_dir or os.environ.get("ECAT_TEST_OUT"))
+        self.sock_dir = socket_dir()  # for control sockets: self.dir may be too long for one
         self.capture = os.path.join(self.dir, "capture.pcap")
         self.eeprom_path = None
         if eeprom is not None:
@@ -187,6 +195,7 @@ class Bus:
 
     def cleanup_files(self):
         shutil.rmtree(self.dir, ignore_errors=True)
+        shutil.rmtree(self.sock_dir, ignore_errors=True)
 
     def slave_alive(self):
         return self.proc is not None and self.proc.poll() is None

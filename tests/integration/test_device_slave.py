@@ -156,7 +156,7 @@ class OfflineOutputs(unittest.TestCase):
 
 class RunTime(unittest.TestCase):
     def test_control_socket_toggles_a_digital_input(self):
-        d = tempfile.mkdtemp(dir=out_dir())
+        d = harness.socket_dir()
         self.addCleanup(shutil.rmtree, d, True)
         path = os.path.join(d, "ctl.sock")
         me = os.path.join(d, "me.sock")

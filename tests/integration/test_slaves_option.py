@@ -16,7 +16,7 @@ ROW = re.compile(r"^(\d+)\s+0x([0-9a-f]{4})\s+(\S+)\s+0x([0-9a-f]{8}) 0x([0-9a-f
 
 class SlavesOption(unittest.TestCase):
     def control(self, bus, path, line):
-        me = os.path.join(bus.dir, f"me{os.getpid()}.sock")
+        me = os.path.join(bus.sock_dir, f"me{os.getpid()}.sock")
         s = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
         self.addCleanup(s.close)
         if os.path.exists(me):
@@ -58,7 +58,7 @@ class SlavesOption(unittest.TestCase):
 
     def test_faults_through_the_control_socket_are_counted(self):
         bus = harness.Bus()  # its folder exists from here on; the slave starts with `with`
-        ctl = os.path.join(bus.dir, "ctl.sock")
+        ctl = os.path.join(bus.sock_dir, "ctl.sock")
         stats = os.path.join(bus.dir, "stats.txt")
         bus.slave_args = ["--slaves", "3", "--control", ctl, "--stats-file", stats]
         with bus:
