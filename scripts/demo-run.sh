@@ -22,7 +22,8 @@ trap 'exit 130' INT TERM
 
 # The slave keeps its stored parameters and firmware images in a state directory (default /var/lib/softecat);
 # the demo uses a throw-away one.
-"$slave" --state-dir "$work/state" --control "$work/control.sock" --capture /tmp/ecat-demo.pcap >"$log" 2>&1 &
+capture="${ECAT_DEMO_CAPTURE:-/tmp/ecat-demo.pcap}"
+"$slave" --state-dir "$work/state" --control "$work/control.sock" --capture "$capture" >"$log" 2>&1 &
 pid=$!
 for _ in $(seq 50); do ip link show ecat1 >/dev/null 2>&1 && break; sleep 0.1; done
 sleep 0.3
@@ -71,4 +72,4 @@ kill "$pid" 2>/dev/null || true
 wait "$pid" 2>/dev/null || true
 pid=""
 echo; echo "== slave log"; cat "$log"
-echo "== frames captured in /tmp/ecat-demo.pcap (open it in Wireshark)"
+echo "== frames captured in $capture (open it in Wireshark)"

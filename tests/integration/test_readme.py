@@ -327,6 +327,25 @@ class Readme(unittest.TestCase):
     def test_readme(self):
         self.run_readme(READMES[0])
 
+    def test_demo(self):
+        """README command (1) past its build (scripts/demo.sh builds ecat-slave and ecatctl, then runs this): in a
+        network namespace of its own, with the build of this test run."""
+        build = os.environ.get("SOFTECAT_BUILD_DIR")
+        if not build:
+            self.skipTest("SOFTECAT_BUILD_DIR not set")
+        ns = f"rdme{os.getpid() % 100000}demo"
+        subprocess.run(["ip", "netns", "add", ns], check=True)
+        self.addCleanup(subprocess.run, ["ip", "netns", "del", ns])
+        capture = os.path.join(self.dir, "demo.pcap")
+        r = subprocess.run(["ip", "netns", "exec", ns, "bash", os.path.join(ROOT, "scripts", "demo-run.sh"), build],
+                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=240,
+                           env=dict(os.environ, ECAT_DEMO_CAPTURE=capture))
+        self.assertEqual(r.returncode, 0, r.stdout[-3000:])
+        self.assertRegex(r.stdout, r"(?m)^1 slave$")
+        self.assertRegex(r.stdout, r"(?m)^ok state ", "the control socket answered the demo's 'status'")
+        self.assertIn(f"frames captured in {capture}", r.stdout)
+        self.assertGreater(os.path.getsize(capture), 24, "frames were captured")
+
     def test_ecatctl_readme(self):
         self.run_readme(READMES[1])
 
