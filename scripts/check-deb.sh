@@ -26,7 +26,7 @@ for d in libc6 libpcap0.8 libxml2 zlib1g iproute2 util-linux; do
 done
 
 export DEBIAN_FRONTEND=noninteractive
-apt-get install -y -qq "$deb" >/dev/null
+apt-get install -y -qq --no-install-recommends "$deb" >/dev/null  # recommends (bash-completion) would change the machine
 trap 'apt-get remove -y -qq softecat >/dev/null 2>&1 || true' EXIT
 for p in "${programs[@]}"; do
     [ "$(command -v "$p")" = "/usr/bin/$p" ] || fail "$p is not on PATH after apt install"
