@@ -112,7 +112,9 @@ void Runtime::set_firmware(Firmware* firmware) {
         (void)::epoll_ctl(epoll_fd_, EPOLL_CTL_DEL, control_fd_, nullptr);
         control_fd_ = -1;
     }
+    if (firmware_ != nullptr) firmware_->set_frame_service(nullptr);
     firmware_ = firmware;
+    if (firmware_ != nullptr) firmware_->set_frame_service(this);
     deadline_ns_ = compute_deadline_ns(clock_.now_ns());
     const int fd = firmware != nullptr ? firmware->control_fd() : -1;
     if (fd < 0) return;
@@ -303,6 +305,16 @@ bool Runtime::spin_to_deadline(uint64_t window_ns) {
     return true;
 }
 
+// Frames that arrived while the runtime was busy (about to tick the ESCs and run the firmware, or between
+// two devices' firmware): answered before that work, as a hardware ESC answers whatever its
+// microcontroller does. Frames coming back on the out link first: they are older.
+int Runtime::serve_frames() {
+    int n = out_ != nullptr ? handle_out_frames() : 0;
+    n += handle_frames();
+    stats_.frames_before_work += static_cast<uint64_t>(n);
+    return n;
+}
+
 // Each frame from the master is walked through the segment.
 int Runtime::handle_frames() {
     int i = 0;
@@ -436,6 +448,9 @@ void Runtime::poll_carrier(uint64_t now) {
 }
 
 void Runtime::service() {
+    // Frames first: one that came while the last work ran (a burst, the control socket, a spin) is answered
+    // before the timers and the firmware run (a look at the receive ring when none waits).
+    serve_frames();
     // One clock read for the segment: its ESCs count the runtime's clock (each with its own drift).
     const uint64_t now = clock_.now_ns();
     const int count = static_cast<int>(segment_.size());

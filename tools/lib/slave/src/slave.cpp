@@ -60,6 +60,7 @@ void write_stats(std::ostream& out, const RuntimeStats& s, const esc::EscStats& 
         << "runtime.loop_gaps_over_50us " << s.loop_gaps_over_50us << '\n'
         << "runtime.loop_gaps_over_1ms " << s.loop_gaps_over_1ms << '\n'
         << "runtime.loop_gap_max_ns " << s.loop_gap_max_ns << '\n'
+        << "runtime.frames_before_work " << s.frames_before_work << '\n'
         << "esc.frames_processed " << e.frames_processed << '\n'
         << "esc.frames_malformed " << e.frames_malformed << '\n'
         << "esc.frames_ignored " << e.frames_ignored << '\n'

@@ -76,6 +76,9 @@ struct RuntimeStats {
     uint64_t out_send_errors = 0;  // not used by the Runtime itself: the external send callback counts here
     uint64_t carrier_changes = 0;  // carrier of the out link gained or lost
     uint64_t reply_batches = 0;    // coalesced replies sent together (a batch of one counts too)
+    // Frames found waiting when other work was about to start or between devices' firmware (they are
+    // answered first): they arrived while the runtime was busy, not asleep.
+    uint64_t frames_before_work = 0;
 };
 
 // Optional record of each frame's processing time (receive to reply ready, clock ns), for benchmarks: a
@@ -87,7 +90,7 @@ struct FrameTimeLog {
     std::atomic<bool> on{false};
 };
 
-class Runtime {
+class Runtime final : private FrameService {
   public:
     static constexpr int kMaxBurst = 64;
     // Longest time a captured frame stays in the capture's buffer before it is written to the file.
@@ -144,7 +147,8 @@ class Runtime {
 
   private:
     Runtime(esc::Link& link, std::unique_ptr<esc::Segment> own, esc::Esc& esc, const esc::Clock& clock);
-    int handle_frames();  // returns the number of frames received
+    int handle_frames();          // returns the number of frames received
+    int serve_frames() override;  // FrameService: frames that came while other work ran
     int handle_out_frames();
     void segment_result(const esc::Segment::Result& result, std::span<uint8_t> frame, uint64_t now);
     void release_held(uint64_t now);
