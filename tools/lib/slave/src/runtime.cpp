@@ -448,9 +448,6 @@ void Runtime::poll_carrier(uint64_t now) {
 }
 
 void Runtime::service() {
-    // Frames first: one that came while the last work ran (a burst, the control socket, a spin) is answered
-    // before the timers and the firmware run (a look at the receive ring when none waits).
-    serve_frames();
     // One clock read for the segment: its ESCs count the runtime's clock (each with its own drift).
     const uint64_t now = clock_.now_ns();
     const int count = static_cast<int>(segment_.size());
@@ -462,6 +459,12 @@ void Runtime::service() {
         else
             e.tick();
     }
+    // Frames before the firmware: one that came while the last work ran (a burst, the control socket, a
+    // spin) is answered before the firmware runs (a look at the receive ring when none waits). After the
+    // ESCs' own timers, which are silicon and run at their time: a SYNC0 pulse due before the frame arrived
+    // comes before it, as on hardware (answering the frame first put a cycle's LRW before the SYNC0 that
+    // precedes it, and a chain of two processes counted SM events missed, integration_segment_chain).
+    serve_frames();
     if (hold_count_ != 0) release_held(now);
     if (carrier_check_) poll_carrier(now);
     if (firmware_ != nullptr) firmware_->poll(now);
