@@ -209,16 +209,22 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink) : dict_(dictionary), a
                                            obj::MotorType.index};
     for (uint16_t index : power_disable_only) {
         if (!dict_.find(index)) continue;
-        dict_.add_validator(index, [flag = powered_](const od::Entry& e, std::span<const uint8_t>) {
-            if (e.index == obj::MotorData && e.subindex != obj::MotorPolePairs.sub)
-                return od::Status::Ok;  // only the pole pairs
-            return flag->load(std::memory_order_relaxed) ? od::Status::WrongState : od::Status::Ok;
-        });
+        // Owned by this drive (removed by its destructor): a dictionary that outlives its drive, or serves
+        // one drive after another, keeps no validator of a drive that is gone.
+        dict_.add_validator(
+            index,
+            [flag = powered_](const od::Entry& e, std::span<const uint8_t>) {
+                if (e.index == obj::MotorData && e.subindex != obj::MotorPolePairs.sub)
+                    return od::Status::Ok;  // only the pole pairs
+                return flag->load(std::memory_order_relaxed) ? od::Status::WrongState : od::Status::Ok;
+            },
+            this);
     }
 }
 
 Drive::~Drive() {
     powered_->store(false);
+    dict_.remove_hooks(this);
 }
 
 od::Status commission(od::Dictionary& d, const MotorModel& m) {

@@ -477,6 +477,10 @@ bool Esc::port_open(int port) const {
     return impl_->ports.port_open(port);
 }
 
+uint8_t Esc::port_descriptor() const {
+    return impl_->cfg.port_descriptor;
+}
+
 void Esc::read(uint16_t address, std::span<uint8_t> out) {
     // An empty span is no access: nothing read, the PDI watchdog not triggered, and no memset/memcpy on
     // the null pointer an empty span may carry.

@@ -3,6 +3,8 @@
 // segmented, complete access), SDO information, anything else. Input: one byte for the reply mailbox size,
 // then a sequence of [control byte][16-bit length][payload]; the control byte picks the AL state (and so a
 // state change), whether the reply queue is full, and how far the clock moves before poll().
+// Per input: the dictionary (built once) is put back into its built state (fuzz_support.hpp), the server is
+// built afresh.
 #include <functional>
 
 #include "coe/diagnosis.hpp"
@@ -19,12 +21,14 @@ namespace {
 constexpr od::AlState kStates[4] = {od::AlState::PreOp, od::AlState::SafeOp, od::AlState::Op,
                                     od::AlState::Init};
 
-od::Dictionary make_dictionary() {
+// The drive's dictionary, built once and put back into its built state for each input.
+od::Dictionary& fresh_dictionary() {
     static const od::DeviceDescription desc = od::default_drive_description();
-    od::Dictionary d = od::make_drive_dictionary(desc);
-    (void)drive::commission(d);
-    coe::install_pdo_validators(d);
-    return d;
+    static PristineDictionary pristine(od::make_drive_dictionary(desc), [](od::Dictionary& d) {
+        (void)drive::commission(d);
+        coe::install_pdo_validators(d);
+    });
+    return pristine.fresh();
 }
 
 }  // namespace
@@ -33,7 +37,7 @@ int fuzz_one(const uint8_t* data, std::size_t size) {
     Input in(data, size);
     // Mailbox sizes a configuration can give: 10 .. 1024 payload bytes.
     const std::size_t max_payload = 10 + (in.u8() * 4u) % 1015u;
-    od::Dictionary dict = make_dictionary();
+    od::Dictionary& dict = fresh_dictionary();
     od::AlState state = od::AlState::PreOp;
     coe::CoeServer server(dict, [&state] { return state; });
     coe::DiagnosisHistory diag(dict, &server.emergency());

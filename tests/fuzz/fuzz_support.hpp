@@ -9,8 +9,11 @@
 #include <cstdlib>
 #include <cstring>
 #include <span>
+#include <utility>
+#include <vector>
 
 #include "ecat/mailbox_handler.hpp"
+#include "od/dictionary.hpp"
 
 namespace fuzz {
 
@@ -52,6 +55,64 @@ class Input {
     do {                                                           \
         if (!(cond)) ::fuzz::finding("fuzz check failed: " #cond); \
     } while (0)
+
+// A dictionary built once per process and put back into its built state before each input. Building the
+// drive's dictionary (some 400 entries with names, limits and validators) was most of what an input cost;
+// putting its values back costs a comparison per entry (and a copy for the few an input changed). Values
+// are all of a dictionary's state besides its objects (fixed once built) and its hooks: the hooks of the
+// build (value sets, PDO validators) belong to the dictionary and stay; every object a harness builds per
+// input installs its hooks with itself as owner and removes them when it is destroyed (od::Dictionary's
+// owner rule), so nothing of an input is left for the next one. Scalars are put back through their storage
+// (Dictionary::mutable_raw, fixed once built), strings (their length changes) through set_raw(); no
+// listener is left to notify, as no object of the last input is alive.
+class PristineDictionary {
+  public:
+    // `finish` completes the build in place (hooks that keep the dictionary's address, such as the PDO
+    // validators, are installed there, after the move).
+    template <typename Finish>
+    PristineDictionary(od::Dictionary built, Finish finish) : dict_(std::move(built)) {
+        finish(dict_);
+        for (const od::Object& o : dict_.objects())
+            for (const od::Entry& e : o.entries) {
+                const std::span<const uint8_t> v = dict_.raw(o.index, e.subindex);
+                const std::span<uint8_t> storage = dict_.mutable_raw(o.index, e.subindex);
+                if (storage.empty())
+                    strings_.push_back({o.index, e.subindex, bytes_.size(), v.size()});
+                else
+                    scalars_.push_back({storage, bytes_.size()});
+                bytes_.insert(bytes_.end(), v.begin(), v.end());
+            }
+    }
+    // The dictionary with every value as built. Call with no object of the last input left alive.
+    od::Dictionary& fresh() {
+        for (const Scalar& s : scalars_)
+            if (std::memcmp(s.storage.data(), bytes_.data() + s.at, s.storage.size()) != 0)
+                std::memcpy(s.storage.data(), bytes_.data() + s.at, s.storage.size());
+        for (const String& s : strings_) {
+            const std::span<const uint8_t> want(bytes_.data() + s.at, s.size);
+            const std::span<const uint8_t> now = dict_.raw(s.index, s.sub);
+            if (now.size() == want.size() && std::equal(now.begin(), now.end(), want.begin())) continue;
+            FUZZ_CHECK(dict_.set_raw(s.index, s.sub, want) == od::Status::Ok);
+        }
+        return dict_;
+    }
+
+  private:
+    struct Scalar {
+        std::span<uint8_t> storage;
+        std::size_t at;
+    };
+    struct String {
+        uint16_t index;
+        uint8_t sub;
+        std::size_t at;
+        std::size_t size;
+    };
+    od::Dictionary dict_;
+    std::vector<Scalar> scalars_;
+    std::vector<String> strings_;
+    std::vector<uint8_t> bytes_;
+};
 
 // The reply side of a mailbox: checks what a protocol server sends against the contract and keeps it.
 class CheckingSender final : public ecat::MailboxSender {

@@ -5,6 +5,8 @@
 // sequence of frames, each [time byte][16-bit length][frame]; the time byte moves the clock (10 us steps)
 // before the frame goes through the ESC, then the ESC's timers and the firmware run, as the runtime does.
 // Checked: nothing crashes (ASan, UBSan) and the stack's AL state is always one of the five.
+// Per input: the dictionary (built once) is put back into its built state (fuzz_support.hpp); the ESC, the
+// stack, the servers and the drive are built afresh.
 #include <algorithm>
 #include <memory>
 #include <vector>
@@ -29,20 +31,24 @@
 namespace fuzz::slave {
 namespace {
 
+// What every input starts from, built once: the description, the dictionary (put back into its built state
+// for each input, fuzz_support.hpp), the SII rendered from it and a firmware image.
 struct Prototype {
     od::DeviceDescription desc = od::default_drive_description();
+    PristineDictionary dict{od::make_drive_dictionary(desc), [](od::Dictionary& d) {
+                                (void)drive::commission(d);
+                                coe::install_pdo_validators(d);
+                            }};
     std::vector<uint8_t> sii;
     std::vector<uint8_t> image;
     Prototype() {
-        od::Dictionary dict = od::make_drive_dictionary(desc);
-        (void)drive::commission(dict);
-        sii = esi::build_sii(desc, dict);
+        sii = esi::build_sii(desc, dict.fresh());
         std::vector<uint8_t> payload(200, 0x5A);
         image = foe::build_image(payload, foe::ImageIdentity::from(desc.identity), desc.identity.revision);
     }
 };
-const Prototype& prototype() {
-    static const Prototype p;
+Prototype& prototype() {
+    static Prototype p;
     return p;
 }
 
@@ -80,13 +86,11 @@ class DriveApp final : public ecat::Application, public drive::EventSink {
 }  // namespace
 
 int fuzz_one(const uint8_t* data, std::size_t size) {
-    const Prototype& proto = prototype();
+    Prototype& proto = prototype();
     esc::ManualClock clock;
     clock.set(1'000'000'000);
     esc::Esc esc(esc::EscConfig{}, clock);
-    od::Dictionary dict = od::make_drive_dictionary(proto.desc);
-    (void)drive::commission(dict);
-    coe::install_pdo_validators(dict);
+    od::Dictionary& dict = proto.dict.fresh();
     DriveApp app;
     ecat::Stack stack(esc, dict, proto.desc, app, [&esc] { return esc.irq(); });
     coe::CoeServer coe(dict, [&stack] { return stack.state(); });

@@ -96,6 +96,39 @@ TEST_F(Runtime, ABurstOfFramesIsAnsweredInOrderThenTheFirmwareRunsOnce) {
     }
 }
 
+// A frame that arrives while the firmware works (here: between the two devices of a pass, and while the
+// control socket is served) is answered before the work that follows, not after the whole pass.
+TEST_F(Runtime, AFrameArrivingDuringTheFirmwaresWorkIsAnsweredBeforeTheNextPartOfIt) {
+    struct TwoDevices : slave::Firmware {
+        explicit TwoDevices(esc::LoopbackLink& m) : master(m) {}
+        void poll(uint64_t) override {
+            ++polls;
+            if (polls != 2) return;
+            const std::size_t waiting = master.pending();  // the reply to the frame before this poll
+            ASSERT_TRUE(master.send(brd_type_frame()));    // comes in while device 0 works
+            served = serve_frames();
+            replies_before_device_1 = master.pending() - waiting;
+        }
+        esc::LoopbackLink& master;
+        int polls = 0;
+        int served = -1;
+        std::size_t replies_before_device_1 = 0;
+    } fw(master());
+    runtime.set_firmware(&fw);
+    ASSERT_TRUE(master().send(brd_type_frame()));
+    ASSERT_TRUE(runtime.run_once(1000));  // poll 1 after the first frame
+    std::array<uint8_t, esc::kMaxFrameSize> buf{};
+    ASSERT_EQ(master().receive(buf), 60u);
+    ASSERT_TRUE(master().send(brd_type_frame()));
+    ASSERT_TRUE(runtime.run_once(1000));  // poll 2: a frame comes in between its two devices
+    EXPECT_EQ(fw.served, 1);
+    EXPECT_EQ(fw.replies_before_device_1, 1u) << "answered between the devices, not after the pass";
+    EXPECT_EQ(runtime.stats().frames_before_work, 1u);
+    EXPECT_EQ(runtime.stats().frames_received, 3u);
+    EXPECT_EQ(runtime.stats().frames_sent, 3u);
+    runtime.set_firmware(nullptr);
+}
+
 TEST_F(Runtime, RuntFramesComeBackAtTheirLength) {
     const auto f = brd_type_frame(29);
     ASSERT_TRUE(master().send(f));

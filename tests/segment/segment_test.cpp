@@ -123,6 +123,22 @@ struct SegmentTest : ::testing::Test, Rig {};
 
 // ---- lines ----------------------------------------------------------------------------------------
 
+// Wiring is no PDI access: an ESC added to (or swapped into) a segment has nothing pending, as when it
+// stands alone (a PDI read would arm its PDI watchdog and wake the runtime when it expires). One ESC
+// alone on its wire runs as a segment of one (slave::Runtime), so this keeps the two the same.
+TEST(SegmentWiring, AddingAnEscIsNoPdiAccess) {
+    Rig rig;
+    const int a = rig.add();
+    const int b = rig.add();
+    rig.seg->connect(a, 1, b, 0);
+    for (const auto& e : rig.escs)
+        EXPECT_EQ(e->next_event_ns(), UINT64_MAX) << "no watchdog armed by the wiring";
+    esc::Esc fresh(esc::EscConfig{}, rig.clock);
+    rig.seg->replace(b, fresh);
+    EXPECT_EQ(fresh.next_event_ns(), UINT64_MAX);
+    rig.seg->replace(b, *rig.escs[1]);
+}
+
 TEST_F(SegmentTest, LineOfThreeCountedByBrd) {
     line(3);
     EXPECT_EQ(brd_count(), 3);

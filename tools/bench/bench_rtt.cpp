@@ -4,7 +4,8 @@
 // measured in the same run, interleaved frame by frame so both see the same machine load.
 // Everything lives in a private network namespace created at start (unshare), which the kernel removes with
 // the two veth pairs when this program and its children exit, however they exit. Needs root.
-// Prints median / p99 for both and their ratio; asserts nothing.
+// Prints median / p99 / p99.9 / max for both, their ratio and the tail (replies later than 500 us and
+// 1 ms); asserts nothing.
 #include <poll.h>
 
 #include <cstdio>
@@ -107,6 +108,8 @@ int run_same_pair(std::size_t frames, const std::string& backend, const std::str
         backend.c_str(), frames, frame.size(), kBlocks, wkc_lrw);
     bench::print("(a) bare echo", se, "us", 1000.0);
     bench::print("(b) ecat-slave", ss, "us", 1000.0);
+    bench::print_tail("tail (a) bare echo", se);
+    bench::print_tail("tail (b) ecat-slave", ss);
     std::printf("lost: echo %zu, slave %zu\n", lost_echo, lost_slave);
     if (se.median > 0 && se.p99 > 0)
         std::printf("ratio slave/echo: median %.3f  p99 %.3f  (target < 1.2)\n", ss.median / se.median,
@@ -243,6 +246,8 @@ int main(int argc, char** argv) {
             backend.c_str(), frames, frame.size(), wkc_lrw);
         bench::print("(a) bare echo", se, "us", 1000.0);
         bench::print("(b) ecat-slave", ss, "us", 1000.0);
+        bench::print_tail("tail (a) bare echo", se);
+        bench::print_tail("tail (b) ecat-slave", ss);
         std::printf("lost: echo %zu, slave %zu\n", lost_echo, lost_slave);
         if (se.median > 0 && se.p99 > 0)
             std::printf("ratio slave/echo: median %.3f  p99 %.3f  (target < 1.2)\n", ss.median / se.median,

@@ -158,7 +158,8 @@ struct Figures {
     bench::Summary walk, latency, rtt, echo, echo_thread;
     double cpu_percent = 0, cpu_us_per_cycle = 0, allocs_per_cycle = 0;
     double wakeups_per_cycle = 0, timer_arms_per_cycle = 0, frames_per_wakeup = 0, replies_per_batch = 0;
-    double spin_us_per_cycle = 0;  // awake waiting for a deadline microseconds away (kChainNs)
+    uint64_t frames_before_work = 0;  // frames found waiting before the timers/firmware or between devices
+    double spin_us_per_cycle = 0;     // awake waiting for a deadline microseconds away (kChainNs)
     uint64_t cycles = 0, missed = 0, lost = 0, wkc_errors = 0, enabled = 0;
     std::size_t frames_per_cycle = 0;
 };
@@ -362,6 +363,7 @@ Figures run_segment(std::size_t drives, double seconds, const std::string& backe
                           static_cast<double>(std::max<uint64_t>(1, rs1.wakeups - rs0.wakeups));
     f.replies_per_batch = static_cast<double>(rs1.frames_sent - rs0.frames_sent) /
                           static_cast<double>(std::max<uint64_t>(1, rs1.reply_batches - rs0.reply_batches));
+    f.frames_before_work = rs1.frames_before_work - rs0.frames_before_work;
     f.rtt = bench::summarize(rtt);
     f.echo = bench::summarize(echo_rtt);
     f.latency = bench::summarize(timed.samples());
@@ -455,6 +457,8 @@ int main(int argc, char** argv) {
         bench::print("  round trip, cyclic", f.rtt, "us", 1000.0);
         bench::print("  round trip, bare echo", f.echo, "us", 1000.0);
         bench::print("  round trip, echo thread", f.echo_thread, "us", 1000.0);
+        bench::print_tail("  tail: latency in slave", f.latency);
+        bench::print_tail("  tail: round trip, cyclic", f.rtt);
         std::printf(
             "  ratio cyclic/echo: median %.3f  p99 %.3f   (against the echo thread run after it: %.3f / "
             "%.3f)\n",
@@ -468,6 +472,8 @@ int main(int argc, char** argv) {
             "replies per batch %.2f, awake waiting for deadlines %.1f us per cycle\n",
             f.wakeups_per_cycle, f.timer_arms_per_cycle, f.frames_per_wakeup, f.replies_per_batch,
             f.spin_us_per_cycle);
+        std::printf("  frames answered before the firmware's work or between devices: %llu\n",
+                    static_cast<unsigned long long>(f.frames_before_work));
         std::printf("  missed cycles %llu, lost frames %llu, wkc errors %llu, allocations per cycle %.3f\n",
                     static_cast<unsigned long long>(f.missed), static_cast<unsigned long long>(f.lost),
                     static_cast<unsigned long long>(f.wkc_errors), f.allocs_per_cycle);

@@ -16,7 +16,6 @@ namespace esc {
 
 namespace {
 
-constexpr uint16_t kPortDescriptorRegister = 0x0007;  // ESC datasheet: Port Descriptor, 2 bits per port
 constexpr int kPortOrder[kPortCount] = {0, 3, 1, 2};  // the frame processing order of an ESC's ports
 constexpr int order_index(int port) {
     return port == 0 ? 0 : port == 3 ? 1 : port == 1 ? 2 : 3;
@@ -101,12 +100,6 @@ struct Segment::Impl {
     }
     bool is_external(int d, int p) const { return d == ext_dev && p == ext_port; }
     bool reachable(int d) const { return d == 0 || devs[d].parent >= 0; }
-
-    static uint8_t read_descriptor(Esc& esc) {
-        uint8_t v = 0;
-        esc.read(kPortDescriptorRegister, std::span<uint8_t>(&v, 1));
-        return v;
-    }
 
     // Is device b reachable from device a over the cables (pulled or not)?
     bool connected(int a, int b) const {
@@ -261,7 +254,7 @@ Segment::~Segment() = default;
 int Segment::add(Esc& esc) {
     Impl::Device dv;
     dv.esc = &esc;
-    dv.descriptor = Impl::read_descriptor(esc);
+    dv.descriptor = esc.port_descriptor();
     const int index = static_cast<int>(impl_->devs.size());
     if (index == 0) dv.up_port = 0;
     impl_->devs.push_back(dv);
@@ -437,7 +430,7 @@ void Segment::replace(int device, Esc& esc) {
     m.check_device(device, "replace");
     Impl::Device& dv = m.devs[static_cast<std::size_t>(device)];
     dv.esc = &esc;
-    dv.descriptor = Impl::read_descriptor(esc);
+    dv.descriptor = esc.port_descriptor();
     m.apply_links(device);
 }
 

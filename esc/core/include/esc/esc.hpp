@@ -134,6 +134,9 @@ class Esc final : public Pdi {
     bool link(int port) const;
     // A frame sent towards `port` leaves the ESC there (the port exists, has a link and its loop is open).
     bool port_open(int port) const;
+    // The port descriptor (0x0007: 2 bits per port, 00 = not implemented), read without a PDI access (the
+    // wiring of a segment asks it; a PDI read would trigger the PDI watchdog).
+    uint8_t port_descriptor() const;
 
   private:
     struct Impl;

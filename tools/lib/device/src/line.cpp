@@ -148,6 +148,9 @@ void Line::poll(uint64_t now_ns) {
         if (!fresh) now = std::max(now, clock_.now_ns());
         u->device->poll(now);
         fresh = false;
+        // Frames that came during this device's work are answered before the next device's (the runtime's
+        // FrameService): a frame never waits for a pass over the whole line.
+        serve_frames();
     }
 }
 

@@ -34,19 +34,6 @@ void on_stop_signal(int) {
 
 }  // namespace
 
-Runtime::Runtime(esc::Link& link, esc::Segment& segment, const esc::Clock& clock, esc::Link* out)
-    : Runtime(link, segment.esc(0), clock) {
-    esc_ = nullptr;
-    segment_ = &segment;
-    out_ = out;
-    hold_buffer_.resize(kHoldSlots * esc::kMaxFrameSize);
-    hold_slots_.resize(kHoldSlots);
-    reply_buffer_.resize(kMaxBurst * esc::kMaxFrameSize);
-    reply_lengths_.resize(kMaxBurst);
-    deadline_ns_ = compute_deadline_ns(clock_.now_ns());
-    if (out_ != nullptr && out_->fd() >= 0) add_watch(out_->fd(), kTagOut);
-}
-
 void Runtime::add_watch(int fd, uint32_t tag) {
     epoll_event ev{};
     ev.events = EPOLLIN;
@@ -64,8 +51,17 @@ void Runtime::set_carrier_check(std::function<bool()> check, Log* log, std::stri
     deadline_ns_ = 0;  // the first carrier poll is due at once
 }
 
-Runtime::Runtime(esc::Link& link, esc::Esc& esc, const esc::Clock& clock)
-    : link_(link), esc_(&esc), clock_(clock), buffer_(esc::kMaxFrameSize), in_copy_(esc::kMaxFrameSize) {
+Runtime::Runtime(esc::Link& link, esc::Segment& segment, const esc::Clock& clock, esc::Link* out)
+    : link_(link),
+      segment_(segment),
+      out_(out),
+      clock_(clock),
+      buffer_(esc::kMaxFrameSize),
+      in_copy_(esc::kMaxFrameSize),
+      hold_buffer_(kHoldSlots * esc::kMaxFrameSize),
+      hold_slots_(kHoldSlots),
+      reply_buffer_(kMaxBurst * esc::kMaxFrameSize),
+      reply_lengths_(kMaxBurst) {
     timer_fd_ = ::timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC);
     if (timer_fd_ < 0) throw std::runtime_error(std::string("timerfd_create: ") + std::strerror(errno));
     stop_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
@@ -80,18 +76,28 @@ Runtime::Runtime(esc::Link& link, esc::Esc& esc, const esc::Clock& clock)
     const struct {
         int fd;
         uint32_t tag;
-    } watched[] = {{link_.fd(), kTagLink}, {timer_fd_, kTagTimer}, {stop_fd_, kTagStop}};
+    } watched[] = {{link_.fd(), kTagLink},
+                   {timer_fd_, kTagTimer},
+                   {stop_fd_, kTagStop},
+                   {out_ != nullptr ? out_->fd() : -1, kTagOut}};
     for (const auto& w : watched) {
         if (w.fd < 0) continue;
-        epoll_event ev{};
-        ev.events = EPOLLIN;
-        ev.data.u32 = w.tag;
-        if (::epoll_ctl(epoll_fd_, EPOLL_CTL_ADD, w.fd, &ev) != 0) {
-            const int err = errno;
+        try {
+            add_watch(w.fd, w.tag);
+        } catch (...) {
             close_fds();
-            throw std::runtime_error(std::string("epoll_ctl: ") + std::strerror(err));
+            throw;
         }
     }
+}
+
+// One ESC alone on its wire is a segment of one device: the runtime owns that segment.
+Runtime::Runtime(esc::Link& link, esc::Esc& esc, const esc::Clock& clock)
+    : Runtime(link, std::make_unique<esc::Segment>(), esc, clock) {}
+
+Runtime::Runtime(esc::Link& link, std::unique_ptr<esc::Segment> own, esc::Esc& esc, const esc::Clock& clock)
+    : Runtime(link, (own->add(esc), *own), clock) {
+    own_segment_ = std::move(own);
 }
 
 void Runtime::close_fds() {
@@ -106,7 +112,9 @@ void Runtime::set_firmware(Firmware* firmware) {
         (void)::epoll_ctl(epoll_fd_, EPOLL_CTL_DEL, control_fd_, nullptr);
         control_fd_ = -1;
     }
+    if (firmware_ != nullptr) firmware_->set_frame_service(nullptr);
     firmware_ = firmware;
+    if (firmware_ != nullptr) firmware_->set_frame_service(this);
     deadline_ns_ = compute_deadline_ns(clock_.now_ns());
     const int fd = firmware != nullptr ? firmware->control_fd() : -1;
     if (fd < 0) return;
@@ -234,18 +242,14 @@ uint64_t Runtime::next_deadline_ns() const {
 
 uint64_t Runtime::compute_deadline_ns(uint64_t now) const {
     uint64_t deadline = kNever;
-    if (esc_ != nullptr) {
-        deadline = esc_->next_event_ns();
-    } else {
-        const int count = static_cast<int>(segment_->size());
-        for (int k = 0; k < count; ++k) {
-            if (!segment_->powered(k)) continue;
-            const esc::Esc& e = segment_->esc(k);
-            deadline = std::min(deadline, &e.clock() == &clock_ ? e.next_event_ns(now) : e.next_event_ns());
-        }
-        if (hold_count_ != 0) deadline = std::min(deadline, hold_slots_[hold_head_].due_ns);
-        if (carrier_check_) deadline = std::min(deadline, carrier_due_ns_);
+    const int count = static_cast<int>(segment_.size());
+    for (int k = 0; k < count; ++k) {
+        if (!segment_.powered(k)) continue;
+        const esc::Esc& e = segment_.esc(k);
+        deadline = std::min(deadline, &e.clock() == &clock_ ? e.next_event_ns(now) : e.next_event_ns());
     }
+    if (hold_count_ != 0) deadline = std::min(deadline, hold_slots_[hold_head_].due_ns);
+    if (carrier_check_) deadline = std::min(deadline, carrier_due_ns_);
     if (firmware_ != nullptr) deadline = std::min(deadline, firmware_->next_deadline_ns());
     if (capture_ != nullptr && capture_->frames_written() != flushed_frames_)
         deadline = std::min(deadline, capture_flush_due_ns_);
@@ -301,40 +305,18 @@ bool Runtime::spin_to_deadline(uint64_t window_ns) {
     return true;
 }
 
-int Runtime::handle_frames() {
-    if (segment_ != nullptr) return handle_segment_frames();
-    int i = 0;
-    for (; i < kMaxBurst; ++i) {
-        const std::size_t len = link_.receive(buffer_);
-        if (len == 0) break;
-        const uint64_t rx_ns = clock_.now_ns();
-        ++stats_.frames_received;
-        std::span<uint8_t> frame(buffer_.data(), len);
-        if (capture_ != nullptr) std::memcpy(in_copy_.data(), buffer_.data(), len);
-        const bool reply = esc_->process_frame(frame, rx_ns);
-        const uint64_t done_ns = clock_.now_ns() - rx_ns;
-        log_frame_time(done_ns);
-        stats_.frame_ns_total += done_ns;
-        stats_.frame_ns_max = std::max(stats_.frame_ns_max, done_ns);
-        if (reply) {
-            if (link_.send(frame))
-                ++stats_.frames_sent;
-            else
-                ++stats_.send_errors;
-        } else {
-            ++stats_.frames_dropped;
-        }
-        // Recorded after the reply went out, so the capture never delays a frame.
-        if (capture_ != nullptr) {
-            capture_->write(std::span<const uint8_t>(in_copy_.data(), len));
-            if (reply) capture_->write(frame);
-        }
-    }
-    return i;
+// Frames that arrived while the runtime was busy (about to tick the ESCs and run the firmware, or between
+// two devices' firmware): answered before that work, as a hardware ESC answers whatever its
+// microcontroller does. Frames coming back on the out link first: they are older.
+int Runtime::serve_frames() {
+    int n = out_ != nullptr ? handle_out_frames() : 0;
+    n += handle_frames();
+    stats_.frames_before_work += static_cast<uint64_t>(n);
+    return n;
 }
 
-// Segment mode: each frame from the master is walked through the segment.
-int Runtime::handle_segment_frames() {
+// Each frame from the master is walked through the segment.
+int Runtime::handle_frames() {
     int i = 0;
     for (; i < kMaxBurst; ++i) {
         const std::size_t len = link_.receive(buffer_);
@@ -344,7 +326,7 @@ int Runtime::handle_segment_frames() {
         if (reply_count_ != 0 && rx_ns - reply_first_ns_ >= kReplyCoalesceNs) flush_replies();
         std::span<uint8_t> frame(buffer_.data(), len);
         if (capture_ != nullptr) std::memcpy(in_copy_.data(), buffer_.data(), len);
-        const esc::Segment::Result result = segment_->walk(frame, rx_ns);
+        const esc::Segment::Result result = segment_.walk(frame, rx_ns);
         const uint64_t done = clock_.now_ns();
         log_frame_time(done - rx_ns);
         stats_.frame_ns_total += done - rx_ns;
@@ -376,7 +358,7 @@ int Runtime::handle_out_frames() {
         const uint64_t rx_ns = clock_.now_ns();
         ++stats_.frames_resumed;
         std::span<uint8_t> frame(buffer_.data(), len);
-        const esc::Segment::Result result = segment_->resume(frame, rx_ns);
+        const esc::Segment::Result result = segment_.resume(frame, rx_ns);
         segment_result(result, frame, clock_.now_ns());
         if (capture_ != nullptr && result.kind == esc::Segment::Result::Kind::Reply) capture_->write(frame);
     }
@@ -413,7 +395,7 @@ void Runtime::segment_result(const esc::Segment::Result& result, std::span<uint8
 }
 
 // A reply joins the burst's batch; the batch goes out when the burst is done (flush_replies() at the end of
-// handle_segment_frames/handle_out_frames) or once its oldest reply has waited kReplyCoalesceNs.
+// handle_frames/handle_out_frames) or once its oldest reply has waited kReplyCoalesceNs.
 void Runtime::send_reply(std::span<const uint8_t> frame, uint64_t now) {
     if (reply_count_ == reply_lengths_.size()) flush_replies();
     if (reply_count_ == 0) reply_first_ns_ = now;
@@ -455,7 +437,7 @@ void Runtime::poll_carrier(uint64_t now) {
     if (up == carrier_state_) return;
     const bool first = carrier_state_ < 0;
     carrier_state_ = up;
-    segment_->set_external_link(up != 0);
+    segment_.set_external_link(up != 0);
     if (!first) ++stats_.carrier_changes;
     if (carrier_log_ != nullptr && (!first || up == 0)) {
         const std::string what = up != 0 ? "carrier on, the external port is open"
@@ -466,25 +448,25 @@ void Runtime::poll_carrier(uint64_t now) {
 }
 
 void Runtime::service() {
-    uint64_t now;
-    if (esc_ != nullptr) {
-        esc_->tick();
-        now = clock_.now_ns();
-    } else {
-        // One clock read for the segment: its ESCs count the runtime's clock (each with its own drift).
-        now = clock_.now_ns();
-        const int count = static_cast<int>(segment_->size());
-        for (int k = 0; k < count; ++k) {
-            if (!segment_->powered(k)) continue;
-            esc::Esc& e = segment_->esc(k);
-            if (&e.clock() == &clock_)
-                e.tick(now);
-            else
-                e.tick();
-        }
-        if (hold_count_ != 0) release_held(now);
-        if (carrier_check_) poll_carrier(now);
+    // One clock read for the segment: its ESCs count the runtime's clock (each with its own drift).
+    const uint64_t now = clock_.now_ns();
+    const int count = static_cast<int>(segment_.size());
+    for (int k = 0; k < count; ++k) {
+        if (!segment_.powered(k)) continue;
+        esc::Esc& e = segment_.esc(k);
+        if (&e.clock() == &clock_)
+            e.tick(now);
+        else
+            e.tick();
     }
+    // Frames before the firmware: one that came while the last work ran (a burst, the control socket, a
+    // spin) is answered before the firmware runs (a look at the receive ring when none waits). After the
+    // ESCs' own timers, which are silicon and run at their time: a SYNC0 pulse due before the frame arrived
+    // comes before it, as on hardware (answering the frame first put a cycle's LRW before the SYNC0 that
+    // precedes it, and a chain of two processes counted SM events missed, integration_segment_chain).
+    serve_frames();
+    if (hold_count_ != 0) release_held(now);
+    if (carrier_check_) poll_carrier(now);
     if (firmware_ != nullptr) firmware_->poll(now);
     // Capture: pushed to the file at most every kCaptureFlushNs, so a reader (or a SIGKILL) sees frames
     // that are at most that old, without a write() per frame.

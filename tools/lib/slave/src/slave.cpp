@@ -60,6 +60,7 @@ void write_stats(std::ostream& out, const RuntimeStats& s, const esc::EscStats& 
         << "runtime.loop_gaps_over_50us " << s.loop_gaps_over_50us << '\n'
         << "runtime.loop_gaps_over_1ms " << s.loop_gaps_over_1ms << '\n'
         << "runtime.loop_gap_max_ns " << s.loop_gap_max_ns << '\n'
+        << "runtime.frames_before_work " << s.frames_before_work << '\n'
         << "esc.frames_processed " << e.frames_processed << '\n'
         << "esc.frames_malformed " << e.frames_malformed << '\n'
         << "esc.frames_ignored " << e.frames_ignored << '\n'
@@ -106,7 +107,7 @@ bool interface_running(int sock, const std::string& name) {
     return (req.ifr_flags & IFF_UP) != 0 && (req.ifr_flags & IFF_RUNNING) != 0;
 }
 
-// The runtime loop common to both modes, until a signal or a lost link. Returns the exit code.
+// The runtime loop, until a signal or a lost link. Returns the exit code.
 int run_loop(Runtime& runtime, const std::string& iface, std::ostream& err) {
     set_signal_target(&runtime);
     try {
@@ -251,26 +252,15 @@ int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err)
         runtime.set_spin(uint64_t{options.spin_us} * 1000u);
         runtime.set_busy_poll(options.busy_poll);
         runtime.set_link_check([&iface] { return interface_exists(iface); });
-        set_signal_target(&runtime);
 
         if (veth) out << "master interface: " << veth->master_end() << '\n';
         out << "ecat-slave: running on " << link->describe()
             << (capture ? ", capturing to " + options.capture_file : "") << '\n';
         out.flush();
 
-        try {
-            runtime.run();
-        } catch (...) {
-            set_signal_target(nullptr);
-            throw;
-        }
-        set_signal_target(nullptr);
-
+        const int code = run_loop(runtime, iface, err);
         if (capture) capture->flush();
-        if (runtime.link_lost()) {
-            err << "ecat-slave: network interface '" << iface << "' disappeared\n";
-            return kExitFailure;
-        }
+        if (code != kExitOk) return code;
         if (eeprom_dirty && options.eeprom_write_back && !options.eeprom_file.empty()) {
             if (!write_file(options.eeprom_file, esc.eeprom()))
                 err << "ecat-slave: warning: could not write the EEPROM image back to " << options.eeprom_file

@@ -1,13 +1,23 @@
 #pragma once
 // The firmware: the code that runs on the slave's microcontroller behind the PDI (the EtherCAT state
 // machine, mailbox protocols, the drive). The runtime calls it after every burst of frames (after the
-// replies went out, so it never delays a frame) and whenever its deadline passes.
+// replies went out, so it never delays a frame) and whenever its deadline passes; it answers the frames
+// that arrived meanwhile before it calls it.
 // Time base: the runtime's clock, CLOCK_MONOTONIC nanoseconds, the same as the ESC's local time.
 #include <cstdint>
 #include <iosfwd>
 #include <limits>
 
 namespace slave {
+
+// What the runtime offers the firmware while it runs: answering the frames that arrived meanwhile.
+class FrameService {
+  public:
+    virtual ~FrameService() = default;
+    // Answers every frame waiting on the link (walks it, sends the reply); returns how many. Cheap when none
+    // waits (a look at the receive ring). Must not be called from within a frame's processing.
+    virtual int serve_frames() = 0;
+};
 
 class Firmware {
   public:
@@ -25,6 +35,17 @@ class Firmware {
     // Statistics for the end of the run ("name value" lines, e.g. ecat::print_stats()); printed by
     // run_slave() at exit with --verbose and written to SlaveOptions::stats_file. Default: nothing.
     virtual void report(std::ostream& /*out*/) const {}
+
+    // Set by the runtime (null: none). A firmware whose poll() is a pass over several devices calls
+    // serve_frames() between them, so a frame never waits for the whole pass: a hardware ESC answers a
+    // frame whatever its microcontroller is doing.
+    void set_frame_service(FrameService* service) { frame_service_ = service; }
+
+  protected:
+    int serve_frames() { return frame_service_ != nullptr ? frame_service_->serve_frames() : 0; }
+
+  private:
+    FrameService* frame_service_ = nullptr;
 };
 
 // Adapts any object with poll(uint64_t) and next_deadline_ns() (e.g. ecat::Stack, which cannot depend on

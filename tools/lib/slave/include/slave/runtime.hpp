@@ -1,12 +1,14 @@
 #pragma once
-// The slave runtime: a single-threaded event loop that owns the link and the ESC and runs the firmware.
+// The slave runtime: a single-threaded event loop that owns the link and a segment of ESCs (esc::Segment)
+// and runs the firmware. One ESC alone on its wire (ecat-slave with one drive) is a segment of one device:
+// there is one loop and one frame path, whatever the number of devices.
 //
-//   epoll_wait(link fd, timerfd, stop eventfd)
+//   epoll_wait(link fd, out link fd, timerfd, stop eventfd, firmware control fd)
 //   for each frame waiting (a burst, at most kMaxBurst):  rx time = clock now
-//       esc.process_frame(frame, rx time); if it says so, link.send(frame); record in/out to the capture
-//   then esc.tick() and firmware.poll(now)                (after the replies: the firmware never delays a
-//   frame) re-arm the timerfd (CLOCK_MONOTONIC, TFD_TIMER_ABSTIME) for min(esc.next_event_ns(), firmware
-//   deadline)
+//       segment.walk(frame, rx time); a reply joins the burst's batch; record in/out to the capture
+//   send the batch; then tick every powered ESC and firmware.poll(now) (after the replies: the firmware
+//   never delays a frame); re-arm the timerfd (CLOCK_MONOTONIC, TFD_TIMER_ABSTIME) for the earliest of the
+//   ESCs' events, the firmware's deadline, a held reply and the carrier poll
 //
 // How it waits for a timed event (a SYNC0 pulse, the application cycle, a watchdog) is a choice:
 //   default        sleeps on the timerfd to the deadline: the wake-up is as late as the platform's timer
@@ -22,19 +24,20 @@
 // One receive buffer, allocated at construction; nothing is allocated per frame or per cycle.
 // The clock must count CLOCK_MONOTONIC nanoseconds (esc::SystemClock) because the timer runs on it.
 //
-// A segment of devices (ecat-slave --slaves N, --topology, --out-iface) runs the same loop over an
-// esc::Segment instead of one Esc: a frame from the link is walked through the segment (Segment::walk);
-// a reply goes back out on the link, held back HopFaults::hold_ns in a preallocated queue when a hop is
-// delayed; a frame the segment sent out of its external port (the `out` link) comes back on that link and
-// finishes its walk (Segment::resume). The carrier of the out link is polled every kCarrierPollNs and given
-// to Segment::set_external_link() (no carrier: the port is closed and loops back). The timers of every ESC
-// of the segment are ticked after each burst; the firmware (all the devices' firmware in one) runs after it.
-// Replies of one burst are coalesced: they go out together when the burst has been walked, or as soon as
-// the oldest has waited kReplyCoalesceNs (docs/decisions/segment.md "Replies of a burst"), so a master that
-// sent several frames is woken once for them instead of once per reply.
+// A frame from the link is walked through the segment (Segment::walk) (ecat-slave --slaves N, --topology,
+// --out-iface, or one drive); a reply goes back out on the link, held back HopFaults::hold_ns in a
+// preallocated queue when a hop is delayed; a frame the segment sent out of its external port (the `out`
+// link) comes back on that link and finishes its walk (Segment::resume). The carrier of the out link is
+// polled every kCarrierPollNs and given to Segment::set_external_link() (no carrier: the port is closed and
+// loops back). The timers of every ESC of the segment are ticked after each burst; the firmware (all the
+// devices' firmware in one) runs after it. Replies of one burst are coalesced: they go out together when the
+// burst has been walked, or as soon as the oldest has waited kReplyCoalesceNs (docs/decisions/segment.md
+// "Replies of a burst"), so a master that sent several frames is woken once for them instead of once per
+// reply.
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "esc/clock.hpp"
@@ -65,7 +68,7 @@ struct RuntimeStats {
     uint64_t loop_gaps_over_50us = 0;
     uint64_t loop_gaps_over_1ms = 0;
     uint64_t loop_gap_max_ns = 0;
-    // Segment mode only:
+    // Segments with faults or an external port:
     uint64_t frames_external = 0;  // walks that left through the external port (sent on the out link)
     uint64_t frames_resumed = 0;   // frames received on the out link (Segment::resume)
     uint64_t frames_held = 0;      // replies held back by a delayed hop
@@ -73,6 +76,9 @@ struct RuntimeStats {
     uint64_t out_send_errors = 0;  // not used by the Runtime itself: the external send callback counts here
     uint64_t carrier_changes = 0;  // carrier of the out link gained or lost
     uint64_t reply_batches = 0;    // coalesced replies sent together (a batch of one counts too)
+    // Frames found waiting when other work was about to start or between devices' firmware (they are
+    // answered first): they arrived while the runtime was busy, not asleep.
+    uint64_t frames_before_work = 0;
 };
 
 // Optional record of each frame's processing time (receive to reply ready, clock ns), for benchmarks: a
@@ -84,7 +90,7 @@ struct FrameTimeLog {
     std::atomic<bool> on{false};
 };
 
-class Runtime {
+class Runtime final : private FrameService {
   public:
     static constexpr int kMaxBurst = 64;
     // Longest time a captured frame stays in the capture's buffer before it is written to the file.
@@ -92,18 +98,19 @@ class Runtime {
 
     // Replies held back by a delayed hop (HopFaults::hold_ns): at most this many at once.
     static constexpr std::size_t kHoldSlots = 256;
-    // Longest time the first reply of a burst waits for the others (segment mode): well below the time a
+    // Longest time the first reply of a burst waits for the others: well below the time a
     // full frame takes on a 100 Mbit/s wire (123 us), so replies never come later than on real cables.
     static constexpr uint64_t kReplyCoalesceNs = 100'000;
     // A deadline this close after a service is waited for awake instead of asleep (see run_once()).
     static constexpr uint64_t kChainNs = 20'000;
-    // How often the out link's carrier is polled (segment mode with an out link).
+    // How often the out link's carrier is polled (with an out link).
     static constexpr uint64_t kCarrierPollNs = 100'000'000;
 
-    Runtime(esc::Link& link, esc::Esc& esc, const esc::Clock& clock);
-    // Segment mode: frames from `link` are walked through `segment`; `out` (may be null) is the link of
-    // the segment's external port, whose send callback the owner set (Segment::set_external).
+    // Frames from `link` are walked through `segment`; `out` (may be null) is the link of the segment's
+    // external port, whose send callback the owner set (Segment::set_external).
     Runtime(esc::Link& link, esc::Segment& segment, const esc::Clock& clock, esc::Link* out = nullptr);
+    // One ESC alone on its wire: the runtime runs it as a segment of one device, which it owns.
+    Runtime(esc::Link& link, esc::Esc& esc, const esc::Clock& clock);
     ~Runtime();
     Runtime(const Runtime&) = delete;
     Runtime& operator=(const Runtime&) = delete;
@@ -116,7 +123,7 @@ class Runtime {
     // is still usable. If it returns false, run() ends and link_lost() is true. Not called per frame.
     void set_link_check(std::function<bool()> check) { link_check_ = std::move(check); }
     bool link_lost() const { return link_lost_; }
-    // Segment mode with an out link: whether the out interface has a carrier, polled every kCarrierPollNs
+    // With an out link: whether the out interface has a carrier, polled every kCarrierPollNs
     // (not per frame); each change is given to Segment::set_external_link() and logged to `log`.
     void set_carrier_check(std::function<bool()> check, Log* log = nullptr, std::string name = {});
     // Wake spin_ns before each timed event and busy-wait to it (0: sleep all the way, the default).
@@ -139,8 +146,9 @@ class Runtime {
     std::size_t held() const { return hold_count_; }
 
   private:
-    int handle_frames();  // returns the number of frames received
-    int handle_segment_frames();
+    Runtime(esc::Link& link, std::unique_ptr<esc::Segment> own, esc::Esc& esc, const esc::Clock& clock);
+    int handle_frames();          // returns the number of frames received
+    int serve_frames() override;  // FrameService: frames that came while other work ran
     int handle_out_frames();
     void segment_result(const esc::Segment::Result& result, std::span<uint8_t> frame, uint64_t now);
     void release_held(uint64_t now);
@@ -159,9 +167,9 @@ class Runtime {
     static constexpr uint32_t kTagLink = 1, kTagTimer = 2, kTagStop = 3, kTagControl = 4, kTagOut = 5;
 
     esc::Link& link_;
-    esc::Esc* esc_ = nullptr;          // one ESC alone on its wire, or
-    esc::Segment* segment_ = nullptr;  // a segment of them
-    esc::Link* out_ = nullptr;         // the segment's external port, may be null
+    esc::Segment& segment_;
+    std::unique_ptr<esc::Segment> own_segment_;  // the segment of one ESC (the Esc constructor), else null
+    esc::Link* out_ = nullptr;                   // the segment's external port, may be null
     const esc::Clock& clock_;
     Firmware* firmware_ = nullptr;
     esc::PcapWriter* capture_ = nullptr;
@@ -183,7 +191,7 @@ class Runtime {
     std::vector<uint8_t> buffer_;         // the receive buffer (frame processed in place)
     std::vector<uint8_t> in_copy_;        // the frame as received, kept for the capture
     RuntimeStats stats_;
-    // Hold queue (segment mode): a ring of kHoldSlots frames, released in order when due.
+    // Hold queue: a ring of kHoldSlots frames, released in order when due.
     struct HeldFrame {
         uint64_t due_ns = 0;
         std::size_t length = 0;
@@ -192,7 +200,7 @@ class Runtime {
     std::vector<HeldFrame> hold_slots_;
     std::size_t hold_head_ = 0;
     std::size_t hold_count_ = 0;
-    // Replies of the current burst (segment mode), sent together by flush_replies().
+    // Replies of the current burst, sent together by flush_replies().
     std::vector<uint8_t> reply_buffer_;  // kMaxBurst * kMaxFrameSize, allocated at construction
     std::vector<std::size_t> reply_lengths_;
     std::size_t reply_count_ = 0;
