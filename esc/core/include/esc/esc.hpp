@@ -124,7 +124,9 @@ class Esc final : public Pdi {
     // the processing unit where it passes it and returns the next port that is open, i.e. where the frame
     // leaves the ESC; that can be `port` itself (all others closed). Returns -1 if the frame is destroyed:
     // received at a closed or non-existent port, or circulating a second time (the circulating bit of the
-    // first datagram set on its way through the processing unit while port 0 is closed, ETG.1000.4).
+    // first datagram set on its way through the processing unit while port 0 is closed, ETG.1000.4), or not
+    // EtherCAT with the forwarding rule set. A frame length error leaves marked in `check` (crc_bad, marked),
+    // as hardware aborts it with a bad FCS; without a FrameCheck it is destroyed.
     // Receive-time latches: a write to 0x0900 arms them; port 0 (0x0900) latches that frame's arrival at
     // port 0, ports 1-3 (0x0904/0x0908/0x090C) the arrival of the next frame received at that port.
     int receive(std::span<uint8_t> frame, int port, uint64_t rx_clock_ns = 0);
