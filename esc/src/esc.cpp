@@ -10,8 +10,6 @@ namespace esc {
 
 namespace {
 
-using wire::kEtherTypeVlan;
-constexpr uint16_t kEtherTypeEcat = wire::kEtherType;
 using util::get16;
 using util::put16;
 
@@ -29,19 +27,11 @@ constexpr uint16_t forwarded_rx_error_counter(int p) {
 // The first datagram's length word (bit 14: circulating frame, ETG.1000.4) of an EtherCAT frame (type 1),
 // nullptr if the frame has none.
 uint8_t* first_length_word(std::span<uint8_t> frame) {
-    const std::size_t size = frame.size();
-    if (size < 14) return nullptr;
-    uint8_t* f = frame.data();
-    std::size_t off = 12;
-    uint16_t type = static_cast<uint16_t>((f[12] << 8) | f[13]);
-    if (type == kEtherTypeVlan) {
-        if (size < 18) return nullptr;
-        type = static_cast<uint16_t>((f[16] << 8) | f[17]);
-        off = 16;
-    }
-    const std::size_t word = off + 2 + 2 + 6;  // EtherCAT header, then the datagram's cmd/idx/adp/ado
-    if (type != kEtherTypeEcat || size < word + 2 || (get16(f + off + 2) >> 12) != 1) return nullptr;
-    return f + word;
+    const wire::EcatLocation loc = wire::locate_ecat(frame);
+    const std::size_t word = loc.header + 2 + 6;  // EtherCAT header, then the datagram's cmd/idx/adp/ado
+    if (!loc.found || frame.size() < word + 2 || (get16(frame.data() + loc.header) >> 12) != 1)
+        return nullptr;
+    return frame.data() + word;
 }
 
 }  // namespace
@@ -218,100 +208,114 @@ int Esc::Impl::receive(std::span<uint8_t> frame, int port, uint64_t rx_clock, Fr
             return ports.exit_after(port);  // does not pass the processing unit
         // Looped back at the closed port 0 into the processing unit: with port 0 closed by its link state
         // the circulating bit is set on the first pass; a frame that comes by with it already set is
-        // destroyed (ETG.1000.4; ESC datasheet section I, circulating frames).
+        // destroyed and counted as a processing unit error (ESC datasheet section I, "Circulating frames"
+        // and Table 57).
         uint8_t* lw = ports.port0_closed_automatically() ? first_length_word(frame) : nullptr;
         if (lw) {
             if (lw[1] & 0x40) {
+                mem.count_error(reg::kProcessingUnitErrors);
                 ++stats.frames_destroyed;
                 return -1;
             }
             lw[1] = static_cast<uint8_t>(lw[1] | 0x40);
         }
     }
-    if (!process(frame, port, rx_clock)) {
-        ++stats.frames_destroyed;
-        return -1;
+    switch (process(frame, port, rx_clock)) {
+        case Outcome::Forward:
+            return ports.exit_after(port);
+        case Outcome::Error:
+            // The ESC aborts the frame with a bad FCS and the marking for forwarded errors: the ESCs after it
+            // count a forwarded error, a master's NIC discards it. Without a FrameCheck to carry the marking
+            // nobody could receive it: it is gone.
+            if (check) {
+                check->crc_bad = true;
+                check->marked = true;
+                return ports.exit_after(port);
+            }
+            ++stats.frames_destroyed;
+            return -1;
+        case Outcome::Destroy:
+            break;
     }
-    return ports.exit_after(port);
+    ++stats.frames_destroyed;
+    return -1;
 }
 
-bool Esc::Impl::process(std::span<uint8_t> frame, int port, uint64_t rx_clock) {
+// ESC datasheet section I, "EtherCAT protocol", "UDP/IP", "Frame processing" and Table 57 (errors and their
+// counters); docs/decisions/esc.md, "Frame tolerance", lists every rule with its test.
+Esc::Impl::Outcome Esc::Impl::process(std::span<uint8_t> frame, int port, uint64_t rx_clock) {
+    (void)port;  // every processing unit error counts in 0x030C alone, whatever port the frame came in at
     const std::size_t size = frame.size();
-    if (size < 14) {
-        ++stats.frames_ignored;
-        return false;
-    }
     uint8_t* f = frame.data();
-    std::size_t off = 12;
-    uint16_t type = static_cast<uint16_t>((f[12] << 8) | f[13]);
-    if (type == kEtherTypeVlan) {
-        if (size < 18) {
-            ++stats.frames_ignored;
-            return false;
-        }
-        type = static_cast<uint16_t>((f[16] << 8) | f[17]);
-        off = 16;
-    }
-    if (type != kEtherTypeEcat) {
-        // DL control 0x0100 bit 0, the forwarding rule (ESC datasheet, DL control): 1 (the reset value)
-        // destroys non-EtherCAT frames, 0 forwards them unchanged.
+    const wire::EcatLocation loc = wire::locate_ecat(frame);
+    if (!loc.found) {
+        // DL control 0x0100 bit 0, the forwarding rule: 1 (the reset value) destroys non-EtherCAT frames and
+        // counts them as processing unit errors, 0 forwards them unchanged.
         ++stats.frames_ignored;
-        return (mem.r8(reg::kDlControl) & 0x01) == 0;
+        if ((mem.r8(reg::kDlControl) & 0x01) == 0 && size >= wire::kEthernetHeaderSize)
+            return Outcome::Forward;
+        mem.count_error(reg::kProcessingUnitErrors);
+        return Outcome::Destroy;
     }
     if (!cfg.faults.source_mac_unchanged)
         f[6] |= 0x02;  // source MAC: locally administered bit, as every ESC sets it
-    const std::size_t hdr = off + 2;
+    if (loc.udp_checksum != 0) {
+        f[loc.udp_checksum] = 0;  // the ESC changes the payload on the fly: checksum "not used"
+        f[loc.udp_checksum + 1] = 0;
+    }
+    const std::size_t hdr = loc.header;
     if (size < hdr + 2) {
         ++stats.frames_malformed;
         ++stats.malformed_no_header;
-        mem.count_error(invalid_frame_counter(port));  // the port it came in at
         mem.count_error(reg::kProcessingUnitErrors);
-        return true;
+        return Outcome::Error;
     }
     const uint16_t h = get16(f + hdr);
     if ((h >> 12) != 1) {
         ++stats.frames_ignored;  // EtherCAT frame of another type: forwarded unprocessed
-        return true;
+        return Outcome::Forward;
     }
+    // The header's Length is not evaluated. The chain is walked first by the datagrams' own lengths and More
+    // bits up to the end of the frame: a frame with a length error is lost to the master (bad FCS) and its
+    // register operations are discarded, so none of its datagrams is executed (docs/decisions/esc.md).
+    std::size_t p = hdr + 2;
+    bool chain_ok = true;
+    for (;;) {
+        if (p + 12 > size || p + 12 + (get16(f + p + 6) & 0x07FF) > size) {
+            chain_ok = false;
+            ++stats.malformed_datagram;
+            break;
+        }
+        const uint16_t lf = get16(f + p + 6);
+        p += 12u + (lf & 0x07FF);
+        if (!(lf & 0x8000)) break;
+    }
+    if (chain_ok && size - p > wire::kMaxPadding) {
+        chain_ok = false;
+        ++stats.malformed_length;
+    }
+    if (!chain_ok) {
+        ++stats.frames_malformed;
+        mem.count_error(reg::kProcessingUnitErrors);
+        return Outcome::Error;
+    }
+
     ++stats.frames_processed;
     time.frame_clock = rx_clock != 0 ? rx_clock : time.clock.now_ns();
     time.frame_local = dc.local_at(time.frame_clock);
     time.in_frame = true;
-
-    bool ok = true;
-    std::size_t p = hdr + 2;
-    const std::size_t end = p + (h & 0x07FF);
-    if (end > size) {
-        ok = false;
-        ++stats.malformed_length;
-    } else {
-        for (;;) {
-            if (p + 12 > end) {
-                ok = false;
-                ++stats.malformed_datagram;
-                break;
-            }
-            const uint16_t lf = get16(f + p + 6);
-            const uint16_t dlen = lf & 0x07FF;
-            if (p + 12 + dlen > end) {
-                ok = false;
-                ++stats.malformed_datagram;
-                break;
-            }
-            datagram(f + p, f + p + 10, dlen);
-            ++stats.datagrams;
-            p += 12u + dlen;
-            if (!(lf & 0x8000)) break;
-        }
+    p = hdr + 2;
+    for (;;) {
+        const uint16_t lf = get16(f + p + 6);
+        const uint16_t dlen = lf & 0x07FF;
+        datagram(f + p, f + p + 10, dlen);
+        ++stats.datagrams;
+        p += 12u + dlen;
+        if (!(lf & 0x8000)) break;
     }
-    if (!ok) {
-        ++stats.frames_malformed;
-        mem.count_error(invalid_frame_counter(port));  // the port it came in at
-        mem.count_error(reg::kProcessingUnitErrors);
-    }
-    end_of_frame(ok);
+    end_of_frame(true);
     time.in_frame = false;
-    return true;
+    return Outcome::Forward;
 }
 
 void Esc::Impl::end_of_frame(bool ok) {

@@ -61,7 +61,10 @@ struct Esc::Impl final {
 
     // Frame processing.
     int receive(std::span<uint8_t> frame, int port, uint64_t rx_clock, FrameCheck* check);
-    bool process(std::span<uint8_t> frame, int port, uint64_t rx_clock);
+    // What became of a frame at the processing unit: forwarded (processed or not), destroyed, or forwarded
+    // with a frame error (hardware aborts it with a bad FCS and the forwarded-error marking).
+    enum class Outcome { Forward, Destroy, Error };
+    Outcome process(std::span<uint8_t> frame, int port, uint64_t rx_clock);
     void end_of_frame(bool ok);
     void datagram(uint8_t* hdr, uint8_t* data, uint16_t len);
 

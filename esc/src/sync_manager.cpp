@@ -157,6 +157,8 @@ void SyncManagers::pdi_control_written(unsigned n, uint8_t value) {
     mem.regs[a] = static_cast<uint8_t>(value & 0x03);
     if (deact != s.pdi_disabled) {
         s.pdi_disabled = deact;
+        pdi_disabled_mask_ = static_cast<uint16_t>(deact ? (pdi_disabled_mask_ | (1u << n))
+                                                         : (pdi_disabled_mask_ & ~(1u << n)));
         reset_state(n);
     }
 }
@@ -167,6 +169,7 @@ void SyncManagers::reset() {
         if (n < count_) update_status(n);
     }
     pending_mask_ = 0;
+    pdi_disabled_mask_ = 0;
 }
 
 void SyncManagers::rebuild() {

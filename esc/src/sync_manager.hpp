@@ -67,11 +67,15 @@ class SyncManagers {
     bool end_of_frame(bool ok) { return pending_mask_ != 0 && commit_pending(ok); }
 
     // Lock rule E3: start, length and control of an SM enabled before the current datagram are read-only.
-    uint16_t enabled_mask() const { return enabled_mask_; }
+    // An SM the PDI deactivated (0x0807.0, what a slave stack does to SM0/SM1 when it enters INIT) is not
+    // operating and takes a new configuration, as a master rewriting the mailbox for Bootstrap relies on
+    // (docs/decisions/esc.md, "SM configuration after a PDI deactivation").
+    uint16_t enabled_mask() const { return static_cast<uint16_t>(enabled_mask_ & ~pdi_disabled_mask_); }
     void set_lock_mask(uint16_t m) { lock_mask_ = m; }
     bool locked(unsigned n) const { return lock_mask_ & (1u << n); }
 
   private:
+    uint16_t pdi_disabled_mask_ = 0;
     bool commit_pending(bool ok);
     void reset_state(unsigned n);
     void commit(unsigned n, bool write, Side side);

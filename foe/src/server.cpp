@@ -247,7 +247,9 @@ void FoeServer::on_ack(uint32_t packet, ecat::MailboxSender& out) {
 void FoeServer::on_data(uint32_t packet, std::span<const uint8_t> data, ecat::MailboxSender& out) {
     reap_commit();
     if (phase_ == Phase::Storing && packet == packet_) {
-        // The master repeats the last DATA after BUSY: answer with the state of the commit.
+        // The master repeats the last DATA after BUSY (or gave up waiting for its answer): answer with the
+        // state of the commit; the pending answer is this one.
+        answer_pending_ = false;
         if (result_ == Result::Running) {
             send_busy(out);
         } else if (result_ == Result::Done) {
@@ -296,7 +298,30 @@ void FoeServer::on_data(uint32_t packet, std::span<const uint8_t> data, ecat::Ma
     phase_ = Phase::Storing;
     result_ = Result::Running;
     start_commit();
-    send_busy(out);
+    if (config_.busy_after_ns == 0) {
+        send_busy(out);
+        return;
+    }
+    // Answered by poll() when the commit ends (ACK only once the image is active), or BUSY at busy_at_ns_.
+    answer_pending_ = true;
+    pending_packet_ = packet;
+    busy_at_ns_ = now_ns_ + config_.busy_after_ns;
+}
+
+void FoeServer::answer_pending(ecat::MailboxSender& out) {
+    if (!answer_pending_ || phase_ != Phase::Storing) return;
+    if (result_ == Result::Done) {
+        answer_pending_ = false;
+        phase_ = Phase::Idle;
+        send_ack(pending_packet_, out);
+    } else if (result_ == Result::Failed) {
+        answer_pending_ = false;
+        phase_ = Phase::Idle;
+        send_error(error_.code, error_.text, out);
+    } else if (now_ns_ >= busy_at_ns_) {
+        answer_pending_ = false;
+        send_busy(out);
+    }
 }
 
 void FoeServer::start_commit() {
@@ -338,21 +363,27 @@ void FoeServer::report_write(uint32_t code, std::string_view text) {
     if (events_ != nullptr) events_->foe_write(write_name_, write_bytes_, code, text);
 }
 
-void FoeServer::poll(uint64_t now_ns, ecat::MailboxSender& /*out*/) {
+void FoeServer::poll(uint64_t now_ns, ecat::MailboxSender& out) {
     now_ns_ = now_ns;
     reap_commit();
     if (phase_ == Phase::Storing && result_ == Result::Running) {
         activity_ns_ = now_ns;
-        if (worker_.joinable()) return;
-        const auto p = store_.commit_step(error_);
-        if (p == FirmwareSink::Progress::Done) {
-            result_ = Result::Done;
-            ++stats_.writes_completed;
-            report_write(0, {});
-        } else if (p == FirmwareSink::Progress::Failed) {
-            result_ = Result::Failed;
-            report_write(static_cast<uint32_t>(error_.code), error_.text);
+        if (!worker_.joinable()) {
+            const auto p = store_.commit_step(error_);
+            if (p == FirmwareSink::Progress::Done) {
+                result_ = Result::Done;
+                ++stats_.writes_completed;
+                report_write(0, {});
+            } else if (p == FirmwareSink::Progress::Failed) {
+                result_ = Result::Failed;
+                report_write(static_cast<uint32_t>(error_.code), error_.text);
+            }
         }
+        answer_pending(out);
+        return;
+    }
+    if (answer_pending_) {
+        answer_pending(out);
         return;
     }
     if (phase_ != Phase::Idle && now_ns - activity_ns_ > config_.timeout_ns) {
@@ -380,6 +411,7 @@ void FoeServer::cancel() {
         if (worker_result_.load() != 0) result_ = worker_result_.load() == 1 ? Result::Done : Result::Failed;
     }
     if (phase_ == Phase::Writing || (phase_ == Phase::Storing && result_ == Result::Running)) store_.abort();
+    answer_pending_ = false;
     if (read_fd_ >= 0) {
         store_.close_image(read_fd_);
         read_fd_ = -1;

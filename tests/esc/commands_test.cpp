@@ -181,8 +181,14 @@ TEST_F(Addressing, EscResetWrongSequenceRestarts) {
 
 TEST_F(Addressing, ErrorCountersClearOnWrite) {
     std::vector<uint8_t> bad = build({dg_len(FPRD, 0x1001, 0x0130, 2)});
-    bad[14] = 0xFF;  // header length beyond the frame
-    e->process_frame(bad);
+    bad[16 + 6] = 0xFF;  // datagram length beyond the frame
+    EXPECT_FALSE(e->process_frame(bad));
+    EXPECT_EQ(e->stats().frames_malformed, 1u);
+    esc::FrameCheck check;
+    check.crc_bad = true;
+    auto f = bad;
+    e->receive(f, 0, 0, check);  // a bad FCS: an invalid frame at port 0
+    EXPECT_EQ(fprd(*e, 0x0300, 1).wkc, 1);
     EXPECT_EQ(fprd(*e, 0x0300, 1).data[0], 1);
     EXPECT_EQ(fprd(*e, 0x030C, 1).data[0], 1);
     fpwr(*e, 0x0300, std::vector<uint8_t>(0x14, 0xAB));

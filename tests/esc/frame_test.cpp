@@ -88,56 +88,188 @@ TEST_F(FrameHandling, MultipleDatagramsSeeEarlierEffects) {
     EXPECT_EQ(e->stats().datagrams, 1u + 4u);  // set_station + 4
 }
 
-TEST_F(FrameHandling, TruncatedDatagramStopsProcessing) {
+// ---- Frame tolerance (docs/decisions/esc.md, "Frame tolerance"; ESC datasheet section I, Table 2 and
+// Table 57): the header Length is not evaluated, the datagrams are walked by their own lengths and More bits
+// up to the real end of the frame; a length error loses the frame, discards all its operations and counts in
+// 0x030C only.
+
+void set_header_length(std::vector<uint8_t>& f, std::size_t len) {
+    f[14] = static_cast<uint8_t>(len);
+    f[15] = static_cast<uint8_t>((f[15] & 0xF8) | ((len >> 8) & 0x07));
+}
+
+// libethercat writes the length of the whole frame; other values a master may leave there.
+TEST_F(FrameHandling, HeaderLengthIsNotEvaluated) {
+    for (std::size_t len : {std::size_t{60}, std::size_t{0x7FF}, std::size_t{0}, std::size_t{12}}) {
+        auto f = build({dg(FPWR, 0x1001, 0x1000, {0x11, 0x22}), dg_len(FPRD, 0x1001, 0x1000, 2)});
+        set_header_length(f, len);
+        EXPECT_TRUE(e->process_frame(f)) << len;
+        EXPECT_EQ(f.size(), 60u);
+        auto d = parse(f);
+        ASSERT_EQ(d.size(), 2u) << len;
+        EXPECT_EQ(d[0].wkc, 1) << len;
+        EXPECT_EQ(d[1].data, (std::vector<uint8_t>{0x11, 0x22})) << len;
+        EXPECT_EQ(d[1].wkc, 1) << len;
+        EXPECT_EQ(f[14], static_cast<uint8_t>(len)) << len;  // the header is forwarded as it came
+        e->write_reg<uint16_t>(0x1000, 0);
+    }
+    EXPECT_EQ(e->stats().frames_malformed, 0u);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x030C), 0);
+}
+
+// A frame with a length error (a datagram past the end of the frame) is lost to the master; none of its
+// operations take effect; only the processing unit error counter counts it.
+TEST_F(FrameHandling, DatagramPastTheEndIsALengthError) {
     auto f = build({dg(FPWR, 0x1001, 0x1000, {0x11}), dg(FPWR, 0x1001, 0x1001, {0x22, 0x33, 0x44})}, 0);
-    // Cut the frame inside the second datagram and shorten the header length to match the frame.
-    f.resize(f.size() - 3);
-    const uint16_t elen = static_cast<uint16_t>(f.size() - 16);
-    f[14] = static_cast<uint8_t>(elen);
-    f[15] = static_cast<uint8_t>(0x10 | (elen >> 8));
-    EXPECT_TRUE(e->process_frame(f));
-    EXPECT_EQ(e->read_reg<uint8_t>(0x1000), 0x11);  // first datagram executed
-    EXPECT_EQ(e->read_reg<uint8_t>(0x1001), 0x00);  // second not
+    f.resize(f.size() - 3);  // the frame ends inside the second datagram
+    set_header_length(f, f.size() - 16);
+    EXPECT_FALSE(e->process_frame(f));
+    EXPECT_EQ(e->read_reg<uint8_t>(0x1000), 0x00);  // the first datagram is not executed either
+    EXPECT_EQ(e->read_reg<uint8_t>(0x1001), 0x00);
     EXPECT_EQ(e->stats().frames_malformed, 1u);
-    EXPECT_EQ(e->read_reg<uint8_t>(0x0300), 1);
+    EXPECT_EQ(e->stats().malformed_datagram, 1u);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x0300), 0);  // not an invalid frame at the port (Table 57)
     EXPECT_EQ(e->read_reg<uint8_t>(0x030C), 1);
 }
 
-TEST_F(FrameHandling, HeaderLengthTooBig) {
+TEST_F(FrameHandling, DatagramLengthPastTheEnd) {
     auto f = build({dg(FPWR, 0x1001, 0x1000, {0x11})});
-    f[14] = 0xF0;
-    f[15] = 0x17;  // 0x7F0 bytes: beyond the 60-byte frame
-    auto size = f.size();
-    EXPECT_TRUE(e->process_frame(f));  // forwarded as a real ESC does
-    EXPECT_EQ(f.size(), size);
+    f[16 + 6] = 0x40;  // 0x40 data bytes: past the 60-byte frame
+    EXPECT_FALSE(e->process_frame(f));
     EXPECT_EQ(e->read_reg<uint8_t>(0x1000), 0x00);
-    EXPECT_EQ(e->stats().frames_malformed, 1u);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x030C), 1);
 }
 
-TEST_F(FrameHandling, HeaderLengthTooSmall) {
-    auto f = build({dg(FPWR, 0x1001, 0x1000, {0x11, 0x22, 0x33, 0x44})});
-    f[14] = 12;  // covers the datagram header but not its data
-    EXPECT_TRUE(e->process_frame(f));
-    EXPECT_EQ(e->read_reg<uint8_t>(0x1000), 0x00);
-    EXPECT_EQ(e->stats().frames_malformed, 1u);
-    auto d = f;  // WKC unchanged
-    EXPECT_EQ(d[16 + 10 + 4], 0);
-}
-
-TEST_F(FrameHandling, MoreBitPastHeaderLength) {
+// More bit on the last datagram: what follows is read as the next datagram header. Zero padding reads as a
+// NOP with M = 0, so a 60-byte frame is processed as an ESC walks it; where the frame ends before the
+// promised header, it is a length error.
+TEST_F(FrameHandling, MoreBitOnTheLastDatagram) {
     auto f = build({dg(FPWR, 0x1001, 0x1000, {0x11})});
-    f[16 + 7] |= 0x80;  // claims a next datagram but the header length ends here
+    f[16 + 7] |= 0x80;
     EXPECT_TRUE(e->process_frame(f));
     EXPECT_EQ(e->read_reg<uint8_t>(0x1000), 0x11);
+    EXPECT_EQ(e->stats().frames_malformed, 0u);
+    f = build({dg(FPWR, 0x1001, 0x1001, {0x22})}, 0);
+    f[16 + 7] |= 0x80;
+    EXPECT_FALSE(e->process_frame(f));
+    EXPECT_EQ(e->read_reg<uint8_t>(0x1001), 0x00);
     EXPECT_EQ(e->stats().frames_malformed, 1u);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x030C), 1);
+}
+
+// Up to 64 bytes after the last datagram are padding; more is a length error (Table 57, "padding > 64 byte").
+TEST_F(FrameHandling, PaddingUpTo64BytesMoreIsALengthError) {
+    auto f = build({dg_len(APRD, 0, 0x0130, 2)}, 0);
+    const std::size_t chain_end = f.size();
+    f.resize(chain_end + 64, 0xA5);
+    EXPECT_TRUE(e->process_frame(f));
+    EXPECT_EQ(parse(f)[0].wkc, 1);
+    EXPECT_EQ(f[chain_end], 0xA5);  // padding untouched
+    f = build({dg_len(APRD, 0, 0x0130, 2)}, 0);
+    f.resize(chain_end + 65, 0);
+    EXPECT_FALSE(e->process_frame(f));
+    EXPECT_EQ(e->stats().malformed_length, 1u);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x030C), 1);
 }
 
 TEST_F(FrameHandling, TooShortForEtherCatHeader) {
     std::vector<uint8_t> f(15, 0);
     f[12] = 0x88;
     f[13] = 0xA4;
-    EXPECT_TRUE(e->process_frame(f));
+    EXPECT_FALSE(e->process_frame(f));
     EXPECT_EQ(e->stats().frames_malformed, 1u);
+    EXPECT_EQ(e->stats().malformed_no_header, 1u);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x030C), 1);
+}
+
+// Non-EtherCAT frames: destroyed and counted in 0x030C with the forwarding rule 0x0100[0] = 1 (reset value),
+// forwarded unchanged with 0.
+TEST_F(FrameHandling, NonEtherCatFollowsTheForwardingRule) {
+    auto f = build({dg_len(APRD, 0, 0x0130, 2)});
+    f[12] = 0x86;
+    f[13] = 0xDD;  // IPv6
+    auto before = f;
+    EXPECT_FALSE(e->process_frame(f));
+    EXPECT_EQ(e->read_reg<uint8_t>(0x030C), 1);
+    EXPECT_EQ(fpwr(*e, 0x0100, {0x00}).wkc, 1);
+    f = before;
+    EXPECT_TRUE(e->process_frame(f));
+    EXPECT_EQ(f, before);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x030C), 1);
+}
+
+// EtherCAT in UDP/IP (ESC datasheet section I, "UDP/IP", Table 8): EtherType 0x0800, IP version 4, header
+// length 5, protocol 0x11, UDP destination port 0x88A4; nothing else of IP/UDP evaluated; the UDP checksum
+// cleared; IP addresses and ports kept.
+std::vector<uint8_t> in_udp(const std::vector<uint8_t>& ecat, uint8_t version_ihl = 0x45,
+                            uint8_t proto = 0x11, uint16_t port = 0x88A4) {
+    std::vector<uint8_t> f(ecat.begin(), ecat.begin() + 12);
+    f.push_back(0x08);
+    f.push_back(0x00);
+    const std::size_t payload = ecat.size() - 14;
+    const std::size_t udp_len = 8 + payload;
+    const uint8_t ip[20] = {version_ihl,
+                            0,
+                            static_cast<uint8_t>((20 + udp_len) >> 8),
+                            static_cast<uint8_t>(20 + udp_len),
+                            0x12,
+                            0x34,
+                            0,
+                            0,
+                            64,
+                            proto,
+                            0xAB,
+                            0xCD,
+                            192,
+                            168,
+                            1,
+                            1,
+                            192,
+                            168,
+                            1,
+                            255};
+    f.insert(f.end(), ip, ip + 20);
+    const uint8_t udp[8] = {0x88,
+                            0xA4,
+                            static_cast<uint8_t>(port >> 8),
+                            static_cast<uint8_t>(port),
+                            static_cast<uint8_t>(udp_len >> 8),
+                            static_cast<uint8_t>(udp_len),
+                            0x5A,
+                            0x5B};
+    f.insert(f.end(), udp, udp + 8);
+    f.insert(f.end(), ecat.begin() + 14, ecat.end());
+    return f;
+}
+
+TEST_F(FrameHandling, EtherCatInUdpIsProcessed) {
+    auto f = in_udp(build({dg_len(FPRD, 0x1001, 0x0010, 2)}, 0));
+    const auto before = f;
+    EXPECT_TRUE(e->process_frame(f));
+    EXPECT_EQ(f[6], before[6] | 0x02);
+    EXPECT_EQ(f[40], 0);  // UDP checksum cleared
+    EXPECT_EQ(f[41], 0);
+    EXPECT_TRUE(std::equal(f.begin() + 12, f.begin() + 40, before.begin() + 12));  // IP, UDP ports and length
+    const std::size_t dg0 = 14 + 28 + 2;
+    EXPECT_EQ(f[dg0 + 10], 0x01);  // configured station address 0x1001
+    EXPECT_EQ(f[dg0 + 11], 0x10);
+    EXPECT_EQ(f[dg0 + 12], 1);  // WKC
+    // With one VLAN tag in front.
+    auto v = in_udp(build({dg_len(FPRD, 0x1001, 0x0010, 2)}, 0));
+    const uint8_t tag[4] = {0x81, 0x00, 0x00, 0x07};
+    v.insert(v.begin() + 12, tag, tag + 4);
+    EXPECT_TRUE(e->process_frame(v));
+    EXPECT_EQ(v[dg0 + 4 + 12], 1);
+}
+
+TEST_F(FrameHandling, UdpOtherThanEtherCatIsNotProcessed) {
+    const auto ecat = build({dg(FPWR, 0x1001, 0x1000, {0x77})}, 0);
+    for (auto f : {in_udp(ecat, 0x46), in_udp(ecat, 0x65), in_udp(ecat, 0x45, 0x06),
+                   in_udp(ecat, 0x45, 0x11, 0x88A5)}) {
+        EXPECT_FALSE(e->process_frame(f));
+        EXPECT_EQ(e->read_reg<uint8_t>(0x1000), 0);
+    }
+    EXPECT_EQ(e->stats().frames_processed, 1u);  // set_station only
 }
 
 TEST_F(FrameHandling, BrdOrsAcrossTwoSlaves) {
@@ -223,12 +355,23 @@ TEST_P(FrameRobustness, RandomFramesNeverCrash) {
             dgs.push_back(d);
         }
         auto f = build(dgs, rnd() % 2 ? 60 : 0);
-        // Corrupt lengths now and then.
+        // Corrupt lengths now and then. The header length is not evaluated: a frame with only that changed
+        // is processed; a datagram length or a cut frame may make it a frame length error (dropped).
         if (rnd() % 8 == 0) f[14] = static_cast<uint8_t>(rnd());
-        if (rnd() % 8 == 0 && f.size() > 23) f[16 + 6] = static_cast<uint8_t>(rnd());
-        if (rnd() % 8 == 0 && f.size() > 20) f.resize(20 + rnd() % (f.size() - 20));
+        bool broken = false;
+        if (rnd() % 8 == 0 && f.size() > 23) {
+            f[16 + 6] = static_cast<uint8_t>(rnd());
+            broken = true;
+        }
+        if (rnd() % 8 == 0 && f.size() > 20) {
+            f.resize(20 + rnd() % (f.size() - 20));
+            broken = true;
+        }
         const auto size = f.size();
-        EXPECT_TRUE(e.process_frame(f, clk.now_ns()));
+        const bool forwarded = e.process_frame(f, clk.now_ns());
+        if (!broken) {
+            EXPECT_TRUE(forwarded);
+        }
         ASSERT_EQ(f.size(), size);
         uint8_t buf[64];
         e.read(static_cast<uint16_t>(rnd()), std::span<uint8_t>(buf, rnd() % 64));

@@ -242,9 +242,11 @@ TEST(PortsLine, CirculatingFrameIsMarkedThenDestroyed) {
     EXPECT_EQ(first_flags(f) & 0x4000, 0x4000);
     EXPECT_EQ(parse(f).at(0).wkc, 1);  // processed on its way through
     const uint64_t destroyed = e.stats().frames_destroyed;
+    EXPECT_EQ(e.read_reg<uint8_t>(0x030C), 0);
     EXPECT_EQ(e.receive(f, 1), -1);  // second pass with the bit set
     EXPECT_EQ(e.stats().frames_destroyed, destroyed + 1);
-    EXPECT_EQ(parse(f).at(0).wkc, 1);  // not processed again
+    EXPECT_EQ(e.read_reg<uint8_t>(0x030C), 1);  // a processing unit error (ESC datasheet section I, Table 57)
+    EXPECT_EQ(parse(f).at(0).wkc, 1);           // not processed again
     // A frame received at port 0 never gets the bit (port 0 open).
     e.set_link(0, true);
     auto g = build({dg_len(BRD, 0, 0x0000, 1)});
@@ -473,20 +475,27 @@ TEST_F(Ports, ForwardingRuleDestroysOrForwardsNonEtherCatFrames) {
     EXPECT_EQ(e->receive(f, 0), -1);
 }
 
-// A malformed EtherCAT frame counts as an invalid frame at the port it was received at, also when it reaches
-// the processing unit through a port 0 the master closed.
-TEST_F(Ports, MalformedFrameCountsAtThePortItCameIn) {
+// A frame length error counts in the processing unit error counter 0x030C only, whatever port it came in at
+// (ESC datasheet section I, Table 57), also when it reaches the processing unit through a port 0 the master
+// closed; the frame leaves marked bad: the next ESC counts a forwarded error.
+TEST_F(Ports, LengthErrorCountsInTheProcessingUnitOnly) {
     auto bad = build({dg_len(BRD, 0, 0x0000, 1)});
-    bad[14] = 0xFF;  // EtherCAT header length 0x7FF: beyond the frame
-    bad[15] = static_cast<uint8_t>((bad[15] & 0xF8) | 0x07);
+    bad[16 + 6] = 0xFF;  // datagram length 0xFF: beyond the frame
     auto f = bad;
-    (void)e->receive(f, 0);
-    EXPECT_EQ(e->read_reg<uint8_t>(0x0300), 1);
-    EXPECT_EQ(e->read_reg<uint8_t>(0x0302), 0);
+    esc::FrameCheck check;
+    EXPECT_EQ(e->receive(f, 0, 0, check), 0);
+    EXPECT_TRUE(check.crc_bad);
+    EXPECT_TRUE(check.marked);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x0300), 0);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x030C), 1);
+    f = bad;
+    EXPECT_EQ(e->receive(f, 0), -1);  // without a FrameCheck to carry the marking, nobody receives it
+    EXPECT_EQ(e->read_reg<uint8_t>(0x030C), 2);
     e->set_link(1, true);
     EXPECT_EQ(fpwr(*e, 0x0101, {0x0B}).wkc, 1);  // port 0 closed, port 1 open
     f = bad;
-    (void)e->receive(f, 1);
-    EXPECT_EQ(e->read_reg<uint8_t>(0x0300), 1);
-    EXPECT_EQ(e->read_reg<uint8_t>(0x0302), 1);
+    esc::FrameCheck c1;
+    (void)e->receive(f, 1, 0, c1);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x0302), 0);
+    EXPECT_EQ(e->read_reg<uint8_t>(0x030C), 3);
 }

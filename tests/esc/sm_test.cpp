@@ -70,6 +70,30 @@ TEST_F(SyncManagerRules, ConfigLockedWhileEnabled) {
     EXPECT_EQ(d.u16(2), 16);
 }
 
+// A slave stack deactivates SM0/SM1 through the PDI (0x0807.0) when it enters INIT (Beckhoff SSC
+// MBX_StopMailboxHandler, SOES ESC_stopmbx). Such an SM is not operating: a master that goes down to INIT and
+// writes the bootstrap mailbox over the still-activated SMs (libethercat, SOEM's firm_update) reconfigures
+// it.
+TEST_F(SyncManagerRules, ConfigWritableWhileDeactivatedByThePdi) {
+    e->write_reg<uint8_t>(0x0807, 0x01);
+    e->write_reg<uint8_t>(0x080F, 0x01);
+    fpwr(*e, 0x0800, sm_bytes(0x1400, 16, 0x26, 1));
+    fpwr(*e, 0x0808, sm_bytes(0x1800, 16, 0x22, 1));
+    Datagram d = fprd(*e, 0x0800, 16);
+    EXPECT_EQ(d.u16(0), 0x1400);
+    EXPECT_EQ(d.u16(2), 16);
+    EXPECT_EQ(d.data[6], 0x01);
+    EXPECT_EQ(d.u16(8), 0x1800);
+    EXPECT_EQ(d.u16(10), 16);
+    // Active again from the PDI side: locked again.
+    e->write_reg<uint8_t>(0x0807, 0x00);
+    fpwr(*e, 0x0800, sm_bytes(0x1000, 8, 0x26, 1));
+    EXPECT_EQ(fprd(*e, 0x0800, 2).u16(0), 0x1400);
+    // The new mailbox works.
+    EXPECT_EQ(fpwr(*e, 0x1400, std::vector<uint8_t>(16, 0x5A)).wkc, 1);
+    EXPECT_EQ(status(0) & 0x08, 0x08);
+}
+
 TEST_F(SyncManagerRules, ActivateWriteRaisesAlEventClearedByPdiRead) {
     EXPECT_EQ(al_event() & 0x10, 0u);
     fpwr(*e, 0x080E, {0x01});
@@ -113,11 +137,8 @@ TEST_F(SyncManagerRules, MailboxCommitAtEndOfFrame) {
 
 TEST_F(SyncManagerRules, MailboxWriteInMalformedFrameIsDiscarded) {
     auto f = build({dg(FPWR, 0x1001, 0x1000, kMsgA), dg_len(FPRD, 0x1001, 0x0000, 2)}, 0);
-    f.resize(f.size() - 2);  // second datagram truncated
-    const uint16_t elen = static_cast<uint16_t>(f.size() - 16);
-    f[14] = static_cast<uint8_t>(elen);
-    f[15] = static_cast<uint8_t>(0x10 | (elen >> 8));
-    e->process_frame(f);
+    f.resize(f.size() - 2);  // second datagram truncated: a frame length error
+    EXPECT_FALSE(e->process_frame(f));
     EXPECT_EQ(status(0) & 0x88, 0x00);
     EXPECT_EQ(fpwr(*e, 0x1000, kMsgB).wkc, 1);  // still writable
 }

@@ -40,10 +40,12 @@ std::string error_string(const Bytes& m) {
     return m.size() > 6 ? std::string(m.begin() + 6, m.end()) : "";
 }
 
-// Commit steps from poll() only: deterministic.
+// Commit steps from poll() only: deterministic. The final DATA answered BUSY at once (busy_after_ns = 0),
+// the path of a commit that outlasts ServerConfig::busy_after_ns; the default is tested on its own below.
 ServerConfig stepped() {
     ServerConfig c;
     c.commit_in_thread = false;
+    c.busy_after_ns = 0;
     return c;
 }
 
@@ -431,6 +433,7 @@ TEST_F(FoeServerSession, RandomPacketsNeverCrash) {
 TEST_F(FoeServerSession, CommitOnAWorkerThread) {
     ServerConfig c;
     ASSERT_TRUE(c.commit_in_thread);
+    c.busy_after_ns = 0;
     FoeServer s(store, c);
     s.set_state(od::AlState::Boot);
     const auto image = image_v(0x01300000, 2'000'000);
@@ -461,6 +464,7 @@ TEST_F(FoeServerSession, CommitOnAWorkerThread) {
 TEST_F(FoeServerSession, NewRequestStopsAWorkerCommit) {
     ASSERT_TRUE(is_ack(download(image_v(0x01200000)), 9));
     ServerConfig c;
+    c.busy_after_ns = 0;
     FoeServer s(store, c);
     s.set_state(od::AlState::Boot);
     const auto image = image_v(0x01300000, 1000);
@@ -636,3 +640,99 @@ TEST_F(FoeServerSession, FaultAnyFileNameAcceptsAnUnknownFile) {
     ASSERT_EQ(out.sent.size(), 1u);
     EXPECT_EQ(error_code(out.take()), 0x800Au);
 }
+
+namespace {
+
+// The default (ServerConfig::busy_after_ns): the final DATA is answered once the image is stored, ACK only
+// when it is active; poll() sends that one answer. A master without BUSY (libethercat) sees only ACK.
+struct AnswerWhenStored : Fixture {
+    ServerConfig c = [] {
+        ServerConfig k;
+        k.commit_in_thread = false;
+        return k;
+    }();
+    FoeServer s{store, c};
+    void SetUp() override {
+        Fixture::SetUp();
+        s.on_state_change(od::AlState::Init, od::AlState::Boot);
+    }
+    // Sends everything but the final DATA; returns it.
+    Bytes send_all_but_last(const Bytes& image, uint32_t& packet) {
+        s.handle(request(Opcode::Write, 0, "MAXPOS"), out);
+        EXPECT_TRUE(is_ack(out.take(), 0));
+        packet = 1;
+        std::size_t off = 0;
+        for (; image.size() - off >= kChunk; off += kChunk, ++packet) {
+            s.handle(data(packet, {image.data() + off, kChunk}), out);
+            EXPECT_TRUE(is_ack(out.take(), packet));
+        }
+        return data(packet, {image.data() + off, image.size() - off});
+    }
+};
+
+TEST_F(AnswerWhenStored, FinalDataIsAcknowledgedOnlyOnceTheImageIsActive) {
+    ASSERT_GT(c.busy_after_ns, 0u);
+    uint32_t packet = 0;
+    const Bytes last = send_all_but_last(image_v(0x01400000, 3000), packet);
+    s.handle(last, out);
+    EXPECT_TRUE(out.sent.empty()) << "no answer before the image is stored";
+    Bytes r;
+    int polls = 0;  // each poll() runs one commit step: the answer waits for the last one
+    for (; polls < 1000 && out.sent.empty(); ++polls) {
+        now += 1'000'000;
+        s.poll(now, out);
+    }
+    EXPECT_GT(polls, 1);
+    ASSERT_EQ(out.sent.size(), 1u);
+    r = out.take();
+    EXPECT_TRUE(is_ack(r, packet));
+    EXPECT_EQ(active_version(), 0x01400000u);
+    EXPECT_EQ(s.stats().busy_sent, 0u);
+    EXPECT_TRUE(s.idle());
+    now += 1'000'000;
+    s.poll(now, out);
+    EXPECT_TRUE(out.sent.empty()) << "one answer only";
+}
+
+TEST_F(AnswerWhenStored, ABadImageIsRefusedNotAcknowledged) {
+    auto image = image_v(0x01400000, 3000);
+    image[image.size() / 2] ^= 0x5A;  // the payload no longer matches its CRC
+    uint32_t packet = 0;
+    const Bytes last = send_all_but_last(image, packet);
+    s.handle(last, out);
+    for (int i = 0; i < 1000 && out.sent.empty(); ++i) {
+        now += 1'000'000;
+        s.poll(now, out);
+    }
+    ASSERT_EQ(out.sent.size(), 1u);
+    const Bytes r = out.take();
+    ASSERT_FALSE(r.empty());
+    EXPECT_EQ(r[0], 5);  // ERR
+    EXPECT_NE(active_version(), 0x01400000u);
+}
+
+// A commit still running at busy_after_ns is answered BUSY; the master repeats the DATA and gets the ACK.
+TEST_F(AnswerWhenStored, BusyOnlyAfterTheBound) {
+    uint32_t packet = 0;
+    const Bytes last = send_all_but_last(image_v(0x01400000, 500'000), packet);
+    s.handle(last, out);
+    EXPECT_TRUE(out.sent.empty());
+    now += c.busy_after_ns;  // the first poll() comes after the bound: one commit step, then BUSY
+    s.poll(now, out);
+    ASSERT_EQ(out.sent.size(), 1u);
+    Bytes r = out.take();
+    if (!is_ack(r, packet)) {
+        EXPECT_TRUE(is_busy(r));
+        for (int i = 0; i < 1000 && is_busy(r); ++i) {
+            now += 1'000'000;
+            s.poll(now, out);
+            EXPECT_TRUE(out.sent.empty()) << "after BUSY the answer waits for the repeated DATA";
+            s.handle(last, out);
+            r = out.take();
+        }
+    }
+    EXPECT_TRUE(is_ack(r, packet));
+    EXPECT_EQ(active_version(), 0x01400000u);
+}
+
+}  // namespace

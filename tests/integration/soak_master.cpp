@@ -8,10 +8,11 @@
 // Bad frames go out through their own raw socket with the source address 02:BA:D0:BA:D0:00 (kBadSource), so
 // the test's loss filter can let them pass (every bad frame then reaches the slave and must be counted
 // there). Each bad
-// frame is malformed before its first datagram could execute (an ESC processes datagrams on the fly, so a
-// frame that breaks after a valid write would legitimately change the slave): no room for the EtherCAT
-// header, the header's length beyond the frame, or the first datagram beyond that length; the rest of the
-// frame is random.
+// frame has a frame length error (ESC datasheet section I, Table 57), which the slave counts by reason and
+// of which it executes nothing: a first datagram that runs past the end of the frame, or a NOP datagram
+// followed by more than 64 bytes of padding. The EtherCAT header length is random (it is not evaluated).
+// No frame is shorter than 60 bytes: the slave's link pads a runt as a wire would, so a frame without room
+// for the EtherCAT header cannot reach it.
 #include <net/if.h>
 #include <netpacket/packet.h>
 #include <sys/socket.h>
@@ -88,8 +89,8 @@ bool parse(int argc, char** argv, Options& o) {
 // The raw socket the bad frames leave through.
 class BadFrames {
   public:
-    enum Kind : uint8_t { NoHeader, Length, Datagram, kKinds };
-    static constexpr const char* kNames[kKinds] = {"no_header", "length", "datagram"};
+    enum Kind : uint8_t { Length, Datagram, kKinds };
+    static constexpr const char* kNames[kKinds] = {"length", "datagram"};
 
     BadFrames(const std::string& iface, uint32_t seed) : rng_(seed) {
         fd_ = ::socket(AF_PACKET, SOCK_RAW | SOCK_CLOEXEC, 0);  // protocol 0: send only
@@ -116,25 +117,19 @@ class BadFrames {
         f[12] = kEtherTypeEcat >> 8;
         f[13] = kEtherTypeEcat & 0xFF;
         std::size_t size = 0;
+        f[15] = static_cast<uint8_t>((f[15] & 0x07) | 0x10);  // type 1, a random length (not evaluated)
         switch (kind) {
-            case NoHeader:  // 14 or 15 bytes: EtherType 0x88A4 and not even the 2-byte EtherCAT header
-                size = 14 + rng_() % 2;
-                break;
-            case Length: {  // the header announces more than the frame holds
-                size = 16 + 12 + rng_() % 200;
-                const uint16_t len = static_cast<uint16_t>(size - 16 + 1 + rng_() % (0x7FF - (size - 16)));
-                put16(f.data() + 14, static_cast<uint16_t>(0x1000 | len));
+            case Length: {  // a NOP datagram (no "more" bit) followed by more than 64 bytes of padding
+                size = 16 + 12 + 65 + rng_() % 400;
+                f[16] = 0;  // NOP
+                put16(f.data() + 16 + 6, 0);
                 break;
             }
-            case Datagram: {  // a consistent header whose first datagram does not fit in it
-                size = 16 + rng_() % 300;
-                const std::size_t body = size - 16;
-                put16(f.data() + 14, static_cast<uint16_t>(0x1000 | body));
-                if (body >= 12) {
-                    const std::size_t room = body - 12;  // data bytes the datagram could have
-                    const uint16_t dlen = static_cast<uint16_t>(room + 1 + rng_() % (0x7FF - room));
-                    put16(f.data() + 16 + 6, dlen);  // no "more datagrams" bit: this one is the last
-                }
+            case Datagram: {  // the first datagram does not fit in the frame
+                size = 60 + rng_() % 300;
+                const std::size_t room = size - 16 - 12;  // data bytes the datagram could have
+                const uint16_t dlen = static_cast<uint16_t>(room + 1 + rng_() % (0x7FF - room));
+                put16(f.data() + 16 + 6, dlen);  // no "more datagrams" bit: this one is the last
                 break;
             }
             case kKinds:

@@ -1,6 +1,8 @@
 """Frames crafted with scapy that a real master would never send: the slave survives each one and
 answers the next good frame (ETG.1000.4 frame structure)."""
+import socket
 import struct
+import time
 import unittest
 
 import harness
@@ -43,12 +45,70 @@ class Malformed(unittest.TestCase):
     def test_good_frame_baseline(self):
         self.assert_still_answers(0x10)
 
-    def test_runt_frame_is_answered_at_its_length(self):
+    def test_runt_frame_is_answered_padded(self):
+        # A veth does not pad: the slave's link pads the runt to 60 bytes, as the master's NIC would have on a
+        # wire, and the reply comes back at that length (docs/decisions/esc.md, "Frame tolerance").
         frame = harness.ecat_frame([(BRD, 0x11, 0, 0, b"\x00")], pad=False)  # 29 bytes, no padding
         reply = harness.exchange(self.sock, frame)
         self.assertIsNotNone(reply)
-        self.assertEqual(len(reply), len(frame))
+        self.assertEqual(len(reply), 60)
+        self.assertEqual(reply[29:], b"\x00" * 31)
         self.assertEqual(harness.parse_datagrams(reply)[0][5], 1)
+
+    def test_header_length_not_evaluated(self):
+        # libethercat writes the length of the whole frame into the EtherCAT header; an ESC ignores the field
+        # and walks the datagrams by their own headers.
+        for hdr_len in (60, 0x7FF, 0):
+            frame = bytearray(harness.ecat_frame([(APRD, 0x12, 0, 0x0000, b"\x00\x00")]))
+            struct.pack_into("<H", frame, 14, hdr_len | 0x1000)
+            reply = harness.exchange(self.sock, bytes(frame))
+            self.assertIsNotNone(reply, f"no answer with header length {hdr_len}")
+            self.assertEqual(struct.unpack_from("<H", reply, 14)[0] & 0x7FF, hdr_len)
+            cmd, idx, adp, lf = struct.unpack_from("<BBH2xH", reply, 16)
+            wkc = struct.unpack_from("<H", reply, 16 + 12)[0]
+            self.assertEqual((cmd, idx, adp, wkc), (APRD, 0x12, 1, 1), f"header length {hdr_len}")
+
+    def test_padding(self):
+        # Up to 64 bytes after the last datagram are padding; more is a frame length error: the frame is lost
+        # (ESC datasheet section I, Table 57).
+        body = harness.ecat_frame([(APRD, 0x13, 0, 0x0000, b"\x00\x00")], pad=False)
+        reply = harness.exchange(self.sock, body + b"\x00" * 64)
+        self.assertIsNotNone(reply)
+        self.assertEqual(len(reply), len(body) + 64)
+        frame = harness.ecat_frame([(APRD, 0x14, 0, 0x0000, b"\x00\x00")], pad=False) + b"\x00" * 65
+        reply = harness.exchange(self.sock, frame, timeout=0.3)
+        self.assertTrue(reply is None or harness.parse_datagrams(reply)[0][1] != 0x14, "answered a length error")
+        self.assert_still_answers(0x15)
+
+    def test_udp(self):
+        # EtherCAT in IPv4/UDP to port 0x88A4 (ESC datasheet section I, UDP/IP): processed, UDP checksum cleared.
+        ecat = harness.ecat_frame([(APRD, 0x16, 0, 0x0000, b"\x00\x00")], pad=False)[14:]
+        udp = struct.pack(">HHHH", 0x88A4, 0x88A4, 8 + len(ecat), 0xBEEF) + ecat
+        ip = struct.pack(">BBHHHBBH4s4s", 0x45, 0, 20 + len(udp), 1, 0, 64, 17, 0, bytes([10, 0, 0, 1]),
+                         bytes([10, 0, 0, 255]))
+        frame = b"\xff" * 6 + b"\x01" * 6 + b"\x08\x00" + ip + udp
+        s = socket.socket(socket.AF_PACKET, socket.SOCK_RAW, socket.htons(0x0800))
+        try:
+            s.bind((self.bus.iface, 0))
+            reply = None
+            s.send(frame)
+            deadline = time.monotonic() + 1.0
+            while reply is None and time.monotonic() < deadline:
+                s.settimeout(max(0.01, deadline - time.monotonic()))
+                try:
+                    data, addr = s.recvfrom(2048)
+                except socket.timeout:
+                    break
+                if addr[2] != harness.PACKET_OUTGOING and data[6] & 0x02:
+                    reply = data
+        finally:
+            s.close()
+        self.assertIsNotNone(reply, "no answer to EtherCAT in UDP")
+        self.assertEqual(reply[12:14], b"\x08\x00")
+        self.assertEqual(struct.unpack_from(">H", reply, 40)[0], 0, "UDP checksum not cleared")
+        cmd, idx, adp = struct.unpack_from("<BBH", reply, 44)
+        wkc = struct.unpack_from("<H", reply, 44 + 12)[0]
+        self.assertEqual((cmd, idx, adp, wkc), (APRD, 0x16, 1, 1))
 
     def test_truncated_datagram(self):
         # Header claims 14 bytes of datagrams, the frame ends inside the first one.

@@ -9,6 +9,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <vector>
@@ -80,21 +81,105 @@ class VethLink : public ::testing::TestWithParam<std::string> {
     }
 };
 
-TEST_P(VethLink, EchoesFramesBothWaysAtTheirExactLength) {
+TEST_P(VethLink, EchoesFramesBothWaysRuntsPaddedAsOnAWire) {
     Pair p = make_pair(GetParam());
     std::array<uint8_t, esc::kMaxFrameSize> buf{};
-    // Runt (29 bytes), minimum (60) and full-size frames all arrive at their length: a veth does not pad.
+    // Minimum (60) and full-size frames arrive at their length. A veth does not pad: a runt (29 bytes) is
+    // returned padded with zeros to 60, as the sender's NIC would have put it on a wire.
     for (std::size_t len : {std::size_t{29}, std::size_t{60}, std::size_t{1514}}) {
         const auto f = ecat_frame(len, static_cast<uint8_t>(len));
+        const std::size_t wire = std::max<std::size_t>(len, 60);
+        buf.fill(0xEE);
         ASSERT_TRUE(p.master->send(f));
-        ASSERT_EQ(receive_within(*p.slave, buf, 2000), len);
+        ASSERT_EQ(receive_within(*p.slave, buf, 2000), wire);
         EXPECT_TRUE(std::equal(f.begin(), f.end(), buf.begin()));
+        EXPECT_TRUE(std::all_of(buf.begin() + static_cast<long>(len), buf.begin() + static_cast<long>(wire),
+                                [](uint8_t b) { return b == 0; }));
         buf[6] |= 0x02;  // what an ESC does to the source MAC
-        ASSERT_TRUE(p.slave->send(std::span<const uint8_t>(buf.data(), len)));
+        ASSERT_TRUE(p.slave->send(std::span<const uint8_t>(buf.data(), wire)));
         std::array<uint8_t, esc::kMaxFrameSize> back{};
-        ASSERT_EQ(receive_within(*p.master, back, 2000), len);
+        ASSERT_EQ(receive_within(*p.master, back, 2000), wire);
         EXPECT_EQ(back[6], 0x03);
     }
+}
+
+// ESC datasheet section I, frame processing: VLAN-tagged frames are processed, the tag not modified. The
+// kernel takes the tag off into the ring's metadata; the link puts it back.
+TEST_P(VethLink, VlanTaggedFrameArrivesWithItsTag) {
+    Pair p = make_pair(GetParam());
+    auto f = ecat_frame(60, 0x42);
+    const uint8_t tag[4] = {0x81, 0x00, 0xA0, 0x07};  // priority 5, VLAN 7
+    f.insert(f.begin() + 12, tag, tag + 4);
+    std::array<uint8_t, esc::kMaxFrameSize> buf{};
+    ASSERT_TRUE(p.master->send(f));
+    ASSERT_EQ(receive_within(*p.slave, buf, 2000), f.size());
+    EXPECT_TRUE(std::equal(f.begin(), f.end(), buf.begin()));
+}
+
+// ESC datasheet section I, UDP/IP: EtherCAT in IPv4/UDP to port 0x88A4 reaches the ESC; other IP traffic not.
+TEST_P(VethLink, EtherCatInUdpArrivesOtherIpDoesNot) {
+    Pair p = make_pair(GetParam());
+    auto udp = [](uint16_t port) {
+        std::vector<uint8_t> f(12, 0xFF);
+        for (int i = 6; i < 12; ++i)
+            f[static_cast<std::size_t>(i)] = 0x01;
+        const uint8_t rest[] = {0x08,
+                                0x00,  // IPv4
+                                0x45,
+                                0,
+                                0,
+                                44,
+                                0,
+                                0,
+                                0,
+                                0,
+                                64,
+                                0x11,
+                                0,
+                                0,  // IP: UDP
+                                10,
+                                0,
+                                0,
+                                1,
+                                10,
+                                0,
+                                0,
+                                255,  // addresses
+                                0x88,
+                                0xA4,
+                                static_cast<uint8_t>(port >> 8),  // UDP ports
+                                static_cast<uint8_t>(port),
+                                0,
+                                24,
+                                0x12,
+                                0x34,  // length, checksum
+                                0x0E,
+                                0x10,
+                                1,
+                                0x33,
+                                0,
+                                0,
+                                0x30,
+                                0x01,
+                                2,
+                                0,
+                                0,
+                                0,
+                                0,
+                                0,
+                                0,
+                                0};
+        f.insert(f.end(), rest, rest + sizeof rest);
+        return f;
+    };
+    std::array<uint8_t, esc::kMaxFrameSize> buf{};
+    ASSERT_TRUE(p.master->send(udp(0x0035)));  // DNS: not for an ESC
+    ASSERT_TRUE(p.master->send(udp(0x88A4)));
+    ASSERT_EQ(receive_within(*p.slave, buf, 2000), 60u);
+    EXPECT_EQ(buf[36], 0x88);
+    EXPECT_EQ(buf[37], 0xA4);
+    EXPECT_EQ(buf[42 + 3], 0x33);  // the datagram index: the EtherCAT frame, not the DNS one
+    EXPECT_EQ(receive_within(*p.slave, buf, 200), 0u);
 }
 
 TEST_P(VethLink, OwnRepliesNeverComeBackIn) {

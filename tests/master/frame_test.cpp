@@ -94,21 +94,27 @@ TEST(Frame, ReaderRejectsMalformedFrames) {
     bad[15] = 0x40;  // type 4: not a DLPDU
     EXPECT_FALSE(FrameReader(std::span<const uint8_t>(bad.data(), n)).valid());
 
+    // The header length is not evaluated (the reader walks the chain as an ESC does, docs/decisions/esc.md
+    // "Frame tolerance"): a length far past the frame still reads the datagram.
     bad = out;
-    bad[14] = 0xFF;  // length far past the frame
+    bad[14] = 0xFF;
     bad[15] = 0x17;
-    EXPECT_FALSE(FrameReader(std::span<const uint8_t>(bad.data(), n)).valid());
+    FrameReader l(std::span<const uint8_t>(bad.data(), n));
+    EXPECT_TRUE(l.valid());
+    EXPECT_TRUE(l.next());
+    EXPECT_FALSE(l.next());
+    EXPECT_TRUE(l.valid());
 
     bad = out;
-    bad[22] = 0x20;  // datagram length 32 > header length 14
+    bad[22] = 0x40;  // datagram length 64: past the end of the 60-byte frame
     FrameReader r(std::span<const uint8_t>(bad.data(), n));
     EXPECT_TRUE(r.valid());
     EXPECT_FALSE(r.next());
     EXPECT_FALSE(r.valid());
 
     bad = out;
-    bad[23] = 0x80;  // more bit set on the last datagram: chain runs past the length
-    FrameReader m(std::span<const uint8_t>(bad.data(), n));
+    bad[23] = 0x80;  // more bit set on the last datagram, and no room for another header
+    FrameReader m(std::span<const uint8_t>(bad.data(), 16 + 14));
     EXPECT_TRUE(m.next());
     EXPECT_FALSE(m.next());
     EXPECT_FALSE(m.valid());

@@ -171,3 +171,39 @@ TEST(Strprintf, KeepsTextOfAnyLength) {
     EXPECT_EQ(util::strprintf("%s", ""), "");
     EXPECT_EQ(util::strprintf("%d", -7), "-7");
 }
+
+// The reader walks a chain as an ESC does (docs/decisions/esc.md, "Frame tolerance"): the header Length is
+// not evaluated, a datagram past the end of the frame is malformed, EtherCAT in UDP/IP is found.
+TEST(FrameBuilder, ReaderIgnoresTheHeaderLengthAndFindsUdp) {
+    const uint8_t data[2] = {0x34, 0x12};
+    auto f = esc::wire::FrameBuilder().add(esc::Command::FPWR, 7, 0x1001, 0x0120, data).build();
+    f[14] = 0x3C;  // the whole frame length, as libethercat writes it
+    esc::wire::DatagramReader r(f);
+    esc::wire::DatagramView v;
+    ASSERT_TRUE(r.valid());
+    ASSERT_TRUE(r.next(v));
+    EXPECT_EQ(v.index, 7);
+    EXPECT_FALSE(r.next(v));
+    EXPECT_FALSE(r.malformed());
+    f[16 + 6] = 0x60;  // a datagram length past the end
+    esc::wire::DatagramReader bad(f);
+    EXPECT_FALSE(bad.next(v));
+    EXPECT_TRUE(bad.malformed());
+    // The same chain in IPv4/UDP to port 0x88A4.
+    std::vector<uint8_t> u(f.begin(), f.begin() + 12);
+    const uint8_t ip_udp[30] = {0x08, 0x00, 0x45, 0,  0, 48, 0,   0,    0,    0,    64,   0x11, 0,  0, 10,
+                                0,    0,    1,    10, 0, 0,  255, 0x88, 0xA4, 0x88, 0xA4, 0,    28, 0, 0};
+    u.insert(u.end(), ip_udp, ip_udp + sizeof ip_udp);
+    const auto g = esc::wire::FrameBuilder().add(esc::Command::FPWR, 9, 0x1001, 0x0120, data).build();
+    u.insert(u.end(), g.begin() + 14, g.begin() + 16 + 14);
+    const auto loc = esc::wire::locate_ecat(u);
+    ASSERT_TRUE(loc.found);
+    EXPECT_EQ(loc.header, 42u);
+    EXPECT_EQ(loc.udp_checksum, 40u);
+    esc::wire::DatagramReader ru(u);
+    ASSERT_TRUE(ru.valid());
+    ASSERT_TRUE(ru.next(v));
+    EXPECT_EQ(v.index, 9);
+    u[14] = 0x46;  // IP header length 6: not for an ESC
+    EXPECT_FALSE(esc::wire::DatagramReader(u).valid());
+}

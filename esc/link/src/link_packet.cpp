@@ -2,6 +2,7 @@
 #include "esc/link_packet.hpp"
 
 #include <arpa/inet.h>
+#include <linux/filter.h>
 #include <linux/if_ether.h>
 #include <linux/if_packet.h>
 #include <net/if.h>
@@ -20,6 +21,25 @@ namespace esc {
 namespace {
 
 constexpr uint16_t kEtherTypeEcat = wire::kEtherType;
+
+// The socket filter (classic BPF) over the frame as the kernel hands it over, a VLAN tag already taken off
+// into the slot header: EtherType 0x88A4, an 802.1Q tag left in place (a second one), or IPv4 with header
+// length 5, protocol UDP and destination port 0x88A4 (what an ESC evaluates, ESC datasheet section I,
+// UDP/IP).
+constexpr sock_filter kFilter[] = {
+    BPF_STMT(BPF_LD | BPF_H | BPF_ABS, 12),                           // 0: EtherType
+    BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, kEtherTypeEcat, 8, 0),        // 1: -> accept
+    BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, wire::kEtherTypeVlan, 7, 0),  // 2: -> accept
+    BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, wire::kEtherTypeIpv4, 0, 7),  // 3: else -> reject
+    BPF_STMT(BPF_LD | BPF_B | BPF_ABS, 14),                           // 4: IP version and header length
+    BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, 0x45, 0, 5),                  // 5
+    BPF_STMT(BPF_LD | BPF_B | BPF_ABS, 23),                           // 6: IP protocol
+    BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, 0x11, 0, 3),                  // 7
+    BPF_STMT(BPF_LD | BPF_H | BPF_ABS, 36),                           // 8: UDP destination port
+    BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, wire::kUdpPortEcat, 0, 1),    // 9
+    BPF_STMT(BPF_RET | BPF_K, 0xFFFF),                                // 10: accept
+    BPF_STMT(BPF_RET | BPF_K, 0),                                     // 11: reject
+};
 // Ring geometry: 2 KiB slots (TPACKET2 header + sockaddr_ll + a 1518-byte frame fit), 8 slots per 16 KiB
 // block, 16 blocks: 128 frames may wait before the kernel drops.
 constexpr std::size_t kSlotSize = 2048;
@@ -66,6 +86,11 @@ PacketLink::PacketLink(const std::string& iface) : iface_(iface) {
     (void)::setsockopt(fd_, SOL_PACKET, PACKET_IGNORE_OUTGOING, &one, sizeof one);
     (void)::setsockopt(fd_, SOL_PACKET, PACKET_QDISC_BYPASS, &one, sizeof one);
 
+    sock_fprog prog{};
+    prog.len = static_cast<unsigned short>(sizeof kFilter / sizeof kFilter[0]);
+    prog.filter = const_cast<sock_filter*>(kFilter);
+    if (::setsockopt(fd_, SOL_SOCKET, SO_ATTACH_FILTER, &prog, sizeof prog) < 0) fail("SO_ATTACH_FILTER");
+
     tpacket_req req{};
     req.tp_block_size = kBlockSize;
     req.tp_block_nr = kBlockCount;
@@ -81,7 +106,7 @@ PacketLink::PacketLink(const std::string& iface) : iface_(iface) {
 
     sockaddr_ll addr{};
     addr.sll_family = AF_PACKET;
-    addr.sll_protocol = htons(kEtherTypeEcat);
+    addr.sll_protocol = htons(ETH_P_ALL);  // the filter chooses: VLAN-tagged and UDP frames too
     addr.sll_ifindex = ifindex_;
     if (::bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) < 0) fail("bind");
 
@@ -107,8 +132,24 @@ std::size_t PacketLink::receive(std::span<uint8_t> buf) {
                                                                TPACKET_ALIGN(sizeof(tpacket2_hdr)));
         std::size_t n = 0;
         if (sll->sll_pkttype != PACKET_OUTGOING && hdr->tp_mac + hdr->tp_snaplen <= frame_size_) {
-            n = std::min<std::size_t>(hdr->tp_snaplen, buf.size());
-            std::memcpy(buf.data(), reinterpret_cast<const uint8_t*>(hdr) + hdr->tp_mac, n);
+            const uint8_t* data = reinterpret_cast<const uint8_t*>(hdr) + hdr->tp_mac;
+            const std::size_t len = hdr->tp_snaplen;
+            if ((status & TP_STATUS_VLAN_VALID) != 0 && len >= 12 && buf.size() >= 16) {
+                // The tag the kernel took off goes back after the source MAC, unchanged.
+                const uint16_t tpid =
+                    (status & TP_STATUS_VLAN_TPID_VALID) != 0 ? hdr->tp_vlan_tpid : wire::kEtherTypeVlan;
+                std::memcpy(buf.data(), data, 12);
+                buf[12] = static_cast<uint8_t>(tpid >> 8);
+                buf[13] = static_cast<uint8_t>(tpid);
+                buf[14] = static_cast<uint8_t>(hdr->tp_vlan_tci >> 8);
+                buf[15] = static_cast<uint8_t>(hdr->tp_vlan_tci);
+                n = std::min<std::size_t>(len + 4, buf.size());
+                std::memcpy(buf.data() + 16, data + 12, n - 16);
+            } else {
+                n = std::min<std::size_t>(len, buf.size());
+                std::memcpy(buf.data(), data, n);
+            }
+            n = pad_to_minimum(buf, n);
         }
         __atomic_store_n(&hdr->tp_status, static_cast<uint32_t>(TP_STATUS_KERNEL), __ATOMIC_RELEASE);
         next_ = (next_ + 1) % frame_count_;

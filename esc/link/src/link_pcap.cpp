@@ -9,6 +9,12 @@ namespace esc {
 
 namespace {
 
+// What an ESC processes (ESC datasheet section I, "EtherCAT protocol", "UDP/IP"): EtherType 0x88A4 and
+// EtherCAT in UDP/IP, each also behind an 802.1Q tag. The ESC checks the rest (IP header length 5).
+constexpr const char* kFilter =
+    "ether proto 0x88a4 or (ip and udp dst port 0x88a4) or "
+    "(vlan and (ether proto 0x88a4 or (ip and udp dst port 0x88a4)))";
+
 std::string permission_hint(const std::string& iface) {
     return "no permission to capture on '" + iface +
            "': raw sockets need CAP_NET_RAW (and CAP_NET_ADMIN for promiscuous mode); run as root or "
@@ -54,7 +60,7 @@ PcapLink::PcapLink(const std::string& iface) : iface_(iface) {
     if (pcap_setdirection(handle_, PCAP_D_IN) != 0)
         fail(LinkError::Kind::System, "pcap_setdirection(" + iface + "): " + pcap_geterr(handle_));
     bpf_program prog{};
-    if (pcap_compile(handle_, &prog, "ether proto 0x88a4", 1, PCAP_NETMASK_UNKNOWN) != 0)
+    if (pcap_compile(handle_, &prog, kFilter, 1, PCAP_NETMASK_UNKNOWN) != 0)
         fail(LinkError::Kind::System, "pcap_compile: " + std::string(pcap_geterr(handle_)));
     const int frc = pcap_setfilter(handle_, &prog);
     pcap_freecode(&prog);
@@ -76,7 +82,7 @@ std::size_t PcapLink::receive(std::span<uint8_t> buf) {
     if (rc != 1 || hdr == nullptr || data == nullptr) return 0;
     const std::size_t n = std::min<std::size_t>(hdr->caplen, buf.size());
     std::memcpy(buf.data(), data, n);
-    return n;
+    return pad_to_minimum(buf, n);
 }
 
 bool PcapLink::send(std::span<const uint8_t> frame) {

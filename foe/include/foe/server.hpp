@@ -40,6 +40,12 @@ struct ServerConfig {
     // Run the commit steps on a worker thread instead of one per poll(): an fsync (10-20 ms on a disk)
     // then never holds up the frame loop. poll() and the repeated DATA only look at its progress.
     bool commit_in_thread = true;
+    // The final DATA is answered when the image is stored: ACK once it is active, ERR if storing failed
+    // (what SOES and Beckhoff's SSC do; libethercat's FoE client knows no BUSY). Only a commit still
+    // running after this long is answered BUSY, well before the shortest mailbox timeout of the masters
+    // (ecatctl 1 s, SOEM's firm_update 2 s, IgH 3 s); the master then repeats the DATA
+    // (docs/decisions/foe.md). 0: BUSY at once.
+    uint64_t busy_after_ns = 500'000'000ull;
     FoeFaults faults;  // testing aid: deliberate deviations (foe/faults.hpp), all off
 
     // Sizes and device name from the device description.
@@ -110,6 +116,11 @@ class FoeServer final : public ecat::MailboxHandler {
     StoreError error_;
     uint64_t now_ns_ = 0;
     uint64_t activity_ns_ = 0;
+    // The final DATA waits for its answer until the commit ends or busy_at_ns_ (ServerConfig::busy_after_ns).
+    bool answer_pending_ = false;
+    uint32_t pending_packet_ = 0;
+    uint64_t busy_at_ns_ = 0;
+    void answer_pending(ecat::MailboxSender& out);
 
     // Writing: next expected packet; the largest DATA payload seen this transfer.
     uint32_t packet_ = 0;

@@ -53,12 +53,12 @@ struct FrameCheck {
 // Counters of what the ECAT side saw (also reflected in the error counter registers 0x0300-0x0313).
 struct EscStats {
     uint64_t frames_processed = 0;
-    uint64_t frames_ignored = 0;    // not EtherCAT (wrong EtherType / type field)
-    uint64_t frames_malformed = 0;  // length fields disagree with the frame, datagram past the end, ...
-    // frames_malformed by reason (they add up to it):
-    uint64_t malformed_no_header = 0;  // EtherType 0x88A4 but no room for the 2-byte EtherCAT header
-    uint64_t malformed_length = 0;     // the EtherCAT header's length runs past the end of the frame
-    uint64_t malformed_datagram = 0;   // a datagram header or its data runs past that length
+    uint64_t frames_ignored = 0;    // not EtherCAT (EtherType, UDP port) or not type 1
+    uint64_t frames_malformed = 0;  // frame length errors (ESC datasheet section I, Table 57)
+    // frames_malformed by reason (they add up to it). The EtherCAT header's Length is not evaluated.
+    uint64_t malformed_no_header = 0;  // EtherCAT (0x88A4 or UDP) but no room for the 2-byte EtherCAT header
+    uint64_t malformed_length = 0;     // more than 64 bytes of padding after the last datagram
+    uint64_t malformed_datagram = 0;   // a datagram header or its data runs past the end of the frame
     uint64_t datagrams = 0;
     // receive(): frames destroyed (received at a closed or non-existent port, circulating a second time,
     // or not EtherCAT at the processing unit, which frames_ignored counts as well) and frames with a bad
@@ -79,7 +79,9 @@ class Esc final : public Pdi {
     // processing unit does: datagrams executed in order, working counters incremented, ADP incremented,
     // source MAC bit 1 set. rx_time_ns is the Clock time the frame's first bit arrived (DC receive-time
     // latch); pass 0 to use the clock's current time. Returns true if the frame is to be sent back out
-    // (an EtherCAT frame, processed or not), false if it is to be dropped. This is receive() at port 0 for
+    // (an EtherCAT frame, processed or not), false if it is to be dropped: not EtherCAT (with DL control
+    // 0x0100 bit 0 set), or a frame length error, which hardware sends on with a bad FCS that the master's
+    // NIC discards (docs/decisions/esc.md, "Frame tolerance"). This is receive() at port 0 for
     // an ESC alone on its wire: true when the frame leaves through port 0 again.
     bool process_frame(std::span<uint8_t> frame, uint64_t rx_time_ns = 0);
 
@@ -122,7 +124,9 @@ class Esc final : public Pdi {
     // the processing unit where it passes it and returns the next port that is open, i.e. where the frame
     // leaves the ESC; that can be `port` itself (all others closed). Returns -1 if the frame is destroyed:
     // received at a closed or non-existent port, or circulating a second time (the circulating bit of the
-    // first datagram set on its way through the processing unit while port 0 is closed, ETG.1000.4).
+    // first datagram set on its way through the processing unit while port 0 is closed, ETG.1000.4), or not
+    // EtherCAT with the forwarding rule set. A frame length error leaves marked in `check` (crc_bad, marked),
+    // as hardware aborts it with a bad FCS; without a FrameCheck it is destroyed.
     // Receive-time latches: a write to 0x0900 arms them; port 0 (0x0900) latches that frame's arrival at
     // port 0, ports 1-3 (0x0904/0x0908/0x090C) the arrival of the next frame received at that port.
     int receive(std::span<uint8_t> frame, int port, uint64_t rx_clock_ns = 0);

@@ -114,30 +114,75 @@ struct DatagramView {
     uint32_t logical() const { return logical_address(adp, ado); }
 };
 
-// Walks the datagram chain of a frame without copying. valid() is false for anything that is not a
-// well-formed EtherCAT type-1 frame (wrong EtherType, length field past the end); next() returns false at
-// the end of the chain and sets malformed() if the chain ended without a datagram with M = 0 or a datagram
-// ran past the announced length.
+// Where a frame's EtherCAT header is, as an ESC finds it (ESC datasheet section I, "EtherCAT protocol" and
+// "UDP/IP"): after EtherType 0x88A4, after one IEEE 802.1Q tag (not evaluated, not modified), or in an
+// IPv4/UDP datagram to port 0x88A4. For UDP/IP an ESC evaluates only EtherType 0x0800, IP version 4, IP
+// header length 5, protocol 0x11 and the UDP destination port; the UDP checksum it clears, since it changes
+// the payload.
+constexpr uint16_t kEtherTypeIpv4 = 0x0800;
+constexpr uint16_t kUdpPortEcat = 0x88A4;
+constexpr std::size_t kIpv4HeaderSize = 20;
+constexpr std::size_t kUdpHeaderSize = 8;
+struct EcatLocation {
+    bool found = false;            // an EtherCAT frame (the header itself may lie past the end: a runt)
+    std::size_t header = 0;        // offset of the 2-byte EtherCAT header
+    std::size_t udp_checksum = 0;  // offset of the UDP checksum; 0 if not carried in UDP/IP
+};
+inline EcatLocation locate_ecat(std::span<const uint8_t> frame, bool accept_vlan = true) {
+    EcatLocation loc;
+    const std::size_t size = frame.size();
+    if (size < kEthernetHeaderSize) return loc;
+    std::size_t off = 12;
+    uint16_t type = static_cast<uint16_t>((frame[off] << 8) | frame[off + 1]);
+    if (accept_vlan && type == kEtherTypeVlan) {
+        off += 4;
+        if (size < off + 2) return loc;
+        type = static_cast<uint16_t>((frame[off] << 8) | frame[off + 1]);
+    }
+    off += 2;
+    if (type == kEtherType) {
+        loc.found = true;
+        loc.header = off;
+    } else if (type == kEtherTypeIpv4 && size >= off + kIpv4HeaderSize + kUdpHeaderSize) {
+        const uint8_t* ip = frame.data() + off;
+        const uint16_t port = static_cast<uint16_t>((ip[kIpv4HeaderSize + 2] << 8) | ip[kIpv4HeaderSize + 3]);
+        if (ip[0] == 0x45 && ip[9] == 0x11 && port == kUdpPortEcat) {
+            loc.found = true;
+            loc.udp_checksum = off + kIpv4HeaderSize + 6;
+            loc.header = off + kIpv4HeaderSize + kUdpHeaderSize;
+        }
+    }
+    return loc;
+}
+
+// An ESC ignores the EtherCAT header's Length (ESC datasheet section I, Table 2: "The EtherCAT header length
+// field is ignored by ESCs, they rely on the datagram length fields"): it walks the datagrams by their own
+// lengths and More bits up to the real end of the frame. What follows the last datagram is padding; more than
+// kMaxPadding bytes of it is a frame length error (ibid., Table 57), as is a datagram that runs past the end.
+constexpr std::size_t kMaxPadding = 64;
+
+// Walks the datagram chain of a frame without copying, as an ESC does (above). valid() is false for anything
+// that is not an EtherCAT type-1 frame or has no room for the EtherCAT header; next() returns false at the
+// end of the chain and sets malformed() if a datagram ran past the end of the frame (or the frame ended where
+// a datagram with M = 1 promised another).
 class DatagramReader {
   public:
-    // accept_vlan: one 802.1Q tag may precede the EtherType. check_type: the EtherType and the EtherCAT
-    // header type must be right (false: take the chain as it stands, a test's view of a frame).
+    // accept_vlan: one 802.1Q tag may precede the EtherType. check_type: the frame must be EtherCAT
+    // (EtherType, VLAN, UDP/IP as locate_ecat) of type 1 (false: the chain starts at byte 16, a test's view
+    // of a frame).
     explicit DatagramReader(std::span<const uint8_t> frame, bool accept_vlan = true, bool check_type = true)
         : frame_(frame) {
-        if (frame.size() < kFrameHeaderSize) return;
-        std::size_t off = 12;
-        uint16_t type = static_cast<uint16_t>((frame[off] << 8) | frame[off + 1]);
-        if (accept_vlan && type == kEtherTypeVlan) {
-            off += 4;
-            if (frame.size() < off + 2 + kEcatHeaderSize) return;
-            type = static_cast<uint16_t>((frame[off] << 8) | frame[off + 1]);
+        std::size_t off = kEthernetHeaderSize;
+        if (check_type) {
+            const EcatLocation loc = locate_ecat(frame, accept_vlan);
+            if (!loc.found) return;
+            off = loc.header;
         }
-        off += 2;
+        if (frame.size() < off + kEcatHeaderSize) return;
         const uint16_t header = static_cast<uint16_t>(frame[off] | (frame[off + 1] << 8));
-        if (check_type && (type != kEtherType || (header >> 12) != kEcatTypeDatagrams)) return;
+        if (check_type && (header >> 12) != kEcatTypeDatagrams) return;
         pos_ = off + kEcatHeaderSize;
-        end_ = pos_ + (header & kEcatLengthMask);
-        if (end_ > frame.size()) return;
+        end_ = frame.size();
         valid_ = true;
     }
     bool valid() const { return valid_; }

@@ -2,8 +2,8 @@
 // A link carries whole Ethernet frames (destination MAC .. payload, no FCS) between the ESC and the wire.
 //
 // Implementations (each in its own header):
-//   esc/link_pcap.hpp      PcapLink      libpcap, immediate mode, inbound only, BPF "ether proto 0x88a4"
-//   esc/link_packet.hpp    PacketLink    AF_PACKET socket with a TPACKET_V2 memory-mapped receive ring
+//   esc/link_pcap.hpp      PcapLink      libpcap, immediate mode, inbound only, BPF: EtherCAT (also VLAN,
+//   UDP) esc/link_packet.hpp    PacketLink    AF_PACKET socket with a TPACKET_V2 memory-mapped receive ring
 //   esc/link_loopback.hpp  LoopbackLink  two in-process ends joined by frame queues (tests)
 //   esc/link_capture.hpp   PcapWriter    records frames to a .pcap file for Wireshark
 #include <cstddef>
@@ -22,7 +22,10 @@ class Link {
     virtual int fd() const = 0;
     // Receives one frame into buf without blocking. Returns its length, 0 if nothing is waiting.
     // Frames this host sent itself (PACKET_OUTGOING) are never returned.
-    // A frame longer than buf is truncated to buf.size().
+    // A frame longer than buf is truncated to buf.size(). A frame shorter than the Ethernet minimum (60 bytes
+    // without FCS) is returned padded with zeros to 60, as the sender's NIC puts it on a wire (a veth pads
+    // nothing), so the reply has the length a hardware ESC returns (docs/decisions/esc.md, "Frame
+    // tolerance").
     virtual std::size_t receive(std::span<uint8_t> buf) = 0;
     // Sends one frame. Returns false on error.
     virtual bool send(std::span<const uint8_t> frame) = 0;
@@ -49,6 +52,15 @@ class LinkError : public std::runtime_error {
 
 // Largest frame a link returns (Ethernet header + 1500 payload + VLAN tag, rounded up).
 inline constexpr std::size_t kMaxFrameSize = 2048;
+// The Ethernet minimum without FCS; receive() pads shorter frames to it.
+inline constexpr std::size_t kMinFrameSize = 60;
+// Pads frame[0, n) with zeros to kMinFrameSize within buf; returns the new length.
+inline std::size_t pad_to_minimum(std::span<uint8_t> buf, std::size_t n) {
+    if (n == 0 || n >= kMinFrameSize || buf.size() < kMinFrameSize) return n;
+    for (std::size_t i = n; i < kMinFrameSize; ++i)
+        buf[i] = 0;
+    return kMinFrameSize;
+}
 
 // Throws LinkError (NoSuchInterface / InterfaceDown) unless iface exists and is up.
 void check_interface(const std::string& iface);

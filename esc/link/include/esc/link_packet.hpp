@@ -1,10 +1,13 @@
 #pragma once
-// PacketLink: a Link over an AF_PACKET raw socket bound to one interface and EtherType 0x88A4.
-// Receives through a TPACKET_V2 memory-mapped ring (one frame per slot, so poll() wakes per frame; TPACKET_V3
-// would hand over whole blocks after a retire timeout of at least a millisecond). Own transmissions are
-// dropped by PACKET_IGNORE_OUTGOING and, as a second line, by skipping slots marked PACKET_OUTGOING.
-// The interface is put in promiscuous mode (PACKET_MR_PROMISC) because masters do not always send to
-// broadcast. Sends with send() on the bound socket, bypassing the qdisc (PACKET_QDISC_BYPASS).
+// PacketLink: a Link over an AF_PACKET raw socket bound to one interface. A socket filter passes what an ESC
+// processes (ESC datasheet section I, "EtherCAT protocol"): EtherType 0x88A4, VLAN-tagged frames, and
+// IPv4/UDP to port 0x88A4. The kernel takes a VLAN tag off into the ring slot's header; receive() puts it
+// back where it was, so the frame and its reply carry it as on a wire. Receives through a TPACKET_V2
+// memory-mapped ring (one frame per slot, so poll() wakes per frame; TPACKET_V3 would hand over whole blocks
+// after a retire timeout of at least a millisecond). Own transmissions are dropped by PACKET_IGNORE_OUTGOING
+// and, as a second line, by skipping slots marked PACKET_OUTGOING. The interface is put in promiscuous mode
+// (PACKET_MR_PROMISC) because masters do not always send to broadcast. Sends with send() on the bound socket,
+// bypassing the qdisc (PACKET_QDISC_BYPASS).
 #include <string>
 
 #include "esc/link.hpp"

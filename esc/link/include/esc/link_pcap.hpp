@@ -1,8 +1,9 @@
 #pragma once
 // PcapLink: a Link over libpcap. Opens the interface promiscuous, in immediate mode (every frame is handed
 // over as it arrives, no buffering timeout), snaplen 2048, inbound only (pcap_setdirection PCAP_D_IN, so
-// our own replies never come back in), with the BPF filter "ether proto 0x88a4", non-blocking, and exposes
-// pcap_get_selectable_fd() for poll(). Sends with pcap_inject().
+// our own replies never come back in), with a BPF filter for EtherCAT frames (EtherType 0x88A4, UDP port
+// 0x88A4, also VLAN-tagged), non-blocking, and exposes pcap_get_selectable_fd() for poll(). Sends with
+// pcap_inject().
 #include <string>
 
 #include "esc/link.hpp"

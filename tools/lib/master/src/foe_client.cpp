@@ -108,6 +108,8 @@ Error FoeClient::write(std::string_view name, std::span<const uint8_t> data, uin
         const std::size_t n = std::min(full, data.size() - done);
         const auto chunk = data.subspan(done, n);
         if (Error e = send(kData, packet, chunk); e != Error::Ok) return e;
+        // After the last packet the slave stores the image before it answers (or answers BUSY while it does).
+        if (n < full && progress_) progress_(FoeProgress{done + n, data.size(), true});
         for (;;) {
             if (Error e = receive(op, value, rest); e != Error::Ok) return e;
             if (op == kBusy) {
