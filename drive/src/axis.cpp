@@ -206,12 +206,11 @@ void Axis::derive() {
         count_ = static_cast<int64_t>(std::floor(pol_ * phys_angle * res_ / kTwoPi));
         prev_raw_pos_ = phys_angle * res_ / kTwoPi;
         home_.invalidate();
-        ctl_.obs_pos = inc_to_rad(static_cast<double>(count_) + 0.5);
-        ctl_.obs_vel = ctl_.obs_load = 0;
+        ctl_.rebase(inc_to_rad(static_cast<double>(count_) + 0.5));
         sp_.reset_to(static_cast<double>(count_));
         plant_dirty_ = true;  // the stops are given in increments
     }
-    ctl_.km = params.torque_constant * 1e-6;
+    ctl_.set_torque_constant(params.torque_constant);
     const double km_plant = ctl_.km > 0 ? ctl_.km : motor_.torque_constant;
     if (plant_dirty_ || km_plant != km_plant_ || env_.take_stops_changed()) {
         // configure() keeps the state (current, speed, angle): changing the model does not jump.
@@ -294,7 +293,7 @@ void Axis::cycle(int64_t now_ns, int64_t dt_ns) {
         func_ = functions(pins_);
         prev_raw_pos_ = phys_position_inc();
         count_ = static_cast<int64_t>(std::floor(raw_position_inc()));
-        ctl_.obs_pos = inc_to_rad(static_cast<double>(count_) + 0.5);
+        ctl_.start_at(inc_to_rad(static_cast<double>(count_) + 0.5));
         dc_.start(*sink_);
     }
     tp_.configure(command.touch_probe_function);
@@ -302,7 +301,7 @@ void Axis::cycle(int64_t now_ns, int64_t dt_ns) {
         // A running homing ends with the mode: interrupted, to be started again.
         if (sp_.mode() == mode::Homing) home_.interrupt();
         sp_.switch_mode(command.mode, dc_.power(), static_cast<double>(count_));
-        ctl_.vel_ref = dc_.power() ? ctl_.vel_ref : 0.0;
+        ctl_.mode_switched(dc_.power());
         if (command.mode == mode::Homing) home_.entered();
     }
     {

@@ -134,7 +134,7 @@ void Controller::tune(const Parameters& p, double km_plant) {
     tuned = in;
     // 0x30A1: bandwidth, damping, reset time, inertia, friction -> cascade gains by pole placement
     // (docs/decisions/drive.md "Control loops").
-    km = p.torque_constant * 1e-6;
+    set_torque_constant(p.torque_constant);
     const double k = km > 0 ? km : km_plant;
     j = std::max<double>(p.inertia, 1.0) * 1e-10;
     r = p.friction * 1e-9 * 60.0 / kTwoPi;

@@ -102,3 +102,22 @@ TEST(ControllerPart, ThermalModelLimitsAboveTheNominalCurrent) {
         c.observe(0, 0, 0.03);
     EXPECT_FALSE(c.i2t_active);
 }
+
+TEST(ControllerPart, ModeSwitchAndFrameChange) {
+    Controller c;
+    c.vel_ref = 3;
+    c.mode_switched(true);
+    EXPECT_EQ(c.vel_ref, 3);
+    c.mode_switched(false);
+    EXPECT_EQ(c.vel_ref, 0);
+    c.obs_vel = 7;
+    c.obs_load = 0.1;
+    c.vel_int = 0.5;
+    c.rebase(2.0);
+    EXPECT_EQ(c.obs_pos, 2.0);
+    EXPECT_EQ(c.obs_vel, 0);
+    EXPECT_EQ(c.obs_load, 0);
+    EXPECT_EQ(c.vel_int, 0.5);  // the loops keep their state
+    c.set_torque_constant(25500);
+    EXPECT_NEAR(c.km, 0.0255, 1e-12);
+}

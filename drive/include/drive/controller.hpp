@@ -60,6 +60,17 @@ struct Controller {
     }
     // Transition 4: the integrators start empty.
     void power_on() { vel_int = cur_int = 0; }
+    // A new mode of operation: without power the speed reference drops to zero.
+    void mode_switched(bool power) { vel_ref = power ? vel_ref : 0.0; }
+    // The observer starts at `pos_rad` (start-up).
+    void start_at(double pos_rad) { obs_pos = pos_rad; }
+    // The encoder frame changed (resolution, polarity): the observer restarts at rest at `pos_rad`.
+    void rebase(double pos_rad) {
+        obs_pos = pos_rad;
+        obs_vel = obs_load = 0;
+    }
+    // 0x3001:05 in uNm/A (0 = not configured); tune() derives the gains from it.
+    void set_torque_constant(uint32_t unm_per_a) { km = unm_per_a * 1e-6; }
     // Position loop (P, 2.5 kHz) on the demand (raw inc, inc/s, inc/s^2) against the encoder count `actual`:
     // the speed reference; with `internal_ff` (profile modes, stops) the demand's own speed and the inertia
     // and friction feed-forward, otherwise the CSP velocity offset. `rad_per_inc`: 2 pi / resolution.
