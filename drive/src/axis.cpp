@@ -31,8 +31,7 @@ int32_t Axis::clamp_i32(double v) const {
 }
 
 double Axis::decel_limit(double rpm_s) const {
-    const double a = std::min<double>(std::max(rpm_s, 1.0), static_cast<double>(params.max_acceleration));
-    return rpm_to_inc_s(a);
+    return limited_acceleration(rpm_s, params.max_acceleration, res_);
 }
 
 PositionFrame Axis::frame() const {
@@ -40,8 +39,8 @@ PositionFrame Axis::frame() const {
 }
 
 DeviceControl::Options Axis::dc_options() const {
-    return {params.shutdown, params.disable_operation, decel_limit(params.profile_deceleration),
-            decel_limit(params.quick_stop_deceleration)};
+    return {params.shutdown, params.disable_operation, params.profile_deceleration,
+            params.quick_stop_deceleration};
 }
 
 // What device control's transitions ask of the other parts.
@@ -57,12 +56,13 @@ class Axis::Parts final : public DeviceControl::Parts {
         a_.ctl_.power_on();
         a_.sp_.power_on(static_cast<double>(a_.count_));
     }
-    void stopping(StopKind kind) override {
+    double stopping(StopKind kind, double decel_rpm_s) override {
         // A stop (quick stop, shutdown, fault) ends a running homing: interrupted, to be started again.
         a_.home_.interrupt(HomingPhase::Finished);
+        if (kind != StopKind::Ramp) return 0;
         // A ramp starts where the motor really is (position and speed), whatever the set-points did.
-        if (kind == StopKind::Ramp)
-            a_.sp_.ramp_from(static_cast<double>(a_.count_), a_.ctl_.obs_vel * a_.res_ / kTwoPi);
+        a_.sp_.ramp_from(static_cast<double>(a_.count_), a_.ctl_.obs_vel * a_.res_ / kTwoPi);
+        return a_.decel_limit(decel_rpm_s);
     }
     void resumed() override { a_.sp_.resume(); }
     bool fault_reset() override {
@@ -173,14 +173,7 @@ void Axis::trajectory_tick(int64_t t_ns) {
         sp_.from_profile();
         return;
     }
-    const SetpointGenerator::Inputs in{
-        static_cast<double>(count_),
-        ctl_.obs_vel,
-        static_cast<double>(res_),
-        decel_limit(params.profile_acceleration),
-        decel_limit(params.profile_deceleration),
-        decel_limit(params.quick_stop_deceleration),
-        rpm_to_inc_s(std::min(params.profile_velocity, params.max_profile_velocity))};
+    const SetpointGenerator::Inputs in{static_cast<double>(count_), ctl_.obs_vel, static_cast<double>(res_)};
     const LoopReference ref = sp_.tick(command, params, in, frame(), t_ns, h);
     ctl_.follow(ref, sp_.control());  // the loop the tick chose
 }

@@ -12,16 +12,16 @@ void DeviceControl::enter(State s, EventSink& sink) {
     sink.diag(Severity::Info, 0, to_string(s));
 }
 
-void DeviceControl::begin_stop(StopKind kind, double decel, Parts& parts) {
+void DeviceControl::begin_stop(StopKind kind, double decel_rpm_s, Parts& parts) {
     stop_ = kind;
     ramp_done_ = false;
+    const double decel = parts.stopping(kind, decel_rpm_s);
     if (kind == StopKind::Ramp) {
         stop_decel_ = decel;
     } else if (kind == StopKind::Disable) {
         power_ = false;
         ramp_done_ = true;
     }
-    parts.stopping(kind);
 }
 
 void DeviceControl::command(uint16_t c, const AxisFaults& faults, const Options& o, Parts& parts,

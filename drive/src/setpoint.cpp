@@ -137,7 +137,10 @@ LoopReference SetpointGenerator::tick(const Command& c, const Parameters& p, con
                                       const PositionFrame& f, int64_t t_ns, double h) {
     LoopReference ref;
     const double rated_a = p.nominal_current * 1e-3;  // rated torque / km
-    const double acc = in.acc, dec = in.dec, qs = in.quick_stop;
+    // The profile modes' limits (inc/s^2).
+    auto limit = [&](uint32_t rpm_s) {
+        return limited_acceleration(rpm_s, p.max_acceleration, in.resolution);
+    };
     switch (mode_) {
         case mode::CyclicSyncPosition: {
             const double fr =
@@ -173,11 +176,14 @@ LoopReference SetpointGenerator::tick(const Command& c, const Parameters& p, con
             profile_.reset(demand_pos_, demand_vel_);
             return ref;
         }
-        case mode::ProfilePosition:
+        case mode::ProfilePosition: {
+            const double acc = limit(p.profile_acceleration), dec = limit(p.profile_deceleration);
+            const double qs = limit(p.quick_stop_deceleration);
+            const double vmax = std::min(p.profile_velocity, p.max_profile_velocity) * in.resolution / 60.0;
             if (halted_) {
                 profile_.step_velocity(0.0, qs, qs, h);
             } else if (ppm_moving_) {
-                if (profile_.step_position(ppm_target_, in.max_velocity, acc, dec, h)) {
+                if (profile_.step_position(ppm_target_, vmax, acc, dec, h)) {
                     ppm_moving_ = false;
                     if (ppm_buffered_) {
                         ppm_buffered_ = false;
@@ -191,7 +197,10 @@ LoopReference SetpointGenerator::tick(const Command& c, const Parameters& p, con
             }
             from_profile();
             return ref;
+        }
         case mode::ProfileVelocity: {
+            const double acc = limit(p.profile_acceleration), dec = limit(p.profile_deceleration);
+            const double qs = limit(p.quick_stop_deceleration);
             const double vlim = static_cast<double>(std::min(p.max_profile_velocity, p.max_motor_speed));
             const double v = std::clamp(static_cast<double>(c.target_velocity), -vlim, vlim);
             if (halted_)
@@ -201,10 +210,12 @@ LoopReference SetpointGenerator::tick(const Command& c, const Parameters& p, con
             from_profile();
             return ref;
         }
-        default:
+        default: {
+            const double dec = limit(p.profile_deceleration);
             profile_.step_velocity(0.0, dec, dec, h);
             from_profile();
             return ref;
+        }
     }
 }
 

@@ -20,7 +20,11 @@ struct FakeParts final : DeviceControl::Parts {
     std::vector<uint16_t> faults;
     uint16_t enable_refused() override { return refuse; }
     void powered() override { ++powered_calls; }
-    void stopping(StopKind k) override { stops.push_back(k); }
+    // Stands in for the limit by 0x60C5 and the unit conversion: twice the rpm/s.
+    double stopping(StopKind k, double decel_rpm_s) override {
+        stops.push_back(k);
+        return 2 * decel_rpm_s;
+    }
     void resumed() override { ++resumed_calls; }
     bool fault_reset() override {
         ++reset_calls;
@@ -35,7 +39,7 @@ struct DcRig {
     FakeParts parts;
     Recorder rec;
     AxisFaults faults;
-    DeviceControl::Options opt{0, 0, 1000.0, 5000.0};
+    DeviceControl::Options opt{0, 0, 1000, 5000};
     int64_t now = 0;
 
     DcRig() { dc.start(rec); }
@@ -82,7 +86,7 @@ TEST(DeviceControlPart, DisableOperationWithRampWaitsForTheRampAndStandstill) {
     r.cw(0x07);  // transition 5
     ASSERT_EQ(r.parts.stops.size(), 1u);
     EXPECT_EQ(r.parts.stops[0], StopKind::Ramp);
-    EXPECT_EQ(r.dc.stop_deceleration(), 1000.0);
+    EXPECT_EQ(r.dc.stop_deceleration(), 2000.0);  // 0x6084, as the parts converted it
     EXPECT_TRUE(r.dc.waiting());
     EXPECT_FALSE(r.dc.operational());
     r.dc.settle(true, 10, 0xFFFF, r.rec, r.now);
@@ -115,8 +119,8 @@ TEST(DeviceControlPart, QuickStopRampsAndEnableOperationResumes) {
     r.cw(0x0B);  // transition 11
     EXPECT_EQ(r.dc.state(), State::QuickStopActive);
     EXPECT_EQ(r.dc.stop(), StopKind::Ramp);
-    EXPECT_EQ(r.dc.stop_deceleration(), 5000.0);
-    r.cw(0x0F);  // transition 16
+    EXPECT_EQ(r.dc.stop_deceleration(), 10000.0);  // 0x6085
+    r.cw(0x0F);                                    // transition 16
     EXPECT_EQ(r.dc.state(), State::OperationEnabled);
     EXPECT_EQ(r.dc.stop(), StopKind::None);
     EXPECT_EQ(r.parts.resumed_calls, 1);
@@ -137,7 +141,7 @@ TEST(DeviceControlPart, FaultReactionRampsWhilePoweredAndEndsInFault) {
                r.now);  // 0x605E = 1: profile ramp
     EXPECT_EQ(r.dc.state(), State::FaultReactionActive);
     EXPECT_EQ(r.dc.stop(), StopKind::Ramp);
-    EXPECT_EQ(r.dc.stop_deceleration(), 1000.0);
+    EXPECT_EQ(r.dc.stop_deceleration(), 2000.0);
     r.cw(0x0F);  // no command while the reaction runs
     EXPECT_EQ(r.dc.state(), State::FaultReactionActive);
     r.dc.ramp_reached(true);

@@ -17,7 +17,7 @@ struct SpRig {
     Command c;
     Parameters p;
     PositionFrame f;
-    SetpointGenerator::Inputs in{0, 0, 2000, 1e6, 1e6, 1e6, 1e5};
+    SetpointGenerator::Inputs in{0, 0, 2000};
 
     explicit SpRig(int8_t m) { sp.switch_mode(m, true, 0); }
     void command(uint16_t cw, uint16_t prev, bool enabled = true, int64_t now = 0) {
@@ -28,6 +28,12 @@ struct SpRig {
 };
 
 }  // namespace
+
+TEST(SetpointPart, AccelerationsAreLimitedAndConverted) {
+    EXPECT_EQ(limited_acceleration(600, 100000, 2000), 600 * 2000 / 60.0);
+    EXPECT_EQ(limited_acceleration(600, 300, 2000), 300 * 2000 / 60.0);  // 0x60C5
+    EXPECT_EQ(limited_acceleration(0, 300, 2000), 2000 / 60.0);          // at least 1 rpm/s
+}
 
 TEST(SetpointPart, NewSetpointEdges) {
     EXPECT_TRUE(new_setpoint_edge(0x1F, 0x0F).rise);

@@ -24,8 +24,9 @@ class DeviceControl {
         virtual uint16_t enable_refused() = 0;
         // Transition 4 done: the loops and set-points start from where the motor is.
         virtual void powered() = 0;
-        // A stop began: a running homing is interrupted; a ramp starts from the actual motion.
-        virtual void stopping(StopKind kind) = 0;
+        // A stop began: a running homing is interrupted; a ramp starts from the actual motion. Returns the
+        // ramp's deceleration `decel_rpm_s` in inc/s^2, limited by 0x60C5 (unused for StopKind::Disable).
+        virtual double stopping(StopKind kind, double decel_rpm_s) = 0;
         // Transition 16: the set-points hold where the quick-stop ramp got to.
         virtual void resumed() = 0;
         // Transition 15: supervision clears the errors; false when a cause is still present.
@@ -38,12 +39,12 @@ class DeviceControl {
       protected:
         ~Parts() = default;
     };
-    // The option codes and decelerations (inc/s^2, already limited by 0x60C5) the transitions use.
+    // The option codes and decelerations the transitions use.
     struct Options {
-        int16_t shutdown = 0;           // 0x605B
-        int16_t disable_operation = 0;  // 0x605C
-        double profile_deceleration = 0;
-        double quick_stop_deceleration = 0;
+        int16_t shutdown = 0;                  // 0x605B
+        int16_t disable_operation = 0;         // 0x605C
+        uint32_t profile_deceleration = 0;     // 0x6084 rpm/s
+        uint32_t quick_stop_deceleration = 0;  // 0x6085 rpm/s
     };
 
     // Start-up: transition 1 (Not Ready to Switch On -> Switch On Disabled).
@@ -83,7 +84,7 @@ class DeviceControl {
         int64_t since_ns = 0;
     };
     void enter(State s, EventSink& sink);
-    void begin_stop(StopKind kind, double decel, Parts& parts);
+    void begin_stop(StopKind kind, double decel_rpm_s, Parts& parts);
 
     State state_ = State::NotReadyToSwitchOn;
     bool power_ = false;

@@ -5,6 +5,7 @@
 // (position, velocity, acceleration in raw increments), which loop it feeds, and the references and
 // feed-forwards it gives the loops (LoopReference). Homing (homing.hpp) moves the same profile while it is
 // the mode. Positions in raw increments.
+#include <algorithm>
 #include <cstdint>
 
 #include "drive/frame.hpp"
@@ -47,16 +48,20 @@ inline SetpointEdge new_setpoint_edge(uint16_t cw, uint16_t prev) {
     return {(cw & bit) && !(prev & bit), !(cw & bit) && (prev & bit)};
 }
 
+// An acceleration of the dictionary (rpm/s) in inc/s^2 at `resolution` inc per turn, at least 1 rpm/s and at
+// most 0x60C5 (`max_acceleration`).
+inline double limited_acceleration(double rpm_s, uint32_t max_acceleration, double resolution) {
+    const double a = std::min<double>(std::max(rpm_s, 1.0), static_cast<double>(max_acceleration));
+    return a * resolution / 60.0;
+}
+
 class SetpointGenerator {
   public:
-    // What a trajectory tick reads of the machine and of the limits.
+    // What a trajectory tick reads of the machine.
     struct Inputs {
         double actual = 0;         // encoder count, raw inc
         double speed = 0;          // estimated speed, rad/s
         double resolution = 2000;  // inc per turn
-        double acc = 0, dec = 0;   // profile acceleration and deceleration, inc/s^2 (limited by 0x60C5)
-        double quick_stop = 0;     // quick-stop deceleration, inc/s^2
-        double max_velocity = 0;   // profile velocity limited by 0x607F, inc/s
     };
 
     // A new mode of operation: it takes over from the current demand without a jump (from `actual` without
