@@ -31,30 +31,157 @@ int32_t Axis::clamp_i32(double v) const {
 }
 
 double Axis::decel_limit(double rpm_s) const {
-    const double a = std::min<double>(std::max(rpm_s, 1.0), static_cast<double>(params.max_acceleration));
-    return rpm_to_inc_s(a);
+    return limited_acceleration(rpm_s, params.max_acceleration, res_);
 }
 
-bool Axis::range_on() const {
-    return params.range_min != std::numeric_limits<int32_t>::min() && params.range_max > params.range_min;
+PositionFrame Axis::frame() const {
+    return {home_.shift(), params.range_min, params.range_max, params.sw_limit_min, params.sw_limit_max};
 }
 
-int32_t Axis::report(int64_t v) const {
-    if (!range_on()) return wrap32(v);
-    const int64_t span = static_cast<int64_t>(params.range_max) - params.range_min + 1;
-    int64_t m = (v - params.range_min) % span;
-    if (m < 0) m += span;
-    return static_cast<int32_t>(params.range_min + m);
+DeviceControl::Options Axis::dc_options() const {
+    return {params.shutdown, params.disable_operation, params.profile_deceleration,
+            params.quick_stop_deceleration};
 }
 
-double Axis::unwrap(int32_t target, double near_raw) const {
-    // The target inside the range, taken the short way from where the axis is (raw increments).
-    const double span = static_cast<double>(params.range_max) - params.range_min + 1.0;
-    const double here = std::round(near_raw + static_cast<double>(shift_));
-    const double here_wrapped = static_cast<double>(report(static_cast<int64_t>(here)));
-    double d = static_cast<double>(target) - here_wrapped;
-    d -= span * std::round(d / span);
-    return here + d - static_cast<double>(shift_);
+// What device control's transitions ask of the other parts.
+class Axis::Parts final : public DeviceControl::Parts {
+  public:
+    Parts(Axis& a, int64_t now_ns) : a_(a), now_ns_(now_ns) {}
+    uint16_t enable_refused() override {
+        if (a_.ctl_.km <= 0) return error_code::TorqueFault;
+        if ((a_.pins_ & 0x30) != 0x30) return error_code::Sto;
+        return 0;
+    }
+    void powered() override {
+        a_.ctl_.power_on();
+        a_.sp_.power_on(static_cast<double>(a_.count_));
+    }
+    double stopping(StopKind kind, double decel_rpm_s) override {
+        // A stop (quick stop, shutdown, fault) ends a running homing: interrupted, to be started again.
+        a_.home_.interrupt(HomingPhase::Finished);
+        if (kind != StopKind::Ramp) return 0;
+        // A ramp starts where the motor really is (position and speed), whatever the set-points did.
+        a_.sp_.ramp_from(static_cast<double>(a_.count_), a_.ctl_.obs_vel * a_.res_ / kTwoPi);
+        return a_.decel_limit(decel_rpm_s);
+    }
+    void resumed() override { a_.sp_.resume(); }
+    bool fault_reset() override {
+        const Supervisor::Causes causes{(a_.pins_ & 0x30) != 0x30, a_.ctl_.km <= 0,
+                                        Supervisor::overspeed(a_.ctl_.obs_vel, a_.params.max_motor_speed)};
+        return a_.sup_.reset(causes, *a_.sink_);
+    }
+    void acknowledge_warnings() override { a_.sup_.acknowledge_warnings(*a_.sink_); }
+    void fault(uint16_t code) override { a_.fault(code, now_ns_); }
+
+  private:
+    Axis& a_;
+    int64_t now_ns_;
+};
+
+void Axis::raise_error(uint16_t code) {
+    fault(code, now_ns_);
+}
+
+void Axis::connection_lost() {
+    // Only a drive that has power on its motor reacts: without power there is nothing to stop, and a master
+    // that merely walks the ESM down after disabling the drive must not find a fault on its next start.
+    if (!dc_.power()) return;
+    fault(error_code::EthercatStateMachine, now_ns_);
+    update_feedback();
+}
+
+void Axis::fault(uint16_t code, int64_t now_ns) {
+    const std::array<uint8_t, 5> mfr{static_cast<uint8_t>(dc_.state()), static_cast<uint8_t>(sp_.mode()), 0,
+                                     0, 0};
+    const Supervisor::Raised r =
+        sup_.raise(code, params.fault_reaction, params.abort_connection, mfr, *sink_);
+    if (!r.react) return;
+    home_.error();
+    const bool at_rest = std::abs(ctl_.vel_avg_rpm) <= static_cast<double>(params.standstill_window);
+    Parts parts(*this, now_ns);
+    dc_.react(r.reaction, r.option, at_rest, dc_options(), parts, *sink_, now_ns);
+}
+
+void Axis::supervise(int64_t now_ns, int64_t dt_ns) {
+    sup_.standstill(ctl_.vel_avg_rpm, params.standstill_window, params.standstill_time, dt_ns);
+    const bool enabled = dc_.state() == State::OperationEnabled && dc_.power() && !dc_.waiting();
+    const int8_t m = sp_.mode();
+    const bool homing = m == mode::Homing && home_.running();
+    // Following error in the position-controlled modes.
+    const bool pos_mode = m == mode::CyclicSyncPosition || m == mode::ProfilePosition || m == mode::Homing;
+    const double ferr = std::abs(sp_.demand_position() - static_cast<double>(count_));
+    if (sup_.following_error(enabled && pos_mode, ferr, params.following_error_window,
+                             params.following_error_timeout, dt_ns))
+        fault(error_code::FollowingError, now_ns);
+    if (enabled && !homing) {
+        const double v =
+            sp_.control() == Control::Torque ? ctl_.obs_vel * res_ / kTwoPi : sp_.demand_velocity();
+        const Supervisor::Motion motion{v,
+                                        (func_ & 0x1) != 0,
+                                        (func_ & 0x2) != 0,
+                                        count_ + home_.shift(),
+                                        m != mode::ProfilePosition,
+                                        sp_.target_outside_limits()};
+        const Supervisor::Found found = Supervisor::limits(motion, frame());
+        for (int i = 0; i < found.count; ++i)
+            fault(found.codes[static_cast<std::size_t>(i)], now_ns);
+    }
+    if (dc_.power() && Supervisor::overspeed(ctl_.obs_vel, params.max_motor_speed))
+        fault(error_code::MaxSpeed, now_ns);
+    if (dc_.power() && (pins_ & 0x30) != 0x30) fault(error_code::Sto, now_ns);
+    dc_.settle(sup_.still(), params.standstill_window, params.standstill_timeout, *sink_, now_ns);
+}
+
+void Axis::mode_commands(int64_t now_ns, int64_t dt_ns) {
+    const bool enabled = dc_.operational() && dc_.stop() == StopKind::None;
+    sp_.command(command, dc_.previous_controlword(), enabled, frame(), params.interpolation_value != 0,
+                now_ns, dt_ns);
+    if (sp_.mode() != mode::Homing) return;
+    const SetpointEdge e = new_setpoint_edge(command.controlword, dc_.previous_controlword());
+    const State s = dc_.state();
+    if (e.rise && enabled) {
+        // Homing clears touch-probe states and latched values (MAXPOS firmware specification §4.5).
+        tp_.clear_for_homing();
+        sp_.profile().reset(sp_.demand_position(), sp_.demand_velocity());
+        home_.start(params, func_, static_cast<double>(count_), *sink_);
+    } else if (e.rise && !dc_.power() && params.homing_method == 37 && s != State::Fault &&
+               s != State::FaultReactionActive) {
+        // Method 37 while disabled: no offset move, the actual position becomes the home position.
+        home_.set_here(params.home_position, count_, *sink_);
+    }
+    if (e.fall) home_.interrupt(HomingPhase::Stopping);
+}
+
+void Axis::trajectory_tick(int64_t t_ns) {
+    const double h = kPosH;
+    ctl_.follow(LoopReference{}, Control::Position);  // no feed-forward unless the mode gives one
+    if (!dc_.power()) {
+        sp_.follow(static_cast<double>(count_));
+        return;
+    }
+    if (dc_.stop() == StopKind::Ramp) {
+        dc_.ramp_reached(sp_.ramp(dc_.stop_deceleration(), h));
+        return;
+    }
+    if (sp_.mode() == mode::Homing) {
+        const Homing::Motion motion{rpm_to_inc_s(params.homing_speed_switch),
+                                    rpm_to_inc_s(params.homing_speed_zero),
+                                    decel_limit(params.homing_acceleration)};
+        const Homing::Inputs in{sp_.halted(), std::abs(plant_.current()), func_, static_cast<double>(count_),
+                                res_};
+        home_.tick(sp_.profile(), motion, in, params, *sink_, h);
+        sp_.from_profile();
+        return;
+    }
+    const SetpointGenerator::Inputs in{static_cast<double>(count_), ctl_.obs_vel, static_cast<double>(res_)};
+    const LoopReference ref = sp_.tick(command, params, in, frame(), t_ns, h);
+    ctl_.follow(ref, sp_.control());  // the loop the tick chose
+}
+
+void Axis::tp_latch(bool rising, double raw_pos) {
+    const uint16_t fn = command.touch_probe_function;
+    if (!TouchProbe::armed(fn, sp_.mode() == mode::Homing)) return;
+    tp_.latch(fn, rising, frame().report(static_cast<int64_t>(std::floor(raw_pos)) + home_.shift()));
 }
 
 void Axis::derive() {
@@ -71,15 +198,12 @@ void Axis::derive() {
         pol_ = pol;
         count_ = static_cast<int64_t>(std::floor(pol_ * phys_angle * res_ / kTwoPi));
         prev_raw_pos_ = phys_angle * res_ / kTwoPi;
-        shift_ = 0;
-        home_.referenced = false;
-        ctl_.obs_pos = inc_to_rad(static_cast<double>(count_) + 0.5);
-        ctl_.obs_vel = ctl_.obs_load = 0;
-        sp_.demand_pos = static_cast<double>(count_);
-        sp_.profile.reset(sp_.demand_pos, 0);
+        home_.invalidate();
+        ctl_.rebase(inc_to_rad(static_cast<double>(count_) + 0.5));
+        sp_.reset_to(static_cast<double>(count_));
         plant_dirty_ = true;  // the stops are given in increments
     }
-    ctl_.km = params.torque_constant * 1e-6;
+    ctl_.set_torque_constant(params.torque_constant);
     const double km_plant = ctl_.km > 0 ? ctl_.km : motor_.torque_constant;
     if (plant_dirty_ || km_plant != km_plant_ || env_.take_stops_changed()) {
         // configure() keeps the state (current, speed, angle): changing the model does not jump.
@@ -139,60 +263,44 @@ void Axis::edges(double prev, double raw, int64_t t_ns, uint64_t changed) {
 }
 
 void Axis::on_edge(int bit, bool rising, double raw_pos) {
-    // Touch-probe source (MAXPOS firmware specification §7.2.84): b3..2 = 00 TP1 input (function 26), 10 =
-    // 0x60D0:01.
-    const uint16_t src = (command.touch_probe_function >> 2) & 0x3;
-    int tp_bit = -1;
-    if (src == 0) tp_bit = 26;
-    if (src == 2) {
-        const int16_t s = params.touch_probe_source;
-        if (s >= 1 && s <= 4) tp_bit = 32 + s - 1;
-        if (s == -2) tp_bit = 32 + 4;
-        if (s == -3) tp_bit = 32 + 5;
-    }
-    if (bit == tp_bit) tp_latch(rising, raw_pos);
-    if (home_.status == HomingStatus::InProgress && bit == home_.bit && rising == home_.rise) {
-        const double v = sp_.profile.velocity();
-        // Only count the edge when moving the way the phase expects (an overshoot during a reversal
-        // must not be taken for the awaited edge).
-        if ((home_.dir > 0 && v > 0) || (home_.dir < 0 && v < 0)) {
-            home_.edge = true;
-            home_.event_pos = raw_pos;
-        }
-    }
+    if (bit == TouchProbe::source_bit(command.touch_probe_function, params.touch_probe_source))
+        tp_latch(rising, raw_pos);
+    home_.edge(bit, rising, sp_.profile().velocity(), raw_pos);
 }
 
 void Axis::on_index(double raw_pos) {
     index_count_ = static_cast<int64_t>(std::floor(raw_pos));
-    const uint16_t src = (command.touch_probe_function >> 2) & 0x3;
-    if (src == 1 || (src == 2 && params.touch_probe_source == 5)) {
+    if (TouchProbe::index_selected(command.touch_probe_function, params.touch_probe_source)) {
         // The index is a pulse: it has both edges at the same place.
         tp_latch(true, raw_pos);
         tp_latch(false, raw_pos);
     }
-    if (home_.status == HomingStatus::InProgress && home_.phase == HomingPhase::ToIndex) {
-        const double v = sp_.profile.velocity();
-        if ((home_.dir > 0 && v > 0) || (home_.dir < 0 && v < 0)) {
-            home_.index = true;
-            home_.event_pos = raw_pos;
-        }
-    }
+    home_.index_pulse(sp_.profile().velocity(), raw_pos);
 }
 
 void Axis::cycle(int64_t now_ns, int64_t dt_ns) {
     now_ns_ = now_ns;
     derive();
-    if (dc_.state == State::NotReadyToSwitchOn) {
+    if (dc_.state() == State::NotReadyToSwitchOn) {
         pins_ = env_.pins(phys_position_inc(), now_ns);
         func_ = functions(pins_);
         prev_raw_pos_ = phys_position_inc();
         count_ = static_cast<int64_t>(std::floor(raw_position_inc()));
-        ctl_.obs_pos = inc_to_rad(static_cast<double>(count_) + 0.5);
-        enter(State::SwitchOnDisabled, 1);
+        ctl_.start_at(inc_to_rad(static_cast<double>(count_) + 0.5));
+        dc_.start(*sink_);
     }
     tp_.configure(command.touch_probe_function);
-    if (command.mode != sp_.mode && mode::supported(command.mode)) switch_mode(command.mode);
-    device_control(now_ns);
+    if (command.mode != sp_.mode() && mode::supported(command.mode)) {
+        // A running homing ends with the mode: interrupted, to be started again.
+        if (sp_.mode() == mode::Homing) home_.interrupt();
+        sp_.switch_mode(command.mode, dc_.power(), static_cast<double>(count_));
+        ctl_.mode_switched(dc_.power());
+        if (command.mode == mode::Homing) home_.entered();
+    }
+    {
+        Parts parts(*this, now_ns);
+        dc_.command(command.controlword, faults, dc_options(), parts, *sink_, now_ns);
+    }
     mode_commands(now_ns, dt_ns);
     // At most one second of simulated time per call: a caller that skipped time (or passed a bogus dt)
     // must not stall its thread for minutes.
@@ -206,9 +314,17 @@ void Axis::cycle(int64_t now_ns, int64_t dt_ns) {
             const int64_t t = now_ns + k * kCurrentTickNs;
             if (tick_ % kPositionDivider == 0) {
                 trajectory_tick(t);
-                position_tick();
+                if (dc_.power() && sp_.control() == Control::Position) {
+                    const bool internal_ff =
+                        sp_.mode() != mode::CyclicSyncPosition || dc_.stop() != StopKind::None;
+                    ctl_.position(sp_.demand_position(), sp_.demand_velocity(), sp_.demand_acceleration(),
+                                  static_cast<double>(count_), internal_ff, plant_.torque_constant(),
+                                  rad_per_inc_);
+                }
             }
-            if (tick_ % kVelocityDivider == 0) velocity_tick();
+            if (tick_ % kVelocityDivider == 0)
+                ctl_.velocity(dc_.power(), sp_.control() == Control::Torque, params.nominal_current,
+                              params.output_current_limit);
             current_tick(t);
             ++tick_;
         }
@@ -221,40 +337,41 @@ void Axis::cycle(int64_t now_ns, int64_t dt_ns) {
         supervise(now_ns + dt_ns, dt_ns);
     }
     update_feedback();
-    dc_.cw_prev = command.controlword;
+    dc_.end_cycle(command.controlword);
 }
 
 void Axis::update_feedback() {
     Feedback& f = fb_;
-    uint16_t s = state_bits(dc_.state, dc_.power);
-    if (dc_.state != State::NotReadyToSwitchOn) s |= sw::Reserved8;
+    uint16_t s = state_bits(dc_.state(), dc_.power());
+    if (dc_.state() != State::NotReadyToSwitchOn) s |= sw::Reserved8;
     s |= sw::Remote;
     if (sup_.warning()) s |= sw::Warning;
-    if (ctl_.i2t_active || (sp_.mode == mode::ProfilePosition && sp_.ppm_limited)) s |= sw::InternalLimit;
-    if (home_.referenced) s |= sw::Referenced;
-    const bool oe = dc_.state == State::OperationEnabled && !dc_.pending.active;
-    const bool ferr =
-        params.following_error_window != kNoWindow && std::abs(sp_.demand_pos - static_cast<double>(count_)) >
-                                                          static_cast<double>(params.following_error_window);
-    switch (sp_.mode) {
+    if (ctl_.i2t_active || (sp_.mode() == mode::ProfilePosition && sp_.target_limited()))
+        s |= sw::InternalLimit;
+    if (home_.referenced()) s |= sw::Referenced;
+    const bool oe = dc_.operational();
+    const bool ferr = params.following_error_window != kNoWindow &&
+                      std::abs(sp_.demand_position() - static_cast<double>(count_)) >
+                          static_cast<double>(params.following_error_window);
+    switch (sp_.mode()) {
         case mode::ProfilePosition:
-            if (sp_.halted ? sp_.profile.velocity() == 0.0 : !sp_.ppm_moving) s |= sw::TargetReached;
-            if (sp_.ppm_ack) s |= sw::Bit12;
-            if (ferr && dc_.power) s |= sw::Bit13;
+            if (sp_.target_reached()) s |= sw::TargetReached;
+            if (sp_.setpoint_acknowledged()) s |= sw::Bit12;
+            if (ferr && dc_.power()) s |= sw::Bit13;
             break;
         case mode::ProfileVelocity: {
             const double vlim =
                 static_cast<double>(std::min(params.max_profile_velocity, params.max_motor_speed));
             const double target =
-                sp_.halted
+                sp_.halted()
                     ? 0.0
                     : rpm_to_inc_s(std::clamp(static_cast<double>(command.target_velocity), -vlim, vlim));
-            if (sp_.profile.velocity() == target) s |= sw::TargetReached;
+            if (sp_.profile().velocity() == target) s |= sw::TargetReached;
             if (std::abs(ctl_.vel_avg_rpm) <= static_cast<double>(params.standstill_window)) s |= sw::Bit12;
             break;
         }
         case mode::Homing:
-            switch (home_.status) {
+            switch (home_.status()) {
                 case HomingStatus::InProgress:
                     break;  // 000
                 case HomingStatus::Idle:
@@ -267,50 +384,51 @@ void Axis::update_feedback() {
                 case HomingStatus::Error:  // 100 / 101
                     s |= sw::Bit13;
                     if (std::abs(ctl_.vel_avg_rpm) <= static_cast<double>(params.standstill_window) &&
-                        sup_.still)
+                        sup_.still())
                         s |= sw::TargetReached;
                     break;
             }
             break;
         case mode::CyclicSyncPosition:
-            if (oe && dc_.stop == StopKind::None) s |= sw::Bit12;
-            if (ferr && dc_.power) s |= sw::Bit13;
+            if (oe && dc_.stop() == StopKind::None) s |= sw::Bit12;
+            if (ferr && dc_.power()) s |= sw::Bit13;
             break;
         case mode::CyclicSyncVelocity:
         case mode::CyclicSyncTorque:
-            if (oe && dc_.stop == StopKind::None) s |= sw::Bit12;
+            if (oe && dc_.stop() == StopKind::None) s |= sw::Bit12;
             break;
         default:
             break;
     }
-    if (dc_.state == State::QuickStopActive && dc_.ramp_done) s |= sw::TargetReached;
+    if (dc_.state() == State::QuickStopActive && dc_.ramp_done()) s |= sw::TargetReached;
     f.statusword = s;
-    if (!faults.mode_display_stuck || f.mode_display == mode::None) f.mode_display = sp_.mode;
-    f.position_actual = report(count_ + shift_);
-    f.position_demand = report(static_cast<int64_t>(std::llround(sp_.demand_pos)) + shift_);
-    f.following_error = clamp_i32(std::round(sp_.demand_pos - static_cast<double>(count_)));
-    const double vd =
-        sp_.control == Control::Velocity ? ctl_.vel_ref * 60.0 / kTwoPi : sp_.demand_vel * 60.0 / res_;
+    if (!faults.mode_display_stuck || f.mode_display == mode::None) f.mode_display = sp_.mode();
+    const PositionFrame fr = frame();
+    f.position_actual = fr.report(count_ + home_.shift());
+    f.position_demand = fr.report(static_cast<int64_t>(std::llround(sp_.demand_position())) + home_.shift());
+    f.following_error = clamp_i32(std::round(sp_.demand_position() - static_cast<double>(count_)));
+    const double vd = sp_.control() == Control::Velocity ? ctl_.vel_ref * 60.0 / kTwoPi
+                                                         : sp_.demand_velocity() * 60.0 / res_;
     f.velocity_demand = clamp_i32(std::round(vd));
     f.velocity_actual = clamp_i32(std::round(ctl_.obs_vel * 60.0 / kTwoPi));
     f.velocity_averaged = clamp_i32(std::round(ctl_.vel_avg_rpm));
     const double in = std::max<double>(params.nominal_current, 1.0) * 1e-3;
     f.torque_actual = sat16(i_meas() / in * 1000.0);
     f.current_actual = sat16(i_meas() * 1000.0);
-    f.current_demand = sat16(dc_.power ? ctl_.cur_ref * 1000.0 : 0.0);
+    f.current_demand = sat16(dc_.power() ? ctl_.cur_ref * 1000.0 : 0.0);
     f.current_averaged = sat16(ctl_.cur_avg_a * 1000.0);
     f.motor_rated_torque =
         static_cast<uint32_t>(static_cast<uint64_t>(params.nominal_current) * params.torque_constant / 1000u);
     f.digital_inputs = static_cast<uint32_t>(func_ & 0x033F0007ull);
     f.input_logic_state = pins_;
-    f.index_position = report(index_count_ + shift_);
-    f.touch_probe_status = tp_.status;
-    f.touch_probe_pos = tp_.pos;
-    f.touch_probe_neg = tp_.neg;
-    f.touch_probe_pos_count = tp_.pos_cnt;
-    f.touch_probe_neg_count = tp_.neg_cnt;
-    f.error_code = sup_.last_error;
-    f.error_register = sup_.error_register;
+    f.index_position = fr.report(index_count_ + home_.shift());
+    f.touch_probe_status = tp_.status();
+    f.touch_probe_pos = tp_.position_rising();
+    f.touch_probe_neg = tp_.position_falling();
+    f.touch_probe_pos_count = tp_.count_rising();
+    f.touch_probe_neg_count = tp_.count_falling();
+    f.error_code = sup_.last_error();
+    f.error_register = sup_.error_register();
 }
 
 }  // namespace drive

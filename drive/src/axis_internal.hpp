@@ -1,10 +1,10 @@
 #pragma once
-// Constants and small helpers shared by the translation units of Axis (axis.cpp and the files of its parts).
+// Constants and small helpers shared by the translation units of Axis and of its parts.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 
-#include "drive/axis.hpp"
+#include "drive/parameters.hpp"
 
 namespace drive::detail {
 

@@ -1,4 +1,6 @@
-// The control loops, the observer and the I2t model (Controller).
+// The control loops, the observer and the I2t model (Controller), and the one piece of Axis that runs them in
+// the current-loop sample with the machine's steps (Axis::current_tick): here, so the controller's current
+// loop and observer compile into the flattened sample (docs/decisions/drive.md "Cost of a cycle").
 #include "drive/controller.hpp"
 
 #include "drive/axis.hpp"
@@ -14,53 +16,55 @@ namespace drive {
 
 using namespace detail;
 
-void Axis::position_tick() {
-    if (!dc_.power || sp_.control != Control::Position) return;
-    const double e = inc_to_rad(sp_.demand_pos - static_cast<double>(count_));
-    const bool internal_ff = sp_.mode != mode::CyclicSyncPosition || dc_.stop != StopKind::None;
-    const double w_ff = internal_ff ? inc_to_rad(sp_.demand_vel) : ctl_.vel_ff;
-    ctl_.vel_ref = ctl_.kpp * e + w_ff;
+void Controller::position(double demand_pos, double demand_vel, double demand_acc, double actual,
+                          bool internal_ff, double km_plant, double rad_per_inc) {
+    const double e = (demand_pos - actual) * rad_per_inc;
+    const double w_ff = internal_ff ? demand_vel * rad_per_inc : vel_ff;
+    vel_ref = kpp * e + w_ff;
     if (internal_ff) {
         // Feed-forward of inertia and viscous friction (0x30A1:04/05) in the profile modes.
-        const double km = ctl_.km > 0 ? ctl_.km : plant_.torque_constant();
-        ctl_.torque_ff_a = (ctl_.j * inc_to_rad(sp_.demand_acc) + ctl_.r * inc_to_rad(sp_.demand_vel)) / km;
+        const double k = km > 0 ? km : km_plant;
+        torque_ff_a = (j * (demand_acc * rad_per_inc) + r * (demand_vel * rad_per_inc)) / k;
     }
 }
 
-void Axis::velocity_tick() {
-    if (!dc_.power) {
-        ctl_.vel_int = 0;
-        ctl_.cur_ref = 0;
+void Controller::velocity(bool power, bool torque_control, uint16_t nominal_ma, uint16_t output_limit_ma) {
+    if (!power) {
+        vel_int = 0;
+        cur_ref = 0;
         return;
     }
-    if (sp_.control == Control::Torque) {
-        ctl_.vel_int = 0;
+    if (torque_control) {
+        vel_int = 0;
     } else {
-        const double e = ctl_.vel_ref - ctl_.obs_vel;
-        ctl_.vel_int += ctl_.kiv * e * kVelH;
-        ctl_.cur_ref = ctl_.kv * e + ctl_.vel_int + ctl_.torque_ff_a;
+        const double e = vel_ref - obs_vel;
+        vel_int += kiv * e * kVelH;
+        cur_ref = kv * e + vel_int + torque_ff_a;
     }
-    const double limit = (ctl_.i2t_active ? params.nominal_current : params.output_current_limit) * 1e-3;
-    if (ctl_.cur_ref > limit || ctl_.cur_ref < -limit) {
-        const double c = std::clamp(ctl_.cur_ref, -limit, limit);
+    const double limit = current_limit(nominal_ma, output_limit_ma);
+    if (cur_ref > limit || cur_ref < -limit) {
+        const double c = std::clamp(cur_ref, -limit, limit);
         // Anti-windup: the integrator takes back what the limit cut off.
-        if (sp_.control != Control::Torque)
-            ctl_.vel_int = std::clamp(ctl_.vel_int - (ctl_.cur_ref - c), -limit, limit);
-        ctl_.cur_ref = c;
+        if (!torque_control) vel_int = std::clamp(vel_int - (cur_ref - c), -limit, limit);
+        cur_ref = c;
     }
 }
 
 // Flattened: the four machine steps and the observer compile into the sample (docs/decisions/drive.md "Cost
 // of a cycle").
 [[gnu::flatten]] void Axis::current_tick(int64_t t_ns) {
+    // The current loop (PI) with back-EMF decoupling, written out here rather than as a Controller method:
+    // as a call (inlined or not) it made the sample 8 % slower (drive-sim --bench 1001 -> 1081 ns, the
+    // registers of the four plant steps below spill), written out it costs nothing (docs/decisions/drive.md
+    // "Cost of a cycle"). It changes only the controller's current-loop state.
     double u = 0;
     const double km = plant_.torque_constant();
-    if (dc_.power) {
-        const double limit = (ctl_.i2t_active ? params.nominal_current : params.output_current_limit) * 1e-3;
-        if (sp_.control == Control::Torque) ctl_.cur_ref = std::clamp(ctl_.cur_ref, -limit, limit);
+    const bool power = dc_.power();
+    if (power) {
+        const double limit = ctl_.current_limit(params.nominal_current, params.output_current_limit);
+        if (sp_.control() == Control::Torque) ctl_.cur_ref = std::clamp(ctl_.cur_ref, -limit, limit);
         const double e = ctl_.cur_ref - i_meas();
         ctl_.cur_int += ctl_.kii * e * kTick;
-        // Back-EMF decoupling with the estimated speed, plus the 0x30A0:03 feed-forward.
         const double unclamped = ctl_.kpi * e + ctl_.cur_int + km * ctl_.obs_vel + ctl_.kff_i * ctl_.cur_ref;
         const double vs = motor_.supply_voltage;
         u = std::clamp(unclamped, -vs, vs);
@@ -78,14 +82,14 @@ void Axis::velocity_tick() {
     // is near (Plant::advance_held); otherwise, one after the other.
     static_assert(kPlantStepsPerTick == Plant::kHeldSteps);
     double angles[Plant::kHeldSteps];
-    if (dc_.power && plant_.advance_held(x, u_motor, angles)) {
+    if (power && plant_.advance_held(x, u_motor, angles)) {
         at_stop = false;
         for (int k = 0; k < kPlantStepsPerTick; ++k)
             machine_step(angles[k] * inc_per_rad_,
                          t_ns + static_cast<int64_t>((k + 1) * kCurrentTickNs / kPlantStepsPerTick));
     } else {
         for (int k = 0; k < kPlantStepsPerTick; ++k) {
-            at_stop = plant_.advance(x, u_motor, dc_.power);
+            at_stop = plant_.advance(x, u_motor, power);
             machine_step(x.angle * inc_per_rad_,
                          t_ns + static_cast<int64_t>((k + 1) * kCurrentTickNs / kPlantStepsPerTick));
         }
@@ -130,7 +134,7 @@ void Controller::tune(const Parameters& p, double km_plant) {
     tuned = in;
     // 0x30A1: bandwidth, damping, reset time, inertia, friction -> cascade gains by pole placement
     // (docs/decisions/drive.md "Control loops").
-    km = p.torque_constant * 1e-6;
+    set_torque_constant(p.torque_constant);
     const double k = km > 0 ? km : km_plant;
     j = std::max<double>(p.inertia, 1.0) * 1e-10;
     r = p.friction * 1e-9 * 60.0 / kTwoPi;

@@ -1,59 +1,43 @@
 // CiA 402 device control: the transitions of IEC 61800-7-201 §6.2.2 and the stop they wait for
 // (DeviceControl).
-#include "drive/axis.hpp"
+#include "drive/device_control.hpp"
 
-#include <algorithm>
-#include <cmath>
-#include <limits>
-
-#include "axis_internal.hpp"
-#include "drive/errors.hpp"
+#include <cstdlib>
 
 namespace drive {
 
-using namespace detail;
-
-void Axis::enter(State s, int number) {
-    if (s == dc_.state) return;
-    dc_.state = s;
-    (void)number;
-    sink_->diag(Severity::Info, 0, to_string(s));
+void DeviceControl::enter(State s, EventSink& sink) {
+    if (s == state_) return;
+    state_ = s;
+    sink.diag(Severity::Info, 0, to_string(s));
 }
 
-void Axis::begin_stop(StopKind kind, double decel_rpm_s, int64_t) {
-    dc_.stop = kind;
-    dc_.ramp_done = false;
-    // A stop (quick stop, shutdown, fault) ends a running homing: interrupted, to be started again.
-    home_.interrupt(HomingPhase::Finished);
+void DeviceControl::begin_stop(StopKind kind, double decel_rpm_s, Parts& parts) {
+    stop_ = kind;
+    ramp_done_ = false;
+    const double decel = parts.stopping(kind, decel_rpm_s);
     if (kind == StopKind::Ramp) {
-        dc_.stop_decel = decel_limit(decel_rpm_s);
-        // The ramp starts where the motor really is (position and speed), whatever the set-points did.
-        sp_.profile.reset(static_cast<double>(count_), ctl_.obs_vel * res_ / kTwoPi);
-        sp_.control = Control::Position;
+        stop_decel_ = decel;
     } else if (kind == StopKind::Disable) {
-        dc_.power = false;
-        dc_.ramp_done = true;
+        power_ = false;
+        ramp_done_ = true;
     }
 }
 
-void Axis::device_control(int64_t now_ns) {
-    const uint16_t c = command.controlword;
-    DeviceCommand dc = decode(c, dc_.cw_prev);
-    if ((dc == DeviceCommand::QuickStop && dc_.state == State::OperationEnabled &&
-         faults.quick_stop_ignored) ||
+void DeviceControl::command(uint16_t c, const AxisFaults& faults, const Options& o, Parts& parts,
+                            EventSink& sink, int64_t now_ns) {
+    DeviceCommand dc = decode(c, cw_prev_);
+    if ((dc == DeviceCommand::QuickStop && state_ == State::OperationEnabled && faults.quick_stop_ignored) ||
         (dc == DeviceCommand::FaultReset && faults.fault_reset_ignored))
         dc = DeviceCommand::None;
-    if (dc_.pending.active || dc_.state == State::FaultReactionActive) return;  // one command completes first
-    if (dc == DeviceCommand::FaultReset && dc_.state != State::Fault) {
+    if (pending_.active || state_ == State::FaultReactionActive) return;  // one command completes first
+    if (dc == DeviceCommand::FaultReset && state_ != State::Fault) {
         // A fault reset outside Fault acknowledges warnings ("fault signal only" reactions).
-        for (auto& w : sup_.warnings) {
-            if (w) sink_->clear(w, sup_.error_register);
-            w = 0;
-        }
+        parts.acknowledge_warnings();
         return;
     }
     for (int pass = 0; pass < 2; ++pass) {
-        const Transition t = next(dc_.state, dc);
+        const Transition t = next(state_, dc);
         if (t.number < 0) return;
         switch (t.number) {
             case 2:
@@ -61,57 +45,47 @@ void Axis::device_control(int64_t now_ns) {
             case 6:
             case 7:
             case 10:
-                enter(t.to, t.number);
+                enter(t.to, sink);
                 break;
             case 4: {
-                if (ctl_.km <= 0) {
-                    fault(error_code::TorqueFault, now_ns);
+                if (const uint16_t refused = parts.enable_refused()) {
+                    parts.fault(refused);
                     return;
                 }
-                if ((pins_ & 0x30) != 0x30) {
-                    fault(error_code::Sto, now_ns);
-                    return;
-                }
-                dc_.power = true;
-                dc_.stop = StopKind::None;
-                ctl_.vel_int = ctl_.cur_int = 0;
-                sp_.demand_pos = static_cast<double>(count_);
-                sp_.demand_vel = sp_.demand_acc = 0;
-                sp_.profile.reset(sp_.demand_pos, 0);
-                sp_.hold(sp_.demand_pos);
-                enter(State::OperationEnabled, 4);
+                power_ = true;
+                stop_ = StopKind::None;
+                parts.powered();
+                enter(State::OperationEnabled, sink);
                 break;
             }
             case 5:
             case 8: {
-                const int16_t code = t.number == 5 ? params.disable_operation : params.shutdown;
+                const int16_t code = t.number == 5 ? o.disable_operation : o.shutdown;
                 if (code == 1)
-                    begin_stop(StopKind::Ramp, params.profile_deceleration, now_ns);
+                    begin_stop(StopKind::Ramp, o.profile_deceleration, parts);
                 else
-                    begin_stop(StopKind::Disable, 0, now_ns);
-                dc_.pending = {true, t.to, t.number, now_ns};
+                    begin_stop(StopKind::Disable, 0, parts);
+                pending_ = {true, t.to, t.number, now_ns};
                 break;
             }
             case 9:
             case 12:
-                begin_stop(StopKind::Disable, 0, now_ns);
-                dc_.pending = {true, t.to, t.number, now_ns};
+                begin_stop(StopKind::Disable, 0, parts);
+                pending_ = {true, t.to, t.number, now_ns};
                 break;
             case 11:
                 // 0x605A = 6 (the only value the MAXPOS firmware specification allows): quick-stop ramp, stay
                 // in Quick Stop Active.
-                begin_stop(StopKind::Ramp, params.quick_stop_deceleration, now_ns);
-                enter(State::QuickStopActive, 11);
+                begin_stop(StopKind::Ramp, o.quick_stop_deceleration, parts);
+                enter(State::QuickStopActive, sink);
                 break;
             case 15:
-                fault_reset();
+                if (parts.fault_reset()) enter(State::SwitchOnDisabled, sink);
                 break;
             case 16:
-                dc_.stop = StopKind::None;
-                sp_.demand_pos = sp_.profile.position();
-                sp_.demand_vel = 0;
-                sp_.hold(sp_.demand_pos);
-                enter(State::OperationEnabled, 16);
+                stop_ = StopKind::None;
+                parts.resumed();
+                enter(State::OperationEnabled, sink);
                 break;
             default:
                 break;
@@ -121,23 +95,49 @@ void Axis::device_control(int64_t now_ns) {
     }
 }
 
-void Axis::check_pending(int64_t now_ns) {
-    if (!dc_.pending.active && !dc_.fra) return;
-    if (dc_.stop == StopKind::Ramp && !dc_.ramp_done) return;
-    dc_.power = false;  // the ramp (if any) is over: power stage off
-    const bool detection_off = params.standstill_window == kNoWindow;
-    const int64_t since = dc_.pending.active ? dc_.pending.since_ns : dc_.pending.since_ns;
-    const bool timeout = params.standstill_timeout != 0xFFFF &&
-                         now_ns - since >= static_cast<int64_t>(params.standstill_timeout) * 1000000;
-    if (!(sup_.still || detection_off || timeout)) return;
-    dc_.stop = StopKind::None;
-    if (dc_.fra) {
-        dc_.fra = false;
-        dc_.pending.active = false;
-        enter(State::Fault, 14);
+void DeviceControl::react(Reaction rx, int16_t option, bool at_rest, const Options& o, Parts& parts,
+                          EventSink& sink, int64_t now_ns) {
+    if (state_ == State::Fault) return;
+    if (state_ == State::FaultReactionActive) {
+        if (rx == Reaction::Disable) begin_stop(StopKind::Disable, 0, parts);
+        return;
+    }
+    const bool was_powered = power_;
+    pending_ = {false, State::Fault, 14, now_ns};
+    fra_ = true;
+    if (!was_powered || rx == Reaction::Disable || option == 0 ||
+        (rx == Reaction::AbortConnectionCode && option == 2)) {
+        begin_stop(StopKind::Disable, 0, parts);
+    } else if (rx == Reaction::FaultReactionCode && option == 1) {
+        begin_stop(StopKind::Ramp, o.profile_deceleration, parts);
     } else {
-        dc_.pending.active = false;
-        enter(dc_.pending.to, dc_.pending.number);
+        begin_stop(StopKind::Ramp, o.quick_stop_deceleration, parts);
+    }
+    enter(State::FaultReactionActive, sink);
+    // Powerless and at rest already: the reaction is complete at once (transition 14).
+    if (!was_powered && at_rest) {
+        fra_ = false;
+        stop_ = StopKind::None;
+        enter(State::Fault, sink);
+    }
+}
+
+void DeviceControl::settle(bool still, uint32_t standstill_window, uint16_t standstill_timeout_ms,
+                           EventSink& sink, int64_t now_ns) {
+    if (!pending_.active && !fra_) return;
+    if (stop_ == StopKind::Ramp && !ramp_done_) return;
+    power_ = false;  // the ramp (if any) is over: power stage off
+    const bool detection_off = standstill_window == 0xFFFFFFFFu;
+    const bool timeout = standstill_timeout_ms != 0xFFFF &&
+                         now_ns - pending_.since_ns >= static_cast<int64_t>(standstill_timeout_ms) * 1000000;
+    if (!(still || detection_off || timeout)) return;
+    stop_ = StopKind::None;
+    pending_.active = false;
+    if (fra_) {
+        fra_ = false;
+        enter(State::Fault, sink);
+    } else {
+        enter(pending_.to, sink);
     }
 }
 

@@ -1,10 +1,12 @@
 // Homing mode (6) (IEC 61800-7-201 homing mode; MAXPOS firmware specification §4.5, §7.2.75-7.2.77; EPOS4
 // Application Notes §7.3): the methods of 0x60E3, run as a small phase machine on top of the profile
-// generator. Edges and index pulses are latched in the plant sub-steps (on_edge/on_index) at the position
-// where they really happened, so the reference point does not depend on the cycle time.
+// generator (Homing). Edges and index pulses are latched in the plant sub-steps (Axis::on_edge/on_index) at
+// the position where they really happened, so the reference point does not depend on the cycle time.
+#include "drive/homing.hpp"
+
 #include <cmath>
 
-#include "drive/axis.hpp"
+#include "od/drive_objects.hpp"
 
 namespace drive {
 
@@ -29,167 +31,188 @@ int offset_sign(int m) {
 }
 }  // namespace
 
-void Axis::homing_start() {
-    // Homing clears touch-probe states and latched values (MAXPOS firmware specification §4.5).
-    tp_.clear_for_homing();
-    home_.method = params.homing_method;
-    home_.referenced = false;
-    home_.status = HomingStatus::InProgress;
-    home_.edge = home_.index = false;
-    home_.settle = 0;
-    home_.bit = -1;
-    home_.rise = true;
-    sp_.profile.reset(sp_.demand_pos, sp_.demand_vel);
-    const int m = home_.method;
-    const bool neg = func_ & ((1ull << 0) | (1ull << 24));
-    const bool pos = func_ & ((1ull << 1) | (1ull << 25));
-    const bool home = func_ & (1ull << 2);
+void Homing::start(const Parameters& p, uint64_t functions, double actual, EventSink& sink) {
+    method_ = p.homing_method;
+    referenced_ = false;
+    status_ = HomingStatus::InProgress;
+    edge_ = index_ = false;
+    settle_ = 0;
+    bit_ = -1;
+    rise_ = true;
+    const int m = method_;
+    const bool neg = functions & ((1ull << 0) | (1ull << 24));
+    const bool pos = functions & ((1ull << 1) | (1ull << 25));
+    const bool home = functions & (1ull << 2);
     // Only the methods of 0x60E3 (declared once in od/drive_objects.hpp, also the 0x6098 validator's).
-    if (!od::contains(od::kHomingMethods, m) || (uses_index(m) && !(params.encoder_type & 0x1))) {
-        homing_fail();
+    if (!od::contains(od::kHomingMethods, m) || (uses_index(m) && !(p.encoder_type & 0x1))) {
+        fail(sink);
         return;
     }
     if (limit_method(m)) {
         const bool negative = (m == 1 || m == 17);
-        home_.bit = negative ? 0 : 1;
-        home_.dir = negative ? -1 : 1;
+        bit_ = negative ? 0 : 1;
+        dir_ = negative ? -1 : 1;
         if (negative ? neg : pos) {  // already on the switch: only back off
-            home_.dir = -home_.dir;
-            home_.rise = false;
-            home_.phase = HomingPhase::Backoff;
+            dir_ = -dir_;
+            rise_ = false;
+            phase_ = HomingPhase::Backoff;
         } else {
-            home_.phase = HomingPhase::Search;
+            phase_ = HomingPhase::Search;
         }
     } else if (home_method(m)) {
-        home_.bit = 2;
-        home_.dir = (m == 7 || m == 23) ? 1 : -1;
+        bit_ = 2;
+        dir_ = (m == 7 || m == 23) ? 1 : -1;
         if (home) {  // starts on the switch: go the other way to its edge
-            home_.dir = -home_.dir;
-            home_.rise = false;
-            home_.phase = HomingPhase::Backoff;
+            dir_ = -dir_;
+            rise_ = false;
+            phase_ = HomingPhase::Backoff;
         } else {
-            home_.phase = HomingPhase::Search;
+            phase_ = HomingPhase::Search;
         }
     } else if (m == 33 || m == 34) {
-        home_.dir = m == 33 ? -1 : 1;
-        home_.search_origin = static_cast<double>(count_);
-        home_.phase = HomingPhase::ToIndex;
+        dir_ = m == 33 ? -1 : 1;
+        search_origin_ = actual;
+        phase_ = HomingPhase::ToIndex;
     } else if (m == 37) {
-        home_.ref = static_cast<double>(count_);
-        home_.phase = HomingPhase::Offset;
+        ref_ = actual;
+        phase_ = HomingPhase::Offset;
     } else if (current_method(m)) {
-        home_.dir = (m == -1 || m == -3) ? 1 : -1;
-        home_.phase = HomingPhase::Search;
+        dir_ = (m == -1 || m == -3) ? 1 : -1;
+        phase_ = HomingPhase::Search;
     } else {
-        homing_fail();
+        fail(sink);
         return;
     }
-    sink_->diag(Severity::Info, 0, "Homing started");
+    sink.diag(Severity::Info, 0, "Homing started");
 }
 
-void Axis::homing_fail() {
-    home_.status = HomingStatus::Error;
-    home_.phase = HomingPhase::Stopping;
-    home_.referenced = false;
-    sink_->diag(Severity::Warning, 0, "Homing error");
+void Homing::set_here(int32_t home_position, int64_t count, EventSink& sink) {
+    // MAXPOS firmware specification §4.5.3.11.
+    method_ = 37;
+    ref_ = static_cast<double>(count);
+    shift_ = static_cast<int64_t>(home_position) - count;
+    status_ = HomingStatus::Done;
+    phase_ = HomingPhase::Finished;
+    referenced_ = true;
+    sink.diag(Severity::Info, 0, "Homing attained");
 }
 
-void Axis::homing_finish_ok() {
-    const double target =
-        std::floor(home_.ref + offset_sign(home_.method) * static_cast<double>(params.home_offset_move));
-    shift_ = static_cast<int64_t>(params.home_position) - static_cast<int64_t>(target);
-    sp_.profile.reset(target, 0);
-    home_.status = HomingStatus::Done;
-    home_.phase = HomingPhase::Finished;
-    home_.referenced = true;
-    sink_->diag(Severity::Info, 0, "Homing attained");
+void Homing::fail(EventSink& sink) {
+    status_ = HomingStatus::Error;
+    phase_ = HomingPhase::Stopping;
+    referenced_ = false;
+    sink.diag(Severity::Warning, 0, "Homing error");
 }
 
-void Axis::homing_tick(double h) {
-    const double fast = rpm_to_inc_s(params.homing_speed_switch);
-    const double slow = rpm_to_inc_s(params.homing_speed_zero);
-    const double acc = decel_limit(params.homing_acceleration);
-    if (home_.status != HomingStatus::InProgress) {
-        sp_.profile.step_velocity(0.0, acc, acc, h);
+void Homing::finish(Profile& profile, const Parameters& p, EventSink& sink) {
+    const double target = std::floor(ref_ + offset_sign(method_) * static_cast<double>(p.home_offset_move));
+    shift_ = static_cast<int64_t>(p.home_position) - static_cast<int64_t>(target);
+    profile.reset(target, 0);
+    status_ = HomingStatus::Done;
+    phase_ = HomingPhase::Finished;
+    referenced_ = true;
+    sink.diag(Severity::Info, 0, "Homing attained");
+}
+
+void Homing::edge(int bit, bool rising, double v, double raw_pos) {
+    if (status_ == HomingStatus::InProgress && bit == bit_ && rising == rise_ && moving_on(v)) {
+        edge_ = true;
+        event_pos_ = raw_pos;
+    }
+}
+
+void Homing::index_pulse(double v, double raw_pos) {
+    if (status_ == HomingStatus::InProgress && phase_ == HomingPhase::ToIndex && moving_on(v)) {
+        index_ = true;
+        event_pos_ = raw_pos;
+    }
+}
+
+void Homing::tick(Profile& profile, const Motion& mo, const Inputs& in, const Parameters& p, EventSink& sink,
+                  double h) {
+    const double fast = mo.fast;
+    const double slow = mo.slow;
+    const double acc = mo.acc;
+    if (status_ != HomingStatus::InProgress) {
+        profile.step_velocity(0.0, acc, acc, h);
         return;
     }
-    if (sp_.halted) {  // halt in homing: stop with the homing acceleration (MAXPOS firmware specification
-                       // Table 4-29)
-        if (sp_.profile.step_velocity(0.0, acc, acc, h)) {
-            home_.status = HomingStatus::Interrupted;
-            home_.phase = HomingPhase::Finished;
+    if (in.halted) {  // halt in homing: stop with the homing acceleration (MAXPOS firmware specification
+                      // Table 4-29)
+        if (profile.step_velocity(0.0, acc, acc, h)) {
+            status_ = HomingStatus::Interrupted;
+            phase_ = HomingPhase::Finished;
         }
         return;
     }
-    const int m = home_.method;
-    const double threshold = params.homing_current_threshold * 1e-3;
-    const double current = std::abs(plant_.current());
-    const bool neg = func_ & ((1ull << 0) | (1ull << 24));
-    const bool pos = func_ & ((1ull << 1) | (1ull << 25));
-    switch (home_.phase) {
+    const int m = method_;
+    const double threshold = p.homing_current_threshold * 1e-3;
+    const double current = in.current;
+    const bool neg = in.functions & ((1ull << 0) | (1ull << 24));
+    const bool pos = in.functions & ((1ull << 1) | (1ull << 25));
+    switch (phase_) {
         case HomingPhase::Search:
-            sp_.profile.step_velocity(home_.dir * fast, acc, acc, h);
+            profile.step_velocity(dir_ * fast, acc, acc, h);
             // A limit switch that is not the target of the search ends homing with an error.
-            if (limit_method(m) && ((home_.bit == 0 && pos) || (home_.bit == 1 && neg))) return homing_fail();
-            if (home_method(m) && ((home_.dir < 0 && neg) || (home_.dir > 0 && pos))) return homing_fail();
+            if (limit_method(m) && ((bit_ == 0 && pos) || (bit_ == 1 && neg))) return fail(sink);
+            if (home_method(m) && ((dir_ < 0 && neg) || (dir_ > 0 && pos))) return fail(sink);
             if (current_method(m)) {
                 // Only at constant speed: the acceleration current must not look like the stop.
-                home_.settle = sp_.profile.velocity() == home_.dir * fast ? home_.settle + 1 : 0;
-                if (current > threshold && home_.settle > 20) {
+                settle_ = profile.velocity() == dir_ * fast ? settle_ + 1 : 0;
+                if (current > threshold && settle_ > 20) {
                     if (m == -3 || m == -4) {
-                        home_.ref = static_cast<double>(count_);
-                        home_.phase = HomingPhase::Offset;
+                        ref_ = in.actual;
+                        phase_ = HomingPhase::Offset;
                     } else {
-                        home_.dir = -home_.dir;
-                        home_.phase = HomingPhase::Backoff;
+                        dir_ = -dir_;
+                        phase_ = HomingPhase::Backoff;
                     }
                 }
-            } else if (home_.edge) {
-                home_.edge = false;
-                home_.dir = -home_.dir;
-                home_.rise = false;
-                home_.phase = HomingPhase::Backoff;
+            } else if (edge_) {
+                edge_ = false;
+                dir_ = -dir_;
+                rise_ = false;
+                phase_ = HomingPhase::Backoff;
             }
             break;
         case HomingPhase::Backoff:
-            sp_.profile.step_velocity(home_.dir * slow, acc, acc, h);
+            profile.step_velocity(dir_ * slow, acc, acc, h);
             if (current_method(m)) {
-                const double v = sp_.profile.velocity();
-                if (current < threshold && ((home_.dir > 0 && v > 0) || (home_.dir < 0 && v < 0))) {
-                    home_.search_origin = static_cast<double>(count_);
-                    home_.index = false;
-                    home_.phase = HomingPhase::ToIndex;
+                const double v = profile.velocity();
+                if (current < threshold && ((dir_ > 0 && v > 0) || (dir_ < 0 && v < 0))) {
+                    search_origin_ = in.actual;
+                    index_ = false;
+                    phase_ = HomingPhase::ToIndex;
                 }
-            } else if (home_.edge) {
-                home_.edge = false;
+            } else if (edge_) {
+                edge_ = false;
                 if (m == 17 || m == 18 || m == 23 || m == 27) {
-                    home_.ref = home_.event_pos;
-                    home_.phase = HomingPhase::Offset;
+                    ref_ = event_pos_;
+                    phase_ = HomingPhase::Offset;
                 } else {
-                    home_.search_origin = home_.event_pos;
-                    home_.index = false;
-                    home_.phase = HomingPhase::ToIndex;
+                    search_origin_ = event_pos_;
+                    index_ = false;
+                    phase_ = HomingPhase::ToIndex;
                 }
             }
             break;
         case HomingPhase::ToIndex:
-            sp_.profile.step_velocity(home_.dir * slow, acc, acc, h);
-            if (home_.index) {
-                home_.ref = home_.event_pos;
-                home_.phase = HomingPhase::Offset;
-            } else if (std::abs(static_cast<double>(count_) - home_.search_origin) > 2.0 * res_) {
-                return homing_fail();  // no index within two turns
+            profile.step_velocity(dir_ * slow, acc, acc, h);
+            if (index_) {
+                ref_ = event_pos_;
+                phase_ = HomingPhase::Offset;
+            } else if (std::abs(in.actual - search_origin_) > 2.0 * in.resolution) {
+                return fail(sink);  // no index within two turns
             }
             break;
         case HomingPhase::Offset: {
-            const double target =
-                std::floor(home_.ref + offset_sign(m) * static_cast<double>(params.home_offset_move));
-            if (sp_.profile.step_position(target, fast, acc, acc, h)) homing_finish_ok();
+            const double target = std::floor(ref_ + offset_sign(m) * static_cast<double>(p.home_offset_move));
+            if (profile.step_position(target, fast, acc, acc, h)) finish(profile, p, sink);
             break;
         }
         case HomingPhase::Stopping:
         case HomingPhase::Finished:
-            sp_.profile.step_velocity(0.0, acc, acc, h);
+            profile.step_velocity(0.0, acc, acc, h);
             break;
     }
 }

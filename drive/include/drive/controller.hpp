@@ -1,13 +1,19 @@
 #pragma once
 // The cascaded loops of one axis (position P 2.5 kHz, velocity PI 5 kHz, current PI 25 kHz), the velocity
 // observer and the I2t model, with the gains derived from 0x30A0/0x30A1 (docs/decisions/drive.md "Control
-// loops"). Angles and speeds in rad and rad/s of the raw frame, currents in A.
+// loops"). Angles and speeds in rad and rad/s of the raw frame, currents in A. Axis runs the loops at their
+// rates (position(), velocity(), observe(); the current loop is written out in Axis's flattened sample) and
+// tells them what they need: the set-point generator's demand and reference, the measured current and
+// position, the power stage.
 #include <cstdint>
+
+#include "drive/setpoint.hpp"
 
 namespace drive {
 
 struct Parameters;
 
+// The loop state stays readable (the feedback and the tests show it); the loops own its changes.
 struct Controller {
     // gains derived from the parameters
     double km = 0, j = 1e-5, r = 0;      // torque constant (0 = not configured), inertia, viscous friction
@@ -45,6 +51,38 @@ struct Controller {
         bool valid = false;
         bool operator==(const TuneInputs&) const = default;
     } tuned;
+    // A trajectory tick's feed-forwards, and the reference of the loop the set-point enters (`control`).
+    void follow(const LoopReference& ref, Control control) {
+        vel_ff = ref.vel_ff;
+        torque_ff_a = ref.torque_ff_a;
+        if (control == Control::Velocity) vel_ref = ref.vel_ref;
+        if (control == Control::Torque) cur_ref = ref.cur_ref;
+    }
+    // Transition 4: the integrators start empty.
+    void power_on() { vel_int = cur_int = 0; }
+    // A new mode of operation: without power the speed reference drops to zero.
+    void mode_switched(bool power) { vel_ref = power ? vel_ref : 0.0; }
+    // The observer starts at `pos_rad` (start-up).
+    void start_at(double pos_rad) { obs_pos = pos_rad; }
+    // The encoder frame changed (resolution, polarity): the observer restarts at rest at `pos_rad`.
+    void rebase(double pos_rad) {
+        obs_pos = pos_rad;
+        obs_vel = obs_load = 0;
+    }
+    // 0x3001:05 in uNm/A (0 = not configured); tune() derives the gains from it.
+    void set_torque_constant(uint32_t unm_per_a) { km = unm_per_a * 1e-6; }
+    // Position loop (P, 2.5 kHz) on the demand (raw inc, inc/s, inc/s^2) against the encoder count `actual`:
+    // the speed reference; with `internal_ff` (profile modes, stops) the demand's own speed and the inertia
+    // and friction feed-forward, otherwise the CSP velocity offset. `rad_per_inc`: 2 pi / resolution.
+    void position(double demand_pos, double demand_vel, double demand_acc, double actual, bool internal_ff,
+                  double km_plant, double rad_per_inc);
+    // Velocity loop (PI, 5 kHz): the current reference, limited to 0x3001:02 (0x3001:01 while I2t limits),
+    // in mA; `torque_control`: CST sets the current reference itself.
+    void velocity(bool power, bool torque_control, uint16_t nominal_ma, uint16_t output_limit_ma);
+    // The current limit, A: 0x3001:02, or 0x3001:01 while I2t limits (both mA).
+    double current_limit(uint16_t nominal_ma, uint16_t output_limit_ma) const {
+        return (i2t_active ? nominal_ma : output_limit_ma) * 1e-3;
+    }
     // One current-loop sample of the observer (measured angle, measured current), the I2t model and the
     // averaged values; `km_plant` stands in for an unconfigured torque constant.
     void observe(double meas_rad, double i_meas, double km_plant);

@@ -2,9 +2,14 @@
 // The set-point generator of one axis: the active mode of operation, the profile modes (profile position
 // with its buffered set-point, profile velocity) on the trajectory generator, and the linear interpolation of
 // the cyclic synchronous modes (CSP; CSV and CST pass their targets through). Its output is the demand
-// (position, velocity, acceleration in raw increments) and which loop it feeds. Positions in raw increments.
+// (position, velocity, acceleration in raw increments), which loop it feeds, and the references and
+// feed-forwards it gives the loops (LoopReference). Homing (homing.hpp) moves the same profile while it is
+// the mode. Positions in raw increments.
+#include <algorithm>
 #include <cstdint>
 
+#include "drive/frame.hpp"
+#include "drive/parameters.hpp"
 #include "drive/profile.hpp"
 #include "od/drive_objects.hpp"
 
@@ -25,30 +30,101 @@ bool supported(int8_t m);
 // Which loop the set-point enters: position loop, velocity loop (CSV) or current loop (CST).
 enum class Control : uint8_t { Position, Velocity, Torque };
 
-struct SetpointGenerator {
-    int8_t mode = mode::None;
-    bool halted = false;
-    Profile profile;
-    // profile position mode
-    bool ppm_moving = false, ppm_buffered = false, ppm_ack = false;
-    double ppm_target = 0, ppm_next_target = 0;
-    bool ppm_next_rel = false;
-    int32_t ppm_next_raw = 0;
-    bool ppm_limited = false;
-    // CSP interpolation (raw increments)
-    double ip_from = 0, ip_to = 0;
-    int64_t ip_t0 = 0, ip_period = 0;
-    bool csp_limit_violation = false;
-    // demand (raw increments, inc/s, inc/s^2)
-    Control control = Control::Position;
-    double demand_pos = 0, demand_vel = 0, demand_acc = 0;
+// What a trajectory tick gives the loops: the feed-forwards (CSP and CSV offsets 0x60B1/0x60B2), and the
+// reference of the loop the set-point enters when that is not the position loop.
+struct LoopReference {
+    double vel_ff = 0;       // rad/s
+    double torque_ff_a = 0;  // A
+    double vel_ref = 0;      // rad/s, Control::Velocity
+    double cur_ref = 0;      // A, Control::Torque
+};
 
+// Controlword bit 4 (new set-point / homing operation start) against the previous cycle's.
+struct SetpointEdge {
+    bool rise = false, fall = false;
+};
+inline SetpointEdge new_setpoint_edge(uint16_t cw, uint16_t prev) {
+    constexpr uint16_t bit = 1u << 4;
+    return {(cw & bit) && !(prev & bit), !(cw & bit) && (prev & bit)};
+}
+
+// An acceleration of the dictionary (rpm/s) in inc/s^2 at `resolution` inc per turn, at least 1 rpm/s and at
+// most 0x60C5 (`max_acceleration`).
+inline double limited_acceleration(double rpm_s, uint32_t max_acceleration, double resolution) {
+    const double a = std::min<double>(std::max(rpm_s, 1.0), static_cast<double>(max_acceleration));
+    return a * resolution / 60.0;
+}
+
+class SetpointGenerator {
+  public:
+    // What a trajectory tick reads of the machine.
+    struct Inputs {
+        double actual = 0;         // encoder count, raw inc
+        double speed = 0;          // estimated speed, rad/s
+        double resolution = 2000;  // inc per turn
+    };
+
+    // A new mode of operation: it takes over from the current demand without a jump (from `actual` without
+    // power).
+    void switch_mode(int8_t m, bool power, double actual);
+    // Once per cycle, the master's set-points: halt, the profile position set-point on bit 4 (`enabled`: the
+    // drive follows set-points), the new CSP target to interpolate over the cycle (`interpolate`: 0x60C2
+    // set).
+    void command(const Command& c, uint16_t cw_prev, bool enabled, const PositionFrame& f, bool interpolate,
+                 int64_t now_ns, int64_t dt_ns);
+    // One trajectory tick of `h` s at time t_ns with the drive powered, in the modes other than homing.
+    LoopReference tick(const Command& c, const Parameters& p, const Inputs& in, const PositionFrame& f,
+                       int64_t t_ns, double h);
+    // Power off: the demand follows the actual position.
+    void follow(double actual);
+    // One tick of a stop ramp of `decel` inc/s^2; true at zero speed.
+    bool ramp(double decel, double h);
+    // The demand is the profile's (homing moves the profile).
+    void from_profile();
+    // Transition 4: the demand starts at `actual`, at rest.
+    void power_on(double actual);
+    // Transition 16: hold where the quick-stop ramp got to.
+    void resume();
+    // A stop ramp starts from the actual motion.
+    void ramp_from(double actual, double speed_inc_s);
+    // The position frame changed (resolution or polarity): the demand is the actual position.
+    void reset_to(double actual);
+
+    Profile& profile() { return profile_; }
+    const Profile& profile() const { return profile_; }
+    int8_t mode() const { return mode_; }
+    bool halted() const { return halted_; }
+    Control control() const { return control_; }
+    double demand_position() const { return demand_pos_; }
+    double demand_velocity() const { return demand_vel_; }
+    double demand_acceleration() const { return demand_acc_; }
+    bool target_reached() const { return halted_ ? profile_.velocity() == 0.0 : !ppm_moving_; }  // PPM
+    bool setpoint_acknowledged() const { return ppm_ack_; }                                      // PPM
+    bool target_limited() const { return ppm_limited_; }                 // PPM target clamped by 0x607D
+    bool target_outside_limits() const { return csp_limit_violation_; }  // CSP target outside 0x607D
+
+  private:
     // Hold at `pos`: no interpolation pending, no profile move.
-    void hold(double pos) {
-        ip_from = ip_to = pos;
-        ip_period = 0;
-        ppm_moving = ppm_buffered = false;
-    }
+    void hold(double pos);
+    // A profile position target (raw) within the software position limits.
+    void move_to(double target, const PositionFrame& f);
+
+    int8_t mode_ = mode::None;
+    bool halted_ = false;
+    Profile profile_;
+    // profile position mode
+    bool ppm_moving_ = false, ppm_buffered_ = false, ppm_ack_ = false;
+    double ppm_target_ = 0;
+    bool ppm_next_rel_ = false;
+    int32_t ppm_next_raw_ = 0;
+    bool ppm_limited_ = false;
+    // CSP interpolation (raw increments)
+    double ip_from_ = 0, ip_to_ = 0;
+    int64_t ip_t0_ = 0, ip_period_ = 0;
+    bool csp_limit_violation_ = false;
+    // demand (raw increments, inc/s, inc/s^2)
+    Control control_ = Control::Position;
+    double demand_pos_ = 0, demand_vel_ = 0, demand_acc_ = 0;
 };
 
 }  // namespace drive
