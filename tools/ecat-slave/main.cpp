@@ -1,5 +1,6 @@
 // ecat-slave: parses the command line (and the configuration file) and hands over to
 // slave::run_slave() with the soft drive (tools/lib/device) as firmware.
+#include <grp.h>
 #include <CLI/CLI.hpp>
 #include <cerrno>
 #include <cstdio>
@@ -18,6 +19,7 @@
 #include "slave/log.hpp"
 #include "slave/slave.hpp"
 #include "slave/topology.hpp"
+#include "util/lex.hpp"
 
 namespace {
 
@@ -84,6 +86,11 @@ int main(int argc, char** argv) {
                    "(lines like 'input 4 on', 'sto off', 'limit-pos 50000', 'status'; "
                    "e.g. echo 'input 4 on' | nc -uUN -w0 PATH)")
         ->type_name("PATH");
+    std::string control_group;
+    app.add_option("--control-group", control_group,
+                   "Let the members of this group use the --control socket too (mode 0660; default: 0600, "
+                   "the owner and root only)")
+        ->type_name("GROUP");
     auto* env = app.add_option_group("Simulated machine", "Positions in raw encoder increments");
     env->add_option("--limit-neg", device.environment.negative_limit,
                     "Negative limit switch (DigIN1), active at and below this position");
@@ -135,7 +142,7 @@ int main(int argc, char** argv) {
                "--slaves", slaves,
                "Serve N drives in a line (device k's port 1 to device k+1's port 0), serial numbers 1..N, "
                "state directories <state-dir>/drive<k> when N > 1")
-            ->check(CLI::Range(1, 1000));
+            ->check(CLI::Range(1, static_cast<int>(slave::kMaxDevices)));
     app.add_option(
            "--topology", topology_file,
            "Serve the devices of this topology file (docs/segment.md): names, config files, where each "
@@ -202,6 +209,23 @@ int main(int argc, char** argv) {
         else if (ec)
             log.warn("cannot remove " + writes.string() + ": " + ec.message());
     }
+    gid_t control_gid = device::ControlSocket::kNoGroup;
+    if (!control_group.empty()) {
+        const group* g = ::getgrnam(control_group.c_str());
+        gid_t number = 0;
+        if (g != nullptr)
+            control_gid = g->gr_gid;
+        else if (util::parse_number(control_group, number) == util::NumberError::None)
+            control_gid = number;
+        else {
+            std::cerr << "ecat-slave: --control-group: no group '" << control_group << "'\n";
+            return slave::kExitUsage;
+        }
+        if (control.empty()) {
+            std::cerr << "ecat-slave: --control-group needs --control\n";
+            return slave::kExitUsage;
+        }
+    }
     if (!control.empty()) {
         const std::filesystem::path parent = std::filesystem::absolute(control).parent_path();
         std::error_code ec;
@@ -247,7 +271,7 @@ int main(int argc, char** argv) {
     if (slaves_opt->count() > 0 && !segment_mode) device.serial_number = 1;  // --slaves 1: serial number 1
     if (!segment_mode) {
         options.eeprom_loader = device::eeprom_loader(device);
-        options.firmware_factory = device::firmware_factory(device, control);
+        options.firmware_factory = device::firmware_factory(device, control, control_gid);
         return slave::run_slave(options, std::cout, std::cerr);
     }
     if (!options.eeprom_file.empty()) {
@@ -291,6 +315,7 @@ int main(int argc, char** argv) {
     line.esc.process_ram_kib = options.ram_kib;
     line.esc.faults = options.esc_faults;
     line.control_path = control;
+    line.control_group = control_gid;
     line.log = &log;
     options.log = &log;
     options.segment_factory = [&line](const esc::Clock& clock, const slave::SlaveOptions&,

@@ -107,11 +107,11 @@ std::optional<T> number(std::string_view s, T lo = std::numeric_limits<T>::lowes
     return v;
 }
 
-// What is expected, in the one wording every format uses: "an integer 0..3", "a number -1000..1000".
+// What is expected, in the one wording every format uses: "an integer 0..3", "-1000..1000".
 template <class T>
 std::string expected_number(T lo, T hi) {
     if constexpr (std::is_floating_point_v<T>)
-        return "a number " + detail::range_text(static_cast<double>(lo), static_cast<double>(hi));
+        return detail::range_text(static_cast<double>(lo), static_cast<double>(hi));
     else if constexpr (std::is_signed_v<T>)
         return "an integer " + detail::range_text(static_cast<long long>(lo), static_cast<long long>(hi));
     else
@@ -119,11 +119,10 @@ std::string expected_number(T lo, T hi) {
                detail::range_text(static_cast<unsigned long long>(lo), static_cast<unsigned long long>(hi));
 }
 
-// "'s' is not a number (expected an integer 0..3)" / "'s' is out of range (expected ...)".
+// "bad number 's' for KEY (expected an integer 0..3)": what every format says of a number it refuses.
 template <class T>
-std::string number_message(std::string_view s, NumberError e, T lo, T hi) {
-    return "'" + std::string(s) + "' " +
-           (e == NumberError::OutOfRange ? "is out of range" : "is not a number") + " (expected " +
+std::string number_message(std::string_view key, std::string_view s, T lo, T hi) {
+    return "bad number '" + std::string(s) + "' for " + std::string(key) + " (expected " +
            expected_number(lo, hi) + ")";
 }
 
