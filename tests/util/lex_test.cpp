@@ -2,6 +2,7 @@
 // (util/input_file.hpp).
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdint>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "support/temp_dir.hpp"
+#include "util/dir_lock.hpp"
 #include "util/input_file.hpp"
 #include "util/lex.hpp"
 
@@ -160,6 +162,36 @@ TEST(InputFile, RefusesDevicesFifosDirectoriesAndMissingFiles) {
         EXPECT_EQ(std::string(e.what()),
                   fifo.string() + ": not a regular file (a FIFO); the topology file must be a file");
     }
+}
+
+}  // namespace
+
+namespace {
+
+// Issue 24, finding 6: nothing stopped two devices or two processes from using one state directory.
+TEST(DirLock, OneHolderPerStateDirectory) {
+    test_support::TempDir dir;
+    const auto state = dir.path / "drive1";
+    {
+        util::DirLock first(state);
+        EXPECT_TRUE(first.held());
+        EXPECT_TRUE(std::filesystem::is_directory(state));       // created as the device would
+        EXPECT_THROW(util::DirLock{state}, util::DirLockError);  // a second device of this process
+        const pid_t child = ::fork();                            // another process
+        if (child == 0) {
+            try {
+                util::DirLock other(state);
+            } catch (const util::DirLockError&) {
+                ::_exit(0);
+            }
+            ::_exit(1);
+        }
+        int status = 0;
+        ASSERT_EQ(::waitpid(child, &status, 0), child);
+        EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    }
+    util::DirLock again(state);  // released with the first
+    EXPECT_TRUE(again.held());
 }
 
 }  // namespace

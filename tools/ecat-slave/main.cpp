@@ -8,7 +8,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <string_view>
+#include <vector>
 
 #include "config_check.hpp"
 #include "device/faults.hpp"
@@ -19,6 +21,7 @@
 #include "slave/log.hpp"
 #include "slave/slave.hpp"
 #include "slave/topology.hpp"
+#include "util/dir_lock.hpp"
 #include "util/lex.hpp"
 
 namespace {
@@ -251,7 +254,7 @@ int main(int argc, char** argv) {
             }
             return slave::kExitOk;
         }
-        (void)device::make_description(device);  // a bad configuration is a usage error, before any setup
+        device::check_device(device);  // a bad configuration is a usage error, before any setup
     } catch (const od::ConfigError& e) {
         std::cerr << "ecat-slave: " << e.what() << '\n';
         return slave::kExitUsage;
@@ -269,7 +272,20 @@ int main(int argc, char** argv) {
     }
     const bool segment_mode = slaves > 1 || !topology_file.empty() || !options.out_iface.empty();
     if (slaves_opt->count() > 0 && !segment_mode) device.serial_number = 1;  // --slaves 1: serial number 1
+    // Each state directory is the one device's that runs on it: locked until exit (a second process, or a
+    // second device of a topology on the same directory, is a usage error before any network set-up).
+    std::vector<std::unique_ptr<util::DirLock>> state_locks;
+    auto lock_state = [&state_locks](const std::filesystem::path& dir) {
+        try {
+            state_locks.push_back(std::make_unique<util::DirLock>(dir));
+            return true;
+        } catch (const util::DirLockError& e) {
+            std::cerr << "ecat-slave: " << e.what() << '\n';
+            return false;
+        }
+    };
     if (!segment_mode) {
+        if (!lock_state(device.state_dir)) return slave::kExitUsage;
         options.eeprom_loader = device::eeprom_loader(device);
         options.firmware_factory = device::firmware_factory(device, control, control_gid);
         return slave::run_slave(options, std::cout, std::cerr);
@@ -298,8 +314,15 @@ int main(int argc, char** argv) {
         if (!d.config.empty()) o.config_file = d.config;
         o.state_dir = d.state_dir;
         try {
-            (void)device::make_description(o);
+            device::check_device(o);
         } catch (const std::exception& e) {
+            std::cerr << "ecat-slave: " << (d.line > 0 ? line.topology.where(d.line) : std::string())
+                      << "device " << d.name << ": " << e.what() << '\n';
+            return slave::kExitUsage;
+        }
+        try {
+            state_locks.push_back(std::make_unique<util::DirLock>(d.state_dir));
+        } catch (const util::DirLockError& e) {
             std::cerr << "ecat-slave: " << (d.line > 0 ? line.topology.where(d.line) : std::string())
                       << "device " << d.name << ": " << e.what() << '\n';
             return slave::kExitUsage;
