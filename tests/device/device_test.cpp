@@ -579,7 +579,8 @@ TEST_F(DeviceAssembly, StateChangesRefusalsSavesFaultsAndRestartsAreLoggedAndSta
     std::filesystem::create_directory(dir / "parameters.bin.tmp");
     EXPECT_NE(sdo.download(0x1010, 1, save), Error::Ok);
     EXPECT_EQ(sdo.last_abort(), 0x06060000u);
-    EXPECT_NE(lines.str().find("ecat-slave: error: stored parameters not saved (0x1010:1 "), std::string::npos)
+    EXPECT_NE(lines.str().find("ecat-slave: error: stored parameters not saved (0x1010:1 "),
+              std::string::npos)
         << lines.str();
     std::filesystem::remove(dir / "parameters.bin.tmp");
 
