@@ -1,6 +1,7 @@
 // The soft drive's control socket (see device/control.hpp).
 #include "device/control.hpp"
 
+#include <fcntl.h>
 #include <grp.h>
 #include <pwd.h>
 #include <sys/epoll.h>
@@ -123,7 +124,9 @@ ControlSocket::ControlSocket(std::filesystem::path path, gid_t group)
     dev_ = st.st_dev;
     ino_ = st.st_ino;
     if (group_ != kNoGroup &&
-        (::chown(p.c_str(), static_cast<uid_t>(-1), group_) != 0 || ::chmod(p.c_str(), 0660) != 0)) {
+        // Never following a symbolic link someone may have put in the socket's place meanwhile.
+        (::lchown(p.c_str(), static_cast<uid_t>(-1), group_) != 0 ||
+         ::fchmodat(AT_FDCWD, p.c_str(), 0660, AT_SYMLINK_NOFOLLOW) != 0)) {
         const int err = errno;
         ::unlink(p.c_str());
         fail(std::string("cannot give the socket to group ") + std::to_string(group_) + ": " +
