@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "od/drive_profile.hpp"
+#include "util/input_file.hpp"
+#include "util/lex.hpp"
 
 namespace od {
 namespace {
@@ -27,75 +29,28 @@ struct Parser {
 
     [[noreturn]] void fail(const std::string& msg) const { throw ConfigError(source, line, msg); }
 
-    // Value text -> string (quotes removed, escapes resolved, trailing comment stripped).
+    // Value text -> string (the one lexer's rule: one quoted word, or bare words; comment dropped).
     std::string value_string(std::string_view v) const {
-        if (v.empty()) return {};
-        if (v.front() == '"') {
-            std::string out;
-            std::size_t i = 1;
-            for (; i < v.size() && v[i] != '"'; ++i) {
-                if (v[i] == '\\') {
-                    if (++i == v.size()) fail("unterminated string");
-                    switch (v[i]) {
-                        case '"':
-                            out += '"';
-                            break;
-                        case '\\':
-                            out += '\\';
-                            break;
-                        case 't':
-                            out += '\t';
-                            break;
-                        case 'n':
-                            out += '\n';
-                            break;
-                        default:
-                            fail(std::string("unknown escape \\") + v[i]);
-                    }
-                } else {
-                    out += v[i];
-                }
-            }
-            if (i == v.size()) fail("unterminated string");
-            check_rest(v.substr(i + 1));
-            return out;
+        try {
+            return util::value_text(v);
+        } catch (const util::LexError& e) {
+            fail(e.what());
         }
-        if (v.front() == '\'') {
-            const auto end = v.find('\'', 1);
-            if (end == std::string_view::npos) fail("unterminated string");
-            check_rest(v.substr(end + 1));
-            return std::string(v.substr(1, end - 1));
-        }
-        return std::string(strip_comment(v));
     }
 
     void check_rest(std::string_view rest) const {
-        rest = trim(rest);
-        if (!rest.empty() && rest.front() != '#' && rest.front() != ';')
-            fail("unexpected text after the string");
-    }
-
-    static std::string_view strip_comment(std::string_view v) {
-        for (std::size_t i = 0; i < v.size(); ++i)
-            if ((v[i] == '#' || v[i] == ';') && (i == 0 || v[i - 1] == ' ' || v[i - 1] == '\t'))
-                return trim(v.substr(0, i));
-        return trim(v);
-    }
-
-    uint64_t value_uint(std::string_view v, uint64_t max) const {
-        const std::string s = value_string(v);
-        std::string_view d = s;
-        int base = 10;
-        if (d.size() > 2 && d[0] == '0' && (d[1] == 'x' || d[1] == 'X')) {
-            base = 16;
-            d.remove_prefix(2);
+        try {
+            if (!util::split(rest).empty()) fail("unexpected text after the section header");
+        } catch (const util::LexError& e) {
+            fail(e.what());
         }
+    }
+
+    uint64_t value_uint(std::string_view key, std::string_view v, uint64_t max) const {
+        const std::string s = value_string(v);
         uint64_t u = 0;
-        auto [p, ec] = std::from_chars(d.data(), d.data() + d.size(), u, base);
-        if (d.empty() || ec == std::errc::invalid_argument || p != d.data() + d.size())
-            fail("'" + s + "' is not an unsigned integer");
-        if (ec == std::errc::result_out_of_range || u > max)
-            fail("'" + s + "' is out of range (maximum " + std::to_string(max) + ")");
+        if (util::parse_number<uint64_t>(s, u, 0, max) != util::NumberError::None)
+            fail(util::number_message<uint64_t>(key, s, 0, max));
         return u;
     }
 };
@@ -125,6 +80,7 @@ DeviceDescription parse_device_config(std::string_view text, const std::string& 
     std::string raw;
     while (std::getline(in, raw)) {
         ++p.line;
+        if (const std::string e = util::text_error(raw); !e.empty()) p.fail(e);
         std::string_view l = trim(raw);
         if (l.empty() || l.front() == '#' || l.front() == ';') continue;
         if (l.front() == '[') {
@@ -150,13 +106,13 @@ DeviceDescription parse_device_config(std::string_view text, const std::string& 
         bool known = true;
         if (section == "identity") {
             if (key == "vendor_id")
-                id.vendor_id = static_cast<uint32_t>(p.value_uint(value, 0xFFFFFFFF));
+                id.vendor_id = static_cast<uint32_t>(p.value_uint(key, value, 0xFFFFFFFF));
             else if (key == "product_code")
-                id.product_code = static_cast<uint32_t>(p.value_uint(value, 0xFFFFFFFF));
+                id.product_code = static_cast<uint32_t>(p.value_uint(key, value, 0xFFFFFFFF));
             else if (key == "revision")
-                id.revision = static_cast<uint32_t>(p.value_uint(value, 0xFFFFFFFF));
+                id.revision = static_cast<uint32_t>(p.value_uint(key, value, 0xFFFFFFFF));
             else if (key == "serial_number")
-                id.serial_number = static_cast<uint32_t>(p.value_uint(value, 0xFFFFFFFF));
+                id.serial_number = static_cast<uint32_t>(p.value_uint(key, value, 0xFFFFFFFF));
             else if (key == "vendor_name")
                 id.vendor_name = p.value_string(value);
             else if (key == "device_name")
@@ -174,30 +130,30 @@ DeviceDescription parse_device_config(std::string_view text, const std::string& 
         } else if (section == "mailbox" || section == "bootstrap_mailbox") {
             MailboxLayout& m = section == "mailbox" ? d.standard_mailbox : d.bootstrap_mailbox;
             if (key == "out_start")
-                m.out_start = static_cast<uint16_t>(p.value_uint(value, 0xFFFF));
+                m.out_start = static_cast<uint16_t>(p.value_uint(key, value, 0xFFFF));
             else if (key == "out_size")
-                m.out_size = static_cast<uint16_t>(p.value_uint(value, 0xFFFF));
+                m.out_size = static_cast<uint16_t>(p.value_uint(key, value, 0xFFFF));
             else if (key == "in_start")
-                m.in_start = static_cast<uint16_t>(p.value_uint(value, 0xFFFF));
+                m.in_start = static_cast<uint16_t>(p.value_uint(key, value, 0xFFFF));
             else if (key == "in_size")
-                m.in_size = static_cast<uint16_t>(p.value_uint(value, 0xFFFF));
+                m.in_size = static_cast<uint16_t>(p.value_uint(key, value, 0xFFFF));
             else
                 known = false;
         } else {  // eeprom
             if (key == "bytes") {
-                const auto b = p.value_uint(value, 32768);
+                const auto b = p.value_uint(key, value, 32768);
                 if (b < 128 || (b & (b - 1)) != 0) p.fail("eeprom bytes must be a power of two, 128...32768");
                 d.eeprom_bytes = static_cast<uint16_t>(b);
             } else if (key == "station_alias")
-                d.station_alias = static_cast<uint16_t>(p.value_uint(value, 0xFFFF));
+                d.station_alias = static_cast<uint16_t>(p.value_uint(key, value, 0xFFFF));
             else if (key == "pdi_control")
-                d.pdi_control = static_cast<uint8_t>(p.value_uint(value, 0xFF));
+                d.pdi_control = static_cast<uint8_t>(p.value_uint(key, value, 0xFF));
             else if (key == "esc_config")
-                d.esc_config = static_cast<uint8_t>(p.value_uint(value, 0xFF));
+                d.esc_config = static_cast<uint8_t>(p.value_uint(key, value, 0xFF));
             else if (key == "pdi_config")
-                d.pdi_config = static_cast<uint16_t>(p.value_uint(value, 0xFFFF));
+                d.pdi_config = static_cast<uint16_t>(p.value_uint(key, value, 0xFFFF));
             else if (key == "sync_pulse_length")
-                d.sync_pulse_length = static_cast<uint16_t>(p.value_uint(value, 0xFFFF));
+                d.sync_pulse_length = static_cast<uint16_t>(p.value_uint(key, value, 0xFFFF));
             else
                 known = false;
         }
@@ -225,22 +181,15 @@ DeviceDescription parse_device_config(std::string_view text, const std::string& 
 }
 
 DeviceDescription load_device_config(const std::filesystem::path& path) {
-    errno = 0;
-    std::ifstream f(path, std::ios::binary);
-    if (!f)
-        throw ConfigError(path.string(), 0,
-                          std::string("cannot open the device configuration file: ") +
-                              std::strerror(errno ? errno : ENOENT));
-    // Read in pieces up to the limit, never the whole of whatever the path names (a pipe or /dev/zero
-    // would not end): a configuration is a few hundred bytes.
     std::string text;
-    char piece[4096];
-    while (f.read(piece, sizeof piece) || f.gcount() > 0) {
-        text.append(piece, static_cast<std::size_t>(f.gcount()));
-        if (text.size() > kMaxConfigBytes)
-            throw ConfigError(
-                path.string(), 0,
-                "larger than " + std::to_string(kMaxConfigBytes) + " bytes: not a device configuration file");
+    try {
+        text = util::read_input_file(path, kMaxConfigBytes, "device configuration file");
+    } catch (const util::InputFileError& e) {
+        // e.what() is "PATH: why"; ConfigError puts the path in front again.
+        std::string_view why = e.what();
+        if (const std::string prefix = path.string() + ": "; why.rfind(prefix, 0) == 0)
+            why.remove_prefix(prefix.size());
+        throw ConfigError(path.string(), 0, std::string(why));
     }
     return parse_device_config(text, path.string());
 }

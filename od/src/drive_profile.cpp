@@ -504,9 +504,11 @@ Entry make_entry(const Line& l, const Identity& id) {
     e.type = l.type;
     e.access = l.acc;
     e.unit = l.unit;
+    // The marker is the table's, never a value: an identity string "=" is text like any other.
+    const bool declared_default_marker = std::string_view(l.def) == "=";
     std::string def = l.def;
     if (!def.empty() && def.front() == '$') def = identity_token(def, id);
-    if (def == "=") {
+    if (declared_default_marker) {
         const std::optional<Number> declared = declared_default(l.index, e.subindex);
         if (!declared) throw std::logic_error("od: row marked \"=\" without a declared default");
         e.default_value = *declared;

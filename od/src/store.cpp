@@ -288,7 +288,8 @@ std::string ParameterStore::restore_defaults(const Dictionary& dict, StoreScope 
     return write_atomic(serialize(dict, keep));
 }
 
-void attach_store(Dictionary& dict, ParameterStore& store, std::function<Status()> restore_allowed) {
+void attach_store(Dictionary& dict, ParameterStore& store, std::function<Status()> restore_allowed,
+                  StoreResult on_result) {
     struct Command {
         uint16_t index;
         bool save;
@@ -301,7 +302,7 @@ void attach_store(Dictionary& dict, ParameterStore& store, std::function<Status(
         Dictionary* d = &dict;
         ParameterStore* s = &store;
         dict.add_validator(
-            cmd.index, [d, s, cmd, restore_allowed](const Entry& e, std::span<const uint8_t> v) {
+            cmd.index, [d, s, cmd, restore_allowed, on_result](const Entry& e, std::span<const uint8_t> v) {
                 if (e.subindex == 0 || v.size() != 4) return Status::Ok;
                 StoreScope scope = StoreScope::All;
                 if (e.subindex == 2)
@@ -316,6 +317,7 @@ void attach_store(Dictionary& dict, ParameterStore& store, std::function<Status(
                 if (!cmd.save && restore_allowed)
                     if (const Status st = restore_allowed(); st != Status::Ok) return st;
                 const std::string err = cmd.save ? s->save(*d, scope) : s->restore_defaults(*d, scope);
+                if (on_result) on_result(e, cmd.save, err);
                 if (!cmd.cia) d->ref<uint32_t>(e.index, e.subindex).set(err.empty() ? 0x1u : 0x2u);
                 return err.empty() ? Status::Ok : Status::HardwareError;
             });

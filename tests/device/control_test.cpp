@@ -1,13 +1,18 @@
 // The soft drive's control socket: command parsing and the datagram socket itself.
 #include <gtest/gtest.h>
 
+#include <poll.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/un.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 
 #include "device/control.hpp"
@@ -164,4 +169,204 @@ TEST(ControlCommands, RandomLinesNeverBreakTheDevice) {
     for (double v :
          {env.negative_limit, env.positive_limit, env.home_from, env.home_to, env.stop_lo, env.stop_hi})
         EXPECT_TRUE(std::isnan(v) || std::isfinite(v));
+}
+
+// Issue 24, finding 4: numbers are parsed into their type with range checks, never cast first.
+TEST(ControlCommands, NumbersAreCheckedBeforeAnyConversion) {
+    Rig r;
+    for (const char* bad :
+         {"input 1e300 on", "input -1e300 on", "input 4.0 on", "input 0x4 on extra",
+          "input 99999999999999999999 on", "limit-pos 1e400", "home -inf 5", "stops 1 nan"}) {
+        const std::string answer = ControlSocket::apply(*r.dev, bad);
+        EXPECT_EQ(answer.rfind("error: ", 0), 0u) << bad << " -> " << answer;
+    }
+    EXPECT_EQ(ControlSocket::apply(*r.dev, "input 0x4 on"), "ok input 4 on");  // the one lexer: hex too
+    EXPECT_EQ(ControlSocket::apply(*r.dev, "input \"4\" off # quoted"), "ok input 4 off");
+    EXPECT_EQ(ControlSocket::apply(*r.dev, "input \"4 on").rfind("error: unterminated string", 0), 0u);
+}
+
+namespace {
+
+// A client socket bound to its own address (it gets the answers).
+struct Client {
+    int fd = -1;
+    sockaddr_un to{};
+    Client(const std::filesystem::path& dir, const std::filesystem::path& server,
+           const char* name = "client.sock") {
+        fd = ::socket(AF_UNIX, SOCK_DGRAM, 0);
+        sockaddr_un me{};
+        me.sun_family = AF_UNIX;
+        std::strcpy(me.sun_path, (dir / name).c_str());
+        if (::bind(fd, reinterpret_cast<sockaddr*>(&me), sizeof me) != 0) throw std::runtime_error("bind");
+        to.sun_family = AF_UNIX;
+        std::strcpy(to.sun_path, server.c_str());
+    }
+    ~Client() { ::close(fd); }
+    bool send(const std::string& msg) const {
+        return ::sendto(fd, msg.data(), msg.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to) ==
+               static_cast<ssize_t>(msg.size());
+    }
+    std::string receive() const {
+        std::string buf(65536, '\0');
+        const ssize_t n = ::recv(fd, buf.data(), buf.size(), MSG_DONTWAIT);
+        return n > 0 ? buf.substr(0, static_cast<std::size_t>(n)) : std::string{};
+    }
+};
+
+bool readable(int fd) {
+    pollfd p{fd, POLLIN, 0};
+    return ::poll(&p, 1, 0) > 0;
+}
+
+}  // namespace
+
+// Issue 24, finding 1: 4096 bytes of padding followed by a command was cut at 4096 bytes and the cut
+// text executed. A datagram that does not fit is refused whole, with an error answer.
+TEST(ControlSocket, ADatagramLongerThanTheBufferIsRefusedWhole) {
+    Rig r;
+    const auto path = r.dir / "control.sock";
+    ControlSocket ctl(path);
+    Client c(r.dir, path);
+    // The padding is blanks: cut anywhere, the rest would be a valid command.
+    ASSERT_TRUE(c.send(std::string(ControlSocket::kMaxDatagram, ' ') + "limit-neg -500\n"));
+    const std::string fits = "limit-pos 500\n";
+    ASSERT_TRUE(c.send(std::string(ControlSocket::kMaxDatagram - fits.size(), ' ') + fits));  // fits exactly
+    ctl.service(*r.dev, r.clock.now_ns());
+    const std::string first = c.receive();
+    EXPECT_EQ(first.rfind("error: datagram longer than 4096 bytes: refused whole", 0), 0u) << first;
+    EXPECT_TRUE(std::isnan(r.dev->environment().negative_limit));  // nothing of it executed
+    ctl.service(*r.dev, r.clock.now_ns());
+    EXPECT_EQ(c.receive(), "ok limit-pos\n");
+    EXPECT_EQ(r.dev->environment().positive_limit, 500);
+}
+
+// Issue 24, finding 2: the control work of one call is bounded in time; what is left waits, and the
+// descriptor the runtime watches stays readable until it is done.
+TEST(ControlSocket, WorkPerCallIsBoundedAndTheRestWaits) {
+    Rig r;
+    const auto path = r.dir / "control.sock";
+    ControlSocket ctl(path);
+    Client c(r.dir, path);
+    std::string many;
+    for (int i = 0; i < 200; ++i)
+        many += "status\n";
+    ASSERT_TRUE(c.send(many));
+    ASSERT_TRUE(c.send("input 4 on\n"));
+    int lines = 0, calls = 0;
+    const auto count = [&](std::string_view line) {
+        ++lines;
+        return ControlSocket::apply(*r.dev, line);
+    };
+    ASSERT_TRUE(readable(ctl.fd()));
+    ctl.service(count, 0);  // no time at all: one line
+    ++calls;
+    EXPECT_EQ(lines, 1);
+    EXPECT_TRUE(ctl.busy());
+    EXPECT_TRUE(readable(ctl.fd()));  // the rest of the datagram: the runtime comes back
+    EXPECT_EQ(c.receive(), "");       // nothing answered before the whole datagram is done
+    while (readable(ctl.fd()) && calls < 1000) {
+        ctl.service(count, 0);
+        ++calls;
+    }
+    EXPECT_EQ(lines, 201);
+    EXPECT_FALSE(readable(ctl.fd()));
+    EXPECT_FALSE(ctl.busy());
+    const std::string answer = c.receive();
+    EXPECT_EQ(std::count(answer.begin(), answer.end(), '\n'), 200) << answer.substr(0, 200);
+    EXPECT_EQ(c.receive(), "ok input 4 on\n");
+}
+
+// Issue 24, finding 3: the socket's mode did not depend on the umask, any path was unlinked, and the path
+// was deleted at exit whatever it then was.
+TEST(ControlSocket, IsTheOwnersOnlyWhateverTheUmask) {
+    Rig r;
+    const auto path = r.dir / "control.sock";
+    const mode_t old = ::umask(0);
+    {
+        ControlSocket ctl(path);
+        struct stat st {};
+        ASSERT_EQ(::lstat(path.c_str(), &st), 0);
+        EXPECT_EQ(st.st_mode & 0777, 0600u);
+    }
+    {
+        ControlSocket ctl(path, ::getegid());
+        struct stat st {};
+        ASSERT_EQ(::lstat(path.c_str(), &st), 0);
+        EXPECT_EQ(st.st_mode & 0777, 0660u);
+        EXPECT_EQ(st.st_gid, ::getegid());
+    }
+    ::umask(old);
+}
+
+TEST(ControlSocket, NeverReplacesOrRemovesWhatItDidNotCreate) {
+    Rig r;
+    const auto path = r.dir / "control.sock";
+    // A live socket of another program: refused, left alone.
+    {
+        const int other = ::socket(AF_UNIX, SOCK_DGRAM, 0);
+        sockaddr_un a{};
+        a.sun_family = AF_UNIX;
+        std::strcpy(a.sun_path, path.c_str());
+        ASSERT_EQ(::bind(other, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+        EXPECT_THROW(ControlSocket{path}, std::runtime_error);
+        EXPECT_TRUE(std::filesystem::is_socket(path));
+        ::close(other);  // now stale: replaced
+        ControlSocket ctl(path);
+        EXPECT_TRUE(std::filesystem::is_socket(path));
+        // Another control socket on the same path (of this process) is refused too.
+        EXPECT_THROW(ControlSocket{path}, std::runtime_error);
+    }
+    EXPECT_FALSE(std::filesystem::exists(path));
+    // A regular file: refused, left alone.
+    std::ofstream(path) << "data";
+    EXPECT_THROW(ControlSocket{path}, std::runtime_error);
+    EXPECT_TRUE(std::filesystem::is_regular_file(path));
+    std::filesystem::remove(path);
+    // Replaced while it runs: what is at the path at the end is not removed.
+    {
+        ControlSocket ctl(path);
+        ::unlink(path.c_str());
+        std::ofstream(path) << "someone else's";
+    }
+    EXPECT_TRUE(std::filesystem::is_regular_file(path));
+}
+
+TEST(ControlSocket, ASenderOfAnotherUserIsRefused) {
+    Rig r;
+    const auto path = r.dir / "control.sock";
+    ControlSocket ctl(path);
+    EXPECT_EQ(ctl.refuse(::geteuid(), ::getegid()), "");
+    EXPECT_EQ(ctl.refuse(0, 0), "");
+    EXPECT_NE(ctl.refuse(::geteuid() + 4242, 4242), "");
+    ControlSocket grouped(r.dir / "grouped.sock", 4242);
+    EXPECT_EQ(grouped.refuse(::geteuid() + 4242, 4242), "");  // a member of the control group
+    if (::geteuid() != 0) GTEST_SKIP() << "sending as another user needs root";
+    // Over the socket: a child that became nobody sends; the mode stops it first, so open the mode.
+    ASSERT_EQ(::chmod(path.c_str(), 0666), 0);
+    ASSERT_EQ(::chmod(r.dir.c_str(), 0755), 0);
+    const pid_t child = ::fork();
+    if (child == 0) {
+        if (::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(3);
+        const int fd = ::socket(AF_UNIX, SOCK_DGRAM, 0);
+        sockaddr_un to{};
+        to.sun_family = AF_UNIX;
+        std::strcpy(to.sun_path, path.c_str());
+        const std::string msg = "input 4 on\n";
+        ::_exit(::sendto(fd, msg.data(), msg.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to) ==
+                        static_cast<ssize_t>(msg.size())
+                    ? 0
+                    : 4);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status));
+    ASSERT_EQ(WEXITSTATUS(status), 0);
+    int lines = 0;
+    ctl.service(
+        [&](std::string_view) {
+            ++lines;
+            return std::string("ok");
+        },
+        ControlSocket::kBudgetNs);
+    EXPECT_EQ(lines, 0);  // received and refused: nothing applied
 }

@@ -574,6 +574,15 @@ TEST_F(DeviceAssembly, StateChangesRefusalsSavesFaultsAndRestartsAreLoggedAndSta
     const uint8_t save[4] = {'s', 'a', 'v', 'e'};
     ASSERT_EQ(sdo.download(0x1010, 1, save), Error::Ok) << std::hex << sdo.last_abort();
     EXPECT_NE(lines.str().find("stored parameters saved (0x1010:1 "), std::string::npos) << lines.str();
+    // Issue 24, finding 9: a failed save (here the temporary file's name is taken by a directory, which
+    // stops root too) was answered with the right abort but not logged.
+    std::filesystem::create_directory(dir / "parameters.bin.tmp");
+    EXPECT_NE(sdo.download(0x1010, 1, save), Error::Ok);
+    EXPECT_EQ(sdo.last_abort(), 0x06060000u);
+    EXPECT_NE(lines.str().find("ecat-slave: error: stored parameters not saved (0x1010:1 "),
+              std::string::npos)
+        << lines.str();
+    std::filesystem::remove(dir / "parameters.bin.tmp");
 
     drive.dev->raise(0x8611, 0x20, {});
     EXPECT_NE(lines.str().find("ecat-slave: error: drive fault 0x8611: "), std::string::npos) << lines.str();

@@ -13,7 +13,10 @@
     X(sii)                         \
     X(device_config)               \
     X(loaders)                     \
-    X(master_reply)
+    X(master_reply)                \
+    X(control)                     \
+    X(topology)                    \
+    X(esi_reader)
 
 #define SOFTECAT_FUZZ_DECLARE(name)                      \
     namespace fuzz::name {                               \

@@ -3,7 +3,14 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
 #include <string>
+
+#include "support/temp_dir.hpp"
 
 namespace {
 
@@ -142,8 +149,57 @@ TEST(Topology, MissingFile) {
         (void)slave::load_topology("/nonexistent/x.topo");
         FAIL() << "no error";
     } catch (const slave::TopologyError& e) {
-        EXPECT_EQ(std::string(e.what()).rfind("/nonexistent/x.topo: cannot read", 0), 0u) << e.what();
+        EXPECT_EQ(std::string(e.what()).rfind("/nonexistent/x.topo: cannot open the topology file", 0), 0u)
+            << e.what();
     }
+}
+
+// Issue 24, finding 6: device names became state directory paths (device ../escapeA, device /tmp/x,
+// device ./a) and NUL was accepted. Names are of a documented character set, unique; state-dir= values are
+// unique.
+TEST(Topology, NamesCannotLeaveTheStateDirectory) {
+    for (const char* bad :
+         {"../escapeA", "/tmp/x", "./a", ".", "..", ".hidden", "a/b", "-a", "\"a b\"", "a\\b"}) {
+        const std::string e = error_of(std::string("device ") + bad + "\n");
+        EXPECT_NE(e.find("line.topo:1: device name"), std::string::npos) << bad << " -> " << e;
+    }
+    EXPECT_NE(error_of(std::string("device a\0b\n", 10)).find("line.topo:1: control character"),
+              std::string::npos);
+    EXPECT_NE(error_of("device " + std::string(65, 'a') + "\n").find("1..64 characters"), std::string::npos);
+    EXPECT_EQ(error_of("device drive_1.x-2\ndevice " + std::string(64, 'a') + "\n"), "");
+    EXPECT_EQ(
+        error_of("device a state-dir=s\ndevice b state-dir=./s\n"),
+        "line.topo:2: state-dir=./s: also the state directory of 'a' (line 1); each device needs its own");
+}
+
+// Issue 24, finding 7: a topology had no device limit (--slaves stopped at 1000); one limit for both.
+TEST(Topology, OneDeviceLimitForTopologyAndSlaves) {
+    std::string text;
+    for (std::size_t k = 0; k < slave::kMaxDevices; ++k)
+        text += "device d" + std::to_string(k) + "\n";
+    EXPECT_EQ(parse(text).devices.size(), slave::kMaxDevices);
+    text += "device one_more\n";
+    EXPECT_EQ(error_of(text), "line.topo:" + std::to_string(slave::kMaxDevices + 1) +
+                                  ": more than 1000 devices (the limit of a segment)");
+}
+
+// Issue 24, finding 5: the topology reader had no limit and read FIFOs and devices.
+TEST(Topology, OnlyARegularFileWithinTheLimitIsRead) {
+    test_support::TempDir dir;
+    const auto fifo = dir.path / "fifo.topo";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    for (const std::string& f : {fifo.string(), std::string("/dev/zero"), dir.path.string()}) {
+        try {
+            (void)slave::load_topology(f);
+            ADD_FAILURE() << f;
+        } catch (const slave::TopologyError& e) {
+            EXPECT_NE(std::string(e.what()).find(f + ": not a regular file"), std::string::npos) << e.what();
+        }
+    }
+    const auto big = dir.path / "big.topo";
+    std::ofstream(big) << "device a\n";
+    std::filesystem::resize_file(big, slave::kMaxTopologyBytes + 1);
+    EXPECT_THROW((void)slave::load_topology(big.string()), slave::TopologyError);
 }
 
 }  // namespace

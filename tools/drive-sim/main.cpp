@@ -39,6 +39,7 @@
 #include "drive/profile.hpp"
 #include "od/drive_profile.hpp"
 #include "plot.hpp"
+#include "util/input_file.hpp"
 
 namespace {
 
@@ -404,9 +405,11 @@ int main(int argc, char** argv) {
         std::istringstream in(kDemo);
         parse_script(in, sc, err);
     } else {
-        std::ifstream in(script_path);
-        if (!in) {
-            std::cerr << "drive-sim: cannot open " << script_path << ": " << std::strerror(errno) << "\n";
+        std::istringstream in;
+        try {  // a regular file of at most 1 MiB, checked before it is read
+            in.str(util::read_input_file(script_path, std::size_t{1} << 20, "script"));
+        } catch (const util::InputFileError& e) {
+            std::cerr << "drive-sim: " << e.what() << "\n";
             return 2;
         }
         if (!parse_script(in, sc, err)) {

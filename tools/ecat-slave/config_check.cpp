@@ -1,12 +1,11 @@
 #include "config_check.hpp"
 
-#include <cerrno>
-#include <cstring>
-#include <fstream>
 #include <sstream>
 #include <string_view>
 
 #include "od/device_config.hpp"
+#include "util/input_file.hpp"
+#include "util/lex.hpp"
 
 namespace ecat_slave {
 
@@ -22,21 +21,6 @@ std::string_view trim(std::string_view s) {
 
 bool device_section(std::string_view name) {
     return name == "identity" || name == "mailbox" || name == "bootstrap_mailbox" || name == "eeprom";
-}
-
-// A line of text: no NUL and no other control character than tab and CR; bytes >= 0x80 must be UTF-8.
-bool text_line(std::string_view l) {
-    for (std::size_t i = 0; i < l.size(); ++i) {
-        const auto c = static_cast<unsigned char>(l[i]);
-        if (c < 0x20 && c != '\t' && c != '\r') return false;
-        if (c == 0x7F) return false;
-        if (c < 0x80) continue;
-        const int more = (c & 0xE0) == 0xC0 ? 1 : (c & 0xF0) == 0xE0 ? 2 : (c & 0xF8) == 0xF0 ? 3 : -1;
-        if (more < 0 || c == 0xC0 || c == 0xC1) return false;
-        for (int k = 0; k < more; ++k)
-            if (++i >= l.size() || (static_cast<unsigned char>(l[i]) & 0xC0) != 0x80) return false;
-    }
-    return true;
 }
 
 }  // namespace
@@ -55,12 +39,12 @@ std::optional<std::string> config_file_argument(int argc, char** argv) {
 }
 
 std::string check_config_file(const CLI::App& app, const std::string& path) {
-    errno = 0;
-    std::ifstream f(path, std::ios::binary);
-    if (!f) return path + ": cannot open: " + std::strerror(errno ? errno : ENOENT);
-    std::ostringstream all;
-    all << f.rdbuf();
-    const std::string text = all.str();
+    std::string text;
+    try {  // a regular file within od::kMaxConfigBytes, checked before anything is read
+        text = util::read_input_file(path, od::kMaxConfigBytes, "configuration file");
+    } catch (const util::InputFileError& e) {
+        return e.what();
+    }
     std::istringstream in(text);
     std::string raw;
     int line = 0;
@@ -68,8 +52,8 @@ std::string check_config_file(const CLI::App& app, const std::string& path) {
     auto at = [&](const std::string& what) { return path + ":" + std::to_string(line) + ": " + what; };
     while (std::getline(in, raw)) {
         ++line;
-        if (!text_line(raw))
-            return at("not a text file (binary data on this line); --config takes a text file");
+        if (const std::string e = util::text_error(raw); !e.empty())
+            return at(e + "; --config takes a text file");
         const std::string_view l = trim(raw);
         if (l.empty() || l.front() == '#' || l.front() == ';') continue;
         if (l.front() == '[') {

@@ -1,5 +1,6 @@
 // ecat-slave: parses the command line (and the configuration file) and hands over to
 // slave::run_slave() with the soft drive (tools/lib/device) as firmware.
+#include <grp.h>
 #include <CLI/CLI.hpp>
 #include <cerrno>
 #include <cstdio>
@@ -7,7 +8,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <string_view>
+#include <vector>
 
 #include "config_check.hpp"
 #include "device/faults.hpp"
@@ -19,6 +22,8 @@
 #include "slave/log.hpp"
 #include "slave/slave.hpp"
 #include "slave/topology.hpp"
+#include "util/dir_lock.hpp"
+#include "util/lex.hpp"
 
 namespace {
 
@@ -92,6 +97,11 @@ int main(int argc, char** argv) {
            "print its answer and exit (0: ok, 1: error or no answer, 2: no such socket); repeatable")
         ->type_name("LINE")
         ->needs("--control");
+    std::string control_group;
+    app.add_option("--control-group", control_group,
+                   "Let the members of this group use the --control socket too (mode 0660; default: 0600, "
+                   "the owner and root only)")
+        ->type_name("GROUP");
     auto* env = app.add_option_group("Simulated machine", "Positions in raw encoder increments");
     env->add_option("--limit-neg", device.environment.negative_limit,
                     "Negative limit switch (DigIN1), active at and below this position");
@@ -143,7 +153,7 @@ int main(int argc, char** argv) {
                "--slaves", slaves,
                "Serve N drives in a line (device k's port 1 to device k+1's port 0), serial numbers 1..N, "
                "state directories <state-dir>/drive<k> when N > 1")
-            ->check(CLI::Range(1, 1000));
+            ->check(CLI::Range(1, static_cast<int>(slave::kMaxDevices)));
     app.add_option(
            "--topology", topology_file,
            "Serve the devices of this topology file (docs/segment.md): names, config files, where each "
@@ -211,6 +221,23 @@ int main(int argc, char** argv) {
         else if (ec)
             log.warn("cannot remove " + writes.string() + ": " + ec.message());
     }
+    gid_t control_gid = device::ControlSocket::kNoGroup;
+    if (!control_group.empty()) {
+        const group* g = ::getgrnam(control_group.c_str());
+        gid_t number = 0;
+        if (g != nullptr)
+            control_gid = g->gr_gid;
+        else if (util::parse_number(control_group, number) == util::NumberError::None)
+            control_gid = number;
+        else {
+            std::cerr << "ecat-slave: --control-group: no group '" << control_group << "'\n";
+            return slave::kExitUsage;
+        }
+        if (control.empty()) {
+            std::cerr << "ecat-slave: --control-group needs --control\n";
+            return slave::kExitUsage;
+        }
+    }
     if (!control.empty()) {
         const std::filesystem::path parent = std::filesystem::absolute(control).parent_path();
         std::error_code ec;
@@ -236,7 +263,7 @@ int main(int argc, char** argv) {
             }
             return slave::kExitOk;
         }
-        (void)device::make_description(device);  // a bad configuration is a usage error, before any setup
+        device::check_device(device);  // a bad configuration is a usage error, before any setup
     } catch (const od::ConfigError& e) {
         std::cerr << "ecat-slave: " << e.what() << '\n';
         return slave::kExitUsage;
@@ -254,9 +281,22 @@ int main(int argc, char** argv) {
     }
     const bool segment_mode = slaves > 1 || !topology_file.empty() || !options.out_iface.empty();
     if (slaves_opt->count() > 0 && !segment_mode) device.serial_number = 1;  // --slaves 1: serial number 1
+    // Each state directory is the one device's that runs on it: locked until exit (a second process, or a
+    // second device of a topology on the same directory, is a usage error before any network set-up).
+    std::vector<std::unique_ptr<util::DirLock>> state_locks;
+    auto lock_state = [&state_locks](const std::filesystem::path& dir) {
+        try {
+            state_locks.push_back(std::make_unique<util::DirLock>(dir));
+            return true;
+        } catch (const util::DirLockError& e) {
+            std::cerr << "ecat-slave: " << e.what() << '\n';
+            return false;
+        }
+    };
     if (!segment_mode) {
+        if (!lock_state(device.state_dir)) return slave::kExitUsage;
         options.eeprom_loader = device::eeprom_loader(device);
-        options.firmware_factory = device::firmware_factory(device, control);
+        options.firmware_factory = device::firmware_factory(device, control, control_gid);
         return slave::run_slave(options, std::cout, std::cerr);
     }
     if (!options.eeprom_file.empty()) {
@@ -283,8 +323,15 @@ int main(int argc, char** argv) {
         if (!d.config.empty()) o.config_file = d.config;
         o.state_dir = d.state_dir;
         try {
-            (void)device::make_description(o);
+            device::check_device(o);
         } catch (const std::exception& e) {
+            std::cerr << "ecat-slave: " << (d.line > 0 ? line.topology.where(d.line) : std::string())
+                      << "device " << d.name << ": " << e.what() << '\n';
+            return slave::kExitUsage;
+        }
+        try {
+            state_locks.push_back(std::make_unique<util::DirLock>(d.state_dir));
+        } catch (const util::DirLockError& e) {
             std::cerr << "ecat-slave: " << (d.line > 0 ? line.topology.where(d.line) : std::string())
                       << "device " << d.name << ": " << e.what() << '\n';
             return slave::kExitUsage;
@@ -300,6 +347,7 @@ int main(int argc, char** argv) {
     line.esc.process_ram_kib = options.ram_kib;
     line.esc.faults = options.esc_faults;
     line.control_path = control;
+    line.control_group = control_gid;
     line.log = &log;
     options.log = &log;
     options.segment_factory = [&line](const esc::Clock& clock, const slave::SlaveOptions&,

@@ -16,6 +16,7 @@
 
 #include "foe/image.hpp"
 #include "identity.hpp"
+#include "util/input_file.hpp"
 
 namespace {
 
@@ -29,18 +30,13 @@ bool parse_u32(const std::string& text, uint32_t& out) {
     return true;
 }
 
+// A regular file of at most kMaxInputBytes (the largest image a firmware store takes), checked first.
+constexpr std::size_t kMaxInputBytes = std::size_t{64} << 20;
 bool read_file(const std::string& path, std::vector<uint8_t>& out) {
-    errno = 0;
-    std::ifstream f(path, std::ios::binary);
-    if (!f) {
-        std::fprintf(stderr, "fwimage: cannot read %s: %s\n", path.c_str(),
-                     std::strerror(errno ? errno : ENOENT));
-        return false;
-    }
-    out.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-    if (f.bad()) {
-        std::fprintf(stderr, "fwimage: cannot read %s: %s\n", path.c_str(),
-                     std::strerror(errno ? errno : EIO));
+    try {
+        out = util::read_input_bytes(path, kMaxInputBytes, "input file");
+    } catch (const util::InputFileError& e) {
+        std::fprintf(stderr, "fwimage: %s\n", e.what());
         return false;
     }
     return true;

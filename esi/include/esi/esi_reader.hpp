@@ -119,7 +119,12 @@ struct EsiFile {
     std::vector<EsiDevice> devices;
 };
 
-// Reads the file; throws std::runtime_error with a readable message if it is not an EtherCATInfo file.
+// The largest ESI file read (vendor files with many devices run to a few MiB).
+constexpr std::size_t kMaxEsiBytes = std::size_t{32} << 20;
+
+// Reads the file; throws std::runtime_error with a readable message if it is not an EtherCATInfo file
+// (or not a regular file of at most kMaxEsiBytes, or a document with a DOCTYPE: vendor XML is untrusted,
+// see esi_reader.cpp).
 EsiFile read_esi_file(const std::string& path);
 EsiFile read_esi_text(const std::string& xml);
 // The first device of an ESI text (throws as read_esi_text does).

@@ -86,6 +86,10 @@ class ParameterStore {
 // last command (bit 0 done, bit 1 error). Both `dict` and `store` must outlive the wiring and stay put.
 // `restore_allowed`, if given, is asked before a restore (MAXPOS firmware specification §7.2.21: only with
 // every axis in "Power Disable"); a non-Ok answer fails the write with that status and nothing is restored.
-void attach_store(Dictionary& dict, ParameterStore& store, std::function<Status()> restore_allowed = {});
+// `on_result`, if given, hears every save or restore the store attempted (a right signature), with "" or
+// the error text: the device logs both outcomes.
+using StoreResult = std::function<void(const Entry& entry, bool save, const std::string& error)>;
+void attach_store(Dictionary& dict, ParameterStore& store, std::function<Status()> restore_allowed = {},
+                  StoreResult on_result = {});
 
 }  // namespace od

@@ -1,54 +1,67 @@
 // The soft drive's control socket (see device/control.hpp).
 #include "device/control.hpp"
 
+#include <fcntl.h>
+#include <grp.h>
+#include <pwd.h>
+#include <sys/epoll.h>
+#include <sys/eventfd.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
-#include <charconv>
-#include <cmath>
+#include <chrono>
+#include <cstddef>
 #include <cstring>
 #include <sstream>
 #include <stdexcept>
 
 #include "device/device.hpp"
+#include "util/lex.hpp"
 
 namespace device {
 
 namespace {
 
-constexpr std::size_t kMaxDatagram = 4096;
-
-std::vector<std::string_view> words(std::string_view line) {
-    std::vector<std::string_view> out;
-    std::size_t i = 0;
-    while (i < line.size()) {
-        while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r'))
-            ++i;
-        std::size_t j = i;
-        while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r')
-            ++j;
-        if (j > i) out.push_back(line.substr(i, j - i));
-        i = j;
-    }
-    return out;
-}
-
-bool number(std::string_view s, double& out) {
-    const std::string text(s);
-    char* end = nullptr;
-    errno = 0;
-    const double v = std::strtod(text.c_str(), &end);
-    if (text.empty() || end != text.c_str() + text.size() || errno != 0 || !std::isfinite(v)) return false;
-    out = v;
-    return true;
-}
-
 bool level(std::string_view s, bool& out) {
     if (s == "on" || s == "1" || s == "high" || s == "true") return out = true, true;
     if (s == "off" || s == "0" || s == "low" || s == "false") return out = false, true;
     return false;
+}
+
+// A position in increments: any finite number (the environment compares it with the actual position).
+bool number(const util::Word& w, double& out) {
+    return util::parse_number(w.text, out) == util::NumberError::None;
+}
+
+// Is a socket bound at path (someone would receive what is sent there)? A datagram connect() succeeds on a
+// bound datagram socket and fails with ECONNREFUSED on a stale file; anything else counts as live.
+bool live_socket(const sockaddr_un& addr) {
+    const int probe = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    if (probe < 0) return true;
+    const int rc = ::connect(probe, reinterpret_cast<const sockaddr*>(&addr), sizeof addr);
+    const int err = errno;
+    ::close(probe);
+    return rc == 0 || err != ECONNREFUSED;
+}
+
+bool in_group(uid_t uid, gid_t gid, gid_t group) {
+    if (gid == group) return true;
+    std::vector<char> buf(16384);
+    passwd pw{};
+    passwd* found = nullptr;
+    if (::getpwuid_r(uid, &pw, buf.data(), buf.size(), &found) != 0 || found == nullptr) return false;
+    int n = 64;
+    std::vector<gid_t> groups(static_cast<std::size_t>(n));
+    if (::getgrouplist(pw.pw_name, pw.pw_gid, groups.data(), &n) < 0) {
+        groups.resize(static_cast<std::size_t>(n));
+        if (::getgrouplist(pw.pw_name, pw.pw_gid, groups.data(), &n) < 0) return false;
+    }
+    groups.resize(static_cast<std::size_t>(n));
+    return std::find(groups.begin(), groups.end(), group) != groups.end();
 }
 
 const char* state_name(od::AlState s) {
@@ -69,76 +82,197 @@ const char* state_name(od::AlState s) {
 
 }  // namespace
 
-ControlSocket::ControlSocket(std::filesystem::path path) : path_(std::move(path)), buffer_(kMaxDatagram) {
+ControlSocket::ControlSocket(std::filesystem::path path, gid_t group)
+    : path_(std::move(path)), group_(group), buffer_(kMaxDatagram) {
     sockaddr_un addr{};
     addr.sun_family = AF_UNIX;
     const std::string p = path_.string();
     if (p.empty() || p.size() >= sizeof addr.sun_path)
         throw std::runtime_error("control socket path '" + p + "' is empty or too long");
     std::memcpy(addr.sun_path, p.c_str(), p.size() + 1);
-    fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-    if (fd_ < 0) throw std::runtime_error(std::string("control socket: ") + std::strerror(errno));
-    std::error_code ec;
-    if (std::filesystem::is_socket(path_, ec)) std::filesystem::remove(path_, ec);
-    if (::bind(fd_, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0) {
+    auto fail = [this, &p](const std::string& why) {
+        for (int* fd : {&fd_, &event_, &sock_})
+            if (*fd >= 0) ::close(*fd), *fd = -1;
+        throw std::runtime_error("control socket '" + p + "': " + why);
+    };
+    // What is at the path already: only a stale socket of this user is replaced.
+    struct stat st {};
+    if (::lstat(p.c_str(), &st) == 0) {
+        if (!S_ISSOCK(st.st_mode)) fail("the path exists and is not a socket; it is left alone");
+        if (live_socket(addr))
+            fail("a socket in use (another program's, or another control socket) is there; it is left alone");
+        if (st.st_uid != ::geteuid())
+            fail("a stale socket of another user (uid " + std::to_string(st.st_uid) +
+                 ") is there; it is left alone");
+        if (::unlink(p.c_str()) != 0)
+            fail(std::string("cannot remove the stale socket: ") + std::strerror(errno));
+    } else if (errno != ENOENT) {
+        fail(std::strerror(errno));
+    }
+    sock_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+    if (sock_ < 0) fail(std::strerror(errno));
+    const int one = 1;
+    if (::setsockopt(sock_, SOL_SOCKET, SO_PASSCRED, &one, sizeof one) != 0) fail(std::strerror(errno));
+    // Mode 0600 from the bind on (the umask decides a socket file's mode): no moment in which others may
+    // send; then the group's, if one is given.
+    const mode_t old_mask = ::umask(0177);
+    const int bound = ::bind(sock_, reinterpret_cast<const sockaddr*>(&addr), sizeof addr);
+    const int bind_errno = errno;
+    ::umask(old_mask);
+    if (bound != 0) fail(std::strerror(bind_errno));
+    if (::lstat(p.c_str(), &st) != 0) fail(std::strerror(errno));
+    dev_ = st.st_dev;
+    ino_ = st.st_ino;
+    if (group_ != kNoGroup &&
+        // Never following a symbolic link someone may have put in the socket's place meanwhile.
+        (::lchown(p.c_str(), static_cast<uid_t>(-1), group_) != 0 ||
+         ::fchmodat(AT_FDCWD, p.c_str(), 0660, AT_SYMLINK_NOFOLLOW) != 0)) {
         const int err = errno;
-        ::close(fd_);
-        fd_ = -1;
-        throw std::runtime_error("control socket '" + p + "': " + std::strerror(err));
+        ::unlink(p.c_str());
+        fail(std::string("cannot give the socket to group ") + std::to_string(group_) + ": " +
+             std::strerror(err));
+    }
+    event_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+    fd_ = ::epoll_create1(EPOLL_CLOEXEC);
+    if (event_ < 0 || fd_ < 0) {
+        ::unlink(p.c_str());
+        fail(std::strerror(errno));
+    }
+    for (const int fd : {sock_, event_}) {
+        epoll_event ev{};
+        ev.events = EPOLLIN;
+        ev.data.fd = fd;
+        if (::epoll_ctl(fd_, EPOLL_CTL_ADD, fd, &ev) != 0) {
+            ::unlink(p.c_str());
+            fail(std::strerror(errno));
+        }
     }
 }
 
 ControlSocket::~ControlSocket() {
-    if (fd_ >= 0) {
-        ::close(fd_);
-        std::error_code ec;
-        std::filesystem::remove(path_, ec);
+    if (sock_ < 0) return;
+    // Only the socket this object created: a path taken over since (another program's socket, a file)
+    // stays.
+    struct stat st {};
+    if (::lstat(path_.c_str(), &st) == 0 && S_ISSOCK(st.st_mode) && st.st_dev == dev_ && st.st_ino == ino_)
+        ::unlink(path_.c_str());
+    for (const int fd : {fd_, event_, sock_})
+        if (fd >= 0) ::close(fd);
+}
+
+std::string ControlSocket::refuse(uid_t uid, gid_t gid) const {
+    if (uid == 0 || uid == ::geteuid()) return {};
+    if (group_ != kNoGroup && in_group(uid, gid, group_)) return {};
+    return "permission denied: uid " + std::to_string(uid) +
+           " may not use this control socket (its owner, root" +
+           (group_ != kNoGroup ? " or the control group" : "") + " only)";
+}
+
+void ControlSocket::answer(const Pending& p) const {
+    if (p.reply.empty() || p.from_len <= sizeof(sa_family_t)) return;
+    (void)::sendto(sock_, p.reply.data(), p.reply.size(), MSG_DONTWAIT | MSG_NOSIGNAL,
+                   reinterpret_cast<const sockaddr*>(&p.from), p.from_len);
+}
+
+bool ControlSocket::receive() {
+    Pending p;
+    iovec iov{buffer_.data(), buffer_.size()};
+    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(ucred))];
+    msghdr m{};
+    m.msg_name = &p.from;
+    m.msg_namelen = sizeof p.from;
+    m.msg_iov = &iov;
+    m.msg_iovlen = 1;
+    m.msg_control = control;
+    m.msg_controllen = sizeof control;
+    const ssize_t n = ::recvmsg(sock_, &m, MSG_DONTWAIT | MSG_CMSG_CLOEXEC);
+    if (n < 0) return false;  // EAGAIN: drained (other errors: nothing more to read either)
+    p.from_len = m.msg_namelen;
+    const ucred* cred = nullptr;
+    for (cmsghdr* c = CMSG_FIRSTHDR(&m); c != nullptr; c = CMSG_NXTHDR(&m, c))
+        if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_CREDENTIALS &&
+            c->cmsg_len >= CMSG_LEN(sizeof(ucred)))
+            cred = reinterpret_cast<const ucred*>(CMSG_DATA(c));
+    std::string refused =
+        cred == nullptr ? "permission denied: no sender credentials" : refuse(cred->uid, cred->gid);
+    if (refused.empty() && (m.msg_flags & MSG_TRUNC) != 0)
+        refused = "datagram longer than " + std::to_string(kMaxDatagram) +
+                  " bytes: refused whole, nothing of it executed (send fewer lines per datagram)";
+    if (!refused.empty()) {
+        p.reply = "error: " + refused + '\n';
+        answer(p);
+        return true;
     }
+    p.text.assign(buffer_.data(), static_cast<std::size_t>(n));
+    pending_ = std::move(p);
+    return true;
+}
+
+void ControlSocket::set_busy(bool busy) {
+    if (busy == event_set_) return;
+    uint64_t v = 1;
+    if (busy)
+        (void)!::write(event_, &v, sizeof v);
+    else
+        (void)!::read(event_, &v, sizeof v);
+    event_set_ = busy;
 }
 
 void ControlSocket::service(Device& device, uint64_t /*now_ns*/) {
     service([&device](std::string_view line) { return apply(device, line); });
 }
 
-void ControlSocket::service(const std::function<std::string(std::string_view)>& apply_line) {
-    for (int i = 0; i < 64; ++i) {  // bounded: a flood cannot starve the event loop
-        sockaddr_un from{};
-        socklen_t from_len = sizeof from;
-        const ssize_t n =
-            ::recvfrom(fd_, buffer_.data(), buffer_.size(), 0, reinterpret_cast<sockaddr*>(&from), &from_len);
-        if (n < 0) return;  // EAGAIN: drained (other errors: nothing more to read either)
-        std::string reply;
-        std::string_view text(buffer_.data(), static_cast<std::size_t>(n));
-        while (!text.empty()) {
-            const std::size_t nl = text.find('\n');
-            const std::string answer = apply_line(text.substr(0, nl));
-            if (!answer.empty()) reply += answer + '\n';
-            text = nl == std::string_view::npos ? std::string_view{} : text.substr(nl + 1);
+void ControlSocket::service(const std::function<std::string(std::string_view)>& apply_line,
+                            uint64_t budget_ns) {
+    // Frames come first: the runtime handled them before this call, and handles them again before the
+    // next, which comes at once while work is left (fd() stays readable). Each datagram received or line
+    // applied is work; the budget is checked after each.
+    const auto start = std::chrono::steady_clock::now();
+    const auto budget = std::chrono::nanoseconds(budget_ns);
+    bool worked = false;
+    while (!worked || std::chrono::steady_clock::now() - start < budget) {
+        if (!pending_) {
+            if (!receive()) break;
+            worked = !pending_.has_value();  // a refusal answered is work; lines received are not yet
+            continue;
         }
-        if (!reply.empty() && from_len > sizeof(sa_family_t))
-            (void)::sendto(fd_, reply.data(), reply.size(), MSG_DONTWAIT, reinterpret_cast<sockaddr*>(&from),
-                           from_len);
+        Pending& p = *pending_;
+        const std::string_view rest = std::string_view(p.text).substr(p.at);
+        const std::size_t nl = rest.find('\n');
+        const std::string answer_line = apply_line(rest.substr(0, nl));
+        if (!answer_line.empty()) p.reply += answer_line + '\n';
+        p.at = nl == std::string_view::npos ? p.text.size() : p.at + nl + 1;
+        worked = true;
+        if (p.at == p.text.size()) {
+            answer(p);
+            pending_.reset();
+        }
     }
+    set_busy(pending_.has_value());
 }
 
 std::string ControlSocket::apply(Device& device, std::string_view line) {
-    if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
-    const auto w = words(line);
+    std::vector<util::Word> w;
+    try {
+        w = util::split(line);
+    } catch (const util::LexError& e) {
+        return std::string("error: ") + e.what();
+    }
     if (w.empty()) return {};
-    const std::string_view cmd = w[0];
+    const std::string& cmd = w[0].text;
     EnvironmentOptions env = device.environment();
-    const bool none = w.size() == 2 && w[1] == "none";
+    const bool none = w.size() == 2 && w[1].text == "none";
     double a = 0, b = 0;
     bool on = false;
     if (cmd == "input") {
-        double pin = 0;
-        if (w.size() != 3 || !number(w[1], pin) || !level(w[2], on) || pin != std::floor(pin) ||
-            !device.set_input(static_cast<int>(pin), on))
+        int pin = 0;
+        if (w.size() != 3 || util::parse_number(w[1].text, pin, 1, 6) != util::NumberError::None ||
+            !level(w[2].text, on) || !device.set_input(pin, on))
             return "error: usage: input <1..6> on|off";
-        return "ok input " + std::string(w[1]) + (on ? " on" : " off");
+        return "ok input " + std::to_string(pin) + (on ? " on" : " off");
     }
     if (cmd == "sto") {
-        if (w.size() != 2 || !level(w[1], on)) return "error: usage: sto on|off";
+        if (w.size() != 2 || !level(w[1].text, on)) return "error: usage: sto on|off";
         device.set_input(5, on);
         device.set_input(6, on);
         return std::string("ok sto ") + (on ? "on" : "off");

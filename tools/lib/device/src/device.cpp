@@ -66,6 +66,18 @@ od::DeviceDescription make_description(const DeviceOptions& options) {
     return d;
 }
 
+void check_device(const DeviceOptions& options) {
+    const od::DeviceDescription d = make_description(options);
+    try {
+        const od::Dictionary dict = od::make_drive_dictionary(d);
+        (void)esi::build_sii(d, dict);
+    } catch (const std::exception& e) {
+        throw od::ConfigError(
+            options.config_file.empty() ? std::string("the built-in drive") : options.config_file.string(), 0,
+            e.what());
+    }
+}
+
 std::vector<uint8_t> make_sii(const DeviceOptions& options) {
     const od::DeviceDescription d = make_description(options);
     const od::Dictionary dict = od::make_drive_dictionary(d);
@@ -270,13 +282,32 @@ void Device::build() {
         log() << "softdrive: stored parameters " << p->params->file().string() << " not used ("
               << p->load.error << "); running with the defaults\n";
     Parts* raw = p.get();
-    od::attach_store(p->dict, *p->params, [raw] {
-        // MAXPOS firmware specification §7.2.21: restoring defaults only with the axis in "Power Disable"
-        // (not switched on).
-        const od::Entry* e = raw->dict.find(0x6041, 0);
-        if (e == nullptr) return od::Status::Ok;
-        return (raw->dict.get<uint16_t>(0x6041, 0) & 0x0002) != 0 ? od::Status::WrongState : od::Status::Ok;
-    });
+    od::attach_store(
+        p->dict, *p->params,
+        [raw] {
+            // MAXPOS firmware specification §7.2.21: restoring defaults only with the axis in "Power Disable"
+            // (not switched on).
+            const od::Entry* e = raw->dict.find(0x6041, 0);
+            if (e == nullptr) return od::Status::Ok;
+            return (raw->dict.get<uint16_t>(0x6041, 0) & 0x0002) != 0 ? od::Status::WrongState
+                                                                      : od::Status::Ok;
+        },
+        // A master's 0x1010/0x2110 "save" and 0x1011/0x2111 "load": what the store did, done or failed (a
+        // failed one was answered with an SDO abort; the log says why).
+        [this, raw](const od::Entry& e, bool save, const std::string& error) {
+            const std::string which =
+                "(" + hex16(e.index) + ":" + std::to_string(e.subindex) + " " + e.name + ")";
+            if (!error.empty())
+                event(slave::LogLevel::Error,
+                      std::string(save ? "stored parameters not saved " : "stored parameters not restored ") +
+                          which + ": " + error + " (the master got SDO abort 0x06060000, hardware error)");
+            else if (save)
+                event(slave::LogLevel::Info,
+                      "stored parameters saved " + which + " to " + raw->params->file().string());
+            else
+                event(slave::LogLevel::Info,
+                      "stored parameters restored to defaults at the next start " + which);
+        });
 
     std::vector<uint8_t> image;
     if (options_.load_sii) {
@@ -298,15 +329,6 @@ void Device::build() {
     p->stack->add_handler(p->firmware->server());
     p->stack->set_event_sink(this);
     p->firmware->server().set_event_sink(this);
-    // A master's 0x1010 "save" / 0x1011 "load" that the store carried out (listeners run after the write).
-    p->dict.add_listener(0x1010, [this, raw](const od::Entry& e) {
-        event(slave::LogLevel::Info, "stored parameters saved (0x1010:" + std::to_string(e.subindex) + " " +
-                                         e.name + ") to " + raw->params->file().string());
-    });
-    p->dict.add_listener(0x1011, [this](const od::Entry& e) {
-        event(slave::LogLevel::Info, "stored parameters restored to defaults at the next start (0x1011:" +
-                                         std::to_string(e.subindex) + " " + e.name + ")");
-    });
     p->drive = std::make_unique<drive::Drive>(p->dict, this);
     p->drive->axis().faults = options_.faults.axis;
 

@@ -8,9 +8,9 @@
 namespace device {
 
 DeviceFirmware::DeviceFirmware(esc::Esc& esc, DeviceOptions options,
-                               const std::filesystem::path& control_path)
+                               const std::filesystem::path& control_path, gid_t control_group)
     : device_(esc, std::move(options)) {
-    if (!control_path.empty()) control_ = std::make_unique<ControlSocket>(control_path);
+    if (!control_path.empty()) control_ = std::make_unique<ControlSocket>(control_path, control_group);
 }
 
 void DeviceFirmware::report(std::ostream& out) const {
@@ -26,12 +26,13 @@ void report_device(std::ostream& out, const Device& device) {
         << "device.diagnosis_events " << s.diagnoses << '\n';
 }
 
-slave::FirmwareFactory firmware_factory(DeviceOptions options, std::filesystem::path control_path) {
-    return [options = std::move(options), control_path = std::move(control_path)](
+slave::FirmwareFactory firmware_factory(DeviceOptions options, std::filesystem::path control_path,
+                                        gid_t control_group) {
+    return [options = std::move(options), control_path = std::move(control_path), control_group](
                esc::Esc& esc, const slave::SlaveOptions& slave) -> std::unique_ptr<slave::Firmware> {
         DeviceOptions o = options;
         o.load_sii = slave.eeprom_file.empty();
-        return std::make_unique<DeviceFirmware>(esc, std::move(o), control_path);
+        return std::make_unique<DeviceFirmware>(esc, std::move(o), control_path, control_group);
     };
 }
 

@@ -11,42 +11,18 @@
 #include <stdexcept>
 
 #include "device/firmware.hpp"
+#include "util/lex.hpp"
 
 namespace device {
 
 namespace {
 
-std::vector<std::string_view> split(std::string_view line) {
-    std::vector<std::string_view> out;
-    std::size_t i = 0;
-    while (i < line.size()) {
-        while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r'))
-            ++i;
-        std::size_t j = i;
-        while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r')
-            ++j;
-        if (j > i) out.push_back(line.substr(i, j - i));
-        i = j;
-    }
-    return out;
-}
-
 bool to_uint(std::string_view s, uint64_t max, uint64_t& out) {
-    uint64_t v = 0;
-    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (s.empty() || ec != std::errc{} || ptr != s.data() + s.size() || v > max) return false;
-    out = v;
-    return true;
+    return util::parse_number<uint64_t>(s, out, 0, max) == util::NumberError::None;
 }
 
 bool to_fraction(std::string_view s, double& out) {
-    const std::string text(s);
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str(), &end);
-    if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v) || v < 0.0 || v > 1.0)
-        return false;
-    out = v;
-    return true;
+    return util::parse_number(s, out, 0.0, 1.0) == util::NumberError::None;
 }
 
 const char* state_name(od::AlState s) {
@@ -122,7 +98,8 @@ Line::Line(const esc::Clock& clock, LineOptions options, slave::ExternalSend sen
         segment_.set_external(dev, topo.external_device >= 0 ? topo.external_port : 1, std::move(send));
     }
     stats_.power_cycles.assign(units_.size(), 0);
-    if (!options_.control_path.empty()) control_ = std::make_unique<ControlSocket>(options_.control_path);
+    if (!options_.control_path.empty())
+        control_ = std::make_unique<ControlSocket>(options_.control_path, options_.control_group);
 }
 
 Line::~Line() = default;
@@ -244,9 +221,17 @@ std::string Line::segment_text() const {
 }
 
 std::string Line::apply(std::string_view line) {
-    std::string_view text = line;
-    if (const std::size_t hash = text.find('#'); hash != std::string_view::npos) text = text.substr(0, hash);
-    const auto w = split(text);
+    const std::string_view text = line;
+    std::vector<std::string> w;
+    std::size_t third = 0;  // where the third word begins (slave <k> <command ...>)
+    try {
+        for (util::Word& word : util::split(text)) {
+            if (w.size() == 2) third = word.begin;
+            w.push_back(std::move(word.text));
+        }
+    } catch (const util::LexError& e) {
+        return std::string("error: ") + e.what();
+    }
     if (w.empty()) return {};
     const std::string_view cmd = w[0];
     const int hops = static_cast<int>(units_.size());
@@ -262,8 +247,7 @@ std::string Line::apply(std::string_view line) {
             Device* d = device(k);
             if (d == nullptr) return "error: " + name(k) + " is powered off";
             // The rest of the line after the device argument, as typed.
-            const std::size_t at = static_cast<std::size_t>(w[2].data() - text.data());
-            return ControlSocket::apply(*d, text.substr(at));
+            return ControlSocket::apply(*d, text.substr(third));
         }
         if (cmd == "link") {
             bool up = false;

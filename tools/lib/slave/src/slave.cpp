@@ -20,15 +20,14 @@
 #include "esc/link_capture.hpp"
 #include "slave/netif.hpp"
 #include "slave/runtime.hpp"
+#include "util/input_file.hpp"
 
 namespace slave {
 
 std::vector<uint8_t> load_eeprom_file(const SlaveOptions& options) {
     if (options.eeprom_file.empty()) return {};
-    std::ifstream in(options.eeprom_file, std::ios::binary);
-    if (!in) throw std::runtime_error("cannot open EEPROM image '" + options.eeprom_file + "'");
-    std::vector<uint8_t> image((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) throw std::runtime_error("cannot read EEPROM image '" + options.eeprom_file + "'");
+    // A regular file of at most 128 KiB (the largest SII EEPROM), checked before it is read.
+    std::vector<uint8_t> image = util::read_input_bytes(options.eeprom_file, 2 * 65536, "EEPROM image");
     if (image.empty() || image.size() % 2 != 0 || image.size() > 2 * 65536)
         throw std::runtime_error("EEPROM image '" + options.eeprom_file + "' has " +
                                  std::to_string(image.size()) +

@@ -1,67 +1,39 @@
 // The topology file of a segment (see slave/topology.hpp).
 #include "slave/topology.hpp"
 
-#include <cerrno>
-#include <charconv>
-#include <cmath>
-#include <cstdlib>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
-#include <sstream>
+
+#include "util/input_file.hpp"
+#include "util/lex.hpp"
 
 namespace slave {
 
 namespace {
 
-std::vector<std::string_view> split_words(std::string_view line) {
-    std::vector<std::string_view> out;
-    std::size_t i = 0;
-    while (i < line.size()) {
-        while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r'))
-            ++i;
-        std::size_t j = i;
-        while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r')
-            ++j;
-        if (j > i) out.push_back(line.substr(i, j - i));
-        i = j;
-    }
-    return out;
-}
-
-// Decimal or 0x-hexadecimal integer in [lo, hi].
+// Decimal or 0x-hexadecimal integer in [lo, hi] (the one lexer's rule, util/lex.hpp).
 bool parse_int(std::string_view s, int64_t lo, int64_t hi, int64_t& out) {
-    bool negative = false;
-    if (!s.empty() && (s[0] == '-' || s[0] == '+')) {
-        negative = s[0] == '-';
-        s.remove_prefix(1);
-    }
-    int base = 10;
-    if (s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) {
-        base = 16;
-        s.remove_prefix(2);
-    }
-    if (s.empty()) return false;
-    uint64_t v = 0;
-    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v, base);
-    if (ec != std::errc{} || ptr != s.data() + s.size()) return false;
-    if (v > static_cast<uint64_t>(std::numeric_limits<int64_t>::max())) return false;
-    const int64_t value = negative ? -static_cast<int64_t>(v) : static_cast<int64_t>(v);
-    if (value < lo || value > hi) return false;
-    out = value;
-    return true;
+    return util::parse_number(s, out, lo, hi) == util::NumberError::None;
 }
 
-bool parse_double(std::string_view s, double& out) {
-    const std::string text(s);
-    char* end = nullptr;
-    errno = 0;
-    const double v = std::strtod(text.c_str(), &end);
-    if (text.empty() || end != text.c_str() + text.size() || errno != 0 || !std::isfinite(v)) return false;
-    out = v;
-    return true;
+// A device name: 1..kMaxNameLength characters of [A-Za-z0-9_.-], beginning with a letter or a digit, not
+// a number. It names the device's state directory under --state-dir: no '/', no "." or "..", nothing that
+// leads out of it.
+std::string name_error(std::string_view name) {
+    if (name.empty() || name.size() > kMaxNameLength)
+        return "must have 1.." + std::to_string(kMaxNameLength) + " characters";
+    const auto alnum = [](char c) {
+        return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
+    };
+    if (!alnum(name[0])) return "must begin with a letter or a digit";
+    for (const char c : name)
+        if (!alnum(c) && c != '_' && c != '.' && c != '-')
+            return "may hold letters, digits, '_', '.' and '-' only (it names the state directory)";
+    int64_t numeric = 0;
+    if (parse_int(name, 0, std::numeric_limits<int64_t>::max(), numeric))
+        return "must not be a number (numbers are device indexes)";
+    return {};
 }
 
 struct Parser {
@@ -92,9 +64,8 @@ struct Parser {
 
     int64_t integer(std::string_view key, std::string_view value, int64_t lo, int64_t hi) const {
         int64_t v = 0;
-        if (!parse_int(value, lo, hi, v))
-            fail("bad number '" + std::string(value) + "' for " + std::string(key) +
-                 " (expected an integer " + std::to_string(lo) + ".." + std::to_string(hi) + ")");
+        if (util::parse_number(value, v, lo, hi) != util::NumberError::None)
+            fail(util::number_message(key, value, lo, hi));
         return v;
     }
 
@@ -107,7 +78,7 @@ struct Parser {
                 static_cast<int>(integer(key, value.substr(colon + 1), 0, esc::kPortCount - 1))};
     }
 
-    void timing(const std::vector<std::string_view>& w) {
+    void timing(const std::vector<std::string>& w) {
         for (std::size_t i = 1; i < w.size(); ++i) {
             const auto [key, value] = key_value(w[i]);
             const auto v = static_cast<uint32_t>(integer(key, value, 0, 100'000'000));
@@ -124,21 +95,19 @@ struct Parser {
     }
 
     std::pair<std::string_view, std::string_view> key_value(std::string_view word) const {
-        const std::size_t eq = word.find('=');
-        if (eq == std::string_view::npos || eq == 0 || eq + 1 == word.size())
-            fail("expected KEY=VALUE, got '" + std::string(word) + "'");
-        return {word.substr(0, eq), word.substr(eq + 1)};
+        const auto kv = util::key_value(word);
+        if (!kv) fail("expected KEY=VALUE, got '" + std::string(word) + "'");
+        return *kv;
     }
 
-    void device(const std::vector<std::string_view>& w) {
+    void device(const std::vector<std::string>& w) {
         if (w.size() < 2 || w[1].find('=') != std::string_view::npos) fail("device: a name is missing");
+        if (topo.devices.size() >= kMaxDevices)
+            fail("more than " + std::to_string(kMaxDevices) + " devices (the limit of a segment)");
         TopologyDevice d;
-        d.name = std::string(w[1]);
+        d.name = w[1];
         d.line = line_no;
-        if (d.name.find(':') != std::string::npos) fail("device name '" + d.name + "' must not contain ':'");
-        int64_t numeric = 0;
-        if (parse_int(d.name, 0, std::numeric_limits<int64_t>::max(), numeric))
-            fail("device name '" + d.name + "' must not be a number (numbers are device indexes)");
+        if (const std::string e = name_error(d.name); !e.empty()) fail("device name '" + d.name + "' " + e);
         if (topo.find(d.name) >= 0)
             fail("device '" + d.name + "' declared twice (first at line " +
                  std::to_string(topo.devices[static_cast<std::size_t>(topo.find(d.name))].line) + ")");
@@ -158,8 +127,8 @@ struct Parser {
             } else if (key == "serial") {
                 d.serial = static_cast<uint32_t>(integer(key, value, 0, 0xFFFFFFFF));
             } else if (key == "drift-ppm") {
-                if (!parse_double(value, d.drift_ppm) || std::fabs(d.drift_ppm) > 1000.0)
-                    fail("bad number '" + std::string(value) + "' for drift-ppm (expected -1000..1000)");
+                if (util::parse_number(value, d.drift_ppm, -1000.0, 1000.0) != util::NumberError::None)
+                    fail(util::number_message("drift-ppm", value, -1000.0, 1000.0));
             } else if (key == "offset-ns") {
                 d.offset_ns = integer(key, value, std::numeric_limits<int64_t>::min() / 2,
                                       std::numeric_limits<int64_t>::max() / 2);
@@ -167,6 +136,10 @@ struct Parser {
                 d.cable_ns = integer(key, value, 0, 100'000'000);
             } else if (key == "state-dir") {
                 d.state_dir = resolve(value);
+                for (const TopologyDevice& o : topo.devices)
+                    if (o.state_dir == d.state_dir)
+                        fail("state-dir=" + std::string(value) + ": also the state directory of '" + o.name +
+                             "' (line " + std::to_string(o.line) + "); each device needs its own");
             } else {
                 fail("unknown key '" + std::string(key) +
                      "' (device takes config, at, port, ports, serial, drift-ppm, offset-ns, cable-ns, "
@@ -187,7 +160,7 @@ struct Parser {
         at.push_back(std::move(a));
     }
 
-    void external(const std::vector<std::string_view>& w) {
+    void external(const std::vector<std::string>& w) {
         if (w.size() != 2) fail("usage: external DEVICE:PORT");
         if (topo.external_line != 0)
             fail("external declared twice (first at line " + std::to_string(topo.external_line) + ")");
@@ -199,9 +172,13 @@ struct Parser {
     std::string ext_name;
 
     void statement(std::string_view line) {
-        if (const std::size_t hash = line.find('#'); hash != std::string_view::npos)
-            line = line.substr(0, hash);
-        const auto w = split_words(line);
+        std::vector<std::string> w;
+        try {
+            for (util::Word& word : util::split(line))
+                w.push_back(std::move(word.text));
+        } catch (const util::LexError& e) {
+            fail(e.what());
+        }
         if (w.empty()) return;
         if (w[0] == "timing")
             timing(w);
@@ -302,12 +279,14 @@ Topology parse_topology(std::string_view text, const std::string& file, const st
 }
 
 Topology load_topology(const std::string& file) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw TopologyError(file + ": cannot read the topology file: " + std::strerror(errno));
-    std::ostringstream text;
-    text << in.rdbuf();
+    std::string text;
+    try {
+        text = util::read_input_file(file, kMaxTopologyBytes, "topology file");
+    } catch (const util::InputFileError& e) {
+        throw TopologyError(e.what());
+    }
     const std::filesystem::path parent = std::filesystem::path(file).parent_path();
-    return parse_topology(text.str(), file, parent.string());
+    return parse_topology(text, file, parent.string());
 }
 
 Topology line_topology(int count) {

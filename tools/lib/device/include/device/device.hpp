@@ -83,6 +83,10 @@ std::filesystem::path firmware_dir(const DeviceOptions& options);
 // with revision and software version of the active firmware image in the state directory, if there is
 // one (the state directory is only read if it exists). Throws od::ConfigError on a bad configuration.
 od::DeviceDescription make_description(const DeviceOptions& options);
+// Everything the device builds from its configuration before it serves (description, dictionary, SII
+// image), so that a value one of them refuses is found before any network set-up. Throws od::ConfigError
+// (naming the configuration file, and the line where the parser knows it).
+void check_device(const DeviceOptions& options);
 // The SII image and the ESI text of that description and its dictionary (what --write-sii/--write-esi
 // write and what the ESC serves: the SII with the words a master wrote into the EEPROM on top).
 std::vector<uint8_t> make_sii(const DeviceOptions& options);

@@ -14,8 +14,9 @@ namespace device {
 
 class DeviceFirmware final : public slave::Firmware {
   public:
-    // control_path: where to create the control socket; empty: none.
-    DeviceFirmware(esc::Esc& esc, DeviceOptions options, const std::filesystem::path& control_path = {});
+    // control_path: where to create the control socket; empty: none. control_group: who else may use it.
+    DeviceFirmware(esc::Esc& esc, DeviceOptions options, const std::filesystem::path& control_path = {},
+                   gid_t control_group = ControlSocket::kNoGroup);
 
     void poll(uint64_t now_ns) override { device_.poll(now_ns); }
     uint64_t next_deadline_ns() const override { return device_.next_deadline_ns(); }
@@ -39,7 +40,8 @@ void report_device(std::ostream& out, const Device& device);
 
 // SlaveOptions::firmware_factory for the soft drive. options.load_sii is set from whether the slave
 // serves a user's image (SlaveOptions::eeprom_file).
-slave::FirmwareFactory firmware_factory(DeviceOptions options, std::filesystem::path control_path = {});
+slave::FirmwareFactory firmware_factory(DeviceOptions options, std::filesystem::path control_path = {},
+                                        gid_t control_group = ControlSocket::kNoGroup);
 // SlaveOptions::eeprom_loader: the user's --eeprom file if one is given, else the SII built from the model.
 slave::EepromLoader eeprom_loader(DeviceOptions options);
 

@@ -43,8 +43,9 @@ struct LineOptions {
     slave::Topology topology;
     DeviceOptions base;  // everything else of each device (environment, faults, commission)
     esc::EscConfig esc;  // base ESC configuration (RAM, faults); ports, drift and offset per device
-    std::filesystem::path control_path;  // the --control socket; empty: none
-    slave::Log* log = nullptr;           // segment events (faults, power); each device logs as "NAME: ..."
+    std::filesystem::path control_path;             // the --control socket; empty: none
+    gid_t control_group = ControlSocket::kNoGroup;  // --control-group: who else may use it
+    slave::Log* log = nullptr;  // segment events (faults, power); each device logs as "NAME: ..."
 };
 
 struct LineStats {

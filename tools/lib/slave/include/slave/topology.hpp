@@ -1,6 +1,8 @@
 #pragma once
 // The topology file of a segment of soft slaves (`ecat-slave --topology FILE`): which devices there are,
-// where each is plugged in, their clocks and cables. One statement per line, '#' starts a comment:
+// where each is plugged in, their clocks and cables. One statement per line, in the one lexer's words
+// (util/lex.hpp: blanks between words, "..." or '...' quoting, a word beginning with '#' starts a comment,
+// numbers decimal or 0x... with range checks):
 //
 //   timing processing-ns=320 forwarding-ns=280 cable-ns=10
 //   device NAME [config=FILE] [at=PARENT:PORT] [port=P] [ports=2|4] [serial=N] [drift-ppm=X] [offset-ns=N]
@@ -11,6 +13,10 @@
 // port 1 (a line); the first device is the root (its port 0 faces the master). port= is the device's own
 // port facing upstream (default 0). ports=4 makes a four-port (junction-capable) ESC. `external` names the
 // port that leads to --out-iface (default: port 1 of the last device).
+//
+// NAME: 1..64 characters of [A-Za-z0-9_.-], beginning with a letter or a digit, not a number, unique; it
+// names the device's state directory <state-dir>/NAME. state-dir= values are unique too. At most
+// kMaxDevices devices (the limit of --slaves as well); the file is at most kMaxTopologyBytes.
 //
 // Errors are reported as "FILE:LINE: message" (TopologyError), for an unknown key or statement, an
 // unknown device, a port used twice or missing on the ESC, a loop, a bad number or a duplicate name.
@@ -24,6 +30,11 @@
 #include "esc/segment.hpp"
 
 namespace slave {
+
+// The most devices of one segment, from --slaves or a topology file (docs/segment.md, "Limits").
+inline constexpr std::size_t kMaxDevices = 1000;
+inline constexpr std::size_t kMaxNameLength = 64;
+inline constexpr std::size_t kMaxTopologyBytes = 1 << 20;
 
 class TopologyError : public std::runtime_error {
   public:
