@@ -395,6 +395,8 @@ MUTANTS = {
     "fprd-foreign-wkc": _m("ETG.1000.4 FPRD to another station address: working counter 0",
                            lambda st, d: (d.cmd == FPRD and d.adp not in (0x1001,) and d.wkc == 0 and d.n
                                           and setattr(d, "wkc", 1))),
+    "liar-wkc": _m("ETG.1000.4 working counter: every datagram but BRD counted once too often",
+                   lambda st, d: d.cmd != BRD and setattr(d, "wkc", d.wkc + 1)),
     # -- SII --
     "sii-vendor-wrong": _m("ETG.2010 SII word 0x08 vendor id as the ESI's Vendor/Id",
                            sii_word(0x08, lambda v: v ^ 0x0001)),

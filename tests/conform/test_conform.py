@@ -227,6 +227,48 @@ class Conform(unittest.TestCase):
             self.assertEqual(statuses[-1], "FAIL")
             self.assertTrue(any("no longer answers" in x["message"] for x in res["results"]), stdout[-2000:])
             return
+        if self.mode == "stopped":
+            # Stopped half-way (--deadline, then SIGTERM): valid JUnit and JSON of the tests done, the running
+            # one marked as interrupted, exit code 3, the text report ends saying where it stopped.
+            import signal
+            import xml.dom.minidom
+            work = tempfile.mkdtemp(prefix="ecat-conform-", dir=os.environ.get("ECAT_TEST_OUT"))
+            sii, esi = alias_images(work)
+            with ConformBus(slave_args=["--eeprom", sii]) as bus:
+                for how in ("deadline", "sigterm"):
+                    out, junit = os.path.join(work, how + ".json"), os.path.join(work, how + ".xml")
+                    cmd = [os.environ["ECAT_CONFORM"], "--iface", bus.iface, "--esi", esi, "--json", out,
+                           "--junit", junit]
+                    if how == "deadline":
+                        cmd += ["--deadline", "2"]
+                    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                    if how == "sigterm":
+                        time.sleep(2.0)
+                        p.send_signal(signal.SIGTERM)
+                    stdout, _ = p.communicate(timeout=60)
+                    self.assertEqual(p.returncode, 3, stdout[-2000:])
+                    self.assertIn("stopped", stdout.splitlines()[-2] + stdout.splitlines()[-1])
+                    res = json.loads(pathlib.Path(out).read_text())
+                    statuses = [x["status"] for x in res["results"]]
+                    self.assertGreater(len(statuses), 5, how)
+                    self.assertLess(len(statuses), 264, how)
+                    self.assertIn("PASS", statuses)
+                    self.assertIn("interrupted", res["results"][-1]["message"])
+                    doc = xml.dom.minidom.parse(junit)
+                    self.assertEqual(len(doc.getElementsByTagName("testcase")), len(statuses))
+                    # Every result in the JSON was printed, as it happened, in the text report.
+                    for x in res["results"][:-1]:
+                        self.assertIn(x["id"], stdout)
+            return
+        if self.mode == "liar":
+            # A slave whose every working counter is one too high (besides BRD, so it is found): the run ends
+            # in under a minute and fails.
+            t0 = time.monotonic()
+            r, res, elapsed = self.run_conform(mutation=mutants.MUTANTS["liar-wkc"][1])
+            self.assertEqual(r.returncode, 1)
+            self.assertLess(time.monotonic() - t0, 60, f"run took {elapsed:.0f} s")
+            print(f"lying slave: {len(res['results'])} tests in {elapsed:.1f} s", file=sys.stderr)
+            return
         if self.mode in ("mutant", "variation", "table"):
             names = self.faults or (list(mutants.MUTANTS) + list(mutants.VARIATIONS))
             for n in names:
@@ -259,7 +301,8 @@ class Conform(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) >= 2 and sys.argv[1] in ("clean", "fault", "noslave", "dies", "mutant", "variation", "table"):
+    if len(sys.argv) >= 2 and sys.argv[1] in ("clean", "fault", "noslave", "dies", "stopped", "liar", "mutant", "variation",
+                                              "table"):
         Conform.mode = sys.argv[1]
         Conform.faults = sys.argv[2:]
         del sys.argv[1:]

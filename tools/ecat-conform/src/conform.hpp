@@ -141,7 +141,10 @@ class Context {
     std::optional<EsiDevice> esi;
     std::string esi_error;  // why there is no ESI expectation
 
-    std::chrono::milliseconds ms(int base) const;  // scaled timeout
+    // Scaled timeout, cut to what is left of the running test's budget (at least 1 ms): a slave that lies
+    // or stops answering makes each wait short once the test has used its budget.
+    std::chrono::milliseconds ms(int base) const;
+    std::chrono::steady_clock::time_point budget_end{};  // epoch: no budget
 
     // Skip reasons ("" = applies).
     std::string need_esi() const;

@@ -119,7 +119,11 @@ void SiiImage::parse() {
 Context::Context(master::Master& master, const Options& o) : m(master), opt(o) {}
 
 std::chrono::milliseconds Context::ms(int base) const {
-    return std::chrono::milliseconds(static_cast<long>(base * opt.timeout_scale + 0.5));
+    const auto scaled = std::chrono::milliseconds(static_cast<long>(base * opt.timeout_scale + 0.5));
+    if (budget_end == std::chrono::steady_clock::time_point{}) return scaled;
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(budget_end - std::chrono::steady_clock::now());
+    return std::clamp(left, std::chrono::milliseconds(1), std::max(scaled, std::chrono::milliseconds(1)));
 }
 
 std::string Context::setup() {

@@ -113,31 +113,50 @@ std::string detail(const Outcome& o) {
 }
 }  // namespace
 
-void write_text(std::ostream& out, const std::vector<TestResult>& results, const RunInfo& info, bool colour,
-                bool verbose) {
-    out << "ecat-conform on " << info.iface << ": " << info.device << "\n";
-    std::string group;
-    for (const auto& r : results) {
-        const TestCase& t = *r.test;
-        if (t.group != group) {
-            group = t.group;
-            out << "\n"
-                << (colour ? "\033[1m" : "") << "== " << group_title(group) << " (" << group << ")"
-                << (colour ? "\033[0m" : "") << "\n";
-        }
-        const Status s = r.outcome.status;
-        out << "  " << (colour ? colour_of(s) : "") << status_name(s) << (colour ? "\033[0m" : "") << "  "
-            << t.id << "  " << t.title << "\n";
-        if (s == Status::Fail || s == Status::Warn) {
-            out << "        " << detail(r.outcome) << "\n";
-            out << "        clause: " << t.clause << "\n";
-        } else if (s == Status::Skip || verbose) {
-            std::string d = detail(r.outcome);
-            if (!d.empty()) out << "        " << d << "\n";
+std::string printable(const std::string& s) {
+    std::string o;
+    char b[8];
+    for (unsigned char c : s) {
+        if (c == '\\') {
+            o += "\\\\";
+        } else if (c < 0x20 || c >= 0x7F) {
+            std::snprintf(b, sizeof b, "\\x%02x", c);
+            o += b;
+        } else {
+            o += static_cast<char>(c);
         }
     }
+    return o;
+}
+
+void write_text_header(std::ostream& out, const RunInfo& info) {
+    out << "ecat-conform on " << printable(info.iface) << ": " << printable(info.device) << "\n";
+}
+
+void write_text_result(std::ostream& out, const TestResult& r, std::string& group, bool colour,
+                       bool verbose) {
+    const TestCase& t = *r.test;
+    if (t.group != group) {
+        group = t.group;
+        out << "\n"
+            << (colour ? "\033[1m" : "") << "== " << group_title(group) << " (" << group << ")"
+            << (colour ? "\033[0m" : "") << "\n";
+    }
+    const Status s = r.outcome.status;
+    out << "  " << (colour ? colour_of(s) : "") << status_name(s) << (colour ? "\033[0m" : "") << "  " << t.id
+        << "  " << t.title << "\n";
+    if (s == Status::Fail || s == Status::Warn) {
+        out << "        " << printable(detail(r.outcome)) << "\n";
+        out << "        clause: " << t.clause << "\n";
+    } else if (s == Status::Skip || verbose) {
+        std::string d = detail(r.outcome);
+        if (!d.empty()) out << "        " << printable(d) << "\n";
+    }
+}
+
+void write_text_footer(std::ostream& out, const std::vector<TestResult>& results, const RunInfo& info) {
     for (const auto& n : info.notes)
-        out << "\nnote: " << n << "\n";
+        out << "\nnote: " << printable(n) << "\n";
     Totals t = totals(results);
     char b[64];
     std::snprintf(b, sizeof b, "%.1f s", static_cast<double>(info.duration.count()) / 1000.0);
@@ -145,6 +164,15 @@ void write_text(std::ostream& out, const std::vector<TestResult>& results, const
     if (t.warned) out << ", " << t.warned << " warning(s)";
     out << "\n";
     out << t.passed << " passed, " << t.failed << " failed, " << t.skipped << " skipped\n";
+}
+
+void write_text(std::ostream& out, const std::vector<TestResult>& results, const RunInfo& info, bool colour,
+                bool verbose) {
+    write_text_header(out, info);
+    std::string group;
+    for (const auto& r : results)
+        write_text_result(out, r, group, colour, verbose);
+    write_text_footer(out, results, info);
 }
 
 void write_junit(std::ostream& out, const std::vector<TestResult>& results, const RunInfo& info) {
