@@ -336,6 +336,10 @@ def adp_not_incremented(st, d):
         struct.pack_into("<H", d.buf, d.off + 2, (d.adp - 1) & 0xFFFF)
 
 
+def m_oe(st):
+    return True
+
+
 def track_al(st, d):
     if d.covers(0x0130):
         st.scratch["al"] = d.get(0x0130)
@@ -464,6 +468,12 @@ MUTANTS = {
     "supported-modes-lie": _m("CiA 402 0x6502 supported drive modes: every mode announced is accepted",
                               sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x6502,
                                            lambda m: m.__setitem__(12, m[12] | 0x10))),
+    "statusword-not-remote": _m("CiA 402 statusword bit 9 remote: set while the controlword is processed",
+                                sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x6041,
+                                             lambda m: m.__setitem__(13, m[13] & ~0x02))),
+    "statusword-following-error": _m("CiA 402 statusword bit 13 (csp): following error only with a deviation",
+                                     sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x6041
+                                                  and m_oe(st), lambda m: m.__setitem__(13, m[13] | 0x20))),
     # -- SDO information --
     "info-opcode": _m("ETG.1000.6 SDO information: object description response opcode 0x04",
                       sdo_info_rewriter(0x04, lambda m: m.__setitem__(8, (m[8] & 0x80) | 0x06))),

@@ -133,7 +133,7 @@ class Conform(unittest.TestCase):
             def run(iface):
                 t0 = time.monotonic()
                 r = subprocess.run([os.environ["ECAT_CONFORM"], "--iface", iface, "--esi", esi, "--foe-file",
-                                    "MAXPOS", "--json", out, "--junit", junit], stdout=subprocess.PIPE,
+                                    "MAXPOS", "--json", out, "--junit", junit, "--allow-fault"], stdout=subprocess.PIPE,
                                    stderr=subprocess.PIPE, text=True, timeout=120)
                 return r, time.monotonic() - t0
 
@@ -260,6 +260,35 @@ class Conform(unittest.TestCase):
                     for x in res["results"][:-1]:
                         self.assertIn(x["id"], stdout)
             return
+        if self.mode == "line":
+            # --slave all on a line of three soft drives, each against the ESI of --esi-dir that matches its
+            # SII: one report, every slave's results tagged with its position, no failure.
+            work = tempfile.mkdtemp(prefix="ecat-conform-", dir=os.environ.get("ECAT_TEST_OUT"))
+            esi_dir = os.path.join(work, "esi")
+            os.makedirs(esi_dir)
+            subprocess.run([os.environ["ECAT_SLAVE"], "--write-esi", os.path.join(esi_dir, "drive.xml"),
+                            "--state-dir", work], check=True, timeout=60, stdout=subprocess.DEVNULL)
+            pathlib.Path(esi_dir, "not-an-esi.xml").write_text("<nothing/>")
+            with ConformBus(slave_args=["--slaves", "3"]) as bus:
+                out, junit = os.path.join(work, "r.json"), os.path.join(work, "r.xml")
+                r = subprocess.run([os.environ["ECAT_CONFORM"], "--iface", bus.iface, "--slave", "all", "--esi-dir",
+                                    esi_dir, "--json", out, "--junit", junit], stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE, text=True, timeout=300)
+            res = json.loads(pathlib.Path(out).read_text())
+            failed = [f"slave {x['slave']} {x['id']}: {x['message']} / {x['observed']}" for x in res["results"]
+                      if x["status"] == "FAIL"]
+            self.assertEqual(failed, [], r.stdout[-3000:])
+            self.assertEqual(r.returncode, 0)
+            per = {k: [x for x in res["results"] if x["slave"] == k] for k in (0, 1, 2)}
+            self.assertEqual(len(per[0]), len(per[1]))
+            self.assertEqual(len(per[0]) * 3, len(res["results"]))
+            self.assertNotIn("needs the ESI", r.stdout)
+            for k in (0, 1, 2):
+                self.assertIn(f"=== slave {k}: slave {k} of 3", r.stdout)
+            import xml.dom.minidom
+            names = {s.getAttribute("name") for s in xml.dom.minidom.parse(junit).getElementsByTagName("testsuite")}
+            self.assertIn("slave2.sdo", names)
+            return
         if self.mode == "liar":
             # A slave whose every working counter is one too high (besides BRD, so it is found): the run ends
             # in under a minute and fails.
@@ -301,7 +330,7 @@ class Conform(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) >= 2 and sys.argv[1] in ("clean", "fault", "noslave", "dies", "stopped", "liar", "mutant", "variation",
+    if len(sys.argv) >= 2 and sys.argv[1] in ("clean", "fault", "noslave", "dies", "stopped", "liar", "line", "mutant", "variation",
                                               "table"):
         Conform.mode = sys.argv[1]
         Conform.faults = sys.argv[2:]

@@ -1,6 +1,7 @@
 // The run context: bus set-up, state changes, raw mailbox access, SDO helpers, SII parsing.
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <thread>
 
 #include "conform.hpp"
@@ -172,6 +173,41 @@ std::string Context::setup() {
         } catch (const std::exception& e) {
             return std::string("ESI: ") + e.what();
         }
+    } else if (!opt.esi_dir.empty()) {
+        // The file whose device has the SII's vendor, product code and revision (product code alone if no
+        // revision matches); files that are not ESI are passed over.
+        std::vector<std::string> files;
+        std::error_code ec;
+        for (const auto& e : std::filesystem::directory_iterator(opt.esi_dir, ec))
+            if (e.path().extension() == ".xml" || e.path().extension() == ".XML") files.push_back(e.path());
+        if (ec) return "--esi-dir " + opt.esi_dir + ": " + ec.message();
+        std::sort(files.begin(), files.end());
+        std::optional<EsiDevice> by_product;
+        std::string by_product_file;
+        for (const auto& path : files) {
+            if (!sii) break;
+            try {
+                EsiFile f = read_esi_file(path);
+                if (f.vendor_id != sii->dword(0x08)) continue;
+                for (const auto& d : f.devices) {
+                    if (d.product_code != sii->dword(0x0A)) continue;
+                    if (d.revision == sii->dword(0x0C)) {
+                        esi = d;
+                        return {};
+                    }
+                    if (!by_product) by_product = d, by_product_file = path;
+                }
+            } catch (const std::exception&) {
+            }
+        }
+        if (by_product) {
+            esi = by_product;
+            notes.push_back("slave " + std::to_string(opt.slave) +
+                            ": no ESI device with the SII's revision; " + by_product_file +
+                            " has its product code");
+            return {};
+        }
+        esi_error = sii ? "no ESI file in " + opt.esi_dir + " describes the SII's identity" : sii_error;
     } else {
         esi_error = "no --esi given";
     }

@@ -136,10 +136,12 @@ void write_text_header(std::ostream& out, const RunInfo& info) {
 void write_text_result(std::ostream& out, const TestResult& r, std::string& group, bool colour,
                        bool verbose) {
     const TestCase& t = *r.test;
-    if (t.group != group) {
-        group = t.group;
+    const std::string key = r.slave < 0 ? t.group : "slave " + std::to_string(r.slave) + ", " + t.group;
+    if (key != group) {
+        group = key;
         out << "\n"
-            << (colour ? "\033[1m" : "") << "== " << group_title(group) << " (" << group << ")"
+            << (colour ? "\033[1m" : "") << "== " << group_title(t.group) << " ("
+            << (r.slave < 0 ? "" : "slave " + std::to_string(r.slave) + ", ") << t.group << ")"
             << (colour ? "\033[0m" : "") << "\n";
     }
     const Status s = r.outcome.status;
@@ -179,8 +181,10 @@ void write_junit(std::ostream& out, const std::vector<TestResult>& results, cons
     std::map<std::string, std::vector<const TestResult*>> by_group;
     std::vector<std::string> order;
     for (const auto& r : results) {
-        if (!by_group.count(r.test->group)) order.push_back(r.test->group);
-        by_group[r.test->group].push_back(&r);
+        const std::string g =
+            r.slave < 0 ? r.test->group : "slave" + std::to_string(r.slave) + "." + r.test->group;
+        if (!by_group.count(g)) order.push_back(g);
+        by_group[g].push_back(&r);
     }
     Totals all = totals(results);
     char secs[32];
@@ -242,14 +246,16 @@ void write_json(std::ostream& out, const std::vector<TestResult>& results, const
     out << "],\n  \"results\": [\n";
     for (std::size_t i = 0; i < results.size(); ++i) {
         const auto& r = results[i];
-        out << "    {\"id\": \"" << json_escape(r.test->id) << "\", \"group\": \""
-            << json_escape(r.test->group) << "\", \"status\": \"" << status_name(r.outcome.status)
-            << "\", \"severity\": \"" << (r.test->severity == Severity::Error ? "error" : "warning")
-            << "\", \"title\": \"" << json_escape(r.test->title) << "\", \"clause\": \""
-            << json_escape(r.test->clause) << "\", \"message\": \"" << json_escape(r.outcome.message)
-            << "\", \"observed\": \"" << json_escape(r.outcome.observed) << "\", \"expected\": \""
-            << json_escape(r.outcome.expected) << "\", \"duration_us\": " << r.duration.count() << "}"
-            << (i + 1 < results.size() ? "," : "") << "\n";
+        out << "    {";
+        if (r.slave >= 0) out << "\"slave\": " << r.slave << ", ";
+        out << "\"id\": \"" << json_escape(r.test->id) << "\", \"group\": \"" << json_escape(r.test->group)
+            << "\", \"status\": \"" << status_name(r.outcome.status) << "\", \"severity\": \""
+            << (r.test->severity == Severity::Error ? "error" : "warning") << "\", \"title\": \""
+            << json_escape(r.test->title) << "\", \"clause\": \"" << json_escape(r.test->clause)
+            << "\", \"message\": \"" << json_escape(r.outcome.message) << "\", \"observed\": \""
+            << json_escape(r.outcome.observed) << "\", \"expected\": \"" << json_escape(r.outcome.expected)
+            << "\", \"duration_us\": " << r.duration.count() << "}" << (i + 1 < results.size() ? "," : "")
+            << "\n";
     }
     out << "  ]\n}\n";
 }
