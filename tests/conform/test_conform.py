@@ -151,10 +151,13 @@ class Conform(unittest.TestCase):
 
     def mutation_runs(self, names):
         """Runs the proxy without mutation, then each named mutant/variation; returns rows of the table."""
-        _, base, _ = self.run_conform(proxy=True)
-        base_fail = sorted(x["id"] for x in base["results"] if x["status"] == "FAIL")
-        self.assertEqual(base_fail, [], "the unmutated run through the proxy fails")
-        base_warn = {x["id"] for x in base["results"] if x["status"] == "WARN"}
+        base_warn = set()
+        if any(n in mutants.VARIATIONS for n in names):
+            # Variations are judged against the warnings of the same run without a mutation.
+            _, base, _ = self.run_conform(proxy=True)
+            base_fail = sorted(x["id"] for x in base["results"] if x["status"] == "FAIL")
+            self.assertEqual(base_fail, [], "the unmutated run through the proxy fails")
+            base_warn = {x["id"] for x in base["results"] if x["status"] == "WARN"}
         rows = []
         for name in names:
             kind = "mutant" if name in mutants.MUTANTS else "variation"

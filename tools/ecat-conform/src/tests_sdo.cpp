@@ -99,6 +99,53 @@ Outcome expedited_sizes(Context& ctx) {
     return pass(dec(static_cast<long long>(cands.size())) + " entries");
 }
 
+// A writable entry of the ESI downloaded with its own value, in one of the four ways; every field of each
+// response checked (expect_response).
+enum class Download { Expedited, Normal, Segmented, WrongToggle };
+Outcome download_own_value(Context& ctx, Download how) {
+    CONFORM_NEED(ctx.need_coe());
+    CONFORM_NEED(ctx.need_esi());
+    CONFORM_PREOP(ctx);
+    const bool segmented = how == Download::Segmented || how == Download::WrongToggle;
+    std::vector<EntryRef> st;
+    const EntryRef* r = pick_rw(ctx, st, segmented ? 16 : 8, 32);
+    if (!r)
+        return skip(segmented ? "no writable 2..4-byte entry in the ESI"
+                              : "no writable 1..4-byte entry in the ESI");
+    const uint16_t index = r->obj->index;
+    const uint8_t sub = r->e->subindex;
+    const std::string name = hex(index) + ":" + dec(sub);
+    auto v = ctx.upload(index, sub);
+    if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
+    const auto size = static_cast<uint32_t>(v->size());
+    if (how == Download::Expedited) {
+        uint32_t value = 0;
+        for (std::size_t i = 0; i < v->size() && i < 4; ++i)
+            value |= static_cast<uint32_t>((*v)[i]) << (8 * i);
+        return expect_response(
+            sdo_raw(ctx, sdo_req(static_cast<uint8_t>(0x23 | ((4 - size) << 2)), index, sub, value)), 3,
+            index, sub, false, name);
+    }
+    auto req = sdo_req(0x21, index, sub, size);
+    if (how == Download::Normal) req.insert(req.end(), v->begin(), v->end());
+    SdoAnswer a = sdo_raw(ctx, req);
+    Outcome o = expect_response(a, 3, index, sub, false, name + (segmented ? " initiate" : ""));
+    if (!segmented || o.status != Status::Pass) return o;
+    // Everything in one last segment, toggle 0 (or 1, wrong, on the first segment).
+    std::vector<uint8_t> seg(10, 0);
+    seg[1] = 0x20;
+    seg[2] = static_cast<uint8_t>((how == Download::WrongToggle ? 0x10 : 0) | 0x01 | ((7 - size) << 1));
+    std::copy(v->begin(), v->end(), seg.begin() + 3);
+    SdoAnswer s = sdo_raw(ctx, seg);
+    if (how == Download::WrongToggle) {
+        if (!s.is_abort()) return fail("wrong toggle taken", s.describe(), "abort 0x05030000");
+        return expect_eq("abort code", hex(s.abort_code(), 8), hex(0x05030000, 8));
+    }
+    if (s.is_abort() || s.cmd() != 0x20 || s.p.size() != 10)
+        return fail("segment response", s.describe(), "0x20 (toggle 0), mailbox length 10");
+    return pass(name);
+}
+
 }  // namespace
 
 void add_sdo_tests(Catalogue& c) {
@@ -246,89 +293,16 @@ void add_sdo_tests(Catalogue& c) {
         "ESI with an object larger than the mailbox");
     add(
         "download.expedited", "Expedited download of a writable entry (its own value): response 0x60", kSdo,
-        [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_NEED(ctx.need_esi());
-            CONFORM_PREOP(ctx);
-            std::vector<EntryRef> st;
-            const EntryRef* r = pick_rw(ctx, st, 8, 32);
-            if (!r) return skip("no writable 1..4-byte entry in the ESI");
-            auto v = ctx.upload_uint(r->obj->index, r->e->subindex);
-            if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
-            const unsigned n = r->e->bit_size / 8u;
-            SdoAnswer a = sdo_raw(ctx, sdo_req(static_cast<uint8_t>(0x23 | ((4 - n) << 2)), r->obj->index,
-                                               r->e->subindex, static_cast<uint32_t>(*v)));
-            return expect_response(a, 3, r->obj->index, r->e->subindex, false,
-                                   hex(r->obj->index) + ":" + dec(r->e->subindex));
-        },
-        "ESI given");
+        [](Context& ctx) { return download_own_value(ctx, Download::Expedited); }, "ESI given");
     add(
         "download.normal", "Normal (size-indicated) download of a writable entry: response 0x60", kSdo,
-        [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_NEED(ctx.need_esi());
-            CONFORM_PREOP(ctx);
-            std::vector<EntryRef> st;
-            const EntryRef* r = pick_rw(ctx, st, 8, 32);
-            if (!r) return skip("no writable 1..4-byte entry in the ESI");
-            auto v = ctx.upload(r->obj->index, r->e->subindex);
-            if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
-            auto req = sdo_req(0x21, r->obj->index, r->e->subindex, static_cast<uint32_t>(v->size()));
-            req.insert(req.end(), v->begin(), v->end());
-            SdoAnswer a = sdo_raw(ctx, req);
-            return expect_response(a, 3, r->obj->index, r->e->subindex, false,
-                                   hex(r->obj->index) + ":" + dec(r->e->subindex));
-        },
-        "ESI given");
+        [](Context& ctx) { return download_own_value(ctx, Download::Normal); }, "ESI given");
     add(
         "download.segmented", "Segmented download (initiate, then a last segment): value taken", kSdo,
-        [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_NEED(ctx.need_esi());
-            CONFORM_PREOP(ctx);
-            std::vector<EntryRef> st;
-            const EntryRef* r = pick_rw(ctx, st, 16, 32);
-            if (!r) return skip("no writable 2..4-byte entry in the ESI");
-            auto v = ctx.upload(r->obj->index, r->e->subindex);
-            if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
-            // Initiate with the complete size and no data, then everything in one last segment.
-            SdoAnswer a =
-                sdo_raw(ctx, sdo_req(0x21, r->obj->index, r->e->subindex, static_cast<uint32_t>(v->size())));
-            if (a.cmd() != 0x60 || a.is_abort()) return fail("initiate", a.describe(), "0x60");
-            std::vector<uint8_t> seg(10, 0);
-            seg[1] = 0x20;
-            seg[2] = static_cast<uint8_t>(0x01 | ((7 - v->size()) << 1));  // toggle 0, last
-            std::copy(v->begin(), v->end(), seg.begin() + 3);
-            SdoAnswer s = sdo_raw(ctx, seg);
-            if (s.is_abort() || (s.cmd() & 0xF0) != 0x20)
-                return fail("segment", s.describe(), "0x20 (segment response, toggle 0)");
-            return pass(hex(r->obj->index) + ":" + dec(r->e->subindex));
-        },
-        "ESI given");
+        [](Context& ctx) { return download_own_value(ctx, Download::Segmented); }, "ESI given");
     add(
         "download.toggle_error", "Download segment with the wrong toggle bit: abort 0x05030000", kAbort,
-        [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_NEED(ctx.need_esi());
-            CONFORM_PREOP(ctx);
-            std::vector<EntryRef> st;
-            const EntryRef* r = pick_rw(ctx, st, 16, 32);
-            if (!r) return skip("no writable 2..4-byte entry in the ESI");
-            auto v = ctx.upload(r->obj->index, r->e->subindex);
-            if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
-            SdoAnswer a =
-                sdo_raw(ctx, sdo_req(0x21, r->obj->index, r->e->subindex, static_cast<uint32_t>(v->size())));
-            if (a.cmd() != 0x60 || a.is_abort()) return fail("initiate", a.describe(), "0x60");
-            std::vector<uint8_t> seg(10, 0);
-            seg[1] = 0x20;
-            seg[2] =
-                static_cast<uint8_t>(0x10 | 0x01 | ((7 - v->size()) << 1));  // toggle 1 on the first segment
-            std::copy(v->begin(), v->end(), seg.begin() + 3);
-            SdoAnswer s = sdo_raw(ctx, seg);
-            if (!s.is_abort()) return fail("wrong toggle taken", s.describe(), "abort 0x05030000");
-            return expect_eq("abort code", hex(s.abort_code(), 8), hex(0x05030000, 8));
-        },
-        "ESI given");
+        [](Context& ctx) { return download_own_value(ctx, Download::WrongToggle); }, "ESI given");
     add(
         "abort.missing_object", "Upload of a missing object: abort 0x06020000", kAbort,
         [](Context& ctx) {
