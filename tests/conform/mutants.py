@@ -386,7 +386,6 @@ MUTANTS = {
                          reg_rewriter(0x0008, clear_bits(0x0004))),
     "features-lrw-unsupported": _m("ESC features 0x0008 bit 9 says LRW unsupported while LRW works",
                                    reg_rewriter(0x0008, set_bits(0x0200))),
-    "features-reserved": _m("ESC features 0x0008 bits 12-15 reserved (0)", reg_rewriter(0x0008, set_bits(0x4000))),
     "dl-control-readback": _m("ETG.1000.4 DL control 0x0100: the value written reads back",
                               reg_rewriter(0x0100, lambda v, st: v ^ 0x0001)),
     "sm-status-reserved": _m("ESC datasheet SM status 0x0805+8n bit 2 reserved (0)",
@@ -467,7 +466,7 @@ MUTANTS = {
                                         lambda m: m.__setitem__(12, m[12] & ~0x04))),
     "supported-modes-lie": _m("CiA 402 0x6502 supported drive modes: every mode announced is accepted",
                               sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x6502,
-                                           lambda m: m.__setitem__(12, m[12] | 0x10))),
+                                           lambda m: m.__setitem__(12, m[12] | 0x02))),
     "statusword-not-remote": _m("CiA 402 statusword bit 9 remote: set while the controlword is processed",
                                 sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x6041,
                                              lambda m: m.__setitem__(13, m[13] & ~0x02))),
@@ -494,8 +493,9 @@ MUTANTS = {
     # -- DC --
     "dc-receive-static": _m("ETG.1000.4 DC receive time port 0 latched by a write to 0x0900",
                             lambda st, d: d.covers(0x0900, 4) and d.put(0x0900, st.scratch.setdefault("rt", d.get(0x0900, 4)), 4)),
-    "sync0-status-never": _m("ESC datasheet 0x098E SYNC0 status set by a SYNC0 pulse",
-                             reg_rewriter(0x098E, lambda v, st: v & ~0x01, 1)),
+    "sync0-next-frozen": _m("ESC datasheet 0x0990 next SYNC0 time advances with every pulse",
+                            lambda st, d: d.covers(0x0990, 4) and d.put(0x0990, st.scratch.setdefault(
+                                "s0", d.get(0x0990, 4)), 4)),
 }
 
 # name: (clause that allows it, mutation). Each must raise no failure and no new warning.
