@@ -132,9 +132,13 @@ class Conform(unittest.TestCase):
 
             def run(iface):
                 t0 = time.monotonic()
-                r = subprocess.run([os.environ["ECAT_CONFORM"], "--iface", iface, "--esi", esi, "--foe-file",
-                                    "MAXPOS", "--json", out, "--junit", junit, "--allow-fault"], stdout=subprocess.PIPE,
-                                   stderr=subprocess.PIPE, text=True, timeout=120)
+                cmd = [os.environ["ECAT_CONFORM"], "--iface", iface, "--esi", esi, "--foe-file", "MAXPOS", "--json",
+                       out, "--junit", junit, "--allow-fault"]
+                try:
+                    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=120)
+                except subprocess.TimeoutExpired as e:
+                    # Killed: the reports hold every test up to the one that ran (marked interrupted).
+                    r = subprocess.CompletedProcess(cmd, -9, e.stdout or "", e.stderr or "")
                 return r, time.monotonic() - t0
 
             if proxy or mutation:
@@ -169,6 +173,8 @@ class Conform(unittest.TestCase):
                       if x["status"] in ("FAIL", "WARN") and x["id"] not in base_warn}
             ok = bool(failed) if kind == "mutant" else not failed and not warned
             rows.append((kind, name, clause, failed, warned, ok, elapsed, detail))
+            print(f"{kind} {name}: {'ok' if ok else 'NOT OK'} in {elapsed:.1f} s: {' '.join(failed[:6])}"
+                  f"{' warned ' + ' '.join(warned) if warned else ''}", file=sys.stderr, flush=True)
         return rows
 
     def test_matrix(self):

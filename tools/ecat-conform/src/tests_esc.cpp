@@ -19,13 +19,29 @@ constexpr uint16_t kEventMask = 0x0200;  // ECAT event mask: read/write from Eth
 struct Sent {
     Error error = Error::Ok;
     uint16_t wkc = 0;
-    uint16_t adp = 0;
+    uint16_t adp = 0;  // as sent
     std::vector<uint8_t> data;
+    Command cmd = Command::NOP;
+    uint16_t ado = 0;
+    std::size_t length = 0;
+    // The datagram as sent and what came back, for failure messages.
+    std::string describe() const {
+        static constexpr const char* kNames[] = {"NOP", "APRD", "APWR", "APRW", "FPRD", "FPWR", "FPRW", "BRD",
+                                                 "BWR", "BRW",  "LRD",  "LWR",  "LRW",  "ARMW", "FRMW"};
+        const auto c = static_cast<std::size_t>(cmd);
+        return std::string(c < std::size(kNames) ? kNames[c] : "cmd?") + " adp " + hex(adp) + " ado " +
+               hex(ado) + " len " + std::to_string(length) + " -> wkc " + std::to_string(wkc) + " data " +
+               bytes_hex(data, 16);
+    }
 };
 
 Sent send(Context& ctx, Command c, uint16_t adp, uint16_t ado, std::vector<uint8_t> data) {
     Sent s;
     s.data = std::move(data);
+    s.cmd = c;
+    s.adp = adp;
+    s.ado = ado;
+    s.length = s.data.size();
     Datagram d{c, adp, ado, s.data};
     s.error = ctx.m.exchange(d);
     s.wkc = d.wkc;
@@ -38,7 +54,8 @@ uint16_t my_adp(const Context& ctx) {
 
 Outcome check_wkc(const Sent& s, uint16_t expected, const std::string& what) {
     if (s.error != Error::Ok) return fail(what + ": no reply", err(s.error), "a reply");
-    if (s.wkc != expected) return fail(what + ": working counter", dec(s.wkc), dec(expected));
+    if (s.wkc != expected)
+        return fail(what + ": working counter", dec(s.wkc) + " (" + s.describe() + ")", dec(expected));
     return pass(what, "wkc " + dec(s.wkc));
 }
 
