@@ -231,8 +231,16 @@ def ca_drop_padding(indices):
         if svc != 3 or t != 3 or len(req) < 6 or not (req[2] & 0x10) or req[5] != 0:
             return None
         idx = struct.unpack_from("<H", req, 3)[0]
-        if idx not in indices or m[8] != 0x51 and m[8] != 0x41:
-            return None  # normal (not segmented further) response only
+        if idx not in indices or (m[8] & 0xE0) != 0x40:
+            return None
+        if m[8] & 0x02:  # expedited (a short assignment fits 4 bytes): one byte fewer
+            n = 4 - ((m[8] >> 2) & 3) if m[8] & 0x01 else 4
+            if n < 2:
+                return None
+            body = m[12:12 + n]
+            m[12:16] = (body[:1] + body[2:]).ljust(4, b"\x00")
+            m[8] = (m[8] & ~0x0C) | ((4 - (n - 1)) << 2) | 0x01
+            return m
         size = struct.unpack_from("<I", m, 12)[0]
         n = mbx_len(m)
         if n != 10 + size or size < 2:
