@@ -481,6 +481,12 @@ MUTANTS = {
     "statusword-following-error": _m("CiA 402 statusword bit 13 (csp): following error only with a deviation",
                                      sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x6041
                                                   and m_oe(st), lambda m: m.__setitem__(13, m[13] | 0x20))),
+    "emcy-register-wrong": _m("CiA 301 / ETG.1000.6 emergency error register equals 0x1001",
+                              mbx_rewriter(lambda st, m: (m.__setitem__(10, m[10] ^ 0x80), m)[1]
+                                           if coe(m)[0] == 1 and len(m) >= 16 else None)),
+    "emcy-code-wrong": _m("IEC 61800-7-201 emergency error code equals 0x603F",
+                          mbx_rewriter(lambda st, m: (m.__setitem__(8, m[8] ^ 0x01), m)[1]
+                                       if coe(m)[0] == 1 and len(m) >= 16 else None)),
     # -- SDO information --
     "info-opcode": _m("ETG.1000.6 SDO information: object description response opcode 0x04",
                       sdo_info_rewriter(0x04, lambda m: m.__setitem__(8, (m[8] & 0x80) | 0x06))),
