@@ -236,7 +236,8 @@ Outcome al_status_bits(Context& ctx) {
         const std::string where = round ? "in PREOP" : "in INIT";
         if (st != 1 && st != 2 && st != 3 && st != 4 && st != 8)
             return fail(where + ": state bits 0-3 not a state", hex(*s), "1, 2, 3, 4 or 8");
-        if (*s & 0xFFC0) return fail(where + ": reserved bits 6-15 set", hex(*s), "bits 6-15 clear");
+        // Bits 6-7 are reserved; 8-15 are left alone (application specific in some profiles).
+        if (*s & 0x00C0) return fail(where + ": reserved bits 6-7 set", hex(*s), "bits 6-7 clear");
         if (*s & 0x0020)
             return fail(where + ": ID bit 5 set although AL control bit 5 was never requested", hex(*s),
                         "bit 5 clear");
@@ -268,9 +269,19 @@ Outcome dl_control_rw(Context& ctx) {
     uint8_t before[4] = {};
     if (Error e = ctx.m.read(ctx.addr, 0x0100, before); e != Error::Ok)
         return fail("0x0100 unreadable", err(e));
-    // Loop control of port 1 set to "closed" (0b11), everything else as it was; then read back and restore.
+    auto desc = ctx.rd<uint8_t>(0x0007);
+    if (!desc) return fail("0x0007 unreadable", err(desc.error()));
+    // Loop control (bits 8-15) of the implemented ports; of the first implemented port after 0 it is set to
+    // "closed" (0b11) and read back, then everything is restored and read back.
+    uint8_t loop_mask = 0;
+    int probe = -1;
+    for (int p = 0; p < 4; ++p)
+        if ((*desc >> (2 * p)) & 3) {
+            loop_mask = static_cast<uint8_t>(loop_mask | (3u << (2 * p)));
+            if (p > 0 && probe < 0) probe = p;
+        }
     uint8_t v[4] = {before[0], before[1], before[2], before[3]};
-    v[1] = static_cast<uint8_t>(v[1] | 0x0C);
+    if (probe > 0) v[1] = static_cast<uint8_t>(v[1] | (3u << (2 * probe)));
     Error w = ctx.m.write(ctx.addr, 0x0100, v);
     uint8_t after[4] = {};
     Error r = ctx.m.read(ctx.addr, 0x0100, after);
@@ -278,15 +289,17 @@ Outcome dl_control_rw(Context& ctx) {
     uint8_t restored[4] = {};
     Error r2 = ctx.m.read(ctx.addr, 0x0100, restored);
     if (w != Error::Ok || r != Error::Ok || r2 != Error::Ok) return fail("0x0100 access failed");
-    // Bits 0 (forwarding rule), 8-15 (loop control) and 16-18 (RX FIFO size) are read/write.
-    auto rw = [](const uint8_t* b) { return std::string(bytes_hex(std::span<const uint8_t>(b, 3))); };
-    auto mask = [](const uint8_t* b) {
-        return std::vector<uint8_t>{static_cast<uint8_t>(b[0] & 0x01), b[1],
+    // Bit 0 (forwarding rule), loop control of the implemented ports, bits 16-18 (RX FIFO size) are
+    // read/write.
+    auto shown = [](const uint8_t* b) { return bytes_hex(std::span<const uint8_t>(b, 3)); };
+    auto mask = [loop_mask](const uint8_t* b) {
+        return std::vector<uint8_t>{static_cast<uint8_t>(b[0] & 0x01), static_cast<uint8_t>(b[1] & loop_mask),
                                     static_cast<uint8_t>(b[2] & 0x07)};
     };
-    if (mask(after) != mask(v)) return fail("written value read back", rw(after), rw(v));
-    if (mask(restored) != mask(before)) return fail("restored value read back", rw(restored), rw(before));
-    return pass("0x0100", rw(before));
+    if (mask(after) != mask(v)) return fail("written value read back", shown(after), shown(v));
+    if (mask(restored) != mask(before))
+        return fail("restored value read back", shown(restored), shown(before));
+    return pass("0x0100", shown(before));
 }
 
 }  // namespace
@@ -595,7 +608,8 @@ void add_esc_tests(Catalogue& c) {
     add("reg.dl_status", "DL status 0x0110: PDI operational, per port link, loop and communication as cabled",
         "ETG.1000.4 DL status register 0x0110; ESC datasheet 0x0007 port descriptor, 0x0100 loop control",
         dl_status_ports);
-    add("reg.al_status_bits", "AL status 0x0130: a defined state, ID bit clear unless asked, reserved bits 0",
+    add("reg.al_status_bits",
+        "AL status 0x0130: a defined state, ID bit clear unless asked, reserved bits 6-7 clear",
         "ETG.1000.6 AL status register 0x0130", al_status_bits);
     add("reg.features", "ESC features 0x0008 agree with the commands: LRW (bit 9), BRW/APRW/FPRW (bit 10)",
         "ESC datasheet register 0x0008 (ESC features supported); ETG.1000.4 datagram commands", features);
