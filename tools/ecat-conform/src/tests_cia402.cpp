@@ -2,6 +2,7 @@
 // controlword/statusword in process data, quick stop as 0x605A says, fault and fault reset, the modes of
 // 0x6502 accepted by 0x6060 and shown by 0x6061. The axis is held: in CSP the target follows the actual
 // position every cycle, so enabling the drive does not move it.
+#include <optional>
 #include <thread>
 
 #include "pdo_map.hpp"
@@ -133,10 +134,10 @@ bool provoke_fault(Context& ctx, Drive& d) {
 
 // The emergency of a drive fault: 8 bytes after the CoE header, its error register as 0x1001 with bit 0
 // (generic error) set, its error code as 0x603F (when the drive has it).
-Outcome fault_emergency(Context& ctx, bool generic_bit) {
+// The drive started, enabled and faulted by a communication loss; an outcome when that cannot be done.
+std::optional<Outcome> faulted_drive(Context& ctx, Drive& d) {
     if (!ctx.opt.allow_fault) return skip("provokes a drive fault: needs --allow-fault");
-    CONFORM_NEED(need_402_profile(ctx));
-    Drive d(ctx);
+    if (auto r = need_402_profile(ctx); !r.empty()) return skip(r);
     if (auto e = d.start(); !e.empty())
         return e.find("not in the process data") != std::string::npos ? skip(e) : fail(e);
     ctx.mbx_resync();
@@ -150,6 +151,12 @@ Outcome fault_emergency(Context& ctx, bool generic_bit) {
         d.finish();
         return skip("the communication loss did not fault the drive (statusword " + s + ")");
     }
+    return std::nullopt;
+}
+
+Outcome fault_emergency(Context& ctx, bool generic_bit) {
+    Drive d(ctx);
+    if (auto o = faulted_drive(ctx, d)) return *o;
     // The emergencies waiting in SM1 (before any SDO transfer could pass them over).
     std::vector<std::vector<uint8_t>> emcy;
     std::vector<uint8_t> raw;
@@ -471,21 +478,8 @@ void add_cia402_tests(Catalogue& c) {
         "Fault (from a communication loss while enabled) and fault reset (0x0080 edge): transition 15",
         "IEC 61800-7-201 (CiA 402) transitions 13-15; 0x6007 abort connection option",
         [](Context& ctx) {
-            if (!ctx.opt.allow_fault) return skip("provokes a drive fault: needs --allow-fault");
-            CONFORM_NEED(need_402_profile(ctx));
             Drive d(ctx);
-            if (auto e = d.start(); !e.empty())
-                return e.find("not in the process data") != std::string::npos ? skip(e) : fail(e);
-            if (!d.to(kOe)) {
-                std::string s = sw_text(d.status());
-                d.finish();
-                return fail("cannot reach operation enabled", s, kOe.name);
-            }
-            if (!provoke_fault(ctx, d)) {
-                const std::string s = sw_text(d.status());
-                d.finish();
-                return skip("the communication loss did not fault the drive (statusword " + s + ")");
-            }
+            if (auto o = faulted_drive(ctx, d)) return *o;
             master::AlStatus st;
             (void)ctx.pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st,
                                          [&d] { d.hold(); });
