@@ -190,6 +190,7 @@ class Context {
     master::Error cycle(unsigned cycles = 1);
     std::unique_ptr<master::ProcessDataSession> pds;
     master::AlStatus last_status;  // of the last refused to_* call
+    unsigned al_timeouts = 0;      // requests neither reached nor refused within their wait
 
     std::unique_ptr<master::Mailbox> mbx;
     std::unique_ptr<master::SdoClient> sdo;

@@ -283,6 +283,9 @@ master::Result<uint8_t> Context::state() {
 master::AlStatus Context::request_raw(uint8_t st, std::chrono::milliseconds wait) {
     master::AlStatus out;
     (void)m.write_reg<uint16_t>(addr, master::reg::AlControl, st);
+    // A slave that has let three requests run out neither reaching nor refusing them (no error indication)
+    // gets 500 ms (scaled) from then on: it would otherwise stretch the run by the full wait on every test.
+    if (al_timeouts >= 3 && wait > ms(500)) wait = ms(500);
     const auto deadline = Clock::now() + wait;
     unsigned polls = 0;
     for (;;) {
@@ -292,6 +295,10 @@ master::AlStatus Context::request_raw(uint8_t st, std::chrono::milliseconds wait
             out.error = *s & 0x10;
             if (out.error || out.state == (st & 0x0F) || Clock::now() >= deadline) {
                 if (auto c = m.read_reg<uint16_t>(addr, master::reg::AlStatusCode)) out.code = *c;
+                if (!out.error && out.state != (st & 0x0F) && ++al_timeouts == 3)
+                    notes.push_back(
+                        "three AL state requests were neither reached nor refused in time: later "
+                        "AL waits were cut to 500 ms (scaled)");
                 return out;
             }
         } else if (Clock::now() >= deadline) {
