@@ -190,7 +190,8 @@ class Context {
     master::Error cycle(unsigned cycles = 1);
     std::unique_ptr<master::ProcessDataSession> pds;
     master::AlStatus last_status;  // of the last refused to_* call
-    unsigned al_timeouts = 0;      // requests neither reached nor refused within their wait
+    unsigned al_timeouts = 0;      // requests of this group neither reached nor refused within their wait
+    bool al_note = false;
 
     std::unique_ptr<master::Mailbox> mbx;
     std::unique_ptr<master::SdoClient> sdo;

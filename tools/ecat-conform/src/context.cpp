@@ -283,9 +283,10 @@ master::Result<uint8_t> Context::state() {
 master::AlStatus Context::request_raw(uint8_t st, std::chrono::milliseconds wait) {
     master::AlStatus out;
     (void)m.write_reg<uint16_t>(addr, master::reg::AlControl, st);
-    // A slave that has let three requests run out neither reaching nor refusing them (no error indication)
-    // gets 500 ms (scaled) from then on: it would otherwise stretch the run by the full wait on every test.
-    if (al_timeouts >= 3 && wait > ms(500)) wait = ms(500);
+    // A slave that has let three requests of this group run out, neither reaching nor refusing them (no
+    // error indication), gets 1 s (scaled) for the rest of the group: it would otherwise stretch the run by
+    // the full wait on every test. The next group starts with the full waits again.
+    if (al_timeouts >= 3 && wait > ms(1000)) wait = ms(1000);
     const auto deadline = Clock::now() + wait;
     unsigned polls = 0;
     for (;;) {
