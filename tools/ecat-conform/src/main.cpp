@@ -307,6 +307,7 @@ int main(int argc, char** argv) {
                 if (t.group != group) {
                     group = t.group;
                     group_broken.clear();
+                    ctx.al_timeouts = 0;
                     ctx.budget_end = s0 + budget_d;
                     master::Error e = ctx.to_init();
                     if (e != master::Error::Ok) {
