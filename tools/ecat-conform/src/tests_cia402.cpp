@@ -470,7 +470,7 @@ void add_cia402_tests(Catalogue& c) {
         [](Context& ctx) { return fault_emergency(ctx, false); }, "profile 402 and --allow-fault");
     add(
         "fault.emergency_generic_bit", "The fault's emergency error register has bit 0 (generic error) set",
-        "CiA 301 error register 0x1001 bit 0 (generic error: signalled at any error situation)",
+        "ETG.1000.6 CoE emergency; CiA 301 error register 0x1001 bit 0 (generic error, at any error)",
         [](Context& ctx) { return fault_emergency(ctx, true); }, "profile 402 and --allow-fault",
         Severity::Warning);
     add(
