@@ -426,9 +426,9 @@ MUTANTS = {
                            mbx_rewriter(lambda st, m: (m.__setitem__(5, m[5] | 0x80), m)[1])),
     "mbx-channel": _m("ETG.1000.4 mailbox header channel (bits 0-5 of byte 4) reserved (0)",
                       mbx_rewriter(lambda st, m: (m.__setitem__(4, m[4] | 0x05), m)[1])),
-    "mbx-length-long": _m("ETG.1000.6 SDO expedited response: mailbox length 10",
-                          sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c),
-                                       lambda m: struct.pack_into("<H", m, 0, mbx_len(m) + 4))),
+    "sdo-expedited-length": _m("ETG.1000.6 SDO expedited response: mailbox length 10",
+                               sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c),
+                                            lambda m: struct.pack_into("<H", m, 0, mbx_len(m) + 4))),
     "mbx-error-detail": _m("ETG.1000.4 mailbox error reply detail 0x0002 unsupported protocol",
                            mbx_rewriter(lambda st, m: None if (m[5] & 0x0F) != 0 or len(m) < 10 else
                                         (struct.pack_into("<H", m, 8, 0x0001), m)[1])),
