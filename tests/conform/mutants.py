@@ -160,7 +160,8 @@ def sdo_rewriter(pred, fn):
 
     def f(st, m):
         svc, _ = coe(m)
-        if svc != 3 or len(m) < 16:
+        # Service 3 (SDO response); 2 as well: an Abort SDO Transfer is a request service from either side.
+        if svc not in (2, 3) or len(m) < 16:
             return None
         if not pred(m[8], struct.unpack_from("<H", m, 9)[0], m[11], st):
             return None
