@@ -314,5 +314,19 @@ TEST(Catalogue, Invariants) {
         EXPECT_GE(per_group[g], 5) << "group " << g;
 }
 
+TEST(Report, SlaveStringsAreEscapedInTheTextReport) {
+    EXPECT_EQ(printable("MAXPOS 50/5"), "MAXPOS 50/5");
+    EXPECT_EQ(printable(std::string("a\x01\n\x7f\xff\\b", 7)), "a\\x01\\x0a\\x7f\\xff\\\\b");
+    Catalogue c = build_catalogue();
+    std::vector<TestResult> r(1);
+    r[0].test = &c.front();
+    r[0].outcome = fail("name", std::string("bad\x1b[2Jname", 11), "good");
+    std::ostringstream o;
+    std::string group;
+    write_text_result(o, r[0], group, false, false);
+    EXPECT_EQ(o.str().find('\033'), std::string::npos);
+    EXPECT_NE(o.str().find("bad\\x1b[2Jname"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace conform

@@ -1,7 +1,12 @@
 """ecat-conform against the soft slave over a veth pair: the clean slave passes every test, and each
 `ecat-slave --fault NAME` makes the test(s) named in faults.txt fail and no test of an unrelated group.
 
-usage: test_conform.py clean | noslave | dies | fault NAME [NAME ...]
+usage: test_conform.py clean | noslave | dies | fault NAME [NAME ...] | mutant NAME [NAME ...]
+       | variation NAME [NAME ...] | table [NAME ...]
+mutant/variation: a proxy between ecat-conform and the clean slave rewrites the slave's answers
+(mutants.py); a mutant must make at least one test fail, a variation must raise no failure and no warning
+that the unmutated run through the proxy does not raise. table: every mutant and variation (or those
+named), with the tests that killed each, as a markdown table (ECAT_TEST_OUT/mutation-table.md).
 The slave serves an SII with station alias 0x1234 (and the ESI says the same), so the alias tests run too.
 """
 import json
@@ -15,6 +20,7 @@ import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "integration"))
 import harness  # noqa: E402
+import mutants  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ALIAS = 0x1234
@@ -64,11 +70,57 @@ class ConformBus(harness.Bus):
         return super().ecatctl(*args, check=check, binary=binary)
 
 
+class ProxyLink:
+    """A veth pair (cm<uid> for ecat-conform, cp<uid> for the proxy) and the proxy between cp<uid> and the
+    bus's master end."""
+    _n = 0
+
+    def __init__(self, bus_iface, mutation):
+        ProxyLink._n += 1
+        uid = f"{os.getpid() % 100000}p{ProxyLink._n}"
+        self.iface, self.peer = f"cm{uid}", f"cp{uid}"
+        self.bus_iface, self.mutation = bus_iface, mutation
+        self.proxy = None
+
+    def __enter__(self):
+        subprocess.run(["ip", "link", "add", self.iface, "type", "veth", "peer", "name", self.peer], check=True)
+        for i in (self.iface, self.peer):
+            subprocess.run(["sysctl", "-qw", f"net.ipv6.conf.{i}.disable_ipv6=1"], check=False)
+            subprocess.run(["ip", "link", "set", i, "up"], check=True)
+        try:
+            self.proxy = mutants.Proxy(self.peer, self.bus_iface, self.mutation).__enter__()
+        except BaseException:
+            subprocess.run(["ip", "link", "del", self.iface], check=False)
+            raise
+        return self
+
+    def __exit__(self, *exc):
+        try:
+            self.proxy.__exit__(*exc)
+        finally:
+            subprocess.run(["ip", "link", "del", self.iface], check=False)
+        return False
+
+
+def table_markdown(rows):
+    lines = ["| kind | name | clause | result | killed by (tests of its group, first 4) | s |", "|---|---|---|---|---|---|"]
+    for kind, name, clause, failed, warned, ok, elapsed, _ in rows:
+        res = ("killed" if ok else "SURVIVED") if kind == "mutant" else ("clean" if ok else "FALSE ALARM")
+        by = failed if kind == "mutant" else failed + warned
+        more = f" +{len(by) - 4}" if len(by) > 4 else ""
+        lines.append(f"| {kind} | `{name}` | {clause} | {res} | {', '.join(by[:4])}{more} | {elapsed:.1f} |")
+    m = [r for r in rows if r[0] == "mutant"]
+    v = [r for r in rows if r[0] == "variation"]
+    lines.append("")
+    lines.append(f"mutants killed {sum(r[5] for r in m)}/{len(m)}; variations clean {sum(r[5] for r in v)}/{len(v)}")
+    return "\n".join(lines) + "\n"
+
+
 class Conform(unittest.TestCase):
     mode = "clean"
     faults = []
 
-    def run_conform(self, fault=None):
+    def run_conform(self, fault=None, mutation=None, proxy=False):
         work = tempfile.mkdtemp(prefix="ecat-conform-", dir=os.environ.get("ECAT_TEST_OUT"))
         sii, esi = alias_images(work)
         args = ["--eeprom", sii]
@@ -77,16 +129,65 @@ class Conform(unittest.TestCase):
         with ConformBus(slave_args=args) as bus:
             out = os.path.join(work, "result.json")
             junit = os.path.join(work, "result.xml")
-            t0 = time.monotonic()
-            r = subprocess.run([os.environ["ECAT_CONFORM"], "--iface", bus.iface, "--esi", esi, "--foe-file", "MAXPOS",
-                                "--json", out, "--junit", junit], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               text=True, timeout=120)
-            elapsed = time.monotonic() - t0
+
+            extra = []
+
+            def run(iface):
+                t0 = time.monotonic()
+                cmd = [os.environ["ECAT_CONFORM"], "--iface", iface, "--esi", esi, "--foe-file", "MAXPOS", "--json",
+                       out, "--junit", junit, "--allow-fault"] + extra
+                try:
+                    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=120)
+                except subprocess.TimeoutExpired as e:
+                    # Killed: the reports hold every test up to the one that ran (marked interrupted).
+                    r = subprocess.CompletedProcess(cmd, -9, e.stdout or "", e.stderr or "")
+                return r, time.monotonic() - t0
+
+            if proxy or mutation:
+                # The proxy is a Python program on a shared host: its latency varies, so the waits are longer.
+                extra.extend(["--timeout-scale", "3"])
+                with ProxyLink(bus.iface, mutation) as p:
+                    r, elapsed = run(p.iface)
+                self.assertEqual(p.proxy.errors, [], "the mutation raised")
+            else:
+                r, elapsed = run(bus.iface)
             self.assertTrue(os.path.exists(out), f"no JSON written: {r.stderr}")
             res = json.loads(pathlib.Path(out).read_text())
             import xml.dom.minidom
             xml.dom.minidom.parse(junit)  # well-formed
             return r, res, elapsed
+
+    def mutation_runs(self, names):
+        """Runs the proxy without mutation, then each named mutant/variation; returns rows of the table."""
+        base_warn = set()
+        if any(n in mutants.VARIATIONS for n in names):
+            # Variations are judged against the warnings of the same run without a mutation.
+            _, base, _ = self.run_conform(proxy=True)
+            base_fail = sorted(x["id"] for x in base["results"] if x["status"] == "FAIL")
+            self.assertEqual(base_fail, [], "the unmutated run through the proxy fails")
+            base_warn = {x["id"] for x in base["results"] if x["status"] == "WARN"}
+        rows = []
+        for name in names:
+            kind = "mutant" if name in mutants.MUTANTS else "variation"
+            clause, fn = (mutants.MUTANTS if kind == "mutant" else mutants.VARIATIONS)[name]
+            _, res, elapsed = self.run_conform(mutation=fn)
+            if kind == "variation" and any(x["status"] == "FAIL" for x in res["results"]):
+                # Once more: process data through a Python proxy on a loaded host can miss a watchdog. A
+                # variation that fails twice is a false alarm of the tool.
+                _, res, elapsed = self.run_conform(mutation=fn)
+            failed = sorted(x["id"] for x in res["results"] if x["status"] == "FAIL")
+            if kind == "mutant":
+                # Only failures in the group where the defect must be caught count as its kill.
+                group = mutants.expected_group(name)
+                failed = [i for i in failed if group == "*" or i.split(".")[0] == group]
+            warned = sorted(x["id"] for x in res["results"] if x["status"] == "WARN" and x["id"] not in base_warn)
+            detail = {x["id"]: x["message"] + " / " + x["observed"] for x in res["results"]
+                      if x["status"] in ("FAIL", "WARN") and x["id"] not in base_warn}
+            ok = bool(failed) if kind == "mutant" else not failed and not warned
+            rows.append((kind, name, clause, failed, warned, ok, elapsed, detail))
+            print(f"{kind} {name}: {'ok' if ok else 'NOT OK'} in {elapsed:.1f} s: {' '.join(failed[:6])}"
+                  f"{' warned ' + ' '.join(warned) if warned else ''}", file=sys.stderr, flush=True)
+        return rows
 
     def test_matrix(self):
         rows = matrix()
@@ -147,6 +248,94 @@ class Conform(unittest.TestCase):
             self.assertEqual(statuses[-1], "FAIL")
             self.assertTrue(any("no longer answers" in x["message"] for x in res["results"]), stdout[-2000:])
             return
+        if self.mode == "stopped":
+            # Stopped half-way (--deadline, then SIGTERM): valid JUnit and JSON of the tests done, the running
+            # one marked as interrupted, exit code 3, the text report ends saying where it stopped.
+            import signal
+            import xml.dom.minidom
+            work = tempfile.mkdtemp(prefix="ecat-conform-", dir=os.environ.get("ECAT_TEST_OUT"))
+            sii, esi = alias_images(work)
+            with ConformBus(slave_args=["--eeprom", sii]) as bus:
+                for how in ("deadline", "sigterm"):
+                    out, junit = os.path.join(work, how + ".json"), os.path.join(work, how + ".xml")
+                    cmd = [os.environ["ECAT_CONFORM"], "--iface", bus.iface, "--esi", esi, "--json", out,
+                           "--junit", junit]
+                    if how == "deadline":
+                        cmd += ["--deadline", "2"]
+                    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                    if how == "sigterm":
+                        time.sleep(2.0)
+                        p.send_signal(signal.SIGTERM)
+                    stdout, _ = p.communicate(timeout=60)
+                    self.assertEqual(p.returncode, 3, stdout[-2000:])
+                    self.assertIn("stopped", stdout.splitlines()[-2] + stdout.splitlines()[-1])
+                    res = json.loads(pathlib.Path(out).read_text())
+                    statuses = [x["status"] for x in res["results"]]
+                    self.assertGreater(len(statuses), 5, how)
+                    self.assertLess(len(statuses), 264, how)
+                    self.assertIn("PASS", statuses)
+                    self.assertIn("interrupted", res["results"][-1]["message"])
+                    doc = xml.dom.minidom.parse(junit)
+                    self.assertEqual(len(doc.getElementsByTagName("testcase")), len(statuses))
+                    # Every result in the JSON was printed, as it happened, in the text report.
+                    for x in res["results"][:-1]:
+                        self.assertIn(x["id"], stdout)
+            return
+        if self.mode == "line":
+            # --slave all on a line of three soft drives, each against the ESI of --esi-dir that matches its
+            # SII: one report, every slave's results tagged with its position, no failure.
+            work = tempfile.mkdtemp(prefix="ecat-conform-", dir=os.environ.get("ECAT_TEST_OUT"))
+            esi_dir = os.path.join(work, "esi")
+            os.makedirs(esi_dir)
+            subprocess.run([os.environ["ECAT_SLAVE"], "--write-esi", os.path.join(esi_dir, "drive.xml"),
+                            "--state-dir", work], check=True, timeout=60, stdout=subprocess.DEVNULL)
+            pathlib.Path(esi_dir, "not-an-esi.xml").write_text("<nothing/>")
+            with ConformBus(slave_args=["--slaves", "3"]) as bus:
+                out, junit = os.path.join(work, "r.json"), os.path.join(work, "r.xml")
+                r = subprocess.run([os.environ["ECAT_CONFORM"], "--iface", bus.iface, "--slave", "all", "--esi-dir",
+                                    esi_dir, "--json", out, "--junit", junit], stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE, text=True, timeout=300)
+            res = json.loads(pathlib.Path(out).read_text())
+            failed = [f"slave {x['slave']} {x['id']}: {x['message']} / {x['observed']}" for x in res["results"]
+                      if x["status"] == "FAIL"]
+            self.assertEqual(failed, [], r.stdout[-3000:])
+            self.assertEqual(r.returncode, 0)
+            per = {k: [x for x in res["results"] if x["slave"] == k] for k in (0, 1, 2)}
+            self.assertEqual(len(per[0]), len(per[1]))
+            self.assertEqual(len(per[0]) * 3, len(res["results"]))
+            self.assertNotIn("needs the ESI", r.stdout)
+            for k in (0, 1, 2):
+                self.assertIn(f"=== slave {k}: slave {k} of 3", r.stdout)
+            import xml.dom.minidom
+            names = {s.getAttribute("name") for s in xml.dom.minidom.parse(junit).getElementsByTagName("testsuite")}
+            self.assertIn("slave2.sdo", names)
+            return
+        if self.mode == "liar":
+            # A slave whose every working counter is one too high (besides BRD, so it is found): the run ends
+            # in under a minute and fails.
+            t0 = time.monotonic()
+            r, res, elapsed = self.run_conform(mutation=mutants.MUTANTS["liar-wkc"][1])
+            self.assertEqual(r.returncode, 1)
+            self.assertLess(time.monotonic() - t0, 60, f"run took {elapsed:.0f} s")
+            print(f"lying slave: {len(res['results'])} tests in {elapsed:.1f} s", file=sys.stderr)
+            return
+        if self.mode in ("mutant", "variation", "table"):
+            names = self.faults or (list(mutants.MUTANTS) + list(mutants.VARIATIONS))
+            for n in mutants.MUTANTS:
+                mutants.expected_group(n)  # every mutant says where it must be caught
+            for n in names:
+                self.assertIn(n, {**mutants.MUTANTS, **mutants.VARIATIONS}, "unknown mutant or variation")
+            rows = self.mutation_runs(names)
+            text = table_markdown(rows)
+            if self.mode == "table":
+                path = os.path.join(os.environ.get("ECAT_TEST_OUT", "."), "mutation-table.md")
+                pathlib.Path(path).write_text(text)
+                print(text)
+                print(f"written to {path}", file=sys.stderr)
+            bad = [f"{r[1]}: " + ("no test failed" if r[0] == "mutant" else "; ".join(
+                f"{k}: {v}" for k, v in r[7].items())) for r in rows if not r[5]]
+            self.assertEqual(bad, [], text)
+            return
         for fault in self.faults:
             with self.subTest(fault=fault):
                 self.assertIn(fault, rows, "no row in faults.txt")
@@ -164,10 +353,14 @@ class Conform(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) >= 2 and sys.argv[1] in ("clean", "fault", "noslave", "dies"):
+    if len(sys.argv) >= 2 and sys.argv[1] in ("clean", "fault", "noslave", "dies", "stopped", "liar", "line", "mutant", "variation",
+                                              "table"):
         Conform.mode = sys.argv[1]
         Conform.faults = sys.argv[2:]
         del sys.argv[1:]
+    # SIGTERM (a ctest time-out, a kill) unwinds like an exception: namespaces, links and the slave go.
+    import signal
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(1))
     if not os.path.exists(os.environ.get("ECAT_CONFORM", "")):
         print("SKIP: ECAT_CONFORM not set")
         sys.exit(harness.SKIP)

@@ -68,6 +68,7 @@ struct TestResult {
     const TestCase* test = nullptr;
     Outcome outcome;
     std::chrono::microseconds duration{0};
+    int slave = -1;  // position of the slave it ran on, with --slave all or a list (-1: the one slave)
 };
 
 using Catalogue = std::vector<TestCase>;
@@ -114,11 +115,16 @@ struct Options {
     std::string iface;
     uint16_t slave = 0;
     std::string esi_path;
-    int device = -1;  // -1: the device whose identity matches the slave
+    std::string esi_dir;  // without esi_path: the ESI file of this directory whose device matches the SII
+    int device = -1;      // -1: the device whose identity matches the slave
     double timeout_scale = 1.0;
     bool verbose = false;
     std::string foe_file;       // a file name the device's FoE server knows (Bootstrap firmware)
     uint32_t foe_password = 0;  // its password
+    // What may change the device beyond its configuration: off unless asked for (docs/conformance.md).
+    bool allow_fault = false;      // provoke a drive fault (fault reaction: the drive stops, may brake)
+    bool allow_motion = false;     // command motion (profile modes with a set-point)
+    bool allow_foe_write = false;  // let an FoE write of --foe-file go through (writes the device's flash)
 };
 
 // ---- the run context -------------------------------------------------------------------------------
@@ -141,7 +147,10 @@ class Context {
     std::optional<EsiDevice> esi;
     std::string esi_error;  // why there is no ESI expectation
 
-    std::chrono::milliseconds ms(int base) const;  // scaled timeout
+    // Scaled timeout, cut to what is left of the running test's budget (at least 1 ms): a slave that lies
+    // or stops answering makes each wait short once the test has used its budget.
+    std::chrono::milliseconds ms(int base) const;
+    std::chrono::steady_clock::time_point budget_end{};  // epoch: no budget
 
     // Skip reasons ("" = applies).
     std::string need_esi() const;
@@ -181,6 +190,8 @@ class Context {
     master::Error cycle(unsigned cycles = 1);
     std::unique_ptr<master::ProcessDataSession> pds;
     master::AlStatus last_status;  // of the last refused to_* call
+    unsigned al_timeouts = 0;      // requests of this group neither reached nor refused within their wait
+    bool al_note = false;
 
     std::unique_ptr<master::Mailbox> mbx;
     std::unique_ptr<master::SdoClient> sdo;

@@ -1,6 +1,7 @@
 // The run context: bus set-up, state changes, raw mailbox access, SDO helpers, SII parsing.
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <thread>
 
 #include "conform.hpp"
@@ -120,7 +121,11 @@ void SiiImage::parse() {
 Context::Context(master::Master& master, const Options& o) : m(master), opt(o) {}
 
 std::chrono::milliseconds Context::ms(int base) const {
-    return std::chrono::milliseconds(static_cast<long>(base * opt.timeout_scale + 0.5));
+    const auto scaled = std::chrono::milliseconds(static_cast<long>(base * opt.timeout_scale + 0.5));
+    if (budget_end == std::chrono::steady_clock::time_point{}) return scaled;
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(budget_end - std::chrono::steady_clock::now());
+    return std::clamp(left, std::chrono::milliseconds(1), std::max(scaled, std::chrono::milliseconds(1)));
 }
 
 std::string Context::setup() {
@@ -169,6 +174,41 @@ std::string Context::setup() {
         } catch (const std::exception& e) {
             return std::string("ESI: ") + e.what();
         }
+    } else if (!opt.esi_dir.empty()) {
+        // The file whose device has the SII's vendor, product code and revision (product code alone if no
+        // revision matches); files that are not ESI are passed over.
+        std::vector<std::string> files;
+        std::error_code ec;
+        for (const auto& e : std::filesystem::directory_iterator(opt.esi_dir, ec))
+            if (e.path().extension() == ".xml" || e.path().extension() == ".XML") files.push_back(e.path());
+        if (ec) return "--esi-dir " + opt.esi_dir + ": " + ec.message();
+        std::sort(files.begin(), files.end());
+        std::optional<EsiDevice> by_product;
+        std::string by_product_file;
+        for (const auto& path : files) {
+            if (!sii) break;
+            try {
+                EsiFile f = read_esi_file(path);
+                if (f.vendor_id != sii->dword(0x08)) continue;
+                for (const auto& d : f.devices) {
+                    if (d.product_code != sii->dword(0x0A)) continue;
+                    if (d.revision == sii->dword(0x0C)) {
+                        esi = d;
+                        return {};
+                    }
+                    if (!by_product) by_product = d, by_product_file = path;
+                }
+            } catch (const std::exception&) {
+            }
+        }
+        if (by_product) {
+            esi = by_product;
+            notes.push_back("slave " + std::to_string(opt.slave) +
+                            ": no ESI device with the SII's revision; " + by_product_file +
+                            " has its product code");
+            return {};
+        }
+        esi_error = sii ? "no ESI file in " + opt.esi_dir + " describes the SII's identity" : sii_error;
     } else {
         esi_error = "no --esi given";
     }
@@ -244,6 +284,10 @@ master::Result<uint8_t> Context::state() {
 master::AlStatus Context::request_raw(uint8_t st, std::chrono::milliseconds wait) {
     master::AlStatus out;
     (void)m.write_reg<uint16_t>(addr, master::reg::AlControl, st);
+    // A slave that has let three requests of this group run out, neither reaching nor refusing them (no
+    // error indication), gets 1 s (scaled) for the rest of the group: it would otherwise stretch the run by
+    // the full wait on every test. The next group starts with the full waits again.
+    if (al_timeouts >= 3 && wait > ms(1000)) wait = ms(1000);
     const auto deadline = Clock::now() + wait;
     unsigned polls = 0;
     for (;;) {
@@ -253,6 +297,10 @@ master::AlStatus Context::request_raw(uint8_t st, std::chrono::milliseconds wait
             out.error = *s & 0x10;
             if (out.error || out.state == (st & 0x0F) || Clock::now() >= deadline) {
                 if (auto c = m.read_reg<uint16_t>(addr, master::reg::AlStatusCode)) out.code = *c;
+                if (!out.error && out.state != (st & 0x0F) && ++al_timeouts == 3)
+                    notes.push_back(
+                        "three AL state requests were neither reached nor refused in time: later "
+                        "AL waits were cut to 500 ms (scaled)");
                 return out;
             }
         } else if (Clock::now() >= deadline) {

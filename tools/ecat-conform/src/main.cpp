@@ -3,6 +3,10 @@
 #include <fnmatch.h>
 #include <unistd.h>
 
+#include <cmath>
+#include <csignal>
+#include <cstring>
+
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <fstream>
@@ -39,6 +43,45 @@ bool selected(const conform::TestCase& t, const std::set<std::string>& groups, c
     return true;
 }
 
+// Stopped from outside (SIGTERM, SIGINT) or by --deadline (SIGALRM): the JUnit and JSON files on disk already
+// hold every finished test and the running one marked as interrupted (written before it started); the
+// handler only ends the text report with a prepared line and exits.
+constexpr int kExitStopped = 3;
+char g_stop_line[512] = "\nstopped\n";
+volatile std::sig_atomic_t g_stop_len = 9;
+
+extern "C" void on_stop(int sig) {
+    const char* why = sig == SIGALRM ? "\nstopped: --deadline reached while running "
+                                     : "\nstopped by a signal while running ";
+    (void)!write(STDOUT_FILENO, why, std::strlen(why));
+    (void)!write(STDOUT_FILENO, g_stop_line, static_cast<std::size_t>(g_stop_len));
+    _exit(kExitStopped);
+}
+
+void prepare_stop_line(const std::string& id) {
+    const std::string line = id + " (reports hold the tests before it)\n";
+    const std::size_t n = std::min(line.size(), sizeof g_stop_line);
+    std::memcpy(g_stop_line, line.data(), n);
+    g_stop_len = static_cast<std::sig_atomic_t>(n);
+}
+
+// Written to FILE.tmp and renamed: a reader (or a kill) never sees half a file.
+template <typename Writer>
+void save_atomically(const std::string& path, Writer w) {
+    if (path.empty()) return;
+    const std::string tmp = path + ".tmp";
+    {
+        std::ofstream f(tmp);
+        w(f);
+        if (!f) {
+            std::fprintf(stderr, "ecat-conform: cannot write %s\n", tmp.c_str());
+            return;
+        }
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0)
+        std::fprintf(stderr, "ecat-conform: cannot write %s\n", path.c_str());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -49,7 +92,14 @@ int main(int argc, char** argv) {
     std::string groups_arg, filter, junit, json, backend;
     bool list = false, markdown = false;
     app.add_option("--iface,-i", o.iface, "Interface the slave is on");
-    app.add_option("--slave", o.slave, "Position of the slave under test on the bus (0 = first)");
+    std::string slave_arg = "0";
+    app.add_option(
+        "--slave", slave_arg,
+        "Position of the slave under test (0 = first); a list (0,2) or 'all': each in turn, one report");
+    app.add_option(
+        "--esi-dir", o.esi_dir,
+        "Without --esi: a directory of ESI files; each slave is tested against the file whose device "
+        "matches its SII identity");
     app.add_option("--esi", o.esi_path,
                    "ESI XML file: the expectation (object dictionary, PDOs, SMs, DC, ...)");
     app.add_option("--device", o.device,
@@ -66,7 +116,22 @@ int main(int argc, char** argv) {
     app.add_option("--foe-file", o.foe_file,
                    "A file name the device accepts over FoE in Bootstrap (enables the password test)");
     app.add_option("--foe-password", o.foe_password, "The FoE password of that file (default 0)");
+    app.add_flag(
+        "--allow-fault", o.allow_fault,
+        "Allow tests that provoke a drive fault (communication loss while enabled; the drive's fault "
+        "reaction runs)");
+    app.add_flag("--allow-motion", o.allow_motion, "Allow tests that command motion of an axis");
+    app.add_flag("--allow-foe-write", o.allow_foe_write,
+                 "Allow an FoE write of --foe-file to go through (writes the device's firmware/flash)");
     app.add_option("--backend", backend, "Raw-socket backend: packet or pcap");
+    double deadline = 0, budget = 30;
+    app.add_option("--deadline", deadline,
+                   "Stop the run after SECONDS (reports complete up to the running test; exit code 3)")
+        ->check(CLI::PositiveNumber);
+    app.add_option("--test-budget", budget,
+                   "Seconds one test may wait in all (scaled by --timeout-scale); past it every wait is cut "
+                   "short, so a slave that lies or stops answering cannot stretch the run (default 30)")
+        ->check(CLI::PositiveNumber);
     app.add_flag("--verbose,-v", o.verbose, "Details of passed and skipped tests too");
     CLI11_PARSE(app, argc, argv);
 
@@ -111,91 +176,198 @@ int main(int argc, char** argv) {
     mo.sii_timeout = std::chrono::milliseconds(static_cast<long>(100 * o.timeout_scale));
     mo.al_timeout = std::chrono::milliseconds(static_cast<long>(5000 * o.timeout_scale));
     master::Master m(*link, mo);
-    conform::Context ctx(m, o);
-    ctx.link = link.get();
+    // The slaves under test: one position, a list, or all of the line.
+    std::vector<uint16_t> units;
+    const bool many = slave_arg == "all" || slave_arg.find(',') != std::string::npos;
+    if (slave_arg == "all") {
+        auto n = m.count_slaves();
+        for (uint16_t i = 0; n && i < *n; ++i)
+            units.push_back(i);
+        if (units.empty()) units.push_back(0);  // the setup says that no slave answered
+    } else {
+        for (const auto& x : split(slave_arg)) {
+            char* end = nullptr;
+            const unsigned long v = std::strtoul(x.c_str(), &end, 0);
+            if (!end || *end || v > 0xFFFF) {
+                std::fprintf(stderr, "ecat-conform: --slave: '%s' is not a position, a list or 'all'\n",
+                             x.c_str());
+                return 2;
+            }
+            units.push_back(static_cast<uint16_t>(v));
+        }
+    }
+    if (units.empty()) {
+        std::fprintf(stderr, "ecat-conform: --slave: no position given\n");
+        return 2;
+    }
 
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<conform::TestResult> results;
+    results.reserve(chosen.size());
     conform::RunInfo info;
     info.iface = o.iface;
-    const std::string setup_error = ctx.setup();
-    if (!setup_error.empty()) {
-        info.device = "(none)";
-        for (const auto& t : chosen) {
+    const bool colour = isatty(STDOUT_FILENO) != 0;
+    auto elapsed = [&] {
+        return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - t0);
+    };
+    // The reports on disk: the results so far, and the running test (if any) marked as interrupted.
+    auto save = [&](const conform::TestCase* running) {
+        info.duration = elapsed();
+        std::vector<conform::TestResult> rs = results;
+        if (running) {
             conform::TestResult r;
-            r.test = &t;
-            r.outcome = conform::fail("cannot start: " + setup_error);
-            results.push_back(r);
+            r.test = running;
+            if (many) r.slave = o.slave;
+            r.outcome = conform::fail("interrupted: the run was stopped while this test ran");
+            rs.push_back(r);
         }
-    } else {
-        if (ctx.sii)
-            info.device = util::strprintf(
-                "slave %u of %u, vendor 0x%08x product 0x%08x revision 0x%08x%s", o.slave, ctx.slave_count,
-                ctx.sii->dword(0x08), ctx.sii->dword(0x0A), ctx.sii->dword(0x0C), ctx.esi ? "" : " (no ESI)");
-        else
-            info.device = util::strprintf("slave %u of %u (SII unreadable)", o.slave, ctx.slave_count);
-        if (ctx.esi) info.device += ", ESI device \"" + ctx.esi->type_name + "\"";
-        std::string group;
-        std::string lost;  // id of the test during which the slave stopped answering, "" while it answers
-        for (const auto& t : chosen) {
-            conform::TestResult r;
-            r.test = &t;
-            const auto s0 = std::chrono::steady_clock::now();
-            if (!lost.empty()) {
-                // Back (restarted, replugged)? Addresses again and carry on; else fail at once.
-                auto n = m.count_slaves();
-                if (n && *n > o.slave && m.assign_station_addresses(*n) == master::Error::Ok) {
-                    ctx.notes.push_back("the slave answered again after it was lost during " + lost);
-                    lost.clear();
-                    group.clear();
-                } else {
-                    r.outcome = conform::fail("the slave no longer answers (lost during " + lost + ")");
-                    results.push_back(r);
-                    continue;
+        save_atomically(junit, [&](std::ostream& f) { conform::write_junit(f, rs, info); });
+        save_atomically(json, [&](std::ostream& f) { conform::write_json(f, rs, info); });
+    };
+    std::signal(SIGTERM, on_stop);
+    std::signal(SIGINT, on_stop);
+    std::signal(SIGALRM, on_stop);
+    if (deadline > 0) alarm(static_cast<unsigned>(std::ceil(deadline)));
+    std::string text_group;
+    auto emit = [&](conform::TestResult r) {
+        results.push_back(std::move(r));
+        conform::write_text_result(std::cout, results.back(), text_group, colour, o.verbose);
+        std::cout << std::flush;
+    };
+    if (many) {
+        info.device = "slaves " + slave_arg;
+        conform::write_text_header(std::cout, info);
+    }
+    for (const uint16_t unit : units) {
+        o.slave = unit;
+        conform::Context ctx(m, o);
+        ctx.link = link.get();
+        auto emit_unit = [&](conform::TestResult r) {
+            if (many) r.slave = unit;
+            emit(std::move(r));
+        };
+        const std::string setup_error = ctx.setup();
+        if (!setup_error.empty()) {
+            if (!many) {
+                info.device = "(none)";
+                conform::write_text_header(std::cout, info);
+            }
+            for (const auto& t : chosen) {
+                conform::TestResult r;
+                r.test = &t;
+                r.outcome = conform::fail("cannot start: " + setup_error);
+                emit_unit(r);
+            }
+        } else {
+            std::string device;
+            if (ctx.sii)
+                device = util::strprintf("slave %u of %u, vendor 0x%08x product 0x%08x revision 0x%08x%s",
+                                         o.slave, ctx.slave_count, ctx.sii->dword(0x08), ctx.sii->dword(0x0A),
+                                         ctx.sii->dword(0x0C), ctx.esi ? "" : " (no ESI)");
+            else
+                device = util::strprintf("slave %u of %u (SII unreadable)", o.slave, ctx.slave_count);
+            if (ctx.esi) device += ", ESI device \"" + ctx.esi->type_name + "\"";
+            if (many) {
+                std::cout << "\n=== slave " << unit << ": " << conform::printable(device) << "\n";
+                info.device += (info.device.empty() ? "" : "; ") + std::string("slave ") +
+                               std::to_string(unit) + ": " + device;
+            } else {
+                info.device = device;
+                conform::write_text_header(std::cout, info);
+            }
+            std::cout << std::flush;
+            std::string group;
+            std::string
+                group_broken;  // id of the test that reported the group's failed start, "" when it started
+            std::string lost;  // id of the test during which the slave stopped answering, "" while it answers
+            const auto budget_d =
+                std::chrono::milliseconds(static_cast<long>(budget * 1000 * o.timeout_scale));
+            for (const auto& t : chosen) {
+                conform::TestResult r;
+                r.test = &t;
+                prepare_stop_line(t.id);
+                save(&t);
+                const auto s0 = std::chrono::steady_clock::now();
+                ctx.budget_end = {};
+                if (!lost.empty()) {
+                    // Back (restarted, replugged)? Addresses again and carry on; else fail at once.
+                    auto n = m.count_slaves();
+                    if (n && *n > o.slave && m.assign_station_addresses(*n) == master::Error::Ok) {
+                        ctx.notes.push_back("the slave answered again after it was lost during " + lost);
+                        lost.clear();
+                        group.clear();
+                    } else {
+                        r.outcome = conform::fail("the slave no longer answers (lost during " + lost + ")");
+                        emit_unit(r);
+                        continue;
+                    }
                 }
-            }
-            // Every group starts from INIT with SMs and FMMUs off, as a master's start-up does.
-            if (t.group != group) {
-                group = t.group;
-                if (ctx.to_init() != master::Error::Ok) {
-                    // Lost the slave (reset, unplugged)? Addresses again, then carry on.
-                    (void)m.assign_station_addresses(ctx.slave_count);
-                    (void)ctx.to_init();
+                // Every group starts from INIT with SMs and FMMUs off (mailbox set up again by the tests that
+                // need it), as a master's start-up does. A group that cannot start says so once, on its first
+                // test; its other tests are not run.
+                if (t.group != group) {
+                    group = t.group;
+                    group_broken.clear();
+                    ctx.al_timeouts = 0;
+                    ctx.budget_end = s0 + budget_d;
+                    master::Error e = ctx.to_init();
+                    if (e != master::Error::Ok) {
+                        // Lost the slave (reset, unplugged)? Addresses again, then carry on.
+                        (void)m.assign_station_addresses(ctx.slave_count);
+                        e = ctx.to_init();
+                    }
+                    if (e != master::Error::Ok) {
+                        auto st = ctx.rd<uint16_t>(esc::reg::kAlStatus);
+                        r.outcome = conform::fail(
+                            "group start: the slave could not be brought to INIT with SMs and FMMUs off: " +
+                                std::string(master::to_string(e)),
+                            st ? "AL status " + conform::hex(*st)
+                               : std::string(master::to_string(st.error())),
+                            "AL status 0x0001");
+                        group_broken = t.id;
+                    }
+                } else if (!group_broken.empty()) {
+                    r.outcome = conform::skip("not run: the group could not start from INIT (see " +
+                                              group_broken + ")");
                 }
+                if (r.outcome.status == Status::Pass && r.outcome.message.empty() && group_broken.empty()) {
+                    ctx.budget_end = std::chrono::steady_clock::now() + budget_d;
+                    try {
+                        r.outcome = t.run(ctx);
+                    } catch (const std::exception& e) {
+                        r.outcome = conform::fail(std::string("test aborted: ") + e.what());
+                    }
+                    if (std::chrono::steady_clock::now() > ctx.budget_end && r.outcome.status == Status::Fail)
+                        r.outcome.message += " (the test used up its budget of " +
+                                             std::to_string(static_cast<long>(budget * o.timeout_scale)) +
+                                             " s; later waits were cut short)";
+                    ctx.budget_end = {};
+                    if (r.outcome.status == Status::Fail && t.severity == conform::Severity::Warning)
+                        r.outcome.status = Status::Warn;
+                    // A slave that stopped answering (reset, crash): say so on the test that saw it.
+                    if (r.outcome.status == Status::Fail && !ctx.rd<uint16_t>(esc::reg::kStationAddress)) {
+                        r.outcome.message += " (the slave no longer answers at its station address)";
+                        auto n = m.count_slaves();
+                        if (!n || *n <= o.slave || m.assign_station_addresses(*n) != master::Error::Ok)
+                            lost = t.id;
+                    }
+                }
+                r.duration = std::chrono::duration_cast<std::chrono::microseconds>(
+                    std::chrono::steady_clock::now() - s0);
+                emit_unit(r);
             }
-            try {
-                r.outcome = t.run(ctx);
-            } catch (const std::exception& e) {
-                r.outcome = conform::fail(std::string("test aborted: ") + e.what());
-            }
-            if (r.outcome.status == Status::Fail && t.severity == conform::Severity::Warning)
-                r.outcome.status = Status::Warn;
-            // A slave that stopped answering (reset, crash): say so on the test that saw it.
-            if (r.outcome.status == Status::Fail && !ctx.rd<uint16_t>(esc::reg::kStationAddress)) {
-                r.outcome.message += " (the slave no longer answers at its station address)";
-                auto n = m.count_slaves();
-                if (!n || *n <= o.slave || m.assign_station_addresses(*n) != master::Error::Ok) lost = t.id;
-            }
-            r.duration =
-                std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - s0);
-            results.push_back(r);
+            prepare_stop_line("the final restore");
+            save(nullptr);
+            const std::string note = ctx.restore();
+            if (!note.empty()) ctx.notes.push_back(note);
         }
-        const std::string note = ctx.restore();
-        if (!note.empty()) ctx.notes.push_back(note);
-        info.notes = ctx.notes;
+        for (const auto& n : ctx.notes)
+            info.notes.push_back(many ? "slave " + std::to_string(unit) + ": " + n : n);
     }
-    info.duration =
-        std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - t0);
-    conform::write_text(std::cout, results, info, isatty(STDOUT_FILENO) != 0, o.verbose);
-    if (!junit.empty()) {
-        std::ofstream f(junit);
-        conform::write_junit(f, results, info);
-        if (!f) std::fprintf(stderr, "ecat-conform: cannot write %s\n", junit.c_str());
-    }
-    if (!json.empty()) {
-        std::ofstream f(json);
-        conform::write_json(f, results, info);
-        if (!f) std::fprintf(stderr, "ecat-conform: cannot write %s\n", json.c_str());
-    }
+    info.duration = elapsed();
+    conform::write_text_footer(std::cout, results, info);
+    std::cout << std::flush;
+    alarm(0);
+    save(nullptr);
     return conform::totals(results).failed ? 1 : 0;
 }

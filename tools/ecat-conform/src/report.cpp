@@ -113,31 +113,52 @@ std::string detail(const Outcome& o) {
 }
 }  // namespace
 
-void write_text(std::ostream& out, const std::vector<TestResult>& results, const RunInfo& info, bool colour,
-                bool verbose) {
-    out << "ecat-conform on " << info.iface << ": " << info.device << "\n";
-    std::string group;
-    for (const auto& r : results) {
-        const TestCase& t = *r.test;
-        if (t.group != group) {
-            group = t.group;
-            out << "\n"
-                << (colour ? "\033[1m" : "") << "== " << group_title(group) << " (" << group << ")"
-                << (colour ? "\033[0m" : "") << "\n";
-        }
-        const Status s = r.outcome.status;
-        out << "  " << (colour ? colour_of(s) : "") << status_name(s) << (colour ? "\033[0m" : "") << "  "
-            << t.id << "  " << t.title << "\n";
-        if (s == Status::Fail || s == Status::Warn) {
-            out << "        " << detail(r.outcome) << "\n";
-            out << "        clause: " << t.clause << "\n";
-        } else if (s == Status::Skip || verbose) {
-            std::string d = detail(r.outcome);
-            if (!d.empty()) out << "        " << d << "\n";
+std::string printable(const std::string& s) {
+    std::string o;
+    char b[8];
+    for (unsigned char c : s) {
+        if (c == '\\') {
+            o += "\\\\";
+        } else if (c < 0x20 || c >= 0x7F) {
+            std::snprintf(b, sizeof b, "\\x%02x", c);
+            o += b;
+        } else {
+            o += static_cast<char>(c);
         }
     }
+    return o;
+}
+
+void write_text_header(std::ostream& out, const RunInfo& info) {
+    out << "ecat-conform on " << printable(info.iface) << ": " << printable(info.device) << "\n";
+}
+
+void write_text_result(std::ostream& out, const TestResult& r, std::string& group, bool colour,
+                       bool verbose) {
+    const TestCase& t = *r.test;
+    const std::string key = r.slave < 0 ? t.group : "slave " + std::to_string(r.slave) + ", " + t.group;
+    if (key != group) {
+        group = key;
+        out << "\n"
+            << (colour ? "\033[1m" : "") << "== " << group_title(t.group) << " ("
+            << (r.slave < 0 ? "" : "slave " + std::to_string(r.slave) + ", ") << t.group << ")"
+            << (colour ? "\033[0m" : "") << "\n";
+    }
+    const Status s = r.outcome.status;
+    out << "  " << (colour ? colour_of(s) : "") << status_name(s) << (colour ? "\033[0m" : "") << "  " << t.id
+        << "  " << t.title << "\n";
+    if (s == Status::Fail || s == Status::Warn) {
+        out << "        " << printable(detail(r.outcome)) << "\n";
+        out << "        clause: " << t.clause << "\n";
+    } else if (s == Status::Skip || verbose) {
+        std::string d = detail(r.outcome);
+        if (!d.empty()) out << "        " << printable(d) << "\n";
+    }
+}
+
+void write_text_footer(std::ostream& out, const std::vector<TestResult>& results, const RunInfo& info) {
     for (const auto& n : info.notes)
-        out << "\nnote: " << n << "\n";
+        out << "\nnote: " << printable(n) << "\n";
     Totals t = totals(results);
     char b[64];
     std::snprintf(b, sizeof b, "%.1f s", static_cast<double>(info.duration.count()) / 1000.0);
@@ -147,12 +168,23 @@ void write_text(std::ostream& out, const std::vector<TestResult>& results, const
     out << t.passed << " passed, " << t.failed << " failed, " << t.skipped << " skipped\n";
 }
 
+void write_text(std::ostream& out, const std::vector<TestResult>& results, const RunInfo& info, bool colour,
+                bool verbose) {
+    write_text_header(out, info);
+    std::string group;
+    for (const auto& r : results)
+        write_text_result(out, r, group, colour, verbose);
+    write_text_footer(out, results, info);
+}
+
 void write_junit(std::ostream& out, const std::vector<TestResult>& results, const RunInfo& info) {
     std::map<std::string, std::vector<const TestResult*>> by_group;
     std::vector<std::string> order;
     for (const auto& r : results) {
-        if (!by_group.count(r.test->group)) order.push_back(r.test->group);
-        by_group[r.test->group].push_back(&r);
+        const std::string g =
+            r.slave < 0 ? r.test->group : "slave" + std::to_string(r.slave) + "." + r.test->group;
+        if (!by_group.count(g)) order.push_back(g);
+        by_group[g].push_back(&r);
     }
     Totals all = totals(results);
     char secs[32];
@@ -214,14 +246,16 @@ void write_json(std::ostream& out, const std::vector<TestResult>& results, const
     out << "],\n  \"results\": [\n";
     for (std::size_t i = 0; i < results.size(); ++i) {
         const auto& r = results[i];
-        out << "    {\"id\": \"" << json_escape(r.test->id) << "\", \"group\": \""
-            << json_escape(r.test->group) << "\", \"status\": \"" << status_name(r.outcome.status)
-            << "\", \"severity\": \"" << (r.test->severity == Severity::Error ? "error" : "warning")
-            << "\", \"title\": \"" << json_escape(r.test->title) << "\", \"clause\": \""
-            << json_escape(r.test->clause) << "\", \"message\": \"" << json_escape(r.outcome.message)
-            << "\", \"observed\": \"" << json_escape(r.outcome.observed) << "\", \"expected\": \""
-            << json_escape(r.outcome.expected) << "\", \"duration_us\": " << r.duration.count() << "}"
-            << (i + 1 < results.size() ? "," : "") << "\n";
+        out << "    {";
+        if (r.slave >= 0) out << "\"slave\": " << r.slave << ", ";
+        out << "\"id\": \"" << json_escape(r.test->id) << "\", \"group\": \"" << json_escape(r.test->group)
+            << "\", \"status\": \"" << status_name(r.outcome.status) << "\", \"severity\": \""
+            << (r.test->severity == Severity::Error ? "error" : "warning") << "\", \"title\": \""
+            << json_escape(r.test->title) << "\", \"clause\": \"" << json_escape(r.test->clause)
+            << "\", \"message\": \"" << json_escape(r.outcome.message) << "\", \"observed\": \""
+            << json_escape(r.outcome.observed) << "\", \"expected\": \"" << json_escape(r.outcome.expected)
+            << "\", \"duration_us\": " << r.duration.count() << "}" << (i + 1 < results.size() ? "," : "")
+            << "\n";
     }
     out << "  ]\n}\n";
 }

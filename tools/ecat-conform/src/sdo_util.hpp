@@ -58,6 +58,47 @@ inline Outcome expect_abort(const SdoAnswer& a, uint16_t index, uint8_t sub,
     return fail(what + ": abort code", a.describe(), want);
 }
 
+// Every field the standard defines in an SDO upload (scs 2) or download (scs 3) response: mailbox type CoE,
+// CoE service 3 (SDO response) with the reserved bits 9-11 clear, the command specifier, the complete-access
+// bit set only for a complete access, index and subindex echoed, and the mailbox length of the response
+// type: 10 for an expedited upload or a download response, 10 + the data for a normal upload (the data
+// may continue in segments: then not more than the size indicated).
+inline Outcome expect_response(const SdoAnswer& a, uint8_t scs, uint16_t index, uint8_t sub, bool ca,
+                               const std::string& what) {
+    const std::string want = scs == 2 ? "upload response 0x4x" : "download response 0x60";
+    if (a.error != master::Error::Ok || a.mailbox_type != 3 || a.p.size() < 10 || a.is_abort())
+        return fail(what + ": no SDO response", a.describe(), want);
+    const std::string head =
+        bytes_hex(std::span<const uint8_t>(a.p).subspan(0, std::min<std::size_t>(a.p.size(), 10)));
+    if ((a.p[1] >> 4) != 3) return fail(what + ": CoE service", dec(a.p[1] >> 4), "3 (SDO response)");
+    if (a.p[1] & 0x0E) return fail(what + ": CoE header reserved bits 9-11 set", head, "clear");
+    const uint8_t c = a.cmd();
+    if ((c >> 5) != scs) return fail(what + ": command specifier", hex(c, 2), want);
+    if ((c & 0x10) && !ca)
+        return fail(what + ": complete-access bit set for a single entry", hex(c, 2), want);
+    if (get16(&a.p[3]) != index || a.p[5] != sub)
+        return fail(what + ": index/subindex not echoed", hex(get16(&a.p[3])) + ":" + dec(a.p[5]),
+                    hex(index) + ":" + dec(sub));
+    if (scs == 3) {
+        if ((c & 0x1F) != (ca ? (c & 0x10) : 0))
+            return fail(what + ": download response bits 0-3 reserved", hex(c, 2), "0x60");
+        if (a.p.size() != 10)
+            return fail(what + ": mailbox length of a download response", dec(a.p.size()), "10");
+        return pass(what, hex(c, 2));
+    }
+    if (c & 0x02) {
+        if (a.p.size() != 10)
+            return fail(what + ": mailbox length of an expedited upload response", dec(a.p.size()), "10");
+        return pass(what, head);
+    }
+    if (!(c & 0x01)) return fail(what + ": normal upload response without size indicated", hex(c, 2), "0x41");
+    const uint32_t size = get32(&a.p[6]);
+    if (a.p.size() - 10 > size)
+        return fail(what + ": more data than the size indicated", dec(a.p.size() - 10) + " bytes",
+                    "<= " + dec(size));
+    return pass(what, head);
+}
+
 // ESI entries that are readable (not wo) with their object.
 struct EntryRef {
     const EsiObject* obj;

@@ -2,6 +2,7 @@
 // controlword/statusword in process data, quick stop as 0x605A says, fault and fault reset, the modes of
 // 0x6502 accepted by 0x6060 and shown by 0x6061. The axis is held: in CSP the target follows the actual
 // position every cycle, so enabling the drive does not move it.
+#include <optional>
 #include <thread>
 
 #include "pdo_map.hpp"
@@ -117,6 +118,76 @@ struct Drive {
         (void)ctx.to_init();
     }
 };
+
+// The master leaves OP while the drive is enabled: a communication loss (0x6007). True when the statusword
+// then shows fault.
+bool provoke_fault(Context& ctx, Drive& d) {
+    (void)ctx.request_raw(4, ctx.ms(1000));
+    (void)ctx.ack_error();
+    d.run(20);
+    for (int i = 0; i < 50; ++i) {
+        d.run(2);
+        if ((d.status() & kFault.mask) == kFault.value) return true;
+    }
+    return false;
+}
+
+// The emergency of a drive fault: 8 bytes after the CoE header, its error register as 0x1001 with bit 0
+// (generic error) set, its error code as 0x603F (when the drive has it).
+// The drive started, enabled and faulted by a communication loss; an outcome when that cannot be done.
+std::optional<Outcome> faulted_drive(Context& ctx, Drive& d) {
+    if (!ctx.opt.allow_fault) return skip("provokes a drive fault: needs --allow-fault");
+    if (auto r = need_402_profile(ctx); !r.empty()) return skip(r);
+    if (auto e = d.start(); !e.empty())
+        return e.find("not in the process data") != std::string::npos ? skip(e) : fail(e);
+    ctx.mbx_resync();
+    if (!d.to(kOe)) {
+        std::string s = sw_text(d.status());
+        d.finish();
+        return fail("cannot reach operation enabled", s, kOe.name);
+    }
+    if (!provoke_fault(ctx, d)) {
+        const std::string s = sw_text(d.status());
+        d.finish();
+        return skip("the communication loss did not fault the drive (statusword " + s + ")");
+    }
+    return std::nullopt;
+}
+
+Outcome fault_emergency(Context& ctx, bool generic_bit) {
+    Drive d(ctx);
+    if (auto o = faulted_drive(ctx, d)) return *o;
+    // The emergencies waiting in SM1 (before any SDO transfer could pass them over).
+    std::vector<std::vector<uint8_t>> emcy;
+    std::vector<uint8_t> raw;
+    while (ctx.mbx_read_raw(raw, ctx.ms(200)) == Error::Ok)
+        if ((raw[5] & 0x0F) == 3 && raw.size() >= 8 && (raw[7] >> 4) == 1) emcy.push_back(raw);
+    ctx.mbx_resync();
+    auto reg = ctx.upload_uint(0x1001, 0);
+    auto code603f = ctx.upload_uint(0x603F, 0);
+    const std::string sw = sw_text(d.status());
+    d.finish();
+    if (emcy.empty()) return skip("the drive sent no emergency for the fault (statusword " + sw + ")");
+    const auto& m = emcy.back();
+    const std::string got =
+        bytes_hex(std::span<const uint8_t>(m).subspan(0, std::min<std::size_t>(m.size(), 16)));
+    if (get16(m.data()) != 10 || m.size() < 16)
+        return fail("emergency length", dec(get16(m.data())), "10 (CoE header and 8 bytes)");
+    const uint16_t code = get16(&m[8]);
+    const uint8_t er = m[10];
+    if (code == 0)
+        return fail("the fault's emergency has error code 0 (no error)", got, "a fault's error code");
+    if (generic_bit) {
+        if (!(er & 0x01))
+            return fail("error register without bit 0 (generic error) while faulted", got, "bit 0 set");
+        return pass("generic error bit", got);
+    }
+    if (!reg) return fail("0x1001 upload: " + ctx.sdo_error(reg.error()));
+    if (*reg != er) return fail("emergency error register against 0x1001", hex(er, 2), hex(*reg, 2));
+    if (code603f && (*code603f & 0xFFFF) != code)
+        return fail("emergency error code against 0x603F", hex(code), hex(*code603f & 0xFFFF));
+    return pass("emergency", got);
+}
 
 Outcome transition(Context& ctx, const DsState& from, uint16_t c, const DsState& want, const char* what) {
     CONFORM_NEED(need_402_profile(ctx));
@@ -352,33 +423,63 @@ void add_cia402_tests(Catalogue& c) {
         },
         "profile 402, 0x605A = 5..8");
     add(
-        "fault_reset",
-        "Fault (from a communication loss while enabled) and fault reset (0x0080 edge): transition 15",
-        "IEC 61800-7-201 (CiA 402) transitions 13-15; 0x6007 abort connection option",
+        "statusword.bits",
+        "Operation enabled, holding in CSP: statusword bit 9 remote set (the controlword is processed), "
+        "bit 11 internal limit and bit 13 following error clear, in the image and over SDO",
+        "IEC 61800-7-201 (CiA 402) statusword 0x6041 bits 9, 11, 13 (csp)",
         [](Context& ctx) {
             CONFORM_NEED(need_402_profile(ctx));
             Drive d(ctx);
             if (auto e = d.start(); !e.empty())
                 return e.find("not in the process data") != std::string::npos ? skip(e) : fail(e);
+            auto mode = ctx.upload_uint(0x6061, 0);
+            const bool csp = mode && (*mode & 0xFF) == 8;
             if (!d.to(kOe)) {
                 std::string s = sw_text(d.status());
                 d.finish();
                 return fail("cannot reach operation enabled", s, kOe.name);
             }
-            // The master leaves OP while the drive is enabled: a communication loss (0x6007).
-            (void)ctx.request_raw(4, ctx.ms(1000));
-            (void)ctx.ack_error();
             d.run(20);
-            bool faulted = false;
-            for (int i = 0; i < 50 && !faulted; ++i) {
-                d.run(2);
-                faulted = (d.status() & kFault.mask) == kFault.value;
+            const uint16_t img = d.status();
+            auto sdo = ctx.upload_uint(0x6041, 0);
+            d.finish();
+            if (!sdo) return fail("0x6041 upload: " + ctx.sdo_error(sdo.error()));
+            for (const auto& [where, sw] :
+                 {std::pair<const char*, uint16_t>{"image", img}, {"SDO", static_cast<uint16_t>(*sdo)}}) {
+                const std::string w = std::string(where) + ": ";
+                if (!(sw & 0x0200))
+                    return fail(w + "bit 9 (remote) clear although the drive follows the controlword",
+                                sw_text(sw), "bit 9 set");
+                if (!csp)
+                    continue;  // bits 11 and 13 are mode-specific: checked where the axis is held in CSP
+                if (sw & 0x0800)
+                    return fail(w + "bit 11 (internal limit active) while holding", sw_text(sw), "clear");
+                if (sw & 0x2000)
+                    return fail(w + "bit 13 (following error) with the target at the actual position",
+                                sw_text(sw), "clear");
             }
-            if (!faulted) {
-                const std::string s = sw_text(d.status());
-                d.finish();
-                return skip("the communication loss did not fault the drive (statusword " + s + ")");
-            }
+            return pass("statusword", sw_text(img) + (csp ? " (csp)" : ""));
+        },
+        "profile 402");
+    add(
+        "fault.emergency",
+        "Fault (communication loss while enabled): its emergency has 8 bytes, a non-zero error code as "
+        "0x603F, "
+        "the error register as 0x1001",
+        "ETG.1000.6 CoE emergency; CiA 301 error register 0x1001; IEC 61800-7-201 error code 0x603F",
+        [](Context& ctx) { return fault_emergency(ctx, false); }, "profile 402 and --allow-fault");
+    add(
+        "fault.emergency_generic_bit", "The fault's emergency error register has bit 0 (generic error) set",
+        "ETG.1000.6 CoE emergency; CiA 301 error register 0x1001 bit 0 (generic error, at any error)",
+        [](Context& ctx) { return fault_emergency(ctx, true); }, "profile 402 and --allow-fault",
+        Severity::Warning);
+    add(
+        "fault_reset",
+        "Fault (from a communication loss while enabled) and fault reset (0x0080 edge): transition 15",
+        "IEC 61800-7-201 (CiA 402) transitions 13-15; 0x6007 abort connection option",
+        [](Context& ctx) {
+            Drive d(ctx);
+            if (auto o = faulted_drive(ctx, d)) return *o;
             master::AlStatus st;
             (void)ctx.pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st,
                                          [&d] { d.hold(); });
@@ -389,7 +490,7 @@ void add_cia402_tests(Catalogue& c) {
             if (!ok) return fail("fault reset edge did not leave fault", s, kSod.name);
             return pass("reset", s);
         },
-        a);
+        "profile 402 and --allow-fault");
 }
 
 }  // namespace conform

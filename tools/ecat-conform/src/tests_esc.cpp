@@ -19,13 +19,29 @@ constexpr uint16_t kEventMask = 0x0200;  // ECAT event mask: read/write from Eth
 struct Sent {
     Error error = Error::Ok;
     uint16_t wkc = 0;
-    uint16_t adp = 0;
+    uint16_t adp = 0;  // as sent
     std::vector<uint8_t> data;
+    Command cmd = Command::NOP;
+    uint16_t ado = 0;
+    std::size_t length = 0;
+    // The datagram as sent and what came back, for failure messages.
+    std::string describe() const {
+        static constexpr const char* kNames[] = {"NOP", "APRD", "APWR", "APRW", "FPRD", "FPWR", "FPRW", "BRD",
+                                                 "BWR", "BRW",  "LRD",  "LWR",  "LRW",  "ARMW", "FRMW"};
+        const auto c = static_cast<std::size_t>(cmd);
+        return std::string(c < std::size(kNames) ? kNames[c] : "cmd?") + " adp " + hex(adp) + " ado " +
+               hex(ado) + " len " + std::to_string(length) + " -> wkc " + std::to_string(wkc) + " data " +
+               bytes_hex(data, 16);
+    }
 };
 
 Sent send(Context& ctx, Command c, uint16_t adp, uint16_t ado, std::vector<uint8_t> data) {
     Sent s;
     s.data = std::move(data);
+    s.cmd = c;
+    s.adp = adp;
+    s.ado = ado;
+    s.length = s.data.size();
     Datagram d{c, adp, ado, s.data};
     s.error = ctx.m.exchange(d);
     s.wkc = d.wkc;
@@ -38,7 +54,8 @@ uint16_t my_adp(const Context& ctx) {
 
 Outcome check_wkc(const Sent& s, uint16_t expected, const std::string& what) {
     if (s.error != Error::Ok) return fail(what + ": no reply", err(s.error), "a reply");
-    if (s.wkc != expected) return fail(what + ": working counter", dec(s.wkc), dec(expected));
+    if (s.wkc != expected)
+        return fail(what + ": working counter", dec(s.wkc) + " (" + s.describe() + ")", dec(expected));
     return pass(what, "wkc " + dec(s.wkc));
 }
 
@@ -159,6 +176,130 @@ std::vector<uint8_t> datagram(Command c, uint8_t index, uint16_t adp, uint16_t a
     put16(&d[6], length_field);
     std::copy(data.begin(), data.end(), d.begin() + 10);
     return d;
+}
+
+// DL status against the topology the tool sees: port 0 carries our frames (link, communication, open); a
+// slave with successors has another port open with communication; the last one has no communication on
+// any other port, and a port without link whose loop control is auto or auto-close is closed. Ports the
+// port descriptor 0x0007 says are not implemented show neither link nor communication.
+Outcome dl_status_ports(Context& ctx) {
+    auto s = ctx.rd<uint16_t>(esc::reg::kDlStatus);
+    if (!s) return fail("0x0110 unreadable", err(s.error()));
+    auto desc = ctx.rd<uint8_t>(0x0007);
+    if (!desc) return fail("0x0007 unreadable", err(desc.error()));
+    auto ctl = ctx.rd<uint8_t>(0x0101);
+    if (!ctl) return fail("0x0101 (DL control loop bits) unreadable", err(ctl.error()));
+    const bool last = ctx.opt.slave + 1u >= ctx.slave_count;
+    std::string problems;
+    auto bad = [&](const std::string& p) { problems += (problems.empty() ? "" : "; ") + p; };
+    if (!(*s & 0x0001)) bad("PDI not operational (bit 0: EEPROM not loaded)");
+    bool successor = false;
+    for (int port = 0; port < 4; ++port) {
+        const bool implemented = ((*desc >> (2 * port)) & 3) != 0;
+        const bool link = *s & (1u << (4 + port));
+        const bool closed = *s & (1u << (8 + 2 * port));
+        const bool comm = *s & (1u << (9 + 2 * port));
+        const unsigned loop_cfg = (*ctl >> (2 * port)) & 3;
+        const std::string p = "port " + dec(port) + ": ";
+        if (port == 0) {
+            if (!link) bad(p + "no link, yet the frames come in there");
+            if (!comm) bad(p + "no communication, yet the frames come in there");
+            if (closed && loop_cfg == 0)
+                bad(p + "loop closed under auto loop control, yet the frames go on from there");
+            continue;
+        }
+        if (!implemented) {
+            if (link || comm) bad(p + "link or communication on a port 0x0007 says is not implemented");
+            continue;
+        }
+        if (comm && !link) bad(p + "communication without link");
+        if (!link && !closed && loop_cfg <= 1) bad(p + "no link but loop open (loop control auto)");
+        if (link && closed && loop_cfg == 0) bad(p + "link but loop closed (loop control auto opens it)");
+        if (comm && !closed) successor = true;
+        if (last && comm) bad(p + "communication on a port with nothing behind it (last slave of the line)");
+    }
+    if (!last && !successor) bad("slaves follow, yet no port other than 0 is open with communication");
+    if (!problems.empty())
+        return fail(
+            problems, hex(*s) + " (0x0007 " + hex(*desc, 2) + ", 0x0101 " + hex(*ctl, 2) + ")",
+            last ? "port 0 link+comm+open, others no communication" : "port 0 and a successor port open");
+    return pass("DL status", hex(*s));
+}
+
+Outcome al_status_bits(Context& ctx) {
+    for (int round = 0; round < 2; ++round) {
+        if (round == 1 && ctx.need_mailbox().empty() && ctx.to_preop() != Error::Ok)
+            return fail("cannot reach PREOP for the second reading");
+        auto s = ctx.rd<uint16_t>(esc::reg::kAlStatus);
+        if (!s) return fail("0x0130 unreadable", err(s.error()));
+        const unsigned st = *s & 0x0F;
+        const std::string where = round ? "in PREOP" : "in INIT";
+        if (st != 1 && st != 2 && st != 3 && st != 4 && st != 8)
+            return fail(where + ": state bits 0-3 not a state", hex(*s), "1, 2, 3, 4 or 8");
+        // Bits 6-7 are reserved; 8-15 are left alone (application specific in some profiles).
+        if (*s & 0x00C0) return fail(where + ": reserved bits 6-7 set", hex(*s), "bits 6-7 clear");
+        if (*s & 0x0020)
+            return fail(where + ": ID bit 5 set although AL control bit 5 was never requested", hex(*s),
+                        "bit 5 clear");
+        if (round == 0 && st != 1) return fail("state after INIT requested", hex(*s), "1 (INIT)");
+    }
+    (void)ctx.to_init();
+    return pass("INIT and PREOP readings defined");
+}
+
+Outcome features(Context& ctx) {
+    auto f = ctx.rd<uint16_t>(0x0008);
+    if (!f) return fail("0x0008 unreadable", err(f.error()));
+    Outcome lrw = logical(ctx, Command::LRW);
+    Outcome fprw = physical_rw(ctx, Command::FPRW);
+    const bool lrw_works = lrw.status == Status::Pass, rw_works = fprw.status == Status::Pass;
+    if ((*f & 0x0200) && lrw_works)
+        return fail("bit 9 says LRW is not supported, yet LRW works", hex(*f), "bit 9 clear");
+    if ((*f & 0x0400) && rw_works)
+        return fail("bit 10 says BRW/APRW/FPRW are not supported, yet FPRW works", hex(*f), "bit 10 clear");
+    if (!(*f & 0x0200) && !lrw_works && lrw.status != Status::Skip)
+        return fail("bit 9 clear (LRW supported), yet LRW fails: " + lrw.message, hex(*f), "LRW working");
+    if (!(*f & 0x0400) && !rw_works)
+        return fail("bit 10 clear (FPRW supported), yet FPRW fails: " + fprw.message, hex(*f),
+                    "FPRW working");
+    return pass("features", hex(*f));
+}
+
+Outcome dl_control_rw(Context& ctx) {
+    uint8_t before[4] = {};
+    if (Error e = ctx.m.read(ctx.addr, 0x0100, before); e != Error::Ok)
+        return fail("0x0100 unreadable", err(e));
+    auto desc = ctx.rd<uint8_t>(0x0007);
+    if (!desc) return fail("0x0007 unreadable", err(desc.error()));
+    // Loop control (bits 8-15) of the implemented ports; of the first implemented port after 0 it is set to
+    // "closed" (0b11) and read back, then everything is restored and read back.
+    uint8_t loop_mask = 0;
+    int probe = -1;
+    for (int p = 0; p < 4; ++p)
+        if ((*desc >> (2 * p)) & 3) {
+            loop_mask = static_cast<uint8_t>(loop_mask | (3u << (2 * p)));
+            if (p > 0 && probe < 0) probe = p;
+        }
+    uint8_t v[4] = {before[0], before[1], before[2], before[3]};
+    if (probe > 0) v[1] = static_cast<uint8_t>(v[1] | (3u << (2 * probe)));
+    Error w = ctx.m.write(ctx.addr, 0x0100, v);
+    uint8_t after[4] = {};
+    Error r = ctx.m.read(ctx.addr, 0x0100, after);
+    (void)ctx.m.write(ctx.addr, 0x0100, before);
+    uint8_t restored[4] = {};
+    Error r2 = ctx.m.read(ctx.addr, 0x0100, restored);
+    if (w != Error::Ok || r != Error::Ok || r2 != Error::Ok) return fail("0x0100 access failed");
+    // Bit 0 (forwarding rule), loop control of the implemented ports, bits 16-18 (RX FIFO size) are
+    // read/write.
+    auto shown = [](const uint8_t* b) { return bytes_hex(std::span<const uint8_t>(b, 3)); };
+    auto mask = [loop_mask](const uint8_t* b) {
+        return std::vector<uint8_t>{static_cast<uint8_t>(b[0] & 0x01), static_cast<uint8_t>(b[1] & loop_mask),
+                                    static_cast<uint8_t>(b[2] & 0x07)};
+    };
+    if (mask(after) != mask(v)) return fail("written value read back", shown(after), shown(v));
+    if (mask(restored) != mask(before))
+        return fail("restored value read back", shown(restored), shown(before));
+    return pass("0x0100", shown(before));
 }
 
 }  // namespace
@@ -452,6 +593,12 @@ void add_esc_tests(Catalogue& c) {
             if (!before) return fail("0x0130 unreadable", err(before.error()));
             (void)send(ctx, Command::FPWR, ctx.station, 0x0130, le16(0x0008));
             auto after = ctx.rd<uint16_t>(esc::reg::kAlStatus);
+            if (after && *after != *before) {
+                // The write was taken: put the slave back (its value, then INIT), so that only this test
+                // fails.
+                (void)send(ctx, Command::FPWR, ctx.station, 0x0130, le16(*before));
+                (void)ctx.to_init();
+            }
             if (!after) return fail("0x0130 unreadable", err(after.error()));
             return expect_eq("AL status after a write to it", hex(*after), hex(*before));
         });
@@ -460,19 +607,20 @@ void add_esc_tests(Catalogue& c) {
         if (!before) return fail("0x0000 unreadable", err(before.error()));
         (void)send(ctx, Command::FPWR, ctx.station, 0x0000, le16(static_cast<uint16_t>(~*before)));
         auto after = ctx.rd<uint16_t>(esc::reg::kType);
+        if (after && *after != *before) (void)send(ctx, Command::FPWR, ctx.station, 0x0000, le16(*before));
         if (!after) return fail("0x0000 unreadable", err(after.error()));
         return expect_eq("0x0000 after a write to it", hex(*after), hex(*before));
     });
-    add(
-        "reg.dl_status", "DL status 0x0110: EEPROM loaded, PDI operational (bit 0)",
-        "ETG.1000.4 DL status register 0x0110",
-        [](Context& ctx) {
-            auto s = ctx.rd<uint16_t>(esc::reg::kDlStatus);
-            if (!s) return fail("0x0110 unreadable", err(s.error()));
-            if (!(*s & 0x0001)) return fail("PDI operational bit clear", hex(*s), "bit 0 set");
-            return pass("DL status", hex(*s));
-        },
-        {}, Severity::Warning);
+    add("reg.dl_status", "DL status 0x0110: PDI operational, per port link, loop and communication as cabled",
+        "ETG.1000.4 DL status register 0x0110; ESC datasheet 0x0007 port descriptor, 0x0100 loop control",
+        dl_status_ports);
+    add("reg.al_status_bits",
+        "AL status 0x0130: a defined state, ID bit clear unless asked, reserved bits 6-7 clear",
+        "ETG.1000.6 AL status register 0x0130", al_status_bits);
+    add("reg.features", "ESC features 0x0008 agree with the commands: LRW (bit 9), BRW/APRW/FPRW (bit 10)",
+        "ESC datasheet register 0x0008 (ESC features supported); ETG.1000.4 datagram commands", features);
+    add("reg.dl_control_rw", "DL control 0x0100: the value written reads back (loop control, forwarding)",
+        "ETG.1000.4 DL control register 0x0100", dl_control_rw);
     add(
         "reg.pdi_control", "PDI control 0x0140 loaded from SII word 0", "ETG.1000.6 SII configuration area",
         [](Context& ctx) {

@@ -10,6 +10,7 @@ namespace {
 
 using master::Error;
 constexpr const char* kMbx = "ETG.1000.4 mailbox (header, counter); ETG.1000.6 mailbox error reply";
+constexpr const char* kSmStatus = "ESC datasheet SyncManager status register 0x0805+8n; ETG.1000.4 mailbox";
 constexpr const char* kRepeat = "ETG.1000.4 mailbox repeat request (SM1 repeat / repeat acknowledge)";
 
 std::vector<uint8_t> message(uint8_t type, uint8_t counter, std::span<const uint8_t> payload,
@@ -129,22 +130,94 @@ void add_mbx_tests(Catalogue& c) {
         },
         "CoE");
     add(
-        "response.counter", "Slave responses carry a counter 1..7 that changes from one to the next", kMbx,
+        "response.counter",
+        "Slave replies carry counters 1..7, each new reply another counter than the one before (never stuck)",
+        kMbx,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_coe());
             CONFORM_PREOP(ctx);
             ctx.mbx_resync();
             auto p = upload_1000();
-            auto a = ask(ctx, message(3, 0, p), ctx.ms(500));
-            auto b = ask(ctx, message(3, 1, p), ctx.ms(500));
+            std::vector<int> seen;
+            std::string list;
+            // Request counters 0 (always executed), 1, 2, 3: none repeats the one a test before may have
+            // left.
+            for (uint8_t k = 0; k < 4; ++k) {
+                auto a = ask(ctx, message(3, k, p), ctx.ms(500));
+                if (a.empty()) {
+                    ctx.mbx_resync();
+                    return fail("no answer to request " + dec(k), list.empty() ? "none" : list);
+                }
+                seen.push_back((a[5] >> 4) & 7);
+                list += (list.empty() ? "" : ", ") + dec(seen.back());
+            }
             ctx.mbx_resync();
-            if (a.empty() || b.empty()) return fail("no answer");
-            const int ca = (a[5] >> 4) & 7, cb = (b[5] >> 4) & 7;
-            if (ca == 0 || cb == 0 || ca == cb)
-                return fail("response counters", dec(ca) + ", " + dec(cb), "1..7, different");
-            return pass("counters", dec(ca) + ", " + dec(cb));
+            for (std::size_t i = 0; i < seen.size(); ++i) {
+                if (seen[i] == 0) return fail("reply counter 0 (only a start value)", list, "1..7");
+                if (i > 0 && seen[i] == seen[i - 1])
+                    return fail("reply counter did not advance for a new reply", list,
+                                "a new counter each reply");
+            }
+            return pass("counters", list);
         },
-        "CoE", Severity::Warning);
+        "CoE");
+    add(
+        "response.header",
+        "Reply header: length within SM1, channel and reserved bits 0, type CoE (3) for a CoE request", kMbx,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            ctx.mbx_resync();
+            auto a = ask(ctx, message(3, 0, upload_1000()), ctx.ms(500));
+            ctx.mbx_resync();
+            if (a.empty()) return fail("no answer to an SDO upload of 0x1000");
+            const std::string got = bytes_hex(std::span<const uint8_t>(a).subspan(0, 6));
+            const uint16_t len = get16(a.data());
+            if (len + 6u > a.size())
+                return fail("length past the SM1 buffer", got, "<= " + dec(a.size() - 6));
+            if (a[4] & 0x3F) return fail("channel (byte 4 bits 0-5) not 0", got, "byte 4 & 0x3F = 0");
+            if (a[5] & 0x80) return fail("reserved bit 7 of byte 5 set", got, "byte 5 bit 7 clear");
+            if ((a[5] & 0x0F) != 3) return fail("reply type", dec(a[5] & 0x0F), "3 (CoE)");
+            return pass("header", got);
+        },
+        "CoE");
+    add(
+        "sm.status",
+        "SM0/SM1 status (0x0805/0x080D): reserved bit 2 clear; SM1 mailbox full only while a reply waits",
+        kSmStatus,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            ctx.mbx_resync();
+            const uint16_t sm0 = master::reg::Sm0 + 5, sm1 = master::reg::Sm0 + 8 + 5;
+            auto idle0 = ctx.rd<uint8_t>(sm0);
+            auto idle1 = ctx.rd<uint8_t>(sm1);
+            if (!idle0 || !idle1) return fail("SM status unreadable");
+            if (Error e = ctx.mbx_write_raw(message(3, 0, upload_1000())); e != Error::Ok)
+                return fail("request not written: " + err(e));
+            master::Result<uint8_t> full = Error::Timeout;
+            const auto deadline = std::chrono::steady_clock::now() + ctx.ms(500);
+            do {
+                full = ctx.rd<uint8_t>(sm1);
+            } while (full && !(*full & 0x08) && std::chrono::steady_clock::now() < deadline);
+            std::vector<uint8_t> reply;
+            const Error re = ctx.mbx_read_raw(reply, ctx.ms(500));
+            auto after = ctx.rd<uint8_t>(sm1);
+            ctx.mbx_resync();
+            const std::string seen = "SM0 idle " + hex(*idle0, 2) + ", SM1 idle " + hex(*idle1, 2) +
+                                     ", reply waiting " + (full ? hex(*full, 2) : err(full.error())) +
+                                     ", read " + (after ? hex(*after, 2) : err(after.error()));
+            for (auto v : {idle0, idle1, full, after})
+                if (v && (*v & 0x04)) return fail("reserved bit 2 set", seen, "bit 2 clear");
+            if (*idle1 & 0x08) return fail("SM1 mailbox full with no reply waiting", seen, "bit 3 clear");
+            if (!full || !(*full & 0x08))
+                return fail("SM1 never showed mailbox full for a reply", seen, "bit 3 set");
+            if (re != Error::Ok) return fail("reply not read: " + err(re), seen);
+            if (!after || (*after & 0x08))
+                return fail("SM1 mailbox full after the reply was read", seen, "bit 3 clear");
+            return pass("status", seen);
+        },
+        "CoE");
     add(
         "repeat.request", "Repeat request (SM1 toggle) puts the last response back, identical", kRepeat,
         [](Context& ctx) {

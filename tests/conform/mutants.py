@@ -1,0 +1,630 @@
+"""Mutation testing of ecat-conform: a proxy on the wire between ecat-conform and a clean ecat-slave that
+rewrites the slave's answers, one defect (mutant) at a time, or one legal variation at a time.
+
+    ecat-conform --iface cm<uid>  ==veth==  cp<uid> [Proxy]  em<uid>  ==veth==  ecat-slave (namespace)
+
+The proxy forwards every frame. On the way out (master -> slave) it only watches: SyncManager and SII
+address writes, mailbox requests written to SM0. On the way back it hands every datagram of the reply to
+the mutation, which may change data and working counter as a defective (or differently built but legal)
+slave would. Each mutation names the clause it breaks; a legal variation names the clause that allows it.
+
+A mutant is killed when ecat-conform reports at least one failure. A variation is clean when it raises no
+failure and no warning that the same run without a mutation does not raise.
+"""
+import select
+import socket
+import struct
+import threading
+
+ETH_P_ECAT = 0x88A4
+PACKET_OUTGOING = 4
+
+APRD, APWR, APRW, FPRD, FPWR, FPRW, BRD, BWR, BRW, LRD, LWR, LRW, ARMW, FRMW = range(1, 15)
+READS = {APRD, FPRD, BRD, APRW, FPRW, BRW, ARMW, FRMW}
+WRITES = {APWR, FPWR, BWR, APRW, FPRW, BRW}
+
+
+class Dg:
+    """One datagram of a frame (bytearray), fields read and written in place."""
+
+    def __init__(self, buf, off):
+        self.buf, self.off = buf, off
+        self.cmd = buf[off]
+        self.adp, self.ado, lf = struct.unpack_from("<HHH", buf, off + 2)
+        self.n = lf & 0x7FF
+        self.more = bool(lf & 0x8000)
+        self.d0 = off + 10
+
+    @property
+    def data(self):
+        return bytearray(self.buf[self.d0:self.d0 + self.n])
+
+    @data.setter
+    def data(self, b):
+        b = bytes(b)[:self.n].ljust(self.n, b"\x00")
+        self.buf[self.d0:self.d0 + self.n] = b
+
+    @property
+    def wkc(self):
+        return struct.unpack_from("<H", self.buf, self.d0 + self.n)[0]
+
+    @wkc.setter
+    def wkc(self, v):
+        struct.pack_into("<H", self.buf, self.d0 + self.n, v & 0xFFFF)
+
+    @property
+    def irq(self):
+        return struct.unpack_from("<H", self.buf, self.off + 8)[0]
+
+    @irq.setter
+    def irq(self, v):
+        struct.pack_into("<H", self.buf, self.off + 8, v & 0xFFFF)
+
+    def covers(self, reg, size=2):
+        return self.cmd in READS and self.ado <= reg and reg + size <= self.ado + self.n and self.wkc > 0
+
+    def get(self, reg, size=2):
+        return int.from_bytes(self.buf[self.d0 + reg - self.ado:self.d0 + reg - self.ado + size], "little")
+
+    def put(self, reg, v, size=2):
+        self.buf[self.d0 + reg - self.ado:self.d0 + reg - self.ado + size] = (v & ((1 << 8 * size) - 1)).to_bytes(
+            size, "little")
+
+
+def datagrams(buf):
+    if len(buf) < 16 or buf[12:14] != b"\x88\xa4":
+        return []
+    hdr = struct.unpack_from("<H", buf, 14)[0]
+    if hdr >> 12 != 1:
+        return []
+    end = min(len(buf), 16 + (hdr & 0x7FF))
+    off, out = 16, []
+    while off + 12 <= end:
+        d = Dg(buf, off)
+        if d.d0 + d.n + 2 > end:
+            break
+        out.append(d)
+        off = d.d0 + d.n + 2
+        if not d.more:
+            break
+    return out
+
+
+class State:
+    """What the proxy has seen the master write (SM and SII registers, mailbox requests), one slave."""
+
+    def __init__(self):
+        self.mem = bytearray(0x10000)
+        self.request = b""  # the last mailbox message written to SM0
+        self.scratch = {}   # for mutations that remember
+
+    def reg(self, a, size=2):
+        return int.from_bytes(self.mem[a:a + size], "little")
+
+    def sm_start(self, n):
+        return self.reg(0x0800 + 8 * n)
+
+    def watch(self, d):
+        if d.cmd not in WRITES or d.n == 0:
+            return
+        if d.ado == self.sm_start(0) and d.n >= 6 and self.reg(0x0802) and self.sm_start(0) >= 0x1000:
+            self.request = bytes(d.data)
+        if d.ado < 0x1000:
+            self.mem[d.ado:d.ado + d.n] = d.data
+
+    # ---- what a reply datagram is ------------------------------------------------------------------
+    def mailbox_reply(self, d):
+        """The SM1 message (bytearray) if the datagram reads the mailbox out, else None."""
+        s1 = self.sm_start(1)
+        if d.cmd in (FPRD, APRD) and s1 >= 0x1000 and d.ado == s1 and d.n >= 6 and d.wkc >= 1:
+            return d.data
+        return None
+
+    def request_coe(self):
+        """(type, coe payload) of the last mailbox request."""
+        r = self.request
+        if len(r) < 6:
+            return None, b""
+        n = struct.unpack_from("<H", r, 0)[0]
+        return r[5] & 0x0F, r[6:6 + n]
+
+
+# ---- helpers for mailbox / CoE mutations -------------------------------------------------------------
+def coe(m):
+    """(service, payload) of a CoE message (bytearray), or (None, None)."""
+    if m is None or (m[5] & 0x0F) != 3 or len(m) < 8:
+        return None, None
+    return m[7] >> 4, m
+
+
+def sdo_cmd(m):
+    return m[8] if len(m) > 8 else None
+
+
+def mbx_rewriter(fn):
+    """A mutation of mailbox replies: fn(state, message bytearray) -> bytearray or None (unchanged)."""
+
+    def mutate(st, d):
+        m = st.mailbox_reply(d)
+        if m is None or struct.unpack_from("<H", m, 0)[0] == 0:
+            return
+        out = fn(st, m)
+        if out is not None:
+            d.data = out
+
+    return mutate
+
+
+def sdo_rewriter(pred, fn):
+    """Mutation of SDO responses (CoE service 3): pred(cmd, index, sub, m) -> bool; fn(m) changes m."""
+
+    def f(st, m):
+        svc, _ = coe(m)
+        # Service 3 (SDO response); 2 as well: an Abort SDO Transfer is a request service from either side.
+        if svc not in (2, 3) or len(m) < 16:
+            return None
+        if not pred(m[8], struct.unpack_from("<H", m, 9)[0], m[11], st):
+            return None
+        fn(m)
+        return m
+
+    return mbx_rewriter(f)
+
+
+def reg_rewriter(reg, fn, size=2):
+    """Mutation of register reads that cover `reg`: fn(value, state) -> new value."""
+
+    def mutate(st, d):
+        if d.covers(reg, size):
+            d.put(reg, fn(d.get(reg, size), st), size)
+
+    return mutate
+
+
+def is_upload_resp(c):
+    return c is not None and (c & 0xE0) == 0x40
+
+
+def is_expedited_upload(c):
+    return is_upload_resp(c) and (c & 0x02)
+
+
+def foe_rewriter(fn):
+    def f(st, m):
+        if (m[5] & 0x0F) != 4 or len(m) < 12:
+            return None
+        fn(m)
+        return m
+
+    return mbx_rewriter(f)
+
+
+def foe_code(old, new):
+    def fn(m):
+        if m[6] == 5 and struct.unpack_from("<I", m, 8)[0] == old:
+            struct.pack_into("<I", m, 8, new)
+
+    return foe_rewriter(fn)
+
+
+def sdo_info_rewriter(opcode, fn):
+    def f(st, m):
+        svc, _ = coe(m)
+        if svc != 8 or len(m) < 12 or (m[8] & 0x7F) != opcode:
+            return None
+        fn(m)
+        return m
+
+    return mbx_rewriter(f)
+
+
+def mbx_len(m):
+    return struct.unpack_from("<H", m, 0)[0]
+
+
+def ca_drop_padding(indices):
+    """Complete-access upload of one of `indices` from subindex 0 answered without the padding byte after
+    subindex 0 (the classic defect)."""
+
+    def f(st, m):
+        svc, _ = coe(m)
+        t, req = st.request_coe()
+        if svc != 3 or t != 3 or len(req) < 6 or not (req[2] & 0x10) or req[5] != 0:
+            return None
+        idx = struct.unpack_from("<H", req, 3)[0]
+        if idx not in indices or (m[8] & 0xE0) != 0x40:
+            return None
+        if m[8] & 0x02:  # expedited (a short assignment fits 4 bytes): one byte fewer
+            n = 4 - ((m[8] >> 2) & 3) if m[8] & 0x01 else 4
+            if n < 2:
+                return None
+            body = m[12:12 + n]
+            m[12:16] = (body[:1] + body[2:]).ljust(4, b"\x00")
+            m[8] = (m[8] & ~0x0C) | ((4 - (n - 1)) << 2) | 0x01
+            return m
+        size = struct.unpack_from("<I", m, 12)[0]
+        n = mbx_len(m)
+        if n != 10 + size or size < 2:
+            return None
+        body = m[16:16 + size]
+        body = body[:1] + body[2:]
+        m[16:16 + size] = body + b"\x00"
+        struct.pack_into("<I", m, 12, size - 1)
+        struct.pack_into("<H", m, 0, n - 1)
+        return m
+
+    return mbx_rewriter(f)
+
+
+def counter_fixed(value):
+    def f(st, m):
+        m[5] = (m[5] & 0x8F) | ((value & 7) << 4)
+        return m
+
+    return mbx_rewriter(f)
+
+
+def counter_offset(k):
+    """A slave whose response counter sequence starts elsewhere (legal: it only has to change and skip 0)."""
+
+    def f(st, m):
+        c = (m[5] >> 4) & 7
+        if c:
+            c = (c - 1 + k) % 7 + 1
+        m[5] = (m[5] & 0x8F) | (c << 4)
+        return m
+
+    return mbx_rewriter(f)
+
+
+def set_bits(mask):
+    return lambda v, st: v | mask
+
+
+def clear_bits(mask):
+    return lambda v, st: v & ~mask
+
+
+def wkc_of(cmd, want, new, reg=None):
+    def mutate(st, d):
+        if d.cmd == cmd and d.wkc == want and (reg is None or d.ado == reg):
+            d.wkc = new
+
+    return mutate
+
+
+def apply_all(*fns):
+    def mutate(st, d):
+        for f in fns:
+            f(st, d)
+
+    return mutate
+
+
+def sii_word(word, fn):
+    """SII reads (0x0508, 4 or 8 bytes) of the data at `word`: fn(value16) -> value16."""
+
+    def mutate(st, d):
+        if not d.covers(0x0508, 4):
+            return
+        a = st.reg(0x0504, 4)
+        n = min(d.ado + d.n, 0x0510) - 0x0508
+        for i in range(0, n // 2):
+            if a + i == word:
+                reg = 0x0508 + 2 * i
+                d.put(reg, fn(d.get(reg)))
+
+    return mutate
+
+
+def lrw_inputs_zero_in(state_code):
+    """Logical reads: the inputs (FMMUs with read direction) replaced by zeros while AL status is state."""
+
+    def mutate(st, d):
+        if d.cmd not in (LRD, LRW) or d.wkc == 0:
+            return
+        if (st.scratch.get("al", 0) & 0x0F) != state_code:
+            return
+        laddr = d.adp | (d.ado << 16)
+        data = d.data
+        for k in range(16):
+            f = 0x0600 + 16 * k
+            if not (st.mem[f + 12] & 1) or not (st.mem[f + 11] & 1):
+                continue
+            la, ln = st.reg(f, 4), st.reg(f + 4)
+            for i in range(ln):
+                if laddr <= la + i < laddr + d.n:
+                    data[la + i - laddr] = 0
+        d.data = data
+
+    return mutate
+
+
+def adp_not_incremented(st, d):
+    if d.cmd in (APRD, APWR, APRW):
+        struct.pack_into("<H", d.buf, d.off + 2, (d.adp - 1) & 0xFFFF)
+
+
+def m_oe(st):
+    return True
+
+
+def track_al(st, d):
+    if d.covers(0x0130):
+        st.scratch["al"] = d.get(0x0130)
+
+
+def od_list_reversed(st, m):
+    """SDO information: the OD list answer (one fragment) with its indices in reverse order (the standard
+    does not order the list)."""
+    svc, _ = coe(m)
+    if svc != 8 or len(m) < 14 or m[8] != 0x02:  # last (complete) fragment only
+        return None
+    n = mbx_len(m)
+    if struct.unpack_from("<H", m, 12)[0] != 1 or n < 12:
+        return None
+    idx = [struct.unpack_from("<H", m, 14 + 2 * i)[0] for i in range((n - 8) // 2)]
+    for i, v in enumerate(reversed(idx)):
+        struct.pack_into("<H", m, 14 + 2 * i, v)
+    return m
+
+
+# ---- the table ---------------------------------------------------------------------------------------------
+# name: (clause broken, mutation). Each must be killed (at least one failure).
+def _m(clause, fn):
+    return (clause, fn)
+
+
+MUTANTS = {
+    # -- ESC registers and datagrams --
+    "dl-status-link-port1": _m("ETG.1000.4 DL status 0x0110: link on port 1 with nothing cabled there",
+                               reg_rewriter(0x0110, set_bits(0x0020))),
+    "dl-status-comm-port0-off": _m("ETG.1000.4 DL status 0x0110: no communication on port 0 that carries the "
+                                   "frames", reg_rewriter(0x0110, clear_bits(0x0200))),
+    "dl-status-loop-port0-closed": _m("ETG.1000.4 DL status 0x0110: loop port 0 closed although frames pass",
+                                      reg_rewriter(0x0110, set_bits(0x0100))),
+    "dl-status-loop-port1-open": _m("ETG.1000.4 DL status 0x0110: port 1 open without a link (auto loop)",
+                                    reg_rewriter(0x0110, clear_bits(0x0400))),
+    "dl-status-pdi-off": _m("ETG.1000.4 DL status 0x0110 bit 0: PDI operational (EEPROM loaded)",
+                            reg_rewriter(0x0110, clear_bits(0x0001))),
+    "al-status-reserved": _m("ETG.1000.6 AL status 0x0130 bits 6-7 reserved (0)",
+                             reg_rewriter(0x0130, set_bits(0x0040))),
+    "al-status-id-unasked": _m("ETG.1000.6 AL status 0x0130 bit 5 (ID loaded) set without the request",
+                               reg_rewriter(0x0130, set_bits(0x0020))),
+    "features-no-dc": _m("ESC features 0x0008 bit 2: DC unit announced by the ESI and working",
+                         reg_rewriter(0x0008, clear_bits(0x0004))),
+    "features-lrw-unsupported": _m("ESC features 0x0008 bit 9 says LRW unsupported while LRW works",
+                                   reg_rewriter(0x0008, set_bits(0x0200))),
+    "dl-control-readback": _m("ETG.1000.4 DL control 0x0100: the value written reads back",
+                              reg_rewriter(0x0100, lambda v, st: v ^ 0x0001)),
+    "sm-status-reserved": _m("ESC datasheet SM status 0x0805+8n bit 2 reserved (0)",
+                             apply_all(reg_rewriter(0x0805, set_bits(0x04), 1), reg_rewriter(0x080D, set_bits(0x04), 1))),
+    "station-alias-wrong": _m("ETG.1000.6 station alias 0x0012 loaded from SII word 4",
+                              reg_rewriter(0x0012, lambda v, st: v ^ 0x0001)),
+    "fprw-wkc-2": _m("ETG.1000.4 FPRW working counter 3", wkc_of(FPRW, 3, 2)),
+    "brd-wkc-extra": _m("ETG.1000.4 BRD working counter = number of slaves", wkc_of(BRD, 1, 2)),
+    "aprd-adp-kept": _m("ETG.1000.4 auto-increment: every slave increments ADP", adp_not_incremented),
+    "fprd-foreign-wkc": _m("ETG.1000.4 FPRD to another station address: working counter 0",
+                           lambda st, d: (d.cmd == FPRD and d.adp not in (0x1001,) and d.wkc == 0 and d.n
+                                          and setattr(d, "wkc", 1))),
+    "liar-wkc": _m("ETG.1000.4 working counter: every datagram but BRD counted once too often",
+                   lambda st, d: d.cmd != BRD and setattr(d, "wkc", d.wkc + 1)),
+    # -- SII --
+    "sii-vendor-wrong": _m("ETG.2010 SII word 0x08 vendor id as the ESI's Vendor/Id",
+                           sii_word(0x08, lambda v: v ^ 0x0001)),
+    "sii-mailbox-size": _m("ETG.2010 SII word 0x19 standard receive mailbox size as the ESI's Sm",
+                           sii_word(0x19, lambda v: v + 2)),
+    # -- ESM --
+    "al-code-other": _m("ETG.1000.6 AL status code 0x0011 on an invalid state change",
+                        reg_rewriter(0x0134, lambda v, st: 0x0012 if v == 0x0011 else v)),
+    "al-error-bit-lost": _m("ETG.1000.6 AL status bit 4 (error indication) on a refused change",
+                            reg_rewriter(0x0130, clear_bits(0x0010))),
+    # -- mailbox --
+    "mbx-counter-stuck": _m("ETG.1000.4 mailbox header counter: a new reply carries the next counter",
+                            counter_fixed(1)),
+    "mbx-counter-zero": _m("ETG.1000.4 mailbox header counter: 0 only at start, then 1..7", counter_fixed(0)),
+    "mbx-reserved-bit": _m("ETG.1000.4 mailbox header byte 5 bit 7 reserved (0)",
+                           mbx_rewriter(lambda st, m: (m.__setitem__(5, m[5] | 0x80), m)[1])),
+    "mbx-channel": _m("ETG.1000.4 mailbox header channel (bits 0-5 of byte 4) reserved (0)",
+                      mbx_rewriter(lambda st, m: (m.__setitem__(4, m[4] | 0x05), m)[1])),
+    "sdo-expedited-length": _m("ETG.1000.6 SDO expedited response: mailbox length 10",
+                               sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c),
+                                            lambda m: struct.pack_into("<H", m, 0, mbx_len(m) + 4))),
+    "mbx-error-detail": _m("ETG.1000.4 mailbox error reply detail 0x0002 unsupported protocol",
+                           mbx_rewriter(lambda st, m: None if (m[5] & 0x0F) != 0 or len(m) < 10 else
+                                        (struct.pack_into("<H", m, 8, 0x0001), m)[1])),
+    # -- CoE SDO --
+    "sdo-upload-subindex": _m("ETG.1000.6 SDO upload response echoes the subindex",
+                              sdo_rewriter(lambda c, i, s, st: is_upload_resp(c) and i < 0x2000,
+                                           lambda m: m.__setitem__(11, m[11] ^ 0x01))),
+    "sdo-upload-index": _m("ETG.1000.6 SDO upload response echoes the index",
+                           sdo_rewriter(lambda c, i, s, st: is_upload_resp(c) and i == 0x1018,
+                                        lambda m: struct.pack_into("<H", m, 9, 0x1019))),
+    "sdo-download-subindex": _m("ETG.1000.6 SDO download response echoes the subindex",
+                                sdo_rewriter(lambda c, i, s, st: c == 0x60,
+                                             lambda m: m.__setitem__(11, m[11] ^ 0x01))),
+    "sdo-download-cmd": _m("ETG.1000.6 SDO download response command specifier 0x60 (reserved bits 0)",
+                           sdo_rewriter(lambda c, i, s, st: c == 0x60, lambda m: m.__setitem__(8, 0x61))),
+    "sdo-upload-ca-bit": _m("ETG.1000.6 SDO upload response: complete-access bit only for a complete access",
+                            sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and not (st.request_coe()[1][2:3] and st.request_coe()[1][2] & 0x10),
+                                         lambda m: m.__setitem__(8, m[8] | 0x10))),
+    "sdo-normal-size": _m("ETG.1000.6 SDO normal upload response: size = the data that follows",
+                          sdo_rewriter(lambda c, i, s, st: c == 0x41,
+                                       lambda m: struct.pack_into("<I", m, 12, struct.unpack_from("<I", m, 12)[0] + 1))),
+    "sdo-abort-index": _m("ETG.1000.6 Abort SDO transfer names the index of the request",
+                          sdo_rewriter(lambda c, i, s, st: c == 0x80,
+                                       lambda m: struct.pack_into("<H", m, 9, struct.unpack_from("<H", m, 9)[0] ^ 1))),
+    "coe-service-request": _m("ETG.1000.6 CoE header: an SDO response has service 3",
+                              sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c),
+                                           lambda m: m.__setitem__(7, (m[7] & 0x0F) | 0x20))),
+    "coe-reserved": _m("ETG.1000.6 CoE header bits 9-11 reserved (0)",
+                       sdo_rewriter(lambda c, i, s, st: is_upload_resp(c), lambda m: m.__setitem__(7, m[7] | 0x04))),
+    "identity-vendor": _m("ETG.1000.6 0x1018:01 vendor id as the SII/ESI",
+                          sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x1018 and s == 1,
+                                       lambda m: m.__setitem__(12, m[12] ^ 0x01))),
+    "device-type": _m("ETG.1000.6 0x1000 device type as the ESI",
+                      sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x1000,
+                                   lambda m: m.__setitem__(14, m[14] ^ 0x02))),
+    "ca-1c12-no-padding": _m("ETG.1000.6 complete access: subindex 0 of 0x1C12/0x1C13 as 16 bits",
+                             ca_drop_padding({0x1C12, 0x1C13})),
+    "sm-comm-type": _m("ETG.1000.6 0x1C00 SM communication types as the SII/ESI SMs",
+                       sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x1C00 and s == 3,
+                                    lambda m: m.__setitem__(12, 4))),
+    "sync-modes-no-dc": _m("ETG.1020 0x1C32:04 bit 2 (DC SYNC0 supported) with a SYNC0 op mode",
+                           sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x1C32 and s == 4,
+                                        lambda m: m.__setitem__(12, m[12] & ~0x04))),
+    "supported-modes-lie": _m("CiA 402 0x6502 supported drive modes: every mode announced is accepted",
+                              sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x6502,
+                                           lambda m: m.__setitem__(12, m[12] | 0x02))),
+    "statusword-not-remote": _m("CiA 402 statusword bit 9 remote: set while the controlword is processed",
+                                sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x6041,
+                                             lambda m: m.__setitem__(13, m[13] & ~0x02))),
+    "statusword-following-error": _m("CiA 402 statusword bit 13 (csp): following error only with a deviation",
+                                     sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x6041
+                                                  and m_oe(st), lambda m: m.__setitem__(13, m[13] | 0x20))),
+    "emcy-register-wrong": _m("CiA 301 / ETG.1000.6 emergency error register equals 0x1001",
+                              mbx_rewriter(lambda st, m: (m.__setitem__(10, m[10] ^ 0x80), m)[1]
+                                           if coe(m)[0] == 1 and len(m) >= 16 else None)),
+    "emcy-code-wrong": _m("IEC 61800-7-201 emergency error code equals 0x603F",
+                          mbx_rewriter(lambda st, m: (m.__setitem__(8, m[8] ^ 0x01), m)[1]
+                                       if coe(m)[0] == 1 and len(m) >= 16 else None)),
+    # -- SDO information --
+    "info-opcode": _m("ETG.1000.6 SDO information: object description response opcode 0x04",
+                      sdo_info_rewriter(0x04, lambda m: m.__setitem__(8, (m[8] & 0x80) | 0x06))),
+    "info-entry-bitlen": _m("ETG.1000.6 SDO information entry description: bit length of the entry",
+                            sdo_info_rewriter(0x06, lambda m: struct.pack_into("<H", m, 18, struct.unpack_from("<H", m, 18)[0] + 8))),
+    # -- FoE --
+    "foe-notfound-general": _m("ETG.1000.6 FoE error 0x8001 (not found) for an unknown name",
+                               foe_code(0x8001, 0x8000)),
+    "foe-bootonly-general": _m("ETG.1000.6 FoE error 0x8008 (bootstrap only) outside Bootstrap",
+                               foe_code(0x8008, 0x8000)),
+    "foe-norights-general": _m("ETG.1000.6 FoE error 0x800A (no rights) for a wrong password",
+                               foe_code(0x800A, 0x8002)),
+    # -- process data --
+    "inputs-zero-safeop": _m("ETG.1000.6 SAFEOP: inputs valid", apply_all(track_al, lrw_inputs_zero_in(4))),
+    "lrw-wkc-op": _m("ETG.1000.4 LRW working counter 3 (outputs written, inputs read)",
+                     apply_all(track_al, lambda st, d: d.cmd == LRW and d.wkc == 3 and (st.scratch.get("al", 0) & 0x0F) == 8
+                               and setattr(d, "wkc", 2))),
+    # -- DC --
+    "dc-receive-static": _m("ETG.1000.4 DC receive time port 0 latched by a write to 0x0900",
+                            lambda st, d: d.covers(0x0900, 4) and d.put(0x0900, st.scratch.setdefault("rt", d.get(0x0900, 4)), 4)),
+    "sync0-next-frozen": _m("ESC datasheet 0x0990 next SYNC0 time advances with every pulse",
+                            lambda st, d: d.covers(0x0990, 4) and d.put(0x0990, st.scratch.setdefault(
+                                "s0", d.get(0x0990, 4)), 4)),
+}
+
+# Where each mutant must be caught: a failure in another group (a flake of a loaded host, fallout) does not
+# count as a kill. "*": the defect breaks discovery itself, every test fails with "cannot start".
+_GROUP_OF = {
+    "esc": ("dl-status-", "al-status-", "features-", "dl-control-", "station-alias-", "fprw-", "aprd-", "fprd-"),
+    "mbx": ("sm-status-", "mbx-"),
+    "sii": ("sii-",),
+    "esm": ("al-code-", "al-error-"),
+    "sdo": ("sdo-", "coe-", "identity-", "device-type", "ca-", "sm-comm-"),
+    "dc": ("sync-modes-", "dc-", "sync0-"),
+    "cia402": ("supported-modes-", "statusword-", "emcy-"),
+    "sdoinfo": ("info-",),
+    "foe": ("foe-",),
+    "pd": ("inputs-", "lrw-"),
+    "*": ("brd-", "liar-"),
+}
+
+
+def expected_group(name):
+    for group, prefixes in _GROUP_OF.items():
+        if name.startswith(prefixes):
+            return group
+    raise KeyError(f"mutant {name} has no group in _GROUP_OF")
+
+
+# name: (clause that allows it, mutation). Each must raise no failure and no new warning.
+VARIATIONS = {
+    "esc-type-other": ("ESC datasheet 0x0000-0x0001: type and revision identify the silicon, any value",
+                       apply_all(reg_rewriter(0x0000, lambda v, st: 0x0411 if v != 0x0411 else 0x0211),
+                                 reg_rewriter(0x0002, lambda v, st: 0x0003))),
+    "irq-field": ("ETG.1000.4 datagram IRQ field: the OR of the slaves' event requests, any value",
+                  lambda st, d: setattr(d, "irq", d.irq | 0x0001 | (0x0004 if d.cmd in READS else 0))),
+    "mbx-tail-content": ("ETG.1000.4 mailbox: bytes after the message's length are undefined",
+                         mbx_rewriter(lambda st, m: (m.__setitem__(slice(6 + mbx_len(m), len(m)),
+                                                                   b"\x55" * (len(m) - 6 - mbx_len(m))), m)[1]
+                                      if 6 + mbx_len(m) < len(m) else None)),
+    "ca-padding-content": ("ETG.1000.6 complete access: the padding byte after subindex 0 has no defined value",
+                           mbx_rewriter(lambda st, m: (
+                               m.__setitem__(17, 0xFF), m)[1] if coe(m)[0] == 3 and len(st.request_coe()[1]) > 5
+                               and st.request_coe()[1][2] & 0x10 and st.request_coe()[1][5] == 0
+                               and m[8] in (0x41, 0x51) and mbx_len(m) >= 12 else None)),
+    "abort-general": ("ETG.1000.6 SDO abort codes: 0x06070010 and 0x06090030 are the general codes of the "
+                      "length and value-range families",
+                      sdo_rewriter(lambda c, i, s, st: c == 0x80,
+                                   lambda m: struct.pack_into("<I", m, 12, {0x06070012: 0x06070010, 0x06070013: 0x06070010,
+                                                                            0x06090031: 0x06090030, 0x06090032: 0x06090030}
+                                                              .get(struct.unpack_from("<I", m, 12)[0],
+                                                                   struct.unpack_from("<I", m, 12)[0])))),
+    "od-list-unsorted": ("ETG.1000.6 SDO information OD list: no order prescribed", mbx_rewriter(od_list_reversed)),
+    "counter-start-other": ("ETG.1000.4 mailbox counter: a slave's sequence may start anywhere in 1..7",
+                            counter_offset(4)),
+    "features-link-detection": ("ESC features 0x0008 bits 4-5 (E-bus jitter, enhanced link detection): "
+                                "silicon options", reg_rewriter(0x0008, set_bits(0x0030))),
+    "foe-error-text": ("ETG.1000.6 FoE error request: the error text is optional",
+                       foe_rewriter(lambda m: m[6] == 5 and struct.pack_into("<H", m, 0, 6))),
+}
+
+
+class Proxy:
+    """Bridges `outer` (ecat-conform's side) and `inner` (the slave's side); applies `mutation` to replies."""
+
+    def __init__(self, outer, inner, mutation=None):
+        self.outer_if, self.inner_if = outer, inner
+        self.mutation = mutation
+        self.state = State()
+        self.stop = threading.Event()
+        self.errors = []
+        self.outer = self._sock(outer)
+        self.inner = self._sock(inner)
+        self.thread = threading.Thread(target=self._run, daemon=True)
+
+    @staticmethod
+    def _sock(iface):
+        s = socket.socket(socket.AF_PACKET, socket.SOCK_RAW, socket.htons(ETH_P_ECAT))
+        s.bind((iface, 0))
+        s.setblocking(False)
+        return s
+
+    def __enter__(self):
+        self.thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self.stop.set()
+        self.thread.join(5)
+        self.outer.close()
+        self.inner.close()
+        return False
+
+    def _run(self):
+        while not self.stop.is_set():
+            r, _, _ = select.select([self.outer, self.inner], [], [], 0.1)
+            for s in r:
+                try:
+                    data, addr = s.recvfrom(2048)
+                except BlockingIOError:
+                    continue
+                if addr[2] == PACKET_OUTGOING:
+                    continue
+                buf = bytearray(data)
+                try:
+                    if s is self.outer:
+                        for d in datagrams(buf):
+                            self.state.watch(d)
+                        self.inner.send(buf)
+                    else:
+                        if self.mutation:
+                            for d in datagrams(buf):
+                                self.mutation(self.state, d)
+                        self.outer.send(buf)
+                except Exception as e:  # a mutation bug must show, not hang the run
+                    self.errors.append(repr(e))
+                    try:
+                        (self.inner if s is self.outer else self.outer).send(bytes(data))
+                    except OSError:
+                        pass
