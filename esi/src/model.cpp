@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "esi/wire/sii.hpp"
+#include "esc/wire/sii.hpp"
 
 namespace esi {
 namespace {
@@ -107,7 +107,7 @@ std::optional<uint64_t> number_bits(const od::Number& n, od::DataType type, uint
 }
 
 uint8_t sii_crc8(const uint8_t* data, std::size_t size) {
-    return sii::crc8(data, size);
+    return esc::sii::crc8(data, size);
 }
 
 DeviceModel derive_model(const od::DeviceDescription& d, const od::Dictionary& dict) {

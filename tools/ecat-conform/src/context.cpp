@@ -4,7 +4,7 @@
 #include <thread>
 
 #include "conform.hpp"
-#include "esi/wire/sii.hpp"
+#include "esc/wire/sii.hpp"
 #include "util/le.hpp"
 
 namespace conform {
@@ -54,7 +54,7 @@ std::string state_text(uint8_t s) {
 
 // ---- SII -------------------------------------------------------------------------------------------
 uint8_t sii_crc8(std::span<const uint8_t> bytes) {
-    return esi::sii::crc8(bytes.data(), bytes.size());
+    return esc::sii::crc8(bytes.data(), bytes.size());
 }
 
 uint16_t SiiImage::word(std::size_t w) const {

@@ -11,7 +11,7 @@
 #include "coe/events.hpp"
 #include "coe/pdo_validation.hpp"
 #include "drive/errors.hpp"
-#include "ecat/al_status.hpp"
+#include "esc/wire/al.hpp"
 #include "esc/wire/registers.hpp"
 #include "esi/esi.hpp"
 #include "esi/sii.hpp"
@@ -189,7 +189,7 @@ std::string requested_text(uint8_t requested) {
 std::string al_code_text(uint16_t code) {
     char b[16];
     std::snprintf(b, sizeof b, "0x%04X", static_cast<unsigned>(code));
-    return std::string(b) + " (" + std::string(ecat::al::name(code)) + ")";
+    return std::string(b) + " (" + std::string(esc::al::status_text(code)) + ")";
 }
 
 std::string hex16(uint16_t v) {

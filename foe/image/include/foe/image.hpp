@@ -19,7 +19,7 @@
 #include <string_view>
 #include <vector>
 
-#include "foe/errors.hpp"
+#include "foe/wire/foe.hpp"
 
 namespace foe {
 
