@@ -53,10 +53,6 @@ std::string state_text(uint8_t s) {
 }
 
 // ---- SII -------------------------------------------------------------------------------------------
-uint8_t sii_crc8(std::span<const uint8_t> bytes) {
-    return esc::sii::crc8(bytes.data(), bytes.size());
-}
-
 uint16_t SiiImage::word(std::size_t w) const {
     if (2 * w + 1 >= bytes.size()) return 0;
     return util::get16(bytes.data() + 2 * w);

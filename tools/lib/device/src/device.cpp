@@ -11,6 +11,7 @@
 #include "coe/events.hpp"
 #include "coe/pdo_validation.hpp"
 #include "drive/errors.hpp"
+#include "drive/state_machine.hpp"
 #include "esc/wire/al.hpp"
 #include "esc/wire/registers.hpp"
 #include "esi/esi.hpp"
@@ -19,7 +20,9 @@
 #include "foe/image.hpp"
 #include "od/device_config.hpp"
 #include "od/diag_texts.hpp"
+#include "od/drive_objects.hpp"
 #include "od/drive_profile.hpp"
+#include "util/le.hpp"
 
 namespace device {
 
@@ -273,9 +276,12 @@ void Device::build() {
     od::attach_store(p->dict, *p->params, [raw] {
         // MAXPOS firmware specification §7.2.21: restoring defaults only with the axis in "Power Disable"
         // (not switched on).
-        const od::Entry* e = raw->dict.find(0x6041, 0);
+        constexpr auto sw = od::obj::Statusword;
+        const od::Entry* e = raw->dict.find(sw.index, sw.sub);
         if (e == nullptr) return od::Status::Ok;
-        return (raw->dict.get<uint16_t>(0x6041, 0) & 0x0002) != 0 ? od::Status::WrongState : od::Status::Ok;
+        return (raw->dict.get<uint16_t>(sw.index, sw.sub) & drive::sw::SwitchedOn) != 0
+                   ? od::Status::WrongState
+                   : od::Status::Ok;
     });
 
     std::vector<uint8_t> image;
@@ -406,10 +412,7 @@ void Device::run_drive(uint64_t now_ns) {
 uint64_t Device::system_time_ns() {
     uint8_t b[8] = {};
     esc_.read(esc::reg::kDcSystemTime, b);
-    uint64_t v = 0;
-    for (int i = 7; i >= 0; --i)
-        v = (v << 8) | b[i];
-    return v;
+    return util::get64(b);
 }
 
 // ---- ecat::Application ------------------------------------------------------------------------------
@@ -437,8 +440,10 @@ void Device::react_to_outputs_lost() {
     // 0x8180 with the 0x6007 reaction in any drive state. A master that asks to leave Op is not an error; it
     // gets the reaction only while its outputs were commanding motion (operation enabled, statusword bit 2).
     const bool fall_back = parts_->stack->error();
-    const od::Entry* sw = parts_->dict.find(0x6041, 0);
-    const bool enabled = sw != nullptr && (parts_->dict.get<uint16_t>(0x6041, 0) & 0x0004) != 0;
+    constexpr auto statusword = od::obj::Statusword;
+    const od::Entry* sw = parts_->dict.find(statusword.index, statusword.sub);
+    const bool enabled = sw != nullptr && (parts_->dict.get<uint16_t>(statusword.index, statusword.sub) &
+                                           drive::sw::OperationEnabled) != 0;
     if (fall_back || enabled) parts_->drive->connection_lost();
 }
 
