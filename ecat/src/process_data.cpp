@@ -2,7 +2,7 @@
 
 #include <cstring>
 
-#include "ecat/al_status.hpp"
+#include "esc/wire/al.hpp"
 
 namespace ecat {
 
@@ -39,7 +39,7 @@ bool is_padding(uint16_t index, uint8_t sub) {
 
 uint16_t ProcessData::build_side(uint16_t assign_index, bool rx, std::vector<PdoCopy>& plan,
                                  std::size_t& bits) {
-    const uint16_t code = rx ? al::InvalidOutputMapping : al::InvalidInputMapping;
+    const uint16_t code = rx ? esc::al::InvalidOutputMapping : esc::al::InvalidInputMapping;
     const uint16_t first = rx ? 0x1600 : 0x1A00;
     const uint16_t last = rx ? 0x17FF : 0x1BFF;
     plan.clear();

@@ -10,7 +10,7 @@ using od::AlState;
 
 // One of the AL states of the AL vocabulary (bits 3:0 of AL control).
 bool known_state(unsigned s) {
-    return al_state_name(static_cast<uint8_t>(s)) != "UNKNOWN";
+    return esc::al_state_name(static_cast<uint8_t>(s)) != "UNKNOWN";
 }
 
 // The ESM transition table (ETG.1000.6, EtherCAT State Machine): true if from -> to is a defined transition.

@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-#include "esi/wire/sii.hpp"
+#include "esc/wire/sii.hpp"
 #include "util/le.hpp"
 
 namespace esc {
@@ -20,7 +20,7 @@ std::vector<uint8_t> default_eeprom() {
     put(0x00, 0x0C80);  // 0x0140 PDI control 0x80, 0x0141 ESC config: SYNC out unit + latch in unit
     put(0x01, 0xCC00);  // 0x0150 0x00, 0x0151: SYNC0/SYNC1 outputs, mapped to AL event bits 2/3
     put(0x02, 0x03E8);  // SYNC pulse length 1000 x 10 ns
-    put(0x07, esi::sii::crc8(img.data(), 14));
+    put(0x07, esc::sii::crc8(img.data(), 14));
     put(0x3E, 0x000F);  // 16 Kbit - 1
     put(0x3F, 0x0001);  // version
     put(0x40, 0xFFFF);  // end of categories
@@ -64,7 +64,7 @@ bool SiiInterface::crc_ok() const {
     if (eeprom.size() < 16) return false;
     const uint16_t w7 = word(7);
     if (w7 == 0x88A4) return true;  // checksum check disabled (B1, debug value)
-    return (w7 & 0xFF) == esi::sii::crc8(eeprom.data(), 14);
+    return (w7 & 0xFF) == esc::sii::crc8(eeprom.data(), 14);
 }
 
 void SiiInterface::load_words(bool power_on) {

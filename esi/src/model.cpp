@@ -4,8 +4,6 @@
 #include <cmath>
 #include <cstdio>
 
-#include "esi/wire/sii.hpp"
-
 namespace esi {
 namespace {
 
@@ -104,10 +102,6 @@ std::optional<uint64_t> number_bits(const od::Number& n, od::DataType type, uint
     if (const auto* pi = std::get_if<int64_t>(&n)) v = static_cast<uint64_t>(*pi);
     if (const auto* pu = std::get_if<uint64_t>(&n)) v = *pu;
     return v & mask;
-}
-
-uint8_t sii_crc8(const uint8_t* data, std::size_t size) {
-    return sii::crc8(data, size);
 }
 
 DeviceModel derive_model(const od::DeviceDescription& d, const od::Dictionary& dict) {

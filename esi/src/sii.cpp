@@ -6,6 +6,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "esc/wire/sii.hpp"
 #include "esi/model.hpp"
 
 namespace esi {
@@ -147,7 +148,7 @@ std::vector<uint8_t> build_sii(const od::DeviceDescription& d, const od::Diction
     // ---- Header ----
     Writer w;
     w.b.insert(w.b.end(), m.config_data.begin(), m.config_data.end());  // words 0-6
-    w.u16(sii_crc8(w.b.data(), 14));                                    // word 7
+    w.u16(esc::sii::crc8(w.b.data(), 14));                              // word 7
     w.u32(d.identity.vendor_id);                                        // 0x08
     w.u32(d.identity.product_code);                                     // 0x0A
     w.u32(d.identity.revision);                                         // 0x0C

@@ -22,10 +22,6 @@ std::string hex32(uint32_t v) {
 
 }  // namespace
 
-uint32_t crc32(std::span<const uint8_t> data, uint32_t crc) {
-    return util::crc32(data, crc);
-}
-
 std::string_view to_string(ImageError e) {
     switch (e) {
         case ImageError::Ok:
@@ -115,7 +111,7 @@ ImageError check_header(const ImageHeader& h, const ImageIdentity& identity) {
 }
 
 uint32_t header_crc(std::span<const uint8_t, kImageHeaderSize> header) {
-    return crc32(header.first<kImageHeaderSize - 4>());
+    return util::crc32(header.first<kImageHeaderSize - 4>());
 }
 
 std::vector<uint8_t> build_image(std::span<const uint8_t> payload, const ImageIdentity& identity,
@@ -128,7 +124,7 @@ std::vector<uint8_t> build_image(std::span<const uint8_t> payload, const ImageId
     h.payload_length = static_cast<uint32_t>(payload.size());
     std::span<uint8_t, kImageHeaderSize> head(out.data(), kImageHeaderSize);
     encode_header(h, head);
-    h.crc = crc32(payload, header_crc(head));
+    h.crc = util::crc32(payload, header_crc(head));
     encode_header(h, head);
     if (!payload.empty()) std::copy(payload.begin(), payload.end(), out.begin() + kImageHeaderSize);
     return out;
@@ -150,7 +146,7 @@ VerifyResult verify_image(std::span<const uint8_t> bytes, const ImageIdentity& i
         r.error = ImageError::TrailingData;
         return r;
     }
-    if (crc32(bytes.subspan(kImageHeaderSize), header_crc(head)) != r.header.crc) {
+    if (util::crc32(bytes.subspan(kImageHeaderSize), header_crc(head)) != r.header.crc) {
         r.error = ImageError::BadChecksum;
         return r;
     }

@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "util/atomic_file.hpp"
+#include "util/crc.hpp"
 
 namespace foe {
 namespace {
@@ -122,7 +123,7 @@ std::optional<StoredImage> FirmwareStore::verify_slot(unsigned slot) {
                 const std::size_t n =
                     static_cast<std::size_t>(std::min<uint64_t>(buffer_.size(), size - off));
                 ok = pread_all(fd, buffer_.data(), n, off);
-                if (ok) crc = crc32({buffer_.data(), n}, crc);
+                if (ok) crc = util::crc32({buffer_.data(), n}, crc);
                 off += n;
             }
             if (ok && crc == h.crc)
@@ -245,7 +246,7 @@ bool FirmwareStore::append(std::span<const uint8_t> data, StoreError& error) {
     }
     if (header_ok_ && received_ + data.size() > kImageHeaderSize + uint64_t{header_.payload_length})
         return fail(error, ErrorCode::FileHeaderError, std::string(to_string(ImageError::TrailingData)));
-    if (!payload.empty()) crc_ = crc32(payload, crc_);
+    if (!payload.empty()) crc_ = util::crc32(payload, crc_);
     step(StoreStep::Append);
     if (!write_all(fd_, data.data(), data.size())) {
         const bool full = errno == ENOSPC || errno == EFBIG || errno == EDQUOT;
@@ -332,7 +333,7 @@ FirmwareStore::Progress FirmwareStore::run_step(StoreError& error) {
                     static_cast<std::size_t>(std::min<uint64_t>(buffer_.size(), size - read_back_offset_));
                 if (!pread_all(fd_, buffer_.data(), n, read_back_offset_))
                     return failed(ErrorCode::FlashError, errno_text("read back slot file"));
-                read_back_crc_ = crc32({buffer_.data(), n}, read_back_crc_);
+                read_back_crc_ = util::crc32({buffer_.data(), n}, read_back_crc_);
                 read_back_offset_ += n;
             }
             if (read_back_offset_ >= size) {

@@ -65,7 +65,7 @@ std::string parse(std::span<const uint8_t> f, const Dictionary& dict, std::vecto
     if (f.size() < ParameterStore::kHeaderBytes)
         return "file too short for the header (" + std::to_string(f.size()) + " bytes)";
     if (std::memcmp(f.data(), kMagic, sizeof kMagic) != 0) return "bad magic: not a parameter file";
-    if (crc32(f.first(36)) != get32(f, 36)) return "header CRC mismatch";
+    if (util::crc32(f.first(36)) != get32(f, 36)) return "header CRC mismatch";
     if (get16(f, 8) != ParameterStore::kFormatVersion)
         return "unsupported format version " + std::to_string(get16(f, 8));
     if (get16(f, 10) != ParameterStore::kHeaderBytes) return "unexpected header size";
@@ -75,7 +75,7 @@ std::string parse(std::span<const uint8_t> f, const Dictionary& dict, std::vecto
         return "file is " + std::to_string(f.size()) + " bytes, header announces " +
                std::to_string(ParameterStore::kHeaderBytes + payload) + " (truncated or extended)";
     const auto body = f.subspan(ParameterStore::kHeaderBytes);
-    if (crc32(body) != get32(f, 32)) return "payload CRC mismatch";
+    if (util::crc32(body) != get32(f, 32)) return "payload CRC mismatch";
     const Ident id = identity_of(dict);
     const Ident fid{get32(f, 12), get32(f, 16), get32(f, 20)};
     if (fid.vendor != id.vendor || fid.product != id.product || fid.revision != id.revision)
@@ -161,10 +161,6 @@ bool sync_dir(const std::filesystem::path& dir) {
 
 }  // namespace
 
-uint32_t crc32(std::span<const uint8_t> data, uint32_t crc) {
-    return util::crc32(data, crc);
-}
-
 bool in_scope(StoreScope scope, uint16_t index) {
     switch (scope) {
         case StoreScope::All:
@@ -227,8 +223,8 @@ std::vector<uint8_t> serialize(const Dictionary& dict, const std::vector<Record>
     }
     const auto payload = std::span<const uint8_t>(b).subspan(ParameterStore::kHeaderBytes);
     set32(b, 28, static_cast<uint32_t>(payload.size()));
-    set32(b, 32, crc32(payload));
-    set32(b, 36, crc32(std::span<const uint8_t>(b).first(36)));
+    set32(b, 32, util::crc32(payload));
+    set32(b, 36, util::crc32(std::span<const uint8_t>(b).first(36)));
     return b;
 }
 

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "conform.hpp"
+#include "esc/wire/sii.hpp"
 #include "report.hpp"
 
 namespace conform {
@@ -163,9 +164,9 @@ TEST(Sii, WalksCategoriesAndChecksums) {
     EXPECT_NE(s.error, "");
     // CRC-8 (0x07, seed 0xFF, no final xor): the message followed by its CRC gives 0.
     std::vector<uint8_t> m = {0x05, 0x0C, 0x00, 0xCC, 0xE8, 0x03, 0, 0, 0, 0, 0, 0, 0, 0};
-    const uint8_t crc = sii_crc8(m);
+    const uint8_t crc = esc::sii::crc8(m.data(), m.size());
     m.push_back(crc);
-    EXPECT_EQ(sii_crc8(m), 0);
+    EXPECT_EQ(esc::sii::crc8(m.data(), m.size()), 0);
 }
 
 // A small JSON well-formedness checker (the report's JSON must load anywhere).

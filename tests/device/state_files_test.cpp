@@ -21,6 +21,7 @@
 #include "od/drive_profile.hpp"
 #include "od/store.hpp"
 #include "support/temp_dir.hpp"
+#include "util/crc.hpp"
 
 namespace fs = std::filesystem;
 
@@ -52,8 +53,8 @@ std::vector<uint8_t> parameters_with_count(const od::Identity& id, uint32_t coun
     put32(b, 20, id.revision);
     put32(b, 24, count);
     put32(b, 28, 0);  // payload bytes
-    put32(b, 32, od::crc32({}));
-    put32(b, 36, od::crc32(std::span<const uint8_t>(b).first(36)));
+    put32(b, 32, util::crc32({}));
+    put32(b, 36, util::crc32(std::span<const uint8_t>(b).first(36)));
     return b;
 }
 
@@ -61,7 +62,7 @@ std::vector<uint8_t> parameters_with_count(const od::Identity& id, uint32_t coun
 std::vector<uint8_t> sii_writes_with_count(uint32_t count) {
     std::vector<uint8_t> b = {'S', 'E', 'C', 'A', 'T', 'S', 'I', 'I', 0, 0, 0, 0, 0, 0, 0, 0};
     put32(b, 8, count);
-    put32(b, 12, od::crc32(std::span<const uint8_t>(b).first(12)));
+    put32(b, 12, util::crc32(std::span<const uint8_t>(b).first(12)));
     return b;
 }
 

@@ -10,7 +10,7 @@ using od::access::RW_PreOp;
 
 // ---- Master -----------------------------------------------------------------------------------------
 
-uint16_t Master::exchange(uint8_t cmd, uint32_t address, std::span<uint8_t> data) {
+uint16_t Master::exchange(esc::Command cmd, uint32_t address, std::span<uint8_t> data) {
     const std::size_t dlen = 10 + data.size() + 2;
     std::vector<uint8_t> f(std::max<std::size_t>(14 + 2 + dlen, 60), 0);
     std::fill(f.begin(), f.begin() + 6, uint8_t{0xFF});
@@ -21,7 +21,7 @@ uint16_t Master::exchange(uint8_t cmd, uint32_t address, std::span<uint8_t> data
     f[14] = static_cast<uint8_t>(eh);
     f[15] = static_cast<uint8_t>(eh >> 8);
     uint8_t* d = f.data() + 16;
-    d[0] = cmd;
+    d[0] = static_cast<uint8_t>(cmd);
     d[1] = index_++;
     for (int i = 0; i < 4; ++i)
         d[2 + i] = static_cast<uint8_t>(address >> (8 * i));
@@ -36,11 +36,11 @@ uint16_t Master::exchange(uint8_t cmd, uint32_t address, std::span<uint8_t> data
 
 uint16_t Master::write(uint16_t ado, std::span<const uint8_t> data) {
     std::vector<uint8_t> b(data.begin(), data.end());
-    return exchange(APWR, static_cast<uint32_t>(ado) << 16, b);  // ADP 0: the first slave
+    return exchange(esc::Command::APWR, static_cast<uint32_t>(ado) << 16, b);  // ADP 0: the first slave
 }
 
 uint16_t Master::read(uint16_t ado, std::span<uint8_t> data) {
-    return exchange(APRD, static_cast<uint32_t>(ado) << 16, data);
+    return exchange(esc::Command::APRD, static_cast<uint32_t>(ado) << 16, data);
 }
 
 // ---- Sample device ----------------------------------------------------------------------------------

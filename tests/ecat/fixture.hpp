@@ -12,6 +12,7 @@
 #include "ecat/stack.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
+#include "esc/wire/datagram.hpp"
 #include "od/device.hpp"
 #include "od/dictionary.hpp"
 
@@ -21,10 +22,9 @@ namespace ecat::test {
 class Master {
   public:
     void attach(esc::Esc& e) { esc_ = &e; }
-    static constexpr uint8_t APRD = 1, APWR = 2, LRD = 10, LWR = 11, LRW = 12;
 
     // Sends one datagram; data is replaced by what came back. Returns the working counter.
-    uint16_t exchange(uint8_t cmd, uint32_t address, std::span<uint8_t> data);
+    uint16_t exchange(esc::Command cmd, uint32_t address, std::span<uint8_t> data);
     uint16_t write(uint16_t ado, std::span<const uint8_t> data);
     uint16_t read(uint16_t ado, std::span<uint8_t> data);
     template <typename T>
@@ -43,7 +43,9 @@ class Master {
             v |= static_cast<uint64_t>(b[i]) << (8 * i);
         return static_cast<T>(v);
     }
-    uint16_t lrw(uint32_t logical, std::span<uint8_t> data) { return exchange(LRW, logical, data); }
+    uint16_t lrw(uint32_t logical, std::span<uint8_t> data) {
+        return exchange(esc::Command::LRW, logical, data);
+    }
 
   private:
     esc::Esc* esc_ = nullptr;

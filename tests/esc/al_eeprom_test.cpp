@@ -23,7 +23,7 @@ std::vector<uint8_t> make_image(uint16_t w0, uint16_t w1, uint16_t w2, uint16_t 
     put(2, w2);
     put(3, w3);
     put(4, alias);
-    const uint8_t crc = esi::sii::crc8(img.data(), 14);
+    const uint8_t crc = esc::sii::crc8(img.data(), 14);
     put(7, good_crc ? crc : static_cast<uint8_t>(crc ^ 0x5A));
     put(8, 0x1234);  // vendor id low word
     put(0x0A, 0x5678);

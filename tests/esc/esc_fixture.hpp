@@ -7,7 +7,7 @@
 #include <optional>
 #include <vector>
 
-#include "esi/wire/sii.hpp"
+#include "esc/wire/sii.hpp"
 #include "frame.hpp"
 
 namespace esc_test {
@@ -25,7 +25,7 @@ struct EscFixture : ::testing::Test {
 
 // Rewrites the SII header checksum (word 7, low byte) after a test changed words 0..6 (ETG.2010).
 inline void fix_sii_header_crc(std::vector<uint8_t>& img) {
-    img[14] = esi::sii::crc8(img.data(), 14);
+    img[14] = esc::sii::crc8(img.data(), 14);
 }
 
 }  // namespace esc_test

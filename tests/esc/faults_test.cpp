@@ -4,7 +4,7 @@
 
 #include <optional>
 
-#include "esi/wire/sii.hpp"
+#include "esc/wire/sii.hpp"
 #include "frame.hpp"
 
 using namespace esc_test;
@@ -93,7 +93,7 @@ TEST(EscFaults, SiiChecksum) {
         return fprd(x, 0x0508, 8).u16(6);
     };
     const uint16_t right = word7(*e.clean);
-    EXPECT_EQ(right & 0xFF, esi::sii::crc8(e.clean->eeprom().data(), 14));
+    EXPECT_EQ(right & 0xFF, esc::sii::crc8(e.clean->eeprom().data(), 14));
     EXPECT_EQ(word7(*e.faulty), right ^ 0x00FF);
     // The ESC itself loaded its configuration: no checksum error, EEPROM loaded.
     EXPECT_EQ(fprd(*e.faulty, 0x0502, 2).u16() & 0x0800, 0);

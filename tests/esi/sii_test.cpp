@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <random>
 
+#include "esc/wire/sii.hpp"
 #include "esi/model.hpp"
 #include "esi/sii.hpp"
 #include "test_device.hpp"
@@ -30,12 +31,12 @@ uint16_t word(const std::vector<uint8_t>& img, std::size_t w) {
 TEST(SiiCrc, Crc8Poly07Init0xFFMsbFirst) {
     // Values computed with an independent bit-by-bit implementation (poly 0x07, init 0xFF, no reflection).
     const uint8_t check[] = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
-    EXPECT_EQ(esi::sii_crc8(check, sizeof check), 0xFB);
+    EXPECT_EQ(esc::sii::crc8(check, sizeof check), 0xFB);
     const uint8_t zeros[14] = {};
-    EXPECT_EQ(esi::sii_crc8(zeros, sizeof zeros), 0x30);
+    EXPECT_EQ(esc::sii::crc8(zeros, sizeof zeros), 0x30);
     // EJ7211 ConfigData 050403ccc4090000000000000000
     const uint8_t ej[14] = {0x05, 0x04, 0x03, 0xCC, 0xC4, 0x09, 0, 0, 0, 0, 0, 0, 0, 0};
-    EXPECT_EQ(esi::sii_crc8(ej, sizeof ej), 0xD8);
+    EXPECT_EQ(esc::sii::crc8(ej, sizeof ej), 0xD8);
 }
 
 // ---- Built image against the description and dictionary ------------------------------------------------
@@ -66,7 +67,7 @@ TEST_P(SiiDevice, HeaderWordsComeFromTheDescription) {
     EXPECT_EQ(word(img, 1), desc.pdi_config);
     EXPECT_EQ(word(img, 2), desc.sync_pulse_length);
     EXPECT_EQ(word(img, 4), desc.station_alias);
-    EXPECT_EQ(word(img, 7), esi::sii_crc8(img.data(), 14)) << "CRC in the low byte, high byte 0";
+    EXPECT_EQ(word(img, 7), esc::sii::crc8(img.data(), 14)) << "CRC in the low byte, high byte 0";
     EXPECT_EQ(word(img, 0x14), desc.bootstrap_mailbox.out_start);
     EXPECT_EQ(word(img, 0x15), desc.bootstrap_mailbox.out_size);
     EXPECT_EQ(word(img, 0x16), desc.bootstrap_mailbox.in_start);
@@ -284,7 +285,7 @@ struct Image {
         add16(static_cast<uint16_t>(data.size() / 2));
         b.insert(b.end(), data.begin(), data.end());
     }
-    void fix_crc() { set16(14, esi::sii_crc8(b.data(), 14)); }
+    void fix_crc() { set16(14, esc::sii::crc8(b.data(), 14)); }
 };
 
 TEST(SiiParse, HandMadeImageLikeNi9144) {

@@ -5,16 +5,17 @@
 #include "foe/image.hpp"
 #include "foe_test_support.hpp"
 #include "od/device.hpp"  // od::Identity (foe/image.hpp is od-free)
+#include "util/crc.hpp"
 
 using namespace foe;
 using foe_test::kMaxpos;
 
 TEST(FoeImage, Crc32MatchesTheStandardCheckValue) {
     const std::string s = "123456789";
-    EXPECT_EQ(crc32({reinterpret_cast<const uint8_t*>(s.data()), s.size()}), 0xCBF43926u);
+    EXPECT_EQ(util::crc32({reinterpret_cast<const uint8_t*>(s.data()), s.size()}), 0xCBF43926u);
     // Continued over pieces gives the same value.
-    const uint32_t part = crc32({reinterpret_cast<const uint8_t*>(s.data()), 4});
-    EXPECT_EQ(crc32({reinterpret_cast<const uint8_t*>(s.data()) + 4, 5}, part), 0xCBF43926u);
+    const uint32_t part = util::crc32({reinterpret_cast<const uint8_t*>(s.data()), 4});
+    EXPECT_EQ(util::crc32({reinterpret_cast<const uint8_t*>(s.data()) + 4, 5}, part), 0xCBF43926u);
 }
 
 TEST(FoeImage, BuildThenVerifyRoundTrips) {

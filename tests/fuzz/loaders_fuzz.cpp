@@ -23,6 +23,7 @@
 #include "od/device_config.hpp"
 #include "od/drive_profile.hpp"
 #include "od/store.hpp"
+#include "util/crc.hpp"
 #include "util/le.hpp"
 
 namespace fuzz::loaders {
@@ -67,8 +68,8 @@ void parameters(std::vector<uint8_t> b, bool repair) {
     constexpr std::size_t kHeader = od::ParameterStore::kHeaderBytes;
     if (repair && b.size() >= kHeader) {
         put32(b, 28, static_cast<uint32_t>(b.size() - kHeader));
-        put32(b, 32, od::crc32(std::span<const uint8_t>(b).subspan(kHeader)));
-        put32(b, 36, od::crc32(std::span<const uint8_t>(b).first(36)));
+        put32(b, 32, util::crc32(std::span<const uint8_t>(b).subspan(kHeader)));
+        put32(b, 36, util::crc32(std::span<const uint8_t>(b).first(36)));
     }
     write_file(state_dir() / "parameters.bin", b);
     // A rejected file changes nothing (all or nothing); an applied one sets stored values, which the next
@@ -84,7 +85,7 @@ void eeprom_writes(std::vector<uint8_t> b, bool repair) {
     if (repair && b.size() >= 16) {
         put32(b, 8, static_cast<uint32_t>((b.size() - 16) / 4));
         b.resize(16 + 4 * std::size_t{get32(b, 8)});
-        put32(b, b.size() - 4, od::crc32(std::span<const uint8_t>(b).first(b.size() - 4)));
+        put32(b, b.size() - 4, util::crc32(std::span<const uint8_t>(b).first(b.size() - 4)));
     }
     write_file(state_dir() / "sii-writes.bin", b);
     device::EepromWrites w(state_dir());
@@ -100,7 +101,7 @@ void repair_image(std::vector<uint8_t>& b) {
     if (b.size() < foe::kImageHeaderSize) return;
     put32(b, 20, static_cast<uint32_t>(b.size() - foe::kImageHeaderSize));
     std::span<const uint8_t, foe::kImageHeaderSize> h(b.data(), foe::kImageHeaderSize);
-    put32(b, 28, foe::crc32(std::span<const uint8_t>(b).subspan(foe::kImageHeaderSize), foe::header_crc(h)));
+    put32(b, 28, util::crc32(std::span<const uint8_t>(b).subspan(foe::kImageHeaderSize), foe::header_crc(h)));
 }
 
 void firmware(Input& in, bool repair) {

@@ -242,7 +242,7 @@ class RunTime(unittest.TestCase):
 
 
 def firmware_image(vendor, product, version, size=4000):
-    """foe/include/foe/image.hpp: 32-byte header with CRC-32 over header bytes 0..27 and the payload."""
+    """foe/image/include/foe/image.hpp: 32-byte header with CRC-32 over header bytes 0..27 and the payload."""
     payload = bytes((i * 13) & 0xFF for i in range(size))
     head = struct.pack("<IHHIIIII", 0x57464553, 1, 32, vendor, product, version, len(payload), 0)
     return head + struct.pack("<I", zlib.crc32(head + payload) & 0xFFFFFFFF) + payload

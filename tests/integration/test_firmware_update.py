@@ -21,7 +21,7 @@ NEW_VERSION = 0x01300000
 
 
 def firmware_image(vendor, product, version, size=6000):
-    """foe/include/foe/image.hpp: 32-byte header (magic, versions, identity, length, flags, CRC-32)."""
+    """foe/image/include/foe/image.hpp: 32-byte header (magic, versions, identity, length, flags, CRC-32)."""
     payload = bytes((i * 7 + (i >> 8)) & 0xFF for i in range(size))
     head = struct.pack("<IHHIIIII", 0x57464553, 1, 32, vendor, product, version, len(payload), 0)
     return head + struct.pack("<I", zlib.crc32(head + payload) & 0xFFFFFFFF) + payload

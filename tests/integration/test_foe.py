@@ -10,7 +10,7 @@ import harness
 
 
 def firmware_image(vendor, product, version=0x01300000, size=5000):
-    """The slave's image format (foe/include/foe/image.hpp): 32-byte header with CRC-32, payload."""
+    """The slave's image format (foe/image/include/foe/image.hpp): 32-byte header with CRC-32, payload."""
     payload = bytes((i * 7) & 0xFF for i in range(size))
     head = struct.pack("<IHHIIIII", 0x57464553, 1, 32, vendor, product, version, len(payload), 0)
     return head + struct.pack("<I", zlib.crc32(head + payload) & 0xFFFFFFFF) + payload

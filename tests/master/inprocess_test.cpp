@@ -7,7 +7,7 @@
 
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
-#include "esi/wire/sii.hpp"
+#include "esc/wire/sii.hpp"
 #include "master/master.hpp"
 #include "support/sii_image.hpp"
 #include "support/wire_link.hpp"

@@ -13,7 +13,7 @@
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
 #include "esc/segment.hpp"
-#include "esi/wire/sii.hpp"
+#include "esc/wire/sii.hpp"
 #include "master/bus.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"

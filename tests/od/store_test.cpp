@@ -15,6 +15,7 @@
 
 #include "od/drive_profile.hpp"
 #include "od/store.hpp"
+#include "util/crc.hpp"
 
 using namespace od;
 namespace fs = std::filesystem;
@@ -69,7 +70,7 @@ class StoredParameters : public ::testing::Test {
 
 TEST(Crc32, KnownVector) {
     const char* s = "123456789";
-    EXPECT_EQ(crc32(std::span(reinterpret_cast<const uint8_t*>(s), 9)), 0xCBF43926u);
+    EXPECT_EQ(util::crc32(std::span(reinterpret_cast<const uint8_t*>(s), 9)), 0xCBF43926u);
 }
 
 TEST_F(StoredParameters, NoFileKeepsDefaults) {
@@ -202,8 +203,8 @@ TEST_F(StoredParameters, ValidCrcButInvalidContentIsRejectedWhole) {
         for (int i = 0; i < 4; ++i)
             b[at + i] = static_cast<uint8_t>(v >> (8 * i));
     };
-    put32(32, crc32(std::span<const uint8_t>(b).subspan(ParameterStore::kHeaderBytes)));
-    put32(36, crc32(std::span<const uint8_t>(b).first(36)));
+    put32(32, util::crc32(std::span<const uint8_t>(b).subspan(ParameterStore::kHeaderBytes)));
+    put32(36, util::crc32(std::span<const uint8_t>(b).first(36)));
     write_all(store.file(), b);
     Dictionary fresh = make_drive_dictionary(desc);
     const auto r = store.load(fresh);
@@ -362,8 +363,8 @@ TEST_F(StoredParameters, CraftedRecordCountsAreReportedNotReserved) {
         };
         put32(24, count);
         put32(28, static_cast<uint32_t>(b.size() - ParameterStore::kHeaderBytes));
-        put32(32, crc32(std::span<const uint8_t>(b).subspan(ParameterStore::kHeaderBytes)));
-        put32(36, crc32(std::span<const uint8_t>(b).first(36)));
+        put32(32, util::crc32(std::span<const uint8_t>(b).subspan(ParameterStore::kHeaderBytes)));
+        put32(36, util::crc32(std::span<const uint8_t>(b).first(36)));
         return b;
     };
     // The file as found: 40 bytes, count 0xFFFFFFFF, both CRCs right.

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "esi/wire/sii.hpp"
+#include "esc/wire/sii.hpp"
 #include "util/le.hpp"
 
 namespace test_support {
@@ -35,7 +35,7 @@ inline std::vector<uint8_t> small_sii_image(uint8_t esc_config = 0x0C, uint32_t 
     std::vector<uint8_t> b;
     for (uint16_t x : w)
         util::append16(b, x);
-    b[14] = esi::sii::crc8(b.data(), 14);
+    b[14] = esc::sii::crc8(b.data(), 14);
     b.resize(2048, 0xFF);
     return b;
 }

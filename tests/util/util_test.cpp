@@ -1,4 +1,5 @@
-// softecat_util (little-endian helpers, CRC-32, crash-safe file write) and the SII CRC-8 of sii_wire.
+// softecat_util (little-endian helpers, CRC-32, crash-safe file write) and the SII CRC-8 of esc_wire
+// (esc/wire/sii.hpp).
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -13,7 +14,7 @@
 #include <vector>
 
 #include "esc/wire/frame_builder.hpp"
-#include "esi/wire/sii.hpp"
+#include "esc/wire/sii.hpp"
 #include "util/atomic_file.hpp"
 #include "util/crc.hpp"
 #include "util/le.hpp"
@@ -64,12 +65,12 @@ TEST(SiiCrc8, KnownVectors) {
     // CRC-8, polynomial 0x07, initial value 0xFF, MSB first, no final xor (the SII word 7 checksum): check
     // value of "123456789", and the words 0-6 of an ESI's ConfigData 050403ccc409 (rest zero), both worked
     // out independently of this implementation (table-driven).
-    EXPECT_EQ(esi::sii::crc8(bytes("123456789").data(), 9), 0xFB);
+    EXPECT_EQ(esc::sii::crc8(bytes("123456789").data(), 9), 0xFB);
     const std::array<uint8_t, 14> header = {0x05, 0x04, 0x03, 0xCC, 0xC4, 0x09, 0, 0, 0, 0, 0, 0, 0, 0};
-    EXPECT_EQ(esi::sii::crc8(header.data(), header.size()), 0xD8);
+    EXPECT_EQ(esc::sii::crc8(header.data(), header.size()), 0xD8);
     const std::array<uint8_t, 14> zeros{};
-    EXPECT_EQ(esi::sii::crc8(zeros.data(), zeros.size()), 0x30);
-    static_assert(esi::sii::crc8(nullptr, 0) == 0xFF);
+    EXPECT_EQ(esc::sii::crc8(zeros.data(), zeros.size()), 0x30);
+    static_assert(esc::sii::crc8(nullptr, 0) == 0xFF);
 }
 
 TEST(LittleEndian, GetPutRoundTrip) {

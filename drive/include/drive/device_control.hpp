@@ -6,7 +6,7 @@
 // narrow `Parts` interface, which Axis implements.
 #include <cstdint>
 
-#include "drive/error_codes.hpp"
+#include "drive/wire/error_codes.hpp"
 #include "drive/event_sink.hpp"
 #include "drive/faults.hpp"
 #include "drive/state_machine.hpp"

@@ -1,11 +1,11 @@
 #pragma once
-// The drive's error table: code, error-register bits and reaction class (declared in drive/error_codes.hpp).
+// The drive's error table: code, error-register bits and reaction class (drive/wire/error_codes.hpp).
 #include <cstdint>
 #include <optional>
 #include <span>
 #include <string_view>
 
-#include "drive/error_codes.hpp"
+#include "drive/wire/error_codes.hpp"
 
 namespace drive {
 

@@ -7,7 +7,7 @@
 #include <array>
 #include <cstdint>
 
-#include "drive/error_codes.hpp"
+#include "drive/wire/error_codes.hpp"
 #include "drive/event_sink.hpp"
 #include "drive/frame.hpp"
 

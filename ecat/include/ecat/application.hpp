@@ -10,7 +10,7 @@ class Application {
   public:
     virtual ~Application() = default;
     // Extra application checks on a requested transition up (I->P, P->S, S->O, I->B), after the stack's
-    // own checks passed. Returns 0 to allow it or an AL status code (ecat/al_status.hpp) to refuse it.
+    // own checks passed. Returns 0 to allow it or an AL status code (esc/wire/al.hpp) to refuse it.
     // Transitions down always succeed and are not asked about.
     virtual uint16_t check_transition(od::AlState /*from*/, od::AlState /*to*/) { return 0; }
     // The AL state changed (also on fall-backs with the error flag).

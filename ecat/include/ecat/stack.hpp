@@ -14,7 +14,6 @@
 #include <functional>
 #include <iosfwd>
 
-#include "ecat/al_status.hpp"
 #include "ecat/application.hpp"
 #include "ecat/cycle.hpp"
 #include "ecat/event_sink.hpp"
@@ -27,6 +26,7 @@
 #include "ecat/state_machine.hpp"
 #include "ecat/sync_control.hpp"
 #include "esc/pdi.hpp"
+#include "esc/wire/al.hpp"
 #include "od/device.hpp"
 #include "od/dictionary.hpp"
 

@@ -11,13 +11,16 @@
 #include "ecat/latency.hpp"
 #include "ecat/mailbox.hpp"
 #include "ecat/process_data.hpp"
-#include "ecat/wire/al.hpp"
 #include "esc/pdi.hpp"
+#include "esc/wire/al.hpp"
 #include "esc/wire/registers.hpp"
 #include "od/device.hpp"
 #include "od/dictionary.hpp"
 
 namespace ecat {
+
+// The AL status codes the stack writes to 0x0134 are the ESC's vocabulary (esc/wire/al.hpp).
+namespace al = esc::al;
 
 struct StackStats {
     uint64_t transitions = 0;  // successful AL state changes

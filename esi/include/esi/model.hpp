@@ -90,7 +90,4 @@ std::optional<uint64_t> number_bits(const od::Number& n, od::DataType type, uint
 // ESI carries as ImageData16x14 and a configuration tool shows in its tree. Drawn here, not loaded.
 std::vector<uint8_t> device_image_bmp();
 
-// CRC-8 of the SII header (polynomial 0x07, initial 0xFF, MSB first) over the given bytes.
-uint8_t sii_crc8(const uint8_t* data, std::size_t size);
-
 }  // namespace esi

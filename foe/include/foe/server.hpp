@@ -19,10 +19,10 @@
 
 #include "ecat/event_sink.hpp"
 #include "ecat/mailbox_handler.hpp"
-#include "foe/errors.hpp"
 #include "foe/faults.hpp"
 #include "foe/sink.hpp"
 #include "foe/store.hpp"
+#include "foe/wire/foe.hpp"
 #include "od/device.hpp"
 #include "od/types.hpp"
 

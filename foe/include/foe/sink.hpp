@@ -10,8 +10,8 @@
 #include <span>
 #include <string>
 
-#include "foe/errors.hpp"
 #include "foe/image.hpp"
+#include "foe/wire/foe.hpp"
 
 namespace foe {
 

@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "foe/errors.hpp"
 #include "foe/image.hpp"
 #include "foe/sink.hpp"
+#include "foe/wire/foe.hpp"
 
 namespace foe {
 

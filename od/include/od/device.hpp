@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "esi/wire/sii.hpp"
+#include "esc/wire/sii.hpp"
 
 namespace od {
 
@@ -31,9 +31,9 @@ struct MailboxLayout {
 };
 
 // Mailbox protocol bits (SII word 0x1C, the ESI) and CoE details bits (SII General category): the SII
-// vocabulary's (esi/wire/sii.hpp).
-namespace mailbox_protocol = esi::sii::mailbox_protocol;
-namespace coe_details = esi::sii::coe_details;
+// vocabulary's (esc/wire/sii.hpp).
+namespace mailbox_protocol = esc::sii::mailbox_protocol;
+namespace coe_details = esc::sii::coe_details;
 
 enum class SmKind : uint8_t { MBoxOut = 1, MBoxIn = 2, Outputs = 3, Inputs = 4 };
 

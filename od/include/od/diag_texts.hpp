@@ -7,7 +7,7 @@
 #include <span>
 #include <string_view>
 
-#include "od/diag_text_table.hpp"
+#include "od/wire/diag_text_table.hpp"
 
 namespace od {
 

@@ -35,8 +35,6 @@ enum class StoreScope : uint8_t {
 
 bool in_scope(StoreScope scope, uint16_t index);
 
-uint32_t crc32(std::span<const uint8_t> data, uint32_t crc = 0);
-
 class ParameterStore {
   public:
     static constexpr uint16_t kFormatVersion = 1;

@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "ecat/wire/al.hpp"
+#include "esc/wire/al.hpp"
 
 namespace od {
 
@@ -31,8 +31,8 @@ enum class DataType : uint16_t {
 enum class ObjectCode : uint8_t { Var = 0x07, Array = 0x08, Record = 0x09 };
 
 // EtherCAT AL states, for state-dependent access ("rw only in Pre-Op"): the AL vocabulary's
-// (ecat/wire/al.hpp).
-using AlState = ecat::AlState;
+// (esc/wire/al.hpp).
+using AlState = esc::AlState;
 
 // Access and flag bits exactly as the SDO information "entry description" ObjectAccess word (ETG.1000.6):
 namespace access {

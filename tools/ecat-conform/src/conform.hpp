@@ -109,8 +109,6 @@ struct SiiImage {
     void parse();
 };
 
-uint8_t sii_crc8(std::span<const uint8_t> bytes);
-
 struct Options {
     std::string iface;
     uint16_t slave = 0;

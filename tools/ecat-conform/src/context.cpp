@@ -5,7 +5,7 @@
 #include <thread>
 
 #include "conform.hpp"
-#include "esi/wire/sii.hpp"
+#include "esc/wire/sii.hpp"
 #include "util/le.hpp"
 #include "util/strfmt.hpp"
 
@@ -55,10 +55,6 @@ std::string state_text(uint8_t s) {
 }
 
 // ---- SII -------------------------------------------------------------------------------------------
-uint8_t sii_crc8(std::span<const uint8_t> bytes) {
-    return esi::sii::crc8(bytes.data(), bytes.size());
-}
-
 uint16_t SiiImage::word(std::size_t w) const {
     if (2 * w + 1 >= bytes.size()) return 0;
     return util::get16(bytes.data() + 2 * w);

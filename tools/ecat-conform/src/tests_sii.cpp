@@ -2,6 +2,7 @@
 // the ESI (ETG.2000 describes how an ESI becomes the SII image).
 #include <set>
 
+#include "esc/wire/sii.hpp"
 #include "testkit.hpp"
 
 namespace conform {
@@ -124,7 +125,7 @@ void add_sii_tests(Catalogue& c) {
     add("header.checksum", "Checksum of words 0-6 in word 7 (CRC-8, polynomial 0x07, seed 0xFF)", kSii,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_sii());
-            const uint8_t crc = sii_crc8(std::span<const uint8_t>(ctx.sii->bytes).subspan(0, 14));
+            const uint8_t crc = esc::sii::crc8(ctx.sii->bytes.data(), 14);
             return expect_eq("word 7 low byte", hex(ctx.sii->bytes[14], 2), hex(crc, 2));
         });
     add(

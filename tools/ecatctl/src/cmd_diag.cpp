@@ -1,7 +1,7 @@
 // ecatctl diag [slave] [--oldest-first] [--new] [--ack]: the diagnosis history 0x10F3 (ETG.1020) read over
 // CoE SDO and printed as text: the header subindices, the flags, then one line per message with its time
 // stamp (DC system time), type, diag code, text and parameters. Texts of emergency-derived codes come from
-// the drive's error table (drive/error_codes.hpp, od-free; ecatctl does not link the drive).
+// the drive's error table (drive/wire/error_codes.hpp, od-free; ecatctl does not link the drive).
 #include "cmd_diag.hpp"
 
 #include <cstdio>
@@ -9,12 +9,12 @@
 #include <string>
 #include <vector>
 
-#include "drive/error_codes.hpp"
+#include "drive/wire/error_codes.hpp"
 #include "format.hpp"
 #include "master/coe.hpp"
 #include "master/diag.hpp"
 #include "master/mailbox.hpp"
-#include "od/diag_text_table.hpp"
+#include "od/wire/diag_text_table.hpp"
 #include "util/strfmt.hpp"
 
 namespace ecatctl {

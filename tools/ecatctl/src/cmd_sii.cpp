@@ -68,9 +68,9 @@ int sii_write(master::Master& m, const SiiArgs& s) {
     if (!img) return usage("cannot read " + s.input);
     if (img->size() < 16 || img->size() % 2 != 0 || img->size() > 65536)
         return usage(s.input + ": an SII image is an even number of bytes, 16 to 65536");
-    const uint16_t w7 = util::get16(img->data() + 2 * esi::sii::word::Checksum);
-    const uint8_t crc = esi::sii::crc8(img->data(), esi::sii::kCrcBytes);
-    if (w7 != esi::sii::kChecksumDisabled && (w7 & 0xFF) != crc && !s.force) {
+    const uint16_t w7 = util::get16(img->data() + 2 * esc::sii::word::Checksum);
+    const uint8_t crc = esc::sii::crc8(img->data(), esc::sii::kCrcBytes);
+    if (w7 != esc::sii::kChecksumDisabled && (w7 & 0xFF) != crc && !s.force) {
         return usage(
             util::strprintf("%s: checksum word 7 is 0x%04x, CRC of words 0-6 is 0x%02x (use --force)",
                             s.input.c_str(), w7, crc));

@@ -1,6 +1,6 @@
 #include "format.hpp"
 
-#include "esi/wire/sii.hpp"
+#include "esc/wire/sii.hpp"
 
 #include <cerrno>
 #include <charconv>
@@ -151,7 +151,7 @@ std::string hex_dump(uint32_t base, std::span<const uint8_t> data) {
 }
 
 uint8_t sii_crc(std::span<const uint8_t> first14) {
-    return esi::sii::crc8(first14.data(), first14.size());
+    return esc::sii::crc8(first14.data(), first14.size());
 }
 
 }  // namespace ecatctl

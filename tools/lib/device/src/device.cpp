@@ -11,7 +11,8 @@
 #include "coe/events.hpp"
 #include "coe/pdo_validation.hpp"
 #include "drive/errors.hpp"
-#include "ecat/al_status.hpp"
+#include "drive/state_machine.hpp"
+#include "esc/wire/al.hpp"
 #include "esc/wire/registers.hpp"
 #include "esi/esi.hpp"
 #include "esi/sii.hpp"
@@ -19,7 +20,9 @@
 #include "foe/image.hpp"
 #include "od/device_config.hpp"
 #include "od/diag_texts.hpp"
+#include "od/drive_objects.hpp"
 #include "od/drive_profile.hpp"
+#include "util/le.hpp"
 #include "util/strfmt.hpp"
 
 namespace device {
@@ -201,7 +204,7 @@ std::string requested_text(uint8_t requested) {
 
 std::string al_code_text(uint16_t code) {
     return util::strprintf("0x%04X (%s)", static_cast<unsigned>(code),
-                           std::string(ecat::al::name(code)).c_str());
+                           std::string(esc::al::status_text(code)).c_str());
 }
 
 std::string hex16(uint16_t v) {
@@ -287,10 +290,11 @@ void Device::build() {
         [raw] {
             // MAXPOS firmware specification §7.2.21: restoring defaults only with the axis in "Power Disable"
             // (not switched on).
-            const od::Entry* e = raw->dict.find(0x6041, 0);
+            constexpr auto sw = od::obj::Statusword;
+            const od::Entry* e = raw->dict.find(sw.index, sw.sub);
             if (e == nullptr) return od::Status::Ok;
-            return (raw->dict.get<uint16_t>(0x6041, 0) & 0x0002) != 0 ? od::Status::WrongState
-                                                                      : od::Status::Ok;
+            return (raw->dict.get<uint16_t>(sw.index, sw.sub) & drive::sw::SwitchedOn) != 0 ? od::Status::WrongState
+                                                                                          : od::Status::Ok;
         },
         // A master's 0x1010/0x2110 "save" and 0x1011/0x2111 "load": what the store did, done or failed (a
         // failed one was answered with an SDO abort; the log says why).
@@ -428,10 +432,7 @@ void Device::run_drive(uint64_t now_ns) {
 uint64_t Device::system_time_ns() {
     uint8_t b[8] = {};
     esc_.read(esc::reg::kDcSystemTime, b);
-    uint64_t v = 0;
-    for (int i = 7; i >= 0; --i)
-        v = (v << 8) | b[i];
-    return v;
+    return util::get64(b);
 }
 
 // ---- ecat::Application ------------------------------------------------------------------------------
@@ -459,8 +460,10 @@ void Device::react_to_outputs_lost() {
     // 0x8180 with the 0x6007 reaction in any drive state. A master that asks to leave Op is not an error; it
     // gets the reaction only while its outputs were commanding motion (operation enabled, statusword bit 2).
     const bool fall_back = parts_->stack->error();
-    const od::Entry* sw = parts_->dict.find(0x6041, 0);
-    const bool enabled = sw != nullptr && (parts_->dict.get<uint16_t>(0x6041, 0) & 0x0004) != 0;
+    constexpr auto statusword = od::obj::Statusword;
+    const od::Entry* sw = parts_->dict.find(statusword.index, statusword.sub);
+    const bool enabled = sw != nullptr && (parts_->dict.get<uint16_t>(statusword.index, statusword.sub) &
+                                           drive::sw::OperationEnabled) != 0;
     if (fall_back || enabled) parts_->drive->connection_lost();
 }
 

@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <cstring>
 
-#include "esi/model.hpp"
+#include "esc/wire/sii.hpp"
 #include "od/store.hpp"
 #include "util/atomic_file.hpp"
 #include "util/crc.hpp"
@@ -109,7 +109,7 @@ std::vector<std::string> sii_drift(std::span<const uint8_t> image, uint32_t vend
         std::snprintf(b, sizeof b, "0x%0*X", digits, static_cast<unsigned>(v));
         return std::string(b);
     };
-    const uint8_t crc = esi::sii_crc8(image.data(), 14);
+    const uint8_t crc = esc::sii::crc8(image.data(), 14);
     if (crc != image[14])
         out.push_back("SII checksum (word 7) is " + hex(image[14], 2) + ", words 0-6 give " + hex(crc, 2) +
                       " (a master checks it and may refuse the slave)");

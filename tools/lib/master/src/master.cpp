@@ -60,11 +60,11 @@ std::string_view to_string(AlState s) {
 }
 
 std::string_view al_state_name(uint8_t state) {
-    return ecat::al_state_name(state);
+    return esc::al_state_name(state);
 }
 
 std::string_view al_status_code_name(uint16_t code) {
-    const std::string_view text = ecat::al::status_text(code);
+    const std::string_view text = esc::al::status_text(code);
     if (!text.empty()) return text;
     return code >= 0x8000 ? "Vendor specific" : "unknown";
 }

@@ -10,10 +10,10 @@
 #include <span>
 #include <vector>
 
-#include "ecat/wire/al.hpp"
 #include "esc/link.hpp"
+#include "esc/wire/al.hpp"
 #include "esc/wire/registers.hpp"
-#include "esi/wire/sii.hpp"
+#include "esc/wire/sii.hpp"
 #include "master/error.hpp"
 #include "master/frame.hpp"
 
@@ -46,24 +46,24 @@ constexpr uint16_t Sm0 = esc::reg::kSm;
 constexpr uint16_t DcSystemTime = esc::reg::kDcSystemTime;
 }  // namespace reg
 
-// SII word addresses of the fixed header (ETG.2010; esi/wire/sii.hpp) and the 0x0502 control/status bits
+// SII word addresses of the fixed header (ETG.2010; esc/wire/sii.hpp) and the 0x0502 control/status bits
 // (esc/wire/registers.hpp), under the master's names.
 namespace sii {
-constexpr uint16_t VendorId = esi::sii::word::VendorId;
-constexpr uint16_t ProductCode = esi::sii::word::ProductCode;
-constexpr uint16_t Revision = esi::sii::word::Revision;
-constexpr uint16_t SerialNumber = esi::sii::word::SerialNumber;
-constexpr uint16_t BootMailboxOut = esi::sii::word::BootMailboxOut;
-constexpr uint16_t StdMailboxOut = esi::sii::word::StdMailboxOut;
-constexpr uint16_t StdMailboxIn = esi::sii::word::StdMailboxIn;
-constexpr uint16_t MailboxProtocols = esi::sii::word::MailboxProtocols;
-constexpr uint16_t EepromSize = esi::sii::word::EepromSize;
-constexpr uint16_t FirstCategory = esi::sii::word::FirstCategory;
-constexpr uint16_t CategoryEnd = esi::sii::category::End;
+constexpr uint16_t VendorId = esc::sii::word::VendorId;
+constexpr uint16_t ProductCode = esc::sii::word::ProductCode;
+constexpr uint16_t Revision = esc::sii::word::Revision;
+constexpr uint16_t SerialNumber = esc::sii::word::SerialNumber;
+constexpr uint16_t BootMailboxOut = esc::sii::word::BootMailboxOut;
+constexpr uint16_t StdMailboxOut = esc::sii::word::StdMailboxOut;
+constexpr uint16_t StdMailboxIn = esc::sii::word::StdMailboxIn;
+constexpr uint16_t MailboxProtocols = esc::sii::word::MailboxProtocols;
+constexpr uint16_t EepromSize = esc::sii::word::EepromSize;
+constexpr uint16_t FirstCategory = esc::sii::word::FirstCategory;
+constexpr uint16_t CategoryEnd = esc::sii::category::End;
 using namespace esc::reg::sii;
 }  // namespace sii
 
-using AlState = ecat::AlState;
+using AlState = esc::AlState;
 constexpr uint16_t kAlErrorAck =
     esc::reg::kAlErrorFlag;  // AL control bit 4 / AL status bit 4 (error indication)
 constexpr uint16_t kAlIdentify = esc::reg::kAlIdFlag;  // AL control bit 5 / AL status bit 5

@@ -1,12 +1,13 @@
 #pragma once
 // The SII EEPROM layout (ETG.1000.6 §5.4, ETG.2010): the word addresses of the fixed header (words
 // 0x00-0x3F), the category header and codes that follow it, the PDO category flags and the CRC-8 over
-// words 0-6 stored in word 7. The SII builder (esi/), the ESC's EEPROM reload (esc/), the master and the
-// tools all take them from here.
+// words 0-6 stored in word 7. The ESC reads this layout at EEPROM reload, so it lives with the ESC: the SII
+// builder (esi/), the ESC's EEPROM interface, the object model, the master and the tools all take it from
+// here.
 #include <cstddef>
 #include <cstdint>
 
-namespace esi::sii {
+namespace esc::sii {
 
 // Word addresses of the fixed header.
 namespace word {
@@ -90,4 +91,4 @@ constexpr uint8_t PdoUpload = 0x10;
 constexpr uint8_t CompleteAccess = 0x20;
 }  // namespace coe_details
 
-}  // namespace esi::sii
+}  // namespace esc::sii

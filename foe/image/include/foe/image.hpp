@@ -19,7 +19,7 @@
 #include <string_view>
 #include <vector>
 
-#include "foe/errors.hpp"
+#include "foe/wire/foe.hpp"
 
 namespace foe {
 
@@ -68,9 +68,6 @@ enum class ImageError : uint8_t {
 std::string_view to_string(ImageError e);
 // The FoE error code a write of such an image is answered with (decisions in docs/decisions/foe.md).
 ErrorCode foe_error(ImageError e);
-
-// CRC-32 (IEEE 802.3); pass the previous result to continue over several pieces.
-uint32_t crc32(std::span<const uint8_t> data, uint32_t crc = 0);
 
 void encode_header(const ImageHeader& h, std::span<uint8_t, kImageHeaderSize> out);
 ImageHeader decode_header(std::span<const uint8_t, kImageHeaderSize> in);

@@ -8,19 +8,20 @@
 #include <string>
 #include <vector>
 
-#include "esi/wire/sii.hpp"
+#include "esc/wire/sii.hpp"
 
 namespace esi {
 
 // Category codes, PDO flags, the checksum-disabled word and the first category word are the SII wire
-// vocabulary (esi/wire/sii.hpp); these names are kept for the reader's users.
+// vocabulary (esc/wire/sii.hpp, the ESC reads that layout); these names are kept for the reader's users.
+namespace sii = esc::sii;
 namespace category = sii::category;
 namespace pdo_flags = sii::pdo_flags;
 constexpr uint16_t kSiiChecksumDisabled = sii::kChecksumDisabled;
 constexpr std::size_t kSiiFirstCategoryWord = sii::word::FirstCategory;
 
 // Mailbox protocol bits (SII word 0x1C, the ESI) and CoE details bits (SII General category): the SII
-// vocabulary's (esi/wire/sii.hpp).
+// vocabulary's (esc/wire/sii.hpp).
 namespace mailbox_protocol = sii::mailbox_protocol;
 namespace coe_details = sii::coe_details;
 

@@ -1,11 +1,12 @@
 #pragma once
 // The AL (application layer) vocabulary of ETG.1000.6 §5.3: the AL states written to AL control (0x0120) and
 // read from AL status (0x0130), and the AL status codes (0x0134, ETG.1000.6 Table 11) with their names.
-// Slave and master both take them from here.
+// The ESC defines these registers, so the vocabulary lives with it: the ESC, the object model, the slave
+// stack, the master and the tools all take it from here.
 #include <cstdint>
 #include <string_view>
 
-namespace ecat {
+namespace esc {
 
 // EtherCAT AL states (AL control/status bits 3:0).
 enum class AlState : uint8_t { Init = 0x01, PreOp = 0x02, Boot = 0x03, SafeOp = 0x04, Op = 0x08 };
@@ -31,10 +32,10 @@ constexpr std::string_view al_state_name(AlState s) {
     return al_state_name(static_cast<uint8_t>(s));
 }
 
-}  // namespace ecat
+}  // namespace esc
 
 // AL status codes (0x0134).
-namespace ecat::al {
+namespace esc::al {
 
 constexpr uint16_t NoError = 0x0000;
 constexpr uint16_t Unspecified = 0x0001;
@@ -235,4 +236,4 @@ constexpr std::string_view status_text(uint16_t code) {
     }
 }
 
-}  // namespace ecat::al
+}  // namespace esc::al

@@ -1,7 +1,7 @@
 #pragma once
 // The drive's diagnosis texts by id (0x10F3, ETG.1020; listed as DiagMessages in the ESI, ETG.2000), as a
 // constexpr table with no other dependency: od/diag_texts.hpp serves it to the slave, and a master tool
-// (ecatctl diag) names the ids without linking the object model. Target `od_diag_texts`.
+// (ecatctl diag) names the ids without linking the object model. Target `od_wire`.
 #include <array>
 #include <cstdint>
 #include <string_view>

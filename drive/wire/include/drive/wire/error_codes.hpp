@@ -1,7 +1,7 @@
 #pragma once
 // The drive's error codes (0x603F, emergency) with their names, error-register bits and reaction class
 // (MAXPOS firmware specification §8.1, Table 8-141; codes per IEC 61800-7-201 / CiA 402): constexpr and
-// od-free, so a master tool (ecatctl) names a code without linking the drive. Target `drive_codes`.
+// od-free, so a master tool (ecatctl) names a code without linking the drive. Target `drive_wire`.
 #include <cstdint>
 #include <string_view>
 
