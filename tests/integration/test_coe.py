@@ -42,6 +42,10 @@ class CoeAndState(unittest.TestCase):
         self.assertTrue(r.stdout.strip(), r.stdout)
 
     def test_download_then_upload(self):
+        # A mapping entry is written while subindex 0 is 0 (ETG.1000.6); the slave refuses it before.
+        r = self.bus.ecatctl("download", "0", "0x1600", "1", "0x607A0020", "--type", "u32", check=False)
+        self.assertIn("0x06010003", r.stderr)
+        self.bus.ecatctl("download", "0", "0x1600", "0", "0", "--type", "u8")
         self.bus.ecatctl("download", "0", "0x1600", "1", "0x607A0020", "--type", "u32")
         self.assertEqual(self.bus.ecatctl("upload", "0", "0x1600", "1").stdout.strip(), "0x607a0020 (1618608160)")
         # Complete access is decoded per subindex with the names and types from SDO information.

@@ -109,9 +109,20 @@ class SdoAbortsThroughEcatctl(unittest.TestCase):
 
     def test_not_mappable(self):
         # The statusword is TxPDO-mappable only; 0x1008 (a string) not at all.
-        self.assert_abort(0x06040041, "download", "0", "0x1600", "1", "0x60410010", "--type", "u32")
-        self.assert_abort(0x06040041, "download", "0", "0x1600", "1", "0x10080008", "--type", "u32")
+        count = self.bus.ecatctl("upload", "0", "0x1600", "0").stdout.split()[0]
+        self.bus.ecatctl("download", "0", "0x1600", "0", "0", "--type", "u8")
+        try:
+            self.assert_abort(0x06040041, "download", "0", "0x1600", "1", "0x60410010", "--type", "u32")
+            self.assert_abort(0x06040041, "download", "0", "0x1600", "1", "0x10080008", "--type", "u32")
+        finally:
+            self.bus.ecatctl("download", "0", "0x1600", "0", count, "--type", "u8", check=False)
         self.assertEqual(self.bus.ecatctl("upload", "0", "0x1600", "1").stdout.split()[0], "0x60400010")
+
+    def test_mapping_entry_needs_subindex_zero_at_zero(self):
+        # ETG.1000.6 / ETG.1020: entries of a mapping or assignment object only while subindex 0 is 0.
+        for obj, sub, value, typ in (("0x1600", "1", "0x60400010", "u32"), ("0x1a00", "1", "0x60410010", "u32"),
+                                     ("0x1c12", "1", "0x1600", "u16"), ("0x1c13", "1", "0x1a00", "u16")):
+            self.assert_abort(0x06010003, "download", "0", obj, sub, value, "--type", typ)
 
     def test_pdo_length_exceeded(self):
         count = self.bus.ecatctl("upload", "0", "0x1600", "0").stdout.split()[0]
@@ -125,6 +136,7 @@ class SdoAbortsThroughEcatctl(unittest.TestCase):
             self.assertEqual(self.bus.ecatctl("upload", "0", "0x1600", "0").stdout.split()[0], "0x00")
         finally:
             # Back to the mapping as it was.
+            self.bus.ecatctl("download", "0", "0x1600", "0", "0", "--type", "u8", check=False)
             for sub, value in enumerate(before, start=1):
                 self.bus.ecatctl("download", "0", "0x1600", str(sub), value, "--type", "u32", check=False)
             self.bus.ecatctl("download", "0", "0x1600", "0", count, "--type", "u8", check=False)
