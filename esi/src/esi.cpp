@@ -231,6 +231,12 @@ std::string sub_name(unsigned sub) {
     return b;
 }
 
+// An array's SubItem name: subindex 0 is named as the dictionary (and so SDO information) names it, the
+// elements "SubIndex nnn" as configuration tools list them.
+std::string array_item_name(const Entry& e) {
+    return e.subindex == 0 && !e.name.empty() ? e.name : sub_name(e.subindex);
+}
+
 // Record-style SubItem names: the entry names, made unique (the XSD keys SubItems by Name).
 std::vector<std::string> record_item_names(const Object& o) {
     std::vector<std::string> names;
@@ -299,7 +305,7 @@ std::string structured_type(xmlNodePtr types, const Object& o, TypeSet& ts, uint
         xmlNodePtr dt = child(types, "DataType");
         child(dt, "Name", name);
         child(dt, "BitSize", std::to_string(bits));
-        sub_item(dt, &si0, sub_name(0), si0_type, si0.bit_length, 0, si0);
+        sub_item(dt, &si0, array_item_name(si0), si0_type, si0.bit_length, 0, si0);
         sub_item(dt, nullptr, "Elements", name + "ARR", arr_bits, elements_offs, el);
         return name;
     }
@@ -352,7 +358,7 @@ void dictionary(xmlNodePtr profile, const od::Dictionary& dict) {
         const auto names = record_item_names(o);
         for (std::size_t i = 0; i < o.entries.size(); ++i) {
             xmlNodePtr si = child(info, "SubItem");
-            child(si, "Name", array ? sub_name(o.entries[i].subindex) : names[i]);
+            child(si, "Name", array ? array_item_name(o.entries[i]) : names[i]);
             value_info(child(si, "Info"), o.entries[i]);
         }
         xmlNodePtr flags = child(obj, "Flags");
