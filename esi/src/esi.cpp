@@ -44,6 +44,14 @@ std::string hex_index(uint16_t v) {
     return b;
 }
 
+// `digits` upper-case hex digits of v.
+std::string hex_digits(uint32_t v, int digits) {
+    std::string s;
+    for (int shift = 4 * (digits - 1); shift >= 0; shift -= 4)
+        s += "0123456789ABCDEF"[(v >> shift) & 0xF];
+    return s;
+}
+
 std::string hex_bytes(const uint8_t* p, std::size_t n) {
     static const char* digits = "0123456789abcdef";
     std::string s;
@@ -200,13 +208,28 @@ void value_info(xmlNodePtr info, const Entry& e) {
 
 // ---- Data types --------------------------------------------------------------------------------------
 
+// An enumerated entry's type: its base type with the named values (ETG.2000 DataType/EnumInfo).
+struct EnumType {
+    std::string base;
+    uint32_t bits = 0;
+    const std::vector<od::NamedValue>* values = nullptr;
+};
+
 struct TypeSet {
-    std::map<std::string, uint32_t> base;  // name -> bit size (scalars and strings)
+    std::map<std::string, uint32_t> base;   // name -> bit size (scalars and strings)
+    std::map<std::string, EnumType> enums;  // "DT6060EN08" -> base type and values
     std::string use(const Entry& e) {
         const std::string n = esi_type_name(e.type, e.bit_length);
         if (e.type == DataType::OctetString) base["BYTE"] = 8;
-        base[n] = od::is_string(e.type) ? e.bit_length : (e.bit_length ? e.bit_length : od::bit_size(e.type));
-        return n;
+        const uint32_t bits =
+            od::is_string(e.type) ? e.bit_length : (e.bit_length ? e.bit_length : od::bit_size(e.type));
+        base[n] = bits;
+        if (e.enumeration.empty() || od::is_string(e.type)) return n;
+        // Named as vendors name them: DT, the index (and subindex if not 0), EN, the bit size.
+        std::string name = "DT" + hex_digits(e.index, 4) + (e.subindex ? hex_digits(e.subindex, 2) : "") +
+                           "EN" + (bits < 10 ? "0" : "") + std::to_string(bits);
+        enums[name] = EnumType{n, bits, &e.enumeration};
+        return name;
     }
 };
 
@@ -376,7 +399,18 @@ void dictionary(xmlNodePtr profile, const od::Dictionary& dict) {
             child(ai, "Elements", std::to_string(bits / 8));
         }
     }
-    // Move the structured types behind the base types.
+    for (const auto& [name, t] : ts.enums) {
+        xmlNodePtr dt = child(types, "DataType");
+        child(dt, "Name", name);
+        child(dt, "BaseType", t.base);
+        child(dt, "BitSize", std::to_string(t.bits));
+        for (const od::NamedValue& v : *t.values) {
+            xmlNodePtr en = child(dt, "EnumInfo");
+            named(en, "Text", v.text);
+            child(en, "Enum", std::to_string(v.value));
+        }
+    }
+    // Move the structured types behind the base and enumerated types.
     for (xmlNodePtr n = structured->children; n != nullptr;) {
         xmlNodePtr next = n->next;
         xmlUnlinkNode(n);

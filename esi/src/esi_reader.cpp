@@ -87,7 +87,16 @@ struct DataType {
         bool backup = false, setting = false;
     };
     std::vector<Sub> subs;
+    std::vector<std::pair<int64_t, std::string>> enums;  // EnumInfo
 };
+
+// An entry of an enumerated type (a DataType with BaseType and EnumInfo) gets the base type and the values.
+void resolve_enum(EsiEntry& e, const std::map<std::string, DataType>& types) {
+    auto it = types.find(e.type);
+    if (it == types.end() || it->second.enums.empty() || it->second.base.empty()) return;
+    e.enumeration = it->second.enums;
+    e.type = it->second.base;
+}
 
 void read_flags(Node flags, std::string& access, std::string& restrictions, std::string& pdo, bool& backup,
                 bool& setting) {
@@ -146,6 +155,8 @@ EsiDevice read_device(Node dev, const std::map<std::string, DataType>& types_in,
                 t.lbound = number(text(ai, "LBound"));
                 t.elements = number(text(ai, "Elements"));
             }
+            for (Node en : children(dt, "EnumInfo"))
+                t.enums.emplace_back(number(text(en, "Enum")), text(en, "Text"));
             for (Node si : children(dt, "SubItem")) {
                 DataType::Sub s;
                 if (Node x = child(si, "SubIdx")) s.subidx = static_cast<int>(number(text(x)));
@@ -181,6 +192,8 @@ EsiDevice read_device(Node dev, const std::map<std::string, DataType>& types_in,
                 e.backup = obackup;
                 e.setting = osetting;
                 read_info(info, e);
+                resolve_enum(e, types);
+                o.type = e.type;  // a VAR of an enumerated type: its base type
                 o.entries.push_back(e);
             } else {
                 const DataType& t = it->second;
@@ -219,6 +232,7 @@ EsiDevice read_device(Node dev, const std::map<std::string, DataType>& types_in,
                         e.pdo_mapping = s.pdo_mapping;
                         e.backup = s.backup;
                         e.setting = s.setting;
+                        resolve_enum(e, types);
                         o.entries.push_back(e);
                     }
                 }

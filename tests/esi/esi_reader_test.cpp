@@ -9,6 +9,7 @@
 #include "esi/esi_reader.hpp"
 #include "esi/model.hpp"
 #include "od/diag_texts.hpp"
+#include "od/drive_objects.hpp"
 #include "test_device.hpp"
 
 namespace {
@@ -142,6 +143,46 @@ TEST(EsiReadBackDrive, DiagMessagesCoverEveryTextIdWithTheWholeText) {
     EXPECT_EQ(esi.sms[0].min_size, dev.description.standard_mailbox.out_size);
     EXPECT_EQ(esi.sms[0].max_size, dev.description.standard_mailbox.out_size);
     EXPECT_EQ(esi.sms[2].max_size, 160u);
+}
+
+// EnumInfo: a configuration tool names the modes, option codes and homing methods; each enumerated entry
+// lists exactly the values the drive accepts (its value set or limits), read back with its base type.
+TEST(EsiReadBackDrive, EnumeratedEntriesNameExactlyTheValuesTheDriveTakes) {
+    const esi_test::Device dev = esi_test::drive_device();
+    const esi::EsiDevice esi = esi::read_esi(esi::build_esi(dev.description, dev.dictionary));
+    auto values = [&](uint16_t index, uint8_t sub) {
+        std::vector<int64_t> v;
+        const esi::EsiEntry* e = esi.objects.at(index).entry(sub);
+        EXPECT_NE(e, nullptr);
+        if (e == nullptr) return v;
+        for (const auto& [value, text] : e->enumeration) {
+            EXPECT_FALSE(text.empty());
+            v.push_back(value);
+        }
+        return v;
+    };
+    std::vector<int64_t> modes(od::kModesOfOperation.begin(), od::kModesOfOperation.end());
+    EXPECT_EQ(values(0x6060, 0), modes);
+    EXPECT_EQ(values(0x6061, 0), modes);
+    std::vector<int64_t> homing(od::kHomingMethods.begin(), od::kHomingMethods.end());
+    EXPECT_EQ(values(0x6098, 0), homing);
+    EXPECT_EQ(values(0x605A, 0), (std::vector<int64_t>{6}));
+    EXPECT_EQ(values(0x605E, 0), (std::vector<int64_t>{-1, 0, 1, 2}));
+    EXPECT_EQ(values(0x1C33, 1), (std::vector<int64_t>{1, 2, 34}));
+    EXPECT_EQ(esi.objects.at(0x6060).entry(0)->type, "SINT");
+    EXPECT_EQ(esi.objects.at(0x605E).entry(0)->type, "INT");
+    EXPECT_EQ(esi.objects.at(0x1C32).entry(1)->type, "UINT");
+    EXPECT_EQ(esi.objects.at(0x6060).entry(0)->enumeration.front().second, "Profile position mode");
+    // Every enumerated entry of the dictionary has its EnumInfo; no other entry has one.
+    unsigned enumerated = 0;
+    for (const od::Object& o : dev.dictionary.objects())
+        for (const od::Entry& e : o.entries) {
+            const esi::EsiEntry* x = esi.objects.at(o.index).entry(e.subindex);
+            ASSERT_NE(x, nullptr);
+            EXPECT_EQ(x->enumeration.size(), e.enumeration.size()) << std::hex << o.index;
+            enumerated += !e.enumeration.empty();
+        }
+    EXPECT_GE(enumerated, 10u);
 }
 
 TEST(EsiReader, RefusesWhatIsNotAnEsi) {

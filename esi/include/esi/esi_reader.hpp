@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace esi {
@@ -14,7 +15,9 @@ namespace esi {
 struct EsiEntry {
     uint8_t subindex = 0;
     std::string name;
-    std::string type;  // ESI type name (UINT, DINT, STRING(6), ...)
+    std::string type;  // ESI type name (UINT, DINT, STRING(6), ...); an enumerated type's base type
+    // An enumerated type's named values (DataType/EnumInfo: Enum, Text); empty otherwise.
+    std::vector<std::pair<int64_t, std::string>> enumeration;
     uint16_t bit_size = 0;
     uint16_t bit_offset = 0;
     std::string access;              // ro, rw, wo
