@@ -559,6 +559,24 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
     }
     for (int port = 0; port < 2; ++port)
         child(child(info, "Port"), "Type", "MII");  // kPhysicalPorts
+    if (!m.pdo_sets.empty()) {
+        // Where TwinCAT and the vendors' CiA 402 drives carry their predefined PDO sets.
+        xmlNodePtr twincat = child(child(info, "VendorSpecific"), "TwinCAT");
+        for (const PdoSetInfo& set : m.pdo_sets) {
+            xmlNodePtr alt = child(twincat, "AlternativeSmMapping");
+            if (set.is_default) attr(alt, "Default", "1");
+            child(alt, "Name", set.name);
+            for (const bool rx : {true, false}) {
+                const int sm = rx ? set.rx_sm : set.tx_sm;
+                const auto& pdos = rx ? set.rx : set.tx;
+                if (sm < 0 || pdos.empty()) continue;
+                xmlNodePtr n = child(alt, "Sm");
+                attr(n, "No", std::to_string(sm));
+                for (uint16_t p : pdos)
+                    child(n, "Pdo", hex_index(p));
+            }
+        }
+    }
     if (kIdentificationInAlStatusCode) child(info, "IdentificationReg134", "true");
     child(device, "GroupType", id.group_type);
 

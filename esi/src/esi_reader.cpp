@@ -134,6 +134,17 @@ EsiDevice read_device(Node dev, const std::map<std::string, DataType>& types_in,
     d.name = text(dev, "Name");
     d.group_type = text(dev, "GroupType");
     d.identification_reg134 = truthy(text(child(dev, "Info"), "IdentificationReg134"));
+    for (Node alt :
+         children(child(child(child(dev, "Info"), "VendorSpecific"), "TwinCAT"), "AlternativeSmMapping")) {
+        EsiPdoSet set;
+        set.name = text(alt, "Name");
+        set.is_default = truthy(attr(alt, "Default"));
+        for (Node sm : children(alt, "Sm"))
+            for (Node p : children(sm, "Pdo"))
+                set.sms[static_cast<int>(number(attr(sm, "No")))].push_back(
+                    static_cast<uint16_t>(number(text(p))));
+        d.pdo_sets.push_back(std::move(set));
+    }
     if (Node timeout = child(child(child(dev, "Info"), "Mailbox"), "Timeout")) {
         d.mailbox_request_timeout_ms = static_cast<uint32_t>(number(text(timeout, "RequestTimeout")));
         d.mailbox_response_timeout_ms = static_cast<uint32_t>(number(text(timeout, "ResponseTimeout")));

@@ -619,6 +619,13 @@ DeviceDescription default_drive_description() {
                 if (j != i) rule.exclude.push_back(static_cast<uint16_t>(base + j));
             d.pdo_rules.push_back(std::move(rule));
         }
+    // One predefined set per pair, named after the mode its mappings serve (7.2.6-7.2.13).
+    d.pdo_sets = {
+        {"Cyclic synchronous position (CSP)", {0x1600}, {0x1A00}},
+        {"Cyclic synchronous velocity (CSV)", {0x1601}, {0x1A01}},
+        {"Cyclic synchronous torque (CST)", {0x1602}, {0x1A02}},
+        {"Profile position / velocity (PPM, PVM)", {0x1603}, {0x1A03}},
+    };
     // A request leaves SM0 at the next poll; the slowest answer is a 0x1010 save (file write and fsync).
     d.mailbox_request_timeout_ms = 100;
     d.mailbox_response_timeout_ms = 2000;

@@ -3,6 +3,8 @@
 // Mandatory, Exclude and entries, the CoE flags, the diagnosis texts, the mailbox timeouts, the picture.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <set>
 
 #include "esi/esi.hpp"
@@ -183,6 +185,43 @@ TEST(EsiReadBackDrive, EnumeratedEntriesNameExactlyTheValuesTheDriveTakes) {
             enumerated += !e.enumeration.empty();
         }
     EXPECT_GE(enumerated, 10u);
+}
+
+// AlternativeSmMapping: one predefined set per cyclic mode; the default is what 0x1C12/0x1C13 hold by
+// default, and no set holds two PDOs that exclude each other (the slave would refuse that assignment).
+TEST(EsiReadBackDrive, PredefinedPdoSetsAreTheDescriptionsWithTheDefaultMarked) {
+    const esi_test::Device dev = esi_test::drive_device();
+    const esi::EsiDevice esi = esi::read_esi(esi::build_esi(dev.description, dev.dictionary));
+    ASSERT_EQ(esi.pdo_sets.size(), dev.description.pdo_sets.size());
+    ASSERT_GE(esi.pdo_sets.size(), 3u);
+    unsigned defaults = 0;
+    for (std::size_t i = 0; i < esi.pdo_sets.size(); ++i) {
+        const esi::EsiPdoSet& set = esi.pdo_sets[i];
+        EXPECT_EQ(set.name, dev.description.pdo_sets[i].name);
+        EXPECT_EQ(set.sms.at(2), dev.description.pdo_sets[i].rx);
+        EXPECT_EQ(set.sms.at(3), dev.description.pdo_sets[i].tx);
+        const bool is_default =
+            set.sms.at(2) == std::vector<uint16_t>{dev.dictionary.get<uint16_t>(0x1C12, 1)} &&
+            set.sms.at(3) == std::vector<uint16_t>{dev.dictionary.get<uint16_t>(0x1C13, 1)};
+        EXPECT_EQ(set.is_default, is_default) << set.name;
+        defaults += set.is_default;
+        for (const auto& [sm, pdos] : set.sms)
+            for (uint16_t p : pdos)
+                for (const auto* list : {&esi.rxpdos, &esi.txpdos})
+                    for (const auto& x : *list) {
+                        if (x.index != p) continue;
+                        for (uint16_t excluded : x.exclude) {
+                            EXPECT_EQ(std::count(pdos.begin(), pdos.end(), excluded), 0) << set.name;
+                        }
+                    }
+    }
+    EXPECT_EQ(defaults, 1u);
+    // A set naming a PDO the dictionary lacks is left out with a warning.
+    od::DeviceDescription d = dev.description;
+    d.pdo_sets.push_back({"broken", {0x1700}, {0x1A00}});
+    const esi::DeviceModel m = esi::derive_model(d, dev.dictionary);
+    EXPECT_EQ(m.pdo_sets.size(), dev.description.pdo_sets.size());
+    EXPECT_FALSE(m.warnings.empty());
 }
 
 TEST(EsiReader, RefusesWhatIsNotAnEsi) {

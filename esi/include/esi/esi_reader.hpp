@@ -83,12 +83,20 @@ struct EsiCoe {
     bool segmented_sdo = true;
 };
 
+// Info/VendorSpecific/TwinCAT/AlternativeSmMapping: a predefined PDO set.
+struct EsiPdoSet {
+    std::string name;
+    bool is_default = false;
+    std::map<int, std::vector<uint16_t>> sms;  // SyncManager number -> PDOs
+};
+
 struct EsiDevice {
     uint32_t vendor_id = 0;
     std::string vendor_name;
     uint32_t product_code = 0;
     uint32_t revision = 0;
     std::string type_name;  // <Type> text (order number)
+    std::vector<EsiPdoSet> pdo_sets;
     std::string name;
     std::string group_type;
     std::optional<uint32_t> profile_no;
