@@ -66,3 +66,12 @@ TEST(EcatctlFormat, SiiCrcCheckValue) {
     const uint8_t zeros[14] = {};
     EXPECT_NE(sii_crc(zeros), 0xFF);
 }
+
+// `pd` / `pd --all` say why a run failed at its end (issue 25: SAFEOP+ERR after a watchdog, exit 0 before).
+TEST(EcatctlFormat, EndStateSaysTheStateTheErrorAndTheAlStatusCode) {
+    EXPECT_EQ(end_state_text("SAFEOP", true, 0x001B, "Sync manager watchdog", "OP"),
+              "ended in SAFEOP+ERR, not OP, AL status code 0x001b (Sync manager watchdog)");
+    EXPECT_EQ(end_state_text("PREOP", false, 0, "", "SAFEOP"), "ended in PREOP, not SAFEOP");
+    EXPECT_EQ(end_state_text("", false, 0, "", "OP"),
+              "no AL status at the end (is the slave still there?), not OP");
+}

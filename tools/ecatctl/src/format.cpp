@@ -10,6 +10,19 @@
 
 namespace ecatctl {
 
+std::string end_state_text(std::string_view state, bool error, uint16_t code, std::string_view code_name,
+                           std::string_view wanted) {
+    const std::string not_wanted = ", not " + std::string(wanted);
+    if (state.empty()) return "no AL status at the end (is the slave still there?)" + not_wanted;
+    std::string text = "ended in " + std::string(state) + (error ? "+ERR" : "") + not_wanted;
+    if (!error) return text;
+    static const char* digits = "0123456789abcdef";
+    std::string hex = "0x";
+    for (int shift = 12; shift >= 0; shift -= 4)
+        hex += digits[(code >> shift) & 0xF];
+    return text + ", AL status code " + hex + " (" + std::string(code_name) + ")";
+}
+
 std::optional<uint64_t> parse_number(std::string_view text, uint64_t max) {
     int base = 10;
     if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {

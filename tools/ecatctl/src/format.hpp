@@ -10,6 +10,11 @@
 
 namespace ecatctl {
 
+// How a process-data run ended when not in the state asked for: "ended in SAFEOP+ERR, not OP, AL status
+// code 0x001b (Sync manager watchdog)"; an empty state name: the slave gave no AL status.
+std::string end_state_text(std::string_view state, bool error, uint16_t code, std::string_view code_name,
+                           std::string_view wanted);
+
 // Exit codes (also listed in `ecatctl --help`).
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitFailure = 1;       // anything not listed below
