@@ -75,3 +75,13 @@ TEST(EcatctlFormat, EndStateSaysTheStateTheErrorAndTheAlStatusCode) {
     EXPECT_EQ(end_state_text("", false, 0, "", "OP"),
               "no AL status at the end (is the slave still there?), not OP");
 }
+
+// `download` without --type encodes values by the entry's CoE type from SDO information.
+TEST(EcatctlFormat, ValueTypeOfCoeBasicTypes) {
+    EXPECT_EQ(value_type_of(0x0006), ValueType::U16);
+    EXPECT_EQ(value_type_of(0x0004), ValueType::I32);
+    EXPECT_EQ(value_type_of(0x0007), ValueType::U32);
+    EXPECT_EQ(value_type_of(0x0002), ValueType::I8);
+    EXPECT_EQ(value_type_of(0x0009), std::nullopt);  // VISIBLE_STRING: text
+    EXPECT_EQ(value_type_of(0x0029), std::nullopt);  // a structure
+}

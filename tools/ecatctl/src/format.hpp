@@ -29,6 +29,9 @@ std::optional<uint64_t> parse_number(std::string_view text, uint64_t max);
 
 enum class ValueType { U8, U16, U32, U64, I8, I16, I32, I64, F32, F64 };  // F32/F64: REAL32/REAL64
 std::optional<ValueType> parse_type(std::string_view name);
+// The value type of a CoE basic data type code (ETG.1000.6: 0x0001 BOOLEAN .. 0x001B UNSIGNED64); nullopt
+// for strings and structured types.
+std::optional<ValueType> value_type_of(uint16_t coe_type);
 std::size_t type_size(ValueType t);
 // Little-endian bytes -> "0x1234 (4660)" (REAL32/REAL64: the number, e.g. "1.5"); data.size() must be
 // type_size(t).
