@@ -15,6 +15,8 @@ uint32_t abort_code(od::Status s) {
             return abort::ReadOnly;
         case Status::WriteOnly:
             return abort::WriteOnly;
+        case Status::SubindexZeroFirst:
+            return abort::SubindexZeroFirst;
         case Status::LengthMismatch:
             return abort::LengthMismatch;
         case Status::LengthTooHigh:

@@ -56,6 +56,8 @@ od::Status check_mapping(const od::Dictionary& d, uint16_t pdo, const od::Entry&
                          std::span<const uint8_t> v, const PdoLimits& lim) {
     const bool rx = is_rx_mapping(pdo);
     if (e.subindex != 0) {
+        // ETG.1000.6 / ETG.1020: a mapping entry can be changed only while subindex 0 is 0.
+        if (u8(d, pdo, 0) != 0) return od::Status::SubindexZeroFirst;
         if (v.size() != 4) return od::Status::LengthMismatch;
         return check_mapping_entry(d, rx, wire::get32(v, 0));
     }
@@ -85,14 +87,14 @@ bool valid_pdo_for(const od::Dictionary& d, uint16_t assign, uint16_t pdo) {
     return range && d.find(pdo) != nullptr;
 }
 
-// The PDOs an assignment holds with `count` entries, entry `changed` (0: none) reading `changed_pdo`.
-od::Status rules_after(const od::Dictionary& d, uint16_t assign, uint8_t count, uint8_t changed,
-                       uint16_t changed_pdo, std::span<const od::PdoRule> rules) {
+// The PDOs an assignment holds with `count` entries.
+od::Status rules_after(const od::Dictionary& d, uint16_t assign, uint8_t count,
+                       std::span<const od::PdoRule> rules) {
     if (rules.empty()) return od::Status::Ok;
     std::array<uint16_t, 255> pdos{};
     std::size_t n = 0;
     for (uint8_t s = 1; s <= count && s != 0; ++s)
-        pdos[n++] = s == changed ? changed_pdo : u16(d, assign, s);
+        pdos[n++] = u16(d, assign, s);
     return check_pdo_rules(assign, std::span<const uint16_t>(pdos.data(), n), rules);
 }
 
@@ -100,12 +102,11 @@ od::Status check_assignment(const od::Dictionary& d, uint16_t assign, const od::
                             std::span<const uint8_t> v, const PdoLimits& lim,
                             std::span<const od::PdoRule> rules) {
     if (e.subindex != 0) {
+        // ETG.1000.6 / ETG.1020: the assignment, like a mapping, is changed only while subindex 0 is 0.
+        if (u8(d, assign, 0) != 0) return od::Status::SubindexZeroFirst;
         if (v.size() != 2) return od::Status::LengthMismatch;
         uint16_t pdo = wire::get16(v, 0);
         if (pdo != 0 && !valid_pdo_for(d, assign, pdo)) return od::Status::InvalidValue;
-        // An entry inside the current count changes the assignment in force.
-        const uint8_t count = u8(d, assign, 0);
-        if (e.subindex <= count) return rules_after(d, assign, count, e.subindex, pdo, rules);
         return od::Status::Ok;
     }
     if (v.size() != 1) return od::Status::LengthMismatch;
@@ -120,7 +121,7 @@ od::Status check_assignment(const od::Dictionary& d, uint16_t assign, const od::
             if (u16(d, assign, t) == pdo) return od::Status::InvalidValue;  // assigned twice
     }
     if (assigned_bytes(d, assign, n, 0, 0) > lim.max_sm_bytes) return od::Status::PdoLengthExceeded;
-    return rules_after(d, assign, n, 0, 0, rules);
+    return rules_after(d, assign, n, rules);
 }
 
 }  // namespace

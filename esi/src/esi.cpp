@@ -44,6 +44,14 @@ std::string hex_index(uint16_t v) {
     return b;
 }
 
+// `digits` upper-case hex digits of v.
+std::string hex_digits(uint32_t v, int digits) {
+    std::string s;
+    for (int shift = 4 * (digits - 1); shift >= 0; shift -= 4)
+        s += "0123456789ABCDEF"[(v >> shift) & 0xF];
+    return s;
+}
+
 std::string hex_bytes(const uint8_t* p, std::size_t n) {
     static const char* digits = "0123456789abcdef";
     std::string s;
@@ -200,13 +208,28 @@ void value_info(xmlNodePtr info, const Entry& e) {
 
 // ---- Data types --------------------------------------------------------------------------------------
 
+// An enumerated entry's type: its base type with the named values (ETG.2000 DataType/EnumInfo).
+struct EnumType {
+    std::string base;
+    uint32_t bits = 0;
+    const std::vector<od::NamedValue>* values = nullptr;
+};
+
 struct TypeSet {
-    std::map<std::string, uint32_t> base;  // name -> bit size (scalars and strings)
+    std::map<std::string, uint32_t> base;   // name -> bit size (scalars and strings)
+    std::map<std::string, EnumType> enums;  // "DT6060EN08" -> base type and values
     std::string use(const Entry& e) {
         const std::string n = esi_type_name(e.type, e.bit_length);
         if (e.type == DataType::OctetString) base["BYTE"] = 8;
-        base[n] = od::is_string(e.type) ? e.bit_length : (e.bit_length ? e.bit_length : od::bit_size(e.type));
-        return n;
+        const uint32_t bits =
+            od::is_string(e.type) ? e.bit_length : (e.bit_length ? e.bit_length : od::bit_size(e.type));
+        base[n] = bits;
+        if (e.enumeration.empty() || od::is_string(e.type)) return n;
+        // Named as vendors name them: DT, the index (and subindex if not 0), EN, the bit size.
+        std::string name = "DT" + hex_digits(e.index, 4) + (e.subindex ? hex_digits(e.subindex, 2) : "") +
+                           "EN" + (bits < 10 ? "0" : "") + std::to_string(bits);
+        enums[name] = EnumType{n, bits, &e.enumeration};
+        return name;
     }
 };
 
@@ -229,6 +252,12 @@ std::string sub_name(unsigned sub) {
     char b[16];
     std::snprintf(b, sizeof b, "SubIndex %03u", sub);
     return b;
+}
+
+// An array's SubItem name: subindex 0 is named as the dictionary (and so SDO information) names it, the
+// elements "SubIndex nnn" as configuration tools list them.
+std::string array_item_name(const Entry& e) {
+    return e.subindex == 0 && !e.name.empty() ? e.name : sub_name(e.subindex);
 }
 
 // Record-style SubItem names: the entry names, made unique (the XSD keys SubItems by Name).
@@ -299,7 +328,7 @@ std::string structured_type(xmlNodePtr types, const Object& o, TypeSet& ts, uint
         xmlNodePtr dt = child(types, "DataType");
         child(dt, "Name", name);
         child(dt, "BitSize", std::to_string(bits));
-        sub_item(dt, &si0, sub_name(0), si0_type, si0.bit_length, 0, si0);
+        sub_item(dt, &si0, array_item_name(si0), si0_type, si0.bit_length, 0, si0);
         sub_item(dt, nullptr, "Elements", name + "ARR", arr_bits, elements_offs, el);
         return name;
     }
@@ -352,7 +381,7 @@ void dictionary(xmlNodePtr profile, const od::Dictionary& dict) {
         const auto names = record_item_names(o);
         for (std::size_t i = 0; i < o.entries.size(); ++i) {
             xmlNodePtr si = child(info, "SubItem");
-            child(si, "Name", array ? sub_name(o.entries[i].subindex) : names[i]);
+            child(si, "Name", array ? array_item_name(o.entries[i]) : names[i]);
             value_info(child(si, "Info"), o.entries[i]);
         }
         xmlNodePtr flags = child(obj, "Flags");
@@ -370,7 +399,18 @@ void dictionary(xmlNodePtr profile, const od::Dictionary& dict) {
             child(ai, "Elements", std::to_string(bits / 8));
         }
     }
-    // Move the structured types behind the base types.
+    for (const auto& [name, t] : ts.enums) {
+        xmlNodePtr dt = child(types, "DataType");
+        child(dt, "Name", name);
+        child(dt, "BaseType", t.base);
+        child(dt, "BitSize", std::to_string(t.bits));
+        for (const od::NamedValue& v : *t.values) {
+            xmlNodePtr en = child(dt, "EnumInfo");
+            named(en, "Text", v.text);
+            child(en, "Enum", std::to_string(v.value));
+        }
+    }
+    // Move the structured types behind the base and enumerated types.
     for (xmlNodePtr n = structured->children; n != nullptr;) {
         xmlNodePtr next = n->next;
         xmlUnlinkNode(n);
@@ -519,6 +559,24 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
     }
     for (int port = 0; port < 2; ++port)
         child(child(info, "Port"), "Type", "MII");  // kPhysicalPorts
+    if (!m.pdo_sets.empty()) {
+        // Where TwinCAT and the vendors' CiA 402 drives carry their predefined PDO sets.
+        xmlNodePtr twincat = child(child(info, "VendorSpecific"), "TwinCAT");
+        for (const PdoSetInfo& set : m.pdo_sets) {
+            xmlNodePtr alt = child(twincat, "AlternativeSmMapping");
+            if (set.is_default) attr(alt, "Default", "1");
+            child(alt, "Name", set.name);
+            for (const bool rx : {true, false}) {
+                const int sm = rx ? set.rx_sm : set.tx_sm;
+                const auto& pdos = rx ? set.rx : set.tx;
+                if (sm < 0 || pdos.empty()) continue;
+                xmlNodePtr n = child(alt, "Sm");
+                attr(n, "No", std::to_string(sm));
+                for (uint16_t p : pdos)
+                    child(n, "Pdo", hex_index(p));
+            }
+        }
+    }
     if (kIdentificationInAlStatusCode) child(info, "IdentificationReg134", "true");
     child(device, "GroupType", id.group_type);
 

@@ -89,7 +89,16 @@ struct DataType {
         bool backup = false, setting = false;
     };
     std::vector<Sub> subs;
+    std::vector<std::pair<int64_t, std::string>> enums;  // EnumInfo
 };
+
+// An entry of an enumerated type (a DataType with BaseType and EnumInfo) gets the base type and the values.
+void resolve_enum(EsiEntry& e, const std::map<std::string, DataType>& types) {
+    auto it = types.find(e.type);
+    if (it == types.end() || it->second.enums.empty() || it->second.base.empty()) return;
+    e.enumeration = it->second.enums;
+    e.type = it->second.base;
+}
 
 void read_flags(Node flags, std::string& access, std::string& restrictions, std::string& pdo, bool& backup,
                 bool& setting) {
@@ -127,6 +136,17 @@ EsiDevice read_device(Node dev, const std::map<std::string, DataType>& types_in,
     d.name = text(dev, "Name");
     d.group_type = text(dev, "GroupType");
     d.identification_reg134 = truthy(text(child(dev, "Info"), "IdentificationReg134"));
+    for (Node alt :
+         children(child(child(child(dev, "Info"), "VendorSpecific"), "TwinCAT"), "AlternativeSmMapping")) {
+        EsiPdoSet set;
+        set.name = text(alt, "Name");
+        set.is_default = truthy(attr(alt, "Default"));
+        for (Node sm : children(alt, "Sm"))
+            for (Node p : children(sm, "Pdo"))
+                set.sms[static_cast<int>(number(attr(sm, "No")))].push_back(
+                    static_cast<uint16_t>(number(text(p))));
+        d.pdo_sets.push_back(std::move(set));
+    }
     if (Node timeout = child(child(child(dev, "Info"), "Mailbox"), "Timeout")) {
         d.mailbox_request_timeout_ms = static_cast<uint32_t>(number(text(timeout, "RequestTimeout")));
         d.mailbox_response_timeout_ms = static_cast<uint32_t>(number(text(timeout, "ResponseTimeout")));
@@ -148,6 +168,8 @@ EsiDevice read_device(Node dev, const std::map<std::string, DataType>& types_in,
                 t.lbound = number(text(ai, "LBound"));
                 t.elements = number(text(ai, "Elements"));
             }
+            for (Node en : children(dt, "EnumInfo"))
+                t.enums.emplace_back(number(text(en, "Enum")), text(en, "Text"));
             for (Node si : children(dt, "SubItem")) {
                 DataType::Sub s;
                 if (Node x = child(si, "SubIdx")) s.subidx = static_cast<int>(number(text(x)));
@@ -183,6 +205,8 @@ EsiDevice read_device(Node dev, const std::map<std::string, DataType>& types_in,
                 e.backup = obackup;
                 e.setting = osetting;
                 read_info(info, e);
+                resolve_enum(e, types);
+                o.type = e.type;  // a VAR of an enumerated type: its base type
                 o.entries.push_back(e);
             } else {
                 const DataType& t = it->second;
@@ -221,6 +245,7 @@ EsiDevice read_device(Node dev, const std::map<std::string, DataType>& types_in,
                         e.pdo_mapping = s.pdo_mapping;
                         e.backup = s.backup;
                         e.setting = s.setting;
+                        resolve_enum(e, types);
                         o.entries.push_back(e);
                     }
                 }

@@ -194,6 +194,43 @@ DeviceModel derive_model(const od::DeviceDescription& d, const od::Dictionary& d
         m.sync_managers.push_back(si);
     }
 
+    // ---- Predefined PDO sets (AlternativeSmMapping): PDOs of their direction, within the PDO rules ----
+    int rx_sm = -1, tx_sm = -1;
+    for (std::size_t n = 0; n < m.sync_managers.size(); ++n) {
+        if (m.sync_managers[n].kind == od::SmKind::Outputs && rx_sm < 0) rx_sm = static_cast<int>(n);
+        if (m.sync_managers[n].kind == od::SmKind::Inputs && tx_sm < 0) tx_sm = static_cast<int>(n);
+    }
+    std::vector<uint16_t> default_rx, default_tx;
+    for (const auto& p : m.pdos)
+        if (p.sm >= 0) (p.rx ? default_rx : default_tx).push_back(p.index);
+    for (const od::PdoSet& set : d.pdo_sets) {
+        PdoSetInfo info{set.name, false, rx_sm, tx_sm, {}, {}};
+        bool ok = true;
+        for (const bool rx : {true, false})
+            for (uint16_t index : rx ? set.rx : set.tx) {
+                const PdoInfo* found = nullptr;
+                for (const auto& p : m.pdos)
+                    if (p.index == index && p.rx == rx) found = &p;
+                if (found == nullptr) {
+                    m.warnings.push_back("PDO set '" + set.name + "' names " + hex4(index) + ", not an " +
+                                         (rx ? "RxPDO" : "TxPDO") + " of this dictionary");
+                    ok = false;
+                    continue;
+                }
+                for (uint16_t x : found->exclude)
+                    for (uint16_t other : rx ? set.rx : set.tx)
+                        if (other == x) {
+                            m.warnings.push_back("PDO set '" + set.name + "' holds " + hex4(index) + " and " +
+                                                 hex4(x) + ", which exclude each other");
+                            ok = false;
+                        }
+                (rx ? info.rx : info.tx).push_back(index);
+            }
+        if (!ok) continue;
+        info.is_default = info.rx == default_rx && info.tx == default_tx;
+        m.pdo_sets.push_back(std::move(info));
+    }
+
     // ---- FMMUs: one per process-data direction, one for the mailbox status ----
     auto has = [&](od::SmKind k) {
         for (const auto& s : m.sync_managers)

@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "od/drive_objects.hpp"
+#include "od/value_names.hpp"
 #include "util/strfmt.hpp"
 
 namespace od {
@@ -496,6 +497,45 @@ Number parse_number(std::string_view s, DataType t, uint16_t index) {
     return u;
 }
 
+// The values an enumerated entry takes: its value set, a display's the value set of what it displays, or
+// the range of its limits. Each must have a name (od/value_names.hpp), so the ESI names every value the
+// drive accepts and no other.
+std::vector<NamedValue> enumeration_of(const Entry& e) {
+    if (!has_value_names(e.index, e.subindex)) return {};
+    uint16_t index = e.index;
+    uint8_t sub = e.subindex;
+    if (index == obj::ModesOfOperationDisplay.index && sub == obj::ModesOfOperationDisplay.sub)
+        index = obj::ModesOfOperation.index, sub = obj::ModesOfOperation.sub;
+    std::vector<int64_t> values;
+    for (const ValueSet& vs : kValueSets)
+        if (vs.index == index && vs.sub == sub) values.assign(vs.values, vs.values + vs.count);
+    if (values.empty()) {
+        const auto* lo = std::get_if<int64_t>(&e.minimum);
+        const auto* hi = std::get_if<int64_t>(&e.maximum);
+        const auto* ulo = std::get_if<uint64_t>(&e.minimum);
+        const auto* uhi = std::get_if<uint64_t>(&e.maximum);
+        const int64_t a = lo ? *lo : (ulo ? static_cast<int64_t>(*ulo) : 0);
+        const int64_t b = hi ? *hi : (uhi ? static_cast<int64_t>(*uhi) : -1);
+        if ((lo || ulo) && (hi || uhi) && b - a < 256)
+            for (int64_t v = a; v <= b; ++v)
+                values.push_back(v);
+    }
+    std::string where = "0x";
+    for (int shift = 12; shift >= 0; shift -= 4)
+        where += "0123456789ABCDEF"[(e.index >> shift) & 0xF];
+    where += ":" + std::to_string(e.subindex);
+    if (values.empty())
+        throw std::logic_error("od: " + where + " has value names but no value set or limits");
+    std::vector<NamedValue> out;
+    for (int64_t v : values) {
+        const std::string_view text = value_name(e.index, e.subindex, v);
+        if (text.empty())
+            throw std::logic_error("od: " + where + " takes " + std::to_string(v) + " but it has no name");
+        out.push_back({v, std::string(text)});
+    }
+    return out;
+}
+
 Entry make_entry(const Line& l, const Identity& id) {
     Entry e;
     e.index = l.index;
@@ -514,6 +554,7 @@ Entry make_entry(const Line& l, const Identity& id) {
         e.default_value = *declared;
         e.minimum = parse_number(l.min, l.type, l.index);
         e.maximum = parse_number(l.max, l.type, l.index);
+        e.enumeration = enumeration_of(e);
         return e;
     }
     if (is_string(l.type)) {
@@ -525,6 +566,7 @@ Entry make_entry(const Line& l, const Identity& id) {
         e.default_value = parse_number(def, l.type, l.index);
         e.minimum = parse_number(l.min, l.type, l.index);
         e.maximum = parse_number(l.max, l.type, l.index);
+        e.enumeration = enumeration_of(e);
     }
     return e;
 }
@@ -579,6 +621,13 @@ DeviceDescription default_drive_description() {
                 if (j != i) rule.exclude.push_back(static_cast<uint16_t>(base + j));
             d.pdo_rules.push_back(std::move(rule));
         }
+    // One predefined set per pair, named after the mode its mappings serve (7.2.6-7.2.13).
+    d.pdo_sets = {
+        {"Cyclic synchronous position (CSP)", {0x1600}, {0x1A00}},
+        {"Cyclic synchronous velocity (CSV)", {0x1601}, {0x1A01}},
+        {"Cyclic synchronous torque (CST)", {0x1602}, {0x1A02}},
+        {"Profile position / velocity (PPM, PVM)", {0x1603}, {0x1A03}},
+    };
     // A request leaves SM0 at the next poll; the slowest answer is a 0x1010 save (file write and fsync).
     d.mailbox_request_timeout_ms = 100;
     d.mailbox_response_timeout_ms = 2000;

@@ -14,6 +14,8 @@ std::string_view to_string(Status s) {
             return "attempt to write a read-only object";
         case Status::WriteOnly:
             return "attempt to read a write-only object";
+        case Status::SubindexZeroFirst:
+            return "subindex 0 must be 0 for write access";
         case Status::LengthMismatch:
             return "length of service parameter does not match";
         case Status::LengthTooHigh:

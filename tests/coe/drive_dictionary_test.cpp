@@ -68,7 +68,10 @@ TEST_F(DriveDictionary, RemapAndCompleteAccessDownloadOfThePdoObjects) {
     EXPECT_EQ(coe::mapped_bits(dict, 0x1600), 48u);
     EXPECT_EQ(ask(sdo(0x33, 0x1C12, 0, 0x16000001)), (Bytes{0x00, 0x30, 0x70, 0x12, 0x1C, 0x00, 0, 0, 0, 0}));
     EXPECT_EQ(dict.get<uint8_t>(0x1C12, 0), 1);
+    // An entry while the count is 2: subindex 0 must be 0 first (ETG.1000.6).
+    EXPECT_EQ(ask(sdo(0x23, 0x1600, 1, 0x60400010)), abort_reply(0x1600, 1, 0x06010003));
     // Statusword is not an RxPDO object.
+    EXPECT_EQ(ask(sdo(0x2F, 0x1600, 0, 0)), (Bytes{0x00, 0x30, 0x60, 0x00, 0x16, 0x00, 0, 0, 0, 0}));
     EXPECT_EQ(ask(sdo(0x23, 0x1600, 1, 0x60410010)), abort_reply(0x1600, 1, 0x06040041));
     state = od::AlState::Op;
     EXPECT_EQ(ask(sdo(0x2F, 0x1C12, 0, 0)), abort_reply(0x1C12, 0, 0x08000022));

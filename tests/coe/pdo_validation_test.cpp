@@ -52,6 +52,8 @@ TEST_F(PdoChecks, MasterRemapSequenceIsAccepted) {
 }
 
 TEST_F(PdoChecks, MappingEntriesMustBeMappableInTheirDirectionWithTheirLength) {
+    EXPECT_EQ(write(0x1600, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1A00, 0, 0, 1), 0u);
     EXPECT_EQ(write(0x1600, 1, 0x60410010, 4), 0x06040041u);  // TxPDO-only object in an RxPDO
     EXPECT_EQ(write(0x1A00, 1, 0x60400010, 4), 0x06040041u);  // RxPDO-only object in a TxPDO
     EXPECT_EQ(write(0x1600, 1, 0x60400020, 4), 0x06040041u);  // wrong bit length
@@ -93,6 +95,8 @@ TEST_F(PdoChecks, PdoLongerThanTheSyncManagerIsRefused) {
 }
 
 TEST_F(PdoChecks, AssignmentOnlyTakesMappingObjectsOfItsDirection) {
+    EXPECT_EQ(write(0x1C12, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1C13, 0, 0, 1), 0u);
     EXPECT_EQ(write(0x1C12, 1, 0x1A00, 2), 0x06090030u);
     EXPECT_EQ(write(0x1C12, 1, 0x1602, 2), 0x06090030u);  // not declared
     EXPECT_EQ(write(0x1C13, 1, 0x1600, 2), 0x06090030u);
@@ -160,9 +164,36 @@ TEST_F(DrivePdoRules, TwoRxPdosThatExcludeEachOtherAreRefusedWithIncompatible) {
     EXPECT_EQ(write(0x1C12, 2, 0x1603, 2), 0u);  // beyond the count: not in force yet
     EXPECT_EQ(write(0x1C12, 0, 2, 1), 0x06040043u);
     EXPECT_EQ(write(0x1C12, 0, 1, 1), 0u);
-    // Within the count, an entry replaces the PDO in force: still one PDO, accepted.
-    EXPECT_EQ(write(0x1C12, 1, 0x1601, 2), 0u);
-    EXPECT_EQ(dict.get<uint16_t>(0x1C12, 1), 0x1601u);
+    // Within the count, an entry cannot replace the PDO in force (subindex 0 must be 0 first).
+    EXPECT_EQ(write(0x1C12, 1, 0x1601, 2), 0x06010003u);
+    EXPECT_EQ(dict.get<uint16_t>(0x1C12, 1), 0x1602u);
+}
+
+// ETG.1000.6 / ETG.1020: the entries of a PDO mapping or assignment object can be written only while its
+// subindex 0 is 0 (abort 0x06010003); the class, over every such object the drive declares.
+TEST_F(DrivePdoRules, EntriesOfEveryMappingAndAssignmentObjectNeedSubindexZeroAtZero) {
+    unsigned checked = 0;
+    for (const od::Object& o : dict.objects()) {
+        const bool mapping =
+            (o.index >= 0x1600 && o.index <= 0x17FF) || (o.index >= 0x1A00 && o.index <= 0x1BFF);
+        const bool assign = o.index == 0x1C12 || o.index == 0x1C13;
+        if (!mapping && !assign) continue;
+        SCOPED_TRACE(o.index);
+        const uint8_t bytes = mapping ? 4 : 2;
+        const uint8_t count = dict.get<uint8_t>(o.index, 0);
+        ASSERT_NE(count, 0u) << "the drive's default mappings and assignments are not empty";
+        const uint32_t value = mapping ? dict.get<uint32_t>(o.index, 1) : dict.get<uint16_t>(o.index, 1);
+        // The same value as it holds, within and beyond the count: refused while subindex 0 is not 0.
+        EXPECT_EQ(write(o.index, 1, value, bytes), 0x06010003u);
+        EXPECT_EQ(write(o.index, o.max_subindex(), value, bytes), 0x06010003u);
+        EXPECT_EQ(dict.get<uint8_t>(o.index, 0), count);
+        // With subindex 0 at 0 the same writes are taken, and the count can be set back.
+        EXPECT_EQ(write(o.index, 0, 0, 1), 0u);
+        EXPECT_EQ(write(o.index, 1, value, bytes), 0u);
+        EXPECT_EQ(write(o.index, 0, count, 1), 0u);
+        ++checked;
+    }
+    EXPECT_EQ(checked, 10u);  // 0x1600-0x1603, 0x1A00-0x1A03, 0x1C12, 0x1C13
 }
 
 TEST_F(DrivePdoRules, TxPdosFollowTheSameRule) {

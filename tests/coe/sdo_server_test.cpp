@@ -300,8 +300,8 @@ TEST_F(SdoServer, AbortWrongState08000022) {
 
 TEST_F(SdoServer, AbortNotMappable06040041AndPdoLength06040042) {
     coe::install_pdo_validators(dict, coe::PdoLimits{4});
-    EXPECT_EQ(ask(sdo(0x23, 0x1600, 1, 0x60410010)), abort_reply(0x1600, 1, 0x06040041));
     EXPECT_EQ(ask(sdo(0x2F, 0x1600, 0, 0)), (Bytes{0x00, 0x30, 0x60, 0x00, 0x16, 0x00, 0, 0, 0, 0}));
+    EXPECT_EQ(ask(sdo(0x23, 0x1600, 1, 0x60410010)), abort_reply(0x1600, 1, 0x06040041));
     // 0x6040 (16) + 0x607A (32) = 6 bytes > 4.
     EXPECT_EQ(ask(sdo(0x2F, 0x1600, 0, 2)), abort_reply(0x1600, 0, 0x06040042));
 }

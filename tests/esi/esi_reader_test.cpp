@@ -3,12 +3,15 @@
 // Mandatory, Exclude and entries, the CoE flags, the diagnosis texts, the mailbox timeouts, the picture.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <set>
 
 #include "esi/esi.hpp"
 #include "esi/esi_reader.hpp"
 #include "esi/model.hpp"
 #include "od/diag_texts.hpp"
+#include "od/drive_objects.hpp"
 #include "test_device.hpp"
 
 namespace {
@@ -142,6 +145,83 @@ TEST(EsiReadBackDrive, DiagMessagesCoverEveryTextIdWithTheWholeText) {
     EXPECT_EQ(esi.sms[0].min_size, dev.description.standard_mailbox.out_size);
     EXPECT_EQ(esi.sms[0].max_size, dev.description.standard_mailbox.out_size);
     EXPECT_EQ(esi.sms[2].max_size, 160u);
+}
+
+// EnumInfo: a configuration tool names the modes, option codes and homing methods; each enumerated entry
+// lists exactly the values the drive accepts (its value set or limits), read back with its base type.
+TEST(EsiReadBackDrive, EnumeratedEntriesNameExactlyTheValuesTheDriveTakes) {
+    const esi_test::Device dev = esi_test::drive_device();
+    const esi::EsiDevice esi = esi::read_esi(esi::build_esi(dev.description, dev.dictionary));
+    auto values = [&](uint16_t index, uint8_t sub) {
+        std::vector<int64_t> v;
+        const esi::EsiEntry* e = esi.objects.at(index).entry(sub);
+        EXPECT_NE(e, nullptr);
+        if (e == nullptr) return v;
+        for (const auto& [value, text] : e->enumeration) {
+            EXPECT_FALSE(text.empty());
+            v.push_back(value);
+        }
+        return v;
+    };
+    std::vector<int64_t> modes(od::kModesOfOperation.begin(), od::kModesOfOperation.end());
+    EXPECT_EQ(values(0x6060, 0), modes);
+    EXPECT_EQ(values(0x6061, 0), modes);
+    std::vector<int64_t> homing(od::kHomingMethods.begin(), od::kHomingMethods.end());
+    EXPECT_EQ(values(0x6098, 0), homing);
+    EXPECT_EQ(values(0x605A, 0), (std::vector<int64_t>{6}));
+    EXPECT_EQ(values(0x605E, 0), (std::vector<int64_t>{-1, 0, 1, 2}));
+    EXPECT_EQ(values(0x1C33, 1), (std::vector<int64_t>{1, 2, 34}));
+    EXPECT_EQ(esi.objects.at(0x6060).entry(0)->type, "SINT");
+    EXPECT_EQ(esi.objects.at(0x605E).entry(0)->type, "INT");
+    EXPECT_EQ(esi.objects.at(0x1C32).entry(1)->type, "UINT");
+    EXPECT_EQ(esi.objects.at(0x6060).entry(0)->enumeration.front().second, "Profile position mode");
+    // Every enumerated entry of the dictionary has its EnumInfo; no other entry has one.
+    unsigned enumerated = 0;
+    for (const od::Object& o : dev.dictionary.objects())
+        for (const od::Entry& e : o.entries) {
+            const esi::EsiEntry* x = esi.objects.at(o.index).entry(e.subindex);
+            ASSERT_NE(x, nullptr);
+            EXPECT_EQ(x->enumeration.size(), e.enumeration.size()) << std::hex << o.index;
+            enumerated += !e.enumeration.empty();
+        }
+    EXPECT_GE(enumerated, 10u);
+}
+
+// AlternativeSmMapping: one predefined set per cyclic mode; the default is what 0x1C12/0x1C13 hold by
+// default, and no set holds two PDOs that exclude each other (the slave would refuse that assignment).
+TEST(EsiReadBackDrive, PredefinedPdoSetsAreTheDescriptionsWithTheDefaultMarked) {
+    const esi_test::Device dev = esi_test::drive_device();
+    const esi::EsiDevice esi = esi::read_esi(esi::build_esi(dev.description, dev.dictionary));
+    ASSERT_EQ(esi.pdo_sets.size(), dev.description.pdo_sets.size());
+    ASSERT_GE(esi.pdo_sets.size(), 3u);
+    unsigned defaults = 0;
+    for (std::size_t i = 0; i < esi.pdo_sets.size(); ++i) {
+        const esi::EsiPdoSet& set = esi.pdo_sets[i];
+        EXPECT_EQ(set.name, dev.description.pdo_sets[i].name);
+        EXPECT_EQ(set.sms.at(2), dev.description.pdo_sets[i].rx);
+        EXPECT_EQ(set.sms.at(3), dev.description.pdo_sets[i].tx);
+        const bool is_default =
+            set.sms.at(2) == std::vector<uint16_t>{dev.dictionary.get<uint16_t>(0x1C12, 1)} &&
+            set.sms.at(3) == std::vector<uint16_t>{dev.dictionary.get<uint16_t>(0x1C13, 1)};
+        EXPECT_EQ(set.is_default, is_default) << set.name;
+        defaults += set.is_default;
+        for (const auto& [sm, pdos] : set.sms)
+            for (uint16_t p : pdos)
+                for (const auto* list : {&esi.rxpdos, &esi.txpdos})
+                    for (const auto& x : *list) {
+                        if (x.index != p) continue;
+                        for (uint16_t excluded : x.exclude) {
+                            EXPECT_EQ(std::count(pdos.begin(), pdos.end(), excluded), 0) << set.name;
+                        }
+                    }
+    }
+    EXPECT_EQ(defaults, 1u);
+    // A set naming a PDO the dictionary lacks is left out with a warning.
+    od::DeviceDescription d = dev.description;
+    d.pdo_sets.push_back({"broken", {0x1700}, {0x1A00}});
+    const esi::DeviceModel m = esi::derive_model(d, dev.dictionary);
+    EXPECT_EQ(m.pdo_sets.size(), dev.description.pdo_sets.size());
+    EXPECT_FALSE(m.warnings.empty());
 }
 
 TEST(EsiReader, RefusesWhatIsNotAnEsi) {

@@ -298,6 +298,23 @@ TEST_P(EsiDevice, EveryObjectAndSubindexAppearsWithTypeAccessMappingAndDefault) 
         EXPECT_EQ(types.count(name), 0u) << "duplicate data type " << name;
         types[name] = t;
     }
+    // An entry's type: its base type, or for an enumerated entry a DataType with that base type and an
+    // EnumInfo for each named value the entry takes, in order.
+    auto check_type = [&](const std::string& name, const od::Entry& e) {
+        if (e.enumeration.empty()) {
+            EXPECT_EQ(name, expected_type(e));
+            return;
+        }
+        ASSERT_EQ(types.count(name), 1u) << name;
+        xmlNodePtr t = types[name];
+        EXPECT_EQ(text(first(t, "BaseType")), expected_type(e));
+        const auto enums = all(t, "EnumInfo");
+        ASSERT_EQ(enums.size(), e.enumeration.size()) << name;
+        for (std::size_t k = 0; k < enums.size(); ++k) {
+            EXPECT_EQ(text(first(enums[k], "Text")), e.enumeration[k].text);
+            EXPECT_EQ(std::stoll(text(first(enums[k], "Enum"))), e.enumeration[k].value);
+        }
+    };
     std::map<uint16_t, xmlNodePtr> objects;
     for (xmlNodePtr o : all(first(dictionary, "Objects"), "Object"))
         objects[static_cast<uint16_t>(hexdec(text(first(o, "Index"))))] = o;
@@ -315,7 +332,7 @@ TEST_P(EsiDevice, EveryObjectAndSubindexAppearsWithTypeAccessMappingAndDefault) 
         xmlNodePtr dt = types[type];
         if (o.code == od::ObjectCode::Var) {
             const od::Entry& e = o.entries.at(0);
-            EXPECT_EQ(type, expected_type(e));
+            check_type(type, e);
             EXPECT_EQ(std::stoul(text(first(x, "BitSize"))), e.bit_length);
             EXPECT_EQ(std::stoul(text(first(dt, "BitSize"))), e.bit_length);
             EXPECT_EQ(access_from(first(x, "Flags")),
@@ -359,7 +376,7 @@ TEST_P(EsiDevice, EveryObjectAndSubindexAppearsWithTypeAccessMappingAndDefault) 
                 EXPECT_EQ(std::stoul(text(first(arr, "BitSize"))), n * e.bit_length);
                 item_access = access_from(first(elements, "Flags"));
             }
-            EXPECT_EQ(item_type, expected_type(e));
+            check_type(item_type, e);
             EXPECT_EQ(types.count(item_type), 1u) << item_type;
             EXPECT_EQ(item_access, e.access & (a::RW | a::RxPdo | a::TxPdo | a::Backup | a::Settings));
             check_value(first(infos[i], "Info"), e, "value");

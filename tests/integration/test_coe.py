@@ -42,12 +42,27 @@ class CoeAndState(unittest.TestCase):
         self.assertTrue(r.stdout.strip(), r.stdout)
 
     def test_download_then_upload(self):
+        # A mapping entry is written while subindex 0 is 0 (ETG.1000.6); the slave refuses it before.
+        r = self.bus.ecatctl("download", "0", "0x1600", "1", "0x607A0020", "--type", "u32", check=False)
+        self.assertIn("0x06010003", r.stderr)
+        self.bus.ecatctl("download", "0", "0x1600", "0", "0", "--type", "u8")
         self.bus.ecatctl("download", "0", "0x1600", "1", "0x607A0020", "--type", "u32")
         self.assertEqual(self.bus.ecatctl("upload", "0", "0x1600", "1").stdout.strip(), "0x607a0020 (1618608160)")
         # Complete access is decoded per subindex with the names and types from SDO information.
         r = self.bus.ecatctl("upload", "0", "0x1600", "0", "--complete")
         self.assertTrue(r.stdout.startswith("0x1600:00 "), r.stdout)
         self.assertRegex(r.stdout, r"(?m)^0x1600:01 .* = 0x607a0020 \(1618608160\)$")
+
+    def test_download_takes_the_type_from_sdo_information(self):
+        # Without --type a value wider than a byte is encoded as the entry's type (here INTEGER32), as upload
+        # decodes it; a value that does not fit the type is a usage error before anything is written.
+        before = self.bus.ecatctl("upload", "0", "0x607a", "0").stdout.strip()
+        self.bus.ecatctl("download", "0", "0x607a", "0", "3000")
+        self.assertTrue(self.bus.ecatctl("upload", "0", "0x607a", "0").stdout.strip().endswith("(3000)"))
+        r = self.bus.ecatctl("download", "0", "0x6060", "0", "3000", check=False)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn("does not fit", r.stderr)
+        self.bus.ecatctl("download", "0", "0x607a", "0", before.split()[-1].strip("()"))
 
     def test_abort_codes_are_reported(self):
         r = self.bus.ecatctl("upload", "0", "0x5fff", "0", check=False)

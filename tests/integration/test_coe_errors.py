@@ -109,9 +109,20 @@ class SdoAbortsThroughEcatctl(unittest.TestCase):
 
     def test_not_mappable(self):
         # The statusword is TxPDO-mappable only; 0x1008 (a string) not at all.
-        self.assert_abort(0x06040041, "download", "0", "0x1600", "1", "0x60410010", "--type", "u32")
-        self.assert_abort(0x06040041, "download", "0", "0x1600", "1", "0x10080008", "--type", "u32")
+        count = self.bus.ecatctl("upload", "0", "0x1600", "0").stdout.split()[0]
+        self.bus.ecatctl("download", "0", "0x1600", "0", "0", "--type", "u8")
+        try:
+            self.assert_abort(0x06040041, "download", "0", "0x1600", "1", "0x60410010", "--type", "u32")
+            self.assert_abort(0x06040041, "download", "0", "0x1600", "1", "0x10080008", "--type", "u32")
+        finally:
+            self.bus.ecatctl("download", "0", "0x1600", "0", count, "--type", "u8", check=False)
         self.assertEqual(self.bus.ecatctl("upload", "0", "0x1600", "1").stdout.split()[0], "0x60400010")
+
+    def test_mapping_entry_needs_subindex_zero_at_zero(self):
+        # ETG.1000.6 / ETG.1020: entries of a mapping or assignment object only while subindex 0 is 0.
+        for obj, sub, value, typ in (("0x1600", "1", "0x60400010", "u32"), ("0x1a00", "1", "0x60410010", "u32"),
+                                     ("0x1c12", "1", "0x1600", "u16"), ("0x1c13", "1", "0x1a00", "u16")):
+            self.assert_abort(0x06010003, "download", "0", obj, sub, value, "--type", typ)
 
     def test_pdo_length_exceeded(self):
         count = self.bus.ecatctl("upload", "0", "0x1600", "0").stdout.split()[0]
@@ -125,6 +136,7 @@ class SdoAbortsThroughEcatctl(unittest.TestCase):
             self.assertEqual(self.bus.ecatctl("upload", "0", "0x1600", "0").stdout.split()[0], "0x00")
         finally:
             # Back to the mapping as it was.
+            self.bus.ecatctl("download", "0", "0x1600", "0", "0", "--type", "u8", check=False)
             for sub, value in enumerate(before, start=1):
                 self.bus.ecatctl("download", "0", "0x1600", str(sub), value, "--type", "u32", check=False)
             self.bus.ecatctl("download", "0", "0x1600", "0", count, "--type", "u8", check=False)
@@ -360,7 +372,9 @@ class DiagnosisHistoryThroughEcatctl(unittest.TestCase):
     """An error the drive raises (0x8180 after the SM watchdog while enabled) read back from 0x10F3 with
     `ecatctl diag`, named from the drive's error table; --new and --ack against :03."""
 
-    LINE = re.compile(r"^:(\d\d)  (\d+)\.(\d{9}) s  (info|warning|error) +0x([0-9a-f]{8})  (.*)$", re.M)
+    # The time stamp: DC system time on the wall clock as a UTC date (ms), else [Nd ]hh:mm:ss.mmm.
+    LINE = re.compile(r"^:(\d\d)  ((?:\d{4}-\d\d-\d\d |\d+d )?\d\d:\d\d:\d\d)\.(\d{3})(?: UTC)?  "
+                      r"(info|warning|error) +0x([0-9a-f]{8})  (.*)$", re.M)
 
     def test_error_message_named_ordered_and_acknowledged(self):
         with harness.Bus() as bus:
@@ -385,7 +399,7 @@ class DiagnosisHistoryThroughEcatctl(unittest.TestCase):
             self.assertEqual(errors[0][3], "error")
             self.assertTrue(errors[0][5].startswith("EtherCAT state machine error  [bytes "), newest_first)
             # Newest first: time stamps do not increase; --oldest-first is the same list reversed.
-            stamps = [int(m[1]) * 10**9 + int(m[2]) for m in lines]
+            stamps = [(m[1], m[2]) for m in lines]  # same format on every line: compares as text
             self.assertEqual(stamps, sorted(stamps, reverse=True))
             oldest_first = self.LINE.findall(bus.ecatctl("diag", "--oldest-first").stdout)
             self.assertEqual(oldest_first, lines[::-1])

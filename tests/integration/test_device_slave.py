@@ -276,6 +276,22 @@ class FirmwareUpdate(unittest.TestCase):
             subprocess.run([bus.slave_bin, "--state-dir", state, "--write-sii", sii], check=True, timeout=30)
             with open(sii, "rb") as f:
                 self.assertEqual(struct.unpack_from("<I", f.read(), 0x0C * 2)[0], 0x01300000)
+        # --write-esi names the firmware it describes: that state directory's when it is named, otherwise the
+        # built-in one, whatever the default state directory holds (a fresh slave's own ESI check passes).
+        named = subprocess.run([harness.env_path("ECAT_SLAVE"), "--state-dir", state, "--write-esi", "-"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=30)
+        self.assertEqual(named.returncode, 0, named.stderr)
+        self.assertIn('RevisionNo="#x01300000"', named.stdout)
+        self.assertIn(f"the firmware active in {state}, software version 0130h, revision 0x01300000", named.stderr)
+        built_in = subprocess.run([harness.env_path("ECAT_SLAVE"), "--write-esi", "-"], stdout=subprocess.PIPE,
+                                  stderr=subprocess.PIPE, text=True, timeout=30)
+        self.assertEqual(built_in.returncode, 0, built_in.stderr)
+        self.assertIn('RevisionNo="#x01200000"', built_in.stdout)
+        self.assertIn("the built-in firmware, software version 0120h, revision 0x01200000", built_in.stderr)
+        fresh = subprocess.run([harness.env_path("ECAT_SLAVE"), "--state-dir", os.path.join(d, "fresh"),
+                                "--write-esi", "-"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               timeout=30)
+        self.assertEqual(fresh.stdout, built_in.stdout)
 
 
 if __name__ == "__main__":

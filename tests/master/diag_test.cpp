@@ -48,7 +48,7 @@ TEST(DiagDecode, EmergencyDerivedErrorWithByteArray) {
     EXPECT_EQ(master::diag_text(*e, names), "Following error");
     EXPECT_EQ(master::diag_text(*e), "monitoring error");  // no table: the CiA 301 class
     EXPECT_EQ(master::format_diag_line(*e, names),
-              ":07  12.345678901 s  error    0x8611e800  Following error  [bytes 01 02 03 04 05]");
+              ":07  00:00:12.345  error    0x8611e800  Following error  [bytes 01 02 03 04 05]");
 }
 
 TEST(DiagDecode, ManufacturerMessageTakesItsTextFromTheAsciiParameter) {
@@ -59,7 +59,7 @@ TEST(DiagDecode, ManufacturerMessageTakesItsTextFromTheAsciiParameter) {
     EXPECT_TRUE(e->local_time);
     EXPECT_EQ(master::diag_text(*e), "hello");
     // The text once, not again as a parameter.
-    EXPECT_EQ(master::format_diag_line(*e), ":06  0.000000005 s (local)  warning  0x0000e000  hello");
+    EXPECT_EQ(master::format_diag_line(*e), ":06  00:00:00.000 (local)  warning  0x0000e000  hello");
 }
 
 TEST(DiagDecode, ValueParametersOfCoeDataTypes) {
@@ -105,7 +105,7 @@ TEST(DiagDecode, AWarningNamedByItsCodeDoesNotRepeatItsCutText) {
         return code == 0x8A80 ? "Negative limit switch" : "";
     };
     EXPECT_EQ(master::format_diag_line(*e, names),
-              ":08  0.000000007 s  warning  0x8a80e800  Negative limit switch");
+              ":08  00:00:00.000  warning  0x8a80e800  Negative limit switch");
 }
 
 TEST(DiagDecode, ShortAndCutMessages) {
@@ -163,7 +163,12 @@ TEST(DiagText, FlagsTimeAndClasses) {
     EXPECT_EQ(master::format_diag_flags(0x0031), "send as emergency, acknowledge mode, overflow");
     EXPECT_EQ(master::format_diag_flags(0x000E),
               "info not stored, warnings not stored, errors not stored, overwrite mode");
-    EXPECT_EQ(master::format_diag_time(1'000'000'001ull), "1.000000001 s");
+    EXPECT_EQ(master::format_diag_time(1'000'000'001ull), "00:00:01.000");
+    // 849055596.6 s of DC system time (what the soft slave reports, set to the wall time): a UTC date.
+    EXPECT_EQ(master::format_diag_time(849'055'596'600'000'000ull), "2026-11-27 00:46:36.600 UTC");
+    EXPECT_EQ(master::format_diag_time(0, true), "00:00:00.000");
+    EXPECT_EQ(master::format_diag_time(90'061'250'000'000ull, true), "1d 01:01:01.250");
+    EXPECT_EQ(master::format_diag_time(90'061'250'000'000ull), "1d 01:01:01.250");
     EXPECT_EQ(master::emergency_class_name(0x2310), "current error");
     EXPECT_EQ(master::emergency_class_name(0x8180), "communication error");
     EXPECT_EQ(master::emergency_class_name(0xFF01), "device specific error");

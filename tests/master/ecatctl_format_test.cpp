@@ -66,3 +66,22 @@ TEST(EcatctlFormat, SiiCrcCheckValue) {
     const uint8_t zeros[14] = {};
     EXPECT_NE(sii_crc(zeros), 0xFF);
 }
+
+// `pd` / `pd --all` say why a run failed at its end (issue 25: SAFEOP+ERR after a watchdog, exit 0 before).
+TEST(EcatctlFormat, EndStateSaysTheStateTheErrorAndTheAlStatusCode) {
+    EXPECT_EQ(end_state_text("SAFEOP", true, 0x001B, "Sync manager watchdog", "OP"),
+              "ended in SAFEOP+ERR, not OP, AL status code 0x001b (Sync manager watchdog)");
+    EXPECT_EQ(end_state_text("PREOP", false, 0, "", "SAFEOP"), "ended in PREOP, not SAFEOP");
+    EXPECT_EQ(end_state_text("", false, 0, "", "OP"),
+              "no AL status at the end (is the slave still there?), not OP");
+}
+
+// `download` without --type encodes values by the entry's CoE type from SDO information.
+TEST(EcatctlFormat, ValueTypeOfCoeBasicTypes) {
+    EXPECT_EQ(value_type_of(0x0006), ValueType::U16);
+    EXPECT_EQ(value_type_of(0x0004), ValueType::I32);
+    EXPECT_EQ(value_type_of(0x0007), ValueType::U32);
+    EXPECT_EQ(value_type_of(0x0002), ValueType::I8);
+    EXPECT_EQ(value_type_of(0x0009), std::nullopt);  // VISIBLE_STRING: text
+    EXPECT_EQ(value_type_of(0x0029), std::nullopt);  // a structure
+}

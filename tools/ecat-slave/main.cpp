@@ -7,8 +7,10 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <memory>
+#include <sstream>
 #include <string_view>
 #include <vector>
 
@@ -81,10 +83,13 @@ int main(int argc, char** argv) {
                    "Directory for stored parameters and firmware images (created if missing)")
         ->capture_default_str();
     app.add_option("--write-sii", write_sii,
-                   "Write the device's SII EEPROM image to FILE ('-': standard output) and exit")
+                   "Write the device's SII EEPROM image to FILE ('-': standard output) and exit: of the "
+                   "built-in firmware, or with --state-dir of the firmware active there (and the EEPROM "
+                   "words a master wrote)")
         ->type_name("FILE");
     app.add_option("--write-esi", write_esi,
-                   "Write the device's ESI (EtherCATInfo XML) to FILE ('-': standard output) and exit")
+                   "Write the device's ESI (EtherCATInfo XML) to FILE ('-': standard output) and exit: of "
+                   "the built-in firmware, or with --state-dir of the firmware active there")
         ->type_name("FILE");
     app.add_option("--control", control,
                    "Create a UNIX datagram socket here that changes the simulated machine at run time "
@@ -249,18 +254,32 @@ int main(int argc, char** argv) {
 
     try {
         if (!write_sii.empty() || !write_esi.empty()) {
+            // Deterministic: the files describe the built-in firmware (what a fresh state directory starts
+            // with) unless a state directory is named, whatever an FoE update left in the default one.
+            device::DeviceOptions described = device;
+            if (app.get_option("--state-dir")->count() == 0) described.state_dir.clear();
+            const od::Identity id = device::make_description(described).identity;
             std::string why;
             const std::vector<uint8_t> sii =
-                write_sii.empty() ? std::vector<uint8_t>{} : device::make_sii(device);
+                write_sii.empty() ? std::vector<uint8_t>{} : device::make_sii(described);
             if (!write_sii.empty() &&
                 !write_output(write_sii, {reinterpret_cast<const char*>(sii.data()), sii.size()}, why)) {
                 std::cerr << "ecat-slave: cannot write " << write_sii << ": " << why << '\n';
                 return slave::kExitFailure;
             }
-            if (!write_esi.empty() && !write_output(write_esi, device::make_esi(device), why)) {
+            if (!write_esi.empty() && !write_output(write_esi, device::make_esi(described), why)) {
                 std::cerr << "ecat-slave: cannot write " << write_esi << ": " << why << '\n';
                 return slave::kExitFailure;
             }
+            std::ostringstream revision;
+            revision << "0x" << std::hex << std::uppercase << std::setw(8) << std::setfill('0')
+                     << id.revision;
+            std::cerr << "ecat-slave: "
+                      << (described.state_dir.empty()
+                              ? "the built-in firmware"
+                              : "the firmware active in " + described.state_dir.string())
+                      << ", software version " << id.software_version << ", revision " << revision.str()
+                      << '\n';
             return slave::kExitOk;
         }
         device::check_device(device);  // a bad configuration is a usage error, before any setup

@@ -37,6 +37,15 @@ struct PdoInfo {
     uint32_t bit_size() const;
 };
 
+// A predefined PDO set (od::PdoSet) as the ESI lists it: AlternativeSmMapping with the SMs it assigns.
+struct PdoSetInfo {
+    std::string name;
+    bool is_default = false;  // the set the default assignment (0x1C12/0x1C13) holds
+    int rx_sm = -1;           // the outputs SyncManager (2), -1 if none
+    int tx_sm = -1;           // the inputs SyncManager (3), -1 if none
+    std::vector<uint16_t> rx, tx;
+};
+
 struct SmInfo {
     od::SmKind kind = od::SmKind::MBoxOut;
     uint16_t start = 0;
@@ -69,6 +78,7 @@ struct DeviceModel {
     std::vector<PdoInfo>
         pdos;  // every mapping object of the dictionary, by index (Rx first: 0x16xx < 0x1Axx)
     std::vector<SmInfo> sync_managers;
+    std::vector<PdoSetInfo> pdo_sets;  // od::DeviceDescription::pdo_sets that name PDOs of the dictionary
     std::vector<FmmuUse> fmmus;
     uint16_t profile_number = 0;            // 0x1000 bits 0-15 (402 for a drive), 0 if 0x1000 has no default
     uint16_t profile_add_info = 0;          // 0x1000 bits 16-31 (CiA 402: 2 = servo)

@@ -78,6 +78,15 @@ struct PdoRule {
     std::vector<uint16_t> exclude;
 };
 
+// A predefined PDO set a configuration tool offers (ESI Info/VendorSpecific/TwinCAT/AlternativeSmMapping, as
+// vendors' CiA 402 drives ship one per cyclic mode): the PDOs to assign to SM2 (0x1C12) and SM3 (0x1C13).
+// The set the default assignment holds is the default one.
+struct PdoSet {
+    std::string name;
+    std::vector<uint16_t> rx;  // 0x1600..
+    std::vector<uint16_t> tx;  // 0x1A00..
+};
+
 struct DcOpMode {
     std::string name;  // "SM-Synchron", "DC"
     std::string description;
@@ -104,6 +113,7 @@ struct DeviceDescription {
     uint16_t sync_pulse_length = 1000;  // SII word 2, 10 ns units
     uint16_t station_alias = 0;         // SII word 4
     std::vector<PdoRule> pdo_rules;     // Mandatory / Exclude of the PDOs (empty: none)
+    std::vector<PdoSet> pdo_sets;       // predefined PDO sets (empty: none)
     // Mailbox timeouts a master should use with this device (ESI Info/Mailbox/Timeout, ms): how long the
     // slave may take to take a request out of SM0 and to answer it (0: not declared).
     uint32_t mailbox_request_timeout_ms = 0;

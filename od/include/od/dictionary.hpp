@@ -24,6 +24,12 @@ namespace od {
 // A declared numeric value (default, minimum, maximum). monostate = not given.
 using Number = std::variant<std::monostate, int64_t, uint64_t, double>;
 
+// One named value of an enumerated entry (ESI EnumInfo).
+struct NamedValue {
+    int64_t value = 0;
+    std::string text;
+};
+
 struct Entry {
     uint16_t index = 0;
     uint8_t subindex = 0;
@@ -36,6 +42,9 @@ struct Entry {
     Number maximum;
     std::string default_string;  // VISIBLE_STRING / OCTET_STRING default
     std::string unit;            // e.g. "inc", "rpm", "mNm", "ms"; empty if none
+    // The values the entry takes, each with its name, if it is an enumeration (od/value_names.hpp); empty
+    // otherwise.
+    std::vector<NamedValue> enumeration;
     // Storage (filled by the dictionary): byte offset of this entry's value in the value image.
     std::size_t offset = 0;
 

@@ -61,6 +61,7 @@ enum class Status : uint8_t {
     NoObject,           // 0x06020000 object does not exist
     NoSubindex,         // 0x06090011 subindex does not exist
     ReadOnly,           // 0x06010002 attempt to write a read-only object
+    SubindexZeroFirst,  // 0x06010003 subindex cannot be written, subindex 0 must be 0 for write access
     WriteOnly,          // 0x06010001 attempt to read a write-only object
     LengthMismatch,     // 0x06070010 data type does not match, length of service parameter does not match
     LengthTooHigh,      // 0x06070012

@@ -4,9 +4,11 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -35,6 +37,18 @@ int fail(Error e, const std::string& what) {
         return kExitProtocol;
     }
     return report_error(e, what);
+}
+
+std::string state_failure(const master::AlStatus* st, const std::string& wanted) {
+    if (st == nullptr || st->state == 0)
+        return "no AL status at the end (is the slave still there?), not " + wanted;
+    std::string text =
+        "ended in " + std::string(master::al_state_name(st->state)) + (st->error ? "+ERR" : "");
+    if (!st->error) return text + ", not " + wanted;
+    std::ostringstream code;
+    code << std::hex << std::setw(4) << std::setfill('0') << st->code;
+    return text + ", not " + wanted + ", AL status code 0x" + code.str() + " (" +
+           std::string(master::al_status_code_name(st->code)) + ")";
 }
 
 int usage(const std::string& what) {

@@ -203,7 +203,11 @@ int process_data(master::Master& m, const PdArgs& p) {
     std::printf("inputs:\n%s", hex_dump(0, pd.inputs()).c_str());
     print_pd_entries(pdo_config, pd.outputs(), pd.inputs());
     if (!p.keep) (void)m.request_state(a, master::AlState::PreOp);
-    const bool clean = s.lost == before.lost && s.wkc_errors == before.wkc_errors && now && !now->error;
+    // A run that ends outside the state asked for, or with an AL error, failed, whatever the counters say.
+    const auto want = static_cast<uint8_t>(t == "OP" ? master::AlState::Op : master::AlState::SafeOp);
+    const bool in_state = now && now->state == want && !now->error;
+    if (!in_state) std::cerr << "ecatctl: " << state_failure(now ? &*now : nullptr, t) << '\n';
+    const bool clean = s.lost == before.lost && s.wkc_errors == before.wkc_errors && in_state;
     return clean ? kExitOk : kExitProtocol;
 }
 

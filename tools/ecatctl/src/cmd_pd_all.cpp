@@ -52,8 +52,8 @@ int process_data_all(master::Master& m, const PdAllArgs& p) {
     // Every slave's SYNC0 gets its start time before the first one is due.
     dc.start_delay = std::max(dc.start_delay, std::chrono::milliseconds(10 + 2 * static_cast<int64_t>(n)));
     if (Error e = pd.configure(dc); e != Error::Ok) return fail(e, "configuring process data");
-    std::printf("%zu slaves, outputs %zu bytes, inputs %zu bytes, expected wkc %u\n", n, pd.outputs().size(),
-                pd.inputs().size(), pd.expected_wkc());
+    std::printf("%zu slave%s, outputs %zu bytes, inputs %zu bytes, expected wkc %u\n", n, n == 1 ? "" : "s",
+                pd.outputs().size(), pd.inputs().size(), pd.expected_wkc());
     const auto period = std::chrono::microseconds(p.cycle_us);
     std::vector<uint8_t> out_bytes = p.outputs;
     auto fill = [&] {
@@ -94,6 +94,21 @@ int process_data_all(master::Master& m, const PdAllArgs& p) {
         for (const Address& a : addresses)
             stations.push_back(a.value);
         (void)m.request_state_all(master::AlState::PreOp, stations);
+    }
+    // A run that ends with a slave outside the state asked for, or with an AL error, failed: say which.
+    if (read != Error::Ok)
+        std::cerr << "ecatctl: reading the AL states at the end: " << to_string(read) << '\n';
+    unsigned off = 0;
+    for (const master::AlStatus& st : states)
+        off += st.state != want || st.error;
+    if (read == Error::Ok && off != 0) {
+        std::cerr << "ecatctl: " << off << " of " << n << (n == 1 ? " slave" : " slaves") << " not in "
+                  << (p.op ? "OP" : "SAFEOP") << " at the end:";
+        for (std::size_t k = 0; k < n; ++k)
+            if (states[k].state != want || states[k].error)
+                std::cerr << "\n  " << slave_text(addresses[k]) << ": "
+                          << state_failure(&states[k], p.op ? "OP" : "SAFEOP");
+        std::cerr << '\n';
     }
     const bool clean = s.lost == before.lost && s.wkc_errors == before.wkc_errors && all_there;
     return clean ? kExitOk : kExitProtocol;

@@ -45,31 +45,45 @@ int sdo_transfer(master::Master& m, const SdoArgs& s, bool upload) {
     if (!index) return usage("bad index '" + s.index + "'");
     auto sub = parse_number(s.sub, 0xFF);
     if (!sub) return usage("bad subindex '" + s.sub + "'");
-    const bool text = s.type == "string";
+    bool text = s.type == "string";
     std::optional<ValueType> type;
     if (!s.type.empty() && !text && !(type = parse_type(s.type))) return usage("bad type '" + s.type + "'");
-    std::vector<uint8_t> data;
-    if (!upload) {
+    if (!upload && s.values.empty()) return usage("nothing to download");
+    // Without --type the values are bytes, unless SDO information names the entry's type (as upload does).
+    auto encode = [&](std::vector<uint8_t>& data, std::string& why) {
         for (const std::string& v : s.values) {
             if (text) {
                 if (!data.empty()) data.push_back(' ');
                 data.insert(data.end(), v.begin(), v.end());
             } else if (type) {
                 auto b = encode_value(*type, v);
-                if (!b) return usage("value '" + v + "' does not fit " + s.type);
+                if (!b) return why = "value '" + v + "' does not fit its type", false;
                 data.insert(data.end(), b->begin(), b->end());
             } else {
                 auto b = parse_number(v, 0xFF);
-                if (!b) return usage("bad byte '" + v + "' (0..0xff; use --type for wider values)");
+                if (!b) return why = "bad byte '" + v + "' (0..0xff; use --type for wider values)", false;
                 data.push_back(static_cast<uint8_t>(*b));
             }
         }
-        if (data.empty()) return usage("nothing to download");
-    }
+        return true;
+    };
+    std::vector<uint8_t> data;
+    std::string why;
+    // With --type, the values are checked before anything is sent.
+    if (!upload && (type || text) && !encode(data, why)) return usage(why);
     master::Mailbox mbx(m, *a);
     if (Error e = open_mailbox(m, mbx, *a); e != Error::Ok)
         return fail(e, "opening the mailbox of " + slave_text(*a));
     master::SdoClient sdo(mbx);
+    if (!upload && !type && !text) {
+        if (!s.complete)
+            if (auto d =
+                    sdo.entry_description(static_cast<uint16_t>(*index), static_cast<uint8_t>(*sub), 0)) {
+                text = d->data_type == 0x0009;
+                type = value_type_of(d->data_type);
+            }
+        if (!encode(data, why)) return usage(why);
+    }
     const std::string what = util::strprintf("%s 0x%04x:%02x", upload ? "upload of" : "download to",
                                              static_cast<unsigned>(*index), static_cast<unsigned>(*sub));
     if (!upload) {

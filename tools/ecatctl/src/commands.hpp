@@ -59,6 +59,9 @@ void print_pd_cycles(const master::ProcessDataSession& pd, const master::CycleSt
 extern master::AlStatus g_refusal;
 // "ecatctl: <what>: <error>" (a refused state request with its AL status code); returns the exit code.
 int fail(master::Error e, const std::string& what);
+// Why a process-data run failed at its end: "ended in SAFEOP+ERR, not OP, AL status code 0x001b (...)";
+// st null or state 0: the slave gave no AL status.
+std::string state_failure(const master::AlStatus* st, const std::string& wanted);
 // "ecatctl: <what>"; returns kExitUsage.
 int usage(const std::string& what);
 std::optional<master::Address> parse_slave(const std::string& text, bool station);

@@ -10,6 +10,47 @@
 
 namespace ecatctl {
 
+std::optional<ValueType> value_type_of(uint16_t coe_type) {
+    switch (coe_type) {
+        case 0x0001:  // BOOLEAN
+        case 0x0005:
+            return ValueType::U8;
+        case 0x0002:
+            return ValueType::I8;
+        case 0x0003:
+            return ValueType::I16;
+        case 0x0004:
+            return ValueType::I32;
+        case 0x0006:
+            return ValueType::U16;
+        case 0x0007:
+            return ValueType::U32;
+        case 0x0008:
+            return ValueType::F32;
+        case 0x0011:
+            return ValueType::F64;
+        case 0x0015:
+            return ValueType::I64;
+        case 0x001B:
+            return ValueType::U64;
+        default:
+            return std::nullopt;
+    }
+}
+
+std::string end_state_text(std::string_view state, bool error, uint16_t code, std::string_view code_name,
+                           std::string_view wanted) {
+    const std::string not_wanted = ", not " + std::string(wanted);
+    if (state.empty()) return "no AL status at the end (is the slave still there?)" + not_wanted;
+    std::string text = "ended in " + std::string(state) + (error ? "+ERR" : "") + not_wanted;
+    if (!error) return text;
+    static const char* digits = "0123456789abcdef";
+    std::string hex = "0x";
+    for (int shift = 12; shift >= 0; shift -= 4)
+        hex += digits[(code >> shift) & 0xF];
+    return text + ", AL status code " + hex + " (" + std::string(code_name) + ")";
+}
+
 std::optional<uint64_t> parse_number(std::string_view text, uint64_t max) {
     int base = 10;
     if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {

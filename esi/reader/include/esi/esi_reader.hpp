@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace esi {
@@ -14,7 +15,9 @@ namespace esi {
 struct EsiEntry {
     uint8_t subindex = 0;
     std::string name;
-    std::string type;  // ESI type name (UINT, DINT, STRING(6), ...)
+    std::string type;  // ESI type name (UINT, DINT, STRING(6), ...); an enumerated type's base type
+    // An enumerated type's named values (DataType/EnumInfo: Enum, Text); empty otherwise.
+    std::vector<std::pair<int64_t, std::string>> enumeration;
     uint16_t bit_size = 0;
     uint16_t bit_offset = 0;
     std::string access;              // ro, rw, wo
@@ -80,12 +83,20 @@ struct EsiCoe {
     bool segmented_sdo = true;
 };
 
+// Info/VendorSpecific/TwinCAT/AlternativeSmMapping: a predefined PDO set.
+struct EsiPdoSet {
+    std::string name;
+    bool is_default = false;
+    std::map<int, std::vector<uint16_t>> sms;  // SyncManager number -> PDOs
+};
+
 struct EsiDevice {
     uint32_t vendor_id = 0;
     std::string vendor_name;
     uint32_t product_code = 0;
     uint32_t revision = 0;
     std::string type_name;  // <Type> text (order number)
+    std::vector<EsiPdoSet> pdo_sets;
     std::string name;
     std::string group_type;
     std::optional<uint32_t> profile_no;

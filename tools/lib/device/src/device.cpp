@@ -62,7 +62,7 @@ std::filesystem::path firmware_dir(const DeviceOptions& options) {
 od::DeviceDescription make_description(const DeviceOptions& options) {
     od::DeviceDescription d = base_description(options);
     std::error_code ec;
-    if (std::filesystem::is_directory(firmware_dir(options), ec)) {
+    if (!options.state_dir.empty() && std::filesystem::is_directory(firmware_dir(options), ec)) {
         foe::FirmwareStore store(store_config(options, d));
         if (store.open()) apply_active_image(d, store);
     }
@@ -85,6 +85,7 @@ std::vector<uint8_t> make_sii(const DeviceOptions& options) {
     const od::DeviceDescription d = make_description(options);
     const od::Dictionary dict = od::make_drive_dictionary(d);
     std::vector<uint8_t> image = esi::build_sii(d, dict);
+    if (options.state_dir.empty()) return image;
     EepromWrites writes(options.state_dir);
     if (writes.load().empty()) writes.apply(image);
     return image;

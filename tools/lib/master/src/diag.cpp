@@ -1,6 +1,9 @@
 #include "master/diag.hpp"
 
 #include <cstdio>
+#include <ctime>
+#include <iomanip>
+#include <sstream>
 
 #include "util/le.hpp"
 #include "util/strfmt.hpp"
@@ -239,9 +242,30 @@ std::string diag_text(const DiagEntry& e, ErrorNameLookup lookup, TextIdLookup t
     return "";
 }
 
-std::string format_diag_time(uint64_t ns) {
-    return util::strprintf("%llu.%09llu s", static_cast<unsigned long long>(ns / 1000000000u),
-                           static_cast<unsigned long long>(ns % 1000000000u));
+std::string format_diag_time(uint64_t ns, bool local) {
+    const uint64_t total_ms = ns / 1000000u;
+    const auto ms = static_cast<unsigned>(total_ms % 1000u);
+    const uint64_t total_s = total_ms / 1000u;
+    std::ostringstream o;
+    o << std::setfill('0');
+    // DC system time counts from 2000-01-01 00:00 UTC (ETG.1000.4); a clock set to the wall time (a year or
+    // more past its epoch) reads as a date, anything else as the time since the clock started.
+    constexpr uint64_t kYear = 365ull * 24 * 3600;
+    if (!local && total_s >= kYear) {
+        const std::time_t t = static_cast<std::time_t>(total_s + 946684800ull);
+        std::tm tm{};
+        if (gmtime_r(&t, &tm) != nullptr) {
+            o << std::setw(4) << tm.tm_year + 1900 << '-' << std::setw(2) << tm.tm_mon + 1 << '-'
+              << std::setw(2) << tm.tm_mday << ' ' << std::setw(2) << tm.tm_hour << ':' << std::setw(2)
+              << tm.tm_min << ':' << std::setw(2) << tm.tm_sec << '.' << std::setw(3) << ms << " UTC";
+            return o.str();
+        }
+    }
+    const uint64_t days = total_s / 86400u;
+    if (days) o << days << "d ";
+    o << std::setw(2) << (total_s / 3600u) % 24u << ':' << std::setw(2) << (total_s / 60u) % 60u << ':'
+      << std::setw(2) << total_s % 60u << '.' << std::setw(3) << ms;
+    return o.str();
 }
 
 std::string format_diag_flags(uint16_t flags) {
@@ -261,9 +285,9 @@ std::string format_diag_flags(uint16_t flags) {
 }
 
 std::string format_diag_line(const DiagEntry& e, ErrorNameLookup lookup, TextIdLookup texts) {
-    std::string s =
-        util::strprintf(":%02u  %s%s  %-7s  0x%08x  ", e.subindex, format_diag_time(e.timestamp_ns).c_str(),
-                        e.local_time ? " (local)" : "", std::string(diag_type_name(e.type)).c_str(), e.code);
+    std::string s = util::strprintf(
+        ":%02u  %s%s  %-7s  0x%08x  ", e.subindex, format_diag_time(e.timestamp_ns, e.local_time).c_str(),
+        e.local_time ? " (local)" : "", std::string(diag_type_name(e.type)).c_str(), e.code);
     const std::string text = diag_text(e, lookup, texts);
     s += text;
     std::vector<std::string> shown;

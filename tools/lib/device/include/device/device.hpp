@@ -81,14 +81,16 @@ std::filesystem::path firmware_dir(const DeviceOptions& options);
 
 // The description the device runs with: the configuration file (or od's default, SyncManagers placed),
 // with revision and software version of the active firmware image in the state directory, if there is
-// one (the state directory is only read if it exists). Throws od::ConfigError on a bad configuration.
+// one (the state directory is only read if it exists; an empty state_dir: the built-in firmware, as a
+// fresh state directory starts with). Throws od::ConfigError on a bad configuration.
 od::DeviceDescription make_description(const DeviceOptions& options);
 // Everything the device builds from its configuration before it serves (description, dictionary, SII
 // image), so that a value one of them refuses is found before any network set-up. Throws od::ConfigError
 // (naming the configuration file, and the line where the parser knows it).
 void check_device(const DeviceOptions& options);
 // The SII image and the ESI text of that description and its dictionary (what --write-sii/--write-esi
-// write and what the ESC serves: the SII with the words a master wrote into the EEPROM on top).
+// write and what the ESC serves: the SII with the words a master wrote into the EEPROM on top; an empty
+// state_dir: of the built-in firmware, no EEPROM writes).
 std::vector<uint8_t> make_sii(const DeviceOptions& options);
 std::string make_esi(const DeviceOptions& options);
 

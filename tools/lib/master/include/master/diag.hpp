@@ -76,7 +76,10 @@ std::string_view emergency_class_name(uint16_t code);
 using TextIdLookup = std::string_view (*)(uint16_t text_id);
 std::string diag_text(const DiagEntry& e, ErrorNameLookup lookup = nullptr, TextIdLookup texts = nullptr);
 // DC system time in ns -> "12.345678901 s".
-std::string format_diag_time(uint64_t ns);
+// A message's time stamp: DC system time set to the wall time as "2026-11-27 02:46:36.600 UTC", otherwise
+// (local time, or a DC clock a year or less past its epoch) the time since the clock started,
+// "[Nd ]hh:mm:ss.mmm".
+std::string format_diag_time(uint64_t ns, bool local = false);
 // "emergency, acknowledge mode, overflow, no info" ...; "none" for 0.
 std::string format_diag_flags(uint16_t flags);
 // One line: ":07  12.345678901 s  error    0x8611e800  Following error  params: ..."
