@@ -8,6 +8,7 @@ namespace coe {
 
 namespace {
 constexpr uint16_t kErrorRegister = 0x1001;
+constexpr uint8_t kGenericBit = 0x01;
 }  // namespace
 
 Emergency::Emergency(od::Dictionary* dict, std::size_t capacity)
@@ -33,6 +34,8 @@ void Emergency::update_register() {
     uint8_t reg = 0;
     for (std::size_t i = 0; i < active_count_; ++i)
         reg = static_cast<uint8_t>(reg | active_[i].bits);
+    // CiA 301 (0x1001): the generic bit (bit 0) is signalled at any error situation.
+    if (active_count_ != 0) reg = static_cast<uint8_t>(reg | kGenericBit);
     register_ = reg;
     if (dict_ != nullptr && dict_->find(kErrorRegister, 0) != nullptr)
         dict_->set<uint8_t>(kErrorRegister, 0, reg);

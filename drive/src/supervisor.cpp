@@ -36,7 +36,8 @@ Supervisor::Raised Supervisor::raise(uint16_t code, int16_t fault_reaction_optio
     auto slot = std::find(active_.begin(), active_.end(), uint16_t{0});
     if (slot != active_.end()) *slot = code;
     last_error_ = code;
-    error_register_ |= reg;
+    // CiA 301 (0x1001): the generic bit is signalled at any error situation, beside the error's own bits.
+    error_register_ |= reg | error_register::kGeneric;
     sink.raise(code, error_register_, mfr);
     return {true, rx, option};
 }
@@ -67,7 +68,7 @@ bool Supervisor::reset(const Causes& causes, EventSink& sink) {
         c = 0;
         uint8_t reg = 0;
         for (uint16_t o : active_)
-            if (o) reg |= find_error(o) ? find_error(o)->error_register : 0x01;
+            if (o) reg |= (find_error(o) ? find_error(o)->error_register : 0x01) | error_register::kGeneric;
         error_register_ = reg;
         sink.clear(code, error_register_);
     }

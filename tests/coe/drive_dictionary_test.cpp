@@ -165,7 +165,8 @@ TEST_F(DriveDictionary, StoreWithAWrongSignatureIs08000020) {
 
 TEST_F(DriveDictionary, EmergencyUpdatesTheErrorRegister) {
     server.emergency().raise(0x4210, 0x08);
-    EXPECT_EQ(ask(sdo(0x40, 0x1001, 0)), (Bytes{0x00, 0x30, 0x4F, 0x01, 0x10, 0x00, 0x08, 0, 0, 0}));
+    // Temperature, and the generic bit that CiA 301 signals at any error.
+    EXPECT_EQ(ask(sdo(0x40, 0x1001, 0)), (Bytes{0x00, 0x30, 0x4F, 0x01, 0x10, 0x00, 0x09, 0, 0, 0}));
 }
 
 }  // namespace

@@ -26,11 +26,13 @@ TEST(Emergency, RaiseAndClearMaintainTheErrorRegister) {
     e.raise(0x2310, 0x03);  // overcurrent: generic + current (MAXPOS firmware specification Table 8-141:
                             // 00000010 -> as given)
     EXPECT_EQ(dict.get<uint8_t>(0x1001, 0), 0x03);
-    e.raise(0x8611, 0x80);  // following error: motion bit only, no generic bit forced
+    e.raise(0x8611, 0x80);  // following error: the motion bit
     EXPECT_EQ(dict.get<uint8_t>(0x1001, 0), 0x83);
     EXPECT_TRUE(e.active(0x2310));
     e.clear(0x2310);
-    EXPECT_EQ(dict.get<uint8_t>(0x1001, 0), 0x80);
+    // The motion bit, and the generic bit: CiA 301 signals it at any error situation, whatever bits the error
+    // itself names.
+    EXPECT_EQ(dict.get<uint8_t>(0x1001, 0), 0x81);
     EXPECT_FALSE(e.active(0x2310));
     e.clear(0x2310);  // not active: nothing
     e.clear(0x8611);

@@ -56,7 +56,7 @@ TEST(DriveOd, ConnectionLostWritesTheErrorIntoTheDictionary) {
     }
     drv.connection_lost();
     EXPECT_EQ(d.get<uint16_t>(0x603F, 0), 0x8180);
-    EXPECT_EQ(d.get<uint8_t>(0x1001, 0), 0x10);
+    EXPECT_EQ(d.get<uint8_t>(0x1001, 0), 0x11);  // communication, and generic as at any error (CiA 301)
     EXPECT_EQ(d.get<uint16_t>(0x6041, 0) & 0x4F, 0x0F);  // fault reaction active
 }
 
