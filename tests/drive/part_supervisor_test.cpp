@@ -20,7 +20,8 @@ TEST(SupervisorPart, AnErrorIsRecordedOnceAndAsksForItsReaction) {
     EXPECT_EQ(r.option, 2);
     EXPECT_TRUE(s.error_active(error_code::FollowingError));
     EXPECT_EQ(s.last_error(), error_code::FollowingError);
-    EXPECT_EQ(s.error_register(), error_register::kMotion | error_register::kGeneric);  // CiA 301: generic too
+    EXPECT_EQ(s.error_register(),
+              error_register::kMotion | error_register::kGeneric);             // CiA 301: generic too
     EXPECT_FALSE(s.raise(error_code::FollowingError, 2, 2, kMfr, rec).react);  // already active
     EXPECT_EQ(rec.raised.size(), 1u);
     const auto sto = s.raise(error_code::Sto, 2, 2, kMfr, rec);

@@ -6,10 +6,10 @@
 // narrow `Parts` interface, which Axis implements.
 #include <cstdint>
 
-#include "drive/wire/error_codes.hpp"
 #include "drive/event_sink.hpp"
 #include "drive/faults.hpp"
 #include "drive/state_machine.hpp"
+#include "drive/wire/error_codes.hpp"
 
 namespace drive {
 

@@ -7,9 +7,9 @@
 #include <array>
 #include <cstdint>
 
-#include "drive/wire/error_codes.hpp"
 #include "drive/event_sink.hpp"
 #include "drive/frame.hpp"
+#include "drive/wire/error_codes.hpp"
 
 namespace drive {
 

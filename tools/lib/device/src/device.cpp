@@ -294,8 +294,9 @@ void Device::build() {
             constexpr auto sw = od::obj::Statusword;
             const od::Entry* e = raw->dict.find(sw.index, sw.sub);
             if (e == nullptr) return od::Status::Ok;
-            return (raw->dict.get<uint16_t>(sw.index, sw.sub) & drive::sw::SwitchedOn) != 0 ? od::Status::WrongState
-                                                                                          : od::Status::Ok;
+            return (raw->dict.get<uint16_t>(sw.index, sw.sub) & drive::sw::SwitchedOn) != 0
+                       ? od::Status::WrongState
+                       : od::Status::Ok;
         },
         // A master's 0x1010/0x2110 "save" and 0x1011/0x2111 "load": what the store did, done or failed (a
         // failed one was answered with an SDO abort; the log says why).
