@@ -97,7 +97,7 @@ TEST(Emergency, ServerSendsQueuedEmergenciesFromPollInMailboxStates) {
     ASSERT_EQ(out.messages.size(), 1u);
     Sent s = out.take();
     EXPECT_EQ(s.type, ecat::MailboxType::CoE);
-    EXPECT_EQ(s.payload, (Bytes{0x00, 0x10, 0x80, 0x81, 0x10, 0, 0, 0, 0, 0}));
+    EXPECT_EQ(s.payload, (Bytes{0x00, 0x10, 0x80, 0x81, 0x11, 0, 0, 0, 0, 0}));
     EXPECT_TRUE(server.emergency().empty());
 }
 

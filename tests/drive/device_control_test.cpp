@@ -58,7 +58,7 @@ TEST(DeviceControl, T4_TorqueConstantZeroRaises8331) {
     EXPECT_TRUE(r.rec.has(error_code::TorqueFault));
     EXPECT_EQ(r.ax.state(), State::Fault);
     EXPECT_EQ(r.fb().error_code, 0x8331);
-    EXPECT_EQ(r.fb().error_register, 0x20);
+    EXPECT_EQ(r.fb().error_register, 0x21);
     // Cause still present: fault reset refused.
     r.cw(0x00);
     r.cw(0x80);
@@ -220,7 +220,7 @@ TEST(DeviceControl, FaultReactionCode0AndDErrorsDisableAtOnce) {
         r.run(1);
         EXPECT_FALSE(r.ax.power_on());
         ASSERT_TRUE(r.until([&] { return r.ax.state() == State::Fault; }, 2000));
-        EXPECT_EQ(r.fb().error_register, 0x02);
+        EXPECT_EQ(r.fb().error_register, 0x03);
     }
 }
 
@@ -258,7 +258,7 @@ TEST(DeviceControl, ConnectionLostFollows6007) {
         EXPECT_EQ(r.ax.state(), State::FaultReactionActive);
         EXPECT_TRUE(r.ax.power_on());
         EXPECT_EQ(r.fb().error_code, 0x8180);
-        EXPECT_EQ(r.fb().error_register, 0x10);
+        EXPECT_EQ(r.fb().error_register, 0x11);
         ASSERT_TRUE(r.until([&] { return r.ax.state() == State::Fault; }, 1000));
     }
     {  // 2: disable voltage

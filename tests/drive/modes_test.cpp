@@ -245,7 +245,7 @@ TEST(Modes, FollowingErrorRaises8611AndRunsTheFaultReaction) {
     r.run(1);
     EXPECT_TRUE(r.rec.has(error_code::FollowingError));
     EXPECT_EQ(r.fb().error_code, 0x8611);
-    EXPECT_EQ(r.fb().error_register, 0x80);
+    EXPECT_EQ(r.fb().error_register, 0x81);
     EXPECT_EQ(r.ax.state(), State::FaultReactionActive);
     ASSERT_TRUE(r.until([&] { return r.ax.state() == State::Fault; }, 1000));
     r.cw(0x00);
@@ -305,7 +305,7 @@ TEST(Modes, SpeedAboveMaxMotorSpeedRaises8A83) {
     r.ax.command.target_torque = 600;  // would settle at ~1490 rpm against the friction
     ASSERT_TRUE(r.until([&] { return r.rec.has(error_code::MaxSpeed); }, 2000));
     EXPECT_GT(std::abs(r.rpm()), 780);
-    EXPECT_EQ(r.fb().error_register, 0x20);
+    EXPECT_EQ(r.fb().error_register, 0x21);
     ASSERT_TRUE(r.until([&] { return r.ax.state() == State::Fault; }, 2000));
 }
 
@@ -315,7 +315,7 @@ TEST(Modes, SecondErrorAddsItsRegisterBitsAndBecomesTheLastError) {
     r.ax.raise_error(error_code::Overvoltage);
     r.run(1);
     EXPECT_EQ(r.fb().error_code, error_code::Overvoltage);
-    EXPECT_EQ(r.fb().error_register, 0x84);
+    EXPECT_EQ(r.fb().error_register, 0x85);
     EXPECT_EQ(r.rec.raised.size(), 2u);
     r.ax.raise_error(error_code::Overvoltage);  // already active: no second emergency
     EXPECT_EQ(r.rec.raised.size(), 2u);

@@ -191,6 +191,10 @@ struct Segment::Impl {
             const int out = dv.esc->receive(frame, port, t, check);
             if (out < 0) return r;
             if (t != 0) t += port == 0 ? timing.processing_delay_ns : timing.forwarding_delay_ns;
+            // A frame with a bad FCS (corrupted on a cable, or aborted by an ESC for a length error) is
+            // discarded by the master's NIC, and cannot be sent on with its bad FCS through a socket: it ends
+            // here (ESC datasheet section I, Table 57; docs/decisions/esc.md, "Frame tolerance").
+            if (check.crc_bad && ((d == 0 && out == 0) || is_external(d, out))) return r;
             if (d == 0 && out == 0) {  // back to the master
                 Hop& h = hops[0];
                 if (!survives(h)) return r;

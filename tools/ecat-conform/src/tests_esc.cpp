@@ -455,7 +455,9 @@ void add_esc_tests(Catalogue& c) {
         "EtherCAT header length not evaluated (a master writing the frame length, or garbage): executed by "
         "the "
         "datagram lengths",
-        "ESC datasheet section I, EtherCAT header: the length field is ignored by ESCs", [](Context& ctx) {
+        "ETG.1000.4 frame structure; ESC datasheet section I, EtherCAT header: the length field is ignored "
+        "by ESCs",
+        [](Context& ctx) {
             auto before = ctx.rd<uint16_t>(kEventMask);
             if (!before) return fail("0x0200 unreadable", err(before.error()));
             const uint16_t want = static_cast<uint16_t>(*before ^ 0x0040);
