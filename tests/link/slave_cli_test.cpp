@@ -344,7 +344,8 @@ TEST(EcatSlaveCli, ConfigurationErrorsNameTheFileAndTheLine) {
         {"# options\nfrobnicate = 1\n", ":2: unknown option 'frobnicate'"},
         {"[identity]\nvendor_idx = 3\n", ":2: unknown key 'vendor_idx' in [identity]"},
         {"[identity]\n[nonsense]\nx = 1\n", ":2: unknown section [nonsense]"},
-        {"limit-neg = -5\n\x7f\x45LF\x02\x01\x01\x00\x00\x00\n", ":2: control character 0x7F at column 1 (not text)"},
+        {"limit-neg = -5\n\x7f\x45LF\x02\x01\x01\x00\x00\x00\n",
+         ":2: control character 0x7F at column 1 (not text)"},
     };
     int n = 0;
     for (const Case& c : cases) {
@@ -357,7 +358,8 @@ TEST(EcatSlaveCli, ConfigurationErrorsNameTheFileAndTheLine) {
     const RunResult missing =
         run({"--config", state_dir() + "/none.conf", "--write-sii", state_dir() + "/o"});
     EXPECT_EQ(missing.code, 2) << missing.output;
-    EXPECT_TRUE(has(missing, "none.conf: cannot open the configuration file: No such file or directory")) << missing.output;
+    EXPECT_TRUE(has(missing, "none.conf: cannot open the configuration file: No such file or directory"))
+        << missing.output;
     // The example configurations are accepted as they are.
     EXPECT_EQ(run({"--config", std::string(SOFTECAT_SOURCE_DIR) + "/tools/ecat-slave/drive.conf",
                    "--write-sii", state_dir() + "/ok.sii"})

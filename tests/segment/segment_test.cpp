@@ -628,7 +628,8 @@ TEST_F(SegmentTest, NoAllocationPerWalk) {
     EXPECT_GT(externals, 150);
     EXPECT_LE(replies, externals);  // hop 50 may lose a frame on its way back up in resume() too
     // A lost frame was dropped on hop 50, or corrupted there: a frame with a bad FCS reaches no master.
-    EXPECT_EQ(seg->hop_stats(50).dropped + seg->hop_stats(50).corrupted, static_cast<uint64_t>(200 - replies));
+    EXPECT_EQ(seg->hop_stats(50).dropped + seg->hop_stats(50).corrupted,
+              static_cast<uint64_t>(200 - replies));
 }
 
 TEST_F(SegmentTest, CyclicFrameThroughHundredEscs) {
