@@ -523,7 +523,8 @@ std::vector<NamedValue> enumeration_of(const Entry& e) {
     std::string where = "0x";
     for (int shift = 12; shift >= 0; shift -= 4)
         where += "0123456789ABCDEF"[(e.index >> shift) & 0xF];
-    where += ":" + std::to_string(e.subindex);
+    where += ':';  // (appended, not "literal" + temporary: GCC 12 -O3 -Wrestrict false positive)
+    where += std::to_string(e.subindex);
     if (values.empty())
         throw std::logic_error("od: " + where + " has value names but no value set or limits");
     std::vector<NamedValue> out;

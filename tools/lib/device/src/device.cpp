@@ -301,8 +301,14 @@ void Device::build() {
         // A master's 0x1010/0x2110 "save" and 0x1011/0x2111 "load": what the store did, done or failed (a
         // failed one was answered with an SDO abort; the log says why).
         [this, raw](const od::Entry& e, bool save, const std::string& error) {
-            const std::string which =
-                "(" + hex16(e.index) + ":" + std::to_string(e.subindex) + " " + e.name + ")";
+            // Appended piece by piece: "literal" + a temporary string trips GCC 12's -Wrestrict at -O3.
+            std::string which = "(";
+            which += hex16(e.index);
+            which += ':';
+            which += std::to_string(e.subindex);
+            which += ' ';
+            which += e.name;
+            which += ')';
             if (!error.empty())
                 event(slave::LogLevel::Error,
                       std::string(save ? "stored parameters not saved " : "stored parameters not restored ") +
