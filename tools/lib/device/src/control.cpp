@@ -20,6 +20,7 @@
 #include <stdexcept>
 
 #include "device/device.hpp"
+#include "esc/wire/al.hpp"
 #include "util/lex.hpp"
 
 namespace device {
@@ -62,22 +63,6 @@ bool in_group(uid_t uid, gid_t gid, gid_t group) {
     }
     groups.resize(static_cast<std::size_t>(n));
     return std::find(groups.begin(), groups.end(), group) != groups.end();
-}
-
-const char* state_name(od::AlState s) {
-    switch (s) {
-        case od::AlState::Init:
-            return "INIT";
-        case od::AlState::PreOp:
-            return "PREOP";
-        case od::AlState::Boot:
-            return "BOOT";
-        case od::AlState::SafeOp:
-            return "SAFEOP";
-        case od::AlState::Op:
-            return "OP";
-    }
-    return "?";
 }
 
 }  // namespace
@@ -304,7 +289,7 @@ std::string ControlSocket::apply(Device& device, std::string_view line) {
     if (cmd == "status" && w.size() == 1) {
         od::Dictionary& d = device.dictionary();
         std::ostringstream s;
-        s << "ok state " << state_name(device.stack().state()) << " statusword 0x" << std::hex
+        s << "ok state " << esc::al_state_name(device.stack().state()) << " statusword 0x" << std::hex
           << d.get<uint16_t>(0x6041, 0) << std::dec << " position " << d.get<int32_t>(0x6064, 0)
           << " error 0x" << std::hex << d.get<uint16_t>(0x603F, 0);
         return s.str();

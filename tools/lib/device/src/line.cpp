@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "device/firmware.hpp"
+#include "esc/wire/al.hpp"
 #include "util/lex.hpp"
 
 namespace device {
@@ -23,22 +24,6 @@ bool to_uint(std::string_view s, uint64_t max, uint64_t& out) {
 
 bool to_fraction(std::string_view s, double& out) {
     return util::parse_number(s, out, 0.0, 1.0) == util::NumberError::None;
-}
-
-const char* state_name(od::AlState s) {
-    switch (s) {
-        case od::AlState::Init:
-            return "INIT";
-        case od::AlState::PreOp:
-            return "PREOP";
-        case od::AlState::Boot:
-            return "BOOT";
-        case od::AlState::SafeOp:
-            return "SAFEOP";
-        case od::AlState::Op:
-            return "OP";
-    }
-    return "?";
 }
 
 bool port_exists(const esc::EscConfig& config, int port) {
@@ -201,7 +186,7 @@ std::string Line::segment_text() const {
     for (std::size_t i = 0; i < units_.size(); ++i) {
         const Unit& u = *units_[i];
         s << "\ndevice " << i << ' ' << u.name << " power " << (u.device ? "on" : "off");
-        if (u.device) s << " state " << state_name(u.device->stack().state());
+        if (u.device) s << " state " << esc::al_state_name(u.device->stack().state());
         s << " links";
         for (int p = 0; p < esc::kPortCount; ++p) {
             s << ' ' << p << ':';
