@@ -40,7 +40,7 @@ def send(path, data, reply=True, timeout=5.0):
 class ControlSocket(unittest.TestCase):
     def setUp(self):
         require_segment(self)
-        self.tmp = tempfile.mkdtemp(dir=os.environ.get("ECAT_TEST_OUT"))
+        self.tmp = harness.socket_dir()  # short: a UNIX socket path is at most 107 bytes, the clone's may be longer
         self.addCleanup(shutil.rmtree, self.tmp, True)
         self.ctl = os.path.join(self.tmp, "ctl.sock")
 
