@@ -1,6 +1,8 @@
 // ecat-conform: runs the conformance catalogue against one slave on a Linux interface and reports, test by
 // test, where the slave differs from what the standards and its ESI file promise.
 #include <fnmatch.h>
+#include <pthread.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -64,6 +66,27 @@ void prepare_stop_line(const std::string& id) {
     std::memcpy(g_stop_line, line.data(), n);
     g_stop_len = static_cast<std::sig_atomic_t>(n);
 }
+
+// The stop signals held back while the reports on disk and the prepared stop line change: the two report
+// files are renamed one after the other, and a stop between the renames would leave JUnit and JSON holding
+// different sets of tests. A signal that arrives meanwhile is delivered when the guard ends.
+class StopSignalsHeld {
+  public:
+    StopSignalsHeld() {
+        sigset_t s;
+        sigemptyset(&s);
+        sigaddset(&s, SIGTERM);
+        sigaddset(&s, SIGINT);
+        sigaddset(&s, SIGALRM);
+        pthread_sigmask(SIG_BLOCK, &s, &old_);
+    }
+    ~StopSignalsHeld() { pthread_sigmask(SIG_SETMASK, &old_, nullptr); }
+    StopSignalsHeld(const StopSignalsHeld&) = delete;
+    StopSignalsHeld& operator=(const StopSignalsHeld&) = delete;
+
+  private:
+    sigset_t old_{};
+};
 
 // Written to FILE.tmp and renamed: a reader (or a kill) never sees half a file.
 template <typename Writer>
@@ -212,6 +235,7 @@ int main(int argc, char** argv) {
     };
     // The reports on disk: the results so far, and the running test (if any) marked as interrupted.
     auto save = [&](const conform::TestCase* running) {
+        const StopSignalsHeld held;
         info.duration = elapsed();
         std::vector<conform::TestResult> rs = results;
         if (running) {
@@ -285,8 +309,11 @@ int main(int argc, char** argv) {
             for (const auto& t : chosen) {
                 conform::TestResult r;
                 r.test = &t;
-                prepare_stop_line(t.id);
-                save(&t);
+                {
+                    const StopSignalsHeld held;
+                    prepare_stop_line(t.id);
+                    save(&t);
+                }
                 const auto s0 = std::chrono::steady_clock::now();
                 ctx.budget_end = {};
                 if (!lost.empty()) {
@@ -356,8 +383,11 @@ int main(int argc, char** argv) {
                     std::chrono::steady_clock::now() - s0);
                 emit_unit(r);
             }
-            prepare_stop_line("the final restore");
-            save(nullptr);
+            {
+                const StopSignalsHeld held;
+                prepare_stop_line("the final restore");
+                save(nullptr);
+            }
             const std::string note = ctx.restore();
             if (!note.empty()) ctx.notes.push_back(note);
         }
