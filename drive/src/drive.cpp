@@ -5,6 +5,92 @@
 #include <stdexcept>
 
 namespace drive {
+namespace {
+
+// Where each vendor parameter lives in the axis: its field in Parameters or Feedback (or the resolution).
+struct VendorField {
+    Param param;
+    uint8_t* (*field)(Parameters&, Feedback&, uint32_t& resolution);
+    uint8_t size;
+    bool feedback;
+};
+template <typename T>
+uint8_t* bytes(T& v) {
+    return reinterpret_cast<uint8_t*>(&v);
+}
+// clang-format off
+#define DRIVE_VENDOR_FIELDS(X) \
+    X(MotorNominalCurrent,           p.nominal_current) \
+    X(MotorOutputCurrentLimit,       p.output_current_limit) \
+    X(MotorPolePairs,                p.pole_pairs) \
+    X(MotorThermalTimeConstant,      p.thermal_time_constant) \
+    X(MotorTorqueConstant,           p.torque_constant) \
+    X(EncoderPulses,                 p.encoder_pulses) \
+    X(EncoderType,                   p.encoder_type) \
+    X(AxisConfigurationMisc,         p.axis_misc) \
+    X(CurrentPGain,                  p.current_p) \
+    X(CurrentIGain,                  p.current_i) \
+    X(CurrentFfGain,                 p.current_ff) \
+    X(PositionBandwidth,             p.bandwidth) \
+    X(PositionDamping,               p.damping) \
+    X(PositionResetTime,             p.reset_time) \
+    X(Inertia,                       p.inertia) \
+    X(Friction,                      p.friction) \
+    X(HomePosition,                  p.home_position) \
+    X(HomeOffsetMoveDistance,        p.home_offset_move) \
+    X(HomingCurrentThreshold,        p.homing_current_threshold) \
+    X(StandstillWindow,              p.standstill_window) \
+    X(StandstillWindowTime,          p.standstill_time) \
+    X(StandstillWindowTimeout,       p.standstill_timeout) \
+    X(DigitalInputPolarity,          p.input_polarity) \
+    X(DigitalInput1Configuration,    p.input_function[0]) \
+    X(DigitalInput2Configuration,    p.input_function[1]) \
+    X(DigitalInput3Configuration,    p.input_function[2]) \
+    X(DigitalInput4Configuration,    p.input_function[3]) \
+    X(DigitalInput5Configuration,    p.input_function[4]) \
+    X(DigitalInput6Configuration,    p.input_function[5]) \
+    X(PositionActualValueSensor1,    f.position_actual) \
+    X(VelocityActualValueSensor1,    f.velocity_actual) \
+    X(VelocityActualAveragedSensor1, f.velocity_averaged) \
+    X(VelocityActualValueAveraged,   f.velocity_averaged) \
+    X(CurrentDemandValue,            f.current_demand) \
+    X(CurrentActualValueAveraged,    f.current_averaged) \
+    X(DigitalInputLogicState,        f.input_logic_state) \
+    X(EncoderIndexPosition,          f.index_position) \
+    X(MainSensorResolution,          resolution)
+// clang-format on
+#define DRIVE_VENDOR_FIELD(name, expr)                                                             \
+    VendorField{Param::name,                                                                       \
+                [](Parameters& p, Feedback& f, uint32_t& resolution) -> uint8_t* {                 \
+                    (void)p, (void)f, (void)resolution;                                            \
+                    static_assert(sizeof(expr) == sizeof(vendor::name.def), #name ": field size"); \
+                    return bytes(expr);                                                            \
+                },                                                                                 \
+                sizeof(vendor::name.def), Role::Feedback == vendor_role(Param::name)},
+constexpr Role vendor_role(Param p) {
+    switch (p) {
+#define DRIVE_PARAM_ROLE(name, T, def, role) \
+    case Param::name:                        \
+        return Role::role;
+        DRIVE_VENDOR_PARAMETERS(DRIVE_PARAM_ROLE)
+#undef DRIVE_PARAM_ROLE
+    }
+    return Role::Parameter;
+}
+constexpr VendorField kVendorFields[] = {DRIVE_VENDOR_FIELDS(DRIVE_VENDOR_FIELD)};
+#undef DRIVE_VENDOR_FIELD
+// The table above is in the order of Param.
+#define DRIVE_PARAM_COUNT(name, T, def, role) +1
+static_assert(std::size(kVendorFields) == 0 DRIVE_VENDOR_PARAMETERS(DRIVE_PARAM_COUNT));
+constexpr bool in_param_order() {
+    for (std::size_t k = 0; k < std::size(kVendorFields); ++k)
+        if (static_cast<std::size_t>(kVendorFields[k].param) != k) return false;
+    return true;
+}
+static_assert(in_param_order());
+#undef DRIVE_PARAM_COUNT
+
+}  // namespace
 
 bool Drive::locate(uint16_t index, uint8_t sub, std::size_t size, Link& link) {
     const od::Entry* e = dict_.find(index, sub);
@@ -70,20 +156,32 @@ void Drive::store_outputs() {
     store<uint32_t>(outputs_[2]);
 }
 
-template <typename T>
-void Drive::in(const od::Obj<T>& h, T& field) {
-    static_assert(sizeof(T) == 1 || sizeof(T) == 2 || sizeof(T) == 4);
+bool Drive::in_raw(uint16_t index, uint8_t sub, std::size_t size, uint8_t* field) {
     Link l{};
-    l.field = reinterpret_cast<uint8_t*>(&field);
-    if (locate(h.index, h.sub, sizeof(T), l)) inputs_[group(sizeof(T))].push_back(l);
+    l.field = field;
+    if (!locate(index, sub, size, l)) return false;
+    inputs_[group(size)].push_back(l);
+    return true;
+}
+
+bool Drive::out_raw(uint16_t index, uint8_t sub, std::size_t size, uint8_t* field) {
+    Link l{};
+    l.field = field;
+    if (!locate(index, sub, size, l)) return false;
+    outputs_[group(size)].push_back(l);
+    return true;
 }
 
 template <typename T>
-void Drive::out(const od::Obj<T>& h, const T& field) {
+void Drive::in(const Obj<T>& h, T& field) {
     static_assert(sizeof(T) == 1 || sizeof(T) == 2 || sizeof(T) == 4);
-    Link l{};
-    l.field = reinterpret_cast<uint8_t*>(const_cast<T*>(&field));
-    if (locate(h.index, h.sub, sizeof(T), l)) outputs_[group(sizeof(T))].push_back(l);
+    in_raw(h.index, h.sub, sizeof(T), reinterpret_cast<uint8_t*>(&field));
+}
+
+template <typename T>
+void Drive::out(const Obj<T>& h, const T& field) {
+    static_assert(sizeof(T) == 1 || sizeof(T) == 2 || sizeof(T) == 4);
+    out_raw(h.index, h.sub, sizeof(T), reinterpret_cast<uint8_t*>(const_cast<T*>(&field)));
 }
 
 bool Drive::binds(uint16_t index, uint8_t sub) const {
@@ -94,128 +192,118 @@ bool Drive::binds(uint16_t index, uint8_t sub) const {
     return false;
 }
 
-Drive::Drive(od::Dictionary& dictionary, EventSink* sink) : dict_(dictionary), axis_(sink) {
-    namespace obj = od::obj;
+Drive::Drive(od::Dictionary& dictionary, EventSink* sink, const VendorObjects& vendor)
+    : dict_(dictionary), axis_(sink) {
     Parameters& p = axis_.params;
     Command& c = axis_.command;
-    // Configuration
-    in(obj::MotorNominalCurrent, p.nominal_current);
-    in(obj::MotorOutputCurrentLimit, p.output_current_limit);
-    in(obj::MotorPolePairs, p.pole_pairs);
-    in(obj::MotorThermalTimeConstant, p.thermal_time_constant);
-    in(obj::MotorTorqueConstant, p.torque_constant);
-    in(obj::MotorType, p.motor_type);
-    in(obj::EncoderPulses, p.encoder_pulses);
-    in(obj::EncoderType, p.encoder_type);
-    in(obj::AxisConfigurationMisc, p.axis_misc);
-    in(obj::CurrentPGain, p.current_p);
-    in(obj::CurrentIGain, p.current_i);
-    in(obj::CurrentFfGain, p.current_ff);
-    in(obj::PositionBandwidth, p.bandwidth);
-    in(obj::PositionDamping, p.damping);
-    in(obj::PositionResetTime, p.reset_time);
-    in(obj::Inertia, p.inertia);
-    in(obj::Friction, p.friction);
-    in(obj::AbortConnectionOptionCode, p.abort_connection);
-    in(obj::QuickStopOptionCode, p.quick_stop);
-    in(obj::ShutdownOptionCode, p.shutdown);
-    in(obj::DisableOperationOptionCode, p.disable_operation);
-    in(obj::HaltOptionCode, p.halt);
-    in(obj::FaultReactionOptionCode, p.fault_reaction);
-    in(obj::FollowingErrorWindow, p.following_error_window);
-    in(obj::FollowingErrorTimeout, p.following_error_timeout);
-    in(obj::SoftwarePositionLimitMin, p.sw_limit_min);
-    in(obj::SoftwarePositionLimitMax, p.sw_limit_max);
-    in(obj::PositionRangeLimitMin, p.range_min);
-    in(obj::PositionRangeLimitMax, p.range_max);
-    in(obj::MaxProfileVelocity, p.max_profile_velocity);
-    in(obj::MaxMotorSpeed, p.max_motor_speed);
-    in(obj::ProfileVelocity, p.profile_velocity);
-    in(obj::ProfileAcceleration, p.profile_acceleration);
-    in(obj::ProfileDeceleration, p.profile_deceleration);
-    in(obj::QuickStopDeceleration, p.quick_stop_deceleration);
-    in(obj::MaxAcceleration, p.max_acceleration);
-    in(obj::HomingMethod, p.homing_method);
-    in(obj::HomingSpeedSwitchSearch, p.homing_speed_switch);
-    in(obj::HomingSpeedZeroSearch, p.homing_speed_zero);
-    in(obj::HomingAcceleration, p.homing_acceleration);
-    in(obj::HomePosition, p.home_position);
-    in(obj::HomeOffsetMoveDistance, p.home_offset_move);
-    in(obj::HomingCurrentThreshold, p.homing_current_threshold);
-    in(obj::InterpolationTimePeriodValue, p.interpolation_value);
-    in(obj::InterpolationTimeIndex, p.interpolation_index);
-    in(obj::StandstillWindow, p.standstill_window);
-    in(obj::StandstillWindowTime, p.standstill_time);
-    in(obj::StandstillWindowTimeout, p.standstill_timeout);
-    in(obj::DigitalInputPolarity, p.input_polarity);
-    in(obj::DigitalInput1Configuration, p.input_function[0]);
-    in(obj::DigitalInput2Configuration, p.input_function[1]);
-    in(obj::DigitalInput3Configuration, p.input_function[2]);
-    in(obj::DigitalInput4Configuration, p.input_function[3]);
-    in(obj::DigitalInput5Configuration, p.input_function[4]);
-    in(obj::DigitalInput6Configuration, p.input_function[5]);
-    in(obj::TouchProbe1Source, p.touch_probe_source);
-    // Commands (RxPDO objects)
-    in(obj::Controlword, c.controlword);
-    in(obj::ModesOfOperation, c.mode);
-    in(obj::TargetPosition, c.target_position);
-    in(obj::TargetVelocity, c.target_velocity);
-    in(obj::TargetTorque, c.target_torque);
-    in(obj::PositionOffset, c.position_offset);
-    in(obj::VelocityOffset, c.velocity_offset);
-    in(obj::TorqueOffset, c.torque_offset);
-    in(obj::TouchProbeFunction, c.touch_probe_function);
-    // Feedback (TxPDO objects and other computed values)
     Feedback& f = fb_copy_;
-    out(obj::Statusword, f.statusword);
-    out(obj::ModesOfOperationDisplay, f.mode_display);
-    out(obj::PositionDemandValue, f.position_demand);
-    out(obj::PositionActualValue, f.position_actual);
-    out(obj::PositionActualValueSensor1, f.position_actual);
-    out(obj::VelocityDemandValue, f.velocity_demand);
-    out(obj::VelocityActualValue, f.velocity_actual);
-    out(obj::VelocityActualValueSensor1, f.velocity_actual);
-    out(obj::VelocityActualAveragedSensor1, f.velocity_averaged);
-    out(obj::VelocityActualValueAveraged, f.velocity_averaged);
-    out(obj::TorqueActualValue, f.torque_actual);
-    out(obj::CurrentActualValue, f.current_actual);
-    out(obj::CurrentDemandValue, f.current_demand);
-    out(obj::CurrentActualValueAveraged, f.current_averaged);
-    out(obj::FollowingErrorActualValue, f.following_error);
-    out(obj::MotorRatedTorque, f.motor_rated_torque);
-    out(obj::DigitalInputs, f.digital_inputs);
-    out(obj::DigitalInputLogicState, f.input_logic_state);
-    out(obj::EncoderIndexPosition, f.index_position);
-    out(obj::TouchProbeStatus, f.touch_probe_status);
-    out(obj::TouchProbePosition1Positive, f.touch_probe_pos);
-    out(obj::TouchProbePosition1Negative, f.touch_probe_neg);
-    out(obj::TouchProbe1PositiveEdgeCounter, f.touch_probe_pos_count);
-    out(obj::TouchProbe1NegativeEdgeCounter, f.touch_probe_neg_count);
-    out(obj::ErrorCode, f.error_code);
-    out(obj::ErrorRegister, f.error_register);
-    out(obj::MainSensorResolution, resolution_);
+    // The CiA 402 objects, by index, wherever they are.
+    {
+        using namespace obj;
+        in(MotorType, p.motor_type);
+        in(AbortConnectionOptionCode, p.abort_connection);
+        in(QuickStopOptionCode, p.quick_stop);
+        in(ShutdownOptionCode, p.shutdown);
+        in(DisableOperationOptionCode, p.disable_operation);
+        in(HaltOptionCode, p.halt);
+        in(FaultReactionOptionCode, p.fault_reaction);
+        in(FollowingErrorWindow, p.following_error_window);
+        in(FollowingErrorTimeout, p.following_error_timeout);
+        in(SoftwarePositionLimitMin, p.sw_limit_min);
+        in(SoftwarePositionLimitMax, p.sw_limit_max);
+        in(PositionRangeLimitMin, p.range_min);
+        in(PositionRangeLimitMax, p.range_max);
+        in(MaxProfileVelocity, p.max_profile_velocity);
+        in(MaxMotorSpeed, p.max_motor_speed);
+        in(ProfileVelocity, p.profile_velocity);
+        in(ProfileAcceleration, p.profile_acceleration);
+        in(ProfileDeceleration, p.profile_deceleration);
+        in(QuickStopDeceleration, p.quick_stop_deceleration);
+        in(MaxAcceleration, p.max_acceleration);
+        in(HomingMethod, p.homing_method);
+        in(HomingSpeedSwitchSearch, p.homing_speed_switch);
+        in(HomingSpeedZeroSearch, p.homing_speed_zero);
+        in(HomingAcceleration, p.homing_acceleration);
+        in(InterpolationTimePeriodValue, p.interpolation_value);
+        in(InterpolationTimeIndex, p.interpolation_index);
+        in(TouchProbe1Source, p.touch_probe_source);
+        in(SupportedDriveModes, p.supported_modes);
+        in(PositionEncoderIncrements, p.resolution_increments);
+        in(PositionEncoderRevolutions, p.resolution_revolutions);
+        in(Controlword, c.controlword);
+        in(ModesOfOperation, c.mode);
+        in(TargetPosition, c.target_position);
+        in(TargetVelocity, c.target_velocity);
+        in(TargetTorque, c.target_torque);
+        in(PositionOffset, c.position_offset);
+        in(VelocityOffset, c.velocity_offset);
+        in(TorqueOffset, c.torque_offset);
+        in(TouchProbeFunction, c.touch_probe_function);
+        out(Statusword, f.statusword);
+        out(ModesOfOperationDisplay, f.mode_display);
+        out(PositionDemandValue, f.position_demand);
+        out(PositionActualValue, f.position_actual);
+        out(VelocityDemandValue, f.velocity_demand);
+        out(VelocityActualValue, f.velocity_actual);
+        out(TorqueActualValue, f.torque_actual);
+        out(CurrentActualValue, f.current_actual);
+        out(FollowingErrorActualValue, f.following_error);
+        out(MotorRatedTorque, f.motor_rated_torque);
+        out(DigitalInputs, f.digital_inputs);
+        out(TouchProbeStatus, f.touch_probe_status);
+        out(TouchProbePosition1Positive, f.touch_probe_pos);
+        out(TouchProbePosition1Negative, f.touch_probe_neg);
+        out(TouchProbe1PositiveEdgeCounter, f.touch_probe_pos_count);
+        out(TouchProbe1NegativeEdgeCounter, f.touch_probe_neg_count);
+        out(ErrorCode, f.error_code);
+        out(ErrorRegister, f.error_register);
+    }
+    // The vendor parameters where the device keeps them.
+    bool bound_params[std::size(kVendorFields)] = {};
+    for (const Binding& b : vendor.bindings) {
+        const auto k = static_cast<std::size_t>(b.param);
+        if (k >= std::size(kVendorFields)) continue;
+        const VendorField& vf = kVendorFields[k];
+        uint8_t* field = vf.field(p, f, resolution_);
+        if (vf.feedback)
+            bound_params[k] = out_raw(b.index, b.sub, vf.size, field);
+        else
+            bound_params[k] = in_raw(b.index, b.sub, vf.size, field);
+    }
+    // Without the device's motor data and tuning, the motor model's (as commission() writes them).
+    const MotorModel& m = axis_.motor();
+    for (const auto& [param, value] : commissioned(m))
+        if (!bound_params[static_cast<std::size_t>(param)]) {
+            uint8_t* field = kVendorFields[static_cast<std::size_t>(param)].field(p, f, resolution_);
+            std::memcpy(field, &value, sizeof value);
+        }
 
-    const uint16_t power_disable_only[] = {obj::AxisConfiguration,
-                                           obj::MotorData,
-                                           obj::DigitalIncrementalEncoder1,
-                                           obj::AnalogIncrementalEncoder,
-                                           obj::SsiAbsoluteEncoder,
-                                           obj::BissAbsoluteEncoder,
-                                           obj::DigitalHallSensor,
-                                           obj::DigitalIncrementalEncoder2,
-                                           obj::SiUnitPosition,
-                                           obj::SiUnitVelocity,
-                                           obj::SiUnitAcceleration,
-                                           obj::MotorType.index};
-    for (uint16_t index : power_disable_only) {
-        if (!dict_.find(index)) continue;
+    // A mode the drive does not implement or the device does not announce in 0x6502 is refused (IEC
+    // 61800-7-201: 0x6061 shows the mode the drive runs; an SDO write answers "value range exceeded").
+    if (dict_.find(obj::ModesOfOperation.index, obj::ModesOfOperation.sub)) {
+        dict_.add_validator(
+            obj::ModesOfOperation.index,
+            [d = &dict_](const od::Entry& e, std::span<const uint8_t> v) {
+                if (e.subindex != obj::ModesOfOperation.sub || v.size() != 1) return od::Status::Ok;
+                uint32_t announced = supported_drive_modes();
+                const od::Entry* sdm = d->find(obj::SupportedDriveModes.index, obj::SupportedDriveModes.sub);
+                if (sdm && sdm->byte_size() == 4)
+                    announced =
+                        d->get<uint32_t>(obj::SupportedDriveModes.index, obj::SupportedDriveModes.sub);
+                return mode::supported(static_cast<int8_t>(v[0]), announced) ? od::Status::Ok
+                                                                             : od::Status::InvalidValue;
+            },
+            this);
+    }
+
+    for (const PowerDisableOnly& lock : vendor.power_disable_only) {
+        if (!dict_.find(lock.index)) continue;
         // Owned by this drive (removed by its destructor): a dictionary that outlives its drive, or serves
         // one drive after another, keeps no validator of a drive that is gone.
         dict_.add_validator(
-            index,
-            [flag = powered_](const od::Entry& e, std::span<const uint8_t>) {
-                if (e.index == obj::MotorData && e.subindex != obj::MotorPolePairs.sub)
-                    return od::Status::Ok;  // only the pole pairs
+            lock.index,
+            [flag = powered_, sub = lock.sub](const od::Entry& e, std::span<const uint8_t>) {
+                if (sub >= 0 && e.subindex != sub) return od::Status::Ok;
                 return flag->load(std::memory_order_relaxed) ? od::Status::WrongState : od::Status::Ok;
             },
             this);
@@ -227,22 +315,24 @@ Drive::~Drive() {
     dict_.remove_hooks(this);
 }
 
-od::Status commission(od::Dictionary& d, const MotorModel& m) {
+std::array<std::pair<Param, uint32_t>, 6> commissioned(const MotorModel& m) {
     const double j = m.rotor_inertia + m.load_inertia;
-    const struct {
-        od::Obj<uint32_t> obj;
-        uint32_t value;
-    } rows[] = {
-        {od::obj::MotorTorqueConstant, static_cast<uint32_t>(std::lround(m.torque_constant * 1e6))},  // uNm/A
-        {od::obj::PositionBandwidth, 20000},                                                          // 20 Hz
-        {od::obj::PositionDamping, 1000},                                  // critical damping
-        {od::obj::PositionResetTime, 50000},                               // 50 ms
-        {od::obj::Inertia, static_cast<uint32_t>(std::lround(j * 1e10))},  // mg cm^2
-        {od::obj::Friction,
+    return {{
+        {Param::MotorTorqueConstant, static_cast<uint32_t>(std::lround(m.torque_constant * 1e6))},  // uNm/A
+        {Param::PositionBandwidth, 20000},                                                          // 20 Hz
+        {Param::PositionDamping, 1000},                                  // critical damping
+        {Param::PositionResetTime, 50000},                               // 50 ms
+        {Param::Inertia, static_cast<uint32_t>(std::lround(j * 1e10))},  // mg cm^2
+        {Param::Friction,
          static_cast<uint32_t>(std::lround(m.viscous_friction * 1e9 * 6.283185307179586 / 60.0))},
-    };
-    for (const auto& r : rows) {
-        const od::Status s = d.set<uint32_t>(r.obj.index, r.obj.sub, r.value);
+    }};
+}
+
+od::Status commission(od::Dictionary& d, const VendorObjects& vendor, const MotorModel& m) {
+    for (const auto& [param, value] : commissioned(m)) {
+        const Binding* b = vendor.find(param);
+        if (b == nullptr || d.find(b->index, b->sub) == nullptr) continue;  // only objects that exist
+        const od::Status s = d.set<uint32_t>(b->index, b->sub, value);
         if (s != od::Status::Ok) return s;
     }
     return od::Status::Ok;

@@ -90,40 +90,4 @@ std::string_view to_string(DataType t) {
     return "UNKNOWN";
 }
 
-uint16_t bit_size(DataType t) {
-    switch (t) {
-        case DataType::Boolean:
-            return 1;
-        case DataType::Integer8:
-        case DataType::Unsigned8:
-            return 8;
-        case DataType::Integer16:
-        case DataType::Unsigned16:
-            return 16;
-        case DataType::Integer32:
-        case DataType::Unsigned32:
-        case DataType::Real32:
-            return 32;
-        case DataType::Integer64:
-        case DataType::Unsigned64:
-        case DataType::Real64:
-            return 64;
-        default:
-            return 0;
-    }
-}
-
-bool is_signed(DataType t) {
-    return t == DataType::Integer8 || t == DataType::Integer16 || t == DataType::Integer32 ||
-           t == DataType::Integer64;
-}
-
-bool is_real(DataType t) {
-    return t == DataType::Real32 || t == DataType::Real64;
-}
-
-bool is_string(DataType t) {
-    return t == DataType::VisibleString || t == DataType::OctetString || t == DataType::UnicodeString;
-}
-
 }  // namespace od

@@ -7,9 +7,9 @@
 #include <utility>
 #include <vector>
 
+#include "maxpos/maxpos.hpp"
 #include "od/device.hpp"
 #include "od/dictionary.hpp"
-#include "od/drive_profile.hpp"
 
 namespace esi_test {
 
@@ -229,8 +229,8 @@ inline Device small_device() {
 }
 
 inline Device drive_device() {
-    auto d = od::default_drive_description();
-    auto dict = od::make_drive_dictionary(d);
+    auto d = maxpos::description();
+    auto dict = maxpos::dictionary(d);
     return {"drive", std::move(d), std::move(dict)};
 }
 

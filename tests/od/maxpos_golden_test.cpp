@@ -18,7 +18,7 @@
 
 #include "esi/esi.hpp"
 #include "esi/sii.hpp"
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 
 namespace {
 
@@ -86,11 +86,11 @@ void compare(const std::string& name, const std::string& actual) {
 }
 
 od::DeviceDescription description() {
-    return od::default_drive_description();
+    return maxpos::description();
 }
 
 od::Dictionary dictionary(const od::DeviceDescription& d) {
-    return od::make_drive_dictionary(d);
+    return maxpos::dictionary(d);
 }
 
 TEST(MaxposGolden, Esi) {

@@ -11,6 +11,7 @@
 #include "coe/events.hpp"
 #include "coe/pdo_validation.hpp"
 #include "drive/errors.hpp"
+#include "drive/objects.hpp"
 #include "drive/state_machine.hpp"
 #include "esc/wire/al.hpp"
 #include "esc/wire/registers.hpp"
@@ -18,10 +19,9 @@
 #include "esi/sii.hpp"
 #include "foe/firmware.hpp"
 #include "foe/image.hpp"
+#include "maxpos/maxpos.hpp"
 #include "od/device_config.hpp"
 #include "od/diag_texts.hpp"
-#include "od/drive_objects.hpp"
-#include "od/drive_profile.hpp"
 #include "util/le.hpp"
 #include "util/strfmt.hpp"
 
@@ -38,8 +38,8 @@ foe::StoreConfig store_config(const DeviceOptions& options, const od::DeviceDesc
 }
 
 od::DeviceDescription base_description(const DeviceOptions& options) {
-    od::DeviceDescription d = options.config_file.empty() ? od::default_drive_description()
-                                                          : od::load_device_config(options.config_file);
+    od::DeviceDescription d =
+        options.config_file.empty() ? maxpos::description() : maxpos::load_config(options.config_file);
     if (options.serial_number) d.identity.serial_number = *options.serial_number;
     return d;
 }
@@ -72,7 +72,7 @@ od::DeviceDescription make_description(const DeviceOptions& options) {
 void check_device(const DeviceOptions& options) {
     const od::DeviceDescription d = make_description(options);
     try {
-        const od::Dictionary dict = od::make_drive_dictionary(d);
+        const od::Dictionary dict = maxpos::dictionary(d);
         (void)esi::build_sii(d, dict);
     } catch (const std::exception& e) {
         throw od::ConfigError(
@@ -83,7 +83,7 @@ void check_device(const DeviceOptions& options) {
 
 std::vector<uint8_t> make_sii(const DeviceOptions& options) {
     const od::DeviceDescription d = make_description(options);
-    const od::Dictionary dict = od::make_drive_dictionary(d);
+    const od::Dictionary dict = maxpos::dictionary(d);
     std::vector<uint8_t> image = esi::build_sii(d, dict);
     if (options.state_dir.empty()) return image;
     EepromWrites writes(options.state_dir);
@@ -93,7 +93,7 @@ std::vector<uint8_t> make_sii(const DeviceOptions& options) {
 
 std::string make_esi(const DeviceOptions& options) {
     const od::DeviceDescription d = make_description(options);
-    const od::Dictionary dict = od::make_drive_dictionary(d);
+    const od::Dictionary dict = maxpos::dictionary(d);
     return esi::build_esi(d, dict);
 }
 
@@ -272,12 +272,12 @@ void Device::build() {
               << p->firmware->error().text << " (running the built-in firmware)\n";
     p->firmware->apply_to(p->desc.identity);
 
-    p->dict = od::make_drive_dictionary(p->desc);
+    p->dict = maxpos::dictionary(p->desc);
     coe::install_pdo_validators(p->dict, {}, p->desc.pdo_rules);
     if (options_.faults.identity_mismatch)
         (void)p->dict.set<uint32_t>(0x1018, 2, p->desc.identity.product_code + 1);
     if (options_.commission) {
-        if (const od::Status s = drive::commission(p->dict); s != od::Status::Ok)
+        if (const od::Status s = drive::commission(p->dict, maxpos::drive_objects()); s != od::Status::Ok)
             log() << "softdrive: commissioning the motor parameters failed: " << od::to_string(s) << '\n';
     }
     p->params = std::make_unique<od::ParameterStore>(options_.state_dir);
@@ -291,7 +291,7 @@ void Device::build() {
         [raw] {
             // MAXPOS firmware specification §7.2.21: restoring defaults only with the axis in "Power Disable"
             // (not switched on).
-            constexpr auto sw = od::obj::Statusword;
+            constexpr auto sw = drive::obj::Statusword;
             const od::Entry* e = raw->dict.find(sw.index, sw.sub);
             if (e == nullptr) return od::Status::Ok;
             return (raw->dict.get<uint16_t>(sw.index, sw.sub) & drive::sw::SwitchedOn) != 0
@@ -341,7 +341,7 @@ void Device::build() {
     p->stack->add_handler(p->firmware->server());
     p->stack->set_event_sink(this);
     p->firmware->server().set_event_sink(this);
-    p->drive = std::make_unique<drive::Drive>(p->dict, this);
+    p->drive = std::make_unique<drive::Drive>(p->dict, this, maxpos::drive_objects());
     p->drive->axis().faults = options_.faults.axis;
 
     if (options_.load_sii) esc_.load_eeprom(image);
@@ -468,7 +468,7 @@ void Device::react_to_outputs_lost() {
     // 0x8180 with the 0x6007 reaction in any drive state. A master that asks to leave Op is not an error; it
     // gets the reaction only while its outputs were commanding motion (operation enabled, statusword bit 2).
     const bool fall_back = parts_->stack->error();
-    constexpr auto statusword = od::obj::Statusword;
+    constexpr auto statusword = drive::obj::Statusword;
     const od::Entry* sw = parts_->dict.find(statusword.index, statusword.sub);
     const bool enabled = sw != nullptr && (parts_->dict.get<uint16_t>(statusword.index, statusword.sub) &
                                            drive::sw::OperationEnabled) != 0;
