@@ -40,7 +40,7 @@ PositionFrame Axis::frame() const {
 
 DeviceControl::Options Axis::dc_options() const {
     return {params.shutdown, params.disable_operation, params.profile_deceleration,
-            params.quick_stop_deceleration};
+            params.quick_stop_deceleration, params.quick_stop};
 }
 
 // What device control's transitions ask of the other parts.
