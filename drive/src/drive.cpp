@@ -1,8 +1,11 @@
 #include "drive/drive.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
+#include <type_traits>
 
 namespace drive {
 namespace {
@@ -173,6 +176,71 @@ bool Drive::out_raw(uint16_t index, uint8_t sub, std::size_t size, uint8_t* fiel
 }
 
 template <typename T>
+void Drive::in_position(const Obj<T>& h, T& field) {
+    static_assert(sizeof(T) == 4);
+    if (!scaled_) return in(h, field);
+    Link l{};
+    l.field = reinterpret_cast<uint8_t*>(&field);
+    l.is_signed = std::is_signed_v<T>;
+    if (locate(h.index, h.sub, sizeof(T), l)) position_in_.push_back(l);
+}
+
+template <typename T>
+void Drive::out_position(const Obj<T>& h, const T& field) {
+    static_assert(sizeof(T) == 4);
+    if (!scaled_) return out(h, field);
+    Link l{};
+    l.field = reinterpret_cast<uint8_t*>(const_cast<T*>(&field));
+    l.is_signed = std::is_signed_v<T>;
+    if (locate(h.index, h.sub, sizeof(T), l)) position_out_.push_back(l);
+}
+
+double Drive::increments_per_unit() const {
+    const Parameters& p = axis_.params;
+    const double per_rev = p.resolution_increments > 0 && p.resolution_revolutions > 0
+                               ? static_cast<double>(p.resolution_increments) / p.resolution_revolutions
+                               : 4.0 * p.encoder_pulses;
+    if (p.feed == 0 || p.feed_shaft_revolutions == 0 || p.gear_motor_revolutions == 0 ||
+        p.gear_shaft_revolutions == 0)
+        return 1.0;  // not configured: increments
+    const double gear = static_cast<double>(p.gear_motor_revolutions) / p.gear_shaft_revolutions;
+    const double feed = static_cast<double>(p.feed) / p.feed_shaft_revolutions;
+    const double f = per_rev * gear / feed;
+    return std::isfinite(f) && f > 0 ? f : 1.0;
+}
+
+namespace {
+// A position value through the factor, saturated; the extremes (limits off, window off) stay extremes.
+uint32_t convert(uint32_t raw, bool is_signed, double factor) {
+    if (is_signed) {
+        const auto v = static_cast<int32_t>(raw);
+        if (v == std::numeric_limits<int32_t>::min() || v == std::numeric_limits<int32_t>::max()) return raw;
+        const double x = std::clamp(std::round(v * factor), -2147483647.0, 2147483646.0);
+        return static_cast<uint32_t>(static_cast<int32_t>(x));
+    }
+    if (raw == 0xFFFFFFFFu) return raw;
+    return static_cast<uint32_t>(std::clamp(std::round(raw * factor), 0.0, 4294967294.0));
+}
+}  // namespace
+
+void Drive::load_positions() {
+    const double f = increments_per_unit();
+    for (const Link& l : position_in_) {
+        const uint32_t v = convert(l.r32.get(), l.is_signed, f);
+        std::memcpy(l.field, &v, sizeof v);
+    }
+}
+
+void Drive::store_positions() {
+    const double f = 1.0 / increments_per_unit();
+    for (Link l : position_out_) {
+        uint32_t v;
+        std::memcpy(&v, l.field, sizeof v);
+        l.r32.set(convert(v, l.is_signed, f));
+    }
+}
+
+template <typename T>
 void Drive::in(const Obj<T>& h, T& field) {
     static_assert(sizeof(T) == 1 || sizeof(T) == 2 || sizeof(T) == 4);
     in_raw(h.index, h.sub, sizeof(T), reinterpret_cast<uint8_t*>(&field));
@@ -189,6 +257,9 @@ bool Drive::binds(uint16_t index, uint8_t sub) const {
         for (const auto& links : *groups)
             for (const Link& l : links)
                 if (l.index == index && l.sub == sub) return true;
+    for (const auto* links : {&position_in_, &position_out_})
+        for (const Link& l : *links)
+            if (l.index == index && l.sub == sub) return true;
     return false;
 }
 
@@ -197,6 +268,10 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink, const VendorObjects& v
     Parameters& p = axis_.params;
     Command& c = axis_.command;
     Feedback& f = fb_copy_;
+    // A device with a gear ratio or feed constant states positions in its position units (IEC 61800-7-201
+    // factor group); without them the units are the encoder's increments and nothing is converted.
+    scaled_ = dict_.find(obj::GearMotorRevolutions.index) != nullptr ||
+              dict_.find(obj::FeedConstantFeed.index) != nullptr;
     // The CiA 402 objects, by index, wherever they are.
     {
         using namespace obj;
@@ -207,12 +282,12 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink, const VendorObjects& v
         in(DisableOperationOptionCode, p.disable_operation);
         in(HaltOptionCode, p.halt);
         in(FaultReactionOptionCode, p.fault_reaction);
-        in(FollowingErrorWindow, p.following_error_window);
+        in_position(FollowingErrorWindow, p.following_error_window);
         in(FollowingErrorTimeout, p.following_error_timeout);
-        in(SoftwarePositionLimitMin, p.sw_limit_min);
-        in(SoftwarePositionLimitMax, p.sw_limit_max);
-        in(PositionRangeLimitMin, p.range_min);
-        in(PositionRangeLimitMax, p.range_max);
+        in_position(SoftwarePositionLimitMin, p.sw_limit_min);
+        in_position(SoftwarePositionLimitMax, p.sw_limit_max);
+        in_position(PositionRangeLimitMin, p.range_min);
+        in_position(PositionRangeLimitMax, p.range_max);
         in(MaxProfileVelocity, p.max_profile_velocity);
         in(MaxMotorSpeed, p.max_motor_speed);
         in(ProfileVelocity, p.profile_velocity);
@@ -230,29 +305,33 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink, const VendorObjects& v
         in(SupportedDriveModes, p.supported_modes);
         in(PositionEncoderIncrements, p.resolution_increments);
         in(PositionEncoderRevolutions, p.resolution_revolutions);
+        in(GearMotorRevolutions, p.gear_motor_revolutions);
+        in(GearShaftRevolutions, p.gear_shaft_revolutions);
+        in(FeedConstantFeed, p.feed);
+        in(FeedConstantShaftRevolutions, p.feed_shaft_revolutions);
         in(Controlword, c.controlword);
         in(ModesOfOperation, c.mode);
-        in(TargetPosition, c.target_position);
+        in_position(TargetPosition, c.target_position);
         in(TargetVelocity, c.target_velocity);
         in(TargetTorque, c.target_torque);
-        in(PositionOffset, c.position_offset);
+        in_position(PositionOffset, c.position_offset);
         in(VelocityOffset, c.velocity_offset);
         in(TorqueOffset, c.torque_offset);
         in(TouchProbeFunction, c.touch_probe_function);
         out(Statusword, f.statusword);
         out(ModesOfOperationDisplay, f.mode_display);
-        out(PositionDemandValue, f.position_demand);
-        out(PositionActualValue, f.position_actual);
+        out_position(PositionDemandValue, f.position_demand);
+        out_position(PositionActualValue, f.position_actual);
         out(VelocityDemandValue, f.velocity_demand);
         out(VelocityActualValue, f.velocity_actual);
         out(TorqueActualValue, f.torque_actual);
         out(CurrentActualValue, f.current_actual);
-        out(FollowingErrorActualValue, f.following_error);
+        out_position(FollowingErrorActualValue, f.following_error);
         out(MotorRatedTorque, f.motor_rated_torque);
         out(DigitalInputs, f.digital_inputs);
         out(TouchProbeStatus, f.touch_probe_status);
-        out(TouchProbePosition1Positive, f.touch_probe_pos);
-        out(TouchProbePosition1Negative, f.touch_probe_neg);
+        out_position(TouchProbePosition1Positive, f.touch_probe_pos);
+        out_position(TouchProbePosition1Negative, f.touch_probe_neg);
         out(TouchProbe1PositiveEdgeCounter, f.touch_probe_pos_count);
         out(TouchProbe1NegativeEdgeCounter, f.touch_probe_neg_count);
         out(ErrorCode, f.error_code);
@@ -340,10 +419,12 @@ od::Status commission(od::Dictionary& d, const VendorObjects& vendor, const Moto
 
 void Drive::cycle(int64_t now_ns, int64_t dt_ns) {
     load_inputs();
+    load_positions();
     axis_.cycle(now_ns, dt_ns);
     fb_copy_ = axis_.feedback();
     resolution_ = static_cast<uint32_t>(axis_.increments_per_rev());
     store_outputs();
+    store_positions();
     powered_->store(axis_.power_on(), std::memory_order_relaxed);
 }
 
@@ -351,6 +432,7 @@ void Drive::connection_lost() {
     axis_.connection_lost();
     fb_copy_ = axis_.feedback();
     store_outputs();
+    store_positions();
 }
 
 }  // namespace drive

@@ -29,9 +29,11 @@ od::Status master_write(od::Dictionary& d, uint16_t index, uint8_t sub, int64_t 
 }
 
 // The CiA 402 objects the drive knows that the MAXPOS has not got (MAXPOS firmware specification chapter 7:
-// no 0x608F; its resolution is 0x3000:05, from the encoder's pulses).
+// no 0x608F, its resolution is 0x3000:05 from the encoder's pulses; no gear ratio 0x6091 or feed constant
+// 0x6092, its positions are increments).
 bool maxpos_lacks(uint16_t index, uint8_t) {
-    return index == drive::obj::PositionEncoderIncrements.index;
+    return index == drive::obj::PositionEncoderIncrements.index ||
+           index == drive::obj::GearMotorRevolutions.index || index == drive::obj::FeedConstantFeed.index;
 }
 std::size_t maxpos_lacks_count() {
     std::size_t n = 0;

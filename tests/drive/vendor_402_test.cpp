@@ -75,7 +75,9 @@ constexpr uint32_t kResolution = 8192;  // 0x608F:01 encoder increments per moto
 
 // A vendor's CiA 402 servo drive as its ESI would declare it: CSP, CSV and CST only (0x6502), position in
 // encoder increments (0x608F, gear 1:1, feed = one revolution), its own PDO layout, two vendor objects.
-od::Dictionary vendor_dictionary(uint32_t supported_modes = 0x00000380) {
+// feed != 0: with a gear ratio 0x6091 of 1:1 and a feed constant 0x6092 of `feed` position units per
+// revolution.
+od::Dictionary vendor_dictionary(uint32_t supported_modes = 0x00000380, uint32_t feed = 0) {
     using T = DataType;
     od::Dictionary d;
     var(d, 0x1000, T::Unsigned32, RO, uint64_t{0x00020192}, "Device type");
@@ -118,6 +120,12 @@ od::Dictionary vendor_dictionary(uint32_t supported_modes = 0x00000380) {
     var(d, 0x6085, T::Unsigned32, RW, uint64_t{50000}, "Quick stop deceleration");
     rec(d, 0x608F, T::Unsigned32, "Position encoder resolution",
         {u32(0x608F, 1, RW, kResolution, "Encoder increments"), u32(0x608F, 2, RW, 1, "Motor revolutions")});
+    if (feed != 0) {
+        rec(d, 0x6091, T::Unsigned32, "Gear ratio",
+            {u32(0x6091, 1, RW, 1, "Motor revolutions"), u32(0x6091, 2, RW, 1, "Shaft revolutions")});
+        rec(d, 0x6092, T::Unsigned32, "Feed constant",
+            {u32(0x6092, 1, RW, feed, "Feed"), u32(0x6092, 2, RW, 1, "Shaft revolutions")});
+    }
     var(d, 0x60B8, T::Unsigned16, RW | RX, uint64_t{0}, "Touch probe function");
     var(d, 0x60B9, T::Unsigned16, RO | TX, uint64_t{0}, "Touch probe status");
     var(d, 0x60BA, T::Integer32, RO | TX, int64_t{0}, "Touch probe 1 positive edge");
@@ -311,6 +319,42 @@ TEST(Vendor402, ModesAnnouncedAreTaken) {
     d.set<int8_t>(0x6060, 0, 1);
     drv.cycle(0, 1'000'000);
     EXPECT_EQ(d.get<int8_t>(0x6061, 0), 1);
+}
+
+TEST(Vendor402, PositionsAreInTheDevicesUnitsThroughGearAndFeed) {
+    // 8192 increments per revolution, 4096 position units per revolution: one unit is two increments.
+    od::Dictionary d = vendor_dictionary(0x00000380, 4096);
+    drive::Drive drv(d);
+    int64_t t = 0;
+    auto cycle = [&](int n) {
+        for (int i = 0; i < n; ++i, t += 1'000'000)
+            drv.cycle(t, 1'000'000);
+    };
+    cycle(1);
+    // Limits and windows of the dictionary arrive in increments.
+    EXPECT_EQ(drv.axis().params.following_error_window, 8000u);
+    EXPECT_EQ(drv.axis().params.sw_limit_max, 2000000);
+    EXPECT_EQ(drv.axis().params.sw_limit_min, -2000000);
+    d.set<int32_t>(0x607A, 0, d.get<int32_t>(0x6064, 0));
+    for (uint16_t cw : {0x06, 0x07, 0x0F}) {
+        d.set<uint16_t>(0x6040, 0, cw);
+        cycle(1);
+    }
+    ASSERT_EQ(d.get<uint16_t>(0x6041, 0) & 0x6F, 0x27);
+    const int32_t start_units = d.get<int32_t>(0x6064, 0);
+    const int32_t start_inc = drv.axis().feedback().position_actual;
+    EXPECT_NEAR(start_units, start_inc / 2.0, 1);
+    int32_t target = start_units;
+    for (int k = 0; k < 400; ++k) {
+        target += std::min(k / 20, 5);
+        d.set<int32_t>(0x607A, 0, target);
+        cycle(1);
+    }
+    cycle(300);
+    EXPECT_GT(target - start_units, 1000);
+    EXPECT_NEAR(d.get<int32_t>(0x6064, 0), target, 2);
+    EXPECT_NEAR(drv.axis().feedback().position_actual - start_inc, 2.0 * (target - start_units), 4);
+    EXPECT_EQ(d.get<uint16_t>(0x603F, 0), 0u);
 }
 
 TEST(Vendor402, TheValidatorGoesWithTheDrive) {

@@ -65,11 +65,20 @@ class Drive {
         uint16_t index;
         uint8_t sub;
         uint8_t size;
+        bool is_signed;
     };
     template <typename T>
     void in(const Obj<T>& object, T& field);
     template <typename T>
     void out(const Obj<T>& object, const T& field);
+    // A position object: through the position factor where the device has one (0x6091/0x6092).
+    template <typename T>
+    void in_position(const Obj<T>& object, T& field);
+    template <typename T>
+    void out_position(const Obj<T>& object, const T& field);
+    double increments_per_unit() const;
+    void load_positions();
+    void store_positions();
     bool in_raw(uint16_t index, uint8_t sub, std::size_t size, uint8_t* field);
     bool out_raw(uint16_t index, uint8_t sub, std::size_t size, uint8_t* field);
     bool locate(uint16_t index, uint8_t sub, std::size_t size, Link& link);
@@ -86,6 +95,8 @@ class Drive {
     Axis axis_;
     std::vector<Link> inputs_[3];   // dictionary -> axis (parameters, commands), by size: 1, 2, 4 bytes
     std::vector<Link> outputs_[3];  // axis -> dictionary (feedback), by size
+    std::vector<Link> position_in_, position_out_;  // position objects in position units (scaled_ only)
+    bool scaled_ = false;
     Feedback fb_copy_;
     uint32_t resolution_ = 0;
     std::size_t bound_ = 0, missing_ = 0;

@@ -101,6 +101,10 @@ constexpr bool contains(const std::array<int8_t, N>& set, int v) {
     X(SupportedDriveModes,            0x6502, 0, uint32_t, supported_drive_modes(), Parameter) \
     X(PositionEncoderIncrements,      0x608F, 1, uint32_t, 0,       Parameter) /* 0: the encoder's 4 x pulses */ \
     X(PositionEncoderRevolutions,     0x608F, 2, uint32_t, 1,       Parameter) \
+    X(GearMotorRevolutions,           0x6091, 1, uint32_t, 1,       Parameter) \
+    X(GearShaftRevolutions,           0x6091, 2, uint32_t, 1,       Parameter) \
+    X(FeedConstantFeed,               0x6092, 1, uint32_t, 0,       Parameter) /* 0: one revolution in inc */ \
+    X(FeedConstantShaftRevolutions,   0x6092, 2, uint32_t, 1,       Parameter) \
     /* commands: the RxPDO objects */ \
     X(Controlword,                    0x6040, 0, uint16_t, 0,       Command) \
     X(ModesOfOperation,               0x6060, 0, int8_t,   8,       Command) \

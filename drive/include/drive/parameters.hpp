@@ -82,6 +82,12 @@ struct Parameters {
     // 0x608F position encoder resolution: increments per motor revolutions; 0 increments: 4 x encoder_pulses.
     uint32_t resolution_increments = obj::PositionEncoderIncrements.def;
     uint32_t resolution_revolutions = obj::PositionEncoderRevolutions.def;
+    // 0x6091 gear ratio (motor : shaft revolutions) and 0x6092 feed constant (feed : shaft revolutions): the
+    // position units of the position objects (Drive converts them; the axis works in increments).
+    uint32_t gear_motor_revolutions = obj::GearMotorRevolutions.def;
+    uint32_t gear_shaft_revolutions = obj::GearShaftRevolutions.def;
+    uint32_t feed = obj::FeedConstantFeed.def;
+    uint32_t feed_shaft_revolutions = obj::FeedConstantShaftRevolutions.def;
 
     bool operator==(const Parameters&) const = default;
 };
