@@ -193,3 +193,47 @@ TEST(DeviceConfig, EveryExampleLoads) {
     EXPECT_EQ(d.bootstrap_mailbox.in_start, d.standard_mailbox.in_start);
     EXPECT_EQ(d.bootstrap_mailbox.in_size, d.standard_mailbox.in_size);
 }
+
+// The parser is the object model's, not the MAXPOS's: it reads on top of any product's description and
+// leaves what the file does not name as that product has it; the SyncManagers are placed by the product's
+// own placer, or kept.
+TEST(DeviceConfig, ReadsOnTopOfAnyProductsDescription) {
+    DeviceDescription base;
+    base.identity.vendor_id = 0x00000002;
+    base.identity.product_code = 0x07D83052;
+    base.identity.device_name = "EL2008";
+    base.mailbox_protocols = 0;  // a device without a mailbox
+    base.sync_managers = {{SmKind::Outputs, 0x0F00, 1, 0x44, true, 0, 0}};
+    const DeviceDescription d = parse_device_config("[identity]\nserial_number = 7\n", "io.conf", base);
+    EXPECT_EQ(d.identity.vendor_id, 0x00000002u);
+    EXPECT_EQ(d.identity.product_code, 0x07D83052u);
+    EXPECT_EQ(d.identity.serial_number, 7u);
+    EXPECT_EQ(d.identity.device_name, "EL2008");
+    ASSERT_EQ(d.sync_managers.size(), 1u);
+    EXPECT_EQ(d.sync_managers[0].start, 0x0F00);
+    int placed = 0;
+    const DeviceDescription p =
+        parse_device_config("[identity]\nserial_number = 8\n", "io.conf", base, [&](DeviceDescription& x) {
+            ++placed;
+            x.sync_managers.clear();
+        });
+    EXPECT_EQ(placed, 1);
+    EXPECT_TRUE(p.sync_managers.empty());
+    // A placer that finds no room is an error of the file.
+    try {
+        parse_device_config("[mailbox]\nout_start = 0x1000\n", "io.conf", base,
+                            [](DeviceDescription&) { throw std::out_of_range("no room"); });
+        FAIL() << "no error";
+    } catch (const ConfigError& e) {
+        EXPECT_EQ(std::string(e.what()), "io.conf: no room");
+    }
+}
+
+// The identity of the generic model names no vendor: each product states its own.
+TEST(DeviceConfig, IdentityDefaultsNameNoProduct) {
+    const Identity id;
+    EXPECT_EQ(id.vendor_id, 0u);
+    EXPECT_TRUE(id.vendor_name.empty());
+    EXPECT_TRUE(id.device_name.empty());
+    EXPECT_TRUE(id.group_type.empty());
+}
