@@ -176,30 +176,38 @@ bool Drive::out_raw(uint16_t index, uint8_t sub, std::size_t size, uint8_t* fiel
 }
 
 template <typename T>
-void Drive::in_position(const Obj<T>& h, T& field) {
+void Drive::in_scaled(const Obj<T>& h, T& field, Unit unit) {
     static_assert(sizeof(T) == 4);
-    if (!scaled_) return in(h, field);
+    if (!scaled_ || (unit == Unit::Velocity && !velocity_per_second_)) return in(h, field);
     Link l{};
     l.field = reinterpret_cast<uint8_t*>(&field);
     l.is_signed = std::is_signed_v<T>;
+    l.unit = unit;
     if (locate(h.index, h.sub, sizeof(T), l)) position_in_.push_back(l);
 }
 
 template <typename T>
-void Drive::out_position(const Obj<T>& h, const T& field) {
+void Drive::out_scaled(const Obj<T>& h, const T& field, Unit unit) {
     static_assert(sizeof(T) == 4);
-    if (!scaled_) return out(h, field);
+    if (!scaled_ || (unit == Unit::Velocity && !velocity_per_second_)) return out(h, field);
     Link l{};
     l.field = reinterpret_cast<uint8_t*>(const_cast<T*>(&field));
     l.is_signed = std::is_signed_v<T>;
+    l.unit = unit;
     if (locate(h.index, h.sub, sizeof(T), l)) position_out_.push_back(l);
 }
 
-double Drive::increments_per_unit() const {
+double Drive::increments_per_rev() const {
     const Parameters& p = axis_.params;
     const double per_rev = p.resolution_increments > 0 && p.resolution_revolutions > 0
                                ? static_cast<double>(p.resolution_increments) / p.resolution_revolutions
                                : 4.0 * p.encoder_pulses;
+    return per_rev > 0 ? per_rev : 4.0;
+}
+
+double Drive::increments_per_unit() const {
+    const Parameters& p = axis_.params;
+    const double per_rev = increments_per_rev();
     if (p.feed == 0 || p.feed_shaft_revolutions == 0 || p.gear_motor_revolutions == 0 ||
         p.gear_shaft_revolutions == 0)
         return 1.0;  // not configured: increments
@@ -224,19 +232,22 @@ uint32_t convert(uint32_t raw, bool is_signed, double factor) {
 }  // namespace
 
 void Drive::load_positions() {
-    const double f = increments_per_unit();
+    // Position: increments per unit; velocity (acceleration): rpm per unit/s (rpm/s per unit/s^2).
+    const double fp = increments_per_unit();
+    const double fv = fp * 60.0 / increments_per_rev();
     for (const Link& l : position_in_) {
-        const uint32_t v = convert(l.r32.get(), l.is_signed, f);
+        const uint32_t v = convert(l.r32.get(), l.is_signed, l.unit == Unit::Position ? fp : fv);
         std::memcpy(l.field, &v, sizeof v);
     }
 }
 
 void Drive::store_positions() {
-    const double f = 1.0 / increments_per_unit();
+    const double fp = 1.0 / increments_per_unit();
+    const double fv = increments_per_rev() / 60.0 * fp;
     for (Link l : position_out_) {
         uint32_t v;
         std::memcpy(&v, l.field, sizeof v);
-        l.r32.set(convert(v, l.is_signed, f));
+        l.r32.set(convert(v, l.is_signed, l.unit == Unit::Position ? fp : fv));
     }
 }
 
@@ -272,6 +283,13 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink, const VendorObjects& v
     // factor group); without them the units are the encoder's increments and nothing is converted.
     scaled_ = dict_.find(obj::GearMotorRevolutions.index) != nullptr ||
               dict_.find(obj::FeedConstantFeed.index) != nullptr;
+    // Velocities then in position units per second (accelerations per second squared), as 0x60A9/0x60AA
+    // default to (IEC 61800-7-201), unless 0x60A9 says revolutions per minute (0x00B447xx).
+    if (scaled_) {
+        const od::Entry* si = dict_.find(0x60A9, 0);
+        velocity_per_second_ =
+            !(si && si->byte_size() == 4 && (dict_.get<uint32_t>(0x60A9, 0) & 0xFFFFFF00u) == 0x00B44700u);
+    }
     // The CiA 402 objects, by index, wherever they are.
     {
         using namespace obj;
@@ -282,23 +300,23 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink, const VendorObjects& v
         in(DisableOperationOptionCode, p.disable_operation);
         in(HaltOptionCode, p.halt);
         in(FaultReactionOptionCode, p.fault_reaction);
-        in_position(FollowingErrorWindow, p.following_error_window);
+        in_scaled(FollowingErrorWindow, p.following_error_window, Unit::Position);
         in(FollowingErrorTimeout, p.following_error_timeout);
-        in_position(SoftwarePositionLimitMin, p.sw_limit_min);
-        in_position(SoftwarePositionLimitMax, p.sw_limit_max);
-        in_position(PositionRangeLimitMin, p.range_min);
-        in_position(PositionRangeLimitMax, p.range_max);
-        in(MaxProfileVelocity, p.max_profile_velocity);
-        in(MaxMotorSpeed, p.max_motor_speed);
-        in(ProfileVelocity, p.profile_velocity);
-        in(ProfileAcceleration, p.profile_acceleration);
-        in(ProfileDeceleration, p.profile_deceleration);
-        in(QuickStopDeceleration, p.quick_stop_deceleration);
-        in(MaxAcceleration, p.max_acceleration);
+        in_scaled(SoftwarePositionLimitMin, p.sw_limit_min, Unit::Position);
+        in_scaled(SoftwarePositionLimitMax, p.sw_limit_max, Unit::Position);
+        in_scaled(PositionRangeLimitMin, p.range_min, Unit::Position);
+        in_scaled(PositionRangeLimitMax, p.range_max, Unit::Position);
+        in_scaled(MaxProfileVelocity, p.max_profile_velocity, Unit::Velocity);
+        in_scaled(MaxMotorSpeed, p.max_motor_speed, Unit::Velocity);
+        in_scaled(ProfileVelocity, p.profile_velocity, Unit::Velocity);
+        in_scaled(ProfileAcceleration, p.profile_acceleration, Unit::Velocity);
+        in_scaled(ProfileDeceleration, p.profile_deceleration, Unit::Velocity);
+        in_scaled(QuickStopDeceleration, p.quick_stop_deceleration, Unit::Velocity);
+        in_scaled(MaxAcceleration, p.max_acceleration, Unit::Velocity);
         in(HomingMethod, p.homing_method);
-        in(HomingSpeedSwitchSearch, p.homing_speed_switch);
-        in(HomingSpeedZeroSearch, p.homing_speed_zero);
-        in(HomingAcceleration, p.homing_acceleration);
+        in_scaled(HomingSpeedSwitchSearch, p.homing_speed_switch, Unit::Velocity);
+        in_scaled(HomingSpeedZeroSearch, p.homing_speed_zero, Unit::Velocity);
+        in_scaled(HomingAcceleration, p.homing_acceleration, Unit::Velocity);
         in(InterpolationTimePeriodValue, p.interpolation_value);
         in(InterpolationTimeIndex, p.interpolation_index);
         in(TouchProbe1Source, p.touch_probe_source);
@@ -311,27 +329,27 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink, const VendorObjects& v
         in(FeedConstantShaftRevolutions, p.feed_shaft_revolutions);
         in(Controlword, c.controlword);
         in(ModesOfOperation, c.mode);
-        in_position(TargetPosition, c.target_position);
-        in(TargetVelocity, c.target_velocity);
+        in_scaled(TargetPosition, c.target_position, Unit::Position);
+        in_scaled(TargetVelocity, c.target_velocity, Unit::Velocity);
         in(TargetTorque, c.target_torque);
-        in_position(PositionOffset, c.position_offset);
-        in(VelocityOffset, c.velocity_offset);
+        in_scaled(PositionOffset, c.position_offset, Unit::Position);
+        in_scaled(VelocityOffset, c.velocity_offset, Unit::Velocity);
         in(TorqueOffset, c.torque_offset);
         in(TouchProbeFunction, c.touch_probe_function);
         out(Statusword, f.statusword);
         out(ModesOfOperationDisplay, f.mode_display);
-        out_position(PositionDemandValue, f.position_demand);
-        out_position(PositionActualValue, f.position_actual);
-        out(VelocityDemandValue, f.velocity_demand);
-        out(VelocityActualValue, f.velocity_actual);
+        out_scaled(PositionDemandValue, f.position_demand, Unit::Position);
+        out_scaled(PositionActualValue, f.position_actual, Unit::Position);
+        out_scaled(VelocityDemandValue, f.velocity_demand, Unit::Velocity);
+        out_scaled(VelocityActualValue, f.velocity_actual, Unit::Velocity);
         out(TorqueActualValue, f.torque_actual);
         out(CurrentActualValue, f.current_actual);
-        out_position(FollowingErrorActualValue, f.following_error);
+        out_scaled(FollowingErrorActualValue, f.following_error, Unit::Position);
         out(MotorRatedTorque, f.motor_rated_torque);
         out(DigitalInputs, f.digital_inputs);
         out(TouchProbeStatus, f.touch_probe_status);
-        out_position(TouchProbePosition1Positive, f.touch_probe_pos);
-        out_position(TouchProbePosition1Negative, f.touch_probe_neg);
+        out_scaled(TouchProbePosition1Positive, f.touch_probe_pos, Unit::Position);
+        out_scaled(TouchProbePosition1Negative, f.touch_probe_neg, Unit::Position);
         out(TouchProbe1PositiveEdgeCounter, f.touch_probe_pos_count);
         out(TouchProbe1NegativeEdgeCounter, f.touch_probe_neg_count);
         out(ErrorCode, f.error_code);

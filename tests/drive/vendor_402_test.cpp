@@ -16,6 +16,7 @@
 #include "drive/wire/error_codes.hpp"
 #include "od/dictionary.hpp"
 #include "recorder.hpp"
+#include "support/alloc_counter.hpp"
 
 namespace {
 
@@ -114,7 +115,8 @@ od::Dictionary vendor_dictionary(uint32_t supported_modes = 0x00000380, uint32_t
     rec(d, 0x607D, T::Integer32, "Software position limit",
         {entry(0x607D, 1, T::Integer32, RW, int64_t{-1000000}, "Min"),
          entry(0x607D, 2, T::Integer32, RW, int64_t{1000000}, "Max")});
-    var(d, 0x607F, T::Unsigned32, RW, uint64_t{3000}, "Max profile velocity");
+    // In rpm without a factor group, in position units per second with one.
+    var(d, 0x607F, T::Unsigned32, RW, uint64_t{feed != 0 ? 200000u : 3000u}, "Max profile velocity");
     var(d, 0x6083, T::Unsigned32, RW, uint64_t{20000}, "Profile acceleration");
     var(d, 0x6084, T::Unsigned32, RW, uint64_t{20000}, "Profile deceleration");
     var(d, 0x6085, T::Unsigned32, RW, uint64_t{50000}, "Quick stop deceleration");
@@ -335,6 +337,10 @@ TEST(Vendor402, PositionsAreInTheDevicesUnitsThroughGearAndFeed) {
     EXPECT_EQ(drv.axis().params.following_error_window, 8000u);
     EXPECT_EQ(drv.axis().params.sw_limit_max, 2000000);
     EXPECT_EQ(drv.axis().params.sw_limit_min, -2000000);
+    // Velocities in units per second: 200000 units/s = 400000 inc/s = 2929.7 rpm of an 8192-inc motor; the
+    // profile acceleration 20000 units/s^2 = 292.97 rpm/s.
+    EXPECT_EQ(drv.axis().params.max_profile_velocity, 2930u);
+    EXPECT_EQ(drv.axis().params.profile_acceleration, 293u);
     d.set<int32_t>(0x607A, 0, d.get<int32_t>(0x6064, 0));
     for (uint16_t cw : {0x06, 0x07, 0x0F}) {
         d.set<uint16_t>(0x6040, 0, cw);
@@ -355,6 +361,26 @@ TEST(Vendor402, PositionsAreInTheDevicesUnitsThroughGearAndFeed) {
     EXPECT_NEAR(d.get<int32_t>(0x6064, 0), target, 2);
     EXPECT_NEAR(drv.axis().feedback().position_actual - start_inc, 2.0 * (target - start_units), 4);
     EXPECT_EQ(d.get<uint16_t>(0x603F, 0), 0u);
+    // At rest the velocity reads near 0; moving at 5 units/ms = 5000 units/s it reads about 5000.
+    EXPECT_LT(std::abs(d.get<int32_t>(0x606C, 0)), 50);
+}
+
+TEST(Vendor402, TheScaledCycleAllocatesNothing) {
+    od::Dictionary d = vendor_dictionary(0x00000380, 4096);
+    drive::NullEventSink sink;
+    drive::Drive drv(d, &sink);
+    int64_t t = 0;
+    for (uint16_t cw : {0x06, 0x07, 0x0F}) {
+        d.set<uint16_t>(0x6040, 0, cw);
+        drv.cycle(t, 1'000'000);
+        t += 1'000'000;
+    }
+    const alloc_counter::Scope counting;
+    for (int k = 0; k < 300; ++k, t += 1'000'000) {
+        d.set<int32_t>(0x607A, 0, k * 3);
+        drv.cycle(t, 1'000'000);
+    }
+    EXPECT_EQ(counting.count(), 0u);
 }
 
 TEST(Vendor402, TheValidatorGoesWithTheDrive) {

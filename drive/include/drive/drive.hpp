@@ -57,6 +57,8 @@ class Drive {
     bool binds(uint16_t index, uint8_t sub) const;
 
   private:
+    // What a scaled link converts: a position, or a velocity or acceleration.
+    enum class Unit : uint8_t { Position, Velocity };
     struct Link {
         od::Ref<uint8_t> r8;
         od::Ref<uint16_t> r16;
@@ -66,16 +68,19 @@ class Drive {
         uint8_t sub;
         uint8_t size;
         bool is_signed;
+        Unit unit;  // of a scaled link
     };
     template <typename T>
     void in(const Obj<T>& object, T& field);
     template <typename T>
     void out(const Obj<T>& object, const T& field);
-    // A position object: through the position factor where the device has one (0x6091/0x6092).
+    // A position (velocity, acceleration) object: through the factor group where the device has one
+    // (0x6091/0x6092), else a raw copy.
     template <typename T>
-    void in_position(const Obj<T>& object, T& field);
+    void in_scaled(const Obj<T>& object, T& field, Unit unit);
     template <typename T>
-    void out_position(const Obj<T>& object, const T& field);
+    void out_scaled(const Obj<T>& object, const T& field, Unit unit);
+    double increments_per_rev() const;
     double increments_per_unit() const;
     void load_positions();
     void store_positions();
@@ -97,6 +102,7 @@ class Drive {
     std::vector<Link> outputs_[3];  // axis -> dictionary (feedback), by size
     std::vector<Link> position_in_, position_out_;  // position objects in position units (scaled_ only)
     bool scaled_ = false;
+    bool velocity_per_second_ = false;
     Feedback fb_copy_;
     uint32_t resolution_ = 0;
     std::size_t bound_ = 0, missing_ = 0;
