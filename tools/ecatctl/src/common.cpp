@@ -162,7 +162,8 @@ std::vector<std::string> position_option_as_argument(int argc, char** argv) {
         if (slave_at >= args.size() || (args[slave_at] != "read" && args[slave_at] != "write")) return args;
         ++slave_at;
     } else if (verb != "state" && verb != "upload" && verb != "download" && verb != "sdos" && verb != "pd" &&
-               verb != "diag" && verb != "slaves" && verb != "pdos" && verb != "cstruct" && verb != "xml") {
+               verb != "diag" && verb != "slaves" && verb != "pdos" && verb != "cstruct" && verb != "xml" &&
+               verb != "alias") {
         return args;  // these verbs have -p/--position as an option of their own
     }
     for (std::size_t k = slave_at; k < args.size(); ++k) {
