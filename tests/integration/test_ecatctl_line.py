@@ -26,6 +26,21 @@ class EcatctlLine(unittest.TestCase):
             self.assertRegex(out, r"(?m)^0\s+alias 0 \(0x0000\)$", out)
             self.assertIn("77:1", bus.ecatctl("slaves").stdout)
 
+    def test_mailbox_verbs_set_up_a_cleared_mailbox_again(self):
+        """A slave in PREOP whose mailbox SyncManagers someone cleared: every verb that talks to the mailbox
+        sets them up again through INIT (as IgH's master does) and says so, instead of failing."""
+        state = harness.tempfile.mkdtemp(prefix="ecat-mbx-", dir=os.environ.get("ECAT_TEST_OUT"))
+        with harness.Bus(slave_args=[STATE_DIR_ARG, state]) as bus:
+            self.assertEqual(bus.ecatctl("state", "0", "preop").stdout.strip(), "PREOP")
+            for verb in (["upload", "0", "0x1008", "0"], ["sdos", "0"], ["diag", "0"], ["pdos", "0"]):
+                for sm in ("0x0806", "0x080E"):  # SM0 and SM1 activate: off
+                    bus.ecatctl("reg", "write", "0", sm, "00")
+                r = bus.ecatctl(*verb, check=False)
+                self.assertEqual(r.returncode, 0, f"{verb}: {r.stderr}")
+                self.assertIn("set up again through INIT", r.stderr, verb)
+                self.assertEqual(bus.ecatctl("state", "0").stdout.split()[0], "PREOP", verb)
+            self.assertIn("MAXPOS", bus.ecatctl("upload", "0", "0x1008", "0").stdout)
+
     def crc_rows(self, out):
         """{(slave, port): (invalid, rx, fwd, lost)} and {slave: (processing unit, pdi)}."""
         ports, units = {}, {}

@@ -4,6 +4,8 @@
 // the drive's error table (drive/wire/error_codes.hpp, od-free; ecatctl does not link the drive).
 #include "cmd_diag.hpp"
 
+#include "commands.hpp"
+
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -53,17 +55,6 @@ int report(const master::SdoClient& sdo, Error e, const char* what) {
     }
     std::fprintf(stderr, "ecatctl: %s: %s\n", what, std::string(master::to_string(e)).c_str());
     return e == Error::Timeout || e == Error::MailboxTimeout ? kExitNoSlave : kExitProtocol;
-}
-
-// Same rule as the SDO verbs: a slave in INIT gets its mailbox from the SII and goes to PREOP.
-Error open_mailbox(master::Master& m, master::Mailbox& mbx, master::Address a) {
-    auto st = m.al_status(a);
-    if (!st) return st.error();
-    if (st->state == static_cast<uint8_t>(master::AlState::Init)) {
-        if (Error e = mbx.configure_from_sii(); e != Error::Ok) return e;
-        return m.request_state(a, master::AlState::PreOp);
-    }
-    return mbx.adopt_current();
 }
 
 int run_diag(master::Master& m, const DiagArgs& d) {

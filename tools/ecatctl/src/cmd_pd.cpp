@@ -120,17 +120,18 @@ namespace {
 
 int process_data(master::Master& m, const PdArgs& p) {
     auto pos = parse_number(p.slave, 0xFFFF);
-    if (!pos && !p.all) return usage("bad slave '" + p.slave + "'");
+    if (!pos && !p.all) return usage_error("bad slave '" + p.slave + "'");
     std::string t = p.state;
     for (auto& c : t)
         c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-    if (t != "OP" && t != "SAFEOP") return usage("--state must be SAFEOP or OP");
+    if (t != "OP" && t != "SAFEOP") return usage_error("--state must be SAFEOP or OP");
     for (const std::string& text : p.steps)
-        if (!parse_step(text)) return usage("bad --step '" + text + "' (CYCLES:BYTE,BYTE,... e.g. 50:06,00)");
+        if (!parse_step(text))
+            return usage_error("bad --step '" + text + "' (CYCLES:BYTE,BYTE,... e.g. 50:06,00)");
     std::vector<uint8_t> out_bytes;
     for (const std::string& v : p.outputs) {
         auto b = parse_number(v, 0xFF);
-        if (!b) return usage("bad output byte '" + v + "'");
+        if (!b) return usage_error("bad output byte '" + v + "'");
         out_bytes.push_back(static_cast<uint8_t>(*b));
     }
     if (p.all) {

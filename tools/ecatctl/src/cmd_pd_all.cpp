@@ -43,7 +43,7 @@ int process_data_all(master::Master& m, const PdAllArgs& p) {
         return open_mailbox(m, mbx, a);
     });
     if (opened != Error::Ok)
-        return fail(opened, "opening the mailbox of " + slave_text(addresses[sdos.failed()]));
+        return fail(opened, "opening the mailbox of " + slave_label(addresses[sdos.failed()]));
     master::ProcessDataSession pd(m, addresses, sdos.clients());
     if (Error e = pd.discover(); e != Error::Ok) return fail(e, "reading the process-data layouts");
     master::DcConfig dc;
@@ -106,7 +106,7 @@ int process_data_all(master::Master& m, const PdAllArgs& p) {
                   << (p.op ? "OP" : "SAFEOP") << " at the end:";
         for (std::size_t k = 0; k < n; ++k)
             if (states[k].state != want || states[k].error)
-                std::cerr << "\n  " << slave_text(addresses[k]) << ": "
+                std::cerr << "\n  " << slave_label(addresses[k]) << ": "
                           << state_failure(&states[k], p.op ? "OP" : "SAFEOP");
         std::cerr << '\n';
     }

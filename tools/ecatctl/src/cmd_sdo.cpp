@@ -42,13 +42,14 @@ int sdo_transfer(master::Master& m, const SdoArgs& s, bool upload) {
     auto a = named_slave(s.slave, s.station);
     if (!a) return kExitUsage;
     auto index = parse_number(s.index, 0xFFFF);
-    if (!index) return usage("bad index '" + s.index + "'");
+    if (!index) return usage_error("bad index '" + s.index + "'");
     auto sub = parse_number(s.sub, 0xFF);
-    if (!sub) return usage("bad subindex '" + s.sub + "'");
+    if (!sub) return usage_error("bad subindex '" + s.sub + "'");
     bool text = s.type == "string";
     std::optional<ValueType> type;
-    if (!s.type.empty() && !text && !(type = parse_type(s.type))) return usage("bad type '" + s.type + "'");
-    if (!upload && s.values.empty()) return usage("nothing to download");
+    if (!s.type.empty() && !text && !(type = parse_type(s.type)))
+        return usage_error("bad type '" + s.type + "'");
+    if (!upload && s.values.empty()) return usage_error("nothing to download");
     // Without --type the values are bytes, unless SDO information names the entry's type (as upload does).
     auto encode = [&](std::vector<uint8_t>& data, std::string& why) {
         for (const std::string& v : s.values) {
@@ -70,10 +71,10 @@ int sdo_transfer(master::Master& m, const SdoArgs& s, bool upload) {
     std::vector<uint8_t> data;
     std::string why;
     // With --type, the values are checked before anything is sent.
-    if (!upload && (type || text) && !encode(data, why)) return usage(why);
+    if (!upload && (type || text) && !encode(data, why)) return usage_error(why);
     master::Mailbox mbx(m, *a);
     if (Error e = open_mailbox(m, mbx, *a); e != Error::Ok)
-        return fail(e, "opening the mailbox of " + slave_text(*a));
+        return fail(e, "opening the mailbox of " + slave_label(*a));
     master::SdoClient sdo(mbx);
     if (!upload && !type && !text) {
         if (!s.complete)
@@ -82,7 +83,7 @@ int sdo_transfer(master::Master& m, const SdoArgs& s, bool upload) {
                 text = d->data_type == 0x0009;
                 type = value_type_of(d->data_type);
             }
-        if (!encode(data, why)) return usage(why);
+        if (!encode(data, why)) return usage_error(why);
     }
     const std::string what = util::strprintf("%s 0x%04x:%02x", upload ? "upload of" : "download to",
                                              static_cast<unsigned>(*index), static_cast<unsigned>(*sub));

@@ -73,7 +73,7 @@ int sdos(master::Master& m, const std::string& slave, bool station, bool quiet) 
     if (!a) return kExitUsage;
     master::Mailbox mbx(m, *a);
     if (Error e = open_mailbox(m, mbx, *a); e != Error::Ok)
-        return fail(e, "opening the mailbox of " + slave_text(*a));
+        return fail(e, "opening the mailbox of " + slave_label(*a));
     master::SdoClient sdo(mbx);
     auto list = sdo.od_list(1);
     if (!list) return sdo_failed(sdo, list.error(), "reading the object list");

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "cmd_diag.hpp"  // MasterRunner
+#include "common.hpp"
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
@@ -62,13 +63,8 @@ int fail(master::Error e, const std::string& what);
 // Why a process-data run failed at its end: "ended in SAFEOP+ERR, not OP, AL status code 0x001b (...)";
 // st null or state 0: the slave gave no AL status.
 std::string state_failure(const master::AlStatus* st, const std::string& wanted);
-// "ecatctl: <what>"; returns kExitUsage.
-int usage(const std::string& what);
-std::optional<master::Address> parse_slave(const std::string& text, bool station);
 // The slave a command names; a bad one is reported as a usage error (exit kExitUsage) and gives nullopt.
 std::optional<master::Address> named_slave(const std::string& text, bool station);
-// "slave 3" or "station 0x1001".
-std::string slave_text(master::Address a);
 std::optional<std::vector<uint8_t>> read_file(const std::string& path);
 // A slave in INIT gets its mailbox SMs from its SII and is taken to PREOP; one already in PREOP or above
 // keeps the SMs it has.
