@@ -61,7 +61,10 @@ int report_error(master::Error e, const std::string& what) {
     if (e == master::Error::Timeout)
         std::cerr << " (check that a slave is connected and running on the interface)";
     if (e == master::Error::WorkingCounter)
-        std::cerr << " (is there a slave at that address? `ecatctl scan` lists them)";
+        // Not only a missing slave: a slave refuses an access it cannot take (a mailbox write while its
+        // last request is still unread, as after a lost reply and a retry) with the same counter.
+        std::cerr << " (no slave at that address, or the slave did not take the access; `ecatctl scan` lists "
+                     "the slaves)";
     std::cerr << "\n";
     return exit_code(e);
 }
