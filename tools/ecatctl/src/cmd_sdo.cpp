@@ -19,6 +19,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
+#include "util/json.hpp"
 #include "util/strfmt.hpp"
 
 namespace ecatctl {
@@ -36,7 +37,35 @@ struct SdoArgs {
     std::string type;
     bool station = false;
     bool complete = false;
+    bool json = false;
 };
+
+// The CoE basic data type of a --type.
+uint16_t coe_type_of(ValueType t) {
+    switch (t) {
+        case ValueType::U8:
+            return dtype::Unsigned8;
+        case ValueType::U16:
+            return dtype::Unsigned16;
+        case ValueType::U32:
+            return dtype::Unsigned32;
+        case ValueType::U64:
+            return dtype::Unsigned64;
+        case ValueType::I8:
+            return dtype::Integer8;
+        case ValueType::I16:
+            return dtype::Integer16;
+        case ValueType::I32:
+            return dtype::Integer32;
+        case ValueType::I64:
+            return dtype::Integer64;
+        case ValueType::F32:
+            return dtype::Real32;
+        case ValueType::F64:
+            return dtype::Real64;
+    }
+    return 0;
+}
 
 int sdo_transfer(master::Master& m, const SdoArgs& s, bool upload) {
     auto a = named_slave(s.slave, s.station);
@@ -96,6 +125,36 @@ int sdo_transfer(master::Master& m, const SdoArgs& s, bool upload) {
     auto n = sdo.upload(static_cast<uint16_t>(*index), static_cast<uint8_t>(*sub), out, s.complete);
     if (!n) return sdo_failed(sdo, n.error(), what);
     out.resize(*n);
+    if (s.json) {
+        // docs/ecatctl-json.md, "upload".
+        util::JsonWriter w(std::cout);
+        std::string hex;
+        for (uint8_t b : out)
+            hex += util::strprintf(hex.empty() ? "%02x" : " %02x", b);
+        w.begin_object()
+            .member("index", *index)
+            .member("subindex", *sub)
+            .member("complete_access", s.complete)
+            .member("size", out.size())
+            .member("bytes", hex);
+        if (text) {
+            w.key("value").value(std::string(out.begin(), out.end()));
+        } else if (type) {
+            const std::size_t size = type_size(*type);
+            w.key("values").begin_array();
+            for (std::size_t i = 0; i + size <= out.size(); i += size) {
+                const auto part = std::span<const uint8_t>(out).subspan(i, size);
+                write_typed_json(w, coe_type_of(*type), static_cast<uint16_t>(size * 8), part);
+            }
+            w.end_array();
+        } else {
+            write_described_upload_json(w, sdo, static_cast<uint16_t>(*index), static_cast<uint8_t>(*sub),
+                                        s.complete, out);
+        }
+        w.end_object();
+        std::cout << std::flush;
+        return kExitOk;
+    }
     if (text) {
         std::fwrite(out.data(), 1, out.size(), stdout);
         std::fputc('\n', stdout);
@@ -136,6 +195,7 @@ void add_sdo_commands(CLI::App& app, MasterRunner run, int& rc) {
                    "u8|u16|u32|u64|i8|i16|i32|i64|real32|real64|string (default: from SDO information)");
     up->add_flag("-s,--station", so->station, "<slave> is a station address");
     up->add_flag("-c,--complete", so->complete, "Complete access (whole object from the subindex, 0 or 1)");
+    up->add_flag("--json", so->json, "JSON on stdout: bytes and the value(s) by type (docs/ecatctl-json.md)");
     up->callback([so, run, &rc] { rc = run([&](master::Master& m) { return sdo_transfer(m, *so, true); }); });
     auto* down =
         app.add_subcommand("download", "Write an object through CoE SDO (INIT slaves are taken to PREOP)");

@@ -42,6 +42,7 @@ struct PdAllArgs {
     std::vector<uint8_t> outputs;  // sent to every slave (from its first output byte)
     std::vector<std::pair<uint64_t, std::vector<uint8_t>>> steps;  // --step: cycles and output bytes
     bool keep = false;
+    bool json = false;  // the outcome as JSON on stdout (docs/ecatctl-json.md, "pd --all")
 };
 int process_data_all(master::Master& m, const PdAllArgs& p);
 // What both forms of pd share (cmd_pd.cpp): SAFEOP then (op) OP while cycling, a refusal reported with its
