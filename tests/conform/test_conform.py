@@ -312,6 +312,19 @@ class Conform(unittest.TestCase):
             names = {s.getAttribute("name") for s in xml.dom.minidom.parse(junit).getElementsByTagName("testsuite")}
             self.assertIn("slave2.sdo", names)
             return
+        if self.mode == "contained":
+            # One defect must not spoil the rest of the run: a slave that keeps a write to its AL status
+            # (stuck in that state until its ESC is reset) fails the test that found it, is reset, and the
+            # other groups run as against a clean slave.
+            _, res, _ = self.run_conform(mutation=mutants.MUTANTS["al-status-write-kept"][1])
+            failed = sorted(x["id"] for x in res["results"] if x["status"] == "FAIL")
+            self.assertIn("esc.reg.al_status_readonly", failed)
+            self.assertLessEqual(len(failed), 3, failed)
+            passed = [x for x in res["results"] if x["status"] == "PASS"]
+            self.assertGreater(len(passed), 100)
+            message = next(x["message"] for x in res["results"] if x["id"] == "esc.reg.al_status_readonly")
+            self.assertIn("ESC reset", message)
+            return
         if self.mode == "liar":
             # A slave whose every working counter is one too high (besides BRD, so it is found): the run ends
             # in under a minute and fails.
@@ -355,7 +368,7 @@ class Conform(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) >= 2 and sys.argv[1] in ("clean", "fault", "noslave", "dies", "stopped", "liar", "line", "mutant", "variation",
+    if len(sys.argv) >= 2 and sys.argv[1] in ("clean", "fault", "noslave", "dies", "stopped", "liar", "line", "mutant", "variation", "contained",
                                               "table"):
         Conform.mode = sys.argv[1]
         Conform.faults = sys.argv[2:]

@@ -171,6 +171,11 @@ class Context {
     master::Result<uint8_t> state();
     // Brings the slave to INIT (acknowledging errors), and clears all SMs and FMMUs.
     master::Error to_init();
+    // ESC reset (ESC datasheet section II, 0x0040 "ESC Reset ECAT": 'R', 'E', 'S' written in three
+    // consecutive frames), for a slave that cannot be brought back to INIT otherwise. True if the ESC was
+    // reset: it no longer answers at its station address (the reset clears 0x0010); the caller assigns
+    // addresses again. False where the ESC has no reset (it still answers there).
+    bool esc_reset();
     // INIT -> PREOP with the standard mailbox; sets up mbx/sdo. Idempotent when already in PREOP.
     master::Error to_preop();
     // Requests a state, returns the AL status reached (error indication kept, not acknowledged).
