@@ -120,9 +120,10 @@ struct Options {
     std::string foe_file;       // a file name the device's FoE server knows (Bootstrap firmware)
     uint32_t foe_password = 0;  // its password
     // What may change the device beyond its configuration: off unless asked for (docs/conformance.md).
-    bool allow_fault = false;      // provoke a drive fault (fault reaction: the drive stops, may brake)
-    bool allow_motion = false;     // command motion (profile modes with a set-point)
-    bool allow_foe_write = false;  // let an FoE write of --foe-file go through (writes the device's flash)
+    bool allow_fault = false;        // provoke a drive fault (fault reaction: the drive stops, may brake)
+    bool allow_motion = false;       // command motion (profile modes with a set-point)
+    bool allow_foe_write = false;    // let an FoE write of --foe-file go through (writes the device's flash)
+    std::vector<uint8_t> foe_image;  // what that write sends (--foe-image): the device's own firmware
 };
 
 // ---- the run context -------------------------------------------------------------------------------

@@ -19,6 +19,7 @@
 #include "conform.hpp"
 #include "esc/link.hpp"
 #include "report.hpp"
+#include "util/input_file.hpp"
 #include "util/strfmt.hpp"
 
 namespace {
@@ -146,6 +147,9 @@ int main(int argc, char** argv) {
     app.add_flag("--allow-motion", o.allow_motion, "Allow tests that command motion of an axis");
     app.add_flag("--allow-foe-write", o.allow_foe_write,
                  "Allow an FoE write of --foe-file to go through (writes the device's firmware/flash)");
+    std::string foe_image;
+    app.add_option("--foe-image", foe_image,
+                   "The file that write sends (the device's own firmware: the device keeps it)");
     app.add_option("--backend", backend, "Raw-socket backend: packet or pcap");
     double deadline = 0, budget = 30;
     app.add_option("--deadline", deadline,
@@ -157,6 +161,14 @@ int main(int argc, char** argv) {
         ->check(CLI::PositiveNumber);
     app.add_flag("--verbose,-v", o.verbose, "Details of passed and skipped tests too");
     CLI11_PARSE(app, argc, argv);
+    if (!foe_image.empty()) {
+        try {
+            o.foe_image = util::read_input_bytes(foe_image, std::size_t{64} << 20, "firmware image");
+        } catch (const util::InputFileError& e) {
+            std::fprintf(stderr, "ecat-conform: %s\n", e.what());
+            return 2;
+        }
+    }
 
     const conform::Catalogue catalogue = conform::build_catalogue();
     std::set<std::string> groups;
