@@ -496,6 +496,9 @@ MUTANTS = {
     "statusword-not-remote": _m("CiA 402 statusword bit 9 remote: set while the controlword is processed",
                                 sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x6041,
                                              lambda m: m.__setitem__(13, m[13] & ~0x02))),
+    "statusword-target-reached-lost": _m("CiA 402 statusword bit 10 (profile velocity, halt): set at velocity 0",
+                                         sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x6041,
+                                                      lambda m: m.__setitem__(13, m[13] & ~0x04))),
     "statusword-following-error": _m("CiA 402 statusword bit 13 (csp): following error only with a deviation",
                                      sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x6041
                                                   and m_oe(st), lambda m: m.__setitem__(13, m[13] | 0x20))),
