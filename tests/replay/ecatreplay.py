@@ -1,0 +1,374 @@
+"""Replay of recorded master start-ups against the current ecat-slave (issue 22, docs/decisions/replay.md).
+
+A recording is a pcap of the master end of a veth pair: the master's frames and the slave's replies, in the
+order they crossed the link, beside a JSON sidecar that says how the slave was started. The replay sends the
+recorded master frames in order, paced by their recorded times, and compares each reply with the recorded one
+by the invariants a master relies on (project()), not by timing-dependent bytes. The rules, in short (the
+decision record has them in full):
+
+* Every datagram's working counter is compared; so are the data a read returns, except the registers and
+  bytes whose value is a time or follows from timing (TIMING_REGISTERS, SM status of the process-data SMs)
+  and the data of logical datagrams (process data: inputs come from the drive's motion).
+* Polls: a frame that only reads (or only exchanges process data / distributes the clock) may be answered
+  ahead of the recording (the observed answer equals the recorded answer of a later identical request within
+  SETTLE_S of recording time: the slave was faster; the identical requests up to that one are then not sent,
+  they were polls for what is already there) or behind it (the frame is sent again, every millisecond, until
+  the recorded answer comes, for at most SETTLE_S: the slave was slower). A read that emptied a mailbox is not
+  sent again.
+* DC times the master writes (system time 0x0910, start time 0x0990) were computed from the recorded slave's
+  clock: they are shifted by the difference between the replayed and the recorded local time (learnt from
+  reads of 0x0910/0x0918).
+* A request the recording has no reply for (lost on the link) is sent and its reply not checked.
+The first mismatch ends the replay with the frame number, the datagram, and the recorded and observed values.
+"""
+import gzip
+import json
+import os
+import socket
+import struct
+import time
+
+ETH_P_ECAT = 0x88A4
+PACKET_OUTGOING = 4
+
+# EtherCAT commands (ETG.1000.4 table "EtherCAT command types").
+NOP, APRD, APWR, APRW, FPRD, FPWR, FPRW, BRD, BWR, BRW, LRD, LWR, LRW, ARMW, FRMW = range(15)
+NAMES = ["NOP", "APRD", "APWR", "APRW", "FPRD", "FPWR", "FPRW", "BRD", "BWR", "BRW", "LRD", "LWR", "LRW",
+         "ARMW", "FRMW"]
+READS = {APRD, FPRD, BRD}
+LOGICAL = {LRD, LWR, LRW}
+PHYS_WRITES = {APWR, APRW, FPWR, FPRW, BWR, BRW}
+CLOCK = {ARMW, FRMW}
+
+# Registers whose value is a time or follows from when frames came (ESC datasheet section II register
+# descriptions): [start, end) byte ranges, masked in every read.
+TIMING_REGISTERS = [
+    (0x0220, 0x0224, "AL event request (set by SM accesses, cleared by the PDI when it gets to them)"),
+    (0x0440, 0x0444, "watchdog status and counters"),
+    (0x0900, 0x0920, "DC receive times, system time, local receive time"),
+    (0x092C, 0x0930, "DC system time difference"),
+    (0x0932, 0x0936, "DC speed counter difference"),
+    (0x098E, 0x0990, "SYNC0/SYNC1 status"),
+    (0x0990, 0x09A0, "DC start time / next SYNC1 pulse (the ESC moves it on)"),
+    (0x09AE, 0x0A00, "latch status and latch times"),
+]
+SETTLE_S = 2.0  # how far (in recording time) an answer may come ahead of or behind the recording
+SM_STATUS_MASKED_FROM = 2  # SM status (byte 5) of SM2 and up: buffer states of process data, timing
+
+
+# ---------------------------------------------------------------------------------------------- pcap files
+def read_pcap(path):
+    """[(time_s, frame_bytes)] of a classic pcap (optionally gzip-compressed)."""
+    opener = gzip.open if path.endswith(".gz") else open
+    with opener(path, "rb") as f:
+        data = f.read()
+    magic = struct.unpack_from("<I", data, 0)[0]
+    if magic in (0xA1B2C3D4, 0xA1B23C4D):
+        end, nano = "<", magic == 0xA1B23C4D
+    elif magic in (0xD4C3B2A1, 0x4D3CB2A1):
+        end, nano = ">", magic == 0x4D3CB2A1
+    else:
+        raise ValueError(f"{path}: not a classic pcap file (magic 0x{magic:08x})")
+    linktype = struct.unpack_from(end + "I", data, 20)[0]
+    if linktype != 1:
+        raise ValueError(f"{path}: link type {linktype}, expected Ethernet (1)")
+    pos, out = 24, []
+    while pos + 16 <= len(data):
+        sec, frac, incl, _orig = struct.unpack_from(end + "IIII", data, pos)
+        pos += 16
+        out.append((sec + frac / (1e9 if nano else 1e6), data[pos:pos + incl]))
+        pos += incl
+    return out
+
+
+def write_pcap(path, frames):
+    """frames: [(time_s, bytes)] -> classic microsecond pcap, gzip-compressed when path ends in .gz."""
+    body = struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)
+    for t, fr in frames:
+        sec = int(t)
+        body += struct.pack("<IIII", sec, int(round((t - sec) * 1e6)) % 1000000, len(fr), len(fr)) + fr
+    if path.endswith(".gz"):
+        with gzip.GzipFile(path, "wb", mtime=0) as f:
+            f.write(body)
+    else:
+        with open(path, "wb") as f:
+            f.write(body)
+
+
+# ---------------------------------------------------------------------------------------------- frames
+def ecat_offset(frame):
+    """Offset of the EtherCAT header in an Ethernet frame (after an optional VLAN tag), or None."""
+    if len(frame) < 16:
+        return None
+    et = struct.unpack_from(">H", frame, 12)[0]
+    if et == 0x8100 and len(frame) >= 20 and struct.unpack_from(">H", frame, 16)[0] == ETH_P_ECAT:
+        return 18
+    return 14 if et == ETH_P_ECAT else None
+
+
+def datagrams(frame):
+    """[(cmd, idx, adp, ado, data, wkc)] walked by the datagram headers (length and More bit) up to the end of
+    the frame, as an ESC walks them (the EtherCAT header's length is not relied on)."""
+    off = ecat_offset(frame)
+    if off is None:
+        return []
+    pos, out = off + 2, []
+    while pos + 12 <= len(frame):
+        cmd, idx, adp, ado, lf, _irq = struct.unpack_from("<BBHHHH", frame, pos)
+        n = lf & 0x7FF
+        if pos + 12 + n > len(frame):
+            break
+        out.append((cmd, idx, adp, ado, frame[pos + 10:pos + 10 + n],
+                    struct.unpack_from("<H", frame, pos + 10 + n)[0]))
+        pos += 12 + n
+        if not lf & 0x8000:
+            break
+    return out
+
+
+def keys(frame):
+    """What a reply keeps of its request: command, index, offset and length of each datagram."""
+    return tuple((d[0], d[1], d[3], len(d[4])) for d in datagrams(frame))
+
+
+def request_identity(frame):
+    """Two requests are 'the same request' (a poll repeated) when their datagrams have the same command, address
+    and length and, for those that write physical memory, the same data (the index may differ)."""
+    return tuple((d[0], d[2], d[3], len(d[4]), bytes(d[4]) if d[0] in PHYS_WRITES else b"")
+                 for d in datagrams(frame))
+
+
+def pair(frames):
+    """Recorded frames -> [(time, request, reply or None)]: a frame is a reply when its source address has bit 1
+    of the first byte set (an ESC sets it) and a request with its keys is waiting; it answers the latest such
+    request (an earlier one with the same keys was lost). Anything else with EtherCAT datagrams is a request."""
+    out, pending = [], {}
+    for t, fr in frames:
+        k = keys(fr)
+        if not k:
+            continue
+        if fr[6] & 0x02 and k in pending:
+            out[pending.pop(k)][2] = fr
+            continue
+        pending[k] = len(out)
+        out.append([t, fr, None])
+    return [tuple(x) for x in out]
+
+
+# ---------------------------------------------------------------------------------------------- invariants
+def _masked_bytes(cmd, ado, n):
+    """Indices of the data bytes of a physical read at ado..ado+n that are timing-dependent."""
+    masked = set()
+    for lo, hi, _why in TIMING_REGISTERS:
+        for a in range(max(lo, ado), min(hi, ado + n)):
+            masked.add(a - ado)
+    for sm in range(SM_STATUS_MASKED_FROM, 16):
+        a = 0x0800 + 8 * sm + 5
+        if ado <= a < ado + n:
+            masked.add(a - ado)
+    return masked
+
+
+def project(request, reply):
+    """The invariants of a reply: per datagram (working counter, data with timing-dependent bytes as None)."""
+    out = []
+    for (cmd, _i, _adp, ado, _rq, _w), (_c, _i2, _a2, _o2, data, wkc) in zip(datagrams(request), datagrams(reply)):
+        if cmd in LOGICAL or cmd == NOP:
+            out.append((wkc, None))
+            continue
+        masked = _masked_bytes(cmd, ado, len(data))
+        out.append((wkc, tuple(None if i in masked else b for i, b in enumerate(data))))
+    return out
+
+
+def describe(request, index):
+    d = datagrams(request)[index]
+    name = NAMES[d[0]] if d[0] < len(NAMES) else f"cmd {d[0]}"
+    return f"datagram {index} {name} adp 0x{d[2]:04x} ado 0x{d[3]:04x} len {len(d[4])}"
+
+
+def _fmt(v):
+    wkc, data = v
+    if data is None:
+        return f"wkc {wkc}"
+    return f"wkc {wkc} data " + "".join("??" if b is None else f"{b:02x}" for b in data[:64]) + (
+        "..." if len(data) > 64 else "")
+
+
+def difference(request, recorded, observed):
+    """Text naming the first datagram whose invariants differ, or None."""
+    rec, obs = project(request, recorded), project(request, observed)
+    if len(rec) != len(obs):
+        return f"{len(obs)} datagrams in the reply, recorded {len(rec)}"
+    for i, (a, b) in enumerate(zip(rec, obs)):
+        if a != b:
+            return f"{describe(request, i)}: recorded {_fmt(a)}, observed {_fmt(b)}"
+    return None
+
+
+def read_only(request):
+    """A frame that changes nothing a repetition would change again: reads, process data, clock distribution."""
+    return all(d[0] in READS or d[0] in LOGICAL or d[0] in CLOCK or d[0] == NOP for d in datagrams(request))
+
+
+def consumed(request, reply):
+    """True if the reply shows a read that emptied a mailbox (memory at 0x1000 and up read with wkc > 0)."""
+    return any(d[0] in READS and d[3] >= 0x1000 and r[5] > 0
+               for d, r in zip(datagrams(request), datagrams(reply)))
+
+
+# ---------------------------------------------------------------------------------------------- DC times
+class ClockShift:
+    """The replayed slave's clock is not the recorded one's: DC times the master computed from a read of it are
+    moved by the difference the last read of 0x0910 or 0x0918 showed."""
+
+    def __init__(self):
+        self.delta = 0
+
+    def learn(self, request, recorded, observed):
+        for d, r, o in zip(datagrams(request), datagrams(recorded), datagrams(observed)):
+            if d[0] in READS | CLOCK and d[3] in (0x0910, 0x0918) and len(d[4]) == 8 and r[5] and o[5]:
+                rec = struct.unpack("<Q", r[4])[0]
+                obs = struct.unpack("<Q", o[4])[0]
+                self.delta = (obs - rec) & 0xFFFFFFFFFFFFFFFF
+
+    def rewrite(self, request):
+        """The request with times written to 0x0910 and 0x0990 moved by the learnt difference."""
+        if not self.delta:
+            return request
+        fr = bytearray(request)
+        off = ecat_offset(request)
+        pos = off + 2
+        for d in datagrams(request):
+            cmd, ado, n = d[0], d[3], len(d[4])
+            if cmd in PHYS_WRITES and ado in (0x0910, 0x0990) and n in (4, 8):
+                fmt = "<Q" if n == 8 else "<I"
+                mask = (1 << (8 * n)) - 1
+                v = struct.unpack_from(fmt, fr, pos + 10)[0]
+                struct.pack_into(fmt, fr, pos + 10, (v + self.delta) & mask)
+            pos += 12 + n
+        return bytes(fr)
+
+
+# ---------------------------------------------------------------------------------------------- the replay
+class Mismatch(AssertionError):
+    pass
+
+
+def _exchange(sock, frame, timeout):
+    """Sends frame, returns the reply to it (same datagram keys, source bit 1 set) or None."""
+    want = keys(frame)
+    sock.setblocking(False)
+    try:
+        while True:
+            sock.recv(4096)
+    except (BlockingIOError, socket.timeout):
+        pass
+    sock.setblocking(True)
+    sock.send(frame)
+    deadline = time.monotonic() + timeout
+    while True:
+        left = deadline - time.monotonic()
+        if left <= 0:
+            return None
+        sock.settimeout(left)
+        try:
+            data, addr = sock.recvfrom(4096)
+        except socket.timeout:
+            return None
+        if addr[2] == PACKET_OUTGOING or not data[6] & 0x02 or keys(data) != want:
+            continue
+        return data
+
+
+def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None):
+    """Sends the recorded requests on iface and checks the replies; raises Mismatch at the first difference.
+    Returns counters {frames, checked, ahead, behind, resent, skipped}."""
+    sock = socket.socket(socket.AF_PACKET, socket.SOCK_RAW, socket.htons(ETH_P_ECAT))
+    sock.bind((iface, 0))
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 20)
+    ids = [request_identity(rq) for _t, rq, _rp in pairs]
+    stats = {"frames": 0, "checked": 0, "ahead": 0, "behind": 0, "resent": 0, "skipped": 0}
+    skip = set()
+    clock = ClockShift()
+    t0_rec = pairs[0][0] if pairs else 0.0
+    t0 = time.monotonic()
+    try:
+        for i, (t, request, recorded) in enumerate(pairs):
+            if i in skip:
+                stats["skipped"] += 1
+                continue
+            wait = t0 + (t - t0_rec) - time.monotonic()
+            if wait > 0:
+                time.sleep(wait)
+            frame = clock.rewrite(request)
+            stats["frames"] += 1
+            observed = _exchange(sock, frame, reply_timeout)
+            if recorded is None:
+                continue  # lost in the recording: nothing to compare
+            tries = 0
+            while observed is None and read_only(request) and tries < 3:
+                tries += 1
+                observed = _exchange(sock, frame, reply_timeout)
+            if observed is None:
+                raise Mismatch(f"frame {i + 1} ({describe(request, 0)}): no reply (recorded one)")
+            stats["checked"] += 1
+            diff = difference(request, recorded, observed)
+            if diff is None:
+                clock.learn(request, recorded, observed)
+                continue
+            if read_only(request):
+                # Ahead: a later identical request within settle_s was answered like this in the recording.
+                ahead = None
+                for j in range(i + 1, len(pairs)):
+                    if pairs[j][0] - t > settle_s:
+                        break
+                    if ids[j] == ids[i] and pairs[j][2] is not None and \
+                            difference(request, pairs[j][2], observed) is None:
+                        ahead = j
+                        break
+                if ahead is not None:
+                    stats["ahead"] += 1
+                    if not any(d[0] in LOGICAL for d in datagrams(request)):
+                        skip.update(k for k in range(i + 1, ahead + 1) if ids[k] == ids[i])
+                    clock.learn(request, pairs[ahead][2], observed)
+                    continue
+                # Behind: send again until the recorded answer comes.
+                if not consumed(request, observed):
+                    deadline = time.monotonic() + settle_s
+                    while diff is not None and time.monotonic() < deadline:
+                        time.sleep(0.001)
+                        stats["resent"] += 1
+                        observed = _exchange(sock, frame, reply_timeout)
+                        if observed is None:
+                            continue
+                        if consumed(request, observed) and difference(request, recorded, observed):
+                            break
+                        diff = difference(request, recorded, observed)
+                    if diff is None:
+                        stats["behind"] += 1
+                        clock.learn(request, recorded, observed)
+                        continue
+            raise Mismatch(f"frame {i + 1} of {len(pairs)} (recorded at {t - t0_rec:.6f} s): {diff}")
+    finally:
+        sock.close()
+    if log:
+        log(f"replayed {stats}")
+    return stats
+
+
+# ---------------------------------------------------------------------------------------------- the corpus
+HERE = os.path.dirname(os.path.abspath(__file__))
+CORPUS = os.path.join(HERE, "corpus")
+
+
+def corpus():
+    """[(name, pcap path, sidecar dict)] of every recording in tests/replay/corpus."""
+    out = []
+    for f in sorted(os.listdir(CORPUS)):
+        if f.endswith(".json"):
+            name = f[:-5]
+            with open(os.path.join(CORPUS, f)) as fh:
+                side = json.load(fh)
+            out.append((name, os.path.join(CORPUS, side["pcap"]), side))
+    return out
