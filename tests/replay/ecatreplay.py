@@ -140,17 +140,18 @@ def request_identity(frame):
 
 def pair(frames):
     """Recorded frames -> [(time, request, reply or None)]: a frame is a reply when its source address has bit 1
-    of the first byte set (an ESC sets it) and a request with its keys is waiting; it answers the latest such
-    request (an earlier one with the same keys was lost). Anything else with EtherCAT datagrams is a request."""
+    of the first byte set (an ESC sets it) and a request with its keys is waiting; it answers the oldest such
+    request (a master may have several frames with the same index in flight: libethercat does). Anything else
+    with EtherCAT datagrams is a request."""
     out, pending = [], {}
     for t, fr in frames:
         k = keys(fr)
         if not k:
             continue
-        if fr[6] & 0x02 and k in pending:
-            out[pending.pop(k)][2] = fr
+        if fr[6] & 0x02 and pending.get(k):
+            out[pending[k].pop(0)][2] = fr
             continue
-        pending[k] = len(out)
+        pending.setdefault(k, []).append(len(out))
         out.append([t, fr, None])
     return [tuple(x) for x in out]
 
@@ -202,7 +203,11 @@ def difference(request, recorded, observed):
         return f"{len(obs)} datagrams in the reply, recorded {len(rec)}"
     for i, (a, b) in enumerate(zip(rec, obs)):
         if a != b:
-            return f"{describe(request, i)}: recorded {_fmt(a)}, observed {_fmt(b)}"
+            where = ""
+            if a[0] == b[0] and a[1] is not None and b[1] is not None:
+                first = next(k for k, (x, y) in enumerate(zip(a[1], b[1])) if x != y)
+                where = f" (first difference at data byte {first})"
+            return f"{describe(request, i)}{where}: recorded {_fmt(a)}, observed {_fmt(b)}"
     return None
 
 
