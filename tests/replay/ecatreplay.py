@@ -134,8 +134,14 @@ def keys(frame):
 def request_identity(frame):
     """Two requests are 'the same request' (a poll repeated) when their datagrams have the same command, address
     and length and, for those that write physical memory, the same data (the index may differ)."""
-    return tuple((d[0], d[2], d[3], len(d[4]), bytes(d[4]) if d[0] in PHYS_WRITES else b"")
+    return tuple((d[0], d[2], d[3], len(d[4]), bytes(d[4]) if d[0] in PHYS_WRITES and not _clock_write(d) else b"")
                  for d in datagrams(frame))
+
+
+def _clock_write(d):
+    """A write of the master's time to a reference clock's system time (0x0910, IgH's
+    ecrt_master_sync_reference_clock every cycle): the cycle's clock distribution, like FRMW."""
+    return d[0] in (APWR, FPWR, BWR) and d[3] == 0x0910 and len(d[4]) in (4, 8)
 
 
 def pair(frames):
@@ -212,8 +218,10 @@ def difference(request, recorded, observed):
 
 
 def read_only(request):
-    """A frame that changes nothing a repetition would change again: reads, process data, clock distribution."""
-    return all(d[0] in READS or d[0] in LOGICAL or d[0] in CLOCK or d[0] == NOP for d in datagrams(request))
+    """A frame that changes nothing a repetition would change again: reads, process data, clock distribution
+    (FRMW/ARMW and the master's time written to 0x0910)."""
+    return all(d[0] in READS or d[0] in LOGICAL or d[0] in CLOCK or d[0] == NOP or _clock_write(d)
+               for d in datagrams(request))
 
 
 def consumed(request, reply):
