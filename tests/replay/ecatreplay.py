@@ -21,6 +21,7 @@ decision record has them in full):
 * A request the recording has no reply for (lost on the link) is sent and its reply not checked.
 The first mismatch ends the replay with the frame number, the datagram, and the recorded and observed values.
 """
+import bisect
 import gzip
 import json
 import os
@@ -53,6 +54,7 @@ TIMING_REGISTERS = [
     (0x09AE, 0x0A00, "latch status and latch times"),
 ]
 SETTLE_S = 2.0  # how far (in recording time) an answer may come ahead of or behind the recording
+CYCLE_GAP_S = 0.05  # a recorded process-data frame this soon after a poll: the master's cycle was running
 SM_STATUS_MASKED_FROM = 2  # SM status (byte 5) of SM2 and up: buffer states of process data, timing
 
 
@@ -233,22 +235,31 @@ def consumed(request, reply):
 # ---------------------------------------------------------------------------------------------- DC times
 class ClockShift:
     """The replayed slave's clock is not the recorded one's: DC times the master computed from a read of it are
-    moved by the difference the last read of 0x0910 or 0x0918 showed."""
+    moved by the difference the last read of the system time (0x0910) or local time (0x0918) showed, plus how much
+    further the replay lags behind the recording since that read (a start time 'now + 100 ms' written late must
+    still be 100 ms ahead of the slave's clock)."""
 
     def __init__(self):
         self.delta = 0
+        self.lag = 0.0
 
-    def learn(self, request, recorded, observed):
+    def learn(self, request, recorded, observed, lag):
         for d, r, o in zip(datagrams(request), datagrams(recorded), datagrams(observed)):
-            if d[0] in READS | CLOCK and d[3] in (0x0910, 0x0918) and len(d[4]) == 8 and r[5] and o[5]:
-                rec = struct.unpack("<Q", r[4])[0]
-                obs = struct.unpack("<Q", o[4])[0]
-                self.delta = (obs - rec) & 0xFFFFFFFFFFFFFFFF
+            if d[0] not in READS | CLOCK or not r[5] or not o[5]:
+                continue
+            for reg in (0x0910, 0x0918):
+                k = reg - d[3]
+                if 0 <= k and k + 8 <= len(r[4]) and k + 8 <= len(o[4]):
+                    rec = struct.unpack_from("<Q", r[4], k)[0]
+                    obs = struct.unpack_from("<Q", o[4], k)[0]
+                    self.delta, self.lag = (obs - rec) & 0xFFFFFFFFFFFFFFFF, lag
+                    break
 
-    def rewrite(self, request):
+    def rewrite(self, request, lag):
         """The request with times written to 0x0910 and 0x0990 moved by the learnt difference."""
         if not self.delta:
             return request
+        delta = (self.delta + int((lag - self.lag) * 1e9)) & 0xFFFFFFFFFFFFFFFF
         fr = bytearray(request)
         off = ecat_offset(request)
         pos = off + 2
@@ -258,12 +269,32 @@ class ClockShift:
                 fmt = "<Q" if n == 8 else "<I"
                 mask = (1 << (8 * n)) - 1
                 v = struct.unpack_from(fmt, fr, pos + 10)[0]
-                struct.pack_into(fmt, fr, pos + 10, (v + self.delta) & mask)
+                struct.pack_into(fmt, fr, pos + 10, (v + delta) & mask)
             pos += 12 + n
         return bytes(fr)
 
 
 # ---------------------------------------------------------------------------------------------- the replay
+def _settled(request, recorded, observed, later):
+    """Whether the observed answer to a read-only request is one the recording allows: every datagram answered as
+    recorded, or as the same datagram of one of the later identical requests (later: their recorded replies, in
+    order). The datagrams of one frame (the states of several slaves) may each be at a different point.
+    Returns None (no), 0 (as recorded) or the number of later requests the answer is ahead of (1..)."""
+    rec, obs = project(request, recorded), project(request, observed)
+    if len(rec) != len(obs):
+        return None
+    lat = [project(request, r) for r in later]
+    furthest = 0
+    for k, o in enumerate(obs):
+        if o == rec[k]:
+            continue
+        n = next((m + 1 for m, p in enumerate(lat) if len(p) == len(obs) and p[k] == o), None)
+        if n is None:
+            return None
+        furthest = max(furthest, n)
+    return furthest
+
+
 class Mismatch(AssertionError):
     pass
 
@@ -301,8 +332,13 @@ def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None):
     sock.bind((iface, 0))
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 20)
     ids = [request_identity(rq) for _t, rq, _rp in pairs]
-    stats = {"frames": 0, "checked": 0, "ahead": 0, "behind": 0, "resent": 0, "skipped": 0}
+    stats = {"frames": 0, "checked": 0, "ahead": 0, "behind": 0, "resent": 0, "skipped": 0, "kept_cycling": 0}
     skip = set()
+    last_cycle = None
+    # Times of the recorded process-data frames: while the recording's cycle runs on past a poll (a master with a
+    # cyclic task beside its state machine), the replay keeps it running while it waits; a master that stopped
+    # cycling (to see the watchdog trip) is not helped along.
+    cycle_times = [t for t, rq, _rp in pairs if read_only(rq) and any(d[0] in LOGICAL for d in datagrams(rq))]
     clock = ClockShift()
     t0_rec = pairs[0][0] if pairs else 0.0
     t0 = time.monotonic()
@@ -314,9 +350,14 @@ def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None):
             wait = t0 + (t - t0_rec) - time.monotonic()
             if wait > 0:
                 time.sleep(wait)
-            frame = clock.rewrite(request)
+            lag = (time.monotonic() - t0) - (t - t0_rec)
+            frame = clock.rewrite(request, lag)
             stats["frames"] += 1
             observed = _exchange(sock, frame, reply_timeout)
+            if read_only(request) and any(d[0] in LOGICAL for d in datagrams(request)):
+                last_cycle = frame
+            if log and observed is None:
+                log(f"frame {i + 1}: no reply within {reply_timeout} s ({describe(request, 0)})")
             if recorded is None:
                 continue  # lost in the recording: nothing to compare
             tries = 0
@@ -328,39 +369,49 @@ def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None):
             stats["checked"] += 1
             diff = difference(request, recorded, observed)
             if diff is None:
-                clock.learn(request, recorded, observed)
+                clock.learn(request, recorded, observed, lag)
                 continue
             if read_only(request):
-                # Ahead: a later identical request within settle_s was answered like this in the recording.
-                ahead = None
-                for j in range(i + 1, len(pairs)):
-                    if pairs[j][0] - t > settle_s:
-                        break
-                    if ids[j] == ids[i] and pairs[j][2] is not None and \
-                            difference(request, pairs[j][2], observed) is None:
-                        ahead = j
-                        break
-                if ahead is not None:
+                later = [j for j in range(i + 1, len(pairs)) if pairs[j][0] - t <= settle_s]
+                later = [j for j in later if ids[j] == ids[i] and pairs[j][2] is not None]
+                verdict = _settled(request, recorded, observed, [pairs[j][2] for j in later])
+                if verdict is not None and verdict > 0:
+                    # Ahead: each datagram answered as in the recording or as a later identical request was.
                     stats["ahead"] += 1
+                    if log:
+                        log(f"frame {i + 1}: ahead, answered as frame {later[verdict - 1] + 1} was ({diff})")
                     if not any(d[0] in LOGICAL for d in datagrams(request)):
-                        skip.update(k for k in range(i + 1, ahead + 1) if ids[k] == ids[i])
-                    clock.learn(request, pairs[ahead][2], observed)
+                        skip.update(k for k in later[:verdict])
                     continue
-                # Behind: send again until the recorded answer comes.
+                # Behind: send again until the recorded answer comes (or, datagram by datagram, a later one).
                 if not consumed(request, observed):
+                    k = bisect.bisect_right(cycle_times, t)
+                    cycling = k < len(cycle_times) and cycle_times[k] - t <= CYCLE_GAP_S
                     deadline = time.monotonic() + settle_s
-                    while diff is not None and time.monotonic() < deadline:
+                    while verdict is None and time.monotonic() < deadline:
                         time.sleep(0.001)
+                        if last_cycle is not None and last_cycle is not frame and cycling:
+                            # The master's cycle runs on while it polls (its own task or thread): the last
+                            # process-data frame again, so watchdogs and clocks see what they saw in the recording.
+                            _exchange(sock, last_cycle, reply_timeout)
+                            stats["kept_cycling"] += 1
                         stats["resent"] += 1
                         observed = _exchange(sock, frame, reply_timeout)
                         if observed is None:
                             continue
-                        if consumed(request, observed) and difference(request, recorded, observed):
-                            break
+                        verdict = _settled(request, recorded, observed, [pairs[j][2] for j in later])
                         diff = difference(request, recorded, observed)
-                    if diff is None:
+                        if verdict is None and consumed(request, observed):
+                            break
+                    if log:
+                        log(f"frame {i + 1}: behind, sent again for {time.monotonic() - deadline + settle_s:.3f} s "
+                            f"({describe(request, 0)})")
+                    if verdict is not None:
                         stats["behind"] += 1
-                        clock.learn(request, recorded, observed)
+                        if verdict > 0 and not any(d[0] in LOGICAL for d in datagrams(request)):
+                            skip.update(k for k in later[:verdict])
+                        if diff is None:
+                            clock.learn(request, recorded, observed, lag)
                         continue
             raise Mismatch(f"frame {i + 1} of {len(pairs)} (recorded at {t - t0_rec:.6f} s): {diff}")
     finally:
@@ -385,3 +436,23 @@ def corpus():
                 side = json.load(fh)
             out.append((name, os.path.join(CORPUS, side["pcap"]), side))
     return out
+
+
+def summary(pairs):
+    """What a recording shows the master got: the slaves counted by broadcast reads (the largest working counter
+    of a BRD), the last AL status read of each station (FPRD 0x0130) and the working counters of the logical
+    datagrams of the last second."""
+    slaves, states, lwkc = 0, {}, {}
+    end = pairs[-1][0] if pairs else 0
+    for t, rq, rp in pairs:
+        if rp is None:
+            continue
+        for d, r in zip(datagrams(rq), datagrams(rp)):
+            if d[0] == BRD:
+                slaves = max(slaves, r[5])
+            if d[0] == FPRD and d[3] == 0x0130 and len(r[4]) >= 1 and r[5] == 1:
+                states[d[2]] = r[4][0] & 0x1F
+            if d[0] in LOGICAL and t > end - 1.0:
+                lwkc[r[5]] = lwkc.get(r[5], 0) + 1
+    return {"slaves": slaves, "al_states": {f"0x{k:04x}": v for k, v in sorted(states.items())},
+            "logical_wkc_last_second": lwkc}

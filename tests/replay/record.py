@@ -33,6 +33,11 @@ def main():
     ap.add_argument("--seconds", type=float, default=None, help="stop the master (SIGINT) after this long")
     ap.add_argument("--master-version", default="", help="version or commit of the master, for the README")
     ap.add_argument("--description", default="")
+    ap.add_argument("--malformed-requests", action="store_true",
+                    help="the master sends malformed frames on purpose (ecat-conform's robustness tests)")
+    ap.add_argument("--rt-priority", type=int, default=None,
+                    help="run the slave at this real-time priority while recording (a loaded host; not replayed: "
+                         "it changes when replies come, not what they say)")
     argv = sys.argv[1:]
     cut = argv.index("--") if "--" in argv else len(argv)
     a = ap.parse_args(argv[:cut])
@@ -41,7 +46,8 @@ def main():
         ap.error("no master command")
     slave_args = ["--slaves", str(a.slaves)] if a.slaves > 1 else []
     os.makedirs(ecatreplay.CORPUS, exist_ok=True)
-    with harness.Bus(slave_args=slave_args) as bus:
+    timing_args = ["--rt-priority", str(a.rt_priority)] if a.rt_priority else []
+    with harness.Bus(slave_args=slave_args + timing_args) as bus:
         tmp = tempfile.NamedTemporaryFile(suffix=".pcap", delete=False, dir=bus.dir).name
         cap = subprocess.Popen(["dumpcap", "-q", "-P", "-i", bus.iface, "-f", "ether proto 0x88a4", "-w", tmp],
                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -51,6 +57,7 @@ def main():
                 time.sleep(0.05)
             time.sleep(0.5)  # dumpcap writes the header before its filter is attached
             argv = [x.replace("{iface}", bus.iface) for x in cmd]
+            stopped = None
             master = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                                       start_new_session=True)
             try:
@@ -59,6 +66,7 @@ def main():
                 if not a.seconds:
                     os.killpg(master.pid, signal.SIGKILL)
                     raise
+                stopped = time.time()  # dumpcap's time stamps are wall-clock time
                 os.killpg(master.pid, signal.SIGINT)
                 try:
                     out, _ = master.communicate(timeout=5)
@@ -73,6 +81,16 @@ def main():
         frames = ecatreplay.read_pcap(tmp)
         if not frames:
             sys.exit("nothing recorded")
+        if stopped is not None:
+            # The start-up and the cycles up to the stop: requests sent after it (the master's shut-down) are
+            # left out, replies to earlier ones kept.
+            kept = set()
+            for t, rq, rp in ecatreplay.pair(frames):
+                if t <= stopped:
+                    kept.add(id(rq))
+                    if rp is not None:
+                        kept.add(id(rp))
+            frames = [(t, fr) for t, fr in frames if id(fr) in kept]
         t0 = frames[0][0]
         frames = [(t - t0, fr) for t, fr in frames]
         pcap = f"{a.name}.pcap.gz"
@@ -85,7 +103,10 @@ def main():
             "master_version": a.master_version,
             "master_exit": master.returncode,
             "seconds": a.seconds,
+            "kept": "start-up and cycles until the master was stopped" if stopped is not None else "everything",
             "slave_args": slave_args,
+            "recording_slave_timing_args": timing_args,
+            "malformed_requests": a.malformed_requests,
             "recorded": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d"),
             "requests": len(pairs),
             "unanswered": sum(1 for p in pairs if p[2] is None),
