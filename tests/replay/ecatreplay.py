@@ -85,10 +85,11 @@ def read_pcap(path):
 
 def write_pcap(path, frames):
     """frames: [(time_s, bytes)] -> classic microsecond pcap, gzip-compressed when path ends in .gz."""
-    body = struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)
+    parts = [struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)]
     for t, fr in frames:
         sec = int(t)
-        body += struct.pack("<IIII", sec, int(round((t - sec) * 1e6)) % 1000000, len(fr), len(fr)) + fr
+        parts.append(struct.pack("<IIII", sec, int(round((t - sec) * 1e6)) % 1000000, len(fr), len(fr)) + fr)
+    body = b"".join(parts)
     if path.endswith(".gz"):
         with gzip.GzipFile(path, "wb", mtime=0) as f:
             f.write(body)
