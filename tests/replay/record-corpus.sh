@@ -24,10 +24,10 @@ if [ -x "$S/slaveinfo/slaveinfo" ]; then
     sfx=$([ $n = 3 ] && echo -line3 || true)
     want "soem-slaveinfo$sfx" && $REC "soem-slaveinfo$sfx" --slaves $n $RT --master-version "$V" \
       --description "SOEM slaveinfo -map" -- "$S/slaveinfo/slaveinfo" {iface} -map
-    want "soem-simple_ng$sfx" && $REC "soem-simple_ng$sfx" --slaves $n $RT --seconds 3 --master-version "$V" \
+    want "soem-simple_ng$sfx" && $REC "soem-simple_ng$sfx" --slaves $n $RT --seconds 2.2 --master-version "$V" \
       --description "SOEM simple_ng: to OP, process data" -- "$S/simple_ng/simple_ng" {iface}
   done
-  want soem-ec_sample && $REC soem-ec_sample $RT --seconds 3 --master-version "$V" \
+  want soem-ec_sample && $REC soem-ec_sample $RT --seconds 2.2 --master-version "$V" \
     --description "SOEM ec_sample: to OP with DC, process data" -- "$S/ec_sample/ec_sample" {iface} 1000
 fi
 
@@ -42,7 +42,7 @@ if [ -x "$L/ethercatdiag" ]; then
   for n in 1 3; do
     sfx=$([ $n = 3 ] && echo -line3 || true)
     want "libethercat-example_with_dc$sfx" && $REC "libethercat-example_with_dc$sfx" --slaves $n $RT \
-      --seconds 3.5 --master-version "$V" --description "libethercat example_with_dc: to OP with DC (SYNC0 1 ms)" \
+      --seconds 2.8 --master-version "$V" --description "libethercat example_with_dc: to OP with DC (SYNC0 1 ms)" \
       -- "$L/example_with_dc" -i sock-raw:{iface} -a 0x1 -p 0
   done
 fi
