@@ -53,6 +53,10 @@ TIMING_REGISTERS = [
     (0x0990, 0x09A0, "DC start time / next SYNC1 pulse (the ESC moves it on)"),
     (0x09AE, 0x0A00, "latch status and latch times"),
 ]
+# Bits of otherwise compared registers that follow from timing: [address] = mask of the bits not compared.
+TIMING_BITS = {
+    0x0110: 0x02,  # DL status bit 1: PDI watchdog reloaded in time (the slave's own task, under load)
+}
 SETTLE_S = 2.0  # how far (in recording time) an answer may come ahead of or behind the recording
 CYCLE_GAP_S = 0.05  # a recorded process-data frame this soon after a poll: the master's cycle was running
 SM_STATUS_MASKED_FROM = 2  # SM status (byte 5) of SM2 and up: buffer states of process data, timing
@@ -187,7 +191,8 @@ def project(request, reply):
             out.append((wkc, None))
             continue
         masked = _masked_bytes(cmd, ado, len(data))
-        out.append((wkc, tuple(None if i in masked else b for i, b in enumerate(data))))
+        out.append((wkc, tuple(None if i in masked else b & ~TIMING_BITS.get(ado + i, 0) & 0xFF
+                               for i, b in enumerate(data))))
     return out
 
 
