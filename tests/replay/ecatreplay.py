@@ -27,10 +27,13 @@ import json
 import os
 import socket
 import struct
+import sys
 import time
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "integration"))
+import harness  # noqa: E402
+
 ETH_P_ECAT = 0x88A4
-PACKET_OUTGOING = 4
 
 # EtherCAT commands (ETG.1000.4 table "EtherCAT command types").
 NOP, APRD, APWR, APRW, FPRD, FPWR, FPRW, BRD, BWR, BRW, LRD, LWR, LRW, ARMW, FRMW = range(15)
@@ -305,30 +308,15 @@ class Mismatch(AssertionError):
     pass
 
 
+def _is_reply(request, data):
+    """The slave's answer to request: source address bit 1 set (an ESC sets it) and the request's datagram keys,
+    walked as an ESC walks them (keys())."""
+    return bool(data[6] & 0x02) and keys(data) == keys(request)
+
+
 def _exchange(sock, frame, timeout):
-    """Sends frame, returns the reply to it (same datagram keys, source bit 1 set) or None."""
-    want = keys(frame)
-    sock.setblocking(False)
-    try:
-        while True:
-            sock.recv(4096)
-    except (BlockingIOError, socket.timeout):
-        pass
-    sock.setblocking(True)
-    sock.send(frame)
-    deadline = time.monotonic() + timeout
-    while True:
-        left = deadline - time.monotonic()
-        if left <= 0:
-            return None
-        sock.settimeout(left)
-        try:
-            data, addr = sock.recvfrom(4096)
-        except socket.timeout:
-            return None
-        if addr[2] == PACKET_OUTGOING or not data[6] & 0x02 or keys(data) != want:
-            continue
-        return data
+    """Sends frame, returns the reply to it or None (harness.exchange: queued frames dropped first)."""
+    return harness.exchange(sock, frame, timeout, match=_is_reply)
 
 
 def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None):

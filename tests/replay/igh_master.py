@@ -17,13 +17,16 @@ SYNC0 every 1 ms (ecrt_slave_config_dc). Exit 0 when every slave reached OP and 
 expected working counter.
 """
 import argparse
+import os
 import socket
 import struct
 import sys
 import time
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "integration"))
+import harness  # noqa: E402  (frame exchange on a raw socket)
+
 ETH_P_ECAT = 0x88A4
-PACKET_OUTGOING = 4
 APRD, APWR, FPRD, FPWR, BRD, BWR, LRW, FRMW = 1, 2, 4, 5, 7, 8, 12, 14
 DC_EPOCH_NS = 946684800 * 10**9  # EtherCAT system time counts from 2000-01-01
 EC_FIRST_SII_CATEGORY_OFFSET = 0x40  # master/globals.h
@@ -82,25 +85,11 @@ class Master:
             body += struct.pack("<BBHHHH", cmd, self.idx, adp, ado, len(data) | more, 0) + data + b"\x00\x00"
         frame = b"\xff" * 6 + b"\x00\x01\x05\x10\x00\x00" + b"\x88\xa4" + struct.pack("<H", len(body) | 0x1000) + body
         frame += b"\x00" * max(0, 60 - len(frame))
-        self.sock.send(frame)
-        deadline = time.monotonic() + timeout
-        while True:
-            left = deadline - time.monotonic()
-            if left <= 0:
-                return None
-            self.sock.settimeout(left)
-            try:
-                data, addr = self.sock.recvfrom(4096)
-            except socket.timeout:
-                return None
-            if addr[2] == PACKET_OUTGOING or len(data) < 28 or data[17] != self.idx or not data[6] & 0x02:
-                continue
-            out, pos = [], 16
-            for cmd, adp, ado, dat in datagrams:
-                n = len(dat)
-                out.append((data[pos + 10:pos + 10 + n], struct.unpack_from("<H", data, pos + 10 + n)[0]))
-                pos += 12 + n
-            return out
+        data = harness.exchange(self.sock, frame, timeout,
+                                match=lambda rq, rp: len(rp) >= 28 and rp[17] == rq[17] and bool(rp[6] & 0x02))
+        if data is None:
+            return None
+        return [(d[4], d[5]) for d in harness.parse_datagrams(data)]
 
     def dg(self, cmd, adp, ado, data):
         """One FSM datagram (master/datagram.c); with the application active, in the cycle's frame beside the
