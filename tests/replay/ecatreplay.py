@@ -314,9 +314,21 @@ def _is_reply(request, data):
     return bool(data[6] & 0x02) and keys(data) == keys(request)
 
 
+_index = [0]
+
+
 def _exchange(sock, frame, timeout):
-    """Sends frame, returns the reply to it or None (harness.exchange: queued frames dropped first)."""
-    return harness.exchange(sock, frame, timeout, match=_is_reply)
+    """Sends frame, returns the reply to it or None (harness.exchange: queued frames dropped first). Every send
+    carries a fresh datagram index (the slave does not look at it; ETG.1000.4 leaves it to the master), so a late
+    reply to an earlier send of the same poll is never taken for this one's."""
+    _index[0] = (_index[0] + 1) & 0xFF
+    fr = bytearray(frame)
+    off = ecat_offset(frame)
+    pos = off + 2
+    for d in datagrams(frame):
+        fr[pos + 1] = _index[0]
+        pos += 12 + len(d[4])
+    return harness.exchange(sock, bytes(fr), timeout, match=_is_reply)
 
 
 def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None):
