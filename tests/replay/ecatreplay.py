@@ -345,6 +345,11 @@ def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None):
     # cyclic task beside its state machine), the replay keeps it running while it waits; a master that stopped
     # cycling (to see the watchdog trip) is not helped along.
     cycle_times = [t for t, rq, _rp in pairs if read_only(rq) and any(d[0] in LOGICAL for d in datagrams(rq))]
+    next_write, nxt = [0] * len(pairs), len(pairs)
+    for k in range(len(pairs) - 1, -1, -1):
+        next_write[k] = nxt
+        if not read_only(pairs[k][1]):
+            nxt = k
     clock = ClockShift()
     t0_rec = pairs[0][0] if pairs else 0.0
     t0 = time.monotonic()
@@ -378,7 +383,10 @@ def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None):
                 clock.learn(request, recorded, observed, lag)
                 continue
             if read_only(request):
-                later = [j for j in range(i + 1, len(pairs)) if pairs[j][0] - t <= settle_s]
+                # The same poll later: identical requests within settle_s, up to the master's next write (after
+                # it the same read asks about something else, e.g. the next SII word).
+                end = next_write[i]
+                later = [j for j in range(i + 1, end) if pairs[j][0] - t <= settle_s]
                 later = [j for j in later if ids[j] == ids[i] and pairs[j][2] is not None]
                 verdict = _settled(request, recorded, observed, [pairs[j][2] for j in later])
                 if verdict is not None and verdict > 0:

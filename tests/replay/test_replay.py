@@ -79,6 +79,43 @@ class Replay(unittest.TestCase):
                     replay(name, pcap, side, ["--fault", fault])
                 print(f"{rec} with --fault {fault}: {cm.exception}")
 
+    def test_tampered_recording_fails(self):
+        """The poll rules accept no answer the recording does not hold: a recording with one SII word or one
+        mailbox answer changed fails at that frame against the correct slave."""
+        by_name = {e[0]: e for e in ecatreplay.corpus()}
+
+        def first(pairs, want):
+            return next(i for i, (_t, rq, rp) in enumerate(pairs) if rp is not None and want(pairs, i))
+
+        def sii_vendor_word(pairs, i):  # the read of SII word 8 (vendor id), after the address that asked for it
+            d = ecatreplay.datagrams(pairs[i][1])[0]
+            if d[0] != ecatreplay.FPRD or d[3] != 0x0508:
+                return False
+            for k in range(i - 1, max(i - 5, -1), -1):
+                p = ecatreplay.datagrams(pairs[k][1])[0]
+                if p[0] == ecatreplay.FPWR and p[3] == 0x0504:
+                    return p[4][:2] == b"\x08\x00"
+            return False
+
+        def mailbox_answer(pairs, i):
+            d, r = ecatreplay.datagrams(pairs[i][1])[0], ecatreplay.datagrams(pairs[i][2])[0]
+            return d[0] == ecatreplay.FPRD and d[3] >= 0x1000 and r[5] == 1
+
+        for rec, want, byte in (("libethercat-eepromtool", sii_vendor_word, 0), ("soem-slaveinfo", mailbox_answer, 8)):
+            with self.subTest(recording=rec):
+                name, pcap, side = by_name[rec]
+                pairs = ecatreplay.pair(ecatreplay.read_pcap(pcap))
+                i = first(pairs, want)
+                t, rq, rp = pairs[i]
+                reply = bytearray(rp)
+                reply[ecatreplay.ecat_offset(rp) + 2 + 10 + byte] ^= 0x01
+                pairs[i] = (t, rq, bytes(reply))
+                with harness.Bus(slave_args=side["slave_args"]) as bus:
+                    with self.assertRaises(ecatreplay.Mismatch) as cm:
+                        ecatreplay.replay(pairs, bus.iface)
+                self.assertIn(f"frame {i + 1} of", str(cm.exception))
+                print(f"{rec} with frame {i + 1} changed: {cm.exception}")
+
 
 if __name__ == "__main__":
     harness.main()
