@@ -20,6 +20,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
+#include "util/input_file.hpp"
 #include "util/strfmt.hpp"
 
 namespace ecatctl {
@@ -58,10 +59,14 @@ std::optional<Address> named_slave(const std::string& text, bool station) {
     return a;
 }
 
-std::optional<std::vector<uint8_t>> read_file(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) return std::nullopt;
-    return std::vector<uint8_t>(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+std::optional<std::vector<uint8_t>> read_file(const std::string& path, std::size_t max_bytes,
+                                              std::string_view what) {
+    try {
+        return util::read_input_bytes(path, max_bytes, what);
+    } catch (const util::InputFileError& e) {
+        std::fprintf(stderr, "ecatctl: %s\n", e.what());
+        return std::nullopt;
+    }
 }
 
 // A slave in INIT gets its mailbox SMs from its SII and is taken to PREOP; one already in PREOP or above

@@ -55,8 +55,8 @@ int foe_transfer(master::Master& m, const FoeArgs& f, bool read) {
     std::vector<uint8_t> data;
     std::string name = f.name;
     if (!read) {
-        auto d = read_file(f.file);
-        if (!d) return usage_error("cannot read " + f.file);
+        auto d = read_file(f.file, kMaxFileBytes, "file to write");
+        if (!d) return kExitUsage;
         data = std::move(*d);
         // The device takes firmware under its device name (0x1008, the SII General name) or the firmware
         // file name built from it; the local file's name means nothing to it.

@@ -64,8 +64,8 @@ int sii_read(master::Master& m, const SiiArgs& s) {
 int sii_write(master::Master& m, const SiiArgs& s) {
     auto a = named_slave(s.slave, s.station);
     if (!a) return kExitUsage;
-    auto img = read_file(s.input);
-    if (!img) return usage_error("cannot read " + s.input);
+    auto img = read_file(s.input, kMaxSiiBytes, "SII image");
+    if (!img) return kExitUsage;
     if (img->size() < 16 || img->size() % 2 != 0 || img->size() > 65536)
         return usage_error(s.input + ": an SII image is an even number of bytes, 16 to 65536");
     const uint16_t w7 = util::get16(img->data() + 2 * esc::sii::word::Checksum);
@@ -114,9 +114,9 @@ void add_sii_command(CLI::App& app, MasterRunner run, int& rc) {
     sii_dec->add_flag("-s,--station", s->station, "--position is a station address");
     sii_dec->callback([s, run, &rc] {
         if (!s->input.empty()) {
-            auto img = read_file(s->input);
+            auto img = read_file(s->input, kMaxSiiBytes, "SII image");
             if (!img) {
-                rc = usage_error("cannot read " + s->input);
+                rc = kExitUsage;
                 return;
             }
             std::fputs(esi::decode_sii(*img).c_str(), stdout);

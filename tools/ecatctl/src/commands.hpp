@@ -13,6 +13,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -66,7 +67,14 @@ int fail(master::Error e, const std::string& what);
 std::string state_failure(const master::AlStatus* st, const std::string& wanted);
 // The slave a command names; a bad one is reported as a usage error (exit kExitUsage) and gives nullopt.
 std::optional<master::Address> named_slave(const std::string& text, bool station);
-std::optional<std::vector<uint8_t>> read_file(const std::string& path);
+// The largest files the verbs read: an SII image (the EEPROM address space), a file written over FoE.
+inline constexpr std::size_t kMaxSiiBytes = 65536;
+inline constexpr std::size_t kMaxFileBytes = std::size_t{64} << 20;
+// A file the command was given, read whole: a regular file of at most max_bytes (util::read_input_bytes; a
+// FIFO, a device or a directory is refused). nullopt after "ecatctl: PATH: why" on stderr; what names the
+// kind of file in that message.
+std::optional<std::vector<uint8_t>> read_file(const std::string& path, std::size_t max_bytes,
+                                              std::string_view what);
 // A slave in INIT gets its mailbox SMs from its SII and is taken to PREOP; one already in PREOP or above
 // keeps the SMs it has.
 master::Error open_mailbox(master::Master& m, master::Mailbox& mbx, master::Address a);
