@@ -603,10 +603,8 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
         attr(sm, "ControlByte", hex(s.control));
         attr(sm, "Enable", s.enable ? "1" : "0");
     }
-    for (const PdoInfo& p : m.pdos)
-        if (p.rx) pdo(device, p);
-    for (const PdoInfo& p : m.pdos)
-        if (!p.rx) pdo(device, p);
+    for (std::size_t i : m.pdo_order)
+        pdo(device, m.pdos[i]);
 
     if (d.mailbox_protocols != 0) {
         namespace mp = od::mailbox_protocol;

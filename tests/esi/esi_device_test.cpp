@@ -146,7 +146,10 @@ std::vector<std::string> describe(const od::Product& p) {
         out.push_back(h.str());
         for (const od::Entry& e : o.entries) {
             std::ostringstream x;
-            x << std::hex << "  " << o.index << ":" << int{e.subindex} << " '" << e.name << "' type "
+            // The ESI names the elements of an array "SubIndex nnn" as configuration tools do (the writer
+            // keeps the MAXPOS's ESI as it is); a vendor's own element names do not survive the round trip.
+            const std::string name = o.code == od::ObjectCode::Array && e.subindex != 0 ? "" : e.name;
+            x << std::hex << "  " << o.index << ":" << int{e.subindex} << " '" << name << "' type "
               << static_cast<unsigned>(e.type) << " bits " << std::dec << e.bit_length << " access "
               << std::hex << e.access << " default " << number_text(e.default_value) << " '"
               << e.default_string << "' min " << number_text(e.minimum) << " max " << number_text(e.maximum)

@@ -271,6 +271,10 @@ std::optional<od::Entry> to_entry(const EsiEntry& e, uint16_t index, const std::
         x.minimum = std::monostate{};
         x.maximum = std::monostate{};
     }
+    if (const double* r = std::get_if<double>(&x.default_value); r && std::isnan(*r)) {
+        ctx.warn(e.line, "object " + where(index, e.subindex) + ": default is not a number (NaN); 0 is used");
+        x.default_value = 0.0;
+    }
     if (x.type == DataType::Boolean) {
         // Writes of 0/1 only (od); a BOOL default of 0xFF (as some tools write TRUE) is true.
         if (auto p = std::get_if<uint64_t>(&x.default_value); p && *p > 1) x.default_value = uint64_t{1};
@@ -718,6 +722,18 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
         ctx.warn(d.line, "Slots: the default configuration (" +
                              (module_list.empty() ? "no modules" : module_list) +
                              ") is served; softecat does not take another module configuration");
+    // A PDO whose index is not a mapping object index of its direction cannot be described by a mapping
+    // object (and so not by SDO information, the SII or the ESI softecat writes): left out.
+    for (auto it = pdos.begin(); it != pdos.end();) {
+        if (is_mapping(it->index, it->esi->rx)) {
+            ++it;
+            continue;
+        }
+        ctx.warn(it->esi->line, std::string(it->esi->rx ? "RxPdo " : "TxPdo ") + hex(it->index) +
+                                    " outside " + (it->esi->rx ? "0x1600-0x17FF" : "0x1A00-0x1BFF") +
+                                    " (ETG.1000.6 PDO mapping objects): not served");
+        it = pdos.erase(it);
+    }
     for (std::size_t i = 0; i < pdos.size(); ++i)
         for (std::size_t j = 0; j < i; ++j)
             if (pdos[i].index == pdos[j].index)
@@ -814,9 +830,6 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
     const bool coe = desc.mailbox_protocols & od::mailbox_protocol::CoE;
     for (const Pdo& p : pdos) {
         const bool rx = p.esi->rx;
-        if (!is_mapping(p.index, rx))
-            ctx.warn(p.esi->line, std::string(rx ? "RxPdo " : "TxPdo ") + hex(p.index) + " outside " +
-                                      (rx ? "0x1600-0x17FF" : "0x1A00-0x1BFF") + " (ETG.1000.6)");
         std::vector<uint64_t> words;
         for (const EsiPdoEntry& e : p.entries)
             words.push_back(uint64_t{e.index} << 16 | uint64_t{e.subindex} << 8 | e.bit_len);
@@ -979,6 +992,20 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
                 (rx ? s.rx : s.tx).push_back(index);
             }
         desc.pdo_sets.push_back(std::move(s));
+    }
+
+    // ---- Entry names unique within an object (as the ESI's SubItems must be, and SDO information lists
+    // them) ----
+    for (auto& [index, o] : built.objects) {
+        if (o.code == od::ObjectCode::Var) continue;
+        std::set<std::string> seen;
+        for (od::Entry& e : o.entries) {
+            if (e.name.empty()) e.name = nth(e.subindex);
+            if (!seen.insert(e.name).second) {
+                e.name += " (" + nth(e.subindex) + ")";
+                seen.insert(e.name);
+            }
+        }
     }
 
     // ---- The dictionary, built once here so that every fault shows now, with its line ----
