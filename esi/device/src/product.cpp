@@ -429,6 +429,14 @@ std::pair<DataType, uint16_t> pdo_entry_type(const EsiPdoEntry& pe, Ctx& ctx) {
                           " bits and type '" + pe.data_type + "': no type of that length");
 }
 
+// The declared limits stay unless they exclude the (new) default.
+void keep_limits_around_default(od::Entry& e) {
+    if (outside(e.default_value, e.minimum, e.maximum)) {
+        e.minimum = std::monostate{};
+        e.maximum = std::monostate{};
+    }
+}
+
 struct Pdo {
     const EsiPdo* esi = nullptr;
     uint16_t index = 0;
@@ -858,13 +866,11 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
             if (fits) {
                 o.entries[0].default_value = uint64_t{words.size()};
                 for (od::Entry& e : o.entries) {
+                    // Subindices past the count keep what the dictionary declares (nothing maps them).
                     if (e.subindex >= 1 && e.subindex <= words.size())
                         e.default_value = words[e.subindex - 1];
-                    else if (e.subindex > words.size())
-                        e.default_value = uint64_t{0};
                     if (p.esi->fixed) e.access &= static_cast<uint16_t>(~od::access::WriteMask);
-                    e.minimum = std::monostate{};
-                    e.maximum = std::monostate{};
+                    keep_limits_around_default(e);
                 }
                 continue;
             }
@@ -927,13 +933,13 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
             }
             if (ok) {
                 o.entries[0].default_value = uint64_t{assigned.size()};
-                for (od::Entry& e : o.entries)
-                    if (e.subindex >= 1) {
-                        e.default_value =
-                            e.subindex <= assigned.size() ? uint64_t{assigned[e.subindex - 1]} : uint64_t{0};
-                        e.minimum = std::monostate{};
-                        e.maximum = std::monostate{};
-                    }
+                for (od::Entry& e : o.entries) {
+                    // Subindices past the count keep what the dictionary declares (nothing is assigned
+                    // there).
+                    if (e.subindex >= 1 && e.subindex <= assigned.size())
+                        e.default_value = uint64_t{assigned[e.subindex - 1]};
+                    keep_limits_around_default(e);
+                }
                 continue;
             }
             ctx.warn(built.lines[index],
