@@ -536,6 +536,35 @@ TEST(EsiExamples, Latin1AndByteOrderMarkAreRead) {
     EXPECT_EQ(c.description.identity.order_code, "EXK1100");
 }
 
+TEST(EsiDevices, ACoeDeviceWithoutADictionaryGetsTheMandatoryObjects) {
+    const std::string xml =
+        "<?xml version=\"1.0\"?><EtherCATInfo><Vendor><Id>#x123</Id><Name>V</Name></Vendor><Descriptions>"
+        "<Devices><Device><Type ProductCode=\"#x77\" RevisionNo=\"#x2\">T77</Type><Name>T 77</Name>"
+        "<Profile><ProfileNo>5001</ProfileNo></Profile>"
+        "<Sm DefaultSize=\"128\" StartAddress=\"#x1000\" ControlByte=\"#x26\" Enable=\"1\">MBoxOut</Sm>"
+        "<Sm DefaultSize=\"128\" StartAddress=\"#x1080\" ControlByte=\"#x22\" Enable=\"1\">MBoxIn</Sm>"
+        "<Sm StartAddress=\"#x1100\" ControlByte=\"#x64\" Enable=\"1\">Outputs</Sm>"
+        "<Sm StartAddress=\"#x1180\" ControlByte=\"#x20\" Enable=\"1\">Inputs</Sm>"
+        "<RxPdo Fixed=\"1\" Sm=\"2\"><Index>#x1600</Index><Name>Out</Name><Entry><Index>#x7000</Index>"
+        "<SubIndex>1</SubIndex><BitLen>16</BitLen><Name>Value</Name><DataType>UINT</DataType></Entry></RxPdo>"
+        "<Mailbox><CoE SdoInfo=\"true\" PdoAssign=\"false\"/></Mailbox></Device></Devices></Descriptions>"
+        "</EtherCATInfo>";
+    const od::Product p = esi::load_product(esi::read_esi_text(xml, "t77.xml"), "");
+    od::DeviceDescription other = p.description;
+    other.identity.serial_number = 42;
+    const od::Dictionary d = p.make_dictionary(other);
+    EXPECT_EQ(d.get<uint32_t>(0x1000, 0), 5001u);
+    EXPECT_EQ(d.get<uint32_t>(0x1018, 1), 0x123u);
+    EXPECT_EQ(d.get<uint32_t>(0x1018, 2), 0x77u);
+    EXPECT_EQ(d.get<uint32_t>(0x1018, 4), 42u);
+    EXPECT_NE(d.find(0x1008, 0), nullptr);
+    EXPECT_EQ(d.get<uint8_t>(0x1C00, 3), 3);
+    EXPECT_EQ(d.get<uint16_t>(0x1C12, 1), 0x1600);
+    EXPECT_FALSE(d.find(0x1C12, 1)->writable(od::AlState::PreOp));  // no PdoAssign
+    EXPECT_TRUE(d.find(0x7000, 1)->rx_mappable());
+    EXPECT_TRUE(p.warnings.empty()) << ::testing::PrintToString(p.warnings);
+}
+
 // ---- Bad input, as a class ----------------------------------------------------------------------------
 
 struct TempDir {

@@ -969,6 +969,49 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
                                           (p.esi->rx ? "Outputs" : "Inputs") +
                                           " SyncManager; it is not assigned");
         }
+    // The objects every CoE device has (ETG.1000.6: 0x1000 and 0x1018 mandatory; 0x1008 as every vendor
+    // has it), for a CoE device whose file does not declare them (files without a Profile/Dictionary):
+    // a master that reads the identity by SDO finds what the SII says.
+    if (coe && !built.objects.count(0x1000)) {
+        od::Object o;
+        o.index = 0x1000;
+        o.code = od::ObjectCode::Var;
+        o.type = DataType::Unsigned32;
+        o.name = "Device type";
+        const uint32_t type = d.profile_no.value_or(0) | d.profile_add_info.value_or(0) << 16;
+        o.entries.push_back(u_entry(0x1000, 0, DataType::Unsigned32, od::access::RO, type, "Device type"));
+        built.objects[0x1000] = std::move(o);
+        built.lines[0x1000] = d.line;
+    }
+    if (coe && !built.objects.count(0x1008) && !id.order_code.empty()) {
+        od::Object o;
+        o.index = 0x1008;
+        o.code = od::ObjectCode::Var;
+        o.type = DataType::VisibleString;
+        o.name = "Device name";
+        od::Entry e = u_entry(0x1008, 0, DataType::VisibleString, od::access::RO, 0, "Device name");
+        e.default_value = std::monostate{};
+        e.default_string = id.order_code.substr(0, 255);
+        e.bit_length = static_cast<uint16_t>(8 * e.default_string.size());
+        o.entries.push_back(std::move(e));
+        built.objects[0x1008] = std::move(o);
+        built.lines[0x1008] = d.line;
+    }
+    if (coe && !built.objects.count(0x1018)) {
+        od::Object o;
+        o.index = 0x1018;
+        o.code = od::ObjectCode::Record;
+        o.type = DataType::Identity;
+        o.name = "Identity";
+        o.entries.push_back(u_entry(0x1018, 0, DataType::Unsigned8, od::access::RO, 4, "SubIndex 000"));
+        const char* names[] = {"Vendor ID", "Product code", "Revision", "Serial number"};
+        const uint32_t values[] = {id.vendor_id, id.product_code, id.revision, 0};
+        for (uint8_t k = 0; k < 4; ++k)
+            o.entries.push_back(u_entry(0x1018, static_cast<uint8_t>(k + 1), DataType::Unsigned32,
+                                        od::access::RO, values[k], names[k]));
+        built.objects[0x1018] = std::move(o);
+        built.lines[0x1018] = d.line;
+    }
     // 0x1C00 (SyncManager communication type) for a CoE device that does not declare it.
     if (coe && !built.objects.count(0x1C00) && !desc.sync_managers.empty()) {
         od::Object o;
