@@ -972,61 +972,50 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
     // The objects every CoE device has (ETG.1000.6: 0x1000 and 0x1018 mandatory; 0x1008 as every vendor
     // has it), for a CoE device whose file does not declare them (files without a Profile/Dictionary):
     // a master that reads the identity by SDO finds what the SII says.
-    if (coe && !built.objects.count(0x1000)) {
+    // An object the file lacks, declared at the Device element's line.
+    auto add_missing = [&built, &d](uint16_t index, od::ObjectCode code, DataType type, const char* name,
+                                    std::vector<od::Entry> entries) {
         od::Object o;
-        o.index = 0x1000;
-        o.code = od::ObjectCode::Var;
-        o.type = DataType::Unsigned32;
-        o.name = "Device type";
+        o.index = index;
+        o.code = code;
+        o.type = type;
+        o.name = name;
+        o.entries = std::move(entries);
+        built.objects[index] = std::move(o);
+        built.lines[index] = d.line;
+    };
+    if (coe && !built.objects.count(0x1000)) {
         const uint32_t type = d.profile_no.value_or(0) | d.profile_add_info.value_or(0) << 16;
-        o.entries.push_back(u_entry(0x1000, 0, DataType::Unsigned32, od::access::RO, type, "Device type"));
-        built.objects[0x1000] = std::move(o);
-        built.lines[0x1000] = d.line;
+        add_missing(0x1000, od::ObjectCode::Var, DataType::Unsigned32, "Device type",
+                    {u_entry(0x1000, 0, DataType::Unsigned32, od::access::RO, type, "Device type")});
     }
     if (coe && !built.objects.count(0x1008) && !id.order_code.empty()) {
-        od::Object o;
-        o.index = 0x1008;
-        o.code = od::ObjectCode::Var;
-        o.type = DataType::VisibleString;
-        o.name = "Device name";
         od::Entry e = u_entry(0x1008, 0, DataType::VisibleString, od::access::RO, 0, "Device name");
         e.default_value = std::monostate{};
         e.default_string = id.order_code.substr(0, 255);
         e.bit_length = static_cast<uint16_t>(8 * e.default_string.size());
-        o.entries.push_back(std::move(e));
-        built.objects[0x1008] = std::move(o);
-        built.lines[0x1008] = d.line;
+        add_missing(0x1008, od::ObjectCode::Var, DataType::VisibleString, "Device name", {std::move(e)});
     }
     if (coe && !built.objects.count(0x1018)) {
-        od::Object o;
-        o.index = 0x1018;
-        o.code = od::ObjectCode::Record;
-        o.type = DataType::Identity;
-        o.name = "Identity";
-        o.entries.push_back(u_entry(0x1018, 0, DataType::Unsigned8, od::access::RO, 4, "SubIndex 000"));
+        std::vector<od::Entry> entries{
+            u_entry(0x1018, 0, DataType::Unsigned8, od::access::RO, 4, "SubIndex 000")};
         const char* names[] = {"Vendor ID", "Product code", "Revision", "Serial number"};
         const uint32_t values[] = {id.vendor_id, id.product_code, id.revision, 0};
         for (uint8_t k = 0; k < 4; ++k)
-            o.entries.push_back(u_entry(0x1018, static_cast<uint8_t>(k + 1), DataType::Unsigned32,
-                                        od::access::RO, values[k], names[k]));
-        built.objects[0x1018] = std::move(o);
-        built.lines[0x1018] = d.line;
+            entries.push_back(u_entry(0x1018, static_cast<uint8_t>(k + 1), DataType::Unsigned32,
+                                      od::access::RO, values[k], names[k]));
+        add_missing(0x1018, od::ObjectCode::Record, DataType::Identity, "Identity", std::move(entries));
     }
     // 0x1C00 (SyncManager communication type) for a CoE device that does not declare it.
     if (coe && !built.objects.count(0x1C00) && !desc.sync_managers.empty()) {
-        od::Object o;
-        o.index = 0x1C00;
-        o.code = od::ObjectCode::Array;
-        o.type = DataType::Unsigned8;
-        o.name = "Sync manager type";
-        o.entries.push_back(u_entry(0x1C00, 0, DataType::Unsigned8, od::access::RO, desc.sync_managers.size(),
-                                    "SubIndex 000"));
+        std::vector<od::Entry> entries{u_entry(0x1C00, 0, DataType::Unsigned8, od::access::RO,
+                                               desc.sync_managers.size(), "SubIndex 000")};
         for (std::size_t n = 0; n < desc.sync_managers.size() && n < 32; ++n)
-            o.entries.push_back(u_entry(0x1C00, static_cast<uint8_t>(n + 1), DataType::Unsigned8,
-                                        od::access::RO, static_cast<uint64_t>(desc.sync_managers[n].kind),
-                                        nth(static_cast<unsigned>(n + 1))));
-        built.objects[0x1C00] = std::move(o);
-        built.lines[0x1C00] = d.line;
+            entries.push_back(u_entry(0x1C00, static_cast<uint8_t>(n + 1), DataType::Unsigned8,
+                                      od::access::RO, static_cast<uint64_t>(desc.sync_managers[n].kind),
+                                      nth(static_cast<unsigned>(n + 1))));
+        add_missing(0x1C00, od::ObjectCode::Array, DataType::Unsigned8, "Sync manager type",
+                    std::move(entries));
     }
 
     // ---- Predefined PDO sets (AlternativeSmMapping) ----
