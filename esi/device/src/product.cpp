@@ -1130,9 +1130,10 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
             try {
                 (void)build_sii(product.description, dict);
                 break;
-            } catch (const std::length_error&) {
+            } catch (const std::length_error& e) {
+                // Too little EEPROM (a larger one helps), or more than the SII can say (255 strings): not.
                 if (product.description.eeprom_bytes >= 32768)
-                    ctx.fail(d.eeprom_line, "the SII of this device does not fit 32 KiB");
+                    ctx.fail(d.eeprom_line, std::string("no SII can be built for this device: ") + e.what());
                 product.description.eeprom_bytes =
                     static_cast<uint16_t>(product.description.eeprom_bytes * 2);
             } catch (const std::invalid_argument& e) {
