@@ -161,6 +161,26 @@ std::vector<std::string> describe(const od::Product& p) {
             out.push_back(x.str());
         }
     }
+    for (const od::Slot& slot : d.slots) {
+        std::ostringstream o;
+        o << std::hex << "slot '" << slot.name << "' " << slot.min_instances << "-" << slot.max_instances
+          << " default " << slot.default_module << " inc " << slot.pdo_increment << "/"
+          << slot.index_increment << " takes";
+        for (uint32_t x : slot.module_idents)
+            o << " " << x;
+        out.push_back(o.str());
+    }
+    for (const od::Module& mod : d.modules) {
+        std::ostringstream o;
+        o << std::hex << "module " << mod.ident << " " << mod.type << " '" << mod.name << "'";
+        for (const od::ModulePdo& mp : mod.pdos) {
+            o << " pdo " << mp.index << (mp.rx ? "r" : "t") << mp.sm << (mp.depend_on_slot ? "+" : "") << ":";
+            for (const od::ModulePdoEntry& e : mp.entries)
+                o << " " << e.index << (e.depend_on_slot ? "+" : "") << ":" << int{e.subindex} << "/"
+                  << int{e.bit_length} << "/" << e.data_type;
+        }
+        out.push_back(o.str());
+    }
     add("application", int(p.application), "eeprom", p.eeprom.size());
     return out;
 }
@@ -505,6 +525,16 @@ TEST(EsiExamples, TheModularDeviceServesTheDefaultModulesOfItsSlots) {
     const esi::DeviceModel m = esi::derive_model(p.description, d);
     EXPECT_EQ(m.sync_managers[2].size, 1);
     EXPECT_EQ(m.sync_managers[3].size, 5);
+    // The slots and their modules are kept for the ESI written back.
+    ASSERT_EQ(p.description.slots.size(), 4u);
+    EXPECT_EQ(p.description.slots[0].default_module, 0x00001001u);
+    EXPECT_EQ(p.description.slots[3].default_module, 0u);
+    EXPECT_EQ(p.description.slots[1].index_increment, 0x10u);
+    EXPECT_EQ(p.description.modules.size(), 3u);
+    const esi::EsiFile back = esi::read_esi_text(esi::build_esi(p.description, d), "back.xml");
+    ASSERT_EQ(back.devices[0].slots.size(), 4u);
+    EXPECT_EQ(back.modules.size(), 3u);
+    EXPECT_TRUE(back.devices[0].txpdos.empty());  // the PDOs are the modules', not the device's
     // EoE declared, not emulated: one warning naming the element.
     EXPECT_EQ(std::count_if(p.warnings.begin(), p.warnings.end(),
                             [](const std::string& w) { return w.find("Mailbox/EoE") != std::string::npos; }),

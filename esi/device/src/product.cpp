@@ -726,6 +726,43 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
             module_objects[at] = {o, m->type_name};
         }
     }
+    // The slots and the modules they take, for the ESI written back.
+    std::set<uint32_t> offered;
+    for (const EsiSlot& slot : d.slots) {
+        od::Slot s;
+        s.name = slot.name;
+        s.min_instances = slot.min_instances;
+        s.max_instances = slot.max_instances;
+        s.module_idents = slot.module_idents;
+        s.default_module = slot.default_module.value_or(0);
+        s.pdo_increment = slot.pdo_increment.value_or(d.slot_pdo_increment);
+        s.index_increment = slot.index_increment.value_or(d.slot_index_increment);
+        offered.insert(slot.module_idents.begin(), slot.module_idents.end());
+        desc.slots.push_back(std::move(s));
+    }
+    for (const EsiModule& m : file.modules) {
+        if (!offered.count(m.ident)) continue;
+        od::Module mod;
+        mod.ident = m.ident;
+        mod.type = m.type_name;
+        mod.name = m.name;
+        for (const auto* list : {&m.rxpdos, &m.txpdos})
+            for (const EsiPdo& p : *list) {
+                od::ModulePdo mp;
+                mp.rx = p.rx;
+                mp.index = p.index;
+                mp.depend_on_slot = p.depend_on_slot;
+                mp.name = p.name;
+                mp.sm = p.sm;
+                mp.fixed = p.fixed;
+                mp.mandatory = p.mandatory;
+                for (const EsiPdoEntry& e : p.entries)
+                    mp.entries.push_back(od::ModulePdoEntry{e.index, e.subindex, e.bit_len, e.name,
+                                                            e.data_type, e.depend_on_slot});
+                mod.pdos.push_back(std::move(mp));
+            }
+        desc.modules.push_back(std::move(mod));
+    }
     if (!d.slots.empty())
         ctx.warn(d.line, "Slots: the default configuration (" +
                              (module_list.empty() ? "no modules" : module_list) +
