@@ -393,7 +393,9 @@ void Device::build() {
         coe_config.faults = options_.faults.coe;
         p->coe = std::make_unique<coe::CoeServer>(
             p->dict, [raw] { return raw->stack->state(); }, coe_config);
-        p->diag = std::make_unique<coe::DiagnosisHistory>(p->dict, &p->coe->emergency());
+        // The diagnosis history where the dictionary has its object (0x10F3, ETG.1020).
+        if (!options_.product || p->dict.find(0x10F3) != nullptr)
+            p->diag = std::make_unique<coe::DiagnosisHistory>(p->dict, &p->coe->emergency());
         p->events = std::make_unique<coe::EventReporter>(p->coe->emergency(), p->diag.get(),
                                                          [this] { return system_time_ns(); });
         p->events->set_text_ids(&od::diag_text_id);  // the texts the ESI lists as DiagMessages
