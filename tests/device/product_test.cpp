@@ -76,6 +76,13 @@ uint16_t u16(std::span<const uint8_t> b, std::size_t at) {
     return static_cast<uint16_t>(b[at] | (b[at + 1] << 8));
 }
 
+// The one slave addressed and taken to Pre-Op, no mailbox configured.
+void preop_without_mailbox(Master& m, Address a) {
+    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m));
+    AlStatus st;
+    ASSERT_EQ(m.request_state(a, AlState::PreOp, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
+}
+
 }  // namespace
 
 TEST(ProductWithoutMailbox, HasOnlyTheProcessDataPartsAndSaysItsWarningsOnce) {
@@ -98,9 +105,8 @@ TEST(ProductWithoutMailbox, ReachesOpWithProcessDataOnlyAndItsInputsFollowTheDef
     UnitLink link(u);
     Master m(link, test_support::in_process_master_options());
     const Address a = Address::station(0x1001);
-    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m));
+    ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
     AlStatus st;
-    ASSERT_EQ(m.request_state(a, AlState::PreOp, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
 
     ProcessDataSession pd(m, std::span<const Address>(&a, 1));
     ASSERT_EQ(pd.discover_sii(0), Error::Ok);
@@ -179,9 +185,8 @@ TEST(ProductWithoutMailbox, InitToPreOpNeedsNoMailboxSmsAndStartsNone) {
     UnitLink link(u);
     Master m(link, test_support::in_process_master_options());
     const Address a = Address::station(0x1001);
-    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m));
+    ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
     AlStatus st;
-    ASSERT_EQ(m.request_state(a, AlState::PreOp, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
     // SM0/SM1 stay deactivated from the PDI until Safe-Op starts the process data in them.
     EXPECT_NE(m.read_reg<uint8_t>(a, 0x0807).value() & 0x01, 0);
     EXPECT_NE(m.read_reg<uint8_t>(a, 0x080F).value() & 0x01, 0);

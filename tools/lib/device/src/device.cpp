@@ -545,8 +545,7 @@ void Device::on_state_change(od::AlState from, od::AlState to) {
         const bool pd_from = from == od::AlState::SafeOp || from == od::AlState::Op;
         const bool pd_to = to == od::AlState::SafeOp || to == od::AlState::Op;
         if (pd_to && !pd_from) {
-            const ecat::ProcessDataSms sms = ecat::process_data_sms(parts_->desc);
-            parts_->io->build(parts_->dict, sms.outputs, sms.inputs, held_);
+            parts_->io->build(parts_->stack->process_data(), held_);
         } else if (pd_from && !pd_to) {
             parts_->io->clear();
         }
