@@ -237,9 +237,14 @@ DeviceModel derive_model(const od::DeviceDescription& d, const od::Dictionary& d
             if (s.kind == k) return true;
         return false;
     };
-    if (has(od::SmKind::Outputs)) m.fmmus.push_back(FmmuUse::Outputs);
-    if (has(od::SmKind::Inputs)) m.fmmus.push_back(FmmuUse::Inputs);
-    if (has(od::SmKind::MBoxIn)) m.fmmus.push_back(FmmuUse::MBoxState);
+    if (!d.fmmus.empty()) {
+        for (uint8_t f : d.fmmus)
+            m.fmmus.push_back(f <= 0x03 ? static_cast<FmmuUse>(f) : FmmuUse::Unused);
+    } else {
+        if (has(od::SmKind::Outputs)) m.fmmus.push_back(FmmuUse::Outputs);
+        if (has(od::SmKind::Inputs)) m.fmmus.push_back(FmmuUse::Inputs);
+        if (has(od::SmKind::MBoxIn)) m.fmmus.push_back(FmmuUse::MBoxState);
+    }
 
     // ---- Profile from the device type 0x1000 ----
     if (const od::Entry* dt = dict.find(0x1000, 0)) {

@@ -126,10 +126,10 @@ std::vector<uint8_t> build_sii(const od::DeviceDescription& d, const od::Diction
     // ---- DC ----
     Writer dc;
     for (const od::DcOpMode& mode : d.dc_modes) {
-        dc.u32(0);  // SYNC0 cycle time: set by the master
+        dc.u32(mode.cycle_time_sync0);  // 0: set by the master
         dc.u32(static_cast<uint32_t>(mode.shift_time_sync0));
-        dc.u32(0);  // SYNC1 shift
-        dc.u16(0);  // SYNC1 cycle factor
+        dc.u32(static_cast<uint32_t>(mode.shift_time_sync1));
+        dc.u16(static_cast<uint16_t>(mode.cycle_time_sync1_factor));
         dc.u16(mode.assign_activate);
         dc.u16(static_cast<uint16_t>(mode.cycle_time_sync0_factor));
         dc.u8(strings.add(mode.name));
