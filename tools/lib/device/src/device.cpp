@@ -187,8 +187,10 @@ Device::Device(esc::Esc& esc, DeviceOptions options)
     // What the product declares that is not emulated: said once.
     if (options_.product)
         for (const std::string& w : options_.product->warnings) {
-            log() << "softecat: " << options_.product->source << ": " << w << '\n';
-            event(slave::LogLevel::Warn, options_.product->source + ": " + w);
+            if (options_.events != nullptr)
+                event(slave::LogLevel::Warn, options_.product->source + ": " + w);
+            else
+                log() << "softecat: " << options_.product->source << ": " << w << '\n';
         }
     // Registered once the device exists: a constructor that throws leaves no callback behind.
     if (options_.load_sii)
