@@ -196,11 +196,14 @@ void StateMachine::follow(AlState to, uint64_t now_ns) {
 }
 
 uint16_t StateMachine::check_bootstrap() const {
+    // Bootstrap is supported when the device announces a bootstrap mailbox (SII words 0x14-0x17, the ESI's
+    // Mailbox/BootStrap): what is served there is the mailbox handlers' business (FoE if declared; any other
+    // request gets "unsupported protocol"). The MAXPOS declares FoE with its bootstrap mailbox; a device with
+    // a mailbox but no bootstrap mailbox announced refuses Bootstrap (0x0013).
     const od::DeviceDescription& desc = ctx_.desc;
-    const bool foe = (desc.mailbox_protocols & od::mailbox_protocol::FoE) != 0;
     const bool sized = desc.bootstrap_mailbox.out_size > kMailboxHeaderSize &&
                        desc.bootstrap_mailbox.in_size > kMailboxHeaderSize;
-    return foe && sized ? al::NoError : al::BootstrapNotSupported;
+    return sized && has_mailbox(desc) ? al::NoError : al::BootstrapNotSupported;
 }
 
 uint16_t StateMachine::check_mailbox(const od::MailboxLayout& layout, uint16_t code) {
