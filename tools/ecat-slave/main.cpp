@@ -305,8 +305,8 @@ int main(int argc, char** argv) {
                           : described.state_dir.empty()
                               ? "the built-in firmware"
                               : "the firmware active in " + described.state_dir.string())
-                      << ", software version " << id.software_version << ", revision " << revision.str()
-                      << '\n';
+                      << (id.software_version.empty() ? "" : ", software version " + id.software_version)
+                      << ", revision " << revision.str() << '\n';
             return slave::kExitOk;
         }
         device::check_device(device);  // a bad configuration is a usage error, before any setup
