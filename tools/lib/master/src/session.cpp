@@ -279,7 +279,10 @@ Error ProcessDataSession::configure(Slave& slave, const DcConfig& dc) {
         if (dc.enable) {
             uint8_t cyc[4];
             put32(cyc, dc.cycle_ns);
-            if (Error e = sdo->download(0x1C32, 2, cyc); e != Error::Ok && !absent(e)) return e;
+            // A read-only cycle time (the ESI's access; the slave takes it from SYNC0) is not an error.
+            if (Error e = sdo->download(0x1C32, 2, cyc);
+                e != Error::Ok && !absent(e) && !(e == Error::SdoAbort && sdo->last_abort() == 0x06010002))
+                return e;
             (void)sdo->download(0x1C33, 2, cyc);  // some slaves derive it from 0x1C32 and refuse the write
         }
     }
