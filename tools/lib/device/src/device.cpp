@@ -185,7 +185,7 @@ Device::Device(esc::Esc& esc, DeviceOptions options)
             event(slave::LogLevel::Warn, "the SII served: " + d);
     }
     // What the product declares that is not emulated: said once.
-    if (options_.product)
+    if (options_.product && options_.announce_product)
         for (const std::string& w : options_.product->warnings) {
             if (options_.events != nullptr)
                 event(slave::LogLevel::Warn, options_.product->source + ": " + w);

@@ -75,6 +75,8 @@ struct DeviceFaults {
 struct DeviceOptions {
     // The product this device is (an ESI's device, ...); null: the built-in MAXPOS, from config_file.
     std::shared_ptr<const od::Product> product;
+    // Say the product's warnings at start (a line of units of one product says them once, for its first).
+    bool announce_product = true;
     std::filesystem::path config_file;  // MAXPOS configuration (od::load_device_config); empty: defaults
     std::filesystem::path state_dir = "/var/lib/softecat";  // parameters.bin, firmware/
     EnvironmentOptions environment;
