@@ -288,3 +288,33 @@ TEST(ProductWithDeviceEmulation, FollowsTheStateTheEscTookWithItsProcessData) {
     EXPECT_EQ(st.code, 0);
     EXPECT_EQ(u.dev->stack().state(), od::AlState::SafeOp);
 }
+
+// A product with its own EEPROM image (ESI Eeprom/Data) is served byte for byte, by make_sii and by the ESC
+// (read through the master's SII access); a unit of a line gets its serial number in words 0x0E/0x0F only.
+TEST(ProductWithEepromImage, IsServedByteForByte) {
+    auto p = std::make_shared<od::Product>(*io_terminal());
+    device::DeviceOptions probe;
+    probe.product = p;
+    std::vector<uint8_t> image = device::make_sii(probe);  // a valid image to start from
+    image[0x40 * 2 + 100] ^= 0x5A;                         // and made different from what would be built
+    p->eeprom = image;
+    device::DeviceOptions o;
+    o.product = p;
+    EXPECT_EQ(device::make_sii(o), image);
+    Unit u(p);
+    UnitLink link(u);
+    Master m(link, test_support::in_process_master_options());
+    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m));
+    auto served = m.sii_read_image(Address::station(0x1001));
+    ASSERT_TRUE(served.ok());
+    ASSERT_LE(served->size(), image.size());
+    EXPECT_TRUE(std::equal(served->begin(), served->end(), image.begin()));
+    o.serial_number = 7;
+    const std::vector<uint8_t> unit = device::make_sii(o);
+    ASSERT_EQ(unit.size(), image.size());
+    EXPECT_EQ(unit[0x1C], 7);
+    for (std::size_t i = 0; i < image.size(); ++i)
+        if (i < 0x1C || i > 0x1F) {
+            ASSERT_EQ(unit[i], image[i]) << "byte " << i;
+        }
+}
