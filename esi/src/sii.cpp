@@ -101,7 +101,8 @@ std::vector<uint8_t> build_sii(const od::DeviceDescription& d, const od::Diction
 
     // ---- TxPDO / RxPDO ----
     Writer txpdo, rxpdo;
-    for (const PdoInfo& p : m.pdos) {
+    for (std::size_t i : m.pdo_order) {
+        const PdoInfo& p = m.pdos[i];
         Writer& w = p.rx ? rxpdo : txpdo;
         w.u16(p.index);
         w.u8(static_cast<uint8_t>(p.entries.size()));
