@@ -19,6 +19,7 @@
 #include "device/firmware.hpp"
 #include "device/line.hpp"
 #include "esc/link.hpp"
+#include "esi/device/product.hpp"
 #include "od/device_config.hpp"
 #include "send_control.hpp"
 #include "slave/log.hpp"
@@ -166,6 +167,18 @@ int main(int argc, char** argv) {
         ->check(CLI::ExistingFile)
         ->excludes(slaves_opt)
         ->type_name("FILE");
+    // A device from its vendor's ESI (issue 21): the product esi::load_product makes of it.
+    std::string esi_file, device_spec;
+    auto* esi_opt =
+        app.add_option("--esi", esi_file,
+                       "Serve the device this ESI file (EtherCATInfo XML) describes instead of the "
+                       "MAXPOS: identity, SII, SMs, dictionary, PDOs, mailbox protocols from the file")
+            ->type_name("FILE");
+    app.add_option(
+           "--device", device_spec,
+           "The device of a --esi file with several: 0xPRODUCT:0xREVISION, 0xPRODUCT, or its Type name")
+        ->needs(esi_opt)
+        ->type_name("SPEC");
     app.add_option("--out-iface", options.out_iface,
                    "Port 1 of the last device (or the topology's 'external' port) leads to this interface: "
                    "the line continues there; no carrier closes the port")
@@ -214,6 +227,19 @@ int main(int argc, char** argv) {
     if (stops.size() == 2) device.environment.stop_lo = stops[0], device.environment.stop_hi = stops[1];
     if (auto* config = app.get_config_ptr(); config != nullptr && config->count() > 0)
         device.config_file = config->as<std::string>();
+    if (!esi_file.empty()) {
+        // A bad file or spec is a usage error naming the file (and line) before anything else is set up.
+        if (!device.config_file.empty()) {
+            std::cerr << "ecat-slave: --esi serves the device of its file: not with a MAXPOS --config\n";
+            return slave::kExitUsage;
+        }
+        try {
+            device.product = std::make_shared<const od::Product>(esi::load_product(esi_file, device_spec));
+        } catch (const std::exception& e) {
+            std::cerr << "ecat-slave: " << e.what() << '\n';
+            return slave::kExitUsage;
+        }
+    }
     device.state_dir = state_dir;
     slave::Log log(std::cerr, quiet ? slave::LogLevel::Error : *slave::parse_log_level(log_level),
                    slave::stderr_is_terminal());
@@ -275,11 +301,12 @@ int main(int argc, char** argv) {
             revision << "0x" << std::hex << std::uppercase << std::setw(8) << std::setfill('0')
                      << id.revision;
             std::cerr << "ecat-slave: "
-                      << (described.state_dir.empty()
+                      << (described.product ? described.product->source
+                          : described.state_dir.empty()
                               ? "the built-in firmware"
                               : "the firmware active in " + described.state_dir.string())
-                      << ", software version " << id.software_version << ", revision " << revision.str()
-                      << '\n';
+                      << (id.software_version.empty() ? "" : ", software version " + id.software_version)
+                      << ", revision " << revision.str() << '\n';
             return slave::kExitOk;
         }
         device::check_device(device);  // a bad configuration is a usage error, before any setup

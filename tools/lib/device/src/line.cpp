@@ -49,6 +49,7 @@ Line::Line(const esc::Clock& clock, LineOptions options, slave::ExternalSend sen
     : clock_(clock), options_(std::move(options)), segment_(options_.topology.timing) {
     const slave::Topology& topo = options_.topology;
     units_.reserve(topo.devices.size());
+    std::vector<const od::Product*> announced;  // products whose warnings a unit said already
     for (const slave::TopologyDevice& d : topo.devices) {
         auto u = std::make_unique<Unit>();
         u->name = d.name;
@@ -62,6 +63,10 @@ Line::Line(const esc::Clock& clock, LineOptions options, slave::ExternalSend sen
             d.state_dir.empty() ? options_.base.state_dir / d.name : std::filesystem::path(d.state_dir);
         if (d.serial) u->options.serial_number = d.serial;
         u->options.events = u->log.get();
+        if (const od::Product* p = u->options.product.get()) {
+            u->options.announce_product = std::find(announced.begin(), announced.end(), p) == announced.end();
+            if (u->options.announce_product) announced.push_back(p);
+        }
         u->options.load_sii = true;
         u->esc_config = options_.esc;
         u->esc_config.port_descriptor = d.port_descriptor();
