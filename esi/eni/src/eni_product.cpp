@@ -131,9 +131,11 @@ od::Dictionary build(const Plan& plan, const od::DeviceDescription& d) {
         id.name = "Identity";
         id.entries.push_back(u_entry(0, DataType::Unsigned8, acc::RO, 4, "Number of entries"));
         id.entries.push_back(u_entry(1, DataType::Unsigned32, acc::RO, d.identity.vendor_id, "Vendor ID"));
-        id.entries.push_back(u_entry(2, DataType::Unsigned32, acc::RO, d.identity.product_code, "Product Code"));
+        id.entries.push_back(
+            u_entry(2, DataType::Unsigned32, acc::RO, d.identity.product_code, "Product Code"));
         id.entries.push_back(u_entry(3, DataType::Unsigned32, acc::RO, d.identity.revision, "Revision"));
-        id.entries.push_back(u_entry(4, DataType::Unsigned32, acc::RO, d.identity.serial_number, "Serial Number"));
+        id.entries.push_back(
+            u_entry(4, DataType::Unsigned32, acc::RO, d.identity.serial_number, "Serial Number"));
         dict.add(std::move(id));
     }
     for (const Plan::Mapping& m : plan.mappings) {
@@ -147,7 +149,8 @@ od::Dictionary build(const Plan& plan, const od::DeviceDescription& d) {
         n.maximum = uint64_t{m.capacity};
         o.entries.push_back(std::move(n));
         for (uint8_t k = 1; k <= m.capacity; ++k)
-            o.entries.push_back(u_entry(k, DataType::Unsigned32, a, k <= m.entries.size() ? m.entries[k - 1u] : 0,
+            o.entries.push_back(u_entry(k, DataType::Unsigned32, a,
+                                        k <= m.entries.size() ? m.entries[k - 1u] : 0,
                                         "Mapped object " + std::to_string(k)));
         dict.add(std::move(o));
     }
@@ -157,10 +160,11 @@ od::Dictionary build(const Plan& plan, const od::DeviceDescription& d) {
         o.code = od::ObjectCode::Array;
         o.type = DataType::Unsigned8;
         o.name = "Sync manager type";
-        o.entries.push_back(u_entry(0, DataType::Unsigned8, acc::RO, plan.sm_types.size(), "Number of entries"));
+        o.entries.push_back(
+            u_entry(0, DataType::Unsigned8, acc::RO, plan.sm_types.size(), "Number of entries"));
         for (std::size_t k = 0; k < plan.sm_types.size(); ++k)
-            o.entries.push_back(u_entry(static_cast<uint8_t>(k + 1), DataType::Unsigned8, acc::RO, plan.sm_types[k],
-                                        "SM" + std::to_string(k)));
+            o.entries.push_back(u_entry(static_cast<uint8_t>(k + 1), DataType::Unsigned8, acc::RO,
+                                        plan.sm_types[k], "SM" + std::to_string(k)));
         dict.add(std::move(o));
     }
     for (const Plan::Assign& as : plan.assigns) {
@@ -169,12 +173,14 @@ od::Dictionary build(const Plan& plan, const od::DeviceDescription& d) {
         o.code = od::ObjectCode::Array;
         o.type = DataType::Unsigned16;
         o.name = "SM" + std::to_string(as.index - 0x1C10) + " PDO assignment";
-        od::Entry n = u_entry(0, DataType::Unsigned8, acc::RW_PreOp, as.pdos.size(), "Number of assigned PDOs");
+        od::Entry n =
+            u_entry(0, DataType::Unsigned8, acc::RW_PreOp, as.pdos.size(), "Number of assigned PDOs");
         n.maximum = uint64_t{as.capacity};
         o.entries.push_back(std::move(n));
         for (uint8_t k = 1; k <= as.capacity; ++k)
             o.entries.push_back(u_entry(k, DataType::Unsigned16, acc::RW_PreOp,
-                                        k <= as.pdos.size() ? as.pdos[k - 1u] : 0, "PDO " + std::to_string(k)));
+                                        k <= as.pdos.size() ? as.pdos[k - 1u] : 0,
+                                        "PDO " + std::to_string(k)));
         dict.add(std::move(o));
     }
     for (const auto& [index, subs] : plan.app) {
@@ -205,7 +211,8 @@ od::Dictionary build(const Plan& plan, const od::DeviceDescription& d) {
 
 od::Product product_from_eni(const Config& config, std::size_t index) {
     const Slave& s = config.slaves.at(index);
-    const std::string who = config.where(s.line) + ": slave " + std::to_string(index) + " '" + s.info.name + "'";
+    const std::string who =
+        config.where(s.line) + ": slave " + std::to_string(index) + " '" + s.info.name + "'";
     auto fail = [&](int line, const std::string& what) { throw EniError(config.where(line) + ": " + what); };
     od::Product p;
     p.source = config.file + ", slave " + std::to_string(index) + " '" + s.info.name + "' (ENI data)";
@@ -235,16 +242,17 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
     if (mb.present) {
         d.standard_mailbox = {mb.send.start, mb.send.length, mb.recv.start, mb.recv.length};
         if (mb.bootstrap_send && mb.bootstrap_recv)
-            d.bootstrap_mailbox = {mb.bootstrap_send->start, mb.bootstrap_send->length, mb.bootstrap_recv->start,
-                                   mb.bootstrap_recv->length};
+            d.bootstrap_mailbox = {mb.bootstrap_send->start, mb.bootstrap_send->length,
+                                   mb.bootstrap_recv->start, mb.bootstrap_recv->length};
         else
             d.bootstrap_mailbox = {0, 0, 0, 0};
         d.mailbox_protocols = mb.protocol_bits();
         if (mb.has("FoE")) d.foe_details = 1;
         for (const char* proto : {"AoE", "EoE", "SoE", "VoE"})
             if (mb.has(proto))
-                warn.push_back(who + ": Mailbox/Protocol " + proto +
-                               ": not emulated (answered with the mailbox error for an unsupported protocol)");
+                warn.push_back(
+                    who + ": Mailbox/Protocol " + proto +
+                    ": not emulated (answered with the mailbox error for an unsupported protocol)");
         for (const auto& [proto, count] : mb.other_init_cmds)
             warn.push_back(who + ": Mailbox/" + proto + "/InitCmds (" + std::to_string(count) +
                            "): not emulated, the protocol is not served");
@@ -303,11 +311,13 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
             return false;
         }
         auto& subs = plan->app[e.index];
-        if (!plan->app_names.count(e.index)) plan->app_names[e.index] = e.name.empty() ? hex(e.index, 4) : e.name;
+        if (!plan->app_names.count(e.index))
+            plan->app_names[e.index] = e.name.empty() ? hex(e.index, 4) : e.name;
         auto it = subs.find(e.subindex);
         if (it != subs.end()) {
             if (it->second.type != *type)
-                fail(pdo.line, what + " is declared " + e.data_type + " here and with another type in another PDO");
+                fail(pdo.line,
+                     what + " is declared " + e.data_type + " here and with another type in another PDO");
             it->second.access |= pdo.rx ? od::access::RxPdo | od::access::RW : od::access::TxPdo;
             return true;
         }
@@ -323,7 +333,8 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
         return true;
     };
     std::map<int, std::vector<uint16_t>> sm_pdos;  // SM -> PDOs, as the ENI assigns them
-    const bool sm_lists = std::any_of(pd.sms.begin(), pd.sms.end(), [](const Sm& sm) { return !sm.pdos.empty(); });
+    const bool sm_lists =
+        std::any_of(pd.sms.begin(), pd.sms.end(), [](const Sm& sm) { return !sm.pdos.empty(); });
     for (const Sm& sm : pd.sms)
         for (uint16_t idx : sm.pdos)
             sm_pdos[sm.number].push_back(idx);
@@ -335,9 +346,11 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
             m.fixed = pdo.fixed;
             for (const PdoEntry& e : pdo.entries) {
                 const bool real = e.index != 0 && add_entry(pdo, e);
-                m.entries.push_back(real ? (uint32_t{e.index} << 16 | uint32_t{e.subindex} << 8 | (e.bit_len & 0xFF))
-                                         : (e.bit_len & 0xFF));
-                if (e.bit_len > 255) fail(pdo.line, "PDO entry of " + std::to_string(e.bit_len) + " bits (at most 255)");
+                m.entries.push_back(
+                    real ? (uint32_t{e.index} << 16 | uint32_t{e.subindex} << 8 | (e.bit_len & 0xFF))
+                         : (e.bit_len & 0xFF));
+                if (e.bit_len > 255)
+                    fail(pdo.line, "PDO entry of " + std::to_string(e.bit_len) + " bits (at most 255)");
             }
             m.capacity = static_cast<uint8_t>(std::min<std::size_t>(255, m.entries.size()));
             plan->mappings.push_back(std::move(m));
@@ -354,7 +367,8 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
         Plan::Assign as;
         as.index = static_cast<uint16_t>(0x1C10 + n);
         as.pdos = pdos;
-        const std::size_t same_direction = sd.kind == od::SmKind::Outputs ? pd.rxpdos.size() : pd.txpdos.size();
+        const std::size_t same_direction =
+            sd.kind == od::SmKind::Outputs ? pd.rxpdos.size() : pd.txpdos.size();
         as.capacity = static_cast<uint8_t>(std::min<std::size_t>(255, std::max(pdos.size(), same_direction)));
         plan->assigns.push_back(std::move(as));
     }
@@ -365,7 +379,8 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
             !sm_pdos.count(static_cast<int>(n))) {
             Plan::Assign as;
             as.index = static_cast<uint16_t>(0x1C10 + n);
-            as.capacity = static_cast<uint8_t>(k == od::SmKind::Outputs ? pd.rxpdos.size() : pd.txpdos.size());
+            as.capacity =
+                static_cast<uint8_t>(k == od::SmKind::Outputs ? pd.rxpdos.size() : pd.txpdos.size());
             plan->assigns.push_back(std::move(as));
         }
     }
@@ -380,8 +395,9 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
             if ((c.index & 0xFFF0) == 0x1C10 || (c.index >= 0x1600 && c.index <= 0x17FF) ||
                 (c.index >= 0x1A00 && c.index <= 0x1BFF)) {
                 if (c.complete_access) {
-                    warn.push_back(who + ": " + what + " by complete access: the object is declared from the PDOs, "
-                                                      "its capacity as the ENI's PDO lists");
+                    warn.push_back(who + ": " + what +
+                                   " by complete access: the object is declared from the PDOs, "
+                                   "its capacity as the ENI's PDO lists");
                     continue;
                 }
                 auto grow = [&](uint8_t& cap) { cap = std::max(cap, c.subindex); };
@@ -391,22 +407,25 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
                 for (auto& as : plan->assigns)
                     if (as.index == c.index) grow(as.capacity), found = true;
                 if (!found) {
-                    if ((c.index & 0xFFF0) == 0x1C10 && static_cast<std::size_t>(c.index - 0x1C10) < d.sync_managers.size()) {
+                    if ((c.index & 0xFFF0) == 0x1C10 &&
+                        static_cast<std::size_t>(c.index - 0x1C10) < d.sync_managers.size()) {
                         Plan::Assign as;
                         as.index = c.index;
                         as.capacity = c.subindex;
                         plan->assigns.push_back(std::move(as));
                     } else {
-                        warn.push_back(who + ": " + what + ": names a PDO or SyncManager the ENI does not declare; "
-                                                          "not emulated");
+                        warn.push_back(who + ": " + what +
+                                       ": names a PDO or SyncManager the ENI does not declare; "
+                                       "not emulated");
                     }
                 }
                 continue;
             }
             if (c.index == 0x1000 || c.index == 0x1008 || c.index == 0x1018 || c.index == 0x1C00) continue;
             if (c.complete_access) {
-                warn.push_back(who + ": " + what + " by complete access: the object's structure is not in the ENI; "
-                                                  "not emulated (the master's transfer is refused)");
+                warn.push_back(who + ": " + what +
+                               " by complete access: the object's structure is not in the ENI; "
+                               "not emulated (the master's transfer is refused)");
                 continue;
             }
             auto& subs = plan->app[c.index];
@@ -415,9 +434,10 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
             auto it = subs.find(c.subindex);
             if (it != subs.end()) {
                 // An entry of a PDO: writable as well, if the lengths agree.
-                if (c.ccs == 1 && !c.data.empty() && c.data.size() != it->second.byte_size()) {
+                const std::size_t size = (od::bit_size(it->second.type) + 7u) / 8u;
+                if (c.ccs == 1 && !c.data.empty() && c.data.size() != size) {
                     warn.push_back(who + ": " + what + " writes " + std::to_string(c.data.size()) +
-                                   " bytes to an entry of " + std::to_string(it->second.byte_size()) +
+                                   " bytes to an entry of " + std::to_string(size) +
                                    ": not emulated (the master's transfer is refused)");
                     continue;
                 }
@@ -433,9 +453,10 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
             e.subindex = c.subindex;
             e.name = c.comment.empty() ? entry_name(c.index, c.subindex) : c.comment;
             e.type = type_of_size(c.data.size());
-            e.access = c.ccs == 1 ? static_cast<uint16_t>(od::access::RO | od::access::WritePreOp |
-                                                          od::access::WriteSafeOp)
-                                  : od::access::RO;
+            e.access =
+                c.ccs == 1
+                    ? static_cast<uint16_t>(od::access::RO | od::access::WritePreOp | od::access::WriteSafeOp)
+                    : od::access::RO;
             if (e.type == od::DataType::OctetString)
                 e.default_string.assign(c.data.begin(), c.data.end());
             else
@@ -468,13 +489,13 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
     }
 
     // ---- what the ENI says that an ENI slave does not have --------------------------------------------
-    for (uint16_t idx : {uint16_t{0x6040}, uint16_t{0x6041}})
-        if (plan->app.count(idx)) {
-            warn.push_back(who + ": maps " + hex(idx, 4) +
-                           " (CiA 402 device control): served as process data only; give the drive's ESI "
-                           "(--esi-dir) for the CiA 402 drive core");
-            break;
-        }
+    // A CiA 402 drive (controlword 0x6040 and statusword 0x6041 mapped) needs its dictionary for the drive
+    // core.
+    auto mapped = [&](uint16_t idx) { return plan->app.count(idx) && plan->app.at(idx).count(0); };
+    if (mapped(0x6040) && mapped(0x6041))
+        warn.push_back(who +
+                       ": maps 0x6040/0x6041 (CiA 402 controlword and statusword): served as process data "
+                       "only; give the drive's ESI (--esi-dir) for the CiA 402 drive core");
 
     // A product is one value: the dictionary builder owns its plan.
     p.make_dictionary = [plan](const od::DeviceDescription& desc) { return build(*plan, desc); };

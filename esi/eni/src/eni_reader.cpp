@@ -100,7 +100,8 @@ class Reader {
                 d = std::tolower(static_cast<unsigned char>(c)) - 'a' + 10;
             else
                 bad();
-            if (v > (std::numeric_limits<uint64_t>::max() >> 5)) fail(where, what + ": " + s + " is out of range");
+            if (v > (std::numeric_limits<uint64_t>::max() >> 5))
+                fail(where, what + ": " + s + " is out of range");
             v = v * static_cast<uint64_t>(base) + static_cast<uint64_t>(d);
         }
         if (v > static_cast<uint64_t>(std::numeric_limits<int64_t>::max()))
@@ -110,13 +111,14 @@ class Reader {
     int64_t ranged(Node where, const std::string& what, const std::string& s, int64_t lo, int64_t hi) const {
         const int64_t v = integer(where, what, s);
         if (v < lo || v > hi)
-            fail(where, what + ": " + s + " is out of range (" + std::to_string(lo) + ".." + std::to_string(hi) +
-                            ")");
+            fail(where, what + ": " + s + " is out of range (" + std::to_string(lo) + ".." +
+                            std::to_string(hi) + ")");
         return v;
     }
     template <class T>
     T value(Node n, const std::string& what) const {
-        return static_cast<T>(ranged(n, what, text(n), std::numeric_limits<T>::min(), std::numeric_limits<T>::max()));
+        return static_cast<T>(
+            ranged(n, what, text(n), std::numeric_limits<T>::min(), std::numeric_limits<T>::max()));
     }
     // A 32-bit identifier or logical address: xs:int writes the top bit as a negative number.
     uint32_t bits32(Node n, const std::string& what) const {
@@ -159,7 +161,8 @@ class Reader {
         out.reserve(s.size() / 2);
         for (std::size_t i = 0; i < s.size(); i += 2) {
             auto h = [&](char c) -> int {
-                if (!std::isxdigit(static_cast<unsigned char>(c))) fail(n, what + ": '" + c + "' is not a hex digit");
+                if (!std::isxdigit(static_cast<unsigned char>(c)))
+                    fail(n, what + ": '" + c + "' is not a hex digit");
                 return c <= '9' ? c - '0' : std::tolower(static_cast<unsigned char>(c)) - 'a' + 10;
             };
             out.push_back(static_cast<uint8_t>(h(s[i]) * 16 + h(s[i + 1])));
@@ -171,7 +174,8 @@ class Reader {
         for (Node t : children(n, "Transition")) {
             std::string s = text(t);
             static const std::string states = "IPSOB";
-            if (s.size() != 2 || states.find(s[0]) == std::string::npos || states.find(s[1]) == std::string::npos)
+            if (s.size() != 2 || states.find(s[0]) == std::string::npos ||
+                states.find(s[1]) == std::string::npos)
                 fail(t, "Transition: '" + s + "' is not a state transition (IP, PS, SO, OI, IB, ...)");
             out.push_back(s);
         }
@@ -182,7 +186,8 @@ class Reader {
                   std::optional<uint16_t>& cnt, std::string& comment) const {
         comment = text(child(n, "Comment"));
         cmd = req<uint8_t>(n, "Cmd");
-        if (cmd > 14) fail(child(n, "Cmd"), "Cmd: " + std::to_string(cmd) + " is not an EtherCAT command (0..14)");
+        if (cmd > 14)
+            fail(child(n, "Cmd"), "Cmd: " + std::to_string(cmd) + " is not an EtherCAT command (0..14)");
         if (Node a = child(n, "Addr")) {
             addr = bits32(a, "Addr");
         } else {
@@ -199,7 +204,8 @@ class Reader {
         datagram(n, c.cmd, c.adp, c.ado, c.addr, c.cnt, c.comment);
         if (Node d = child(n, "Data")) c.data = hex(d, "Data");
         if (Node l = child(n, "DataLength")) c.data.assign(value<uint16_t>(l, "DataLength"), 0);
-        if (c.data.size() > 1486) fail(n, "InitCmd: " + std::to_string(c.data.size()) + " bytes do not fit a frame");
+        if (c.data.size() > 1486)
+            fail(n, "InitCmd: " + std::to_string(c.data.size()) + " bytes do not fit a frame");
         c.retries = opt<uint16_t>(n, "Retries").value_or(0);
         return c;
     }
@@ -218,7 +224,8 @@ class Reader {
         c.comment = text(child(n, "Comment"));
         c.ccs = req<uint8_t>(n, "Ccs");
         if (c.ccs != 1 && c.ccs != 2)
-            fail(child(n, "Ccs"), "Ccs: " + std::to_string(c.ccs) + " is neither 1 (download) nor 2 (upload)");
+            fail(child(n, "Ccs"),
+                 "Ccs: " + std::to_string(c.ccs) + " is neither 1 (download) nor 2 (upload)");
         c.index = req<uint16_t>(n, "Index");
         c.subindex = req<uint8_t>(n, "SubIndex");
         if (Node d = child(n, "Data")) c.data = hex(d, "Data");
@@ -288,7 +295,9 @@ class Reader {
     ProcessData process_data(Node n) const {
         ProcessData pd;
         if (!n) return pd;
-        auto range = [&](Node r) { return BitRange{req<uint32_t>(r, "BitStart"), req<uint32_t>(r, "BitLength")}; };
+        auto range = [&](Node r) {
+            return BitRange{req<uint32_t>(r, "BitStart"), req<uint32_t>(r, "BitLength")};
+        };
         for (Node s : children(n, "Send"))
             pd.send.push_back(range(s));
         for (Node r : children(n, "Recv"))
@@ -300,7 +309,8 @@ class Reader {
                 sm.number = k;
                 sm.line = line_of(s);
                 sm.type = text(child(s, "Type"));
-                if (sm.type != "MBoxOut" && sm.type != "MBoxIn" && sm.type != "Outputs" && sm.type != "Inputs")
+                if (sm.type != "MBoxOut" && sm.type != "MBoxIn" && sm.type != "Outputs" &&
+                    sm.type != "Inputs")
                     fail(s, tag + "/Type: '" + sm.type + "' is not MBoxOut, MBoxIn, Outputs or Inputs");
                 sm.start = req<uint16_t>(s, "StartAddress");
                 sm.control = req<uint8_t>(s, "ControlByte");
@@ -322,21 +332,23 @@ class Reader {
         for (const Sm& sm : pd.sms)
             for (uint16_t idx : sm.pdos) {
                 const Pdo* p = pd.pdo(idx);
-                if (!p) fail(child(n, ("Sm" + std::to_string(sm.number)).c_str()),
-                             "Sm" + std::to_string(sm.number) + " assigns PDO " + hex16(idx) +
-                                 ", which this slave does not declare");
+                if (!p)
+                    fail(child(n, ("Sm" + std::to_string(sm.number)).c_str()),
+                         "Sm" + std::to_string(sm.number) + " assigns PDO " + hex16(idx) +
+                             ", which this slave does not declare");
             }
         for (const auto* list : {&pd.rxpdos, &pd.txpdos})
             for (const Pdo& p : *list) {
                 if (p.sm && !pd.sms.empty() && !pd.sm(*p.sm))
                     throw EniError(file_ + ":" + std::to_string(p.line) + ": PDO " + hex16(p.index) +
-                                   " is assigned to Sm" + std::to_string(*p.sm) + ", which this slave does not declare");
+                                   " is assigned to Sm" + std::to_string(*p.sm) +
+                                   ", which this slave does not declare");
                 if (p.sm) {
                     const Sm* sm = pd.sm(*p.sm);
                     if (sm && sm->type != (p.rx ? "Outputs" : "Inputs"))
-                        throw EniError(file_ + ":" + std::to_string(p.line) + ": " + (p.rx ? "RxPdo " : "TxPdo ") +
-                                       hex16(p.index) + " is assigned to Sm" + std::to_string(*p.sm) + " of type " +
-                                       sm->type);
+                        throw EniError(file_ + ":" + std::to_string(p.line) + ": " +
+                                       (p.rx ? "RxPdo " : "TxPdo ") + hex16(p.index) + " is assigned to Sm" +
+                                       std::to_string(*p.sm) + " of type " + sm->type);
                 }
             }
         return pd;
@@ -419,8 +431,10 @@ class Reader {
         Node root = xmlDocGetRootElement(doc);
         if (!root) throw EniError(file_ + ": an empty document: not an ENI (EtherCATConfig) file");
         if (!is(root, "EtherCATConfig"))
-            fail(root, "the root element is <" + name_of(root) + ">, not <EtherCATConfig>: not an ENI file" +
-                           (name_of(root) == "EtherCATInfo" ? " (an ESI file: give it with --esi or --esi-dir)" : ""));
+            fail(root,
+                 "the root element is <" + name_of(root) + ">, not <EtherCATConfig>: not an ENI file" +
+                     (name_of(root) == "EtherCATInfo" ? " (an ESI file: give it with --esi or --esi-dir)"
+                                                      : ""));
         Node cfg = require(root, "Config");
         Config c;
         c.file = file_;
@@ -460,7 +474,8 @@ class Reader {
             for (const PreviousPort& pp : s.previous_ports) {
                 const int up = c.find_phys_addr(pp.phys_addr);
                 if (up < 0 || up >= static_cast<int>(i))
-                    throw EniError(c.where(pp.line) + ": PreviousPort PhysAddr " + std::to_string(pp.phys_addr) +
+                    throw EniError(c.where(pp.line) + ": PreviousPort PhysAddr " +
+                                   std::to_string(pp.phys_addr) +
                                    " is not the station address of a slave before this one");
             }
         }

@@ -32,11 +32,11 @@ struct InitCmd {
     std::vector<std::string> transitions;  // "IP", "PS", "SO", "OI", ... (Transition, repeated)
     std::string comment;
     uint8_t cmd = 0;
-    uint16_t adp = 0;                // Adp (position or station address)
-    uint16_t ado = 0;                // Ado (register)
-    std::optional<uint32_t> addr;    // Addr (logical) instead of Adp/Ado
-    std::vector<uint8_t> data;       // Data (hex), or DataLength zeros
-    std::optional<uint16_t> cnt;     // Cnt: the working counter expected
+    uint16_t adp = 0;              // Adp (position or station address)
+    uint16_t ado = 0;              // Ado (register)
+    std::optional<uint32_t> addr;  // Addr (logical) instead of Adp/Ado
+    std::vector<uint8_t> data;     // Data (hex), or DataLength zeros
+    std::optional<uint16_t> cnt;   // Cnt: the working counter expected
     uint16_t retries = 0;
     int line = 0;
 };
