@@ -166,8 +166,16 @@ void Cycle::run_cycle(uint64_t now_ns, bool fresh_outputs) {
 void Cycle::process_data_events(uint32_t events, uint64_t now_ns) {
     esc::Pdi& pdi = ctx_.pdi;
     const bool has_outputs = !sm2_buf_.empty();
+    // Outputs in an SM on the register space (the digital-output registers 0x0F00 of an ESC with digital
+    // I/O, as EL2xxx terminals declare them): the ESC serves them as registers (docs/decisions/esc.md,
+    // "SyncManager over the register area"), no SM event says when the master wrote them; what they hold is
+    // taken every pass.
+    const bool register_outputs = has_outputs && sm2_start_ < esc::reg::kRamBase;
     bool new_outputs = false;
-    if (has_outputs) {
+    if (register_outputs) {
+        new_outputs = true;
+        outputs_seen_ = true;
+    } else if (has_outputs) {
         const uint8_t st = pdi.read_reg<uint8_t>(esc::reg::sm_base(out_sm_) + esc::reg::kSmStatus);
         new_outputs = (st & esc::reg::kSmStatusIrqWrite) != 0 || (events & esc::alev::sm(out_sm_)) != 0;
         if (new_outputs) outputs_seen_ = true;
@@ -175,7 +183,7 @@ void Cycle::process_data_events(uint32_t events, uint64_t now_ns) {
     switch (sync_.mode()) {
         case SyncMode::SmSync:
         case SyncMode::SmSync2:
-            if (has_outputs) {
+            if (has_outputs && !register_outputs) {
                 if (new_outputs) {
                     sync_.sample_sm2_latency();
                     run_cycle(now_ns, true);
@@ -184,7 +192,9 @@ void Cycle::process_data_events(uint32_t events, uint64_t now_ns) {
                 // Inputs only: a new cycle each time the master has read the inputs.
                 const uint8_t st = pdi.read_reg<uint8_t>(esc::reg::sm_base(in_sm_) + esc::reg::kSmStatus);
                 if ((st & esc::reg::kSmStatusIrqRead) || (events & esc::alev::sm(in_sm_)))
-                    run_cycle(now_ns, false);
+                    run_cycle(now_ns, register_outputs);
+            } else if (register_outputs) {
+                run_cycle(now_ns, true);
             }
             break;
         case SyncMode::FreeRun:

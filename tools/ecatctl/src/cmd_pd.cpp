@@ -1,12 +1,15 @@
 // `ecatctl pd`: bring a slave to OP and exchange process data cyclically (LRW), with optional DC.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -166,16 +169,34 @@ int process_data(master::Master& m, const PdArgs& p) {
         if (Error e = m.request_state(a, master::AlState::PreOp); e != Error::Ok)
             return fail(e, "going to PREOP");
     }
+    // A slave without mailbox (SII words 0x18-0x1B all zero: a coupler, a digital IO terminal) has its
+    // layout in the SII alone (the PDOs its SyncM/TxPDO/RxPDO categories assign) and no SDO.
+    uint8_t mbx_words[8] = {};
+    if (Error e = m.sii_read(a, 0x18, mbx_words); e != Error::Ok) return fail(e, "reading the SII");
+    const bool has_mailbox =
+        std::any_of(std::begin(mbx_words), std::end(mbx_words), [](uint8_t b) { return b != 0; });
     master::Mailbox mbx(m, a);
-    if (Error e = open_mailbox(m, mbx, a); e != Error::Ok) return fail(e, "opening the mailbox");
     master::SdoClient sdo(mbx);
-    master::ProcessDataSession pd(m, a, sdo);
-    if (Error e = pd.discover(); e != Error::Ok) return sdo_failed(sdo, e, "reading the process-data layout");
+    std::unique_ptr<master::ProcessDataSession> session;
     std::vector<SyncView> pdo_config;  // names and types of the entries, for the decoded images at the end
-    if (Error e = read_pdo_config(sdo, pdo_config); e != Error::Ok) pdo_config.clear();
+    if (has_mailbox) {
+        if (Error e = open_mailbox(m, mbx, a); e != Error::Ok) return fail(e, "opening the mailbox");
+        session = std::make_unique<master::ProcessDataSession>(m, a, sdo);
+        if (Error e = session->discover(); e != Error::Ok)
+            return sdo_failed(sdo, e, "reading the process-data layout");
+        if (Error e = read_pdo_config(sdo, pdo_config); e != Error::Ok) pdo_config.clear();
+    } else {
+        if (st->state == init)
+            if (Error e = m.request_state(a, master::AlState::PreOp); e != Error::Ok)
+                return fail(e, "going to PREOP");
+        session = std::make_unique<master::ProcessDataSession>(m, std::span<const Address>(&a, 1));
+        if (Error e = session->discover_sii(0); e != Error::Ok)
+            return fail(e, "reading the process-data layout");
+    }
+    master::ProcessDataSession& pd = *session;
     const auto& l = pd.layout();
-    std::printf("outputs: SM2 0x%04x, %u bytes; inputs: SM3 0x%04x, %u bytes\n", l.sm2_start, l.sm2_length,
-                l.sm3_start, l.sm3_length);
+    std::printf("outputs: SM%u 0x%04x, %u bytes; inputs: SM%u 0x%04x, %u bytes\n", l.out_sm, l.sm2_start,
+                l.sm2_length, l.in_sm, l.sm3_start, l.sm3_length);
     master::DcConfig dc;
     dc.enable = p.dc;
     dc.cycle_ns = p.cycle_us * 1000u;

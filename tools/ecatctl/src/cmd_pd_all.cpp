@@ -1,8 +1,10 @@
 // `ecatctl pd --all`: every slave on the line to OP in one process-data session (one LRW per cycle over all
 // slaves' SM2/SM3, expected working counter = the sum of their shares), with optional DC (delays and offsets
 // measured over the line, SYNC0 on every slave with one start time).
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
@@ -32,20 +34,41 @@ int process_data_all(master::Master& m, const PdAllArgs& p) {
     std::vector<Address> addresses;
     for (const master::SlaveInfo& s : *bus)
         addresses.push_back(Address::station(s.station));
+    // Slaves without mailbox (SII words 0x18-0x1B all zero: couplers, digital IO terminals) get their layout
+    // from the SII alone and no SDO client.
+    std::vector<bool> mailbox(n, true);
+    for (std::size_t k = 0; k < n; ++k) {
+        uint8_t words[8] = {};
+        if (Error e = m.sii_read(addresses[k], 0x18, words); e != Error::Ok)
+            return fail(e, "reading the SII of " + slave_text(addresses[k]));
+        mailbox[k] = std::any_of(std::begin(words), std::end(words), [](uint8_t b) { return b != 0; });
+    }
     master::SdoClients sdos;
     const Error opened = sdos.open(m, addresses, [&](master::Mailbox& mbx, Address a) {
-        const master::SlaveInfo& s = (*bus)[a.value - 0x1001u];
+        const std::size_t k = a.value - 0x1001u;
+        const master::SlaveInfo& s = (*bus)[k];
         // Configuration happens in PREOP.
         if (s.al.state != static_cast<uint8_t>(master::AlState::Init) &&
             (s.al.state != static_cast<uint8_t>(master::AlState::PreOp) || s.al.error)) {
             if (Error e = m.request_state(a, master::AlState::PreOp); e != Error::Ok) return e;
         }
+        if (!mailbox[k])
+            return s.al.state == static_cast<uint8_t>(master::AlState::Init)
+                       ? m.request_state(a, master::AlState::PreOp)
+                       : Error::Ok;
         return open_mailbox(m, mbx, a);
     });
     if (opened != Error::Ok)
         return fail(opened, "opening the mailbox of " + slave_text(addresses[sdos.failed()]));
-    master::ProcessDataSession pd(m, addresses, sdos.clients());
+    std::vector<master::SdoClient*> clients(sdos.clients().begin(), sdos.clients().end());
+    for (std::size_t k = 0; k < n; ++k)
+        if (!mailbox[k]) clients[k] = nullptr;
+    master::ProcessDataSession pd(m, addresses, clients);
     if (Error e = pd.discover(); e != Error::Ok) return fail(e, "reading the process-data layouts");
+    for (std::size_t k = 0; k < n; ++k)
+        if (!mailbox[k])
+            if (Error e = pd.discover_sii(k); e != Error::Ok)
+                return fail(e, "reading the process-data layout of " + slave_text(addresses[k]));
     master::DcConfig dc;
     dc.enable = p.dc;
     dc.cycle_ns = p.cycle_us * 1000u;

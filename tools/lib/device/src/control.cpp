@@ -322,6 +322,10 @@ std::string ControlSocket::apply(Device& device, std::string_view line) {
     const bool none = w.size() == 2 && w[1].text == "none";
     double a = 0, b = 0;
     bool on = false;
+    const bool drive_command = cmd == "input" || cmd == "sto" || cmd == "limit-neg" || cmd == "limit-pos" ||
+                               cmd == "home" || cmd == "stops";
+    if (drive_command && !device.has_drive())
+        return "error: '" + std::string(cmd) + "' acts on a drive; this device has none (get, set, status)";
     if (cmd == "input") {
         int pin = 0;
         if (w.size() != 3 || util::parse_number(w[1].text, pin, 1, 6) != util::NumberError::None ||

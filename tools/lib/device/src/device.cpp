@@ -332,7 +332,15 @@ void Device::build() {
         (void)p->dict.set_raw(static_cast<uint16_t>(key >> 8), static_cast<uint8_t>(key & 0xFF), raw);
     const bool drive = has_drive_part(options_);
     if (drive && options_.commission) {
-        if (const od::Status s = drive::commission(p->dict); s != od::Status::Ok)
+        // Only what exists is commissioned (a vendor's drive may lack the MAXPOS motor objects).
+        od::Status s = od::Status::Ok;
+        try {
+            s = drive::commission(p->dict);
+        } catch (const std::exception& e) {
+            if (!options_.product) throw;
+            log() << "softdrive: commissioning the motor parameters failed: " << e.what() << '\n';
+        }
+        if (s != od::Status::Ok)
             log() << "softdrive: commissioning the motor parameters failed: " << od::to_string(s) << '\n';
     }
     Parts* raw = p.get();
@@ -393,7 +401,9 @@ void Device::build() {
         coe_config.faults = options_.faults.coe;
         p->coe = std::make_unique<coe::CoeServer>(
             p->dict, [raw] { return raw->stack->state(); }, coe_config);
-        p->diag = std::make_unique<coe::DiagnosisHistory>(p->dict, &p->coe->emergency());
+        // The diagnosis history where the dictionary has its object (0x10F3, ETG.1020).
+        if (!options_.product || p->dict.find(0x10F3) != nullptr)
+            p->diag = std::make_unique<coe::DiagnosisHistory>(p->dict, &p->coe->emergency());
         p->events = std::make_unique<coe::EventReporter>(p->coe->emergency(), p->diag.get(),
                                                          [this] { return system_time_ns(); });
         p->events->set_text_ids(&od::diag_text_id);  // the texts the ESI lists as DiagMessages
@@ -405,11 +415,19 @@ void Device::build() {
     }
     p->stack->set_event_sink(this);
     if (drive) {
-        p->drive = std::make_unique<drive::Drive>(p->dict, this);
-        p->drive->axis().faults = options_.faults.axis;
-    } else {
-        p->io = std::make_unique<IoModel>();
+        // A vendor's CiA 402 dictionary the drive core cannot run on: said, and served as process data.
+        try {
+            p->drive = std::make_unique<drive::Drive>(p->dict, this);
+            p->drive->axis().faults = options_.faults.axis;
+        } catch (const std::exception& e) {
+            if (!options_.product) throw;
+            log() << "softecat: " << options_.product->source
+                  << ": the CiA 402 drive core does not run on this dictionary (" << e.what()
+                  << "); serving its process data without a drive\n";
+            p->drive.reset();
+        }
     }
+    if (!p->drive) p->io = std::make_unique<IoModel>();
 
     if (options_.load_sii) esc_.load_eeprom(image);
     if (parts_) ecat::add_stats(earlier_stacks_, parts_->stack->stats());

@@ -1,0 +1,182 @@
+"""ecat-slave --esi FILE [--device SPEC] for every device of every example ESI in esi/examples (a new example, or a
+new device in one, is covered without editing this file): ecatctl finds it with the identity and name the ESI
+gives, it reaches OP with the process data of its default assignment and the exact working counter, its control
+socket shows the process data, and ecat-conform --esi FILE against it reports no failure. Bad files and specs
+are usage errors (exit 2) that name the file."""
+import json
+import os
+import re
+import subprocess
+import tempfile
+import unittest
+import xml.etree.ElementTree as ET
+
+import harness
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+EXAMPLES = os.path.normpath(os.path.join(HERE, "..", "..", "esi", "examples"))
+ROW = re.compile(r"^(\d+)\s+0x([0-9a-f]{4})\s+(\S+)\s+0x([0-9a-f]{8}) 0x([0-9a-f]{8}) 0x([0-9a-f]{8}) 0x([0-9a-f]{8}) ?(.*)$",
+                 re.M)
+LAYOUT = re.compile(r"outputs: SM(\d+) 0x([0-9a-f]+), (\d+) bytes; inputs: SM(\d+) 0x([0-9a-f]+), (\d+) bytes")
+
+
+def number(text):
+    """An ESI number: #x hex or decimal."""
+    t = text.strip()
+    return int(t[2:], 16) if t.lower().startswith("#x") else int(t, 0)
+
+
+def pdo_bits(pdos, sm_of):
+    """Bits of the PDOs assigned by default (those with an Sm attribute) to the SM of each direction."""
+    bits = {"out": 0, "in": 0}
+    for kind, pdo in pdos:
+        if pdo.get("Sm") is None:
+            continue
+        side = "out" if kind == "RxPdo" else "in"
+        if sm_of.get(side) is not None and int(pdo.get("Sm")) != sm_of[side]:
+            continue
+        for e in pdo.findall("Entry"):
+            bits[side] += number(e.findtext("BitLen"))
+    return bits
+
+
+def examples():
+    """(file, spec, expected) for each device of each example: identity, name, process-data bytes."""
+    out = []
+    for name in sorted(os.listdir(EXAMPLES)):
+        if not name.endswith(".xml"):
+            continue
+        path = os.path.join(EXAMPLES, name)
+        root = ET.parse(path).getroot()
+        vendor = number(root.findtext("Vendor/Id"))
+        modules = {}
+        for m in root.iter("Module"):
+            t = m.find("Type")
+            if t is not None and t.get("ModuleIdent"):
+                modules[number(t.get("ModuleIdent"))] = m
+        for dev in root.findall("Descriptions/Devices/Device"):
+            t = dev.find("Type")
+            product, revision = number(t.get("ProductCode")), number(t.get("RevisionNo"))
+            sms = [s.text.strip() for s in dev.findall("Sm")]
+            sm_of = {"out": sms.index("Outputs") if "Outputs" in sms else None,
+                     "in": sms.index("Inputs") if "Inputs" in sms else None}
+            pdos = [(p.tag, p) for p in dev if p.tag in ("RxPdo", "TxPdo")]
+            # A modular device: the default module of each slot brings its PDOs.
+            for slot in dev.findall("Slots/Slot"):
+                for ident in slot.findall("ModuleIdent"):
+                    if ident.get("Default") in ("1", "true") and number(ident.text) in modules:
+                        m = modules[number(ident.text)]
+                        pdos += [(p.tag, p) for p in m if p.tag in ("RxPdo", "TxPdo")]
+            bits = pdo_bits(pdos, sm_of)
+            out.append({"file": path, "spec": f"0x{product:08x}:0x{revision:08x}", "vendor": vendor,
+                        "product": product, "revision": revision, "type": (t.text or "").strip(),
+                        "out_bytes": (bits["out"] + 7) // 8, "in_bytes": (bits["in"] + 7) // 8,
+                        "mailbox": dev.find("Mailbox") is not None})
+    return out
+
+
+class EsiDevices(unittest.TestCase):
+    def serve(self, d, *extra):
+        bus = harness.Bus()
+        ctl = os.path.join(bus.sock_dir, f"ctl{os.getpid()}.sock")
+        bus.slave_args = ["--esi", d["file"], "--device", d["spec"], "--control", ctl] + list(extra)
+        return bus, ctl
+
+    def check_found(self, bus, d):
+        r = bus.ecatctl("scan")
+        rows = ROW.findall(r.stdout)
+        self.assertEqual(len(rows), 1, r.stdout)
+        _pos, _station, _state, vendor, product, revision, _serial, name = rows[0]
+        self.assertEqual(int(vendor, 16), d["vendor"], r.stdout)
+        self.assertEqual(int(product, 16), d["product"], r.stdout)
+        self.assertEqual(int(revision, 16), d["revision"], r.stdout)
+        self.assertIn(d["type"], name + r.stdout, "the name from the ESI")
+
+    def check_op(self, bus, d, ctl):
+        r = bus.ecatctl("pd", "0", "OP", "-n", "200", "--keep", check=False)
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr + bus.slave_output())
+        m = LAYOUT.search(r.stdout)
+        self.assertIsNotNone(m, r.stdout)
+        self.assertEqual(int(m.group(3)), d["out_bytes"], "output bytes of the default assignment\n" + r.stdout)
+        self.assertEqual(int(m.group(6)), d["in_bytes"], "input bytes of the default assignment\n" + r.stdout)
+        self.assertRegex(r.stdout, r"state: OP\b")
+        status = harness.control(ctl, "status")
+        self.assertTrue(status.startswith("ok state OP"), status)
+
+    def test_every_example_device_is_found_reaches_op_and_conforms(self):
+        devices = examples()
+        self.assertGreater(len(devices), 0, EXAMPLES)
+        conform = os.environ.get("ECAT_CONFORM")
+        for d in devices:
+            with self.subTest(file=os.path.basename(d["file"]), device=d["spec"]):
+                bus, ctl = self.serve(d)
+                with bus:
+                    self.check_found(bus, d)
+                    self.check_op(bus, d, ctl)
+                    if conform and os.path.exists(conform):
+                        out = os.path.join(bus.dir, "conform.json")
+                        bus.ecatctl("state", "0", "INIT", check=False)
+                        r = subprocess.run([conform, "--iface", bus.iface, "--esi", d["file"], "--json", out],
+                                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=600)
+                        with open(out) as f:
+                            report = json.load(f)
+                        failed = [t for t in report.get("tests", []) if t.get("result") in ("fail", "failed")]
+                        self.assertEqual(failed, [], r.stdout[-4000:])
+                    self.assertTrue(bus.slave_alive(), bus.slave_output())
+
+    def test_several_units_of_an_example_have_serial_numbers_one_to_n(self):
+        d = next(x for x in examples() if not x["mailbox"])
+        bus, _ctl = self.serve(d, "--slaves", "3")
+        with bus:
+            rows = ROW.findall(bus.ecatctl("scan").stdout)
+            self.assertEqual([int(r[6], 16) for r in rows], [1, 2, 3])
+            self.assertTrue(all(int(r[4], 16) == d["product"] for r in rows))
+
+
+class EsiErrors(unittest.TestCase):
+    def run_slave(self, *args):
+        return subprocess.run([os.environ["ECAT_SLAVE"], *args, "--write-esi", "-"], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True, timeout=60)
+
+    def test_a_file_with_several_devices_needs_a_spec_and_lists_them(self):
+        multi = next(f for f in {d["file"] for d in examples()}
+                     if sum(1 for x in examples() if x["file"] == f) > 1)
+        r = self.run_slave("--esi", multi)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn(os.path.basename(multi), r.stderr)
+        for d in examples():
+            if d["file"] == multi:
+                self.assertIn(f"{d['product']:08x}".lower(), r.stderr.lower())
+
+    def test_a_bad_spec_and_a_bad_file_are_usage_errors_naming_the_file(self):
+        d = examples()[0]
+        r = self.run_slave("--esi", d["file"], "--device", "0x12345678:0x1")
+        self.assertEqual(r.returncode, 2, r.stderr)
+        with tempfile.TemporaryDirectory() as tmp:
+            bad = os.path.join(tmp, "bad.xml")
+            with open(bad, "w") as f:
+                f.write("<EtherCATInfo>\n  <Vendor>\n</EtherCATInfo>\n")
+            r = self.run_slave("--esi", bad)
+            self.assertEqual(r.returncode, 2, r.stderr)
+            self.assertIn("bad.xml", r.stderr)
+            r = self.run_slave("--esi", os.path.join(tmp, "missing.xml"))
+            self.assertEqual(r.returncode, 2, r.stderr)
+
+    def test_write_esi_and_write_sii_round_trip(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            for d in examples():
+                with self.subTest(file=os.path.basename(d["file"]), device=d["spec"]):
+                    esi, sii, sii2 = (os.path.join(tmp, n) for n in ("back.xml", "a.bin", "b.bin"))
+                    slave = os.environ["ECAT_SLAVE"]
+                    subprocess.run([slave, "--esi", d["file"], "--device", d["spec"], "--write-esi", esi,
+                                    "--write-sii", sii], check=True, timeout=60, stderr=subprocess.PIPE)
+                    # The ESI written back describes the same device: its SII is the same.
+                    r = subprocess.run([slave, "--esi", esi, "--write-sii", sii2], timeout=60,
+                                       stderr=subprocess.PIPE, text=True)
+                    self.assertEqual(r.returncode, 0, r.stderr)
+                    with open(sii, "rb") as a, open(sii2, "rb") as b:
+                        self.assertEqual(a.read(), b.read())
+
+
+if __name__ == "__main__":
+    harness.main()
