@@ -18,7 +18,9 @@
 #include "device/faults.hpp"
 #include "device/firmware.hpp"
 #include "device/line.hpp"
+#include "eni_line.hpp"
 #include "esc/link.hpp"
+#include "esi/eni/eni_reader.hpp"
 #include "od/device_config.hpp"
 #include "send_control.hpp"
 #include "slave/log.hpp"
@@ -166,6 +168,14 @@ int main(int argc, char** argv) {
         ->check(CLI::ExistingFile)
         ->excludes(slaves_opt)
         ->type_name("FILE");
+    std::string eni_file;
+    app.add_option(
+           "--eni", eni_file,
+           "Serve the line this ENI (ETG.2100 EtherCAT Network Information, as TwinCAT or EC-Engineer "
+           "export it) describes, in its order and wiring; each slave from the ENI's data "
+           "(docs/eni.md)")
+        ->excludes(slaves_opt)
+        ->type_name("FILE");
     app.add_option("--out-iface", options.out_iface,
                    "Port 1 of the last device (or the topology's 'external' port) leads to this interface: "
                    "the line continues there; no carrier closes the port")
@@ -298,7 +308,8 @@ int main(int argc, char** argv) {
             return slave::kExitUsage;
         }
     }
-    const bool segment_mode = slaves > 1 || !topology_file.empty() || !options.out_iface.empty();
+    const bool segment_mode =
+        slaves > 1 || !topology_file.empty() || !eni_file.empty() || !options.out_iface.empty();
     if (slaves_opt->count() > 0 && !segment_mode) device.serial_number = 1;  // --slaves 1: serial number 1
     // Each state directory is the one device's that runs on it: locked until exit (a second process, or a
     // second device of a topology on the same directory, is a usage error before any network set-up).
@@ -323,10 +334,25 @@ int main(int argc, char** argv) {
         return slave::kExitUsage;
     }
     device::LineOptions line;
+    if (!eni_file.empty() && !topology_file.empty()) {
+        std::cerr << "ecat-slave: --eni and --topology both describe the line: give one\n";
+        return slave::kExitUsage;
+    }
     try {
-        line.topology =
-            topology_file.empty() ? slave::line_topology(slaves) : slave::load_topology(topology_file);
+        if (!eni_file.empty()) {
+            ecat_slave::EniLine eni = ecat_slave::eni_line(eni_file);
+            line.topology = std::move(eni.topology);
+            line.products = std::move(eni.products);
+            for (const std::string& r : eni.report)
+                std::cerr << "ecat-slave: " << r << '\n';
+        } else {
+            line.topology =
+                topology_file.empty() ? slave::line_topology(slaves) : slave::load_topology(topology_file);
+        }
     } catch (const slave::TopologyError& e) {
+        std::cerr << "ecat-slave: " << e.what() << '\n';
+        return slave::kExitUsage;
+    } catch (const esi::eni::EniError& e) {
         std::cerr << "ecat-slave: " << e.what() << '\n';
         return slave::kExitUsage;
     }
@@ -335,11 +361,13 @@ int main(int argc, char** argv) {
         // One drive with --out-iface only: the serial number of its configuration, as without --out-iface.
         if (slaves_opt->count() == 0) line.topology.devices[0].serial = 0;
     }
-    for (slave::TopologyDevice& d : line.topology.devices) {
+    for (std::size_t k = 0; k < line.topology.devices.size(); ++k) {
+        slave::TopologyDevice& d = line.topology.devices[k];
         if (d.state_dir.empty()) d.state_dir = (device.state_dir / d.name).string();
         // Each device's configuration is loaded now: a bad one is a usage error naming the topology line.
         device::DeviceOptions o = device;
         if (!d.config.empty()) o.config_file = d.config;
+        if (k < line.products.size() && line.products[k]) o.product = line.products[k];
         o.state_dir = d.state_dir;
         try {
             device::check_device(o);

@@ -1,0 +1,82 @@
+// The line of an ENI (see eni_line.hpp).
+#include "eni_line.hpp"
+
+#include <cstdio>
+
+#include "esi/eni/eni_product.hpp"
+#include "esi/eni/eni_reader.hpp"
+
+namespace ecat_slave {
+
+namespace {
+
+// A topology name for slave k: "<k>-<order code>" in the characters a device name may have.
+std::string unit_name(std::size_t k, const std::string& order) {
+    std::string name = std::to_string(k) + "-";
+    for (char c : order) {
+        if (name.size() >= slave::kMaxNameLength) break;
+        const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
+                        c == '_' || c == '.' || c == '-';
+        name.push_back(ok ? c : '_');
+    }
+    return name;
+}
+
+bool port_has_phy(const std::string& physics, int port) {
+    return static_cast<std::size_t>(port) < physics.size() && physics[static_cast<std::size_t>(port)] != ' ';
+}
+
+}  // namespace
+
+EniLine eni_line(const std::string& file) {
+    const esi::eni::Config eni = esi::eni::read_eni_file(file);
+    if (eni.slaves.empty()) throw esi::eni::EniError(file + ": the ENI declares no slave");
+    if (eni.slaves.size() > slave::kMaxDevices)
+        throw esi::eni::EniError(file + ": more than " + std::to_string(slave::kMaxDevices) + " slaves");
+    EniLine out;
+    out.topology.file = file;
+    for (std::size_t k = 0; k < eni.slaves.size(); ++k) {
+        const esi::eni::Slave& s = eni.slaves[k];
+        auto product = std::make_shared<od::Product>(esi::eni::product_from_eni(eni, k));
+        slave::TopologyDevice d;
+        d.name = unit_name(k, product->description.identity.order_code);
+        d.line = s.line;
+        if (s.info.serial != 0) d.serial = s.info.serial;
+        if (const esi::eni::PreviousPort* pp = s.previous_port()) {
+            d.parent = eni.find_phys_addr(pp->phys_addr);
+            d.parent_port = pp->port;
+        } else if (k > 0) {
+            d.parent = static_cast<int>(k) - 1;
+            d.parent_port = 1;
+        }
+        d.ports = port_has_phy(s.info.physics, 2) || port_has_phy(s.info.physics, 3) ? 4 : 2;
+        char station[16];
+        std::snprintf(station, sizeof station, "0x%04X", s.info.phys_addr);
+        out.report.push_back("ENI slave " + std::to_string(k) + " '" + s.info.name + "' (station address " +
+                             station + " from the master): served from " + product->source +
+                             (product->warnings.empty() ? ""
+                                                        : "; " + std::to_string(product->warnings.size()) +
+                                                              " things not emulated (below)"));
+        out.topology.devices.push_back(std::move(d));
+        out.products.push_back(std::move(product));
+    }
+    // A device plugged into port 2 or 3 of another needs a four-port ESC there, whatever Physics says.
+    for (std::size_t k = 1; k < out.topology.devices.size(); ++k) {
+        slave::TopologyDevice& d = out.topology.devices[k];
+        if (d.parent < 0 || d.parent >= static_cast<int>(k))
+            throw esi::eni::EniError(eni.where(d.line) + ": PreviousPort names no slave before this one");
+        if (d.parent_port >= 2) out.topology.devices[static_cast<std::size_t>(d.parent)].ports = 4;
+        for (std::size_t j = 1; j < k; ++j)
+            if (out.topology.devices[j].parent == d.parent &&
+                out.topology.devices[j].parent_port == d.parent_port)
+                throw esi::eni::EniError(
+                    eni.where(d.line) + ": port " + std::string(1, char('A' + d.parent_port)) + " of slave " +
+                    std::to_string(d.parent) + " is taken by slave " + std::to_string(j) + " already");
+        if (d.parent_port == 0)
+            throw esi::eni::EniError(eni.where(d.line) +
+                                     ": PreviousPort A: port A of a slave faces the master");
+    }
+    return out;
+}
+
+}  // namespace ecat_slave
