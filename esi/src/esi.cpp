@@ -580,13 +580,15 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
     if (kIdentificationInAlStatusCode) child(info, "IdentificationReg134", "true");
     child(device, "GroupType", id.group_type);
 
-    xmlNodePtr profile = child(device, "Profile");
-    if (m.profile_number != 0) {
-        child(profile, "ProfileNo", std::to_string(m.profile_number));
-        child(profile, "AddInfo", std::to_string(m.profile_add_info));
+    if (!dict.objects().empty()) {  // a coupler has no dictionary
+        xmlNodePtr profile = child(device, "Profile");
+        if (m.profile_number != 0) {
+            child(profile, "ProfileNo", std::to_string(m.profile_number));
+            child(profile, "AddInfo", std::to_string(m.profile_add_info));
+        }
+        dictionary(profile, dict);
+        if (dict.find(0x10F3) != nullptr) diag_messages(profile);
     }
-    dictionary(profile, dict);
-    if (dict.find(0x10F3) != nullptr) diag_messages(profile);
 
     for (FmmuUse f : m.fmmus)
         child(device, "Fmmu", fmmu_text(f));
@@ -601,10 +603,8 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
         attr(sm, "ControlByte", hex(s.control));
         attr(sm, "Enable", s.enable ? "1" : "0");
     }
-    for (const PdoInfo& p : m.pdos)
-        if (p.rx) pdo(device, p);
-    for (const PdoInfo& p : m.pdos)
-        if (!p.rx) pdo(device, p);
+    for (std::size_t i : m.pdo_order)
+        pdo(device, m.pdos[i]);
 
     if (d.mailbox_protocols != 0) {
         namespace mp = od::mailbox_protocol;
@@ -637,9 +637,16 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
             if (!mode.description.empty()) child(op, "Desc", mode.description);
             child(op, "AssignActivate", hex(mode.assign_activate));
             if (mode.assign_activate != 0) {
-                xmlNodePtr c0 = child(op, "CycleTimeSync0", "0");
+                xmlNodePtr c0 = child(op, "CycleTimeSync0", std::to_string(mode.cycle_time_sync0));
                 attr(c0, "Factor", std::to_string(mode.cycle_time_sync0_factor));
                 child(op, "ShiftTimeSync0", std::to_string(mode.shift_time_sync0));
+                if (mode.cycle_time_sync1 != 0 || mode.cycle_time_sync1_factor != 0 ||
+                    mode.shift_time_sync1 != 0) {
+                    xmlNodePtr c1 = child(op, "CycleTimeSync1", std::to_string(mode.cycle_time_sync1));
+                    if (mode.cycle_time_sync1_factor != 0)
+                        attr(c1, "Factor", std::to_string(mode.cycle_time_sync1_factor));
+                    child(op, "ShiftTimeSync1", std::to_string(mode.shift_time_sync1));
+                }
             }
         }
     }

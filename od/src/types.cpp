@@ -86,6 +86,26 @@ std::string_view to_string(DataType t) {
             return "IDENTITY";
         case DataType::SyncManagerParameter:
             return "SYNC_PAR";
+        case DataType::Integer24:
+            return "INT24";
+        case DataType::Unsigned24:
+            return "UINT24";
+        case DataType::Bit1:
+            return "BIT1";
+        case DataType::Bit2:
+            return "BIT2";
+        case DataType::Bit3:
+            return "BIT3";
+        case DataType::Bit4:
+            return "BIT4";
+        case DataType::Bit5:
+            return "BIT5";
+        case DataType::Bit6:
+            return "BIT6";
+        case DataType::Bit7:
+            return "BIT7";
+        case DataType::Bit8:
+            return "BIT8";
     }
     return "UNKNOWN";
 }
@@ -108,14 +128,26 @@ uint16_t bit_size(DataType t) {
         case DataType::Unsigned64:
         case DataType::Real64:
             return 64;
+        case DataType::Integer24:
+        case DataType::Unsigned24:
+            return 24;
+        case DataType::Bit1:
+        case DataType::Bit2:
+        case DataType::Bit3:
+        case DataType::Bit4:
+        case DataType::Bit5:
+        case DataType::Bit6:
+        case DataType::Bit7:
+        case DataType::Bit8:
+            return static_cast<uint16_t>(static_cast<uint16_t>(t) - 0x002F);
         default:
             return 0;
     }
 }
 
 bool is_signed(DataType t) {
-    return t == DataType::Integer8 || t == DataType::Integer16 || t == DataType::Integer32 ||
-           t == DataType::Integer64;
+    return t == DataType::Integer8 || t == DataType::Integer16 || t == DataType::Integer24 ||
+           t == DataType::Integer32 || t == DataType::Integer64;
 }
 
 bool is_real(DataType t) {

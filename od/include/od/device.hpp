@@ -87,12 +87,22 @@ struct PdoSet {
     std::vector<uint16_t> tx;  // 0x1A00..
 };
 
+// A DC operation mode (ESI Dc/OpMode, SII DC category, ETG.2000 / ETG.2010). (New fields go at the end:
+// descriptions initialise the first ones by position.)
 struct DcOpMode {
     std::string name;  // "SM-Synchron", "DC"
     std::string description;
     uint16_t assign_activate = 0;  // value for 0x0980/0x0981 (e.g. 0x0300: SYNC0 + cyclic unit)
+    // SYNC0 cycle: the bus cycle times cycle_time_sync0_factor, or cycle_time_sync0 ns if that is not 0.
     int32_t cycle_time_sync0_factor = 1;
     int32_t shift_time_sync0 = 0;
+    uint32_t cycle_time_sync0 = 0;
+    // SYNC1 (AssignActivate bit 0x0400): its cycle as a multiple of the SYNC0 cycle (cycle_time_sync1_factor,
+    // 0: not declared) or cycle_time_sync1 ns, and its shift after SYNC0 in ns.
+    uint32_t cycle_time_sync1 = 0;
+    int32_t cycle_time_sync1_factor = 0;
+    int32_t shift_time_sync1 = 0;
+    bool operator==(const DcOpMode&) const = default;
 };
 
 struct DeviceDescription {
@@ -103,7 +113,11 @@ struct DeviceDescription {
     uint8_t coe_details = coe_details::Sdo | coe_details::SdoInfo | coe_details::PdoAssign |
                           coe_details::PdoConfig | coe_details::CompleteAccess;
     uint8_t foe_details = 0;
-    std::vector<SyncManagerDefault> sync_managers;  // SM0..SM3 in order
+    std::vector<SyncManagerDefault> sync_managers;  // SM0..SM3 in order (none: a device without mailbox and
+                                                    // process data, as a coupler)
+    // The FMMUs as declared (ESI Fmmu, SII FMMU category: 1 outputs, 2 inputs, 3 mailbox state, 0 unused);
+    // empty: one for each process-data direction and one for the mailbox state, as the SMs need.
+    std::vector<uint8_t> fmmus;
     std::vector<DcOpMode> dc_modes;
     uint16_t eeprom_bytes = 2048;
     uint8_t pdi_control = 0x05;  // SII word 0 low: SPI (as the MAXPOS's ESC) -- see docs/decisions.md
