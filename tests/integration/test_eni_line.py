@@ -176,6 +176,14 @@ class EniLine(unittest.TestCase):
         self.assertIn("BIT2", log)
         self.assertIn("CiA 402", log)
 
+    def test_with_esi_dir_reaches_op(self):
+        log = self.run_line(["--eni", EXAMPLE, "--esi-dir", os.path.join(SOURCE, "esi", "examples")])
+        # Every slave of the example has its ESI in esi/examples: each is served from it.
+        self.assertEqual(log.count("(ENI data)"), 0, log)
+        self.assertEqual(log.count("served from"), 5, log)
+        for esi in ("coupler.xml", "digital-io.xml", "analog-in.xml", "drive402.xml"):
+            self.assertIn(esi, log)
+
     def test_bad_eni_is_file_line_exit_2(self):
         require_eni(self)
         slave = harness.env_path("ECAT_SLAVE")

@@ -1,8 +1,12 @@
 // The line of an ENI (see eni_line.hpp).
 #include "eni_line.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
+#include <stdexcept>
 
+#include "esi/device/product.hpp"
 #include "esi/eni/eni_product.hpp"
 #include "esi/eni/eni_reader.hpp"
 
@@ -28,7 +32,32 @@ bool port_has_phy(const std::string& physics, int port) {
 
 }  // namespace
 
-EniLine eni_line(const std::string& file) {
+EsiIndex index_esi_dir(const std::string& dir) {
+    namespace fs = std::filesystem;
+    EsiIndex index;
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) throw std::runtime_error(dir + ": not a folder");
+    std::vector<fs::path> files;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+        if (it->path().extension() == ".xml" && it->is_regular_file(ec)) files.push_back(it->path());
+    if (ec) throw std::runtime_error(dir + ": " + ec.message());
+    std::sort(files.begin(), files.end());  // the first file declaring an identity wins, in name order
+    for (const fs::path& path : files) {
+        std::shared_ptr<const esi::EsiFile> file;
+        try {
+            file = std::make_shared<const esi::EsiFile>(esi::read_esi_file(path.string()));
+        } catch (const std::exception& e) {
+            index.skipped.push_back(e.what());
+            continue;
+        }
+        for (const esi::EsiDevice& d : file->devices)
+            index.devices.emplace(std::make_tuple(d.vendor_id, d.product_code, d.revision),
+                                  EsiIndex::Found{file, &d, path.string()});
+    }
+    return index;
+}
+
+EniLine eni_line(const std::string& file, const EsiIndex* esis) {
     const esi::eni::Config eni = esi::eni::read_eni_file(file);
     if (eni.slaves.empty()) throw esi::eni::EniError(file + ": the ENI declares no slave");
     if (eni.slaves.size() > slave::kMaxDevices)
@@ -37,7 +66,15 @@ EniLine eni_line(const std::string& file) {
     out.topology.file = file;
     for (std::size_t k = 0; k < eni.slaves.size(); ++k) {
         const esi::eni::Slave& s = eni.slaves[k];
-        auto product = std::make_shared<od::Product>(esi::eni::product_from_eni(eni, k));
+        std::shared_ptr<od::Product> product;
+        if (esis) {
+            auto it =
+                esis->devices.find(std::make_tuple(s.info.vendor_id, s.info.product_code, s.info.revision));
+            if (it != esis->devices.end())
+                product =
+                    std::make_shared<od::Product>(esi::load_product(*it->second.file, *it->second.device));
+        }
+        if (!product) product = std::make_shared<od::Product>(esi::eni::product_from_eni(eni, k));
         slave::TopologyDevice d;
         d.name = unit_name(k, product->description.identity.order_code);
         d.line = s.line;

@@ -20,6 +20,7 @@
 #include "device/line.hpp"
 #include "eni_line.hpp"
 #include "esc/link.hpp"
+#include "esi/device/product.hpp"
 #include "esi/eni/eni_reader.hpp"
 #include "od/device_config.hpp"
 #include "send_control.hpp"
@@ -176,6 +177,12 @@ int main(int argc, char** argv) {
            "(docs/eni.md)")
         ->excludes(slaves_opt)
         ->type_name("FILE");
+    std::string esi_dir;
+    app.add_option(
+           "--esi-dir", esi_dir,
+           "With --eni: serve each slave whose vendor id, product code and revision a device of an ESI "
+           "file in this folder (*.xml) has from that ESI, the others from the ENI's data")
+        ->type_name("DIR");
     app.add_option("--out-iface", options.out_iface,
                    "Port 1 of the last device (or the topology's 'external' port) leads to this interface: "
                    "the line continues there; no carrier closes the port")
@@ -339,8 +346,18 @@ int main(int argc, char** argv) {
         return slave::kExitUsage;
     }
     try {
+        if (!esi_dir.empty() && eni_file.empty()) {
+            std::cerr << "ecat-slave: --esi-dir goes with --eni (a topology names each ESI with esi=)\n";
+            return slave::kExitUsage;
+        }
         if (!eni_file.empty()) {
-            ecat_slave::EniLine eni = ecat_slave::eni_line(eni_file);
+            ecat_slave::EsiIndex index;
+            if (!esi_dir.empty()) {
+                index = ecat_slave::index_esi_dir(esi_dir);
+                for (const std::string& skipped : index.skipped)
+                    log.info("--esi-dir: left out: " + skipped);
+            }
+            ecat_slave::EniLine eni = ecat_slave::eni_line(eni_file, esi_dir.empty() ? nullptr : &index);
             line.topology = std::move(eni.topology);
             line.products = std::move(eni.products);
             for (const std::string& r : eni.report)
@@ -355,6 +372,23 @@ int main(int argc, char** argv) {
     } catch (const esi::eni::EniError& e) {
         std::cerr << "ecat-slave: " << e.what() << '\n';
         return slave::kExitUsage;
+    } catch (const std::runtime_error& e) {  // an ESI of --esi-dir that matches but cannot be served
+        std::cerr << "ecat-slave: " << e.what() << '\n';
+        return slave::kExitUsage;
+    }
+    // Devices of a topology file from an ESI (esi=FILE [device=SPEC]).
+    line.products.resize(line.topology.devices.size());
+    for (std::size_t k = 0; k < line.topology.devices.size(); ++k) {
+        const slave::TopologyDevice& d = line.topology.devices[k];
+        if (d.esi.empty()) continue;
+        try {
+            line.products[k] = std::make_shared<const od::Product>(esi::load_product(d.esi, d.device_spec));
+        } catch (const std::exception& e) {
+            std::cerr << "ecat-slave: " << line.topology.where(d.line) << "device " << d.name << ": "
+                      << e.what() << '\n';
+            return slave::kExitUsage;
+        }
+        log.info("device " + d.name + ": served from " + line.products[k]->source);
     }
     if (topology_file.empty() && slaves == 1) {
         line.topology.devices[0].state_dir = device.state_dir.string();
