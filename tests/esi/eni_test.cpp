@@ -356,16 +356,15 @@ TEST(EniProduct, AnalogTerminalWithCoeInitCmds) {
     EXPECT_EQ(d.write(0x1C13, 0, od::AlState::PreOp, {&zero, 1}), od::Status::Ok);
     const uint8_t pdo[2] = {0x00, 0x1A};
     EXPECT_EQ(d.write(0x1C13, 1, od::AlState::PreOp, pdo), od::Status::Ok);
-    // The BIT2 limits are gaps, with one warning each; the Sync error entry (0x1C33:20) exists.
+    // The BIT2 limits are entries of two bits; the Sync error entry (0x1C33:20) exists.
     EXPECT_NE(d.find(0x1C33, 0x20), nullptr);
-    EXPECT_EQ(d.find(0x6000, 3), nullptr);
-    EXPECT_EQ(d.get<uint32_t>(0x1A00, 3), 0x00000002u);
-    int bit2 = 0;
-    for (const std::string& w : p.warnings) {
-        EXPECT_EQ(w.rfind(kExample + ":", 0), 0u) << w;
-        bit2 += w.find("BIT2") != std::string::npos;
-    }
-    EXPECT_EQ(bit2, 8);
+    ASSERT_NE(d.find(0x6000, 3), nullptr);
+    EXPECT_EQ(d.find(0x6000, 3)->type, od::DataType::Bit2);
+    EXPECT_EQ(d.find(0x6000, 3)->bit_length, 2);
+    EXPECT_EQ(d.get<uint32_t>(0x1A00, 3), 0x60000302u);
+    EXPECT_EQ(d.get<uint32_t>(0x1A00, 6), 0x00000009u);  // the gap
+    for (const std::string& w : p.warnings)
+        ADD_FAILURE() << w;
 }
 
 TEST(EniProduct, DriveFromEniDataIsProcessDataWithDc) {

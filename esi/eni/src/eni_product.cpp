@@ -20,15 +20,19 @@ std::string entry_name(uint16_t index, uint8_t sub) {
 }
 
 // The od type of an ENI (ETG.2000 base) data type name with its bit length; nothing when softecat has no
-// storage of that size (BIT2..BIT7, STRING in a PDO, structured types).
+// storage of that size (STRING in a PDO, structured types, a bit length that is not the type's).
 std::optional<od::DataType> scalar_type(const std::string& name, uint16_t bits) {
     static const std::map<std::string, od::DataType> types = {
-        {"BOOL", od::DataType::Boolean},     {"BIT", od::DataType::Boolean},
-        {"BIT1", od::DataType::Boolean},     {"SINT", od::DataType::Integer8},
-        {"INT", od::DataType::Integer16},    {"DINT", od::DataType::Integer32},
+        {"BOOL", od::DataType::Boolean},     {"BIT", od::DataType::Bit1},
+        {"BIT1", od::DataType::Bit1},        {"BIT2", od::DataType::Bit2},
+        {"BIT3", od::DataType::Bit3},        {"BIT4", od::DataType::Bit4},
+        {"BIT5", od::DataType::Bit5},        {"BIT6", od::DataType::Bit6},
+        {"BIT7", od::DataType::Bit7},        {"BIT8", od::DataType::Bit8},
+        {"SINT", od::DataType::Integer8},    {"INT", od::DataType::Integer16},
+        {"INT24", od::DataType::Integer24},  {"DINT", od::DataType::Integer32},
         {"LINT", od::DataType::Integer64},   {"USINT", od::DataType::Unsigned8},
-        {"BYTE", od::DataType::Unsigned8},   {"BIT8", od::DataType::Unsigned8},
-        {"UINT", od::DataType::Unsigned16},  {"WORD", od::DataType::Unsigned16},
+        {"BYTE", od::DataType::Unsigned8},   {"UINT", od::DataType::Unsigned16},
+        {"WORD", od::DataType::Unsigned16},  {"UINT24", od::DataType::Unsigned24},
         {"UDINT", od::DataType::Unsigned32}, {"DWORD", od::DataType::Unsigned32},
         {"ULINT", od::DataType::Unsigned64}, {"LWORD", od::DataType::Unsigned64},
         {"REAL", od::DataType::Real32},      {"LREAL", od::DataType::Real64}};
