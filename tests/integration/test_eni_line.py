@@ -234,6 +234,8 @@ class EniLine(unittest.TestCase):
                 "broken.xml": ("<EtherCATConfig>\n<Config>\n", ":3: "),
                 "dangling.xml": (example.replace("<PhysAddr>1002</PhysAddr>\n\t\t\t</PreviousPort>",
                                                               "<PhysAddr>4242</PhysAddr>\n\t\t\t</PreviousPort>"), ":"),
+                # The drive on port D: a frame passes it before the terminals of port B, not in the ENI's order.
+                "order.xml": (example.replace("<Port>C</Port>", "<Port>D</Port>"), ":"),
             }
             for name, (text, where) in cases.items():
                 path = os.path.join(d, name)

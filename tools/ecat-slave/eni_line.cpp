@@ -74,6 +74,15 @@ EniLine eni_line(const std::string& file, const EsiIndex* esis) {
                 product =
                     std::make_shared<od::Product>(esi::load_product(*it->second.file, *it->second.device));
         }
+        std::string other_revisions;  // an ESI of DIR with this device in other revisions: said, not used
+        if (esis && !product)
+            for (const auto& [id, found] : esis->devices)
+                if (std::get<0>(id) == s.info.vendor_id && std::get<1>(id) == s.info.product_code) {
+                    char rev[16];
+                    std::snprintf(rev, sizeof rev, "0x%08X", std::get<2>(id));
+                    other_revisions +=
+                        (other_revisions.empty() ? "" : ", ") + std::string(rev) + " (" + found.path + ")";
+                }
         if (!product) product = std::make_shared<od::Product>(esi::eni::product_from_eni(eni, k));
         slave::TopologyDevice d;
         d.name = unit_name(k, product->description.identity.order_code);
@@ -89,11 +98,13 @@ EniLine eni_line(const std::string& file, const EsiIndex* esis) {
         d.ports = port_has_phy(s.info.physics, 2) || port_has_phy(s.info.physics, 3) ? 4 : 2;
         char station[16];
         std::snprintf(station, sizeof station, "0x%04X", s.info.phys_addr);
-        out.report.push_back("ENI slave " + std::to_string(k) + " '" + s.info.name + "' (station address " +
-                             station + " from the master): served from " + product->source +
-                             (product->warnings.empty() ? ""
-                                                        : "; " + std::to_string(product->warnings.size()) +
-                                                              " things not emulated (below)"));
+        out.report.push_back(
+            "ENI slave " + std::to_string(k) + " '" + s.info.name + "' (station address " + station +
+            " from the master): served from " + product->source +
+            (product->warnings.empty()
+                 ? ""
+                 : "; " + std::to_string(product->warnings.size()) + " things not emulated (below)") +
+            (other_revisions.empty() ? "" : "; the ESIs have only revision(s) " + other_revisions));
         out.topology.devices.push_back(std::move(d));
         out.products.push_back(std::move(product));
     }
@@ -113,6 +124,30 @@ EniLine eni_line(const std::string& file, const EsiIndex* esis) {
             throw esi::eni::EniError(eni.where(d.line) +
                                      ": PreviousPort A: port A of a slave faces the master");
     }
+    // The ENI lists the slaves in the order a frame passes them (their auto-increment positions); the wiring
+    // must give that order, through each ESC's ports in processing order A, D, B, C (ESC datasheet, "frame
+    // processing"), or the master would not find the line it was configured for.
+    auto child_at = [&](int parent, int port) {
+        for (std::size_t j = 1; j < out.topology.devices.size(); ++j)
+            if (out.topology.devices[j].parent == parent && out.topology.devices[j].parent_port == port)
+                return static_cast<int>(j);
+        return -1;
+    };
+    std::vector<int> order;
+    std::vector<int> todo{0};
+    while (!todo.empty()) {
+        const int v = todo.back();
+        todo.pop_back();
+        order.push_back(v);
+        for (int port : {2, 1, 3})  // pushed in reverse: D first, then B, then C
+            if (const int c = child_at(v, port); c >= 0) todo.push_back(c);
+    }
+    for (std::size_t k = 0; k < order.size(); ++k)
+        if (order[k] != static_cast<int>(k))
+            throw esi::eni::EniError(eni.where(eni.slaves[static_cast<std::size_t>(order[k])].line) +
+                                     ": slave " + std::to_string(order[k]) + " is at position " +
+                                     std::to_string(k) +
+                                     " by its PreviousPort wiring (ports in processing order A, D, B, C)");
     return out;
 }
 
