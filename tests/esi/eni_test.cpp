@@ -1,5 +1,5 @@
 // The ENI reader (esi/eni/eni_reader.hpp) and the ENI slave -> od::Product conversion
-// (esi/eni/eni_product.hpp): every field of the example ENI (esi/examples/eni/mixed-line.xml), and bad input
+// (esi/eni/eni_product.hpp): every field of the example ENI (esi/eni/examples/mixed-line.xml), and bad input
 // as a class: one message with file and line, never a crash.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -17,7 +17,7 @@ namespace {
 
 using namespace esi::eni;
 
-const std::string kExample = std::string(SOFTECAT_SOURCE_DIR) + "/esi/examples/eni/mixed-line.xml";
+const std::string kExample = std::string(SOFTECAT_SOURCE_DIR) + "/esi/eni/examples/mixed-line.xml";
 
 std::string wrap_slave(const std::string& inside) {
     return "<EtherCATConfig>\n<Config>\n<Slave>\n<Info><Name>S</Name><PhysAddr>1001</PhysAddr><VendorId>1</"

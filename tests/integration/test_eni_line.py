@@ -1,4 +1,4 @@
-"""A line from an ENI (issue 21 part 4): `ecat-slave --eni esi/examples/eni/mixed-line.xml` serves the line that ENI
+"""A line from an ENI (issue 21 part 4): `ecat-slave --eni esi/eni/examples/mixed-line.xml` serves the line that ENI
 describes, and a master configured with that ENI finds what it expects. The master here is EniMaster: it knows
 nothing but the ENI. It checks the slaves' identities and order (ecatctl scan), then runs the ENI as a master runs
 it: per state transition the register init commands of every slave (station addresses by position, SyncManagers,
@@ -16,7 +16,7 @@ import xml.etree.ElementTree as ET
 import harness
 
 SOURCE = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
-EXAMPLE = os.path.join(SOURCE, "esi", "examples", "eni", "mixed-line.xml")
+EXAMPLE = os.path.join(SOURCE, "esi", "eni", "examples", "mixed-line.xml")
 STATE_CODES = {"I": 1, "P": 2, "B": 3, "S": 4, "O": 8}
 STATE_NAMES = {1: "INIT", 2: "PREOP", 4: "SAFEOP", 8: "OP"}
 
