@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <string>
 
@@ -289,6 +290,50 @@ TEST(EniReader, FilesThatAreNotRegularOrTooLarge) {
     std::filesystem::remove_all(dir);
 }
 
+// Damaged copies of the example: cut anywhere, an element's value replaced by garbage, a closing tag lost.
+// Each is a Config whose slaves convert (or give an EniError) or an EniError with the file name: never
+// another exception, never a crash.
+TEST(EniReader, DamagedExamplesAreErrorsOrLines) {
+    std::ifstream f(kExample);
+    const std::string good((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    ASSERT_GT(good.size(), 10000u);
+    std::vector<std::string> damaged;
+    for (std::size_t cut = 0; cut < good.size(); cut += 997)
+        damaged.push_back(good.substr(0, cut));
+    for (std::size_t at = good.find('>'), k = 0; at != std::string::npos; at = good.find('>', at + 1), ++k) {
+        if (k % 7 != 0) continue;
+        const std::size_t end = good.find('<', at);
+        if (end == std::string::npos) break;
+        std::string v = good;
+        v.replace(at + 1, end - at - 1, k % 2 ? "-99999999999" : "#xZZ");
+        damaged.push_back(std::move(v));
+        std::string w = good;
+        const std::size_t close = good.find("</", at);
+        if (close != std::string::npos) w.erase(close, good.find('>', close) - close + 1);
+        damaged.push_back(std::move(w));
+    }
+    int configs = 0, errors = 0;
+    for (const std::string& xml : damaged) {
+        try {
+            const Config c = read_eni_text(xml, "damaged.xml");
+            ++configs;
+            for (std::size_t k = 0; k < c.slaves.size(); ++k) {
+                try {
+                    const od::Product p = product_from_eni(c, k);
+                    (void)p.make_dictionary(p.description);
+                } catch (const EniError& e) {
+                    EXPECT_EQ(std::string(e.what()).rfind("damaged.xml:", 0), 0u) << e.what();
+                }
+            }
+        } catch (const EniError& e) {
+            ++errors;
+            EXPECT_EQ(std::string(e.what()).rfind("damaged.xml", 0), 0u) << e.what();
+        }
+    }
+    EXPECT_GT(configs, 0);
+    EXPECT_GT(errors, 100);
+}
+
 // ---- the conversion -------------------------------------------------------------------------------------
 
 TEST(EniProduct, CouplerWithoutMailboxOrProcessData) {
@@ -403,7 +448,9 @@ TEST(EniProduct, UnemulatedThingsAreWarningsOnePerElement) {
         "ControlByte>"
         "<Enable>1</Enable></Sm3><TxPdo "
         "Sm=\"3\"><Index>#x1a00</Index><Entry><Index>#x6000</Index><SubIndex>1</SubIndex>"
-        "<BitLen>16</BitLen><DataType>STRING(2)</DataType></Entry></TxPdo></ProcessData>"
+        "<BitLen>16</BitLen><DataType>STRING(2)</DataType></Entry><Entry><Index>#x1018</Index><SubIndex>1</"
+        "SubIndex>"
+        "<BitLen>32</BitLen><DataType>UDINT</DataType></Entry></TxPdo></ProcessData>"
         "<Mailbox><Send><Start>4096</Start><Length>128</Length></Send><Recv><Start>4224</Start><Length>128</"
         "Length>"
         "</Recv><Protocol>CoE</Protocol><Protocol>EoE</Protocol><Protocol>SoE</Protocol>"
@@ -417,7 +464,8 @@ TEST(EniProduct, UnemulatedThingsAreWarningsOnePerElement) {
     std::string all;
     for (const std::string& w : p.warnings)
         all += w + "\n";
-    EXPECT_EQ(p.warnings.size(), 5u) << all;
+    EXPECT_EQ(p.warnings.size(), 6u) << all;
+    EXPECT_NE(all.find("0x1018:0x01"), std::string::npos) << all;
     EXPECT_NE(all.find("Protocol EoE"), std::string::npos) << all;
     EXPECT_NE(all.find("Protocol SoE"), std::string::npos) << all;
     EXPECT_NE(all.find("EoE/InitCmds"), std::string::npos) << all;

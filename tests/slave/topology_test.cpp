@@ -113,10 +113,12 @@ TEST(Topology, DevicesFromAnEsi) {
     EXPECT_EQ(t.devices[1].esi, "/abs/io.xml");
     EXPECT_EQ(t.devices[1].device_spec, "0x03f03052:0x00110000");
     EXPECT_EQ(t.devices[2].esi, "");
-    EXPECT_EQ(error_of("device a\ndevice b device=EXD1008\n"), "line.topo:2: device=EXD1008: without esi=FILE");
-    EXPECT_EQ(error_of("device a esi=x.xml config=y.conf\n"),
-              "line.topo:1: esi= and config= together: config= configures the built-in drive, esi= serves another "
-              "device");
+    EXPECT_EQ(error_of("device a\ndevice b device=EXD1008\n"),
+              "line.topo:2: device=EXD1008: without esi=FILE");
+    EXPECT_EQ(
+        error_of("device a esi=x.xml config=y.conf\n"),
+        "line.topo:1: esi= and config= together: config= configures the built-in drive, esi= serves another "
+        "device");
 }
 
 TEST(Topology, ALoopIsRefused) {

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <stdexcept>
 
 namespace esi::eni {
 
@@ -308,6 +309,15 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
     auto add_entry = [&](const Pdo& pdo, const PdoEntry& e) -> bool {
         const std::string what = (pdo.rx ? "RxPdo " : "TxPdo ") + hex(pdo.index, 4) + " entry " +
                                  entry_name(e.index, e.subindex) + " '" + e.name + "'";
+        const bool own = e.index == 0x1000 || e.index == 0x1008 || e.index == 0x1018 || e.index == 0x1C00 ||
+                         (e.index & 0xFFF0) == 0x1C10 || (e.index >= 0x1600 && e.index <= 0x17FF) ||
+                         (e.index >= 0x1A00 && e.index <= 0x1BFF);
+        if (own) {
+            warn.push_back(who + ": " + what +
+                           ": an object the slave declares itself (identity, SyncManager or "
+                           "PDO objects) cannot be mapped; its bits are a gap (always 0)");
+            return false;
+        }
         const auto type = scalar_type(e.data_type, e.bit_len);
         if (!type) {
             warn.push_back(who + ": " + what + " of type " + e.data_type + " (" + std::to_string(e.bit_len) +
@@ -505,7 +515,11 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
     p.make_dictionary = [plan](const od::DeviceDescription& desc) { return build(*plan, desc); };
     p.application = od::Application::None;
     // Everything must be declarable now, not when the first unit starts.
-    (void)p.make_dictionary(p.description);
+    try {
+        (void)p.make_dictionary(p.description);
+    } catch (const std::logic_error& e) {
+        fail(s.line, "slave " + std::to_string(index) + " cannot be served from the ENI: " + e.what());
+    }
     return p;
 }
 
