@@ -456,6 +456,45 @@ void pdo(xmlNodePtr device, const PdoInfo& p) {
     }
 }
 
+// A module's PDO (Descriptions/Modules/Module), indices as the module declares them (before the slot's
+// increments).
+void module_pdo(xmlNodePtr module, const od::ModulePdo& p) {
+    xmlNodePtr n = child(module, p.rx ? "RxPdo" : "TxPdo");
+    if (p.fixed) attr(n, "Fixed", "1");
+    if (p.mandatory) attr(n, "Mandatory", "1");
+    if (p.sm >= 0) attr(n, "Sm", std::to_string(p.sm));
+    xmlNodePtr index = child(n, "Index", hex_index(p.index));
+    if (p.depend_on_slot) attr(index, "DependOnSlot", "true");
+    named(n, "Name", p.name);
+    for (const od::ModulePdoEntry& e : p.entries) {
+        xmlNodePtr en = child(n, "Entry");
+        xmlNodePtr ei = child(en, "Index", hex_index(e.index));
+        if (e.depend_on_slot && e.index != 0) attr(ei, "DependOnSlot", "true");
+        if (e.index != 0) child(en, "SubIndex", std::to_string(e.subindex));
+        child(en, "BitLen", std::to_string(e.bit_length));
+        if (e.index != 0) {
+            named(en, "Name", e.name);
+            if (!e.data_type.empty()) child(en, "DataType", e.data_type);
+        }
+    }
+}
+
+// The PDO indices the slots' default modules place (they are written with their module, not the device).
+std::set<uint16_t> slot_pdos(const od::DeviceDescription& d) {
+    std::set<uint16_t> out;
+    for (std::size_t n = 0; n < d.slots.size(); ++n) {
+        const od::Slot& slot = d.slots[n];
+        if (slot.default_module == 0) continue;
+        for (const od::Module& m : d.modules) {
+            if (m.ident != slot.default_module) continue;
+            for (const od::ModulePdo& p : m.pdos)
+                out.insert(static_cast<uint16_t>(p.index + (p.depend_on_slot ? n * slot.pdo_increment : 0)));
+            break;
+        }
+    }
+    return out;
+}
+
 const char* sm_text(od::SmKind k) {
     switch (k) {
         case od::SmKind::MBoxOut:
@@ -603,8 +642,9 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
         attr(sm, "ControlByte", hex(s.control));
         attr(sm, "Enable", s.enable ? "1" : "0");
     }
+    const std::set<uint16_t> in_slots = slot_pdos(d);
     for (std::size_t i : m.pdo_order)
-        pdo(device, m.pdos[i]);
+        if (!in_slots.count(m.pdos[i].index)) pdo(device, m.pdos[i]);
 
     if (d.mailbox_protocols != 0) {
         namespace mp = od::mailbox_protocol;
@@ -651,12 +691,42 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
         }
     }
 
+    if (!d.slots.empty()) {
+        xmlNodePtr slots = child(device, "Slots");
+        for (const od::Slot& slot : d.slots) {
+            if (slot.module_idents.empty()) continue;  // the schema needs a ModuleIdent
+            xmlNodePtr sl = child(slots, "Slot");
+            attr(sl, "MinInstances", std::to_string(slot.min_instances));
+            attr(sl, "MaxInstances", std::to_string(slot.max_instances));
+            attr(sl, "SlotPdoIncrement", std::to_string(slot.pdo_increment));
+            attr(sl, "SlotIndexIncrement", hex(slot.index_increment));
+            if (!slot.name.empty()) named(sl, "Name", slot.name);
+            for (uint32_t ident : slot.module_idents) {
+                xmlNodePtr mi = child(sl, "ModuleIdent", hex32(ident));
+                if (ident == slot.default_module) attr(mi, "Default", "1");
+            }
+        }
+    }
+
     xmlNodePtr eeprom = child(device, "Eeprom");
     child(eeprom, "ByteSize", std::to_string(d.eeprom_bytes));
     child(eeprom, "ConfigData", hex_bytes(m.config_data.data(), m.config_data.size()));
     child(eeprom, "BootStrap", hex_bytes(m.bootstrap.data(), m.bootstrap.size()));
     const std::vector<uint8_t> image = device_image_bmp();
     child(device, "ImageData16x14", hex_bytes(image.data(), image.size()));
+
+    if (!d.modules.empty()) {
+        xmlNodePtr modules = child(descriptions, "Modules");
+        for (const od::Module& mod : d.modules) {
+            xmlNodePtr mn = child(modules, "Module");
+            xmlNodePtr t = child(mn, "Type", mod.type);
+            attr(t, "ModuleIdent", hex32(mod.ident));
+            named(mn, "Name", mod.name.empty() ? mod.type : mod.name);
+            for (const bool rx : {true, false})
+                for (const od::ModulePdo& p : mod.pdos)
+                    if (p.rx == rx) module_pdo(mn, p);
+        }
+    }
 
     xmlChar* buf = nullptr;
     int size = 0;

@@ -59,9 +59,11 @@ std::string read_all(const fs::path& p) {
 std::vector<std::string> schema_errors(const std::string& xml) {
     static std::vector<std::string> errors;
     errors.clear();
-    std::unique_ptr<xmlSchemaParserCtxt, decltype(&xmlSchemaFreeParserCtxt)> pc(
+    // Parsed once for the whole run.
+    static std::unique_ptr<xmlSchemaParserCtxt, decltype(&xmlSchemaFreeParserCtxt)> pc(
         xmlSchemaNewParserCtxt(SOFTECAT_ESI_SCHEMA), &xmlSchemaFreeParserCtxt);
-    std::unique_ptr<xmlSchema, decltype(&xmlSchemaFree)> schema(xmlSchemaParse(pc.get()), &xmlSchemaFree);
+    static std::unique_ptr<xmlSchema, decltype(&xmlSchemaFree)> schema(xmlSchemaParse(pc.get()),
+                                                                       &xmlSchemaFree);
     if (!schema) return {"cannot load the schema"};
     std::unique_ptr<xmlSchemaValidCtxt, decltype(&xmlSchemaFreeValidCtxt)> vc(
         xmlSchemaNewValidCtxt(schema.get()), &xmlSchemaFreeValidCtxt);
@@ -158,6 +160,26 @@ std::vector<std::string> describe(const od::Product& p) {
                 x << " " << v.value << "=" << v.text;
             out.push_back(x.str());
         }
+    }
+    for (const od::Slot& slot : d.slots) {
+        std::ostringstream o;
+        o << std::hex << "slot '" << slot.name << "' " << slot.min_instances << "-" << slot.max_instances
+          << " default " << slot.default_module << " inc " << slot.pdo_increment << "/"
+          << slot.index_increment << " takes";
+        for (uint32_t x : slot.module_idents)
+            o << " " << x;
+        out.push_back(o.str());
+    }
+    for (const od::Module& mod : d.modules) {
+        std::ostringstream o;
+        o << std::hex << "module " << mod.ident << " " << mod.type << " '" << mod.name << "'";
+        for (const od::ModulePdo& mp : mod.pdos) {
+            o << " pdo " << mp.index << (mp.rx ? "r" : "t") << mp.sm << (mp.depend_on_slot ? "+" : "") << ":";
+            for (const od::ModulePdoEntry& e : mp.entries)
+                o << " " << e.index << (e.depend_on_slot ? "+" : "") << ":" << int{e.subindex} << "/"
+                  << int{e.bit_length} << "/" << e.data_type;
+        }
+        out.push_back(o.str());
     }
     add("application", int(p.application), "eeprom", p.eeprom.size());
     return out;
@@ -503,6 +525,16 @@ TEST(EsiExamples, TheModularDeviceServesTheDefaultModulesOfItsSlots) {
     const esi::DeviceModel m = esi::derive_model(p.description, d);
     EXPECT_EQ(m.sync_managers[2].size, 1);
     EXPECT_EQ(m.sync_managers[3].size, 5);
+    // The slots and their modules are kept for the ESI written back.
+    ASSERT_EQ(p.description.slots.size(), 4u);
+    EXPECT_EQ(p.description.slots[0].default_module, 0x00001001u);
+    EXPECT_EQ(p.description.slots[3].default_module, 0u);
+    EXPECT_EQ(p.description.slots[1].index_increment, 0x10u);
+    EXPECT_EQ(p.description.modules.size(), 3u);
+    const esi::EsiFile back = esi::read_esi_text(esi::build_esi(p.description, d), "back.xml");
+    ASSERT_EQ(back.devices[0].slots.size(), 4u);
+    EXPECT_EQ(back.modules.size(), 3u);
+    EXPECT_TRUE(back.devices[0].txpdos.empty());  // the PDOs are the modules', not the device's
     // EoE declared, not emulated: one warning naming the element.
     EXPECT_EQ(std::count_if(p.warnings.begin(), p.warnings.end(),
                             [](const std::string& w) { return w.find("Mailbox/EoE") != std::string::npos; }),
@@ -532,6 +564,35 @@ TEST(EsiExamples, Latin1AndByteOrderMarkAreRead) {
     EXPECT_EQ(f.devices[0].group_name, "Digital Output Terminals (EXD2xxx)");
     const od::Product c = esi::load_product(example("coupler.xml").string(), "");
     EXPECT_EQ(c.description.identity.order_code, "EXK1100");
+}
+
+TEST(EsiDevices, ACoeDeviceWithoutADictionaryGetsTheMandatoryObjects) {
+    const std::string xml =
+        "<?xml version=\"1.0\"?><EtherCATInfo><Vendor><Id>#x123</Id><Name>V</Name></Vendor><Descriptions>"
+        "<Devices><Device><Type ProductCode=\"#x77\" RevisionNo=\"#x2\">T77</Type><Name>T 77</Name>"
+        "<Profile><ProfileNo>5001</ProfileNo></Profile>"
+        "<Sm DefaultSize=\"128\" StartAddress=\"#x1000\" ControlByte=\"#x26\" Enable=\"1\">MBoxOut</Sm>"
+        "<Sm DefaultSize=\"128\" StartAddress=\"#x1080\" ControlByte=\"#x22\" Enable=\"1\">MBoxIn</Sm>"
+        "<Sm StartAddress=\"#x1100\" ControlByte=\"#x64\" Enable=\"1\">Outputs</Sm>"
+        "<Sm StartAddress=\"#x1180\" ControlByte=\"#x20\" Enable=\"1\">Inputs</Sm>"
+        "<RxPdo Fixed=\"1\" Sm=\"2\"><Index>#x1600</Index><Name>Out</Name><Entry><Index>#x7000</Index>"
+        "<SubIndex>1</SubIndex><BitLen>16</BitLen><Name>Value</Name><DataType>UINT</DataType></Entry></RxPdo>"
+        "<Mailbox><CoE SdoInfo=\"true\" PdoAssign=\"false\"/></Mailbox></Device></Devices></Descriptions>"
+        "</EtherCATInfo>";
+    const od::Product p = esi::load_product(esi::read_esi_text(xml, "t77.xml"), "");
+    od::DeviceDescription other = p.description;
+    other.identity.serial_number = 42;
+    const od::Dictionary d = p.make_dictionary(other);
+    EXPECT_EQ(d.get<uint32_t>(0x1000, 0), 5001u);
+    EXPECT_EQ(d.get<uint32_t>(0x1018, 1), 0x123u);
+    EXPECT_EQ(d.get<uint32_t>(0x1018, 2), 0x77u);
+    EXPECT_EQ(d.get<uint32_t>(0x1018, 4), 42u);
+    EXPECT_NE(d.find(0x1008, 0), nullptr);
+    EXPECT_EQ(d.get<uint8_t>(0x1C00, 3), 3);
+    EXPECT_EQ(d.get<uint16_t>(0x1C12, 1), 0x1600);
+    EXPECT_FALSE(d.find(0x1C12, 1)->writable(od::AlState::PreOp));  // no PdoAssign
+    EXPECT_TRUE(d.find(0x7000, 1)->rx_mappable());
+    EXPECT_TRUE(p.warnings.empty()) << ::testing::PrintToString(p.warnings);
 }
 
 // ---- Bad input, as a class ----------------------------------------------------------------------------
@@ -718,7 +779,7 @@ TEST(EsiBadInput, TruncatedAndMutatedExamplesNeverCrash) {
 TEST(EsiPublicFiles, EveryDeviceLoadsOrIsRefusedClearlyAndRoundTrips) {
     const char* dir = std::getenv("SOFTECAT_ESI_PUBLIC_DIR");
     if (dir == nullptr) GTEST_SKIP() << "SOFTECAT_ESI_PUBLIC_DIR not set";
-    int files = 0, read = 0, devices = 0, loaded = 0, refused = 0, round_trips = 0;
+    int files = 0, read = 0, devices = 0, loaded = 0, refused = 0, round_trips = 0, not_valid = 0;
     for (const fs::path& path : xml_files(dir)) {
         ++files;
         esi::EsiFile file;
@@ -734,7 +795,14 @@ TEST(EsiPublicFiles, EveryDeviceLoadsOrIsRefusedClearlyAndRoundTrips) {
             try {
                 const od::Product p = esi::load_product(file, d);
                 ++loaded;
-                const od::Product q = round_trip(p);
+                std::string xml;
+                const od::Product q = round_trip(p, &xml);
+                const auto invalid = schema_errors(xml);
+                if (!invalid.empty()) {
+                    ++not_valid;
+                    ADD_FAILURE() << path.string() << " " << d.type_name
+                                  << ": generated ESI: " << invalid.front();
+                }
                 std::vector<std::string> a = describe(p), b = describe(q);
                 a.pop_back();
                 b.pop_back();
@@ -751,8 +819,9 @@ TEST(EsiPublicFiles, EveryDeviceLoadsOrIsRefusedClearlyAndRoundTrips) {
         }
     }
     std::printf(
-        "public ESI files: %d files (%d read), %d devices: %d loaded, %d refused clearly, %d round-trip\n",
-        files, read, devices, loaded, refused, round_trips);
+        "public ESI files: %d files (%d read), %d devices: %d loaded, %d refused clearly, %d round-trip, "
+        "%d generated ESIs not schema-valid\n",
+        files, read, devices, loaded, refused, round_trips, not_valid);
 }
 
 }  // namespace

@@ -429,6 +429,14 @@ std::pair<DataType, uint16_t> pdo_entry_type(const EsiPdoEntry& pe, Ctx& ctx) {
                           " bits and type '" + pe.data_type + "': no type of that length");
 }
 
+// The declared limits stay unless they exclude the (new) default.
+void keep_limits_around_default(od::Entry& e) {
+    if (outside(e.default_value, e.minimum, e.maximum)) {
+        e.minimum = std::monostate{};
+        e.maximum = std::monostate{};
+    }
+}
+
 struct Pdo {
     const EsiPdo* esi = nullptr;
     uint16_t index = 0;
@@ -718,6 +726,43 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
             module_objects[at] = {o, m->type_name};
         }
     }
+    // The slots and the modules they take, for the ESI written back.
+    std::set<uint32_t> offered;
+    for (const EsiSlot& slot : d.slots) {
+        od::Slot s;
+        s.name = slot.name;
+        s.min_instances = slot.min_instances;
+        s.max_instances = slot.max_instances;
+        s.module_idents = slot.module_idents;
+        s.default_module = slot.default_module.value_or(0);
+        s.pdo_increment = slot.pdo_increment.value_or(d.slot_pdo_increment);
+        s.index_increment = slot.index_increment.value_or(d.slot_index_increment);
+        offered.insert(slot.module_idents.begin(), slot.module_idents.end());
+        desc.slots.push_back(std::move(s));
+    }
+    for (const EsiModule& m : file.modules) {
+        if (!offered.count(m.ident)) continue;
+        od::Module mod;
+        mod.ident = m.ident;
+        mod.type = m.type_name;
+        mod.name = m.name;
+        for (const auto* list : {&m.rxpdos, &m.txpdos})
+            for (const EsiPdo& p : *list) {
+                od::ModulePdo mp;
+                mp.rx = p.rx;
+                mp.index = p.index;
+                mp.depend_on_slot = p.depend_on_slot;
+                mp.name = p.name;
+                mp.sm = p.sm;
+                mp.fixed = p.fixed;
+                mp.mandatory = p.mandatory;
+                for (const EsiPdoEntry& e : p.entries)
+                    mp.entries.push_back(od::ModulePdoEntry{e.index, e.subindex, e.bit_len, e.name,
+                                                            e.data_type, e.depend_on_slot});
+                mod.pdos.push_back(std::move(mp));
+            }
+        desc.modules.push_back(std::move(mod));
+    }
     if (!d.slots.empty())
         ctx.warn(d.line, "Slots: the default configuration (" +
                              (module_list.empty() ? "no modules" : module_list) +
@@ -858,13 +903,11 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
             if (fits) {
                 o.entries[0].default_value = uint64_t{words.size()};
                 for (od::Entry& e : o.entries) {
+                    // Subindices past the count keep what the dictionary declares (nothing maps them).
                     if (e.subindex >= 1 && e.subindex <= words.size())
                         e.default_value = words[e.subindex - 1];
-                    else if (e.subindex > words.size())
-                        e.default_value = uint64_t{0};
                     if (p.esi->fixed) e.access &= static_cast<uint16_t>(~od::access::WriteMask);
-                    e.minimum = std::monostate{};
-                    e.maximum = std::monostate{};
+                    keep_limits_around_default(e);
                 }
                 continue;
             }
@@ -927,13 +970,13 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
             }
             if (ok) {
                 o.entries[0].default_value = uint64_t{assigned.size()};
-                for (od::Entry& e : o.entries)
-                    if (e.subindex >= 1) {
-                        e.default_value =
-                            e.subindex <= assigned.size() ? uint64_t{assigned[e.subindex - 1]} : uint64_t{0};
-                        e.minimum = std::monostate{};
-                        e.maximum = std::monostate{};
-                    }
+                for (od::Entry& e : o.entries) {
+                    // Subindices past the count keep what the dictionary declares (nothing is assigned
+                    // there).
+                    if (e.subindex >= 1 && e.subindex <= assigned.size())
+                        e.default_value = uint64_t{assigned[e.subindex - 1]};
+                    keep_limits_around_default(e);
+                }
                 continue;
             }
             ctx.warn(built.lines[index],
@@ -963,21 +1006,53 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
                                           (p.esi->rx ? "Outputs" : "Inputs") +
                                           " SyncManager; it is not assigned");
         }
+    // The objects every CoE device has (ETG.1000.6: 0x1000 and 0x1018 mandatory; 0x1008 as every vendor
+    // has it), for a CoE device whose file does not declare them (files without a Profile/Dictionary):
+    // a master that reads the identity by SDO finds what the SII says.
+    // An object the file lacks, declared at the Device element's line.
+    auto add_missing = [&built, &d](uint16_t index, od::ObjectCode code, DataType type, const char* name,
+                                    std::vector<od::Entry> entries) {
+        od::Object o;
+        o.index = index;
+        o.code = code;
+        o.type = type;
+        o.name = name;
+        o.entries = std::move(entries);
+        built.objects[index] = std::move(o);
+        built.lines[index] = d.line;
+    };
+    if (coe && !built.objects.count(0x1000)) {
+        const uint32_t type = d.profile_no.value_or(0) | d.profile_add_info.value_or(0) << 16;
+        add_missing(0x1000, od::ObjectCode::Var, DataType::Unsigned32, "Device type",
+                    {u_entry(0x1000, 0, DataType::Unsigned32, od::access::RO, type, "Device type")});
+    }
+    if (coe && !built.objects.count(0x1008) && !id.order_code.empty()) {
+        od::Entry e = u_entry(0x1008, 0, DataType::VisibleString, od::access::RO, 0, "Device name");
+        e.default_value = std::monostate{};
+        e.default_string = id.order_code.substr(0, 255);
+        e.bit_length = static_cast<uint16_t>(8 * e.default_string.size());
+        add_missing(0x1008, od::ObjectCode::Var, DataType::VisibleString, "Device name", {std::move(e)});
+    }
+    if (coe && !built.objects.count(0x1018)) {
+        std::vector<od::Entry> entries{
+            u_entry(0x1018, 0, DataType::Unsigned8, od::access::RO, 4, "SubIndex 000")};
+        const char* names[] = {"Vendor ID", "Product code", "Revision", "Serial number"};
+        const uint32_t values[] = {id.vendor_id, id.product_code, id.revision, 0};
+        for (uint8_t k = 0; k < 4; ++k)
+            entries.push_back(u_entry(0x1018, static_cast<uint8_t>(k + 1), DataType::Unsigned32,
+                                      od::access::RO, values[k], names[k]));
+        add_missing(0x1018, od::ObjectCode::Record, DataType::Identity, "Identity", std::move(entries));
+    }
     // 0x1C00 (SyncManager communication type) for a CoE device that does not declare it.
     if (coe && !built.objects.count(0x1C00) && !desc.sync_managers.empty()) {
-        od::Object o;
-        o.index = 0x1C00;
-        o.code = od::ObjectCode::Array;
-        o.type = DataType::Unsigned8;
-        o.name = "Sync manager type";
-        o.entries.push_back(u_entry(0x1C00, 0, DataType::Unsigned8, od::access::RO, desc.sync_managers.size(),
-                                    "SubIndex 000"));
+        std::vector<od::Entry> entries{u_entry(0x1C00, 0, DataType::Unsigned8, od::access::RO,
+                                               desc.sync_managers.size(), "SubIndex 000")};
         for (std::size_t n = 0; n < desc.sync_managers.size() && n < 32; ++n)
-            o.entries.push_back(u_entry(0x1C00, static_cast<uint8_t>(n + 1), DataType::Unsigned8,
-                                        od::access::RO, static_cast<uint64_t>(desc.sync_managers[n].kind),
-                                        nth(static_cast<unsigned>(n + 1))));
-        built.objects[0x1C00] = std::move(o);
-        built.lines[0x1C00] = d.line;
+            entries.push_back(u_entry(0x1C00, static_cast<uint8_t>(n + 1), DataType::Unsigned8,
+                                      od::access::RO, static_cast<uint64_t>(desc.sync_managers[n].kind),
+                                      nth(static_cast<unsigned>(n + 1))));
+        add_missing(0x1C00, od::ObjectCode::Array, DataType::Unsigned8, "Sync manager type",
+                    std::move(entries));
     }
 
     // ---- Predefined PDO sets (AlternativeSmMapping) ----
@@ -1092,9 +1167,10 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
             try {
                 (void)build_sii(product.description, dict);
                 break;
-            } catch (const std::length_error&) {
+            } catch (const std::length_error& e) {
+                // Too little EEPROM (a larger one helps), or more than the SII can say (255 strings): not.
                 if (product.description.eeprom_bytes >= 32768)
-                    ctx.fail(d.eeprom_line, "the SII of this device does not fit 32 KiB");
+                    ctx.fail(d.eeprom_line, std::string("no SII can be built for this device: ") + e.what());
                 product.description.eeprom_bytes =
                     static_cast<uint16_t>(product.description.eeprom_bytes * 2);
             } catch (const std::invalid_argument& e) {

@@ -105,6 +105,41 @@ struct DcOpMode {
     bool operator==(const DcOpMode&) const = default;
 };
 
+// A modular device's slots and the modules they take (ESI Slots, Descriptions/Modules; ETG.2000), kept so
+// that the ESI written back offers the same choices. The dictionary and the PDOs hold the default
+// configuration (each slot's default module placed); these say where it came from.
+struct ModulePdoEntry {
+    uint16_t index = 0;  // 0: padding; the module's base index (before the slot's increment)
+    uint8_t subindex = 0;
+    uint8_t bit_length = 0;
+    std::string name;
+    std::string data_type;        // ESI type name ("BOOL", "INT", ...), empty for padding
+    bool depend_on_slot = false;  // the slot's index increment is added
+};
+struct ModulePdo {
+    bool rx = false;
+    uint16_t index = 0;  // base index (before the slot's PDO increment)
+    bool depend_on_slot = false;
+    std::string name;
+    int sm = -1;
+    bool fixed = false;
+    bool mandatory = false;
+    std::vector<ModulePdoEntry> entries;
+};
+struct Module {
+    uint32_t ident = 0;  // ModuleIdent
+    std::string type;    // Type text
+    std::string name;
+    std::vector<ModulePdo> pdos;
+};
+struct Slot {
+    std::string name;
+    uint32_t min_instances = 0, max_instances = 1;
+    std::vector<uint32_t> module_idents;  // the modules it takes
+    uint32_t default_module = 0;          // 0: empty by default
+    uint32_t pdo_increment = 0, index_increment = 0;
+};
+
 struct DeviceDescription {
     Identity identity;
     MailboxLayout standard_mailbox;
@@ -132,6 +167,9 @@ struct DeviceDescription {
     // slave may take to take a request out of SM0 and to answer it (0: not declared).
     uint32_t mailbox_request_timeout_ms = 0;
     uint32_t mailbox_response_timeout_ms = 0;
+    // A modular device (empty: not modular). The PDOs of the slots' default modules are in the dictionary.
+    std::vector<Slot> slots;
+    std::vector<Module> modules;
 };
 
 }  // namespace od
