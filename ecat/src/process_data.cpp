@@ -69,7 +69,7 @@ uint16_t ProcessData::build_side(uint16_t assign_index, bool rx, std::vector<Pdo
                 if (raw.size() * 8 < length) return code;
                 // The value image is owned by the dictionary and never moves after declaration; the plan
                 // writes outputs straight into it, as od::Ref<T> does.
-                plan.push_back({const_cast<uint8_t*>(raw.data()), static_cast<uint32_t>(bits), length});
+                plan.push_back({const_cast<uint8_t*>(raw.data()), static_cast<uint32_t>(bits), length, e});
             }
             bits += length;
         }

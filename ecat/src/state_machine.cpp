@@ -51,6 +51,11 @@ int rank(AlState s) {
 }  // namespace
 
 void StateMachine::write_status() {
+    if (device_emulation()) {
+        // The ESC owns AL status; no error indication, no code.
+        ctx_.pdi.write_reg<uint16_t>(esc::reg::kAlStatusCode, 0);
+        return;
+    }
     uint16_t status = static_cast<uint16_t>(state_);
     if (error_) status |= esc::reg::kAlErrorFlag;
     if (id_loaded_ && !error_) status |= esc::reg::kAlIdFlag;
@@ -126,6 +131,10 @@ void StateMachine::request(AlState to, uint64_t now_ns) {
 }
 
 void StateMachine::request_checked(AlState to, uint64_t now_ns) {
+    if (device_emulation()) {
+        follow(to, now_ns);
+        return;
+    }
     const AlState from = state_;
     const bool boot_supported = check_bootstrap() == 0;
     if (to == AlState::Boot && from == AlState::Init && (!boot_supported || ctx_.faults.bootstrap_refused)) {
@@ -165,12 +174,36 @@ void StateMachine::request_checked(AlState to, uint64_t now_ns) {
     go(to, now_ns);
 }
 
+bool StateMachine::device_emulation() const {
+    // ESC configuration 0x0141 bit 0 (from SII word 0): the ESC copies AL control into AL status itself
+    // (ESC datasheet, AL status; the ConfigData of IO terminals without a controller). Such a device has no
+    // state machine of its own that could refuse a request.
+    return (ctx_.pdi.read_reg<uint8_t>(esc::reg::kEscConfig) & 0x01) != 0;
+}
+
+void StateMachine::follow(AlState to, uint64_t now_ns) {
+    // The state the ESC took: the stack goes along, setting up (or stopping) its process data on the way
+    // and never raising an error (there is no AL status code without a controller). Bootstrap is not
+    // followed: nothing to start without a bootstrap mailbox.
+    if (to == AlState::Boot) return;
+    const bool pd = rank(to) >= rank(AlState::SafeOp);
+    if (rank(state_) < rank(AlState::PreOp) && rank(to) >= rank(AlState::PreOp)) go(AlState::PreOp, now_ns);
+    if (pd && !process_data_state(state_)) {
+        if (check_pre_op_to_safe_op() != al::NoError) ctx_.pd.clear();  // the ESC runs without data from us
+        go(AlState::SafeOp, now_ns);
+    }
+    go(to, now_ns);
+}
+
 uint16_t StateMachine::check_bootstrap() const {
+    // Bootstrap is supported when the device announces a bootstrap mailbox (SII words 0x14-0x17, the ESI's
+    // Mailbox/BootStrap): what is served there is the mailbox handlers' business (FoE if declared; any other
+    // request gets "unsupported protocol"). The MAXPOS declares FoE with its bootstrap mailbox; a device with
+    // a mailbox but no bootstrap mailbox announced refuses Bootstrap (0x0013).
     const od::DeviceDescription& desc = ctx_.desc;
-    const bool foe = (desc.mailbox_protocols & od::mailbox_protocol::FoE) != 0;
     const bool sized = desc.bootstrap_mailbox.out_size > kMailboxHeaderSize &&
                        desc.bootstrap_mailbox.in_size > kMailboxHeaderSize;
-    return foe && sized ? al::NoError : al::BootstrapNotSupported;
+    return sized && has_mailbox(desc) ? al::NoError : al::BootstrapNotSupported;
 }
 
 uint16_t StateMachine::check_mailbox(const od::MailboxLayout& layout, uint16_t code) {
@@ -369,6 +402,9 @@ void StateMachine::refuse(uint16_t code) {
 }
 
 void StateMachine::fall_back(AlState to, uint16_t code, uint64_t now_ns) {
+    // With device emulation the ESC keeps the state the master asked for (a watchdog expiry clears the
+    // outputs in hardware): nothing to fall back to, no error indication to set.
+    if (device_emulation()) return;
     op_pending_ = false;
     if (rank(to) < rank(state_)) go(to, now_ns);
     refuse(code);

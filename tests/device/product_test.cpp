@@ -76,6 +76,13 @@ uint16_t u16(std::span<const uint8_t> b, std::size_t at) {
     return static_cast<uint16_t>(b[at] | (b[at + 1] << 8));
 }
 
+// The one slave addressed and taken to Pre-Op, no mailbox configured.
+void preop_without_mailbox(Master& m, Address a) {
+    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m));
+    AlStatus st;
+    ASSERT_EQ(m.request_state(a, AlState::PreOp, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
+}
+
 }  // namespace
 
 TEST(ProductWithoutMailbox, HasOnlyTheProcessDataPartsAndSaysItsWarningsOnce) {
@@ -98,9 +105,8 @@ TEST(ProductWithoutMailbox, ReachesOpWithProcessDataOnlyAndItsInputsFollowTheDef
     UnitLink link(u);
     Master m(link, test_support::in_process_master_options());
     const Address a = Address::station(0x1001);
-    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m));
+    ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
     AlStatus st;
-    ASSERT_EQ(m.request_state(a, AlState::PreOp, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
 
     ProcessDataSession pd(m, std::span<const Address>(&a, 1));
     ASSERT_EQ(pd.discover_sii(0), Error::Ok);
@@ -179,9 +185,8 @@ TEST(ProductWithoutMailbox, InitToPreOpNeedsNoMailboxSmsAndStartsNone) {
     UnitLink link(u);
     Master m(link, test_support::in_process_master_options());
     const Address a = Address::station(0x1001);
-    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m));
+    ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
     AlStatus st;
-    ASSERT_EQ(m.request_state(a, AlState::PreOp, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
     // SM0/SM1 stay deactivated from the PDI until Safe-Op starts the process data in them.
     EXPECT_NE(m.read_reg<uint8_t>(a, 0x0807).value() & 0x01, 0);
     EXPECT_NE(m.read_reg<uint8_t>(a, 0x080F).value() & 0x01, 0);
@@ -250,4 +255,36 @@ TEST(ProductWithCoe, EveryProtocolItDoesNotServeGetsTheUnsupportedProtocolError)
     SdoClient sdo(mbx);
     uint8_t b[4] = {};
     EXPECT_TRUE(sdo.upload(0x1018, 1, b).ok());
+}
+
+// A device whose ESC does device emulation (ESC configuration bit 0 from SII word 0, as IO terminals without
+// a controller declare in their ConfigData): the ESC copies AL control into AL status, so any request is
+// taken as it comes (Init -> Op directly, no refusal, AL status code 0), and the stack follows it with its
+// process data.
+TEST(ProductWithDeviceEmulation, FollowsTheStateTheEscTookWithItsProcessData) {
+    auto p = std::make_shared<od::Product>(*io_terminal());
+    p->description.esc_config = 0x01;
+    Unit u(p);
+    UnitLink link(u);
+    Master m(link, test_support::in_process_master_options());
+    const Address a = Address::station(0x1001);
+    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m));
+    ProcessDataSession pd(m, std::span<const Address>(&a, 1));
+    ASSERT_EQ(pd.discover_sii(0), Error::Ok);
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    AlStatus st;
+    ASSERT_EQ(m.request_state(a, AlState::Op, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
+    EXPECT_EQ(st.code, 0);
+    EXPECT_EQ(u.dev->stack().state(), od::AlState::Op);
+    auto fill = [&] {
+        pd.outputs()[0] = 0x21;
+        pd.outputs()[1] = 0x43;
+    };
+    ASSERT_EQ(pd.run(5, std::chrono::microseconds(100), fill), Error::Ok);
+    EXPECT_EQ(u16(pd.inputs(), 0), 0x4321);
+    // An invalid request is not refused either: the ESC took it.
+    ASSERT_EQ(m.request_state(a, AlState::Init, &st), Error::Ok);
+    ASSERT_EQ(m.request_state(a, AlState::SafeOp, &st), Error::Ok);
+    EXPECT_EQ(st.code, 0);
+    EXPECT_EQ(u.dev->stack().state(), od::AlState::SafeOp);
 }

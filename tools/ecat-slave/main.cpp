@@ -169,6 +169,18 @@ int main(int argc, char** argv) {
         ->check(CLI::ExistingFile)
         ->excludes(slaves_opt)
         ->type_name("FILE");
+    // A device from its vendor's ESI (issue 21): the product esi::load_product makes of it.
+    std::string esi_file, device_spec;
+    auto* esi_opt =
+        app.add_option("--esi", esi_file,
+                       "Serve the device this ESI file (EtherCATInfo XML) describes instead of the "
+                       "MAXPOS: identity, SII, SMs, dictionary, PDOs, mailbox protocols from the file")
+            ->type_name("FILE");
+    app.add_option(
+           "--device", device_spec,
+           "The device of a --esi file with several: 0xPRODUCT:0xREVISION, 0xPRODUCT, or its Type name")
+        ->needs(esi_opt)
+        ->type_name("SPEC");
     std::string eni_file;
     app.add_option(
            "--eni", eni_file,
@@ -176,6 +188,7 @@ int main(int argc, char** argv) {
            "export it) describes, in its order and wiring; each slave from the ENI's data "
            "(docs/eni.md)")
         ->excludes(slaves_opt)
+        ->excludes(esi_opt)
         ->type_name("FILE");
     std::string esi_dir;
     app.add_option(
@@ -231,6 +244,19 @@ int main(int argc, char** argv) {
     if (stops.size() == 2) device.environment.stop_lo = stops[0], device.environment.stop_hi = stops[1];
     if (auto* config = app.get_config_ptr(); config != nullptr && config->count() > 0)
         device.config_file = config->as<std::string>();
+    if (!esi_file.empty()) {
+        // A bad file or spec is a usage error naming the file (and line) before anything else is set up.
+        if (!device.config_file.empty()) {
+            std::cerr << "ecat-slave: --esi serves the device of its file: not with a MAXPOS --config\n";
+            return slave::kExitUsage;
+        }
+        try {
+            device.product = std::make_shared<const od::Product>(esi::load_product(esi_file, device_spec));
+        } catch (const std::exception& e) {
+            std::cerr << "ecat-slave: " << e.what() << '\n';
+            return slave::kExitUsage;
+        }
+    }
     device.state_dir = state_dir;
     slave::Log log(std::cerr, quiet ? slave::LogLevel::Error : *slave::parse_log_level(log_level),
                    slave::stderr_is_terminal());
@@ -292,11 +318,12 @@ int main(int argc, char** argv) {
             revision << "0x" << std::hex << std::uppercase << std::setw(8) << std::setfill('0')
                      << id.revision;
             std::cerr << "ecat-slave: "
-                      << (described.state_dir.empty()
+                      << (described.product ? described.product->source
+                          : described.state_dir.empty()
                               ? "the built-in firmware"
                               : "the firmware active in " + described.state_dir.string())
-                      << ", software version " << id.software_version << ", revision " << revision.str()
-                      << '\n';
+                      << (id.software_version.empty() ? "" : ", software version " + id.software_version)
+                      << ", revision " << revision.str() << '\n';
             return slave::kExitOk;
         }
         device::check_device(device);  // a bad configuration is a usage error, before any setup

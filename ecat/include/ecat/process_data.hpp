@@ -16,6 +16,7 @@ struct PdoCopy {
     uint8_t* storage = nullptr;  // entry value in the dictionary's image (nullptr: padding, never copied)
     uint32_t bit_offset = 0;     // position in the SM buffer
     uint16_t bits = 0;
+    const od::Entry* entry = nullptr;  // the entry mapped (for the application's view of the mapping)
 };
 
 class ProcessData {

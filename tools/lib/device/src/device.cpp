@@ -187,8 +187,10 @@ Device::Device(esc::Esc& esc, DeviceOptions options)
     // What the product declares that is not emulated: said once.
     if (options_.product)
         for (const std::string& w : options_.product->warnings) {
-            log() << "softecat: " << options_.product->source << ": " << w << '\n';
-            event(slave::LogLevel::Warn, options_.product->source + ": " + w);
+            if (options_.events != nullptr)
+                event(slave::LogLevel::Warn, options_.product->source + ": " + w);
+            else
+                log() << "softecat: " << options_.product->source << ": " << w << '\n';
         }
     // Registered once the device exists: a constructor that throws leaves no callback behind.
     if (options_.load_sii)
@@ -545,8 +547,7 @@ void Device::on_state_change(od::AlState from, od::AlState to) {
         const bool pd_from = from == od::AlState::SafeOp || from == od::AlState::Op;
         const bool pd_to = to == od::AlState::SafeOp || to == od::AlState::Op;
         if (pd_to && !pd_from) {
-            const ecat::ProcessDataSms sms = ecat::process_data_sms(parts_->desc);
-            parts_->io->build(parts_->dict, sms.outputs, sms.inputs, held_);
+            parts_->io->build(parts_->stack->process_data(), held_);
         } else if (pd_from && !pd_to) {
             parts_->io->clear();
         }

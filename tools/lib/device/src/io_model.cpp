@@ -10,38 +10,11 @@
 namespace device {
 namespace {
 
-bool read_unsigned(const od::Dictionary& d, uint16_t index, uint8_t sub, uint64_t& value) {
-    const auto raw = d.raw(index, sub);
-    if (raw.empty() || raw.size() > 8) return false;
-    value = 0;
-    for (std::size_t i = 0; i < raw.size(); ++i)
-        value |= static_cast<uint64_t>(raw[i]) << (8 * i);
-    return true;
-}
-
-// The entries mapped by the PDOs assigned to SM n, in mapping order (padding left out).
-void mapped(od::Dictionary& d, unsigned sm, std::vector<IoEntry>& out) {
+// The entries of a copy plan, in mapping order (padding is not in the plan).
+void mapped(std::span<const ecat::PdoCopy> plan, std::vector<IoEntry>& out) {
     out.clear();
-    if (sm >= 32) return;
-    const uint16_t assign = ecat::ProcessData::assign_index(sm);
-    uint64_t pdos = 0;
-    if (d.find(assign) == nullptr || !read_unsigned(d, assign, 0, pdos)) return;
-    for (uint8_t i = 1; i <= pdos && i != 0; ++i) {
-        uint64_t pdo = 0, count = 0;
-        if (!read_unsigned(d, assign, i, pdo) || !read_unsigned(d, static_cast<uint16_t>(pdo), 0, count))
-            continue;
-        for (uint8_t k = 1; k <= count && k != 0; ++k) {
-            uint64_t m = 0;
-            if (!read_unsigned(d, static_cast<uint16_t>(pdo), k, m)) continue;
-            const auto index = static_cast<uint16_t>(m >> 16);
-            const auto sub = static_cast<uint8_t>(m >> 8);
-            const od::Entry* e = d.find(index, sub);
-            if (e == nullptr || index < 0x1000 || e->bit_length == 0) continue;  // padding or missing
-            const auto raw = d.mutable_raw(index, sub);
-            if (raw.empty()) continue;
-            out.push_back({e, raw.data()});
-        }
-    }
+    for (const ecat::PdoCopy& c : plan)
+        if (c.entry != nullptr && c.storage != nullptr) out.push_back({c.entry, c.storage});
 }
 
 std::string lower(std::string_view s) {
@@ -62,11 +35,10 @@ bool IoModel::is_counter_name(std::string_view name) {
     return lower(name).find("counter") != std::string::npos;
 }
 
-void IoModel::build(od::Dictionary& dict, unsigned outputs_sm, unsigned inputs_sm,
-                    const std::set<uint32_t>& held) {
+void IoModel::build(const ecat::ProcessData& pd, const std::set<uint32_t>& held) {
     clear();
-    mapped(dict, outputs_sm, outputs_);
-    mapped(dict, inputs_sm, inputs_);
+    mapped(pd.rx_plan(), outputs_);
+    mapped(pd.tx_plan(), inputs_);
     std::vector<bool> taken(outputs_.size(), false);
     for (const IoEntry& in : inputs_) {
         const uint32_t key = io_key(in.entry->index, in.entry->subindex);

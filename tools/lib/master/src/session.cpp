@@ -262,18 +262,27 @@ Error ProcessDataSession::configure(Slave& slave, const DcConfig& dc) {
     const ProcessDataLayout& layout = slave.layout;
     const Address a = slave.address;
     if (SdoClient* sdo = slave.sdo) {
-        // Sync mode first: the slave checks it against 0x0981 on PREOP -> SAFEOP.
+        // Sync mode first: the slave checks it against 0x0981 on PREOP -> SAFEOP. A slave without 0x1C32
+        // (an input terminal has only 0x1C33, a simple one neither: ETG.1020 makes them optional) runs in
+        // the mode its SMs and 0x0981 give.
+        const auto absent = [sdo](Error e) {
+            return e == Error::SdoAbort &&
+                   (sdo->last_abort() == 0x06020000 || sdo->last_abort() == 0x06090011);
+        };
         const uint8_t mode_out[2] = {static_cast<uint8_t>(dc.enable ? 2 : 1), 0};
-        if (Error e = sdo->download(0x1C32, 1, mode_out); e != Error::Ok) return e;
+        if (Error e = sdo->download(0x1C32, 1, mode_out); e != Error::Ok && !absent(e)) return e;
         const uint8_t mode_in[2] = {static_cast<uint8_t>(dc.enable ? 2 : (layout.sm2_length ? 0x22 : 1)), 0};
-        if (Error e = sdo->download(0x1C33, 1, mode_in); e != Error::Ok) {
+        if (Error e = sdo->download(0x1C33, 1, mode_in); e != Error::Ok && !absent(e)) {
             const uint8_t plain[2] = {static_cast<uint8_t>(dc.enable ? 2 : 1), 0};
             if (sdo->download(0x1C33, 1, plain) != Error::Ok) return e;
         }
         if (dc.enable) {
             uint8_t cyc[4];
             put32(cyc, dc.cycle_ns);
-            if (Error e = sdo->download(0x1C32, 2, cyc); e != Error::Ok) return e;
+            // A read-only cycle time (the ESI's access; the slave takes it from SYNC0) is not an error.
+            if (Error e = sdo->download(0x1C32, 2, cyc);
+                e != Error::Ok && !absent(e) && !(e == Error::SdoAbort && sdo->last_abort() == 0x06010002))
+                return e;
             (void)sdo->download(0x1C33, 2, cyc);  // some slaves derive it from 0x1C32 and refuse the write
         }
     }

@@ -17,6 +17,7 @@
 #include <span>
 #include <vector>
 
+#include "ecat/process_data.hpp"
 #include "od/dictionary.hpp"
 
 namespace device {
@@ -29,8 +30,8 @@ struct IoEntry {
 class IoModel {
   public:
     IoModel();
-    // From the PDO assignment objects of the output and input SM (0x1C10 + n; n >= 32: none).
-    void build(od::Dictionary& dict, unsigned outputs_sm, unsigned inputs_sm, const std::set<uint32_t>& held);
+    // From the stack's copy plans (the mapping taken over at Pre-Op -> Safe-Op).
+    void build(const ecat::ProcessData& pd, const std::set<uint32_t>& held);
     void clear();
     // Mirrors and counters of one cycle.
     void cycle();
