@@ -103,7 +103,7 @@ EniLine eni_line(const std::string& file, const EsiIndex* esis) {
             " from the master): served from " + product->source +
             (product->warnings.empty()
                  ? ""
-                 : "; " + std::to_string(product->warnings.size()) + " things not emulated (below)") +
+                 : "; not emulated: " + std::to_string(product->warnings.size()) + " (said below)") +
             (other_revisions.empty() ? "" : "; the ESIs have only revision(s) " + other_revisions));
         out.topology.devices.push_back(std::move(d));
         out.products.push_back(std::move(product));

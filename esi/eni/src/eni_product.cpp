@@ -216,8 +216,7 @@ od::Dictionary build(const Plan& plan, const od::DeviceDescription& d) {
 
 od::Product product_from_eni(const Config& config, std::size_t index) {
     const Slave& s = config.slaves.at(index);
-    const std::string who =
-        config.where(s.line) + ": slave " + std::to_string(index) + " '" + s.info.name + "'";
+    const std::string who = config.where(s.line);  // Product::source names the slave
     auto fail = [&](int line, const std::string& what) { throw EniError(config.where(line) + ": " + what); };
     od::Product p;
     p.source = config.file + ", slave " + std::to_string(index) + " '" + s.info.name + "' (ENI data)";
