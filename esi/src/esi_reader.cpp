@@ -11,41 +11,18 @@
 #include <stdexcept>
 
 #include "util/input_file.hpp"
+#include "xml_tree.hpp"
 
 namespace esi {
 
 namespace {
 
-using Node = xmlNode*;
-
-std::string name_of(Node n) {
-    return n && n->name ? reinterpret_cast<const char*>(n->name) : "";
-}
-bool is(Node n, const char* name) {
-    return n && n->type == XML_ELEMENT_NODE && name_of(n) == name;
-}
-Node child(Node n, const char* name) {
-    if (!n) return nullptr;
-    for (Node c = n->children; c; c = c->next)
-        if (is(c, name)) return c;
-    return nullptr;
-}
-std::vector<Node> children(Node n, const char* name) {
-    std::vector<Node> out;
-    if (!n) return out;
-    for (Node c = n->children; c; c = c->next)
-        if (is(c, name)) out.push_back(c);
-    return out;
-}
-std::string text(Node n) {
-    if (!n) return "";
-    xmlChar* t = xmlNodeGetContent(n);
-    std::string s = t ? reinterpret_cast<const char*>(t) : "";
-    xmlFree(t);
-    auto b = s.find_first_not_of(" \t\r\n");
-    auto e = s.find_last_not_of(" \t\r\n");
-    return b == std::string::npos ? "" : s.substr(b, e - b + 1);
-}
+using xml::child;
+using xml::children;
+using xml::is;
+using xml::name_of;
+using xml::Node;
+using xml::text;
 std::string text(Node n, const char* name) {
     return text(child(n, name));
 }

@@ -50,7 +50,8 @@ Line::Line(const esc::Clock& clock, LineOptions options, slave::ExternalSend sen
     const slave::Topology& topo = options_.topology;
     units_.reserve(topo.devices.size());
     std::vector<const od::Product*> announced;  // products whose warnings a unit said already
-    for (const slave::TopologyDevice& d : topo.devices) {
+    for (std::size_t i = 0; i < topo.devices.size(); ++i) {
+        const slave::TopologyDevice& d = topo.devices[i];
         auto u = std::make_unique<Unit>();
         u->name = d.name;
         u->log_name = "ecat-slave: " + d.name;
@@ -59,6 +60,7 @@ Line::Line(const esc::Clock& clock, LineOptions options, slave::ExternalSend sen
                                                   options_.log->colour(), u->log_name);
         u->options = options_.base;
         if (!d.config.empty()) u->options.config_file = d.config;
+        if (i < options_.products.size() && options_.products[i]) u->options.product = options_.products[i];
         u->options.state_dir =
             d.state_dir.empty() ? options_.base.state_dir / d.name : std::filesystem::path(d.state_dir);
         if (d.serial) u->options.serial_number = d.serial;
