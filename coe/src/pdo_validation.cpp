@@ -121,6 +121,10 @@ od::Status check_assignment(const od::Dictionary& d, uint16_t assign, const od::
             if (u16(d, assign, t) == pdo) return od::Status::InvalidValue;  // assigned twice
     }
     if (assigned_bytes(d, assign, n, 0, 0) > lim.max_sm_bytes) return od::Status::PdoLengthExceeded;
+    // Count 0 opens the assignment for a change (the first write of every reassignment a configuration tool
+    // makes, TwinCAT's and EC-Engineer's CoE init commands alike): Mandatory and Exclude are checked on the
+    // count that puts an assignment in force.
+    if (n == 0) return od::Status::Ok;
     return rules_after(d, assign, n, rules);
 }
 

@@ -232,6 +232,18 @@ uint32_t convert(uint32_t raw, bool is_signed, double factor) {
 }  // namespace
 
 void Drive::load_positions() {
+    if (resolution_from_feed_) {
+        // No 0x608F: the position unit is the increment, so a revolution has as many increments as the feed
+        // constant and gear ratio give it (the encoder's resolution the device implies).
+        Parameters& p = axis_.params;
+        if (p.feed != 0 && p.feed_shaft_revolutions != 0 && p.gear_shaft_revolutions != 0) {
+            const double per_rev = static_cast<double>(p.feed) / p.feed_shaft_revolutions *
+                                   p.gear_motor_revolutions / p.gear_shaft_revolutions;
+            p.resolution_increments =
+                static_cast<uint32_t>(std::clamp(std::round(per_rev), 4.0, 1073741824.0));
+            p.resolution_revolutions = 1;
+        }
+    }
     // Position: increments per unit; velocity (acceleration): rpm per unit/s (rpm/s per unit/s^2).
     const double fp = increments_per_unit();
     const double fv = fp * 60.0 / increments_per_rev();
@@ -283,6 +295,7 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink, const VendorObjects& v
     // factor group); without them the units are the encoder's increments and nothing is converted.
     scaled_ = dict_.find(obj::GearMotorRevolutions.index) != nullptr ||
               dict_.find(obj::FeedConstantFeed.index) != nullptr;
+    resolution_from_feed_ = scaled_ && dict_.find(obj::PositionEncoderIncrements.index) == nullptr;
     // Velocities then in position units per second (accelerations per second squared), as 0x60A9/0x60AA
     // default to (IEC 61800-7-201), unless 0x60A9 says revolutions per minute (0x00B447xx).
     if (scaled_) {

@@ -11,12 +11,18 @@ using od::AlState;
 
 Cycle::Cycle(StackContext& ctx, StateMachine& esm, SyncControl& sync, IrqLine irq)
     : ctx_(ctx), esm_(esm), sync_(sync), irq_(std::move(irq)) {
+    out_sm_ = ctx_.sms.outputs < 4 ? ctx_.sms.outputs : 2;
+    in_sm_ = ctx_.sms.inputs < 4 ? ctx_.sms.inputs : 3;
+    event_mask_ = kEventMask & ~(esc::alev::sm(0) | esc::alev::sm(2) | esc::alev::sm(3));
+    if (has_mailbox(ctx_.desc)) event_mask_ |= esc::alev::sm(0);
+    if (ctx_.sms.outputs < 4) event_mask_ |= esc::alev::sm(ctx_.sms.outputs);
+    if (ctx_.sms.inputs < 4) event_mask_ |= esc::alev::sm(ctx_.sms.inputs);
     sm2_buf_.reserve(1024);
     sm3_buf_.reserve(1024);
 }
 
 void Cycle::set_up_registers() {
-    ctx_.pdi.write_reg<uint32_t>(esc::reg::kAlEventMask, kEventMask);
+    ctx_.pdi.write_reg<uint32_t>(esc::reg::kAlEventMask, event_mask_);
 }
 
 // ---- poll -------------------------------------------------------------------------------------------
@@ -80,7 +86,7 @@ uint64_t Cycle::next_deadline_ns() const {
 bool Cycle::esc_was_reset() {
     // The AL event mask is written only through the PDI (by this stack, at start); an ESC reset puts it
     // back to its reset value. On a device the ESC's reset would reset the controller behind it as well.
-    return ctx_.pdi.read_reg<uint32_t>(esc::reg::kAlEventMask) != kEventMask;
+    return ctx_.pdi.read_reg<uint32_t>(esc::reg::kAlEventMask) != event_mask_;
 }
 
 void Cycle::restart_after_esc_reset(uint64_t now_ns) {
@@ -108,8 +114,8 @@ void Cycle::update_irq_usable() {
         usable = usable && (read_sm(pdi, 0).control & kPdiEvent) && (read_sm(pdi, 1).control & kPdiEvent);
     }
     if (process_data_state(esm_.state())) {
-        if (!sm2_buf_.empty()) usable = usable && (read_sm(pdi, 2).control & kPdiEvent);
-        if (!sm3_buf_.empty()) usable = usable && (read_sm(pdi, 3).control & kPdiEvent);
+        if (!sm2_buf_.empty()) usable = usable && (read_sm(pdi, out_sm_).control & kPdiEvent);
+        if (!sm3_buf_.empty()) usable = usable && (read_sm(pdi, in_sm_).control & kPdiEvent);
     }
     irq_usable_ = usable;
 }
@@ -122,16 +128,16 @@ void Cycle::start_process_data(uint64_t now_ns) {
     sm3_buf_.assign(pd.tx_bytes(), 0);
     outputs_seen_ = false;
     sync_.start(now_ns);
-    if (pd.rx_bytes() > 0) set_sm_pdi_deactivated(ctx_.pdi, 2, false);
+    if (pd.rx_bytes() > 0) set_sm_pdi_deactivated(ctx_.pdi, out_sm_, false);
     if (pd.tx_bytes() > 0) {
-        set_sm_pdi_deactivated(ctx_.pdi, 3, false);
+        set_sm_pdi_deactivated(ctx_.pdi, in_sm_, false);
         write_inputs();  // valid inputs from the first Safe-Op frame on
     }
 }
 
 void Cycle::stop_process_data() {
-    set_sm_pdi_deactivated(ctx_.pdi, 2, true);
-    set_sm_pdi_deactivated(ctx_.pdi, 3, true);
+    if (ctx_.sms.outputs < 4) set_sm_pdi_deactivated(ctx_.pdi, ctx_.sms.outputs, true);
+    if (ctx_.sms.inputs < 4) set_sm_pdi_deactivated(ctx_.pdi, ctx_.sms.inputs, true);
     ctx_.pd.clear();
     sm2_buf_.clear();
     sm3_buf_.clear();
@@ -160,25 +166,35 @@ void Cycle::run_cycle(uint64_t now_ns, bool fresh_outputs) {
 void Cycle::process_data_events(uint32_t events, uint64_t now_ns) {
     esc::Pdi& pdi = ctx_.pdi;
     const bool has_outputs = !sm2_buf_.empty();
+    // Outputs in an SM on the register space (the digital-output registers 0x0F00 of an ESC with digital
+    // I/O, as EL2xxx terminals declare them): the ESC serves them as registers (docs/decisions/esc.md,
+    // "SyncManager over the register area"), no SM event says when the master wrote them; what they hold is
+    // taken every pass.
+    const bool register_outputs = has_outputs && sm2_start_ < esc::reg::kRamBase;
     bool new_outputs = false;
-    if (has_outputs) {
-        const uint8_t st = pdi.read_reg<uint8_t>(esc::reg::sm_base(2) + esc::reg::kSmStatus);
-        new_outputs = (st & esc::reg::kSmStatusIrqWrite) != 0 || (events & esc::alev::sm(2)) != 0;
+    if (register_outputs) {
+        new_outputs = true;
+        outputs_seen_ = true;
+    } else if (has_outputs) {
+        const uint8_t st = pdi.read_reg<uint8_t>(esc::reg::sm_base(out_sm_) + esc::reg::kSmStatus);
+        new_outputs = (st & esc::reg::kSmStatusIrqWrite) != 0 || (events & esc::alev::sm(out_sm_)) != 0;
         if (new_outputs) outputs_seen_ = true;
     }
     switch (sync_.mode()) {
         case SyncMode::SmSync:
         case SyncMode::SmSync2:
-            if (has_outputs) {
+            if (has_outputs && !register_outputs) {
                 if (new_outputs) {
                     sync_.sample_sm2_latency();
                     run_cycle(now_ns, true);
                 }
             } else if (!sm3_buf_.empty()) {
                 // Inputs only: a new cycle each time the master has read the inputs.
-                const uint8_t st = pdi.read_reg<uint8_t>(esc::reg::sm_base(3) + esc::reg::kSmStatus);
-                if ((st & esc::reg::kSmStatusIrqRead) || (events & esc::alev::sm(3)))
-                    run_cycle(now_ns, false);
+                const uint8_t st = pdi.read_reg<uint8_t>(esc::reg::sm_base(in_sm_) + esc::reg::kSmStatus);
+                if ((st & esc::reg::kSmStatusIrqRead) || (events & esc::alev::sm(in_sm_)))
+                    run_cycle(now_ns, register_outputs);
+            } else if (register_outputs) {
+                run_cycle(now_ns, true);
             }
             break;
         case SyncMode::FreeRun:

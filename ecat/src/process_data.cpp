@@ -69,7 +69,7 @@ uint16_t ProcessData::build_side(uint16_t assign_index, bool rx, std::vector<Pdo
                 if (raw.size() * 8 < length) return code;
                 // The value image is owned by the dictionary and never moves after declaration; the plan
                 // writes outputs straight into it, as od::Ref<T> does.
-                plan.push_back({const_cast<uint8_t*>(raw.data()), static_cast<uint32_t>(bits), length});
+                plan.push_back({const_cast<uint8_t*>(raw.data()), static_cast<uint32_t>(bits), length, e});
             }
             bits += length;
         }
@@ -77,9 +77,11 @@ uint16_t ProcessData::build_side(uint16_t assign_index, bool rx, std::vector<Pdo
     return 0;
 }
 
-uint16_t ProcessData::build() {
-    uint16_t code = build_side(kRxAssign, true, rx_, rx_bits_);
-    if (code == 0) code = build_side(kTxAssign, false, tx_, tx_bits_);
+uint16_t ProcessData::build(unsigned outputs_sm, unsigned inputs_sm) {
+    clear();
+    uint16_t code = 0;
+    if (outputs_sm < 32) code = build_side(assign_index(outputs_sm), true, rx_, rx_bits_);
+    if (code == 0 && inputs_sm < 32) code = build_side(assign_index(inputs_sm), false, tx_, tx_bits_);
     if (code != 0) clear();
     return code;
 }

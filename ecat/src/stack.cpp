@@ -17,7 +17,8 @@ Stack::Stack(esc::Pdi& pdi, od::Dictionary& dictionary, const od::DeviceDescript
              Application& application, IrqLine irq)
     : mailbox_(pdi, max_mailbox(description)),
       pd_(dictionary),
-      ctx_{pdi, dictionary, description, application, mailbox_, pd_, stats_, faults_, nullptr},
+      ctx_{pdi, dictionary, description, application, mailbox_,
+           pd_, stats_,     faults_,     nullptr,     process_data_sms(description)},
       sync_(ctx_),
       esm_(ctx_, sync_, cycle_),
       cycle_(ctx_, esm_, sync_, std::move(irq)) {

@@ -51,6 +51,11 @@ int rank(AlState s) {
 }  // namespace
 
 void StateMachine::write_status() {
+    if (device_emulation()) {
+        // The ESC owns AL status; no error indication, no code.
+        ctx_.pdi.write_reg<uint16_t>(esc::reg::kAlStatusCode, 0);
+        return;
+    }
     uint16_t status = static_cast<uint16_t>(state_);
     if (error_) status |= esc::reg::kAlErrorFlag;
     if (id_loaded_ && !error_) status |= esc::reg::kAlIdFlag;
@@ -126,6 +131,10 @@ void StateMachine::request(AlState to, uint64_t now_ns) {
 }
 
 void StateMachine::request_checked(AlState to, uint64_t now_ns) {
+    if (device_emulation()) {
+        follow(to, now_ns);
+        return;
+    }
     const AlState from = state_;
     const bool boot_supported = check_bootstrap() == 0;
     if (to == AlState::Boot && from == AlState::Init && (!boot_supported || ctx_.faults.bootstrap_refused)) {
@@ -165,16 +174,43 @@ void StateMachine::request_checked(AlState to, uint64_t now_ns) {
     go(to, now_ns);
 }
 
+bool StateMachine::device_emulation() const {
+    // ESC configuration 0x0141 bit 0 (from SII word 0): the ESC copies AL control into AL status itself
+    // (ESC datasheet, AL status; the ConfigData of IO terminals without a controller). Such a device has no
+    // state machine of its own that could refuse a request.
+    return (ctx_.pdi.read_reg<uint8_t>(esc::reg::kEscConfig) & 0x01) != 0;
+}
+
+void StateMachine::follow(AlState to, uint64_t now_ns) {
+    // The state the ESC took: the stack goes along, setting up (or stopping) its process data on the way
+    // and never raising an error (there is no AL status code without a controller). Bootstrap is not
+    // followed: nothing to start without a bootstrap mailbox.
+    if (to == AlState::Boot) return;
+    const bool pd = rank(to) >= rank(AlState::SafeOp);
+    if (rank(state_) < rank(AlState::PreOp) && rank(to) >= rank(AlState::PreOp)) go(AlState::PreOp, now_ns);
+    if (pd && !process_data_state(state_)) {
+        if (check_pre_op_to_safe_op() != al::NoError) ctx_.pd.clear();  // the ESC runs without data from us
+        go(AlState::SafeOp, now_ns);
+    }
+    go(to, now_ns);
+}
+
 uint16_t StateMachine::check_bootstrap() const {
+    // Bootstrap is supported when the device announces a bootstrap mailbox (SII words 0x14-0x17, the ESI's
+    // Mailbox/BootStrap): what is served there is the mailbox handlers' business (FoE if declared; any other
+    // request gets "unsupported protocol"). The MAXPOS declares FoE with its bootstrap mailbox; a device with
+    // a mailbox but no bootstrap mailbox announced refuses Bootstrap (0x0013).
     const od::DeviceDescription& desc = ctx_.desc;
-    const bool foe = (desc.mailbox_protocols & od::mailbox_protocol::FoE) != 0;
     const bool sized = desc.bootstrap_mailbox.out_size > kMailboxHeaderSize &&
                        desc.bootstrap_mailbox.in_size > kMailboxHeaderSize;
-    return foe && sized ? al::NoError : al::BootstrapNotSupported;
+    return sized && has_mailbox(desc) ? al::NoError : al::BootstrapNotSupported;
 }
 
 uint16_t StateMachine::check_mailbox(const od::MailboxLayout& layout, uint16_t code) {
-    if (layout.out_size == 0 && layout.in_size == 0) return al::NoError;  // device without mailbox
+    // A device without mailbox (ETG.2000: no Mailbox element, no MBoxOut/MBoxIn SM) goes to Pre-Op with
+    // whatever its SMs hold: SM0/SM1 are process-data SMs there, checked at Pre-Op -> Safe-Op.
+    if (layout.out_size == 0 && layout.in_size == 0) return al::NoError;
+    if (!has_mailbox(ctx_.desc)) return al::NoError;
     const SmRegs sm0 = read_sm(ctx_.pdi, 0);
     const SmRegs sm1 = read_sm(ctx_.pdi, 1);
     // Mode and direction must match; event-enable and watchdog bits are the master's choice.
@@ -202,7 +238,7 @@ uint16_t StateMachine::check_pre_op_to_safe_op() {
         if (kind != static_cast<uint64_t>(desc.sync_managers[n].kind)) return al::InvalidSmTypes;
     }
     // Take over the PDO assignment and mapping.
-    if (const uint16_t code = pd.build(); code != 0) return code;
+    if (const uint16_t code = pd.build(ctx_.sms.outputs, ctx_.sms.inputs); code != 0) return code;
 
     struct Side {
         unsigned sm;
@@ -211,19 +247,26 @@ uint16_t StateMachine::check_pre_op_to_safe_op() {
         uint16_t code;
         uint8_t fallback_control;
     };
-    const Side sides[2] = {{2, pd.rx_bytes(), esc::reg::kSmDirWrite, al::InvalidOutputConfig, 0x64},
-                           {3, pd.tx_bytes(), esc::reg::kSmDirRead, al::InvalidInputConfig, 0x20}};
+    const Side sides[2] = {
+        {ctx_.sms.outputs, pd.rx_bytes(), esc::reg::kSmDirWrite, al::InvalidOutputConfig, 0x64},
+        {ctx_.sms.inputs, pd.tx_bytes(), esc::reg::kSmDirRead, al::InvalidInputConfig, 0x20}};
     SmRegs regs[4];
     for (unsigned n = 0; n < 4; ++n)
         regs[n] = read_sm(ctx_.pdi, n);
     for (const Side& s : sides) {
+        if (s.sm >= 4) {
+            // No SM for this direction (a device with inputs only, or none): nothing mapped to check.
+            if (s.bytes != 0) return s.code;
+            continue;
+        }
         const SmRegs& r = regs[s.sm];
         const bool enabled = (r.activate & esc::reg::kSmEnable) && r.length > 0;
         if (s.bytes == 0) {
             if (enabled) return s.code;
             continue;
         }
-        if (!enabled || (r.length != s.bytes && !(s.sm == 2 && ctx_.faults.sm2_length_unchecked)))
+        if (!enabled ||
+            (r.length != s.bytes && !(s.sm == ctx_.sms.outputs && ctx_.faults.sm2_length_unchecked)))
             return s.code;
         if ((r.control & esc::reg::kSmModeMask) != esc::reg::kSmModeBuffered) return al::InvalidSmTypes;
         const uint8_t expected = expected_control(s.sm, s.fallback_control);
@@ -250,15 +293,16 @@ uint16_t StateMachine::check_pre_op_to_safe_op() {
         for (std::size_t j = i + 1; j < count; ++j)
             if (areas[i].begin < areas[j].end && areas[j].begin < areas[i].end) return al::InvalidSmConfig;
 
-    cycle_.set_sm_starts(regs[2].start, regs[3].start);
+    cycle_.set_sm_starts(ctx_.sms.outputs < 4 ? regs[ctx_.sms.outputs].start : 0,
+                         ctx_.sms.inputs < 4 ? regs[ctx_.sms.inputs].start : 0);
     if (const uint16_t code = sync_.configure(); code != 0) return code;
     return check_watchdog();
 }
 
 uint16_t StateMachine::check_watchdog() {
     esc::Pdi& pdi = ctx_.pdi;
-    if (ctx_.pd.rx_bytes() == 0) return al::NoError;
-    const SmRegs sm2 = read_sm(pdi, 2);
+    if (ctx_.pd.rx_bytes() == 0 || ctx_.sms.outputs >= 4) return al::NoError;
+    const SmRegs sm2 = read_sm(pdi, ctx_.sms.outputs);
     if (!(sm2.control & esc::reg::kSmWatchdogEnable)) return al::NoError;
     const uint16_t time = pdi.read_reg<uint16_t>(esc::reg::kWdTimePd);
     if (time == 0) return al::NoError;  // watchdog off
@@ -273,15 +317,17 @@ void StateMachine::check_process_data_sms(uint64_t now_ns) {
     // The master changed an SM while process data runs: SM2/SM3 must still be what Safe-Op was entered
     // with (ETG.1000.6 AL status codes 0x001D / 0x001E, Op or Safe-Op -> Safe-Op with error).
     auto still_valid = [this](unsigned n, std::size_t bytes, uint16_t start_address) {
+        if (n >= 4) return true;  // no SM for this direction
         const SmRegs r = read_sm(ctx_.pdi, n);
         const bool enabled = (r.activate & esc::reg::kSmEnable) && r.length > 0;
         if (bytes == 0) return !enabled;
-        const bool length_ok = r.length == bytes || (n == 2 && ctx_.faults.sm2_length_unchecked);
+        const bool length_ok =
+            r.length == bytes || (n == ctx_.sms.outputs && ctx_.faults.sm2_length_unchecked);
         return enabled && length_ok && r.start == start_address;
     };
-    if (!still_valid(2, cycle_.output_bytes(), cycle_.sm2_start())) {
+    if (!still_valid(ctx_.sms.outputs, cycle_.output_bytes(), cycle_.sm2_start())) {
         fall_back(AlState::SafeOp, al::InvalidOutputConfig, now_ns);
-    } else if (!still_valid(3, cycle_.input_bytes(), cycle_.sm3_start())) {
+    } else if (!still_valid(ctx_.sms.inputs, cycle_.input_bytes(), cycle_.sm3_start())) {
         fall_back(AlState::SafeOp, al::InvalidInputConfig, now_ns);
     }
 }
@@ -291,7 +337,8 @@ bool StateMachine::op_conditions_met() {
     if (ctx_.pd.rx_bytes() > 0) {
         if (!cycle_.outputs_seen()) return false;
         // Outputs seen once but since stopped: the process-data watchdog says they are stale.
-        const bool watched = (read_sm(pdi, 2).control & esc::reg::kSmWatchdogEnable) &&
+        const bool watched = ctx_.sms.outputs < 4 &&
+                             (read_sm(pdi, ctx_.sms.outputs).control & esc::reg::kSmWatchdogEnable) &&
                              pdi.read_reg<uint16_t>(esc::reg::kWdTimePd) != 0;
         if (watched && !(pdi.read_reg<uint16_t>(esc::reg::kWdStatusPd) & 0x0001)) return false;
     }
@@ -325,11 +372,13 @@ void StateMachine::go(AlState to, uint64_t now_ns) {
     // Downward: stop outputs, inputs, mailbox as the target state requires.
     if (from == AlState::Op) ctx_.app.on_outputs_lost();
     if (process_data_state(from) && !process_data_state(to)) cycle_.stop_process_data();
-    if (from != AlState::Init && (to == AlState::Init)) ctx_.mailbox.stop();
+    // A device without mailbox has no mailbox SMs to start or stop: SM0/SM1 carry its process data.
+    const bool mailbox = has_mailbox(ctx_.desc);
+    if (from != AlState::Init && (to == AlState::Init) && mailbox) ctx_.mailbox.stop();
     // Upward: start the mailbox (standard or bootstrap layout), the process data.
     if (from == AlState::Init && to == AlState::PreOp) {
         sync_.pre_op_entered();
-        ctx_.mailbox.start(ctx_.desc.standard_mailbox, AlState::PreOp);
+        if (mailbox) ctx_.mailbox.start(ctx_.desc.standard_mailbox, AlState::PreOp);
     }
     if (from == AlState::Init && to == AlState::Boot)
         ctx_.mailbox.start(ctx_.desc.bootstrap_mailbox, AlState::Boot);
@@ -353,6 +402,9 @@ void StateMachine::refuse(uint16_t code) {
 }
 
 void StateMachine::fall_back(AlState to, uint16_t code, uint64_t now_ns) {
+    // With device emulation the ESC keeps the state the master asked for (a watchdog expiry clears the
+    // outputs in hardware): nothing to fall back to, no error indication to set.
+    if (device_emulation()) return;
     op_pending_ = false;
     if (rank(to) < rank(state_)) go(to, now_ns);
     refuse(code);

@@ -208,10 +208,19 @@ void Esc::Impl::reg_special_write(uint16_t a, uint16_t e, const uint8_t* src, co
             mem.w8(kDlControlLoop, static_cast<uint8_t>(M(kDlControlLoop, 1)));
             ports.dl_control_written();
         }
-        if (hit(0x0300, 0x14)) {
-            for (uint16_t x = std::max<uint16_t>(a, 0x0300); x < std::min<uint16_t>(e, 0x0314); ++x)
+        // Error counters (ESC datasheet section II, 0x0300-0x0313): a write clears a whole group whatever
+        // byte it hits and whatever value it carries: any RX error counter byte (0x0300-0x030B) clears the
+        // invalid-frame, RX error and forwarded-RX error counters of every port; 0x030C the processing unit
+        // counter; 0x030D the PDI error counter; any lost-link byte (0x0310-0x0313) the four lost-link
+        // counters.
+        const auto clear = [&](uint16_t from, uint16_t len) {
+            for (uint16_t x = from; x < from + len; ++x)
                 mem.regs[x] = 0;
-        }
+        };
+        if (hit(0x0300, 0x0C)) clear(0x0300, 0x0C);
+        if (hit(0x030C, 1)) clear(0x030C, 1);
+        if (hit(0x030D, 1)) clear(0x030D, 2);
+        if (hit(0x0310, 4)) clear(0x0310, 4);
         if (hit(reg::kWdCounterPd, 2)) {
             mem.regs[reg::kWdCounterPd] = 0;
             mem.regs[reg::kWdCounterPdi] = 0;

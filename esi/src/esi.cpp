@@ -456,6 +456,45 @@ void pdo(xmlNodePtr device, const PdoInfo& p) {
     }
 }
 
+// A module's PDO (Descriptions/Modules/Module), indices as the module declares them (before the slot's
+// increments).
+void module_pdo(xmlNodePtr module, const od::ModulePdo& p) {
+    xmlNodePtr n = child(module, p.rx ? "RxPdo" : "TxPdo");
+    if (p.fixed) attr(n, "Fixed", "1");
+    if (p.mandatory) attr(n, "Mandatory", "1");
+    if (p.sm >= 0) attr(n, "Sm", std::to_string(p.sm));
+    xmlNodePtr index = child(n, "Index", hex_index(p.index));
+    if (p.depend_on_slot) attr(index, "DependOnSlot", "true");
+    named(n, "Name", p.name);
+    for (const od::ModulePdoEntry& e : p.entries) {
+        xmlNodePtr en = child(n, "Entry");
+        xmlNodePtr ei = child(en, "Index", hex_index(e.index));
+        if (e.depend_on_slot && e.index != 0) attr(ei, "DependOnSlot", "true");
+        if (e.index != 0) child(en, "SubIndex", std::to_string(e.subindex));
+        child(en, "BitLen", std::to_string(e.bit_length));
+        if (e.index != 0) {
+            named(en, "Name", e.name);
+            if (!e.data_type.empty()) child(en, "DataType", e.data_type);
+        }
+    }
+}
+
+// The PDO indices the slots' default modules place (they are written with their module, not the device).
+std::set<uint16_t> slot_pdos(const od::DeviceDescription& d) {
+    std::set<uint16_t> out;
+    for (std::size_t n = 0; n < d.slots.size(); ++n) {
+        const od::Slot& slot = d.slots[n];
+        if (slot.default_module == 0) continue;
+        for (const od::Module& m : d.modules) {
+            if (m.ident != slot.default_module) continue;
+            for (const od::ModulePdo& p : m.pdos)
+                out.insert(static_cast<uint16_t>(p.index + (p.depend_on_slot ? n * slot.pdo_increment : 0)));
+            break;
+        }
+    }
+    return out;
+}
+
 const char* sm_text(od::SmKind k) {
     switch (k) {
         case od::SmKind::MBoxOut:
@@ -580,13 +619,15 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
     if (kIdentificationInAlStatusCode) child(info, "IdentificationReg134", "true");
     child(device, "GroupType", id.group_type);
 
-    xmlNodePtr profile = child(device, "Profile");
-    if (m.profile_number != 0) {
-        child(profile, "ProfileNo", std::to_string(m.profile_number));
-        child(profile, "AddInfo", std::to_string(m.profile_add_info));
+    if (!dict.objects().empty()) {  // a coupler has no dictionary
+        xmlNodePtr profile = child(device, "Profile");
+        if (m.profile_number != 0) {
+            child(profile, "ProfileNo", std::to_string(m.profile_number));
+            child(profile, "AddInfo", std::to_string(m.profile_add_info));
+        }
+        dictionary(profile, dict);
+        if (dict.find(0x10F3) != nullptr) diag_messages(profile);
     }
-    dictionary(profile, dict);
-    if (dict.find(0x10F3) != nullptr) diag_messages(profile);
 
     for (FmmuUse f : m.fmmus)
         child(device, "Fmmu", fmmu_text(f));
@@ -601,10 +642,9 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
         attr(sm, "ControlByte", hex(s.control));
         attr(sm, "Enable", s.enable ? "1" : "0");
     }
-    for (const PdoInfo& p : m.pdos)
-        if (p.rx) pdo(device, p);
-    for (const PdoInfo& p : m.pdos)
-        if (!p.rx) pdo(device, p);
+    const std::set<uint16_t> in_slots = slot_pdos(d);
+    for (std::size_t i : m.pdo_order)
+        if (!in_slots.count(m.pdos[i].index)) pdo(device, m.pdos[i]);
 
     if (d.mailbox_protocols != 0) {
         namespace mp = od::mailbox_protocol;
@@ -637,9 +677,33 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
             if (!mode.description.empty()) child(op, "Desc", mode.description);
             child(op, "AssignActivate", hex(mode.assign_activate));
             if (mode.assign_activate != 0) {
-                xmlNodePtr c0 = child(op, "CycleTimeSync0", "0");
+                xmlNodePtr c0 = child(op, "CycleTimeSync0", std::to_string(mode.cycle_time_sync0));
                 attr(c0, "Factor", std::to_string(mode.cycle_time_sync0_factor));
                 child(op, "ShiftTimeSync0", std::to_string(mode.shift_time_sync0));
+                if (mode.cycle_time_sync1 != 0 || mode.cycle_time_sync1_factor != 0 ||
+                    mode.shift_time_sync1 != 0) {
+                    xmlNodePtr c1 = child(op, "CycleTimeSync1", std::to_string(mode.cycle_time_sync1));
+                    if (mode.cycle_time_sync1_factor != 0)
+                        attr(c1, "Factor", std::to_string(mode.cycle_time_sync1_factor));
+                    child(op, "ShiftTimeSync1", std::to_string(mode.shift_time_sync1));
+                }
+            }
+        }
+    }
+
+    if (!d.slots.empty()) {
+        xmlNodePtr slots = child(device, "Slots");
+        for (const od::Slot& slot : d.slots) {
+            if (slot.module_idents.empty()) continue;  // the schema needs a ModuleIdent
+            xmlNodePtr sl = child(slots, "Slot");
+            attr(sl, "MinInstances", std::to_string(slot.min_instances));
+            attr(sl, "MaxInstances", std::to_string(slot.max_instances));
+            attr(sl, "SlotPdoIncrement", std::to_string(slot.pdo_increment));
+            attr(sl, "SlotIndexIncrement", hex(slot.index_increment));
+            if (!slot.name.empty()) named(sl, "Name", slot.name);
+            for (uint32_t ident : slot.module_idents) {
+                xmlNodePtr mi = child(sl, "ModuleIdent", hex32(ident));
+                if (ident == slot.default_module) attr(mi, "Default", "1");
             }
         }
     }
@@ -650,6 +714,19 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
     child(eeprom, "BootStrap", hex_bytes(m.bootstrap.data(), m.bootstrap.size()));
     const std::vector<uint8_t> image = device_image_bmp();
     child(device, "ImageData16x14", hex_bytes(image.data(), image.size()));
+
+    if (!d.modules.empty()) {
+        xmlNodePtr modules = child(descriptions, "Modules");
+        for (const od::Module& mod : d.modules) {
+            xmlNodePtr mn = child(modules, "Module");
+            xmlNodePtr t = child(mn, "Type", mod.type);
+            attr(t, "ModuleIdent", hex32(mod.ident));
+            named(mn, "Name", mod.name.empty() ? mod.type : mod.name);
+            for (const bool rx : {true, false})
+                for (const od::ModulePdo& p : mod.pdos)
+                    if (p.rx == rx) module_pdo(mn, p);
+        }
+    }
 
     xmlChar* buf = nullptr;
     int size = 0;

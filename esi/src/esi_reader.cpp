@@ -6,45 +6,23 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <memory>
 #include <stdexcept>
 
 #include "util/input_file.hpp"
+#include "xml_tree.hpp"
 
 namespace esi {
 
 namespace {
 
-using Node = xmlNode*;
-
-std::string name_of(Node n) {
-    return n && n->name ? reinterpret_cast<const char*>(n->name) : "";
-}
-bool is(Node n, const char* name) {
-    return n && n->type == XML_ELEMENT_NODE && name_of(n) == name;
-}
-Node child(Node n, const char* name) {
-    if (!n) return nullptr;
-    for (Node c = n->children; c; c = c->next)
-        if (is(c, name)) return c;
-    return nullptr;
-}
-std::vector<Node> children(Node n, const char* name) {
-    std::vector<Node> out;
-    if (!n) return out;
-    for (Node c = n->children; c; c = c->next)
-        if (is(c, name)) out.push_back(c);
-    return out;
-}
-std::string text(Node n) {
-    if (!n) return "";
-    xmlChar* t = xmlNodeGetContent(n);
-    std::string s = t ? reinterpret_cast<const char*>(t) : "";
-    xmlFree(t);
-    auto b = s.find_first_not_of(" \t\r\n");
-    auto e = s.find_last_not_of(" \t\r\n");
-    return b == std::string::npos ? "" : s.substr(b, e - b + 1);
-}
+using xml::child;
+using xml::children;
+using xml::is;
+using xml::name_of;
+using xml::Node;
+using xml::text;
 std::string text(Node n, const char* name) {
     return text(child(n, name));
 }
@@ -77,35 +55,83 @@ std::vector<uint8_t> hex_bytes(const std::string& s) {
     return out;
 }
 
+int line_of(Node n) {
+    return n ? static_cast<int>(xmlGetLineNo(n)) : 0;
+}
+
+// The Name child in English (LcId 1033) if there is one, else the first.
+std::string name_text(Node n, const char* tag = "Name") {
+    Node first = nullptr;
+    for (Node c : children(n, tag)) {
+        if (attr(c, "LcId") == "1033") return text(c);
+        if (!first) first = c;
+    }
+    return text(first);
+}
+
 struct DataType {
     std::string name, base;
     unsigned bits = 0;
     bool array = false;
     int64_t lbound = 0, elements = 0;
+    std::optional<uint16_t> index;
     struct Sub {
         int subidx = -1;
-        std::string name, type, access, write_restrictions, pdo_mapping;
+        std::string name, type, access, write_restrictions, read_restrictions, pdo_mapping;
         unsigned bits = 0, offs = 0;
         bool backup = false, setting = false;
+        int line = 0;
     };
     std::vector<Sub> subs;
     std::vector<std::pair<int64_t, std::string>> enums;  // EnumInfo
 };
+using TypeMap = std::map<std::string, DataType>;
 
-// An entry of an enumerated type (a DataType with BaseType and EnumInfo) gets the base type and the values.
-void resolve_enum(EsiEntry& e, const std::map<std::string, DataType>& types) {
-    auto it = types.find(e.type);
-    if (it == types.end() || it->second.enums.empty() || it->second.base.empty()) return;
-    e.enumeration = it->second.enums;
-    e.type = it->second.base;
+// A type name the reader knows without a DataType: the basic types, STRING(n), ARRAY [..] OF BYTE.
+bool basic_type(const std::string& t) {
+    if (esi_basic_bits(t) > 0 || esi_coe_type(t) != 0) return true;
+    return t.rfind("STRING", 0) == 0 || t.rfind("ARRAY", 0) == 0 || t.rfind("UNICODE_STRING", 0) == 0 ||
+           t == "OCTET_STRING" || t == "VISIBLE_STRING" || t == "FLOAT" || t == "DOUBLE" || t == "BITARR8" ||
+           t == "BITARR16" || t == "BITARR32";
 }
 
-void read_flags(Node flags, std::string& access, std::string& restrictions, std::string& pdo, bool& backup,
-                bool& setting) {
+// Resolves an entry's type: an enumerated type becomes its base type with the values, an alias (BaseType
+// only) its base; marks a type that is neither basic nor defined.
+void resolve_type(EsiEntry& e, const TypeMap& types) {
+    e.declared_type = e.type;
+    for (int depth = 0; depth < 8; ++depth) {
+        auto it = types.find(e.type);
+        if (it == types.end()) {
+            e.type_known = basic_type(e.type);
+            return;
+        }
+        const DataType& t = it->second;
+        if (!t.enums.empty() && !t.base.empty()) {
+            e.enumeration = t.enums;
+            e.type = t.base;
+            continue;
+        }
+        if (!t.array && t.subs.empty() && !t.base.empty() && t.base != e.type) {
+            e.type = t.base;  // an alias
+            continue;
+        }
+        e.type_known = true;  // defined: a basic type's own DataType, an array, a record
+        return;
+    }
+}
+
+struct Flags {
+    std::string access, write_restrictions, read_restrictions, pdo;
+    bool backup = false, setting = false;
+};
+
+void read_flags(Node flags, std::string& access, std::string& wr, std::string& rr, std::string& pdo,
+                bool& backup, bool& setting) {
     if (!flags) return;
     if (Node a = child(flags, "Access")) {
         access = text(a);
-        restrictions = attr(a, "WriteRestrictions");
+        wr = attr(a, "WriteRestrictions");
+        rr = attr(a, "ReadRestrictions");
     }
     if (Node p = child(flags, "PdoMapping")) pdo = text(p);
     if (Node b = child(flags, "Backup")) backup = truthy(text(b));
@@ -116,30 +142,205 @@ void read_info(Node info, EsiEntry& e) {
     if (!info) return;
     if (Node d = child(info, "DefaultData")) e.default_data = hex_bytes(text(d));
     if (Node d = child(info, "DefaultString")) {
-        std::string s = text(d);
-        e.default_data.assign(s.begin(), s.end());
+        // The text as written (not trimmed: a default may end in spaces).
+        xmlChar* t = xmlNodeGetContent(d);
+        std::string str = t ? reinterpret_cast<const char*>(t) : "";
+        xmlFree(t);
+        e.default_data.assign(str.begin(), str.end());
+        e.default_is_string = true;
     }
+    if (Node d = child(info, "MinData")) e.min_data = hex_bytes(text(d));
+    if (Node d = child(info, "MaxData")) e.max_data = hex_bytes(text(d));
     if (Node d = child(info, "MinValue")) e.min = parse_esi_number(text(d));
     if (Node d = child(info, "MaxValue")) e.max = parse_esi_number(text(d));
     if (Node d = child(info, "DefaultValue")) e.default_value = parse_esi_number(text(d));
+    if (Node u = child(info, "Unit"))
+        if (auto v = parse_esi_number(text(u))) e.unit = static_cast<uint32_t>(*v);
 }
 
-EsiDevice read_device(Node dev, const std::map<std::string, DataType>& types_in, uint32_t vendor,
-                      const std::string& vendor_name) {
+void read_types(Node dict, TypeMap& types) {
+    for (Node dt : children(child(dict, "DataTypes"), "DataType")) {
+        DataType t;
+        t.name = text(dt, "Name");
+        t.base = text(dt, "BaseType");
+        t.bits = static_cast<unsigned>(number(text(dt, "BitSize")));
+        if (Node i = child(dt, "Index"))
+            if (auto v = parse_esi_number(text(i))) t.index = static_cast<uint16_t>(*v);
+        if (Node ai = child(dt, "ArrayInfo")) {
+            t.array = true;
+            t.lbound = number(text(ai, "LBound"));
+            t.elements = number(text(ai, "Elements"));
+            if (t.elements < 0 || t.elements > 255) t.elements = 0;
+            if (t.lbound < 0 || t.lbound > 255) t.lbound = 0;
+        }
+        for (Node en : children(dt, "EnumInfo"))
+            t.enums.emplace_back(number(text(en, "Enum")), text(en, "Text"));
+        for (Node si : children(dt, "SubItem")) {
+            DataType::Sub sub;
+            if (Node x = child(si, "SubIdx")) sub.subidx = static_cast<int>(number(text(x)));
+            sub.name = text(si, "Name");
+            sub.type = text(si, "Type");
+            sub.bits = static_cast<unsigned>(number(text(si, "BitSize")));
+            sub.offs = static_cast<unsigned>(number(text(si, "BitOffs")));
+            sub.line = line_of(si);
+            read_flags(child(si, "Flags"), sub.access, sub.write_restrictions, sub.read_restrictions,
+                       sub.pdo_mapping, sub.backup, sub.setting);
+            t.subs.push_back(sub);
+        }
+        types[t.name] = t;
+    }
+}
+
+EsiEntry entry_from(const DataType::Sub& s, const Flags& of) {
+    EsiEntry e;
+    e.name = s.name;
+    e.type = s.type;
+    e.bit_size = static_cast<uint16_t>(s.bits);
+    e.bit_offset = static_cast<uint16_t>(s.offs);
+    // A SubItem without its own flags has the object's.
+    e.access = s.access.empty() ? of.access : s.access;
+    e.write_restrictions = s.access.empty() ? of.write_restrictions : s.write_restrictions;
+    e.read_restrictions = s.access.empty() ? of.read_restrictions : s.read_restrictions;
+    e.pdo_mapping = s.pdo_mapping;
+    e.backup = s.backup || of.backup;
+    e.setting = s.setting || of.setting;
+    e.line = s.line;
+    return e;
+}
+
+EsiObject read_object(Node ob, const TypeMap& types) {
+    EsiObject o;
+    Node index = child(ob, "Index");
+    o.index = static_cast<uint16_t>(number(text(index)));
+    o.depend_on_slot = truthy(attr(index, "DependOnSlot"));
+    o.name = text(ob, "Name");
+    o.type = text(ob, "Type");
+    o.bit_size = static_cast<uint16_t>(number(text(ob, "BitSize")));
+    o.line = line_of(ob);
+    Flags of;
+    read_flags(child(ob, "Flags"), of.access, of.write_restrictions, of.read_restrictions, of.pdo, of.backup,
+               of.setting);
+    Node info = child(ob, "Info");
+    auto it = types.find(o.type);
+    if (it == types.end() || it->second.subs.empty()) {
+        EsiEntry e;
+        e.name = o.name;
+        e.type = o.type;
+        e.bit_size = o.bit_size;
+        e.access = of.access;
+        e.write_restrictions = of.write_restrictions;
+        e.read_restrictions = of.read_restrictions;
+        e.pdo_mapping = of.pdo;
+        e.backup = of.backup;
+        e.setting = of.setting;
+        e.line = o.line;
+        read_info(info, e);
+        resolve_type(e, types);
+        o.type = e.type;  // a VAR of an enumerated type: its base type
+        o.entries.push_back(e);
+        return o;
+    }
+    const DataType& t = it->second;
+    o.type_index = t.index;
+    // An array object: SubIndex 0 plus one SubItem whose type is an ArrayInfo type.
+    bool array = false;
+    for (const auto& s : t.subs) {
+        auto at = types.find(s.type);
+        if (s.subidx < 0 && at != types.end() && at->second.array) {
+            array = true;
+            const DataType& a = at->second;
+            const auto el_bits =
+                static_cast<uint16_t>(a.elements ? a.bits / static_cast<unsigned>(a.elements) : 0);
+            for (int64_t k = 0; k < a.elements && a.lbound + k <= 255; ++k) {
+                EsiEntry e = entry_from(s, of);
+                e.subindex = static_cast<uint8_t>(a.lbound + k);
+                char n[16];
+                std::snprintf(n, sizeof n, "SubIndex %03u", static_cast<unsigned>(e.subindex));
+                e.name = n;  // as configuration tools list array elements (Object/Info may rename them)
+                e.type = a.base;
+                e.bit_size = el_bits;
+                e.bit_offset = static_cast<uint16_t>(s.offs + k * el_bits);
+                resolve_type(e, types);
+                o.entries.push_back(e);
+            }
+        } else {
+            EsiEntry e = entry_from(s, of);
+            e.subindex = static_cast<uint8_t>(s.subidx < 0 ? 0 : s.subidx);
+            resolve_type(e, types);
+            o.entries.push_back(e);
+        }
+    }
+    o.object_code = array ? 8 : 9;
+    // Object/Info/SubItem names the entry it describes (defaults, limits): by name where the name is
+    // unique, else by position.
+    auto infos = children(info, "SubItem");
+    for (std::size_t i = 0; i < infos.size(); ++i) {
+        const std::string n = text(infos[i], "Name");
+        std::size_t target = i, matches = 0;
+        for (std::size_t j = 0; j < o.entries.size(); ++j)
+            if (o.entries[j].name == n) {
+                target = j;
+                ++matches;
+            }
+        if (matches != 1) target = i;
+        if (target >= o.entries.size()) continue;
+        // Array elements take the names the Info gives them ("SubIndex 001").
+        if (array && matches == 0 && !n.empty() && target > 0) o.entries[target].name = n;
+        read_info(child(infos[i], "Info"), o.entries[target]);
+    }
+    return o;
+}
+
+void read_pdos(Node parent, const char* tag, bool rx, std::vector<EsiPdo>& out) {
+    for (Node p : children(parent, tag)) {
+        EsiPdo pdo;
+        pdo.rx = rx;
+        Node index = child(p, "Index");
+        pdo.index = static_cast<uint16_t>(number(text(index)));
+        pdo.depend_on_slot = truthy(attr(index, "DependOnSlot"));
+        std::string sm = attr(p, "Sm");
+        if (!sm.empty()) pdo.sm = static_cast<int>(number(sm, -1));
+        pdo.fixed = truthy(attr(p, "Fixed"));
+        pdo.mandatory = truthy(attr(p, "Mandatory"));
+        pdo.is_virtual = truthy(attr(p, "Virtual"));
+        pdo.name = name_text(p);
+        pdo.line = line_of(p);
+        for (Node x : children(p, "Exclude"))
+            pdo.exclude.push_back(static_cast<uint16_t>(number(text(x))));
+        for (Node e : children(p, "Entry")) {
+            EsiPdoEntry pe;
+            Node ei = child(e, "Index");
+            pe.index = static_cast<uint16_t>(number(text(ei)));
+            pe.depend_on_slot = truthy(attr(ei, "DependOnSlot"));
+            pe.subindex = static_cast<uint8_t>(number(text(e, "SubIndex")));
+            pe.bit_len = static_cast<uint8_t>(number(text(e, "BitLen")));
+            pe.name = name_text(e);
+            pe.data_type = text(e, "DataType");
+            pe.line = line_of(e);
+            pdo.entries.push_back(pe);
+        }
+        out.push_back(pdo);
+    }
+}
+
+EsiDevice read_device(Node dev, const TypeMap& types_in, uint32_t vendor, const std::string& vendor_name,
+                      const std::map<std::string, std::string>& group_names) {
     EsiDevice d;
     d.vendor_id = vendor;
     d.vendor_name = vendor_name;
+    d.line = line_of(dev);
     Node type = child(dev, "Type");
     d.type_name = text(type);
     d.product_code = static_cast<uint32_t>(number(attr(type, "ProductCode")));
     d.revision = static_cast<uint32_t>(number(attr(type, "RevisionNo")));
-    d.name = text(dev, "Name");
+    d.name = name_text(dev);
     d.group_type = text(dev, "GroupType");
-    d.identification_reg134 = truthy(text(child(dev, "Info"), "IdentificationReg134"));
-    for (Node alt :
-         children(child(child(child(dev, "Info"), "VendorSpecific"), "TwinCAT"), "AlternativeSmMapping")) {
+    if (auto g = group_names.find(d.group_type); g != group_names.end()) d.group_name = g->second;
+    Node info = child(dev, "Info");
+    d.identification_reg134 = truthy(text(info, "IdentificationReg134"));
+    for (Node alt : children(child(child(info, "VendorSpecific"), "TwinCAT"), "AlternativeSmMapping")) {
         EsiPdoSet set;
-        set.name = text(alt, "Name");
+        set.name = name_text(alt);
         set.is_default = truthy(attr(alt, "Default"));
         for (Node sm : children(alt, "Sm"))
             for (Node p : children(sm, "Pdo"))
@@ -147,114 +348,23 @@ EsiDevice read_device(Node dev, const std::map<std::string, DataType>& types_in,
                     static_cast<uint16_t>(number(text(p))));
         d.pdo_sets.push_back(std::move(set));
     }
-    if (Node timeout = child(child(child(dev, "Info"), "Mailbox"), "Timeout")) {
+    if (Node timeout = child(child(info, "Mailbox"), "Timeout")) {
         d.mailbox_request_timeout_ms = static_cast<uint32_t>(number(text(timeout, "RequestTimeout")));
         d.mailbox_response_timeout_ms = static_cast<uint32_t>(number(text(timeout, "ResponseTimeout")));
     }
     d.image16x14 = hex_bytes(text(dev, "ImageData16x14"));
-    std::map<std::string, DataType> types = types_in;
+    TypeMap types = types_in;
     for (Node prof : children(dev, "Profile")) {
         if (Node p = child(prof, "ProfileNo")) d.profile_no = static_cast<uint32_t>(number(text(p)));
+        if (Node p = child(prof, "AddInfo")) d.profile_add_info = static_cast<uint32_t>(number(text(p)));
         for (Node m : children(child(prof, "DiagMessages"), "DiagMessage"))
-            d.diag_messages[static_cast<uint16_t>(number(text(m, "TextId")))] = text(m, "MessageText");
+            d.diag_messages[static_cast<uint16_t>(number(text(m, "TextId")))] = name_text(m, "MessageText");
         Node dict = child(prof, "Dictionary");
-        for (Node dt : children(child(dict, "DataTypes"), "DataType")) {
-            DataType t;
-            t.name = text(dt, "Name");
-            t.base = text(dt, "BaseType");
-            t.bits = static_cast<unsigned>(number(text(dt, "BitSize")));
-            if (Node ai = child(dt, "ArrayInfo")) {
-                t.array = true;
-                t.lbound = number(text(ai, "LBound"));
-                t.elements = number(text(ai, "Elements"));
-            }
-            for (Node en : children(dt, "EnumInfo"))
-                t.enums.emplace_back(number(text(en, "Enum")), text(en, "Text"));
-            for (Node si : children(dt, "SubItem")) {
-                DataType::Sub s;
-                if (Node x = child(si, "SubIdx")) s.subidx = static_cast<int>(number(text(x)));
-                s.name = text(si, "Name");
-                s.type = text(si, "Type");
-                s.bits = static_cast<unsigned>(number(text(si, "BitSize")));
-                s.offs = static_cast<unsigned>(number(text(si, "BitOffs")));
-                read_flags(child(si, "Flags"), s.access, s.write_restrictions, s.pdo_mapping, s.backup,
-                           s.setting);
-                t.subs.push_back(s);
-            }
-            types[t.name] = t;
-        }
+        if (dict) d.has_dictionary = true;
+        if (child(prof, "DictionaryFile")) d.unsupported.push_back("Profile/DictionaryFile");
+        read_types(dict, types);
         for (Node ob : children(child(dict, "Objects"), "Object")) {
-            EsiObject o;
-            o.index = static_cast<uint16_t>(number(text(ob, "Index")));
-            o.name = text(ob, "Name");
-            o.type = text(ob, "Type");
-            o.bit_size = static_cast<uint16_t>(number(text(ob, "BitSize")));
-            std::string oaccess, orestr, opdo;
-            bool obackup = false, osetting = false;
-            read_flags(child(ob, "Flags"), oaccess, orestr, opdo, obackup, osetting);
-            Node info = child(ob, "Info");
-            auto it = types.find(o.type);
-            if (it == types.end() || it->second.subs.empty()) {
-                EsiEntry e;
-                e.name = o.name;
-                e.type = o.type;
-                e.bit_size = o.bit_size;
-                e.access = oaccess;
-                e.write_restrictions = orestr;
-                e.pdo_mapping = opdo;
-                e.backup = obackup;
-                e.setting = osetting;
-                read_info(info, e);
-                resolve_enum(e, types);
-                o.type = e.type;  // a VAR of an enumerated type: its base type
-                o.entries.push_back(e);
-            } else {
-                const DataType& t = it->second;
-                // An array object: SubIndex 0 plus one SubItem whose type is an ArrayInfo type.
-                bool array = false;
-                for (const auto& s : t.subs) {
-                    auto at = types.find(s.type);
-                    if (s.subidx < 0 && at != types.end() && at->second.array) {
-                        array = true;
-                        for (int64_t k = 0; k < at->second.elements; ++k) {
-                            EsiEntry e;
-                            e.subindex = static_cast<uint8_t>(at->second.lbound + k);
-                            e.name = s.name;
-                            e.type = at->second.base;
-                            e.bit_size = static_cast<uint16_t>(
-                                at->second.elements
-                                    ? at->second.bits / static_cast<unsigned>(at->second.elements)
-                                    : 0);
-                            e.bit_offset = static_cast<uint16_t>(s.offs + k * e.bit_size);
-                            e.access = s.access;
-                            e.write_restrictions = s.write_restrictions;
-                            e.pdo_mapping = s.pdo_mapping;
-                            e.backup = s.backup;
-                            e.setting = s.setting;
-                            o.entries.push_back(e);
-                        }
-                    } else {
-                        EsiEntry e;
-                        e.subindex = static_cast<uint8_t>(s.subidx < 0 ? 0 : s.subidx);
-                        e.name = s.name;
-                        e.type = s.type;
-                        e.bit_size = static_cast<uint16_t>(s.bits);
-                        e.bit_offset = static_cast<uint16_t>(s.offs);
-                        e.access = s.access;
-                        e.write_restrictions = s.write_restrictions;
-                        e.pdo_mapping = s.pdo_mapping;
-                        e.backup = s.backup;
-                        e.setting = s.setting;
-                        resolve_enum(e, types);
-                        o.entries.push_back(e);
-                    }
-                }
-                o.object_code = array ? 8 : 9;
-                // Object/Info/SubItem i describes the i-th entry (defaults, limits).
-                auto infos = children(info, "SubItem");
-                for (std::size_t i = 0; i < infos.size() && i < o.entries.size(); ++i)
-                    read_info(child(infos[i], "Info"), o.entries[i]);
-            }
+            EsiObject o = read_object(ob, types);
             d.objects[o.index] = std::move(o);
         }
     }
@@ -268,37 +378,18 @@ EsiDevice read_device(Node dev, const std::map<std::string, DataType>& types_in,
         if (auto v = parse_esi_number(attr(s, "MaxSize"))) sm.max_size = static_cast<uint32_t>(*v);
         sm.control = static_cast<uint8_t>(number(attr(s, "ControlByte")));
         sm.enable = truthy(attr(s, "Enable"));
+        sm.watchdog = truthy(attr(s, "Watchdog"));
+        sm.is_virtual = truthy(attr(s, "Virtual"));
         sm.type = text(s);
+        sm.line = line_of(s);
         d.sms.push_back(sm);
     }
-    auto read_pdos = [&](const char* tag, std::vector<EsiPdo>& out) {
-        for (Node p : children(dev, tag)) {
-            EsiPdo pdo;
-            pdo.rx = &out == &d.rxpdos;
-            pdo.index = static_cast<uint16_t>(number(text(p, "Index")));
-            std::string sm = attr(p, "Sm");
-            if (!sm.empty()) pdo.sm = static_cast<int>(number(sm));
-            pdo.fixed = truthy(attr(p, "Fixed"));
-            pdo.mandatory = truthy(attr(p, "Mandatory"));
-            pdo.name = text(p, "Name");
-            for (Node x : children(p, "Exclude"))
-                pdo.exclude.push_back(static_cast<uint16_t>(number(text(x))));
-            for (Node e : children(p, "Entry")) {
-                EsiPdoEntry pe;
-                pe.index = static_cast<uint16_t>(number(text(e, "Index")));
-                pe.subindex = static_cast<uint8_t>(number(text(e, "SubIndex")));
-                pe.bit_len = static_cast<uint8_t>(number(text(e, "BitLen")));
-                pe.name = text(e, "Name");
-                pe.data_type = text(e, "DataType");
-                pdo.entries.push_back(pe);
-            }
-            out.push_back(pdo);
-        }
-    };
-    read_pdos("RxPdo", d.rxpdos);
-    read_pdos("TxPdo", d.txpdos);
+    if (child(dev, "Su")) d.unsupported.push_back("Su (sync units)");
+    read_pdos(dev, "RxPdo", true, d.rxpdos);
+    read_pdos(dev, "TxPdo", false, d.txpdos);
     if (Node mb = child(dev, "Mailbox")) {
         d.has_mailbox = true;
+        d.mailbox_data_link_layer = truthy(attr(mb, "DataLinkLayer"));
         if (Node c = child(mb, "CoE")) {
             d.coe.present = true;
             d.coe.sdo_info = truthy(attr(c, "SdoInfo"));
@@ -313,6 +404,7 @@ EsiDevice read_device(Node dev, const std::map<std::string, DataType>& types_in,
                 if (v == "true" || v == "false" || v == "1" || v == "0")
                     d.coe_attributes[reinterpret_cast<const char*>(a->name)] = truthy(v);
             }
+            if (child(c, "InitCmd")) d.unsupported.push_back("Mailbox/CoE/InitCmd");
         }
         d.foe = child(mb, "FoE") != nullptr;
         d.eoe = child(mb, "EoE") != nullptr;
@@ -325,33 +417,105 @@ EsiDevice read_device(Node dev, const std::map<std::string, DataType>& types_in,
         for (Node om : children(dc, "OpMode")) {
             EsiOpMode m;
             m.name = text(om, "Name");
+            m.desc = text(om, "Desc");
+            m.line = line_of(om);
             m.assign_activate = static_cast<uint16_t>(number(text(om, "AssignActivate")));
-            m.cycle_time_sync0 = static_cast<uint32_t>(number(text(om, "CycleTimeSync0")));
+            if (Node c0 = child(om, "CycleTimeSync0")) {
+                m.cycle_time_sync0 = static_cast<uint32_t>(number(text(c0)));
+                if (auto f = parse_esi_number(attr(c0, "Factor")))
+                    m.cycle_time_sync0_factor = static_cast<int32_t>(*f);
+            }
             m.shift_time_sync0 = static_cast<int32_t>(number(text(om, "ShiftTimeSync0")));
+            if (Node c1 = child(om, "CycleTimeSync1")) {
+                m.has_sync1 = true;
+                m.cycle_time_sync1 = static_cast<uint32_t>(number(text(c1)));
+                if (auto f = parse_esi_number(attr(c1, "Factor")))
+                    m.cycle_time_sync1_factor = static_cast<int32_t>(*f);
+            }
+            if (Node s1 = child(om, "ShiftTimeSync1")) {
+                m.has_sync1 = true;
+                m.shift_time_sync1 = static_cast<int32_t>(number(text(s1)));
+            }
             d.op_modes.push_back(m);
         }
     }
+    if (Node slots = child(dev, "Slots")) {
+        d.slot_pdo_increment = static_cast<uint32_t>(number(attr(slots, "SlotPdoIncrement")));
+        d.slot_index_increment = static_cast<uint32_t>(number(attr(slots, "SlotIndexIncrement")));
+        for (Node sl : children(slots, "Slot")) {
+            EsiSlot slot;
+            slot.name = name_text(sl);
+            slot.line = line_of(sl);
+            slot.min_instances = static_cast<uint32_t>(number(attr(sl, "MinInstances")));
+            slot.max_instances = static_cast<uint32_t>(number(attr(sl, "MaxInstances")));
+            if (auto v = parse_esi_number(attr(sl, "SlotPdoIncrement")))
+                slot.pdo_increment = static_cast<uint32_t>(*v);
+            if (auto v = parse_esi_number(attr(sl, "SlotIndexIncrement")))
+                slot.index_increment = static_cast<uint32_t>(*v);
+            for (Node mi : children(sl, "ModuleIdent")) {
+                const auto ident = static_cast<uint32_t>(number(text(mi)));
+                slot.module_idents.push_back(ident);
+                if (truthy(attr(mi, "Default")) && !slot.default_module) slot.default_module = ident;
+            }
+            if (child(sl, "ModuleClass")) d.unsupported.push_back("Slots/Slot/ModuleClass");
+            d.slots.push_back(std::move(slot));
+        }
+    }
     if (Node ee = child(dev, "Eeprom")) {
+        d.has_eeprom = true;
+        d.eeprom_line = line_of(ee);
         d.eeprom_bytes = static_cast<uint32_t>(number(text(ee, "ByteSize")));
         d.config_data = hex_bytes(text(ee, "ConfigData"));
         d.bootstrap = hex_bytes(text(ee, "BootStrap"));
+        d.eeprom_data = hex_bytes(text(ee, "Data"));
+        if (child(ee, "Category")) d.unsupported.push_back("Eeprom/Category");
     }
     return d;
 }
 
-EsiFile read_doc(xmlDoc* doc) {
+EsiModule read_module(Node mod, const TypeMap& device_types) {
+    EsiModule m;
+    Node type = child(mod, "Type");
+    m.ident = static_cast<uint32_t>(number(attr(type, "ModuleIdent")));
+    m.type_name = text(type);
+    m.name = name_text(mod);
+    m.line = line_of(mod);
+    read_pdos(mod, "RxPdo", true, m.rxpdos);
+    read_pdos(mod, "TxPdo", false, m.txpdos);
+    TypeMap types = device_types;
+    for (Node prof : children(mod, "Profile")) {
+        Node dict = child(prof, "Dictionary");
+        read_types(dict, types);
+        for (Node ob : children(child(dict, "Objects"), "Object")) {
+            EsiObject o = read_object(ob, types);
+            m.objects[o.index] = std::move(o);
+        }
+    }
+    return m;
+}
+
+EsiFile read_doc(xmlDoc* doc, const std::string& source) {
     std::unique_ptr<xmlDoc, void (*)(xmlDoc*)> guard(doc, xmlFreeDoc);
-    if (!doc) throw std::runtime_error("not well-formed XML");
     Node root = xmlDocGetRootElement(doc);
-    if (!is(root, "EtherCATInfo")) throw std::runtime_error("root element is not EtherCATInfo");
+    if (!root) throw InputError(source, 0, "no root element");
+    if (!is(root, "EtherCATInfo"))
+        throw InputError(source, line_of(root),
+                         "root element is " + name_of(root) + ", not EtherCATInfo: not an ESI file");
     EsiFile f;
+    f.source = source;
     f.vendor_id = static_cast<uint32_t>(number(text(child(root, "Vendor"), "Id")));
-    f.vendor_name = text(child(root, "Vendor"), "Name");
+    f.vendor_name = name_text(child(root, "Vendor"));
     Node desc = child(root, "Descriptions");
-    std::map<std::string, DataType> none;
+    std::map<std::string, std::string> group_names;
+    for (Node g : children(child(desc, "Groups"), "Group"))
+        group_names[text(g, "Type")] = name_text(g);
+    TypeMap none;
     for (Node dev : children(child(desc, "Devices"), "Device"))
-        f.devices.push_back(read_device(dev, none, f.vendor_id, f.vendor_name));
-    if (f.devices.empty()) throw std::runtime_error("no Device in Descriptions/Devices");
+        f.devices.push_back(read_device(dev, none, f.vendor_id, f.vendor_name, group_names));
+    for (Node mod : children(child(desc, "Modules"), "Module"))
+        f.modules.push_back(read_module(mod, none));
+    if (f.devices.empty())
+        throw InputError(source, line_of(desc ? desc : root), "no Device in Descriptions/Devices");
     return f;
 }
 
@@ -458,33 +622,89 @@ namespace {
 // substitution (no XML_PARSE_NOENT), libxml2's own limits on depth and entity amplification kept (no
 // XML_PARSE_HUGE); a document with a DOCTYPE is refused altogether: ETG.2000 files carry none, and an
 // entity reference left in the tree would still be expanded when its text is read.
+// What the parser saw that the reader refuses, or the first error it reported.
+struct ParseState {
+    bool doctype = false;
+    int doctype_line = 0;
+    bool error = false;
+    int error_line = 0;
+    std::string message;
+};
+thread_local ParseState* t_state = nullptr;
+
+// SAX internalSubset: the DOCTYPE starts. Stops the parser before any declaration in it is read.
+void on_doctype(void* ctx, const xmlChar*, const xmlChar*, const xmlChar*) {
+    auto* c = static_cast<xmlParserCtxtPtr>(ctx);
+    if (t_state && !t_state->doctype) {
+        t_state->doctype = true;
+        t_state->doctype_line = c->input ? c->input->line : 0;
+    }
+    xmlStopParser(c);
+}
+
+void on_error(void*, xmlErrorPtr e) {
+    if (t_state == nullptr || t_state->error || e == nullptr || e->level < XML_ERR_ERROR) return;
+    t_state->error = true;
+    t_state->error_line = e->line;
+    t_state->message = e->message ? e->message : "parse error";
+    while (!t_state->message.empty() && (t_state->message.back() == '\n' || t_state->message.back() == ' '))
+        t_state->message.pop_back();
+}
+
 EsiFile parse_esi(const std::string& xml, const std::string& name) {
     if (xml.size() > kMaxEsiBytes)
-        throw std::runtime_error(name + ": larger than " + std::to_string(kMaxEsiBytes) +
-                                 " bytes: not an ESI file");
-    xmlDoc* doc = xmlReadMemory(xml.data(), static_cast<int>(xml.size()), name.c_str(), nullptr,
-                                XML_PARSE_NONET | XML_PARSE_NOERROR | XML_PARSE_NOWARNING);
-    if (doc != nullptr && (doc->intSubset != nullptr || doc->extSubset != nullptr)) {
-        xmlFreeDoc(doc);
-        throw std::runtime_error(name +
-                                 ": a DOCTYPE (DTD or entity declarations) is not allowed in an ESI file");
+        throw InputError(name, 0, "larger than " + std::to_string(kMaxEsiBytes) + " bytes: not an ESI file");
+    if (xml.empty()) throw InputError(name, 0, "empty file: not an ESI file");
+    std::unique_ptr<xmlParserCtxt, void (*)(xmlParserCtxtPtr)> ctxt(xmlNewParserCtxt(), xmlFreeParserCtxt);
+    if (!ctxt || !ctxt->sax) throw InputError(name, 0, "out of memory");
+    ctxt->sax->internalSubset = on_doctype;
+    ctxt->sax->serror = on_error;
+    ParseState state;
+    t_state = &state;
+    xmlDoc* doc =
+        xmlCtxtReadMemory(ctxt.get(), xml.data(), static_cast<int>(xml.size()), name.c_str(), nullptr,
+                          XML_PARSE_NONET | XML_PARSE_NOERROR | XML_PARSE_NOWARNING | XML_PARSE_BIG_LINES);
+    t_state = nullptr;
+    if (state.doctype || (doc != nullptr && (doc->intSubset != nullptr || doc->extSubset != nullptr))) {
+        if (doc) xmlFreeDoc(doc);
+        throw InputError(name, state.doctype_line > 0 ? state.doctype_line : 1,
+                         "a DOCTYPE (DTD or entity declarations) is not allowed in an ESI file");
     }
-    if (doc == nullptr) throw std::runtime_error(name + ": not well-formed XML");
-    return read_doc(doc);
+    if (doc == nullptr) {
+        if (!state.error) {
+            const xmlError* err = xmlCtxtGetLastError(ctxt.get());
+            state.error_line = err ? err->line : 0;
+            state.message = err && err->message ? err->message : "parse error";
+            while (!state.message.empty() && (state.message.back() == '\n' || state.message.back() == ' '))
+                state.message.pop_back();
+        }
+        throw InputError(name, state.error_line, "not well-formed XML: " + state.message);
+    }
+    return read_doc(doc, name);
 }
 
 }  // namespace
 
 EsiFile read_esi_file(const std::string& path) {
+    std::string text;
     try {
-        return parse_esi(util::read_input_file(path, kMaxEsiBytes, "ESI file"), path);
+        text = util::read_input_file(path, kMaxEsiBytes, "ESI file");
     } catch (const util::InputFileError& e) {
-        throw std::runtime_error(e.what());
+        std::string m = e.what();  // "PATH: what went wrong"
+        if (m.rfind(path + ": ", 0) == 0) m.erase(0, path.size() + 2);
+        throw InputError(path, 0, m);
     }
+    return parse_esi(text, path);
 }
 
-EsiFile read_esi_text(const std::string& xml) {
-    return parse_esi(xml, "esi.xml");
+EsiFile read_esi_text(const std::string& xml, const std::string& name) {
+    return parse_esi(xml, name);
+}
+
+const EsiModule* EsiFile::module(uint32_t ident) const {
+    for (const EsiModule& m : modules)
+        if (m.ident == ident) return &m;
+    return nullptr;
 }
 
 EsiDevice read_esi(const std::string& xml) {

@@ -194,6 +194,29 @@ DeviceModel derive_model(const od::DeviceDescription& d, const od::Dictionary& d
         m.sync_managers.push_back(si);
     }
 
+    // ---- The order of the PDOs: assigned ones in their assignment order first ----
+    for (const bool rx : {true, false}) {
+        std::vector<bool> taken(m.pdos.size(), false);
+        for (std::size_t n = 0; n < m.sync_managers.size(); ++n) {
+            if (m.sync_managers[n].kind != (rx ? od::SmKind::Outputs : od::SmKind::Inputs)) continue;
+            const od::Object* assign = dict.find(static_cast<uint16_t>(0x1C10 + n));
+            if (assign == nullptr) continue;
+            const uint64_t count = default_of(assign->entry(0));
+            for (uint64_t k = 1; k <= count && k <= 0xFF; ++k) {
+                const auto pdo_index =
+                    static_cast<uint16_t>(default_of(assign->entry(static_cast<uint8_t>(k))));
+                for (std::size_t i = 0; i < m.pdos.size(); ++i)
+                    if (!taken[i] && m.pdos[i].rx == rx && m.pdos[i].index == pdo_index &&
+                        m.pdos[i].sm == static_cast<int>(n)) {
+                        taken[i] = true;
+                        m.pdo_order.push_back(i);
+                    }
+            }
+        }
+        for (std::size_t i = 0; i < m.pdos.size(); ++i)
+            if (!taken[i] && m.pdos[i].rx == rx) m.pdo_order.push_back(i);
+    }
+
     // ---- Predefined PDO sets (AlternativeSmMapping): PDOs of their direction, within the PDO rules ----
     int rx_sm = -1, tx_sm = -1;
     for (std::size_t n = 0; n < m.sync_managers.size(); ++n) {
@@ -237,9 +260,14 @@ DeviceModel derive_model(const od::DeviceDescription& d, const od::Dictionary& d
             if (s.kind == k) return true;
         return false;
     };
-    if (has(od::SmKind::Outputs)) m.fmmus.push_back(FmmuUse::Outputs);
-    if (has(od::SmKind::Inputs)) m.fmmus.push_back(FmmuUse::Inputs);
-    if (has(od::SmKind::MBoxIn)) m.fmmus.push_back(FmmuUse::MBoxState);
+    if (!d.fmmus.empty()) {
+        for (uint8_t f : d.fmmus)
+            m.fmmus.push_back(f <= 0x03 ? static_cast<FmmuUse>(f) : FmmuUse::Unused);
+    } else {
+        if (has(od::SmKind::Outputs)) m.fmmus.push_back(FmmuUse::Outputs);
+        if (has(od::SmKind::Inputs)) m.fmmus.push_back(FmmuUse::Inputs);
+        if (has(od::SmKind::MBoxIn)) m.fmmus.push_back(FmmuUse::MBoxState);
+    }
 
     // ---- Profile from the device type 0x1000 ----
     if (const od::Entry* dt = dict.find(0x1000, 0)) {

@@ -101,7 +101,8 @@ std::vector<uint8_t> build_sii(const od::DeviceDescription& d, const od::Diction
 
     // ---- TxPDO / RxPDO ----
     Writer txpdo, rxpdo;
-    for (const PdoInfo& p : m.pdos) {
+    for (std::size_t i : m.pdo_order) {
+        const PdoInfo& p = m.pdos[i];
         Writer& w = p.rx ? rxpdo : txpdo;
         w.u16(p.index);
         w.u8(static_cast<uint8_t>(p.entries.size()));
@@ -126,10 +127,10 @@ std::vector<uint8_t> build_sii(const od::DeviceDescription& d, const od::Diction
     // ---- DC ----
     Writer dc;
     for (const od::DcOpMode& mode : d.dc_modes) {
-        dc.u32(0);  // SYNC0 cycle time: set by the master
+        dc.u32(mode.cycle_time_sync0);  // 0: set by the master
         dc.u32(static_cast<uint32_t>(mode.shift_time_sync0));
-        dc.u32(0);  // SYNC1 shift
-        dc.u16(0);  // SYNC1 cycle factor
+        dc.u32(static_cast<uint32_t>(mode.shift_time_sync1));
+        dc.u16(static_cast<uint16_t>(mode.cycle_time_sync1_factor));
         dc.u16(mode.assign_activate);
         dc.u16(static_cast<uint16_t>(mode.cycle_time_sync0_factor));
         dc.u8(strings.add(mode.name));

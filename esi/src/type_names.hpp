@@ -42,6 +42,26 @@ inline const char* base_type_name(uint16_t code) {
             return "IDENTITY";
         case 0x0029:  // SyncManagerParameter
             return "SYNC_PAR";
+        case 0x0010:  // Integer24
+            return "INT24";
+        case 0x0016:  // Unsigned24
+            return "UINT24";
+        case 0x0030:  // Bit1 .. Bit8
+            return "BIT1";
+        case 0x0031:
+            return "BIT2";
+        case 0x0032:
+            return "BIT3";
+        case 0x0033:
+            return "BIT4";
+        case 0x0034:
+            return "BIT5";
+        case 0x0035:
+            return "BIT6";
+        case 0x0036:
+            return "BIT7";
+        case 0x0037:
+            return "BIT8";
     }
     return nullptr;
 }

@@ -86,6 +86,26 @@ std::string_view to_string(DataType t) {
             return "IDENTITY";
         case DataType::SyncManagerParameter:
             return "SYNC_PAR";
+        case DataType::Integer24:
+            return "INT24";
+        case DataType::Unsigned24:
+            return "UINT24";
+        case DataType::Bit1:
+            return "BIT1";
+        case DataType::Bit2:
+            return "BIT2";
+        case DataType::Bit3:
+            return "BIT3";
+        case DataType::Bit4:
+            return "BIT4";
+        case DataType::Bit5:
+            return "BIT5";
+        case DataType::Bit6:
+            return "BIT6";
+        case DataType::Bit7:
+            return "BIT7";
+        case DataType::Bit8:
+            return "BIT8";
     }
     return "UNKNOWN";
 }

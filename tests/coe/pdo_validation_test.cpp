@@ -206,6 +206,25 @@ TEST_F(DrivePdoRules, TxPdosFollowTheSameRule) {
     EXPECT_EQ(write(0x1C13, 0, 0, 1), 0u);
 }
 
+// A master reassigns as ETG.1000.6 says: count 0, the PDOs, the count. With a Mandatory PDO the first step
+// must be taken (an ENI's CoE init commands begin with it); the count that leaves the Mandatory PDO out is
+// refused.
+class MandatoryPdoRules : public DrivePdoRules {
+  protected:
+    void SetUp() override {
+        desc.pdo_rules = {od::PdoRule{0x1A00, true, {}}};
+        coe::install_pdo_validators(dict, {}, desc.pdo_rules);
+    }
+};
+
+TEST_F(MandatoryPdoRules, CountZeroOpensTheAssignmentTheCountIsChecked) {
+    EXPECT_EQ(write(0x1C13, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1C13, 1, 0x1A01, 2), 0u);
+    EXPECT_EQ(write(0x1C13, 0, 1, 1), 0x06040043u);  // 0x1A00 is Mandatory
+    EXPECT_EQ(write(0x1C13, 1, 0x1A00, 2), 0u);
+    EXPECT_EQ(write(0x1C13, 0, 1, 1), 0u);
+}
+
 TEST(PdoRules, MandatoryAndExcludeChecks) {
     std::vector<od::PdoRule> rules(3);
     rules[0].pdo = 0x1600;

@@ -261,7 +261,8 @@ TEST(Report, JunitIsWellFormedXmlWithCounts) {
 TEST(Report, JsonIsWellFormed) {
     Catalogue c = build_catalogue();
     auto r = sample(c);
-    RunInfo info{"veth0", "dev \"x\"", std::chrono::milliseconds(5), {"n\t1"}};
+    // A device string with an ISO-8859-1 byte (a vendor's SII name): the JSON stays valid UTF-8.
+    RunInfo info{"veth0", "dev \"x\" Ger\xE4t", std::chrono::milliseconds(5), {"n\t1"}};
     std::ostringstream o;
     write_json(o, r, info);
     const std::string s = o.str();
@@ -269,7 +270,8 @@ TEST(Report, JsonIsWellFormed) {
     EXPECT_TRUE(j.value()) << s;
     j.ws();
     EXPECT_EQ(j.p, s.size());
-    EXPECT_NE(s.find("\"failed\": 1"), std::string::npos);
+    EXPECT_NE(s.find("\"failed\":1"), std::string::npos);
+    EXPECT_NE(s.find("Ger\xC3\xA4t"), std::string::npos);
 }
 
 TEST(Report, TextEndsWithTheTotalsAndHasNoColourOffATerminal) {

@@ -354,6 +354,21 @@ def track_al(st, d):
         st.scratch["al"] = d.get(0x0130)
 
 
+def al_status_write_kept(st, d):
+    """A defect seen in an emulator: a write to AL status 0x0130 (read-only for EtherCAT) is taken, and from
+    then on every read shows the first value written, whatever the state machine does and whatever is written
+    later, until the ESC is reset (0x0040: 'R', 'E', 'S')."""
+    if d.cmd in WRITES and d.wkc and d.ado <= 0x0130 and 0x0132 <= d.ado + d.n:
+        st.scratch.setdefault("al_kept", d.get(0x0130))
+    if d.cmd in WRITES and d.wkc and d.ado <= 0x0040 < d.ado + d.n:
+        seq = (st.scratch.get("reset_seq", b"") + bytes([d.get(0x0040, 1)]))[-3:]
+        st.scratch["reset_seq"] = seq
+        if seq == b"RES":
+            st.scratch.pop("al_kept", None)
+    if "al_kept" in st.scratch and d.covers(0x0130):
+        d.put(0x0130, st.scratch["al_kept"])
+
+
 def od_list_reversed(st, m):
     """SDO information: the OD list answer (one fragment) with its indices in reverse order (the standard
     does not order the list)."""
@@ -389,6 +404,8 @@ MUTANTS = {
                             reg_rewriter(0x0110, clear_bits(0x0001))),
     "al-status-reserved": _m("ETG.1000.6 AL status 0x0130 bits 6-7 reserved (0)",
                              reg_rewriter(0x0130, set_bits(0x0040))),
+    "al-status-write-kept": _m("ETG.1000.6 AL status 0x0130 read-only for EtherCAT (a write kept until an ESC "
+                               "reset)", al_status_write_kept),
     "al-status-id-unasked": _m("ETG.1000.6 AL status 0x0130 bit 5 (ID loaded) set without the request",
                                reg_rewriter(0x0130, set_bits(0x0020))),
     "features-no-dc": _m("ESC features 0x0008 bit 2: DC unit announced by the ESI and working",
@@ -479,6 +496,9 @@ MUTANTS = {
     "statusword-not-remote": _m("CiA 402 statusword bit 9 remote: set while the controlword is processed",
                                 sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x6041,
                                              lambda m: m.__setitem__(13, m[13] & ~0x02))),
+    "statusword-target-reached-lost": _m("CiA 402 statusword bit 10 (profile velocity, halt): set at velocity 0",
+                                         sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x6041,
+                                                      lambda m: m.__setitem__(13, m[13] & ~0x04))),
     "statusword-following-error": _m("CiA 402 statusword bit 13 (csp): following error only with a deviation",
                                      sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c) and i == 0x6041
                                                   and m_oe(st), lambda m: m.__setitem__(13, m[13] | 0x20))),

@@ -312,6 +312,49 @@ class Conform(unittest.TestCase):
             names = {s.getAttribute("name") for s in xml.dom.minidom.parse(junit).getElementsByTagName("testsuite")}
             self.assertIn("slave2.sdo", names)
             return
+        if self.mode == "foe_write":
+            # The whole FoE write (--allow-foe-write): an image built with the device's own identity goes
+            # through packet by packet, the slave restarts into it from Bootstrap, and 0x100A then names it.
+            work = tempfile.mkdtemp(prefix="ecat-conform-", dir=os.environ.get("ECAT_TEST_OUT"))
+            sii, esi = alias_images(work)
+            payload = os.path.join(work, "payload.bin")
+            pathlib.Path(payload).write_bytes(bytes((i * 13 + (i >> 7)) & 0xFF for i in range(3000)))
+            image = os.path.join(work, "image.bin")
+            subprocess.run([os.environ["FWIMAGE"], "build", "--payload", payload, "--version", "0x01310000",
+                            "--esi", esi, "-o", image], check=True, timeout=60, stdout=subprocess.DEVNULL)
+            with ConformBus(slave_args=["--eeprom", sii]) as bus:
+                out = os.path.join(work, "r.json")
+                r = subprocess.run([os.environ["ECAT_CONFORM"], "--iface", bus.iface, "--esi", esi, "--group", "foe",
+                                    "--foe-file", "MAXPOS", "--allow-foe-write", "--foe-image", image, "--json", out],
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=300)
+                res = {x["id"]: x for x in json.loads(pathlib.Path(out).read_text())["results"]}
+                self.assertEqual(res["foe.write_complete"]["status"], "PASS", r.stdout[-3000:])
+                self.assertEqual(r.returncode, 0, r.stdout[-3000:])
+                self.assertIn("3032 bytes", res["foe.write_complete"]["observed"])
+                sw = bus.ecatctl("upload", "0", "0x100A", "0").stdout
+                self.assertIn("0131h", sw)
+            # Without --allow-foe-write the test says why it did not run.
+            with ConformBus(slave_args=["--eeprom", sii]) as bus:
+                r = subprocess.run([os.environ["ECAT_CONFORM"], "--iface", bus.iface, "--esi", esi, "--filter",
+                                    "foe.write_complete", "--foe-file", "MAXPOS", "--json", out],
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=120)
+                x = json.loads(pathlib.Path(out).read_text())["results"][0]
+                self.assertEqual(x["status"], "SKIP")
+                self.assertIn("--allow-foe-write", x["message"])
+            return
+        if self.mode == "contained":
+            # One defect must not spoil the rest of the run: a slave that keeps a write to its AL status
+            # (stuck in that state until its ESC is reset) fails the test that found it, is reset, and the
+            # other groups run as against a clean slave.
+            _, res, _ = self.run_conform(mutation=mutants.MUTANTS["al-status-write-kept"][1])
+            failed = sorted(x["id"] for x in res["results"] if x["status"] == "FAIL")
+            self.assertIn("esc.reg.al_status_readonly", failed)
+            self.assertLessEqual(len(failed), 3, failed)
+            passed = [x for x in res["results"] if x["status"] == "PASS"]
+            self.assertGreater(len(passed), 100)
+            message = next(x["message"] for x in res["results"] if x["id"] == "esc.reg.al_status_readonly")
+            self.assertIn("ESC reset", message)
+            return
         if self.mode == "liar":
             # A slave whose every working counter is one too high (besides BRD, so it is found): the run ends
             # in under a minute and fails.
@@ -355,7 +398,7 @@ class Conform(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) >= 2 and sys.argv[1] in ("clean", "fault", "noslave", "dies", "stopped", "liar", "line", "mutant", "variation",
+    if len(sys.argv) >= 2 and sys.argv[1] in ("clean", "fault", "noslave", "dies", "stopped", "liar", "line", "mutant", "variation", "contained", "foe_write",
                                               "table"):
         Conform.mode = sys.argv[1]
         Conform.faults = sys.argv[2:]

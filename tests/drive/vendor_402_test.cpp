@@ -78,7 +78,8 @@ constexpr uint32_t kResolution = 8192;  // 0x608F:01 encoder increments per moto
 // encoder increments (0x608F, gear 1:1, feed = one revolution), its own PDO layout, two vendor objects.
 // feed != 0: with a gear ratio 0x6091 of 1:1 and a feed constant 0x6092 of `feed` position units per
 // revolution.
-od::Dictionary vendor_dictionary(uint32_t supported_modes = 0x00000380, uint32_t feed = 0) {
+od::Dictionary vendor_dictionary(uint32_t supported_modes = 0x00000380, uint32_t feed = 0,
+                                 bool resolution = true) {
     using T = DataType;
     od::Dictionary d;
     var(d, 0x1000, T::Unsigned32, RO, uint64_t{0x00020192}, "Device type");
@@ -120,8 +121,10 @@ od::Dictionary vendor_dictionary(uint32_t supported_modes = 0x00000380, uint32_t
     var(d, 0x6083, T::Unsigned32, RW, uint64_t{20000}, "Profile acceleration");
     var(d, 0x6084, T::Unsigned32, RW, uint64_t{20000}, "Profile deceleration");
     var(d, 0x6085, T::Unsigned32, RW, uint64_t{50000}, "Quick stop deceleration");
-    rec(d, 0x608F, T::Unsigned32, "Position encoder resolution",
-        {u32(0x608F, 1, RW, kResolution, "Encoder increments"), u32(0x608F, 2, RW, 1, "Motor revolutions")});
+    if (resolution)
+        rec(d, 0x608F, T::Unsigned32, "Position encoder resolution",
+            {u32(0x608F, 1, RW, kResolution, "Encoder increments"),
+             u32(0x608F, 2, RW, 1, "Motor revolutions")});
     if (feed != 0) {
         rec(d, 0x6091, T::Unsigned32, "Gear ratio",
             {u32(0x6091, 1, RW, 1, "Motor revolutions"), u32(0x6091, 2, RW, 1, "Shaft revolutions")});
@@ -363,6 +366,17 @@ TEST(Vendor402, PositionsAreInTheDevicesUnitsThroughGearAndFeed) {
     EXPECT_EQ(d.get<uint16_t>(0x603F, 0), 0u);
     // At rest the velocity reads near 0; moving at 5 units/ms = 5000 units/s it reads about 5000.
     EXPECT_LT(std::abs(d.get<int32_t>(0x606C, 0)), 50);
+}
+
+TEST(Vendor402, WithoutAnEncoderResolutionTheFeedConstantGivesTheIncrements) {
+    // A 20-bit feed per revolution, gear 1:1, no 0x608F: one position unit is one increment.
+    od::Dictionary d = vendor_dictionary(0x00000380, 1u << 20, false);
+    drive::Drive drv(d);
+    drv.cycle(0, 1'000'000);
+    drv.cycle(1'000'000, 1'000'000);
+    EXPECT_EQ(drv.axis().increments_per_rev(), 1 << 20);
+    EXPECT_EQ(drv.axis().params.following_error_window, 4000u);
+    EXPECT_EQ(d.get<int32_t>(0x6064, 0), drv.axis().feedback().position_actual);
 }
 
 TEST(Vendor402, TheScaledCycleAllocatesNothing) {

@@ -112,12 +112,25 @@ TEST_F(Esm, IB_InitToBoot_StandardMailbox_0x0015) {
 }
 
 TEST_F(Esm, IB_InitToBoot_NotSupported_0x0013) {
-    desc.mailbox_protocols = od::mailbox_protocol::CoE;  // no FoE: no bootstrap
+    desc.mailbox_protocols = od::mailbox_protocol::CoE;
+    desc.bootstrap_mailbox = {0, 0, 0, 0};  // no bootstrap mailbox announced: no Bootstrap
     start();
     configure_bootstrap_mailbox();
     request(0x03);
     EXPECT_EQ(al_status(), 0x01 | kErr);
     EXPECT_EQ(al_code(), 0x0013);
+}
+
+// A bootstrap mailbox announced (SII words 0x14-0x17, ESI Mailbox/BootStrap) is Bootstrap supported, whether
+// or not FoE is declared: what is served there is the mailbox's business.
+TEST_F(Esm, IB_InitToBoot_BootstrapMailboxWithoutFoe) {
+    desc.mailbox_protocols = od::mailbox_protocol::CoE;
+    desc.bootstrap_mailbox = {0x1000, 256, 0x1100, 256};
+    start();
+    configure_bootstrap_mailbox();
+    request(0x03);
+    EXPECT_EQ(al_status(), 0x03);
+    EXPECT_EQ(al_code(), 0x0000);
 }
 
 TEST_F(Esm, Invalid_InitToSafeOp_0x0011) {

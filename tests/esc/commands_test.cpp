@@ -2,6 +2,7 @@
 // processing).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <optional>
 #include <string>
 
@@ -194,6 +195,53 @@ TEST_F(Addressing, ErrorCountersClearOnWrite) {
     fpwr(*e, 0x0300, std::vector<uint8_t>(0x14, 0xAB));
     EXPECT_EQ(fprd(*e, 0x0300, 1).data[0], 0);
     EXPECT_EQ(fprd(*e, 0x030C, 1).data[0], 0);
+}
+
+// A write clears a whole group of error counters whatever byte of the group it hits (ESC datasheet section
+// II): 0x0300-0x030B together, 0x030C alone, 0x0310-0x0313 together. Every byte of each group is tried.
+TEST_F(Addressing, ErrorCounterWriteClearsItsWholeGroup) {
+    auto raise_every_counter = [&] {
+        esc::FrameCheck check;
+        check.crc_bad = true;
+        std::vector<uint8_t> f = build({dg_len(FPRD, 0x1001, 0x0130, 2)});
+        e->set_link(1, true);
+        (void)e->receive(f, 0, 0, check);  // invalid frame + RX error at port 0
+        esc::FrameCheck marked;
+        marked.crc_bad = true;
+        marked.marked = true;
+        f = build({dg_len(FPRD, 0x1001, 0x0130, 2)});
+        (void)e->receive(f, 1, 0, marked);  // forwarded RX error at port 1
+        std::vector<uint8_t> bad = build({dg_len(FPRD, 0x1001, 0x0130, 2)});
+        bad[16 + 6] = 0xFF;
+        (void)e->process_frame(bad);  // length error: processing unit
+        e->set_link(1, false);        // lost link at port 1
+        ASSERT_NE(fprd(*e, 0x0300, 1).data[0], 0);
+        ASSERT_NE(fprd(*e, 0x0309, 1).data[0], 0);
+        ASSERT_NE(fprd(*e, 0x030C, 1).data[0], 0);
+        ASSERT_NE(fprd(*e, 0x0311, 1).data[0], 0);
+    };
+    auto all_zero = [&](uint16_t from, uint16_t len) {
+        const auto d = fprd(*e, from, len).data;
+        return std::all_of(d.begin(), d.end(), [](uint8_t b) { return b == 0; });
+    };
+    for (uint16_t a = 0x0300; a < 0x030C; ++a) {
+        raise_every_counter();
+        fpwr(*e, a, std::vector<uint8_t>{0x5A});
+        EXPECT_TRUE(all_zero(0x0300, 0x0C)) << std::hex << a;
+        EXPECT_NE(fprd(*e, 0x030C, 1).data[0], 0) << std::hex << a;
+        EXPECT_NE(fprd(*e, 0x0311, 1).data[0], 0) << std::hex << a;
+    }
+    for (uint16_t a = 0x0310; a < 0x0314; ++a) {
+        raise_every_counter();
+        fpwr(*e, a, std::vector<uint8_t>{0x5A});
+        EXPECT_TRUE(all_zero(0x0310, 4)) << std::hex << a;
+        EXPECT_NE(fprd(*e, 0x0300, 1).data[0], 0) << std::hex << a;
+    }
+    raise_every_counter();
+    fpwr(*e, 0x030C, std::vector<uint8_t>{0x5A});
+    EXPECT_EQ(fprd(*e, 0x030C, 1).data[0], 0);
+    EXPECT_NE(fprd(*e, 0x0300, 1).data[0], 0);
+    EXPECT_NE(fprd(*e, 0x0311, 1).data[0], 0);
 }
 
 }  // namespace

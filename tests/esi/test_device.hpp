@@ -1,7 +1,7 @@
 #pragma once
 // Devices the esi tests run against: a small hand-made dictionary that exercises every shape the generators
 // handle (VAR, uniform ARRAY, ARRAY with gaps, RECORD with gaps, strings, reals, min/max, units, backup,
-// state-dependent access, padding in a mapping), and the real drive (od::make_drive_dictionary).
+// state-dependent access, padding in a mapping), and the real drive (maxpos::dictionary).
 #include <functional>
 #include <string>
 #include <utility>

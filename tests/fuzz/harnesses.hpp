@@ -16,7 +16,8 @@
     X(master_reply)                \
     X(control)                     \
     X(topology)                    \
-    X(esi_reader)
+    X(esi_reader)                  \
+    X(eni_reader)
 
 #define SOFTECAT_FUZZ_DECLARE(name)                      \
     namespace fuzz::name {                               \

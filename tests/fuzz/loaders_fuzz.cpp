@@ -5,7 +5,7 @@
 //   1  sii-writes.bin    device::EepromWrites::load, then apply onto the SII (tools/lib/device)
 //   2  firmware/         foe::FirmwareStore::open: the slot pointer "active" and both slot images, input =
 //                        three records (16-bit length + bytes): pointer, slot0.bin, slot1.bin
-//   3  device config     od::load_device_config of the file (tools/ecat-slave --config)
+//   3  device config     maxpos::load_config of the file (tools/ecat-slave --config)
 // The contract (issue 14, finding 3): a bad file is reported and the defaults run; nothing else.
 #include <stdlib.h>
 #include <unistd.h>

@@ -268,10 +268,11 @@ def drain(sock):
         sock.setblocking(True)
 
 
-def exchange(sock, frame, timeout=0.5):
-    """Sends a frame and returns the reply to it (is_reply_to), or None when none came within timeout.
-    Frames queued before are dropped and replies to other requests skipped, so a late reply to an earlier
-    request is never taken for this one's."""
+def exchange(sock, frame, timeout=0.5, match=None):
+    """Sends a frame and returns the reply to it (is_reply_to, or match(frame, reply) when given), or None when
+    none came within timeout. Frames queued before are dropped and replies to other requests skipped, so a late
+    reply to an earlier request is never taken for this one's."""
+    match = match or is_reply_to
     drain(sock)
     sock.send(frame)
     deadline = time.monotonic() + timeout
@@ -284,7 +285,7 @@ def exchange(sock, frame, timeout=0.5):
             data, addr = sock.recvfrom(4096)
         except socket.timeout:
             return None
-        if addr[2] == PACKET_OUTGOING or not is_reply_to(frame, data):
+        if addr[2] == PACKET_OUTGOING or not match(frame, data):
             continue
         return data
 

@@ -215,6 +215,23 @@ class LongPaths(unittest.TestCase):
         self.assert_named(tool("DRIVE_SIM", "-s", os.path.join(self.dir, "none.txt")),
                           os.path.join(self.dir, "none.txt"))
 
+    def test_ecatctl_input_files_that_are_not_regular_files(self):
+        """Every file ecatctl reads goes through the one bounded reader: a FIFO without a writer is refused at
+        once (no hang), a device or a directory likewise, a file past the limit unread; exit 2, named."""
+        fifo = os.path.join(self.dir, "fifo")
+        os.mkfifo(fifo)
+        big = self.file("big.bin", b"")
+        os.truncate(big, 65537)
+        for path, why in ((fifo, "not a regular file (a FIFO)"), ("/dev/zero", "not a regular file"),
+                          (self.dir, "not a regular file"), (big, "larger than 65536 bytes")):
+            r = run("sii", "decode", path)
+            self.assertEqual(r.returncode, 2, r.stderr)
+            self.assertIn(path, r.stderr)
+            self.assertIn(why, r.stderr)
+        r = run("-i", "nosuchif0", "firmware-update", fifo)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn("not a regular file (a FIFO)", r.stderr)
+
 
 class ControlClient(unittest.TestCase):
     """`ecat-slave --control PATH --send LINE`, the project's own client of the control socket, against a stand-in

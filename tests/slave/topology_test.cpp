@@ -88,8 +88,8 @@ TEST(Topology, ForwardReferencesAreResolved) {
 
 TEST(Topology, ErrorsNameFileAndLine) {
     EXPECT_EQ(error_of("device a\ndevice b colour=red\n"),
-              "line.topo:2: unknown key 'colour' (device takes config, at, port, ports, serial, drift-ppm, "
-              "offset-ns, cable-ns, state-dir)");
+              "line.topo:2: unknown key 'colour' (device takes config, esi, device, at, port, ports, serial, "
+              "drift-ppm, offset-ns, cable-ns, state-dir)");
     EXPECT_EQ(error_of("device a\n\ndevice b at=zz:1\n"), "line.topo:3: at=zz:1: unknown device 'zz'");
     EXPECT_EQ(error_of("device a\ndevice b at=a:1\ndevice c at=a:1\n"),
               "line.topo:3: at=a:1: port 1 of 'a' used twice (also at line 2)");
@@ -100,6 +100,25 @@ TEST(Topology, ErrorsNameFileAndLine) {
     EXPECT_EQ(error_of("timing cable-ns=-1\n"),
               "line.topo:1: bad number '-1' for cable-ns (expected an integer 0..100000000)");
     EXPECT_EQ(error_of("wire a b\n"), "line.topo:1: unknown statement 'wire' (timing, device, external)");
+}
+
+// esi=FILE [device=SPEC]: a device from its ESI (a mixed line by hand); paths relative to the file's folder.
+TEST(Topology, DevicesFromAnEsi) {
+    const slave::Topology t = slave::parse_topology(
+        "device coupler esi=ex/coupler.xml ports=4\ndevice di esi=/abs/io.xml device=0x03f03052:0x00110000\n"
+        "device drive config=d.conf\n",
+        "line.topo", "/base");
+    EXPECT_EQ(t.devices[0].esi, "/base/ex/coupler.xml");
+    EXPECT_EQ(t.devices[0].device_spec, "");
+    EXPECT_EQ(t.devices[1].esi, "/abs/io.xml");
+    EXPECT_EQ(t.devices[1].device_spec, "0x03f03052:0x00110000");
+    EXPECT_EQ(t.devices[2].esi, "");
+    EXPECT_EQ(error_of("device a\ndevice b device=EXD1008\n"),
+              "line.topo:2: device=EXD1008: without esi=FILE");
+    EXPECT_EQ(
+        error_of("device a esi=x.xml config=y.conf\n"),
+        "line.topo:1: esi= and config= together: config= configures the built-in drive, esi= serves another "
+        "device");
 }
 
 TEST(Topology, ALoopIsRefused) {

@@ -69,7 +69,7 @@ std::string check_config_file(const CLI::App& app, const std::string& path) {
                           "ecat-slave go before the first section or in [default])");
             continue;
         }
-        if (!section.empty()) continue;  // a device section: od::load_device_config checks it below
+        if (!section.empty()) continue;  // a device section: maxpos::parse_config checks it below
         const auto eq = l.find('=');
         if (eq == std::string_view::npos) return at("expected 'option = value'");
         std::string key(trim(l.substr(0, eq)));

@@ -18,7 +18,10 @@
 #include "device/faults.hpp"
 #include "device/firmware.hpp"
 #include "device/line.hpp"
+#include "eni_line.hpp"
 #include "esc/link.hpp"
+#include "esi/device/product.hpp"
+#include "esi/eni/eni_reader.hpp"
 #include "od/device_config.hpp"
 #include "send_control.hpp"
 #include "slave/log.hpp"
@@ -166,6 +169,33 @@ int main(int argc, char** argv) {
         ->check(CLI::ExistingFile)
         ->excludes(slaves_opt)
         ->type_name("FILE");
+    // A device from its vendor's ESI (issue 21): the product esi::load_product makes of it.
+    std::string esi_file, device_spec;
+    auto* esi_opt =
+        app.add_option("--esi", esi_file,
+                       "Serve the device this ESI file (EtherCATInfo XML) describes instead of the "
+                       "MAXPOS: identity, SII, SMs, dictionary, PDOs, mailbox protocols from the file")
+            ->type_name("FILE");
+    app.add_option(
+           "--device", device_spec,
+           "The device of a --esi file with several: 0xPRODUCT:0xREVISION, 0xPRODUCT, or its Type name")
+        ->needs(esi_opt)
+        ->type_name("SPEC");
+    std::string eni_file;
+    app.add_option(
+           "--eni", eni_file,
+           "Serve the line this ENI (ETG.2100 EtherCAT Network Information, as TwinCAT or EC-Engineer "
+           "export it) describes, in its order and wiring; each slave from the ENI's data "
+           "(docs/eni.md)")
+        ->excludes(slaves_opt)
+        ->excludes(esi_opt)
+        ->type_name("FILE");
+    std::string esi_dir;
+    app.add_option(
+           "--esi-dir", esi_dir,
+           "With --eni: serve each slave whose vendor id, product code and revision a device of an ESI "
+           "file in this folder (*.xml) has from that ESI, the others from the ENI's data")
+        ->type_name("DIR");
     app.add_option("--out-iface", options.out_iface,
                    "Port 1 of the last device (or the topology's 'external' port) leads to this interface: "
                    "the line continues there; no carrier closes the port")
@@ -214,6 +244,19 @@ int main(int argc, char** argv) {
     if (stops.size() == 2) device.environment.stop_lo = stops[0], device.environment.stop_hi = stops[1];
     if (auto* config = app.get_config_ptr(); config != nullptr && config->count() > 0)
         device.config_file = config->as<std::string>();
+    if (!esi_file.empty()) {
+        // A bad file or spec is a usage error naming the file (and line) before anything else is set up.
+        if (!device.config_file.empty()) {
+            std::cerr << "ecat-slave: --esi serves the device of its file: not with a MAXPOS --config\n";
+            return slave::kExitUsage;
+        }
+        try {
+            device.product = std::make_shared<const od::Product>(esi::load_product(esi_file, device_spec));
+        } catch (const std::exception& e) {
+            std::cerr << "ecat-slave: " << e.what() << '\n';
+            return slave::kExitUsage;
+        }
+    }
     device.state_dir = state_dir;
     slave::Log log(std::cerr, quiet ? slave::LogLevel::Error : *slave::parse_log_level(log_level),
                    slave::stderr_is_terminal());
@@ -275,11 +318,12 @@ int main(int argc, char** argv) {
             revision << "0x" << std::hex << std::uppercase << std::setw(8) << std::setfill('0')
                      << id.revision;
             std::cerr << "ecat-slave: "
-                      << (described.state_dir.empty()
+                      << (described.product ? described.product->source
+                          : described.state_dir.empty()
                               ? "the built-in firmware"
                               : "the firmware active in " + described.state_dir.string())
-                      << ", software version " << id.software_version << ", revision " << revision.str()
-                      << '\n';
+                      << (id.software_version.empty() ? "" : ", software version " + id.software_version)
+                      << ", revision " << revision.str() << '\n';
             return slave::kExitOk;
         }
         device::check_device(device);  // a bad configuration is a usage error, before any setup
@@ -298,7 +342,8 @@ int main(int argc, char** argv) {
             return slave::kExitUsage;
         }
     }
-    const bool segment_mode = slaves > 1 || !topology_file.empty() || !options.out_iface.empty();
+    const bool segment_mode =
+        slaves > 1 || !topology_file.empty() || !eni_file.empty() || !options.out_iface.empty();
     if (slaves_opt->count() > 0 && !segment_mode) device.serial_number = 1;  // --slaves 1: serial number 1
     // Each state directory is the one device's that runs on it: locked until exit (a second process, or a
     // second device of a topology on the same directory, is a usage error before any network set-up).
@@ -323,23 +368,67 @@ int main(int argc, char** argv) {
         return slave::kExitUsage;
     }
     device::LineOptions line;
+    if (!eni_file.empty() && !topology_file.empty()) {
+        std::cerr << "ecat-slave: --eni and --topology both describe the line: give one\n";
+        return slave::kExitUsage;
+    }
     try {
-        line.topology =
-            topology_file.empty() ? slave::line_topology(slaves) : slave::load_topology(topology_file);
+        if (!esi_dir.empty() && eni_file.empty()) {
+            std::cerr << "ecat-slave: --esi-dir goes with --eni (a topology names each ESI with esi=)\n";
+            return slave::kExitUsage;
+        }
+        if (!eni_file.empty()) {
+            ecat_slave::EsiIndex index;
+            if (!esi_dir.empty()) {
+                index = ecat_slave::index_esi_dir(esi_dir);
+                for (const std::string& skipped : index.skipped)
+                    log.info("--esi-dir: left out: " + skipped);
+            }
+            ecat_slave::EniLine eni = ecat_slave::eni_line(eni_file, esi_dir.empty() ? nullptr : &index);
+            line.topology = std::move(eni.topology);
+            line.products = std::move(eni.products);
+            for (const std::string& r : eni.report)
+                std::cerr << "ecat-slave: " << r << '\n';
+        } else {
+            line.topology =
+                topology_file.empty() ? slave::line_topology(slaves) : slave::load_topology(topology_file);
+        }
     } catch (const slave::TopologyError& e) {
         std::cerr << "ecat-slave: " << e.what() << '\n';
         return slave::kExitUsage;
+    } catch (const esi::eni::EniError& e) {
+        std::cerr << "ecat-slave: " << e.what() << '\n';
+        return slave::kExitUsage;
+    } catch (const std::runtime_error& e) {  // an ESI of --esi-dir that matches but cannot be served
+        std::cerr << "ecat-slave: " << e.what() << '\n';
+        return slave::kExitUsage;
+    }
+    // Devices of a topology file from an ESI (esi=FILE [device=SPEC]).
+    line.products.resize(line.topology.devices.size());
+    for (std::size_t k = 0; k < line.topology.devices.size(); ++k) {
+        const slave::TopologyDevice& d = line.topology.devices[k];
+        if (d.esi.empty()) continue;
+        try {
+            line.products[k] = std::make_shared<const od::Product>(esi::load_product(d.esi, d.device_spec));
+        } catch (const std::exception& e) {
+            std::cerr << "ecat-slave: " << line.topology.where(d.line) << "device " << d.name << ": "
+                      << e.what() << '\n';
+            return slave::kExitUsage;
+        }
+        log.info("device " + d.name + ": served from " + line.products[k]->source);
     }
     if (topology_file.empty() && slaves == 1) {
         line.topology.devices[0].state_dir = device.state_dir.string();
         // One drive with --out-iface only: the serial number of its configuration, as without --out-iface.
         if (slaves_opt->count() == 0) line.topology.devices[0].serial = 0;
     }
-    for (slave::TopologyDevice& d : line.topology.devices) {
+    for (std::size_t k = 0; k < line.topology.devices.size(); ++k) {
+        slave::TopologyDevice& d = line.topology.devices[k];
         if (d.state_dir.empty()) d.state_dir = (device.state_dir / d.name).string();
         // Each device's configuration is loaded now: a bad one is a usage error naming the topology line.
         device::DeviceOptions o = device;
         if (!d.config.empty()) o.config_file = d.config;
+        if (k < line.products.size() && line.products[k]) o.product = line.products[k];
         o.state_dir = d.state_dir;
         try {
             device::check_device(o);

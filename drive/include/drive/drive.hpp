@@ -103,6 +103,7 @@ class Drive {
     std::vector<Link> position_in_, position_out_;  // position objects in position units (scaled_ only)
     bool scaled_ = false;
     bool velocity_per_second_ = false;
+    bool resolution_from_feed_ = false;  // a factor group without 0x608F: increments per unit 1
     Feedback fb_copy_;
     uint32_t resolution_ = 0;
     std::size_t bound_ = 0, missing_ = 0;

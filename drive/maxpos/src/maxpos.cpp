@@ -542,7 +542,7 @@ Number parse_number(std::string_view s, DataType t, uint16_t index) {
 }
 
 // The values an enumerated entry takes: its value set, a display's the value set of what it displays, or
-// the range of its limits. Each must have a name (od/value_names.hpp), so the ESI names every value the
+// the range of its limits. Each must have a name (value_names.hpp), so the ESI names every value the
 // drive accepts and no other.
 std::vector<NamedValue> enumeration_of(const Entry& e) {
     if (!has_value_names(e.index, e.subindex)) return {};

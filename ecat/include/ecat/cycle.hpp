@@ -1,9 +1,9 @@
 #pragma once
 // The cycle of ecat::Stack: the poll loop (AL event request 0x0220 and its dispatch to the state machine,
 // the mailbox and the process data), the ESC-reset restart, the process-data watchdog, and the process data
-// exchange itself (SM2 outputs into the dictionary, the application cycle, inputs out through SM3) at the
-// moments SyncControl says. It owns the process-data images (sized at Safe-Op, never per frame) and the
-// interrupt-line bookkeeping.
+// exchange itself (SM2 outputs into the dictionary, the application cycle, inputs out through SM3; other SMs
+// where the description puts the process data) at the moments SyncControl says. It owns the process-data
+// images (sized at Safe-Op, never per frame) and the interrupt-line bookkeeping.
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -25,7 +25,10 @@ class Cycle {
     // its event ("buffer read by the master") stays set until the PDI writes the next message (ESC
     // datasheet, SM status 0x0805 bit 1), so after the last reply it would hold the interrupt line high for
     // good and every pass would poll the stack. While messages wait for SM1, quiet() is false anyway.
+    // That is the mask of a device with mailbox and process data in SM2/SM3; a device without mailbox or
+    // with its process data in other SMs (ProcessDataSms) gets the SM events of those.
     static constexpr uint32_t kEventMask = 0x00000D55;
+    uint32_t event_mask() const { return event_mask_; }
 
     Cycle(StackContext& ctx, StateMachine& esm, SyncControl& sync, IrqLine irq);
     Cycle(const Cycle&) = delete;
@@ -69,6 +72,9 @@ class Cycle {
     SyncControl& sync_;
     IrqLine irq_;
 
+    uint32_t event_mask_ = kEventMask;
+    unsigned out_sm_ = 2;  // ctx_.sms, kNoSm mapped to an SM that is never used (its buffer stays empty)
+    unsigned in_sm_ = 3;
     std::vector<uint8_t> sm2_buf_;
     std::vector<uint8_t> sm3_buf_;
     uint16_t sm2_start_ = 0;

@@ -16,6 +16,7 @@ struct PdoCopy {
     uint8_t* storage = nullptr;  // entry value in the dictionary's image (nullptr: padding, never copied)
     uint32_t bit_offset = 0;     // position in the SM buffer
     uint16_t bits = 0;
+    const od::Entry* entry = nullptr;  // the entry mapped (for the application's view of the mapping)
 };
 
 class ProcessData {
@@ -23,12 +24,17 @@ class ProcessData {
     static constexpr std::size_t kMaxEntries = 256;  // per direction
     static constexpr uint16_t kRxAssign = 0x1C12;
     static constexpr uint16_t kTxAssign = 0x1C13;
+    // The PDO assignment object of SM n (ETG.1000.6: 0x1C10 + n); a device without mailbox assigns its
+    // process data to SM0/SM1 (0x1C10/0x1C11).
+    static constexpr uint16_t assign_index(unsigned sm) { return static_cast<uint16_t>(0x1C10 + sm); }
+    static constexpr unsigned kNoSm = 0xFF;
 
     explicit ProcessData(od::Dictionary& dictionary);
 
     // Reads the assignment and mapping objects and builds both plans. Returns 0 or the AL status code:
     // 0x0025 invalid output mapping (RxPDO side) / 0x0024 invalid input mapping (TxPDO side).
-    uint16_t build();
+    // outputs_sm / inputs_sm: the SyncManagers of the two directions (kNoSm: none, no process data).
+    uint16_t build(unsigned outputs_sm = 2, unsigned inputs_sm = 3);
     void clear();
 
     std::size_t rx_bits() const { return rx_bits_; }

@@ -46,6 +46,37 @@ void add_stats(StackStats& total, const StackStats& more);
 // The statistics as "stack.<name> <value>" lines (latencies in ns), for logs and benchmark scripts.
 void print_stats(std::ostream& out, const StackStats& stats);
 
+// The SyncManagers that carry process data: the first SM of kind Outputs and of kind Inputs in the
+// description (ETG.2000 Sm elements; a device without mailbox has them at SM0/SM1, a device with one at
+// SM2/SM3). A description without SyncManagers: SM2/SM3. kNoSm: no SM for that direction.
+struct ProcessDataSms {
+    static constexpr unsigned kNoSm = ProcessData::kNoSm;
+    unsigned outputs = 2;
+    unsigned inputs = 3;
+};
+
+inline ProcessDataSms process_data_sms(const od::DeviceDescription& desc) {
+    ProcessDataSms s;
+    if (desc.sync_managers.empty()) return s;
+    s.outputs = s.inputs = ProcessDataSms::kNoSm;
+    for (unsigned n = 0; n < desc.sync_managers.size() && n < 16; ++n) {
+        const od::SmKind k = desc.sync_managers[n].kind;
+        if (k == od::SmKind::Outputs && s.outputs == ProcessDataSms::kNoSm) s.outputs = n;
+        if (k == od::SmKind::Inputs && s.inputs == ProcessDataSms::kNoSm) s.inputs = n;
+    }
+    return s;
+}
+
+// True if the description declares a mailbox: an SM of kind MBoxOut/MBoxIn (or, without SyncManagers,
+// a standard mailbox with a size).
+inline bool has_mailbox(const od::DeviceDescription& desc) {
+    if (desc.sync_managers.empty())
+        return desc.standard_mailbox.out_size != 0 || desc.standard_mailbox.in_size != 0;
+    for (const od::SyncManagerDefault& sm : desc.sync_managers)
+        if (sm.kind == od::SmKind::MBoxOut || sm.kind == od::SmKind::MBoxIn) return true;
+    return false;
+}
+
 struct StackContext {
     esc::Pdi& pdi;
     od::Dictionary& dict;
@@ -56,6 +87,7 @@ struct StackContext {
     StackStats& stats;
     const StackFaults& faults;
     EventSink* events = nullptr;
+    ProcessDataSms sms{};
 };
 
 // States in which process data (SM2/SM3) runs.

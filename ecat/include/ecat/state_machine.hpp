@@ -47,6 +47,8 @@ class StateMachine {
   private:
     void request(od::AlState to, uint64_t now_ns);
     void request_checked(od::AlState to, uint64_t now_ns);  // request() without the refusal report
+    bool device_emulation() const;
+    void follow(od::AlState to, uint64_t now_ns);  // device emulation: the state the ESC took
     uint16_t check_mailbox(const od::MailboxLayout& layout, uint16_t code);
     uint16_t check_bootstrap() const;
     uint16_t check_pre_op_to_safe_op();

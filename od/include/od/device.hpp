@@ -88,12 +88,57 @@ struct PdoSet {
     std::vector<uint16_t> tx;  // 0x1A00..
 };
 
+// A DC operation mode (ESI Dc/OpMode, SII DC category, ETG.2000 / ETG.2010). (New fields go at the end:
+// descriptions initialise the first ones by position.)
 struct DcOpMode {
     std::string name;  // "SM-Synchron", "DC"
     std::string description;
     uint16_t assign_activate = 0;  // value for 0x0980/0x0981 (e.g. 0x0300: SYNC0 + cyclic unit)
+    // SYNC0 cycle: the bus cycle times cycle_time_sync0_factor, or cycle_time_sync0 ns if that is not 0.
     int32_t cycle_time_sync0_factor = 1;
     int32_t shift_time_sync0 = 0;
+    uint32_t cycle_time_sync0 = 0;
+    // SYNC1 (AssignActivate bit 0x0400): its cycle as a multiple of the SYNC0 cycle (cycle_time_sync1_factor,
+    // 0: not declared) or cycle_time_sync1 ns, and its shift after SYNC0 in ns.
+    uint32_t cycle_time_sync1 = 0;
+    int32_t cycle_time_sync1_factor = 0;
+    int32_t shift_time_sync1 = 0;
+    bool operator==(const DcOpMode&) const = default;
+};
+
+// A modular device's slots and the modules they take (ESI Slots, Descriptions/Modules; ETG.2000), kept so
+// that the ESI written back offers the same choices. The dictionary and the PDOs hold the default
+// configuration (each slot's default module placed); these say where it came from.
+struct ModulePdoEntry {
+    uint16_t index = 0;  // 0: padding; the module's base index (before the slot's increment)
+    uint8_t subindex = 0;
+    uint8_t bit_length = 0;
+    std::string name;
+    std::string data_type;        // ESI type name ("BOOL", "INT", ...), empty for padding
+    bool depend_on_slot = false;  // the slot's index increment is added
+};
+struct ModulePdo {
+    bool rx = false;
+    uint16_t index = 0;  // base index (before the slot's PDO increment)
+    bool depend_on_slot = false;
+    std::string name;
+    int sm = -1;
+    bool fixed = false;
+    bool mandatory = false;
+    std::vector<ModulePdoEntry> entries;
+};
+struct Module {
+    uint32_t ident = 0;  // ModuleIdent
+    std::string type;    // Type text
+    std::string name;
+    std::vector<ModulePdo> pdos;
+};
+struct Slot {
+    std::string name;
+    uint32_t min_instances = 0, max_instances = 1;
+    std::vector<uint32_t> module_idents;  // the modules it takes
+    uint32_t default_module = 0;          // 0: empty by default
+    uint32_t pdo_increment = 0, index_increment = 0;
 };
 
 struct DeviceDescription {
@@ -104,7 +149,11 @@ struct DeviceDescription {
     uint8_t coe_details = coe_details::Sdo | coe_details::SdoInfo | coe_details::PdoAssign |
                           coe_details::PdoConfig | coe_details::CompleteAccess;
     uint8_t foe_details = 0;
-    std::vector<SyncManagerDefault> sync_managers;  // SM0..SM3 in order
+    std::vector<SyncManagerDefault> sync_managers;  // SM0..SM3 in order (none: a device without mailbox and
+                                                    // process data, as a coupler)
+    // The FMMUs as declared (ESI Fmmu, SII FMMU category: 1 outputs, 2 inputs, 3 mailbox state, 0 unused);
+    // empty: one for each process-data direction and one for the mailbox state, as the SMs need.
+    std::vector<uint8_t> fmmus;
     std::vector<DcOpMode> dc_modes;
     uint16_t eeprom_bytes = 2048;
     uint8_t pdi_control = 0x05;  // SII word 0 low: SPI (as the MAXPOS's ESC) -- see docs/decisions.md
@@ -119,6 +168,9 @@ struct DeviceDescription {
     // slave may take to take a request out of SM0 and to answer it (0: not declared).
     uint32_t mailbox_request_timeout_ms = 0;
     uint32_t mailbox_response_timeout_ms = 0;
+    // A modular device (empty: not modular). The PDOs of the slots' default modules are in the dictionary.
+    std::vector<Slot> slots;
+    std::vector<Module> modules;
 };
 
 }  // namespace od

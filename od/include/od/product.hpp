@@ -1,7 +1,7 @@
 #pragma once
 // A product: one kind of device a soft slave can be, as one value. The built-in MAXPOS drive is one; a device
-// read from a vendor's ESI file (esi/device) or from an ENI's slave data is another. device::Device builds its
-// firmware from a product; od/ itself declares no product.
+// read from a vendor's ESI file (esi/device) or from an ENI's slave data is another. device::Device builds
+// its firmware from a product; od/ itself declares no product.
 #include <cstdint>
 #include <functional>
 #include <string>

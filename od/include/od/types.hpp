@@ -20,12 +20,24 @@ enum class DataType : uint16_t {
     VisibleString = 0x0009,
     OctetString = 0x000A,
     UnicodeString = 0x000B,
+    Integer24 = 0x0010,
     Real64 = 0x0011,
     Integer64 = 0x0015,
+    Unsigned24 = 0x0016,
     Unsigned64 = 0x001B,
     PdoMapping = 0x0021,
     Identity = 0x0023,
     SyncManagerParameter = 0x0029,  // not a scalar: used as the type of RECORD objects
+    // Bit strings of 1..8 bits (ETG.1000.6 BIT1..BIT8, the ESI's BIT2, BIT3, ...): the status bits and
+    // small enumerations of IO terminals, packed into PDOs without padding.
+    Bit1 = 0x0030,
+    Bit2 = 0x0031,
+    Bit3 = 0x0032,
+    Bit4 = 0x0033,
+    Bit5 = 0x0034,
+    Bit6 = 0x0035,
+    Bit7 = 0x0036,
+    Bit8 = 0x0037,
 };
 
 enum class ObjectCode : uint8_t { Var = 0x07, Array = 0x08, Record = 0x09 };
@@ -103,14 +115,26 @@ constexpr uint16_t bit_size(DataType t) {
         case DataType::Unsigned64:
         case DataType::Real64:
             return 64;
+        case DataType::Integer24:
+        case DataType::Unsigned24:
+            return 24;
+        case DataType::Bit1:
+        case DataType::Bit2:
+        case DataType::Bit3:
+        case DataType::Bit4:
+        case DataType::Bit5:
+        case DataType::Bit6:
+        case DataType::Bit7:
+        case DataType::Bit8:
+            return static_cast<uint16_t>(static_cast<uint16_t>(t) - 0x002F);
         default:
             return 0;
     }
 }
 
 constexpr bool is_signed(DataType t) {
-    return t == DataType::Integer8 || t == DataType::Integer16 || t == DataType::Integer32 ||
-           t == DataType::Integer64;
+    return t == DataType::Integer8 || t == DataType::Integer16 || t == DataType::Integer24 ||
+           t == DataType::Integer32 || t == DataType::Integer64;
 }
 
 constexpr bool is_real(DataType t) {

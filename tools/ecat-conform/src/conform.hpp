@@ -120,9 +120,10 @@ struct Options {
     std::string foe_file;       // a file name the device's FoE server knows (Bootstrap firmware)
     uint32_t foe_password = 0;  // its password
     // What may change the device beyond its configuration: off unless asked for (docs/conformance.md).
-    bool allow_fault = false;      // provoke a drive fault (fault reaction: the drive stops, may brake)
-    bool allow_motion = false;     // command motion (profile modes with a set-point)
-    bool allow_foe_write = false;  // let an FoE write of --foe-file go through (writes the device's flash)
+    bool allow_fault = false;        // provoke a drive fault (fault reaction: the drive stops, may brake)
+    bool allow_motion = false;       // command motion (profile modes with a set-point)
+    bool allow_foe_write = false;    // let an FoE write of --foe-file go through (writes the device's flash)
+    std::vector<uint8_t> foe_image;  // what that write sends (--foe-image): the device's own firmware
 };
 
 // ---- the run context -------------------------------------------------------------------------------
@@ -171,6 +172,11 @@ class Context {
     master::Result<uint8_t> state();
     // Brings the slave to INIT (acknowledging errors), and clears all SMs and FMMUs.
     master::Error to_init();
+    // ESC reset (ESC datasheet section II, 0x0040 "ESC Reset ECAT": 'R', 'E', 'S' written in three
+    // consecutive frames), for a slave that cannot be brought back to INIT otherwise. True if the ESC was
+    // reset: it no longer answers at its station address (the reset clears 0x0010); the caller assigns
+    // addresses again. False where the ESC has no reset (it still answers there).
+    bool esc_reset();
     // INIT -> PREOP with the standard mailbox; sets up mbx/sdo. Idempotent when already in PREOP.
     master::Error to_preop();
     // Requests a state, returns the AL status reached (error indication kept, not acknowledged).

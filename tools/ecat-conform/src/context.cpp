@@ -351,6 +351,18 @@ Error Context::to_init() {
     return Error::Ok;
 }
 
+bool Context::esc_reset() {
+    in_preop = false;
+    pds.reset();
+    sdo.reset();
+    mbx.reset();
+    for (const uint8_t v : {uint8_t{0x52}, uint8_t{0x45}, uint8_t{0x53}})
+        if (m.write_reg<uint8_t>(addr, esc::reg::kEscResetEcat, v) != Error::Ok) return false;
+    // The firmware behind the PDI starts again after the reset: give it a moment before asking.
+    std::this_thread::sleep_for(ms(100));
+    return !m.read_reg<uint16_t>(addr, esc::reg::kStationAddress);
+}
+
 Error Context::to_preop() {
     if (in_preop && mbx) {
         auto s = state();

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <map>
 
+#include "util/json.hpp"
+
 namespace conform {
 
 Totals totals(const std::vector<TestResult>& results) {
@@ -66,23 +68,6 @@ std::string xml_escape(const std::string& s) {
                     o += '?';
                 else
                     o += static_cast<char>(c);
-        }
-    }
-    return o;
-}
-
-std::string json_escape(const std::string& s) {
-    std::string o;
-    char b[8];
-    for (unsigned char c : s) {
-        if (c == '"' || c == '\\') {
-            o += '\\';
-            o += static_cast<char>(c);
-        } else if (c < 0x20) {
-            std::snprintf(b, sizeof b, "\\u%04x", c);
-            o += b;
-        } else {
-            o += static_cast<char>(c);
         }
     }
     return o;
@@ -235,29 +220,38 @@ void write_junit(std::ostream& out, const std::vector<TestResult>& results, cons
 }
 
 void write_json(std::ostream& out, const std::vector<TestResult>& results, const RunInfo& info) {
-    Totals t = totals(results);
-    out << "{\n  \"tool\": \"ecat-conform\",\n  \"iface\": \"" << json_escape(info.iface)
-        << "\",\n  \"device\": \"" << json_escape(info.device)
-        << "\",\n  \"duration_ms\": " << info.duration.count() << ",\n  \"passed\": " << t.passed
-        << ",\n  \"failed\": " << t.failed << ",\n  \"skipped\": " << t.skipped
-        << ",\n  \"warnings\": " << t.warned << ",\n  \"notes\": [";
-    for (std::size_t i = 0; i < info.notes.size(); ++i)
-        out << (i ? ", " : "") << "\"" << json_escape(info.notes[i]) << "\"";
-    out << "],\n  \"results\": [\n";
-    for (std::size_t i = 0; i < results.size(); ++i) {
-        const auto& r = results[i];
-        out << "    {";
-        if (r.slave >= 0) out << "\"slave\": " << r.slave << ", ";
-        out << "\"id\": \"" << json_escape(r.test->id) << "\", \"group\": \"" << json_escape(r.test->group)
-            << "\", \"status\": \"" << status_name(r.outcome.status) << "\", \"severity\": \""
-            << (r.test->severity == Severity::Error ? "error" : "warning") << "\", \"title\": \""
-            << json_escape(r.test->title) << "\", \"clause\": \"" << json_escape(r.test->clause)
-            << "\", \"message\": \"" << json_escape(r.outcome.message) << "\", \"observed\": \""
-            << json_escape(r.outcome.observed) << "\", \"expected\": \"" << json_escape(r.outcome.expected)
-            << "\", \"duration_us\": " << r.duration.count() << "}" << (i + 1 < results.size() ? "," : "")
-            << "\n";
+    const Totals t = totals(results);
+    util::JsonWriter w(out);
+    w.begin_object()
+        .member("tool", "ecat-conform")
+        .member("iface", info.iface)
+        .member("device", info.device)
+        .member("duration_ms", info.duration.count())
+        .member("passed", t.passed)
+        .member("failed", t.failed)
+        .member("skipped", t.skipped)
+        .member("warnings", t.warned);
+    w.key("notes").begin_array();
+    for (const auto& n : info.notes)
+        w.value(n);
+    w.end_array();
+    w.key("results").begin_array();
+    for (const auto& r : results) {
+        w.begin_object();
+        if (r.slave >= 0) w.member("slave", r.slave);
+        w.member("id", r.test->id)
+            .member("group", r.test->group)
+            .member("status", status_name(r.outcome.status))
+            .member("severity", r.test->severity == Severity::Error ? "error" : "warning")
+            .member("title", r.test->title)
+            .member("clause", r.test->clause)
+            .member("message", r.outcome.message)
+            .member("observed", r.outcome.observed)
+            .member("expected", r.outcome.expected)
+            .member("duration_us", r.duration.count())
+            .end_object();
     }
-    out << "  ]\n}\n";
+    w.end_array().end_object();
 }
 
 void write_list(std::ostream& out, const Catalogue& c, bool markdown) {

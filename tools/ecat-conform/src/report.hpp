@@ -38,6 +38,5 @@ void write_json(std::ostream& out, const std::vector<TestResult>& results, const
 void write_list(std::ostream& out, const Catalogue& c, bool markdown);
 
 std::string xml_escape(const std::string& s);
-std::string json_escape(const std::string& s);
 
 }  // namespace conform

@@ -462,6 +462,61 @@ void add_cia402_tests(Catalogue& c) {
         },
         "profile 402");
     add(
+        "statusword.target_reached_halt",
+        "Profile velocity mode, target velocity 0, halt set, operation enabled: statusword bit 10 (target "
+        "reached) set once the axis stands (no motion is commanded)",
+        "IEC 61800-7-201 (CiA 402) statusword 0x6041 bit 10 in profile velocity mode: with halt, set at "
+        "velocity 0",
+        [](Context& ctx) {
+            CONFORM_NEED(need_402_profile(ctx));
+            CONFORM_PREOP(ctx);
+            auto modes = ctx.upload_uint(0x6502, 0);
+            if (!modes || !(*modes & 0x04)) return skip("0x6502 does not announce profile velocity mode");
+            Drive d(ctx);
+            if (auto e = d.start(); !e.empty())
+                return e.find("not in the process data") != std::string::npos ? skip(e) : fail(e);
+            // Profile velocity, target velocity 0: in the image where mapped, else over SDO.
+            if (d.mode)
+                image_set(ctx.pds->outputs(), *d.mode, 3);
+            else
+                (void)ctx.download_uint(0x6060, 0, 3, 1);
+            if (const MappedEntry* v = d.map.find_out(0x60FF))
+                image_set(ctx.pds->outputs(), *v, 0);
+            else
+                (void)ctx.download_uint(0x60FF, 0, 0, 4);
+            d.run(20);
+            auto shown = ctx.upload_uint(0x6061, 0);
+            if (!shown || (*shown & 0xFF) != 3) {
+                d.finish();
+                return skip("the drive did not take profile velocity mode (0x6061 " +
+                            (shown ? hex(*shown & 0xFF) : std::string("unreadable")) + ")");
+            }
+            if (!d.to(kOe)) {
+                const std::string s = sw_text(d.status());
+                d.finish();
+                return fail("cannot reach operation enabled", s, kOe.name);
+            }
+            image_set(ctx.pds->outputs(), *d.cw, 0x010F);  // halt
+            const auto deadline = std::chrono::steady_clock::now() + ctx.ms(1000);
+            uint16_t sw = d.status();
+            while (!(sw & 0x0400) && std::chrono::steady_clock::now() < deadline) {
+                d.run(1);
+                sw = d.status();
+            }
+            d.run(5);
+            auto sdo = ctx.upload_uint(0x6041, 0);
+            d.finish();
+            if (!(sw & 0x0400))
+                return fail("image: bit 10 (target reached) clear with halt at velocity 0", sw_text(sw),
+                            "bit 10 set");
+            if (!sdo) return fail("0x6041 upload: " + ctx.sdo_error(sdo.error()));
+            if (!(*sdo & 0x0400))
+                return fail("SDO: bit 10 (target reached) clear with halt at velocity 0",
+                            sw_text(static_cast<uint16_t>(*sdo)), "bit 10 set");
+            return pass("target reached", sw_text(sw));
+        },
+        "profile 402, 0x6502 announces profile velocity");
+    add(
         "fault.emergency",
         "Fault (communication loss while enabled): its emergency has 8 bytes, a non-zero error code as "
         "0x603F, "

@@ -1,6 +1,9 @@
 // Group foe: Bootstrap and FoE: entry into BOOT with the SII's bootstrap mailbox, writes refused outside
 // Bootstrap, unknown file names and wrong passwords refused with their FoE error codes. No firmware is
-// ever written: an accepted write request is cancelled at once with an FoE error packet.
+// written unless asked: an accepted write request is cancelled at once with an FoE error packet; with
+// --allow-foe-write --foe-file --foe-image one whole write goes through, packet by packet.
+#include <thread>
+
 #include "testkit.hpp"
 
 namespace conform {
@@ -81,6 +84,66 @@ Outcome expect_foe_error(const FoeAnswer& a, std::initializer_list<uint32_t> cod
             " code " + hex((ctx).last_status.code),                                                        \
         "BOOT")
 
+// One whole FoE write (ETG.1000.6 FoE): WRQ answered by ACK 0, DATA packets 1..n each answered by the ACK of
+// its number (BUSY in between allowed: the packet is sent again), the last one shorter than a full packet
+// (an empty one when the file fills its last packet), the final ACK within the budget. Returns "" or what
+// went wrong; busy counts the BUSY answers.
+std::string foe_write_whole(Context& ctx, const std::string& name, uint32_t password,
+                            std::span<const uint8_t> file, unsigned& busy, unsigned& packets) {
+    auto receive = [&](uint8_t& opcode, uint32_t& value, std::string& text) -> std::string {
+        for (;;) {
+            master::MailboxMessage m;
+            if (Error e = ctx.mbx->receive(m, ctx.ms(5000)); e != Error::Ok) return "no answer: " + err(e);
+            if (m.type == master::MailboxType::Error) return "a mailbox error reply";
+            if (m.type != master::MailboxType::FoE) continue;
+            if (m.payload.size() < 6) return "an FoE packet of " + dec(m.payload.size()) + " bytes";
+            opcode = m.payload[0];
+            value = get32(&m.payload[2]);
+            text.assign(m.payload.begin() + 6, m.payload.end());
+            return "";
+        }
+    };
+    std::vector<uint8_t> p(6, 0);
+    p[0] = 2;  // WRQ
+    put32(&p[2], password);
+    p.insert(p.end(), name.begin(), name.end());
+    if (Error e = ctx.mbx->send(master::MailboxType::FoE, p); e != Error::Ok)
+        return "WRQ not sent: " + err(e);
+    uint8_t op = 0;
+    uint32_t value = 0;
+    std::string text;
+    if (auto w = receive(op, value, text); !w.empty()) return "WRQ: " + w;
+    if (op == 5) return "WRQ refused: ERR " + hex(value) + " \"" + text + "\"";
+    if (op != 4 || value != 0)
+        return "WRQ answered by opcode " + dec(op) + " value " + dec(value) + ", not ACK 0";
+    const std::size_t chunk = ctx.mbx->config().out_size - 6 - 6;  // mailbox header, FoE header
+    std::size_t at = 0;
+    uint32_t number = 0;
+    for (;;) {
+        const std::size_t n = std::min(chunk, file.size() - at);
+        ++number;
+        std::vector<uint8_t> d(6, 0);
+        d[0] = 3;  // DATA
+        put32(&d[2], number);
+        d.insert(d.end(), file.begin() + static_cast<std::ptrdiff_t>(at),
+                 file.begin() + static_cast<std::ptrdiff_t>(at + n));
+        for (;;) {
+            if (Error e = ctx.mbx->send(master::MailboxType::FoE, d); e != Error::Ok)
+                return "DATA " + dec(number) + " not sent: " + err(e);
+            if (auto w = receive(op, value, text); !w.empty()) return "DATA " + dec(number) + ": " + w;
+            if (op != 6) break;  // BUSY: the same packet again after a pause
+            if (++busy > 1000) return "BUSY answered more than 1000 times";
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        }
+        ++packets;
+        if (op == 5) return "DATA " + dec(number) + " refused: ERR " + hex(value) + " \"" + text + "\"";
+        if (op != 4) return "DATA " + dec(number) + " answered by opcode " + dec(op);
+        if (value != number) return "DATA " + dec(number) + " answered by ACK " + dec(value);
+        at += n;
+        if (n < chunk) return "";  // the short packet ended the file and was acknowledged
+    }
+}
+
 }  // namespace
 
 void add_foe_tests(Catalogue& c) {
@@ -160,6 +223,37 @@ void add_foe_tests(Catalogue& c) {
             return expect_foe_error(r, {0x8001, 0x800F}, "read of an unknown name");
         },
         a);
+    add(
+        "write_complete",
+        "A whole FoE write of --foe-image as --foe-file in BOOT: ACK 0 to the request, each DATA packet "
+        "acknowledged with its number (BUSY allowed), the final ACK; then INIT and PREOP again",
+        kFoe,
+        [](Context& ctx) {
+            if (!ctx.opt.allow_foe_write)
+                return skip("writes the device's firmware: needs --allow-foe-write");
+            if (ctx.opt.foe_file.empty() || ctx.opt.foe_image.empty())
+                return skip("needs --foe-file and --foe-image (the device's own firmware)");
+            CONFORM_BOOT(ctx);
+            unsigned busy = 0, packets = 0;
+            const std::string w = foe_write_whole(ctx, ctx.opt.foe_file, ctx.opt.foe_password,
+                                                  ctx.opt.foe_image, busy, packets);
+            const std::string how = dec(ctx.opt.foe_image.size()) + " bytes in " + dec(packets) +
+                                    " packets, " + dec(busy) + " BUSY";
+            if (!w.empty()) {
+                ctx.mbx_resync();
+                (void)ctx.to_init();
+                return fail("FoE write of \"" + ctx.opt.foe_file + "\": " + w, how,
+                            "every packet acknowledged");
+            }
+            master::AlStatus st = ctx.request_raw(1, ctx.ms(10000));
+            if (st.state != 1 || st.error)
+                return fail("BOOT -> INIT after the write",
+                            state_text(static_cast<uint8_t>(st.state | (st.error ? 0x10 : 0))), "INIT");
+            if (Error e = ctx.to_preop(); e != Error::Ok)
+                return fail("INIT -> PREOP after the write: " + err(e), how, "PREOP");
+            return pass("written and acknowledged", how);
+        },
+        "--allow-foe-write, --foe-file and --foe-image given");
     add(
         "boot.exit", "BOOT -> INIT leaves Bootstrap; INIT -> PREOP works again", kBoot,
         [](Context& ctx) {

@@ -20,6 +20,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
+#include "util/input_file.hpp"
 #include "util/strfmt.hpp"
 
 namespace ecatctl {
@@ -51,49 +52,56 @@ std::string state_failure(const master::AlStatus* st, const std::string& wanted)
            std::string(master::al_status_code_name(st->code)) + ")";
 }
 
-int usage(const std::string& what) {
-    std::cerr << "ecatctl: " << what << "\n";
-    return kExitUsage;
-}
-
-std::optional<Address> parse_slave(const std::string& text, bool station) {
-    auto v = parse_number(text, 0xFFFF);
-    if (!v) return std::nullopt;
-    return station ? Address::station(static_cast<uint16_t>(*v))
-                   : Address::position(static_cast<uint16_t>(*v));
-}
-
 // The slave a command names; a bad one is reported as a usage error (exit kExitUsage) and gives nullopt.
 std::optional<Address> named_slave(const std::string& text, bool station) {
-    auto a = parse_slave(text, station);
-    if (!a) usage("bad slave '" + text + "'");
+    auto a = parse_slave_address(text, station);
+    if (!a) usage_error("bad slave '" + text + "'");
     return a;
 }
 
-std::string slave_text(Address a) {
-    return a.mode == Address::Mode::Station ? util::strprintf("station 0x%04x", a.value)
-                                            : util::strprintf("slave %u", a.value);
-}
-
-std::optional<std::vector<uint8_t>> read_file(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) return std::nullopt;
-    return std::vector<uint8_t>(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+std::optional<std::vector<uint8_t>> read_file(const std::string& path, std::size_t max_bytes,
+                                              std::string_view what) {
+    try {
+        return util::read_input_bytes(path, max_bytes, what);
+    } catch (const util::InputFileError& e) {
+        std::fprintf(stderr, "ecatctl: %s\n", e.what());
+        return std::nullopt;
+    }
 }
 
 // A slave in INIT gets its mailbox SMs from its SII and is taken to PREOP; one already in PREOP or above
-// keeps the SMs it has.
+// keeps the SMs it has. A slave in PREOP whose mailbox SMs are gone (cleared by another tool, or a master
+// that stopped half-way) is set up again through INIT, as IgH's master does; above PREOP that would stop its
+// process data, so it is only said.
 Error open_mailbox(master::Master& m, master::Mailbox& mbx, Address a) {
     auto st = m.al_status(a);
     if (!st) return st.error();
-    if (st->state == static_cast<uint8_t>(master::AlState::Init)) {
+    const auto from_init = [&] {
         if (Error e = mbx.configure_from_sii(); e != Error::Ok) return e;
         master::AlStatus final;
         const Error e = m.request_state(a, master::AlState::PreOp, &final);
         if (e == Error::AlRefused) g_refusal = final;  // fail() reports it, in one message
         return e;
+    };
+    if (st->state == static_cast<uint8_t>(master::AlState::Init)) return from_init();
+    const Error e = mbx.adopt_current();
+    if (e != Error::MailboxNotConfigured) return e;
+    if (st->state != static_cast<uint8_t>(master::AlState::PreOp)) {
+        std::fprintf(stderr,
+                     "ecatctl: %s is in %s without its mailbox SyncManagers; `ecatctl state %u init` and "
+                     "again sets them up\n",
+                     slave_label(a).c_str(), std::string(master::al_state_name(st->state)).c_str(), a.value);
+        return e;
     }
-    return mbx.adopt_current();
+    std::fprintf(stderr,
+                 "ecatctl: %s is in PREOP without its mailbox SyncManagers: set up again through INIT\n",
+                 slave_label(a).c_str());
+    master::AlStatus final;
+    if (Error back = m.request_state(a, master::AlState::Init, &final); back != Error::Ok) {
+        if (back == Error::AlRefused) g_refusal = final;
+        return back;
+    }
+    return from_init();
 }
 
 int sdo_failed(const master::SdoClient& sdo, Error e, const std::string& what) {

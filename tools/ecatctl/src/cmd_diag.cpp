@@ -4,8 +4,12 @@
 // the drive's error table (drive/wire/error_codes.hpp, od-free; ecatctl does not link the drive).
 #include "cmd_diag.hpp"
 
+#include "commands.hpp"
+
 #include <cstdio>
+#include <iostream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -15,6 +19,7 @@
 #include "master/diag.hpp"
 #include "master/mailbox.hpp"
 #include "od/wire/diag_text_table.hpp"
+#include "util/json.hpp"
 #include "util/strfmt.hpp"
 
 namespace ecatctl {
@@ -29,6 +34,7 @@ struct DiagArgs {
     bool oldest_first = false;
     bool only_new = false;
     bool ack = false;
+    bool json = false;
 };
 
 std::string_view drive_error_name(uint16_t code) {
@@ -53,17 +59,6 @@ int report(const master::SdoClient& sdo, Error e, const char* what) {
     }
     std::fprintf(stderr, "ecatctl: %s: %s\n", what, std::string(master::to_string(e)).c_str());
     return e == Error::Timeout || e == Error::MailboxTimeout ? kExitNoSlave : kExitProtocol;
-}
-
-// Same rule as the SDO verbs: a slave in INIT gets its mailbox from the SII and goes to PREOP.
-Error open_mailbox(master::Master& m, master::Mailbox& mbx, master::Address a) {
-    auto st = m.al_status(a);
-    if (!st) return st.error();
-    if (st->state == static_cast<uint8_t>(master::AlState::Init)) {
-        if (Error e = mbx.configure_from_sii(); e != Error::Ok) return e;
-        return m.request_state(a, master::AlState::PreOp);
-    }
-    return mbx.adopt_current();
 }
 
 int run_diag(master::Master& m, const DiagArgs& d) {
@@ -115,10 +110,24 @@ int run_diag(master::Master& m, const DiagArgs& d) {
                 h.flags = val;
         }
     }
-    std::printf("diagnosis history 0x10F3: %u messages at most, newest :%02u, acknowledged :%02u, %s\n",
-                h.max_messages, h.newest, h.acknowledged,
-                h.new_available ? "new messages" : "no new messages");
-    std::printf("flags 0x%04x: %s\n", h.flags, master::format_diag_flags(h.flags).c_str());
+    // JSON (docs/ecatctl-json.md, "diag") is written once everything is read: no half document on stdout.
+    std::ostringstream json_text;
+    util::JsonWriter w(json_text);
+    if (d.json) {
+        w.begin_object()
+            .member("max_messages", h.max_messages)
+            .member("newest", h.newest)
+            .member("acknowledged", h.acknowledged)
+            .member("new_messages", h.new_available)
+            .member("flags", h.flags)
+            .key("messages")
+            .begin_array();
+    } else {
+        std::printf("diagnosis history 0x10F3: %u messages at most, newest :%02u, acknowledged :%02u, %s\n",
+                    h.max_messages, h.newest, h.acknowledged,
+                    h.new_available ? "new messages" : "no new messages");
+        std::printf("flags 0x%04x: %s\n", h.flags, master::format_diag_flags(h.flags).c_str());
+    }
 
     const auto order = master::diag_message_order(h, !d.oldest_first, d.only_new);
     std::vector<uint8_t> msg(512);
@@ -130,18 +139,43 @@ int run_diag(master::Master& m, const DiagArgs& d) {
         }
         auto e = master::decode_diag_message(std::span<const uint8_t>(msg.data(), *n), sub);
         if (!e) continue;  // an empty slot of a ring not yet full
-        std::printf("%s\n", master::format_diag_line(*e, drive_error_name, drive_text).c_str());
         ++shown;
+        if (!d.json) {
+            std::printf("%s\n", master::format_diag_line(*e, drive_error_name, drive_text).c_str());
+            continue;
+        }
+        w.begin_object()
+            .member("subindex", e->subindex)
+            .member("type", master::diag_type_name(e->type))
+            .member("code", e->code)
+            .member("text_id", e->text_id)
+            .member("timestamp_ns", e->timestamp_ns)
+            .member("local_time", e->local_time)
+            .member("text", master::diag_text(*e, drive_error_name, drive_text))
+            .key("parameters")
+            .begin_array();
+        for (const auto& p : e->params)
+            w.value(master::format_diag_param(p));
+        w.end_array().member("truncated", e->truncated).end_object();
     }
-    if (shown == 0) std::printf("%s\n", d.only_new ? "no new messages" : "no messages");
+    if (d.json) w.end_array();
+    if (shown == 0 && !d.json) std::printf("%s\n", d.only_new ? "no new messages" : "no messages");
 
     if (d.ack && h.newest != 0) {
         const uint8_t newest = h.newest;
         if (Error e = sdo.download(master::kDiagIndex, 3, std::span<const uint8_t>(&newest, 1));
             e != Error::Ok)
             return report(sdo, e, "acknowledging (0x10F3:03)");
-        std::printf("acknowledged up to :%02u%s\n", newest,
-                    (h.flags & master::kDiagFlagAcknowledgeMode) ? "" : " (the slave is in overwrite mode)");
+        if (d.json)
+            w.member("acknowledged_now", newest);
+        else
+            std::printf(
+                "acknowledged up to :%02u%s\n", newest,
+                (h.flags & master::kDiagFlagAcknowledgeMode) ? "" : " (the slave is in overwrite mode)");
+    }
+    if (d.json) {
+        w.end_object();
+        std::cout << json_text.str() << std::flush;
     }
     return kExitOk;
 }
@@ -157,6 +191,7 @@ void add_diag_command(CLI::App& app, MasterRunner run, int& rc) {
     c->add_flag("--oldest-first", args->oldest_first, "Oldest message first (default: newest first)");
     c->add_flag("--new", args->only_new, "Only messages newer than the acknowledged one");
     c->add_flag("--ack", args->ack, "Acknowledge up to the newest message afterwards (write 0x10F3:03)");
+    c->add_flag("--json", args->json, "JSON on stdout (docs/ecatctl-json.md)");
     c->callback([args, run = std::move(run), &rc] {
         rc = run([&](master::Master& m) { return run_diag(m, *args); });
     });

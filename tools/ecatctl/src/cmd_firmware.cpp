@@ -25,6 +25,7 @@
 #include <thread>
 #include <vector>
 
+#include "commands.hpp"
 #include "common.hpp"
 #include "foe/image.hpp"
 #include "format.hpp"
@@ -275,14 +276,6 @@ int restart(master::Master& m, Address a, const Args& args, Steps& steps, Identi
     return kExitOk;
 }
 
-std::optional<std::vector<uint8_t>> read_file(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) return std::nullopt;
-    std::vector<uint8_t> v{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-    if (f.bad()) return std::nullopt;
-    return v;
-}
-
 // After a failure in Bootstrap: back to INIT (the device restarts with the firmware it kept) and say
 // which revision runs now.
 void recover(master::Master& m, Address a, const Args& args, Steps& steps) {
@@ -299,11 +292,8 @@ struct Image {
 // The image: a well-formed header and the right CRC, checked before the link is opened and the device
 // touched.
 int load_image(const Args& args, Image& out) {
-    auto image = read_file(args.file);
-    if (!image) {
-        std::fprintf(stderr, "ecatctl: cannot read %s\n", args.file.c_str());
-        return kExitUsage;
-    }
+    auto image = read_file(args.file, kMaxFileBytes, "firmware image");
+    if (!image) return kExitUsage;
     if (image->size() < foe::kImageHeaderSize) {
         std::fprintf(stderr, "ecatctl: %s: not a firmware image (%zu bytes, shorter than its header)\n",
                      args.file.c_str(), image->size());

@@ -51,26 +51,27 @@ int foe_transfer(master::Master& m, const FoeArgs& f, bool read) {
     auto a = named_slave(f.slave, f.station);
     if (!a) return kExitUsage;
     auto password = parse_number(f.password, 0xFFFFFFFF);
-    if (!password) return usage("bad password '" + f.password + "'");
+    if (!password) return usage_error("bad password '" + f.password + "'");
     std::vector<uint8_t> data;
     std::string name = f.name;
     if (!read) {
-        auto d = read_file(f.file);
-        if (!d) return usage("cannot read " + f.file);
+        auto d = read_file(f.file, kMaxFileBytes, "file to write");
+        if (!d) return kExitUsage;
         data = std::move(*d);
         // The device takes firmware under its device name (0x1008, the SII General name) or the firmware
         // file name built from it; the local file's name means nothing to it.
         if (name.empty()) {
             auto device = sii_device_name(m, *a);
             if (!device)
-                return usage(foe_names_hint(slave_text(*a) + " has no device name in its SII: give --name"));
+                return usage_error(
+                    foe_names_hint(slave_label(*a) + " has no device name in its SII: give --name"));
             name = *device;
         }
     }
-    if (name.empty()) return usage("give the file name on the slave");
+    if (name.empty()) return usage_error("give the file name on the slave");
     master::Mailbox mbx(m, *a);
     auto st = m.al_status(*a);
-    if (!st) return fail(st.error(), "reading the AL status of " + slave_text(*a));
+    if (!st) return fail(st.error(), "reading the AL status of " + slave_label(*a));
     const auto boot = static_cast<uint8_t>(master::AlState::Boot);
     bool entered_boot = false;
     if (st->state == boot) {
@@ -93,7 +94,7 @@ int foe_transfer(master::Master& m, const FoeArgs& f, bool read) {
         }
         entered_boot = true;
     } else if (Error e = open_mailbox(m, mbx, *a); e != Error::Ok) {
-        return fail(e, "opening the mailbox of " + slave_text(*a));
+        return fail(e, "opening the mailbox of " + slave_label(*a));
     }
     master::FoeClient foe(mbx);
     int rc = kExitOk;

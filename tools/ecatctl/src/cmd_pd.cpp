@@ -1,12 +1,15 @@
 // `ecatctl pd`: bring a slave to OP and exchange process data cyclically (LRW), with optional DC.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -20,6 +23,8 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
+#include "util/json.hpp"
+#include "util/strfmt.hpp"
 
 namespace ecatctl {
 
@@ -39,6 +44,7 @@ struct PdArgs {
     bool keep = false;
     bool station = false;  // slave is a station address (as scan assigns them)
     bool all = false;      // every slave on the line in one session (cmd_pd_all.cpp)
+    bool json = false;     // the outcome as JSON on stdout (docs/ecatctl-json.md, "pd")
 };
 
 // "CYCLES:B0,B1,..." -> cycles and the output bytes sent (from the first byte) during them.
@@ -118,19 +124,76 @@ void print_pd_cycles(const master::ProcessDataSession& pd, const master::CycleSt
 
 namespace {
 
+// docs/ecatctl-json.md, "pd": how the run ended, its counters, and the last images by PDO entry.
+void write_pd_json(master::ProcessDataSession& pd, const master::CycleStats& before,
+                   const master::AlStatus* now, bool dc, const std::vector<SyncView>& pdo_config) {
+    const auto& s = pd.stats();
+    const uint64_t cycles = s.cycles - before.cycles;
+    const uint64_t ok = cycles - (s.lost - before.lost);
+    util::JsonWriter w(std::cout);
+    w.begin_object();
+    if (now)
+        w.member("state", master::al_state_name(now->state))
+            .member("al_error", now->error)
+            .member("al_status_code", now->code);
+    else
+        w.key("state").null();
+    w.member("cycles", cycles)
+        .member("lost", s.lost - before.lost)
+        .member("wkc_errors", s.wkc_errors - before.wkc_errors)
+        .member("expected_wkc", pd.expected_wkc())
+        .member("rtt_min_ns", ok ? s.rtt_min.count() : 0)
+        .member("rtt_avg_ns", ok ? (s.rtt_sum - before.rtt_sum).count() / static_cast<int64_t>(ok) : 0)
+        .member("rtt_max_ns", ok ? s.rtt_max.count() : 0);
+    if (dc) w.member("reference_time_ns", pd.reference_time());
+    for (const bool output : {true, false}) {
+        const std::span<const uint8_t> image = output ? pd.outputs() : pd.inputs();
+        std::string hex;
+        for (uint8_t b : image)
+            hex += util::strprintf(hex.empty() ? "%02x" : " %02x", b);
+        w.member(output ? "outputs_bytes" : "inputs_bytes", hex);
+        w.key(output ? "outputs" : "inputs").begin_array();
+        std::size_t bit = 0;
+        for (const auto& sv : pdo_config) {
+            if (sv.output != output) continue;
+            for (const auto& pdo : sv.pdos)
+                for (const auto& e : pdo.entries) {
+                    if (e.index != 0) {
+                        w.begin_object()
+                            .member("pdo", pdo.index)
+                            .member("index", e.index)
+                            .member("subindex", e.subindex)
+                            .member("name", e.name)
+                            .member("type", esi_type_name(e.data_type))
+                            .member("bit_length", e.bit_length)
+                            .key("value");
+                        write_typed_json(w, e.data_type, e.bit_length,
+                                         extract_bits(image, bit, e.bit_length));
+                        w.end_object();
+                    }
+                    bit += e.bit_length;
+                }
+        }
+        w.end_array();
+    }
+    w.end_object();
+    std::cout << std::flush;
+}
+
 int process_data(master::Master& m, const PdArgs& p) {
     auto pos = parse_number(p.slave, 0xFFFF);
-    if (!pos && !p.all) return usage("bad slave '" + p.slave + "'");
+    if (!pos && !p.all) return usage_error("bad slave '" + p.slave + "'");
     std::string t = p.state;
     for (auto& c : t)
         c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-    if (t != "OP" && t != "SAFEOP") return usage("--state must be SAFEOP or OP");
+    if (t != "OP" && t != "SAFEOP") return usage_error("--state must be SAFEOP or OP");
     for (const std::string& text : p.steps)
-        if (!parse_step(text)) return usage("bad --step '" + text + "' (CYCLES:BYTE,BYTE,... e.g. 50:06,00)");
+        if (!parse_step(text))
+            return usage_error("bad --step '" + text + "' (CYCLES:BYTE,BYTE,... e.g. 50:06,00)");
     std::vector<uint8_t> out_bytes;
     for (const std::string& v : p.outputs) {
         auto b = parse_number(v, 0xFF);
-        if (!b) return usage("bad output byte '" + v + "'");
+        if (!b) return usage_error("bad output byte '" + v + "'");
         out_bytes.push_back(static_cast<uint8_t>(*b));
     }
     if (p.all) {
@@ -145,6 +208,7 @@ int process_data(master::Master& m, const PdArgs& p) {
             all.steps.emplace_back(step->cycles, step->bytes);
         }
         all.keep = p.keep;
+        all.json = p.json;
         return process_data_all(m, all);
     }
     // Station addresses as scan gives them; DC's FRMW addresses the reference clock by station.
@@ -166,16 +230,35 @@ int process_data(master::Master& m, const PdArgs& p) {
         if (Error e = m.request_state(a, master::AlState::PreOp); e != Error::Ok)
             return fail(e, "going to PREOP");
     }
+    // A slave without mailbox (SII words 0x18-0x1B all zero: a coupler, a digital IO terminal) has its
+    // layout in the SII alone (the PDOs its SyncM/TxPDO/RxPDO categories assign) and no SDO.
+    uint8_t mbx_words[8] = {};
+    if (Error e = m.sii_read(a, 0x18, mbx_words); e != Error::Ok) return fail(e, "reading the SII");
+    const bool has_mailbox =
+        std::any_of(std::begin(mbx_words), std::end(mbx_words), [](uint8_t b) { return b != 0; });
     master::Mailbox mbx(m, a);
-    if (Error e = open_mailbox(m, mbx, a); e != Error::Ok) return fail(e, "opening the mailbox");
     master::SdoClient sdo(mbx);
-    master::ProcessDataSession pd(m, a, sdo);
-    if (Error e = pd.discover(); e != Error::Ok) return sdo_failed(sdo, e, "reading the process-data layout");
+    std::unique_ptr<master::ProcessDataSession> session;
     std::vector<SyncView> pdo_config;  // names and types of the entries, for the decoded images at the end
-    if (Error e = read_pdo_config(sdo, pdo_config); e != Error::Ok) pdo_config.clear();
+    if (has_mailbox) {
+        if (Error e = open_mailbox(m, mbx, a); e != Error::Ok) return fail(e, "opening the mailbox");
+        session = std::make_unique<master::ProcessDataSession>(m, a, sdo);
+        if (Error e = session->discover(); e != Error::Ok)
+            return sdo_failed(sdo, e, "reading the process-data layout");
+        if (Error e = read_pdo_config(sdo, pdo_config); e != Error::Ok) pdo_config.clear();
+    } else {
+        if (st->state == init)
+            if (Error e = m.request_state(a, master::AlState::PreOp); e != Error::Ok)
+                return fail(e, "going to PREOP");
+        session = std::make_unique<master::ProcessDataSession>(m, std::span<const Address>(&a, 1));
+        if (Error e = session->discover_sii(0); e != Error::Ok)
+            return fail(e, "reading the process-data layout");
+    }
+    master::ProcessDataSession& pd = *session;
     const auto& l = pd.layout();
-    std::printf("outputs: SM2 0x%04x, %u bytes; inputs: SM3 0x%04x, %u bytes\n", l.sm2_start, l.sm2_length,
-                l.sm3_start, l.sm3_length);
+    if (!p.json)
+        std::printf("outputs: SM%u 0x%04x, %u bytes; inputs: SM%u 0x%04x, %u bytes\n", l.out_sm, l.sm2_start,
+                    l.sm2_length, l.in_sm, l.sm3_start, l.sm3_length);
     master::DcConfig dc;
     dc.enable = p.dc;
     dc.cycle_ns = p.cycle_us * 1000u;
@@ -195,13 +278,18 @@ int process_data(master::Master& m, const PdArgs& p) {
     pd_run(pd, steps, p.count, period, out_bytes, fill);
     const auto& s = pd.stats();
     auto now = m.al_status(a);
-    std::printf("state: %s%s\n", now ? std::string(master::al_state_name(now->state)).c_str() : "?",
-                now && now->error ? " +ERR" : "");
-    print_pd_cycles(pd, before);
-    if (p.dc)
-        std::printf("reference system time %llu ns\n", static_cast<unsigned long long>(pd.reference_time()));
-    std::printf("inputs:\n%s", hex_dump(0, pd.inputs()).c_str());
-    print_pd_entries(pdo_config, pd.outputs(), pd.inputs());
+    if (p.json) {
+        write_pd_json(pd, before, now ? &*now : nullptr, p.dc, pdo_config);
+    } else {
+        std::printf("state: %s%s\n", now ? std::string(master::al_state_name(now->state)).c_str() : "?",
+                    now && now->error ? " +ERR" : "");
+        print_pd_cycles(pd, before);
+        if (p.dc)
+            std::printf("reference system time %llu ns\n",
+                        static_cast<unsigned long long>(pd.reference_time()));
+        std::printf("inputs:\n%s", hex_dump(0, pd.inputs()).c_str());
+        print_pd_entries(pdo_config, pd.outputs(), pd.inputs());
+    }
     if (!p.keep) (void)m.request_state(a, master::AlState::PreOp);
     // A run that ends outside the state asked for, or with an AL error, failed, whatever the counters say.
     const auto want = static_cast<uint8_t>(t == "OP" ? master::AlState::Op : master::AlState::SafeOp);
@@ -235,6 +323,9 @@ void add_pd_command(CLI::App& app, MasterRunner run, int& rc) {
                     "CYCLES:BYTES before the --count cycles, in order; bytes in hex, comma-separated "
                     "(e.g. --step 50:06,00 --step 50:0f,00)");
     pdc->add_flag("--keep", pa->keep, "Leave the slave in the state reached (default: back to PREOP)");
+    pdc->add_flag(
+        "--json", pa->json,
+        "The outcome as JSON on stdout: state, counters, images by PDO entry (docs/ecatctl-json.md)");
     pdc->callback([pa, run, &rc] { rc = run([&](master::Master& m) { return process_data(m, *pa); }); });
 }
 

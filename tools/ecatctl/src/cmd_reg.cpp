@@ -39,23 +39,23 @@ int reg_read(master::Master& m, const RegArgs& r) {
     auto a = named_slave(r.slave, r.station);
     if (!a) return kExitUsage;
     auto addr = parse_number(r.address, 0xFFFF);
-    if (!addr) return usage("bad register address '" + r.address + "'");
+    if (!addr) return usage_error("bad register address '" + r.address + "'");
     std::optional<ValueType> type;
-    if (!r.type.empty() && !(type = parse_type(r.type))) return usage("bad type '" + r.type + "'");
+    if (!r.type.empty() && !(type = parse_type(r.type))) return usage_error("bad type '" + r.type + "'");
     std::size_t len = type ? type_size(*type) : 0;
     if (!r.length.empty()) {
         auto l = parse_number(r.length, master::kMaxDatagramData);
         if (!l || *l == 0)
-            return usage("bad length '" + r.length + "' (1.." + std::to_string(master::kMaxDatagramData) +
-                         ")");
+            return usage_error("bad length '" + r.length + "' (1.." +
+                               std::to_string(master::kMaxDatagramData) + ")");
         len = *l;
     }
-    if (len == 0) return usage("give a length or --type");
-    if (type && len % type_size(*type) != 0) return usage("length is not a multiple of the type size");
-    if (*addr + len > 0x10000) return usage("register range runs past 0xffff");
+    if (len == 0) return usage_error("give a length or --type");
+    if (type && len % type_size(*type) != 0) return usage_error("length is not a multiple of the type size");
+    if (*addr + len > 0x10000) return usage_error("register range runs past 0xffff");
     std::vector<uint8_t> data(len);
     if (Error e = m.read(*a, static_cast<uint16_t>(*addr), data); e != Error::Ok)
-        return fail(e, "reading " + slave_text(*a));
+        return fail(e, "reading " + slave_label(*a));
     if (type) {
         const std::size_t n = type_size(*type);
         for (std::size_t i = 0; i < len; i += n)
@@ -70,25 +70,26 @@ int reg_write(master::Master& m, const RegArgs& r) {
     auto a = named_slave(r.slave, r.station);
     if (!a) return kExitUsage;
     auto addr = parse_number(r.address, 0xFFFF);
-    if (!addr) return usage("bad register address '" + r.address + "'");
+    if (!addr) return usage_error("bad register address '" + r.address + "'");
     std::optional<ValueType> type;
-    if (!r.type.empty() && !(type = parse_type(r.type))) return usage("bad type '" + r.type + "'");
+    if (!r.type.empty() && !(type = parse_type(r.type))) return usage_error("bad type '" + r.type + "'");
     std::vector<uint8_t> data;
     for (const std::string& v : r.values) {
         if (type) {
             auto b = encode_value(*type, v);
-            if (!b) return usage("value '" + v + "' does not fit " + r.type);
+            if (!b) return usage_error("value '" + v + "' does not fit " + r.type);
             data.insert(data.end(), b->begin(), b->end());
         } else {
             auto b = parse_number(v, 0xFF);
-            if (!b) return usage("bad byte '" + v + "' (0..0xff; use --type for wider values)");
+            if (!b) return usage_error("bad byte '" + v + "' (0..0xff; use --type for wider values)");
             data.push_back(static_cast<uint8_t>(*b));
         }
     }
-    if (data.empty() || data.size() > master::kMaxDatagramData) return usage("nothing to write, or too much");
-    if (*addr + data.size() > 0x10000) return usage("register range runs past 0xffff");
+    if (data.empty() || data.size() > master::kMaxDatagramData)
+        return usage_error("nothing to write, or too much");
+    if (*addr + data.size() > 0x10000) return usage_error("register range runs past 0xffff");
     if (Error e = m.write(*a, static_cast<uint16_t>(*addr), data); e != Error::Ok)
-        return fail(e, "writing " + slave_text(*a));
+        return fail(e, "writing " + slave_label(*a));
     return kExitOk;
 }
 

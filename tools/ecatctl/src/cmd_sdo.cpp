@@ -19,6 +19,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
+#include "util/json.hpp"
 #include "util/strfmt.hpp"
 
 namespace ecatctl {
@@ -36,19 +37,48 @@ struct SdoArgs {
     std::string type;
     bool station = false;
     bool complete = false;
+    bool json = false;
 };
+
+// The CoE basic data type of a --type.
+uint16_t coe_type_of(ValueType t) {
+    switch (t) {
+        case ValueType::U8:
+            return dtype::Unsigned8;
+        case ValueType::U16:
+            return dtype::Unsigned16;
+        case ValueType::U32:
+            return dtype::Unsigned32;
+        case ValueType::U64:
+            return dtype::Unsigned64;
+        case ValueType::I8:
+            return dtype::Integer8;
+        case ValueType::I16:
+            return dtype::Integer16;
+        case ValueType::I32:
+            return dtype::Integer32;
+        case ValueType::I64:
+            return dtype::Integer64;
+        case ValueType::F32:
+            return dtype::Real32;
+        case ValueType::F64:
+            return dtype::Real64;
+    }
+    return 0;
+}
 
 int sdo_transfer(master::Master& m, const SdoArgs& s, bool upload) {
     auto a = named_slave(s.slave, s.station);
     if (!a) return kExitUsage;
     auto index = parse_number(s.index, 0xFFFF);
-    if (!index) return usage("bad index '" + s.index + "'");
+    if (!index) return usage_error("bad index '" + s.index + "'");
     auto sub = parse_number(s.sub, 0xFF);
-    if (!sub) return usage("bad subindex '" + s.sub + "'");
+    if (!sub) return usage_error("bad subindex '" + s.sub + "'");
     bool text = s.type == "string";
     std::optional<ValueType> type;
-    if (!s.type.empty() && !text && !(type = parse_type(s.type))) return usage("bad type '" + s.type + "'");
-    if (!upload && s.values.empty()) return usage("nothing to download");
+    if (!s.type.empty() && !text && !(type = parse_type(s.type)))
+        return usage_error("bad type '" + s.type + "'");
+    if (!upload && s.values.empty()) return usage_error("nothing to download");
     // Without --type the values are bytes, unless SDO information names the entry's type (as upload does).
     auto encode = [&](std::vector<uint8_t>& data, std::string& why) {
         for (const std::string& v : s.values) {
@@ -70,10 +100,10 @@ int sdo_transfer(master::Master& m, const SdoArgs& s, bool upload) {
     std::vector<uint8_t> data;
     std::string why;
     // With --type, the values are checked before anything is sent.
-    if (!upload && (type || text) && !encode(data, why)) return usage(why);
+    if (!upload && (type || text) && !encode(data, why)) return usage_error(why);
     master::Mailbox mbx(m, *a);
     if (Error e = open_mailbox(m, mbx, *a); e != Error::Ok)
-        return fail(e, "opening the mailbox of " + slave_text(*a));
+        return fail(e, "opening the mailbox of " + slave_label(*a));
     master::SdoClient sdo(mbx);
     if (!upload && !type && !text) {
         if (!s.complete)
@@ -82,7 +112,7 @@ int sdo_transfer(master::Master& m, const SdoArgs& s, bool upload) {
                 text = d->data_type == 0x0009;
                 type = value_type_of(d->data_type);
             }
-        if (!encode(data, why)) return usage(why);
+        if (!encode(data, why)) return usage_error(why);
     }
     const std::string what = util::strprintf("%s 0x%04x:%02x", upload ? "upload of" : "download to",
                                              static_cast<unsigned>(*index), static_cast<unsigned>(*sub));
@@ -95,6 +125,36 @@ int sdo_transfer(master::Master& m, const SdoArgs& s, bool upload) {
     auto n = sdo.upload(static_cast<uint16_t>(*index), static_cast<uint8_t>(*sub), out, s.complete);
     if (!n) return sdo_failed(sdo, n.error(), what);
     out.resize(*n);
+    if (s.json) {
+        // docs/ecatctl-json.md, "upload".
+        util::JsonWriter w(std::cout);
+        std::string hex;
+        for (uint8_t b : out)
+            hex += util::strprintf(hex.empty() ? "%02x" : " %02x", b);
+        w.begin_object()
+            .member("index", *index)
+            .member("subindex", *sub)
+            .member("complete_access", s.complete)
+            .member("size", out.size())
+            .member("bytes", hex);
+        if (text) {
+            w.key("value").value(std::string(out.begin(), out.end()));
+        } else if (type) {
+            const std::size_t size = type_size(*type);
+            w.key("values").begin_array();
+            for (std::size_t i = 0; i + size <= out.size(); i += size) {
+                const auto part = std::span<const uint8_t>(out).subspan(i, size);
+                write_typed_json(w, coe_type_of(*type), static_cast<uint16_t>(size * 8), part);
+            }
+            w.end_array();
+        } else {
+            write_described_upload_json(w, sdo, static_cast<uint16_t>(*index), static_cast<uint8_t>(*sub),
+                                        s.complete, out);
+        }
+        w.end_object();
+        std::cout << std::flush;
+        return kExitOk;
+    }
     if (text) {
         std::fwrite(out.data(), 1, out.size(), stdout);
         std::fputc('\n', stdout);
@@ -135,6 +195,7 @@ void add_sdo_commands(CLI::App& app, MasterRunner run, int& rc) {
                    "u8|u16|u32|u64|i8|i16|i32|i64|real32|real64|string (default: from SDO information)");
     up->add_flag("-s,--station", so->station, "<slave> is a station address");
     up->add_flag("-c,--complete", so->complete, "Complete access (whole object from the subindex, 0 or 1)");
+    up->add_flag("--json", so->json, "JSON on stdout: bytes and the value(s) by type (docs/ecatctl-json.md)");
     up->callback([so, run, &rc] { rc = run([&](master::Master& m) { return sdo_transfer(m, *so, true); }); });
     auto* down =
         app.add_subcommand("download", "Write an object through CoE SDO (INIT slaves are taken to PREOP)");

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
+#include "util/json.hpp"
 
 namespace ecatctl {
 
@@ -31,6 +33,7 @@ struct SdosArgs {
     std::string slave = "0";
     bool station = false;
     bool quiet = false;
+    bool json = false;
 };
 
 const char* type_name(uint16_t t) {
@@ -68,15 +71,52 @@ const char* type_name(uint16_t t) {
     }
 }
 
-int sdos(master::Master& m, const std::string& slave, bool station, bool quiet) {
+int sdos(master::Master& m, const std::string& slave, bool station, bool quiet, bool json) {
     auto a = named_slave(slave, station);
     if (!a) return kExitUsage;
     master::Mailbox mbx(m, *a);
     if (Error e = open_mailbox(m, mbx, *a); e != Error::Ok)
-        return fail(e, "opening the mailbox of " + slave_text(*a));
+        return fail(e, "opening the mailbox of " + slave_label(*a));
     master::SdoClient sdo(mbx);
     auto list = sdo.od_list(1);
     if (!list) return sdo_failed(sdo, list.error(), "reading the object list");
+    if (json) {
+        // docs/ecatctl-json.md, "sdos". The whole dictionary is read before anything is written: a failure
+        // half-way leaves no half document on stdout.
+        std::ostringstream o;
+        util::JsonWriter w(o);
+        w.begin_object().key("objects").begin_array();
+        for (uint16_t index : *list) {
+            auto od = sdo.object_description(index);
+            if (!od) return sdo_failed(sdo, od.error(), "describing object " + std::to_string(index));
+            w.begin_object()
+                .member("index", index)
+                .member("object_code", od->object_code)
+                .member("max_subindex", od->max_subindex)
+                .member("name", od->name);
+            if (!quiet) {
+                std::vector<EntryView> entries;
+                const uint8_t last = od->object_code == 7 ? 0 : od->max_subindex;
+                if (Error e = describe_entries(sdo, index, last, entries); e != Error::Ok)
+                    return sdo_failed(sdo, e, "describing an entry");
+                w.key("entries").begin_array();
+                for (const auto& e : entries)
+                    w.begin_object()
+                        .member("subindex", e.subindex)
+                        .member("name", e.name)
+                        .member("data_type", e.data_type)
+                        .member("type", esi_type_name(e.data_type))
+                        .member("bit_length", e.bit_length)
+                        .member("access", e.access)
+                        .end_object();
+                w.end_array();
+            }
+            w.end_object();
+        }
+        w.end_array().end_object();
+        std::cout << o.str() << std::flush;
+        return kExitOk;
+    }
     for (uint16_t index : *list) {
         auto od = sdo.object_description(index);
         if (!od) return sdo_failed(sdo, od.error(), "describing object " + std::to_string(index));
@@ -117,8 +157,9 @@ void add_sdos_command(CLI::App& app, MasterRunner run, int& rc) {
         ->capture_default_str();
     c->add_flag("-s,--station", sd->station, "<slave> is a station address");
     c->add_flag("-q,--quiet", sd->quiet, "Objects only, no entries");
+    c->add_flag("--json", sd->json, "JSON on stdout (docs/ecatctl-json.md)");
     c->callback([sd, run, &rc] {
-        rc = run([&](master::Master& m) { return sdos(m, sd->slave, sd->station, sd->quiet); });
+        rc = run([&](master::Master& m) { return sdos(m, sd->slave, sd->station, sd->quiet, sd->json); });
     });
 }
 

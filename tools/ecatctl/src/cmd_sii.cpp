@@ -42,7 +42,7 @@ int sii_read(master::Master& m, const SiiArgs& s) {
     auto a = named_slave(s.slave, s.station);
     if (!a) return kExitUsage;
     auto img = m.sii_read_image(*a, s.all);
-    if (!img) return fail(img.error(), "reading the SII of " + slave_text(*a));
+    if (!img) return fail(img.error(), "reading the SII of " + slave_label(*a));
     if (s.output.empty()) {
         std::fputs(hex_dump(0, *img).c_str(), stdout);
         return kExitOk;
@@ -64,14 +64,14 @@ int sii_read(master::Master& m, const SiiArgs& s) {
 int sii_write(master::Master& m, const SiiArgs& s) {
     auto a = named_slave(s.slave, s.station);
     if (!a) return kExitUsage;
-    auto img = read_file(s.input);
-    if (!img) return usage("cannot read " + s.input);
+    auto img = read_file(s.input, kMaxSiiBytes, "SII image");
+    if (!img) return kExitUsage;
     if (img->size() < 16 || img->size() % 2 != 0 || img->size() > 65536)
-        return usage(s.input + ": an SII image is an even number of bytes, 16 to 65536");
+        return usage_error(s.input + ": an SII image is an even number of bytes, 16 to 65536");
     const uint16_t w7 = util::get16(img->data() + 2 * esc::sii::word::Checksum);
     const uint8_t crc = esc::sii::crc8(img->data(), esc::sii::kCrcBytes);
     if (w7 != esc::sii::kChecksumDisabled && (w7 & 0xFF) != crc && !s.force) {
-        return usage(
+        return usage_error(
             util::strprintf("%s: checksum word 7 is 0x%04x, CRC of words 0-6 is 0x%02x (use --force)",
                             s.input.c_str(), w7, crc));
     }
@@ -79,7 +79,7 @@ int sii_write(master::Master& m, const SiiArgs& s) {
     for (std::size_t w = 0; w < words; ++w) {
         const uint16_t v = util::get16(img->data() + 2 * w);
         if (Error e = m.sii_write_word(*a, static_cast<uint32_t>(w), v); e != Error::Ok)
-            return fail(e, "writing SII word " + std::to_string(w) + " of " + slave_text(*a));
+            return fail(e, "writing SII word " + std::to_string(w) + " of " + slave_label(*a));
     }
     std::cerr << "ecatctl: " << words << " words written\n";
     return kExitOk;
@@ -114,9 +114,9 @@ void add_sii_command(CLI::App& app, MasterRunner run, int& rc) {
     sii_dec->add_flag("-s,--station", s->station, "--position is a station address");
     sii_dec->callback([s, run, &rc] {
         if (!s->input.empty()) {
-            auto img = read_file(s->input);
+            auto img = read_file(s->input, kMaxSiiBytes, "SII image");
             if (!img) {
-                rc = usage("cannot read " + s->input);
+                rc = kExitUsage;
                 return;
             }
             std::fputs(esi::decode_sii(*img).c_str(), stdout);
@@ -127,9 +127,9 @@ void add_sii_command(CLI::App& app, MasterRunner run, int& rc) {
             auto a = named_slave(s->slave, s->station);
             if (!a) return kExitUsage;
             auto img = m.sii_read_image(*a);
-            if (!img) return fail(img.error(), "reading the SII of " + slave_text(*a));
+            if (!img) return fail(img.error(), "reading the SII of " + slave_label(*a));
             std::fputs(esi::decode_sii(*img).c_str(), stdout);
-            return sii_problems("the SII of " + slave_text(*a), *img) ? kExitProtocol : kExitOk;
+            return sii_problems("the SII of " + slave_label(*a), *img) ? kExitProtocol : kExitOk;
         });
     });
 }

@@ -4,11 +4,13 @@
 // the SM and FMMU registers, the mailboxes, mailbox protocols and CoE/FoE/EoE details (SII General category).
 // Register reads only (position addressing): nothing on the slave is changed.
 #include <cstdio>
+#include <iostream>
 #include <string>
 
 #include "cmd_verbs.hpp"
 #include "esi/sii_reader.hpp"
 #include "format.hpp"
+#include "util/json.hpp"
 #include "util/le.hpp"
 
 namespace ecatctl {
@@ -22,6 +24,7 @@ struct SlavesArgs {
     std::string slave;  // empty: all
     bool station = false;
     bool verbose = false;
+    bool json = false;
 };
 
 std::string protocols_text(uint16_t p) {
@@ -55,7 +58,7 @@ unsigned default_pdo_bits(const std::vector<esi::SiiPdo>& pdos) {
     return n;
 }
 
-int show_slave(master::Master& m, uint16_t pos, bool verbose) {
+int show_slave(master::Master& m, uint16_t pos, bool verbose, util::JsonWriter* json) {
     const Address a = Address::position(pos);
     uint8_t info[10] = {};
     if (Error e = m.read(a, esc::reg::kType, info); e != Error::Ok)
@@ -71,6 +74,27 @@ int show_slave(master::Master& m, uint16_t pos, bool verbose) {
         have_sii = true;
     }
     const std::string name = sii.general ? sii.general->name : std::string();
+    if (json) {
+        // docs/ecatctl-json.md, "slaves".
+        json->begin_object()
+            .member("position", pos)
+            .member("station", util::get16(addr))
+            .member("alias", util::get16(addr + 2));
+        if (st)
+            json->member("state", master::al_state_name(st->state))
+                .member("al_error", st->error)
+                .member("al_status_code", st->code);
+        json->member("name", name);
+        if (have_sii)
+            json->member("vendor_id", sii.vendor_id)
+                .member("product_code", sii.product_code)
+                .member("revision", sii.revision)
+                .member("serial", sii.serial_number)
+                .member("output_bits", default_pdo_bits(sii.rx_pdos))
+                .member("input_bits", default_pdo_bits(sii.tx_pdos));
+        json->end_object();
+        return kExitOk;
+    }
     if (!verbose) {
         std::printf("%-3u 0x%04x %5u:%-3u %-8s %s\n", pos, util::get16(addr), util::get16(addr + 2), pos,
                     state.c_str(), name.c_str());
@@ -179,7 +203,15 @@ int run_slaves(master::Master& m, const SlavesArgs& s) {
         }
         for (uint16_t p = 0; p < *n; ++p) {
             auto st = m.read_reg<uint16_t>(Address::position(p), 0x0010);
-            if (st && *st == *want) return show_slave(m, p, s.verbose);
+            if (st && *st == *want) {
+                if (!s.json) return show_slave(m, p, s.verbose, nullptr);
+                util::JsonWriter w(std::cout);
+                w.begin_object().key("slaves").begin_array();
+                const int rc = show_slave(m, p, false, &w);
+                w.end_array().end_object();
+                std::cout << std::flush;
+                return rc;
+            }
         }
         std::fprintf(stderr, "ecatctl: no slave has station address %s\n", s.slave.c_str());
         return kExitNoSlave;
@@ -197,8 +229,17 @@ int run_slaves(master::Master& m, const SlavesArgs& s) {
         first = last = static_cast<uint16_t>(*p);
     }
     int rc = kExitOk;
+    if (s.json) {
+        util::JsonWriter w(std::cout);
+        w.begin_object().key("slaves").begin_array();
+        for (uint16_t p = first; p <= last; ++p)
+            if (int r = show_slave(m, p, false, &w); r != kExitOk) rc = r;
+        w.end_array().end_object();
+        std::cout << std::flush;
+        return rc;
+    }
     for (uint16_t p = first; p <= last; ++p) {
-        if (int r = show_slave(m, p, s.verbose); r != kExitOk) rc = r;
+        if (int r = show_slave(m, p, s.verbose, nullptr); r != kExitOk) rc = r;
         if (s.verbose && p != last) std::printf("\n");
     }
     return rc;
@@ -214,6 +255,7 @@ void add_slaves_command(CLI::App& app, MasterRunner run, int& rc) {
     c->add_flag("-s,--station", s->station, "<slave> is a station address");
     c->add_flag("-v,--verbose", s->verbose,
                 "Identity, sizes, ports, DC, SMs, FMMUs, mailbox, protocols, CoE details");
+    c->add_flag("--json", s->json, "JSON on stdout: position, station, alias, state, name, identity, sizes");
     c->callback(
         [s, run = std::move(run), &rc] { rc = run([&](master::Master& m) { return run_slaves(m, *s); }); });
 }

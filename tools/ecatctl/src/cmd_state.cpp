@@ -96,6 +96,59 @@ int to_safeop_op(master::Master& m, Address a, bool op) {
     return kExitOk;
 }
 
+}  // namespace
+
+std::string state_word(const std::string& text) {
+    std::string t = text;
+    for (auto& c : t)
+        c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    return t;
+}
+
+bool is_state_word(const std::string& text) {
+    const std::string t = state_word(text);
+    return t == "INIT" || t == "PREOP" || t == "BOOT" || t == "SAFEOP" || t == "OP";
+}
+
+int go_to_state(master::Master& m, master::Address a, const std::string& target) {
+    auto st = m.al_status(a);
+    if (!st) return report_error(st.error(), "reading the AL status of " + slave_label(a));
+    const std::string t = state_word(target);
+    const uint8_t now = st->state;
+    const auto boot = static_cast<uint8_t>(AlState::Boot);
+    int rc = kExitOk;
+    if (t == "INIT") {
+        rc = go(m, a, AlState::Init, "INIT");
+    } else if (t == "PREOP") {
+        rc = to_preop(m, a, now);
+    } else if (t == "BOOT") {
+        if (now != boot || st->error) {
+            // INIT is not requested again from a slave in INIT (request_state writes nothing then).
+            rc = go(m, a, AlState::Init, "INIT");
+            if (rc == kExitOk) {
+                master::Mailbox mbx(m, a);
+                if (Error e = mbx.configure_from_sii(true); e != Error::Ok)
+                    rc = report_error(
+                        e, "setting up the bootstrap mailbox (SM0/SM1) from the SII of " + slave_label(a));
+                else
+                    rc = go(m, a, AlState::Boot, "BOOT");
+            }
+        }
+    } else if (t == "SAFEOP" || t == "OP") {
+        const auto wanted = static_cast<uint8_t>(t == "OP" ? AlState::Op : AlState::SafeOp);
+        if (now != wanted || st->error) {
+            // The process data is set up in PREOP: a slave above it steps down to PREOP first.
+            rc = to_preop(m, a, now);
+            if (rc == kExitOk) rc = to_safeop_op(m, a, t == "OP");
+        }
+    } else {
+        return usage_error("unknown state '" + target + "' (INIT, PREOP, BOOT, SAFEOP, OP)");
+    }
+    return rc;
+}
+
+namespace {
+
 int run_state(master::Master& m, const StateArgs& args) {
     auto a = parse_slave_address(args.slave, args.station);
     if (!a) return usage_error("bad slave '" + args.slave + "'");
@@ -115,40 +168,7 @@ int run_state(master::Master& m, const StateArgs& args) {
         std::printf("\n");
         return kExitOk;
     }
-    std::string t = args.target;
-    for (auto& c : t)
-        c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-    const uint8_t now = st->state;
-    const auto boot = static_cast<uint8_t>(AlState::Boot);
-    int rc = kExitOk;
-    if (t == "INIT") {
-        rc = go(m, *a, AlState::Init, "INIT");
-    } else if (t == "PREOP") {
-        rc = to_preop(m, *a, now);
-    } else if (t == "BOOT") {
-        if (now != boot || st->error) {
-            // INIT is not requested again from a slave in INIT (request_state writes nothing then).
-            rc = go(m, *a, AlState::Init, "INIT");
-            if (rc == kExitOk) {
-                master::Mailbox mbx(m, *a);
-                if (Error e = mbx.configure_from_sii(true); e != Error::Ok)
-                    rc = report_error(
-                        e, "setting up the bootstrap mailbox (SM0/SM1) from the SII of " + slave_label(*a));
-                else
-                    rc = go(m, *a, AlState::Boot, "BOOT");
-            }
-        }
-    } else if (t == "SAFEOP" || t == "OP") {
-        const auto wanted = static_cast<uint8_t>(t == "OP" ? AlState::Op : AlState::SafeOp);
-        if (now != wanted || st->error) {
-            // The process data is set up in PREOP: a slave above it steps down to PREOP first.
-            rc = to_preop(m, *a, now);
-            if (rc == kExitOk) rc = to_safeop_op(m, *a, t == "OP");
-        }
-    } else {
-        return usage_error("unknown state '" + args.target + "' (INIT, PREOP, BOOT, SAFEOP, OP)");
-    }
-    if (rc != kExitOk) return rc;
+    if (int rc = go_to_state(m, *a, args.target); rc != kExitOk) return rc;
     auto final = m.al_status(*a);
     if (!final) return report_error(final.error(), "reading the AL status of " + slave_label(*a));
     std::printf("%s\n", name_of(final->state).c_str());

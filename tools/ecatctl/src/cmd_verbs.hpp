@@ -50,6 +50,11 @@ int report_error(const master::SdoClient* sdo, master::Error e, const std::strin
 bool print_described_upload(master::SdoClient& sdo, uint16_t index, uint8_t sub, bool complete_access,
                             std::span<const uint8_t> data);
 
+// The same as JSON members of the object being written: "entries": [{subindex, name, type, bit_length,
+// value}] (docs/ecatctl-json.md, "upload"); an empty list when the slave gives no description.
+void write_described_upload_json(util::JsonWriter& w, master::SdoClient& sdo, uint16_t index, uint8_t sub,
+                                 bool complete_access, std::span<const uint8_t> data);
+
 // Prints the process image by PDO entry: "  0xIIII:SS name = value" for outputs, then inputs.
 void print_pd_entries(const std::vector<SyncView>& syncs, std::span<const uint8_t> outputs,
                       std::span<const uint8_t> inputs);

@@ -111,6 +111,55 @@ std::string format_typed(uint16_t data_type, uint16_t bit_length, std::span<cons
     return hex_bytes(data);
 }
 
+void write_typed_json(util::JsonWriter& w, uint16_t data_type, uint16_t bit_length,
+                      std::span<const uint8_t> data) {
+    if (data_type == dtype::VisibleString) {
+        std::string s(data.begin(), data.end());
+        if (auto nul = s.find('\0'); nul != std::string::npos) s.resize(nul);
+        w.value(s);
+        return;
+    }
+    auto vt = value_type(data_type, bit_length);
+    if (!vt || data.size() > type_size(*vt)) {
+        w.value(hex_bytes(data));
+        return;
+    }
+    uint8_t v[8] = {};
+    std::memcpy(v, data.data(), data.size());
+    if (bit_length > 0 && bit_length < 8) v[0] = static_cast<uint8_t>(v[0] & ((1u << bit_length) - 1));
+    uint64_t u = 0;
+    for (std::size_t i = type_size(*vt); i-- > 0;)
+        u = (u << 8) | v[i];
+    switch (*vt) {
+        case ValueType::I8:
+            w.value(static_cast<int8_t>(u));
+            break;
+        case ValueType::I16:
+            w.value(static_cast<int16_t>(u));
+            break;
+        case ValueType::I32:
+            w.value(static_cast<int32_t>(u));
+            break;
+        case ValueType::I64:
+            w.value(static_cast<int64_t>(u));
+            break;
+        case ValueType::F32: {
+            float f;
+            std::memcpy(&f, v, sizeof f);
+            w.value(static_cast<double>(f));
+            break;
+        }
+        case ValueType::F64: {
+            double d;
+            std::memcpy(&d, v, sizeof d);
+            w.value(d);
+            break;
+        }
+        default:
+            w.value(u);
+    }
+}
+
 std::optional<std::vector<uint8_t>> encode_typed(uint16_t data_type, uint16_t bit_length,
                                                  const std::vector<std::string>& words) {
     if (data_type == dtype::VisibleString) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "master/coe.hpp"
+#include "util/json.hpp"
 
 namespace ecatctl {
 
@@ -27,6 +28,12 @@ std::string_view esi_type_name(uint16_t data_type);
 // integers "0x0237 (567)", REAL32/REAL64 the number, VISIBLE_STRING the text (up to the first NUL),
 // anything else a hex byte string.
 std::string format_typed(uint16_t data_type, uint16_t bit_length, std::span<const uint8_t> data);
+
+// The same value as a JSON value: integers as numbers (BOOLEAN and bit types too), REAL32/REAL64 as numbers,
+// VISIBLE_STRING as a string, anything else (octet strings, unknown types) as a string of hex bytes
+// "0a 1b ...".
+void write_typed_json(util::JsonWriter& w, uint16_t data_type, uint16_t bit_length,
+                      std::span<const uint8_t> data);
 
 // Text -> bytes of data_type (integers, REAL32/REAL64, strings); nullopt if it does not fit.
 std::optional<std::vector<uint8_t>> encode_typed(uint16_t data_type, uint16_t bit_length,

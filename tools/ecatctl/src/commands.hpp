@@ -13,10 +13,12 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 #include "cmd_diag.hpp"  // MasterRunner
+#include "common.hpp"
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
@@ -41,6 +43,7 @@ struct PdAllArgs {
     std::vector<uint8_t> outputs;  // sent to every slave (from its first output byte)
     std::vector<std::pair<uint64_t, std::vector<uint8_t>>> steps;  // --step: cycles and output bytes
     bool keep = false;
+    bool json = false;  // the outcome as JSON on stdout (docs/ecatctl-json.md, "pd --all")
 };
 int process_data_all(master::Master& m, const PdAllArgs& p);
 // What both forms of pd share (cmd_pd.cpp): SAFEOP then (op) OP while cycling, a refusal reported with its
@@ -62,14 +65,16 @@ int fail(master::Error e, const std::string& what);
 // Why a process-data run failed at its end: "ended in SAFEOP+ERR, not OP, AL status code 0x001b (...)";
 // st null or state 0: the slave gave no AL status.
 std::string state_failure(const master::AlStatus* st, const std::string& wanted);
-// "ecatctl: <what>"; returns kExitUsage.
-int usage(const std::string& what);
-std::optional<master::Address> parse_slave(const std::string& text, bool station);
 // The slave a command names; a bad one is reported as a usage error (exit kExitUsage) and gives nullopt.
 std::optional<master::Address> named_slave(const std::string& text, bool station);
-// "slave 3" or "station 0x1001".
-std::string slave_text(master::Address a);
-std::optional<std::vector<uint8_t>> read_file(const std::string& path);
+// The largest files the verbs read: an SII image (the EEPROM address space), a file written over FoE.
+inline constexpr std::size_t kMaxSiiBytes = 65536;
+inline constexpr std::size_t kMaxFileBytes = std::size_t{64} << 20;
+// A file the command was given, read whole: a regular file of at most max_bytes (util::read_input_bytes; a
+// FIFO, a device or a directory is refused). nullopt after "ecatctl: PATH: why" on stderr; what names the
+// kind of file in that message.
+std::optional<std::vector<uint8_t>> read_file(const std::string& path, std::size_t max_bytes,
+                                              std::string_view what);
 // A slave in INIT gets its mailbox SMs from its SII and is taken to PREOP; one already in PREOP or above
 // keeps the SMs it has.
 master::Error open_mailbox(master::Master& m, master::Mailbox& mbx, master::Address a);

@@ -61,7 +61,10 @@ int report_error(master::Error e, const std::string& what) {
     if (e == master::Error::Timeout)
         std::cerr << " (check that a slave is connected and running on the interface)";
     if (e == master::Error::WorkingCounter)
-        std::cerr << " (is there a slave at that address? `ecatctl scan` lists them)";
+        // Not only a missing slave: a slave refuses an access it cannot take (a mailbox write while its
+        // last request is still unread, as after a lost reply and a retry) with the same counter.
+        std::cerr << " (no slave at that address, or the slave did not take the access; `ecatctl scan` lists "
+                     "the slaves)";
     std::cerr << "\n";
     return exit_code(e);
 }
@@ -162,7 +165,8 @@ std::vector<std::string> position_option_as_argument(int argc, char** argv) {
         if (slave_at >= args.size() || (args[slave_at] != "read" && args[slave_at] != "write")) return args;
         ++slave_at;
     } else if (verb != "state" && verb != "upload" && verb != "download" && verb != "sdos" && verb != "pd" &&
-               verb != "diag" && verb != "slaves" && verb != "pdos" && verb != "cstruct" && verb != "xml") {
+               verb != "diag" && verb != "slaves" && verb != "pdos" && verb != "cstruct" && verb != "xml" &&
+               verb != "alias") {
         return args;  // these verbs have -p/--position as an option of their own
     }
     for (std::size_t k = slave_at; k < args.size(); ++k) {

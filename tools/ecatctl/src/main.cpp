@@ -10,6 +10,7 @@
 
 #include "cmd_diag.hpp"
 #include "cmd_firmware.hpp"
+#include "cmd_line.hpp"
 #include "cmd_state.hpp"
 #include "cmd_verbs.hpp"
 #include "commands.hpp"
@@ -119,6 +120,8 @@ int main(int argc, char** argv) {
     add_cstruct_command(
         app, [&](const auto& fn) { return with_master(g, fn); }, rc);
     add_xml_command(
+        app, [&](const auto& fn) { return with_master(g, fn); }, rc);
+    add_line_commands(
         app, [&](const auto& fn) { return with_master(g, fn); }, rc);
 
     // `-p N` names the slave in every verb, also in those that take it as their first argument.

@@ -37,6 +37,41 @@ bool print_described_upload(master::SdoClient& sdo, uint16_t index, uint8_t sub,
     return true;
 }
 
+void write_described_upload_json(util::JsonWriter& w, master::SdoClient& sdo, uint16_t index, uint8_t sub,
+                                 bool complete_access, std::span<const uint8_t> data) {
+    auto one = [&](const EntryView& e, std::span<const uint8_t> v) {
+        w.begin_object()
+            .member("subindex", e.subindex)
+            .member("name", e.name)
+            .member("type", esi_type_name(e.data_type))
+            .member("bit_length", e.bit_length)
+            .key("value");
+        write_typed_json(w, e.data_type, e.bit_length, v);
+        w.end_object();
+    };
+    // No description (the slave has no SDO information): an empty list, the bytes say the rest.
+    w.key("entries").begin_array();
+    if (!complete_access) {
+        if (auto e = sdo.entry_description(index, sub, 0))
+            one({sub, e->data_type, e->bit_length, e->access, e->name}, data);
+    } else if (auto od = sdo.object_description(index)) {
+        if (od->object_code == 7) {  // a VAR: complete access is a plain access
+            if (auto e = sdo.entry_description(index, 0, 0))
+                one({0, e->data_type, e->bit_length, e->access, e->name}, data);
+        } else if (std::vector<EntryView> entries;
+                   describe_entries(sdo, index, od->max_subindex, entries) == master::Error::Ok) {
+            // An ARRAY carries as many entries as subindex 0 says.
+            if (od->object_code == 8 && sub == 0 && !data.empty()) {
+                const unsigned count = data[0];
+                std::erase_if(entries, [&](const EntryView& e) { return e.subindex > count; });
+            }
+            for (const auto& part : split_complete_access(entries, sub, data))
+                one(part.entry, part.value);
+        }
+    }
+    w.end_array();
+}
+
 namespace {
 
 void print_image(const char* title, const std::vector<SyncView>& syncs, bool output,

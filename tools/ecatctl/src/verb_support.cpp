@@ -1,6 +1,7 @@
 #include <cstdio>
 
 #include "cmd_verbs.hpp"
+#include "commands.hpp"
 #include "common.hpp"
 #include "format.hpp"
 
@@ -26,13 +27,7 @@ std::optional<Address> SlaveArg::address() const {
 }
 
 Error open_coe_mailbox(master::Master& m, master::Mailbox& mbx, Address a) {
-    auto st = m.al_status(a);
-    if (!st) return st.error();
-    if (st->state == static_cast<uint8_t>(master::AlState::Init)) {
-        if (Error e = mbx.configure_from_sii(); e != Error::Ok) return e;
-        return m.request_state(a, master::AlState::PreOp);
-    }
-    return mbx.adopt_current();
+    return open_mailbox(m, mbx, a);
 }
 
 int report_error(const master::SdoClient* sdo, Error e, const std::string& what) {

@@ -6,11 +6,37 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace esi {
+
+// A bad ESI file: "FILE:LINE: message", or "FILE: message" when no line is to blame (a file that cannot be
+// read, a device spec that matches nothing). Every error the reader and the device loader (esi/device)
+// throw is one of these; a program turns it into exit status 2.
+class InputError : public std::runtime_error {
+  public:
+    InputError(const std::string& file, int line, const std::string& message)
+        : std::runtime_error(text(file, line, message)), file_(file), line_(line) {}
+    const std::string& file() const { return file_; }
+    int line() const { return line_; }  // 1-based; 0 if not tied to a line
+
+  private:
+    static std::string text(const std::string& file, int line, const std::string& message) {
+        std::string t = file;
+        if (line > 0) {
+            t += ':';
+            t += std::to_string(line);
+        }
+        t += ": ";
+        t += message;
+        return t;
+    }
+    std::string file_;
+    int line_ = 0;
+};
 
 struct EsiEntry {
     uint8_t subindex = 0;
@@ -22,11 +48,20 @@ struct EsiEntry {
     uint16_t bit_offset = 0;
     std::string access;              // ro, rw, wo
     std::string write_restrictions;  // e.g. PreOP
+    std::string read_restrictions;   // e.g. PreOP_SafeOP
     std::string pdo_mapping;         // "", R, T, RT, TR
     bool backup = false;
     bool setting = false;
-    std::vector<uint8_t> default_data;  // little-endian bytes, empty if not given
+    std::vector<uint8_t> default_data;        // little-endian bytes, empty if not given
+    bool default_is_string = false;           // default_data came from DefaultString (text, not hex)
+    std::vector<uint8_t> min_data, max_data;  // MinData/MaxData, little-endian bytes
     std::optional<int64_t> min, max, default_value;
+    std::optional<uint32_t> unit;  // Info/Unit (ETG.1004 unit code)
+    // The ESI type name as the object or SubItem wrote it (before an enumerated type was resolved to its
+    // base), and whether it is a type the file defines or a basic type (false: an undefined type).
+    std::string declared_type;
+    bool type_known = true;
+    int line = 0;  // of the SubItem (or Object) that declares the entry
 };
 
 struct EsiObject {
@@ -34,8 +69,11 @@ struct EsiObject {
     std::string name;
     std::string type;
     uint16_t bit_size = 0;
-    uint8_t object_code = 7;        // 7 VAR, 8 ARRAY, 9 RECORD
-    std::vector<EsiEntry> entries;  // VAR: one entry, subindex 0
+    uint8_t object_code = 7;             // 7 VAR, 8 ARRAY, 9 RECORD
+    std::optional<uint16_t> type_index;  // DataType/Index of a structured type, if the file gives it
+    std::vector<EsiEntry> entries;       // VAR: one entry, subindex 0
+    bool depend_on_slot = false;  // a module's object: Index DependOnSlot (the slot's increment is added)
+    int line = 0;
     uint8_t max_subindex() const;
     const EsiEntry* entry(uint8_t sub) const;
 };
@@ -46,7 +84,10 @@ struct EsiSm {
     std::optional<uint32_t> min_size, max_size;  // MinSize/MaxSize attributes, if given
     uint8_t control = 0;
     bool enable = false;
+    bool watchdog = false;  // Watchdog attribute
+    bool is_virtual = false;
     std::string type;  // MBoxOut, MBoxIn, Outputs, Inputs
+    int line = 0;
 };
 
 struct EsiPdoEntry {
@@ -55,6 +96,8 @@ struct EsiPdoEntry {
     uint8_t bit_len = 0;
     std::string name;
     std::string data_type;
+    bool depend_on_slot = false;  // Index DependOnSlot
+    int line = 0;
 };
 
 struct EsiPdo {
@@ -66,14 +109,44 @@ struct EsiPdo {
     std::string name;
     std::vector<uint16_t> exclude;
     std::vector<EsiPdoEntry> entries;
+    bool is_virtual = false;      // Virtual attribute
+    bool depend_on_slot = false;  // Index DependOnSlot
+    int line = 0;
     unsigned bits() const;
 };
 
 struct EsiOpMode {
     std::string name;
+    std::string desc;
     uint16_t assign_activate = 0;
     uint32_t cycle_time_sync0 = 0;
+    std::optional<int32_t> cycle_time_sync0_factor;  // CycleTimeSync0 Factor
     int32_t shift_time_sync0 = 0;
+    bool has_sync1 = false;  // CycleTimeSync1 or ShiftTimeSync1 given
+    uint32_t cycle_time_sync1 = 0;
+    std::optional<int32_t> cycle_time_sync1_factor;  // CycleTimeSync1 Factor
+    int32_t shift_time_sync1 = 0;
+    int line = 0;
+};
+
+// Slots/Slot: one place of a modular device and the modules it takes (ModuleIdent, the Default one).
+struct EsiSlot {
+    std::string name;
+    uint32_t min_instances = 0, max_instances = 0;
+    std::vector<uint32_t> module_idents;
+    std::optional<uint32_t> default_module;                  // ModuleIdent with Default="1"
+    std::optional<uint32_t> pdo_increment, index_increment;  // SlotPdoIncrement / SlotIndexIncrement
+    int line = 0;
+};
+
+// Descriptions/Modules/Module: what a slot of a modular device can hold.
+struct EsiModule {
+    uint32_t ident = 0;  // Type ModuleIdent
+    std::string type_name;
+    std::string name;
+    std::vector<EsiPdo> rxpdos, txpdos;
+    std::map<uint16_t, EsiObject> objects;  // Profile/Dictionary/Objects (base indices)
+    int line = 0;
 };
 
 struct EsiCoe {
@@ -97,23 +170,34 @@ struct EsiDevice {
     uint32_t revision = 0;
     std::string type_name;  // <Type> text (order number)
     std::vector<EsiPdoSet> pdo_sets;
-    std::string name;
+    std::string name;  // Name with LcId 1033 (English) if given, else the first Name
     std::string group_type;
+    std::string group_name;  // the Group's Name (LcId 1033 if given)
     std::optional<uint32_t> profile_no;
+    std::optional<uint32_t> profile_add_info;
+    bool has_dictionary = false;  // Profile/Dictionary present
     std::map<uint16_t, EsiObject> objects;
     std::vector<std::string> fmmus;
     std::vector<EsiSm> sms;
+    std::vector<EsiSlot> slots;                                 // Slots/Slot, in order
+    uint32_t slot_pdo_increment = 0, slot_index_increment = 0;  // Slots attributes (a Slot may override)
+    std::vector<std::string> unsupported;  // elements present that a reader of this structure ignores
     std::vector<EsiPdo> rxpdos, txpdos;
     bool has_mailbox = false;
     EsiCoe coe;
     std::map<std::string, bool> coe_attributes;  // every boolean attribute of Mailbox/CoE as written
     std::optional<uint32_t> mailbox_request_timeout_ms, mailbox_response_timeout_ms;  // Info/Mailbox/Timeout
     bool foe = false, eoe = false, soe = false, aoe = false, voe = false;
+    bool mailbox_data_link_layer = false;
     bool has_dc = false;
     std::vector<EsiOpMode> op_modes;
     uint32_t eeprom_bytes = 0;
     std::vector<uint8_t> config_data;  // Eeprom/ConfigData (SII words 0..6)
     std::vector<uint8_t> bootstrap;    // Eeprom/BootStrap (SII words 0x14..0x17)
+    std::vector<uint8_t> eeprom_data;  // Eeprom/Data: the whole EEPROM content, if the file gives it
+    bool has_eeprom = false;
+    int line = 0;  // of the Device element
+    int eeprom_line = 0;
     bool identification_reg134 = false;
     std::map<uint16_t, std::string> diag_messages;  // Profile/DiagMessages: TextId -> MessageText
     std::vector<uint8_t> image16x14;                // ImageData16x14, empty if none
@@ -125,19 +209,24 @@ struct EsiDevice {
 };
 
 struct EsiFile {
+    std::string source;  // the path (or name) messages give
     uint32_t vendor_id = 0;
     std::string vendor_name;
     std::vector<EsiDevice> devices;
+    std::vector<EsiModule> modules;  // Descriptions/Modules
+    const EsiModule* module(uint32_t ident) const;
 };
 
 // The largest ESI file read (vendor files with many devices run to a few MiB).
 constexpr std::size_t kMaxEsiBytes = std::size_t{32} << 20;
 
-// Reads the file; throws std::runtime_error with a readable message if it is not an EtherCATInfo file
-// (or not a regular file of at most kMaxEsiBytes, or a document with a DOCTYPE: vendor XML is untrusted,
-// see esi_reader.cpp).
+// Reads the file; throws InputError ("FILE:LINE: message") if it is not an EtherCATInfo file (or not a
+// regular file of at most kMaxEsiBytes, or a document with a DOCTYPE: vendor XML is untrusted, see
+// esi_reader.cpp). Any encoding the XML declaration names that libxml2 knows (UTF-8, ISO-8859-1, ...) and a
+// UTF-8 byte order mark are accepted; the strings read are UTF-8.
 EsiFile read_esi_file(const std::string& path);
-EsiFile read_esi_text(const std::string& xml);
+// `name` names the text in messages.
+EsiFile read_esi_text(const std::string& xml, const std::string& name = "esi.xml");
 // The first device of an ESI text (throws as read_esi_text does).
 EsiDevice read_esi(const std::string& xml);
 

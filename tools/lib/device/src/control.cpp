@@ -12,9 +12,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cstddef>
+#include <cstdio>
 #include <cstring>
 #include <sstream>
 #include <stdexcept>
@@ -63,6 +65,77 @@ bool in_group(uid_t uid, gid_t gid, gid_t group) {
     }
     groups.resize(static_cast<std::size_t>(n));
     return std::find(groups.begin(), groups.end(), group) != groups.end();
+}
+
+std::string lower(std::string_view s) {
+    std::string r(s);
+    for (char& c : r)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return r;
+}
+
+std::string where(uint16_t index, uint8_t sub) {
+    char b[16];
+    std::snprintf(b, sizeof b, "0x%04X:%02X", static_cast<unsigned>(index), static_cast<unsigned>(sub));
+    return b;
+}
+
+// An entry named on the command line: index:subindex (numbers, 0x for hex: "0x6000:1"), or a name: the
+// entry's name, or "<object name>/<entry name>" (any case). Names are looked up first among the entries
+// mapped for process data, then in the whole dictionary; a name that fits several entries is an error that
+// lists them.
+struct Found {
+    const od::Entry* entry = nullptr;
+    std::string error;
+};
+
+Found find_entry(const Device& device, od::Dictionary& dict, std::string_view text) {
+    Found f;
+    if (const std::size_t colon = text.find(':'); colon != std::string_view::npos) {
+        uint16_t index = 0;
+        uint8_t sub = 0;
+        if (util::parse_number(text.substr(0, colon), index) == util::NumberError::None &&
+            util::parse_number(text.substr(colon + 1), sub) == util::NumberError::None) {
+            f.entry = dict.find(index, sub);
+            if (f.entry == nullptr) f.error = "no entry " + where(index, sub);
+            return f;
+        }
+    }
+    const std::string want = lower(text);
+    auto matches = [&](const od::Entry& e) {
+        if (lower(e.name) == want) return true;
+        const od::Object* o = dict.find(e.index);
+        return o != nullptr && lower(o->name + "/" + e.name) == want;
+    };
+    std::vector<const od::Entry*> hits;
+    if (const IoModel* io = device.io_model()) {
+        for (const auto list : {io->inputs(), io->outputs()})
+            for (const IoEntry& m : list)
+                if (matches(*m.entry) && std::find(hits.begin(), hits.end(), m.entry) == hits.end())
+                    hits.push_back(m.entry);
+    }
+    if (hits.empty())
+        for (const od::Object& o : dict.objects())
+            for (const od::Entry& e : o.entries)
+                if (matches(e)) hits.push_back(&e);
+    if (hits.size() == 1) {
+        f.entry = hits.front();
+    } else if (hits.empty()) {
+        f.error = "no entry named '" + std::string(text) + "'";
+    } else {
+        f.error = "'" + std::string(text) + "' names " + std::to_string(hits.size()) + " entries (";
+        for (std::size_t i = 0; i < hits.size() && i < 8; ++i)
+            f.error += (i ? " " : "") + where(hits[i]->index, hits[i]->subindex);
+        f.error += hits.size() > 8 ? " ...): give index:subindex" : "): give index:subindex";
+    }
+    return f;
+}
+
+// "0x7000:01 "Output"=1" for each entry of a list.
+void list_entries(std::ostringstream& s, const Device& device, std::span<const IoEntry> list) {
+    for (const IoEntry& m : list)
+        s << ' ' << where(m.entry->index, m.entry->subindex) << " \"" << m.entry->name
+          << "\"=" << device.value_text(m.entry->index, m.entry->subindex);
 }
 
 }  // namespace
@@ -249,6 +322,10 @@ std::string ControlSocket::apply(Device& device, std::string_view line) {
     const bool none = w.size() == 2 && w[1].text == "none";
     double a = 0, b = 0;
     bool on = false;
+    const bool drive_command = cmd == "input" || cmd == "sto" || cmd == "limit-neg" || cmd == "limit-pos" ||
+                               cmd == "home" || cmd == "stops";
+    if (drive_command && !device.has_drive())
+        return "error: '" + std::string(cmd) + "' acts on a drive; this device has none (get, set, status)";
     if (cmd == "input") {
         int pin = 0;
         if (w.size() != 3 || util::parse_number(w[1].text, pin, 1, 6) != util::NumberError::None ||
@@ -289,13 +366,40 @@ std::string ControlSocket::apply(Device& device, std::string_view line) {
     if (cmd == "status" && w.size() == 1) {
         od::Dictionary& d = device.dictionary();
         std::ostringstream s;
-        s << "ok state " << esc::al_state_name(device.stack().state()) << " statusword 0x" << std::hex
-          << d.get<uint16_t>(0x6041, 0) << std::dec << " position " << d.get<int32_t>(0x6064, 0)
-          << " error 0x" << std::hex << d.get<uint16_t>(0x603F, 0);
+        s << "ok state " << esc::al_state_name(device.stack().state());
+        if (const IoModel* io = device.io_model()) {
+            // A device without application: its process data by entry, with values.
+            s << " outputs";
+            list_entries(s, device, io->outputs());
+            s << " inputs";
+            list_entries(s, device, io->inputs());
+            return s.str();
+        }
+        if (d.find(0x6041, 0) != nullptr)
+            s << " statusword 0x" << std::hex << d.get<uint16_t>(0x6041, 0) << std::dec;
+        if (d.find(0x6064, 0) != nullptr) s << " position " << d.get<int32_t>(0x6064, 0);
+        if (d.find(0x603F, 0) != nullptr) s << " error 0x" << std::hex << d.get<uint16_t>(0x603F, 0);
         return s.str();
     }
+    if (cmd == "get") {
+        if (w.size() != 2) return "error: usage: get <entry name>|<index>:<subindex>";
+        const Found f = find_entry(device, device.dictionary(), w[1].text);
+        if (f.entry == nullptr) return "error: " + f.error;
+        return "ok " + where(f.entry->index, f.entry->subindex) + " \"" + f.entry->name +
+               "\"=" + device.value_text(f.entry->index, f.entry->subindex);
+    }
+    if (cmd == "set") {
+        if (w.size() != 3) return "error: usage: set <entry name>|<index>:<subindex> <value>";
+        const Found f = find_entry(device, device.dictionary(), w[1].text);
+        if (f.entry == nullptr) return "error: " + f.error;
+        const uint16_t index = f.entry->index;
+        const uint8_t sub = f.entry->subindex;
+        if (const std::string error = device.set_value(index, sub, w[2].text); !error.empty())
+            return "error: " + error;
+        return "ok " + where(index, sub) + "=" + device.value_text(index, sub);
+    }
     return "error: unknown command '" + std::string(cmd) +
-           "' (input, sto, limit-neg, limit-pos, home, stops, status)";
+           "' (input, sto, limit-neg, limit-pos, home, stops, status, get, set)";
 }
 
 }  // namespace device

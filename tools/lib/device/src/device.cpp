@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <stdexcept>
 #include <system_error>
@@ -23,6 +24,7 @@
 #include "od/device_config.hpp"
 #include "od/diag_texts.hpp"
 #include "util/le.hpp"
+#include "util/lex.hpp"
 #include "util/strfmt.hpp"
 
 namespace device {
@@ -38,10 +40,59 @@ foe::StoreConfig store_config(const DeviceOptions& options, const od::DeviceDesc
 }
 
 od::DeviceDescription base_description(const DeviceOptions& options) {
-    od::DeviceDescription d =
-        options.config_file.empty() ? maxpos::description() : maxpos::load_config(options.config_file);
+    od::DeviceDescription d = options.product               ? options.product->description
+                              : options.config_file.empty() ? maxpos::description()
+                                                            : maxpos::load_config(options.config_file);
     if (options.serial_number) d.identity.serial_number = *options.serial_number;
     return d;
+}
+
+od::Dictionary make_dictionary(const DeviceOptions& options, const od::DeviceDescription& d) {
+    return options.product ? options.product->make_dictionary(d) : maxpos::dictionary(d);
+}
+
+// The built-in MAXPOS has every part; a product the parts it declares.
+bool has_foe_part(const DeviceOptions& options, const od::DeviceDescription& d) {
+    return !options.product || (d.mailbox_protocols & od::mailbox_protocol::FoE) != 0;
+}
+bool has_coe_part(const DeviceOptions& options, const od::DeviceDescription& d) {
+    return !options.product || (d.mailbox_protocols & od::mailbox_protocol::CoE) != 0;
+}
+bool has_drive_part(const DeviceOptions& options) {
+    return !options.product || options.product->application == od::Application::Cia402Drive;
+}
+
+// Where the product keeps the drive's vendor parameters: the built-in MAXPOS's; a product from an ESI or ENI
+// has only the CiA 402 objects, which the drive binds by index.
+const drive::VendorObjects& vendor_objects(const DeviceOptions& options) {
+    static const drive::VendorObjects none{};
+    return options.product ? none : maxpos::drive_objects();
+}
+
+bool has_parameter_part(const DeviceOptions& options, const od::Dictionary& dict) {
+    return !options.product || dict.find(0x1010) != nullptr || dict.find(0x1011) != nullptr;
+}
+
+// The SII image as built: the product's own EEPROM image byte for byte (a unit of a line with its serial
+// number in words 0x0E/0x0F, which the checksum of words 0..6 does not cover), else built from the
+// description and the dictionary.
+std::vector<uint8_t> built_sii(const DeviceOptions& options, const od::DeviceDescription& d,
+                               const od::Dictionary& dict) {
+    if (options.product && !options.product->eeprom.empty()) {
+        std::vector<uint8_t> image = options.product->eeprom;
+        if (options.serial_number && image.size() >= 0x20) {
+            const uint32_t serial = *options.serial_number;
+            for (int i = 0; i < 4; ++i)
+                image[static_cast<std::size_t>(0x1C + i)] = static_cast<uint8_t>(serial >> (8 * i));
+        }
+        return image;
+    }
+    return esi::build_sii(d, dict);
+}
+
+std::string source_name(const DeviceOptions& options) {
+    if (options.product) return options.product->source;
+    return options.config_file.empty() ? std::string("the built-in drive") : options.config_file.string();
 }
 
 // The description with the version of the active image of an opened store.
@@ -62,7 +113,8 @@ std::filesystem::path firmware_dir(const DeviceOptions& options) {
 od::DeviceDescription make_description(const DeviceOptions& options) {
     od::DeviceDescription d = base_description(options);
     std::error_code ec;
-    if (!options.state_dir.empty() && std::filesystem::is_directory(firmware_dir(options), ec)) {
+    if (has_foe_part(options, d) && !options.state_dir.empty() &&
+        std::filesystem::is_directory(firmware_dir(options), ec)) {
         foe::FirmwareStore store(store_config(options, d));
         if (store.open()) apply_active_image(d, store);
     }
@@ -72,19 +124,17 @@ od::DeviceDescription make_description(const DeviceOptions& options) {
 void check_device(const DeviceOptions& options) {
     const od::DeviceDescription d = make_description(options);
     try {
-        const od::Dictionary dict = maxpos::dictionary(d);
-        (void)esi::build_sii(d, dict);
+        const od::Dictionary dict = make_dictionary(options, d);
+        (void)built_sii(options, d, dict);
     } catch (const std::exception& e) {
-        throw od::ConfigError(
-            options.config_file.empty() ? std::string("the built-in drive") : options.config_file.string(), 0,
-            e.what());
+        throw od::ConfigError(source_name(options), 0, e.what());
     }
 }
 
 std::vector<uint8_t> make_sii(const DeviceOptions& options) {
     const od::DeviceDescription d = make_description(options);
-    const od::Dictionary dict = maxpos::dictionary(d);
-    std::vector<uint8_t> image = esi::build_sii(d, dict);
+    const od::Dictionary dict = make_dictionary(options, d);
+    std::vector<uint8_t> image = built_sii(options, d, dict);
     if (options.state_dir.empty()) return image;
     EepromWrites writes(options.state_dir);
     if (writes.load().empty()) writes.apply(image);
@@ -93,7 +143,7 @@ std::vector<uint8_t> make_sii(const DeviceOptions& options) {
 
 std::string make_esi(const DeviceOptions& options) {
     const od::DeviceDescription d = make_description(options);
-    const od::Dictionary dict = maxpos::dictionary(d);
+    const od::Dictionary dict = make_dictionary(options, d);
     return esi::build_esi(d, dict);
 }
 
@@ -109,6 +159,7 @@ struct Device::Parts {
     std::unique_ptr<coe::DiagnosisHistory> diag;
     std::unique_ptr<coe::EventReporter> events;
     std::unique_ptr<drive::Drive> drive;
+    std::unique_ptr<IoModel> io;  // a device without application
 };
 
 Device::Device(esc::Esc& esc, DeviceOptions options)
@@ -134,13 +185,21 @@ Device::Device(esc::Esc& esc, DeviceOptions options)
                                          eeprom_writes_.file().string() +
                                          "; delete that file (or start with --reset-sii) to serve the "
                                          "SII generated from the object model");
-        std::vector<uint8_t> image = esi::build_sii(parts_->desc, parts_->dict);
+        std::vector<uint8_t> image = built_sii(options_, parts_->desc, parts_->dict);
         eeprom_writes_.apply(image);
         const od::Identity& id = parts_->desc.identity;
         for (const std::string& d :
              sii_drift(image, id.vendor_id, id.product_code, id.revision, id.serial_number))
             event(slave::LogLevel::Warn, "the SII served: " + d);
     }
+    // What the product declares that is not emulated: said once.
+    if (options_.product && options_.announce_product)
+        for (const std::string& w : options_.product->warnings) {
+            if (options_.events != nullptr)
+                event(slave::LogLevel::Warn, options_.product->source + ": " + w);
+            else
+                log() << "softecat: " << options_.product->source << ": " << w << '\n';
+        }
     // Registered once the device exists: a constructor that throws leaves no callback behind.
     if (options_.load_sii)
         esc_.on_eeprom_write([this](uint16_t address, uint16_t value) {
@@ -264,85 +323,121 @@ void Device::build() {
     // (e.g. the state directory became unusable) leaves the old firmware running.
     auto p = std::make_unique<Parts>();
     p->desc = base_description(options_);
-    foe::ServerConfig foe_config = foe::ServerConfig::from(p->desc);
-    foe_config.faults = options_.faults.foe;
-    p->firmware = std::make_unique<foe::FirmwareUpdate>(options_.state_dir, p->desc, foe_config);
-    if (!p->firmware->ok())
-        log() << "softdrive: firmware store " << firmware_dir(options_).string() << ": "
-              << p->firmware->error().text << " (running the built-in firmware)\n";
-    p->firmware->apply_to(p->desc.identity);
+    if (has_foe_part(options_, p->desc)) {
+        foe::ServerConfig foe_config = foe::ServerConfig::from(p->desc);
+        foe_config.faults = options_.faults.foe;
+        p->firmware = std::make_unique<foe::FirmwareUpdate>(options_.state_dir, p->desc, foe_config);
+        if (!p->firmware->ok())
+            log() << "softdrive: firmware store " << firmware_dir(options_).string() << ": "
+                  << p->firmware->error().text << " (running the built-in firmware)\n";
+        p->firmware->apply_to(p->desc.identity);
+    }
 
-    p->dict = maxpos::dictionary(p->desc);
+    p->dict = make_dictionary(options_, p->desc);
     coe::install_pdo_validators(p->dict, {}, p->desc.pdo_rules);
-    if (options_.faults.identity_mismatch)
+    if (options_.faults.identity_mismatch && p->dict.find(0x1018, 2) != nullptr)
         (void)p->dict.set<uint32_t>(0x1018, 2, p->desc.identity.product_code + 1);
-    if (options_.commission) {
-        if (const od::Status s = drive::commission(p->dict, maxpos::drive_objects()); s != od::Status::Ok)
+    // Values set at run time (set_value), kept across restarts.
+    for (const auto& [key, raw] : set_values_)
+        (void)p->dict.set_raw(static_cast<uint16_t>(key >> 8), static_cast<uint8_t>(key & 0xFF), raw);
+    const bool drive = has_drive_part(options_);
+    if (drive && options_.commission) {
+        // Only what exists is commissioned (a vendor's drive may lack the MAXPOS motor objects).
+        od::Status s = od::Status::Ok;
+        try {
+            s = drive::commission(p->dict, vendor_objects(options_));
+        } catch (const std::exception& e) {
+            if (!options_.product) throw;
+            log() << "softdrive: commissioning the motor parameters failed: " << e.what() << '\n';
+        }
+        if (s != od::Status::Ok)
             log() << "softdrive: commissioning the motor parameters failed: " << od::to_string(s) << '\n';
     }
-    p->params = std::make_unique<od::ParameterStore>(options_.state_dir);
-    p->load = p->params->load(p->dict);
-    if (p->load.found && !p->load.applied)
-        log() << "softdrive: stored parameters " << p->params->file().string() << " not used ("
-              << p->load.error << "); running with the defaults\n";
     Parts* raw = p.get();
-    od::attach_store(
-        p->dict, *p->params,
-        [raw] {
-            // MAXPOS firmware specification §7.2.21: restoring defaults only with the axis in "Power Disable"
-            // (not switched on).
-            constexpr auto sw = drive::obj::Statusword;
-            const od::Entry* e = raw->dict.find(sw.index, sw.sub);
-            if (e == nullptr) return od::Status::Ok;
-            return (raw->dict.get<uint16_t>(sw.index, sw.sub) & drive::sw::SwitchedOn) != 0
-                       ? od::Status::WrongState
-                       : od::Status::Ok;
-        },
-        // A master's 0x1010/0x2110 "save" and 0x1011/0x2111 "load": what the store did, done or failed (a
-        // failed one was answered with an SDO abort; the log says why).
-        [this, raw](const od::Entry& e, bool save, const std::string& error) {
-            // Appended piece by piece: "literal" + a temporary string trips GCC 12's -Wrestrict at -O3.
-            std::string which = "(";
-            which += hex16(e.index);
-            which += ':';
-            which += std::to_string(e.subindex);
-            which += ' ';
-            which += e.name;
-            which += ')';
-            if (!error.empty())
-                event(slave::LogLevel::Error,
-                      std::string(save ? "stored parameters not saved " : "stored parameters not restored ") +
-                          which + ": " + error + " (the master got SDO abort 0x06060000, hardware error)");
-            else if (save)
-                event(slave::LogLevel::Info,
-                      "stored parameters saved " + which + " to " + raw->params->file().string());
-            else
-                event(slave::LogLevel::Info,
-                      "stored parameters restored to defaults at the next start " + which);
-        });
+    if (has_parameter_part(options_, p->dict)) {
+        p->params = std::make_unique<od::ParameterStore>(options_.state_dir);
+        p->load = p->params->load(p->dict);
+        if (p->load.found && !p->load.applied)
+            log() << "softdrive: stored parameters " << p->params->file().string() << " not used ("
+                  << p->load.error << "); running with the defaults\n";
+        od::attach_store(
+            p->dict, *p->params,
+            [raw] {
+                // MAXPOS firmware specification §7.2.21: restoring defaults only with the axis in "Power
+                // Disable" (not switched on).
+                constexpr auto sw = drive::obj::Statusword;
+                const od::Entry* e = raw->dict.find(sw.index, sw.sub);
+                if (e == nullptr) return od::Status::Ok;
+                return (raw->dict.get<uint16_t>(sw.index, sw.sub) & drive::sw::SwitchedOn) != 0
+                           ? od::Status::WrongState
+                           : od::Status::Ok;
+            },
+            // A master's 0x1010/0x2110 "save" and 0x1011/0x2111 "load": what the store did, done or failed (a
+            // failed one was answered with an SDO abort; the log says why).
+            [this, raw](const od::Entry& e, bool save, const std::string& error) {
+                // Appended piece by piece: "literal" + a temporary string trips GCC 12's -Wrestrict at -O3.
+                std::string which = "(";
+                which += hex16(e.index);
+                which += ':';
+                which += std::to_string(e.subindex);
+                which += ' ';
+                which += e.name;
+                which += ')';
+                if (!error.empty())
+                    event(slave::LogLevel::Error,
+                          std::string(save ? "stored parameters not saved "
+                                           : "stored parameters not restored ") +
+                              which + ": " + error +
+                              " (the master got SDO abort 0x06060000, hardware error)");
+                else if (save)
+                    event(slave::LogLevel::Info,
+                          "stored parameters saved " + which + " to " + raw->params->file().string());
+                else
+                    event(slave::LogLevel::Info,
+                          "stored parameters restored to defaults at the next start " + which);
+            });
+    }
 
     std::vector<uint8_t> image;
     if (options_.load_sii) {
-        image = esi::build_sii(p->desc, p->dict);
+        image = built_sii(options_, p->desc, p->dict);
         eeprom_writes_.apply(image);
     }
 
     p->stack = std::make_unique<ecat::Stack>(esc_, p->dict, p->desc, *this, [this] { return esc_.irq(); });
     p->stack->set_faults(options_.faults.stack);
-    coe::CoeConfig coe_config;
-    coe_config.faults = options_.faults.coe;
-    p->coe = std::make_unique<coe::CoeServer>(
-        p->dict, [raw] { return raw->stack->state(); }, coe_config);
-    p->diag = std::make_unique<coe::DiagnosisHistory>(p->dict, &p->coe->emergency());
-    p->events = std::make_unique<coe::EventReporter>(p->coe->emergency(), p->diag.get(),
-                                                     [this] { return system_time_ns(); });
-    p->events->set_text_ids(&od::diag_text_id);  // the texts the ESI lists as DiagMessages
-    p->stack->add_handler(*p->coe);
-    p->stack->add_handler(p->firmware->server());
+    if (has_coe_part(options_, p->desc)) {
+        coe::CoeConfig coe_config;
+        coe_config.faults = options_.faults.coe;
+        p->coe = std::make_unique<coe::CoeServer>(
+            p->dict, [raw] { return raw->stack->state(); }, coe_config);
+        // The diagnosis history where the dictionary has its object (0x10F3, ETG.1020).
+        if (!options_.product || p->dict.find(0x10F3) != nullptr)
+            p->diag = std::make_unique<coe::DiagnosisHistory>(p->dict, &p->coe->emergency());
+        p->events = std::make_unique<coe::EventReporter>(p->coe->emergency(), p->diag.get(),
+                                                         [this] { return system_time_ns(); });
+        p->events->set_text_ids(&od::diag_text_id);  // the texts the ESI lists as DiagMessages
+        p->stack->add_handler(*p->coe);
+    }
+    if (p->firmware) {
+        p->stack->add_handler(p->firmware->server());
+        p->firmware->server().set_event_sink(this);
+    }
     p->stack->set_event_sink(this);
-    p->firmware->server().set_event_sink(this);
-    p->drive = std::make_unique<drive::Drive>(p->dict, this, maxpos::drive_objects());
-    p->drive->axis().faults = options_.faults.axis;
+    if (drive) {
+        // A vendor's CiA 402 dictionary the drive core cannot run on: said, and served as process data.
+        try {
+            p->drive = std::make_unique<drive::Drive>(p->dict, this, vendor_objects(options_));
+            p->drive->axis().faults = options_.faults.axis;
+        } catch (const std::exception& e) {
+            if (!options_.product) throw;
+            log() << "softecat: " << options_.product->source
+                  << ": the CiA 402 drive core does not run on this dictionary (" << e.what()
+                  << "); serving its process data without a drive\n";
+            p->drive.reset();
+        }
+    }
+    if (!p->drive) p->io = std::make_unique<IoModel>();
 
     if (options_.load_sii) esc_.load_eeprom(image);
     if (parts_) ecat::add_stats(earlier_stacks_, parts_->stack->stats());
@@ -355,6 +450,7 @@ void Device::build() {
 }
 
 void Device::apply_environment() {
+    if (!parts_->drive) return;
     drive::Environment& env = parts_->drive->environment();
     const EnvironmentOptions& e = options_.environment;
     env.remove_switches();
@@ -372,7 +468,7 @@ void Device::apply_environment() {
 }
 
 bool Device::set_input(int pin, bool level) {
-    if (pin < 1 || pin > static_cast<int>(inputs_.size())) return false;
+    if (pin < 1 || pin > static_cast<int>(inputs_.size()) || !parts_->drive) return false;
     inputs_[static_cast<std::size_t>(pin - 1)] = level ? 1 : 0;
     parts_->drive->environment().set_input(pin, level);
     return true;
@@ -404,7 +500,8 @@ void Device::poll(uint64_t now_ns) {
     }
     // The drive's own loop: it runs when no master cycle drives it (outside Op), as the controller of a
     // hardware drive never stops; the first run right after a build sets the statusword.
-    if (last_cycle_ns_ == 0 || (parts_->stack->state() != od::AlState::Op && now_ns >= free_run_due_ns()))
+    if (parts_->drive &&
+        (last_cycle_ns_ == 0 || (parts_->stack->state() != od::AlState::Op && now_ns >= free_run_due_ns())))
         run_drive(now_ns);
     if (eeprom_dirty_) {
         if (eeprom_save_ns_ == 0)
@@ -415,16 +512,17 @@ void Device::poll(uint64_t now_ns) {
 }
 
 bool Device::quiet(uint64_t now_ns) const {
-    if (restart_pending_ || outputs_lost_pending_ || last_cycle_ns_ == 0) return false;
+    if (restart_pending_ || outputs_lost_pending_ || (parts_->drive && last_cycle_ns_ == 0)) return false;
     if (!parts_->stack->quiet(now_ns)) return false;
     if (eeprom_dirty_ && (eeprom_save_ns_ == 0 || now_ns >= eeprom_save_ns_)) return false;
+    if (!parts_->drive) return true;  // nothing runs on its own
     return parts_->stack->state() == od::AlState::Op || now_ns < free_run_due_ns();
 }
 
 uint64_t Device::next_deadline_ns() const {
     uint64_t next = parts_->stack->next_deadline_ns();
     if (eeprom_dirty_ && eeprom_save_ns_ != 0) next = std::min(next, eeprom_save_ns_);
-    if (parts_->stack->state() == od::AlState::Op || last_cycle_ns_ == 0) return next;
+    if (!parts_->drive || parts_->stack->state() == od::AlState::Op || last_cycle_ns_ == 0) return next;
     return std::min(next, free_run_due_ns());
 }
 
@@ -452,10 +550,26 @@ uint16_t Device::check_transition(od::AlState /*from*/, od::AlState /*to*/) {
 void Device::on_state_change(od::AlState from, od::AlState to) {
     // Leaving Op by any path ends the outputs, whether or not on_outputs_lost() came first.
     if (from == od::AlState::Op && to != od::AlState::Op) outputs_lost_pending_ = true;
+    if (parts_->io) {
+        // The mapping is fixed from Safe-Op on: the plan of the IO model is built once, here.
+        const bool pd_from = from == od::AlState::SafeOp || from == od::AlState::Op;
+        const bool pd_to = to == od::AlState::SafeOp || to == od::AlState::Op;
+        if (pd_to && !pd_from) {
+            parts_->io->build(parts_->stack->process_data(), held_);
+        } else if (pd_from && !pd_to) {
+            parts_->io->clear();
+        }
+    }
 }
 
 void Device::on_cycle(uint64_t now_ns) {
-    run_drive(now_ns);
+    if (parts_->drive) {
+        run_drive(now_ns);
+        return;
+    }
+    last_cycle_ns_ = now_ns;
+    parts_->io->cycle();
+    ++stats_.cycles;
 }
 
 void Device::on_outputs_lost() {
@@ -464,6 +578,7 @@ void Device::on_outputs_lost() {
 
 void Device::react_to_outputs_lost() {
     outputs_lost_pending_ = false;
+    if (!parts_->drive) return;
     // A fall-back (watchdog, sync loss: the stack set the error indication) is a communication failure:
     // 0x8180 with the 0x6007 reaction in any drive state. A master that asks to leave Op is not an error; it
     // gets the reaction only while its outputs were commanding motion (operation enabled, statusword bit 2).
@@ -489,14 +604,14 @@ void Device::raise(uint16_t error_code, uint8_t error_register, const std::array
     }
     ++stats_.emergencies;
     ++stats_.diagnoses;
-    parts_->events->raise(error_code, error_register, mfr);
+    if (parts_->events) parts_->events->raise(error_code, error_register, mfr);
 }
 
 void Device::clear(uint16_t error_code, uint8_t error_register) {
     if (options_.events != nullptr && options_.events->enabled(slave::LogLevel::Debug))
         event(slave::LogLevel::Debug, "drive error " + hex16(error_code) + " cleared");
     ++stats_.emergencies;
-    parts_->events->clear(error_code, error_register);
+    if (parts_->events) parts_->events->clear(error_code, error_register);
 }
 
 void Device::diag(drive::Severity severity, uint16_t code, std::string_view text) {
@@ -512,6 +627,7 @@ void Device::diag(drive::Severity severity, uint16_t code, std::string_view text
         event(level, line);
     }
     ++stats_.diagnoses;
+    if (!parts_->events) return;
     parts_->events->diag(severity == drive::Severity::Error     ? coe::DiagType::Error
                          : severity == drive::Severity::Warning ? coe::DiagType::Warning
                                                                 : coe::DiagType::Info,
@@ -519,6 +635,22 @@ void Device::diag(drive::Severity severity, uint16_t code, std::string_view text
 }
 
 // ---- parts ------------------------------------------------------------------------------------------
+
+bool Device::has_coe() const {
+    return parts_->coe != nullptr;
+}
+bool Device::has_foe() const {
+    return parts_->firmware != nullptr;
+}
+bool Device::has_parameters() const {
+    return parts_->params != nullptr;
+}
+bool Device::has_drive() const {
+    return parts_->drive != nullptr;
+}
+const IoModel* Device::io_model() const {
+    return parts_->io.get();
+}
 
 const od::DeviceDescription& Device::description() const {
     return parts_->desc;
@@ -552,6 +684,113 @@ od::ParameterStore& Device::parameters() {
 }
 const od::ParameterStore::LoadResult& Device::parameter_load() const {
     return parts_->load;
+}
+
+}  // namespace device
+
+// ---- values at run time -----------------------------------------------------------------------------
+
+namespace device {
+namespace {
+
+// The bytes of an entry's value from text: an integer in the entry's range (decimal, 0x hex, negative for
+// signed types), a real number for REAL types, true/false/on/off for BOOL. false if it does not fit.
+bool encode(const od::Entry& e, std::string_view text, std::vector<uint8_t>& raw) {
+    const std::size_t bytes = e.byte_size();
+    if (bytes == 0 || bytes > 8 || od::is_string(e.type)) return false;
+    raw.assign(bytes, 0);
+    if (od::is_real(e.type)) {
+        double v = 0;
+        if (util::parse_number(text, v) != util::NumberError::None) return false;
+        if (bytes == 4) {
+            const auto f = static_cast<float>(v);
+            std::memcpy(raw.data(), &f, 4);
+        } else if (bytes == 8) {
+            std::memcpy(raw.data(), &v, 8);
+        } else {
+            return false;
+        }
+        return true;
+    }
+    uint64_t bits = 0;
+    const unsigned width = std::min<unsigned>(e.bit_length, 64);
+    if (text == "true" || text == "on") {
+        bits = 1;
+    } else if (text == "false" || text == "off") {
+        bits = 0;
+    } else if (od::is_signed(e.type)) {
+        const int64_t lo = width >= 64 ? INT64_MIN : -(int64_t{1} << (width - 1));
+        const int64_t hi = width >= 64 ? INT64_MAX : (int64_t{1} << (width - 1)) - 1;
+        int64_t v = 0;
+        if (util::parse_number(text, v, lo, hi) != util::NumberError::None) return false;
+        bits = static_cast<uint64_t>(v);
+    } else {
+        const uint64_t hi = width >= 64 ? UINT64_MAX : (uint64_t{1} << width) - 1;
+        uint64_t v = 0;
+        if (util::parse_number(text, v, uint64_t{0}, hi) != util::NumberError::None) return false;
+        bits = v;
+    }
+    for (std::size_t i = 0; i < bytes; ++i)
+        raw[i] = static_cast<uint8_t>(bits >> (8 * i));
+    return true;
+}
+
+}  // namespace
+
+std::string Device::set_value(uint16_t index, uint8_t sub, std::string_view text) {
+    od::Dictionary& d = parts_->dict;
+    const od::Entry* e = d.find(index, sub);
+    const std::string where = util::strprintf("0x%04X:%02X", static_cast<unsigned>(index), sub);
+    if (e == nullptr) return "no entry " + where;
+    if (!e->tx_mappable()) return where + " is not a process-data input (not TxPDO-mappable)";
+    std::vector<uint8_t> raw;
+    if (!encode(*e, text, raw))
+        return "'" + std::string(text) + "' is no value of " + where + " (" +
+               std::string(od::to_string(e->type)) + ", " + std::to_string(e->bit_length) + " bits)";
+    if (const od::Status st = d.set_raw(index, sub, raw); st != od::Status::Ok)
+        return where + ": " + std::string(od::to_string(st));
+    const uint32_t key = io_key(index, sub);
+    set_values_[key] = std::move(raw);
+    held_.insert(key);
+    if (parts_->io) parts_->io->hold(index, sub);
+    return {};
+}
+
+std::string Device::value_text(uint16_t index, uint8_t sub) const {
+    const od::Dictionary& d = parts_->dict;
+    const od::Entry* e = d.find(index, sub);
+    if (e == nullptr) return {};
+    const auto raw = d.raw(index, sub);
+    if (od::is_string(e->type) || raw.size() > 8) {
+        std::string s = "\"";
+        for (const uint8_t c : raw) {
+            if (c == 0 && e->type == od::DataType::VisibleString) break;
+            if (c >= 0x20 && c < 0x7F && c != '"' && c != '\\')
+                s += static_cast<char>(c);
+            else
+                s += util::strprintf("\\x%02X", static_cast<unsigned>(c));
+        }
+        return s + "\"";
+    }
+    uint64_t v = 0;
+    for (std::size_t i = 0; i < raw.size(); ++i)
+        v |= static_cast<uint64_t>(raw[i]) << (8 * i);
+    if (od::is_real(e->type)) {
+        double x = 0;
+        if (raw.size() == 4) {
+            float f = 0;
+            std::memcpy(&f, raw.data(), 4);
+            x = f;
+        } else if (raw.size() == 8) {
+            std::memcpy(&x, raw.data(), 8);
+        }
+        return util::strprintf("%.9g", x);
+    }
+    const unsigned width = std::min<unsigned>(e->bit_length, 64);
+    if (width < 64) v &= (uint64_t{1} << width) - 1;
+    if (od::is_signed(e->type) && width > 0 && width < 64 && (v >> (width - 1)) != 0)
+        v |= ~uint64_t{0} << width;
+    return od::is_signed(e->type) ? std::to_string(static_cast<int64_t>(v)) : std::to_string(v);
 }
 
 }  // namespace device

@@ -49,7 +49,9 @@ Line::Line(const esc::Clock& clock, LineOptions options, slave::ExternalSend sen
     : clock_(clock), options_(std::move(options)), segment_(options_.topology.timing) {
     const slave::Topology& topo = options_.topology;
     units_.reserve(topo.devices.size());
-    for (const slave::TopologyDevice& d : topo.devices) {
+    std::vector<const od::Product*> announced;  // products whose warnings a unit said already
+    for (std::size_t i = 0; i < topo.devices.size(); ++i) {
+        const slave::TopologyDevice& d = topo.devices[i];
         auto u = std::make_unique<Unit>();
         u->name = d.name;
         u->log_name = "ecat-slave: " + d.name;
@@ -58,10 +60,15 @@ Line::Line(const esc::Clock& clock, LineOptions options, slave::ExternalSend sen
                                                   options_.log->colour(), u->log_name);
         u->options = options_.base;
         if (!d.config.empty()) u->options.config_file = d.config;
+        if (i < options_.products.size() && options_.products[i]) u->options.product = options_.products[i];
         u->options.state_dir =
             d.state_dir.empty() ? options_.base.state_dir / d.name : std::filesystem::path(d.state_dir);
         if (d.serial) u->options.serial_number = d.serial;
         u->options.events = u->log.get();
+        if (const od::Product* p = u->options.product.get()) {
+            u->options.announce_product = std::find(announced.begin(), announced.end(), p) == announced.end();
+            if (u->options.announce_product) announced.push_back(p);
+        }
         u->options.load_sii = true;
         u->esc_config = options_.esc;
         u->esc_config.port_descriptor = d.port_descriptor();

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <iterator>
 #include <thread>
+#include <utility>
 
 #include "util/le.hpp"
 
@@ -75,38 +76,101 @@ Error ProcessDataSession::discover() {
     return Error::Ok;
 }
 
+namespace {
+
+// The process-data SMs from the SII SyncM category (41): start, control, and index of the first SM of
+// type 3 (outputs) and 4 (inputs); the PDOs of the TxPDO (50) / RxPDO (51) categories assigned to them
+// (sizes, for a slave without mailbox). false: no process-data SM.
+bool sii_layout(const std::vector<uint8_t>& s, ProcessDataLayout& layout, bool pdos) {
+    bool out = false, in = false;
+    uint32_t rx_bits = 0, tx_bits = 0;
+    if (pdos) {
+        layout.rx_pdos.clear();
+        layout.tx_pdos.clear();
+    }
+    for (int pass = 0; pass < 2; ++pass) {  // SMs first: the PDO categories refer to their indices
+        for (std::size_t w = sii::FirstCategory; 2 * w + 4 <= s.size();) {
+            const uint16_t type = get16(&s[2 * w]);
+            const uint16_t len = get16(&s[2 * w + 2]);
+            if (type == sii::CategoryEnd) break;
+            const std::size_t data = 2 * w + 4;
+            const std::size_t end = std::min<std::size_t>(data + 2u * len, s.size());
+            if (pass == 0 && type == 41) {
+                for (std::size_t k = 0; data + (k + 1) * 8 <= end; ++k) {
+                    const uint8_t* sm = &s[data + 8 * k];
+                    const uint8_t kind = sm[7];
+                    if (kind == 3 && !out) {
+                        layout.sm2_start = get16(sm);
+                        layout.sm2_control = sm[4];
+                        layout.out_sm = static_cast<uint8_t>(k);
+                        out = true;
+                    } else if (kind == 4 && !in) {
+                        layout.sm3_start = get16(sm);
+                        layout.sm3_control = sm[4];
+                        layout.in_sm = static_cast<uint8_t>(k);
+                        in = true;
+                    }
+                }
+            } else if (pass == 1 && pdos && (type == 50 || type == 51)) {
+                // ETG.1000.6 TxPDO/RxPDO category: per PDO 8 bytes (index, entries, SM, ...), then 8 per
+                // entry (..., bit length at byte 5).
+                for (std::size_t p = data; p + 8 <= end;) {
+                    const uint16_t index = get16(&s[p]);
+                    const uint8_t entries = s[p + 2];
+                    const uint8_t sm = s[p + 3];
+                    uint32_t bits = 0;
+                    std::size_t q = p + 8;
+                    for (uint8_t e = 0; e < entries && q + 8 <= end; ++e, q += 8)
+                        bits += s[q + 5];
+                    if (type == 51 && out && sm == layout.out_sm) {
+                        rx_bits += bits;
+                        layout.rx_pdos.push_back(index);
+                    } else if (type == 50 && in && sm == layout.in_sm) {
+                        tx_bits += bits;
+                        layout.tx_pdos.push_back(index);
+                    }
+                    p = q;
+                }
+            }
+            w += 2 + len;
+        }
+    }
+    if (pdos) {
+        layout.sm2_length = static_cast<uint16_t>((rx_bits + 7) / 8);
+        layout.sm3_length = static_cast<uint16_t>((tx_bits + 7) / 8);
+    }
+    return out || in;
+}
+
+}  // namespace
+
 Error ProcessDataSession::discover(Slave& slave) {
-    // SM2/SM3 start and control from the SII SyncM category (41).
+    // The process-data SMs from the SII, the PDOs from the assignment objects of those SMs (0x1C10 + n).
     ProcessDataLayout& layout = slave.layout;
     auto img = m_.sii_read_image(slave.address);
     if (!img) return img.error();
-    const auto& s = *img;
-    bool found = false;
-    for (std::size_t w = sii::FirstCategory; 2 * w + 4 <= s.size();) {
-        const uint16_t type = get16(&s[2 * w]);
-        const uint16_t len = get16(&s[2 * w + 2]);
-        if (type == sii::CategoryEnd) break;
-        const std::size_t data = 2 * w + 4;
-        if (type == 41 && data + 2u * len <= s.size()) {
-            for (std::size_t k = 0; (k + 1) * 8 <= 2u * len; ++k) {
-                const uint8_t* sm = &s[data + 8 * k];
-                const uint8_t kind = sm[7];
-                if (kind == 3) {
-                    layout.sm2_start = get16(sm);
-                    layout.sm2_control = sm[4];
-                    found = true;
-                } else if (kind == 4) {
-                    layout.sm3_start = get16(sm);
-                    layout.sm3_control = sm[4];
-                    found = true;
-                }
-            }
-        }
-        w += 2 + len;
+    if (!sii_layout(*img, layout, false)) return Error::SiiFormat;
+    if (Error e = pdo_bytes(*slave.sdo, static_cast<uint16_t>(0x1C10 + layout.out_sm), layout.rx_pdos,
+                            layout.sm2_length);
+        e != Error::Ok)
+        return e;
+    if (Error e = pdo_bytes(*slave.sdo, static_cast<uint16_t>(0x1C10 + layout.in_sm), layout.tx_pdos,
+                            layout.sm3_length);
+        e != Error::Ok)
+        return e;
+    return Error::Ok;
+}
+
+Error ProcessDataSession::discover_sii(std::size_t k) {
+    Slave& slave = slaves_.at(k);
+    auto img = m_.sii_read_image(slave.address);
+    if (!img) return img.error();
+    ProcessDataLayout layout;
+    if (!sii_layout(*img, layout, true)) {
+        // No process-data SM at all (a coupler): no process data.
+        layout.sm2_length = layout.sm3_length = 0;
     }
-    if (!found) return Error::SiiFormat;
-    if (Error e = pdo_bytes(*slave.sdo, 0x1C12, layout.rx_pdos, layout.sm2_length); e != Error::Ok) return e;
-    if (Error e = pdo_bytes(*slave.sdo, 0x1C13, layout.tx_pdos, layout.sm3_length); e != Error::Ok) return e;
+    slave.layout = layout;
     return Error::Ok;
 }
 
@@ -198,18 +262,27 @@ Error ProcessDataSession::configure(Slave& slave, const DcConfig& dc) {
     const ProcessDataLayout& layout = slave.layout;
     const Address a = slave.address;
     if (SdoClient* sdo = slave.sdo) {
-        // Sync mode first: the slave checks it against 0x0981 on PREOP -> SAFEOP.
+        // Sync mode first: the slave checks it against 0x0981 on PREOP -> SAFEOP. A slave without 0x1C32
+        // (an input terminal has only 0x1C33, a simple one neither: ETG.1020 makes them optional) runs in
+        // the mode its SMs and 0x0981 give.
+        const auto absent = [sdo](Error e) {
+            return e == Error::SdoAbort &&
+                   (sdo->last_abort() == 0x06020000 || sdo->last_abort() == 0x06090011);
+        };
         const uint8_t mode_out[2] = {static_cast<uint8_t>(dc.enable ? 2 : 1), 0};
-        if (Error e = sdo->download(0x1C32, 1, mode_out); e != Error::Ok) return e;
+        if (Error e = sdo->download(0x1C32, 1, mode_out); e != Error::Ok && !absent(e)) return e;
         const uint8_t mode_in[2] = {static_cast<uint8_t>(dc.enable ? 2 : (layout.sm2_length ? 0x22 : 1)), 0};
-        if (Error e = sdo->download(0x1C33, 1, mode_in); e != Error::Ok) {
+        if (Error e = sdo->download(0x1C33, 1, mode_in); e != Error::Ok && !absent(e)) {
             const uint8_t plain[2] = {static_cast<uint8_t>(dc.enable ? 2 : 1), 0};
             if (sdo->download(0x1C33, 1, plain) != Error::Ok) return e;
         }
         if (dc.enable) {
             uint8_t cyc[4];
             put32(cyc, dc.cycle_ns);
-            if (Error e = sdo->download(0x1C32, 2, cyc); e != Error::Ok) return e;
+            // A read-only cycle time (the ESI's access; the slave takes it from SYNC0) is not an error.
+            if (Error e = sdo->download(0x1C32, 2, cyc);
+                e != Error::Ok && !absent(e) && !(e == Error::SdoAbort && sdo->last_abort() == 0x06010002))
+                return e;
             (void)sdo->download(0x1C33, 2, cyc);  // some slaves derive it from 0x1C32 and refuse the write
         }
     }
@@ -217,7 +290,6 @@ Error ProcessDataSession::configure(Slave& slave, const DcConfig& dc) {
     // §8).
     uint8_t sm[16] = {};
     const uint8_t off[16] = {};
-    if (Error e = m_.write(a, static_cast<uint16_t>(reg::Sm0 + 16), off); e != Error::Ok) return e;
     put16(sm + 0, layout.sm2_start);
     put16(sm + 2, layout.sm2_length);
     sm[4] = layout.sm2_control;
@@ -226,7 +298,19 @@ Error ProcessDataSession::configure(Slave& slave, const DcConfig& dc) {
     put16(sm + 10, layout.sm3_length);
     sm[12] = layout.sm3_control;
     sm[14] = layout.sm3_length ? 1 : 0;
-    if (Error e = m_.write(a, static_cast<uint16_t>(reg::Sm0 + 16), sm); e != Error::Ok) return e;
+    if (layout.out_sm == 2 && layout.in_sm == 3) {
+        if (Error e = m_.write(a, static_cast<uint16_t>(reg::Sm0 + 16), off); e != Error::Ok) return e;
+        if (Error e = m_.write(a, static_cast<uint16_t>(reg::Sm0 + 16), sm); e != Error::Ok) return e;
+    } else {
+        // Process data in other SMs (SM0/SM1 of a device without mailbox): each SM on its own.
+        const std::pair<uint8_t, const uint8_t*> sms[2] = {{layout.out_sm, sm}, {layout.in_sm, sm + 8}};
+        for (const auto& [n, regs] : sms) {
+            if (n >= 16) continue;
+            const auto base = static_cast<uint16_t>(reg::Sm0 + 8 * n);
+            if (Error e = m_.write(a, base, std::span<const uint8_t>(off, 8)); e != Error::Ok) return e;
+            if (Error e = m_.write(a, base, std::span<const uint8_t>(regs, 8)); e != Error::Ok) return e;
+        }
+    }
     // FMMU0: outputs (write), FMMU1: inputs (read), at this slave's places in the image (ESC datasheet
     // section I §7).
     uint8_t fm[32] = {};

@@ -116,6 +116,10 @@ struct Parser {
             const auto [key, value] = key_value(w[i]);
             if (key == "config") {
                 d.config = resolve(value);
+            } else if (key == "esi") {
+                d.esi = resolve(value);
+            } else if (key == "device") {
+                d.device_spec = std::string(value);
             } else if (key == "at") {
                 std::tie(a.parent, a.port) = device_port(key, value);
                 a.given = true;
@@ -142,10 +146,15 @@ struct Parser {
                              "' (line " + std::to_string(o.line) + "); each device needs its own");
             } else {
                 fail("unknown key '" + std::string(key) +
-                     "' (device takes config, at, port, ports, serial, drift-ppm, offset-ns, cable-ns, "
-                     "state-dir)");
+                     "' (device takes config, esi, device, at, port, ports, serial, drift-ppm, offset-ns, "
+                     "cable-ns, state-dir)");
             }
         }
+        if (!d.device_spec.empty() && d.esi.empty()) fail("device=" + d.device_spec + ": without esi=FILE");
+        if (!d.esi.empty() && !d.config.empty())
+            fail(
+                "esi= and config= together: config= configures the built-in drive, esi= serves another "
+                "device");
         if (d.port >= d.ports)
             fail("port=" + std::to_string(d.port) + ": the device has only ports 0.." +
                  std::to_string(d.ports - 1));

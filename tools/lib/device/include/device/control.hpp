@@ -8,7 +8,15 @@
 //   limit-pos <inc>|none      positive limit switch, active at and above <inc>
 //   home <from> <to>|none     home switch, active on [from, to]
 //   stops <lo> <hi>|none      mechanical stops
-//   status                    AL state, statusword, actual position
+//   status                    AL state; a drive: statusword, actual position, error code; a device
+//                             without application: its mapped outputs and inputs, `0x7000:01 "Output"=1`
+//   get <entry>               the value of an entry
+//   set <entry> <value>       sets a process-data input (TxPDO-mappable entry); on a device without
+//                             application it is held there (device/io_model.hpp)
+//
+// <entry> is index:subindex (numbers, 0x for hex: 0x6000:1) or a name: the entry's, or
+// "<object name>/<entry name>", any case, looked up among the mapped entries first; a name that fits
+// several entries is an error listing them. Drive commands (input .. stops) need a device with drive.
 //
 // A sender with an address of its own (e.g. `socat - UNIX-SENDTO:PATH,bind=/tmp/me`) gets one reply per
 // line ("ok ..." or "error: ..."); `echo 'input 4 on' | nc -uU -w0 PATH` works without one. Lines follow

@@ -1,13 +1,20 @@
 #pragma once
-// The soft drive's firmware, composed: everything that runs behind the ESC's PDI of a MAXPOS.
+// A soft device's firmware, composed: everything that runs behind the ESC's PDI of a product (od::Product:
+// the built-in MAXPOS, or a device read from a vendor's ESI). For the MAXPOS (DeviceOptions::product null):
 //
-//   description  od::load_device_config (or the default), revision/0x100A from the active FoE image
-//   dictionary   od::make_drive_dictionary + PDO validators + parameter store (0x1010/0x1011, state dir)
+//   description  maxpos::load_config (or the default), revision/0x100A from the active FoE image
+//   dictionary   maxpos::dictionary (or the product's) + PDO validators + parameter store (0x1010/0x1011, state dir)
 //   SII          esi::build_sii of the same description and dictionary, loaded into the ESC
 //   ecat::Stack  over the ESC's PDI, esc.irq() as interrupt line, with this as its Application
 //   CoE          coe::CoeServer (SDO, SDO info, emergencies) + coe::DiagnosisHistory (0x10F3)
 //   FoE          foe::FoeServer over a two-slot foe::FirmwareStore in the state dir
 //   drive        drive::Drive on the dictionary, with this as its EventSink
+//
+// For a product, only the parts it needs: its own dictionary builder (with 0x1018 from its description),
+// its EEPROM image byte for byte when it has one (esi::build_sii otherwise), the CoE server only with CoE
+// declared, the FoE server and firmware store only with FoE declared, the parameter store only if
+// 0x1010/0x1011 exist, the drive only for od::Application::Cia402Drive. A product without application
+// gets the IO model (device/io_model.hpp) for its process data. Its warnings are said once at start.
 //
 // A Bootstrap -> Init restart rebuilds all of it from the then active firmware image, after the Stack's
 // poll() returned. The Device runs in the runtime's thread; nothing here is thread-safe.
@@ -16,14 +23,18 @@
 #include <filesystem>
 #include <iosfwd>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "coe/diagnosis.hpp"
 #include "coe/sdo_server.hpp"
 #include "device/eeprom_writes.hpp"
+#include "device/io_model.hpp"
 #include "drive/drive.hpp"
 #include "drive/event_sink.hpp"
 #include "ecat/application.hpp"
@@ -34,6 +45,7 @@
 #include "foe/store.hpp"
 #include "od/device.hpp"
 #include "od/dictionary.hpp"
+#include "od/product.hpp"
 #include "od/store.hpp"
 #include "slave/log.hpp"
 
@@ -61,7 +73,11 @@ struct DeviceFaults {
 };
 
 struct DeviceOptions {
-    std::filesystem::path config_file;  // device configuration (od::load_device_config); empty: defaults
+    // The product this device is (an ESI's device, ...); null: the built-in MAXPOS, from config_file.
+    std::shared_ptr<const od::Product> product;
+    // Say the product's warnings at start (a line of units of one product says them once, for its first).
+    bool announce_product = true;
+    std::filesystem::path config_file;  // MAXPOS configuration (maxpos::load_config); empty: defaults
     std::filesystem::path state_dir = "/var/lib/softecat";  // parameters.bin, firmware/
     EnvironmentOptions environment;
     bool load_sii = true;         // false: the ESC serves a user's image (--eeprom), leave it alone
@@ -126,8 +142,24 @@ class Device final : public ecat::Application, public drive::EventSink, public e
     bool quiet(uint64_t now_ns) const;
     uint64_t next_deadline_ns() const;
 
+    // Which parts this device has (see the header comment); the accessors below of a part it has not
+    // must not be called.
+    bool has_coe() const;
+    bool has_foe() const;
+    bool has_parameters() const;
+    bool has_drive() const;
+    // The process data of a device without application (null for a drive).
+    const IoModel* io_model() const;
+    // Sets the value of entry index:sub from its text (an integer, hex 0x.., a real number for REAL
+    // types, true/false); an input of a device without application is held at it (io_model.hpp). Returns
+    // "" or why not (no such entry, not a process-data input (TxPDO-mappable), bad value). Kept across
+    // restarts.
+    std::string set_value(uint16_t index, uint8_t sub, std::string_view text);
+    // The value of an entry as text ("" if there is no such entry).
+    std::string value_text(uint16_t index, uint8_t sub) const;
+
     // The machine at run time: a digital input pin 1..6 (not wired to a switch). Kept across restarts.
-    // Returns false for a pin outside 1..6.
+    // Returns false for a pin outside 1..6 or on a device without drive.
     bool set_input(int pin, bool level);
     // Replaces the switches / stops; kept across restarts.
     void set_environment(const EnvironmentOptions& environment);
@@ -192,6 +224,8 @@ class Device final : public ecat::Application, public drive::EventSink, public e
     DeviceOptions options_;
     std::unique_ptr<Parts> parts_;
     std::array<int8_t, 6> inputs_{-1, -1, -1, -1, -1, -1};  // user-set pin levels, -1: untouched
+    std::map<uint32_t, std::vector<uint8_t>> set_values_;   // set_value(): io_key -> raw value
+    std::set<uint32_t> held_;                               // keys of set_values_
     bool restart_pending_ = false;
     bool outputs_lost_pending_ = false;  // outputs ended in this poll(); reacted to when it returns
     uint64_t free_run_due_ns() const { return (last_cycle_ns_ / kFreeRunNs + 1) * kFreeRunNs; }

@@ -42,6 +42,9 @@ struct LineOptions {
     // Devices, wiring, timing (state_dir of every device resolved by the caller; config empty: base's).
     slave::Topology topology;
     DeviceOptions base;  // everything else of each device (environment, faults, commission)
+    // The product of each device, by topology index (a device from an ESI or an ENI slave); missing or null:
+    // base.product (the built-in drive unless base says otherwise).
+    std::vector<std::shared_ptr<const od::Product>> products;
     esc::EscConfig esc;  // base ESC configuration (RAM, faults); ports, drift and offset per device
     std::filesystem::path control_path;             // the --control socket; empty: none
     gid_t control_group = ControlSocket::kNoGroup;  // --control-group: who else may use it

@@ -26,6 +26,9 @@ struct ProcessDataLayout {
     uint16_t sm3_start = 0, sm3_length = 0;  // inputs (TxPDOs), bytes
     uint8_t sm3_control = 0x20;
     std::vector<uint16_t> rx_pdos, tx_pdos;  // assigned PDOs
+    // The SyncManagers of outputs and inputs (the SII's first SM of type 3 / 4): SM2/SM3 with a mailbox,
+    // SM0/SM1 on a device without one (ETG.2000 Sm elements).
+    uint8_t out_sm = 2, in_sm = 3;
 };
 
 struct DcConfig {
@@ -66,6 +69,9 @@ class ProcessDataSession {
 
     // Reads each slave's layout (SII + CoE). The slaves must be in PREOP.
     Error discover();
+    // Slave k's layout from its SII alone (SyncM category, and the PDOs of the TxPDO/RxPDO categories
+    // assigned to the process-data SMs): for a slave without mailbox.
+    Error discover_sii(std::size_t k);
     const ProcessDataLayout& layout(std::size_t k = 0) const { return slaves_[k].layout; }
     void set_layout(std::size_t k, const ProcessDataLayout& layout) { slaves_[k].layout = layout; }
     // For each slave: sync mode objects (0x1C32:01, 0x1C33:01): DC SYNC0 (2) with dc.enable, else

@@ -5,14 +5,17 @@
 // numbers decimal or 0x... with range checks):
 //
 //   timing processing-ns=320 forwarding-ns=280 cable-ns=10
-//   device NAME [config=FILE] [at=PARENT:PORT] [port=P] [ports=2|4] [serial=N] [drift-ppm=X] [offset-ns=N]
+//   device NAME [config=FILE | esi=FILE [device=SPEC]] [at=PARENT:PORT] [port=P] [ports=2|4] [serial=N]
+//   [drift-ppm=X] [offset-ns=N]
 //          [cable-ns=N] [state-dir=DIR]
 //   external DEVICE:PORT
 //
-// config= and state-dir= are relative to the topology file's folder. at= defaults to the previous device's
-// port 1 (a line); the first device is the root (its port 0 faces the master). port= is the device's own
-// port facing upstream (default 0). ports=4 makes a four-port (junction-capable) ESC. `external` names the
-// port that leads to --out-iface (default: port 1 of the last device).
+// esi= serves the device an ESI file describes instead of the built-in drive; device= picks one device of a
+// file with several (product code and revision "0x07d83052:0x00110000", or its Type name), as ecat-slave's
+// --esi/--device do. config=, esi= and state-dir= are relative to the topology file's folder. at= defaults to
+// the previous device's port 1 (a line); the first device is the root (its port 0 faces the master). port= is
+// the device's own port facing upstream (default 0). ports=4 makes a four-port (junction-capable) ESC.
+// `external` names the port that leads to --out-iface (default: port 1 of the last device).
 //
 // NAME: 1..64 characters of [A-Za-z0-9_.-], beginning with a letter or a digit, not a number, unique; it
 // names the device's state directory <state-dir>/NAME. state-dir= values are unique too. At most
@@ -43,11 +46,13 @@ class TopologyError : public std::runtime_error {
 
 struct TopologyDevice {
     std::string name;
-    std::string config;   // device configuration file (resolved), empty: the built-in drive
-    int parent = -1;      // index of the upstream device, -1: the root (faces the master)
-    int parent_port = 1;  // port of the parent this device is plugged into
-    int port = 0;         // this device's own port facing upstream
-    int ports = 2;        // 2: ports 0 and 1 (port descriptor 0x0F), 4: ports 0-3 (0xFF)
+    std::string config;       // device configuration file (resolved), empty: the built-in drive
+    std::string esi;          // ESI file of the device (resolved), empty: not from an ESI
+    std::string device_spec;  // device= of a file with several devices, empty: the only one
+    int parent = -1;          // index of the upstream device, -1: the root (faces the master)
+    int parent_port = 1;      // port of the parent this device is plugged into
+    int port = 0;             // this device's own port facing upstream
+    int ports = 2;            // 2: ports 0 and 1 (port descriptor 0x0F), 4: ports 0-3 (0xFF)
     std::optional<uint32_t> serial;
     double drift_ppm = 0.0;
     int64_t offset_ns = 0;

@@ -1,0 +1,320 @@
+// device::Device built from an od::Product made by hand (as the ESI reader makes them): a digital IO
+// terminal without mailbox (process data in SM0/SM1, reaches Op with process data only, the IO model's
+// mirror / counter / keep and `set`), and an analog terminal with CoE but no drive (SDO, no FoE, no drive;
+// every mailbox protocol it does not serve answered with the mailbox error "unsupported protocol").
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "device/control.hpp"
+#include "device/device.hpp"
+#include "esc/clock.hpp"
+#include "esc/esc.hpp"
+#include "master/coe.hpp"
+#include "master/mailbox.hpp"
+#include "master/master.hpp"
+#include "master/session.hpp"
+#include "od/product.hpp"
+#include "products.hpp"
+
+#include "support/master_bring_up.hpp"
+#include "support/temp_dir.hpp"
+#include "support/wire_link.hpp"
+
+using namespace master;
+using test_products::coe_terminal;
+using test_products::io_terminal;
+
+namespace {
+
+// One device "powered" on a manual clock; the master's frames go through its ESC, then the firmware.
+struct Unit {
+    esc::ManualClock clock;
+    std::ostringstream log;
+    std::unique_ptr<esc::Esc> esc;
+    std::unique_ptr<device::Device> dev;
+    std::filesystem::path dir;
+
+    explicit Unit(std::shared_ptr<const od::Product> product)
+        : dir(test_support::make_temp_dir("softecat-product-")) {
+        clock.set(1'000'000'000);
+        device::DeviceOptions o;
+        o.product = std::move(product);
+        o.state_dir = dir;
+        o.log = &log;
+        esc = std::make_unique<esc::Esc>(esc::EscConfig{}, clock);
+        dev = std::make_unique<device::Device>(*esc, o);
+        service();
+    }
+    ~Unit() {
+        dev.reset();
+        std::error_code ec;
+        std::filesystem::remove_all(dir, ec);
+    }
+    void service() {
+        esc->tick();
+        dev->poll(clock.now_ns());
+    }
+};
+
+struct UnitLink final : test_support::WireLink {
+    explicit UnitLink(Unit& u)
+        : WireLink([&u](std::vector<uint8_t>& f) {
+              u.clock.advance(20'000);
+              const bool back = u.esc->process_frame(f);
+              u.service();
+              return back;
+          }) {}
+};
+
+uint16_t u16(std::span<const uint8_t> b, std::size_t at) {
+    return static_cast<uint16_t>(b[at] | (b[at + 1] << 8));
+}
+
+// The one slave addressed and taken to Pre-Op, no mailbox configured.
+void preop_without_mailbox(Master& m, Address a) {
+    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m));
+    AlStatus st;
+    ASSERT_EQ(m.request_state(a, AlState::PreOp, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
+}
+
+}  // namespace
+
+TEST(ProductWithoutMailbox, HasOnlyTheProcessDataPartsAndSaysItsWarningsOnce) {
+    Unit u(io_terminal());
+    EXPECT_FALSE(u.dev->has_coe());
+    EXPECT_FALSE(u.dev->has_foe());
+    EXPECT_FALSE(u.dev->has_parameters());
+    EXPECT_FALSE(u.dev->has_drive());
+    ASSERT_NE(u.dev->io_model(), nullptr);
+    const std::string log = u.log.str();
+    const std::string w = "Element 'Info/VendorSpecific' is not emulated";
+    ASSERT_NE(log.find(w), std::string::npos) << log;
+    EXPECT_EQ(log.find(w), log.rfind(w));
+    // Drive commands have no machine to act on.
+    EXPECT_EQ(device::ControlSocket::apply(*u.dev, "input 1 on").rfind("error:", 0), 0u);
+}
+
+TEST(ProductWithoutMailbox, ReachesOpWithProcessDataOnlyAndItsInputsFollowTheDefaultModel) {
+    Unit u(io_terminal());
+    UnitLink link(u);
+    Master m(link, test_support::in_process_master_options());
+    const Address a = Address::station(0x1001);
+    ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
+    AlStatus st;
+
+    ProcessDataSession pd(m, std::span<const Address>(&a, 1));
+    ASSERT_EQ(pd.discover_sii(0), Error::Ok);
+    const ProcessDataLayout& l = pd.layout(0);
+    EXPECT_EQ(l.out_sm, 0);
+    EXPECT_EQ(l.in_sm, 1);
+    EXPECT_EQ(l.sm2_start, 0x0F00);
+    EXPECT_EQ(l.sm3_start, 0x1000);
+    ASSERT_EQ(l.sm2_length, 3);
+    ASSERT_EQ(l.sm3_length, 5);
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    auto fill = [&] {
+        auto o = pd.outputs();
+        o[0] = 0x34;
+        o[1] = 0x12;
+        o[2] = 0x01;  // Output = 1
+    };
+    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(100), &st, fill), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    {
+        const Error e = pd.request_state(AlState::Op, std::chrono::microseconds(100), &st, fill);
+        std::string regs;
+        for (uint16_t r :
+             {0x0130, 0x0134, 0x0220, 0x0440, 0x0800, 0x0802, 0x0804, 0x0806, 0x0808, 0x080A, 0x080C, 0x080E})
+            regs += " " + std::to_string(r) + "=" + std::to_string(m.read_reg<uint16_t>(a, r).value());
+        ASSERT_EQ(e, Error::Ok) << "AL code 0x" << std::hex << st.code << regs << " " << u.log.str();
+    }
+    EXPECT_EQ(u.dev->stack().state(), od::AlState::Op);
+    EXPECT_EQ(pd.expected_wkc(), 3);
+
+    ASSERT_EQ(pd.run(5, std::chrono::microseconds(100), fill), Error::Ok);
+    EXPECT_EQ(pd.last_wkc(), 3);
+    // The output taken, and shown by entry name with its value.
+    EXPECT_EQ(u.dev->dictionary().get<uint16_t>(0x7000, 1), 0x1234);
+    const std::string status = device::ControlSocket::apply(*u.dev, "status");
+    EXPECT_NE(status.find("ok state OP"), std::string::npos) << status;
+    EXPECT_NE(status.find("0x7000:01 \"Value\"=4660"), std::string::npos) << status;
+    EXPECT_NE(status.find("0x7000:02 \"Output\"=1"), std::string::npos) << status;
+    EXPECT_NE(status.find("0x6000:03 \"Status\"=4660"), std::string::npos) << status;
+    // Mirror, counter (wrapping at 8 bits), kept value.
+    auto in = pd.inputs();
+    EXPECT_EQ(u16(in, 0), 0x1234);
+    EXPECT_EQ(u16(in, 3), 0x1234);
+    const uint8_t c0 = in[2];
+    ASSERT_EQ(pd.cycle(), Error::Ok);
+    const uint8_t c1 = pd.inputs()[2];
+    EXPECT_EQ(static_cast<uint8_t>(c1 - c0), 1);
+    // Exactly one count per process-data cycle: 260 cycles past 250 wrap.
+    for (int i = 0; i < 10; ++i)
+        ASSERT_EQ(pd.cycle(), Error::Ok);
+    EXPECT_EQ(static_cast<uint8_t>(pd.inputs()[2] - c1), 10);
+
+    // Set at run time, by name and by index:subindex: held there, neither mirrored nor counted.
+    EXPECT_EQ(device::ControlSocket::apply(*u.dev, "set Status 0x55AA"), "ok 0x6000:03=21930");
+    EXPECT_EQ(device::ControlSocket::apply(*u.dev, "set 0x6000:2 7"), "ok 0x6000:02=7");
+    EXPECT_EQ(device::ControlSocket::apply(*u.dev, "set Inputs/Value 9"), "ok 0x6000:01=9");
+    for (int i = 0; i < 3; ++i)
+        ASSERT_EQ(pd.cycle(), Error::Ok);
+    in = pd.inputs();
+    EXPECT_EQ(u16(in, 0), 9);
+    EXPECT_EQ(in[2], 7);
+    EXPECT_EQ(u16(in, 3), 0x55AA);
+    EXPECT_EQ(device::ControlSocket::apply(*u.dev, "get Cycle Counter").rfind("error:", 0), 0u);  // 2 words
+    EXPECT_EQ(device::ControlSocket::apply(*u.dev, "get \"cycle counter\""),
+              "ok 0x6000:02 \"Cycle Counter\"=7");
+    // Ambiguous names, outputs, out-of-range values and unknown entries are refused.
+    EXPECT_NE(device::ControlSocket::apply(*u.dev, "set Value 1").find("names 2 entries"), std::string::npos);
+    EXPECT_EQ(device::ControlSocket::apply(*u.dev, "set Output 1").rfind("error:", 0), 0u);
+    EXPECT_EQ(device::ControlSocket::apply(*u.dev, "set Status 65536").rfind("error:", 0), 0u);
+    EXPECT_EQ(device::ControlSocket::apply(*u.dev, "set 0x6000:09 1").rfind("error:", 0), 0u);
+    EXPECT_EQ(u16(pd.inputs(), 3), 0x55AA);
+}
+
+TEST(ProductWithoutMailbox, InitToPreOpNeedsNoMailboxSmsAndStartsNone) {
+    Unit u(io_terminal());
+    UnitLink link(u);
+    Master m(link, test_support::in_process_master_options());
+    const Address a = Address::station(0x1001);
+    ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
+    AlStatus st;
+    // SM0/SM1 stay deactivated from the PDI until Safe-Op starts the process data in them.
+    EXPECT_NE(m.read_reg<uint8_t>(a, 0x0807).value() & 0x01, 0);
+    EXPECT_NE(m.read_reg<uint8_t>(a, 0x080F).value() & 0x01, 0);
+    // No Bootstrap without a mailbox.
+    ASSERT_NE(m.request_state(a, AlState::Init, &st), Error::Timeout);
+    EXPECT_NE(m.request_state(a, AlState::Boot, &st), Error::Ok);
+}
+
+TEST(ProductWithCoe, ServesSdoWithoutDriveAndFoe) {
+    Unit u(coe_terminal());
+    EXPECT_TRUE(u.dev->has_coe());
+    EXPECT_FALSE(u.dev->has_foe());
+    EXPECT_FALSE(u.dev->has_drive());
+    EXPECT_FALSE(u.dev->has_parameters());
+    UnitLink link(u);
+    Master m(link, test_support::in_process_master_options());
+    const Address a = Address::station(0x1001);
+    Mailbox mbx(m, a);
+    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(m, mbx, a));
+    SdoClient sdo(mbx);
+    uint8_t b[4] = {};
+    ASSERT_TRUE(sdo.upload(0x1018, 2, b).ok());
+    EXPECT_EQ(b[0] | (b[1] << 8), 0x5678);
+
+    ProcessDataSession pd(m, a, sdo);
+    ASSERT_EQ(pd.discover(), Error::Ok);
+    EXPECT_EQ(pd.layout().sm2_length, 3);
+    EXPECT_EQ(pd.layout().sm3_length, 5);
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    auto fill = [&] {
+        auto o = pd.outputs();
+        o[0] = 0x21;
+        o[1] = 0x43;
+    };
+    AlStatus st;
+    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(100), &st, fill), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(100), &st, fill), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(pd.run(3, std::chrono::microseconds(100), fill), Error::Ok);
+    EXPECT_EQ(u16(pd.inputs(), 0), 0x4321);
+}
+
+// Every mailbox protocol the device does not serve (here all but CoE, FoE among them since it is not
+// declared) is answered with the mailbox error reply "unsupported protocol" (ETG.1000.4, code 0x0002).
+TEST(ProductWithCoe, EveryProtocolItDoesNotServeGetsTheUnsupportedProtocolError) {
+    Unit u(coe_terminal());
+    UnitLink link(u);
+    Master m(link, test_support::in_process_master_options());
+    const Address a = Address::station(0x1001);
+    Mailbox mbx(m, a);
+    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(m, mbx, a));
+    for (const MailboxType type :
+         {MailboxType::AoE, MailboxType::EoE, MailboxType::FoE, MailboxType::SoE, MailboxType::VoE,
+          static_cast<MailboxType>(0x6), static_cast<MailboxType>(0xE)}) {
+        std::vector<uint8_t> body(40, 0);
+        ASSERT_EQ(mbx.send(type, body), Error::Ok);
+        MailboxMessage reply;
+        ASSERT_EQ(mbx.receive(reply), Error::Ok) << "type " << static_cast<int>(type);
+        EXPECT_EQ(reply.type, MailboxType::Error) << "type " << static_cast<int>(type);
+        ASSERT_GE(reply.payload.size(), 4u);
+        EXPECT_EQ(u16(reply.payload, 0), 0x0001);  // mailbox command: error
+        EXPECT_EQ(u16(reply.payload, 2), 0x0002) << "type " << static_cast<int>(type);
+    }
+    // CoE still served after them.
+    SdoClient sdo(mbx);
+    uint8_t b[4] = {};
+    EXPECT_TRUE(sdo.upload(0x1018, 1, b).ok());
+}
+
+// A device whose ESC does device emulation (ESC configuration bit 0 from SII word 0, as IO terminals without
+// a controller declare in their ConfigData): the ESC copies AL control into AL status, so any request is
+// taken as it comes (Init -> Op directly, no refusal, AL status code 0), and the stack follows it with its
+// process data.
+TEST(ProductWithDeviceEmulation, FollowsTheStateTheEscTookWithItsProcessData) {
+    auto p = std::make_shared<od::Product>(*io_terminal());
+    p->description.esc_config = 0x01;
+    Unit u(p);
+    UnitLink link(u);
+    Master m(link, test_support::in_process_master_options());
+    const Address a = Address::station(0x1001);
+    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m));
+    ProcessDataSession pd(m, std::span<const Address>(&a, 1));
+    ASSERT_EQ(pd.discover_sii(0), Error::Ok);
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    AlStatus st;
+    ASSERT_EQ(m.request_state(a, AlState::Op, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
+    EXPECT_EQ(st.code, 0);
+    EXPECT_EQ(u.dev->stack().state(), od::AlState::Op);
+    auto fill = [&] {
+        pd.outputs()[0] = 0x21;
+        pd.outputs()[1] = 0x43;
+    };
+    ASSERT_EQ(pd.run(5, std::chrono::microseconds(100), fill), Error::Ok);
+    EXPECT_EQ(u16(pd.inputs(), 0), 0x4321);
+    // An invalid request is not refused either: the ESC took it.
+    ASSERT_EQ(m.request_state(a, AlState::Init, &st), Error::Ok);
+    ASSERT_EQ(m.request_state(a, AlState::SafeOp, &st), Error::Ok);
+    EXPECT_EQ(st.code, 0);
+    EXPECT_EQ(u.dev->stack().state(), od::AlState::SafeOp);
+}
+
+// A product with its own EEPROM image (ESI Eeprom/Data) is served byte for byte, by make_sii and by the ESC
+// (read through the master's SII access); a unit of a line gets its serial number in words 0x0E/0x0F only.
+TEST(ProductWithEepromImage, IsServedByteForByte) {
+    auto p = std::make_shared<od::Product>(*io_terminal());
+    device::DeviceOptions probe;
+    probe.product = p;
+    std::vector<uint8_t> image = device::make_sii(probe);  // a valid image to start from
+    image[0x40 * 2 + 100] ^= 0x5A;                         // and made different from what would be built
+    p->eeprom = image;
+    device::DeviceOptions o;
+    o.product = p;
+    EXPECT_EQ(device::make_sii(o), image);
+    Unit u(p);
+    UnitLink link(u);
+    Master m(link, test_support::in_process_master_options());
+    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m));
+    auto served = m.sii_read_image(Address::station(0x1001));
+    ASSERT_TRUE(served.ok());
+    ASSERT_LE(served->size(), image.size());
+    EXPECT_TRUE(std::equal(served->begin(), served->end(), image.begin()));
+    o.serial_number = 7;
+    const std::vector<uint8_t> unit = device::make_sii(o);
+    ASSERT_EQ(unit.size(), image.size());
+    EXPECT_EQ(unit[0x1C], 7);
+    for (std::size_t i = 0; i < image.size(); ++i)
+        if (i < 0x1C || i > 0x1F) {
+            ASSERT_EQ(unit[i], image[i]) << "byte " << i;
+        }
+}

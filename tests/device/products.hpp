@@ -1,0 +1,168 @@
+#pragma once
+// Products made by hand through the od API, as the ESI reader makes them (tests/device): a digital IO
+// terminal without mailbox and an analog terminal with CoE but no drive.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "od/dictionary.hpp"
+#include "od/product.hpp"
+
+namespace test_products {
+
+inline od::Entry entry(uint8_t sub, std::string name, od::DataType type, uint16_t access,
+                       uint64_t value = 0) {
+    od::Entry e;
+    e.subindex = sub;
+    e.name = std::move(name);
+    e.type = type;
+    e.access = access;
+    e.default_value = value;
+    return e;
+}
+
+inline od::Object var(uint16_t index, std::string name, od::DataType type, uint64_t value) {
+    od::Object o;
+    o.index = index;
+    o.code = od::ObjectCode::Var;
+    o.name = name;
+    o.type = type;
+    o.entries.push_back(entry(0, std::move(name), type, od::access::RO, value));
+    return o;
+}
+
+inline od::Object record(uint16_t index, std::string name, std::vector<od::Entry> entries) {
+    od::Object o;
+    o.index = index;
+    o.code = od::ObjectCode::Record;
+    o.name = std::move(name);
+    o.type = od::DataType::Identity;
+    o.entries = std::move(entries);
+    return o;
+}
+
+inline od::Object array(uint16_t index, std::string name, od::DataType type,
+                        const std::vector<uint64_t>& values) {
+    od::Object o;
+    o.index = index;
+    o.code = od::ObjectCode::Array;
+    o.name = std::move(name);
+    o.type = type;
+    for (std::size_t i = 0; i < values.size(); ++i)
+        o.entries.push_back(entry(static_cast<uint8_t>(i + 1), "SubIndex " + std::to_string(i + 1), type,
+                                  od::access::RO, values[i]));
+    return o;
+}
+
+inline void add_identity(od::Dictionary& d, const od::DeviceDescription& desc) {
+    d.add(var(0x1000, "Device type", od::DataType::Unsigned32, 0x00001389));
+    const od::Identity& id = desc.identity;
+    d.add(record(0x1018, "Identity",
+                 {entry(1, "Vendor ID", od::DataType::Unsigned32, od::access::RO, id.vendor_id),
+                  entry(2, "Product code", od::DataType::Unsigned32, od::access::RO, id.product_code),
+                  entry(3, "Revision", od::DataType::Unsigned32, od::access::RO, id.revision),
+                  entry(4, "Serial number", od::DataType::Unsigned32, od::access::RO, id.serial_number)}));
+}
+
+constexpr uint16_t kRo = od::access::RO;
+constexpr uint16_t kTx = od::access::RO | od::access::TxPdo;
+constexpr uint16_t kRx = od::access::RO | od::access::WritePreOp | od::access::WriteSafeOp |
+                         od::access::WriteOp | od::access::RxPdo;
+
+// The PDOs of both products: RxPDO 0x1600 (0x7000:01 "Value" U16, 0x7000:02 "Output" BOOL, 7 bits
+// padding: 3 bytes), TxPDO 0x1A00 (0x6000:01 "Value" U16 mirrors the output of that name, 0x6000:02
+// "Cycle Counter" U8 counts, 0x6000:03 "Status" U16 keeps 0x1234: 5 bytes).
+inline void add_io(od::Dictionary& d, uint16_t out_assign, uint16_t in_assign) {
+    d.add(record(0x1600, "Outputs",
+                 {entry(1, "SubIndex 001", od::DataType::Unsigned32, kRo, 0x70000110),
+                  entry(2, "SubIndex 002", od::DataType::Unsigned32, kRo, 0x70000201),
+                  entry(3, "SubIndex 003", od::DataType::Unsigned32, kRo, 0x00000007)}));
+    d.add(record(0x1A00, "Inputs",
+                 {entry(1, "SubIndex 001", od::DataType::Unsigned32, kRo, 0x60000110),
+                  entry(2, "SubIndex 002", od::DataType::Unsigned32, kRo, 0x60000208),
+                  entry(3, "SubIndex 003", od::DataType::Unsigned32, kRo, 0x60000310)}));
+    d.add(array(out_assign, "RxPDO assign", od::DataType::Unsigned16, {0x1600}));
+    d.add(array(in_assign, "TxPDO assign", od::DataType::Unsigned16, {0x1A00}));
+    d.add(record(0x6000, "Inputs",
+                 {entry(1, "Value", od::DataType::Unsigned16, kTx, 0),
+                  entry(2, "Cycle Counter", od::DataType::Unsigned8, kTx, 250),
+                  entry(3, "Status", od::DataType::Unsigned16, kTx, 0x1234)}));
+    d.add(record(0x7000, "Outputs",
+                 {entry(1, "Value", od::DataType::Unsigned16, kRx, 0),
+                  entry(2, "Output", od::DataType::Boolean, kRx, 0)}));
+}
+
+inline od::SyncManagerDefault sm(od::SmKind kind, uint16_t start, uint16_t size, uint8_t control) {
+    od::SyncManagerDefault s;
+    s.kind = kind;
+    s.start = start;
+    s.default_size = size;
+    s.control = control;
+    return s;
+}
+
+inline od::Identity identity(uint32_t product) {
+    od::Identity id;
+    id.vendor_id = 0xE0000123;
+    id.product_code = product;
+    id.revision = 0x00010000;
+    id.vendor_name = "Example";
+    id.device_name = "IO terminal";
+    id.order_code = "EX1234";
+    id.group_type = "DigIO";
+    return id;
+}
+
+// A digital IO terminal without mailbox: outputs in SM0 (0x0F00, 0x44), inputs in SM1 (0x1000, 0x00).
+inline std::shared_ptr<const od::Product> io_terminal() {
+    auto p = std::make_shared<od::Product>();
+    p->source = "hand-built IO terminal";
+    od::DeviceDescription& d = p->description;
+    d.identity = identity(0x00001234);
+    d.standard_mailbox = {0, 0, 0, 0};
+    d.bootstrap_mailbox = {0, 0, 0, 0};
+    d.mailbox_protocols = 0;
+    d.coe_details = 0;
+    d.sync_managers = {sm(od::SmKind::Outputs, 0x0F00, 3, 0x44), sm(od::SmKind::Inputs, 0x1000, 5, 0x00)};
+    d.pdi_control = 0x04;  // digital IO
+    d.esc_config = 0;
+    p->make_dictionary = [](const od::DeviceDescription& desc) {
+        od::Dictionary dict;
+        add_identity(dict, desc);
+        add_io(dict, 0x1C10, 0x1C11);
+        return dict;
+    };
+    p->application = od::Application::None;
+    p->warnings = {"Element 'Info/VendorSpecific' is not emulated"};
+    return p;
+}
+
+// An analog terminal with CoE (SDO, SDO info) and no drive: standard mailbox, process data in SM2/SM3.
+inline std::shared_ptr<const od::Product> coe_terminal() {
+    auto p = std::make_shared<od::Product>();
+    p->source = "hand-built CoE terminal";
+    od::DeviceDescription& d = p->description;
+    d.identity = identity(0x00005678);
+    d.bootstrap_mailbox = {0, 0, 0, 0};
+    d.mailbox_protocols = od::mailbox_protocol::CoE;
+    d.coe_details = od::coe_details::Sdo | od::coe_details::SdoInfo;
+    d.sync_managers = {sm(od::SmKind::MBoxOut, 0x1000, 128, 0x26), sm(od::SmKind::MBoxIn, 0x1080, 128, 0x22),
+                       sm(od::SmKind::Outputs, 0x1100, 3, 0x64), sm(od::SmKind::Inputs, 0x1180, 5, 0x20)};
+    p->make_dictionary = [](const od::DeviceDescription& desc) {
+        od::Dictionary dict;
+        add_identity(dict, desc);
+        dict.add(array(0x1C00, "Sync manager type", od::DataType::Unsigned8, {1, 2, 3, 4}));
+        // SM output/input parameters (ETG.1000.6): sync mode writable in Pre-Op, free run / SM-synchronous.
+        constexpr uint16_t kRwPreOp = od::access::RO | od::access::WritePreOp;
+        for (const uint16_t index : {uint16_t{0x1C32}, uint16_t{0x1C33}})
+            dict.add(record(index, index == 0x1C32 ? "SM output parameter" : "SM input parameter",
+                            {entry(1, "Sync mode", od::DataType::Unsigned16, kRwPreOp, 1),
+                             entry(2, "Cycle time", od::DataType::Unsigned32, kRwPreOp, 0),
+                             entry(4, "Sync modes supported", od::DataType::Unsigned16, kRo, 0x0003)}));
+        add_io(dict, 0x1C12, 0x1C13);
+        return dict;
+    };
+    return p;
+}
+
+}  // namespace test_products

@@ -1,0 +1,827 @@
+// The ESI -> object model direction (esi/device): every example ESI of esi/examples loads as its file says,
+// round-trips through build_esi / read_esi_text / load_product to the same device, validates against the
+// schema, and gives an SII the SII reader parses to the same device; bad ESI input, as a class, gives one
+// clear message naming the file (and the line where the parser knows it), never a crash.
+#include <gtest/gtest.h>
+#include <libxml/parser.h>
+#include <libxml/xmlschemas.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "esi/device/product.hpp"
+#include "esi/esi.hpp"
+#include "esi/esi_reader.hpp"
+#include "esi/model.hpp"
+#include "esi/sii.hpp"
+
+#ifndef SOFTECAT_ESI_SCHEMA
+#error "SOFTECAT_ESI_SCHEMA must be defined"
+#endif
+#ifndef SOFTECAT_ESI_EXAMPLES
+#error "SOFTECAT_ESI_EXAMPLES must be defined"
+#endif
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<fs::path> xml_files(const fs::path& dir) {
+    std::vector<fs::path> out;
+    std::error_code ec;
+    for (const auto& e : fs::recursive_directory_iterator(dir, ec))
+        if (e.is_regular_file() && (e.path().extension() == ".xml" || e.path().extension() == ".XML"))
+            out.push_back(e.path());
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+std::vector<fs::path> examples() {
+    return xml_files(SOFTECAT_ESI_EXAMPLES);
+}
+
+std::string read_all(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
+
+// Schema errors of an XML text against esi/schema (empty: valid).
+std::vector<std::string> schema_errors(const std::string& xml) {
+    static std::vector<std::string> errors;
+    errors.clear();
+    // Parsed once for the whole run.
+    static std::unique_ptr<xmlSchemaParserCtxt, decltype(&xmlSchemaFreeParserCtxt)> pc(
+        xmlSchemaNewParserCtxt(SOFTECAT_ESI_SCHEMA), &xmlSchemaFreeParserCtxt);
+    static std::unique_ptr<xmlSchema, decltype(&xmlSchemaFree)> schema(xmlSchemaParse(pc.get()),
+                                                                       &xmlSchemaFree);
+    if (!schema) return {"cannot load the schema"};
+    std::unique_ptr<xmlSchemaValidCtxt, decltype(&xmlSchemaFreeValidCtxt)> vc(
+        xmlSchemaNewValidCtxt(schema.get()), &xmlSchemaFreeValidCtxt);
+    xmlSchemaSetValidStructuredErrors(
+        vc.get(),
+        [](void*, xmlError* e) {
+            errors.push_back("line " + std::to_string(e->line) + ": " + (e->message ? e->message : "?"));
+        },
+        nullptr);
+    std::unique_ptr<xmlDoc, decltype(&xmlFreeDoc)> doc(
+        xmlReadMemory(xml.data(), static_cast<int>(xml.size()), "generated.xml", nullptr, XML_PARSE_NONET),
+        &xmlFreeDoc);
+    if (!doc) return {"not well-formed"};
+    if (xmlSchemaValidateDoc(vc.get(), doc.get()) != 0 && errors.empty()) errors.push_back("invalid");
+    return errors;
+}
+
+std::string number_text(const od::Number& n) {
+    if (auto p = std::get_if<int64_t>(&n)) return "i" + std::to_string(*p);
+    if (auto p = std::get_if<uint64_t>(&n)) return "u" + std::to_string(*p);
+    if (auto p = std::get_if<double>(&n)) return "d" + std::to_string(*p);
+    return "-";
+}
+
+// Everything a master can see of a product, as text lines, so that two products compare line by line.
+std::vector<std::string> describe(const od::Product& p) {
+    std::vector<std::string> out;
+    const od::DeviceDescription& d = p.description;
+    const od::Dictionary dict = p.make_dictionary(d);
+    const esi::DeviceModel m = esi::derive_model(d, dict);
+    std::ostringstream s;
+    const od::Identity& id = d.identity;
+    s << std::hex << "identity " << id.vendor_id << " " << id.product_code << " " << id.revision << " "
+      << id.vendor_name << "|" << id.device_name << "|" << id.order_code << "|" << id.group_type << "|"
+      << id.hardware_version << "|" << id.software_version;
+    out.push_back(s.str());
+    auto add = [&out](auto&&... parts) {
+        std::ostringstream o;
+        ((o << parts << ' '), ...);
+        out.push_back(o.str());
+    };
+    add("mailbox", d.standard_mailbox.out_start, d.standard_mailbox.out_size, d.standard_mailbox.in_start,
+        d.standard_mailbox.in_size, "boot", d.bootstrap_mailbox.out_start, d.bootstrap_mailbox.out_size,
+        d.bootstrap_mailbox.in_start, d.bootstrap_mailbox.in_size);
+    add("protocols", d.mailbox_protocols, "coe", int{d.coe_details}, "timeouts", d.mailbox_request_timeout_ms,
+        d.mailbox_response_timeout_ms);
+    add("config", int{d.pdi_control}, int{d.esc_config}, d.pdi_config, d.sync_pulse_length, d.station_alias);
+    for (const esi::SmInfo& sm : m.sync_managers)
+        add("sm", int(sm.kind), sm.start, sm.size, int{sm.control}, sm.enable, sm.min_size, sm.max_size);
+    for (esi::FmmuUse f : m.fmmus)
+        add("fmmu", int(f));
+    for (const esi::PdoInfo& pdo : m.pdos) {
+        std::ostringstream o;
+        o << std::hex << "pdo " << pdo.index << " rx=" << pdo.rx << " sm=" << pdo.sm << " fixed=" << pdo.fixed
+          << " mandatory=" << pdo.mandatory << " '" << pdo.name << "' excl";
+        for (uint16_t x : pdo.exclude)
+            o << " " << x;
+        o << " entries";
+        for (const esi::PdoEntryInfo& e : pdo.entries)
+            o << " " << e.index << ":" << int{e.subindex} << "/" << int{e.bit_length};
+        out.push_back(o.str());
+    }
+    for (const esi::PdoSetInfo& set : m.pdo_sets) {
+        std::ostringstream o;
+        o << std::hex << "set '" << set.name << "' default=" << set.is_default << " rx";
+        for (uint16_t x : set.rx)
+            o << " " << x;
+        o << " tx";
+        for (uint16_t x : set.tx)
+            o << " " << x;
+        out.push_back(o.str());
+    }
+    for (const od::DcOpMode& mode : d.dc_modes)
+        add("dc", mode.name, mode.description, mode.assign_activate, mode.cycle_time_sync0,
+            mode.cycle_time_sync0_factor, mode.shift_time_sync0, mode.cycle_time_sync1,
+            mode.cycle_time_sync1_factor, mode.shift_time_sync1);
+    for (const esi::PdoInfo& pdo : m.pdos)
+        (void)pdo;
+    for (const od::Object& o : dict.objects()) {
+        std::ostringstream h;
+        h << std::hex << "object " << o.index << " code " << int(o.code) << " '" << o.name << "'";
+        out.push_back(h.str());
+        for (const od::Entry& e : o.entries) {
+            std::ostringstream x;
+            // The ESI names the elements of an array "SubIndex nnn" as configuration tools do (the writer
+            // keeps the MAXPOS's ESI as it is); a vendor's own element names do not survive the round trip.
+            const std::string name = o.code == od::ObjectCode::Array && e.subindex != 0 ? "" : e.name;
+            x << std::hex << "  " << o.index << ":" << int{e.subindex} << " '" << name << "' type "
+              << static_cast<unsigned>(e.type) << " bits " << std::dec << e.bit_length << " access "
+              << std::hex << e.access << " default " << number_text(e.default_value) << " '"
+              << e.default_string << "' min " << number_text(e.minimum) << " max " << number_text(e.maximum)
+              << " enum";
+            for (const od::NamedValue& v : e.enumeration)
+                x << " " << v.value << "=" << v.text;
+            out.push_back(x.str());
+        }
+    }
+    for (const od::Slot& slot : d.slots) {
+        std::ostringstream o;
+        o << std::hex << "slot '" << slot.name << "' " << slot.min_instances << "-" << slot.max_instances
+          << " default " << slot.default_module << " inc " << slot.pdo_increment << "/"
+          << slot.index_increment << " takes";
+        for (uint32_t x : slot.module_idents)
+            o << " " << x;
+        out.push_back(o.str());
+    }
+    for (const od::Module& mod : d.modules) {
+        std::ostringstream o;
+        o << std::hex << "module " << mod.ident << " " << mod.type << " '" << mod.name << "'";
+        for (const od::ModulePdo& mp : mod.pdos) {
+            o << " pdo " << mp.index << (mp.rx ? "r" : "t") << mp.sm << (mp.depend_on_slot ? "+" : "") << ":";
+            for (const od::ModulePdoEntry& e : mp.entries)
+                o << " " << e.index << (e.depend_on_slot ? "+" : "") << ":" << int{e.subindex} << "/"
+                  << int{e.bit_length} << "/" << e.data_type;
+        }
+        out.push_back(o.str());
+    }
+    add("application", int(p.application), "eeprom", p.eeprom.size());
+    return out;
+}
+
+void expect_same(const std::vector<std::string>& a, const std::vector<std::string>& b,
+                 const std::string& what) {
+    const std::size_t n = std::max(a.size(), b.size());
+    int shown = 0;
+    for (std::size_t i = 0; i < n && shown < 10; ++i) {
+        const std::string x = i < a.size() ? a[i] : "<none>";
+        const std::string y = i < b.size() ? b[i] : "<none>";
+        if (x != y) {
+            ADD_FAILURE() << what << " line " << i << ":\n  first:  " << x << "\n  second: " << y;
+            ++shown;
+        }
+    }
+}
+
+// The product's ESI, read and loaded again.
+od::Product round_trip(const od::Product& p, std::string* xml_out = nullptr) {
+    const od::Dictionary dict = p.make_dictionary(p.description);
+    const std::string xml = esi::build_esi(p.description, dict);
+    if (xml_out) *xml_out = xml;
+    return esi::load_product(esi::read_esi_text(xml, "round-trip.xml"), "");
+}
+
+// ---- Every device of every example ------------------------------------------------------------------
+
+TEST(EsiExamples, TheFolderHoldsTheExamples) {
+    // The examples this suite is about; a new one is picked up by the tests below without a change here.
+    EXPECT_GE(examples().size(), 7u);
+}
+
+TEST(EsiExamples, EveryExampleValidatesAgainstTheSchema) {
+    for (const fs::path& f : examples())
+        for (const std::string& e : schema_errors(read_all(f)))
+            ADD_FAILURE() << f << ": " << e;
+}
+
+TEST(EsiExamples, EveryDeviceLoadsAsItsFileSays) {
+    int devices = 0;
+    for (const fs::path& path : examples()) {
+        SCOPED_TRACE(path.string());
+        const esi::EsiFile file = esi::read_esi_file(path.string());
+        for (const esi::EsiDevice& d : file.devices) {
+            SCOPED_TRACE(d.type_name);
+            ++devices;
+            const od::Product p = esi::load_product(file, d);
+            const od::DeviceDescription& desc = p.description;
+            EXPECT_EQ(desc.identity.vendor_id, 0x00000A5Eu);
+            EXPECT_EQ(desc.identity.product_code, d.product_code);
+            EXPECT_EQ(desc.identity.revision, d.revision);
+            EXPECT_EQ(desc.identity.order_code, d.type_name);
+            EXPECT_EQ(desc.identity.device_name, d.name);
+            EXPECT_EQ(desc.identity.vendor_name, "Example Automation");
+            ASSERT_EQ(desc.sync_managers.size(), d.sms.size());
+            for (std::size_t n = 0; n < d.sms.size(); ++n) {
+                EXPECT_EQ(desc.sync_managers[n].start, d.sms[n].start);
+                EXPECT_EQ(desc.sync_managers[n].control, d.sms[n].control);
+                EXPECT_EQ(desc.sync_managers[n].enable, d.sms[n].enable);
+            }
+            EXPECT_EQ(desc.mailbox_protocols, d.has_mailbox ? d.mailbox_protocols() : 0);
+            const od::Dictionary dict = p.make_dictionary(desc);
+            const esi::DeviceModel m = esi::derive_model(desc, dict);
+            EXPECT_TRUE(m.warnings.empty()) << ::testing::PrintToString(m.warnings);
+            // Every PDO as declared: index, direction, entries, the SM that assigns it by default.
+            const std::size_t declared_pdos = d.rxpdos.size() + d.txpdos.size();
+            if (d.slots.empty()) {
+                EXPECT_EQ(m.pdos.size(), declared_pdos);
+            }
+            for (const auto* list : {&d.rxpdos, &d.txpdos})
+                for (const esi::EsiPdo& ep : *list) {
+                    const auto it = std::find_if(m.pdos.begin(), m.pdos.end(),
+                                                 [&](const esi::PdoInfo& x) { return x.index == ep.index; });
+                    ASSERT_NE(it, m.pdos.end()) << "PDO " << ep.index;
+                    EXPECT_EQ(it->rx, ep.rx);
+                    EXPECT_EQ(it->sm, ep.sm);
+                    EXPECT_EQ(it->fixed, ep.fixed || !d.coe.pdo_config);
+                    EXPECT_EQ(it->mandatory, ep.mandatory);
+                    EXPECT_EQ(it->exclude, ep.exclude);
+                    ASSERT_EQ(it->entries.size(), ep.entries.size());
+                    for (std::size_t k = 0; k < ep.entries.size(); ++k) {
+                        EXPECT_EQ(it->entries[k].index, ep.entries[k].index);
+                        EXPECT_EQ(it->entries[k].subindex, ep.entries[k].index ? ep.entries[k].subindex : 0);
+                        EXPECT_EQ(it->entries[k].bit_length, ep.entries[k].bit_len);
+                        if (ep.entries[k].index != 0) {
+                            EXPECT_NE(it->entries[k].entry, nullptr);
+                        }
+                    }
+                }
+            // Every declared object with its entries, names, types' sizes and defaults.
+            for (const auto& [index, eo] : d.objects) {
+                const od::Object* o = dict.find(index);
+                ASSERT_NE(o, nullptr) << "object " << index;
+                EXPECT_EQ(o->name, eo.name);
+                for (const esi::EsiEntry& ee : eo.entries) {
+                    const od::Entry* e = dict.find(index, ee.subindex);
+                    ASSERT_NE(e, nullptr) << index << ":" << int{ee.subindex};
+                    EXPECT_EQ(e->name, ee.name);
+                    if (!od::is_string(e->type) && ee.bit_size != 0 && index != 0x1C12 && index != 0x1C13) {
+                        EXPECT_EQ(e->bit_length, ee.bit_size) << index << ":" << int{ee.subindex};
+                    }
+                    if (!ee.default_data.empty() && !od::is_string(e->type) && ee.subindex != 0 &&
+                        !(index >= 0x1600 && index <= 0x1BFF) && index != 0x1018 &&
+                        !(index >= 0x1C10 && index <= 0x1C2F)) {
+                        const auto raw = dict.default_raw(index, ee.subindex);
+                        ASSERT_GE(ee.default_data.size(), raw.size());
+                        EXPECT_TRUE(std::equal(raw.begin(), raw.end(), ee.default_data.begin()))
+                            << index << ":" << int{ee.subindex};
+                    }
+                }
+            }
+            // 0x1018 follows the identity passed.
+            if (dict.find(0x1018, 2) != nullptr) {
+                od::DeviceDescription other = desc;
+                other.identity.serial_number = 0x12345678;
+                const od::Dictionary d2 = p.make_dictionary(other);
+                EXPECT_EQ(d2.get<uint32_t>(0x1018, 4), 0x12345678u);
+                EXPECT_EQ(d2.get<uint32_t>(0x1018, 2), d.product_code);
+            }
+            EXPECT_EQ(p.eeprom, d.eeprom_data);
+            for (const std::string& w : p.warnings)
+                std::printf("    warning: %s\n", w.c_str());
+        }
+    }
+    EXPECT_GE(devices, 9);
+}
+
+TEST(EsiExamples, EveryDeviceRoundTripsThroughItsGeneratedEsi) {
+    for (const fs::path& path : examples()) {
+        const esi::EsiFile file = esi::read_esi_file(path.string());
+        for (const esi::EsiDevice& d : file.devices) {
+            SCOPED_TRACE(path.string() + " " + d.type_name);
+            const od::Product p = esi::load_product(file, d);
+            std::string xml;
+            od::Product q = round_trip(p, &xml);
+            for (const std::string& e : schema_errors(xml))
+                ADD_FAILURE() << "generated ESI: " << e;
+            std::vector<std::string> a = describe(p), b = describe(q);
+            // The image (Eeprom/Data) is the device's, not part of the ESI softecat writes.
+            a.pop_back();
+            b.pop_back();
+            expect_same(a, b, "round trip");
+            // And a second time: a fixed point.
+            std::vector<std::string> c = describe(round_trip(q));
+            c.pop_back();
+            expect_same(b, c, "second round trip");
+        }
+    }
+}
+
+TEST(EsiExamples, EverySiiParsesToTheSameDevice) {
+    for (const fs::path& path : examples()) {
+        const esi::EsiFile file = esi::read_esi_file(path.string());
+        for (const esi::EsiDevice& d : file.devices) {
+            SCOPED_TRACE(path.string() + " " + d.type_name);
+            const od::Product p = esi::load_product(file, d);
+            const od::Dictionary dict = p.make_dictionary(p.description);
+            const std::vector<uint8_t> image =
+                p.eeprom.empty() ? esi::build_sii(p.description, dict) : p.eeprom;
+            const esi::SiiInfo sii = esi::parse_sii(image);
+            EXPECT_TRUE(sii.crc_ok);
+            EXPECT_TRUE(sii.problems.empty()) << ::testing::PrintToString(sii.problems);
+            EXPECT_EQ(sii.vendor_id, d.vendor_id);
+            EXPECT_EQ(sii.product_code, d.product_code);
+            EXPECT_EQ(sii.revision, d.revision);
+            ASSERT_EQ(sii.sync_managers.size(), d.sms.size());
+            const esi::DeviceModel m = esi::derive_model(p.description, dict);
+            for (std::size_t n = 0; n < d.sms.size(); ++n) {
+                EXPECT_EQ(sii.sync_managers[n].start, d.sms[n].start);
+                EXPECT_EQ(sii.sync_managers[n].control, d.sms[n].control);
+                EXPECT_EQ(sii.sync_managers[n].type, static_cast<uint8_t>(m.sync_managers[n].kind));
+                EXPECT_EQ(sii.sync_managers[n].length, m.sync_managers[n].size);
+            }
+            EXPECT_EQ(sii.rx_pdos.size() + sii.tx_pdos.size(), m.pdos.size());
+            for (const auto* list : {&sii.rx_pdos, &sii.tx_pdos})
+                for (const esi::SiiPdo& sp : *list) {
+                    const auto it = std::find_if(m.pdos.begin(), m.pdos.end(),
+                                                 [&](const esi::PdoInfo& x) { return x.index == sp.index; });
+                    ASSERT_NE(it, m.pdos.end());
+                    EXPECT_EQ(sp.sm == 0xFF ? -1 : int{sp.sm}, it->sm);
+                    ASSERT_EQ(sp.entries.size(), it->entries.size());
+                    for (std::size_t k = 0; k < sp.entries.size(); ++k) {
+                        EXPECT_EQ(sp.entries[k].index, it->entries[k].index);
+                        EXPECT_EQ(sp.entries[k].bit_length, it->entries[k].bit_length);
+                    }
+                }
+            EXPECT_EQ(sii.mailbox_protocols, p.description.mailbox_protocols);
+            if (p.description.mailbox_protocols == 0) {
+                EXPECT_EQ(sii.standard_mailbox.out_size, 0);
+                EXPECT_EQ(sii.standard_mailbox.in_size, 0);
+            }
+            EXPECT_EQ(sii.dc_modes.size(),
+                      p.eeprom.empty() ? p.description.dc_modes.size() : sii.dc_modes.size());
+        }
+    }
+}
+
+// ---- What particular examples exercise --------------------------------------------------------------
+
+fs::path example(const char* name) {
+    return fs::path(SOFTECAT_ESI_EXAMPLES) / name;
+}
+
+TEST(EsiExamples, TheCouplerHasNoMailboxNoSyncManagerAndNoDictionary) {
+    const od::Product p = esi::load_product(example("coupler.xml").string(), "");
+    EXPECT_TRUE(p.description.sync_managers.empty());
+    EXPECT_EQ(p.description.mailbox_protocols, 0);
+    EXPECT_EQ(p.description.esc_config, 0x01);  // device emulation
+    EXPECT_TRUE(p.make_dictionary(p.description).objects().empty());
+    EXPECT_EQ(p.application, od::Application::None);
+}
+
+TEST(EsiExamples, AFileOfSeveralDevicesNeedsASpec) {
+    const std::string f = example("digital-io.xml").string();
+    try {
+        (void)esi::load_product(f, "");
+        FAIL() << "no error";
+    } catch (const esi::InputError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find(f), std::string::npos) << m;
+        EXPECT_NE(m.find("EXD1008 0x03F03052:0x00100000"), std::string::npos) << m;
+        EXPECT_NE(m.find("EXD2008 0x07D03052:0x00100000"), std::string::npos) << m;
+    }
+    EXPECT_EQ(esi::load_product(f, "0x03f03052:0x00110000").description.identity.revision, 0x00110000u);
+    EXPECT_EQ(esi::load_product(f, "#x03F03052:#x00100000").description.identity.revision, 0x00100000u);
+    EXPECT_EQ(esi::load_product(f, "EXD2008").description.identity.product_code, 0x07D03052u);
+    EXPECT_EQ(esi::load_product(f, "0x07d03052").description.identity.order_code, "EXD2008");
+    for (const char* bad : {"EXD1008", "0x03f03052", "EXD9999", "0x1234:0x5", "0x07d03052:0x1"}) {
+        try {
+            (void)esi::load_product(f, bad);
+            ADD_FAILURE() << bad << ": no error";
+        } catch (const esi::InputError& e) {
+            const std::string m = e.what();
+            EXPECT_EQ(m.rfind(f + ": ", 0), 0u) << m;
+            EXPECT_NE(m.find("EXD1008 0x03F03052:0x00110000"), std::string::npos) << m;
+        }
+    }
+}
+
+TEST(EsiExamples, DigitalTerminalsServeTheirPdoEntriesWithoutCoe) {
+    const od::Product in = esi::load_product(example("digital-io.xml").string(), "0x03f03052:0x00110000");
+    const od::Dictionary d = in.make_dictionary(in.description);
+    for (uint16_t ch = 0; ch < 8; ++ch) {
+        const od::Entry* e = d.find(static_cast<uint16_t>(0x6000 + 0x10 * ch), 1);
+        ASSERT_NE(e, nullptr);
+        EXPECT_EQ(e->type, od::DataType::Boolean);
+        EXPECT_TRUE(e->tx_mappable());
+    }
+    const esi::DeviceModel m = esi::derive_model(in.description, d);
+    ASSERT_EQ(m.sync_managers.size(), 1u);
+    EXPECT_EQ(m.sync_managers[0].kind, od::SmKind::Inputs);
+    EXPECT_EQ(m.sync_managers[0].size, 1);  // 8 bits
+    EXPECT_EQ(in.description.mailbox_protocols, 0);
+    const od::Product out = esi::load_product(example("digital-io.xml").string(), "EXD2008");
+    const esi::DeviceModel mo = esi::derive_model(out.description, out.make_dictionary(out.description));
+    ASSERT_EQ(mo.sync_managers.size(), 1u);
+    EXPECT_EQ(mo.sync_managers[0].control, 0x44);
+    EXPECT_EQ(mo.sync_managers[0].start, 0x0F00);
+    EXPECT_EQ(mo.sync_managers[0].size, 1);
+}
+
+TEST(EsiExamples, TheAnalogTerminalsDictionaryHasItsTypes) {
+    const od::Product p = esi::load_product(example("analog-in.xml").string(), "");
+    const od::Dictionary d = p.make_dictionary(p.description);
+    const od::Entry* limit = d.find(0x6010, 3);
+    ASSERT_NE(limit, nullptr);
+    EXPECT_EQ(limit->type, od::DataType::Bit2);
+    EXPECT_EQ(limit->bit_length, 2);
+    const od::Entry* pres = d.find(0x8000, 2);
+    ASSERT_NE(pres, nullptr);
+    EXPECT_EQ(pres->type, od::DataType::Bit3);
+    ASSERT_EQ(pres->enumeration.size(), 3u);
+    EXPECT_EQ(pres->enumeration[2].text, "Absolute value with MSB as sign");
+    const od::Entry* filter = d.find(0x8030, 0x15);
+    ASSERT_NE(filter, nullptr);
+    EXPECT_EQ(filter->enumeration.size(), 5u);
+    EXPECT_TRUE(filter->writable(od::AlState::PreOp));
+    EXPECT_FALSE(filter->writable(od::AlState::SafeOp));  // WriteRestrictions PreOP
+    EXPECT_TRUE(filter->access & od::access::Backup);
+    const od::Entry* lim1 = d.find(0x8000, 0x13);
+    ASSERT_NE(lim1, nullptr);
+    EXPECT_EQ(number_text(lim1->minimum), "i-32768");
+    EXPECT_EQ(d.get<int32_t>(0x8000, 0x12), 65536);
+    EXPECT_EQ(d.find(0x6000, 8), nullptr);  // the gap in DT6000
+    EXPECT_EQ(d.find(0x1018)->type, od::DataType::Identity);
+    const esi::DeviceModel m = esi::derive_model(p.description, d);
+    EXPECT_EQ(m.sync_managers[3].size, 18);  // 4 x 4 bytes + the status PDO
+    ASSERT_EQ(p.description.dc_modes.size(), 3u);
+    EXPECT_EQ(p.description.dc_modes[2].assign_activate, 0x0700);
+    EXPECT_EQ(p.description.dc_modes[2].cycle_time_sync1_factor, 1);
+    EXPECT_EQ(p.description.dc_modes[2].shift_time_sync1, 250000);
+    EXPECT_EQ(p.description.mailbox_request_timeout_ms, 100u);
+    EXPECT_EQ(p.description.coe_details & od::coe_details::PdoConfig, 0);
+    const auto mandatory = std::find_if(p.description.pdo_rules.begin(), p.description.pdo_rules.end(),
+                                        [](const od::PdoRule& r) { return r.pdo == 0x1A08; });
+    ASSERT_NE(mandatory, p.description.pdo_rules.end());
+    EXPECT_TRUE(mandatory->mandatory);
+    // The SII carries SYNC1.
+    const esi::SiiInfo sii = esi::parse_sii(esi::build_sii(p.description, d));
+    ASSERT_EQ(sii.dc_modes.size(), 3u);
+    EXPECT_EQ(sii.dc_modes[2].sync1_cycle_factor, 1);
+    EXPECT_EQ(sii.dc_modes[2].sync1_shift_time, 250000);
+}
+
+TEST(EsiExamples, TheDriveIsACia402DriveWithItsOwnUnitsAndPdos) {
+    const od::Product p = esi::load_product(example("drive402.xml").string(), "EXS7200-0010");
+    EXPECT_EQ(p.application, od::Application::Cia402Drive);
+    const od::Dictionary d = p.make_dictionary(p.description);
+    EXPECT_EQ(d.get<uint32_t>(0x1000, 0), 0x00020192u);
+    EXPECT_EQ(d.get<uint32_t>(0x608F, 1), 1048576u);
+    EXPECT_EQ(d.get<uint32_t>(0x6502, 0), 0x3A5u);
+    EXPECT_EQ(d.get<int32_t>(0x607D, 1), -104857600);
+    EXPECT_EQ(d.get<int8_t>(0x6098, 0), 35);
+    EXPECT_EQ(d.find(0x6060, 0)->enumeration.size(), 7u);
+    EXPECT_EQ(d.get<uint16_t>(0x1C12, 1), 0x1600);
+    EXPECT_TRUE(d.find(0x1600, 1)->writable(od::AlState::PreOp));  // PdoConfig, not Fixed
+    EXPECT_EQ(d.get<uint32_t>(0x2000, 0), 3000u);
+    ASSERT_EQ(p.description.pdo_sets.size(), 3u);
+    EXPECT_EQ(p.description.pdo_sets[1].rx, std::vector<uint16_t>{0x1601});
+    EXPECT_EQ(p.description.standard_mailbox.in_start, 0x1400);
+    EXPECT_EQ(p.description.standard_mailbox.out_size, 256);
+    EXPECT_TRUE(p.description.mailbox_protocols & od::mailbox_protocol::FoE);
+    EXPECT_EQ(p.description.bootstrap_mailbox.out_size, 0x0200);
+    EXPECT_TRUE(p.warnings.empty()) << ::testing::PrintToString(p.warnings);
+}
+
+TEST(EsiExamples, TheModularDeviceServesTheDefaultModulesOfItsSlots) {
+    const od::Product p = esi::load_product(example("modular-io.xml").string(), "");
+    const od::Dictionary d = p.make_dictionary(p.description);
+    // Slot 1: DI8 at 0x1A00/0x6000, slot 2: DO8 at 0x1601/0x7010, slot 3: AI2 at 0x1A02/0x6020, slot 4 empty.
+    ASSERT_NE(d.find(0x6000, 8), nullptr);
+    ASSERT_NE(d.find(0x7010, 8), nullptr);
+    ASSERT_NE(d.find(0x6020, 2), nullptr);
+    EXPECT_EQ(d.find(0x6020, 2)->type, od::DataType::Integer16);
+    EXPECT_EQ(d.get<uint8_t>(0x1C12, 0), 1);
+    EXPECT_EQ(d.get<uint16_t>(0x1C12, 1), 0x1601);
+    EXPECT_EQ(d.get<uint8_t>(0x1C13, 0), 2);
+    EXPECT_EQ(d.get<uint16_t>(0x1C13, 1), 0x1A00);
+    EXPECT_EQ(d.get<uint16_t>(0x1C13, 2), 0x1A02);
+    EXPECT_EQ(d.get<uint32_t>(0x1A02, 1), 0x60200110u);
+    const esi::DeviceModel m = esi::derive_model(p.description, d);
+    EXPECT_EQ(m.sync_managers[2].size, 1);
+    EXPECT_EQ(m.sync_managers[3].size, 5);
+    // The slots and their modules are kept for the ESI written back.
+    ASSERT_EQ(p.description.slots.size(), 4u);
+    EXPECT_EQ(p.description.slots[0].default_module, 0x00001001u);
+    EXPECT_EQ(p.description.slots[3].default_module, 0u);
+    EXPECT_EQ(p.description.slots[1].index_increment, 0x10u);
+    EXPECT_EQ(p.description.modules.size(), 3u);
+    const esi::EsiFile back = esi::read_esi_text(esi::build_esi(p.description, d), "back.xml");
+    ASSERT_EQ(back.devices[0].slots.size(), 4u);
+    EXPECT_EQ(back.modules.size(), 3u);
+    EXPECT_TRUE(back.devices[0].txpdos.empty());  // the PDOs are the modules', not the device's
+    // EoE declared, not emulated: one warning naming the element.
+    EXPECT_EQ(std::count_if(p.warnings.begin(), p.warnings.end(),
+                            [](const std::string& w) { return w.find("Mailbox/EoE") != std::string::npos; }),
+              1);
+}
+
+TEST(EsiExamples, TheEepromImageIsServedByteForByte) {
+    const std::string f = example("eeprom-blob.xml").string();
+    const esi::EsiFile file = esi::read_esi_file(f);
+    const od::Product p = esi::load_product(file, "");
+    ASSERT_EQ(p.eeprom.size(), 512u);
+    EXPECT_EQ(p.eeprom, file.devices[0].eeprom_data);
+    const esi::SiiInfo sii = esi::parse_sii(p.eeprom);
+    EXPECT_TRUE(sii.crc_ok);
+    EXPECT_EQ(sii.product_code, 0x03EA3052u);
+    ASSERT_TRUE(sii.general);
+    EXPECT_EQ(sii.general->order, "EXD1002");
+    EXPECT_TRUE(p.warnings.empty()) << ::testing::PrintToString(p.warnings);
+}
+
+TEST(EsiExamples, Latin1AndByteOrderMarkAreRead) {
+    const od::Product p = esi::load_product(example("latin1.xml").string(), "");
+    EXPECT_EQ(p.description.identity.device_name, "EXD2004 4Ch. Dig. Output 24V, 0.5A");
+    const od::Dictionary d = p.make_dictionary(p.description);
+    EXPECT_EQ(d.find(0x1600)->name, "Kanal 1 (Ausg\xC3\xA4nge)");  // UTF-8 now
+    const esi::EsiFile f = esi::read_esi_file(example("latin1.xml").string());
+    EXPECT_EQ(f.devices[0].group_name, "Digital Output Terminals (EXD2xxx)");
+    const od::Product c = esi::load_product(example("coupler.xml").string(), "");
+    EXPECT_EQ(c.description.identity.order_code, "EXK1100");
+}
+
+TEST(EsiDevices, ACoeDeviceWithoutADictionaryGetsTheMandatoryObjects) {
+    const std::string xml =
+        "<?xml version=\"1.0\"?><EtherCATInfo><Vendor><Id>#x123</Id><Name>V</Name></Vendor><Descriptions>"
+        "<Devices><Device><Type ProductCode=\"#x77\" RevisionNo=\"#x2\">T77</Type><Name>T 77</Name>"
+        "<Profile><ProfileNo>5001</ProfileNo></Profile>"
+        "<Sm DefaultSize=\"128\" StartAddress=\"#x1000\" ControlByte=\"#x26\" Enable=\"1\">MBoxOut</Sm>"
+        "<Sm DefaultSize=\"128\" StartAddress=\"#x1080\" ControlByte=\"#x22\" Enable=\"1\">MBoxIn</Sm>"
+        "<Sm StartAddress=\"#x1100\" ControlByte=\"#x64\" Enable=\"1\">Outputs</Sm>"
+        "<Sm StartAddress=\"#x1180\" ControlByte=\"#x20\" Enable=\"1\">Inputs</Sm>"
+        "<RxPdo Fixed=\"1\" Sm=\"2\"><Index>#x1600</Index><Name>Out</Name><Entry><Index>#x7000</Index>"
+        "<SubIndex>1</SubIndex><BitLen>16</BitLen><Name>Value</Name><DataType>UINT</DataType></Entry></RxPdo>"
+        "<Mailbox><CoE SdoInfo=\"true\" PdoAssign=\"false\"/></Mailbox></Device></Devices></Descriptions>"
+        "</EtherCATInfo>";
+    const od::Product p = esi::load_product(esi::read_esi_text(xml, "t77.xml"), "");
+    od::DeviceDescription other = p.description;
+    other.identity.serial_number = 42;
+    const od::Dictionary d = p.make_dictionary(other);
+    EXPECT_EQ(d.get<uint32_t>(0x1000, 0), 5001u);
+    EXPECT_EQ(d.get<uint32_t>(0x1018, 1), 0x123u);
+    EXPECT_EQ(d.get<uint32_t>(0x1018, 2), 0x77u);
+    EXPECT_EQ(d.get<uint32_t>(0x1018, 4), 42u);
+    EXPECT_NE(d.find(0x1008, 0), nullptr);
+    EXPECT_EQ(d.get<uint8_t>(0x1C00, 3), 3);
+    EXPECT_EQ(d.get<uint16_t>(0x1C12, 1), 0x1600);
+    EXPECT_FALSE(d.find(0x1C12, 1)->writable(od::AlState::PreOp));  // no PdoAssign
+    EXPECT_TRUE(d.find(0x7000, 1)->rx_mappable());
+    EXPECT_TRUE(p.warnings.empty()) << ::testing::PrintToString(p.warnings);
+}
+
+// ---- Bad input, as a class ----------------------------------------------------------------------------
+
+struct TempDir {
+    fs::path dir;
+    TempDir() {
+        char t[] = "/tmp/esi_device_test.XXXXXX";
+        dir = mkdtemp(t);
+    }
+    ~TempDir() {
+        std::error_code ec;
+        fs::remove_all(dir, ec);
+    }
+    std::string write(const std::string& name, const std::string& text) const {
+        const fs::path p = dir / name;
+        std::ofstream(p, std::ios::binary) << text;
+        return p.string();
+    }
+};
+
+// The message of loading `path`: an InputError that names the file (and the line, if `line` > 0).
+void expect_input_error(const std::string& path, const std::string& spec, int line, const std::string& part) {
+    try {
+        (void)esi::load_product(path, spec);
+        ADD_FAILURE() << path << ": no error";
+    } catch (const esi::InputError& e) {
+        const std::string m = e.what();
+        EXPECT_EQ(m.rfind(path, 0), 0u) << m;
+        if (line > 0) {
+            EXPECT_EQ(e.line(), line) << m;
+        }
+        EXPECT_NE(m.find(part), std::string::npos) << m;
+        EXPECT_EQ(m.find('\0'), std::string::npos);
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << path << ": not an InputError: " << e.what();
+    }
+}
+
+std::string wrap(const std::string& device, const std::string& modules = "") {
+    return "<?xml version=\"1.0\"?>\n<EtherCATInfo>\n<Vendor><Id>#x00000A5E</Id><Name>V</Name></Vendor>\n"
+           "<Descriptions><Groups/><Devices>\n" +
+           device + "\n</Devices>" + modules + "</Descriptions>\n</EtherCATInfo>\n";
+}
+
+TEST(EsiBadInput, MalformedXmlNamesFileAndLine) {
+    TempDir t;
+    expect_input_error(
+        t.write("a.xml", "<?xml version=\"1.0\"?>\n<EtherCATInfo>\n<Vendor>\n</EtherCATInfo>\n"), "", 4,
+        "not well-formed");
+    expect_input_error(t.write("b.xml", "\x01\x02garbage"), "", 1, "not well-formed");
+    expect_input_error(t.write("c.xml", wrap("<Device><Type ProductCode=\"#x1\">X</Type><Name>n</Name>")), "",
+                       0, "not well-formed");
+}
+
+TEST(EsiBadInput, NotAnEtherCATInfo) {
+    TempDir t;
+    expect_input_error(
+        t.write("eni.xml", "<?xml version=\"1.0\"?>\n<EtherCATConfig><Config/></EtherCATConfig>\n"), "", 2,
+        "EtherCATConfig, not EtherCATInfo");
+    expect_input_error(t.write("x.html", "<html xmlns=\"http://www.w3.org/1999/xhtml\"><body/></html>"), "",
+                       1, "not EtherCATInfo");
+    expect_input_error(t.write("nodev.xml", wrap("")), "", 0, "no Device");
+}
+
+TEST(EsiBadInput, UnknownDataTypeOfAMappedObjectIsAnErrorWithItsLine) {
+    TempDir t;
+    const std::string dev =
+        "<Device><Type ProductCode=\"#x1\" RevisionNo=\"#x1\">X</Type><Name>n</Name>\n"
+        "<Profile><Dictionary><DataTypes/><Objects>\n"
+        "<Object><Index>#x6000</Index><Name>In</Name><Type>DTNOWHERE</Type><BitSize>16</BitSize></Object>\n"
+        "</Objects></Dictionary></Profile>\n"
+        "<Sm StartAddress=\"#x1000\" ControlByte=\"#x00\" Enable=\"1\">Inputs</Sm>\n"
+        "<TxPdo "
+        "Sm=\"0\"><Index>#x1a00</Index><Name>P</Name><Entry><Index>#x6000</Index><SubIndex>0</SubIndex>"
+        "<BitLen>16</BitLen><Name>In</Name><DataType>UINT</DataType></Entry></TxPdo></Device>";
+    expect_input_error(t.write("type.xml", wrap(dev)), "", 7, "'DTNOWHERE' is not defined in DataTypes");
+    // Not mapped: the device is still served, with a warning naming the object.
+    std::string unmapped = dev;
+    unmapped.replace(unmapped.find("<TxPdo"), unmapped.find("</TxPdo>") + 8 - unmapped.find("<TxPdo"), "");
+    const od::Product p = esi::load_product(t.write("type2.xml", wrap(unmapped)), "");
+    ASSERT_EQ(p.warnings.size(), 1u);
+    EXPECT_NE(p.warnings[0].find("type2.xml:7: object 0x6000:00"), std::string::npos) << p.warnings[0];
+}
+
+TEST(EsiBadInput, DanglingPdoEntry) {
+    TempDir t;
+    // A PDO entry naming a subindex of a VAR: an error with the entry's line.
+    const std::string dev =
+        "<Device><Type ProductCode=\"#x1\" RevisionNo=\"#x1\">X</Type><Name>n</Name>\n"
+        "<Profile><Dictionary><DataTypes><DataType><Name>UINT</Name><BitSize>16</BitSize></DataType></"
+        "DataTypes>"
+        "<Objects>\n"
+        "<Object><Index>#x6000</Index><Name>In</Name><Type>UINT</Type><BitSize>16</BitSize></Object>\n"
+        "</Objects></Dictionary></Profile>\n"
+        "<Sm StartAddress=\"#x1000\" ControlByte=\"#x00\" Enable=\"1\">Inputs</Sm>\n"
+        "<TxPdo "
+        "Sm=\"0\"><Index>#x1a00</Index><Name>P</Name>\n<Entry><Index>#x6000</Index><SubIndex>3</SubIndex>"
+        "<BitLen>16</BitLen><Name>In</Name><DataType>UINT</DataType></Entry></TxPdo></Device>";
+    expect_input_error(t.write("dangle.xml", wrap(dev)), "", 11, "is a VAR with subindex 0 only");
+    // A PDO entry naming an object the dictionary lacks: served (the object is added), with a warning.
+    std::string missing = dev;
+    missing.replace(missing.find("<Index>#x6000</Index><SubIndex>3"), 32, "<Index>#x6010</Index><SubIndex>1");
+    const od::Product p = esi::load_product(t.write("dangle2.xml", wrap(missing)), "");
+    ASSERT_EQ(p.warnings.size(), 1u);
+    EXPECT_NE(p.warnings[0].find("dangle2.xml:11: PDO 0x1A00 maps 0x6010:01"), std::string::npos)
+        << p.warnings[0];
+    EXPECT_NE(p.make_dictionary(p.description).find(0x6010, 1), nullptr);
+}
+
+TEST(EsiBadInput, HugeEmptyFifoDirectory) {
+    TempDir t;
+    const std::string huge = (t.dir / "huge.xml").string();
+    {
+        std::ofstream f(huge, std::ios::binary);
+        f << "<?xml version=\"1.0\"?><EtherCATInfo><!--";
+        const std::string chunk(1 << 20, 'x');
+        for (std::size_t i = 0; i <= esi::kMaxEsiBytes >> 20; ++i)
+            f << chunk;
+        f << "--></EtherCATInfo>";
+    }
+    expect_input_error(huge, "", 0, "larger than");
+    expect_input_error(t.write("empty.xml", ""), "", 0, "empty");
+    const std::string fifo = (t.dir / "fifo.xml").string();
+    ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+    expect_input_error(fifo, "", 0, "not a regular file");
+    expect_input_error(t.dir.string(), "", 0, "not a regular file");
+    expect_input_error((t.dir / "missing.xml").string(), "", 0, "cannot open");
+}
+
+TEST(EsiBadInput, EntitiesAreRefusedNotExpanded) {
+    TempDir t;
+    const std::string laughs =
+        "<?xml version=\"1.0\"?>\n<!DOCTYPE EtherCATInfo [\n<!ENTITY a \"aaaaaaaaaa\">\n"
+        "<!ENTITY b \"&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;\">\n<!ENTITY c \"&b;&b;&b;&b;&b;&b;&b;&b;&b;&b;\">\n"
+        "<!ENTITY d \"&c;&c;&c;&c;&c;&c;&c;&c;&c;&c;\">\n<!ENTITY e \"&d;&d;&d;&d;&d;&d;&d;&d;&d;&d;\">\n]>\n"
+        "<EtherCATInfo><Vendor><Id>1</Id><Name>&e;&e;&e;&e;&e;&e;&e;&e;</Name></Vendor></EtherCATInfo>\n";
+    expect_input_error(t.write("laughs.xml", laughs), "", 2, "DOCTYPE");
+    const std::string secret = t.write("secret.txt", "SECRET-CONTENT");
+    for (const std::string& uri : {"file://" + secret, std::string("http://127.0.0.1:9/esi.dtd")}) {
+        const std::string ext =
+            "<?xml version=\"1.0\"?>\n<!DOCTYPE EtherCATInfo [\n<!ENTITY x SYSTEM \"" + uri +
+            "\">\n]>\n<EtherCATInfo><Vendor><Id>1</Id><Name>&x;</Name></Vendor></EtherCATInfo>\n";
+        const std::string path = t.write("ext.xml", ext);
+        try {
+            (void)esi::load_product(path, "");
+            ADD_FAILURE() << "no error";
+        } catch (const esi::InputError& e) {
+            EXPECT_EQ(std::string(e.what()).find("SECRET"), std::string::npos);
+            EXPECT_NE(std::string(e.what()).find("DOCTYPE"), std::string::npos) << e.what();
+        }
+    }
+    const std::string dtd =
+        "<?xml version=\"1.0\"?>\n<!DOCTYPE EtherCATInfo SYSTEM \"http://127.0.0.1:9/x.dtd\">\n"
+        "<EtherCATInfo/>\n";
+    expect_input_error(t.write("dtd.xml", dtd), "", 0, "DOCTYPE");
+}
+
+TEST(EsiBadInput, TruncatedAndMutatedExamplesNeverCrash) {
+    // Every prefix-cut and byte-flipped variant of every example: an InputError or a product, nothing else.
+    for (const fs::path& path : examples()) {
+        const std::string text = read_all(path);
+        for (std::size_t cut = 0; cut < text.size(); cut += std::max<std::size_t>(1, text.size() / 40)) {
+            for (int variant = 0; variant < 2; ++variant) {
+                std::string s = text.substr(0, variant == 0 ? cut : text.size());
+                if (variant == 1 && cut < s.size()) s[cut] = static_cast<char>(s[cut] ^ 0x20);
+                try {
+                    const esi::EsiFile f = esi::read_esi_text(s, "mutated.xml");
+                    for (const esi::EsiDevice& d : f.devices) {
+                        const od::Product p = esi::load_product(f, d);
+                        (void)p.make_dictionary(p.description);
+                    }
+                } catch (const esi::InputError& e) {
+                    EXPECT_EQ(std::string(e.what()).rfind("mutated.xml", 0), 0u) << e.what();
+                }
+            }
+        }
+    }
+}
+
+// ---- Public vendor ESI files (outside the repository) ---------------------------------------------------
+// SOFTECAT_ESI_PUBLIC_DIR names a folder of ESI files (vendor files are copyrighted: never in the
+// repository). Every device must load or be refused with an InputError, and round-trip when it loads.
+TEST(EsiPublicFiles, EveryDeviceLoadsOrIsRefusedClearlyAndRoundTrips) {
+    const char* dir = std::getenv("SOFTECAT_ESI_PUBLIC_DIR");
+    if (dir == nullptr) GTEST_SKIP() << "SOFTECAT_ESI_PUBLIC_DIR not set";
+    int files = 0, read = 0, devices = 0, loaded = 0, refused = 0, round_trips = 0, not_valid = 0;
+    for (const fs::path& path : xml_files(dir)) {
+        ++files;
+        esi::EsiFile file;
+        try {
+            file = esi::read_esi_file(path.string());
+            ++read;
+        } catch (const esi::InputError& e) {
+            std::printf("  file refused: %s\n", e.what());
+            continue;
+        }
+        for (const esi::EsiDevice& d : file.devices) {
+            ++devices;
+            try {
+                const od::Product p = esi::load_product(file, d);
+                ++loaded;
+                std::string xml;
+                const od::Product q = round_trip(p, &xml);
+                const auto invalid = schema_errors(xml);
+                if (!invalid.empty()) {
+                    ++not_valid;
+                    ADD_FAILURE() << path.string() << " " << d.type_name
+                                  << ": generated ESI: " << invalid.front();
+                }
+                std::vector<std::string> a = describe(p), b = describe(q);
+                a.pop_back();
+                b.pop_back();
+                if (a == b) {
+                    ++round_trips;
+                } else {
+                    SCOPED_TRACE(path.string() + " " + d.type_name);
+                    expect_same(a, b, "round trip");
+                }
+            } catch (const esi::InputError& e) {
+                ++refused;
+                std::printf("  device refused: %s\n", e.what());
+            }
+        }
+    }
+    std::printf(
+        "public ESI files: %d files (%d read), %d devices: %d loaded, %d refused clearly, %d round-trip, "
+        "%d generated ESIs not schema-valid\n",
+        files, read, devices, loaded, refused, round_trips, not_valid);
+}
+
+}  // namespace
