@@ -3,7 +3,7 @@
 // the built-in MAXPOS, or a device read from a vendor's ESI). For the MAXPOS (DeviceOptions::product null):
 //
 //   description  maxpos::load_config (or the default), revision/0x100A from the active FoE image
-//   dictionary   maxpos::dictionary (or the product's) + PDO validators + parameter store (0x1010/0x1011, state dir)
+//   dictionary   the product's (maxpos::dictionary) + PDO validators + parameter store (0x1010/0x1011)
 //   SII          esi::build_sii of the same description and dictionary, loaded into the ESC
 //   ecat::Stack  over the ESC's PDI, esc.irq() as interrupt line, with this as its Application
 //   CoE          coe::CoeServer (SDO, SDO info, emergencies) + coe::DiagnosisHistory (0x10F3)
