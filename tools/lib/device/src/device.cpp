@@ -744,9 +744,10 @@ std::string Device::set_value(uint16_t index, uint8_t sub, std::string_view text
     if (e == nullptr) return "no entry " + where;
     if (!e->tx_mappable()) return where + " is not a process-data input (not TxPDO-mappable)";
     std::vector<uint8_t> raw;
-    if (!encode(*e, text, raw))
-        return "'" + std::string(text) + "' is no value of " + where + " (" +
-               std::string(od::to_string(e->type)) + ", " + std::to_string(e->bit_length) + " bits)";
+    if (!encode(*e, text, raw))  // printf, not "literal" + std::string&& (GCC 12 -O3 -Wrestrict, bug 105651)
+        return util::strprintf("'%.*s' is no value of %s (%.*s, %u bits)", static_cast<int>(text.size()),
+                               text.data(), where.c_str(), static_cast<int>(od::to_string(e->type).size()),
+                               od::to_string(e->type).data(), static_cast<unsigned>(e->bit_length));
     if (const od::Status st = d.set_raw(index, sub, raw); st != od::Status::Ok)
         return where + ": " + std::string(od::to_string(st));
     const uint32_t key = io_key(index, sub);
