@@ -385,6 +385,97 @@ fs::path example(const char* name) {
     return fs::path(SOFTECAT_ESI_EXAMPLES) / name;
 }
 
+// A master that lays out the process image from the SII and one that lays it out from the ESI must get the
+// same PDO order: the SII built for a device, the ESI it came from and the ESI written for it list the PDOs
+// of each direction alike, and the default-assigned ones in the order of the assignment objects 0x1C1n.
+TEST(EsiExamples, TheSiiTheSourceEsiAndTheWrittenEsiListThePdosInOneOrder) {
+    auto indices = [](const std::vector<esi::EsiPdo>& pdos) {
+        std::vector<uint16_t> out;
+        for (const esi::EsiPdo& p : pdos)
+            out.push_back(p.index);
+        return out;
+    };
+    auto sii_indices = [](const std::vector<esi::SiiPdo>& pdos) {
+        std::vector<uint16_t> out;
+        for (const esi::SiiPdo& p : pdos)
+            out.push_back(p.index);
+        return out;
+    };
+    // The entries of `a` that `b` has too, in a's order.
+    auto common = [](const std::vector<uint16_t>& a, const std::vector<uint16_t>& b) {
+        std::vector<uint16_t> out;
+        for (uint16_t x : a)
+            if (std::find(b.begin(), b.end(), x) != b.end()) out.push_back(x);
+        return out;
+    };
+    int compared = 0;
+    for (const fs::path& path : examples()) {
+        const esi::EsiFile file = esi::read_esi_file(path.string());
+        for (const esi::EsiDevice& d : file.devices) {
+            SCOPED_TRACE(path.string() + " " + d.type_name);
+            const od::Product p = esi::load_product(file, d);
+            if (!p.eeprom.empty()) continue;  // the vendor's own image: served as it is
+            const od::Dictionary dict = p.make_dictionary(p.description);
+            const esi::SiiInfo sii = esi::parse_sii(esi::build_sii(p.description, dict));
+            const esi::EsiFile written =
+                esi::read_esi_text(esi::build_esi(p.description, dict), "written.xml");
+            ASSERT_EQ(written.devices.size(), 1u);
+            for (const bool rx : {true, false}) {
+                const std::vector<uint16_t> in_sii = sii_indices(rx ? sii.rx_pdos : sii.tx_pdos);
+                const std::vector<uint16_t> in_source = indices(rx ? d.rxpdos : d.txpdos);
+                const std::vector<uint16_t> in_written =
+                    indices(rx ? written.devices[0].rxpdos : written.devices[0].txpdos);
+                EXPECT_EQ(common(in_sii, in_source), common(in_source, in_sii)) << (rx ? "RxPDOs" : "TxPDOs");
+                EXPECT_EQ(common(in_sii, in_written), common(in_written, in_sii))
+                    << (rx ? "RxPDOs" : "TxPDOs");
+                // The assigned ones in the order of 0x1C1n.
+                for (std::size_t n = 0; n < p.description.sync_managers.size(); ++n) {
+                    const od::Object* assign = dict.find(static_cast<uint16_t>(0x1C10 + n));
+                    if (assign == nullptr || assign->entries.empty()) continue;
+                    std::vector<uint16_t> assigned;
+                    const auto count =
+                        esi::number_bits(assign->entries[0].default_value, od::DataType::Unsigned8, 8);
+                    for (uint64_t k = 1; k <= count.value_or(0); ++k)
+                        if (const od::Entry* e = assign->entry(static_cast<uint8_t>(k)))
+                            assigned.push_back(static_cast<uint16_t>(
+                                esi::number_bits(e->default_value, e->type, e->bit_length).value_or(0)));
+                    const std::vector<uint16_t> mine = common(in_sii, assigned);
+                    if (!mine.empty()) {
+                        EXPECT_EQ(mine, common(assigned, mine)) << "0x1C1" << n;
+                    }
+                }
+                compared += !in_sii.empty();
+            }
+        }
+    }
+    EXPECT_GT(compared, 5);
+}
+
+TEST(EsiModel, AnAssignmentOutOfIndexOrderKeepsTheOtherPdosInTheirPlaces) {
+    // 0x1C13 assigns 0x1A02 before 0x1A00; 0x1A01 and 0x1A03 are not assigned. The assigned ones take the
+    // places they have by index, in assignment order: 0x1A02, 0x1A01, 0x1A00, 0x1A03.
+    const esi::EsiFile file = esi::read_esi_file(example("analog-in.xml").string());
+    const od::Product p = esi::load_product(file, file.devices[0]);
+    const od::Dictionary declared = p.make_dictionary(p.description);
+    od::Dictionary dict;
+    for (od::Object o : declared.objects()) {
+        if (o.index == 0x1C13) {
+            ASSERT_GE(o.entries.size(), 3u);
+            o.entries[0].default_value = uint64_t{2};
+            o.entries[1].default_value = uint64_t{0x1A02};
+            o.entries[2].default_value = uint64_t{0x1A00};
+        }
+        dict.add(std::move(o));
+    }
+    const esi::DeviceModel m = esi::derive_model(p.description, dict);
+    std::vector<uint16_t> tx;
+    for (std::size_t i : m.pdo_order)
+        if (!m.pdos[i].rx) tx.push_back(m.pdos[i].index);
+    ASSERT_GE(tx.size(), 4u);
+    EXPECT_EQ(std::vector<uint16_t>(tx.begin(), tx.begin() + 4),
+              (std::vector<uint16_t>{0x1A02, 0x1A01, 0x1A00, 0x1A03}));
+}
+
 TEST(EsiExamples, TheCouplerHasNoMailboxNoSyncManagerAndNoDictionary) {
     const od::Product p = esi::load_product(example("coupler.xml").string(), "");
     EXPECT_TRUE(p.description.sync_managers.empty());

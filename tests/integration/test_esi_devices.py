@@ -108,8 +108,6 @@ KNOWN = {
         "dc.sync_modes.1c32": "conform expects 0x1C32 for a SYNC0 op mode; the ESI (inputs only) has 0x1C33 only",
         "dc.sync_type.1c32": "conform expects 0x1C32 for a SYNC0 op mode; the ESI (inputs only) has 0x1C33 only",
         "dc.cycle_time.1c32": "conform expects 0x1C32 for a SYNC0 op mode; the ESI (inputs only) has 0x1C33 only",
-        "sii.esi.txpdo": "the SII lists the assigned PDOs first (esi, since main 2026-11-27), the ESI in document "
-                         "order; conform compares the order",
     },
     "modular-io.xml": {t: "conform compares with the device's own PDOs/objects, not the slots' default modules"
                        for t in ("sii.esi.syncm", "sii.esi.txpdo", "sii.esi.rxpdo", "sdoinfo.list.all",
