@@ -136,6 +136,9 @@ std::vector<uint8_t> make_sii(const DeviceOptions& options) {
 std::string make_esi(const DeviceOptions& options) {
     const od::DeviceDescription d = make_description(options);
     const od::Dictionary dict = make_dictionary(options, d);
+    // A device with its own EEPROM image (ESI Eeprom/Data) is described with that image.
+    if (options.product && !options.product->eeprom.empty())
+        return esi::build_esi(d, dict, options.product->eeprom);
     return esi::build_esi(d, dict);
 }
 
