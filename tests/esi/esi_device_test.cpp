@@ -648,6 +648,32 @@ TEST(EsiExamples, TheEepromImageIsServedByteForByte) {
     EXPECT_TRUE(p.warnings.empty()) << ::testing::PrintToString(p.warnings);
 }
 
+// A declared EEPROM smaller than even the most compact SII (128 bytes: the header alone): one warning that
+// names both sizes, and the next size that holds the full content is emulated; the SII parses with its
+// identity.
+TEST(EsiExamples, AnEepromTooSmallForAnySiiIsWarnedAndEmulatedLarger) {
+    std::string xml = read_all(example("latin1.xml"));
+    const std::string declared = "<ByteSize>2048</ByteSize>";
+    const std::size_t at = xml.find(declared);
+    ASSERT_NE(at, std::string::npos);
+    xml.replace(at, declared.size(), "<ByteSize>128</ByteSize>");
+    const esi::EsiFile file = esi::read_esi_text(xml, "small.xml");
+    const od::Product p = esi::load_product(file, file.devices[0]);
+    EXPECT_GT(p.description.eeprom_bytes, 128u);
+    EXPECT_EQ(std::count_if(p.warnings.begin(), p.warnings.end(),
+                            [](const std::string& w) {
+                                return w.find("ByteSize 128") != std::string::npos &&
+                                       w.find(" bytes are emulated") != std::string::npos;
+                            }),
+              1)
+        << ::testing::PrintToString(p.warnings);
+    const od::Dictionary dict = p.make_dictionary(p.description);
+    const esi::SiiInfo sii = esi::parse_sii(esi::build_sii(p.description, dict));
+    EXPECT_TRUE(sii.problems.empty());
+    EXPECT_EQ(sii.product_code, file.devices[0].product_code);
+    EXPECT_EQ(sii.eeprom_bytes(), p.description.eeprom_bytes);
+}
+
 TEST(EsiExamples, Latin1AndByteOrderMarkAreRead) {
     const od::Product p = esi::load_product(example("latin1.xml").string(), "");
     EXPECT_EQ(p.description.identity.device_name, "EXD2004 4Ch. Dig. Output 24V, 0.5A");

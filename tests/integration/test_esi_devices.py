@@ -93,11 +93,9 @@ NO_MAILBOX_EMULATION = {  # devices without mailbox whose ESC does device emulat
 KNOWN = {
     "coupler.xml": dict(NO_MAILBOX_EMULATION),
     "digital-io.xml": dict(NO_MAILBOX_EMULATION, **{
-        "sii.header.size_vs_esi": "esi_device: the SII needs 512 bytes, the ESI says ByteSize 128",
         "sii.esi.syncm": "conform expects size 0 where the ESI's Sm has no DefaultSize; the SII carries the PDO size",
     }),
     "latin1.xml": dict(NO_MAILBOX_EMULATION, **{
-        "sii.header.size_vs_esi": "esi_device: the SII needs 512 bytes, the ESI says ByteSize 128",
         "sii.esi.syncm": "conform expects size 0 where the ESI's Sm has no DefaultSize; the SII carries the PDO size",
     }),
     "eeprom-blob.xml": dict(NO_MAILBOX_EMULATION, **{
