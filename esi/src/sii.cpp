@@ -69,10 +69,13 @@ enum class Compaction {
 // The content (header and categories, up to the End marker) at one compaction level.
 std::vector<uint8_t> build_content(const od::DeviceDescription& d, const DeviceModel& m, Compaction level) {
     StringTable strings;
+    // String 1 is the order number (ESI Type), as vendors write it: a master that names a slave by the first
+    // string (SOEM's ecx_config_init: ecx_siistring(..., 1)) shows "EL2008", not its group "DigOut"; one
+    // that follows the General category's indices finds order, name and group there.
     const std::string order = d.identity.order_code.empty() ? d.identity.device_name : d.identity.order_code;
-    const uint8_t group_idx = strings.add(d.identity.group_type);
     const uint8_t order_idx = strings.add(order);
     const uint8_t name_idx = strings.add(d.identity.device_name);
+    const uint8_t group_idx = strings.add(d.identity.group_type);
 
     // ---- General ----
     std::vector<uint8_t> general(32, 0);

@@ -651,6 +651,32 @@ TEST(EsiExamples, TheEepromImageIsServedByteForByte) {
 // A declared EEPROM smaller than even the most compact SII (128 bytes: the header alone): one warning that
 // names both sizes, and the next size that holds the full content is emulated; the SII parses with its
 // identity.
+// A master that names a slave by the SII's first string (SOEM: ecx_siistring(..., 1)) shows the device's
+// order number (ESI Type), as for a vendor's terminal, not its group; the General category's indices name the
+// order number, the device name and the group.
+TEST(EsiExamples, TheSiiNamesTheDeviceByItsFirstStringAndTheGeneralCategory) {
+    int checked = 0;
+    for (const fs::path& path : examples()) {
+        const esi::EsiFile file = esi::read_esi_file(path.string());
+        for (const esi::EsiDevice& d : file.devices) {
+            SCOPED_TRACE(path.string() + " " + d.type_name);
+            const od::Product p = esi::load_product(file, d);
+            if (!p.eeprom.empty()) continue;  // the vendor's own image: served as it is
+            const od::Dictionary dict = p.make_dictionary(p.description);
+            const esi::SiiInfo sii = esi::parse_sii(esi::build_sii(p.description, dict));
+            ASSERT_FALSE(sii.strings.empty());
+            EXPECT_EQ(sii.strings[0], d.type_name);
+            ASSERT_TRUE(sii.general);
+            EXPECT_EQ(sii.general->order_idx, 1);
+            EXPECT_EQ(sii.general->order, d.type_name);
+            EXPECT_EQ(sii.general->name, d.name);
+            EXPECT_EQ(sii.general->group, d.group_type);
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, 5);
+}
+
 TEST(EsiExamples, AnEepromTooSmallForAnySiiIsWarnedAndEmulatedLarger) {
     std::string xml = read_all(example("latin1.xml"));
     const std::string declared = "<ByteSize>2048</ByteSize>";
