@@ -387,6 +387,22 @@ fs::path example(const char* name) {
     return fs::path(SOFTECAT_ESI_EXAMPLES) / name;
 }
 
+// Calls fn(device, product, dictionary, parsed SII) for every device of every example whose SII softecat
+// builds (not the ones served from their own Eeprom/Data image).
+template <typename Fn>
+void for_each_built_sii(Fn fn) {
+    for (const fs::path& path : examples()) {
+        const esi::EsiFile file = esi::read_esi_file(path.string());
+        for (const esi::EsiDevice& d : file.devices) {
+            SCOPED_TRACE(path.string() + " " + d.type_name);
+            const od::Product p = esi::load_product(file, d);
+            if (!p.eeprom.empty()) continue;  // the vendor's own image: served as it is
+            const od::Dictionary dict = p.make_dictionary(p.description);
+            fn(d, p, dict, esi::parse_sii(esi::build_sii(p.description, dict)));
+        }
+    }
+}
+
 // A master that lays out the process image from the SII and one that lays it out from the ESI must get the
 // same PDO order: the SII built for a device, the ESI it came from and the ESI written for it list the PDOs
 // of each direction alike, and the default-assigned ones in the order of the assignment objects 0x1C1n.
@@ -411,14 +427,9 @@ TEST(EsiExamples, TheSiiTheSourceEsiAndTheWrittenEsiListThePdosInOneOrder) {
         return out;
     };
     int compared = 0;
-    for (const fs::path& path : examples()) {
-        const esi::EsiFile file = esi::read_esi_file(path.string());
-        for (const esi::EsiDevice& d : file.devices) {
-            SCOPED_TRACE(path.string() + " " + d.type_name);
-            const od::Product p = esi::load_product(file, d);
-            if (!p.eeprom.empty()) continue;  // the vendor's own image: served as it is
-            const od::Dictionary dict = p.make_dictionary(p.description);
-            const esi::SiiInfo sii = esi::parse_sii(esi::build_sii(p.description, dict));
+    for_each_built_sii([&](const esi::EsiDevice& d, const od::Product& p, const od::Dictionary& dict,
+                           const esi::SiiInfo& sii) {
+        {
             const esi::EsiFile written =
                 esi::read_esi_text(esi::build_esi(p.description, dict), "written.xml");
             ASSERT_EQ(written.devices.size(), 1u);
@@ -449,7 +460,7 @@ TEST(EsiExamples, TheSiiTheSourceEsiAndTheWrittenEsiListThePdosInOneOrder) {
                 compared += !in_sii.empty();
             }
         }
-    }
+    });
     EXPECT_GT(compared, 5);
 }
 
@@ -656,24 +667,19 @@ TEST(EsiExamples, TheEepromImageIsServedByteForByte) {
 // order number, the device name and the group.
 TEST(EsiExamples, TheSiiNamesTheDeviceByItsFirstStringAndTheGeneralCategory) {
     int checked = 0;
-    for (const fs::path& path : examples()) {
-        const esi::EsiFile file = esi::read_esi_file(path.string());
-        for (const esi::EsiDevice& d : file.devices) {
-            SCOPED_TRACE(path.string() + " " + d.type_name);
-            const od::Product p = esi::load_product(file, d);
-            if (!p.eeprom.empty()) continue;  // the vendor's own image: served as it is
-            const od::Dictionary dict = p.make_dictionary(p.description);
-            const esi::SiiInfo sii = esi::parse_sii(esi::build_sii(p.description, dict));
-            ASSERT_FALSE(sii.strings.empty());
-            EXPECT_EQ(sii.strings[0], d.type_name);
-            ASSERT_TRUE(sii.general);
-            EXPECT_EQ(sii.general->order_idx, 1);
-            EXPECT_EQ(sii.general->order, d.type_name);
-            EXPECT_EQ(sii.general->name, d.name);
-            EXPECT_EQ(sii.general->group, d.group_type);
-            ++checked;
-        }
-    }
+    for_each_built_sii(
+        [&](const esi::EsiDevice& d, const od::Product&, const od::Dictionary&, const esi::SiiInfo& sii) {
+            {
+                ASSERT_FALSE(sii.strings.empty());
+                EXPECT_EQ(sii.strings[0], d.type_name);
+                ASSERT_TRUE(sii.general);
+                EXPECT_EQ(sii.general->order_idx, 1);
+                EXPECT_EQ(sii.general->order, d.type_name);
+                EXPECT_EQ(sii.general->name, d.name);
+                EXPECT_EQ(sii.general->group, d.group_type);
+                ++checked;
+            }
+        });
     EXPECT_GT(checked, 5);
 }
 
