@@ -144,6 +144,9 @@ std::vector<uint8_t> make_sii(const DeviceOptions& options) {
 std::string make_esi(const DeviceOptions& options) {
     const od::DeviceDescription d = make_description(options);
     const od::Dictionary dict = make_dictionary(options, d);
+    // A device with its own EEPROM image (ESI Eeprom/Data) is described with that image.
+    if (options.product && !options.product->eeprom.empty())
+        return esi::build_esi(d, dict, options.product->eeprom);
     return esi::build_esi(d, dict);
 }
 
@@ -549,7 +552,10 @@ uint16_t Device::check_transition(od::AlState /*from*/, od::AlState /*to*/) {
 
 void Device::on_state_change(od::AlState from, od::AlState to) {
     // Leaving Op by any path ends the outputs, whether or not on_outputs_lost() came first.
-    if (from == od::AlState::Op && to != od::AlState::Op) outputs_lost_pending_ = true;
+    if (from == od::AlState::Op && to != od::AlState::Op) {
+        outputs_lost_pending_ = true;
+        if (parts_->io) parts_->io->safe_outputs();  // before a plan that ends here is cleared
+    }
     if (parts_->io) {
         // The mapping is fixed from Safe-Op on: the plan of the IO model is built once, here.
         const bool pd_from = from == od::AlState::SafeOp || from == od::AlState::Op;
@@ -578,7 +584,10 @@ void Device::on_outputs_lost() {
 
 void Device::react_to_outputs_lost() {
     outputs_lost_pending_ = false;
-    if (!parts_->drive) return;
+    if (!parts_->drive) {
+        if (parts_->io) parts_->io->safe_outputs();  // also a watchdog that leaves the device in Op
+        return;
+    }
     // A fall-back (watchdog, sync loss: the stack set the error indication) is a communication failure:
     // 0x8180 with the 0x6007 reaction in any drive state. A master that asks to leave Op is not an error; it
     // gets the reaction only while its outputs were commanding motion (operation enabled, statusword bit 2).
