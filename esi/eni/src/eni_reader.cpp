@@ -393,8 +393,10 @@ class Reader {
         CyclicCmd c;
         c.line = line_of(n);
         std::string state;
-        for (Node st : children(n, "State"))
-            state += (state.empty() ? "" : " ") + text(st);
+        for (Node st : children(n, "State")) {
+            if (!state.empty()) state += ' ';
+            state += text(st);
+        }
         c.state = state;
         datagram(n, c.cmd, c.adp, c.ado, c.addr, c.cnt, c.comment);
         c.data_length = req<uint16_t>(n, "DataLength");
