@@ -30,7 +30,7 @@
 // through CoE; a slave whose outputs map 0x6040/0x607A and inputs 0x6041/0x6064 is a drive and is driven in
 // CSP like the N-drive line, the outputs of the other slaves get a counting byte. Per line it prints the same
 // figures as for N drives, plus the drives enabled in CSP, faulted or not in OP at the end (a line that does
-// not reach OP is reported and the next one runs). --mixed runs coupler:1 and coupler:1,io:60 (whose
+// not reach OP is reported and the next one runs). --mixed runs coupler:1,io:3 and coupler:1,io:60 (whose
 // difference is the cost of one IO terminal per cycle), then coupler:1,io:60,drive:40 and
 // coupler:1,io:60,maxpos:40.
 #include <poll.h>
@@ -622,8 +622,8 @@ int main(int argc, char** argv) {
         } else if (a == "--line") {
             lines.push_back(next());
         } else if (a == "--mixed") {
-            for (const char* l :
-                 {"coupler:1", "coupler:1,io:60", "coupler:1,io:60,drive:40", "coupler:1,io:60,maxpos:40"})
+            for (const char* l : {"coupler:1,io:3", "coupler:1,io:60", "coupler:1,io:60,drive:40",
+                                  "coupler:1,io:60,maxpos:40"})
                 lines.emplace_back(l);
         } else if (a == "--esi-dir") {
             esi_dir = next();
@@ -689,20 +689,25 @@ int main(int argc, char** argv) {
                 f.allocs_per_cycle, static_cast<unsigned long long>(f.enabled), f.drives);
         for (const std::string& l : failed)
             std::printf("not measured: %s\n", l.c_str());
-        // The cost of a device without drive: two lines of the run that differ only in such devices (the
-        // first line that is a prefix of another, of devices without drive).
-        for (const Figures& a : all)
-            for (const Figures& b : all)
-                if (a.drives == 0 && b.drives == 0 && b.devices > a.devices &&
-                    b.label.compare(0, a.label.size(), a.label) == 0) {
-                    const double n = static_cast<double>(b.devices - a.devices);
-                    std::printf(
-                        "per device without drive (%s against %s): slave CPU %.3f us per cycle, frame "
-                        "through "
-                        "segment %.3f us (median), allocations per cycle %.3f (whole line)\n",
-                        b.label.c_str(), a.label.c_str(), (b.cpu_us_per_cycle - a.cpu_us_per_cycle) / n,
-                        (b.walk.median - a.walk.median) / 1000.0 / n, b.allocs_per_cycle);
-                }
+        // The cost of a device without drive: the smallest and the largest line of devices without drive
+        // (a line without process data at all does not run: configure() has no LRW to make).
+        const Figures* small = nullptr;
+        const Figures* large = nullptr;
+        for (const Figures& f : all)
+            if (f.drives == 0) {
+                if (small == nullptr || f.devices < small->devices) small = &f;
+                if (large == nullptr || f.devices > large->devices) large = &f;
+            }
+        if (small != nullptr && large->devices > small->devices) {
+            const double n = static_cast<double>(large->devices - small->devices);
+            std::printf(
+                "per device without drive (%s against %s): slave CPU %.3f us per cycle, frame through "
+                "segment "
+                "%.3f us (median), allocations per cycle %.3f (whole line)\n",
+                large->label.c_str(), small->label.c_str(),
+                (large->cpu_us_per_cycle - small->cpu_us_per_cycle) / n,
+                (large->walk.median - small->walk.median) / 1000.0 / n, large->allocs_per_cycle);
+        }
         return 0;
     }
     std::printf("\n%-7s %-22s %-10s %-8s %-22s %-8s\n", "drives", "segment med/p99 us", "cpu %core", "missed",
