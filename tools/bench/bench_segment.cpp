@@ -304,7 +304,10 @@ Figures run_segment(const Plan& plan, double seconds, const std::string& backend
             if (Error e = mbx.configure_from_sii(); e != Error::Ok) return e;
         return m.request_state(a, master::AlState::PreOp);
     });
-    if (opened != Error::Ok) fail("mailbox / PREOP of slave " + std::to_string(clients.failed() + 1), opened);
+    if (opened != Error::Ok)
+        fail("mailbox / PREOP of " + std::string(plan.label.empty() ? "drive " : "slave ") +
+                 std::to_string(clients.failed() + 1),
+             opened);
     std::vector<master::SdoClient*> sdos(clients.clients().begin(), clients.clients().end());
     for (std::size_t k = 0; k < devices; ++k)
         if (!mailbox[k]) sdos[k] = nullptr;
@@ -495,7 +498,9 @@ void usage() {
 
 // A line of the examples from SPEC ("coupler:1,io:60,drive:40"); throws std::runtime_error (a bad SPEC or an
 // ESI that cannot be served).
-Plan make_plan(const std::string& spec, const std::string& esi_dir) {
+// loaded: the products made so far (file/device -> product), shared by the lines of a run.
+using Loaded = std::vector<std::pair<std::string, std::shared_ptr<const od::Product>>>;
+Plan make_plan(const std::string& spec, const std::string& esi_dir, Loaded& loaded) {
     struct Kind {
         const char* name;
         std::vector<std::pair<const char*, const char*>> devices;  // file, device spec; cycled through
@@ -511,7 +516,6 @@ Plan make_plan(const std::string& spec, const std::string& esi_dir) {
     };
     Plan plan;
     plan.label = spec;
-    std::vector<std::pair<std::string, std::shared_ptr<const od::Product>>> loaded;  // one per file+device
     for (std::size_t pos = 0; pos < spec.size();) {
         const std::size_t comma = std::min(spec.find(',', pos), spec.size());
         const std::string item = spec.substr(pos, comma - pos);
@@ -640,8 +644,9 @@ int main(int argc, char** argv) {
             plans.push_back(Plan{{}, std::vector<std::shared_ptr<const od::Product>>(n), {}});
     } else {
         try {
+            Loaded loaded;
             for (const std::string& l : lines)
-                plans.push_back(make_plan(l, esi_dir));
+                plans.push_back(make_plan(l, esi_dir, loaded));
         } catch (const std::exception& e) {
             std::fprintf(stderr, "bench-segment: %s\n", e.what());
             return 2;
@@ -698,15 +703,22 @@ int main(int argc, char** argv) {
                 if (small == nullptr || f.devices < small->devices) small = &f;
                 if (large == nullptr || f.devices > large->devices) large = &f;
             }
+        // The frames' walk per cycle (median per frame times frames per cycle), line a less line b, in us.
+        auto walk_us = [](const Figures& a, const Figures& b) {
+            return (a.walk.median * static_cast<double>(a.frames_per_cycle) -
+                    b.walk.median * static_cast<double>(b.frames_per_cycle)) /
+                   1000.0;
+        };
         if (small != nullptr && large->devices > small->devices) {
             const double n = static_cast<double>(large->devices - small->devices);
+            const double cpu = large->cpu_us_per_cycle - small->cpu_us_per_cycle;
+            const double walk = walk_us(*large, *small);
             std::printf(
-                "per device without drive (%s against %s): slave CPU %.3f us per cycle, frame through "
-                "segment "
-                "%.3f us (median), allocations per cycle %.3f (whole line)\n",
-                large->label.c_str(), small->label.c_str(),
-                (large->cpu_us_per_cycle - small->cpu_us_per_cycle) / n,
-                (large->walk.median - small->walk.median) / 1000.0 / n, large->allocs_per_cycle);
+                "per device without drive (%s against %s): slave CPU %.3f us per cycle, of which the frame "
+                "walk %.3f us (median) and outside the walk %.3f us; allocations per cycle %.3f (whole "
+                "line)\n",
+                large->label.c_str(), small->label.c_str(), cpu / n, walk / n, (cpu - walk) / n,
+                large->allocs_per_cycle);
         }
         return 0;
     }
