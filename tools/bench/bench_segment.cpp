@@ -370,8 +370,10 @@ Figures run_segment(const Plan& plan, double seconds, const std::string& backend
             if (io[k].mode >= 0) o[static_cast<std::size_t>(io[k].mode)] = 8;
             util::put32(o.data() + io[k].target, static_cast<uint32_t>(target[k]));
         }
-        for (std::size_t k : other_slaves)
-            std::fill(pd.outputs(k).begin(), pd.outputs(k).end(), static_cast<uint8_t>(i >> 4));
+        for (std::size_t k : other_slaves) {
+            const auto o = pd.outputs(k);
+            std::fill(o.begin(), o.end(), static_cast<uint8_t>(i >> 4));
+        }
     };
     auto hold = [&] {  // target = actual position
         for (std::size_t k : drive_slaves)
