@@ -115,14 +115,7 @@ KNOWN = {
                        for t in ("sii.esi.syncm", "sii.esi.txpdo", "sii.esi.rxpdo", "sdoinfo.list.all",
                                  "sdoinfo.list.rxpdo", "sdoinfo.list.txpdo", "pd.assign.rx_vs_esi",
                                  "pd.assign.tx_vs_esi", "pd.sm2.size_vs_esi", "pd.sm3.size_vs_esi")},
-    "drive402.xml": dict({t: "the drive core faults on this vendor dictionary (statusword 0x0308): engineer maxpos"
-                     for t in ("cia402.dc.enable_operation",
-                               "cia402.dc.disable_operation", "cia402.dc.switched_on_shutdown",
-                               "cia402.dc.disable_voltage", "cia402.dc.enabled_shutdown",
-                               "cia402.dc.enabled_disable_voltage", "cia402.dc.switched_on_disable_voltage",
-                               "cia402.dc.quick_stop", "cia402.statusword.bits",
-                               "cia402.statusword.target_reached_halt")},
-                         **{"dc.cycle_time.1c32": "conform writes 0x1C32:02; the ESI declares it ro"}),
+    "drive402.xml": {"dc.cycle_time.1c32": "conform writes 0x1C32:02; the ESI declares it ro"},
 }
 
 
