@@ -185,6 +185,7 @@ struct Figures {
     std::string label;                                   // the plan's
     std::size_t devices = 0, no_mailbox = 0, in_op = 0;  // mixed line: slaves, without mailbox, in OP at end
     uint64_t faulted = 0;                                // drives with statusword bit 3 (fault) at the end
+    double followed_min = 0, followed_max = 0;  // mixed line: position actual's advance over the ramp's, 0..1
     bench::Summary walk, latency, rtt, echo, echo_thread;
     double cpu_percent = 0, cpu_us_per_cycle = 0, allocs_per_cycle = 0;
     double wakeups_per_cycle = 0, timer_arms_per_cycle = 0, frames_per_wakeup = 0, replies_per_batch = 0;
@@ -404,6 +405,11 @@ Figures run_segment(const Plan& plan, double seconds, const std::string& backend
     rtt.reserve(cycles);
     echo_rtt.reserve(cycles);
     uint64_t cpu = 0, echo_missed = 0;
+    std::vector<int32_t> pos0(devices, 0), target0(devices, 0);
+    for (std::size_t k : drive_slaves) {
+        pos0[k] = static_cast<int32_t>(util::get32(pd.inputs(k).data() + io[k].pos));
+        target0[k] = target[k];
+    }
     const slave::RuntimeStats rs0 = snapshot();
     const alloc_counter::Scope allocs;
     walk_log.on.store(true);
@@ -434,6 +440,13 @@ Figures run_segment(const Plan& plan, double seconds, const std::string& backend
         const uint16_t sw = util::get16(pd.inputs(k).data() + io[k].sw);
         if ((sw & 0x006F) == 0x0027) ++f.enabled;
         if (sw & 0x0008) ++f.faulted;
+        // How far the actual position followed the ramp (the drive lags its target by a cycle or two).
+        const double ramp = static_cast<double>(target[k] - target0[k]);
+        const double moved =
+            static_cast<double>(static_cast<int32_t>(util::get32(pd.inputs(k).data() + io[k].pos)) - pos0[k]);
+        const double followed = ramp > 0 ? moved / ramp : 0.0;
+        f.followed_min = k == drive_slaves.front() ? followed : std::min(f.followed_min, followed);
+        f.followed_max = k == drive_slaves.front() ? followed : std::max(f.followed_max, followed);
     }
     if (!plan.label.empty()) {
         std::vector<master::AlStatus> states(devices);
@@ -558,11 +571,13 @@ void print_figures(const Figures& f) {
     if (mixed)
         std::printf(
             "\nline %s: %zu devices (%zu without mailbox, %zu drives), %zu frame%s per cycle, %llu cycles\n"
-            "  drives enabled in CSP %llu of %zu, faulted %llu; slaves in OP at the end %zu of %zu\n",
+            "  drives enabled in CSP %llu of %zu, faulted %llu, position actual followed the ramp "
+            "%.3f..%.3f; "
+            "slaves in OP at the end %zu of %zu\n",
             f.label.c_str(), f.devices, f.no_mailbox, f.drives, f.frames_per_cycle,
             f.frames_per_cycle == 1 ? "" : "s", static_cast<unsigned long long>(f.cycles),
             static_cast<unsigned long long>(f.enabled), f.drives, static_cast<unsigned long long>(f.faulted),
-            f.in_op, f.devices);
+            f.followed_min, f.followed_max, f.in_op, f.devices);
     else
         std::printf("\n%zu drive%s (%zu frame%s per cycle), %llu cycles, %llu enabled in CSP\n", f.drives,
                     f.drives == 1 ? "" : "s", f.frames_per_cycle, f.frames_per_cycle == 1 ? "" : "s",
