@@ -127,6 +127,27 @@ std::chrono::milliseconds Context::ms(int base) const {
 
 namespace {
 
+// A module PDO assigned by default to its SM n joins the assignment object 0x1C10 + n (ETG.1000.6 PDO
+// assignment): one more in subindex 0, its index in the next subindex, as the defaults of the device.
+void assign_by_default(EsiDevice& d, const EsiPdo& p) {
+    auto o = d.objects.find(static_cast<uint16_t>(0x1C10 + p.sm));
+    if (o == d.objects.end()) return;
+    auto entry = [&](uint8_t sub) -> EsiEntry* {
+        for (EsiEntry& e : o->second.entries)
+            if (e.subindex == sub) return &e;
+        return nullptr;
+    };
+    EsiEntry* count = entry(0);
+    if (count == nullptr) return;
+    const uint8_t n = static_cast<uint8_t>((count->default_data.empty() ? 0 : count->default_data[0]) + 1);
+    count->default_data = {n};
+    count->default_value = n;
+    if (EsiEntry* e = entry(n)) {
+        e->default_data = {static_cast<uint8_t>(p.index & 0xFF), static_cast<uint8_t>(p.index >> 8)};
+        e->default_value = p.index;
+    }
+}
+
 // A modular device as its ESI configures it by default (ETG.2000 Slots/Slot, Modules/Module): the device's
 // own PDOs and objects, then those of the default module of each slot in slot order, the indices of what
 // DependOnSlot moved by the slot number times SlotPdoIncrement (PDOs) or SlotIndexIncrement (objects and the
@@ -148,6 +169,7 @@ EsiDevice as_configured(const EsiFile& f, EsiDevice d, std::set<uint16_t>& mappi
                     if (e.depend_on_slot && e.index != 0)
                         e.index = static_cast<uint16_t>(e.index + n * idx_inc);
                 if (!d.objects.count(p.index) && !m->objects.count(p.index)) mapping_objects.insert(p.index);
+                if (p.sm >= 0) assign_by_default(d, p);
                 (p.rx ? d.rxpdos : d.txpdos).push_back(std::move(p));
             }
         for (const auto& [index, o] : m->objects) {

@@ -11,6 +11,8 @@ namespace {
 using master::Error;
 constexpr const char* kEsm = "ETG.1000.6 EtherCAT state machine (state transitions)";
 constexpr const char* kCodes = "ETG.1000.6 AL status codes";
+// What an ESC with device emulation does instead of a state machine.
+constexpr const char* kEmulation = "ESC datasheet section II 0x0141 (device emulation)";
 
 const char* short_name(uint8_t s) {
     switch (s) {
@@ -193,7 +195,7 @@ void add_esm_tests(Catalogue& c) {
         if (t.from == 3 || t.to == 3)
             applies = "bootstrap mailbox in the SII";
         else if (t.from >= 4 || t.to >= 4)
-            applies = "CoE (process-data layout)";
+            applies = "process-data layout (over CoE, else from the SII)";
         add(
             id,
             "Valid transition " + std::string(master::al_state_name(t.from)) + " -> " +
@@ -205,19 +207,23 @@ void add_esm_tests(Catalogue& c) {
         add(
             id,
             "Invalid request " + std::string(master::al_state_name(t.from)) + " -> " +
-                std::string(master::al_state_name(t.to)) + ": refused with 0x0011, state kept",
-            std::string(kEsm) + "; " + kCodes + " (0x0011)",
+                std::string(master::al_state_name(t.to)) +
+                ": refused with 0x0011, state kept (device emulation: taken as written)",
+            std::string(kEsm) + "; " + kCodes + " (0x0011); " + kEmulation,
             [t](Context& ctx) { return invalid(ctx, t.from, t.to, 0x0011); },
             t.from == 3 ? "bootstrap mailbox in the SII" : "");
     }
     for (uint8_t s : {uint8_t{0x05}, uint8_t{0x06}, uint8_t{0x07}, uint8_t{0x09}}) {
         add("unknown_state_" + hex(s, 2).substr(2),
-            "Unknown requested state " + hex(s, 2) + ": refused with 0x0012",
-            std::string(kCodes) + " (0x0012)", [s](Context& ctx) { return invalid(ctx, 2, s, 0x0012); });
+            "Unknown requested state " + hex(s, 2) +
+                ": refused with 0x0012 (device emulation: taken as written)",
+            std::string(kCodes) + " (0x0012); " + kEmulation,
+            [s](Context& ctx) { return invalid(ctx, 2, s, 0x0012); });
     }
     add(
-        "boot.not_supported", "INIT -> BOOT without a bootstrap mailbox: refused with 0x0013",
-        std::string(kCodes) + " (0x0013)",
+        "boot.not_supported",
+        "INIT -> BOOT without a bootstrap mailbox: refused with 0x0013 (device emulation: taken as written)",
+        std::string(kCodes) + " (0x0013); " + kEmulation,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_sii());
             if (ctx.need_boot().empty()) return skip("the SII announces a bootstrap mailbox");
@@ -247,13 +253,16 @@ void add_esm_tests(Catalogue& c) {
         "bootstrap mailbox differs from the standard one");
     add(
         "mbx.sm0_length", "INIT -> PREOP with a wrong SM0 length: refused with 0x0016",
-        std::string(kCodes) + " (0x0016)", [](Context& ctx) { return bad_mailbox(ctx, 0); }, "mailbox slave");
+        std::string(kCodes) + " (0x0016)", [](Context& ctx) { return bad_mailbox(ctx, 0); },
+        "mailbox slave, no device emulation");
     add(
         "mbx.sm1_address", "INIT -> PREOP with a wrong SM1 start address: refused with 0x0016",
-        std::string(kCodes) + " (0x0016)", [](Context& ctx) { return bad_mailbox(ctx, 1); }, "mailbox slave");
+        std::string(kCodes) + " (0x0016)", [](Context& ctx) { return bad_mailbox(ctx, 1); },
+        "mailbox slave, no device emulation");
     add(
         "mbx.sm_disabled", "INIT -> PREOP with the mailbox SMs not activated: refused with 0x0016",
-        std::string(kCodes) + " (0x0016)", [](Context& ctx) { return bad_mailbox(ctx, 2); }, "mailbox slave");
+        std::string(kCodes) + " (0x0016)", [](Context& ctx) { return bad_mailbox(ctx, 2); },
+        "mailbox slave, no device emulation");
     add(
         "mbx.boot_layout_in_preop", "INIT -> PREOP with the bootstrap mailbox layout: refused with 0x0016",
         std::string(kCodes) + " (0x0016)",
@@ -269,19 +278,19 @@ void add_esm_tests(Catalogue& c) {
     add(
         "sm2.length", "PREOP -> SAFEOP with a wrong SM2 (outputs) length: refused with 0x001D",
         std::string(kCodes) + " (0x001D)", [](Context& ctx) { return bad_pd_sm(ctx, true, false); },
-        "outputs");
+        "outputs, no device emulation");
     add(
         "sm2.address", "PREOP -> SAFEOP with a wrong SM2 (outputs) start address: refused with 0x001D",
         std::string(kCodes) + " (0x001D)", [](Context& ctx) { return bad_pd_sm(ctx, true, true); },
-        "outputs");
+        "outputs, no device emulation");
     add(
         "sm3.length", "PREOP -> SAFEOP with a wrong SM3 (inputs) length: refused with 0x001E",
         std::string(kCodes) + " (0x001E)", [](Context& ctx) { return bad_pd_sm(ctx, false, false); },
-        "inputs");
+        "inputs, no device emulation");
     add(
         "sm3.address", "PREOP -> SAFEOP with a wrong SM3 (inputs) start address: refused with 0x001E",
         std::string(kCodes) + " (0x001E)", [](Context& ctx) { return bad_pd_sm(ctx, false, true); },
-        "inputs");
+        "inputs, no device emulation");
     add("error.sticky", "With the error indication set, a request without acknowledge is not executed",
         "ETG.1000.6 AL control (error indication acknowledge)", [](Context& ctx) {
             CONFORM_NEED(ctx.need_state_machine());
