@@ -40,7 +40,7 @@ PositionFrame Axis::frame() const {
 
 DeviceControl::Options Axis::dc_options() const {
     return {params.shutdown, params.disable_operation, params.profile_deceleration,
-            params.quick_stop_deceleration};
+            params.quick_stop_deceleration, params.quick_stop};
 }
 
 // What device control's transitions ask of the other parts.
@@ -185,8 +185,12 @@ void Axis::tp_latch(bool rising, double raw_pos) {
 }
 
 void Axis::derive() {
-    const int32_t res =
-        static_cast<int32_t>(std::clamp<uint64_t>(4ull * params.encoder_pulses, 4ull, 1ull << 30));
+    // Increments per motor revolution: 0x608F where the device has it (IEC 61800-7-201 position encoder
+    // resolution), else 4 x the encoder's pulses (quadrature).
+    const uint64_t per_rev = params.resolution_increments > 0 && params.resolution_revolutions > 0
+                                 ? params.resolution_increments / params.resolution_revolutions
+                                 : 4ull * params.encoder_pulses;
+    const int32_t res = static_cast<int32_t>(std::clamp<uint64_t>(per_rev, 4ull, 1ull << 30));
     const double pol = (params.axis_misc & 0x1) ? -1.0 : 1.0;
     if (res != res_ || pol != pol_) {
         // A new resolution or polarity invalidates the position and the reference (MAXPOS firmware
@@ -290,7 +294,7 @@ void Axis::cycle(int64_t now_ns, int64_t dt_ns) {
         dc_.start(*sink_);
     }
     tp_.configure(command.touch_probe_function);
-    if (command.mode != sp_.mode() && mode::supported(command.mode)) {
+    if (command.mode != sp_.mode() && mode::supported(command.mode, params.supported_modes)) {
         // A running homing ends with the mode: interrupted, to be started again.
         if (sp_.mode() == mode::Homing) home_.interrupt();
         sp_.switch_mode(command.mode, dc_.power(), static_cast<double>(count_));

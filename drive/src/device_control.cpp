@@ -73,12 +73,22 @@ void DeviceControl::command(uint16_t c, const AxisFaults& faults, const Options&
                 begin_stop(StopKind::Disable, 0, parts);
                 pending_ = {true, t.to, t.number, now_ns};
                 break;
-            case 11:
-                // 0x605A = 6 (the only value the MAXPOS firmware specification allows): quick-stop ramp, stay
-                // in Quick Stop Active.
-                begin_stop(StopKind::Ramp, o.quick_stop_deceleration, parts);
+            case 11: {
+                // 0x605A (IEC 61800-7-201): 0 disable the drive function; 1/5 slow down on the slow-down ramp
+                // (0x6084), 2/6 on the quick stop ramp (0x6085), 3/4/7/8 on the current or voltage limit (the
+                // quick stop ramp here, see docs/decisions/drive.md). 0...4 then go on to Switch On Disabled
+                // (transition 12 once stopped), 5...8 stay in Quick Stop Active. The MAXPOS allows only 6.
+                const int16_t code = o.quick_stop;
+                if (code == 0)
+                    begin_stop(StopKind::Disable, 0, parts);
+                else if (code == 1 || code == 5)
+                    begin_stop(StopKind::Ramp, o.profile_deceleration, parts);
+                else
+                    begin_stop(StopKind::Ramp, o.quick_stop_deceleration, parts);
                 enter(State::QuickStopActive, sink);
+                if (code >= 0 && code <= 4) pending_ = {true, State::SwitchOnDisabled, 12, now_ns};
                 break;
+            }
             case 15:
                 if (parts.fault_reset()) enter(State::SwitchOnDisabled, sink);
                 break;

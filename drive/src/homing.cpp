@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "od/drive_objects.hpp"
+#include "drive/objects.hpp"
 
 namespace drive {
 
@@ -43,8 +43,8 @@ void Homing::start(const Parameters& p, uint64_t functions, double actual, Event
     const bool neg = functions & ((1ull << 0) | (1ull << 24));
     const bool pos = functions & ((1ull << 1) | (1ull << 25));
     const bool home = functions & (1ull << 2);
-    // Only the methods of 0x60E3 (declared once in od/drive_objects.hpp, also the 0x6098 validator's).
-    if (!od::contains(od::kHomingMethods, m) || (uses_index(m) && !(p.encoder_type & 0x1))) {
+    // Only the methods of 0x60E3 (declared once in drive/objects.hpp).
+    if (!contains(kHomingMethods, m) || (uses_index(m) && !(p.encoder_type & 0x1))) {
         fail(sink);
         return;
     }

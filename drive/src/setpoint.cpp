@@ -12,8 +12,8 @@ namespace drive {
 
 using namespace detail;
 
-bool mode::supported(int8_t m) {
-    return od::contains(od::kModesOfOperation, m);
+bool mode::supported(int8_t m, uint32_t announced) {
+    return contains(kModesOfOperation, m) && (announced & mode_bit(m)) != 0;
 }
 
 void SetpointGenerator::hold(double pos) {

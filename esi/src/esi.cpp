@@ -565,7 +565,8 @@ std::optional<uint32_t> unit_code(const std::string& unit) {
     return std::nullopt;
 }
 
-std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict) {
+std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict,
+                      std::span<const uint8_t> eeprom_image) {
     const DeviceModel m = derive_model(d, dict);
     std::unique_ptr<xmlDoc, decltype(&xmlFreeDoc)> doc(xmlNewDoc(X("1.0")), &xmlFreeDoc);
     xmlNodePtr root = xmlNewNode(nullptr, X("EtherCATInfo"));
@@ -709,9 +710,13 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
     }
 
     xmlNodePtr eeprom = child(device, "Eeprom");
-    child(eeprom, "ByteSize", std::to_string(d.eeprom_bytes));
-    child(eeprom, "ConfigData", hex_bytes(m.config_data.data(), m.config_data.size()));
-    child(eeprom, "BootStrap", hex_bytes(m.bootstrap.data(), m.bootstrap.size()));
+    if (!eeprom_image.empty()) {
+        child(eeprom, "Data", hex_bytes(eeprom_image.data(), eeprom_image.size()));
+    } else {
+        child(eeprom, "ByteSize", std::to_string(d.eeprom_bytes));
+        child(eeprom, "ConfigData", hex_bytes(m.config_data.data(), m.config_data.size()));
+        child(eeprom, "BootStrap", hex_bytes(m.bootstrap.data(), m.bootstrap.size()));
+    }
     const std::vector<uint8_t> image = device_image_bmp();
     child(device, "ImageData16x14", hex_bytes(image.data(), image.size()));
 
@@ -737,9 +742,9 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
     return out;
 }
 
-void write_esi(const std::filesystem::path& path, const od::DeviceDescription& d,
-               const od::Dictionary& dict) {
-    const std::string xml = build_esi(d, dict);
+void write_esi(const std::filesystem::path& path, const od::DeviceDescription& d, const od::Dictionary& dict,
+               std::span<const uint8_t> eeprom_image) {
+    const std::string xml = build_esi(d, dict, eeprom_image);
     std::ofstream f(path, std::ios::binary | std::ios::trunc);
     f << xml;
     if (!f) throw std::runtime_error("cannot write " + path.string());

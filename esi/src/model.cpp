@@ -194,8 +194,12 @@ DeviceModel derive_model(const od::DeviceDescription& d, const od::Dictionary& d
         m.sync_managers.push_back(si);
     }
 
-    // ---- The order of the PDOs: assigned ones in their assignment order first ----
+    // ---- The order of the PDOs: by index, the default-assigned ones permuted among their own places into
+    // their assignment order. A vendor lists its PDOs by index and assigns them in that order, so the ESI
+    // it wrote, the ESI written here and the SII all list them alike; where the assignment order differs
+    // from the index order, both files still give a master the process-image order of 0x1C1n.
     for (const bool rx : {true, false}) {
+        std::vector<std::size_t> assigned;  // in assignment order
         std::vector<bool> taken(m.pdos.size(), false);
         for (std::size_t n = 0; n < m.sync_managers.size(); ++n) {
             if (m.sync_managers[n].kind != (rx ? od::SmKind::Outputs : od::SmKind::Inputs)) continue;
@@ -209,12 +213,13 @@ DeviceModel derive_model(const od::DeviceDescription& d, const od::Dictionary& d
                     if (!taken[i] && m.pdos[i].rx == rx && m.pdos[i].index == pdo_index &&
                         m.pdos[i].sm == static_cast<int>(n)) {
                         taken[i] = true;
-                        m.pdo_order.push_back(i);
+                        assigned.push_back(i);
                     }
             }
         }
-        for (std::size_t i = 0; i < m.pdos.size(); ++i)
-            if (!taken[i] && m.pdos[i].rx == rx) m.pdo_order.push_back(i);
+        std::size_t next = 0;
+        for (std::size_t i = 0; i < m.pdos.size(); ++i)  // m.pdos is in index order
+            if (m.pdos[i].rx == rx) m.pdo_order.push_back(taken[i] ? assigned[next++] : i);
     }
 
     // ---- Predefined PDO sets (AlternativeSmMapping): PDOs of their direction, within the PDO rules ----

@@ -54,18 +54,28 @@ struct Writer {
     }
 };
 
-}  // namespace
+// What the SII leaves out when the full content does not fit the EEPROM, in this order
+// (docs/decisions/esi.md): the categories a configuration tool needs stay (strings of the identity, General,
+// FMMU, SyncM, DC, the PDOs of the default assignment); names that the ESI and the CoE dictionary carry
+// anyway go first.
+enum class Compaction {
+    None,
+    NoEntryNames,     // PDO entries without name strings (index 0: no string, ETG.2010)
+    NoPdoNames,       // PDOs without name strings
+    DefaultPdosOnly,  // only the default-assigned PDOs (a master without CoE can use no other)
+    NoPdos,           // a CoE device: no PDO categories (a master reads 0x1C1n and the mappings by SDO)
+};
 
-std::vector<uint8_t> build_sii(const od::DeviceDescription& d, const od::Dictionary& dict) {
-    if (d.eeprom_bytes < 128 || d.eeprom_bytes % 128 != 0)
-        throw std::invalid_argument("SII: eeprom_bytes must be a positive multiple of 128 (1 KiBit)");
-    const DeviceModel m = derive_model(d, dict);
-
+// The content (header and categories, up to the End marker) at one compaction level.
+std::vector<uint8_t> build_content(const od::DeviceDescription& d, const DeviceModel& m, Compaction level) {
     StringTable strings;
+    // String 1 is the order number (ESI Type), as vendors write it: a master that names a slave by the first
+    // string (SOEM's ecx_config_init: ecx_siistring(..., 1)) shows "EL2008", not its group "DigOut"; one
+    // that follows the General category's indices finds order, name and group there.
     const std::string order = d.identity.order_code.empty() ? d.identity.device_name : d.identity.order_code;
-    const uint8_t group_idx = strings.add(d.identity.group_type);
     const uint8_t order_idx = strings.add(order);
     const uint8_t name_idx = strings.add(d.identity.device_name);
+    const uint8_t group_idx = strings.add(d.identity.group_type);
 
     // ---- General ----
     std::vector<uint8_t> general(32, 0);
@@ -103,12 +113,14 @@ std::vector<uint8_t> build_sii(const od::DeviceDescription& d, const od::Diction
     Writer txpdo, rxpdo;
     for (std::size_t i : m.pdo_order) {
         const PdoInfo& p = m.pdos[i];
+        if (level >= Compaction::DefaultPdosOnly && p.sm < 0) continue;
+        if (level >= Compaction::NoPdos && (d.mailbox_protocols & od::mailbox_protocol::CoE)) continue;
         Writer& w = p.rx ? rxpdo : txpdo;
         w.u16(p.index);
         w.u8(static_cast<uint8_t>(p.entries.size()));
         w.u8(p.sm >= 0 ? static_cast<uint8_t>(p.sm) : 0xFF);
         w.u8(0);  // DC sync
-        w.u8(strings.add(p.name));
+        w.u8(level >= Compaction::NoPdoNames ? 0 : strings.add(p.name));
         uint16_t flags = 0;
         if (p.sm >= 0) flags |= pdo_flags::Default;
         if (p.fixed) flags |= pdo_flags::FixedContent;
@@ -117,7 +129,7 @@ std::vector<uint8_t> build_sii(const od::DeviceDescription& d, const od::Diction
         for (const PdoEntryInfo& e : p.entries) {
             w.u16(e.index);
             w.u8(e.subindex);
-            w.u8(strings.add(e.name));
+            w.u8(level >= Compaction::NoEntryNames ? 0 : strings.add(e.name));
             w.u8(e.entry != nullptr ? static_cast<uint8_t>(e.type) : 0);
             w.u8(e.bit_length);
             w.u16(0);
@@ -175,11 +187,30 @@ std::vector<uint8_t> build_sii(const od::DeviceDescription& d, const od::Diction
     if (!rxpdo.b.empty()) w.category(category::RxPdo, rxpdo.b);
     if (!dc.b.empty()) w.category(category::Dc, dc.b);
     w.u16(category::End);
-    if (w.b.size() > d.eeprom_bytes)
-        throw std::length_error("SII: content needs " + std::to_string(w.b.size()) +
-                                " bytes, the EEPROM has " + std::to_string(d.eeprom_bytes));
-    w.b.resize(d.eeprom_bytes, 0xFF);
-    return w.b;
+    return std::move(w.b);
+}
+
+}  // namespace
+
+std::vector<uint8_t> build_sii(const od::DeviceDescription& d, const od::Dictionary& dict) {
+    if (d.eeprom_bytes < 128 || d.eeprom_bytes % 128 != 0)
+        throw std::invalid_argument("SII: eeprom_bytes must be a positive multiple of 128 (1 KiBit)");
+    const DeviceModel m = derive_model(d, dict);
+    std::size_t full = 0;
+    for (const Compaction level : {Compaction::None, Compaction::NoEntryNames, Compaction::NoPdoNames,
+                                   Compaction::DefaultPdosOnly, Compaction::NoPdos}) {
+        std::vector<uint8_t> image = build_content(d, m, level);
+        if (full == 0) full = image.size();
+        if (image.size() <= d.eeprom_bytes) {
+            image.resize(d.eeprom_bytes, 0xFF);
+            return image;
+        }
+        if (level == Compaction::NoPdos)
+            throw std::length_error("SII: content needs " + std::to_string(full) + " bytes (" +
+                                    std::to_string(image.size()) + " at its most compact), the EEPROM has " +
+                                    std::to_string(d.eeprom_bytes));
+    }
+    return {};  // not reached
 }
 
 void write_sii(const std::filesystem::path& path, const od::DeviceDescription& d,

@@ -8,7 +8,6 @@
 #include <set>
 #include <sstream>
 
-#include "od/drive_profile.hpp"
 #include "util/input_file.hpp"
 #include "util/lex.hpp"
 
@@ -70,8 +69,9 @@ void check_mailbox(const Parser& p, const MailboxLayout& m, const char* what) {
 
 }  // namespace
 
-DeviceDescription parse_device_config(std::string_view text, const std::string& source) {
-    DeviceDescription d = default_drive_description();
+DeviceDescription parse_device_config(std::string_view text, const std::string& source,
+                                      const DeviceDescription& base, const SyncManagerPlacer& place) {
+    DeviceDescription d = base;
     Parser p{source, 0};
     std::string section = "identity";
     bool in_top_level = true;
@@ -173,14 +173,15 @@ DeviceDescription parse_device_config(std::string_view text, const std::string& 
     check_mailbox(p, d.standard_mailbox, "mailbox");
     check_mailbox(p, d.bootstrap_mailbox, "bootstrap_mailbox");
     try {
-        place_sync_managers(d);
+        if (place) place(d);
     } catch (const std::out_of_range& e) {
         p.fail(e.what());
     }
     return d;
 }
 
-DeviceDescription load_device_config(const std::filesystem::path& path) {
+DeviceDescription load_device_config(const std::filesystem::path& path, const DeviceDescription& base,
+                                     const SyncManagerPlacer& place) {
     std::string text;
     try {
         text = util::read_input_file(path, kMaxConfigBytes, "device configuration file");
@@ -191,7 +192,7 @@ DeviceDescription load_device_config(const std::filesystem::path& path) {
             why.remove_prefix(prefix.size());
         throw ConfigError(path.string(), 0, std::string(why));
     }
-    return parse_device_config(text, path.string());
+    return parse_device_config(text, path.string(), base, place);
 }
 
 }  // namespace od

@@ -10,7 +10,6 @@
 #include <cstring>
 #include <vector>
 
-#include "od/drive_profile.hpp"
 #include "util/atomic_file.hpp"
 #include "util/crc.hpp"
 #include "util/le.hpp"

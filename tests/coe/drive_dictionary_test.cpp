@@ -9,7 +9,7 @@
 #include "coe/sdo_info.hpp"
 #include "coe/sdo_server.hpp"
 #include "coe_test_support.hpp"
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 #include "od/store.hpp"
 
 using namespace coe_test;
@@ -18,7 +18,7 @@ namespace {
 
 class DriveDictionary : public ::testing::Test {
   protected:
-    od::Dictionary dict = od::make_drive_dictionary(od::default_drive_description());
+    od::Dictionary dict = maxpos::dictionary(maxpos::description());
     od::AlState state = od::AlState::PreOp;
     coe::CoeServer server{dict, [this] { return state; }};
     RecordingSender out;
@@ -136,7 +136,7 @@ TEST_F(DriveDictionary, EveryEntryHasADescription) {
 
 TEST_F(DriveDictionary, DiagnosisHistoryOnTheDriveObject) {
     coe::DiagnosisHistory diag(dict, &server.emergency());
-    EXPECT_EQ(diag.max_messages(), od::kDiagMaxMessages);
+    EXPECT_EQ(diag.max_messages(), maxpos::kDiagMaxMessages);
     coe::DiagMessage m;
     m.code = coe::DiagnosisHistory::from_emergency(0x8611);
     m.type = coe::DiagType::Error;

@@ -5,7 +5,7 @@
 #include "coe/pdo_validation.hpp"
 #include "coe/sdo_server.hpp"
 #include "coe_test_support.hpp"
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 
 using namespace coe_test;
 
@@ -134,12 +134,12 @@ TEST(PdoMappingEntry, Checks) {
 
 }  // namespace
 
-// The drive's PDO rules (od::default_drive_description().pdo_rules, the ESI's Exclude): one RxPDO and one
+// The drive's PDO rules (maxpos::description().pdo_rules, the ESI's Exclude): one RxPDO and one
 // TxPDO at a time, since each maps the controlword / statusword and the mode.
 class DrivePdoRules : public ::testing::Test {
   protected:
-    od::DeviceDescription desc = od::default_drive_description();
-    od::Dictionary dict = od::make_drive_dictionary(desc);
+    od::DeviceDescription desc = maxpos::description();
+    od::Dictionary dict = maxpos::dictionary(desc);
     coe::CoeServer server{dict, [] { return od::AlState::PreOp; }};
     RecordingSender out;
 

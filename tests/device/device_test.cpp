@@ -25,7 +25,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 #include "slave/log.hpp"
 
 #include "support/master_bring_up.hpp"
@@ -324,7 +324,7 @@ TEST_F(DeviceAssembly, AProvokedFaultSendsAnEmergencyAndIsInTheDiagnosisHistory)
     uint32_t code = 0;
     // Any message since the fault carries it; the newest is the error itself or a later state message.
     bool in_history = false;
-    for (uint8_t sub = 6; sub < 6 + od::kDiagMaxMessages; ++sub) {
+    for (uint8_t sub = 6; sub < 6 + maxpos::kDiagMaxMessages; ++sub) {
         std::array<uint8_t, 64> b{};
         auto k = sdo.upload(0x10F3, sub, b);
         if (!k.ok() || *k < 16) continue;

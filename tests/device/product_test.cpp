@@ -180,6 +180,59 @@ TEST(ProductWithoutMailbox, ReachesOpWithProcessDataOnlyAndItsInputsFollowTheDef
     EXPECT_EQ(u16(pd.inputs(), 3), 0x55AA);
 }
 
+// Outputs lost: an IO terminal's outputs go to their safe state, 0 (EL2xxx switch their outputs off on the
+// watchdog; the ESC's process-data watchdog: the PDI side sets the outputs safe), whether the master leaves
+// Op or stops writing (watchdog); they come back with the next outputs written in Op.
+TEST(ProductWithoutMailbox, LostOutputsGoToTheirSafeStateZero) {
+    for (const bool watchdog : {false, true}) {
+        SCOPED_TRACE(watchdog ? "watchdog" : "master leaves Op");
+        // The process data in ordinary SyncManagers (the terminal's own SM0 at 0x0F00 is on the ESC's
+        // digital-output registers, outside the SM watchdog this test runs into).
+        auto p = std::make_shared<od::Product>(*io_terminal());
+        p->description.sync_managers = {test_products::sm(od::SmKind::Outputs, 0x1100, 3, 0x64),
+                                        test_products::sm(od::SmKind::Inputs, 0x1180, 5, 0x20)};
+        Unit u(p);
+        UnitLink link(u);
+        Master m(link, test_support::in_process_master_options());
+        const Address a = Address::station(0x1001);
+        ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
+        AlStatus st;
+        ProcessDataSession pd(m, std::span<const Address>(&a, 1));
+        ASSERT_EQ(pd.discover_sii(0), Error::Ok);
+        ASSERT_EQ(pd.configure(), Error::Ok);
+        auto fill = [&] {
+            auto o = pd.outputs();
+            o[0] = 0x34;
+            o[1] = 0x12;
+            o[2] = 0x01;
+        };
+        ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(100), &st, fill), Error::Ok);
+        ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(100), &st, fill), Error::Ok);
+        ASSERT_EQ(pd.run(5, std::chrono::microseconds(100), fill), Error::Ok);
+        ASSERT_EQ(u.dev->dictionary().get<uint16_t>(0x7000, 1), 0x1234);
+        ASSERT_EQ(u.dev->dictionary().get<uint8_t>(0x7000, 2), 1);
+        if (watchdog) {
+            // No process data for 500 ms: the SM watchdog (100 ms by default) expires.
+            for (int i = 0; i < 500; ++i) {
+                u.clock.advance(1'000'000);
+                u.service();
+            }
+            EXPECT_NE(u.dev->stack().state(), od::AlState::Op);
+        } else {
+            ASSERT_EQ(m.request_state(a, AlState::SafeOp, &st), Error::Ok);
+        }
+        EXPECT_EQ(u.dev->dictionary().get<uint16_t>(0x7000, 1), 0);
+        EXPECT_EQ(u.dev->dictionary().get<uint8_t>(0x7000, 2), 0);
+        const std::string status = device::ControlSocket::apply(*u.dev, "status");
+        EXPECT_NE(status.find("0x7000:01 \"Value\"=0"), std::string::npos) << status;
+        if (watchdog) continue;
+        // Back in Op, the master's outputs are taken again.
+        ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(100), &st, fill), Error::Ok);
+        ASSERT_EQ(pd.run(3, std::chrono::microseconds(100), fill), Error::Ok);
+        EXPECT_EQ(u.dev->dictionary().get<uint16_t>(0x7000, 1), 0x1234);
+    }
+}
+
 TEST(ProductWithoutMailbox, InitToPreOpNeedsNoMailboxSmsAndStartsNone) {
     Unit u(io_terminal());
     UnitLink link(u);

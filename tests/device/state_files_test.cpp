@@ -18,7 +18,7 @@
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
 #include "foe/image.hpp"
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 #include "od/store.hpp"
 #include "support/temp_dir.hpp"
 #include "util/crc.hpp"
@@ -70,7 +70,7 @@ std::vector<uint8_t> sii_writes_with_count(uint32_t count) {
 
 TEST(DeviceStateFiles, CraftedFilesAreReportedAndTheDefaultsRun) {
     StateDir d;
-    const od::DeviceDescription desc = od::default_drive_description();
+    const od::DeviceDescription desc = maxpos::description();
     write_file(d.path / "parameters.bin", parameters_with_count(desc.identity, 0xFFFFFFFFu));
     ASSERT_EQ(fs::file_size(d.path / "parameters.bin"), 40u);
     write_file(d.path / device::EepromWrites::kFileName, sii_writes_with_count(0xFFFFFFFFu));
@@ -104,7 +104,7 @@ TEST(DeviceStateFiles, CraftedFilesAreReportedAndTheDefaultsRun) {
     EXPECT_NE(log.str().find("stored parameters"), std::string::npos) << log.str();
     EXPECT_NE(log.str().find(device::EepromWrites::kFileName), std::string::npos) << log.str();
     // ... and the defaults run: the dictionary's stored parameters, the built-in firmware, the SII as built.
-    const od::Dictionary defaults = od::make_drive_dictionary(desc);
+    const od::Dictionary defaults = maxpos::dictionary(desc);
     EXPECT_EQ(dev->dictionary().get<uint32_t>(0x6065, 0), defaults.get<uint32_t>(0x6065, 0));
     EXPECT_EQ(dev->dictionary().get<uint32_t>(0x1018, 3), desc.identity.revision);
     EXPECT_FALSE(dev->firmware_store().active_image());
@@ -133,7 +133,7 @@ TEST(DeviceStateFiles, StaleTemporariesAreRemovedAtTheStart) {
     fs::create_directories(d.path / "firmware");
     // parameters.bin.tmp the way the campaign got it: a save SIGKILLed once its temporary was written.
     {
-        od::Dictionary dict = od::make_drive_dictionary(od::default_drive_description());
+        od::Dictionary dict = maxpos::dictionary(maxpos::description());
         od::ParameterStore store(d.path);
         const pid_t pid = ::fork();
         ASSERT_GE(pid, 0);

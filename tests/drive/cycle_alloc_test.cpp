@@ -5,20 +5,20 @@
 #include <cstdint>
 
 #include "drive/drive.hpp"
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 #include "support/alloc_counter.hpp"
 
 namespace drive {
 namespace {
 
 struct Bench {
-    od::Dictionary d = od::make_drive_dictionary(od::default_drive_description());
+    od::Dictionary d = maxpos::dictionary(maxpos::description());
     NullEventSink sink;
-    Drive drv{d, &sink};
+    Drive drv{d, &sink, maxpos::drive_objects()};
     int64_t t = 0;
 
     explicit Bench(int8_t mode) {
-        EXPECT_EQ(commission(d, drv.motor()), od::Status::Ok);
+        EXPECT_EQ(commission(d, maxpos::drive_objects(), drv.motor()), od::Status::Ok);
         d.set<int8_t>(0x6060, 0, mode);
         d.set<uint16_t>(0x60B8, 0, 0x0017);  // touch probe armed on the index
         for (uint16_t cw : {0x06, 0x07, 0x0F})

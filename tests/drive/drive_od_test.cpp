@@ -2,15 +2,15 @@
 #include <gtest/gtest.h>
 
 #include "drive/drive.hpp"
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 #include "rig.hpp"
 
 using namespace drive;
 
 TEST(DriveOd, RunsCspThroughTheDictionary) {
-    od::Dictionary d = od::make_drive_dictionary(od::default_drive_description());
+    od::Dictionary d = maxpos::dictionary(maxpos::description());
     test::Recorder rec;
-    Drive drv(d, &rec);
+    Drive drv(d, &rec, maxpos::drive_objects());
     EXPECT_GT(drv.bound(), 80u);
     ASSERT_EQ(d.set<uint32_t>(0x3001, 5, 25500), od::Status::Ok);
     ASSERT_EQ(d.set<uint32_t>(0x30A1, 1, 20000), od::Status::Ok);   // 20 Hz
@@ -45,8 +45,8 @@ TEST(DriveOd, RunsCspThroughTheDictionary) {
 }
 
 TEST(DriveOd, ConnectionLostWritesTheErrorIntoTheDictionary) {
-    od::Dictionary d = od::make_drive_dictionary(od::default_drive_description());
-    Drive drv(d);
+    od::Dictionary d = maxpos::dictionary(maxpos::description());
+    Drive drv(d, nullptr, maxpos::drive_objects());
     d.set<uint32_t>(0x3001, 5, 25500);
     int64_t t = 0;
     for (uint16_t cw : {0x06, 0x07, 0x0F}) {
@@ -61,12 +61,12 @@ TEST(DriveOd, ConnectionLostWritesTheErrorIntoTheDictionary) {
 }
 
 TEST(DriveOd, CommissionWritesAMatchedTuningSoTheDriveEnables) {
-    od::Dictionary d = od::make_drive_dictionary(od::default_drive_description());
-    ASSERT_EQ(commission(d), od::Status::Ok);
+    od::Dictionary d = maxpos::dictionary(maxpos::description());
+    ASSERT_EQ(commission(d, maxpos::drive_objects()), od::Status::Ok);
     EXPECT_EQ(d.get<uint32_t>(0x3001, 5), 25500u);
     EXPECT_EQ(d.get<uint32_t>(0x30A1, 4), 188300u);
     EXPECT_EQ(d.get<uint32_t>(0x30A1, 5), 46674u);  // 445.7 uNm/(rad/s) in nNm/rpm
-    Drive drv(d);
+    Drive drv(d, nullptr, maxpos::drive_objects());
     int64_t t = 0;
     for (uint16_t cw : {0x06, 0x07, 0x0F}) {
         d.set<uint16_t>(0x6040, 0, cw);
@@ -78,8 +78,8 @@ TEST(DriveOd, CommissionWritesAMatchedTuningSoTheDriveEnables) {
 }
 
 TEST(DriveOd, SeedDefaultsRefuseToEnableWith8331) {
-    od::Dictionary d = od::make_drive_dictionary(od::default_drive_description());
-    Drive drv(d);
+    od::Dictionary d = maxpos::dictionary(maxpos::description());
+    Drive drv(d, nullptr, maxpos::drive_objects());
     int64_t t = 0;
     for (uint16_t cw : {0x06, 0x07, 0x0F}) {
         d.set<uint16_t>(0x6040, 0, cw);
@@ -91,9 +91,9 @@ TEST(DriveOd, SeedDefaultsRefuseToEnableWith8331) {
 }
 
 TEST(DriveOd, PowerDisableOnlyObjectsRefuseMasterWritesWhileEnabled) {
-    od::Dictionary d = od::make_drive_dictionary(od::default_drive_description());
-    ASSERT_EQ(commission(d), od::Status::Ok);
-    Drive drv(d);
+    od::Dictionary d = maxpos::dictionary(maxpos::description());
+    ASSERT_EQ(commission(d, maxpos::drive_objects()), od::Status::Ok);
+    Drive drv(d, nullptr, maxpos::drive_objects());
     const uint8_t pulses[4] = {0x00, 0x04, 0x00, 0x00};  // 1024
     EXPECT_EQ(d.write(0x3010, 1, od::AlState::PreOp, pulses), od::Status::Ok);
     int64_t t = 0;

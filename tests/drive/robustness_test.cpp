@@ -4,7 +4,7 @@
 #include <random>
 
 #include "drive/drive.hpp"
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 #include "rig.hpp"
 #include "support/alloc_counter.hpp"
 
@@ -72,9 +72,9 @@ TEST(Robustness, ZeroAndOddCycleTimes) {
 }
 
 TEST(Robustness, SteadyStateCycleAllocatesNothing) {
-    od::Dictionary d = od::make_drive_dictionary(od::default_drive_description());
+    od::Dictionary d = maxpos::dictionary(maxpos::description());
     NullEventSink sink;
-    Drive drv(d, &sink);
+    Drive drv(d, &sink, maxpos::drive_objects());
     d.set<uint32_t>(0x3001, 5, 25500);
     d.set<uint16_t>(0x60B8, 0, 0x0017);
     int64_t t = 0;

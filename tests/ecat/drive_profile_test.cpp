@@ -1,7 +1,7 @@
-// The stack on the real drive's description and dictionary (od::default_drive_description(),
-// od::make_drive_dictionary()): what a master meets on the wire.
-#include "od/drive_profile.hpp"
+// The stack on the real drive's description and dictionary (maxpos::description(),
+// maxpos::dictionary()): what a master meets on the wire.
 #include "fixture.hpp"
+#include "maxpos/maxpos.hpp"
 
 namespace ecat::test {
 namespace {
@@ -11,8 +11,8 @@ using od::AlState;
 class RealDrive : public StackTest {
   protected:
     void SetUp() override {
-        desc = od::default_drive_description();
-        dict = od::make_drive_dictionary(desc);
+        desc = maxpos::description();
+        dict = maxpos::dictionary(desc);
         StackTest::SetUp();
     }
     uint16_t default_rx() const { return desc.sync_managers.at(2).default_size; }

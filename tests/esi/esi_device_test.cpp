@@ -181,7 +181,12 @@ std::vector<std::string> describe(const od::Product& p) {
         }
         out.push_back(o.str());
     }
-    add("application", int(p.application), "eeprom", p.eeprom.size());
+    std::ostringstream image;  // the device's own EEPROM image, byte for byte
+    image << std::hex;
+    for (uint8_t b : p.eeprom)
+        image << int{b} << ' ';
+    add("eeprom", p.eeprom.size(), image.str());
+    add("application", int(p.application));  // last: see EsiPublicFiles
     return out;
 }
 
@@ -202,7 +207,7 @@ void expect_same(const std::vector<std::string>& a, const std::vector<std::strin
 // The product's ESI, read and loaded again.
 od::Product round_trip(const od::Product& p, std::string* xml_out = nullptr) {
     const od::Dictionary dict = p.make_dictionary(p.description);
-    const std::string xml = esi::build_esi(p.description, dict);
+    const std::string xml = esi::build_esi(p.description, dict, p.eeprom);
     if (xml_out) *xml_out = xml;
     return esi::load_product(esi::read_esi_text(xml, "round-trip.xml"), "");
 }
@@ -319,14 +324,11 @@ TEST(EsiExamples, EveryDeviceRoundTripsThroughItsGeneratedEsi) {
             od::Product q = round_trip(p, &xml);
             for (const std::string& e : schema_errors(xml))
                 ADD_FAILURE() << "generated ESI: " << e;
-            std::vector<std::string> a = describe(p), b = describe(q);
-            // The image (Eeprom/Data) is the device's, not part of the ESI softecat writes.
-            a.pop_back();
-            b.pop_back();
+            // Everything, the device's own EEPROM image (Eeprom/Data) included.
+            const std::vector<std::string> a = describe(p), b = describe(q);
             expect_same(a, b, "round trip");
             // And a second time: a fixed point.
-            std::vector<std::string> c = describe(round_trip(q));
-            c.pop_back();
+            const std::vector<std::string> c = describe(round_trip(q));
             expect_same(b, c, "second round trip");
         }
     }
@@ -383,6 +385,108 @@ TEST(EsiExamples, EverySiiParsesToTheSameDevice) {
 
 fs::path example(const char* name) {
     return fs::path(SOFTECAT_ESI_EXAMPLES) / name;
+}
+
+// Calls fn(device, product, dictionary, parsed SII) for every device of every example whose SII softecat
+// builds (not the ones served from their own Eeprom/Data image).
+template <typename Fn>
+void for_each_built_sii(Fn fn) {
+    for (const fs::path& path : examples()) {
+        const esi::EsiFile file = esi::read_esi_file(path.string());
+        for (const esi::EsiDevice& d : file.devices) {
+            SCOPED_TRACE(path.string() + " " + d.type_name);
+            const od::Product p = esi::load_product(file, d);
+            if (!p.eeprom.empty()) continue;  // the vendor's own image: served as it is
+            const od::Dictionary dict = p.make_dictionary(p.description);
+            fn(d, p, dict, esi::parse_sii(esi::build_sii(p.description, dict)));
+        }
+    }
+}
+
+// A master that lays out the process image from the SII and one that lays it out from the ESI must get the
+// same PDO order: the SII built for a device, the ESI it came from and the ESI written for it list the PDOs
+// of each direction alike, and the default-assigned ones in the order of the assignment objects 0x1C1n.
+TEST(EsiExamples, TheSiiTheSourceEsiAndTheWrittenEsiListThePdosInOneOrder) {
+    auto indices = [](const std::vector<esi::EsiPdo>& pdos) {
+        std::vector<uint16_t> out;
+        for (const esi::EsiPdo& p : pdos)
+            out.push_back(p.index);
+        return out;
+    };
+    auto sii_indices = [](const std::vector<esi::SiiPdo>& pdos) {
+        std::vector<uint16_t> out;
+        for (const esi::SiiPdo& p : pdos)
+            out.push_back(p.index);
+        return out;
+    };
+    // The entries of `a` that `b` has too, in a's order.
+    auto common = [](const std::vector<uint16_t>& a, const std::vector<uint16_t>& b) {
+        std::vector<uint16_t> out;
+        for (uint16_t x : a)
+            if (std::find(b.begin(), b.end(), x) != b.end()) out.push_back(x);
+        return out;
+    };
+    int compared = 0;
+    for_each_built_sii([&](const esi::EsiDevice& d, const od::Product& p, const od::Dictionary& dict,
+                           const esi::SiiInfo& sii) {
+        {
+            const esi::EsiFile written =
+                esi::read_esi_text(esi::build_esi(p.description, dict), "written.xml");
+            ASSERT_EQ(written.devices.size(), 1u);
+            for (const bool rx : {true, false}) {
+                const std::vector<uint16_t> in_sii = sii_indices(rx ? sii.rx_pdos : sii.tx_pdos);
+                const std::vector<uint16_t> in_source = indices(rx ? d.rxpdos : d.txpdos);
+                const std::vector<uint16_t> in_written =
+                    indices(rx ? written.devices[0].rxpdos : written.devices[0].txpdos);
+                EXPECT_EQ(common(in_sii, in_source), common(in_source, in_sii)) << (rx ? "RxPDOs" : "TxPDOs");
+                EXPECT_EQ(common(in_sii, in_written), common(in_written, in_sii))
+                    << (rx ? "RxPDOs" : "TxPDOs");
+                // The assigned ones in the order of 0x1C1n.
+                for (std::size_t n = 0; n < p.description.sync_managers.size(); ++n) {
+                    const od::Object* assign = dict.find(static_cast<uint16_t>(0x1C10 + n));
+                    if (assign == nullptr || assign->entries.empty()) continue;
+                    std::vector<uint16_t> assigned;
+                    const auto count =
+                        esi::number_bits(assign->entries[0].default_value, od::DataType::Unsigned8, 8);
+                    for (uint64_t k = 1; k <= count.value_or(0); ++k)
+                        if (const od::Entry* e = assign->entry(static_cast<uint8_t>(k)))
+                            assigned.push_back(static_cast<uint16_t>(
+                                esi::number_bits(e->default_value, e->type, e->bit_length).value_or(0)));
+                    const std::vector<uint16_t> mine = common(in_sii, assigned);
+                    if (!mine.empty()) {
+                        EXPECT_EQ(mine, common(assigned, mine)) << "0x1C1" << n;
+                    }
+                }
+                compared += !in_sii.empty();
+            }
+        }
+    });
+    EXPECT_GT(compared, 5);
+}
+
+TEST(EsiModel, AnAssignmentOutOfIndexOrderKeepsTheOtherPdosInTheirPlaces) {
+    // 0x1C13 assigns 0x1A02 before 0x1A00; 0x1A01 and 0x1A03 are not assigned. The assigned ones take the
+    // places they have by index, in assignment order: 0x1A02, 0x1A01, 0x1A00, 0x1A03.
+    const esi::EsiFile file = esi::read_esi_file(example("analog-in.xml").string());
+    const od::Product p = esi::load_product(file, file.devices[0]);
+    const od::Dictionary declared = p.make_dictionary(p.description);
+    od::Dictionary dict;
+    for (od::Object o : declared.objects()) {
+        if (o.index == 0x1C13) {
+            ASSERT_GE(o.entries.size(), 3u);
+            o.entries[0].default_value = uint64_t{2};
+            o.entries[1].default_value = uint64_t{0x1A02};
+            o.entries[2].default_value = uint64_t{0x1A00};
+        }
+        dict.add(std::move(o));
+    }
+    const esi::DeviceModel m = esi::derive_model(p.description, dict);
+    std::vector<uint16_t> tx;
+    for (std::size_t i : m.pdo_order)
+        if (!m.pdos[i].rx) tx.push_back(m.pdos[i].index);
+    ASSERT_GE(tx.size(), 4u);
+    EXPECT_EQ(std::vector<uint16_t>(tx.begin(), tx.begin() + 4),
+              (std::vector<uint16_t>{0x1A02, 0x1A01, 0x1A00, 0x1A03}));
 }
 
 TEST(EsiExamples, TheCouplerHasNoMailboxNoSyncManagerAndNoDictionary) {
@@ -553,6 +657,53 @@ TEST(EsiExamples, TheEepromImageIsServedByteForByte) {
     ASSERT_TRUE(sii.general);
     EXPECT_EQ(sii.general->order, "EXD1002");
     EXPECT_TRUE(p.warnings.empty()) << ::testing::PrintToString(p.warnings);
+}
+
+// A declared EEPROM smaller than even the most compact SII (128 bytes: the header alone): one warning that
+// names both sizes, and the next size that holds the full content is emulated; the SII parses with its
+// identity.
+// A master that names a slave by the SII's first string (SOEM: ecx_siistring(..., 1)) shows the device's
+// order number (ESI Type), as for a vendor's terminal, not its group; the General category's indices name the
+// order number, the device name and the group.
+TEST(EsiExamples, TheSiiNamesTheDeviceByItsFirstStringAndTheGeneralCategory) {
+    int checked = 0;
+    for_each_built_sii(
+        [&](const esi::EsiDevice& d, const od::Product&, const od::Dictionary&, const esi::SiiInfo& sii) {
+            {
+                ASSERT_FALSE(sii.strings.empty());
+                EXPECT_EQ(sii.strings[0], d.type_name);
+                ASSERT_TRUE(sii.general);
+                EXPECT_EQ(sii.general->order_idx, 1);
+                EXPECT_EQ(sii.general->order, d.type_name);
+                EXPECT_EQ(sii.general->name, d.name);
+                EXPECT_EQ(sii.general->group, d.group_type);
+                ++checked;
+            }
+        });
+    EXPECT_GT(checked, 5);
+}
+
+TEST(EsiExamples, AnEepromTooSmallForAnySiiIsWarnedAndEmulatedLarger) {
+    std::string xml = read_all(example("latin1.xml"));
+    const std::string declared = "<ByteSize>2048</ByteSize>";
+    const std::size_t at = xml.find(declared);
+    ASSERT_NE(at, std::string::npos);
+    xml.replace(at, declared.size(), "<ByteSize>128</ByteSize>");
+    const esi::EsiFile file = esi::read_esi_text(xml, "small.xml");
+    const od::Product p = esi::load_product(file, file.devices[0]);
+    EXPECT_GT(p.description.eeprom_bytes, 128u);
+    EXPECT_EQ(std::count_if(p.warnings.begin(), p.warnings.end(),
+                            [](const std::string& w) {
+                                return w.find("ByteSize 128") != std::string::npos &&
+                                       w.find(" bytes are emulated") != std::string::npos;
+                            }),
+              1)
+        << ::testing::PrintToString(p.warnings);
+    const od::Dictionary dict = p.make_dictionary(p.description);
+    const esi::SiiInfo sii = esi::parse_sii(esi::build_sii(p.description, dict));
+    EXPECT_TRUE(sii.problems.empty());
+    EXPECT_EQ(sii.product_code, file.devices[0].product_code);
+    EXPECT_EQ(sii.eeprom_bytes(), p.description.eeprom_bytes);
 }
 
 TEST(EsiExamples, Latin1AndByteOrderMarkAreRead) {
@@ -804,6 +955,9 @@ TEST(EsiPublicFiles, EveryDeviceLoadsOrIsRefusedClearlyAndRoundTrips) {
                                   << ": generated ESI: " << invalid.front();
                 }
                 std::vector<std::string> a = describe(p), b = describe(q);
+                // Not compared here (open defect): the written ESI takes ProfileNo from 0x1000's default, so
+                // a vendor file whose 0x1000 disagrees with its ProfileNo 402 (Ingenia EVS-NET-01: 0x1000 =
+                // 4) comes back without the drive application.
                 a.pop_back();
                 b.pop_back();
                 if (a == b) {

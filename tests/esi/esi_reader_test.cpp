@@ -7,11 +7,11 @@
 
 #include <set>
 
+#include "drive/objects.hpp"
 #include "esi/esi.hpp"
 #include "esi/esi_reader.hpp"
 #include "esi/model.hpp"
 #include "od/diag_texts.hpp"
-#include "od/drive_objects.hpp"
 #include "test_device.hpp"
 
 namespace {
@@ -163,10 +163,10 @@ TEST(EsiReadBackDrive, EnumeratedEntriesNameExactlyTheValuesTheDriveTakes) {
         }
         return v;
     };
-    std::vector<int64_t> modes(od::kModesOfOperation.begin(), od::kModesOfOperation.end());
+    std::vector<int64_t> modes(drive::kModesOfOperation.begin(), drive::kModesOfOperation.end());
     EXPECT_EQ(values(0x6060, 0), modes);
     EXPECT_EQ(values(0x6061, 0), modes);
-    std::vector<int64_t> homing(od::kHomingMethods.begin(), od::kHomingMethods.end());
+    std::vector<int64_t> homing(drive::kHomingMethods.begin(), drive::kHomingMethods.end());
     EXPECT_EQ(values(0x6098, 0), homing);
     EXPECT_EQ(values(0x605A, 0), (std::vector<int64_t>{6}));
     EXPECT_EQ(values(0x605E, 0), (std::vector<int64_t>{-1, 0, 1, 2}));

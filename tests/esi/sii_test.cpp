@@ -568,6 +568,74 @@ TEST(SiiBuild, ContentThatDoesNotFitThrows) {
     EXPECT_THROW(esi::build_sii(tiny, d.dictionary), std::invalid_argument);
 }
 
+// A vendor's SII fits the EEPROM its ESI declares. When softecat's full content does not, it leaves out, in
+// this order, the PDO entry names, the PDO names, the PDOs not assigned by default, and (a CoE device only)
+// the PDO categories; the identity strings, General, FMMU, SyncM and DC stay. Only when even that does not
+// fit is the content refused (load_product then warns and emulates a larger EEPROM).
+TEST(SiiBuild, ContentThatDoesNotFitIsCompactedInTheDocumentedOrder) {
+    for (const auto& [name, make] : esi_test::all_devices()) {
+        SCOPED_TRACE(name);
+        Device d = make();
+        const esi::DeviceModel m = esi::derive_model(d.description, d.dictionary);
+        const bool coe = d.description.mailbox_protocols & od::mailbox_protocol::CoE;
+        std::size_t assigned = 0;
+        for (const esi::PdoInfo& p : m.pdos)
+            assigned += p.sm >= 0;
+        int full = 0, compact = 0, refused = 0;
+        for (uint16_t bytes = 128; bytes <= 4096; bytes = static_cast<uint16_t>(bytes + 128)) {
+            SCOPED_TRACE(bytes);
+            d.description.eeprom_bytes = bytes;
+            std::vector<uint8_t> img;
+            try {
+                img = esi::build_sii(d.description, d.dictionary);
+            } catch (const std::length_error&) {
+                EXPECT_EQ(full + compact, 0) << "a smaller EEPROM held it";
+                ++refused;
+                continue;
+            }
+            ASSERT_EQ(img.size(), bytes);
+            const esi::SiiInfo info = esi::parse_sii(img);
+            EXPECT_TRUE(info.crc_ok);
+            EXPECT_TRUE(info.problems.empty()) << ::testing::PrintToString(info.problems);
+            ASSERT_TRUE(info.general);
+            EXPECT_EQ(info.general->name, d.description.identity.device_name);
+            EXPECT_EQ(info.sync_managers.size(), m.sync_managers.size());
+            EXPECT_GE(info.fmmus.size(), m.fmmus.size());  // padded to whole words with 0xFF (unused)
+            EXPECT_EQ(info.dc_modes.size(), d.description.dc_modes.size());
+            std::vector<const esi::SiiPdo*> pdos;
+            for (const auto* list : {&info.rx_pdos, &info.tx_pdos})
+                for (const esi::SiiPdo& p : *list)
+                    pdos.push_back(&p);
+            bool entry_names = false, pdo_names = false;
+            for (const esi::SiiPdo* p : pdos) {
+                pdo_names = pdo_names || p->name_idx != 0;
+                for (const esi::SiiPdoEntry& e : p->entries)
+                    entry_names = entry_names || e.name_idx != 0;
+            }
+            if (entry_names) {  // nothing left out
+                EXPECT_EQ(pdos.size(), m.pdos.size());
+                ++full;
+                continue;
+            }
+            ++compact;
+            EXPECT_EQ(full, 0) << "compacted although a smaller EEPROM held it all";
+            if (pdo_names) {  // only the entry names left out
+                EXPECT_EQ(pdos.size(), m.pdos.size());
+            }
+            if (pdos.empty()) {
+                EXPECT_TRUE(coe) << "a device without CoE keeps the PDOs of its default assignment";
+            } else {
+                EXPECT_GE(pdos.size(), assigned);
+            }
+        }
+        EXPECT_GT(full, 0);
+        EXPECT_GT(refused, 0);  // 128 bytes: the header alone
+        if (name == "drive") {
+            EXPECT_GT(compact, 0);
+        }
+    }
+}
+
 TEST(SiiBuild, PaddedWithErasedBytesAndAliasInWord4) {
     Device d = esi_test::small_device();
     d.description.station_alias = 0x1234;

@@ -1,15 +1,15 @@
 #pragma once
 // Devices the esi tests run against: a small hand-made dictionary that exercises every shape the generators
 // handle (VAR, uniform ARRAY, ARRAY with gaps, RECORD with gaps, strings, reals, min/max, units, backup,
-// state-dependent access, padding in a mapping), and the real drive (od::make_drive_dictionary).
+// state-dependent access, padding in a mapping), and the real drive (maxpos::dictionary).
 #include <functional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "maxpos/maxpos.hpp"
 #include "od/device.hpp"
 #include "od/dictionary.hpp"
-#include "od/drive_profile.hpp"
 
 namespace esi_test {
 
@@ -229,8 +229,8 @@ inline Device small_device() {
 }
 
 inline Device drive_device() {
-    auto d = od::default_drive_description();
-    auto dict = od::make_drive_dictionary(d);
+    auto d = maxpos::description();
+    auto dict = maxpos::dictionary(d);
     return {"drive", std::move(d), std::move(dict)};
 }
 

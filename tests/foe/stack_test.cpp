@@ -20,7 +20,7 @@
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 
 #include "support/master_bring_up.hpp"
 #include "support/wire_link.hpp"
@@ -55,9 +55,9 @@ struct Slave {
     std::unique_ptr<coe::CoeServer> coe;
 
     Slave() {
-        desc = od::default_drive_description();
-        od::place_sync_managers(desc);
-        dict = od::make_drive_dictionary(desc);
+        desc = maxpos::description();
+        maxpos::place_sync_managers(desc);
+        dict = maxpos::dictionary(desc);
         clock.set(1'000'000'000);
         fw = std::make_unique<foe::FirmwareUpdate>(dir.path, desc);
         EXPECT_TRUE(fw->ok());

@@ -13,7 +13,7 @@
 #include "drive/drive.hpp"
 #include "fuzz_support.hpp"
 #include "harnesses.hpp"
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 
 namespace fuzz::coe_mailbox {
 namespace {
@@ -23,9 +23,9 @@ constexpr od::AlState kStates[4] = {od::AlState::PreOp, od::AlState::SafeOp, od:
 
 // The drive's dictionary, built once and put back into its built state for each input.
 od::Dictionary& fresh_dictionary() {
-    static const od::DeviceDescription desc = od::default_drive_description();
-    static PristineDictionary pristine(od::make_drive_dictionary(desc), [](od::Dictionary& d) {
-        (void)drive::commission(d);
+    static const od::DeviceDescription desc = maxpos::description();
+    static PristineDictionary pristine(maxpos::dictionary(desc), [](od::Dictionary& d) {
+        (void)drive::commission(d, maxpos::drive_objects());
         coe::install_pdo_validators(d);
     });
     return pristine.fresh();

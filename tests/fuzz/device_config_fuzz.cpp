@@ -9,8 +9,8 @@
 #include "esi/sii.hpp"
 #include "fuzz_support.hpp"
 #include "harnesses.hpp"
+#include "maxpos/maxpos.hpp"
 #include "od/device_config.hpp"
-#include "od/drive_profile.hpp"
 
 namespace fuzz::device_config {
 
@@ -18,12 +18,12 @@ int fuzz_one(const uint8_t* data, std::size_t size) {
     const std::string_view text(reinterpret_cast<const char*>(data), size);
     od::DeviceDescription desc;
     try {
-        desc = od::parse_device_config(text, "fuzz.conf");
+        desc = maxpos::parse_config(text, "fuzz.conf");
     } catch (const od::ConfigError& e) {
         FUZZ_CHECK(e.what() != nullptr);
         return 0;
     }
-    const od::Dictionary dict = od::make_drive_dictionary(desc);
+    const od::Dictionary dict = maxpos::dictionary(desc);
     std::vector<uint8_t> image;
     try {
         image = esi::build_sii(desc, dict);

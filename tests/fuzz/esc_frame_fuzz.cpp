@@ -14,15 +14,15 @@
 #include "esi/sii.hpp"
 #include "fuzz_support.hpp"
 #include "harnesses.hpp"
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 
 namespace fuzz::esc_frame {
 namespace {
 
 const std::vector<uint8_t>& sii_image() {
     static const std::vector<uint8_t> image = [] {
-        const od::DeviceDescription desc = od::default_drive_description();
-        return esi::build_sii(desc, od::make_drive_dictionary(desc));
+        const od::DeviceDescription desc = maxpos::description();
+        return esi::build_sii(desc, maxpos::dictionary(desc));
     }();
     return image;
 }

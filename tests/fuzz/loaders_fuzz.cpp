@@ -5,7 +5,7 @@
 //   1  sii-writes.bin    device::EepromWrites::load, then apply onto the SII (tools/lib/device)
 //   2  firmware/         foe::FirmwareStore::open: the slot pointer "active" and both slot images, input =
 //                        three records (16-bit length + bytes): pointer, slot0.bin, slot1.bin
-//   3  device config     od::load_device_config of the file (tools/ecat-slave --config)
+//   3  device config     maxpos::load_config of the file (tools/ecat-slave --config)
 // The contract (issue 14, finding 3): a bad file is reported and the defaults run; nothing else.
 #include <stdlib.h>
 #include <unistd.h>
@@ -20,8 +20,8 @@
 #include "foe/store.hpp"
 #include "fuzz_support.hpp"
 #include "harnesses.hpp"
+#include "maxpos/maxpos.hpp"
 #include "od/device_config.hpp"
-#include "od/drive_profile.hpp"
 #include "od/store.hpp"
 #include "util/crc.hpp"
 #include "util/le.hpp"
@@ -56,11 +56,11 @@ using util::get32;
 using util::put32;
 
 const od::DeviceDescription& description() {
-    static const od::DeviceDescription d = od::default_drive_description();
+    static const od::DeviceDescription d = maxpos::description();
     return d;
 }
 od::Dictionary& dictionary() {
-    static od::Dictionary dict = od::make_drive_dictionary(description());
+    static od::Dictionary dict = maxpos::dictionary(description());
     return dict;
 }
 
@@ -134,7 +134,7 @@ void firmware(Input& in, bool repair) {
 void device_config(std::span<const uint8_t> b) {
     write_file(state_dir() / "device.conf", b);
     try {
-        const od::DeviceDescription d = od::load_device_config(state_dir() / "device.conf");
+        const od::DeviceDescription d = maxpos::load_config(state_dir() / "device.conf");
         (void)d;
     } catch (const od::ConfigError&) {
     }

@@ -25,8 +25,8 @@
 #include "foe/server.hpp"
 #include "fuzz_support.hpp"
 #include "harnesses.hpp"
+#include "maxpos/maxpos.hpp"
 #include "memory_sink.hpp"
-#include "od/drive_profile.hpp"
 
 namespace fuzz::slave {
 namespace {
@@ -34,9 +34,9 @@ namespace {
 // What every input starts from, built once: the description, the dictionary (put back into its built state
 // for each input, fuzz_support.hpp), the SII rendered from it and a firmware image.
 struct Prototype {
-    od::DeviceDescription desc = od::default_drive_description();
-    PristineDictionary dict{od::make_drive_dictionary(desc), [](od::Dictionary& d) {
-                                (void)drive::commission(d);
+    od::DeviceDescription desc = maxpos::description();
+    PristineDictionary dict{maxpos::dictionary(desc), [](od::Dictionary& d) {
+                                (void)drive::commission(d, maxpos::drive_objects());
                                 coe::install_pdo_validators(d);
                             }};
     std::vector<uint8_t> sii;
@@ -104,7 +104,7 @@ int fuzz_one(const uint8_t* data, std::size_t size) {
     foe::FoeServer foe(sink, fc);
     stack.add_handler(coe);
     stack.add_handler(foe);
-    drive::Drive drive(dict, &app);
+    drive::Drive drive(dict, &app, maxpos::drive_objects());
     app.attach(&drive, &events);
     esc.load_eeprom(proto.sii);
     stack.poll(clock.now_ns());

@@ -15,7 +15,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 #include "support/alloc_counter.hpp"
 #include "support/fixed_link.hpp"
 #include "support/master_bring_up.hpp"
@@ -27,8 +27,8 @@ namespace {}  // namespace
 TEST(MasterAllocations, CyclesAndMailboxMessagesAllocateNothing) {
     esc::ManualClock clock;
     clock.set(1'000'000'000);
-    od::DeviceDescription desc = od::default_drive_description();
-    od::Dictionary dict = od::make_drive_dictionary(desc);
+    od::DeviceDescription desc = maxpos::description();
+    od::Dictionary dict = maxpos::dictionary(desc);
     esc::Esc esc(esc::EscConfig{}, clock);
     esc.load_eeprom(esi::build_sii(desc, dict));
     ecat::Application app;

@@ -23,7 +23,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 #include "master/session.hpp"
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 
 #include "support/master_bring_up.hpp"
 #include "support/wire_link.hpp"
@@ -48,13 +48,13 @@ struct Slave {
     std::unique_ptr<foe::FoeServer> foe;
 
     explicit Slave(uint16_t mailbox_size, bool real = false) : real_time(real) {
-        desc = od::default_drive_description();
+        desc = maxpos::description();
         desc.standard_mailbox.out_size = mailbox_size;
         desc.standard_mailbox.in_start =
             static_cast<uint16_t>(desc.standard_mailbox.out_start + mailbox_size);
         desc.standard_mailbox.in_size = mailbox_size;
-        od::place_sync_managers(desc);
-        dict = od::make_drive_dictionary(desc);
+        maxpos::place_sync_managers(desc);
+        dict = maxpos::dictionary(desc);
         clock.set(1'000'000'000);
         esc = std::make_unique<esc::Esc>(esc::EscConfig{}, clk());
         esc->load_eeprom(esi::build_sii(desc, dict));

@@ -2,11 +2,11 @@
 // listeners), set, Ref<T>, lookup.
 #include <gtest/gtest.h>
 
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 #include "support/alloc_counter.hpp"
 
 TEST(OdAlloc, AccessPathsAllocateNothing) {
-    od::Dictionary d = od::make_drive_dictionary(od::default_drive_description());
+    od::Dictionary d = maxpos::dictionary(maxpos::description());
     int heard = 0;
     d.add_listener(0x6040, [&heard](const od::Entry&) { ++heard; });
     d.add_validator(0x6040, [](const od::Entry&, std::span<const uint8_t>) { return od::Status::Ok; });

@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "maxpos/maxpos.hpp"
 #include "od/device_config.hpp"
-#include "od/drive_profile.hpp"
 
 using namespace od;
 
@@ -15,7 +15,7 @@ namespace {
 // Runs the parser and returns the ConfigError line (or -1 if it did not throw).
 int error_line(const std::string& text, std::string* message = nullptr) {
     try {
-        parse_device_config(text, "t.conf");
+        maxpos::parse_config(text, "t.conf");
     } catch (const ConfigError& e) {
         if (message) *message = e.what();
         return e.line();
@@ -26,7 +26,7 @@ int error_line(const std::string& text, std::string* message = nullptr) {
 }  // namespace
 
 TEST(DeviceConfig, ExampleFileLoads) {
-    const DeviceDescription d = load_device_config(std::filesystem::path(OD_EXAMPLES_DIR) / "device.conf");
+    const DeviceDescription d = maxpos::load_config(std::filesystem::path(OD_EXAMPLES_DIR) / "device.conf");
     EXPECT_EQ(d.identity.vendor_id, 0xFBu);
     EXPECT_EQ(d.identity.product_code, 0x30010000u);
     EXPECT_EQ(d.identity.revision, 0x01200000u);
@@ -36,12 +36,12 @@ TEST(DeviceConfig, ExampleFileLoads) {
     EXPECT_EQ(d.standard_mailbox.in_start, 0x1080);
     EXPECT_EQ(d.bootstrap_mailbox.in_size, 1024);
     EXPECT_EQ(d.eeprom_bytes, 2048);
-    Dictionary dict = make_drive_dictionary(d);
+    Dictionary dict = maxpos::dictionary(d);
     EXPECT_EQ(dict.get<uint32_t>(0x1018, 4), 0x12345678u);
 }
 
 TEST(DeviceConfig, EveryKeyAndValueForm) {
-    const DeviceDescription d = parse_device_config(R"(
+    const DeviceDescription d = maxpos::parse_config(R"(
 vendor_id = 0x22        # top-level identity key
 interface = veth0       # a program option before any section: ignored
 [identity]
@@ -133,7 +133,7 @@ TEST(DeviceConfig, ErrorsNameTheLine) {
 }
 
 TEST(DeviceConfig, MissingFileIsAnError) {
-    EXPECT_THROW(load_device_config("/nonexistent/dir/device.conf"), ConfigError);
+    EXPECT_THROW(maxpos::load_config("/nonexistent/dir/device.conf"), ConfigError);
 }
 
 // Issue 14, finding 3 (every loader checks sizes against the bytes present): a configuration path that
@@ -141,7 +141,7 @@ TEST(DeviceConfig, MissingFileIsAnError) {
 // (/dev/zero) is refused before anything is read, as not a regular file.
 TEST(DeviceConfig, OversizedOrEndlessFileIsAnError) {
     try {
-        load_device_config("/dev/zero");
+        maxpos::load_config("/dev/zero");
         ADD_FAILURE() << "/dev/zero was accepted";
     } catch (const ConfigError& e) {
         EXPECT_NE(std::string(e.what()).find("/dev/zero: not a regular file"), std::string::npos) << e.what();
@@ -154,15 +154,15 @@ TEST(DeviceConfig, OversizedOrEndlessFileIsAnError) {
         while (f.tellp() <= static_cast<std::streamoff>(kMaxConfigBytes))
             f << comment;
     }
-    EXPECT_THROW(load_device_config(path), ConfigError);
+    EXPECT_THROW(maxpos::load_config(path), ConfigError);
     std::filesystem::resize_file(path, 200);  // the same file, short: reads
-    EXPECT_EQ(load_device_config(path).identity.vendor_id, 0xFBu);
+    EXPECT_EQ(maxpos::load_config(path).identity.vendor_id, 0xFBu);
     std::filesystem::remove(path);
 }
 
 TEST(DeviceConfig, MessagesNameTheFileAndALineOnlyWhenThereIsOne) {
     try {
-        load_device_config("/nonexistent/dir/device.conf");
+        maxpos::load_config("/nonexistent/dir/device.conf");
         FAIL() << "no error";
     } catch (const ConfigError& e) {
         EXPECT_EQ(std::string(e.what()),
@@ -182,14 +182,58 @@ TEST(DeviceConfig, EveryExampleLoads) {
     int n = 0;
     for (const auto& f : std::filesystem::directory_iterator(OD_EXAMPLES_DIR)) {
         if (f.path().extension() != ".conf") continue;
-        EXPECT_NO_THROW(load_device_config(f.path())) << f.path();
+        EXPECT_NO_THROW(maxpos::load_config(f.path())) << f.path();
         ++n;
     }
     EXPECT_GE(n, 2);
     const DeviceDescription d =
-        load_device_config(std::filesystem::path(OD_EXAMPLES_DIR) / "bootstrap-as-standard.conf");
+        maxpos::load_config(std::filesystem::path(OD_EXAMPLES_DIR) / "bootstrap-as-standard.conf");
     EXPECT_EQ(d.bootstrap_mailbox.out_start, d.standard_mailbox.out_start);
     EXPECT_EQ(d.bootstrap_mailbox.out_size, d.standard_mailbox.out_size);
     EXPECT_EQ(d.bootstrap_mailbox.in_start, d.standard_mailbox.in_start);
     EXPECT_EQ(d.bootstrap_mailbox.in_size, d.standard_mailbox.in_size);
+}
+
+// The parser is the object model's, not the MAXPOS's: it reads on top of any product's description and
+// leaves what the file does not name as that product has it; the SyncManagers are placed by the product's
+// own placer, or kept.
+TEST(DeviceConfig, ReadsOnTopOfAnyProductsDescription) {
+    DeviceDescription base;
+    base.identity.vendor_id = 0x00000002;
+    base.identity.product_code = 0x07D83052;
+    base.identity.device_name = "EL2008";
+    base.mailbox_protocols = 0;  // a device without a mailbox
+    base.sync_managers = {{SmKind::Outputs, 0x0F00, 1, 0x44, true, 0, 0}};
+    const DeviceDescription d = parse_device_config("[identity]\nserial_number = 7\n", "io.conf", base);
+    EXPECT_EQ(d.identity.vendor_id, 0x00000002u);
+    EXPECT_EQ(d.identity.product_code, 0x07D83052u);
+    EXPECT_EQ(d.identity.serial_number, 7u);
+    EXPECT_EQ(d.identity.device_name, "EL2008");
+    ASSERT_EQ(d.sync_managers.size(), 1u);
+    EXPECT_EQ(d.sync_managers[0].start, 0x0F00);
+    int placed = 0;
+    const DeviceDescription p =
+        parse_device_config("[identity]\nserial_number = 8\n", "io.conf", base, [&](DeviceDescription& x) {
+            ++placed;
+            x.sync_managers.clear();
+        });
+    EXPECT_EQ(placed, 1);
+    EXPECT_TRUE(p.sync_managers.empty());
+    // A placer that finds no room is an error of the file.
+    try {
+        parse_device_config("[mailbox]\nout_start = 0x1000\n", "io.conf", base,
+                            [](DeviceDescription&) { throw std::out_of_range("no room"); });
+        FAIL() << "no error";
+    } catch (const ConfigError& e) {
+        EXPECT_EQ(std::string(e.what()), "io.conf: no room");
+    }
+}
+
+// The identity of the generic model names no vendor: each product states its own.
+TEST(DeviceConfig, IdentityDefaultsNameNoProduct) {
+    const Identity id;
+    EXPECT_EQ(id.vendor_id, 0u);
+    EXPECT_TRUE(id.vendor_name.empty());
+    EXPECT_TRUE(id.device_name.empty());
+    EXPECT_TRUE(id.group_type.empty());
 }

@@ -5,7 +5,7 @@
 #include <set>
 #include <vector>
 
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 
 using namespace od;
 
@@ -127,8 +127,8 @@ const std::vector<Expected> kSeedTable = {
 
 class DriveDictionary : public ::testing::Test {
   protected:
-    DeviceDescription desc = default_drive_description();
-    Dictionary d = make_drive_dictionary(desc);
+    DeviceDescription desc = maxpos::description();
+    Dictionary d = maxpos::dictionary(desc);
 };
 
 }  // namespace
@@ -328,7 +328,7 @@ TEST_F(DriveDictionary, IdentityObjectsComeFromTheDescription) {
     other.identity.device_name = "MAXPOS 50/5 soft";
     other.identity.hardware_version = "HW 3002h";
     other.identity.software_version = "FW 0130h";
-    Dictionary o = make_drive_dictionary(other);
+    Dictionary o = maxpos::dictionary(other);
     EXPECT_EQ(o.get<uint32_t>(0x1018, 1), 0x12345678u);
     EXPECT_EQ(o.get<uint32_t>(0x1018, 2), 0x30020001u);
     EXPECT_EQ(o.get<uint32_t>(0x1018, 3), 0x01300002u);
@@ -343,12 +343,12 @@ TEST_F(DriveDictionary, IdentityObjectsComeFromTheDescription) {
 }
 
 TEST_F(DriveDictionary, DiagnosisHistoryMessages) {
-    EXPECT_EQ(d.get<uint8_t>(0x10F3, 1), kDiagMaxMessages);
-    for (uint8_t s = 6; s < 6 + kDiagMaxMessages; ++s) {
+    EXPECT_EQ(d.get<uint8_t>(0x10F3, 1), maxpos::kDiagMaxMessages);
+    for (uint8_t s = 6; s < 6 + maxpos::kDiagMaxMessages; ++s) {
         const Entry* e = d.find(0x10F3, s);
         ASSERT_NE(e, nullptr);
         EXPECT_EQ(e->type, DataType::OctetString);
-        EXPECT_EQ(e->byte_size(), kDiagMessageBytes);
+        EXPECT_EQ(e->byte_size(), maxpos::kDiagMessageBytes);
         EXPECT_TRUE(d.raw(0x10F3, s).empty());
     }
     uint8_t msg[20] = {0x31, 0x83, 0, 0};
@@ -359,7 +359,7 @@ TEST_F(DriveDictionary, DiagnosisHistoryMessages) {
 }
 
 TEST(DriveDescription, DefaultsAsDecided) {
-    const DeviceDescription d = default_drive_description();
+    const DeviceDescription d = maxpos::description();
     EXPECT_EQ(d.identity.vendor_id, 0xFBu);
     EXPECT_EQ(d.identity.product_code, 0x30010000u);
     EXPECT_EQ(d.identity.revision, 0x01200000u);

@@ -13,7 +13,7 @@
 #include <iterator>
 #include <vector>
 
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 #include "od/store.hpp"
 #include "util/crc.hpp"
 
@@ -63,7 +63,7 @@ class StoredParameters : public ::testing::Test {
     }
 
     fs::path dir;
-    DeviceDescription desc = default_drive_description();
+    DeviceDescription desc = maxpos::description();
 };
 
 }  // namespace
@@ -74,7 +74,7 @@ TEST(Crc32, KnownVector) {
 }
 
 TEST_F(StoredParameters, NoFileKeepsDefaults) {
-    Dictionary d = make_drive_dictionary(desc);
+    Dictionary d = maxpos::dictionary(desc);
     ParameterStore store(dir);
     const auto r = store.load(d);
     EXPECT_FALSE(r.found);
@@ -84,7 +84,7 @@ TEST_F(StoredParameters, NoFileKeepsDefaults) {
 }
 
 TEST_F(StoredParameters, RoundTripRestoresEveryBackupEntry) {
-    Dictionary d = make_drive_dictionary(desc);
+    Dictionary d = maxpos::dictionary(desc);
     modify(d);
     ASSERT_EQ(d.set<int8_t>(0x6060, 0, 9), Status::Ok);  // not a Backup entry: not stored
     ParameterStore store(dir);
@@ -92,7 +92,7 @@ TEST_F(StoredParameters, RoundTripRestoresEveryBackupEntry) {
     EXPECT_TRUE(fs::exists(store.file()));
     EXPECT_FALSE(fs::exists(fs::path(store.file()).concat(".tmp")));
 
-    Dictionary fresh = make_drive_dictionary(desc);
+    Dictionary fresh = maxpos::dictionary(desc);
     const auto r = store.load(fresh);
     EXPECT_TRUE(r.found);
     ASSERT_TRUE(r.applied) << r.error;
@@ -106,47 +106,47 @@ TEST_F(StoredParameters, RoundTripRestoresEveryBackupEntry) {
 }
 
 TEST_F(StoredParameters, RestoreDefaultsDropsTheStoredSet) {
-    Dictionary d = make_drive_dictionary(desc);
+    Dictionary d = maxpos::dictionary(desc);
     modify(d);
     ParameterStore store(dir);
     ASSERT_EQ(store.save(d), "");
     ASSERT_EQ(store.restore_defaults(d), "");
     expect_modified(d);  // running values unchanged (CiA 301: defaults at the next start)
     EXPECT_FALSE(fs::exists(store.file()));
-    Dictionary fresh = make_drive_dictionary(desc);
+    Dictionary fresh = maxpos::dictionary(desc);
     EXPECT_FALSE(store.load(fresh).found);
     expect_defaults(fresh);
     EXPECT_EQ(store.restore_defaults(d), "");  // nothing stored: still fine
 }
 
 TEST_F(StoredParameters, ScopedStoreAndRestore) {
-    Dictionary d = make_drive_dictionary(desc);
+    Dictionary d = maxpos::dictionary(desc);
     modify(d);
     ParameterStore store(dir);
     ASSERT_EQ(store.save(d, StoreScope::Communication), "");  // 0x1600, 0x1C12 only
-    Dictionary a = make_drive_dictionary(desc);
+    Dictionary a = maxpos::dictionary(desc);
     ASSERT_TRUE(store.load(a).applied);
     EXPECT_EQ(a.get<uint8_t>(0x1600, 0), 2);
     EXPECT_EQ(a.get<uint32_t>(0x6065, 0), 2000u);           // application parameters not stored yet
     ASSERT_EQ(store.save(d, StoreScope::Application), "");  // adds them, keeps the communication ones
-    Dictionary b = make_drive_dictionary(desc);
+    Dictionary b = maxpos::dictionary(desc);
     ASSERT_TRUE(store.load(b).applied);
     expect_modified(b);
     ASSERT_EQ(store.restore_defaults(d, StoreScope::Communication), "");
-    Dictionary c = make_drive_dictionary(desc);
+    Dictionary c = maxpos::dictionary(desc);
     ASSERT_TRUE(store.load(c).applied);
     EXPECT_EQ(c.get<uint8_t>(0x1600, 0), 8);
     EXPECT_EQ(c.get<uint32_t>(0x6065, 0), 4321u);
 }
 
 TEST_F(StoredParameters, FlippedByteAnywhereKeepsDefaults) {
-    Dictionary d = make_drive_dictionary(desc);
+    Dictionary d = maxpos::dictionary(desc);
     modify(d);
     ParameterStore store(dir);
     ASSERT_EQ(store.save(d), "");
     const std::vector<uint8_t> good = read_all(store.file());
     ASSERT_GT(good.size(), ParameterStore::kHeaderBytes);
-    Dictionary fresh = make_drive_dictionary(desc);  // one dictionary: no rejected file may touch it
+    Dictionary fresh = maxpos::dictionary(desc);  // one dictionary: no rejected file may touch it
     for (std::size_t i = 0; i < good.size(); ++i) {
         std::vector<uint8_t> bad = good;
         bad[i] ^= 0x01;
@@ -160,12 +160,12 @@ TEST_F(StoredParameters, FlippedByteAnywhereKeepsDefaults) {
 }
 
 TEST_F(StoredParameters, TruncatedAtEveryLengthKeepsDefaults) {
-    Dictionary d = make_drive_dictionary(desc);
+    Dictionary d = maxpos::dictionary(desc);
     modify(d);
     ParameterStore store(dir);
     ASSERT_EQ(store.save(d), "");
     const std::vector<uint8_t> good = read_all(store.file());
-    Dictionary fresh = make_drive_dictionary(desc);
+    Dictionary fresh = maxpos::dictionary(desc);
     for (std::size_t n = 0; n < good.size(); ++n) {
         write_all(store.file(), std::vector<uint8_t>(good.begin(), good.begin() + static_cast<long>(n)));
         const auto r = store.load(fresh);
@@ -182,7 +182,7 @@ TEST_F(StoredParameters, TruncatedAtEveryLengthKeepsDefaults) {
 
 TEST_F(StoredParameters, ValidCrcButInvalidContentIsRejectedWhole) {
     // A file that is well-formed but holds an out-of-range value must not apply the entries before it.
-    Dictionary d = make_drive_dictionary(desc);
+    Dictionary d = maxpos::dictionary(desc);
     modify(d);
     ParameterStore store(dir);
     ASSERT_EQ(store.save(d), "");
@@ -206,7 +206,7 @@ TEST_F(StoredParameters, ValidCrcButInvalidContentIsRejectedWhole) {
     put32(32, util::crc32(std::span<const uint8_t>(b).subspan(ParameterStore::kHeaderBytes)));
     put32(36, util::crc32(std::span<const uint8_t>(b).first(36)));
     write_all(store.file(), b);
-    Dictionary fresh = make_drive_dictionary(desc);
+    Dictionary fresh = maxpos::dictionary(desc);
     const auto r = store.load(fresh);
     EXPECT_FALSE(r.applied);
     EXPECT_NE(r.error.find("0x605A"), std::string::npos) << r.error;
@@ -214,7 +214,7 @@ TEST_F(StoredParameters, ValidCrcButInvalidContentIsRejectedWhole) {
 }
 
 TEST_F(StoredParameters, MismatchedIdentityIsRejected) {
-    Dictionary d = make_drive_dictionary(desc);
+    Dictionary d = maxpos::dictionary(desc);
     modify(d);
     ParameterStore store(dir);
     ASSERT_EQ(store.save(d), "");
@@ -223,7 +223,7 @@ TEST_F(StoredParameters, MismatchedIdentityIsRejected) {
         if (which == 0) other.identity.vendor_id = 0x2;
         if (which == 1) other.identity.product_code ^= 1;
         if (which == 2) other.identity.revision += 0x00010000;
-        Dictionary o = make_drive_dictionary(other);
+        Dictionary o = maxpos::dictionary(other);
         const auto r = store.load(o);
         EXPECT_TRUE(r.found);
         EXPECT_FALSE(r.applied);
@@ -232,12 +232,12 @@ TEST_F(StoredParameters, MismatchedIdentityIsRejected) {
     }
     DeviceDescription same_but_serial = desc;  // the serial number is not part of the match
     same_but_serial.identity.serial_number = 77;
-    Dictionary s = make_drive_dictionary(same_but_serial);
+    Dictionary s = maxpos::dictionary(same_but_serial);
     EXPECT_TRUE(store.load(s).applied);
 }
 
 TEST_F(StoredParameters, CrashBetweenTempWriteAndRenameKeepsTheOldFile) {
-    Dictionary d = make_drive_dictionary(desc);
+    Dictionary d = maxpos::dictionary(desc);
     ParameterStore store(dir);
     ASSERT_EQ(d.set<uint32_t>(0x6065, 0, 1111), Status::Ok);
     ASSERT_EQ(store.save(d), "");
@@ -258,7 +258,7 @@ TEST_F(StoredParameters, CrashBetweenTempWriteAndRenameKeepsTheOldFile) {
         ASSERT_EQ(::waitpid(pid, &status, 0), pid);
         ASSERT_TRUE(WIFEXITED(status));
         ASSERT_EQ(WEXITSTATUS(status), 42);
-        Dictionary fresh = make_drive_dictionary(desc);
+        Dictionary fresh = maxpos::dictionary(desc);
         const auto r = store.load(fresh);
         ASSERT_TRUE(r.applied) << r.error;
         if (std::string_view(crash_at) == "temp-written") {
@@ -274,7 +274,7 @@ TEST_F(StoredParameters, CrashBetweenTempWriteAndRenameKeepsTheOldFile) {
 }
 
 TEST_F(StoredParameters, UnwritableDirectoryReportsAnError) {
-    Dictionary d = make_drive_dictionary(desc);
+    Dictionary d = maxpos::dictionary(desc);
     fs::create_directories(dir.parent_path());
     write_all(dir, {1, 2, 3});  // "state" is a file, not a directory
     ParameterStore store(dir);
@@ -282,7 +282,7 @@ TEST_F(StoredParameters, UnwritableDirectoryReportsAnError) {
 }
 
 TEST_F(StoredParameters, SdoStoreAndRestoreObjects) {
-    Dictionary d = make_drive_dictionary(desc);
+    Dictionary d = maxpos::dictionary(desc);
     ParameterStore store(dir);
     attach_store(d, store);
     modify(d);
@@ -297,7 +297,7 @@ TEST_F(StoredParameters, SdoStoreAndRestoreObjects) {
     ASSERT_EQ(d.write(0x1010, 1, AlState::Op, le32(kSignatureSave)), Status::Ok);
     EXPECT_TRUE(fs::exists(store.file()));
     EXPECT_EQ(d.get<uint32_t>(0x1010, 1), 1u);  // reads as "saves on command", not the signature
-    Dictionary a = make_drive_dictionary(desc);
+    Dictionary a = maxpos::dictionary(desc);
     ASSERT_TRUE(store.load(a).applied);
     expect_modified(a);
     // "load" through 0x2111:01 only in Pre-Op; the file goes, the running values stay
@@ -309,7 +309,7 @@ TEST_F(StoredParameters, SdoStoreAndRestoreObjects) {
     expect_modified(d);
     // maxon store of the axis parameters only (0x2110:06)
     ASSERT_EQ(d.write(0x2110, 6, AlState::SafeOp, le32(kSignatureSave)), Status::Ok);
-    Dictionary b = make_drive_dictionary(desc);
+    Dictionary b = maxpos::dictionary(desc);
     ASSERT_TRUE(store.load(b).applied);
     EXPECT_EQ(b.get<uint32_t>(0x6065, 0), 4321u);
     EXPECT_EQ(b.get<uint8_t>(0x1600, 0), 8);
@@ -320,7 +320,7 @@ TEST_F(StoredParameters, SdoStoreAndRestoreObjects) {
 }
 
 TEST_F(StoredParameters, SdoStoreFailureIsAHardwareErrorAndShowsInTheState) {
-    Dictionary d = make_drive_dictionary(desc);
+    Dictionary d = maxpos::dictionary(desc);
     fs::create_directories(dir.parent_path());
     write_all(dir, {1});  // cannot create the state directory
     ParameterStore store(dir);
@@ -331,7 +331,7 @@ TEST_F(StoredParameters, SdoStoreFailureIsAHardwareErrorAndShowsInTheState) {
 }
 
 TEST_F(StoredParameters, RestoreWaitsForThePowerDisableCondition) {
-    Dictionary d = make_drive_dictionary(desc);
+    Dictionary d = maxpos::dictionary(desc);
     ParameterStore store(dir);
     bool power_disabled = false;
     attach_store(d, store, [&] { return power_disabled ? Status::Ok : Status::WrongState; });
@@ -348,7 +348,7 @@ TEST_F(StoredParameters, RestoreWaitsForThePowerDisableCondition) {
 // 0xFFFFFFFF threw std::bad_alloc from every start. Crafted headers of every kind are reported and the
 // defaults run; nothing is reserved for what the bytes present cannot hold.
 TEST_F(StoredParameters, CraftedRecordCountsAreReportedNotReserved) {
-    Dictionary d = make_drive_dictionary(desc);
+    Dictionary d = maxpos::dictionary(desc);
     modify(d);
     ParameterStore store(dir);
     ASSERT_EQ(store.save(d), "");
@@ -378,7 +378,7 @@ TEST_F(StoredParameters, CraftedRecordCountsAreReportedNotReserved) {
              {static_cast<uint32_t>(real_count + 1), good.size()}}) {  // one more than present
         SCOPED_TRACE("count " + std::to_string(count) + ", payload " + std::to_string(payload));
         write_all(store.file(), crafted(count, payload));
-        Dictionary fresh = make_drive_dictionary(desc);
+        Dictionary fresh = maxpos::dictionary(desc);
         ParameterStore::LoadResult r;
         ASSERT_NO_THROW(r = store.load(fresh));
         EXPECT_TRUE(r.found);
@@ -391,13 +391,13 @@ TEST_F(StoredParameters, CraftedRecordCountsAreReportedNotReserved) {
         EXPECT_EQ(store.restore_defaults(d, StoreScope::Application), "");
     }
     write_all(store.file(), found);
-    Dictionary fresh = make_drive_dictionary(desc);
+    Dictionary fresh = maxpos::dictionary(desc);
     EXPECT_NE(store.load(fresh).error.find("records"), std::string::npos);
 }
 
 // Neither a file far beyond any dictionary nor a FIFO in place of parameters.bin stops the start.
 TEST_F(StoredParameters, OversizedFileAndFifoAreReported) {
-    Dictionary d = make_drive_dictionary(desc);
+    Dictionary d = maxpos::dictionary(desc);
     ParameterStore store(dir);
     fs::create_directories(dir);
     { std::ofstream f(store.file(), std::ios::binary); }
@@ -418,7 +418,7 @@ TEST_F(StoredParameters, OversizedFileAndFifoAreReported) {
 // Issue 14, finding 7: a save SIGKILLed after its temporary file was written left parameters.bin.tmp behind
 // for good. It is removed at the next start (remove_stale_temp), and the file that loads is the old one.
 TEST_F(StoredParameters, TemporaryOfASaveKilledHalfWayIsRemovedAtTheStart) {
-    Dictionary d = make_drive_dictionary(desc);
+    Dictionary d = maxpos::dictionary(desc);
     ParameterStore store(dir);
     ASSERT_EQ(d.set<uint32_t>(0x6065, 0, 1111), Status::Ok);
     ASSERT_EQ(store.save(d), "");
@@ -443,7 +443,7 @@ TEST_F(StoredParameters, TemporaryOfASaveKilledHalfWayIsRemovedAtTheStart) {
     EXPECT_TRUE(at_start.remove_stale_temp());
     EXPECT_FALSE(fs::exists(tmp));
     EXPECT_FALSE(at_start.remove_stale_temp());  // nothing left the second time
-    Dictionary fresh = make_drive_dictionary(desc);
+    Dictionary fresh = maxpos::dictionary(desc);
     ASSERT_TRUE(at_start.load(fresh).applied);
     EXPECT_EQ(fresh.get<uint32_t>(0x6065, 0), 1111u);
 }

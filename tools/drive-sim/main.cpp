@@ -37,7 +37,7 @@
 
 #include "drive/drive.hpp"
 #include "drive/profile.hpp"
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 #include "plot.hpp"
 #include "util/input_file.hpp"
 
@@ -155,8 +155,8 @@ class Sim {
     // (drive::commission); otherwise the seed defaults (torque constant 0: enabling fails with 0x8331 until
     // the script sets it).
     explicit Sim(bool commissioned = true)
-        : dict_(od::make_drive_dictionary(od::default_drive_description())), drive_(dict_) {
-        if (commissioned) drive::commission(dict_, drive_.motor());
+        : dict_(maxpos::dictionary(maxpos::description())), drive_(dict_, nullptr, maxpos::drive_objects()) {
+        if (commissioned) drive::commission(dict_, maxpos::drive_objects(), drive_.motor());
     }
 
     bool apply(const Step& st, std::string& err) {

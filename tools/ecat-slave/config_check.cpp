@@ -3,6 +3,7 @@
 #include <sstream>
 #include <string_view>
 
+#include "maxpos/maxpos.hpp"
 #include "od/device_config.hpp"
 #include "util/input_file.hpp"
 #include "util/lex.hpp"
@@ -68,7 +69,7 @@ std::string check_config_file(const CLI::App& app, const std::string& path) {
                           "ecat-slave go before the first section or in [default])");
             continue;
         }
-        if (!section.empty()) continue;  // a device section: od::load_device_config checks it below
+        if (!section.empty()) continue;  // a device section: maxpos::parse_config checks it below
         const auto eq = l.find('=');
         if (eq == std::string_view::npos) return at("expected 'option = value'");
         std::string key(trim(l.substr(0, eq)));
@@ -80,7 +81,7 @@ std::string check_config_file(const CLI::App& app, const std::string& path) {
             return at("unknown option '" + key + "' (`ecat-slave --help` lists the options)");
     }
     try {
-        (void)od::parse_device_config(text, path);
+        (void)maxpos::parse_config(text, path);
     } catch (const od::ConfigError& e) {
         return e.what();
     }

@@ -1,7 +1,7 @@
 #pragma once
 // Checks ecat-slave's --config file before CLI11 reads it, so that every error names the file and the line:
 // a file that is not text, a section header without ']', an unknown section, an unknown program option,
-// and (through od::load_device_config) every error in the device sections.
+// and (through maxpos::parse_config) every error in the device sections.
 #include <CLI/CLI.hpp>
 #include <optional>
 #include <string>

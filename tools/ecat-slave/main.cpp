@@ -32,7 +32,7 @@
 
 namespace {
 
-// Config file sections that belong to the object model (od::load_device_config), not to the program.
+// Config file sections that belong to the device description (maxpos::load_config), not to the program.
 bool device_section(const std::string& item) {
     for (const char* s : {"identity.", "mailbox.", "bootstrap_mailbox.", "eeprom."})
         if (item.rfind(s, 0) == 0) return true;

@@ -8,8 +8,8 @@
 #include <cstring>
 #include <memory>
 
+#include "maxpos/maxpos.hpp"
 #include "od/device_config.hpp"
-#include "od/drive_profile.hpp"
 
 namespace fwimage {
 
@@ -58,12 +58,12 @@ std::string attr_of(xmlNodePtr n, const char* name) {
 }  // namespace
 
 DeviceIdentity default_identity() {
-    return from(od::default_drive_description().identity);
+    return from(maxpos::description().identity);
 }
 
 std::optional<DeviceIdentity> identity_from_config(const std::string& path, std::string& error) {
     try {
-        return from(od::load_device_config(path).identity);
+        return from(maxpos::load_config(path).identity);
     } catch (const std::exception& e) {
         error = e.what();
         return std::nullopt;

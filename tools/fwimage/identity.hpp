@@ -14,7 +14,7 @@ struct DeviceIdentity {
     std::string device_name;
 };
 
-// The soft drive's own identity (od::default_drive_description()).
+// The soft drive's own identity (maxpos::description()).
 DeviceIdentity default_identity();
 // From ecat-slave's --config file; on error, error says why (with the file and line) and nullopt.
 std::optional<DeviceIdentity> identity_from_config(const std::string& path, std::string& error);

@@ -15,7 +15,7 @@ namespace coe {
 
 struct PdoLimits {
     // Largest process-data image one SyncManager may carry (SM2 outputs, SM3 inputs), in bytes. The default
-    // is the room od::place_sync_managers() leaves: 4 PDOs x 10 entries x 32 bits (MAXPOS firmware
+    // is the room maxpos::place_sync_managers() leaves: 4 PDOs x 10 entries x 32 bits (MAXPOS firmware
     // specification §7.2.6-16).
     std::size_t max_sm_bytes = 160;
 };

@@ -1,6 +1,6 @@
 #pragma once
 // One servo axis that runs without an object dictionary (its defaults are the dictionary's, declared once in
-// od/drive_objects.hpp), composed of parts that each own their state and behaviour and are tested alone:
+// drive/objects.hpp), composed of parts that each own their state and behaviour and are tested alone:
 // device control (device_control.hpp), the set-point generator (setpoint.hpp), the cascaded loops and
 // observer (controller.hpp), supervision and errors (supervisor.hpp), the touch probe (touch_probe.hpp) and
 // homing (homing.hpp), plus the simulated machine (plant.hpp, environment.hpp). Axis sequences them in the
@@ -20,6 +20,7 @@
 #include "drive/event_sink.hpp"
 #include "drive/faults.hpp"
 #include "drive/homing.hpp"
+#include "drive/objects.hpp"
 #include "drive/parameters.hpp"
 #include "drive/plant.hpp"
 #include "drive/profile.hpp"
@@ -27,7 +28,6 @@
 #include "drive/state_machine.hpp"
 #include "drive/supervisor.hpp"
 #include "drive/touch_probe.hpp"
-#include "od/drive_objects.hpp"
 
 namespace drive {
 

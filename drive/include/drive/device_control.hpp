@@ -45,6 +45,7 @@ class DeviceControl {
         int16_t disable_operation = 0;         // 0x605C
         uint32_t profile_deceleration = 0;     // 0x6084 rpm/s
         uint32_t quick_stop_deceleration = 0;  // 0x6085 rpm/s
+        int16_t quick_stop = 6;                // 0x605A
     };
 
     // Start-up: transition 1 (Not Ready to Switch On -> Switch On Disabled).

@@ -4,31 +4,40 @@
 // its configuration and commands from the dictionary, runs the axis for dt and writes the inputs (0x6041,
 // 0x6064, ...) back. Objects the dictionary does not declare keep the Axis defaults (Parameters), so the
 // drive also runs on a partial dictionary.
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "drive/axis.hpp"
 #include "drive/event_sink.hpp"
+#include "drive/objects.hpp"
 #include "od/dictionary.hpp"
-#include "od/drive_objects.hpp"
 
 namespace drive {
 
-// Writes the parameters a commissioning tool would have stored for the simulated motor into the dictionary:
-// torque constant 0x3001:05 (the default 0 of the MAXPOS firmware specification refuses to enable with
-// 0x8331), and a position/velocity tuning 0x30A1 matched to the motor and load (20 Hz bandwidth, critical
-// damping, 50 ms reset time, the model's inertia and viscous friction). Device-side writes, range-checked;
-// returns the first failure or Ok.
-od::Status commission(od::Dictionary& dictionary, const MotorModel& motor = MotorModel{});
+// The parameters a commissioning tool would store for the simulated motor: torque constant (uNm/A; a
+// dictionary default of 0, as the MAXPOS firmware specification's 0x3001:05, refuses to enable with 0x8331),
+// and a position/velocity tuning matched to the motor and load (20 Hz bandwidth, critical damping, 50 ms
+// reset time, the model's inertia and viscous friction). The drive runs on these where the device keeps no
+// such parameter.
+std::array<std::pair<Param, uint32_t>, 6> commissioned(const MotorModel& motor);
+
+// Writes commissioned(motor) into the objects `vendor` names for them, those that exist. Device-side writes,
+// range-checked; returns the first failure or Ok.
+od::Status commission(od::Dictionary& dictionary, const VendorObjects& vendor,
+                      const MotorModel& motor = MotorModel{});
 
 class Drive {
   public:
-    // Also registers validators on the objects the MAXPOS firmware specification lets a master write only in
-    // "Power Disable" (0x3000, 0x3001:03, the sensor records, 0x60A8..0x60AA, 0x6402): such writes answer
-    // WrongState (SDO abort 0x08000022) while the power stage is on.
-    explicit Drive(od::Dictionary& dictionary, EventSink* sink = nullptr);
+    // Binds the CiA 402 objects (drive/objects.hpp) the dictionary has, by index, and the vendor parameters
+    // where `vendor` says; the rest run on the drive's defaults (the motor model's tuning, commissioned()).
+    // Registers a validator on 0x6060 that refuses a mode the drive does not implement or 0x6502 does not
+    // announce (InvalidValue, SDO abort 0x06090030), and one on each of `vendor.power_disable_only`: such
+    // writes answer WrongState (SDO abort 0x08000022) while the power stage is on.
+    explicit Drive(od::Dictionary& dictionary, EventSink* sink = nullptr, const VendorObjects& vendor = {});
     Drive(const Drive&) = delete;
     Drive& operator=(const Drive&) = delete;
     ~Drive();
@@ -44,10 +53,12 @@ class Drive {
     // How many (index, subindex) pairs the drive found in the dictionary, and how many it had to run without.
     std::size_t bound() const { return bound_; }
     std::size_t missing() const { return missing_; }
-    // Whether the drive found and bound this entry (one of the od/drive_objects.hpp handles).
+    // Whether the drive found and bound this entry (a drive/objects.hpp handle or a vendor binding).
     bool binds(uint16_t index, uint8_t sub) const;
 
   private:
+    // What a scaled link converts: a position, or a velocity or acceleration.
+    enum class Unit : uint8_t { Position, Velocity };
     struct Link {
         od::Ref<uint8_t> r8;
         od::Ref<uint16_t> r16;
@@ -56,11 +67,25 @@ class Drive {
         uint16_t index;
         uint8_t sub;
         uint8_t size;
+        bool is_signed;
+        Unit unit;  // of a scaled link
     };
     template <typename T>
-    void in(const od::Obj<T>& object, T& field);
+    void in(const Obj<T>& object, T& field);
     template <typename T>
-    void out(const od::Obj<T>& object, const T& field);
+    void out(const Obj<T>& object, const T& field);
+    // A position (velocity, acceleration) object: through the factor group where the device has one
+    // (0x6091/0x6092), else a raw copy.
+    template <typename T>
+    void in_scaled(const Obj<T>& object, T& field, Unit unit);
+    template <typename T>
+    void out_scaled(const Obj<T>& object, const T& field, Unit unit);
+    double increments_per_rev() const;
+    double increments_per_unit() const;
+    void load_positions();
+    void store_positions();
+    bool in_raw(uint16_t index, uint8_t sub, std::size_t size, uint8_t* field);
+    bool out_raw(uint16_t index, uint8_t sub, std::size_t size, uint8_t* field);
     bool locate(uint16_t index, uint8_t sub, std::size_t size, Link& link);
     // The copies of a cycle, one loop per entry size (no test of the size per entry).
     template <typename T>
@@ -75,6 +100,10 @@ class Drive {
     Axis axis_;
     std::vector<Link> inputs_[3];   // dictionary -> axis (parameters, commands), by size: 1, 2, 4 bytes
     std::vector<Link> outputs_[3];  // axis -> dictionary (feedback), by size
+    std::vector<Link> position_in_, position_out_;  // position objects in position units (scaled_ only)
+    bool scaled_ = false;
+    bool velocity_per_second_ = false;
+    bool resolution_from_feed_ = false;  // a factor group without 0x608F: increments per unit 1
     Feedback fb_copy_;
     uint32_t resolution_ = 0;
     std::size_t bound_ = 0, missing_ = 0;

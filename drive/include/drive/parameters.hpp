@@ -7,91 +7,102 @@
 #include <array>
 #include <cstdint>
 
-#include "od/drive_objects.hpp"
+#include "drive/objects.hpp"
 
 namespace drive {
 
-// Configuration objects. Defaults: the dictionary's, declared once in od/drive_objects.hpp (the MAXPOS
-// firmware specification's defaults, except where docs/decisions/od.md notes otherwise).
+// Configuration objects. Defaults: the drive's, declared once in drive/objects.hpp (a dictionary that has the
+// object replaces them with its own every cycle).
 struct Parameters {
     // Motor data 0x3001, 0x6402
-    uint16_t nominal_current = od::obj::MotorNominalCurrent.def;             // :01 mA
-    uint16_t output_current_limit = od::obj::MotorOutputCurrentLimit.def;    // :02 mA
-    uint8_t pole_pairs = od::obj::MotorPolePairs.def;                        // :03
-    uint16_t thermal_time_constant = od::obj::MotorThermalTimeConstant.def;  // :04 in 100 ms
-    uint32_t torque_constant = od::obj::MotorTorqueConstant.def;  // :05 uNm/A (0 -> 0x8331 on enable)
-    uint16_t motor_type = od::obj::MotorType.def;                 // 0x6402
+    uint16_t nominal_current = vendor::MotorNominalCurrent.def;             // :01 mA
+    uint16_t output_current_limit = vendor::MotorOutputCurrentLimit.def;    // :02 mA
+    uint8_t pole_pairs = vendor::MotorPolePairs.def;                        // :03
+    uint16_t thermal_time_constant = vendor::MotorThermalTimeConstant.def;  // :04 in 100 ms
+    uint32_t torque_constant = vendor::MotorTorqueConstant.def;  // :05 uNm/A (0 -> 0x8331 on enable)
+    uint16_t motor_type = obj::MotorType.def;                    // 0x6402
     // Encoder 0x3010
-    uint32_t encoder_pulses = od::obj::EncoderPulses.def;     // :01 pulses/rev, inc/rev = 4 x
-    uint16_t encoder_type = od::obj::EncoderType.def;         // :02 bit0 index present
-    uint32_t axis_misc = od::obj::AxisConfigurationMisc.def;  // 0x3000:04 bit0 polarity: 1 = inverse
+    uint32_t encoder_pulses = vendor::EncoderPulses.def;     // :01 pulses/rev, inc/rev = 4 x
+    uint16_t encoder_type = vendor::EncoderType.def;         // :02 bit0 index present
+    uint32_t axis_misc = vendor::AxisConfigurationMisc.def;  // 0x3000:04 bit0 polarity: 1 = inverse
     // Current loop 0x30A0 (2^-16 V/A; I gain per 40 us current-loop sample, see decisions)
-    uint32_t current_p = od::obj::CurrentPGain.def, current_i = od::obj::CurrentIGain.def,
-             current_ff = od::obj::CurrentFfGain.def;
+    uint32_t current_p = vendor::CurrentPGain.def, current_i = vendor::CurrentIGain.def,
+             current_ff = vendor::CurrentFfGain.def;
     // Position (and velocity) loop 0x30A1
-    uint32_t bandwidth = od::obj::PositionBandwidth.def;   // :01 0.001 Hz
-    uint32_t damping = od::obj::PositionDamping.def;       // :02 per mille of critical
-    uint32_t reset_time = od::obj::PositionResetTime.def;  // :03 us
-    uint32_t inertia = od::obj::Inertia.def;               // :04 mg cm^2
-    uint32_t friction = od::obj::Friction.def;             // :05 nNm/rpm (viscous)
+    uint32_t bandwidth = vendor::PositionBandwidth.def;   // :01 0.001 Hz
+    uint32_t damping = vendor::PositionDamping.def;       // :02 per mille of critical
+    uint32_t reset_time = vendor::PositionResetTime.def;  // :03 us
+    uint32_t inertia = vendor::Inertia.def;               // :04 mg cm^2
+    uint32_t friction = vendor::Friction.def;             // :05 nNm/rpm (viscous)
     // Option codes 0x6007, 0x605A..0x605E
-    int16_t abort_connection = od::obj::AbortConnectionOptionCode.def;
-    int16_t quick_stop = od::obj::QuickStopOptionCode.def;
-    int16_t shutdown = od::obj::ShutdownOptionCode.def;
-    int16_t disable_operation = od::obj::DisableOperationOptionCode.def;
-    int16_t halt = od::obj::HaltOptionCode.def;
-    int16_t fault_reaction = od::obj::FaultReactionOptionCode.def;
+    int16_t abort_connection = obj::AbortConnectionOptionCode.def;
+    int16_t quick_stop = obj::QuickStopOptionCode.def;
+    int16_t shutdown = obj::ShutdownOptionCode.def;
+    int16_t disable_operation = obj::DisableOperationOptionCode.def;
+    int16_t halt = obj::HaltOptionCode.def;
+    int16_t fault_reaction = obj::FaultReactionOptionCode.def;
     // Motion limits and profile
-    uint32_t following_error_window = od::obj::FollowingErrorWindow.def;    // 0x6065 inc; 0xFFFFFFFF = off
-    uint16_t following_error_timeout = od::obj::FollowingErrorTimeout.def;  // 0x6066 ms
-    int32_t sw_limit_min = od::obj::SoftwarePositionLimitMin.def;           // 0x607D:01
-    int32_t sw_limit_max = od::obj::SoftwarePositionLimitMax.def;           // 0x607D:02
-    int32_t range_min = od::obj::PositionRangeLimitMin.def;                 // 0x607B:01 (-2^31 = off)
-    int32_t range_max = od::obj::PositionRangeLimitMax.def;                 // 0x607B:02
-    uint32_t max_profile_velocity = od::obj::MaxProfileVelocity.def;        // 0x607F rpm
-    uint32_t max_motor_speed = od::obj::MaxMotorSpeed.def;                  // 0x6080 rpm
-    uint32_t profile_velocity = od::obj::ProfileVelocity.def;               // 0x6081 rpm
-    uint32_t profile_acceleration = od::obj::ProfileAcceleration.def;       // 0x6083 rpm/s
-    uint32_t profile_deceleration = od::obj::ProfileDeceleration.def;       // 0x6084 rpm/s
-    uint32_t quick_stop_deceleration = od::obj::QuickStopDeceleration.def;  // 0x6085 rpm/s
-    uint32_t max_acceleration = od::obj::MaxAcceleration.def;               // 0x60C5 rpm/s
+    uint32_t following_error_window = obj::FollowingErrorWindow.def;    // 0x6065 inc; 0xFFFFFFFF = off
+    uint16_t following_error_timeout = obj::FollowingErrorTimeout.def;  // 0x6066 ms
+    int32_t sw_limit_min = obj::SoftwarePositionLimitMin.def;           // 0x607D:01
+    int32_t sw_limit_max = obj::SoftwarePositionLimitMax.def;           // 0x607D:02
+    int32_t range_min = obj::PositionRangeLimitMin.def;                 // 0x607B:01 (-2^31 = off)
+    int32_t range_max = obj::PositionRangeLimitMax.def;                 // 0x607B:02
+    uint32_t max_profile_velocity = obj::MaxProfileVelocity.def;        // 0x607F rpm
+    uint32_t max_motor_speed = obj::MaxMotorSpeed.def;                  // 0x6080 rpm
+    uint32_t profile_velocity = obj::ProfileVelocity.def;               // 0x6081 rpm
+    uint32_t profile_acceleration = obj::ProfileAcceleration.def;       // 0x6083 rpm/s
+    uint32_t profile_deceleration = obj::ProfileDeceleration.def;       // 0x6084 rpm/s
+    uint32_t quick_stop_deceleration = obj::QuickStopDeceleration.def;  // 0x6085 rpm/s
+    uint32_t max_acceleration = obj::MaxAcceleration.def;               // 0x60C5 rpm/s
     // Homing
-    int8_t homing_method = od::obj::HomingMethod.def;                         // 0x6098
-    uint32_t homing_speed_switch = od::obj::HomingSpeedSwitchSearch.def;      // 0x6099:01 rpm
-    uint32_t homing_speed_zero = od::obj::HomingSpeedZeroSearch.def;          // 0x6099:02 rpm
-    uint32_t homing_acceleration = od::obj::HomingAcceleration.def;           // 0x609A rpm/s
-    int32_t home_position = od::obj::HomePosition.def;                        // 0x30B0 inc
-    int32_t home_offset_move = od::obj::HomeOffsetMoveDistance.def;           // 0x30B1 inc
-    uint16_t homing_current_threshold = od::obj::HomingCurrentThreshold.def;  // 0x30B2 mA
+    int8_t homing_method = obj::HomingMethod.def;                            // 0x6098
+    uint32_t homing_speed_switch = obj::HomingSpeedSwitchSearch.def;         // 0x6099:01 rpm
+    uint32_t homing_speed_zero = obj::HomingSpeedZeroSearch.def;             // 0x6099:02 rpm
+    uint32_t homing_acceleration = obj::HomingAcceleration.def;              // 0x609A rpm/s
+    int32_t home_position = vendor::HomePosition.def;                        // 0x30B0 inc
+    int32_t home_offset_move = vendor::HomeOffsetMoveDistance.def;           // 0x30B1 inc
+    uint16_t homing_current_threshold = vendor::HomingCurrentThreshold.def;  // 0x30B2 mA
     // Interpolation 0x60C2 (value x 10^index s); 0 = no interpolation
-    uint8_t interpolation_value = od::obj::InterpolationTimePeriodValue.def;
-    int8_t interpolation_index = od::obj::InterpolationTimeIndex.def;
+    uint8_t interpolation_value = obj::InterpolationTimePeriodValue.def;
+    int8_t interpolation_index = obj::InterpolationTimeIndex.def;
     // Standstill 0x30E0
-    uint32_t standstill_window = od::obj::StandstillWindow.def;          // rpm; 0xFFFFFFFF = detection off
-    uint16_t standstill_time = od::obj::StandstillWindowTime.def;        // ms
-    uint16_t standstill_timeout = od::obj::StandstillWindowTimeout.def;  // ms; 0xFFFF = no timeout
+    uint32_t standstill_window = vendor::StandstillWindow.def;          // rpm; 0xFFFFFFFF = detection off
+    uint16_t standstill_time = vendor::StandstillWindowTime.def;        // ms
+    uint16_t standstill_timeout = vendor::StandstillWindowTimeout.def;  // ms; 0xFFFF = no timeout
     // Digital inputs 0x3141:02, 0x3142:01..06
-    uint16_t input_polarity = od::obj::DigitalInputPolarity.def;
+    uint16_t input_polarity = vendor::DigitalInputPolarity.def;
     std::array<uint8_t, 6> input_function{
-        od::obj::DigitalInput1Configuration.def, od::obj::DigitalInput2Configuration.def,
-        od::obj::DigitalInput3Configuration.def, od::obj::DigitalInput4Configuration.def,
-        od::obj::DigitalInput5Configuration.def, od::obj::DigitalInput6Configuration.def};
-    int16_t touch_probe_source = od::obj::TouchProbe1Source.def;  // 0x60D0:01
+        vendor::DigitalInput1Configuration.def, vendor::DigitalInput2Configuration.def,
+        vendor::DigitalInput3Configuration.def, vendor::DigitalInput4Configuration.def,
+        vendor::DigitalInput5Configuration.def, vendor::DigitalInput6Configuration.def};
+    int16_t touch_probe_source = obj::TouchProbe1Source.def;  // 0x60D0:01
+    // 0x6502: the modes the device announces; the drive takes only those it also implements.
+    uint32_t supported_modes = obj::SupportedDriveModes.def;
+    // 0x608F position encoder resolution: increments per motor revolutions; 0 increments: 4 x encoder_pulses.
+    uint32_t resolution_increments = obj::PositionEncoderIncrements.def;
+    uint32_t resolution_revolutions = obj::PositionEncoderRevolutions.def;
+    // 0x6091 gear ratio (motor : shaft revolutions) and 0x6092 feed constant (feed : shaft revolutions): the
+    // position units of the position objects (Drive converts them; the axis works in increments).
+    uint32_t gear_motor_revolutions = obj::GearMotorRevolutions.def;
+    uint32_t gear_shaft_revolutions = obj::GearShaftRevolutions.def;
+    uint32_t feed = obj::FeedConstantFeed.def;
+    uint32_t feed_shaft_revolutions = obj::FeedConstantShaftRevolutions.def;
 
     bool operator==(const Parameters&) const = default;
 };
 
 // Process-data outputs of the master (RxPDO objects).
 struct Command {
-    uint16_t controlword = od::obj::Controlword.def;                  // 0x6040
-    int8_t mode = od::obj::ModesOfOperation.def;                      // 0x6060
-    int32_t target_position = od::obj::TargetPosition.def;            // 0x607A
-    int32_t target_velocity = od::obj::TargetVelocity.def;            // 0x60FF
-    int16_t target_torque = od::obj::TargetTorque.def;                // 0x6071
-    int32_t position_offset = od::obj::PositionOffset.def;            // 0x60B0
-    int32_t velocity_offset = od::obj::VelocityOffset.def;            // 0x60B1
-    int16_t torque_offset = od::obj::TorqueOffset.def;                // 0x60B2
-    uint16_t touch_probe_function = od::obj::TouchProbeFunction.def;  // 0x60B8
+    uint16_t controlword = obj::Controlword.def;                  // 0x6040
+    int8_t mode = obj::ModesOfOperation.def;                      // 0x6060
+    int32_t target_position = obj::TargetPosition.def;            // 0x607A
+    int32_t target_velocity = obj::TargetVelocity.def;            // 0x60FF
+    int16_t target_torque = obj::TargetTorque.def;                // 0x6071
+    int32_t position_offset = obj::PositionOffset.def;            // 0x60B0
+    int32_t velocity_offset = obj::VelocityOffset.def;            // 0x60B1
+    int16_t torque_offset = obj::TorqueOffset.def;                // 0x60B2
+    uint16_t touch_probe_function = obj::TouchProbeFunction.def;  // 0x60B8
 
     bool operator==(const Command&) const = default;
 };

@@ -9,22 +9,23 @@
 #include <cstdint>
 
 #include "drive/frame.hpp"
+#include "drive/objects.hpp"
 #include "drive/parameters.hpp"
 #include "drive/profile.hpp"
-#include "od/drive_objects.hpp"
 
 namespace drive {
 
-// Modes of operation 0x6060; the set is declared once in od/drive_objects.hpp (also the 0x6060 validator's).
+// Modes of operation 0x6060; the set is declared once in drive/objects.hpp.
 namespace mode {
 constexpr int8_t None = 0;
-constexpr int8_t ProfilePosition = od::modes::ProfilePosition;
-constexpr int8_t ProfileVelocity = od::modes::ProfileVelocity;
-constexpr int8_t Homing = od::modes::Homing;
-constexpr int8_t CyclicSyncPosition = od::modes::CyclicSyncPosition;
-constexpr int8_t CyclicSyncVelocity = od::modes::CyclicSyncVelocity;
-constexpr int8_t CyclicSyncTorque = od::modes::CyclicSyncTorque;
-bool supported(int8_t m);
+constexpr int8_t ProfilePosition = drive::modes::ProfilePosition;
+constexpr int8_t ProfileVelocity = drive::modes::ProfileVelocity;
+constexpr int8_t Homing = drive::modes::Homing;
+constexpr int8_t CyclicSyncPosition = drive::modes::CyclicSyncPosition;
+constexpr int8_t CyclicSyncVelocity = drive::modes::CyclicSyncVelocity;
+constexpr int8_t CyclicSyncTorque = drive::modes::CyclicSyncTorque;
+// Implemented by the drive and announced in `announced` (0x6502 bits, IEC 61800-7-201).
+bool supported(int8_t m, uint32_t announced = supported_drive_modes());
 }  // namespace mode
 
 // Which loop the set-point enters: position loop, velocity loop (CSV) or current loop (CST).

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "od/device.hpp"
@@ -14,9 +15,13 @@
 
 namespace esi {
 
-std::string build_esi(const od::DeviceDescription& description, const od::Dictionary& dictionary);
+// eeprom_image: the device's own EEPROM content (od::Product::eeprom, ESI Eeprom/Data), written back as
+// Eeprom/Data so that the file describes the SII the device serves; empty: Eeprom/ByteSize, ConfigData and
+// BootStrap of the SII built from the description (esi::build_sii).
+std::string build_esi(const od::DeviceDescription& description, const od::Dictionary& dictionary,
+                      std::span<const uint8_t> eeprom_image = {});
 void write_esi(const std::filesystem::path& path, const od::DeviceDescription& description,
-               const od::Dictionary& dictionary);
+               const od::Dictionary& dictionary, std::span<const uint8_t> eeprom_image = {});
 
 // ESI names of the pieces the writer uses, exposed for tests and tools.
 // Data type name of an entry: "UINT", "DINT", "STRING(6)", "ARRAY [0..3] OF BYTE", ...

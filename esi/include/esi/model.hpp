@@ -78,8 +78,9 @@ struct DeviceModel {
     std::vector<PdoInfo>
         pdos;  // every mapping object of the dictionary, by index (Rx first: 0x16xx < 0x1Axx)
     // The order the ESI and the SII list the PDOs in (indices into pdos): the RxPDOs, then the TxPDOs; of
-    // each direction the default-assigned ones in their assignment order (as a master lays out the process
-    // image of a device it cannot ask by CoE), then the others by index.
+    // each direction by index, except that the places of the default-assigned ones hold them in their
+    // assignment order (as a master lays out the process image of a device it cannot ask by CoE). A vendor
+    // ESI that lists by index and assigns in that order (the usual case) is listed as it was written.
     std::vector<std::size_t> pdo_order;
     std::vector<SmInfo> sync_managers;
     std::vector<PdoSetInfo> pdo_sets;  // od::DeviceDescription::pdo_sets that name PDOs of the dictionary

@@ -10,17 +10,18 @@
 
 namespace od {
 
+// Empty by default: each product states its own (maxpos::description(), an ESI's Vendor and Type).
 struct Identity {
-    uint32_t vendor_id = 0x000000FB;  // maxon motor ag
-    uint32_t product_code = 0;        // MAXPOS firmware specification §7.2.4.3
-    uint32_t revision = 0;            // high word software version, low word application version
+    uint32_t vendor_id = 0;     // ETG vendor id (0x1018:01)
+    uint32_t product_code = 0;  // 0x1018:02
+    uint32_t revision = 0;      // 0x1018:03
     uint32_t serial_number = 0;
-    std::string vendor_name = "maxon motor ag";
-    std::string device_name = "MAXPOS";  // 0x1008
-    std::string hardware_version;        // 0x1009
-    std::string software_version;        // 0x100A
-    std::string order_code;              // ESI Type text
-    std::string group_type = "Drives";   // ESI group
+    std::string vendor_name;
+    std::string device_name;       // 0x1008
+    std::string hardware_version;  // 0x1009
+    std::string software_version;  // 0x100A
+    std::string order_code;        // ESI Type text
+    std::string group_type;        // ESI group
 };
 
 struct MailboxLayout {

@@ -1,5 +1,6 @@
 #pragma once
-// The device's identity and layout from a configuration file, so one binary can be any drive of the family.
+// A device's identity and layout from a configuration file, on top of a product's own description, so one
+// binary can be any device of a family (the built-in MAXPOS reads its --config through maxpos::load_config).
 //
 // Format (the subset of CLI11's INI/TOML config that the `ecat-slave` program reads from the same file):
 //   # comment            ; comment
@@ -14,6 +15,7 @@
 // Other sections, and unknown keys before the first section, belong to the program and are ignored;
 // an unknown key inside a known section, a duplicate key, a bad value or a malformed line is an error.
 #include <filesystem>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -47,11 +49,17 @@ class ConfigError : public std::runtime_error {
 // Longest configuration file load_device_config() reads (a real one is a few hundred bytes).
 constexpr std::size_t kMaxConfigBytes = 1u << 20;
 
-// Reads `path` on top of default_drive_description(). Throws ConfigError (file:line: message), also for a
-// file longer than kMaxConfigBytes (nothing beyond that is read).
-DeviceDescription load_device_config(const std::filesystem::path& path);
+// Lays out a product's SyncManagers again after the mailbox moved (SM2/SM3 after the mailbox); throws
+// std::out_of_range if they do not fit (reported as an error of the file).
+using SyncManagerPlacer = std::function<void(DeviceDescription&)>;
+
+// Reads `path` on top of `base`, then calls `place` (if any). Throws ConfigError (file:line: message), also
+// for a file longer than kMaxConfigBytes (nothing beyond that is read).
+DeviceDescription load_device_config(const std::filesystem::path& path, const DeviceDescription& base,
+                                     const SyncManagerPlacer& place = {});
 
 // Same, from text; `source` names it in error messages.
-DeviceDescription parse_device_config(std::string_view text, const std::string& source = "<config>");
+DeviceDescription parse_device_config(std::string_view text, const std::string& source,
+                                      const DeviceDescription& base, const SyncManagerPlacer& place = {});
 
 }  // namespace od

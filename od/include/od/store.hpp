@@ -26,6 +26,10 @@
 
 namespace od {
 
+// Signatures of the store (0x1010) and restore (0x1011) commands (CiA 301).
+constexpr uint32_t kSignatureSave = 0x65766173;  // "save", little-endian
+constexpr uint32_t kSignatureLoad = 0x64616F6C;  // "load", little-endian
+
 // Which entries a store/restore command covers (0x2110/0x2111 subindex 1 all, 2 communication, 6 axis).
 enum class StoreScope : uint8_t {
     All,            // every Backup entry

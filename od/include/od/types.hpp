@@ -95,10 +95,54 @@ enum class Status : uint8_t {
 std::string_view to_string(Status s);
 std::string_view to_string(DataType t);
 
-// Bit size of a scalar data type (0 for strings and structured types).
-uint16_t bit_size(DataType t);
-bool is_signed(DataType t);
-bool is_real(DataType t);
-bool is_string(DataType t);
+// Bit size of a scalar data type (0 for strings and structured types). constexpr, so a table of a product
+// can be checked at compile time.
+constexpr uint16_t bit_size(DataType t) {
+    switch (t) {
+        case DataType::Boolean:
+            return 1;
+        case DataType::Integer8:
+        case DataType::Unsigned8:
+            return 8;
+        case DataType::Integer16:
+        case DataType::Unsigned16:
+            return 16;
+        case DataType::Integer32:
+        case DataType::Unsigned32:
+        case DataType::Real32:
+            return 32;
+        case DataType::Integer64:
+        case DataType::Unsigned64:
+        case DataType::Real64:
+            return 64;
+        case DataType::Integer24:
+        case DataType::Unsigned24:
+            return 24;
+        case DataType::Bit1:
+        case DataType::Bit2:
+        case DataType::Bit3:
+        case DataType::Bit4:
+        case DataType::Bit5:
+        case DataType::Bit6:
+        case DataType::Bit7:
+        case DataType::Bit8:
+            return static_cast<uint16_t>(static_cast<uint16_t>(t) - 0x002F);
+        default:
+            return 0;
+    }
+}
+
+constexpr bool is_signed(DataType t) {
+    return t == DataType::Integer8 || t == DataType::Integer16 || t == DataType::Integer24 ||
+           t == DataType::Integer32 || t == DataType::Integer64;
+}
+
+constexpr bool is_real(DataType t) {
+    return t == DataType::Real32 || t == DataType::Real64;
+}
+
+constexpr bool is_string(DataType t) {
+    return t == DataType::VisibleString || t == DataType::OctetString || t == DataType::UnicodeString;
+}
 
 }  // namespace od

@@ -24,6 +24,7 @@
 #include "device/device.hpp"
 #include "esc/wire/al.hpp"
 #include "util/lex.hpp"
+#include "util/strfmt.hpp"
 
 namespace device {
 
@@ -121,12 +122,18 @@ Found find_entry(const Device& device, od::Dictionary& dict, std::string_view te
     if (hits.size() == 1) {
         f.entry = hits.front();
     } else if (hits.empty()) {
-        f.error = "no entry named '" + std::string(text) + "'";
+        // printf, not "literal" + std::string&& or a literal assigned: GCC 12 at -O3 misjudges those as
+        // overlapping copies (-Werror=restrict, GCC bug 105651).
+        f.error = util::strprintf("no entry named '%.*s'", static_cast<int>(text.size()), text.data());
     } else {
-        f.error = "'" + std::string(text) + "' names " + std::to_string(hits.size()) + " entries (";
-        for (std::size_t i = 0; i < hits.size() && i < 8; ++i)
-            f.error += (i ? " " : "") + where(hits[i]->index, hits[i]->subindex);
-        f.error += hits.size() > 8 ? " ...): give index:subindex" : "): give index:subindex";
+        std::string list;
+        for (std::size_t i = 0; i < hits.size() && i < 8; ++i) {
+            if (i) list += ' ';
+            list += where(hits[i]->index, hits[i]->subindex);
+        }
+        f.error = util::strprintf("'%.*s' names %zu entries (%s%s): give index:subindex",
+                                  static_cast<int>(text.size()), text.data(), hits.size(), list.c_str(),
+                                  hits.size() > 8 ? " ..." : "");
     }
     return f;
 }

@@ -12,6 +12,7 @@
 #include "coe/events.hpp"
 #include "coe/pdo_validation.hpp"
 #include "drive/errors.hpp"
+#include "drive/objects.hpp"
 #include "drive/state_machine.hpp"
 #include "esc/wire/al.hpp"
 #include "esc/wire/registers.hpp"
@@ -19,10 +20,9 @@
 #include "esi/sii.hpp"
 #include "foe/firmware.hpp"
 #include "foe/image.hpp"
+#include "maxpos/maxpos.hpp"
 #include "od/device_config.hpp"
 #include "od/diag_texts.hpp"
-#include "od/drive_objects.hpp"
-#include "od/drive_profile.hpp"
 #include "util/le.hpp"
 #include "util/lex.hpp"
 #include "util/strfmt.hpp"
@@ -41,14 +41,14 @@ foe::StoreConfig store_config(const DeviceOptions& options, const od::DeviceDesc
 
 od::DeviceDescription base_description(const DeviceOptions& options) {
     od::DeviceDescription d = options.product               ? options.product->description
-                              : options.config_file.empty() ? od::default_drive_description()
-                                                            : od::load_device_config(options.config_file);
+                              : options.config_file.empty() ? maxpos::description()
+                                                            : maxpos::load_config(options.config_file);
     if (options.serial_number) d.identity.serial_number = *options.serial_number;
     return d;
 }
 
 od::Dictionary make_dictionary(const DeviceOptions& options, const od::DeviceDescription& d) {
-    return options.product ? options.product->make_dictionary(d) : od::make_drive_dictionary(d);
+    return options.product ? options.product->make_dictionary(d) : maxpos::dictionary(d);
 }
 
 // The built-in MAXPOS has every part; a product the parts it declares.
@@ -61,6 +61,14 @@ bool has_coe_part(const DeviceOptions& options, const od::DeviceDescription& d) 
 bool has_drive_part(const DeviceOptions& options) {
     return !options.product || options.product->application == od::Application::Cia402Drive;
 }
+
+// Where the product keeps the drive's vendor parameters: the built-in MAXPOS's; a product from an ESI or ENI
+// has only the CiA 402 objects, which the drive binds by index.
+const drive::VendorObjects& vendor_objects(const DeviceOptions& options) {
+    static const drive::VendorObjects none{};
+    return options.product ? none : maxpos::drive_objects();
+}
+
 bool has_parameter_part(const DeviceOptions& options, const od::Dictionary& dict) {
     return !options.product || dict.find(0x1010) != nullptr || dict.find(0x1011) != nullptr;
 }
@@ -136,6 +144,9 @@ std::vector<uint8_t> make_sii(const DeviceOptions& options) {
 std::string make_esi(const DeviceOptions& options) {
     const od::DeviceDescription d = make_description(options);
     const od::Dictionary dict = make_dictionary(options, d);
+    // A device with its own EEPROM image (ESI Eeprom/Data) is described with that image.
+    if (options.product && !options.product->eeprom.empty())
+        return esi::build_esi(d, dict, options.product->eeprom);
     return esi::build_esi(d, dict);
 }
 
@@ -337,7 +348,7 @@ void Device::build() {
         // Only what exists is commissioned (a vendor's drive may lack the MAXPOS motor objects).
         od::Status s = od::Status::Ok;
         try {
-            s = drive::commission(p->dict);
+            s = drive::commission(p->dict, vendor_objects(options_));
         } catch (const std::exception& e) {
             if (!options_.product) throw;
             log() << "softdrive: commissioning the motor parameters failed: " << e.what() << '\n';
@@ -357,7 +368,7 @@ void Device::build() {
             [raw] {
                 // MAXPOS firmware specification §7.2.21: restoring defaults only with the axis in "Power
                 // Disable" (not switched on).
-                constexpr auto sw = od::obj::Statusword;
+                constexpr auto sw = drive::obj::Statusword;
                 const od::Entry* e = raw->dict.find(sw.index, sw.sub);
                 if (e == nullptr) return od::Status::Ok;
                 return (raw->dict.get<uint16_t>(sw.index, sw.sub) & drive::sw::SwitchedOn) != 0
@@ -419,7 +430,7 @@ void Device::build() {
     if (drive) {
         // A vendor's CiA 402 dictionary the drive core cannot run on: said, and served as process data.
         try {
-            p->drive = std::make_unique<drive::Drive>(p->dict, this);
+            p->drive = std::make_unique<drive::Drive>(p->dict, this, vendor_objects(options_));
             p->drive->axis().faults = options_.faults.axis;
         } catch (const std::exception& e) {
             if (!options_.product) throw;
@@ -541,7 +552,10 @@ uint16_t Device::check_transition(od::AlState /*from*/, od::AlState /*to*/) {
 
 void Device::on_state_change(od::AlState from, od::AlState to) {
     // Leaving Op by any path ends the outputs, whether or not on_outputs_lost() came first.
-    if (from == od::AlState::Op && to != od::AlState::Op) outputs_lost_pending_ = true;
+    if (from == od::AlState::Op && to != od::AlState::Op) {
+        outputs_lost_pending_ = true;
+        if (parts_->io) parts_->io->safe_outputs();  // before a plan that ends here is cleared
+    }
     if (parts_->io) {
         // The mapping is fixed from Safe-Op on: the plan of the IO model is built once, here.
         const bool pd_from = from == od::AlState::SafeOp || from == od::AlState::Op;
@@ -570,12 +584,15 @@ void Device::on_outputs_lost() {
 
 void Device::react_to_outputs_lost() {
     outputs_lost_pending_ = false;
-    if (!parts_->drive) return;
+    if (!parts_->drive) {
+        if (parts_->io) parts_->io->safe_outputs();  // also a watchdog that leaves the device in Op
+        return;
+    }
     // A fall-back (watchdog, sync loss: the stack set the error indication) is a communication failure:
     // 0x8180 with the 0x6007 reaction in any drive state. A master that asks to leave Op is not an error; it
     // gets the reaction only while its outputs were commanding motion (operation enabled, statusword bit 2).
     const bool fall_back = parts_->stack->error();
-    constexpr auto statusword = od::obj::Statusword;
+    constexpr auto statusword = drive::obj::Statusword;
     const od::Entry* sw = parts_->dict.find(statusword.index, statusword.sub);
     const bool enabled = sw != nullptr && (parts_->dict.get<uint16_t>(statusword.index, statusword.sub) &
                                            drive::sw::OperationEnabled) != 0;
@@ -736,9 +753,10 @@ std::string Device::set_value(uint16_t index, uint8_t sub, std::string_view text
     if (e == nullptr) return "no entry " + where;
     if (!e->tx_mappable()) return where + " is not a process-data input (not TxPDO-mappable)";
     std::vector<uint8_t> raw;
-    if (!encode(*e, text, raw))
-        return "'" + std::string(text) + "' is no value of " + where + " (" +
-               std::string(od::to_string(e->type)) + ", " + std::to_string(e->bit_length) + " bits)";
+    if (!encode(*e, text, raw))  // printf, not "literal" + std::string&& (GCC 12 -O3 -Wrestrict, bug 105651)
+        return util::strprintf("'%.*s' is no value of %s (%.*s, %u bits)", static_cast<int>(text.size()),
+                               text.data(), where.c_str(), static_cast<int>(od::to_string(e->type).size()),
+                               od::to_string(e->type).data(), static_cast<unsigned>(e->bit_length));
     if (const od::Status st = d.set_raw(index, sub, raw); st != od::Status::Ok)
         return where + ": " + std::string(od::to_string(st));
     const uint32_t key = io_key(index, sub);

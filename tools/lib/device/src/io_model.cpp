@@ -73,6 +73,14 @@ void IoModel::hold(uint16_t index, uint8_t sub) {
     std::erase_if(counters_, [key](const Counter& c) { return c.key == key; });
 }
 
+void IoModel::safe_outputs() {
+    static constexpr uint8_t kZero[8] = {};
+    for (const IoEntry& out : outputs_)
+        for (std::size_t bit = 0; bit < out.entry->bit_length; bit += 64)
+            ecat::ProcessData::copy_bits(kZero, 0, out.storage, bit,
+                                         std::min<std::size_t>(64, out.entry->bit_length - bit));
+}
+
 void IoModel::cycle() {
     for (const Mirror& m : mirrors_)
         ecat::ProcessData::copy_bits(m.src, 0, m.dst, 0, m.bits);

@@ -2,8 +2,8 @@
 // A soft device's firmware, composed: everything that runs behind the ESC's PDI of a product (od::Product:
 // the built-in MAXPOS, or a device read from a vendor's ESI). For the MAXPOS (DeviceOptions::product null):
 //
-//   description  od::load_device_config (or the default), revision/0x100A from the active FoE image
-//   dictionary   od::make_drive_dictionary + PDO validators + parameter store (0x1010/0x1011, state dir)
+//   description  maxpos::load_config (or the default), revision/0x100A from the active FoE image
+//   dictionary   the product's (maxpos::dictionary) + PDO validators + parameter store (0x1010/0x1011)
 //   SII          esi::build_sii of the same description and dictionary, loaded into the ESC
 //   ecat::Stack  over the ESC's PDI, esc.irq() as interrupt line, with this as its Application
 //   CoE          coe::CoeServer (SDO, SDO info, emergencies) + coe::DiagnosisHistory (0x10F3)
@@ -77,7 +77,7 @@ struct DeviceOptions {
     std::shared_ptr<const od::Product> product;
     // Say the product's warnings at start (a line of units of one product says them once, for its first).
     bool announce_product = true;
-    std::filesystem::path config_file;  // MAXPOS configuration (od::load_device_config); empty: defaults
+    std::filesystem::path config_file;  // MAXPOS configuration (maxpos::load_config); empty: defaults
     std::filesystem::path state_dir = "/var/lib/softecat";  // parameters.bin, firmware/
     EnvironmentOptions environment;
     bool load_sii = true;         // false: the ESC serves a user's image (--eeprom), leave it alone

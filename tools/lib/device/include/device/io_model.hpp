@@ -12,6 +12,12 @@
 // An input set at run time (Device::set_value, the control socket's `set`) is held: it keeps the value
 // set and is no longer mirrored or counted. The plan is built when the mapping is fixed (Pre-Op ->
 // Safe-Op) and cleared when process data stops; a cycle only copies and counts (no allocation).
+//
+// When the outputs are lost (process-data watchdog, sync loss, leaving Op by any path) every output goes to
+// its safe state, 0, as an IO terminal's outputs do (EL2xxx: "outputs are switched off" on watchdog; the
+// ESC datasheet's process-data watchdog: the output SM is no longer updated and the PDI side sets the
+// outputs to a safe state; ETG.1000.6: Safe-Op keeps the outputs in their safe state). They stay 0 until
+// the master writes outputs again in Op.
 #include <cstdint>
 #include <set>
 #include <span>
@@ -35,6 +41,8 @@ class IoModel {
     void clear();
     // Mirrors and counters of one cycle.
     void cycle();
+    // Every mapped output to its safe state, 0 (outputs lost). No allocation.
+    void safe_outputs();
     // An entry was set at run time: it is neither mirrored nor counted from now on.
     void hold(uint16_t index, uint8_t sub);
 

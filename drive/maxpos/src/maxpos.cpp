@@ -1,7 +1,7 @@
 // The MAXPOS object dictionary, declared as data: one line per object header or entry, in the order and
 // with the values of the MAXPOS firmware specification (maxon), chapter 7 (its § numbers in the comments).
 // Where the specification is inconsistent the choice is written down in docs/decisions/od.md.
-#include "od/drive_profile.hpp"
+#include "maxpos/maxpos.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -10,11 +10,14 @@
 #include <string>
 #include <string_view>
 
-#include "od/drive_objects.hpp"
-#include "od/value_names.hpp"
+#include "od/device_config.hpp"
 #include "util/strfmt.hpp"
+#include "value_names.hpp"
 
-namespace od {
+namespace maxpos {
+
+using namespace od;
+
 namespace {
 
 enum Kind : uint8_t { VAR, ARR, REC, SUB };
@@ -41,9 +44,10 @@ constexpr DataType IDENT = DataType::Identity;
 constexpr DataType SMPAR = DataType::SyncManagerParameter;
 constexpr DataType STRUCT = DataType::Unsigned8;  // RECORD without a standard structure type (decisions)
 
-// def/min/max: "" = not given; numbers in C syntax (0x.., -3); "$name" = from the identity; "=" = the typed
-// default declared once in od/drive_objects.hpp (the objects the drive binds, the value sets, 0x1C00);
-// for strings, def is the text and max the capacity in bytes.
+// def/min/max: "" = not given; numbers in C syntax (0x.., -3); "$name" = from the identity; for strings,
+// def is the text and max the capacity in bytes. P(name): the entry holds the drive's vendor parameter
+// drive::Param::name (drive/objects.hpp), so drive_objects() binds it; its type is checked against the
+// parameter's at compile time.
 struct Line {
     Kind kind;
     uint16_t index;
@@ -55,13 +59,16 @@ struct Line {
     const char* max;
     const char* unit;
     const char* name;
+    bool binds = false;
+    drive::Param param{};
 };
+#define P(name) true, drive::Param::name
 
 // clang-format off
 constexpr Line kTable[] = {
 // kind idx  sub type  access     default       min      max          unit     name
 {VAR, 0x1000, 0, U32,  RO,        "0x00020192", "",      "",          "",      "Device Type"},                        // 7.2.1
-{VAR, 0x1001, 0, U8,   RO|TX,     "=",          "",      "",          "",      "Error Register"},                     // 7.2.2
+{VAR, 0x1001, 0, U8,   RO|TX,     "0",          "",      "",          "",      "Error Register"},                     // 7.2.2
 {VAR, 0x1008, 0, VSTR, RO,        "$device_name", "",    "",          "",      "Manufacturer Device Name"},           // 7.2.3
 {VAR, 0x1009, 0, VSTR, RO,        "$hardware_version", "", "",        "",      "Manufacturer Hardware Version"},      // CiA 301 (decisions)
 {VAR, 0x100A, 0, VSTR, RO,        "$software_version", "", "",        "",      "Manufacturer Software Version"},      // CiA 301 (decisions)
@@ -191,11 +198,11 @@ constexpr Line kTable[] = {
 {SUB, 0x1A03, 10, U32, RWP|BK,    "0",          "",      "",          "",      "10th mapped Object in TxPDO 4"},
 // Sync managers (7.2.14-7.2.18)
 {ARR, 0x1C00, 0, U8,   RO,        "",           "",      "",          "",      "Sync Manager Communication Type"},    // 7.2.14
-{SUB, 0x1C00, 0, U8,   RO,        "=",          "",      "",          "",      "Number of used Sync Manager Channels"},
-{SUB, 0x1C00, 1, U8,   RO,        "=",          "",      "",          "",      "Communication Type Sync Channel 0"},
-{SUB, 0x1C00, 2, U8,   RO,        "=",          "",      "",          "",      "Communication Type Sync Channel 1"},
-{SUB, 0x1C00, 3, U8,   RO,        "=",          "",      "",          "",      "Communication Type Sync Channel 2"},
-{SUB, 0x1C00, 4, U8,   RO,        "=",          "",      "",          "",      "Communication Type Sync Channel 3"},
+{SUB, 0x1C00, 0, U8,   RO,        "4",          "",      "",          "",      "Number of used Sync Manager Channels"},
+{SUB, 0x1C00, 1, U8,   RO,        "1",          "",      "",          "",      "Communication Type Sync Channel 0"},
+{SUB, 0x1C00, 2, U8,   RO,        "2",          "",      "",          "",      "Communication Type Sync Channel 1"},
+{SUB, 0x1C00, 3, U8,   RO,        "3",          "",      "",          "",      "Communication Type Sync Channel 2"},
+{SUB, 0x1C00, 4, U8,   RO,        "4",          "",      "",          "",      "Communication Type Sync Channel 3"},
 {ARR, 0x1C12, 0, U16,  RO,        "",           "",      "",          "",      "Sync Manager 2 PDO Assignment"},      // 7.2.15
 {SUB, 0x1C12, 0, U8,   RWP|BK,    "1",          "0",     "4",         "",      "Number of assigned RxPDOs"},
 {SUB, 0x1C12, 1, U16,  RWP|BK,    "0x1600",     "0x1600", "0x1603",   "",      "1st assigned RxPDO"},
@@ -236,18 +243,18 @@ constexpr Line kTable[] = {
 {SUB, 0x3000, 1, U32,  RW|BK,     "0x00100001", "",      "",          "",      "Sensors Configuration"},
 {SUB, 0x3000, 2, U32,  RW|BK,     "0x00000011", "",      "",          "",      "Control Structure"},
 {SUB, 0x3000, 3, U32,  RW|BK,     "0x00000031", "",      "",          "",      "Commutation Sensors"},
-{SUB, 0x3000, 4, U32,  RW|BK,     "="         , "",      "",          "",      "Axis Configuration Miscellaneous"},
-{SUB, 0x3000, 5, U32,  RO,        "="   ,       "",      "",          "inc",   "Main Sensor Resolution"},
+{SUB, 0x3000, 4, U32,  RW|BK,     "0",          "",      "",          "",      "Axis Configuration Miscellaneous", P(AxisConfigurationMisc)},
+{SUB, 0x3000, 5, U32,  RO,        "2000",       "",      "",          "inc",   "Main Sensor Resolution", P(MainSensorResolution)},
 {REC, 0x3001, 0, STRUCT, RO,      "",           "",      "",          "",      "Motor Data"},                         // 7.2.23
-{SUB, 0x3001, 1, U16,  RW|BK,     "="   ,       "0",     "5000",      "mA",    "Nominal Current"},
-{SUB, 0x3001, 2, U16,  RW|BK,     "="    ,      "0",     "15000",     "mA",    "Output Current Limit"},
-{SUB, 0x3001, 3, U8,   RW|BK,     "=",          "1",     "31",        "",      "Number of Pole Pairs"},
-{SUB, 0x3001, 4, U16,  RW|BK,     "=" ,         "1",     "10000",     "0.1 s", "Thermal Time Constant Winding"},
-{SUB, 0x3001, 5, U32,  RW|BK,     "=",          "0",     "10000000",  "uNm/A", "Torque Constant"},
+{SUB, 0x3001, 1, U16,  RW|BK,     "5000",       "0",     "5000",      "mA",    "Nominal Current", P(MotorNominalCurrent)},
+{SUB, 0x3001, 2, U16,  RW|BK,     "15000",      "0",     "15000",     "mA",    "Output Current Limit", P(MotorOutputCurrentLimit)},
+{SUB, 0x3001, 3, U8,   RW|BK,     "1",          "1",     "31",        "",      "Number of Pole Pairs", P(MotorPolePairs)},
+{SUB, 0x3001, 4, U16,  RW|BK,     "40",         "1",     "10000",     "0.1 s", "Thermal Time Constant Winding", P(MotorThermalTimeConstant)},
+{SUB, 0x3001, 5, U32,  RW|BK,     "0",          "0",     "10000000",  "uNm/A", "Torque Constant", P(MotorTorqueConstant)},
 {REC, 0x3010, 0, STRUCT, RO,      "",           "",      "",          "",      "Digital Incremental Encoder 1"},      // 7.2.24
-{SUB, 0x3010, 1, U32,  RW|BK,     "="  ,        "16",    "2500000",   "pulse/rev", "Digital Incremental Encoder 1 Number of Pulses"},
-{SUB, 0x3010, 2, U16,  RW|BK,     "="     ,     "",      "",          "",      "Digital Incremental Encoder 1 Type"},
-{SUB, 0x3010, 4, I32,  RO|TX,     "=",          "",      "",          "inc",   "Digital Incremental Encoder 1 Index Position"},
+{SUB, 0x3010, 1, U32,  RW|BK,     "500",        "16",    "2500000",   "pulse/rev", "Digital Incremental Encoder 1 Number of Pulses", P(EncoderPulses)},
+{SUB, 0x3010, 2, U16,  RW|BK,     "1",          "",      "",          "",      "Digital Incremental Encoder 1 Type", P(EncoderType)},
+{SUB, 0x3010, 4, I32,  RO|TX,     "0",          "",      "",          "inc",   "Digital Incremental Encoder 1 Index Position", P(EncoderIndexPosition)},
 {REC, 0x3011, 0, STRUCT, RO,      "",           "",      "",          "",      "Analog Incremental Encoder"},         // 7.2.25
 {SUB, 0x3011, 1, U16,  RW|BK,     "0x0001",     "",      "",          "",      "Analog Incremental Encoder Type"},
 {SUB, 0x3011, 2, U32,  RW|BK,     "0x00080004", "",      "",          "",      "Analog Incremental Encoder Resolution"},
@@ -284,35 +291,35 @@ constexpr Line kTable[] = {
 {SUB, 0x3020, 2, U16,  RW|BK,     "0x0001",     "",      "",          "",      "Digital Incremental Encoder 2 Type"},
 {SUB, 0x3020, 4, I32,  RO|TX,     "0",          "",      "",          "inc",   "Digital Incremental Encoder 2 Index Position"},
 {ARR, 0x30A0, 0, U32,  RO,        "",           "",      "",          "",      "Current Control Parameter Set"},      // 7.2.30
-{SUB, 0x30A0, 1, U32,  RW|TRX|BK, "="    ,      "",      "",          "2^-16 V/A", "Current Regulator P Gain"},
-{SUB, 0x30A0, 2, U32,  RW|TRX|BK, "="   ,       "",      "",          "2^-16 V/(A*ms)", "Current Regulator I Gain"},
-{SUB, 0x30A0, 3, U32,  RW|TRX|BK, "=",          "",      "",          "2^-16 V/A", "Current Regulator FF Gain"},
+{SUB, 0x30A0, 1, U32,  RW|TRX|BK, "32768",      "",      "",          "2^-16 V/A", "Current Regulator P Gain", P(CurrentPGain)},
+{SUB, 0x30A0, 2, U32,  RW|TRX|BK, "4096",       "",      "",          "2^-16 V/(A*ms)", "Current Regulator I Gain", P(CurrentIGain)},
+{SUB, 0x30A0, 3, U32,  RW|TRX|BK, "0",          "",      "",          "2^-16 V/A", "Current Regulator FF Gain", P(CurrentFfGain)},
 {ARR, 0x30A1, 0, U32,  RO,        "",           "",      "",          "",      "Position Control Parameter Set"},     // 7.2.31
-{SUB, 0x30A1, 1, U32,  RW|TRX|BK, "="   ,       "10",    "1000000",   "mHz",   "Position Regulator Bandwidth"},
-{SUB, 0x30A1, 2, U32,  RW|TRX|BK, "="   ,       "0",     "10000",     "0.1 %", "Position Regulator Damping"},
-{SUB, 0x30A1, 3, U32,  RW|TRX|BK, "="      ,    "100",   "3600000000", "us",   "Position Regulator Reset Time"},
-{SUB, 0x30A1, 4, U32,  RW|TRX|BK, "="     ,     "10",    "1000000000", "mg*cm^2", "Inertia"},
-{SUB, 0x30A1, 5, U32,  RW|TRX|BK, "=",          "0",     "1000000000", "nNm/rpm", "Friction"},
-{VAR, 0x30B0, 0, I32,  RW|TRX|BK, "=",          "",      "",          "inc",   "Home Position"},                      // 7.2.32
-{VAR, 0x30B1, 0, I32,  RW|BK,     "=",          "",      "",          "inc",   "Home Offset Move Distance"},          // 7.2.33
-{VAR, 0x30B2, 0, U16,  RW|BK,     "="  ,        "",      "",          "mA",    "Current Threshold for Homing Mode"},  // 7.2.34
-{VAR, 0x30D0, 0, I16,  RO|TX,     "=",          "",      "",          "mA",    "Current Demand Value"},               // 7.2.35
-{VAR, 0x30D1, 0, I16,  RO|TX,     "=",          "",      "",          "mA",    "Current Actual Value Averaged"},      // 7.2.36
-{VAR, 0x30D5, 0, I32,  RO|TX,     "=",          "",      "",          "rpm",   "Velocity Actual Value Averaged"},     // 7.2.37
+{SUB, 0x30A1, 1, U32,  RW|TRX|BK, "4000",       "10",    "1000000",   "mHz",   "Position Regulator Bandwidth", P(PositionBandwidth)},
+{SUB, 0x30A1, 2, U32,  RW|TRX|BK, "1000",       "0",     "10000",     "0.1 %", "Position Regulator Damping", P(PositionDamping)},
+{SUB, 0x30A1, 3, U32,  RW|TRX|BK, "1000000",    "100",   "3600000000", "us",   "Position Regulator Reset Time", P(PositionResetTime)},
+{SUB, 0x30A1, 4, U32,  RW|TRX|BK, "100000",     "10",    "1000000000", "mg*cm^2", "Inertia", P(Inertia)},
+{SUB, 0x30A1, 5, U32,  RW|TRX|BK, "0",          "0",     "1000000000", "nNm/rpm", "Friction", P(Friction)},
+{VAR, 0x30B0, 0, I32,  RW|TRX|BK, "0",          "",      "",          "inc",   "Home Position", P(HomePosition)},                      // 7.2.32
+{VAR, 0x30B1, 0, I32,  RW|BK,     "0",          "",      "",          "inc",   "Home Offset Move Distance", P(HomeOffsetMoveDistance)},          // 7.2.33
+{VAR, 0x30B2, 0, U16,  RW|BK,     "500",        "",      "",          "mA",    "Current Threshold for Homing Mode", P(HomingCurrentThreshold)},  // 7.2.34
+{VAR, 0x30D0, 0, I16,  RO|TX,     "0",          "",      "",          "mA",    "Current Demand Value", P(CurrentDemandValue)},               // 7.2.35
+{VAR, 0x30D1, 0, I16,  RO|TX,     "0",          "",      "",          "mA",    "Current Actual Value Averaged", P(CurrentActualValueAveraged)},      // 7.2.36
+{VAR, 0x30D5, 0, I32,  RO|TX,     "0",          "",      "",          "rpm",   "Velocity Actual Value Averaged", P(VelocityActualValueAveraged)},     // 7.2.37
 {REC, 0x30E0, 0, STRUCT, RO,      "",           "",      "",          "",      "Standstill Window Configuration"},    // 7.2.38
-{SUB, 0x30E0, 1, U32,  RW|BK,     "=" ,         "",      "",          "rpm",   "Standstill Window"},
-{SUB, 0x30E0, 2, U16,  RW|BK,     "=" ,         "",      "",          "ms",    "Standstill Window Time"},
-{SUB, 0x30E0, 3, U16,  RW|BK,     "="   ,       "",      "",          "ms",    "Standstill Window Timeout"},
+{SUB, 0x30E0, 1, U32,  RW|BK,     "30",         "",      "",          "rpm",   "Standstill Window", P(StandstillWindow)},
+{SUB, 0x30E0, 2, U16,  RW|BK,     "50",         "",      "",          "ms",    "Standstill Window Time", P(StandstillWindowTime)},
+{SUB, 0x30E0, 3, U16,  RW|BK,     "1000",       "",      "",          "ms",    "Standstill Window Timeout", P(StandstillWindowTimeout)},
 {ARR, 0x3141, 0, U16,  RO,        "",           "",      "",          "",      "Digital Input Properties"},           // 7.2.39
-{SUB, 0x3141, 1, U16,  RO|TX,     "=",          "",      "",          "",      "Digital Input Properties Logic State"},
-{SUB, 0x3141, 2, U16,  RW|BK,     "="     ,     "0",     "0x003F",    "",      "Digital Input Properties Polarity"},
+{SUB, 0x3141, 1, U16,  RO|TX,     "0",          "",      "",          "",      "Digital Input Properties Logic State", P(DigitalInputLogicState)},
+{SUB, 0x3141, 2, U16,  RW|BK,     "0",          "0",     "0x003F",    "",      "Digital Input Properties Polarity", P(DigitalInputPolarity)},
 {ARR, 0x3142, 0, U8,   RO,        "",           "",      "",          "",      "Configuration of Digital Inputs"},    // 7.2.40
-{SUB, 0x3142, 1, U8,   RW|BK,     "=",          "",      "",          "",      "Configuration of Digital Input 1"},
-{SUB, 0x3142, 2, U8,   RW|BK,     "=",          "",      "",          "",      "Configuration of Digital Input 2"},
-{SUB, 0x3142, 3, U8,   RW|BK,     "=",          "",      "",          "",      "Configuration of Digital Input 3"},
-{SUB, 0x3142, 4, U8,   RW|BK,     "=" ,         "",      "",          "",      "Configuration of Digital Input 4"},
-{SUB, 0x3142, 5, U8,   RW|BK,     "=" ,         "",      "",          "",      "Configuration of Digital Input 5"},
-{SUB, 0x3142, 6, U8,   RW|BK,     "=" ,         "",      "",          "",      "Configuration of Digital Input 6"},
+{SUB, 0x3142, 1, U8,   RW|BK,     "0",          "",      "",          "",      "Configuration of Digital Input 1", P(DigitalInput1Configuration)},
+{SUB, 0x3142, 2, U8,   RW|BK,     "1",          "",      "",          "",      "Configuration of Digital Input 2", P(DigitalInput2Configuration)},
+{SUB, 0x3142, 3, U8,   RW|BK,     "2",          "",      "",          "",      "Configuration of Digital Input 3", P(DigitalInput3Configuration)},
+{SUB, 0x3142, 4, U8,   RW|BK,     "19",         "",      "",          "",      "Configuration of Digital Input 4", P(DigitalInput4Configuration)},
+{SUB, 0x3142, 5, U8,   RW|BK,     "20",         "",      "",          "",      "Configuration of Digital Input 5", P(DigitalInput5Configuration)},
+{SUB, 0x3142, 6, U8,   RW|BK,     "21",         "",      "",          "",      "Configuration of Digital Input 6", P(DigitalInput6Configuration)},
 {ARR, 0x3150, 0, U16,  RO,        "",           "",      "",          "",      "Digital Output Properties"},          // 7.2.41
 {SUB, 0x3150, 1, U16,  RO|TX,     "0",          "",      "",          "",      "Digital Output Properties Logic State"},
 {SUB, 0x3150, 2, U16,  RW|BK,     "0x0000",     "0",     "0x0007",    "",      "Digital Output Properties Polarity"},
@@ -324,98 +331,98 @@ constexpr Line kTable[] = {
 {SUB, 0x3158, 1, U16,  RW|BK,     "10",         "",      "",          "ms",    "Holding Brake Rise Time"},
 {SUB, 0x3158, 2, U16,  RW|BK,     "10",         "",      "",          "ms",    "Holding Brake Fall Time"},
 // CiA 402 (7.2.44-7.2.101)
-{VAR, 0x6007, 0, I16,  RW|BK,     "=",          "1",     "3",         "",      "Abort Connection Option Code"},       // 7.2.44
-{VAR, 0x603F, 0, U16,  RO|TX,     "=",          "",      "",          "",      "Error Code"},                         // 7.2.45
-{VAR, 0x6040, 0, U16,  RW|TRX,    "=",          "",      "",          "",      "Controlword"},                        // 7.2.46
-{VAR, 0x6041, 0, U16,  RO|TX,     "=",          "",      "",          "",      "Statusword"},                         // 7.2.47
-{VAR, 0x605A, 0, I16,  RW|BK,     "=",          "6",     "6",         "",      "Quick Stop Option Code"},             // 7.2.48
-{VAR, 0x605B, 0, I16,  RW|BK,     "=",          "0",     "1",         "",      "Shutdown Option Code"},               // 7.2.49
-{VAR, 0x605C, 0, I16,  RW|BK,     "=",          "0",     "1",         "",      "Disable Operation Option Code"},      // 7.2.50
-{VAR, 0x605D, 0, I16,  RW|BK,     "=",          "2",     "2",         "",      "Halt Option Code"},                   // 7.2.51
-{VAR, 0x605E, 0, I16,  RW|BK,     "=",          "-1",    "2",         "",      "Fault Reaction Option Code"},         // 7.2.52
-{VAR, 0x6060, 0, I8,   RW|TRX,    "=",          "",      "",          "",      "Modes of Operation"},                 // 7.2.53
-{VAR, 0x6061, 0, I8,   RO|TX,     "=",          "",      "",          "",      "Modes of Operation Display"},         // 7.2.54
-{VAR, 0x6062, 0, I32,  RO|TX,     "=",          "",      "",          "inc",   "Position Demand Value"},              // 7.2.55
-{VAR, 0x6064, 0, I32,  RO|TX,     "=",          "",      "",          "inc",   "Position Actual Value"},              // 7.2.56
-{VAR, 0x6065, 0, U32,  RW|TRX|BK, "="   ,       "",      "",          "inc",   "Following Error Window"},             // 7.2.57
-{VAR, 0x6066, 0, U16,  RW|TRX|BK, "=",          "0",     "0",         "ms",    "Following Error Timeout"},            // 7.2.58
-{VAR, 0x606B, 0, I32,  RO|TX,     "=",          "",      "",          "rpm",   "Velocity Demand Value"},              // 7.2.59
-{VAR, 0x606C, 0, I32,  RO|TX,     "=",          "",      "",          "rpm",   "Velocity Actual Value"},              // 7.2.60
-{VAR, 0x6071, 0, I16,  RW|TRX,    "=",          "",      "",          "0.1 %", "Target Torque"},                      // 7.2.61
-{VAR, 0x6076, 0, U32,  RO|TX,     "=",          "",      "",          "uNm",   "Motor Rated Torque"},                 // 7.2.62
-{VAR, 0x6077, 0, I16,  RO|TX,     "=",          "",      "",          "0.1 %", "Torque Actual Value"},                // 7.2.63
-{VAR, 0x6078, 0, I16,  RO|TX,     "=",          "",      "",          "mA",    "Current Actual Value"},               // 7.2.64
-{VAR, 0x607A, 0, I32,  RW|TRX,    "=",          "",      "",          "inc",   "Target Position"},                    // 7.2.65
+{VAR, 0x6007, 0, I16,  RW|BK,     "3",          "1",     "3",         "",      "Abort Connection Option Code"},       // 7.2.44
+{VAR, 0x603F, 0, U16,  RO|TX,     "0",          "",      "",          "",      "Error Code"},                         // 7.2.45
+{VAR, 0x6040, 0, U16,  RW|TRX,    "0",          "",      "",          "",      "Controlword"},                        // 7.2.46
+{VAR, 0x6041, 0, U16,  RO|TX,     "0",          "",      "",          "",      "Statusword"},                         // 7.2.47
+{VAR, 0x605A, 0, I16,  RW|BK,     "6",          "6",     "6",         "",      "Quick Stop Option Code"},             // 7.2.48
+{VAR, 0x605B, 0, I16,  RW|BK,     "0",          "0",     "1",         "",      "Shutdown Option Code"},               // 7.2.49
+{VAR, 0x605C, 0, I16,  RW|BK,     "1",          "0",     "1",         "",      "Disable Operation Option Code"},      // 7.2.50
+{VAR, 0x605D, 0, I16,  RW|BK,     "2",          "2",     "2",         "",      "Halt Option Code"},                   // 7.2.51
+{VAR, 0x605E, 0, I16,  RW|BK,     "2",          "-1",    "2",         "",      "Fault Reaction Option Code"},         // 7.2.52
+{VAR, 0x6060, 0, I8,   RW|TRX,    "8",          "",      "",          "",      "Modes of Operation"},                 // 7.2.53
+{VAR, 0x6061, 0, I8,   RO|TX,     "1",          "",      "",          "",      "Modes of Operation Display"},         // 7.2.54
+{VAR, 0x6062, 0, I32,  RO|TX,     "0",          "",      "",          "inc",   "Position Demand Value"},              // 7.2.55
+{VAR, 0x6064, 0, I32,  RO|TX,     "0",          "",      "",          "inc",   "Position Actual Value"},              // 7.2.56
+{VAR, 0x6065, 0, U32,  RW|TRX|BK, "2000",       "",      "",          "inc",   "Following Error Window"},             // 7.2.57
+{VAR, 0x6066, 0, U16,  RW|TRX|BK, "0",          "0",     "0",         "ms",    "Following Error Timeout"},            // 7.2.58
+{VAR, 0x606B, 0, I32,  RO|TX,     "0",          "",      "",          "rpm",   "Velocity Demand Value"},              // 7.2.59
+{VAR, 0x606C, 0, I32,  RO|TX,     "0",          "",      "",          "rpm",   "Velocity Actual Value"},              // 7.2.60
+{VAR, 0x6071, 0, I16,  RW|TRX,    "0",          "",      "",          "0.1 %", "Target Torque"},                      // 7.2.61
+{VAR, 0x6076, 0, U32,  RO|TX,     "0",          "",      "",          "uNm",   "Motor Rated Torque"},                 // 7.2.62
+{VAR, 0x6077, 0, I16,  RO|TX,     "0",          "",      "",          "0.1 %", "Torque Actual Value"},                // 7.2.63
+{VAR, 0x6078, 0, I16,  RO|TX,     "0",          "",      "",          "mA",    "Current Actual Value"},               // 7.2.64
+{VAR, 0x607A, 0, I32,  RW|TRX,    "0",          "",      "",          "inc",   "Target Position"},                    // 7.2.65
 {ARR, 0x607B, 0, I32,  RO,        "",           "",      "",          "",      "Position Range Limit"},               // 7.2.66
-{SUB, 0x607B, 1, I32,  RW|TRX|BK, "="          , "",     "",          "inc",   "Min Position Range Limit"},
-{SUB, 0x607B, 2, I32,  RW|TRX|BK, "="         , "",      "",          "inc",   "Max Position Range Limit"},
+{SUB, 0x607B, 1, I32,  RW|TRX|BK, "-2147483648", "",     "",          "inc",   "Min Position Range Limit"},
+{SUB, 0x607B, 2, I32,  RW|TRX|BK, "2147483647", "",      "",          "inc",   "Max Position Range Limit"},
 {ARR, 0x607D, 0, I32,  RO,        "",           "",      "",          "",      "Software Position Limit"},            // 7.2.67
-{SUB, 0x607D, 1, I32,  RW|TRX|BK, "="          , "",     "",          "inc",   "Min Position Limit"},
-{SUB, 0x607D, 2, I32,  RW|TRX|BK, "="         , "",      "",          "inc",   "Max Position Limit"},
-{VAR, 0x607F, 0, U32,  RW|TRX|BK, "="     ,     "1",     "",          "rpm",   "Max Profile Velocity"},               // 7.2.68
-{VAR, 0x6080, 0, U32,  RW|BK,     "="     ,     "1",     "200000",    "rpm",   "Max Motor Speed"},                    // 7.2.69
-{VAR, 0x6081, 0, U32,  RW|TRX|BK, "="   ,       "1",     "",          "rpm",   "Profile Velocity"},                   // 7.2.70
-{VAR, 0x6083, 0, U32,  RW|TRX|BK, "="    ,      "1",     "",          "rpm/s", "Profile Acceleration"},               // 7.2.71
-{VAR, 0x6084, 0, U32,  RW|TRX|BK, "="    ,      "1",     "",          "rpm/s", "Profile Deceleration"},               // 7.2.72
-{VAR, 0x6085, 0, U32,  RW|TRX|BK, "="    ,      "1",     "",          "rpm/s", "Quick Stop Deceleration"},            // 7.2.73
+{SUB, 0x607D, 1, I32,  RW|TRX|BK, "-2147483648", "",     "",          "inc",   "Min Position Limit"},
+{SUB, 0x607D, 2, I32,  RW|TRX|BK, "2147483647", "",      "",          "inc",   "Max Position Limit"},
+{VAR, 0x607F, 0, U32,  RW|TRX|BK, "200000",     "1",     "",          "rpm",   "Max Profile Velocity"},               // 7.2.68
+{VAR, 0x6080, 0, U32,  RW|BK,     "200000",     "1",     "200000",    "rpm",   "Max Motor Speed"},                    // 7.2.69
+{VAR, 0x6081, 0, U32,  RW|TRX|BK, "1000",       "1",     "",          "rpm",   "Profile Velocity"},                   // 7.2.70
+{VAR, 0x6083, 0, U32,  RW|TRX|BK, "10000",      "1",     "",          "rpm/s", "Profile Acceleration"},               // 7.2.71
+{VAR, 0x6084, 0, U32,  RW|TRX|BK, "10000",      "1",     "",          "rpm/s", "Profile Deceleration"},               // 7.2.72
+{VAR, 0x6085, 0, U32,  RW|TRX|BK, "15000",      "1",     "",          "rpm/s", "Quick Stop Deceleration"},            // 7.2.73
 {VAR, 0x6086, 0, I16,  RW|TRX|BK, "0",          "0",     "0",         "",      "Motion Profile Type"},                // 7.2.74
-{VAR, 0x6098, 0, I8,   RW|TRX|BK, "=" ,         "",      "",          "",      "Homing Method"},                      // 7.2.75
+{VAR, 0x6098, 0, I8,   RW|TRX|BK, "37",         "",      "",          "",      "Homing Method"},                      // 7.2.75
 {ARR, 0x6099, 0, U32,  RO,        "",           "",      "",          "",      "Homing Speeds"},                      // 7.2.76
-{SUB, 0x6099, 1, U32,  RW|TRX|BK, "="  ,        "1",     "",          "rpm",   "Speed for Switch Search"},
-{SUB, 0x6099, 2, U32,  RW|TRX|BK, "=" ,         "1",     "",          "rpm",   "Speed for Zero Search"},
-{VAR, 0x609A, 0, U32,  RW|TRX|BK, "="   ,       "1",     "",          "rpm/s", "Homing Acceleration"},                // 7.2.77
+{SUB, 0x6099, 1, U32,  RW|TRX|BK, "100",        "1",     "",          "rpm",   "Speed for Switch Search"},
+{SUB, 0x6099, 2, U32,  RW|TRX|BK, "10",         "1",     "",          "rpm",   "Speed for Zero Search"},
+{VAR, 0x609A, 0, U32,  RW|TRX|BK, "1000",       "1",     "",          "rpm/s", "Homing Acceleration"},                // 7.2.77
 {VAR, 0x60A8, 0, U32,  RW|TRX|BK, "0x00B50000", "0x00B50000", "0x00B50000", "", "SI Unit Position"},                  // 7.2.78
 {VAR, 0x60A9, 0, U32,  RW|BK,     "0x00B44700", "0x00B44700", "0x00B44700", "", "SI Unit Velocity"},                  // 7.2.79
 {VAR, 0x60AA, 0, U32,  RW|BK,     "0x00C00300", "0x00C00300", "0x00C00300", "", "SI Unit Acceleration"},              // 7.2.80
-{VAR, 0x60B0, 0, I32,  RW|TRX,    "=",          "",      "",          "inc",   "Position Offset"},                    // 7.2.81
-{VAR, 0x60B1, 0, I32,  RW|TRX,    "=",          "-200000", "200000",  "rpm",   "Velocity Offset"},                    // 7.2.82
-{VAR, 0x60B2, 0, I16,  RW|TRX,    "=",          "",      "",          "0.1 %", "Torque Offset"},                      // 7.2.83
-{VAR, 0x60B8, 0, U16,  RW|TRX|BK, "=",          "",      "",          "",      "Touch Probe Function"},               // 7.2.84
-{VAR, 0x60B9, 0, U16,  RO|TX,     "=",          "",      "",          "",      "Touch Probe Status"},                 // 7.2.85
-{VAR, 0x60BA, 0, I32,  RO|TX,     "=",          "",      "",          "inc",   "Touch Probe Position 1 Positive Value"}, // 7.2.86
-{VAR, 0x60BB, 0, I32,  RO|TX,     "=",          "",      "",          "inc",   "Touch Probe Position 1 Negative Value"}, // 7.2.87
+{VAR, 0x60B0, 0, I32,  RW|TRX,    "0",          "",      "",          "inc",   "Position Offset"},                    // 7.2.81
+{VAR, 0x60B1, 0, I32,  RW|TRX,    "0",          "-200000", "200000",  "rpm",   "Velocity Offset"},                    // 7.2.82
+{VAR, 0x60B2, 0, I16,  RW|TRX,    "0",          "",      "",          "0.1 %", "Torque Offset"},                      // 7.2.83
+{VAR, 0x60B8, 0, U16,  RW|TRX|BK, "0",          "",      "",          "",      "Touch Probe Function"},               // 7.2.84
+{VAR, 0x60B9, 0, U16,  RO|TX,     "0",          "",      "",          "",      "Touch Probe Status"},                 // 7.2.85
+{VAR, 0x60BA, 0, I32,  RO|TX,     "0",          "",      "",          "inc",   "Touch Probe Position 1 Positive Value"}, // 7.2.86
+{VAR, 0x60BB, 0, I32,  RO|TX,     "0",          "",      "",          "inc",   "Touch Probe Position 1 Negative Value"}, // 7.2.87
 {REC, 0x60C2, 0, STRUCT, RO,      "",           "",      "",          "",      "Interpolation Time Period"},          // 7.2.88
-{SUB, 0x60C2, 1, U8,   RW|TRX|BK, "=",          "1",     "1",         "",      "Interpolation Time Period Value"},
-{SUB, 0x60C2, 2, I8,   RW|TRX|BK, "=" ,         "-3",    "-3",        "",      "Interpolation Time Index"},
-{VAR, 0x60C5, 0, U32,  RW|BK,     "="         , "1",     "4294967295", "rpm/s", "Max Acceleration"},                  // 7.2.89
+{SUB, 0x60C2, 1, U8,   RW|TRX|BK, "1",          "1",     "1",         "",      "Interpolation Time Period Value"},
+{SUB, 0x60C2, 2, I8,   RW|TRX|BK, "-3",         "-3",    "-3",        "",      "Interpolation Time Index"},
+{VAR, 0x60C5, 0, U32,  RW|BK,     "0xFFFFFFFF", "1",     "4294967295", "rpm/s", "Max Acceleration"},                  // 7.2.89
 {ARR, 0x60D0, 0, I16,  RO,        "",           "",      "",          "",      "Touch Probe Source"},                 // 7.2.90
-{SUB, 0x60D0, 1, I16,  RO,        "=" ,         "",      "",          "",      "Touch Probe 1 Source"},
-{VAR, 0x60D5, 0, U16,  RO|TX,     "=",          "",      "",          "",      "Touch Probe 1 Positive Edge Counter"}, // 7.2.91
-{VAR, 0x60D6, 0, U16,  RO|TX,     "=",          "",      "",          "",      "Touch Probe 1 Negative Edge Counter"}, // 7.2.92
+{SUB, 0x60D0, 1, I16,  RO,        "-1",         "",      "",          "",      "Touch Probe 1 Source"},
+{VAR, 0x60D5, 0, U16,  RO|TX,     "0",          "",      "",          "",      "Touch Probe 1 Positive Edge Counter"}, // 7.2.91
+{VAR, 0x60D6, 0, U16,  RO|TX,     "0",          "",      "",          "",      "Touch Probe 1 Negative Edge Counter"}, // 7.2.92
 {ARR, 0x60E3, 0, I16,  RO,        "",           "",      "",          "",      "Supported Homing Methods"},           // 7.2.93
-{SUB, 0x60E3, 1, I16,  RO,        "=",          "",      "",          "",      "1st Supported Homing Method"},
-{SUB, 0x60E3, 2, I16,  RO,        "=",          "",      "",          "",      "2nd Supported Homing Method"},
-{SUB, 0x60E3, 3, I16,  RO,        "=",          "",      "",          "",      "3rd Supported Homing Method"},
-{SUB, 0x60E3, 4, I16,  RO,        "=" ,         "",      "",          "",      "4th Supported Homing Method"},
-{SUB, 0x60E3, 5, I16,  RO,        "=" ,         "",      "",          "",      "5th Supported Homing Method"},
-{SUB, 0x60E3, 6, I16,  RO,        "=" ,         "",      "",          "",      "6th Supported Homing Method"},
-{SUB, 0x60E3, 7, I16,  RO,        "=" ,         "",      "",          "",      "7th Supported Homing Method"},
-{SUB, 0x60E3, 8, I16,  RO,        "=" ,         "",      "",          "",      "8th Supported Homing Method"},
-{SUB, 0x60E3, 9, I16,  RO,        "=" ,         "",      "",          "",      "9th Supported Homing Method"},
-{SUB, 0x60E3, 10, I16, RO,        "=" ,         "",      "",          "",      "10th Supported Homing Method"},
-{SUB, 0x60E3, 11, I16, RO,        "=" ,         "",      "",          "",      "11th Supported Homing Method"},
-{SUB, 0x60E3, 12, I16, RO,        "=" ,         "",      "",          "",      "12th Supported Homing Method"},
-{SUB, 0x60E3, 13, I16, RO,        "=" ,         "",      "",          "",      "13th Supported Homing Method"},
-{SUB, 0x60E3, 14, I16, RO,        "=" ,         "",      "",          "",      "14th Supported Homing Method"},
-{SUB, 0x60E3, 15, I16, RO,        "=" ,         "",      "",          "",      "15th Supported Homing Method"},
+{SUB, 0x60E3, 1, I16,  RO,        "1",          "",      "",          "",      "1st Supported Homing Method"},
+{SUB, 0x60E3, 2, I16,  RO,        "2",          "",      "",          "",      "2nd Supported Homing Method"},
+{SUB, 0x60E3, 3, I16,  RO,        "7",          "",      "",          "",      "3rd Supported Homing Method"},
+{SUB, 0x60E3, 4, I16,  RO,        "11",         "",      "",          "",      "4th Supported Homing Method"},
+{SUB, 0x60E3, 5, I16,  RO,        "17",         "",      "",          "",      "5th Supported Homing Method"},
+{SUB, 0x60E3, 6, I16,  RO,        "18",         "",      "",          "",      "6th Supported Homing Method"},
+{SUB, 0x60E3, 7, I16,  RO,        "23",         "",      "",          "",      "7th Supported Homing Method"},
+{SUB, 0x60E3, 8, I16,  RO,        "27",         "",      "",          "",      "8th Supported Homing Method"},
+{SUB, 0x60E3, 9, I16,  RO,        "33",         "",      "",          "",      "9th Supported Homing Method"},
+{SUB, 0x60E3, 10, I16, RO,        "34",         "",      "",          "",      "10th Supported Homing Method"},
+{SUB, 0x60E3, 11, I16, RO,        "37",         "",      "",          "",      "11th Supported Homing Method"},
+{SUB, 0x60E3, 12, I16, RO,        "-1",         "",      "",          "",      "12th Supported Homing Method"},
+{SUB, 0x60E3, 13, I16, RO,        "-2",         "",      "",          "",      "13th Supported Homing Method"},
+{SUB, 0x60E3, 14, I16, RO,        "-3",         "",      "",          "",      "14th Supported Homing Method"},
+{SUB, 0x60E3, 15, I16, RO,        "-4",         "",      "",          "",      "15th Supported Homing Method"},
 {ARR, 0x60E4, 0, I32,  RO,        "",           "",      "",          "",      "Additional Position Actual Values"},   // 7.2.94
-{SUB, 0x60E4, 1, I32,  RO|TX,     "=",          "",      "",          "inc",   "Position Actual Value Sensor 1"},
+{SUB, 0x60E4, 1, I32,  RO|TX,     "0",          "",      "",          "inc",   "Position Actual Value Sensor 1", P(PositionActualValueSensor1)},
 {SUB, 0x60E4, 2, I32,  RO|TX,     "0",          "",      "",          "inc",   "Position Actual Value Sensor 2"},
 {SUB, 0x60E4, 3, I32,  RO|TX,     "0",          "",      "",          "inc",   "Position Actual Value Sensor 3"},
 {ARR, 0x60E5, 0, I32,  RO,        "",           "",      "",          "",      "Additional Velocity Actual Values"},   // 7.2.95
-{SUB, 0x60E5, 1, I32,  RO|TX,     "=",          "",      "",          "rpm",   "Velocity Actual Value Sensor 1"},
+{SUB, 0x60E5, 1, I32,  RO|TX,     "0",          "",      "",          "rpm",   "Velocity Actual Value Sensor 1", P(VelocityActualValueSensor1)},
 {SUB, 0x60E5, 2, I32,  RO|TX,     "0",          "",      "",          "rpm",   "Velocity Actual Value Sensor 2"},
 {SUB, 0x60E5, 3, I32,  RO|TX,     "0",          "",      "",          "rpm",   "Velocity Actual Value Sensor 3"},
-{SUB, 0x60E5, 9, I32,  RO|TX,     "=",          "",      "",          "rpm",   "Velocity Actual Value Averaged Sensor 1"},
+{SUB, 0x60E5, 9, I32,  RO|TX,     "0",          "",      "",          "rpm",   "Velocity Actual Value Averaged Sensor 1", P(VelocityActualAveragedSensor1)},
 {SUB, 0x60E5, 10, I32, RO|TX,     "0",          "",      "",          "rpm",   "Velocity Actual Value Averaged Sensor 2"},
 {SUB, 0x60E5, 11, I32, RO|TX,     "0",          "",      "",          "rpm",   "Velocity Actual Value Averaged Sensor 3"},
-{VAR, 0x60F4, 0, I32,  RO|TX,     "=",          "",      "",          "inc",   "Following Error Actual Value"},       // 7.2.96
-{VAR, 0x60FD, 0, U32,  RO|TX,     "=",          "",      "",          "",      "Digital Inputs"},                     // 7.2.97
+{VAR, 0x60F4, 0, I32,  RO|TX,     "0",          "",      "",          "inc",   "Following Error Actual Value"},       // 7.2.96
+{VAR, 0x60FD, 0, U32,  RO|TX,     "0",          "",      "",          "",      "Digital Inputs"},                     // 7.2.97
 {ARR, 0x60FE, 0, U32,  RO,        "",           "",      "",          "",      "Digital Outputs"},                    // 7.2.98
 {SUB, 0x60FE, 1, U32,  RW|TRX,    "0",          "",      "",          "",      "Physical Outputs"},
-{VAR, 0x60FF, 0, I32,  RW|TRX,    "=",          "-200000", "200000",  "rpm",   "Target Velocity"},                    // 7.2.99
-{VAR, 0x6402, 0, U16,  RW|BK,     "=" ,         "1",     "10",        "",      "Motor Type"},                         // 7.2.100
-{VAR, 0x6502, 0, U32,  RO,        "="         , "",      "",          "",      "Supported Drive Modes"},              // 7.2.101
+{VAR, 0x60FF, 0, I32,  RW|TRX,    "0",          "-200000", "200000",  "rpm",   "Target Velocity"},                    // 7.2.99
+{VAR, 0x6402, 0, U16,  RW|BK,     "10",         "1",     "10",        "",      "Motor Type"},                         // 7.2.100
+{VAR, 0x6502, 0, U32,  RO,        "0x000003A5", "",      "",          "",      "Supported Drive Modes"},              // 7.2.101
 // Modular device profile (7.2.102-7.2.104)
 {REC, 0xF000, 0, STRUCT, RO,      "",           "",      "",          "",      "Modular Device Profile"},             // 7.2.102
 {SUB, 0xF000, 1, U16,  RO,        "0x0010",     "",      "",          "",      "Index Distance"},
@@ -451,11 +458,48 @@ constexpr ValueSet kValueSets[] = {
     {0x1C33, 1, {1, 2, 34}, 3},                                                 // 7.2.18.1, T7-79
     {0x3000, 2, {0x01, 0x11, 0x21, 0x31}, 4},                                   // T7-88
     {0x3000, 3, {0x00, 0x30, 0x31, 0x32}, 4},                                   // T7-90
-    value_set(obj::ModesOfOperation.index, obj::ModesOfOperation.sub, kModesOfOperation), // T7-123
-    value_set(obj::HomingMethod.index, obj::HomingMethod.sub, kHomingMethods),             // T7-126
+    value_set(0x6060, 0, drive::kModesOfOperation),                             // T7-123
+    value_set(0x6098, 0, drive::kHomingMethods),                                // T7-126
     {0x6402, 0, {1, 10}, 2},                                                    // T7-139
 };
 // clang-format on
+
+// The rows that hold a vendor parameter, as the drive's bindings; each row's type is the parameter's.
+constexpr std::size_t kBindingCount = [] {
+    std::size_t n = 0;
+    for (const Line& l : kTable)
+        if (l.binds) ++n;
+    return n;
+}();
+constexpr std::array<drive::Binding, kBindingCount> kBindings = [] {
+    std::array<drive::Binding, kBindingCount> out{};
+    std::size_t n = 0;
+    for (const Line& l : kTable)
+        if (l.binds) out[n++] = drive::Binding{l.param, l.index, l.kind == VAR ? uint8_t{0} : l.sub};
+    return out;
+}();
+constexpr bool bindings_typed() {
+    for (const Line& l : kTable)
+        if (l.binds && (bit_size(l.type) != 8 * drive::param_size(l.param) ||
+                        is_signed(l.type) != drive::param_signed(l.param)))
+            return false;
+    return true;
+}
+static_assert(bindings_typed(), "a P(...) row's type differs from the drive parameter's");
+constexpr bool bindings_unique() {
+    for (std::size_t i = 0; i < kBindings.size(); ++i)
+        for (std::size_t k = i + 1; k < kBindings.size(); ++k)
+            if (kBindings[i].param == kBindings[k].param) return false;
+    return true;
+}
+static_assert(bindings_unique(), "a drive parameter is held by two rows");
+
+// What a master may write only in "Power Disable" (§7.2.22-7.2.29, §7.2.78-7.2.80, §7.2.100): the axis
+// configuration, of the motor data only the pole pairs, the sensor records, the SI units, the motor type.
+constexpr drive::PowerDisableOnly kPowerDisableOnly[] = {
+    {0x3000}, {0x3001, 3}, {0x3010}, {0x3011}, {0x3012}, {0x3014},
+    {0x301A}, {0x3020},    {0x60A8}, {0x60A9}, {0x60AA}, {0x6402},
+};
 
 std::string identity_token(std::string_view token, const Identity& id) {
     auto hex = [](uint32_t v) {
@@ -498,14 +542,13 @@ Number parse_number(std::string_view s, DataType t, uint16_t index) {
 }
 
 // The values an enumerated entry takes: its value set, a display's the value set of what it displays, or
-// the range of its limits. Each must have a name (od/value_names.hpp), so the ESI names every value the
+// the range of its limits. Each must have a name (value_names.hpp), so the ESI names every value the
 // drive accepts and no other.
 std::vector<NamedValue> enumeration_of(const Entry& e) {
     if (!has_value_names(e.index, e.subindex)) return {};
     uint16_t index = e.index;
     uint8_t sub = e.subindex;
-    if (index == obj::ModesOfOperationDisplay.index && sub == obj::ModesOfOperationDisplay.sub)
-        index = obj::ModesOfOperation.index, sub = obj::ModesOfOperation.sub;
+    if (index == 0x6061 && sub == 0) index = 0x6060;  // the display takes the modes of operation
     std::vector<int64_t> values;
     for (const ValueSet& vs : kValueSets)
         if (vs.index == index && vs.sub == sub) values.assign(vs.values, vs.values + vs.count);
@@ -545,19 +588,8 @@ Entry make_entry(const Line& l, const Identity& id) {
     e.type = l.type;
     e.access = l.acc;
     e.unit = l.unit;
-    // The marker is the table's, never a value: an identity string "=" is text like any other.
-    const bool declared_default_marker = std::string_view(l.def) == "=";
     std::string def = l.def;
     if (!def.empty() && def.front() == '$') def = identity_token(def, id);
-    if (declared_default_marker) {
-        const std::optional<Number> declared = declared_default(l.index, e.subindex);
-        if (!declared) throw std::logic_error("od: row marked \"=\" without a declared default");
-        e.default_value = *declared;
-        e.minimum = parse_number(l.min, l.type, l.index);
-        e.maximum = parse_number(l.max, l.type, l.index);
-        e.enumeration = enumeration_of(e);
-        return e;
-    }
     if (is_string(l.type)) {
         e.default_string = def;
         std::size_t cap = def.size();
@@ -587,7 +619,7 @@ uint32_t default_pdo_bits(uint16_t pdo) {
 
 }  // namespace
 
-DeviceDescription default_drive_description() {
+DeviceDescription description() {
     DeviceDescription d;
     Identity& id = d.identity;
     id.vendor_id = 0x000000FB;     // 7.2.4.2
@@ -645,7 +677,7 @@ void place_sync_managers(DeviceDescription& d) {
     const uint32_t sm2 = round_up(mbx_end, 0x80);
     const uint32_t sm3 = round_up(sm2 + 3 * kMaxPdoBytes, 0x80);
     if (sm3 + 3 * kMaxPdoBytes > 0x10000)
-        throw std::out_of_range("od: no room for the process-data SyncManagers after the mailbox");
+        throw std::out_of_range("maxpos: no room for the process-data SyncManagers after the mailbox");
     const auto rx_bytes = static_cast<uint16_t>((default_pdo_bits(0x1600) + 7) / 8);
     const auto tx_bytes = static_cast<uint16_t>((default_pdo_bits(0x1A00) + 7) / 8);
     // SM0..SM3 in the order of 0x1C00, each with its kind's control byte.
@@ -662,7 +694,7 @@ void place_sync_managers(DeviceDescription& d) {
     };
 }
 
-Dictionary make_drive_dictionary(const DeviceDescription& description) {
+Dictionary dictionary(const DeviceDescription& description) {
     Dictionary dict;
     const Identity& id = description.identity;
     std::size_t i = 0;
@@ -710,4 +742,26 @@ Dictionary make_drive_dictionary(const DeviceDescription& description) {
     return dict;
 }
 
-}  // namespace od
+DeviceDescription parse_config(std::string_view text, const std::string& source) {
+    return parse_device_config(text, source, description(), place_sync_managers);
+}
+
+DeviceDescription load_config(const std::filesystem::path& path) {
+    return load_device_config(path, description(), place_sync_managers);
+}
+
+Product product(const std::filesystem::path& config_file) {
+    Product p;
+    p.source = config_file.empty() ? "the built-in MAXPOS" : "the MAXPOS of " + config_file.string();
+    p.description = config_file.empty() ? description() : load_config(config_file);
+    p.make_dictionary = [](const DeviceDescription& d) { return dictionary(d); };
+    p.application = Application::Cia402Drive;
+    return p;
+}
+
+const drive::VendorObjects& drive_objects() {
+    static const drive::VendorObjects objects{kBindings, kPowerDisableOnly};
+    return objects;
+}
+
+}  // namespace maxpos

@@ -1,8 +1,8 @@
-#include "od/value_names.hpp"
+#include "value_names.hpp"
 
 #include <array>
 
-namespace od {
+namespace maxpos {
 namespace {
 
 struct Named {
@@ -125,4 +125,4 @@ std::string_view value_name(uint16_t index, uint8_t sub, int64_t value) {
     return {};
 }
 
-}  // namespace od
+}  // namespace maxpos
