@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <span>
 #include <string>
 #include <vector>
@@ -145,6 +146,9 @@ class Context {
     std::string sii_error;
     std::optional<EsiDevice> esi;
     std::string esi_error;  // why there is no ESI expectation
+    // A modular device: the mapping objects of its slots' default modules' PDOs (esi holds the device as
+    // configured by default: its own PDOs and objects and those of the default modules).
+    std::set<uint16_t> module_mapping_objects;
 
     // Scaled timeout, cut to what is left of the running test's budget (at least 1 ms): a slave that lies
     // or stops answering makes each wait short once the test has used its budget.
@@ -162,6 +166,21 @@ class Context {
     std::string need_complete_access() const;
     std::string need_402() const;
     std::string need_boot() const;
+    // The process-data layout: over CoE where the device has it, else from the SII (SyncM and PDO
+    // categories), as a master configures a device without mailbox.
+    std::string need_pd_layout() const { return need_sii(); }
+
+    bool has_mailbox() const { return need_mailbox().empty(); }
+    // ESC configuration 0x0141 bit 0, read at setup (loaded from SII word 0, ConfigData): with device
+    // emulation the ESC itself sets AL status to the value written to AL control (ESC datasheet section II,
+    // 0x0141 and 0x0130): no state machine that checks or refuses a request, no error indication, no AL
+    // status code (simple IO devices without a controller).
+    bool device_emulation = false;
+    std::string need_state_machine() const {
+        return device_emulation ? "device emulation (0x0141 bit 0): the ESC copies AL control to AL status, "
+                                  "no state machine refuses a request or sets the error indication"
+                                : "";
+    }
 
     // Protocols the slave announces (SII word 0x1C).
     uint16_t protocols() const;
@@ -192,6 +211,14 @@ class Context {
     master::Error reach(uint8_t state);
     // Exchanges process data for `cycles` cycles of 1 ms (keeps outputs valid and the watchdog fed).
     master::Error cycle(unsigned cycles = 1);
+    // A fresh process-data session for the slave in PREOP with its layout discovered: over CoE (sdo) or,
+    // without CoE, from the SII.
+    master::Error discover_pd();
+    // Sets up SMs/FMMUs for the discovered layout; a device without process data (a coupler) needs none.
+    master::Error configure_pd(const master::DcConfig& dc = {});
+    bool has_process_data() const { return pds && (pds->layout().sm2_length || pds->layout().sm3_length); }
+    // SAFEOP -> OP: exchanging process data where there is some, else by AL control alone.
+    master::Error request_op(master::AlStatus& st);
     std::unique_ptr<master::ProcessDataSession> pds;
     master::AlStatus last_status;  // of the last refused to_* call
     unsigned al_timeouts = 0;      // requests of this group neither reached nor refused within their wait

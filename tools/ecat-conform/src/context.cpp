@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <set>
 #include <thread>
 
 #include "conform.hpp"
@@ -124,6 +125,67 @@ std::chrono::milliseconds Context::ms(int base) const {
     return std::clamp(left, std::chrono::milliseconds(1), std::max(scaled, std::chrono::milliseconds(1)));
 }
 
+namespace {
+
+// A module PDO assigned by default to its SM n joins the assignment object 0x1C10 + n (ETG.1000.6 PDO
+// assignment): one more in subindex 0, its index in the next subindex, as the defaults of the device.
+void assign_by_default(EsiDevice& d, const EsiPdo& p) {
+    auto o = d.objects.find(static_cast<uint16_t>(0x1C10 + p.sm));
+    if (o == d.objects.end()) return;
+    auto entry = [&](uint8_t sub) -> EsiEntry* {
+        for (EsiEntry& e : o->second.entries)
+            if (e.subindex == sub) return &e;
+        return nullptr;
+    };
+    EsiEntry* count = entry(0);
+    if (count == nullptr) return;
+    const uint8_t n = static_cast<uint8_t>((count->default_data.empty() ? 0 : count->default_data[0]) + 1);
+    count->default_data = {n};
+    count->default_value = n;
+    if (EsiEntry* e = entry(n)) {
+        e->default_data = {static_cast<uint8_t>(p.index & 0xFF), static_cast<uint8_t>(p.index >> 8)};
+        e->default_value = p.index;
+    }
+}
+
+// A modular device as its ESI configures it by default (ETG.2000 Slots/Slot, Modules/Module): the device's
+// own PDOs and objects, then those of the default module of each slot in slot order, the indices of what
+// DependOnSlot moved by the slot number times SlotPdoIncrement (PDOs) or SlotIndexIncrement (objects and the
+// entries they map). A slot without a default module, or a module the file lacks, stays empty. The mapping
+// objects of the modules' PDOs (0x1600.../0x1A00..., ETG.1000.6 PDO mapping) exist in the device's dictionary
+// although a module's own Dictionary does not list them: they go to mapping_objects.
+EsiDevice as_configured(const EsiFile& f, EsiDevice d, std::set<uint16_t>& mapping_objects) {
+    for (std::size_t n = 0; n < d.slots.size(); ++n) {
+        const esi::EsiSlot& slot = d.slots[n];
+        if (!slot.default_module) continue;
+        const esi::EsiModule* m = f.module(*slot.default_module);
+        if (m == nullptr) continue;
+        const uint32_t pdo_inc = slot.pdo_increment.value_or(d.slot_pdo_increment);
+        const uint32_t idx_inc = slot.index_increment.value_or(d.slot_index_increment);
+        for (const auto* list : {&m->rxpdos, &m->txpdos})
+            for (EsiPdo p : *list) {
+                if (p.depend_on_slot) p.index = static_cast<uint16_t>(p.index + n * pdo_inc);
+                for (EsiPdoEntry& e : p.entries)
+                    if (e.depend_on_slot && e.index != 0)
+                        e.index = static_cast<uint16_t>(e.index + n * idx_inc);
+                if (!d.objects.count(p.index) && !m->objects.count(p.index)) mapping_objects.insert(p.index);
+                if (p.sm >= 0) assign_by_default(d, p);
+                (p.rx ? d.rxpdos : d.txpdos).push_back(std::move(p));
+            }
+        for (const auto& [index, o] : m->objects) {
+            const auto at = static_cast<uint16_t>(index + (o.depend_on_slot ? n * idx_inc : 0));
+            if (!d.objects.count(at)) {
+                EsiObject x = o;
+                x.index = at;
+                d.objects[at] = std::move(x);
+            }
+        }
+    }
+    return d;
+}
+
+}  // namespace
+
 std::string Context::setup() {
     auto n = m.count_slaves();
     if (!n)
@@ -138,6 +200,8 @@ std::string Context::setup() {
     station = static_cast<uint16_t>(0x1001 + opt.slave);
     addr = master::Address::station(station);
     if (auto s = m.al_status(addr)) initial_state = s->state;
+    // What the ESC itself does: the ESC configuration register as the SII loaded it.
+    if (auto c = m.read_reg<uint8_t>(addr, esc::reg::kEscConfig)) device_emulation = *c & 0x01;
     // The whole EEPROM, as big as word 0x3E says.
     auto img = m.sii_read_image(addr, true);
     if (img) {
@@ -166,7 +230,7 @@ std::string Context::setup() {
             if (pick >= static_cast<int>(f.devices.size()))
                 return opt.esi_path + ": no device " + std::to_string(pick) + " (" +
                        std::to_string(f.devices.size()) + " in the file)";
-            esi = f.devices[static_cast<std::size_t>(pick)];
+            esi = as_configured(f, f.devices[static_cast<std::size_t>(pick)], module_mapping_objects);
         } catch (const std::exception& e) {
             return std::string("ESI: ") + e.what();
         }
@@ -180,6 +244,7 @@ std::string Context::setup() {
         if (ec) return "--esi-dir " + opt.esi_dir + ": " + ec.message();
         std::sort(files.begin(), files.end());
         std::optional<EsiDevice> by_product;
+        std::set<uint16_t> by_product_mapping;
         std::string by_product_file;
         for (const auto& path : files) {
             if (!sii) break;
@@ -189,16 +254,23 @@ std::string Context::setup() {
                 for (const auto& d : f.devices) {
                     if (d.product_code != sii->dword(0x0A)) continue;
                     if (d.revision == sii->dword(0x0C)) {
-                        esi = d;
+                        module_mapping_objects.clear();
+                        esi = as_configured(f, d, module_mapping_objects);
                         return {};
                     }
-                    if (!by_product) by_product = d, by_product_file = path;
+                    if (!by_product) {
+                        std::set<uint16_t> mapping;
+                        by_product = as_configured(f, d, mapping);
+                        by_product_file = path;
+                        by_product_mapping = std::move(mapping);
+                    }
                 }
             } catch (const std::exception&) {
             }
         }
         if (by_product) {
             esi = by_product;
+            module_mapping_objects = std::move(by_product_mapping);
             notes.push_back("slave " + std::to_string(opt.slave) +
                             ": no ESI device with the SII's revision; " + by_product_file +
                             " has its product code");
@@ -364,11 +436,23 @@ bool Context::esc_reset() {
 }
 
 Error Context::to_preop() {
-    if (in_preop && mbx) {
+    const bool mailbox = has_mailbox();
+    if (in_preop && (mbx || !mailbox)) {
         auto s = state();
         if (s && *s == 0x02) return Error::Ok;
     }
     if (Error e = to_init(); e != Error::Ok) return e;
+    if (!mailbox) {
+        // A device without mailbox (no standard mailbox in the SII): INIT -> PREOP with no SM set up
+        // (ETG.1000.6 ESM: the mailbox is checked only where the device has one).
+        last_status = request_raw(0x02, ms(5000));
+        if (last_status.state != 0x02 || last_status.error) {
+            (void)ack_error();
+            return Error::AlRefused;
+        }
+        in_preop = true;
+        return Error::Ok;
+    }
     mbx = std::make_unique<master::Mailbox>(m, addr, ms(1000));
     if (Error e = mbx->configure_from_sii(); e != Error::Ok) return e;
     master::AlStatus st = request_raw(0x02, ms(5000));
@@ -522,9 +606,8 @@ namespace conform {
 Error Context::to_safeop(const master::DcConfig& dc) {
     if (Error e = to_preop(); e != Error::Ok) return e;
     in_preop = false;  // the next to_preop() goes through INIT again
-    pds = std::make_unique<master::ProcessDataSession>(m, addr, *sdo);
-    if (Error e = pds->discover(); e != Error::Ok) return e;
-    if (Error e = pds->configure(dc); e != Error::Ok) return e;
+    if (Error e = discover_pd(); e != Error::Ok) return e;
+    if (Error e = configure_pd(dc); e != Error::Ok) return e;
     last_status = request_raw(0x04, ms(5000));
     if (last_status.state != 0x04 || last_status.error) {
         (void)ack_error();
@@ -538,11 +621,36 @@ Error Context::to_op() {
     if (!s || *s != 0x04 || !pds) {
         if (Error e = to_safeop(); e != Error::Ok) return e;
     }
-    (void)cycle(3);
     master::AlStatus st;
-    Error e = pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st);
+    Error e = request_op(st);
     last_status = st;
     return e;
+}
+
+Error Context::discover_pd() {
+    pds.reset();
+    if (sdo && has_coe()) {
+        pds = std::make_unique<master::ProcessDataSession>(m, addr, *sdo);
+        return pds->discover();
+    }
+    pds = std::make_unique<master::ProcessDataSession>(m, std::span<const master::Address>(&addr, 1));
+    return pds->discover_sii(0);
+}
+
+Error Context::configure_pd(const master::DcConfig& dc) {
+    if (!pds) return Error::InvalidArgument;
+    if (!has_process_data()) return Error::Ok;
+    return pds->configure(dc);
+}
+
+Error Context::request_op(master::AlStatus& st) {
+    if (!has_process_data()) {
+        st = request_raw(0x08, ms(5000));
+        if (st.state == 0x08 && !st.error) return Error::Ok;
+        return st.error ? Error::AlRefused : Error::AlTimeout;
+    }
+    (void)cycle(3);
+    return pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st);
 }
 
 Error Context::to_boot() {
@@ -576,6 +684,7 @@ Error Context::reach(uint8_t st) {
 
 Error Context::cycle(unsigned cycles) {
     if (!pds) return Error::InvalidArgument;
+    if (!has_process_data()) return Error::Ok;  // nothing to exchange (a coupler)
     Error first = Error::Ok;
     for (unsigned i = 0; i < cycles; ++i) {
         Error e = pds->cycle();

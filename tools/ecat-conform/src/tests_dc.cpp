@@ -24,6 +24,34 @@ uint16_t dc_assign(const Context& ctx) {
     return 0x0300;
 }
 
+// The sync manager parameter object of the outputs (0x1C32) or the inputs (0x1C33) is there for an SM that
+// carries process data (ETG.1020 synchronisation: 0x1C32 describes the outputs SM, 0x1C33 the inputs SM): a
+// device whose ESI assigns no PDO of that direction and whose dictionary has no such object (an input
+// terminal without outputs) is not asked for it. An ESI that assigns PDOs of that direction is.
+std::string need_sync_object(const Context& ctx, uint16_t index) {
+    if (auto r = ctx.need_dc(); !r.empty()) return r;
+    if (auto r = ctx.need_coe(); !r.empty()) return r;
+    if (!ctx.esi || !ctx.esi->has_dictionary || ctx.esi->object(index)) return {};
+    const bool outputs = index == 0x1C32;
+    for (const auto& p : outputs ? ctx.esi->rxpdos : ctx.esi->txpdos)
+        if (p.sm >= 0) return {};
+    return std::string("no ") + (outputs ? "outputs" : "inputs") + ": the ESI assigns no " +
+           (outputs ? "RxPDO" : "TxPDO") + " and its dictionary has no " + hex(index) +
+           " (ETG.1020: the parameter object of an SM without process data)";
+}
+
+// A subindex the ESI declares read-only is not written by a test that checks a write (od.read_only checks
+// that such a write is refused).
+std::string need_writable(const Context& ctx, uint16_t index, uint8_t sub) {
+    if (!ctx.esi) return {};
+    const EsiObject* o = ctx.esi->object(index);
+    const EsiEntry* e = o ? o->entry(sub) : nullptr;
+    if (e && e->access == "ro")
+        return "the ESI declares " + hex(index) + ":" + hex(sub, 2) +
+               " read-only (od.read_only checks that a write is refused)";
+    return {};
+}
+
 Outcome dc_state(Context& ctx, bool op) {
     CONFORM_NEED(ctx.need_dc());
     CONFORM_NEED(ctx.need_coe());
@@ -215,8 +243,7 @@ void add_dc_tests(Catalogue& c) {
     add(
         "sync_modes.1c32", "0x1C32:04 announces DC SYNC0 (bit 2) when the ESI has a SYNC0 op mode", kSync,
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_dc());
-            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(need_sync_object(ctx, 0x1C32));
             CONFORM_PREOP(ctx);
             auto v = ctx.upload_uint(0x1C32, 4);
             if (!v) return fail("0x1C32:04: " + ctx.sdo_error(v.error()));
@@ -228,8 +255,8 @@ void add_dc_tests(Catalogue& c) {
     add(
         "sync_type.1c32", "0x1C32:01 accepts 2 (DC SYNC0) and reads it back", kSync,
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_dc());
-            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(need_sync_object(ctx, 0x1C32));
+            CONFORM_NEED(need_writable(ctx, 0x1C32, 1));
             CONFORM_PREOP(ctx);
             auto old = ctx.upload_uint(0x1C32, 1);
             if (Error e = ctx.download_uint(0x1C32, 1, 2, 2); e != Error::Ok)
@@ -242,8 +269,8 @@ void add_dc_tests(Catalogue& c) {
     add(
         "cycle_time.1c32", "0x1C32:02 cycle time written in PREOP reads back", kSync,
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_dc());
-            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(need_sync_object(ctx, 0x1C32));
+            CONFORM_NEED(need_writable(ctx, 0x1C32, 2));
             CONFORM_PREOP(ctx);
             auto old = ctx.upload_uint(0x1C32, 2);
             if (Error e = ctx.download_uint(0x1C32, 2, 2'000'000, 4); e != Error::Ok)
@@ -256,8 +283,7 @@ void add_dc_tests(Catalogue& c) {
     add(
         "min_cycle.1c32", "0x1C32:05 minimum cycle time present and not 0", kSync,
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_dc());
-            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(need_sync_object(ctx, 0x1C32));
             CONFORM_PREOP(ctx);
             auto v = ctx.upload_uint(0x1C32, 5);
             if (!v) return fail("0x1C32:05: " + ctx.sdo_error(v.error()));
@@ -268,8 +294,8 @@ void add_dc_tests(Catalogue& c) {
     add(
         "sync_type.1c33", "0x1C33:01 accepts 2 (DC SYNC0)", kSync,
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_dc());
-            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(need_sync_object(ctx, 0x1C33));
+            CONFORM_NEED(need_writable(ctx, 0x1C33, 1));
             CONFORM_PREOP(ctx);
             auto old = ctx.upload_uint(0x1C33, 1);
             Error e = ctx.download_uint(0x1C33, 1, 2, 2);

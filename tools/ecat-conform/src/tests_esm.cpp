@@ -11,6 +11,8 @@ namespace {
 using master::Error;
 constexpr const char* kEsm = "ETG.1000.6 EtherCAT state machine (state transitions)";
 constexpr const char* kCodes = "ETG.1000.6 AL status codes";
+// What an ESC with device emulation does instead of a state machine.
+constexpr const char* kEmulation = "ESC datasheet section II 0x0141 (device emulation)";
 
 const char* short_name(uint8_t s) {
     switch (s) {
@@ -36,11 +38,10 @@ std::string needs_for(const Context& ctx, uint8_t a, uint8_t b) {
     if (a == 3 || b == 3) {
         if (auto r = ctx.need_boot(); !r.empty()) return r;
     }
-    if (a >= 2 && a != 3) {
-        if (auto r = ctx.need_mailbox(); !r.empty()) return r;
-    }
+    // A device without mailbox runs the same state sequence with process data only; its process-data layout
+    // comes from the SII where there is no CoE (ETG.1000.6 ESM; ETG.2010 SyncM/PDO categories).
     if (a >= 4 || b >= 4) {
-        if (auto r = ctx.need_coe(); !r.empty()) return "the process-data layout is read over CoE: " + r;
+        if (auto r = ctx.need_pd_layout(); !r.empty()) return "the process-data layout: " + r;
     }
     return {};
 }
@@ -52,12 +53,13 @@ Outcome valid(Context& ctx, uint8_t from, uint8_t to) {
                     (e == Error::AlRefused ? " (" + status_text(ctx.last_status) + ")" : ""));
     master::AlStatus st;
     if (from == 2 && to == 4) {
-        ctx.pds = std::make_unique<master::ProcessDataSession>(ctx.m, ctx.addr, *ctx.sdo);
-        if (Error e = ctx.pds->discover(); e != Error::Ok)
-            return fail("process-data layout over CoE: " + ctx.sdo_error(e));
-        if (Error e = ctx.pds->configure(); e != Error::Ok)
+        if (Error e = ctx.discover_pd(); e != Error::Ok)
+            return fail("process-data layout: " + ctx.sdo_error(e));
+        if (Error e = ctx.configure_pd(); e != Error::Ok)
             return fail("process-data set-up: " + ctx.sdo_error(e));
         st = ctx.request_raw(4, ctx.ms(5000));
+    } else if (from == 1 && to == 2 && !ctx.has_mailbox()) {
+        st = ctx.request_raw(2, ctx.ms(5000));  // no mailbox to set up
     } else if (from == 1 && (to == 2 || to == 3)) {
         ctx.mbx = std::make_unique<master::Mailbox>(ctx.m, ctx.addr, ctx.ms(1000));
         if (Error e = ctx.mbx->configure_from_sii(to == 3); e != Error::Ok)
@@ -65,8 +67,7 @@ Outcome valid(Context& ctx, uint8_t from, uint8_t to) {
         st = ctx.request_raw(to, ctx.ms(5000));
         ctx.mbx.reset();
     } else if (to == 8) {
-        (void)ctx.cycle(3);
-        (void)ctx.pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st);
+        (void)ctx.request_op(st);
         if (auto c = ctx.rd<uint16_t>(esc::reg::kAlStatusCode)) st.code = *c;
     } else {
         st = ctx.request_raw(to, ctx.ms(5000));
@@ -80,8 +81,24 @@ Outcome valid(Context& ctx, uint8_t from, uint8_t to) {
     return pass("reached", status_text(st));
 }
 
+// With device emulation (ESC configuration 0x0141 bit 0) the ESC sets AL status to the state written to AL
+// control (ESC datasheet section II, 0x0141, 0x0120, 0x0130): nothing refuses, no error indication, code 0.
+// That is what such a device must do for a request another device refuses.
+Outcome emulated(Context& ctx, uint8_t from, uint8_t to) {
+    if (Error e = ctx.reach(from); e != Error::Ok)
+        return fail(std::string("cannot reach ") + short_name(from) + ": " + err(e),
+                    status_text(ctx.last_status));
+    master::AlStatus st = ctx.request_raw(to, ctx.ms(1000));
+    (void)ctx.to_init();
+    const std::string want = state_text(to & 0x0F) + " code " + hex(0);
+    if (st.error || st.state != (to & 0x0F) || st.code != 0)
+        return fail("device emulation: AL status does not follow AL control", status_text(st), want);
+    return pass("device emulation: the ESC took the request as written", status_text(st));
+}
+
 Outcome invalid(Context& ctx, uint8_t from, uint8_t to, uint16_t code) {
     CONFORM_NEED(needs_for(ctx, from, from));
+    if (ctx.device_emulation) return emulated(ctx, from, to);
     if (Error e = ctx.reach(from); e != Error::Ok)
         return fail(
             std::string("cannot reach ") + short_name(from) + ": " + err(e),
@@ -117,6 +134,7 @@ Error write_sm(Context& ctx, unsigned n, uint16_t start, uint16_t len, uint8_t c
 
 Outcome bad_mailbox(Context& ctx, int variant) {
     CONFORM_NEED(ctx.need_mailbox());
+    CONFORM_NEED(ctx.need_state_machine());
     if (Error e = ctx.to_init(); e != Error::Ok) return fail("cannot reach INIT", err(e));
     const SiiImage& s = *ctx.sii;
     uint16_t o_start = s.word(0x18), o_len = s.word(0x19), i_start = s.word(0x1A), i_len = s.word(0x1B);
@@ -138,21 +156,20 @@ Outcome bad_mailbox(Context& ctx, int variant) {
 }
 
 Outcome bad_pd_sm(Context& ctx, bool outputs, bool address) {
-    CONFORM_NEED(ctx.need_coe());
+    CONFORM_NEED(ctx.need_pd_layout());
+    CONFORM_NEED(ctx.need_state_machine());
     if (Error e = ctx.to_preop(); e != Error::Ok) return fail("cannot reach PREOP", err(e));
-    ctx.pds = std::make_unique<master::ProcessDataSession>(ctx.m, ctx.addr, *ctx.sdo);
-    if (Error e = ctx.pds->discover(); e != Error::Ok)
-        return fail("process-data layout: " + ctx.sdo_error(e));
-    if (Error e = ctx.pds->configure(); e != Error::Ok)
-        return fail("process-data set-up: " + ctx.sdo_error(e));
+    if (Error e = ctx.discover_pd(); e != Error::Ok) return fail("process-data layout: " + ctx.sdo_error(e));
+    if (Error e = ctx.configure_pd(); e != Error::Ok) return fail("process-data set-up: " + ctx.sdo_error(e));
     const auto& l = ctx.pds->layout();
     if (outputs && !l.sm2_length) return skip("no outputs (SM2 length 0)");
     if (!outputs && !l.sm3_length) return skip("no inputs (SM3 length 0)");
+    // The SMs of outputs and inputs are SM2/SM3 with a mailbox, SM0/SM1 on a device without one.
     if (outputs)
-        (void)write_sm(ctx, 2, static_cast<uint16_t>(l.sm2_start + (address ? 0x40 : 0)),
+        (void)write_sm(ctx, l.out_sm, static_cast<uint16_t>(l.sm2_start + (address ? 0x40 : 0)),
                        static_cast<uint16_t>(l.sm2_length + (address ? 0 : 1)), l.sm2_control, true);
     else
-        (void)write_sm(ctx, 3, static_cast<uint16_t>(l.sm3_start + (address ? 0x40 : 0)),
+        (void)write_sm(ctx, l.in_sm, static_cast<uint16_t>(l.sm3_start + (address ? 0x40 : 0)),
                        static_cast<uint16_t>(l.sm3_length + (address ? 0 : 1)), l.sm3_control, true);
     master::AlStatus st = ctx.request_raw(4, ctx.ms(2000));
     (void)ctx.ack_error();
@@ -178,7 +195,7 @@ void add_esm_tests(Catalogue& c) {
         if (t.from == 3 || t.to == 3)
             applies = "bootstrap mailbox in the SII";
         else if (t.from >= 4 || t.to >= 4)
-            applies = "CoE (process-data layout)";
+            applies = "process-data layout (over CoE, else from the SII)";
         add(
             id,
             "Valid transition " + std::string(master::al_state_name(t.from)) + " -> " +
@@ -190,19 +207,23 @@ void add_esm_tests(Catalogue& c) {
         add(
             id,
             "Invalid request " + std::string(master::al_state_name(t.from)) + " -> " +
-                std::string(master::al_state_name(t.to)) + ": refused with 0x0011, state kept",
-            std::string(kEsm) + "; " + kCodes + " (0x0011)",
+                std::string(master::al_state_name(t.to)) +
+                ": refused with 0x0011, state kept (device emulation: taken as written)",
+            std::string(kEsm) + "; " + kCodes + " (0x0011); " + kEmulation,
             [t](Context& ctx) { return invalid(ctx, t.from, t.to, 0x0011); },
             t.from == 3 ? "bootstrap mailbox in the SII" : "");
     }
     for (uint8_t s : {uint8_t{0x05}, uint8_t{0x06}, uint8_t{0x07}, uint8_t{0x09}}) {
         add("unknown_state_" + hex(s, 2).substr(2),
-            "Unknown requested state " + hex(s, 2) + ": refused with 0x0012",
-            std::string(kCodes) + " (0x0012)", [s](Context& ctx) { return invalid(ctx, 2, s, 0x0012); });
+            "Unknown requested state " + hex(s, 2) +
+                ": refused with 0x0012 (device emulation: taken as written)",
+            std::string(kCodes) + " (0x0012); " + kEmulation,
+            [s](Context& ctx) { return invalid(ctx, 2, s, 0x0012); });
     }
     add(
-        "boot.not_supported", "INIT -> BOOT without a bootstrap mailbox: refused with 0x0013",
-        std::string(kCodes) + " (0x0013)",
+        "boot.not_supported",
+        "INIT -> BOOT without a bootstrap mailbox: refused with 0x0013 (device emulation: taken as written)",
+        std::string(kCodes) + " (0x0013); " + kEmulation,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_sii());
             if (ctx.need_boot().empty()) return skip("the SII announces a bootstrap mailbox");
@@ -232,13 +253,16 @@ void add_esm_tests(Catalogue& c) {
         "bootstrap mailbox differs from the standard one");
     add(
         "mbx.sm0_length", "INIT -> PREOP with a wrong SM0 length: refused with 0x0016",
-        std::string(kCodes) + " (0x0016)", [](Context& ctx) { return bad_mailbox(ctx, 0); }, "mailbox slave");
+        std::string(kCodes) + " (0x0016)", [](Context& ctx) { return bad_mailbox(ctx, 0); },
+        "mailbox slave, no device emulation");
     add(
         "mbx.sm1_address", "INIT -> PREOP with a wrong SM1 start address: refused with 0x0016",
-        std::string(kCodes) + " (0x0016)", [](Context& ctx) { return bad_mailbox(ctx, 1); }, "mailbox slave");
+        std::string(kCodes) + " (0x0016)", [](Context& ctx) { return bad_mailbox(ctx, 1); },
+        "mailbox slave, no device emulation");
     add(
         "mbx.sm_disabled", "INIT -> PREOP with the mailbox SMs not activated: refused with 0x0016",
-        std::string(kCodes) + " (0x0016)", [](Context& ctx) { return bad_mailbox(ctx, 2); }, "mailbox slave");
+        std::string(kCodes) + " (0x0016)", [](Context& ctx) { return bad_mailbox(ctx, 2); },
+        "mailbox slave, no device emulation");
     add(
         "mbx.boot_layout_in_preop", "INIT -> PREOP with the bootstrap mailbox layout: refused with 0x0016",
         std::string(kCodes) + " (0x0016)",
@@ -254,28 +278,30 @@ void add_esm_tests(Catalogue& c) {
     add(
         "sm2.length", "PREOP -> SAFEOP with a wrong SM2 (outputs) length: refused with 0x001D",
         std::string(kCodes) + " (0x001D)", [](Context& ctx) { return bad_pd_sm(ctx, true, false); },
-        "outputs");
+        "outputs, no device emulation");
     add(
         "sm2.address", "PREOP -> SAFEOP with a wrong SM2 (outputs) start address: refused with 0x001D",
         std::string(kCodes) + " (0x001D)", [](Context& ctx) { return bad_pd_sm(ctx, true, true); },
-        "outputs");
+        "outputs, no device emulation");
     add(
         "sm3.length", "PREOP -> SAFEOP with a wrong SM3 (inputs) length: refused with 0x001E",
         std::string(kCodes) + " (0x001E)", [](Context& ctx) { return bad_pd_sm(ctx, false, false); },
-        "inputs");
+        "inputs, no device emulation");
     add(
         "sm3.address", "PREOP -> SAFEOP with a wrong SM3 (inputs) start address: refused with 0x001E",
         std::string(kCodes) + " (0x001E)", [](Context& ctx) { return bad_pd_sm(ctx, false, true); },
-        "inputs");
+        "inputs, no device emulation");
     add("error.sticky", "With the error indication set, a request without acknowledge is not executed",
         "ETG.1000.6 AL control (error indication acknowledge)", [](Context& ctx) {
+            CONFORM_NEED(ctx.need_state_machine());
             if (Error e = ctx.to_init(); e != Error::Ok) return fail("cannot reach INIT", err(e));
             master::AlStatus st = ctx.request_raw(8, ctx.ms(1000));  // I -> O: refused
             if (!st.error)
                 return fail("INIT -> OP did not set the error indication", status_text(st), "INIT+ERR");
-            CONFORM_NEED(ctx.need_mailbox());
-            ctx.mbx = std::make_unique<master::Mailbox>(ctx.m, ctx.addr, ctx.ms(1000));
-            (void)ctx.mbx->configure_from_sii();
+            if (ctx.has_mailbox()) {  // else INIT -> PREOP needs nothing set up
+                ctx.mbx = std::make_unique<master::Mailbox>(ctx.m, ctx.addr, ctx.ms(1000));
+                (void)ctx.mbx->configure_from_sii();
+            }
             master::AlStatus st2 = ctx.request_raw(2, ctx.ms(100));  // no acknowledge bit
             (void)ctx.ack_error();
             (void)ctx.to_init();
@@ -287,7 +313,7 @@ void add_esm_tests(Catalogue& c) {
         "error.ack", "Error acknowledge (PREOP + 0x10) clears the error indication and keeps the state",
         "ETG.1000.6 AL control (error indication acknowledge)",
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_mailbox());
+            CONFORM_NEED(ctx.need_state_machine());
             if (Error e = ctx.to_preop(); e != Error::Ok) return fail("cannot reach PREOP", err(e));
             master::AlStatus st = ctx.request_raw(8, ctx.ms(1000));  // P -> O: refused
             if (!st.error)
@@ -303,7 +329,7 @@ void add_esm_tests(Catalogue& c) {
             if (st2.state != 2 || st2.error) return fail("after acknowledge", status_text(st2), "PREOP");
             return pass("acknowledged", status_text(st2));
         },
-        "mailbox slave");
+        "a state machine (no device emulation)");
     add(
         "error.code_cleared", "AL status code 0x0000 once the error is acknowledged", kCodes,
         [](Context& ctx) {
@@ -319,10 +345,10 @@ void add_esm_tests(Catalogue& c) {
         "watchdog.op_to_safeop", "SM watchdog: outputs stop in OP -> SAFEOP with error 0x001B",
         std::string(kCodes) + " (0x001B); ESC SyncManager watchdog (0x0400, 0x0420)",
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_pd_layout());
             if (Error e = ctx.to_op(); e != Error::Ok)
                 return fail("cannot reach OP: " + err(e), status_text(ctx.last_status));
-            if (!ctx.pds->layout().sm2_length) return skip("no outputs: no SM watchdog");
+            if (!ctx.pds || !ctx.pds->layout().sm2_length) return skip("no outputs: no SM watchdog");
             auto div = ctx.rd<uint16_t>(esc::reg::kWdDivider);
             auto wd = ctx.rd<uint16_t>(esc::reg::kWdTimePd);
             if (!div || !wd) return fail("watchdog registers unreadable");
@@ -335,8 +361,22 @@ void add_esm_tests(Catalogue& c) {
                 std::this_thread::sleep_for(std::chrono::milliseconds(2));
                 if (auto s = ctx.m.al_status(ctx.addr)) st = *s;
                 if (st.error || std::chrono::steady_clock::now() > deadline) break;
+                if (ctx.device_emulation) {
+                    if (auto w = ctx.rd<uint16_t>(esc::reg::kWdStatusPd); w && !(*w & 0x0001)) break;
+                }
             }
             (void)ctx.ack_error();
+            if (ctx.device_emulation) {
+                // No controller to change the state: the ESC keeps OP and shows the expiry in the watchdog
+                // status 0x0440 bit 0 (0 = expired; ESC datasheet section II, 0x0440), clearing the outputs.
+                auto wds = ctx.rd<uint16_t>(esc::reg::kWdStatusPd);
+                const std::string got = status_text(st) + ", 0x0440 " + (wds ? hex(*wds) : "?");
+                if (st.state != 8 || st.error || !wds || (*wds & 0x0001))
+                    return fail(
+                        "device emulation: watchdog expiry not shown in 0x0440 (or the state changed)", got,
+                        "OP code 0x0000, 0x0440 bit 0 clear");
+                return pass("device emulation: expiry in 0x0440, state kept", got);
+            }
             const std::string want = "SAFEOP+ERR code " + hex(0x001B);
             if (st.state != 4 || !st.error || st.code != 0x001B)
                 return fail("no watchdog reaction " + dec(static_cast<long long>(ms * 2 + 250)) +

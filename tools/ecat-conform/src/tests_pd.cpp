@@ -55,18 +55,20 @@ Outcome mapping_vs_esi(Context& ctx, bool outputs) {
     return expect_eq("mapping objects", got, want);
 }
 
+// The layout as a master finds it (over CoE, else from the SII: a device without mailbox, whose outputs and
+// inputs SMs may be SM0/SM1) against the ESI's PDOs assigned by default to that SM.
 Outcome sm_size_vs_esi(Context& ctx, bool outputs) {
-    CONFORM_NEED(ctx.need_coe());
+    CONFORM_NEED(ctx.need_pd_layout());
     CONFORM_NEED(ctx.need_esi());
     CONFORM_PREOP(ctx);
-    master::ProcessDataSession s(ctx.m, ctx.addr, *ctx.sdo);
-    if (Error e = s.discover(); e != Error::Ok) return fail("layout: " + ctx.sdo_error(e));
+    if (Error e = ctx.discover_pd(); e != Error::Ok) return fail("layout: " + ctx.sdo_error(e));
+    const auto& l = ctx.pds->layout();
+    const int sm = outputs ? l.out_sm : l.in_sm;
     unsigned bits = 0;
     for (const auto& p : outputs ? ctx.esi->rxpdos : ctx.esi->txpdos)
-        if (p.sm == (outputs ? 2 : 3)) bits += p.bits();
-    const unsigned got = outputs ? s.layout().sm2_length : s.layout().sm3_length;
-    return expect_eq(std::string(outputs ? "SM2" : "SM3") + " bytes of the default assignment", dec(got),
-                     dec((bits + 7) / 8));
+        if (p.sm == sm) bits += p.bits();
+    const unsigned got = outputs ? l.sm2_length : l.sm3_length;
+    return expect_eq("SM" + dec(sm) + " bytes of the default assignment", dec(got), dec((bits + 7) / 8));
 }
 
 // A mapped output entry that is safe to change (not the controlword, not a mode), value via SDO readable.
@@ -140,9 +142,10 @@ Outcome outputs(Context& ctx, bool op) {
 }
 
 Outcome cycle_wkc(Context& ctx, uint8_t state) {
-    CONFORM_NEED(ctx.need_coe());
+    CONFORM_NEED(ctx.need_pd_layout());
     Error e = state == 8 ? ctx.to_op() : ctx.to_safeop();
     if (e != Error::Ok) return fail("cannot reach the state: " + err(e));
+    if (!ctx.has_process_data()) return skip("no process data (no PDO assigned to a process-data SM)");
     (void)ctx.cycle(3);
     Error c = ctx.pds->cycle();
     return expect_eq("LRW working counter", c == Error::Timeout ? "no reply" : dec(ctx.pds->last_wkc()),
@@ -150,8 +153,9 @@ Outcome cycle_wkc(Context& ctx, uint8_t state) {
 }
 
 Outcome logical_only(Context& ctx, master::Command cmd) {
-    CONFORM_NEED(ctx.need_coe());
+    CONFORM_NEED(ctx.need_pd_layout());
     if (Error e = ctx.to_op(); e != Error::Ok) return fail("cannot reach OP: " + err(e));
+    if (!ctx.has_process_data()) return skip("no process data (no PDO assigned to a process-data SM)");
     const auto& l = ctx.pds->layout();
     std::vector<uint8_t> img(static_cast<std::size_t>(l.sm2_length) + l.sm3_length);
     if (cmd == master::Command::LWR)
@@ -182,13 +186,13 @@ void add_pd_tests(Catalogue& c) {
         [](Context& ctx) { return mapping_vs_esi(ctx, false); }, "CoE and ESI");
     add(
         "sm2.size_vs_esi", "SM2 size of the default assignment equals the ESI's RxPdo bit lengths", kPdEsi,
-        [](Context& ctx) { return sm_size_vs_esi(ctx, true); }, "CoE and ESI");
+        [](Context& ctx) { return sm_size_vs_esi(ctx, true); }, "ESI (layout over CoE, else from the SII)");
     add(
         "sm3.size_vs_esi", "SM3 size of the default assignment equals the ESI's TxPdo bit lengths", kPdEsi,
-        [](Context& ctx) { return sm_size_vs_esi(ctx, false); }, "CoE and ESI");
+        [](Context& ctx) { return sm_size_vs_esi(ctx, false); }, "ESI (layout over CoE, else from the SII)");
     add(
         "safeop.wkc", "SAFEOP: LRW over outputs and inputs has the exact working counter", kPd,
-        [](Context& ctx) { return cycle_wkc(ctx, 4); }, "CoE");
+        [](Context& ctx) { return cycle_wkc(ctx, 4); }, "process data (layout over CoE, else from the SII)");
     add(
         "safeop.inputs_valid", "SAFEOP: inputs in the image equal their objects", kPd,
         [](Context& ctx) { return inputs_match(ctx, 4); }, "CoE");
@@ -197,7 +201,7 @@ void add_pd_tests(Catalogue& c) {
         [](Context& ctx) { return outputs(ctx, false); }, "CoE");
     add(
         "op.wkc", "OP: LRW over outputs and inputs has the exact working counter", kPd,
-        [](Context& ctx) { return cycle_wkc(ctx, 8); }, "CoE");
+        [](Context& ctx) { return cycle_wkc(ctx, 8); }, "process data (layout over CoE, else from the SII)");
     add(
         "op.inputs_valid", "OP: inputs in the image equal their objects", kPd,
         [](Context& ctx) { return inputs_match(ctx, 8); }, "CoE");
@@ -207,11 +211,13 @@ void add_pd_tests(Catalogue& c) {
     add(
         "op.lrd_wkc", "OP: LRD over the image: working counter 1 (only the inputs are readable)",
         "ETG.1000.4 working counter of LRD",
-        [](Context& ctx) { return logical_only(ctx, master::Command::LRD); }, "CoE");
+        [](Context& ctx) { return logical_only(ctx, master::Command::LRD); },
+        "process data (layout over CoE, else from the SII)");
     add(
         "op.lwr_wkc", "OP: LWR over the image: working counter 1 (only the outputs are writable)",
         "ETG.1000.4 working counter of LWR",
-        [](Context& ctx) { return logical_only(ctx, master::Command::LWR); }, "CoE");
+        [](Context& ctx) { return logical_only(ctx, master::Command::LWR); },
+        "process data (layout over CoE, else from the SII)");
     add(
         "remap.safeop",
         "Another ESI RxPDO assigned in PREOP: SAFEOP with the new SM2 size and exact working counter", kPdEsi,

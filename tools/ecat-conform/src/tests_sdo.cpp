@@ -739,9 +739,14 @@ void add_sdo_tests(Catalogue& c) {
             CONFORM_NEED(ctx.need_esi());
             if (!ctx.esi->coe.pdo_assign) return skip("the ESI does not announce PdoAssign");
             CONFORM_PREOP(ctx);
+            // Only the subindices the assignment has are read: an empty one (no outputs) may have
+            // subindex 0 alone (ETG.1000.6 PDO assignment: subindices 1..n exist up to the maximum).
             auto n = ctx.upload_uint(0x1C12, 0);
+            if (!n) return fail("0x1C12:00 upload: " + ctx.sdo_error(n.error()));
+            if (*n != 1)
+                return skip("needs one assigned RxPDO (0x1C12:00 = " + dec(static_cast<long long>(*n)) + ")");
             auto first = ctx.upload_uint(0x1C12, 1);
-            if (!n || !first) return fail("0x1C12 upload failed");
+            if (!first) return fail("0x1C12:01 upload: " + ctx.sdo_error(first.error()));
             uint16_t other = 0;
             for (const auto& p : ctx.esi->rxpdos)
                 if (p.index != *first) {

@@ -67,6 +67,7 @@ Outcome list_vs_esi(Context& ctx, uint16_t type, const std::function<bool(const 
     std::set<uint16_t> got(l->begin(), l->end()), want;
     for (const auto& [i, o] : ctx.esi->objects)
         if (in_list(o)) want.insert(i);
+    if (type == 1) want.insert(ctx.module_mapping_objects.begin(), ctx.module_mapping_objects.end());
     std::set<uint16_t> missing, extra;
     for (auto i : want)
         if (!got.count(i)) missing.insert(i);

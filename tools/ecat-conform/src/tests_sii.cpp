@@ -346,14 +346,28 @@ void add_sii_tests(Catalogue& c) {
             CONFORM_NEED(ctx.need_esi());
             CONFORM_NEED(ctx.need_sii());
             std::string got, want;
+            std::vector<uint16_t> sizes;
             if (const SiiCategory* s = ctx.sii->find(kSyncM)) {
                 auto d = ctx.sii->data(*s);
-                for (std::size_t i = 0; i + 8 <= d.size(); i += 8)
+                for (std::size_t i = 0; i + 8 <= d.size(); i += 8) {
+                    sizes.push_back(get16(&d[i + 2]));
                     got += hex(get16(&d[i])) + "/" + dec(get16(&d[i + 2])) + "/" + hex(d[i + 4], 2) + "/" +
                            ((d[i + 6] & 1) ? "1" : "0") + " ";
+                }
             }
-            for (const auto& s : ctx.esi->sms)
+            for (std::size_t n = 0; n < ctx.esi->sms.size(); ++n) {
+                EsiSm s = ctx.esi->sms[n];
+                // A process-data Sm without DefaultSize leaves the size to the configuration (ETG.2000 Sm):
+                // the SII may carry 0 or the size of the PDOs the ESI assigns to it by default.
+                if (s.default_size == 0 && (s.type == "Outputs" || s.type == "Inputs") && n < sizes.size()) {
+                    unsigned bits = 0;
+                    for (const auto* list : {&ctx.esi->rxpdos, &ctx.esi->txpdos})
+                        for (const EsiPdo& p : *list)
+                            if (p.sm == static_cast<int>(n)) bits += p.bits();
+                    if (sizes[n] == (bits + 7) / 8) s.default_size = sizes[n];
+                }
                 want += esi_sm(s) + " ";
+            }
             return expect_eq("SMs start/size/control/enable", got, want);
         },
         "ESI given");
