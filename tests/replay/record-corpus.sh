@@ -47,6 +47,15 @@ if [ -x "$L/ethercatdiag" ]; then
   done
 fi
 
+K=$EXT/kickcat/build/tools/scan_topology
+if [ -x "$K" ]; then
+  # KickCAT's tools give up on a reply after 500 us: record on a quiet host, without the capture's extra load
+  # from other work, and again if it timed out (the sidecar keeps the master's exit status).
+  V="KickCAT source snapshot in $EXT/kickcat (argparse.hpp added outside this repository)"
+  want kickcat-scan_topology-line3 && $REC kickcat-scan_topology-line3 --slaves 3 --master-version "$V" \
+    --description "KickCAT scan_topology: scan and topology of a line" -- "$K" -i {iface}
+fi
+
 # The project's own master and conformance tool, through the pcap backend: the packet backend sends past the
 # kernel's packet taps (PACKET_QDISC_BYPASS), so a capture on the master end would not see its frames.
 V="softecat $(git rev-parse --short HEAD)"
