@@ -17,6 +17,12 @@ RT=${RT:---rt-priority 40}
 want() { case "$1" in $ONLY) return 0 ;; *) return 1 ;; esac; }
 rev() { git -C "$1" rev-parse --short HEAD 2>/dev/null || echo unknown; }
 
+# A firmware image for the FoE updates (8 KiB payload of 'S', version 1.32), under the name the drive takes.
+FW=$(mktemp -d); trap 'rm -rf "$FW"' EXIT
+head -c 8192 /dev/zero | tr '\0' 'S' >"$FW/payload.bin"
+IMG=MAXPOS_0132h_3001h_0000h_0000h.bin
+"$B/tools/fwimage/fwimage" build --payload "$FW/payload.bin" --version 0x01320000 -o "$FW/$IMG" >/dev/null
+
 S=$EXT/soem/build/samples
 if [ -x "$S/slaveinfo/slaveinfo" ]; then
   V="SOEM $(rev "$EXT/soem")"
@@ -29,6 +35,10 @@ if [ -x "$S/slaveinfo/slaveinfo" ]; then
   done
   want soem-ec_sample && $REC soem-ec_sample $RT --seconds 2.2 --master-version "$V" \
     --description "SOEM ec_sample: to OP with DC, process data" -- "$S/ec_sample/ec_sample" {iface} 1000
+  # firm_update sends its file argument as the FoE file name: run it in the image's directory.
+  want soem-firm_update && $REC soem-firm_update $RT --master-version "$V" \
+    --description "SOEM firm_update: PREOP -> INIT -> BOOT, FoE write of a firmware image, INIT" -- \
+    sh -c "cd $FW && exec $S/firm_update/firm_update {iface} 1 $IMG"
 fi
 
 L=$EXT/libethercat/build
@@ -45,6 +55,9 @@ if [ -x "$L/ethercatdiag" ]; then
       --seconds 2.8 --master-version "$V" --description "libethercat example_with_dc: to OP with DC (SYNC0 1 ms)" \
       -- "$L/example_with_dc" -i sock-raw:{iface} -a 0x1 -p 0
   done
+  want libethercat-foe_tool && $REC libethercat-foe_tool $RT --master-version "$V" \
+    --description "libethercat foe_tool: INIT -> BOOT, FoE write of a firmware image, INIT" -- \
+    "$L/foe_tool" -i sock-raw:{iface} -w -s 0 "$FW/$IMG" MAXPOS
 fi
 
 K=$EXT/kickcat/build/tools/scan_topology

@@ -68,9 +68,11 @@ class Replay(unittest.TestCase):
 
     def test_faulty_slave_fails(self):
         """A slave that answers an expedited SDO upload with the wrong size (a mailbox answer) or never starts
-        SYNC0 (so Op is refused: AL status and code) does not pass the replay of a master that relies on it."""
+        SYNC0 (so Op is refused: AL status and code), or refuses Bootstrap (so no firmware update), does not pass
+        the replay of a master that relies on it."""
         by_name = {e[0]: e for e in ecatreplay.corpus()}
-        cases = [("soem-slaveinfo", "expedited-size-wrong"), ("libethercat-example_with_dc", "sync0-never")]
+        cases = [("soem-slaveinfo", "expedited-size-wrong"), ("libethercat-example_with_dc", "sync0-never"),
+                 ("soem-firm_update", "bootstrap-refused"), ("libethercat-foe_tool", "bootstrap-refused")]
         for rec, fault in cases:
             self.assertIn(rec, by_name)
             with self.subTest(recording=rec, fault=fault):
