@@ -86,6 +86,9 @@ Error open_mailbox(master::Master& m, master::Mailbox& mbx, Address a) {
     if (st->state == static_cast<uint8_t>(master::AlState::Init)) return from_init();
     const Error e = mbx.adopt_current();
     if (e != Error::MailboxNotConfigured) return e;
+    const auto declared = m.sii_has_mailbox(a);  // a coupler or an IO terminal has none: nothing to set up
+    if (!declared) return declared.error();
+    if (!*declared) return Error::NoMailbox;
     if (st->state != static_cast<uint8_t>(master::AlState::PreOp)) {
         std::fprintf(stderr,
                      "ecatctl: %s is in %s without its mailbox SyncManagers; `ecatctl state %u init` and "

@@ -232,10 +232,9 @@ int process_data(master::Master& m, const PdArgs& p) {
     }
     // A slave without mailbox (SII words 0x18-0x1B all zero: a coupler, a digital IO terminal) has its
     // layout in the SII alone (the PDOs its SyncM/TxPDO/RxPDO categories assign) and no SDO.
-    uint8_t mbx_words[8] = {};
-    if (Error e = m.sii_read(a, 0x18, mbx_words); e != Error::Ok) return fail(e, "reading the SII");
-    const bool has_mailbox =
-        std::any_of(std::begin(mbx_words), std::end(mbx_words), [](uint8_t b) { return b != 0; });
+    const auto declared = m.sii_has_mailbox(a);
+    if (!declared) return fail(declared.error(), "reading the SII");
+    const bool has_mailbox = *declared;
     master::Mailbox mbx(m, a);
     master::SdoClient sdo(mbx);
     std::unique_ptr<master::ProcessDataSession> session;

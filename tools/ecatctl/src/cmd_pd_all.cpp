@@ -39,10 +39,9 @@ int process_data_all(master::Master& m, const PdAllArgs& p) {
     // from the SII alone and no SDO client.
     std::vector<bool> mailbox(n, true);
     for (std::size_t k = 0; k < n; ++k) {
-        uint8_t words[8] = {};
-        if (Error e = m.sii_read(addresses[k], 0x18, words); e != Error::Ok)
-            return fail(e, "reading the SII of " + slave_label(addresses[k]));
-        mailbox[k] = std::any_of(std::begin(words), std::end(words), [](uint8_t b) { return b != 0; });
+        const auto declared = m.sii_has_mailbox(addresses[k]);
+        if (!declared) return fail(declared.error(), "reading the SII of " + slave_label(addresses[k]));
+        mailbox[k] = *declared;
     }
     master::SdoClients sdos;
     const Error opened = sdos.open(m, addresses, [&](master::Mailbox& mbx, Address a) {

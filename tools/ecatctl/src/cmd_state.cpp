@@ -66,8 +66,9 @@ int to_preop(master::Master& m, Address a, uint8_t current) {
         current = init;
     }
     if (current == init) {
+        // A slave without mailbox (a coupler, a digital IO terminal) goes to PREOP as it is.
         master::Mailbox mbx(m, a);
-        if (Error e = mbx.configure_from_sii(); e != Error::Ok)
+        if (Error e = mbx.configure_from_sii(); e != Error::Ok && e != Error::NoMailbox)
             return report_error(e, "setting up the mailbox (SM0/SM1) from the SII of " + slave_label(a));
     }
     return go(m, a, AlState::PreOp, "PREOP");
@@ -75,12 +76,27 @@ int to_preop(master::Master& m, Address a, uint8_t current) {
 
 // PREOP -> SAFEOP (-> OP): process-data SMs and FMMUs as `pd` sets them up, cycling during the requests.
 int to_safeop_op(master::Master& m, Address a, bool op) {
+    const auto declared = m.sii_has_mailbox(a);
+    if (!declared) return report_error(declared.error(), "reading the SII of " + slave_label(a));
     master::Mailbox mbx(m, a);
-    if (Error e = mbx.adopt_current(); e != Error::Ok) return report_error(e, "opening the mailbox");
     master::SdoClient sdo(mbx);
-    master::ProcessDataSession pd(m, a, sdo);
-    if (Error e = pd.discover(); e != Error::Ok)
-        return report_sdo_failure(sdo, e, "reading the process-data layout", report_error);
+    std::unique_ptr<master::ProcessDataSession> session;
+    if (*declared) {
+        if (Error e = mbx.adopt_current(); e != Error::Ok) return report_error(e, "opening the mailbox");
+        session = std::make_unique<master::ProcessDataSession>(m, a, sdo);
+        if (Error e = session->discover(); e != Error::Ok)
+            return report_sdo_failure(sdo, e, "reading the process-data layout", report_error);
+    } else {  // no mailbox: the layout the SII's SyncM/TxPDO/RxPDO categories assign, as `pd` takes it
+        session = std::make_unique<master::ProcessDataSession>(m, std::span<const Address>(&a, 1));
+        if (Error e = session->discover_sii(0); e != Error::Ok)
+            return report_error(e, "reading the process-data layout of " + slave_label(a));
+    }
+    master::ProcessDataSession& pd = *session;
+    if (pd.layout().sm2_length + pd.layout().sm3_length ==
+        0) {  // no process data (a coupler): no SM, no FMMU
+        if (int rc = go(m, a, AlState::SafeOp, "SAFEOP"); rc != kExitOk || !op) return rc;
+        return go(m, a, AlState::Op, "OP");
+    }
     if (Error e = pd.configure(); e != Error::Ok)
         return report_sdo_failure(sdo, e, "configuring process data", report_error);
     const auto period = std::chrono::microseconds(1000);

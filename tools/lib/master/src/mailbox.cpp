@@ -33,6 +33,7 @@ Error Mailbox::configure_from_sii(bool bootstrap) {
     c.in_start = get16(w + 4);
     c.in_size = get16(w + 6);
     c.protocols = get16(w + 8);
+    if (std::all_of(w, w + 8, [](uint8_t b) { return b == 0; })) return Error::NoMailbox;
     if (!c.valid()) return Error::MailboxNotConfigured;
     return configure(c);
 }

@@ -39,6 +39,8 @@ std::string_view to_string(Error e) {
             return "AL state change refused by the slave";
         case Error::MailboxNotConfigured:
             return "mailbox not configured";
+        case Error::NoMailbox:
+            return "the slave has no mailbox (its SII declares none)";
         case Error::MailboxTimeout:
             return "no mailbox answer (timeout)";
         case Error::MailboxError:

@@ -119,6 +119,12 @@ Result<uint32_t> Master::sii_read_u32(Address a, uint32_t word) {
     return util::get32(b);
 }
 
+Result<bool> Master::sii_has_mailbox(Address a) {
+    uint8_t w[8];  // words 0x18-0x1B: SM0 and SM1 of the standard mailbox, offset and size
+    if (Error e = sii_read(a, sii::StdMailboxOut, w); e != Error::Ok) return e;
+    return std::any_of(std::begin(w), std::end(w), [](uint8_t b) { return b != 0; });
+}
+
 Result<std::vector<uint8_t>> Master::sii_read_image(Address a, bool whole_eeprom) {
     std::vector<uint8_t> image;
     if (Error e = sii_take(a); e != Error::Ok) return e;

@@ -8,23 +8,24 @@ namespace master {
 
 enum class Error : uint8_t {
     Ok,
-    InvalidArgument,   // a caller error: datagram too long, empty frame, bad address, ...
-    SendFailed,        // the link refused the frame (interface down, no privileges, ...)
-    Timeout,           // no matching reply within the timeout, after all retries ("no slave answered")
-    WorkingCounter,    // a reply came back but its working counter is not the expected one
-    SiiBusy,           // the SII interface stayed busy past the timeout
-    SiiNack,           // the SII interface kept reporting "missing acknowledge / invalid command"
-    SiiWriteDisabled,  // the SII write was refused with "write without write enable"
-    SiiFormat,         // the category chain runs past the EEPROM size or never ends
-    AlTimeout,         // the slave did not reach the requested AL state in time
-    AlRefused,         // the slave set the Error Indication bit (AL status code tells why)
-    MailboxNotConfigured,
-    MailboxTimeout,   // no mailbox answer within the timeout
-    MailboxError,     // the slave answered with a mailbox error message (type 0)
-    MailboxProtocol,  // the answer does not fit the request (wrong type, service, length)
-    SdoAbort,         // the SDO server aborted the transfer (abort code tells why)
-    BufferTooSmall,   // the caller's buffer cannot hold the answer
-    FoeError,         // the FoE server answered with an ERR packet (code and text kept by the client)
+    InvalidArgument,       // a caller error: datagram too long, empty frame, bad address, ...
+    SendFailed,            // the link refused the frame (interface down, no privileges, ...)
+    Timeout,               // no matching reply within the timeout, after all retries ("no slave answered")
+    WorkingCounter,        // a reply came back but its working counter is not the expected one
+    SiiBusy,               // the SII interface stayed busy past the timeout
+    SiiNack,               // the SII interface kept reporting "missing acknowledge / invalid command"
+    SiiWriteDisabled,      // the SII write was refused with "write without write enable"
+    SiiFormat,             // the category chain runs past the EEPROM size or never ends
+    AlTimeout,             // the slave did not reach the requested AL state in time
+    AlRefused,             // the slave set the Error Indication bit (AL status code tells why)
+    MailboxNotConfigured,  // the mailbox SyncManagers are not set up (or not as a mailbox)
+    NoMailbox,             // the slave has none: its SII declares no standard mailbox (words 0x18-0x1B zero)
+    MailboxTimeout,        // no mailbox answer within the timeout
+    MailboxError,          // the slave answered with a mailbox error message (type 0)
+    MailboxProtocol,       // the answer does not fit the request (wrong type, service, length)
+    SdoAbort,              // the SDO server aborted the transfer (abort code tells why)
+    BufferTooSmall,        // the caller's buffer cannot hold the answer
+    FoeError,              // the FoE server answered with an ERR packet (code and text kept by the client)
 };
 
 std::string_view to_string(Error e);

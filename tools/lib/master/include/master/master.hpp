@@ -164,6 +164,10 @@ class Master {
     Error sii_read(Address a, uint32_t word, std::span<uint8_t> out);
     Result<uint16_t> sii_read_word(Address a, uint32_t word);
     Result<uint32_t> sii_read_u32(Address a, uint32_t word);
+    // Whether the SII declares a standard mailbox: false when words 0x18-0x1B (SM0/SM1 offset and size) are
+    // all zero, as for a coupler or a digital IO terminal (ETG.2010 SII words); such a slave goes from INIT
+    // to PREOP without mailbox SyncManagers and has its process-data layout in the SII alone.
+    Result<bool> sii_has_mailbox(Address a);
     // The whole image: the fixed header and the category chain up to and including the 0xFFFF end
     // word; with whole_eeprom, every byte of the size given in word 0x3E instead.
     Result<std::vector<uint8_t>> sii_read_image(Address a, bool whole_eeprom = false);
