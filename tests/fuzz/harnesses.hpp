@@ -17,7 +17,8 @@
     X(control)                     \
     X(topology)                    \
     X(esi_reader)                  \
-    X(eni_reader)
+    X(eni_reader)                  \
+    X(esi_line)
 
 #define SOFTECAT_FUZZ_DECLARE(name)                      \
     namespace fuzz::name {                               \

@@ -14,9 +14,11 @@ through Bootstrap, process data), recorded with `ecat-slave --capture`; then the
   device_config      the example configurations in the tree
   loaders            the files the slave wrote into its state directory (parameters.bin after 0x1010
                      "save", the firmware slot pointer and slot images, sii-writes.bin after `sii write`)
+  esi_line           a second session against a line of every device of the example ESIs (esi/examples,
+                     `ecat-slave --topology` with esi= lines): scan, states, SDO, process data of the line
 
 Usage (as root): tests/fuzz/make_corpus.py --slave build/tools/ecat-slave/ecat-slave \
-                    --ecatctl build/tools/ecatctl/ecatctl [--out tests/fuzz/corpus]
+                    --ecatctl build/tools/ecatctl/ecatctl [--out tests/fuzz/corpus] [--only esi_line]
 """
 import argparse
 import hashlib
@@ -25,7 +27,9 @@ import shutil
 import struct
 import subprocess
 import sys
+import tempfile
 import time
+import xml.etree.ElementTree as ET
 import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -97,15 +101,71 @@ def firmware_image(vendor, product, version=0x01300000, size=700):
     return head + struct.pack("<I", zlib.crc32(head + payload) & 0xFFFFFFFF) + payload
 
 
+def esi_line_corpus(harness, a, w):
+    """The esi_line seeds: a session of ecatctl against a line of every device of every example ESI, in the
+    order the harness builds it (files sorted by name, devices in file order)."""
+    shutil.rmtree(os.path.join(a.out, "esi_line"), ignore_errors=True)
+    examples = os.path.join(ROOT, "esi", "examples")
+    files = sorted(f for f in os.listdir(examples) if f.endswith(".xml"))
+    marks = []
+    lines, analog = [], None
+    for f in files:
+        path = os.path.join(examples, f)
+        for t in ET.parse(path).getroot().findall("Descriptions/Devices/Device/Type"):
+            spec = f"{t.get('ProductCode').replace('#x', '0x')}:{t.get('RevisionNo').replace('#x', '0x')}"
+            if f == "analog-in.xml" and analog is None:
+                analog = len(lines)
+            lines.append(f"device d{len(lines)} esi={path} device={spec}")
+    tmp = tempfile.mkdtemp(prefix="softecat-corpus-")
+    topo = os.path.join(tmp, "line.topo")
+    with open(topo, "w") as t:
+        t.write("\n".join(lines) + "\n")
+    with harness.Bus(slave_args=["--topology", topo]) as bus:
+        def run(name, *args):
+            t0 = time.time_ns()
+            r = bus.ecatctl(*args, check=False)
+            marks.append((name, t0, time.time_ns()))
+            if r.returncode != 0:
+                print(f"esi_line: ecatctl {' '.join(args)}: exit {r.returncode}: {r.stderr.strip()[-300:]}")
+
+        run("scan", "scan")
+        run("preop", "states", "PREOP")
+        if analog is not None:
+            run("upload", "upload", str(analog), "0x1018", "1")
+            run("sdo_info", "sdos", str(analog))
+        run("safeop", "states", "SAFEOP")
+        run("pd", "pd", "--all", "-n", "40", "--cycle-us", "1000")
+        run("init", "states", "INIT")
+        time.sleep(0.3)
+        bus.stop_slave()
+        capture = read_pcap(bus.capture)
+    shutil.rmtree(tmp, ignore_errors=True)
+    requests = [(t, f) for t, f in capture if len(f) > 6 and not f[6] & 0x02]
+    setup_end = next(e for n, _s, e in marks if n == "scan")
+    setup = [(t, f) for t, f in requests if t <= setup_end]
+    for name, s, e in marks:
+        req = [(t, f) for t, f in requests if s <= t <= e]
+        if req:
+            w.put("esi_line", name, records(setup[-10:] + req if name != "scan" else req), 16384)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--slave", required=True)
     ap.add_argument("--ecatctl", required=True)
     ap.add_argument("--out", default=os.path.join(HERE, "corpus"))
     ap.add_argument("--max-seed", type=int, default=6144, help="bytes per seed file at most")
+    ap.add_argument("--only", choices=["esi_line"], help="build this corpus alone")
     a = ap.parse_args()
     os.environ["ECAT_SLAVE"], os.environ["ECATCTL"] = os.path.abspath(a.slave), os.path.abspath(a.ecatctl)
     import harness  # noqa: E402 (needs the environment above)
+
+    if a.only == "esi_line":
+        w = Writer(a.out, a.max_seed)
+        esi_line_corpus(harness, a, w)
+        for k, v in sorted(w.count.items()):
+            print(f"{k}: {v} seeds")
+        return
 
     for h in ("esc_frame", "slave", "master_reply", "coe_mailbox", "foe_server", "sii", "loaders"):
         shutil.rmtree(os.path.join(a.out, h), ignore_errors=True)
@@ -240,7 +300,7 @@ def main():
         w.put("device_config", os.path.basename(conf), text)
         w.put("loaders", "config-" + os.path.basename(conf), b"\x03" + text)
 
-    # A diagnosis message as the slave encodes it, read back by the master (0x10F3 upload replies).
+    esi_line_corpus(harness, a, w)
     for k, v in sorted(w.count.items()):
         print(f"{k}: {v} seeds")
 

@@ -4,7 +4,8 @@
 # Each harness runs SECONDS on a scratch copy of tests/fuzz/corpus/<harness> (the corpus in the tree is
 # not grown) with ASan + UBSan halting on the first error. Prints per harness the executions, executions
 # per second, corpus size and the result; crashing inputs go to BUILD_DIR/fuzz-artifacts/<harness>/.
-# Exit status 1 if any harness found something (or could not run).
+# Exit status 1 if any harness found something (or could not run). FUZZ_JOBS harnesses run at once (default:
+# the number of CPUs); the table is printed in the order given when all are done.
 set -uo pipefail
 build=${1:?build dir}; seconds=${2:?seconds per harness}; shift 2
 here=$(cd "$(dirname "$0")" && pwd)
@@ -14,11 +15,13 @@ if ((${#harnesses[@]} == 0)); then
 fi
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:allocator_may_return_null=0}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}
-failed=0
-printf '%-14s %14s %10s %8s  %s\n' harness executions exec/s units result
-for h in "${harnesses[@]}"; do
-    bin="$build/tests/fuzz/${h}_fuzzer"
-    if [ ! -x "$bin" ]; then echo "$h: $bin missing"; failed=1; continue; fi
+parallel=${FUZZ_JOBS:-$(nproc)}  # harnesses at once: each libFuzzer run is one process on one core
+mkdir -p "$build/fuzz-artifacts"
+# One harness: its run, then one result line (and the first lines of a finding) in BUILD_DIR/fuzz-artifacts/H.result.
+run_one() {
+    local h=$1 bin="$build/tests/fuzz/${1}_fuzzer" out="$build/fuzz-artifacts/$1.result"
+    if [ ! -x "$bin" ]; then echo "$h: $bin missing" >"$out"; return 1; fi
+    local work art log rc execs rate units result
     work=$(mktemp -d "${TMPDIR:-/tmp}/softecat-fuzz-$h-XXXXXX")
     art="$build/fuzz-artifacts/$h"; mkdir -p "$art"
     log="$build/fuzz-artifacts/$h.log"
@@ -28,9 +31,24 @@ for h in "${harnesses[@]}"; do
     execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
     rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
     units=$(find "$work" -type f | wc -l)
-    if [ "$rc" -eq 0 ]; then result=ok; else result="FINDING (exit $rc, see $log)"; failed=1; fi
-    printf '%-14s %14s %10s %8s  %s\n' "$h" "${execs:-?}" "${rate:-?}" "$units" "$result"
-    if [ "$rc" -ne 0 ]; then grep -E "ERROR|runtime error|fuzz check|Test unit written" "$log" | head -5; fi
+    if [ "$rc" -eq 0 ]; then result=ok; else result="FINDING (exit $rc, see $log)"; fi
+    {
+        printf '%-14s %14s %10s %8s  %s\n' "$h" "${execs:-?}" "${rate:-?}" "$units" "$result"
+        if [ "$rc" -ne 0 ]; then grep -E "ERROR|runtime error|fuzz check|Test unit written" "$log" | head -5; fi
+    } >"$out"
     rm -rf "$work"
+    return "$rc"
+}
+printf '%-14s %14s %10s %8s  %s\n' harness executions exec/s units result
+pids=()
+for h in "${harnesses[@]}"; do
+    while (($(jobs -rp | wc -l) >= parallel)); do wait -n || true; done
+    run_one "$h" &
+    pids+=($!)
+done
+failed=0
+for i in "${!harnesses[@]}"; do
+    wait "${pids[$i]}" || failed=1
+    cat "$build/fuzz-artifacts/${harnesses[$i]}.result"
 done
 exit "$failed"
