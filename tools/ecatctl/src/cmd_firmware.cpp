@@ -159,11 +159,6 @@ class Steps {
     Clock::time_point start_ = Clock::now();
 };
 
-int fail(Error e, const std::string& what) {
-    std::fprintf(stderr, "ecatctl: %s: %s\n", what.c_str(), std::string(master::to_string(e)).c_str());
-    return exit_code(e);
-}
-
 Error read_sii_identity(master::Master& m, Address a, Identity& id) {
     uint8_t b[16];
     if (Error e = m.sii_read(a, master::sii::VendorId, b); e != Error::Ok) return e;
@@ -196,20 +191,21 @@ int refused(const char* target, const master::AlStatus& st) {
 int read_coe_identity(master::Master& m, Address a, CoeIdentity& out) {
     master::Mailbox mbx(m, a);
     auto st = m.al_status(a);
-    if (!st) return fail(st.error(), "reading the AL status");
+    if (!st) return report_error(st.error(), "reading the AL status");
     if (st->state == static_cast<uint8_t>(AlState::Init) ||
         st->state == static_cast<uint8_t>(AlState::Boot)) {
         if (st->state == static_cast<uint8_t>(AlState::Boot)) {
-            if (Error e = m.request_state(a, AlState::Init); e != Error::Ok) return fail(e, "going to INIT");
+            if (Error e = m.request_state(a, AlState::Init); e != Error::Ok)
+                return report_error(e, "going to INIT");
         }
         if (Error e = mbx.configure_from_sii(); e != Error::Ok)
-            return fail(e, "setting up the mailbox from the SII");
+            return report_error(e, "setting up the mailbox from the SII");
         master::AlStatus final;
         const Error e = m.request_state(a, AlState::PreOp, &final);
         if (e == Error::AlRefused) return refused("PREOP", final);
-        if (e != Error::Ok) return fail(e, "going to PREOP");
+        if (e != Error::Ok) return report_error(e, "going to PREOP");
     } else if (Error e = mbx.adopt_current(); e != Error::Ok) {
-        return fail(e, "opening the mailbox");
+        return report_error(e, "opening the mailbox");
     }
     master::SdoClient sdo(mbx);
     uint8_t b[128];
@@ -258,7 +254,7 @@ int restart(master::Master& m, Address a, const Args& args, Steps& steps, Identi
             (void)m.write_reg<uint16_t>(a, master::reg::AlControl, static_cast<uint8_t>(AlState::Init));
         }
         if (Clock::now() >= deadline) {
-            if (!st) return fail(st.error(), "waiting for the device to restart");
+            if (!st) return report_error(st.error(), "waiting for the device to restart");
             std::fprintf(stderr,
                          "ecatctl: the device did not come back in INIT within %u ms (AL status %s%s)\n",
                          args.restart_timeout_ms, std::string(master::al_state_name(st->state)).c_str(),
@@ -270,7 +266,7 @@ int restart(master::Master& m, Address a, const Args& args, Steps& steps, Identi
     for (;;) {
         e = read_sii_identity(m, a, sii);
         if (e == Error::Ok) break;
-        if (Clock::now() >= deadline) return fail(e, "reading the SII after the restart");
+        if (Clock::now() >= deadline) return report_error(e, "reading the SII after the restart");
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
     return kExitOk;
@@ -338,7 +334,7 @@ int firmware_update(master::Master& m, const Args& args, const Image& img) {
 
     // 1. The device as it runs now. A device left in BOOT by an interrupted update is reset first.
     auto st = m.al_status(a);
-    if (!st) return fail(st.error(), "reading the AL status");
+    if (!st) return report_error(st.error(), "reading the AL status");
     if (st->state == static_cast<uint8_t>(AlState::Boot)) {
         steps.say("device is in BOOT (an earlier update did not finish): resetting it to INIT");
         Identity ignored;
@@ -346,7 +342,7 @@ int firmware_update(master::Master& m, const Args& args, const Image& img) {
     }
     Identity sii;
     if (Error e = read_sii_identity(m, a, sii); e != Error::Ok)
-        return fail(e, "reading the identity from the SII");
+        return report_error(e, "reading the identity from the SII");
     CoeIdentity coe;
     if (int rc = read_coe_identity(m, a, coe); rc != kExitOk) return rc;
     steps.say("device '%s': vendor 0x%08x, product 0x%08x, revision 0x%08x (0x100A '%s'), serial 0x%08x",
@@ -379,17 +375,17 @@ int firmware_update(master::Master& m, const Args& args, const Image& img) {
     // 3. Bootstrap.
     master::Mailbox mbx(m, a);
     if (args.no_boot) {
-        if (Error e = mbx.adopt_current(); e != Error::Ok) return fail(e, "opening the mailbox");
+        if (Error e = mbx.adopt_current(); e != Error::Ok) return report_error(e, "opening the mailbox");
         steps.say("--no-boot: writing in the current state");
     } else {
         master::AlStatus final;
         if (Error e = m.request_state(a, AlState::Init, &final); e != Error::Ok)
-            return e == Error::AlRefused ? refused("INIT", final) : fail(e, "going to INIT");
+            return e == Error::AlRefused ? refused("INIT", final) : report_error(e, "going to INIT");
         if (Error e = mbx.configure_from_sii(true); e != Error::Ok)
-            return fail(e, "setting up the bootstrap mailbox (SII words 0x14-0x17)");
+            return report_error(e, "setting up the bootstrap mailbox (SII words 0x14-0x17)");
         const Error e = m.request_state(a, AlState::Boot, &final);
         if (e == Error::AlRefused) return refused("BOOT", final);
-        if (e != Error::Ok) return fail(e, "going to BOOT");
+        if (e != Error::Ok) return report_error(e, "going to BOOT");
         steps.say("BOOT (bootstrap mailbox %u/%u bytes)", mbx.config().out_size, mbx.config().in_size);
     }
 
@@ -409,7 +405,7 @@ int firmware_update(master::Master& m, const Args& args, const Image& img) {
             std::fprintf(stderr, "ecatctl: writing '%s': mailbox error (the device serves no FoE here)\n",
                          name.c_str());
         else
-            (void)fail(we, "writing '" + name + "'");
+            (void)report_error(we, "writing '" + name + "'");
         if (!args.no_boot) recover(m, a, args, steps);
         return exit_code(we);
     }

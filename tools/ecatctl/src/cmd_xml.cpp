@@ -56,7 +56,7 @@ std::string hx(uint64_t v, int digits = 0) {
     return b;
 }
 
-std::string hex_bytes(std::span<const uint8_t> d) {
+std::string hex_upper(std::span<const uint8_t> d) {
     std::string s;
     char b[4];
     for (uint8_t x : d) {
@@ -318,10 +318,10 @@ int run_xml(master::Master& m, const XmlArgs& x) {
     }
     w("        <Eeprom>\n          <ByteSize>" + std::to_string(sii.eeprom_bytes()) + "</ByteSize>\n");
     if (img->size() >= 16)
-        w("          <ConfigData>" + hex_bytes(std::span<const uint8_t>(*img).subspan(0, 14)) +
+        w("          <ConfigData>" + hex_upper(std::span<const uint8_t>(*img).subspan(0, 14)) +
           "</ConfigData>\n");
     if (img->size() >= 0x30 && sii.bootstrap_mailbox.out_size != 0)
-        w("          <BootStrap>" + hex_bytes(std::span<const uint8_t>(*img).subspan(0x28, 8)) +
+        w("          <BootStrap>" + hex_upper(std::span<const uint8_t>(*img).subspan(0x28, 8)) +
           "</BootStrap>\n");
     w("        </Eeprom>\n      </Device>\n    </Devices>\n  </Descriptions>\n</EtherCATInfo>\n");
 
