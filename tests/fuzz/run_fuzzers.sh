@@ -11,7 +11,8 @@ build=${1:?build dir}; seconds=${2:?seconds per harness}; shift 2
 here=$(cd "$(dirname "$0")" && pwd)
 harnesses=("$@")
 if ((${#harnesses[@]} == 0)); then
-    harnesses=(esc_frame slave coe_mailbox foe_server sii device_config loaders master_reply control topology esi_reader eni_reader)
+    harnesses=(esc_frame slave coe_mailbox foe_server sii device_config loaders master_reply control topology esi_reader eni_reader
+               esi_line)
 fi
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:allocator_may_return_null=0}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}
