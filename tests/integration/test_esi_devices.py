@@ -79,6 +79,7 @@ def examples():
                         "mailbox": dev.find("Mailbox") is not None,
                         "eeprom_data": dev.find("Eeprom/Data") is not None,
                         "out_sm_start": number(sm_out.get("StartAddress")) if sm_out is not None else None,
+                        "out_sm_control": number(sm_out.get("ControlByte")) if sm_out is not None else None,
                         "first_output": None if first_out is None else
                         f"0x{number(first_out.findtext('Index')):04x}:{number(first_out.findtext('SubIndex'))}"})
     return out
@@ -180,24 +181,36 @@ class EsiDevices(unittest.TestCase):
             with self.subTest(file=os.path.basename(d["file"]), device=d["spec"]):
                 bus, ctl = self.serve(d)
                 with bus:
+                    bus.ecatctl("scan")  # station address 0x1001
+                    m = LAYOUT.search(bus.ecatctl("pd", "0", "-n", "1", "--state", "SAFEOP").stdout)
+                    self.assertIsNotNone(m)
+                    sm, start, size = int(m.group(1)), int(m.group(2), 16), int(m.group(3))
+                    self.assertEqual(start, d["out_sm_start"])
                     mm = harness.MiniMaster(bus)
                     try:
-                        mm.to_op(dc=False)
-                        self.assertEqual(mm.layouts[0][0], d["out_sm_start"])
-                        image = bytearray(mm.image)
+                        # The outputs SM as the ESI declares it, one write FMMU onto it; only the outputs.
+                        mm.fpwr(0x1001, 0x0800 + 8 * sm, struct.pack("<HHBBBB", start, size, d["out_sm_control"], 0,
+                                                                      1, 0))
+                        mm.fpwr(0x1001, 0x0600, struct.pack("<IHBBHBBBxxx", 0x10000, size, 0, 7, start, 0, 2, 1))
+                        image = bytearray(size)
                         image[0] = 0xFF  # the first output entry sits at bit 0 of the image
 
                         def write(n):
                             for _ in range(n):
                                 r = mm.txrx([(harness.LRW, 0x0000, 0x0001, bytes(image))])
                                 if r is not None:
-                                    self.assertEqual(r[0][1], mm.expected_wkc)
+                                    self.assertEqual(r[0][1], 2)
                                 time.sleep(0.001)
+
+                        for state in (2, 4, 8):
+                            mm.fpwr(0x1001, 0x0120, struct.pack("<H", state))
+                            write(20)
+                            self.assertEqual(struct.unpack("<H", mm.fprd(0x1001, 0x0130, 2))[0], state)
 
                         def output():
                             r = harness.control(ctl, f"get {d['first_output']}")
                             self.assertTrue(r.startswith("ok "), r)
-                            return r.rsplit("=", 1)[1]
+                            return r.rsplit("=", 1)[1].strip()
 
                         write(50)
                         self.assertNotEqual(output(), "0")
