@@ -1151,6 +1151,14 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
     uint32_t device_type = 0;
     if (auto it = built.objects.find(0x1000); it != built.objects.end())
         device_type = static_cast<uint32_t>(default_u(it->second.entries[0]));
+    // The profile is the one the ESI's ProfileNo names (0x1000 as the vendor wrote it may say otherwise: an
+    // ESI with ProfileNo 402 and a device type 0x00000004 is still a CiA 402 drive); AddInfo, where not
+    // given, is 0x1000's high word if 0x1000 names the same profile.
+    if (d.profile_no && *d.profile_no != 0 && *d.profile_no <= 0xFFFF) {
+        desc.profile_number = static_cast<uint16_t>(*d.profile_no);
+        desc.profile_add_info = static_cast<uint16_t>(
+            d.profile_add_info.value_or((device_type & 0xFFFF) == *d.profile_no ? device_type >> 16 : 0));
+    }
     const bool profile402 = (d.profile_no && *d.profile_no == 402) || (device_type & 0xFFFF) == 402;
     if (profile402 && built.objects.count(0x6040) && built.objects.count(0x6041))
         product.application = od::Application::Cia402Drive;
