@@ -646,6 +646,67 @@ TEST(EsiExamples, TheModularDeviceServesTheDefaultModulesOfItsSlots) {
               1);
 }
 
+// Another module configuration than the default, chosen in the device spec (SPEC@MODULES): each slot's PDOs,
+// objects and increments as the slot's module brings them, the SM sizes of the SII (what SOEM's slaveinfo and
+// a master without CoE read) and the assignment objects (what a CoE master reads) from the same modules.
+TEST(EsiExamples, TheModularDeviceServesTheModulesTheSpecChooses) {
+    const std::string f = example("modular-io.xml").string();
+    struct Case {
+        std::string modules;
+        uint16_t out_bytes, in_bytes;
+        std::vector<uint16_t> rx, tx;
+    };
+    const Case cases[] = {
+        // Slot 1 and 2: AI2 (0x1A00, 0x1A01 after the PDO increment), slot 3 empty, slot 4: DO8 (0x1603).
+        {"EXM-AI2,exm-ai2,-,#x00002001", 1, 8, {0x1603}, {0x1A00, 0x1A01}},
+        {"EXM-DI8", 0, 1, {}, {0x1A00}},                             // the other slots empty
+        {"0x1001,0x2001,0x3001", 1, 5, {0x1601}, {0x1A00, 0x1A02}},  // the default, by ModuleIdent
+        {",,,EXM-DO8", 1, 0, {0x1603}, {}},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.modules);
+        const od::Product p = esi::load_product(f, "EXM9000@" + c.modules);
+        const od::Dictionary d = p.make_dictionary(p.description);
+        const esi::DeviceModel m = esi::derive_model(p.description, d);
+        ASSERT_EQ(m.sync_managers.size(), 4u);
+        EXPECT_EQ(m.sync_managers[2].size, c.out_bytes);
+        EXPECT_EQ(m.sync_managers[3].size, c.in_bytes);
+        auto assigned = [&d](uint16_t index) {
+            std::vector<uint16_t> out;
+            for (uint8_t k = 1; k <= d.get<uint8_t>(index, 0); ++k)
+                out.push_back(d.get<uint16_t>(index, k));
+            return out;
+        };
+        EXPECT_EQ(assigned(0x1C12), c.rx);
+        EXPECT_EQ(assigned(0x1C13), c.tx);
+        // The SII says the same sizes (SyncM category).
+        const std::vector<uint8_t> sii = esi::build_sii(p.description, d);
+        const esi::SiiInfo info = esi::parse_sii(sii);
+        ASSERT_GE(info.sync_managers.size(), 4u);
+        EXPECT_EQ(info.sync_managers[2].length, c.out_bytes);
+        EXPECT_EQ(info.sync_managers[3].length, c.in_bytes);
+    }
+    // Slot 2 holding AI2: its objects with the slot's index increment (0x6010 for slot 2).
+    const od::Product two = esi::load_product(f, "EXM9000@-,EXM-AI2");
+    const od::Dictionary d2 = two.make_dictionary(two.description);
+    ASSERT_NE(d2.find(0x6010, 2), nullptr);
+    EXPECT_EQ(d2.find(0x6010, 2)->type, od::DataType::Integer16);
+    EXPECT_EQ(d2.find(0x6000, 1), nullptr);
+    // Bad lists: usage errors naming the file.
+    for (const char* bad :
+         {"EXM9000@EXM-DI8,EXM-DI8,EXM-DI8,EXM-DI8,EXM-DI8", "EXM9000@EXM-XX9", "EXM9000@0x9999"}) {
+        SCOPED_TRACE(bad);
+        try {
+            (void)esi::load_product(f, bad);
+            ADD_FAILURE() << "no error";
+        } catch (const esi::InputError& e) {
+            EXPECT_EQ(std::string(e.what()).rfind(f, 0), 0u) << e.what();
+        }
+    }
+    // Modules for a device without slots.
+    EXPECT_THROW((void)esi::load_product(example("coupler.xml").string(), "@EXM-DI8"), esi::InputError);
+}
+
 TEST(EsiExamples, TheEepromImageIsServedByteForByte) {
     const std::string f = example("eeprom-blob.xml").string();
     const esi::EsiFile file = esi::read_esi_file(f);
