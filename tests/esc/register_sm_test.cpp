@@ -15,17 +15,6 @@ using namespace esc_test;
 
 namespace {
 
-std::vector<uint8_t> sm_bytes(uint16_t start, uint16_t len, uint8_t ctrl, uint8_t act) {
-    std::vector<uint8_t> b = le(start, 2);
-    auto l = le(len, 2);
-    b.insert(b.end(), l.begin(), l.end());
-    b.push_back(ctrl);
-    b.push_back(0);
-    b.push_back(act);
-    b.push_back(0);
-    return b;
-}
-
 // FMMU n: logical la, len bytes (whole bytes), physical pa, type (1 read, 2 write, 3 both), enabled.
 std::vector<uint8_t> fmmu(uint32_t la, uint16_t len, uint16_t pa, uint8_t type) {
     std::vector<uint8_t> b = le(la, 4);

@@ -42,46 +42,52 @@ def pdo_bits(pdos, sm_of):
     return bits
 
 
-def examples():
-    """(file, spec, expected) for each device of each example: identity, name, process-data bytes."""
-    out = []
+def example_devices():
+    """(file, root, modules by ModuleIdent, device element, SM of each direction) for each device of each example."""
     for name in sorted(os.listdir(EXAMPLES)):
         if not name.endswith(".xml"):
             continue
         path = os.path.join(EXAMPLES, name)
         root = ET.parse(path).getroot()
-        vendor = number(root.findtext("Vendor/Id"))
         modules = {}
         for m in root.iter("Module"):
             t = m.find("Type")
             if t is not None and t.get("ModuleIdent"):
                 modules[number(t.get("ModuleIdent"))] = m
         for dev in root.findall("Descriptions/Devices/Device"):
-            t = dev.find("Type")
-            product, revision = number(t.get("ProductCode")), number(t.get("RevisionNo"))
             sms = [s.text.strip() for s in dev.findall("Sm")]
             sm_of = {"out": sms.index("Outputs") if "Outputs" in sms else None,
                      "in": sms.index("Inputs") if "Inputs" in sms else None}
-            pdos = [(p.tag, p) for p in dev if p.tag in ("RxPdo", "TxPdo")]
-            # A modular device: the default module of each slot brings its PDOs.
-            for slot in dev.findall("Slots/Slot"):
-                for ident in slot.findall("ModuleIdent"):
-                    if ident.get("Default") in ("1", "true") and number(ident.text) in modules:
-                        m = modules[number(ident.text)]
-                        pdos += [(p.tag, p) for p in m if p.tag in ("RxPdo", "TxPdo")]
-            bits = pdo_bits(pdos, sm_of)
-            sm_out = dev.findall("Sm")[sm_of["out"]] if sm_of["out"] is not None else None
-            first_out = next((e for kind, p in pdos if kind == "RxPdo" and p.get("Sm") is not None
-                              for e in p.findall("Entry") if number(e.findtext("Index")) != 0), None)
-            out.append({"file": path, "spec": f"0x{product:08x}:0x{revision:08x}", "vendor": vendor,
-                        "product": product, "revision": revision, "type": (t.text or "").strip(),
-                        "out_bytes": (bits["out"] + 7) // 8, "in_bytes": (bits["in"] + 7) // 8,
-                        "mailbox": dev.find("Mailbox") is not None,
-                        "eeprom_data": dev.find("Eeprom/Data") is not None,
-                        "out_sm_start": number(sm_out.get("StartAddress")) if sm_out is not None else None,
-                        "out_sm_control": number(sm_out.get("ControlByte")) if sm_out is not None else None,
-                        "first_output": None if first_out is None else
-                        f"0x{number(first_out.findtext('Index')):04x}:{number(first_out.findtext('SubIndex'))}"})
+            yield path, root, modules, dev, sm_of
+
+
+def examples():
+    """(file, spec, expected) for each device of each example: identity, name, process-data bytes."""
+    out = []
+    for path, root, modules, dev, sm_of in example_devices():
+        vendor = number(root.findtext("Vendor/Id"))
+        t = dev.find("Type")
+        product, revision = number(t.get("ProductCode")), number(t.get("RevisionNo"))
+        pdos = [(p.tag, p) for p in dev if p.tag in ("RxPdo", "TxPdo")]
+        # A modular device: the default module of each slot brings its PDOs.
+        for slot in dev.findall("Slots/Slot"):
+            for ident in slot.findall("ModuleIdent"):
+                if ident.get("Default") in ("1", "true") and number(ident.text) in modules:
+                    m = modules[number(ident.text)]
+                    pdos += [(p.tag, p) for p in m if p.tag in ("RxPdo", "TxPdo")]
+        bits = pdo_bits(pdos, sm_of)
+        sm_out = dev.findall("Sm")[sm_of["out"]] if sm_of["out"] is not None else None
+        first_out = next((e for kind, p in pdos if kind == "RxPdo" and p.get("Sm") is not None
+                          for e in p.findall("Entry") if number(e.findtext("Index")) != 0), None)
+        out.append({"file": path, "spec": f"0x{product:08x}:0x{revision:08x}", "vendor": vendor,
+                    "product": product, "revision": revision, "type": (t.text or "").strip(),
+                    "out_bytes": (bits["out"] + 7) // 8, "in_bytes": (bits["in"] + 7) // 8,
+                    "mailbox": dev.find("Mailbox") is not None,
+                    "eeprom_data": dev.find("Eeprom/Data") is not None,
+                    "out_sm_start": number(sm_out.get("StartAddress")) if sm_out is not None else None,
+                    "out_sm_control": number(sm_out.get("ControlByte")) if sm_out is not None else None,
+                    "first_output": None if first_out is None else
+                    f"0x{number(first_out.findtext('Index')):04x}:{number(first_out.findtext('SubIndex'))}"})
     return out
 
 
@@ -236,37 +242,26 @@ class EsiDevices(unittest.TestCase):
         device spec (SPEC@MODULE,MODULE,...): slot n takes the module after its default in the list it offers. The
         master finds the process image of those modules and reaches OP with the exact working counter."""
         chosen = []
-        for name in sorted(os.listdir(EXAMPLES)):
-            if not name.endswith(".xml"):
+        for path, _root, modules, dev, sm_of in example_devices():
+            slots = dev.findall("Slots/Slot")
+            if not slots:
                 continue
-            path = os.path.join(EXAMPLES, name)
-            root = ET.parse(path).getroot()
-            modules = {number(m.find("Type").get("ModuleIdent")): m for m in root.iter("Module")
-                       if m.find("Type") is not None and m.find("Type").get("ModuleIdent")}
-            for dev in root.findall("Descriptions/Devices/Device"):
-                slots = dev.findall("Slots/Slot")
-                if not slots:
-                    continue
-                t = dev.find("Type")
-                product, revision = number(t.get("ProductCode")), number(t.get("RevisionNo"))
-                idents = []
-                for n, slot in enumerate(slots):
-                    offered = [number(i.text) for i in slot.findall("ModuleIdent")]
-                    default = next((k for k, i in enumerate(slot.findall("ModuleIdent"))
-                                    if i.get("Default") in ("1", "true")), -1)
-                    idents.append(offered[(default + 1 + n) % len(offered)] if offered else None)
-                sms = [x.text.strip() for x in dev.findall("Sm")]
-                sm_of = {"out": sms.index("Outputs") if "Outputs" in sms else None,
-                         "in": sms.index("Inputs") if "Inputs" in sms else None}
-                pdos = [(p.tag, p) for p in dev if p.tag in ("RxPdo", "TxPdo")]
-                for i in idents:
-                    if i in modules:
-                        pdos += [(p.tag, p) for p in modules[i] if p.tag in ("RxPdo", "TxPdo")]
-                bits = pdo_bits(pdos, sm_of)
-                spec = f"0x{product:08x}:0x{revision:08x}@" + ",".join("-" if i is None else f"0x{i:x}"
-                                                                     for i in idents)
-                chosen.append({"file": path, "spec": spec, "out_bytes": (bits["out"] + 7) // 8,
-                               "in_bytes": (bits["in"] + 7) // 8})
+            t = dev.find("Type")
+            product, revision = number(t.get("ProductCode")), number(t.get("RevisionNo"))
+            idents = []
+            for n, slot in enumerate(slots):
+                offered = [number(i.text) for i in slot.findall("ModuleIdent")]
+                default = next((k for k, i in enumerate(slot.findall("ModuleIdent"))
+                                if i.get("Default") in ("1", "true")), -1)
+                idents.append(offered[(default + 1 + n) % len(offered)] if offered else None)
+            pdos = [(p.tag, p) for p in dev if p.tag in ("RxPdo", "TxPdo")]
+            for i in idents:
+                if i in modules:
+                    pdos += [(p.tag, p) for p in modules[i] if p.tag in ("RxPdo", "TxPdo")]
+            bits = pdo_bits(pdos, sm_of)
+            spec = f"0x{product:08x}:0x{revision:08x}@" + ",".join("-" if i is None else f"0x{i:x}" for i in idents)
+            chosen.append({"file": path, "spec": spec, "out_bytes": (bits["out"] + 7) // 8,
+                           "in_bytes": (bits["in"] + 7) // 8})
         self.assertGreater(len(chosen), 0, "a modular example")
         for d in chosen:
             with self.subTest(file=os.path.basename(d["file"]), device=d["spec"]):
