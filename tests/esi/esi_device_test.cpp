@@ -685,6 +685,8 @@ TEST(EsiExamples, TheModularDeviceServesTheModulesTheSpecChooses) {
         ASSERT_GE(info.sync_managers.size(), 4u);
         EXPECT_EQ(info.sync_managers[2].length, c.out_bytes);
         EXPECT_EQ(info.sync_managers[3].length, c.in_bytes);
+        // Written back with the chosen modules as the slots' defaults: the same device again.
+        expect_same(describe(p), describe(round_trip(p)), "round trip");
     }
     // Slot 2 holding AI2: its objects with the slot's index increment (0x6010 for slot 2).
     const od::Product two = esi::load_product(f, "EXM9000@-,EXM-AI2");

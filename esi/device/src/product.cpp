@@ -796,13 +796,15 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
     }
     // The slots and the modules they take, for the ESI written back.
     std::set<uint32_t> offered;
-    for (const EsiSlot& slot : d.slots) {
+    for (std::size_t n = 0; n < d.slots.size(); ++n) {
+        const EsiSlot& slot = d.slots[n];
         od::Slot s;
         s.name = slot.name;
         s.min_instances = slot.min_instances;
         s.max_instances = slot.max_instances;
         s.module_idents = slot.module_idents;
-        s.default_module = slot.default_module.value_or(0);
+        // The module served in the slot: the ESI written back serves the same device.
+        s.default_module = n < modules.size() ? modules[n].value_or(0) : 0;
         s.pdo_increment = slot.pdo_increment.value_or(d.slot_pdo_increment);
         s.index_increment = slot.index_increment.value_or(d.slot_index_increment);
         offered.insert(slot.module_idents.begin(), slot.module_idents.end());
