@@ -48,7 +48,17 @@ void Cycle::poll(uint64_t now_ns) {
         const uint16_t wd = pdi.read_reg<uint16_t>(esc::reg::kWdStatusPd);
         if (!(wd & 0x0001)) {
             ++ctx_.stats.watchdog_expiries;
-            if (esm_.state() == AlState::Op) {
+            if (esm_.state() == AlState::Op && esm_.device_emulation()) {
+                // No controller to change the state: the ESC itself resets its digital outputs at the expiry,
+                // or with the next output event when the digital I/O configuration 0x0150 bit 3 says so
+                // (ESC datasheet section II, 0x0150 PDI configuration, 0x0F00 digital I/O output data).
+                if (ctx_.events != nullptr) ctx_.events->watchdog_expired(esm_.state());
+                if (pdi.read_reg<uint8_t>(esc::reg::kPdiConfig) & kOutputsResetAtNextEvent) {
+                    outputs_reset_pending_ = true;
+                } else {
+                    ctx_.app.on_outputs_lost();
+                }
+            } else if (esm_.state() == AlState::Op) {
                 // Reported where it matters: outside Op no outputs are used, and one expires after every Op.
                 if (ctx_.events != nullptr) ctx_.events->watchdog_expired(esm_.state());
                 // Outputs are no longer refreshed: Safe-Op with error 0x001B (ETG.1000.6, process-data
@@ -127,6 +137,7 @@ void Cycle::start_process_data(uint64_t now_ns) {
     sm2_buf_.assign(pd.rx_bytes(), 0);
     sm3_buf_.assign(pd.tx_bytes(), 0);
     outputs_seen_ = false;
+    outputs_reset_pending_ = false;
     sync_.start(now_ns);
     if (pd.rx_bytes() > 0) set_sm_pdi_deactivated(ctx_.pdi, out_sm_, false);
     if (pd.tx_bytes() > 0) {
@@ -151,6 +162,12 @@ void Cycle::write_inputs() {
 }
 
 void Cycle::run_cycle(uint64_t now_ns, bool fresh_outputs) {
+    if (outputs_reset_pending_) {
+        // The output event after an expiry of the watchdog (0x0150 bit 3): it puts out zeros, not the data.
+        outputs_reset_pending_ = false;
+        ctx_.app.on_outputs_lost();
+        fresh_outputs = false;
+    }
     if (!sm2_buf_.empty()) {
         // Reading SM2 from its first to its last byte takes the newest buffer and releases it.
         if (fresh_outputs) ctx_.pdi.read(sm2_start_, sm2_buf_);
@@ -167,15 +184,10 @@ void Cycle::process_data_events(uint32_t events, uint64_t now_ns) {
     esc::Pdi& pdi = ctx_.pdi;
     const bool has_outputs = !sm2_buf_.empty();
     // Outputs in an SM on the register space (the digital-output registers 0x0F00 of an ESC with digital
-    // I/O, as EL2xxx terminals declare them): the ESC serves them as registers (docs/decisions/esc.md,
-    // "SyncManager over the register area"), no SM event says when the master wrote them; what they hold is
-    // taken every pass.
-    const bool register_outputs = has_outputs && sm2_start_ < esc::reg::kRamBase;
+    // I/O) signal a write like those in the RAM: the ESC closes such an SM at its last byte
+    // (docs/decisions/esc.md, "SyncManager over the register space").
     bool new_outputs = false;
-    if (register_outputs) {
-        new_outputs = true;
-        outputs_seen_ = true;
-    } else if (has_outputs) {
+    if (has_outputs) {
         const uint8_t st = pdi.read_reg<uint8_t>(esc::reg::sm_base(out_sm_) + esc::reg::kSmStatus);
         new_outputs = (st & esc::reg::kSmStatusIrqWrite) != 0 || (events & esc::alev::sm(out_sm_)) != 0;
         if (new_outputs) outputs_seen_ = true;
@@ -183,7 +195,7 @@ void Cycle::process_data_events(uint32_t events, uint64_t now_ns) {
     switch (sync_.mode()) {
         case SyncMode::SmSync:
         case SyncMode::SmSync2:
-            if (has_outputs && !register_outputs) {
+            if (has_outputs) {
                 if (new_outputs) {
                     sync_.sample_sm2_latency();
                     run_cycle(now_ns, true);
@@ -192,9 +204,7 @@ void Cycle::process_data_events(uint32_t events, uint64_t now_ns) {
                 // Inputs only: a new cycle each time the master has read the inputs.
                 const uint8_t st = pdi.read_reg<uint8_t>(esc::reg::sm_base(in_sm_) + esc::reg::kSmStatus);
                 if ((st & esc::reg::kSmStatusIrqRead) || (events & esc::alev::sm(in_sm_)))
-                    run_cycle(now_ns, register_outputs);
-            } else if (register_outputs) {
-                run_cycle(now_ns, true);
+                    run_cycle(now_ns, false);
             }
             break;
         case SyncMode::FreeRun:

@@ -40,6 +40,7 @@ bool Esc::Impl::phys_read(uint32_t a, uint8_t* dst, uint8_t* ok, uint32_t n, Sid
             p = q;
         }
     }
+    if (!sm.register_sms().empty()) close_register_sms(a, end, false, side);
     return any;
 }
 
@@ -47,8 +48,7 @@ bool Esc::Impl::phys_write(uint32_t a, const uint8_t* src, const uint8_t* bm, ui
     const uint32_t end = a + n;
     bool any = false;
     uint32_t p = a;
-    const bool esc_protected =
-        side == Side::Ecat && (mem.regs[reg::kEscWriteProtect] & 0x01) && !frame_esc_write_enable;
+    const bool esc_protected = esc_write_protected(side);
     while (p < end) {
         const SmArea* hit = sm.first_area(p, end);
         const uint32_t seg_end = hit ? std::max(p, hit->start) : end;
@@ -86,7 +86,24 @@ bool Esc::Impl::phys_write(uint32_t a, const uint8_t* src, const uint8_t* bm, ui
             p = q;
         }
     }
+    if (!sm.register_sms().empty()) close_register_sms(a, end, true, side);
     return any;
+}
+
+void Esc::Impl::close_register_sms(uint32_t a, uint32_t end, bool write, Side side) {
+    // The SM's last byte was accessed if it lies in this access, in the memory, and (a write) was not
+    // write-protected; the data itself went where the byte's own rules sent it.
+    for (const SmWatch& w : sm.register_sms()) {
+        if (w.last < a || w.last >= end || w.last >= mem.ram_end) continue;
+        if (write) {
+            const bool esc_prot = esc_write_protected(side);
+            const bool blocked = w.last < reg::kRamBase ? write_blocked(static_cast<uint16_t>(w.last),
+                                                                        esc_prot, reg_write_protected(side))
+                                                        : esc_prot;
+            if (blocked) continue;
+        }
+        sm.close_transparent(w.sm, write, side);
+    }
 }
 
 uint64_t Esc::Impl::merged(uint16_t r, unsigned size, uint16_t a, uint16_t e, const uint8_t* src,
@@ -128,17 +145,13 @@ void Esc::Impl::reg_read(uint16_t a, uint8_t* dst, uint32_t n, Side side) {
 bool Esc::Impl::reg_write(uint16_t a, const uint8_t* src, const uint8_t* bm, uint32_t n, Side side) {
     const uint8_t* kind = side == Side::Ecat ? ecat_kind.data() : pdi_kind.data();
     const uint8_t* wmask = side == Side::Ecat ? ecat_wmask.data() : pdi_wmask.data();
-    const bool reg_prot =
-        side == Side::Ecat && (mem.regs[reg::kRegWriteProtect] & 0x01) && !frame_write_enable;
-    const bool esc_prot =
-        side == Side::Ecat && (mem.regs[reg::kEscWriteProtect] & 0x01) && !frame_esc_write_enable;
+    const bool reg_prot = reg_write_protected(side);
+    const bool esc_prot = esc_write_protected(side);
     bool any = false;
     bool special = false;
     for (uint32_t i = 0; i < n; ++i) {
         const uint16_t addr = static_cast<uint16_t>(a + i);
-        if (esc_prot && addr != reg::kEscWriteEnable) continue;
-        if (reg_prot && addr < reg::kUserRam && addr != reg::kRegWriteEnable && addr != reg::kEscWriteEnable)
-            continue;
+        if (write_blocked(addr, esc_prot, reg_prot)) continue;
         any = true;
         if (kind[addr] == kPlain) {
             const uint8_t m = static_cast<uint8_t>(wmask[addr] & (bm ? bm[i] : 0xFF));

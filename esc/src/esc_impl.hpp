@@ -73,6 +73,23 @@ struct Esc::Impl final {
     // bytes. write: bm (optional) is a per-byte bit mask of the bits to write.
     bool phys_read(uint32_t a, uint8_t* dst, uint8_t* ok, uint32_t n, Side side);
     bool phys_write(uint32_t a, const uint8_t* src, const uint8_t* bm, uint32_t n, Side side);
+    // An access [a, end) of one side reached the last byte of an SM over the register space: close it.
+    void close_register_sms(uint32_t a, uint32_t end, bool write, Side side);
+    // Write protection of an ECAT write (0x0020/0x0030 and their enables of this frame); the PDI writes
+    // freely.
+    bool reg_write_protected(Side side) const {
+        return side == Side::Ecat && (mem.regs[reg::kRegWriteProtect] & 0x01) && !frame_write_enable;
+    }
+    bool esc_write_protected(Side side) const {
+        return side == Side::Ecat && (mem.regs[reg::kEscWriteProtect] & 0x01) && !frame_esc_write_enable;
+    }
+    // A register byte a protected write does not reach (the enables themselves and, for the register
+    // protection, the user RAM from 0x0F80 stay writable).
+    static bool write_blocked(uint16_t addr, bool esc_prot, bool reg_prot) {
+        if (esc_prot && addr != reg::kEscWriteEnable) return true;
+        return reg_prot && addr < reg::kUserRam && addr != reg::kRegWriteEnable &&
+               addr != reg::kEscWriteEnable;
+    }
     void reg_read(uint16_t a, uint8_t* dst, uint32_t n, Side side);
     bool reg_write(uint16_t a, const uint8_t* src, const uint8_t* bm, uint32_t n, Side side);
     void reg_special_write(uint16_t a, uint16_t e, const uint8_t* src, const uint8_t* bm, Side side);

@@ -93,15 +93,7 @@ bool SyncManagers::access(unsigned n, uint32_t off, uint8_t* dst, const uint8_t*
 
     if (len == 1) {  // single byte: transparent, only interrupt and watchdog
         copy(mem.at(s.start));
-        if (write) {
-            s.irq_write = true;
-            s.irq_read = false;
-            if (side == Side::Ecat && (s.control & 0x40)) wd.pd_trigger();
-        } else {
-            s.irq_read = true;
-            s.irq_write = false;
-        }
-        update_status(n);
+        close_transparent(n, write, side);
         return true;
     }
     if (s.pending) return false;  // closed in this frame: the end address cannot be accessed twice
@@ -135,6 +127,22 @@ bool SyncManagers::access(unsigned n, uint32_t off, uint8_t* dst, const uint8_t*
     }
     update_status(n);
     return true;
+}
+
+void SyncManagers::close_transparent(unsigned n, bool write, Side side) {
+    SyncManager& s = sm[n];
+    if (s.pdi_disabled) return;
+    // Only the producer's write and the consumer's read close it; the other side's accesses are plain.
+    if (write != ((side == Side::Ecat) == s.ecat_writes)) return;
+    if (write) {
+        s.irq_write = true;
+        s.irq_read = false;
+        if (side == Side::Ecat && (s.control & 0x40)) wd.pd_trigger();
+    } else {
+        s.irq_read = true;
+        s.irq_write = false;
+    }
+    update_status(n);
 }
 
 bool SyncManagers::activate_written(unsigned n, uint8_t value) {
@@ -175,6 +183,7 @@ void SyncManagers::reset() {
 void SyncManagers::rebuild() {
     enabled_mask_ = 0;
     area_count_ = 0;
+    watch_count_ = 0;
     for (unsigned n = 0; n < count_; ++n) {
         uint16_t b = static_cast<uint16_t>(reg::kSm + 8 * n);
         SyncManager& s = sm[n];
@@ -188,11 +197,21 @@ void SyncManagers::rebuild() {
         if (act & 0x01) enabled_mask_ = static_cast<uint16_t>(enabled_mask_ | (1u << n));
         uint32_t area = (s.mailbox || s.length == 1) ? s.length : 3u * s.length;
         uint32_t end = s.start + area;
-        // SyncManagers act on the process RAM only (ESC datasheet section I, SyncManager): an area that
-        // starts in the register space or does not fit the RAM is not served and captures no address,
-        // so the registers (the SM's own included) and the RAM stay reachable (decisions/esc.md).
-        s.area_valid = s.start >= reg::kRamBase && end <= mem.ram_end;
-        if (!s.enabled || !s.area_valid) continue;
+        // Buffers (3-buffer redirection, mailbox gating) live in the process RAM: an area that fits it is
+        // served as a buffer and captures its addresses. An SM that starts in the register space (the
+        // digital-output SM on 0x0F00 of a digital I/O ESC) has no buffer of its own: the bytes keep their
+        // own rules and its last byte closes it as the single-byte SM is closed (ESC datasheet section I,
+        // SyncManager; section II, 0x0F00 digital I/O output data). One that starts in the RAM but runs past
+        // its end is not served (decisions/esc.md).
+        s.in_registers = s.start < reg::kRamBase;
+        s.area_valid = !s.in_registers && end <= mem.ram_end;
+        if (!s.enabled) continue;
+        if (s.in_registers) {
+            watches_[watch_count_++] =
+                SmWatch{static_cast<uint32_t>(s.start) + s.length - 1u, static_cast<uint8_t>(n)};
+            continue;
+        }
+        if (!s.area_valid) continue;
         // Insertion by start address.
         unsigned pos = area_count_;
         while (pos > 0 && areas_[pos - 1].start > s.start) {

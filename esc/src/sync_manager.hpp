@@ -3,6 +3,7 @@
 // (ETG.1000.4 and ESC datasheet section I, SyncManager; registers 0x0800 + 8n).
 #include <array>
 #include <cstdint>
+#include <span>
 
 #include "memory.hpp"
 #include "watchdog.hpp"
@@ -14,10 +15,11 @@ struct SyncManager {
     uint16_t start = 0;
     uint16_t length = 0;
     uint8_t control = 0;
-    bool enabled = false;      // activate bit 0 and length > 0
-    bool mailbox = false;      // control bits 1:0 == 10
-    bool ecat_writes = false;  // direction: ECAT writes, PDI reads (control bits 3:2 == 01)
-    bool area_valid = false;   // whole buffer area (3*length for buffered) inside the memory
+    bool enabled = false;       // activate bit 0 and length > 0
+    bool mailbox = false;       // control bits 1:0 == 10
+    bool ecat_writes = false;   // direction: ECAT writes, PDI reads (control bits 3:2 == 01)
+    bool area_valid = false;    // whole buffer area (3*length for buffered) inside the process RAM
+    bool in_registers = false;  // starts in the register space: transparent, closed at its last byte
     // Run-time state.
     bool pdi_disabled = false;             // PDI control bit 0
     bool full = false;                     // mailbox full
@@ -38,6 +40,14 @@ struct SmArea {
     uint8_t sm = 0;
 };
 
+// An enabled SM that starts in the register space (below 0x1000): it captures no address, the bytes it
+// covers keep their own rules (registers, RAM), and an access of its last byte closes it as the single-byte
+// SM is closed (docs/decisions/esc.md, "SyncManager over the register space").
+struct SmWatch {
+    uint32_t last = 0;  // start + length - 1
+    uint8_t sm = 0;
+};
+
 class SyncManagers {
   public:
     SyncManagers(Memory& m, Watchdogs& w, uint8_t count) : mem(m), wd(w), count_(count) {}
@@ -55,6 +65,11 @@ class SyncManagers {
         return nullptr;
     }
     uint16_t length(unsigned n) const { return sm[n].length; }
+    // The enabled SMs over the register space, for the access routing to close them.
+    std::span<const SmWatch> register_sms() const { return {watches_.data(), watch_count_}; }
+    // Access of the last byte of a transparent SM (single byte, or any SM over the register space) by one
+    // side: status, events and the process-data watchdog as the datasheet gives them to the single-byte SM.
+    void close_transparent(unsigned n, bool write, Side side);
     // Access of cnt bytes at offset off of SM n's area. Returns false if not accessible (direction, state).
     bool access(unsigned n, uint32_t off, uint8_t* dst, const uint8_t* src, const uint8_t* bm, uint32_t cnt,
                 bool write, Side side);
@@ -87,6 +102,8 @@ class SyncManagers {
     std::array<SyncManager, 16> sm{};
     std::array<SmArea, 16> areas_{};  // enabled SMs' areas sorted by start
     uint8_t area_count_ = 0;
+    std::array<SmWatch, 16> watches_{};  // enabled SMs over the register space
+    uint8_t watch_count_ = 0;
     uint16_t enabled_mask_ = 0;  // activate bit 0 of every SM
     uint16_t pending_mask_ = 0;  // SMs with a close waiting for the end of the frame
     uint16_t lock_mask_ = 0;     // SMs enabled before the current datagram

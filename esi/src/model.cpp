@@ -274,8 +274,11 @@ DeviceModel derive_model(const od::DeviceDescription& d, const od::Dictionary& d
         if (has(od::SmKind::MBoxIn)) m.fmmus.push_back(FmmuUse::MBoxState);
     }
 
-    // ---- Profile from the device type 0x1000 ----
-    if (const od::Entry* dt = dict.find(0x1000, 0)) {
+    // ---- Profile: the one the description names (ESI ProfileNo), else the device type 0x1000's ----
+    if (d.profile_number != 0) {
+        m.profile_number = d.profile_number;
+        m.profile_add_info = d.profile_add_info;
+    } else if (const od::Entry* dt = dict.find(0x1000, 0)) {
         const auto v = static_cast<uint32_t>(default_of(dt));
         m.profile_number = static_cast<uint16_t>(v);
         m.profile_add_info = static_cast<uint16_t>(v >> 16);

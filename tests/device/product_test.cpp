@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -184,13 +185,17 @@ TEST(ProductWithoutMailbox, ReachesOpWithProcessDataOnlyAndItsInputsFollowTheDef
 // watchdog; the ESC's process-data watchdog: the PDI side sets the outputs safe), whether the master leaves
 // Op or stops writing (watchdog); they come back with the next outputs written in Op.
 TEST(ProductWithoutMailbox, LostOutputsGoToTheirSafeStateZero) {
-    for (const bool watchdog : {false, true}) {
-        SCOPED_TRACE(watchdog ? "watchdog" : "master leaves Op");
-        // The process data in ordinary SyncManagers (the terminal's own SM0 at 0x0F00 is on the ESC's
-        // digital-output registers, outside the SM watchdog this test runs into).
+    for (const int variant : {0, 1, 2, 3}) {
+        const bool watchdog = variant & 1;
+        const bool registers = variant & 2;
+        SCOPED_TRACE(std::string(watchdog ? "watchdog" : "master leaves Op") +
+                     (registers ? ", outputs SM on 0x0F00" : ", outputs SM in the RAM"));
+        // The terminal's own SM0 on the ESC's digital-output registers 0x0F00 (its writes trigger the SM
+        // watchdog, decisions/esc.md), or the process data in ordinary SyncManagers in the RAM.
         auto p = std::make_shared<od::Product>(*io_terminal());
-        p->description.sync_managers = {test_products::sm(od::SmKind::Outputs, 0x1100, 3, 0x64),
-                                        test_products::sm(od::SmKind::Inputs, 0x1180, 5, 0x20)};
+        if (!registers)
+            p->description.sync_managers = {test_products::sm(od::SmKind::Outputs, 0x1100, 3, 0x64),
+                                            test_products::sm(od::SmKind::Inputs, 0x1180, 5, 0x20)};
         Unit u(p);
         UnitLink link(u);
         Master m(link, test_support::in_process_master_options());
@@ -314,32 +319,86 @@ TEST(ProductWithCoe, EveryProtocolItDoesNotServeGetsTheUnsupportedProtocolError)
 // a controller declare in their ConfigData): the ESC copies AL control into AL status, so any request is
 // taken as it comes (Init -> Op directly, no refusal, AL status code 0), and the stack follows it with its
 // process data.
-TEST(ProductWithDeviceEmulation, FollowsTheStateTheEscTookWithItsProcessData) {
-    auto p = std::make_shared<od::Product>(*io_terminal());
-    p->description.esc_config = 0x01;
-    Unit u(p);
-    UnitLink link(u);
-    Master m(link, test_support::in_process_master_options());
+namespace {
+
+// The IO terminal with device emulation (ESC configuration 0x0141 bit 0) and the in-process master before it.
+struct EmulatedTerminal {
+    explicit EmulatedTerminal(std::optional<uint16_t> pdi_config = std::nullopt) : u(product(pdi_config)) {}
+    static std::shared_ptr<od::Product> product(std::optional<uint16_t> pdi_config) {
+        auto p = std::make_shared<od::Product>(*io_terminal());
+        p->description.esc_config = 0x01;
+        if (pdi_config) p->description.pdi_config = *pdi_config;
+        return p;
+    }
+    // The one slave addressed, its process data from the SII, Init -> Op in one request taken without error.
+    void to_op() {
+        ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m));
+        ASSERT_EQ(pd.discover_sii(0), Error::Ok);
+        ASSERT_EQ(pd.configure(), Error::Ok);
+        AlStatus st;
+        ASSERT_EQ(m.request_state(a, AlState::Op, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
+        EXPECT_EQ(st.code, 0);
+    }
+    Unit u;
+    UnitLink link{u};
+    Master m{link, test_support::in_process_master_options()};
     const Address a = Address::station(0x1001);
-    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m));
-    ProcessDataSession pd(m, std::span<const Address>(&a, 1));
-    ASSERT_EQ(pd.discover_sii(0), Error::Ok);
-    ASSERT_EQ(pd.configure(), Error::Ok);
+    ProcessDataSession pd{m, std::span<const Address>(&a, 1)};
+};
+
+}  // namespace
+
+TEST(ProductWithDeviceEmulation, FollowsTheStateTheEscTookWithItsProcessData) {
+    EmulatedTerminal t;
+    ASSERT_NO_FATAL_FAILURE(t.to_op());
     AlStatus st;
-    ASSERT_EQ(m.request_state(a, AlState::Op, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
-    EXPECT_EQ(st.code, 0);
-    EXPECT_EQ(u.dev->stack().state(), od::AlState::Op);
+    EXPECT_EQ(t.u.dev->stack().state(), od::AlState::Op);
     auto fill = [&] {
-        pd.outputs()[0] = 0x21;
-        pd.outputs()[1] = 0x43;
+        t.pd.outputs()[0] = 0x21;
+        t.pd.outputs()[1] = 0x43;
     };
-    ASSERT_EQ(pd.run(5, std::chrono::microseconds(100), fill), Error::Ok);
-    EXPECT_EQ(u16(pd.inputs(), 0), 0x4321);
+    ASSERT_EQ(t.pd.run(5, std::chrono::microseconds(100), fill), Error::Ok);
+    EXPECT_EQ(u16(t.pd.inputs(), 0), 0x4321);
     // An invalid request is not refused either: the ESC took it.
-    ASSERT_EQ(m.request_state(a, AlState::Init, &st), Error::Ok);
-    ASSERT_EQ(m.request_state(a, AlState::SafeOp, &st), Error::Ok);
+    ASSERT_EQ(t.m.request_state(t.a, AlState::Init, &st), Error::Ok);
+    ASSERT_EQ(t.m.request_state(t.a, AlState::SafeOp, &st), Error::Ok);
     EXPECT_EQ(st.code, 0);
-    EXPECT_EQ(u.dev->stack().state(), od::AlState::SafeOp);
+    EXPECT_EQ(t.u.dev->stack().state(), od::AlState::SafeOp);
+}
+
+// Device emulation with the outputs on the digital-output registers (0x0F00, SM control 0x44): the master's
+// writes through that SM trigger the process-data watchdog; when it expires the ESC keeps Op, shows the
+// expiry in 0x0440 bit 0, and the device's outputs go to 0 at once (0x0150 bit 3 = 0) or are held until the
+// next output event (bit 3 = 1); the master's next writes bring them back (ESC datasheet section II, 0x0150
+// PDI configuration, 0x0F00 digital I/O output data, 0x0440 watchdog status process data).
+TEST(ProductWithDeviceEmulation, OutputsOnTheRegistersGoToZeroWhenTheWatchdogExpires) {
+    for (const bool at_next_event : {false, true}) {
+        SCOPED_TRACE(at_next_event ? "0x0150 bit 3 = 1" : "0x0150 bit 3 = 0");
+        EmulatedTerminal t(at_next_event ? 0x08 : 0x00);
+        ASSERT_NO_FATAL_FAILURE(t.to_op());
+        ASSERT_EQ(t.pd.layout(0).sm2_start, 0x0F00);
+        auto fill = [&] {
+            auto o = t.pd.outputs();
+            o[0] = 0x34;
+            o[1] = 0x12;
+            o[2] = 0x01;
+        };
+        ASSERT_EQ(t.pd.run(5, std::chrono::microseconds(100), fill), Error::Ok);
+        ASSERT_EQ(t.u.dev->dictionary().get<uint16_t>(0x7000, 1), 0x1234);
+        EXPECT_EQ(t.m.read_reg<uint16_t>(t.a, 0x0440).value() & 1, 1);
+        // No process data for 500 ms: the SM watchdog (100 ms by default) expires.
+        for (int i = 0; i < 500; ++i) {
+            t.u.clock.advance(1'000'000);
+            t.u.service();
+        }
+        EXPECT_EQ(t.m.read_reg<uint16_t>(t.a, 0x0440).value() & 1, 0);
+        EXPECT_EQ(t.u.dev->stack().state(), od::AlState::Op);
+        EXPECT_EQ(t.u.dev->dictionary().get<uint16_t>(0x7000, 1), at_next_event ? 0x1234 : 0);
+        EXPECT_EQ(t.u.dev->dictionary().get<uint8_t>(0x7000, 2), at_next_event ? 1 : 0);
+        ASSERT_EQ(t.pd.run(5, std::chrono::microseconds(100), fill), Error::Ok);
+        EXPECT_EQ(t.u.dev->dictionary().get<uint16_t>(0x7000, 1), 0x1234);
+        EXPECT_EQ(t.m.read_reg<uint16_t>(t.a, 0x0440).value() & 1, 1);
+    }
 }
 
 // A product with its own EEPROM image (ESI Eeprom/Data) is served byte for byte, by make_sii and by the ESC

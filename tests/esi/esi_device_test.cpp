@@ -111,6 +111,7 @@ std::vector<std::string> describe(const od::Product& p) {
     add("protocols", d.mailbox_protocols, "coe", int{d.coe_details}, "timeouts", d.mailbox_request_timeout_ms,
         d.mailbox_response_timeout_ms);
     add("config", int{d.pdi_control}, int{d.esc_config}, d.pdi_config, d.sync_pulse_length, d.station_alias);
+    add("application", int(p.application), "profile", m.profile_number, m.profile_add_info);
     for (const esi::SmInfo& sm : m.sync_managers)
         add("sm", int(sm.kind), sm.start, sm.size, int{sm.control}, sm.enable, sm.min_size, sm.max_size);
     for (esi::FmmuUse f : m.fmmus)
@@ -645,6 +646,69 @@ TEST(EsiExamples, TheModularDeviceServesTheDefaultModulesOfItsSlots) {
               1);
 }
 
+// Another module configuration than the default, chosen in the device spec (SPEC@MODULES): each slot's PDOs,
+// objects and increments as the slot's module brings them, the SM sizes of the SII (what SOEM's slaveinfo and
+// a master without CoE read) and the assignment objects (what a CoE master reads) from the same modules.
+TEST(EsiExamples, TheModularDeviceServesTheModulesTheSpecChooses) {
+    const std::string f = example("modular-io.xml").string();
+    struct Case {
+        std::string modules;
+        uint16_t out_bytes, in_bytes;
+        std::vector<uint16_t> rx, tx;
+    };
+    const Case cases[] = {
+        // Slot 1 and 2: AI2 (0x1A00, 0x1A01 after the PDO increment), slot 3 empty, slot 4: DO8 (0x1603).
+        {"EXM-AI2,exm-ai2,-,#x00002001", 1, 8, {0x1603}, {0x1A00, 0x1A01}},
+        {"EXM-DI8", 0, 1, {}, {0x1A00}},                             // the other slots empty
+        {"0x1001,0x2001,0x3001", 1, 5, {0x1601}, {0x1A00, 0x1A02}},  // the default, by ModuleIdent
+        {",,,EXM-DO8", 1, 0, {0x1603}, {}},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.modules);
+        const od::Product p = esi::load_product(f, "EXM9000@" + c.modules);
+        const od::Dictionary d = p.make_dictionary(p.description);
+        const esi::DeviceModel m = esi::derive_model(p.description, d);
+        ASSERT_EQ(m.sync_managers.size(), 4u);
+        EXPECT_EQ(m.sync_managers[2].size, c.out_bytes);
+        EXPECT_EQ(m.sync_managers[3].size, c.in_bytes);
+        auto assigned = [&d](uint16_t index) {
+            std::vector<uint16_t> out;
+            for (uint8_t k = 1; k <= d.get<uint8_t>(index, 0); ++k)
+                out.push_back(d.get<uint16_t>(index, k));
+            return out;
+        };
+        EXPECT_EQ(assigned(0x1C12), c.rx);
+        EXPECT_EQ(assigned(0x1C13), c.tx);
+        // The SII says the same sizes (SyncM category).
+        const std::vector<uint8_t> sii = esi::build_sii(p.description, d);
+        const esi::SiiInfo info = esi::parse_sii(sii);
+        ASSERT_GE(info.sync_managers.size(), 4u);
+        EXPECT_EQ(info.sync_managers[2].length, c.out_bytes);
+        EXPECT_EQ(info.sync_managers[3].length, c.in_bytes);
+        // Written back with the chosen modules as the slots' defaults: the same device again.
+        expect_same(describe(p), describe(round_trip(p)), "round trip");
+    }
+    // Slot 2 holding AI2: its objects with the slot's index increment (0x6010 for slot 2).
+    const od::Product two = esi::load_product(f, "EXM9000@-,EXM-AI2");
+    const od::Dictionary d2 = two.make_dictionary(two.description);
+    ASSERT_NE(d2.find(0x6010, 2), nullptr);
+    EXPECT_EQ(d2.find(0x6010, 2)->type, od::DataType::Integer16);
+    EXPECT_EQ(d2.find(0x6000, 1), nullptr);
+    // Bad lists: usage errors naming the file.
+    for (const char* bad :
+         {"EXM9000@EXM-DI8,EXM-DI8,EXM-DI8,EXM-DI8,EXM-DI8", "EXM9000@EXM-XX9", "EXM9000@0x9999"}) {
+        SCOPED_TRACE(bad);
+        try {
+            (void)esi::load_product(f, bad);
+            ADD_FAILURE() << "no error";
+        } catch (const esi::InputError& e) {
+            EXPECT_EQ(std::string(e.what()).rfind(f, 0), 0u) << e.what();
+        }
+    }
+    // Modules for a device without slots.
+    EXPECT_THROW((void)esi::load_product(example("coupler.xml").string(), "@EXM-DI8"), esi::InputError);
+}
+
 TEST(EsiExamples, TheEepromImageIsServedByteForByte) {
     const std::string f = example("eeprom-blob.xml").string();
     const esi::EsiFile file = esi::read_esi_file(f);
@@ -744,6 +808,72 @@ TEST(EsiDevices, ACoeDeviceWithoutADictionaryGetsTheMandatoryObjects) {
     EXPECT_FALSE(d.find(0x1C12, 1)->writable(od::AlState::PreOp));  // no PdoAssign
     EXPECT_TRUE(d.find(0x7000, 1)->rx_mappable());
     EXPECT_TRUE(p.warnings.empty()) << ::testing::PrintToString(p.warnings);
+}
+
+// A vendor drive whose ESI names profile 402 (Profile/ProfileNo) while its device type 0x1000 says something
+// else (0x00000004, as some vendors' files do): the ESI's ProfileNo names the profile a configuration tool
+// goes by (ETG.2000), so the device is a CiA 402 drive; 0x1000 is served as the vendor wrote it. The written
+// ESI keeps both, so the drive survives ESI -> device -> --write-esi -> device (and its SII says DS402).
+TEST(EsiDevices, ProfileNoNamesTheProfileWhenTheDeviceTypeDisagrees) {
+    auto object = [](const char* index, const char* name, const char* type, int bits, const char* dflt,
+                     const char* access) {
+        return std::string("<Object><Index>") + index + "</Index><Name>" + name + "</Name><Type>" + type +
+               "</Type><BitSize>" + std::to_string(bits) + "</BitSize><Info><DefaultData>" + dflt +
+               "</DefaultData></Info><Flags><Access>" + access + "</Access><PdoMapping>" +
+               (std::string(access) == "rw" ? "R" : "T") + "</PdoMapping></Flags></Object>";
+    };
+    const std::string xml =
+        "<?xml version=\"1.0\"?><EtherCATInfo><Vendor><Id>#x00000A5E</Id><Name>Example Motion</Name></Vendor>"
+        "<Descriptions><Groups><Group><Type>Drives</Type><Name>Drives</Name></Group></Groups><Devices>"
+        "<Device><Type ProductCode=\"#x00402004\" RevisionNo=\"#x00010000\">EXM-402</Type>"
+        "<Name>EXM-402 servo drive</Name><GroupType>Drives</GroupType>"
+        "<Profile><ProfileNo>402</ProfileNo><AddInfo>2</AddInfo><Dictionary><DataTypes>"
+        "<DataType><Name>UDINT</Name><BitSize>32</BitSize></DataType>"
+        "<DataType><Name>UINT</Name><BitSize>16</BitSize></DataType>"
+        "<DataType><Name>SINT</Name><BitSize>8</BitSize></DataType>"
+        "<DataType><Name>DINT</Name><BitSize>32</BitSize></DataType></DataTypes><Objects>" +
+        object("#x1000", "Device type", "UDINT", 32, "04000000", "ro") +
+        object("#x6040", "Controlword", "UINT", 16, "0000", "rw") +
+        object("#x6041", "Statusword", "UINT", 16, "0000", "ro") +
+        object("#x6060", "Modes of operation", "SINT", 8, "08", "rw") +
+        object("#x6061", "Modes of operation display", "SINT", 8, "08", "ro") +
+        object("#x6064", "Position actual value", "DINT", 32, "00000000", "ro") +
+        object("#x607A", "Target position", "DINT", 32, "00000000", "rw") +
+        object("#x6502", "Supported drive modes", "UDINT", 32, "80030000", "ro") +
+        "</Objects></Dictionary></Profile>"
+        "<Sm DefaultSize=\"128\" StartAddress=\"#x1000\" ControlByte=\"#x26\" Enable=\"1\">MBoxOut</Sm>"
+        "<Sm DefaultSize=\"128\" StartAddress=\"#x1080\" ControlByte=\"#x22\" Enable=\"1\">MBoxIn</Sm>"
+        "<Sm StartAddress=\"#x1100\" ControlByte=\"#x64\" Enable=\"1\">Outputs</Sm>"
+        "<Sm StartAddress=\"#x1180\" ControlByte=\"#x20\" Enable=\"1\">Inputs</Sm>"
+        "<RxPdo Fixed=\"1\" Sm=\"2\"><Index>#x1600</Index><Name>Outputs</Name>"
+        "<Entry><Index>#x6040</Index><SubIndex>0</SubIndex><BitLen>16</BitLen><Name>Controlword</Name>"
+        "<DataType>UINT</DataType></Entry><Entry><Index>#x607A</Index><SubIndex>0</SubIndex><BitLen>32</"
+        "BitLen>"
+        "<Name>Target position</Name><DataType>DINT</DataType></Entry></RxPdo>"
+        "<TxPdo Fixed=\"1\" Sm=\"3\"><Index>#x1A00</Index><Name>Inputs</Name>"
+        "<Entry><Index>#x6041</Index><SubIndex>0</SubIndex><BitLen>16</BitLen><Name>Statusword</Name>"
+        "<DataType>UINT</DataType></Entry><Entry><Index>#x6064</Index><SubIndex>0</SubIndex><BitLen>32</"
+        "BitLen>"
+        "<Name>Position actual value</Name><DataType>DINT</DataType></Entry></TxPdo>"
+        "<Mailbox><CoE SdoInfo=\"true\" PdoAssign=\"false\" PdoConfig=\"false\"/></Mailbox>"
+        "<Eeprom><ByteSize>2048</ByteSize><ConfigData>080E00CC88130000</ConfigData></Eeprom>"
+        "</Device></Devices></Descriptions></EtherCATInfo>";
+    const od::Product p = esi::load_product(esi::read_esi_text(xml, "exm402.xml"), "");
+    EXPECT_EQ(p.application, od::Application::Cia402Drive);
+    EXPECT_EQ(p.make_dictionary(p.description).get<uint32_t>(0x1000, 0), 4u);
+    std::string written;
+    const od::Product q = round_trip(p, &written);
+    for (const std::string& e : schema_errors(written))
+        ADD_FAILURE() << "generated ESI: " << e;
+    EXPECT_NE(written.find("<ProfileNo>402</ProfileNo>"), std::string::npos) << written;
+    EXPECT_EQ(q.application, od::Application::Cia402Drive);
+    const od::Dictionary dq = q.make_dictionary(q.description);
+    EXPECT_EQ(dq.get<uint32_t>(0x1000, 0), 4u);  // as the vendor wrote it
+    const esi::DeviceModel m = esi::derive_model(q.description, dq);
+    EXPECT_EQ(m.profile_number, 402);
+    EXPECT_EQ(m.profile_add_info, 2);
+    expect_same(describe(p), describe(q), "round trip");
+    expect_same(describe(q), describe(round_trip(q)), "second round trip");
 }
 
 // ---- Bad input, as a class ----------------------------------------------------------------------------

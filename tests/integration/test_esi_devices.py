@@ -42,54 +42,60 @@ def pdo_bits(pdos, sm_of):
     return bits
 
 
-def examples():
-    """(file, spec, expected) for each device of each example: identity, name, process-data bytes."""
-    out = []
+def example_devices():
+    """(file, root, modules by ModuleIdent, device element, SM of each direction) for each device of each example."""
     for name in sorted(os.listdir(EXAMPLES)):
         if not name.endswith(".xml"):
             continue
         path = os.path.join(EXAMPLES, name)
         root = ET.parse(path).getroot()
-        vendor = number(root.findtext("Vendor/Id"))
         modules = {}
         for m in root.iter("Module"):
             t = m.find("Type")
             if t is not None and t.get("ModuleIdent"):
                 modules[number(t.get("ModuleIdent"))] = m
         for dev in root.findall("Descriptions/Devices/Device"):
-            t = dev.find("Type")
-            product, revision = number(t.get("ProductCode")), number(t.get("RevisionNo"))
             sms = [s.text.strip() for s in dev.findall("Sm")]
             sm_of = {"out": sms.index("Outputs") if "Outputs" in sms else None,
                      "in": sms.index("Inputs") if "Inputs" in sms else None}
-            pdos = [(p.tag, p) for p in dev if p.tag in ("RxPdo", "TxPdo")]
-            # A modular device: the default module of each slot brings its PDOs.
-            for slot in dev.findall("Slots/Slot"):
-                for ident in slot.findall("ModuleIdent"):
-                    if ident.get("Default") in ("1", "true") and number(ident.text) in modules:
-                        m = modules[number(ident.text)]
-                        pdos += [(p.tag, p) for p in m if p.tag in ("RxPdo", "TxPdo")]
-            bits = pdo_bits(pdos, sm_of)
-            out.append({"file": path, "spec": f"0x{product:08x}:0x{revision:08x}", "vendor": vendor,
-                        "product": product, "revision": revision, "type": (t.text or "").strip(),
-                        "out_bytes": (bits["out"] + 7) // 8, "in_bytes": (bits["in"] + 7) // 8,
-                        "mailbox": dev.find("Mailbox") is not None,
-                        "eeprom_data": dev.find("Eeprom/Data") is not None})
+            yield path, root, modules, dev, sm_of
+
+
+def examples():
+    """(file, spec, expected) for each device of each example: identity, name, process-data bytes."""
+    out = []
+    for path, root, modules, dev, sm_of in example_devices():
+        vendor = number(root.findtext("Vendor/Id"))
+        t = dev.find("Type")
+        product, revision = number(t.get("ProductCode")), number(t.get("RevisionNo"))
+        pdos = [(p.tag, p) for p in dev if p.tag in ("RxPdo", "TxPdo")]
+        # A modular device: the default module of each slot brings its PDOs.
+        for slot in dev.findall("Slots/Slot"):
+            for ident in slot.findall("ModuleIdent"):
+                if ident.get("Default") in ("1", "true") and number(ident.text) in modules:
+                    m = modules[number(ident.text)]
+                    pdos += [(p.tag, p) for p in m if p.tag in ("RxPdo", "TxPdo")]
+        bits = pdo_bits(pdos, sm_of)
+        sm_out = dev.findall("Sm")[sm_of["out"]] if sm_of["out"] is not None else None
+        first_out = next((e for kind, p in pdos if kind == "RxPdo" and p.get("Sm") is not None
+                          for e in p.findall("Entry") if number(e.findtext("Index")) != 0), None)
+        out.append({"file": path, "spec": f"0x{product:08x}:0x{revision:08x}", "vendor": vendor,
+                    "product": product, "revision": revision, "type": (t.text or "").strip(),
+                    "out_bytes": (bits["out"] + 7) // 8, "in_bytes": (bits["in"] + 7) // 8,
+                    "mailbox": dev.find("Mailbox") is not None,
+                    "eeprom_data": dev.find("Eeprom/Data") is not None,
+                    "out_sm_start": number(sm_out.get("StartAddress")) if sm_out is not None else None,
+                    "out_sm_control": number(sm_out.get("ControlByte")) if sm_out is not None else None,
+                    "first_output": None if first_out is None else
+                    f"0x{number(first_out.findtext('Index')):04x}:{number(first_out.findtext('SubIndex'))}"})
     return out
 
 
 # ecat-conform failures that remain, each with its reason (reported, issue 21): defects of the device served that
 # belong to another part of the work. A failure not listed fails the test; a listed one that no longer fails fails
-# it too, so the list cannot go stale. A key is an example file, or "file@SPEC" for one device of it.
-# The SM of the digital outputs at 0x0F00 lies in the register space; the software ESC serves no SM there
-# (docs/decisions/esc.md, SyncManagers), so a write of the outputs never triggers the process-data watchdog that
-# such an ESC has (ESC datasheet: SM watchdog trigger, 0x0440): the expiry is never shown.
-WATCHDOG_0F00 = {"esm.watchdog.op_to_safeop": "esc: no SM over the register space (outputs at 0x0F00), so the "
-                                              "SM watchdog never triggers and never expires"}
-KNOWN = {
-    "digital-io.xml@0x07d03052:0x00100000": dict(WATCHDOG_0F00),
-    "latin1.xml": dict(WATCHDOG_0F00),
-}
+# it too, so the list cannot go stale. A key is an example file, or "file@SPEC" for one device of it; the value maps
+# the check's name to its reason. Empty: every example passes ecat-conform.
+KNOWN = {}
 
 
 def known_failures(d):
@@ -202,6 +208,100 @@ class EsiDevices(unittest.TestCase):
                             self.assertEqual(r.returncode, 6, r.stdout + r.stderr)
                             self.assertIn("has no mailbox", r.stderr)
                 self.assertTrue(bus.slave_alive(), bus.slave_output())
+
+    def test_outputs_on_the_register_space_follow_the_sm_and_the_watchdog(self):
+        """A device whose output SM lies on the register space (a digital-output terminal: 0x0F00, device
+        emulation, no controller): the outputs an LRW writes reach the device's outputs; when the master stops,
+        the process-data watchdog that the SM's writes triggered expires (0x0440 bit 0 clears, ESC datasheet
+        section II), the state stays OP and the outputs go to 0; the next writes bring them back."""
+        devices = [d for d in examples() if d["out_sm_start"] is not None and d["out_sm_start"] < 0x1000]
+        self.assertGreater(len(devices), 0, "an example with its outputs on 0x0F00")
+        for d in devices:
+            with self.subTest(file=os.path.basename(d["file"]), device=d["spec"]):
+                bus, ctl = self.serve(d)
+                with bus:
+                    bus.ecatctl("scan")  # station address 0x1001
+                    m = LAYOUT.search(bus.ecatctl("pd", "0", "-n", "1", "--state", "SAFEOP").stdout)
+                    self.assertIsNotNone(m)
+                    sm, start, size = int(m.group(1)), int(m.group(2), 16), int(m.group(3))
+                    self.assertEqual(start, d["out_sm_start"])
+                    mm = harness.MiniMaster(bus)
+                    try:
+                        # The outputs SM as the ESI declares it, one write FMMU onto it; only the outputs.
+                        mm.fpwr(0x1001, 0x0800 + 8 * sm, struct.pack("<HHBBBB", start, size, d["out_sm_control"], 0,
+                                                                      1, 0))
+                        mm.fpwr(0x1001, 0x0600, struct.pack("<IHBBHBBBxxx", 0x10000, size, 0, 7, start, 0, 2, 1))
+                        image = bytearray(size)
+                        image[0] = 0xFF  # the first output entry sits at bit 0 of the image
+
+                        def write(n):
+                            for _ in range(n):
+                                r = mm.txrx([(harness.LRW, 0x0000, 0x0001, bytes(image))])
+                                if r is not None:
+                                    self.assertEqual(r[0][1], 2)
+                                time.sleep(0.001)
+
+                        for state in (2, 4, 8):
+                            mm.fpwr(0x1001, 0x0120, struct.pack("<H", state))
+                            write(20)
+                            self.assertEqual(struct.unpack("<H", mm.fprd(0x1001, 0x0130, 2))[0], state)
+
+                        def output():
+                            r = harness.control(ctl, f"get {d['first_output']}")
+                            self.assertTrue(r.startswith("ok "), r)
+                            return r.rsplit("=", 1)[1].strip()
+
+                        write(50)
+                        self.assertNotEqual(output(), "0")
+                        self.assertEqual(struct.unpack("<H", mm.fprd(0x1001, 0x0440, 2))[0] & 1, 1)
+                        div = struct.unpack("<H", mm.fprd(0x1001, 0x0400, 2))[0]
+                        wd = struct.unpack("<H", mm.fprd(0x1001, 0x0420, 2))[0]
+                        self.assertNotEqual(wd, 0)
+                        time.sleep((div + 2) * 40e-9 * wd * 3 + 0.2)  # the master is gone
+                        self.assertEqual(struct.unpack("<H", mm.fprd(0x1001, 0x0440, 2))[0] & 1, 0)
+                        self.assertEqual(struct.unpack("<H", mm.fprd(0x1001, 0x0130, 2))[0], 8)
+                        deadline = time.monotonic() + 5
+                        while output() != "0" and time.monotonic() < deadline:
+                            time.sleep(0.01)
+                        self.assertEqual(output(), "0")
+                        write(50)
+                        self.assertNotEqual(output(), "0")
+                    finally:
+                        mm.close()
+                    self.assertTrue(bus.slave_alive(), bus.slave_output())
+
+    def test_modular_devices_serve_the_modules_their_spec_chooses(self):
+        """A modular device (Slots/Modules) with another module configuration than the default, chosen in the
+        device spec (SPEC@MODULE,MODULE,...): slot n takes the module after its default in the list it offers. The
+        master finds the process image of those modules and reaches OP with the exact working counter."""
+        chosen = []
+        for path, _root, modules, dev, sm_of in example_devices():
+            slots = dev.findall("Slots/Slot")
+            if not slots:
+                continue
+            t = dev.find("Type")
+            product, revision = number(t.get("ProductCode")), number(t.get("RevisionNo"))
+            idents = []
+            for n, slot in enumerate(slots):
+                offered = [number(i.text) for i in slot.findall("ModuleIdent")]
+                default = next((k for k, i in enumerate(slot.findall("ModuleIdent"))
+                                if i.get("Default") in ("1", "true")), -1)
+                idents.append(offered[(default + 1 + n) % len(offered)] if offered else None)
+            pdos = [(p.tag, p) for p in dev if p.tag in ("RxPdo", "TxPdo")]
+            for i in idents:
+                if i in modules:
+                    pdos += [(p.tag, p) for p in modules[i] if p.tag in ("RxPdo", "TxPdo")]
+            bits = pdo_bits(pdos, sm_of)
+            spec = f"0x{product:08x}:0x{revision:08x}@" + ",".join("-" if i is None else f"0x{i:x}" for i in idents)
+            chosen.append({"file": path, "spec": spec, "out_bytes": (bits["out"] + 7) // 8,
+                           "in_bytes": (bits["in"] + 7) // 8})
+        self.assertGreater(len(chosen), 0, "a modular example")
+        for d in chosen:
+            with self.subTest(file=os.path.basename(d["file"]), device=d["spec"]):
+                bus, ctl = self.serve(d)
+                with bus:
+                    self.check_op(bus, d, ctl)
+                    self.assertTrue(bus.slave_alive(), bus.slave_output())
 
     def test_several_units_of_an_example_have_serial_numbers_one_to_n(self):
         d = next(x for x in examples() if not x["mailbox"])

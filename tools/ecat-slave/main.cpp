@@ -178,7 +178,9 @@ int main(int argc, char** argv) {
             ->type_name("FILE");
     app.add_option(
            "--device", device_spec,
-           "The device of a --esi file with several: 0xPRODUCT:0xREVISION, 0xPRODUCT, or its Type name")
+           "The device of a --esi file with several: 0xPRODUCT:0xREVISION, 0xPRODUCT, or its Type name; "
+           "a modular device's modules after '@', one per slot (Type or ModuleIdent, '-' empty): "
+           "EXM9000@EXM-DI8,-,EXM-AI2")
         ->needs(esi_opt)
         ->type_name("SPEC");
     std::string eni_file;

@@ -80,6 +80,10 @@ class Cycle {
     uint16_t sm2_start_ = 0;
     uint16_t sm3_start_ = 0;
     bool outputs_seen_ = false;
+    // Device emulation, digital I/O configuration 0x0150 bit 3: the outputs are reset with the next output
+    // event after a watchdog expiry rather than at the expiry (ESC datasheet section II, 0x0150).
+    static constexpr uint8_t kOutputsResetAtNextEvent = 0x08;
+    bool outputs_reset_pending_ = false;
 
     bool irq_usable_ = true;
     uint64_t housekeeping_at_ns_ = 0;

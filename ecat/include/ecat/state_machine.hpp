@@ -43,12 +43,13 @@ class StateMachine {
     bool op_pending() const { return op_pending_; }
     uint64_t op_deadline_ns() const { return op_deadline_ns_; }
     void set_op_wait_timeout_ns(uint64_t ns) { op_wait_timeout_ns_ = ns; }
+    // ESC configuration 0x0141 bit 0: the ESC follows AL control itself, no state of the stack's own.
+    bool device_emulation() const;
 
   private:
     void request(od::AlState to, uint64_t now_ns);
     void request_checked(od::AlState to, uint64_t now_ns);  // request() without the refusal report
-    bool device_emulation() const;
-    void follow(od::AlState to, uint64_t now_ns);  // device emulation: the state the ESC took
+    void follow(od::AlState to, uint64_t now_ns);           // device emulation: the state the ESC took
     uint16_t check_mailbox(const od::MailboxLayout& layout, uint16_t code);
     uint16_t check_bootstrap() const;
     uint16_t check_pre_op_to_safe_op();

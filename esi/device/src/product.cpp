@@ -461,7 +461,7 @@ const EsiDevice& select_device(const EsiFile& file, const std::string& spec_in) 
             s += "\n  " + l;
         return s;
     };
-    std::string spec = spec_in;
+    std::string spec = spec_in.substr(0, spec_in.find('@'));  // the module list is load_product's
     while (!spec.empty() && std::isspace(static_cast<unsigned char>(spec.back())))
         spec.pop_back();
     while (!spec.empty() && std::isspace(static_cast<unsigned char>(spec.front())))
@@ -506,11 +506,77 @@ od::Product load_product(const std::string& path, const std::string& spec) {
     return load_product(read_esi_file(path), spec);
 }
 
+namespace {
+
+// The module of each slot a "@MODULES" list names (load_product(file, spec)).
+std::vector<std::optional<uint32_t>> slot_modules(const EsiFile& file, const EsiDevice& d,
+                                                  const std::string& list) {
+    std::vector<std::string> items;
+    std::size_t from = 0;
+    for (;;) {
+        const std::size_t comma = list.find(',', from);
+        std::string item = list.substr(from, comma == std::string::npos ? std::string::npos : comma - from);
+        while (!item.empty() && std::isspace(static_cast<unsigned char>(item.back())))
+            item.pop_back();
+        while (!item.empty() && std::isspace(static_cast<unsigned char>(item.front())))
+            item.erase(0, 1);
+        items.push_back(std::move(item));
+        if (comma == std::string::npos) break;
+        from = comma + 1;
+    }
+    const std::string device = d.type_name + " " + hex(d.product_code, 8) + ":" + hex(d.revision, 8);
+    if (d.slots.empty())
+        throw InputError(file.source, d.line, device + " has no slots: no modules to choose");
+    if (items.size() > d.slots.size())
+        throw InputError(file.source, d.line,
+                         std::to_string(items.size()) + " modules for the " + std::to_string(d.slots.size()) +
+                             " slots of " + device);
+    std::vector<std::optional<uint32_t>> out(d.slots.size());
+    for (std::size_t n = 0; n < items.size(); ++n) {
+        const std::string& item = items[n];
+        if (item.empty() || item == "-") continue;  // an empty slot
+        const EsiModule* m = nullptr;
+        if (const auto ident = parse_esi_number(item)) m = file.module(static_cast<uint32_t>(*ident));
+        for (std::size_t k = 0; m == nullptr && k < file.modules.size(); ++k)
+            if (upper(file.modules[k].type_name) == upper(item)) m = &file.modules[k];
+        const EsiSlot& slot = d.slots[n];
+        std::string offered;
+        for (uint32_t ident : slot.module_idents) {
+            const EsiModule* o = file.module(ident);
+            offered += " " + (o != nullptr ? o->type_name + " (" + hex(ident, 8) + ")" : hex(ident, 8));
+        }
+        if (m == nullptr)
+            throw InputError(file.source, slot.line,
+                             "slot " + std::to_string(n + 1) + ": no module '" + item +
+                                 "' in the file; the slot takes:" + offered);
+        if (std::find(slot.module_idents.begin(), slot.module_idents.end(), m->ident) ==
+            slot.module_idents.end())
+            throw InputError(file.source, slot.line,
+                             "slot " + std::to_string(n + 1) + " does not take module " + m->type_name +
+                                 "; it takes:" + offered);
+        out[n] = m->ident;
+    }
+    return out;
+}
+
+}  // namespace
+
 od::Product load_product(const EsiFile& file, const std::string& spec) {
-    return load_product(file, select_device(file, spec));
+    const EsiDevice& d = select_device(file, spec);
+    const std::size_t at = spec.find('@');
+    if (at == std::string::npos) return load_product(file, d);
+    return load_product(file, d, slot_modules(file, d, spec.substr(at + 1)));
 }
 
 od::Product load_product(const EsiFile& file, const EsiDevice& d) {
+    std::vector<std::optional<uint32_t>> defaults;
+    for (const EsiSlot& slot : d.slots)
+        defaults.push_back(slot.default_module);
+    return load_product(file, d, defaults);
+}
+
+od::Product load_product(const EsiFile& file, const EsiDevice& d,
+                         const std::vector<std::optional<uint32_t>>& modules) {
     Ctx ctx{file.source, {}};
     od::Product product;
     product.source = file.source + ", device " + d.type_name + " rev " + hex(d.revision, 8);
@@ -687,20 +753,22 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
     desc.mailbox_request_timeout_ms = d.mailbox_request_timeout_ms.value_or(0);
     desc.mailbox_response_timeout_ms = d.mailbox_response_timeout_ms.value_or(0);
 
-    // ---- The PDOs: the device's own and those of the default module of each slot ----
+    // ---- The PDOs: the device's own and those of the module of each slot (its default, or as chosen) ----
     std::vector<Pdo> pdos;
     for (const auto* list : {&d.rxpdos, &d.txpdos})
         for (const EsiPdo& p : *list)
             pdos.push_back(Pdo{&p, p.index, p.entries, p.sm, ""});
     std::map<uint16_t, std::pair<EsiObject, std::string>> module_objects;  // with the slot's increment
     std::string module_list;
+    bool chosen = false;  // a configuration other than the default
     for (std::size_t n = 0; n < d.slots.size(); ++n) {
         const EsiSlot& slot = d.slots[n];
-        if (!slot.default_module) continue;
-        const EsiModule* m = file.module(*slot.default_module);
+        const std::optional<uint32_t> ident = n < modules.size() ? modules[n] : std::nullopt;
+        if (ident != slot.default_module) chosen = true;
+        if (!ident) continue;
+        const EsiModule* m = file.module(*ident);
         if (m == nullptr) {
-            ctx.warn(slot.line, "slot " + std::to_string(n + 1) + ": default module " +
-                                    hex(*slot.default_module, 8) +
+            ctx.warn(slot.line, "slot " + std::to_string(n + 1) + ": module " + hex(*ident, 8) +
                                     " is not in Descriptions/Modules; the slot is left empty");
             continue;
         }
@@ -728,13 +796,15 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
     }
     // The slots and the modules they take, for the ESI written back.
     std::set<uint32_t> offered;
-    for (const EsiSlot& slot : d.slots) {
+    for (std::size_t n = 0; n < d.slots.size(); ++n) {
+        const EsiSlot& slot = d.slots[n];
         od::Slot s;
         s.name = slot.name;
         s.min_instances = slot.min_instances;
         s.max_instances = slot.max_instances;
         s.module_idents = slot.module_idents;
-        s.default_module = slot.default_module.value_or(0);
+        // The module served in the slot: the ESI written back serves the same device.
+        s.default_module = n < modules.size() ? modules[n].value_or(0) : 0;
         s.pdo_increment = slot.pdo_increment.value_or(d.slot_pdo_increment);
         s.index_increment = slot.index_increment.value_or(d.slot_index_increment);
         offered.insert(slot.module_idents.begin(), slot.module_idents.end());
@@ -764,9 +834,9 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
         desc.modules.push_back(std::move(mod));
     }
     if (!d.slots.empty())
-        ctx.warn(d.line, "Slots: the default configuration (" +
-                             (module_list.empty() ? "no modules" : module_list) +
-                             ") is served; softecat does not take another module configuration");
+        ctx.warn(d.line, std::string("Slots: ") + (chosen ? "the chosen" : "the default") +
+                             " configuration (" + (module_list.empty() ? "no modules" : module_list) +
+                             ") is served; another is chosen by the device spec (SPEC@MODULE,MODULE,...)");
     // A PDO whose index is not a mapping object index of its direction cannot be described by a mapping
     // object (and so not by SDO information, the SII or the ESI softecat writes): left out.
     for (auto it = pdos.begin(); it != pdos.end();) {
@@ -1151,6 +1221,14 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
     uint32_t device_type = 0;
     if (auto it = built.objects.find(0x1000); it != built.objects.end())
         device_type = static_cast<uint32_t>(default_u(it->second.entries[0]));
+    // The profile is the one the ESI's ProfileNo names (0x1000 as the vendor wrote it may say otherwise: an
+    // ESI with ProfileNo 402 and a device type 0x00000004 is still a CiA 402 drive); AddInfo, where not
+    // given, is 0x1000's high word if 0x1000 names the same profile.
+    if (d.profile_no && *d.profile_no != 0 && *d.profile_no <= 0xFFFF) {
+        desc.profile_number = static_cast<uint16_t>(*d.profile_no);
+        desc.profile_add_info = static_cast<uint16_t>(
+            d.profile_add_info.value_or((device_type & 0xFFFF) == *d.profile_no ? device_type >> 16 : 0));
+    }
     const bool profile402 = (d.profile_no && *d.profile_no == 402) || (device_type & 0xFFFF) == 402;
     if (profile402 && built.objects.count(0x6040) && built.objects.count(0x6041))
         product.application = od::Application::Cia402Drive;

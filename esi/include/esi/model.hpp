@@ -85,8 +85,10 @@ struct DeviceModel {
     std::vector<SmInfo> sync_managers;
     std::vector<PdoSetInfo> pdo_sets;  // od::DeviceDescription::pdo_sets that name PDOs of the dictionary
     std::vector<FmmuUse> fmmus;
-    uint16_t profile_number = 0;            // 0x1000 bits 0-15 (402 for a drive), 0 if 0x1000 has no default
-    uint16_t profile_add_info = 0;          // 0x1000 bits 16-31 (CiA 402: 2 = servo)
+    // The description's profile (ESI ProfileNo/AddInfo) if it names one, else 0x1000 bits 0-15 (402 for a
+    // drive; 0 if 0x1000 has no default) and bits 16-31 (CiA 402: 2 = servo).
+    uint16_t profile_number = 0;
+    uint16_t profile_add_info = 0;
     std::array<uint8_t, 14> config_data{};  // SII words 0-6 (ESI Eeprom/ConfigData)
     std::array<uint8_t, 8> bootstrap{};     // SII words 0x14-0x17 (ESI Eeprom/BootStrap)
     // Contradictions between the description and the dictionary (the dictionary wins in the output): a

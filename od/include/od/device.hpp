@@ -162,8 +162,13 @@ struct DeviceDescription {
         0xCC00;  // SII word 1: 0x0151 = 0xCC, SYNC0/SYNC1 driven and mapped to AL event bits 2/3 (as EJ7211)
     uint16_t sync_pulse_length = 1000;  // SII word 2, 10 ns units
     uint16_t station_alias = 0;         // SII word 4
-    std::vector<PdoRule> pdo_rules;     // Mandatory / Exclude of the PDOs (empty: none)
-    std::vector<PdoSet> pdo_sets;       // predefined PDO sets (empty: none)
+    // The device profile the ESI names (Profile/ProfileNo and AddInfo, ETG.2000), which a configuration tool
+    // goes by; 0: the device type 0x1000 gives it (bits 0-15 the profile number, 16-31 additional
+    // information, ETG.1000.6 / CiA 301). Vendor files whose 0x1000 disagrees keep both as written.
+    uint16_t profile_number = 0;
+    uint16_t profile_add_info = 0;
+    std::vector<PdoRule> pdo_rules;  // Mandatory / Exclude of the PDOs (empty: none)
+    std::vector<PdoSet> pdo_sets;    // predefined PDO sets (empty: none)
     // Mailbox timeouts a master should use with this device (ESI Info/Mailbox/Timeout, ms): how long the
     // slave may take to take a request out of SM0 and to answer it (0: not declared).
     uint32_t mailbox_request_timeout_ms = 0;

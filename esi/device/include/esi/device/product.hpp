@@ -6,6 +6,7 @@
 // PDO mapping and assignment objects), the device's own EEPROM image (Eeprom/Data) and the application
 // (the CiA 402 drive core for a profile 402 device). Target `esi_device`. The decisions (what is an error,
 // what a warning) are in docs/decisions/esi.md.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,8 +28,18 @@ std::vector<std::string> list_devices(const EsiFile& file);
 // served (an undefined data type an object or PDO needs, a PDO entry naming a subindex a VAR lacks, a
 // default the type cannot hold, ...); what can be served despite a fault, or is declared but not emulated
 // (EoE, SoE, AoE, VoE, module configurations other than the default), becomes a line of Product::warnings.
+//
+// A spec may end in "@MODULES", the module configuration of a modular device (ESI Slots/Modules): one item
+// per slot in order, comma-separated, each a module's Type name (any case) or ModuleIdent (0x, #x or
+// decimal),
+// "-" or nothing for an empty slot; slots past the list are empty ("EXM9000@EXM-DI8,-,EXM-AI2"). A module the
+// file lacks or the slot does not take, more items than slots, or modules for a device without slots are
+// InputErrors naming the file. Without "@", each slot holds its default module.
 od::Product load_product(const std::string& path, const std::string& spec);
 od::Product load_product(const EsiFile& file, const std::string& spec);
 od::Product load_product(const EsiFile& file, const EsiDevice& device);
+// The product with the module of each slot given (nullopt: empty slot; slots past the vector are empty).
+od::Product load_product(const EsiFile& file, const EsiDevice& device,
+                         const std::vector<std::optional<uint32_t>>& modules);
 
 }  // namespace esi
