@@ -440,8 +440,7 @@ void Esc::Impl::datagram(uint8_t* d, uint8_t* data, uint16_t len) {
 // Public API
 // ==================================================================================================
 
-Esc::Esc(const EscConfig& config, const Clock& clock)
-    : clock_(clock), impl_(std::make_unique<Impl>(config, clock)) {}
+Esc::Esc(const EscConfig& config, const Clock& clock) : impl_(std::make_unique<Impl>(config, clock)) {}
 Esc::~Esc() = default;
 
 bool Esc::process_frame(std::span<uint8_t> frame, uint64_t rx_time_ns) {
@@ -532,6 +531,10 @@ uint64_t Esc::next_event_ns() const {
 uint64_t Esc::next_event_ns(uint64_t now_clock) const {
     std::lock_guard lock(impl_->mu);
     return impl_->next_event(now_clock);
+}
+
+const Clock& Esc::clock() const {
+    return impl_->time.clock;
 }
 
 uint64_t Esc::local_time_ns() const {

@@ -7,10 +7,8 @@
 #include "esc/segment.hpp"
 #include "util/strfmt.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -424,26 +422,6 @@ void Segment::set_power(int device, bool on) {
     m.check_device(device, "set_power");
     m.devs[static_cast<std::size_t>(device)].powered = on;
     m.apply_links_with_peers(device);
-}
-
-void Segment::tick(const Clock& clock, uint64_t now_clock) {
-    for (Impl::Device& d : impl_->devs) {
-        if (!d.powered) continue;
-        if (&d.esc->clock() == &clock)
-            d.esc->tick(now_clock);
-        else
-            d.esc->tick();
-    }
-}
-
-uint64_t Segment::next_event_ns(const Clock& clock, uint64_t now_clock) const {
-    uint64_t next = std::numeric_limits<uint64_t>::max();
-    for (const Impl::Device& d : impl_->devs) {
-        if (!d.powered) continue;
-        next = std::min(next,
-                        &d.esc->clock() == &clock ? d.esc->next_event_ns(now_clock) : d.esc->next_event_ns());
-    }
-    return next;
 }
 
 bool Segment::powered(int device) const {

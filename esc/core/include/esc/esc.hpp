@@ -101,9 +101,7 @@ class Esc final : public Pdi {
     // serves many ESCs on one clock, e.g. a segment).
     void tick(uint64_t now_clock);
     uint64_t next_event_ns(uint64_t now_clock) const;
-    // Inline: a runtime serving many ESCs asks it of each on every pass (same clock: tick(now) with its own
-    // reading of it).
-    const Clock& clock() const { return clock_; }
+    const Clock& clock() const;
     // Local clock of this ESC (DC local time, 0x0900 base), in ns.
     uint64_t local_time_ns() const;
 
@@ -146,7 +144,6 @@ class Esc final : public Pdi {
 
   private:
     struct Impl;
-    const Clock& clock_;  // the Impl's time base as well
     std::unique_ptr<Impl> impl_;
 };
 

@@ -79,13 +79,6 @@ class Segment {
 
     std::size_t size() const;
     Esc& esc(int device);
-
-    // ---- time ------------------------------------------------------------------------------------
-    // Esc::tick of every powered ESC, in one pass: those on `clock` with now_clock (its time, read once by
-    // the caller), the others with their own clock's time.
-    void tick(const Clock& clock, uint64_t now_clock);
-    // The earliest Esc::next_event_ns of the powered ESCs (same rule); UINT64_MAX if none.
-    uint64_t next_event_ns(const Clock& clock, uint64_t now_clock) const;
     // Device at the other end of (device, port), -1 if none (or the master / the external port).
     int neighbour(int device, int port) const;
     // Upstream port of a device (towards the master) and its parent (-1 for the root).

@@ -241,7 +241,13 @@ uint64_t Runtime::next_deadline_ns() const {
 }
 
 uint64_t Runtime::compute_deadline_ns(uint64_t now) const {
-    uint64_t deadline = segment_.next_event_ns(clock_, now);
+    uint64_t deadline = kNever;
+    const int count = static_cast<int>(segment_.size());
+    for (int k = 0; k < count; ++k) {
+        if (!segment_.powered(k)) continue;
+        const esc::Esc& e = segment_.esc(k);
+        deadline = std::min(deadline, &e.clock() == &clock_ ? e.next_event_ns(now) : e.next_event_ns());
+    }
     if (hold_count_ != 0) deadline = std::min(deadline, hold_slots_[hold_head_].due_ns);
     if (carrier_check_) deadline = std::min(deadline, carrier_due_ns_);
     if (firmware_ != nullptr) deadline = std::min(deadline, firmware_->next_deadline_ns());
@@ -444,8 +450,15 @@ void Runtime::poll_carrier(uint64_t now) {
 void Runtime::service() {
     // One clock read for the segment: its ESCs count the runtime's clock (each with its own drift).
     const uint64_t now = clock_.now_ns();
-    ++stats_.services;
-    segment_.tick(clock_, now);
+    const int count = static_cast<int>(segment_.size());
+    for (int k = 0; k < count; ++k) {
+        if (!segment_.powered(k)) continue;
+        esc::Esc& e = segment_.esc(k);
+        if (&e.clock() == &clock_)
+            e.tick(now);
+        else
+            e.tick();
+    }
     // Frames before the firmware: one that came while the last work ran (a burst, the control socket, a
     // spin) is answered before the firmware runs (a look at the receive ring when none waits). After the
     // ESCs' own timers, which are silicon and run at their time: a SYNC0 pulse due before the frame arrived
