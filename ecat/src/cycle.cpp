@@ -68,7 +68,8 @@ void Cycle::poll(uint64_t now_ns) {
 }
 
 bool Cycle::quiet(uint64_t now_ns) const {
-    return waits_for_irq() && !irq_() && now_ns < next_deadline_ns();
+    return irq_ && irq_usable_ && !first_poll_ && ctx_.mailbox.queued() == 0 && !irq_() &&
+           now_ns < next_deadline_ns();
 }
 
 uint64_t Cycle::next_deadline_ns() const {

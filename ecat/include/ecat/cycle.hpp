@@ -41,9 +41,6 @@ class Cycle {
     // True if poll(now_ns) would return at once: the interrupt line is usable and low, no mailbox message
     // waits to be sent, and no deadline is due.
     bool quiet(uint64_t now_ns) const;
-    // The part of quiet() that only poll() changes: the interrupt line is usable and no mailbox message
-    // waits to be sent. quiet(now) == waits_for_irq() && !irq() && now < next_deadline_ns().
-    bool waits_for_irq() const { return irq_ && irq_usable_ && !first_poll_ && ctx_.mailbox.queued() == 0; }
     uint64_t next_deadline_ns() const;
     uint64_t last_now_ns() const { return last_now_ns_; }
 

@@ -55,11 +55,6 @@ class Stack {
     // True if poll(now_ns) would return at once without a register read beyond the interrupt line: nothing
     // signalled, no deadline due. Lets a caller with many stacks skip those with nothing to do.
     bool quiet(uint64_t now_ns) const { return cycle_.quiet(now_ns); }
-    // The part of quiet() that changes only in poll(): with an interrupt line that covers every event the
-    // stack waits on and no mailbox message waiting to be sent. Then poll() has something to do only once
-    // the line is high or next_deadline_ns() has come (a caller with many stacks keeps that time and looks
-    // at the line, Cycle::waits_for_irq()).
-    bool waits_for_irq() const { return cycle_.waits_for_irq(); }
     // Time at which poll() must run again even if no frame arrives; UINT64_MAX if nothing is pending.
     uint64_t next_deadline_ns() const { return cycle_.next_deadline_ns(); }
 

@@ -515,23 +515,11 @@ void Device::poll(uint64_t now_ns) {
 }
 
 bool Device::quiet(uint64_t now_ns) const {
-    return !signalled() && now_ns < poll_due_ns();
-}
-
-// The stack waits for its interrupt line or its deadline; a restart, an outputs-lost reaction or the first
-// drive cycle after a build is due at once; EEPROM words are saved at their time (scheduled by the first
-// poll after the write: at once); a drive outside Op runs its own cycle on the kFreeRunNs grid.
-uint64_t Device::poll_due_ns() const {
-    if (restart_pending_ || outputs_lost_pending_ || (parts_->drive && last_cycle_ns_ == 0)) return 0;
-    const ecat::Stack& stack = *parts_->stack;
-    if (!stack.waits_for_irq()) return 0;
-    uint64_t due = stack.next_deadline_ns();
-    if (eeprom_dirty_) {
-        if (eeprom_save_ns_ == 0) return 0;
-        due = std::min(due, eeprom_save_ns_);
-    }
-    if (parts_->drive && stack.state() != od::AlState::Op) due = std::min(due, free_run_due_ns());
-    return due;
+    if (restart_pending_ || outputs_lost_pending_ || (parts_->drive && last_cycle_ns_ == 0)) return false;
+    if (!parts_->stack->quiet(now_ns)) return false;
+    if (eeprom_dirty_ && (eeprom_save_ns_ == 0 || now_ns >= eeprom_save_ns_)) return false;
+    if (!parts_->drive) return true;  // nothing runs on its own
+    return parts_->stack->state() == od::AlState::Op || now_ns < free_run_due_ns();
 }
 
 uint64_t Device::next_deadline_ns() const {

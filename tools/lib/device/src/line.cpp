@@ -90,9 +90,6 @@ Line::Line(const esc::Clock& clock, LineOptions options, slave::ExternalSend sen
         segment_.set_external(dev, topo.external_device >= 0 ? topo.external_port : 1, std::move(send));
     }
     stats_.power_cycles.assign(units_.size(), 0);
-    slots_.resize(units_.size());
-    for (std::size_t i = 0; i < units_.size(); ++i)
-        refresh(i);
     if (!options_.control_path.empty())
         control_ = std::make_unique<ControlSocket>(options_.control_path, options_.control_group);
 }
@@ -103,34 +100,23 @@ void Line::event(slave::LogLevel level, const std::string& text) const {
     if (options_.log != nullptr) options_.log->write(level, text);
 }
 
-void Line::refresh(std::size_t index) {
-    Slot& slot = slots_[index];
-    slot.device = units_[index]->device.get();
-    slot.due_ns = slot.device != nullptr ? slot.device->poll_due_ns() : std::numeric_limits<uint64_t>::max();
-    slot.deadline_ns =
-        slot.device != nullptr ? slot.device->next_deadline_ns() : std::numeric_limits<uint64_t>::max();
-}
-
 void Line::poll(uint64_t now_ns) {
     // Each device polled gets the time it is polled at: a pass over many devices takes a while, and a device
     // that compares its ESC's registers (read now) with a stale time would misjudge when its next SYNC0
-    // comes. A quiet device (nothing signalled, its poll not due) is passed over without reading the clock:
-    // most are, on each pass. One whose time comes while the pass goes on is passed over as well; its
+    // comes. A quiet device (interrupt line low, no deadline due) is skipped without reading the clock: most
+    // are, on each pass. One whose deadline falls due while the pass goes on is skipped as well; its
     // deadline, now past, brings the runtime straight back to serve it.
     uint64_t now = now_ns;
     bool fresh = true;  // now_ns is still the time: no device examined yet
-    const std::size_t count = slots_.size();
-    for (std::size_t i = 0; i < count; ++i) {
-        Device* const device = slots_[i].device;
-        if (device == nullptr) continue;
-        if (now < slots_[i].due_ns && !device->signalled()) {  // Device::quiet(now), its due time kept
+    for (const auto& u : units_) {
+        if (!u->device) continue;
+        if (u->device->quiet(now)) {
             fresh = false;
             continue;
         }
         if (!fresh) now = std::max(now, clock_.now_ns());
-        device->poll(now);
+        u->device->poll(now);
         fresh = false;
-        refresh(i);
         // Frames that came during this device's work are answered before the next device's (the runtime's
         // FrameService): a frame never waits for a pass over the whole line.
         serve_frames();
@@ -139,8 +125,8 @@ void Line::poll(uint64_t now_ns) {
 
 uint64_t Line::next_deadline_ns() const {
     uint64_t deadline = std::numeric_limits<uint64_t>::max();
-    for (const Slot& slot : slots_)
-        deadline = std::min(deadline, slot.deadline_ns);
+    for (const auto& u : units_)
+        if (u->device) deadline = std::min(deadline, u->device->next_deadline_ns());
     return deadline;
 }
 
@@ -180,7 +166,6 @@ void Line::power(int index, bool on) {
         // ESC go (what they stored on disk stays). A blank ESC holds the device's place in the segment.
         segment_.set_power(index, false);
         u.device.reset();
-        refresh(static_cast<std::size_t>(index));
         auto blank = std::make_unique<esc::Esc>(u.esc_config, clock_);
         segment_.replace(index, *blank);
         u.esc = std::move(blank);
@@ -194,7 +179,6 @@ void Line::power(int index, bool on) {
     segment_.replace(index, *fresh);
     u.esc = std::move(fresh);
     u.device = std::move(device);
-    refresh(static_cast<std::size_t>(index));
     segment_.set_power(index, true);
     ++stats_.power_cycles[static_cast<std::size_t>(index)];
     event(slave::LogLevel::Warn, "power: " + u.name + " (device " + std::to_string(index) +
@@ -229,14 +213,6 @@ std::string Line::segment_text() const {
 }
 
 std::string Line::apply(std::string_view line) {
-    std::string answer = apply_line(line);
-    // A command may have given a device something to do (a fault, a restart, an emergency to send).
-    for (std::size_t i = 0; i < slots_.size(); ++i)
-        refresh(i);
-    return answer;
-}
-
-std::string Line::apply_line(std::string_view line) {
     const std::string_view text = line;
     std::vector<std::string> w;
     std::size_t third = 0;  // where the third word begins (slave <k> <command ...>)

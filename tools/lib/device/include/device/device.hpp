@@ -139,18 +139,7 @@ class Device final : public ecat::Application, public drive::EventSink, public e
     void poll(uint64_t now_ns);
     // True if poll(now_ns) would do nothing: the stack is quiet, no restart or reaction pending, no
     // free-running drive cycle or EEPROM save due. A line polls only the devices that are not.
-    // quiet(now) == !signalled() && now < poll_due_ns(); a line of many devices keeps poll_due_ns() and
-    // looks only at signalled() until then.
     bool quiet(uint64_t now_ns) const;
-    // When poll() has something to do even if nothing is signalled (0: at once, UINT64_MAX: never). Changes
-    // only in poll() (and through the device commands of control.hpp): between two polls it stands.
-    uint64_t poll_due_ns() const;
-    // Whether something that happens between polls gave poll() work: the ESC's interrupt line (frames, the
-    // ESC's timers), EEPROM words a master wrote, a restart or an outputs-lost reaction pending.
-    bool signalled() const {
-        return restart_pending_ || outputs_lost_pending_ || (eeprom_dirty_ && eeprom_save_ns_ == 0) ||
-               esc_.irq();
-    }
     uint64_t next_deadline_ns() const;
 
     // Which parts this device has (see the header comment); the accessors below of a part it has not

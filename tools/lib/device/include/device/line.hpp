@@ -93,18 +93,6 @@ class Line final : public slave::SegmentFirmware {
 
   private:
     struct Unit;
-    // What a pass of poll() and next_deadline_ns() look at, per device in line order, in one array: the
-    // device (null while powered off), when it must be polled even if not signalled (Device::poll_due_ns())
-    // and its deadline for the runtime (Device::next_deadline_ns()), both taken after each poll of it, after
-    // control commands and when it is switched on. A device with nothing due and nothing signalled is
-    // passed over without a call into its stack.
-    struct Slot {
-        Device* device = nullptr;
-        uint64_t due_ns = 0;
-        uint64_t deadline_ns = 0;
-    };
-    void refresh(std::size_t index);
-    std::string apply_line(std::string_view line);
     void build_unit(Unit& unit);
     void event(slave::LogLevel level, const std::string& text) const;
     std::string segment_text() const;
@@ -112,7 +100,6 @@ class Line final : public slave::SegmentFirmware {
     const esc::Clock& clock_;
     LineOptions options_;
     std::vector<std::unique_ptr<Unit>> units_;  // before segment_: the ESCs outlive the Segment
-    std::vector<Slot> slots_;                   // one per unit
     esc::Segment segment_;
     std::unique_ptr<ControlSocket> control_;
     LineStats stats_;
