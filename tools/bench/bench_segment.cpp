@@ -12,11 +12,11 @@
 // Prints per N: the processing time of one frame through the whole segment (the runtime's walk, from the
 // frame's receive to its reply being ready) and its latency in the slave (receive to send, with the wait
 // for the other replies of a burst), the CPU time of the slave thread per cycle as % of one core at 1 kHz
-// (CLOCK_THREAD_CPUTIME_ID of that thread over the cyclic blocks), the runtime's wake-ups and timer arms per
-// cycle, missed cycles (the master loop woke a whole period late), lost frames and working-counter errors of
-// the cyclic blocks, the round trips of the cyclic frame and of the echoes (median/p99 and their ratios) and
-// the allocations per cycle of the whole process during the measured window (a counting global operator
-// new). Asserts nothing. Needs root.
+// (CLOCK_THREAD_CPUTIME_ID of that thread over the cyclic blocks), the runtime's wake-ups, passes over the
+// line and timer arms per cycle, missed cycles (the master loop woke a whole period late), lost frames and
+// working-counter errors of the cyclic blocks, the round trips of the cyclic frame and of the echoes
+// (median/p99 and their ratios) and the allocations per cycle of the whole process during the measured window
+// (a counting global operator new). Asserts nothing. Needs root.
 //
 // --line SPEC (repeatable) and --mixed: a MIXED LINE of devices from ESIs instead of N MAXPOS drives. SPEC is
 // a comma-separated list of KIND:COUNT in line order; the kinds are the example devices of esi/examples
