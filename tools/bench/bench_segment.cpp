@@ -12,11 +12,11 @@
 // Prints per N: the processing time of one frame through the whole segment (the runtime's walk, from the
 // frame's receive to its reply being ready) and its latency in the slave (receive to send, with the wait
 // for the other replies of a burst), the CPU time of the slave thread per cycle as % of one core at 1 kHz
-// (CLOCK_THREAD_CPUTIME_ID of that thread over the cyclic blocks), the runtime's wake-ups and timer arms per
-// cycle, missed cycles (the master loop woke a whole period late), lost frames and working-counter errors of
-// the cyclic blocks, the round trips of the cyclic frame and of the echoes (median/p99 and their ratios) and
-// the allocations per cycle of the whole process during the measured window (a counting global operator
-// new). Asserts nothing. Needs root.
+// (CLOCK_THREAD_CPUTIME_ID of that thread over the cyclic blocks), the runtime's wake-ups, passes over the
+// line and timer arms per cycle, missed cycles (the master loop woke a whole period late), lost frames and
+// working-counter errors of the cyclic blocks, the round trips of the cyclic frame and of the echoes
+// (median/p99 and their ratios) and the allocations per cycle of the whole process during the measured window
+// (a counting global operator new). Asserts nothing. Needs root.
 //
 // --line SPEC (repeatable) and --mixed: a MIXED LINE of devices from ESIs instead of N MAXPOS drives. SPEC is
 // a comma-separated list of KIND:COUNT in line order; the kinds are the example devices of esi/examples
@@ -188,7 +188,8 @@ struct Figures {
     double followed_min = 0, followed_max = 0;  // mixed line: position actual's advance over the ramp's, 0..1
     bench::Summary walk, latency, rtt, echo, echo_thread;
     double cpu_percent = 0, cpu_us_per_cycle = 0, allocs_per_cycle = 0;
-    double wakeups_per_cycle = 0, timer_arms_per_cycle = 0, frames_per_wakeup = 0, replies_per_batch = 0;
+    double wakeups_per_cycle = 0, services_per_cycle = 0, timer_arms_per_cycle = 0, frames_per_wakeup = 0,
+           replies_per_batch = 0;
     uint64_t frames_before_work = 0;  // frames found waiting before the timers/firmware or between devices
     double spin_us_per_cycle = 0;     // awake waiting for a deadline microseconds away (kChainNs)
     uint64_t cycles = 0, missed = 0, lost = 0, wkc_errors = 0, enabled = 0;
@@ -463,6 +464,7 @@ Figures run_segment(const Plan& plan, double seconds, const std::string& backend
     f.allocs_per_cycle = static_cast<double>(alloc_count) / window_cycles;
     f.wakeups_per_cycle = static_cast<double>(rs1.wakeups - rs0.wakeups) / window_cycles;
     f.timer_arms_per_cycle = static_cast<double>(rs1.timer_arms - rs0.timer_arms) / window_cycles;
+    f.services_per_cycle = static_cast<double>(rs1.services - rs0.services) / window_cycles;
     f.spin_us_per_cycle = static_cast<double>(rs1.spin_ns_total - rs0.spin_ns_total) / 1000.0 / window_cycles;
     f.frames_per_wakeup = static_cast<double>(rs1.frames_received - rs0.frames_received) /
                           static_cast<double>(std::max<uint64_t>(1, rs1.wakeups - rs0.wakeups));
@@ -603,10 +605,10 @@ void print_figures(const Figures& f) {
             "  slave thread CPU: %.1f us per cycle (%.2f us per drive) = %.1f %% of one core at 1 kHz\n",
             f.cpu_us_per_cycle, f.cpu_us_per_cycle / static_cast<double>(f.drives), f.cpu_percent);
     std::printf(
-        "  slave wake-ups per cycle %.2f, timer arms per cycle %.2f, frames per wake-up %.2f, "
-        "replies per batch %.2f, awake waiting for deadlines %.1f us per cycle\n",
-        f.wakeups_per_cycle, f.timer_arms_per_cycle, f.frames_per_wakeup, f.replies_per_batch,
-        f.spin_us_per_cycle);
+        "  slave wake-ups per cycle %.2f, passes over the line per cycle %.2f, timer arms per cycle %.2f, "
+        "frames per wake-up %.2f, replies per batch %.2f, awake waiting for deadlines %.1f us per cycle\n",
+        f.wakeups_per_cycle, f.services_per_cycle, f.timer_arms_per_cycle, f.frames_per_wakeup,
+        f.replies_per_batch, f.spin_us_per_cycle);
     std::printf("  frames answered before the firmware's work or between devices: %llu\n",
                 static_cast<unsigned long long>(f.frames_before_work));
     std::printf("  missed cycles %llu, lost frames %llu, wkc errors %llu, allocations per cycle %.3f\n",

@@ -450,6 +450,7 @@ void Runtime::poll_carrier(uint64_t now) {
 void Runtime::service() {
     // One clock read for the segment: its ESCs count the runtime's clock (each with its own drift).
     const uint64_t now = clock_.now_ns();
+    ++stats_.services;
     const int count = static_cast<int>(segment_.size());
     for (int k = 0; k < count; ++k) {
         if (!segment_.powered(k)) continue;

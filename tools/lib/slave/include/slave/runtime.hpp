@@ -57,6 +57,7 @@ struct RuntimeStats {
     uint64_t send_errors = 0;
     uint64_t link_errors = 0;  // POLLERR on the link (interface went down, ...)
     uint64_t wakeups = 0;
+    uint64_t services = 0;  // passes over the segment's timers and the firmware (service())
     uint64_t timer_expiries = 0;
     uint64_t timer_arms = 0;      // timerfd_settime() calls
     uint64_t frame_ns_total = 0;  // sum over frames of (reply ready to send - frame received), clock ns
