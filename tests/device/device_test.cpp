@@ -561,11 +561,11 @@ TEST_F(DeviceAssembly, StateChangesRefusalsSavesFaultsAndRestartsAreLoggedAndSta
     drive.options.events = &log;
     drive.power_on();
     ASSERT_NO_FATAL_FAILURE(to_preop());
-    EXPECT_NE(lines.str().find("ecat-slave: AL state Init -> Pre-Op\n"), std::string::npos) << lines.str();
+    EXPECT_NE(lines.str().find("ecat-slave: AL state INIT -> PREOP\n"), std::string::npos) << lines.str();
 
     AlStatus st;
     EXPECT_NE(m.request_state(a, AlState::Op, &st), Error::Ok);  // Pre-Op -> Op skips Safe-Op
-    EXPECT_NE(lines.str().find("ecat-slave: warning: refused AL state request Pre-Op -> Op: AL status code "
+    EXPECT_NE(lines.str().find("ecat-slave: warning: refused AL state request PREOP -> OP: AL status code "
                                "0x0011 (Invalid requested state change)"),
               std::string::npos)
         << lines.str();
