@@ -304,25 +304,25 @@ std::string Context::need_dc() const {
     if (sii && sii->find(60)) return {};
     return "no DC announced (no ESI Dc element, no SII DC category)";
 }
-std::string Context::need_sdo_info() const {
-    if (auto r = need_coe(); !r.empty()) return r;
-    if (esi) return esi->coe.sdo_info ? "" : "the ESI does not announce SdoInfo";
-    if (sii) {
-        if (const auto* g = sii->find(30); g && g->length > 5)
-            return (sii->bytes[g->offset + 5] & 0x02) ? ""
-                                                      : "SII general category: SDO information not announced";
+// A CoE detail: announced by the ESI's CoE attribute `attribute` (when an ESI is given), else by bit sii_bit
+// of the CoE details byte of the SII's General category (byte 5). "" when announced, else why not.
+static std::string need_coe_detail(const Context& c, bool EsiCoe::*flag, const char* attribute,
+                                   uint8_t sii_bit, const std::string& what) {
+    if (auto r = c.need_coe(); !r.empty()) return r;
+    if (c.esi) return c.esi->coe.*flag ? "" : std::string("the ESI does not announce ") + attribute;
+    if (c.sii) {
+        if (const auto* g = c.sii->find(30); g && g->length > 5)
+            return (c.sii->bytes[g->offset + 5] & sii_bit)
+                       ? ""
+                       : "SII general category: " + what + " not announced";
     }
-    return "SDO information not announced";
+    return what + " not announced";
+}
+std::string Context::need_sdo_info() const {
+    return need_coe_detail(*this, &EsiCoe::sdo_info, "SdoInfo", 0x02, "SDO information");
 }
 std::string Context::need_complete_access() const {
-    if (auto r = need_coe(); !r.empty()) return r;
-    if (esi) return esi->coe.complete_access ? "" : "the ESI does not announce CompleteAccess";
-    if (sii) {
-        if (const auto* g = sii->find(30); g && g->length > 5)
-            return (sii->bytes[g->offset + 5] & 0x20) ? ""
-                                                      : "SII general category: complete access not announced";
-    }
-    return "complete access not announced";
+    return need_coe_detail(*this, &EsiCoe::complete_access, "CompleteAccess", 0x20, "complete access");
 }
 std::string Context::need_402() const {
     if (auto r = need_coe(); !r.empty()) return r;
