@@ -14,14 +14,6 @@
 namespace od {
 namespace {
 
-std::string_view trim(std::string_view s) {
-    while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r'))
-        s.remove_prefix(1);
-    while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r'))
-        s.remove_suffix(1);
-    return s;
-}
-
 struct Parser {
     std::string source;
     int line = 0;
@@ -81,21 +73,21 @@ DeviceDescription parse_device_config(std::string_view text, const std::string& 
     while (std::getline(in, raw)) {
         ++p.line;
         if (const std::string e = util::text_error(raw); !e.empty()) p.fail(e);
-        std::string_view l = trim(raw);
+        std::string_view l = util::trim_blanks(raw);
         if (l.empty() || l.front() == '#' || l.front() == ';') continue;
         if (l.front() == '[') {
             const auto close = l.find(']');
             if (close == std::string_view::npos) p.fail("section header without ']'");
             p.check_rest(l.substr(close + 1));
-            section = std::string(trim(l.substr(1, close - 1)));
+            section = std::string(util::trim_blanks(l.substr(1, close - 1)));
             if (section.empty()) p.fail("empty section name");
             in_top_level = false;
             continue;
         }
         const auto eq = l.find_first_of("=:");
         if (eq == std::string_view::npos) p.fail("expected 'key = value'");
-        const std::string key(trim(l.substr(0, eq)));
-        const std::string_view value = trim(l.substr(eq + 1));
+        const std::string key(util::trim_blanks(l.substr(0, eq)));
+        const std::string_view value = util::trim_blanks(l.substr(eq + 1));
         if (key.empty()) p.fail("missing key before '='");
 
         const bool known_section = section == "identity" || section == "mailbox" ||

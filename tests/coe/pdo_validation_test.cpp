@@ -11,6 +11,17 @@ using namespace coe_test;
 
 namespace {
 
+// An expedited download of `bytes` (1..4) bytes through the server: 0 for a download response, the abort code
+// otherwise.
+uint32_t expedited_download(coe::CoeServer& server, RecordingSender& out, uint16_t index, uint8_t sub,
+                            uint32_t value, uint8_t bytes) {
+    static const uint8_t cmd[] = {0, 0x2F, 0x2B, 0x27, 0x23};
+    server.handle(sdo(cmd[bytes], index, sub, value), out);
+    EXPECT_EQ(out.messages.size(), 1u);
+    Bytes r = out.take().payload;
+    return r[2] == 0x80 ? le32(r, 6) : 0;
+}
+
 class PdoChecks : public ::testing::Test {
   protected:
     od::Dictionary dict = make_test_dictionary();
@@ -20,13 +31,8 @@ class PdoChecks : public ::testing::Test {
 
     void SetUp() override { coe::install_pdo_validators(dict, coe::PdoLimits{16}); }
 
-    // Returns 0 for a download response, the abort code otherwise.
     uint32_t write(uint16_t index, uint8_t sub, uint32_t value, uint8_t bytes) {
-        static const uint8_t cmd[] = {0, 0x2F, 0x2B, 0x27, 0x23};
-        server.handle(sdo(cmd[bytes], index, sub, value), out);
-        EXPECT_EQ(out.messages.size(), 1u);
-        Bytes r = out.take().payload;
-        return r[2] == 0x80 ? le32(r, 6) : 0;
+        return expedited_download(server, out, index, sub, value, bytes);
     }
 };
 
@@ -146,11 +152,7 @@ class DrivePdoRules : public ::testing::Test {
     void SetUp() override { coe::install_pdo_validators(dict, {}, desc.pdo_rules); }
 
     uint32_t write(uint16_t index, uint8_t sub, uint32_t value, uint8_t bytes) {
-        static const uint8_t cmd[] = {0, 0x2F, 0x2B, 0x27, 0x23};
-        server.handle(sdo(cmd[bytes], index, sub, value), out);
-        EXPECT_EQ(out.messages.size(), 1u);
-        Bytes r = out.take().payload;
-        return r[2] == 0x80 ? le32(r, 6) : 0;
+        return expedited_download(server, out, index, sub, value, bytes);
     }
 };
 

@@ -42,6 +42,12 @@ class SdoInfo : public ::testing::Test {
         if (fragments) *fragments = n;
         return body;
     }
+    // The whole answer (opcode 0x02) to "get OD list" of list type `type`, through the default sender.
+    Bytes od_list(uint8_t type) {
+        RecordingSender out;
+        server.handle(info(0x01, {type, 0x00}), out);
+        return collect(out, 0x02);
+    }
     std::vector<uint16_t> indexes(const Bytes& body) {
         std::vector<uint16_t> v;
         for (std::size_t i = 2; i + 1 < body.size(); i += 2)
@@ -57,9 +63,7 @@ class SdoInfo : public ::testing::Test {
 };
 
 TEST_F(SdoInfo, OdListAllObjects) {
-    RecordingSender out;
-    server.handle(info(0x01, {0x01, 0x00}), out);
-    Bytes body = collect(out, 0x02);
+    Bytes body = od_list(0x01);
     ASSERT_GE(body.size(), 2u);
     EXPECT_EQ(le16(body, 0), 1u);
     auto all = indexes(body);
@@ -76,9 +80,7 @@ TEST_F(SdoInfo, OdListPerListType) {
         {5, {0x2002}},
     };
     for (const auto& [type, want] : lists) {
-        RecordingSender out;
-        server.handle(info(0x01, {static_cast<uint8_t>(type), 0x00}), out);
-        Bytes body = collect(out, 0x02);
+        Bytes body = od_list(static_cast<uint8_t>(type));
         ASSERT_GE(body.size(), 2u);
         EXPECT_EQ(le16(body, 0), type);
         EXPECT_EQ(indexes(body), want) << "list type " << type;
@@ -86,9 +88,7 @@ TEST_F(SdoInfo, OdListPerListType) {
 }
 
 TEST_F(SdoInfo, OdListType0GivesTheLengthsOfLists1To5) {
-    RecordingSender out;
-    server.handle(info(0x01, {0x00, 0x00}), out);
-    Bytes body = collect(out, 0x02);
+    Bytes body = od_list(0x00);
     ASSERT_EQ(body.size(), 12u);
     EXPECT_EQ(le16(body, 0), 0u);
     EXPECT_EQ(le16(body, 2), dict.objects().size());

@@ -238,13 +238,19 @@ std::vector<TestResult> sample(const Catalogue& c) {
     return r;
 }
 
-TEST(Report, JunitIsWellFormedXmlWithCounts) {
-    Catalogue c = build_catalogue();
-    auto r = sample(c);
-    RunInfo info{"veth0", "dev \"x\" <y>", std::chrono::milliseconds(1234), {"note & more"}};
+// The report of the sample results, as `write` gives it for the run `info`.
+std::string sample_report(const RunInfo& info,
+                          void (*write)(std::ostream&, const std::vector<TestResult>&, const RunInfo&)) {
+    const Catalogue c = build_catalogue();
+    const std::vector<TestResult> r = sample(c);
     std::ostringstream o;
-    write_junit(o, r, info);
-    const std::string x = o.str();
+    write(o, r, info);
+    return o.str();
+}
+
+TEST(Report, JunitIsWellFormedXmlWithCounts) {
+    const std::string x = sample_report(
+        {"veth0", "dev \"x\" <y>", std::chrono::milliseconds(1234), {"note & more"}}, write_junit);
     xmlDoc* doc = xmlReadMemory(x.data(), static_cast<int>(x.size()), "j.xml", nullptr,
                                 XML_PARSE_NONET | XML_PARSE_NOERROR);
     ASSERT_NE(doc, nullptr) << x;
@@ -259,13 +265,9 @@ TEST(Report, JunitIsWellFormedXmlWithCounts) {
 }
 
 TEST(Report, JsonIsWellFormed) {
-    Catalogue c = build_catalogue();
-    auto r = sample(c);
     // A device string with an ISO-8859-1 byte (a vendor's SII name): the JSON stays valid UTF-8.
-    RunInfo info{"veth0", "dev \"x\" Ger\xE4t", std::chrono::milliseconds(5), {"n\t1"}};
-    std::ostringstream o;
-    write_json(o, r, info);
-    const std::string s = o.str();
+    const std::string s =
+        sample_report({"veth0", "dev \"x\" Ger\xE4t", std::chrono::milliseconds(5), {"n\t1"}}, write_json);
     Json j{s};
     EXPECT_TRUE(j.value()) << s;
     j.ws();

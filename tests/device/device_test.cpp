@@ -28,6 +28,7 @@
 #include "maxpos/maxpos.hpp"
 #include "slave/log.hpp"
 
+#include "powered_device.hpp"
 #include "support/master_bring_up.hpp"
 #include "support/temp_dir.hpp"
 #include "support/wire_link.hpp"
@@ -40,52 +41,19 @@ std::filesystem::path temp_dir() {
     return test_support::make_temp_dir("softdrive-test-");
 }
 
-// One soft drive "powered" on a manual clock.
-struct Drive {
-    esc::ManualClock clock;
+// One soft drive "powered" on a manual clock; power_on() is a power cycle from the same state directory.
+struct Drive : test_device::PoweredDevice {
     device::DeviceOptions options;
-    std::ostringstream log;
-    std::unique_ptr<esc::Esc> esc;
-    std::unique_ptr<device::Device> dev;
-    uint64_t frame_ns = 20'000;  // slave time that passes with each frame
 
     explicit Drive(const std::filesystem::path& state_dir) {
-        clock.set(1'000'000'000);
         options.state_dir = state_dir;
-        options.log = &log;
         power_on();
     }
-    // A power cycle: new ESC, new Device from the same state directory.
-    void power_on() {
-        dev.reset();
-        esc = std::make_unique<esc::Esc>(esc::EscConfig{}, clock);
-        dev = std::make_unique<device::Device>(*esc, options);
-        service();
-    }
-    void service() {
-        esc->tick();
-        dev->poll(clock.now_ns());
-    }
-    // Time passes without frames; the slave runs at least every millisecond, as the runtime's timer would.
-    void idle(uint64_t ns) {
-        for (uint64_t t = 0; t < ns; t += 1'000'000) {
-            clock.advance(1'000'000);
-            service();
-        }
-    }
+    void power_on() { PoweredDevice::power_on(options); }
     od::Dictionary& dict() { return dev->dictionary(); }
 };
 
-// The master's link to this slave: each frame through the ESC, then the firmware, as the runtime does.
-struct DriveLink final : test_support::WireLink {
-    explicit DriveLink(Drive& d)
-        : WireLink([&d](std::vector<uint8_t>& f) {
-              d.clock.advance(d.frame_ns);
-              const bool back = d.esc->process_frame(f);
-              d.service();
-              return back;
-          }) {}
-};
+using DriveLink = test_device::PoweredLink;
 
 MasterOptions master_options() {
     return test_support::in_process_master_options();
@@ -561,11 +529,11 @@ TEST_F(DeviceAssembly, StateChangesRefusalsSavesFaultsAndRestartsAreLoggedAndSta
     drive.options.events = &log;
     drive.power_on();
     ASSERT_NO_FATAL_FAILURE(to_preop());
-    EXPECT_NE(lines.str().find("ecat-slave: AL state Init -> Pre-Op\n"), std::string::npos) << lines.str();
+    EXPECT_NE(lines.str().find("ecat-slave: AL state INIT -> PREOP\n"), std::string::npos) << lines.str();
 
     AlStatus st;
     EXPECT_NE(m.request_state(a, AlState::Op, &st), Error::Ok);  // Pre-Op -> Op skips Safe-Op
-    EXPECT_NE(lines.str().find("ecat-slave: warning: refused AL state request Pre-Op -> Op: AL status code "
+    EXPECT_NE(lines.str().find("ecat-slave: warning: refused AL state request PREOP -> OP: AL status code "
                                "0x0011 (Invalid requested state change)"),
               std::string::npos)
         << lines.str();

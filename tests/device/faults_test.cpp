@@ -19,6 +19,7 @@
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
 
+#include "powered_device.hpp"
 #include "support/master_bring_up.hpp"
 #include "support/temp_dir.hpp"
 #include "support/wire_link.hpp"
@@ -105,34 +106,21 @@ std::filesystem::path temp_dir() {
     return test_support::make_temp_dir("softdrive-faults-");
 }
 
-struct FaultyDrive {
+struct FaultyDrive : test_device::PoweredDevice {
     std::filesystem::path dir = temp_dir();
-    esc::ManualClock clock;
-    std::ostringstream log;
-    std::unique_ptr<esc::Esc> esc;
-    std::unique_ptr<Device> dev;
-    std::unique_ptr<test_support::WireLink> link;
+    std::unique_ptr<test_device::PoweredLink> link;
     std::unique_ptr<master::Master> m;
     std::unique_ptr<master::Mailbox> mbx;
     std::unique_ptr<master::SdoClient> sdo;
     const master::Address a = master::Address::station(0x1001);
 
     explicit FaultyDrive(const FaultSet& faults) {
-        clock.set(1'000'000'000);
         esc::EscConfig config;
         DeviceOptions options;
         options.state_dir = dir;
-        options.log = &log;
         apply_faults(faults, config.faults, options.faults);
-        esc = std::make_unique<esc::Esc>(config, clock);
-        dev = std::make_unique<Device>(*esc, options);
-        service();
-        link = std::make_unique<test_support::WireLink>([this](std::vector<uint8_t>& f) {
-            clock.advance(20'000);
-            const bool back = esc->process_frame(f);
-            service();
-            return back;
-        });
+        power_on(options, config);
+        link = std::make_unique<test_device::PoweredLink>(*this);
         m = std::make_unique<master::Master>(*link, test_support::in_process_master_options());
         mbx = std::make_unique<master::Mailbox>(*m, a);
         sdo = std::make_unique<master::SdoClient>(*mbx);
@@ -141,16 +129,6 @@ struct FaultyDrive {
         dev.reset();
         std::error_code ec;
         std::filesystem::remove_all(dir, ec);
-    }
-    void service() {
-        esc->tick();
-        dev->poll(clock.now_ns());
-    }
-    void idle(uint64_t ns) {
-        for (uint64_t t = 0; t < ns; t += 1'000'000) {
-            clock.advance(1'000'000);
-            service();
-        }
     }
     void to_preop() { ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(*m, *mbx, a)); }
     uint32_t sdo_u32(uint16_t index, uint8_t sub) {

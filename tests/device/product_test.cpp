@@ -23,6 +23,7 @@
 #include "od/product.hpp"
 #include "products.hpp"
 
+#include "powered_device.hpp"
 #include "support/master_bring_up.hpp"
 #include "support/temp_dir.hpp"
 #include "support/wire_link.hpp"
@@ -33,45 +34,25 @@ using test_products::io_terminal;
 
 namespace {
 
-// One device "powered" on a manual clock; the master's frames go through its ESC, then the firmware.
-struct Unit {
-    esc::ManualClock clock;
-    std::ostringstream log;
-    std::unique_ptr<esc::Esc> esc;
-    std::unique_ptr<device::Device> dev;
+// One device made from `product`, "powered" on a manual clock, with a state directory of its own.
+struct Unit : test_device::PoweredDevice {
     std::filesystem::path dir;
 
     explicit Unit(std::shared_ptr<const od::Product> product)
         : dir(test_support::make_temp_dir("softecat-product-")) {
-        clock.set(1'000'000'000);
         device::DeviceOptions o;
         o.product = std::move(product);
         o.state_dir = dir;
-        o.log = &log;
-        esc = std::make_unique<esc::Esc>(esc::EscConfig{}, clock);
-        dev = std::make_unique<device::Device>(*esc, o);
-        service();
+        power_on(o);
     }
     ~Unit() {
         dev.reset();
         std::error_code ec;
         std::filesystem::remove_all(dir, ec);
     }
-    void service() {
-        esc->tick();
-        dev->poll(clock.now_ns());
-    }
 };
 
-struct UnitLink final : test_support::WireLink {
-    explicit UnitLink(Unit& u)
-        : WireLink([&u](std::vector<uint8_t>& f) {
-              u.clock.advance(20'000);
-              const bool back = u.esc->process_frame(f);
-              u.service();
-              return back;
-          }) {}
-};
+using UnitLink = test_device::PoweredLink;
 
 uint16_t u16(std::span<const uint8_t> b, std::size_t at) {
     return static_cast<uint16_t>(b[at] | (b[at + 1] << 8));

@@ -31,6 +31,19 @@ struct StateDir : test_support::TempDir {
     StateDir() : TempDir("softdrive-state-") {}
 };
 
+// An ESC on a manual clock and the options that start a Device from the state directory dir, its log kept.
+struct PowerOn {
+    esc::ManualClock clock;
+    esc::Esc esc{esc::EscConfig{}, clock};
+    std::ostringstream log;
+    device::DeviceOptions options;
+    explicit PowerOn(const fs::path& dir) {
+        clock.set(1'000'000'000);
+        options.state_dir = dir;
+        options.log = &log;
+    }
+};
+
 void put32(std::vector<uint8_t>& b, std::size_t at, uint32_t v) {
     for (int i = 0; i < 4; ++i)
         b[at + i] = static_cast<uint8_t>(v >> (8 * i));
@@ -89,27 +102,21 @@ TEST(DeviceStateFiles, CraftedFilesAreReportedAndTheDefaultsRun) {
         std::ofstream(d.path / "firmware" / "active") << "slot0\n";
     }
 
-    esc::ManualClock clock;
-    clock.set(1'000'000'000);
-    esc::Esc esc(esc::EscConfig{}, clock);
-    std::ostringstream log;
-    device::DeviceOptions options;
-    options.state_dir = d.path;
-    options.log = &log;
+    PowerOn on(d.path);
     std::unique_ptr<device::Device> dev;
-    ASSERT_NO_THROW(dev = std::make_unique<device::Device>(esc, options)) << log.str();
+    ASSERT_NO_THROW(dev = std::make_unique<device::Device>(on.esc, on.options)) << on.log.str();
     // Reported ...
     EXPECT_TRUE(dev->parameter_load().found);
     EXPECT_FALSE(dev->parameter_load().applied);
-    EXPECT_NE(log.str().find("stored parameters"), std::string::npos) << log.str();
-    EXPECT_NE(log.str().find(device::EepromWrites::kFileName), std::string::npos) << log.str();
+    EXPECT_NE(on.log.str().find("stored parameters"), std::string::npos) << on.log.str();
+    EXPECT_NE(on.log.str().find(device::EepromWrites::kFileName), std::string::npos) << on.log.str();
     // ... and the defaults run: the dictionary's stored parameters, the built-in firmware, the SII as built.
     const od::Dictionary defaults = maxpos::dictionary(desc);
     EXPECT_EQ(dev->dictionary().get<uint32_t>(0x6065, 0), defaults.get<uint32_t>(0x6065, 0));
     EXPECT_EQ(dev->dictionary().get<uint32_t>(0x1018, 3), desc.identity.revision);
     EXPECT_FALSE(dev->firmware_store().active_image());
     EXPECT_TRUE(dev->eeprom_writes().empty());
-    dev->poll(clock.now_ns());
+    dev->poll(on.clock.now_ns());
 }
 
 TEST(DeviceStateFiles, OversizedSiiWritesFileIsNotRead) {
@@ -156,17 +163,11 @@ TEST(DeviceStateFiles, StaleTemporariesAreRemovedAtTheStart) {
     for (const auto& p : stale)
         ASSERT_TRUE(fs::exists(p)) << p;
 
-    esc::ManualClock clock;
-    clock.set(1'000'000'000);
-    esc::Esc esc(esc::EscConfig{}, clock);
-    std::ostringstream log;
-    device::DeviceOptions options;
-    options.state_dir = d.path;
-    options.log = &log;
-    device::Device dev(esc, options);
+    PowerOn on(d.path);
+    device::Device dev(on.esc, on.options);
     for (const auto& p : stale)
         EXPECT_FALSE(fs::exists(p)) << p;
-    EXPECT_NE(log.str().find("parameters.bin.tmp left by an interrupted save"), std::string::npos)
-        << log.str();
+    EXPECT_NE(on.log.str().find("parameters.bin.tmp left by an interrupted save"), std::string::npos)
+        << on.log.str();
     EXPECT_FALSE(dev.parameter_load().found);  // the temporary was never the parameter file
 }

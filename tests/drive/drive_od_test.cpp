@@ -7,6 +7,22 @@
 
 using namespace drive;
 
+namespace {
+
+// Controlwords 0x06, 0x07, 0x0F, one 1 ms cycle each from time 0 (shutdown, switch on, enable operation);
+// returns the time of the next cycle.
+int64_t enable(od::Dictionary& d, Drive& drv) {
+    int64_t t = 0;
+    for (uint16_t cw : {0x06, 0x07, 0x0F}) {
+        d.set<uint16_t>(0x6040, 0, cw);
+        drv.cycle(t, 1'000'000);
+        t += 1'000'000;
+    }
+    return t;
+}
+
+}  // namespace
+
 TEST(DriveOd, RunsCspThroughTheDictionary) {
     od::Dictionary d = maxpos::dictionary(maxpos::description());
     test::Recorder rec;
@@ -48,12 +64,7 @@ TEST(DriveOd, ConnectionLostWritesTheErrorIntoTheDictionary) {
     od::Dictionary d = maxpos::dictionary(maxpos::description());
     Drive drv(d, nullptr, maxpos::drive_objects());
     d.set<uint32_t>(0x3001, 5, 25500);
-    int64_t t = 0;
-    for (uint16_t cw : {0x06, 0x07, 0x0F}) {
-        d.set<uint16_t>(0x6040, 0, cw);
-        drv.cycle(t, 1'000'000);
-        t += 1'000'000;
-    }
+    enable(d, drv);
     drv.connection_lost();
     EXPECT_EQ(d.get<uint16_t>(0x603F, 0), 0x8180);
     EXPECT_EQ(d.get<uint8_t>(0x1001, 0), 0x11);  // communication, and generic as at any error (CiA 301)
@@ -67,12 +78,7 @@ TEST(DriveOd, CommissionWritesAMatchedTuningSoTheDriveEnables) {
     EXPECT_EQ(d.get<uint32_t>(0x30A1, 4), 188300u);
     EXPECT_EQ(d.get<uint32_t>(0x30A1, 5), 46674u);  // 445.7 uNm/(rad/s) in nNm/rpm
     Drive drv(d, nullptr, maxpos::drive_objects());
-    int64_t t = 0;
-    for (uint16_t cw : {0x06, 0x07, 0x0F}) {
-        d.set<uint16_t>(0x6040, 0, cw);
-        drv.cycle(t, 1'000'000);
-        t += 1'000'000;
-    }
+    enable(d, drv);
     EXPECT_EQ(d.get<uint16_t>(0x6041, 0) & 0x6F, 0x27);
     EXPECT_EQ(d.get<uint16_t>(0x603F, 0), 0);
 }
@@ -80,12 +86,7 @@ TEST(DriveOd, CommissionWritesAMatchedTuningSoTheDriveEnables) {
 TEST(DriveOd, SeedDefaultsRefuseToEnableWith8331) {
     od::Dictionary d = maxpos::dictionary(maxpos::description());
     Drive drv(d, nullptr, maxpos::drive_objects());
-    int64_t t = 0;
-    for (uint16_t cw : {0x06, 0x07, 0x0F}) {
-        d.set<uint16_t>(0x6040, 0, cw);
-        drv.cycle(t, 1'000'000);
-        t += 1'000'000;
-    }
+    enable(d, drv);
     EXPECT_EQ(d.get<uint16_t>(0x603F, 0), 0x8331);
     EXPECT_EQ(d.get<uint16_t>(0x6041, 0) & 0x4F, 0x08);
 }
@@ -96,12 +97,7 @@ TEST(DriveOd, PowerDisableOnlyObjectsRefuseMasterWritesWhileEnabled) {
     Drive drv(d, nullptr, maxpos::drive_objects());
     const uint8_t pulses[4] = {0x00, 0x04, 0x00, 0x00};  // 1024
     EXPECT_EQ(d.write(0x3010, 1, od::AlState::PreOp, pulses), od::Status::Ok);
-    int64_t t = 0;
-    for (uint16_t cw : {0x06, 0x07, 0x0F}) {
-        d.set<uint16_t>(0x6040, 0, cw);
-        drv.cycle(t, 1'000'000);
-        t += 1'000'000;
-    }
+    int64_t t = enable(d, drv);
     EXPECT_EQ(drv.axis().increments_per_rev(), 4096);
     EXPECT_EQ(d.write(0x3010, 1, od::AlState::Op, pulses), od::Status::WrongState);
     const uint8_t pp[1] = {2};

@@ -4,6 +4,32 @@
 using namespace drive;
 using namespace drive::test;
 
+namespace {
+
+// Profile position mode with the profile velocity and the same acceleration and deceleration, enabled.
+void enable_profile_position(Rig& r, uint32_t velocity, uint32_t acceleration) {
+    r.ax.command.mode = mode::ProfilePosition;
+    r.ax.params.profile_velocity = velocity;
+    r.ax.params.profile_acceleration = acceleration;
+    r.ax.params.profile_deceleration = acceleration;
+    r.enable();
+}
+
+// A new set-point in profile position mode: the target, then controlword bit 4 raised (with `bits`: 0x20
+// change immediately, 0x40 relative) and lowered again.
+void new_setpoint(Rig& r, int32_t target, uint16_t bits = 0) {
+    r.ax.command.target_position = target;
+    r.cw(static_cast<uint16_t>(0x1F | bits));
+    r.cw(0x0F);
+}
+
+// Runs until statusword bit 10 (target reached) is set, for ms milliseconds at most.
+bool target_reached_within(Rig& r, int ms) {
+    return r.until([&] { return (r.sw() & sw::TargetReached) != 0; }, ms);
+}
+
+}  // namespace
+
 TEST(Modes, DisplayFollowsSupportedModesOnly) {
     Rig r;
     EXPECT_EQ(r.fb().mode_display, mode::CyclicSyncPosition);
@@ -108,11 +134,7 @@ TEST(Modes, CstTorqueGivesTheAccelerationTheInertiaPredicts) {
 
 TEST(Modes, PpmAbsoluteMoveWithSetpointHandshake) {
     Rig r;
-    r.ax.command.mode = mode::ProfilePosition;
-    r.ax.params.profile_velocity = 2000;
-    r.ax.params.profile_acceleration = 20000;
-    r.ax.params.profile_deceleration = 20000;
-    r.enable();
+    enable_profile_position(r, 2000, 20000);
     const int32_t start = r.fb().position_actual;
     r.ax.command.target_position = start + 10000;
     r.cw(0x1F);
@@ -140,34 +162,22 @@ TEST(Modes, PpmRelativeAndChangeImmediately) {
     r.ax.params.profile_velocity = 1000;
     r.enable();
     const int32_t start = r.fb().position_actual;
-    r.ax.command.target_position = 4000;
-    r.cw(0x5F);  // relative
-    r.cw(0x0F);
-    ASSERT_TRUE(r.until([&] { return (r.sw() & sw::TargetReached) != 0; }, 3000));
+    new_setpoint(r, 4000, 0x40);  // relative
+    ASSERT_TRUE(target_reached_within(r, 3000));
     EXPECT_EQ(r.fb().position_demand, start + 4000);
     // A long move, replaced half-way by an immediate new target behind us.
-    r.ax.command.target_position = start + 40000;
-    r.cw(0x1F);
-    r.cw(0x0F);
+    new_setpoint(r, start + 40000);
     r.run_ms(300);
-    r.ax.command.target_position = start;
-    r.cw(0x3F);
-    r.cw(0x0F);
-    ASSERT_TRUE(r.until([&] { return (r.sw() & sw::TargetReached) != 0; }, 5000));
+    new_setpoint(r, start, 0x20);
+    ASSERT_TRUE(target_reached_within(r, 5000));
     EXPECT_EQ(r.fb().position_demand, start);
 }
 
 TEST(Modes, PpmBufferedSetpointRunsAfterTheFirst) {
     Rig r;
-    r.ax.command.mode = mode::ProfilePosition;
-    r.ax.params.profile_velocity = 3000;
-    r.ax.params.profile_acceleration = 30000;
-    r.ax.params.profile_deceleration = 30000;
-    r.enable();
+    enable_profile_position(r, 3000, 30000);
     const int32_t start = r.fb().position_actual;
-    r.ax.command.target_position = start + 6000;
-    r.cw(0x1F);
-    r.cw(0x0F);
+    new_setpoint(r, start + 6000);
     r.run_ms(20);
     r.ax.command.target_position = start - 2000;
     r.cw(0x1F);  // not immediate: buffered, acknowledged
@@ -191,10 +201,8 @@ TEST(Modes, PpmTargetClampedBySoftwareLimitSetsInternalLimit) {
     const int32_t start = r.fb().position_actual;
     r.ax.params.sw_limit_max = start + 3000;
     r.enable();
-    r.ax.command.target_position = start + 9000;
-    r.cw(0x1F);
-    r.cw(0x0F);
-    ASSERT_TRUE(r.until([&] { return (r.sw() & sw::TargetReached) != 0; }, 3000));
+    new_setpoint(r, start + 9000);
+    ASSERT_TRUE(target_reached_within(r, 3000));
     EXPECT_EQ(r.fb().position_demand, start + 3000);
     EXPECT_TRUE(r.sw() & sw::InternalLimit);
 }
@@ -210,7 +218,7 @@ TEST(Modes, PvmReachesVelocityAndReportsSpeedZero) {
     EXPECT_FALSE(r.sw() & sw::TargetReached);
     r.run_ms(80);
     EXPECT_NEAR(r.fb().velocity_demand, -800, 30);  // 10000 rpm/s ramp
-    ASSERT_TRUE(r.until([&] { return (r.sw() & sw::TargetReached) != 0; }, 500));
+    ASSERT_TRUE(target_reached_within(r, 500));
     r.run_ms(100);
     EXPECT_NEAR(r.rpm(), -1000, 20);
     EXPECT_FALSE(r.sw() & sw::Bit12);
@@ -396,17 +404,15 @@ TEST(Modes, PpmHaltStopsWithQuickStopDecelerationAndResumes) {
     r.ax.params.quick_stop_deceleration = 40000;
     r.enable();
     const int32_t start = r.fb().position_actual;
-    r.ax.command.target_position = start + 30000;
-    r.cw(0x1F);
-    r.cw(0x0F);
+    new_setpoint(r, start + 30000);
     r.run_ms(400);
     r.cw(0x10F);  // halt
     EXPECT_FALSE(r.sw() & sw::TargetReached);
-    ASSERT_TRUE(r.until([&] { return (r.sw() & sw::TargetReached) != 0; }, 500));  // halted: velocity 0
+    ASSERT_TRUE(target_reached_within(r, 500));  // halted: velocity 0
     EXPECT_LT(r.fb().position_demand, start + 30000);
     r.cw(0x0F);  // halt released: the move continues to the target
     EXPECT_FALSE(r.sw() & sw::TargetReached);
-    ASSERT_TRUE(r.until([&] { return (r.sw() & sw::TargetReached) != 0; }, 3000));
+    ASSERT_TRUE(target_reached_within(r, 3000));
     EXPECT_EQ(r.fb().position_demand, start + 30000);
 }
 
@@ -464,10 +470,8 @@ TEST(Modes, PpmAbsoluteTargetInARangeTakesTheShortWay) {
     r.ax.command.mode = mode::ProfilePosition;
     r.enable();
     const double raw0 = r.ax.raw_position_inc();
-    r.ax.command.target_position = 100;
-    r.cw(0x1F);
-    r.cw(0x0F);
-    ASSERT_TRUE(r.until([&] { return (r.sw() & sw::TargetReached) != 0; }, 3000));
+    new_setpoint(r, 100);
+    ASSERT_TRUE(target_reached_within(r, 3000));
     r.run_ms(100);
     EXPECT_NEAR(r.ax.raw_position_inc() - raw0, 200, 6);  // +200, not -3800
     EXPECT_NEAR(r.fb().position_actual, 100, 5);

@@ -25,12 +25,30 @@ class Sync : public StackTest {
         master.wr<uint16_t>(0x0980, 0);
         enable_dc(cycle_ns, 0x03, start_delay_ns);
     }
-    void safeop_dc(uint32_t cycle_ns) {
+    // Pre-Op, process data of 6 + 6 bytes configured, DC SYNC0 set up (enable_dc).
+    void preop_dc(uint32_t cycle_ns, uint8_t activation = 0x03, uint64_t start_delay_ns = 1'000'000) {
         go_preop();
         configure_process_data(6, 6);
-        enable_dc(cycle_ns);
+        enable_dc(cycle_ns, activation, start_delay_ns);
+    }
+    // ... and Safe-Op reached.
+    void safeop_dc(uint32_t cycle_ns, uint8_t activation = 0x03, uint64_t start_delay_ns = 1'000'000) {
+        preop_dc(cycle_ns, activation, start_delay_ns);
         request(0x04);
         ASSERT_EQ(al_status(), 0x04) << std::hex << al_code();
+    }
+    // Pre-Op, the sync mode written to 0x1C32:01 (0 free run, 1 SM synchronous, 2 DC SYNC0, 3 DC SYNC1),
+    // process data of 6 + 6 bytes configured.
+    void preop_with_sync_mode(uint16_t mode) {
+        go_preop();
+        ASSERT_EQ(master_write16(0x1C32, 1, mode), od::Status::Ok);
+        configure_process_data(6, 6);
+    }
+    // A request for Safe-Op refused: Pre-Op with the error indication and the AL status code `code`.
+    void expect_safeop_refused(uint16_t code) {
+        request(0x04);
+        EXPECT_EQ(al_status(), 0x02 | kErr);
+        EXPECT_EQ(al_code(), code);
     }
     // Advances in steps, polling after each (the runtime's timer).
     void run_for(uint64_t total_ns, uint64_t step_ns, bool send_outputs) {
@@ -126,11 +144,7 @@ TEST_F(Sync, Dc_Sync0NotMappedToAlEvent_SeenThrough0x0990) {
 }
 
 TEST_F(Sync, Dc_SafeOpToOp_WaitsForSync0) {
-    go_preop();
-    configure_process_data(6, 6);
-    enable_dc(1'000'000, 0x03, 5'000'000);  // first SYNC0 5 ms from now
-    request(0x04);
-    ASSERT_EQ(al_status(), 0x04);
+    ASSERT_NO_FATAL_FAILURE(safeop_dc(1'000'000, 0x03, 5'000'000));  // first SYNC0 5 ms from now
     std::vector<uint8_t> out(6), in(6);
     exchange_pd(out, in);
     poll();
@@ -141,11 +155,7 @@ TEST_F(Sync, Dc_SafeOpToOp_WaitsForSync0) {
 }
 
 TEST_F(Sync, Dc_SafeOpToOp_NoSync0_0x002D) {
-    go_preop();
-    configure_process_data(6, 6);
-    enable_dc(1'000'000, 0x03, 60'000'000'000ull);  // start time a minute away
-    request(0x04);
-    ASSERT_EQ(al_status(), 0x04);
+    ASSERT_NO_FATAL_FAILURE(safeop_dc(1'000'000, 0x03, 60'000'000'000ull));  // start time a minute away
     std::vector<uint8_t> out(6), in(6);
     exchange_pd(out, in);
     poll();
@@ -276,12 +286,8 @@ TEST_F(Sync, Dc_ReactivatedInOp_JudgedFromNewStart_LossStillFatal) {
 }
 
 TEST_F(Sync, Dc_Sync0CycleBelowMinimum_0x0036) {
-    go_preop();
-    configure_process_data(6, 6);
-    enable_dc(50'000);  // 0x1C32:05 = 100 us
-    request(0x04);
-    EXPECT_EQ(al_status(), 0x02 | kErr);
-    EXPECT_EQ(al_code(), 0x0036);
+    preop_dc(50'000);  // 0x1C32:05 = 100 us
+    expect_safeop_refused(0x0036);
 }
 
 TEST_F(Sync, Dc_StartTimeInThePast_0x0030) {
@@ -290,52 +296,32 @@ TEST_F(Sync, Dc_StartTimeInThePast_0x0030) {
     master.wr<uint32_t>(0x09A0, 1'000'000);
     master.wr<uint64_t>(0x0990, master.rd<uint64_t>(0x0910) - 5'000'000);
     master.wr<uint8_t>(0x0981, 0x03);
-    request(0x04);
-    EXPECT_EQ(al_status(), 0x02 | kErr);
-    EXPECT_EQ(al_code(), 0x0030);
+    expect_safeop_refused(0x0030);
 }
 
 TEST_F(Sync, Dc_Sync0CycleZero_0x0035) {
-    go_preop();
-    configure_process_data(6, 6);
-    enable_dc(0);
-    request(0x04);
-    EXPECT_EQ(al_status(), 0x02 | kErr);
-    EXPECT_EQ(al_code(), 0x0035);
+    preop_dc(0);
+    expect_safeop_refused(0x0035);
 }
 
 TEST_F(Sync, Dc_Sync1WithoutSync0_0x0030) {
-    go_preop();
-    configure_process_data(6, 6);
-    enable_dc(1'000'000, 0x05);
-    request(0x04);
-    EXPECT_EQ(al_status(), 0x02 | kErr);
-    EXPECT_EQ(al_code(), 0x0030);
+    preop_dc(1'000'000, 0x05);
+    expect_safeop_refused(0x0030);
 }
 
 TEST_F(Sync, Dc_SyncModeSaysDcButNotActivated_0x0030) {
-    go_preop();
-    ASSERT_EQ(master_write16(0x1C32, 1, 2), od::Status::Ok);
-    configure_process_data(6, 6);
-    request(0x04);
-    EXPECT_EQ(al_status(), 0x02 | kErr);
-    EXPECT_EQ(al_code(), 0x0030);
+    ASSERT_NO_FATAL_FAILURE(preop_with_sync_mode(2));
+    expect_safeop_refused(0x0030);
 }
 
 TEST_F(Sync, SmSyncRequestedButDcActive_0x0030) {
-    go_preop();
-    ASSERT_EQ(master_write16(0x1C32, 1, 1), od::Status::Ok);
-    configure_process_data(6, 6);
+    ASSERT_NO_FATAL_FAILURE(preop_with_sync_mode(1));
     enable_dc(1'000'000);
-    request(0x04);
-    EXPECT_EQ(al_status(), 0x02 | kErr);
-    EXPECT_EQ(al_code(), 0x0030);
+    expect_safeop_refused(0x0030);
 }
 
 TEST_F(Sync, Dc_SyncModeWrittenAndActivated_Accepted) {
-    go_preop();
-    ASSERT_EQ(master_write16(0x1C32, 1, 2), od::Status::Ok);
-    configure_process_data(6, 6);
+    ASSERT_NO_FATAL_FAILURE(preop_with_sync_mode(2));
     enable_dc(1'000'000);
     request(0x04);
     EXPECT_EQ(al_status(), 0x04);
@@ -343,40 +329,26 @@ TEST_F(Sync, Dc_SyncModeWrittenAndActivated_Accepted) {
 }
 
 TEST_F(Sync, FreeRunNotSupported_0x0027) {
-    go_preop();
-    ASSERT_EQ(master_write16(0x1C32, 1, 0), od::Status::Ok);
-    configure_process_data(6, 6);
-    request(0x04);
-    EXPECT_EQ(al_status(), 0x02 | kErr);
-    EXPECT_EQ(al_code(), 0x0027);
+    ASSERT_NO_FATAL_FAILURE(preop_with_sync_mode(0));
+    expect_safeop_refused(0x0027);
 }
 
 TEST_F(Sync, UnknownSyncMode_0x0028) {
-    go_preop();
-    ASSERT_EQ(master_write16(0x1C32, 1, 7), od::Status::Ok);
-    configure_process_data(6, 6);
-    request(0x04);
-    EXPECT_EQ(al_status(), 0x02 | kErr);
-    EXPECT_EQ(al_code(), 0x0028);
+    ASSERT_NO_FATAL_FAILURE(preop_with_sync_mode(7));
+    expect_safeop_refused(0x0028);
 }
 
 TEST_F(Sync, Dc_Sync1ModeNotSupported_0x0028) {
-    go_preop();
-    ASSERT_EQ(master_write16(0x1C32, 1, 3), od::Status::Ok);
-    configure_process_data(6, 6);
+    ASSERT_NO_FATAL_FAILURE(preop_with_sync_mode(3));
     enable_dc(1'000'000, 0x07);
-    request(0x04);
-    EXPECT_EQ(al_status(), 0x02 | kErr);
-    EXPECT_EQ(al_code(), 0x0028);  // 0x1C32:04 = 0x0006: no SYNC1 mode
+    expect_safeop_refused(0x0028);  // 0x1C32:04 = 0x0006: no SYNC1 mode
 }
 
 TEST_F(Sync, SmSync_CycleTimeTooSmall_0x002E) {
     go_preop();
     ASSERT_EQ(master_write32(0x1C32, 2, 50'000), od::Status::Ok);
     configure_process_data(6, 6);
-    request(0x04);
-    EXPECT_EQ(al_status(), 0x02 | kErr);
-    EXPECT_EQ(al_code(), 0x002E);
+    expect_safeop_refused(0x002E);
 }
 
 TEST_F(Sync, FreeRun_TimerDrivesCycle) {

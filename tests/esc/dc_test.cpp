@@ -19,6 +19,12 @@ struct DistributedClocks : EscFixture<kT0> {
         fpwr(*e, 0x0410, {0x00, 0x00});  // PDI watchdog off: next_event_ns() only shows DC events
     }
     uint32_t al_event() { return e->read_reg<uint32_t>(0x0220); }
+    // The AL event register after the clock is set to t and the ESC's timers ran.
+    uint32_t al_event_at(uint64_t t) {
+        clk.set(t);
+        e->tick();
+        return al_event();
+    }
     // Programs SYNC0 (and SYNC1) like IgH/SOEM: cycle times, start time, activation.
     uint64_t start_sync(uint32_t c0, uint32_t c1, uint8_t activation, int64_t start_in = 100'000) {
         auto c = le(c0, 4);
@@ -243,12 +249,8 @@ TEST_F(DistributedClocks, Sync0Generation) {
     const uint64_t start = start_sync(1'000'000, 0, 0x03);
     EXPECT_EQ(fprd(*e, 0x0984, 1).data[0], 0x01);  // first SYNC0 pending
     EXPECT_EQ(e->next_event_ns(), start);
-    clk.set(start - 1);
-    e->tick();
-    EXPECT_EQ(al_event() & 0x04, 0u);
-    clk.set(start);
-    e->tick();
-    EXPECT_EQ(al_event() & 0x04, 0x04u);
+    EXPECT_EQ(al_event_at(start - 1) & 0x04, 0u);
+    EXPECT_EQ(al_event_at(start) & 0x04, 0x04u);
     EXPECT_TRUE(e->irq());
     EXPECT_EQ(fprd(*e, 0x0984, 1).data[0], 0x00);
     EXPECT_EQ(fprd(*e, 0x0990, 8).u64(), start + 1'000'000);  // next SYNC0
@@ -259,9 +261,7 @@ TEST_F(DistributedClocks, Sync0Generation) {
     clk.set(start + 10'000);
     EXPECT_EQ(e->read_reg<uint8_t>(0x098E), 0);
     // Several cycles late: one pulse, then back on the grid.
-    clk.set(start + 5'500'000);
-    e->tick();
-    EXPECT_EQ(al_event() & 0x04, 0x04u);
+    EXPECT_EQ(al_event_at(start + 5'500'000) & 0x04, 0x04u);
     EXPECT_EQ(fprd(*e, 0x0990, 8).u64(), start + 6'000'000);
     // Deactivation stops it.
     fpwr(*e, 0x0981, {0x00});
@@ -270,13 +270,9 @@ TEST_F(DistributedClocks, Sync0Generation) {
 
 TEST_F(DistributedClocks, OutputsEnabledAfterActivation) {
     const uint64_t start = start_sync(1'000'000, 0, 0x01);  // cyclic unit only, no SYNC output yet
-    clk.set(start);
-    e->tick();
-    EXPECT_EQ(al_event() & 0x04, 0u);
+    EXPECT_EQ(al_event_at(start) & 0x04, 0u);
     fpwr(*e, 0x0981, {0x03});
-    clk.set(start + 1'000'000);
-    e->tick();
-    EXPECT_EQ(al_event() & 0x04, 0x04u);
+    EXPECT_EQ(al_event_at(start + 1'000'000) & 0x04, 0x04u);
 }
 
 TEST_F(DistributedClocks, StartTimeLockedWhileActive) {
@@ -293,14 +289,10 @@ TEST_F(DistributedClocks, Sync1DelayedAfterSync0) {
     EXPECT_EQ(al_event() & 0x0C, 0x04u);
     EXPECT_EQ(fprd(*e, 0x0998, 8).u64(), start + 200'000);
     EXPECT_EQ(e->next_event_ns(), start + 200'000);
-    clk.set(start + 200'000);
-    e->tick();
-    EXPECT_EQ(al_event() & 0x08, 0x08u);
+    EXPECT_EQ(al_event_at(start + 200'000) & 0x08, 0x08u);
     e->read_reg<uint8_t>(0x098F);
     EXPECT_EQ(al_event() & 0x08, 0u);
-    clk.set(start + 1'200'000);
-    e->tick();
-    EXPECT_EQ(al_event() & 0x08, 0x08u);
+    EXPECT_EQ(al_event_at(start + 1'200'000) & 0x08, 0x08u);
 }
 
 TEST_F(DistributedClocks, Sync1CycleZeroMirrorsSync0) {
@@ -313,26 +305,16 @@ TEST_F(DistributedClocks, Sync1CycleZeroMirrorsSync0) {
 TEST_F(DistributedClocks, Sync1LongerThanSync0) {
     // SYNC1 cycle 2 x SYNC0: SYNC1 at start + 2 ms, the next SYNC0 after it restarts the timer.
     const uint64_t start = start_sync(1'000'000, 2'000'000, 0x07);
-    clk.set(start + 1'999'999);
-    e->tick();
-    EXPECT_EQ(al_event() & 0x08, 0u);
-    clk.set(start + 2'000'000);
-    e->tick();
-    EXPECT_EQ(al_event() & 0x08, 0x08u);
+    EXPECT_EQ(al_event_at(start + 1'999'999) & 0x08, 0u);
+    EXPECT_EQ(al_event_at(start + 2'000'000) & 0x08, 0x08u);
     e->read_reg<uint8_t>(0x098F);
-    clk.set(start + 4'999'999);
-    e->tick();
-    EXPECT_EQ(al_event() & 0x08, 0u);
-    clk.set(start + 5'000'000);
-    e->tick();
-    EXPECT_EQ(al_event() & 0x08, 0x08u);
+    EXPECT_EQ(al_event_at(start + 4'999'999) & 0x08, 0u);
+    EXPECT_EQ(al_event_at(start + 5'000'000) & 0x08, 0x08u);
 }
 
 TEST_F(DistributedClocks, SingleShotWithCycleZero) {
     const uint64_t start = start_sync(0, 0, 0x03);
-    clk.set(start);
-    e->tick();
-    EXPECT_EQ(al_event() & 0x04, 0x04u);
+    EXPECT_EQ(al_event_at(start) & 0x04, 0x04u);
     EXPECT_EQ(e->next_event_ns(), UINT64_MAX);
 }
 
@@ -358,9 +340,7 @@ TEST_F(DistributedClocks, SyncNotMappedToAlEvent) {
     fix_sii_header_crc(img);
     e->load_eeprom(img);
     const uint64_t start = start_sync(1'000'000, 0, 0x03);
-    clk.set(start + 50'000);
-    e->tick();
-    EXPECT_EQ(al_event() & 0x04, 0u);
+    EXPECT_EQ(al_event_at(start + 50'000) & 0x04, 0u);
     // Acknowledge mode: the status stays until the PDI reads it.
     EXPECT_EQ(fprd(*e, 0x098E, 1).data[0], 1);
     EXPECT_EQ(e->read_reg<uint8_t>(0x098E), 1);
@@ -373,9 +353,7 @@ TEST_F(DistributedClocks, SyncUnitDisabledInEscConfig) {
     fix_sii_header_crc(img);
     e->load_eeprom(img);
     const uint64_t start = start_sync(1'000'000, 0, 0x03);
-    clk.set(start + 1);
-    e->tick();
-    EXPECT_EQ(al_event() & 0x04, 0u);
+    EXPECT_EQ(al_event_at(start + 1) & 0x04, 0u);
     EXPECT_EQ(e->next_event_ns(), UINT64_MAX);
 }
 

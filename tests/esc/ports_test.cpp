@@ -124,11 +124,8 @@ TEST_F(Ports, LinkOnPortOneOpensIt) {
 }
 
 TEST(PortsJunction, OrderIsZeroThreeOneTwo) {
-    esc::ManualClock clk;
-    clk.set(kT0);
-    esc::EscConfig c;
-    c.port_descriptor = 0xFF;
-    esc::Esc e(c, clk);
+    Line junction(1, 0xFF);  // one ESC with four ports
+    esc::Esc& e = *junction.escs[0];
     for (int p = 1; p < 4; ++p)
         e.set_link(p, true);
     EXPECT_EQ(dl_status(e) & 0xFFF0, 0xAAF0);  // all links, all loops open, communication on all
@@ -155,11 +152,9 @@ TEST(PortsJunction, OrderIsZeroThreeOneTwo) {
 // is open, never processes a frame entering at a closed port, and DL status always matches
 // link()/port_open().
 TEST(PortsJunction, RandomLinksAndLoopSettingsKeepTheInvariants) {
-    esc::ManualClock clk;
-    clk.set(kT0);
-    esc::EscConfig c;
-    c.port_descriptor = 0xFF;
-    esc::Esc e(c, clk);
+    Line junction(1, 0xFF);  // one ESC with four ports
+    esc::Esc& e = *junction.escs[0];
+    esc::ManualClock& clk = junction.clk;
     set_station(e, 0x1001);
     uint32_t s = 12345;
     auto rnd = [&](uint32_t n) {

@@ -123,6 +123,23 @@ struct Fixture : ::testing::Test {
     uint32_t active_version() const {
         return store.active_image() ? store.active_image()->header.version : 0;
     }
+    // The clean server refuses the write request `taken` with the FoE error taken_code; a server with `fault`
+    // set, in Bootstrap, takes it (ACK 0) and still refuses `refused` with refused_code.
+    void expect_fault_takes(bool FoeFaults::*fault, const Bytes& taken, uint32_t taken_code,
+                            const Bytes& refused, uint32_t refused_code) {
+        EXPECT_EQ(error_code(exchange(taken)), taken_code);
+        ServerConfig c = stepped();
+        c.faults.*fault = true;
+        FoeServer faulty(store, c);
+        faulty.on_state_change(od::AlState::Init, od::AlState::Boot);
+        faulty.handle(taken, out);
+        ASSERT_EQ(out.sent.size(), 1u);
+        EXPECT_TRUE(is_ack(out.take(), 0));
+        faulty.abort_transfer();
+        faulty.handle(refused, out);
+        ASSERT_EQ(out.sent.size(), 1u);
+        EXPECT_EQ(error_code(out.take()), refused_code);
+    }
 };
 
 Bytes image_v(uint32_t version, std::size_t size = 1000) {
@@ -609,36 +626,15 @@ TEST_F(FoeServerSession, EveryWriteEndIsReportedOnceWithNameSizeAndResult) {
 
 // ---- Deliberate faults (foe/faults.hpp, `ecat-slave --fault`) ----------------------------------------
 
+// The two faults mirror each other: each takes the write it is about and still refuses the other one.
 TEST_F(FoeServerSession, FaultPasswordIgnoredAcceptsAWrongPassword) {
-    EXPECT_EQ(error_code(exchange(request(Opcode::Write, 0x1234, "MAXPOS"))), 0x800Au);  // clean: no rights
-    ServerConfig c = stepped();
-    c.faults.password_ignored = true;
-    FoeServer faulty(store, c);
-    faulty.on_state_change(od::AlState::Init, od::AlState::Boot);
-    faulty.handle(request(Opcode::Write, 0x1234, "MAXPOS"), out);
-    ASSERT_EQ(out.sent.size(), 1u);
-    EXPECT_TRUE(is_ack(out.take(), 0));
-    faulty.abort_transfer();
-    // An unknown file name is still refused.
-    faulty.handle(request(Opcode::Write, 0, "NOSUCHFILE"), out);
-    ASSERT_EQ(out.sent.size(), 1u);
-    EXPECT_EQ(error_code(out.take()), 0x8001u);
+    expect_fault_takes(&FoeFaults::password_ignored, request(Opcode::Write, 0x1234, "MAXPOS"), 0x800Au,
+                       request(Opcode::Write, 0, "NOSUCHFILE"), 0x8001u);
 }
 
 TEST_F(FoeServerSession, FaultAnyFileNameAcceptsAnUnknownFile) {
-    EXPECT_EQ(error_code(exchange(request(Opcode::Write, 0, "NOSUCHFILE"))), 0x8001u);  // clean: not found
-    ServerConfig c = stepped();
-    c.faults.any_file_name = true;
-    FoeServer faulty(store, c);
-    faulty.on_state_change(od::AlState::Init, od::AlState::Boot);
-    faulty.handle(request(Opcode::Write, 0, "NOSUCHFILE"), out);
-    ASSERT_EQ(out.sent.size(), 1u);
-    EXPECT_TRUE(is_ack(out.take(), 0));
-    faulty.abort_transfer();
-    // A wrong password is still refused.
-    faulty.handle(request(Opcode::Write, 0x1234, "MAXPOS"), out);
-    ASSERT_EQ(out.sent.size(), 1u);
-    EXPECT_EQ(error_code(out.take()), 0x800Au);
+    expect_fault_takes(&FoeFaults::any_file_name, request(Opcode::Write, 0, "NOSUCHFILE"), 0x8001u,
+                       request(Opcode::Write, 0x1234, "MAXPOS"), 0x800Au);
 }
 
 namespace {

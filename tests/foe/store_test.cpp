@@ -49,6 +49,24 @@ bool no_temp_files(const std::filesystem::path& dir) {
     return true;
 }
 
+// Forks a child that installs `image` into the store at dir and calls stop() (which ends it) before commit
+// step k. The child exits 3 if the store does not open, 2 if step k never came (the step list changed) unless
+// may_finish, then 0 for an installed image, 4 for a refused one. Returns the child's pid (-1: no fork).
+pid_t install_in_child(const std::filesystem::path& dir, const std::vector<uint8_t>& image, std::size_t k,
+                       void (*stop)(), bool may_finish) {
+    const pid_t child = ::fork();
+    if (child != 0) return child;
+    FirmwareStore s(config(dir));
+    if (!s.open()) ::_exit(3);
+    std::size_t count = 0;
+    s.set_step_hook([&](StoreStep) {
+        if (count++ == k) stop();
+    });
+    StoreError e = install(s, image);
+    if (!may_finish) ::_exit(2);
+    ::_exit(e.code == ErrorCode::NotDefined ? 0 : 4);
+}
+
 }  // namespace
 
 TEST(FoeStore, EmptyDirectoryHasNoActiveImage) {
@@ -198,18 +216,9 @@ TEST(FoeStore, KilledAtEveryStepLeavesABootableDevice) {
             ASSERT_TRUE(s.open());
             ASSERT_EQ(install(s, old_image).code, ErrorCode::NotDefined);
         }
-        const pid_t child = ::fork();
+        const pid_t child = install_in_child(
+            d.path, new_image, k, [] { ::_exit(0); }, false);
         ASSERT_GE(child, 0);
-        if (child == 0) {
-            FirmwareStore s(config(d.path));
-            if (!s.open()) ::_exit(3);
-            std::size_t count = 0;
-            s.set_step_hook([&](StoreStep) {
-                if (count++ == k) ::_exit(0);
-            });
-            install(s, new_image);
-            ::_exit(2);  // not killed: the step list changed
-        }
         int status = 0;
         ASSERT_EQ(::waitpid(child, &status, 0), child);
         ASSERT_TRUE(WIFEXITED(status));
@@ -363,19 +372,9 @@ TEST(FoeStore, FirstUpdateKilledAtEveryStepBootsOnlyWhatWasSwitchedTo) {
             "killed before step " + std::to_string(k) +
             (k < steps.size() ? " (" + std::string(to_string(steps[k])) + ")" : " (after the last)"));
         TempDir d;
-        const pid_t child = ::fork();
+        const pid_t child = install_in_child(
+            d.path, new_image, k, [] { ::kill(::getpid(), SIGKILL); }, k >= steps.size());
         ASSERT_GE(child, 0);
-        if (child == 0) {
-            FirmwareStore s(config(d.path));
-            if (!s.open()) ::_exit(3);
-            std::size_t count = 0;
-            s.set_step_hook([&](StoreStep) {
-                if (count++ == k) ::kill(::getpid(), SIGKILL);
-            });
-            StoreError e = install(s, new_image);
-            if (k < steps.size()) ::_exit(2);  // not killed: the step list changed
-            ::_exit(e.code == ErrorCode::NotDefined ? 0 : 4);
-        }
         int status = 0;
         ASSERT_EQ(::waitpid(child, &status, 0), child);
         if (k < steps.size()) {

@@ -169,6 +169,16 @@ class SdoAbortsThroughEcatctl(unittest.TestCase):
 class RawMailbox:
     """Mailbox messages as frames: FPWR of the whole SM0 buffer, FPRD of the whole SM1 buffer."""
 
+    @staticmethod
+    def on_started_slave():
+        """Slave.start()'s bus and a RawMailbox on it (the bus closed if the mailbox cannot be had)."""
+        bus = Slave.start()
+        try:
+            return bus, RawMailbox(bus)
+        except BaseException:
+            bus.close()
+            raise
+
     def __init__(self, bus):
         self.bus = bus
         self.sock = bus.raw_socket()
@@ -232,12 +242,7 @@ class CraftedRequests(unittest.TestCase):
 
     @classmethod
     def setUpClass(cls):
-        cls.bus = Slave.start()
-        try:
-            cls.mbx = RawMailbox(cls.bus)
-        except BaseException:
-            cls.bus.close()
-            raise
+        cls.bus, cls.mbx = RawMailbox.on_started_slave()
 
     @classmethod
     def tearDownClass(cls):

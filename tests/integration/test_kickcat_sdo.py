@@ -24,12 +24,7 @@ def kickcat_download(index, sub, data, complete_access=False):
 class KickCatDownloads(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.bus = Slave.start()
-        try:
-            cls.mbx = RawMailbox(cls.bus)
-        except BaseException:
-            cls.bus.close()
-            raise
+        cls.bus, cls.mbx = RawMailbox.on_started_slave()
         cls.counter = 0
 
     @classmethod

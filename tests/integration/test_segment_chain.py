@@ -48,17 +48,7 @@ class Chain(harness.Bus):
                                       self.out_iface, "--capture", self.capture, "--state-dir",
                                       os.path.join(self.dir, "state"), *self.slave_args],
                                      stdout=self._log, stderr=subprocess.STDOUT, start_new_session=True)
-        deadline = time.monotonic() + 10
-        while True:
-            for p in (self.proc, self.proc_b):
-                if p.poll() is not None:
-                    raise RuntimeError(f"ecat-slave exited with {p.returncode}: {self.slave_output()}")
-            r = self.ecatctl("--timeout", "20", "--retries", "0", "reg", "read", "0", "0", "1", check=False)
-            if r.returncode == 0:
-                return
-            if time.monotonic() > deadline:
-                raise RuntimeError(f"ecat-slave did not answer: {r.stderr} / {self.slave_output()}")
-            time.sleep(0.05)
+        self.wait_answering(self.proc, self.proc_b)
 
     def ns_ip(self, *args):
         return self._run("ip", "netns", "exec", self.ns, "ip", *args)

@@ -54,16 +54,22 @@ class SegmentFaults(unittest.TestCase):
         for pos in range(3):
             self.bus.ecatctl("download", str(pos), "0x6065", "0", str(0x1000 + pos), "--type", "u32")
 
-    def stats_file(self):
-        self.assertEqual(self.bus.stop_slave(), 0, self.bus.slave_output()[-3000:])
-        return harness.read_stats(self.stats)
-
-    def test_cable_pulled_and_plugged_back_mid_cycle(self):
+    def line_in_op(self):
+        """The line scanned, its parameters written and read back (the configuration of each drive), then in
+        OP with DC: the master and the configurations."""
         m = self.m
         m.scan()
         self.write_parameters()
         before = [self.configuration(pos) for pos in range(3)]
         m.to_op(dc=True)
+        return m, before
+
+    def stats_file(self):
+        self.assertEqual(self.bus.stop_slave(), 0, self.bus.slave_output()[-3000:])
+        return harness.read_stats(self.stats)
+
+    def test_cable_pulled_and_plugged_back_mid_cycle(self):
+        m, before = self.line_in_op()
         s = m.run(300)
         self.assertEqual((s["wkc_min"], s["wkc_max"]), (9, 9), s)
         # The cable between drive 2 and drive 3, pulled at drive 2's port 1: drive 2 closes the port (loop back).
@@ -142,11 +148,7 @@ class SegmentFaults(unittest.TestCase):
         self.assertEqual(sorted(cycles.values()), [0, 0, 1], stats)
 
     def test_five_percent_frame_loss_for_10000_cycles(self):
-        m = self.m
-        m.scan()
-        self.write_parameters()
-        before = [self.configuration(pos) for pos in range(3)]
-        m.to_op(dc=True)
+        m, before = self.line_in_op()
         self.control("drop 1 0.05")  # the cable into drive 2
         s = m.run(10000, timeout=0.01)
         self.control("clear")

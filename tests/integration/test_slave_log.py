@@ -44,12 +44,12 @@ class SlaveLog(unittest.TestCase):
     def test_state_change_refused_request_and_parameter_save_are_logged(self):
         with harness.Bus() as bus:
             refuse_op_from_init(bus)
-            self.assertTrue(wait_for(bus, "refused AL state request Init -> Op: AL status code 0x0011"),
+            self.assertTrue(wait_for(bus, "refused AL state request INIT -> OP: AL status code 0x0011"),
                             bus.slave_output())
             bus.ecatctl("reg", "write", "0", "0x0120", "0x11", "0x00")  # acknowledge, stay in Init
             bus.ecatctl("pd", "0", "-n", "20", "--cycle-us", "1000")  # up to Op and back to Pre-Op
-            self.assertTrue(wait_for(bus, "AL state Init -> Pre-Op"), bus.slave_output())
-            self.assertTrue(wait_for(bus, "AL state Safe-Op -> Op"), bus.slave_output())
+            self.assertTrue(wait_for(bus, "AL state INIT -> PREOP"), bus.slave_output())
+            self.assertTrue(wait_for(bus, "AL state SAFEOP -> OP"), bus.slave_output())
             bus.ecatctl("download", "0", "0x1010", "1", "0x65766173", "--type", "u32")
             self.assertTrue(wait_for(bus, "stored parameters saved (0x1010:1"), bus.slave_output())
             # The drive's diagnosis texts travel as text ids: ecatctl shows the whole text, once per message.
@@ -59,7 +59,7 @@ class SlaveLog(unittest.TestCase):
             for l in diag.splitlines():
                 self.assertLessEqual(l.count("Switch On Disabled"), 1, l)
             out = bus.slave_output()
-            self.assertNotIn("watchdog expired in Pre-Op", out)  # the watchdog after leaving Op is no news
+            self.assertNotIn("watchdog expired in PREOP", out)  # the watchdog after leaving Op is no news
             line = [l for l in out.splitlines() if "refused AL state request" in l][0]
             # Journal-friendly: program name, level, no colour codes when not on a terminal.
             self.assertTrue(line.startswith("ecat-slave: warning: "), line)
@@ -74,7 +74,7 @@ class SlaveLog(unittest.TestCase):
             self.assertEqual(bus.stop_slave(), 0)
             out = bus.slave_output()
             self.assertNotIn("refused AL state request", out)
-            self.assertNotIn("AL state Init -> Pre-Op", out)
+            self.assertNotIn("AL state INIT -> PREOP", out)
 
     def test_log_level_debug_adds_the_drive_states(self):
         with harness.Bus(slave_args=["--log-level", "debug"]) as bus:

@@ -88,18 +88,18 @@ class SlavesOption(unittest.TestCase):
         d = tempfile.mkdtemp(prefix="ecat-it-topo-", dir=os.environ.get("ECAT_TEST_OUT"))
         self.addCleanup(shutil.rmtree, d, True)
         topo = os.path.join(d, "bad.topo")
-        with open(topo, "w") as f:
-            f.write("# a line\ndevice a\ndevice b at=nowhere:1\n")
-        r = subprocess.run([harness.env_path("ECAT_SLAVE"), "--topology", topo, "--iface", "lo",
-                            "--state-dir", os.path.join(d, "state")],
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=60)
+
+        def run_with(text):
+            with open(topo, "w") as f:
+                f.write(text)
+            return subprocess.run([harness.env_path("ECAT_SLAVE"), "--topology", topo, "--iface", "lo",
+                                   "--state-dir", os.path.join(d, "state")],
+                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=60)
+
+        r = run_with("# a line\ndevice a\ndevice b at=nowhere:1\n")
         self.assertEqual(r.returncode, 2, r.stderr)
         self.assertIn(f"{topo}:3: at=nowhere:1: unknown device 'nowhere'", r.stderr)
-        with open(topo, "w") as f:
-            f.write("device a\ndevice b config=missing.conf\n")
-        r = subprocess.run([harness.env_path("ECAT_SLAVE"), "--topology", topo, "--iface", "lo",
-                            "--state-dir", os.path.join(d, "state")],
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=60)
+        r = run_with("device a\ndevice b config=missing.conf\n")
         self.assertEqual(r.returncode, 2, r.stderr)
         self.assertIn(f"{topo}:2: device b: ", r.stderr)
 

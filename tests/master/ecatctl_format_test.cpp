@@ -58,15 +58,6 @@ TEST(EcatctlFormat, HexDumpSixteenPerLine) {
     EXPECT_EQ(hex_dump(0, {}), "");
 }
 
-TEST(EcatctlFormat, SiiCrcCheckValue) {
-    // ETG.2010 SII CRC-8: poly 0x07, init 0xFF, no reflection, no final XOR. Its check
-    // value over "123456789" is 0xFB (the same polynomial with init 0x00, CRC-8/SMBUS, gives 0xF4).
-    const uint8_t check[] = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
-    EXPECT_EQ(sii_crc(check), 0xFB);
-    const uint8_t zeros[14] = {};
-    EXPECT_NE(sii_crc(zeros), 0xFF);
-}
-
 // `pd` / `pd --all` say why a run failed at its end (issue 25: SAFEOP+ERR after a watchdog, exit 0 before).
 TEST(EcatctlFormat, EndStateSaysTheStateTheErrorAndTheAlStatusCode) {
     EXPECT_EQ(end_state_text("SAFEOP", true, 0x001B, "Sync manager watchdog", "OP"),

@@ -121,7 +121,7 @@ TEST(SegmentRuntime, ThreeDrivesAreCountedAddressedAndTakenToPreOp) {
         EXPECT_EQ(bus.line->device(k)->stack().state(), od::AlState::PreOp) << k;
         EXPECT_TRUE(std::filesystem::is_directory(bus.dir.path / ("drive" + std::to_string(k + 1)))) << k;
     }
-    EXPECT_NE(bus.log_text.str().find("ecat-slave: drive2: AL state Init -> Pre-Op"), std::string::npos)
+    EXPECT_NE(bus.log_text.str().find("ecat-slave: drive2: AL state INIT -> PREOP"), std::string::npos)
         << bus.log_text.str();
 }
 

@@ -80,6 +80,13 @@ TEST(Lex, ValueTextKeepsBareWordsOrOneQuotedWord) {
     EXPECT_THROW(util::value_text(R"("a" b)"), util::LexError);
 }
 
+TEST(Lex, TrimBlanksDropsSpaceTabAndCrAtBothEnds) {
+    EXPECT_EQ(util::trim_blanks(" \t key = v \r"), "key = v");
+    EXPECT_EQ(util::trim_blanks("a b"), "a b");
+    EXPECT_EQ(util::trim_blanks(" \t\r "), "");
+    EXPECT_EQ(util::trim_blanks("\nx\n"), "\nx\n");  // a newline is not a blank
+}
+
 TEST(Lex, KeyValue) {
     const auto kv = util::key_value("at=a:1");
     ASSERT_TRUE(kv);

@@ -133,6 +133,16 @@ bool to_init(master::Master& m) {
     return false;
 }
 
+// Waits for the slave, then reads its identity (vendor, product) from the SII: "" or why not.
+std::string slave_identity(master::Master& m, const std::filesystem::path& log, foe::ImageIdentity& who) {
+    if (!wait_for_slave(m)) return "the slave does not answer: " + read_text(log);
+    uint8_t id[8];
+    if (Error e = m.sii_read(kSlave, master::sii::VendorId, id); e != Error::Ok)
+        return std::string("SII identity: ") + err(e);
+    who = {util::get32(id), util::get32(id + 4)};
+    return {};
+}
+
 struct Throughput {
     unsigned mailbox = 0;
     std::size_t bytes = 0;
@@ -153,16 +163,8 @@ void measure_throughput(const Options& o, unsigned size, const std::filesystem::
         log.string());
     auto link = esc::open_link(kMasterEnd, o.backend);
     master::Master m(*link);
-    if (!wait_for_slave(m)) {
-        r.failure = "the slave does not answer: " + read_text(log);
-        return;
-    }
-    uint8_t id[8];
-    if (Error e = m.sii_read(kSlave, master::sii::VendorId, id); e != Error::Ok) {
-        r.failure = std::string("SII identity: ") + err(e);
-        return;
-    }
-    const foe::ImageIdentity who{util::get32(id), util::get32(id + 4)};
+    foe::ImageIdentity who{};
+    if (r.failure = slave_identity(m, log, who); !r.failure.empty()) return;
     std::vector<uint8_t> payload(o.bytes > foe::kImageHeaderSize ? o.bytes - foe::kImageHeaderSize : 1);
     for (std::size_t i = 0; i < payload.size(); ++i)
         payload[i] = static_cast<uint8_t>(i * 7 + (i >> 9));
@@ -245,16 +247,7 @@ void measure_update(const Options& o, const std::filesystem::path& dir, UpdateTi
     {
         auto link = esc::open_link(kMasterEnd, o.backend);
         master::Master m(*link);
-        if (!wait_for_slave(m)) {
-            r.failure = "the slave does not answer: " + read_text(log);
-            return;
-        }
-        uint8_t id[8];
-        if (Error e = m.sii_read(kSlave, master::sii::VendorId, id); e != Error::Ok) {
-            r.failure = std::string("SII identity: ") + err(e);
-            return;
-        }
-        who = {util::get32(id), util::get32(id + 4)};
+        if (r.failure = slave_identity(m, log, who); !r.failure.empty()) return;
     }
     std::vector<uint8_t> payload(o.update_bytes - foe::kImageHeaderSize);
     for (std::size_t i = 0; i < payload.size(); ++i)

@@ -65,6 +65,21 @@ void measure(esc::Link& link, std::vector<uint8_t>& frame, std::vector<uint8_t>&
     }
 }
 
+// The figures of (a) the bare echo and (b) ecat-slave: each distribution, its tail, the losses, the ratio.
+void print_echo_vs_slave(const std::vector<uint64_t>& rtt_echo, std::size_t lost_echo,
+                         const std::vector<uint64_t>& rtt_slave, std::size_t lost_slave) {
+    const bench::Summary se = bench::summarize(rtt_echo);
+    const bench::Summary ss = bench::summarize(rtt_slave);
+    bench::print("(a) bare echo", se, "us", 1000.0);
+    bench::print("(b) ecat-slave", ss, "us", 1000.0);
+    bench::print_tail("tail (a) bare echo", se);
+    bench::print_tail("tail (b) ecat-slave", ss);
+    std::printf("lost: echo %zu, slave %zu\n", lost_echo, lost_slave);
+    if (se.median > 0 && se.p99 > 0)
+        std::printf("ratio slave/echo: median %.3f  p99 %.3f  (target < 1.2)\n", ss.median / se.median,
+                    ss.p99 / se.p99);
+}
+
 // --same-pair: (a) and (b) on the same veth pair, one after the other, in alternating blocks (the echo and
 // the slave are restarted for each block) so that both see the same load on average.
 int run_same_pair(std::size_t frames, const std::string& backend, const std::string& slave_path,
@@ -100,20 +115,11 @@ int run_same_pair(std::size_t frames, const std::string& backend, const std::str
             wkc_lrw = bench::datagram_wkc(rx, 0);
         }
     }
-    const bench::Summary se = bench::summarize(rtt_echo);
-    const bench::Summary ss = bench::summarize(rtt_slave);
     std::printf(
         "bench-rtt: backend %s, same veth pair, %zu frames of %zu bytes in %zu alternating blocks; "
         "last slave reply LRW wkc %d\n",
         backend.c_str(), frames, frame.size(), kBlocks, wkc_lrw);
-    bench::print("(a) bare echo", se, "us", 1000.0);
-    bench::print("(b) ecat-slave", ss, "us", 1000.0);
-    bench::print_tail("tail (a) bare echo", se);
-    bench::print_tail("tail (b) ecat-slave", ss);
-    std::printf("lost: echo %zu, slave %zu\n", lost_echo, lost_slave);
-    if (se.median > 0 && se.p99 > 0)
-        std::printf("ratio slave/echo: median %.3f  p99 %.3f  (target < 1.2)\n", ss.median / se.median,
-                    ss.p99 / se.p99);
+    print_echo_vs_slave(rtt_echo, lost_echo, rtt_slave, lost_slave);
     return 0;
 }
 
@@ -244,14 +250,7 @@ int main(int argc, char** argv) {
         std::printf(
             "bench-rtt: backend %s, %zu frames of %zu bytes, interleaved; last slave reply LRW wkc %d\n",
             backend.c_str(), frames, frame.size(), wkc_lrw);
-        bench::print("(a) bare echo", se, "us", 1000.0);
-        bench::print("(b) ecat-slave", ss, "us", 1000.0);
-        bench::print_tail("tail (a) bare echo", se);
-        bench::print_tail("tail (b) ecat-slave", ss);
-        std::printf("lost: echo %zu, slave %zu\n", lost_echo, lost_slave);
-        if (se.median > 0 && se.p99 > 0)
-            std::printf("ratio slave/echo: median %.3f  p99 %.3f  (target < 1.2)\n", ss.median / se.median,
-                        ss.p99 / se.p99);
+        print_echo_vs_slave(rtt_echo, lost_echo, rtt_slave, lost_slave);
         if (!slave.alive()) std::printf("warning: ecat-slave exited during the run\n");
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench-rtt: %s\n", e.what());

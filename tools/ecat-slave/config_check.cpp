@@ -12,14 +12,6 @@ namespace ecat_slave {
 
 namespace {
 
-std::string_view trim(std::string_view s) {
-    while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r'))
-        s.remove_prefix(1);
-    while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r'))
-        s.remove_suffix(1);
-    return s;
-}
-
 bool device_section(std::string_view name) {
     return name == "identity" || name == "mailbox" || name == "bootstrap_mailbox" || name == "eeprom";
 }
@@ -55,13 +47,13 @@ std::string check_config_file(const CLI::App& app, const std::string& path) {
         ++line;
         if (const std::string e = util::text_error(raw); !e.empty())
             return at(e + "; --config takes a text file");
-        const std::string_view l = trim(raw);
+        const std::string_view l = util::trim_blanks(raw);
         if (l.empty() || l.front() == '#' || l.front() == ';') continue;
         if (l.front() == '[') {
             const auto close = l.find(']');
             if (close == std::string_view::npos)
                 return at("section header '" + std::string(l) + "' without ']'");
-            section = std::string(trim(l.substr(1, close - 1)));
+            section = std::string(util::trim_blanks(l.substr(1, close - 1)));
             if (section == "default") section.clear();
             if (!section.empty() && !device_section(section))
                 return at("unknown section [" + section +
@@ -72,7 +64,7 @@ std::string check_config_file(const CLI::App& app, const std::string& path) {
         if (!section.empty()) continue;  // a device section: maxpos::parse_config checks it below
         const auto eq = l.find('=');
         if (eq == std::string_view::npos) return at("expected 'option = value'");
-        std::string key(trim(l.substr(0, eq)));
+        std::string key(util::trim_blanks(l.substr(0, eq)));
         std::string dashed = key;
         for (char& c : dashed)
             if (c == '_') c = '-';

@@ -14,6 +14,14 @@ bool blank(char c) {
 
 }  // namespace
 
+std::string_view trim_blanks(std::string_view s) {
+    while (!s.empty() && blank(s.front()))
+        s.remove_prefix(1);
+    while (!s.empty() && blank(s.back()))
+        s.remove_suffix(1);
+    return s;
+}
+
 std::string text_error(std::string_view l) {
     for (std::size_t i = 0; i < l.size(); ++i) {
         const auto c = static_cast<unsigned char>(l[i]);

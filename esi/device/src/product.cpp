@@ -15,6 +15,7 @@
 
 #include "esc/wire/sii.hpp"
 #include "esi/sii.hpp"
+#include "esi/slots.hpp"
 
 namespace esi {
 namespace {
@@ -509,8 +510,8 @@ od::Product load_product(const std::string& path, const std::string& spec) {
 namespace {
 
 // The module of each slot a "@MODULES" list names (load_product(file, spec)).
-std::vector<std::optional<uint32_t>> slot_modules(const EsiFile& file, const EsiDevice& d,
-                                                  const std::string& list) {
+std::vector<std::optional<uint32_t>> parse_module_list(const EsiFile& file, const EsiDevice& d,
+                                                       const std::string& list) {
     std::vector<std::string> items;
     std::size_t from = 0;
     for (;;) {
@@ -565,14 +566,11 @@ od::Product load_product(const EsiFile& file, const std::string& spec) {
     const EsiDevice& d = select_device(file, spec);
     const std::size_t at = spec.find('@');
     if (at == std::string::npos) return load_product(file, d);
-    return load_product(file, d, slot_modules(file, d, spec.substr(at + 1)));
+    return load_product(file, d, parse_module_list(file, d, spec.substr(at + 1)));
 }
 
 od::Product load_product(const EsiFile& file, const EsiDevice& d) {
-    std::vector<std::optional<uint32_t>> defaults;
-    for (const EsiSlot& slot : d.slots)
-        defaults.push_back(slot.default_module);
-    return load_product(file, d, defaults);
+    return load_product(file, d, default_modules(d));
 }
 
 od::Product load_product(const EsiFile& file, const EsiDevice& d,
@@ -761,37 +759,26 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
     std::map<uint16_t, std::pair<EsiObject, std::string>> module_objects;  // with the slot's increment
     std::string module_list;
     bool chosen = false;  // a configuration other than the default
-    for (std::size_t n = 0; n < d.slots.size(); ++n) {
-        const EsiSlot& slot = d.slots[n];
-        const std::optional<uint32_t> ident = n < modules.size() ? modules[n] : std::nullopt;
-        if (ident != slot.default_module) chosen = true;
-        if (!ident) continue;
-        const EsiModule* m = file.module(*ident);
+    for (std::size_t n = 0; n < d.slots.size(); ++n)
+        if ((n < modules.size() ? modules[n] : std::nullopt) != d.slots[n].default_module) chosen = true;
+    for (const SlotModule& sm : slot_modules(file, d, modules)) {
+        const std::size_t n = sm.slot;
+        const EsiModule* m = sm.module;
         if (m == nullptr) {
-            ctx.warn(slot.line, "slot " + std::to_string(n + 1) + ": module " + hex(*ident, 8) +
-                                    " is not in Descriptions/Modules; the slot is left empty");
+            ctx.warn(sm.esi_slot->line, "slot " + std::to_string(n + 1) + ": module " + hex(sm.ident, 8) +
+                                            " is not in Descriptions/Modules; the slot is left empty");
             continue;
         }
-        const uint32_t pdo_inc = slot.pdo_increment.value_or(d.slot_pdo_increment);
-        const uint32_t idx_inc = slot.index_increment.value_or(d.slot_index_increment);
         module_list += (module_list.empty() ? "" : ", ") + std::to_string(n + 1) + ": " + m->type_name;
-        for (const auto* list : {&m->rxpdos, &m->txpdos})
-            for (const EsiPdo& p : *list) {
-                Pdo x{&p, static_cast<uint16_t>(p.index + (p.depend_on_slot ? n * pdo_inc : 0)), p.entries,
-                      p.sm, m->type_name};
-                for (EsiPdoEntry& e : x.entries)
-                    if (e.depend_on_slot && e.index != 0)
-                        e.index = static_cast<uint16_t>(e.index + n * idx_inc);
-                pdos.push_back(std::move(x));
-            }
-        for (const auto& [index, o] : m->objects) {
-            const auto at = static_cast<uint16_t>(index + (o.depend_on_slot ? n * idx_inc : 0));
-            if (module_objects.count(at) || d.object(at)) {
-                ctx.warn(o.line, "module " + m->type_name + " in slot " + std::to_string(n + 1) +
-                                     ": object " + hex(at) + " exists already; the first is used");
+        for (const SlotPdo& p : sm.pdos)
+            pdos.push_back(Pdo{p.esi, p.index, p.entries, p.esi->sm, m->type_name});
+        for (const SlotObject& o : sm.objects) {
+            if (module_objects.count(o.index) || d.object(o.index)) {
+                ctx.warn(o.esi->line, "module " + m->type_name + " in slot " + std::to_string(n + 1) +
+                                          ": object " + hex(o.index) + " exists already; the first is used");
                 continue;
             }
-            module_objects[at] = {o, m->type_name};
+            module_objects[o.index] = {*o.esi, m->type_name};
         }
     }
     // The slots and the modules they take, for the ESI written back.

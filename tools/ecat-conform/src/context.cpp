@@ -7,6 +7,7 @@
 
 #include "conform.hpp"
 #include "esc/wire/sii.hpp"
+#include "esi/slots.hpp"
 #include "util/le.hpp"
 #include "util/strfmt.hpp"
 
@@ -155,31 +156,23 @@ void assign_by_default(EsiDevice& d, const EsiPdo& p) {
 // objects of the modules' PDOs (0x1600.../0x1A00..., ETG.1000.6 PDO mapping) exist in the device's dictionary
 // although a module's own Dictionary does not list them: they go to mapping_objects.
 EsiDevice as_configured(const EsiFile& f, EsiDevice d, std::set<uint16_t>& mapping_objects) {
-    for (std::size_t n = 0; n < d.slots.size(); ++n) {
-        const esi::EsiSlot& slot = d.slots[n];
-        if (!slot.default_module) continue;
-        const esi::EsiModule* m = f.module(*slot.default_module);
-        if (m == nullptr) continue;
-        const uint32_t pdo_inc = slot.pdo_increment.value_or(d.slot_pdo_increment);
-        const uint32_t idx_inc = slot.index_increment.value_or(d.slot_index_increment);
-        for (const auto* list : {&m->rxpdos, &m->txpdos})
-            for (EsiPdo p : *list) {
-                if (p.depend_on_slot) p.index = static_cast<uint16_t>(p.index + n * pdo_inc);
-                for (EsiPdoEntry& e : p.entries)
-                    if (e.depend_on_slot && e.index != 0)
-                        e.index = static_cast<uint16_t>(e.index + n * idx_inc);
-                if (!d.objects.count(p.index) && !m->objects.count(p.index)) mapping_objects.insert(p.index);
-                if (p.sm >= 0) assign_by_default(d, p);
-                (p.rx ? d.rxpdos : d.txpdos).push_back(std::move(p));
-            }
-        for (const auto& [index, o] : m->objects) {
-            const auto at = static_cast<uint16_t>(index + (o.depend_on_slot ? n * idx_inc : 0));
-            if (!d.objects.count(at)) {
-                EsiObject x = o;
-                x.index = at;
-                d.objects[at] = std::move(x);
-            }
+    for (const esi::SlotModule& sm : esi::default_slot_modules(f, d)) {
+        if (sm.module == nullptr) continue;
+        for (const esi::SlotPdo& sp : sm.pdos) {
+            EsiPdo p = *sp.esi;
+            p.index = sp.index;
+            p.entries = sp.entries;
+            if (!d.objects.count(p.index) && !sm.module->objects.count(p.index))
+                mapping_objects.insert(p.index);
+            if (p.sm >= 0) assign_by_default(d, p);
+            (p.rx ? d.rxpdos : d.txpdos).push_back(std::move(p));
         }
+        for (const esi::SlotObject& o : sm.objects)
+            if (!d.objects.count(o.index)) {
+                EsiObject x = *o.esi;
+                x.index = o.index;
+                d.objects[o.index] = std::move(x);
+            }
     }
     return d;
 }
@@ -311,25 +304,25 @@ std::string Context::need_dc() const {
     if (sii && sii->find(60)) return {};
     return "no DC announced (no ESI Dc element, no SII DC category)";
 }
-std::string Context::need_sdo_info() const {
-    if (auto r = need_coe(); !r.empty()) return r;
-    if (esi) return esi->coe.sdo_info ? "" : "the ESI does not announce SdoInfo";
-    if (sii) {
-        if (const auto* g = sii->find(30); g && g->length > 5)
-            return (sii->bytes[g->offset + 5] & 0x02) ? ""
-                                                      : "SII general category: SDO information not announced";
+// A CoE detail: announced by the ESI's CoE attribute `attribute` (when an ESI is given), else by bit sii_bit
+// of the CoE details byte of the SII's General category (byte 5). "" when announced, else why not.
+static std::string need_coe_detail(const Context& c, bool EsiCoe::*flag, const char* attribute,
+                                   uint8_t sii_bit, const std::string& what) {
+    if (auto r = c.need_coe(); !r.empty()) return r;
+    if (c.esi) return c.esi->coe.*flag ? "" : std::string("the ESI does not announce ") + attribute;
+    if (c.sii) {
+        if (const auto* g = c.sii->find(30); g && g->length > 5)
+            return (c.sii->bytes[g->offset + 5] & sii_bit)
+                       ? ""
+                       : "SII general category: " + what + " not announced";
     }
-    return "SDO information not announced";
+    return what + " not announced";
+}
+std::string Context::need_sdo_info() const {
+    return need_coe_detail(*this, &EsiCoe::sdo_info, "SdoInfo", 0x02, "SDO information");
 }
 std::string Context::need_complete_access() const {
-    if (auto r = need_coe(); !r.empty()) return r;
-    if (esi) return esi->coe.complete_access ? "" : "the ESI does not announce CompleteAccess";
-    if (sii) {
-        if (const auto* g = sii->find(30); g && g->length > 5)
-            return (sii->bytes[g->offset + 5] & 0x20) ? ""
-                                                      : "SII general category: complete access not announced";
-    }
-    return "complete access not announced";
+    return need_coe_detail(*this, &EsiCoe::complete_access, "CompleteAccess", 0x20, "complete access");
 }
 std::string Context::need_402() const {
     if (auto r = need_coe(); !r.empty()) return r;

@@ -111,6 +111,12 @@ inline std::vector<EntryRef> esi_entries(const EsiDevice& d) {
             v.push_back({&o, &e});
     return v;
 }
+// An index of the manufacturer range the ESI has no object at (from 0x5FFE down; 0x5FFE without an ESI).
+inline uint16_t missing_index(Context& ctx) {
+    for (uint16_t i = 0x5FFE; i > 0x2000; --i)
+        if (!ctx.esi || !ctx.esi->object(i)) return i;
+    return 0x5FFE;
+}
 inline bool command_object(uint16_t index) {
     // Store/restore parameters (signature commands), diagnosis history, PDO mapping/assignment: writing
     // them has effects beyond the value; tests of plain entries leave them out.

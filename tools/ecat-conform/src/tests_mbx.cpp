@@ -80,9 +80,8 @@ void add_mbx_tests(Catalogue& c) {
     Adder add{c, "mbx"};
     add(
         "counter.repeat_not_executed", "A request repeating the previous counter is not executed again", kMbx,
+        {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             ctx.mbx_resync();
             auto p = upload_1000();
             auto r0 = ask(ctx, message(3, 0, p), ctx.ms(500));
@@ -97,9 +96,8 @@ void add_mbx_tests(Catalogue& c) {
         "CoE");
     add(
         "counter.next_executed", "After a dropped repeat, the next counter is executed", kMbx,
+        {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             ctx.mbx_resync();
             auto p = upload_1000();
             (void)ask(ctx, message(3, 0, p), ctx.ms(500));
@@ -112,10 +110,8 @@ void add_mbx_tests(Catalogue& c) {
         },
         "CoE");
     add(
-        "counter.wraps", "Counters 1..7 then 1 again are all executed", kMbx,
+        "counter.wraps", "Counters 1..7 then 1 again are all executed", kMbx, {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             ctx.mbx_resync();
             auto p = upload_1000();
             (void)ask(ctx, message(3, 0, p), ctx.ms(500));
@@ -132,10 +128,8 @@ void add_mbx_tests(Catalogue& c) {
     add(
         "response.counter",
         "Slave replies carry counters 1..7, each new reply another counter than the one before (never stuck)",
-        kMbx,
+        kMbx, {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             ctx.mbx_resync();
             auto p = upload_1000();
             std::vector<int> seen;
@@ -164,9 +158,8 @@ void add_mbx_tests(Catalogue& c) {
     add(
         "response.header",
         "Reply header: length within SM1, channel and reserved bits 0, type CoE (3) for a CoE request", kMbx,
+        {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             ctx.mbx_resync();
             auto a = ask(ctx, message(3, 0, upload_1000()), ctx.ms(500));
             ctx.mbx_resync();
@@ -184,10 +177,8 @@ void add_mbx_tests(Catalogue& c) {
     add(
         "sm.status",
         "SM0/SM1 status (0x0805/0x080D): reserved bit 2 clear; SM1 mailbox full only while a reply waits",
-        kSmStatus,
+        kSmStatus, {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             ctx.mbx_resync();
             const uint16_t sm0 = master::reg::Sm0 + 5, sm1 = master::reg::Sm0 + 8 + 5;
             auto idle0 = ctx.rd<uint8_t>(sm0);
@@ -220,9 +211,8 @@ void add_mbx_tests(Catalogue& c) {
         "CoE");
     add(
         "repeat.request", "Repeat request (SM1 toggle) puts the last response back, identical", kRepeat,
+        {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             ctx.mbx_resync();
             auto first = ask(ctx, message(3, 0, upload_1000()), ctx.ms(500));
             if (first.empty()) {
@@ -259,10 +249,8 @@ void add_mbx_tests(Catalogue& c) {
         "CoE");
     add(
         "sm1.empty_read", "Reading an empty SM1 mailbox: working counter 0",
-        "ETG.1000.4 SyncManager mailbox mode (read of an empty buffer)",
+        "ETG.1000.4 SyncManager mailbox mode (read of an empty buffer)", {&Context::need_mailbox},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_mailbox());
-            CONFORM_PREOP(ctx);
             ctx.mbx_resync();
             const auto& cfg = ctx.mbx->config();
             std::vector<uint8_t> buf(cfg.in_size);
@@ -273,10 +261,8 @@ void add_mbx_tests(Catalogue& c) {
         "mailbox slave");
     add(
         "sm0.partial_write", "A write that does not reach the end of SM0 is not taken as a request",
-        "ETG.1000.4 SyncManager mailbox mode (buffer written completely)",
+        "ETG.1000.4 SyncManager mailbox mode (buffer written completely)", {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             ctx.mbx_resync();
             auto m = message(3, 0, upload_1000());
             const auto& cfg = ctx.mbx->config();
@@ -356,9 +342,8 @@ void add_mbx_tests(Catalogue& c) {
         "CoE", Severity::Warning);
     add(
         "mailbox_after_error", "After a mailbox error, a correct request is answered normally", kMbx,
+        {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             ctx.mbx_resync();
             uint8_t p[8] = {};
             (void)ask(ctx, message(0x06, 0, p), ctx.ms(300));

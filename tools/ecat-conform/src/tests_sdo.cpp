@@ -37,12 +37,6 @@ const EntryRef* pick_rw(Context& ctx, std::vector<EntryRef>& store, unsigned bit
     return nullptr;
 }
 
-uint16_t missing_index(Context& ctx) {
-    for (uint16_t i = 0x5FFE; i > 0x2000; --i)
-        if (!ctx.esi || !ctx.esi->object(i)) return i;
-    return 0x5FFE;
-}
-
 Outcome identity(Context& ctx, uint8_t sub, std::size_t word) {
     CONFORM_NEED(ctx.need_coe());
     CONFORM_PREOP(ctx);
@@ -152,9 +146,8 @@ void add_sdo_tests(Catalogue& c) {
     Adder add{c, "sdo"};
     add(
         "upload.expedited", "Expedited upload of 0x1000: response 0x43 with the 4 bytes", kSdo,
+        {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             SdoAnswer a = sdo_raw(ctx, sdo_req(0x40, 0x1000, 0));
             if (Outcome o = expect_response(a, 2, 0x1000, 0, false, "0x1000"); o.status != Status::Pass)
                 return o;
@@ -168,10 +161,8 @@ void add_sdo_tests(Catalogue& c) {
         "upload.response_fields",
         "Upload responses of 0x1000, 0x1008, 0x1018:00-04, 0x1C00, 0x1C12, 0x1C13 entries: every field as "
         "the request (index, subindex, specifier, service, length)",
-        kSdo,
+        kSdo, {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             const std::pair<uint16_t, uint8_t> probes[] = {
                 {0x1000, 0}, {0x1008, 0}, {0x1018, 0}, {0x1018, 1}, {0x1018, 2}, {0x1018, 3}, {0x1018, 4},
                 {0x1C00, 0}, {0x1C00, 1}, {0x1C00, 2}, {0x1C12, 0}, {0x1C13, 0}, {0x1C12, 1}, {0x1C13, 1}};
@@ -189,10 +180,8 @@ void add_sdo_tests(Catalogue& c) {
         "CoE");
     add(
         "upload.normal", "Normal upload of an object of 5..mailbox bytes: size indicated, data complete",
-        kSdo,
+        kSdo, {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             uint16_t idx = 0x1008;
             uint8_t sub = 0;
             std::size_t want = 0;
@@ -224,10 +213,8 @@ void add_sdo_tests(Catalogue& c) {
     add(
         "upload.segmented",
         "Segmented upload of an object larger than the mailbox: complete, toggles alternate", kSdo,
+        {&Context::need_coe, &Context::need_esi},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_NEED(ctx.need_esi());
-            CONFORM_PREOP(ctx);
             auto b = big_object(ctx);
             if (!b) return skip("no object larger than the mailbox in the ESI");
             auto r = ctx.upload(b->index, b->sub, b->ca);
@@ -239,10 +226,8 @@ void add_sdo_tests(Catalogue& c) {
         "ESI with an object larger than the mailbox");
     add(
         "upload.toggle_error", "Upload segment request with the wrong toggle bit: abort 0x05030000", kAbort,
+        {&Context::need_coe, &Context::need_esi},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_NEED(ctx.need_esi());
-            CONFORM_PREOP(ctx);
             auto b = big_object(ctx);
             if (!b) return skip("no object larger than the mailbox in the ESI");
             SdoAnswer a =
@@ -259,10 +244,8 @@ void add_sdo_tests(Catalogue& c) {
         "ESI with an object larger than the mailbox");
     add(
         "upload.toggle_sequence", "Segmented upload responses alternate the toggle bit from 0", kSdo,
+        {&Context::need_coe, &Context::need_esi},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_NEED(ctx.need_esi());
-            CONFORM_PREOP(ctx);
             auto b = big_object(ctx);
             if (!b) return skip("no object larger than the mailbox in the ESI");
             SdoAnswer a =
@@ -291,32 +274,37 @@ void add_sdo_tests(Catalogue& c) {
             return pass("segments", dec(static_cast<long long>(size)) + " bytes");
         },
         "ESI with an object larger than the mailbox");
+    // A writable entry downloaded with its own value, in each of the four ways (download_own_value).
+    const struct {
+        const char* id;
+        const char* title;
+        const char* clause;
+        Download how;
+    } downloads[] = {
+        {"download.expedited", "Expedited download of a writable entry (its own value): response 0x60", kSdo,
+         Download::Expedited},
+        {"download.normal", "Normal (size-indicated) download of a writable entry: response 0x60", kSdo,
+         Download::Normal},
+        {"download.segmented", "Segmented download (initiate, then a last segment): value taken", kSdo,
+         Download::Segmented},
+        {"download.toggle_error", "Download segment with the wrong toggle bit: abort 0x05030000", kAbort,
+         Download::WrongToggle},
+    };
+    for (const auto& d : downloads)
+        add(
+            d.id, d.title, d.clause, [how = d.how](Context& ctx) { return download_own_value(ctx, how); },
+            "ESI given");
     add(
-        "download.expedited", "Expedited download of a writable entry (its own value): response 0x60", kSdo,
-        [](Context& ctx) { return download_own_value(ctx, Download::Expedited); }, "ESI given");
-    add(
-        "download.normal", "Normal (size-indicated) download of a writable entry: response 0x60", kSdo,
-        [](Context& ctx) { return download_own_value(ctx, Download::Normal); }, "ESI given");
-    add(
-        "download.segmented", "Segmented download (initiate, then a last segment): value taken", kSdo,
-        [](Context& ctx) { return download_own_value(ctx, Download::Segmented); }, "ESI given");
-    add(
-        "download.toggle_error", "Download segment with the wrong toggle bit: abort 0x05030000", kAbort,
-        [](Context& ctx) { return download_own_value(ctx, Download::WrongToggle); }, "ESI given");
-    add(
-        "abort.missing_object", "Upload of a missing object: abort 0x06020000", kAbort,
+        "abort.missing_object", "Upload of a missing object: abort 0x06020000", kAbort, {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             const uint16_t i = missing_index(ctx);
             return expect_abort(sdo_raw(ctx, sdo_req(0x40, i, 0)), i, 0, {0x06020000}, "upload " + hex(i));
         },
         "CoE");
     add(
         "abort.missing_object_download", "Download to a missing object: abort 0x06020000", kAbort,
+        {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             const uint16_t i = missing_index(ctx);
             return expect_abort(sdo_raw(ctx, sdo_req(0x2F, i, 0, 1)), i, 0, {0x06020000},
                                 "download " + hex(i));
@@ -324,9 +312,8 @@ void add_sdo_tests(Catalogue& c) {
         "CoE");
     add(
         "abort.missing_subindex", "Upload of a missing subindex of 0x1018: abort 0x06090011", kAbort,
+        {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             auto n = ctx.upload_uint(0x1018, 0);
             if (!n) return fail("0x1018:00 upload: " + ctx.sdo_error(n.error()));
             const uint8_t s = static_cast<uint8_t>(*n + 1);
@@ -336,9 +323,8 @@ void add_sdo_tests(Catalogue& c) {
         "CoE");
     add(
         "abort.write_read_only", "Download to the read-only 0x1018:01: abort 0x06010002", kAbort,
+        {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             auto v = ctx.upload_uint(0x1018, 1);
             if (!v) return fail("0x1018:01 upload: " + ctx.sdo_error(v.error()));
             return expect_abort(sdo_raw(ctx, sdo_req(0x23, 0x1018, 1, static_cast<uint32_t>(*v))), 0x1018, 1,
@@ -348,9 +334,8 @@ void add_sdo_tests(Catalogue& c) {
     add(
         "abort.command_byte_download",
         "Abort of a failed download: command byte 0x80, index and subindex echoed", kAbort,
+        {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             SdoAnswer a = sdo_raw(ctx, sdo_req(0x23, 0x1018, 1, 0));
             if (a.error != Error::Ok || a.mailbox_type != 3 || a.p.size() < 10)
                 return fail("no answer", a.describe());
@@ -363,10 +348,8 @@ void add_sdo_tests(Catalogue& c) {
         "CoE");
     add(
         "abort.command_byte_upload", "Abort of a failed upload: command byte 0x80, index and subindex echoed",
-        kAbort,
+        kAbort, {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             const uint16_t i = missing_index(ctx);
             SdoAnswer a = sdo_raw(ctx, sdo_req(0x40, i, 3));
             if (a.error != Error::Ok || a.mailbox_type != 3 || a.p.size() < 10)
@@ -380,9 +363,8 @@ void add_sdo_tests(Catalogue& c) {
         "CoE");
     add(
         "abort.unknown_command", "Request with client command specifier 7: abort 0x05040001", kAbort,
+        {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             return expect_abort(sdo_raw(ctx, sdo_req(0xE0, 0x1000, 0)), 0x1000, 0, {0x05040001},
                                 "command 0xe0");
         },
@@ -390,10 +372,8 @@ void add_sdo_tests(Catalogue& c) {
     add(
         "abort.length_too_long",
         "Download of more bytes than the entry holds: abort 0x06070012 (or 0x06070010)", kAbort,
+        {&Context::need_coe, &Context::need_esi},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_NEED(ctx.need_esi());
-            CONFORM_PREOP(ctx);
             std::vector<EntryRef> st;
             const EntryRef* r = pick_rw(ctx, st, 8, 16);
             if (!r) return skip("no writable 1..2-byte entry in the ESI");
@@ -405,10 +385,8 @@ void add_sdo_tests(Catalogue& c) {
     add(
         "abort.length_too_short",
         "Download of fewer bytes than the entry holds: abort 0x06070013 (or 0x06070010)", kAbort,
+        {&Context::need_coe, &Context::need_esi},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_NEED(ctx.need_esi());
-            CONFORM_PREOP(ctx);
             std::vector<EntryRef> st;
             const EntryRef* r = pick_rw(ctx, st, 32, 32);
             if (!r) return skip("no writable 4-byte entry in the ESI");
@@ -507,10 +485,8 @@ void add_sdo_tests(Catalogue& c) {
     }
     add(
         "device_type_vs_esi", "0x1000 device type equals the ESI's default", kOd,
+        {&Context::need_coe, &Context::need_esi},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_NEED(ctx.need_esi());
-            CONFORM_PREOP(ctx);
             const EsiObject* o = ctx.esi->object(0x1000);
             if (!o || o->entries.empty() || o->entries[0].default_data.size() < 4)
                 return skip("no 0x1000 default in the ESI");
@@ -521,10 +497,8 @@ void add_sdo_tests(Catalogue& c) {
         "ESI given");
     add(
         "sm_types", "0x1C00 SM communication types equal the SII SyncM types",
-        "ETG.1000.6 0x1C00 sync manager communication type",
+        "ETG.1000.6 0x1C00 sync manager communication type", {&Context::need_coe},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_PREOP(ctx);
             const SiiCategory* sm = ctx.sii->find(41);
             if (!sm) return skip("no SII SyncM category");
             auto n = ctx.upload_uint(0x1C00, 0);
@@ -541,10 +515,8 @@ void add_sdo_tests(Catalogue& c) {
         "CoE");
     add(
         "od.present", "Every object of the ESI answers an upload of subindex 0 (or of its only entry)", kOd,
+        {&Context::need_coe, &Context::need_esi},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_NEED(ctx.need_esi());
-            CONFORM_PREOP(ctx);
             std::string missing;
             for (const auto& [i, o] : ctx.esi->objects) {
                 if (!o.entries.empty() && o.entries[0].access == "wo") continue;
@@ -559,10 +531,8 @@ void add_sdo_tests(Catalogue& c) {
         "ESI given");
     add(
         "od.size", "Every readable entry of the ESI uploads with its declared size", kOd,
+        {&Context::need_coe, &Context::need_esi},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_NEED(ctx.need_esi());
-            CONFORM_PREOP(ctx);
             unsigned n = 0;
             for (const auto& r : esi_entries(*ctx.esi)) {
                 if (r.e->access == "wo" || r.e->bit_size % 8 || r.e->bit_size == 0) continue;
@@ -586,10 +556,8 @@ void add_sdo_tests(Catalogue& c) {
         "ESI given");
     add(
         "od.read_only", "Every read-only entry of the ESI refuses a download with 0x06010002", kOd,
+        {&Context::need_coe, &Context::need_esi},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_NEED(ctx.need_esi());
-            CONFORM_PREOP(ctx);
             unsigned n = 0;
             for (const auto& r : esi_entries(*ctx.esi)) {
                 if (r.e->access != "ro" || r.e->subindex == 0 || r.e->bit_size > 32 || r.e->bit_size % 8 ||
@@ -610,10 +578,8 @@ void add_sdo_tests(Catalogue& c) {
         "ESI given");
     add(
         "od.defaults", "Read-only, unmapped entries hold the ESI's default value", kOd,
+        {&Context::need_coe, &Context::need_esi},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_NEED(ctx.need_esi());
-            CONFORM_PREOP(ctx);
             unsigned n = 0;
             for (const auto& r : esi_entries(*ctx.esi)) {
                 if (r.e->access != "ro" || !r.e->pdo_mapping.empty() || r.e->default_data.empty()) continue;
@@ -634,10 +600,8 @@ void add_sdo_tests(Catalogue& c) {
         "ESI given", Severity::Warning);
     add(
         "od.limits", "Entries with ESI limits hold a value within MinValue..MaxValue", kOd,
+        {&Context::need_coe, &Context::need_esi},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_coe());
-            CONFORM_NEED(ctx.need_esi());
-            CONFORM_PREOP(ctx);
             unsigned n = 0;
             for (const auto& r : esi_entries(*ctx.esi)) {
                 if (!r.e->min || !r.e->max || r.e->bit_size > 32 || r.e->bit_size % 8 || !r.e->bit_size)
@@ -690,9 +654,8 @@ void add_sdo_tests(Catalogue& c) {
     add(
         "ca.upload_from_sub1",
         "Complete access upload of 0x1018 from subindex 1: the entries without subindex 0", kCa,
+        {&Context::need_complete_access},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_complete_access());
-            CONFORM_PREOP(ctx);
             auto n = ctx.upload_uint(0x1018, 0);
             if (!n) return fail("0x1018:00: " + ctx.sdo_error(n.error()));
             std::vector<uint8_t> want;

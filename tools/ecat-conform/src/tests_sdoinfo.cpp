@@ -84,6 +84,36 @@ bool any_entry(const EsiObject& o, const std::function<bool(const EsiEntry&)>& f
     return false;
 }
 
+// Each object of the ESI against its object description: the first failure `check` returns, else a pass.
+Outcome objects_vs_esi(Context& ctx,
+                       const std::function<std::optional<Outcome>(uint16_t, const EsiObject&,
+                                                                  const master::ObjectDescription&)>& check) {
+    CONFORM_INFO(ctx);
+    for (const auto& [i, o] : ctx.esi->objects)
+        if (auto r = check(i, o, info.objects[i])) return *r;
+    return pass();
+}
+
+// Each entry of the ESI against its entry description: the first failure `check` returns, else a pass.
+Outcome entries_vs_esi(
+    Context& ctx,
+    const std::function<std::optional<Outcome>(const EntryRef&, const master::EntryDescription&)>& check) {
+    CONFORM_INFO(ctx);
+    for (const auto& r : esi_entries(*ctx.esi))
+        if (auto o = check(r, info.entries[{r.obj->index, r.e->subindex}])) return *o;
+    return pass();
+}
+
+// The answer to a description request for something missing: an error reply with `code`. `described` is
+// the failure when the slave describes it.
+template <class D>
+Outcome expect_error_reply(Context& ctx, const master::Result<D>& d, const std::string& described,
+                           uint32_t code) {
+    if (d) return fail(described, d->name, "error " + hex(code, 8));
+    if (d.error() != Error::SdoAbort) return fail("no error reply: " + ctx.sdo_error(d.error()));
+    return expect_eq("error code", hex(ctx.sdo->last_abort(), 8), hex(code, 8));
+}
+
 // Access bits of an entry description: 0-2 read in PREOP/SAFEOP/OP, 3-5 write in PREOP/SAFEOP/OP.
 uint16_t expected_access(const EsiEntry& e) {
     uint16_t a = 0;
@@ -115,48 +145,34 @@ void add_sdoinfo_tests(Catalogue& c) {
     add(
         "list.all", "Object list 'all objects' (type 1) equals the ESI's objects", kInfo,
         [](Context& ctx) { return list_vs_esi(ctx, 1, [](const EsiObject&) { return true; }); }, a);
+    // The lists of type 2..5 hold the objects with an entry of a kind (ETG.1000.6 SDO information list
+    // types).
+    const struct {
+        const char* id;
+        uint16_t type;
+        const char* title;
+        bool (*in)(const EsiEntry&);
+        Severity sev;
+    } lists[] = {
+        {"list.rxpdo", 2, "Object list 'RxPDO-mappable' (type 2) equals the ESI's objects with PdoMapping R",
+         [](const EsiEntry& e) { return e.pdo_mapping.find('R') != std::string::npos; }, Severity::Error},
+        {"list.txpdo", 3, "Object list 'TxPDO-mappable' (type 3) equals the ESI's objects with PdoMapping T",
+         [](const EsiEntry& e) { return e.pdo_mapping.find('T') != std::string::npos; }, Severity::Error},
+        {"list.backup", 4, "Object list 'backup' (type 4) equals the ESI's objects with Backup entries",
+         [](const EsiEntry& e) { return e.backup; }, Severity::Warning},
+        {"list.settings", 5, "Object list 'settings' (type 5) equals the ESI's objects with Setting entries",
+         [](const EsiEntry& e) { return e.setting; }, Severity::Warning},
+    };
+    for (const auto& l : lists)
+        add(
+            l.id, l.title, kInfo,
+            [type = l.type, in = l.in](Context& ctx) {
+                return list_vs_esi(ctx, type, [in](const EsiObject& o) { return any_entry(o, in); });
+            },
+            a, l.sev);
     add(
-        "list.rxpdo", "Object list 'RxPDO-mappable' (type 2) equals the ESI's objects with PdoMapping R",
-        kInfo,
+        "list.lengths", "List type 0 gives the lengths of lists 1..5", kInfo, {&Context::need_sdo_info},
         [](Context& ctx) {
-            return list_vs_esi(ctx, 2, [](const EsiObject& o) {
-                return any_entry(
-                    o, [](const EsiEntry& e) { return e.pdo_mapping.find('R') != std::string::npos; });
-            });
-        },
-        a);
-    add(
-        "list.txpdo", "Object list 'TxPDO-mappable' (type 3) equals the ESI's objects with PdoMapping T",
-        kInfo,
-        [](Context& ctx) {
-            return list_vs_esi(ctx, 3, [](const EsiObject& o) {
-                return any_entry(
-                    o, [](const EsiEntry& e) { return e.pdo_mapping.find('T') != std::string::npos; });
-            });
-        },
-        a);
-    add(
-        "list.backup", "Object list 'backup' (type 4) equals the ESI's objects with Backup entries", kInfo,
-        [](Context& ctx) {
-            return list_vs_esi(ctx, 4, [](const EsiObject& o) {
-                return any_entry(o, [](const EsiEntry& e) { return e.backup; });
-            });
-        },
-        a, Severity::Warning);
-    add(
-        "list.settings", "Object list 'settings' (type 5) equals the ESI's objects with Setting entries",
-        kInfo,
-        [](Context& ctx) {
-            return list_vs_esi(ctx, 5, [](const EsiObject& o) {
-                return any_entry(o, [](const EsiEntry& e) { return e.setting; });
-            });
-        },
-        a, Severity::Warning);
-    add(
-        "list.lengths", "List type 0 gives the lengths of lists 1..5", kInfo,
-        [](Context& ctx) {
-            CONFORM_NEED(ctx.need_sdo_info());
-            CONFORM_PREOP(ctx);
             auto l = ctx.sdo->od_list(0);
             if (!l) return fail("list type 0: " + ctx.sdo_error(l.error()));
             std::string got, want;
@@ -171,9 +187,8 @@ void add_sdoinfo_tests(Catalogue& c) {
         "SDO information");
     add(
         "list.fragments", "A list longer than the mailbox comes in fragments counting down to 0", kInfo,
+        {&Context::need_sdo_info},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_sdo_info());
-            CONFORM_PREOP(ctx);
             SdoAnswer r = info_raw(ctx, 0x01, {0x01, 0x00});
             if (r.error != Error::Ok || r.p.size() < 6) return fail("no answer", r.describe());
             int n = 0;
@@ -213,103 +228,87 @@ void add_sdoinfo_tests(Catalogue& c) {
             return pass(dec(static_cast<long long>(info.objects.size())) + " objects");
         },
         a);
-    add(
-        "od.max_subindex", "Object descriptions: maximum subindex as the ESI", kInfo,
-        [](Context& ctx) {
-            CONFORM_INFO(ctx);
-            for (const auto& [i, o] : ctx.esi->objects)
-                if (info.objects[i].max_subindex != o.max_subindex())
-                    return fail(hex(i) + " max subindex", dec(info.objects[i].max_subindex),
-                                dec(o.max_subindex()));
-            return pass();
-        },
-        a);
-    add(
-        "od.data_type", "Object descriptions of VAR and ARRAY objects: data type as the ESI", kInfo,
-        [](Context& ctx) {
-            CONFORM_INFO(ctx);
-            for (const auto& [i, o] : ctx.esi->objects) {
-                std::string t =
-                    o.object_code == 7
-                        ? o.type
-                        : (o.object_code == 8 && o.entries.size() > 1 ? o.entries.back().type : "");
-                const uint16_t want = esi_coe_type(t);
-                if (want && info.objects[i].data_type != want)
-                    return fail(hex(i) + " data type", hex(info.objects[i].data_type),
-                                hex(want) + " (" + t + ")");
-            }
-            return pass();
-        },
-        a);
-    add(
-        "od.name", "Object descriptions: name as the ESI", kInfo,
-        [](Context& ctx) {
-            CONFORM_INFO(ctx);
-            for (const auto& [i, o] : ctx.esi->objects)
-                if (info.objects[i].name != o.name)
-                    return fail(hex(i) + " name", info.objects[i].name, o.name);
-            return pass();
-        },
-        a, Severity::Warning);
-    add(
-        "entry.data_type", "Entry descriptions: data type as the ESI", kInfo,
-        [](Context& ctx) {
-            CONFORM_INFO(ctx);
-            for (const auto& r : esi_entries(*ctx.esi)) {
-                const uint16_t want = esi_coe_type(r.e->type);
-                const auto& d = info.entries[{r.obj->index, r.e->subindex}];
-                if (want && d.data_type != want)
-                    return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " data type", hex(d.data_type),
-                                hex(want) + " (" + r.e->type + ")");
-            }
-            return pass();
-        },
-        a);
-    add(
-        "entry.bit_length", "Entry descriptions: bit length as the ESI", kInfo,
-        [](Context& ctx) {
-            CONFORM_INFO(ctx);
-            for (const auto& r : esi_entries(*ctx.esi)) {
-                const auto& d = info.entries[{r.obj->index, r.e->subindex}];
-                if (d.bit_length != r.e->bit_size)
-                    return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " bit length",
-                                dec(d.bit_length), dec(r.e->bit_size));
-            }
-            return pass();
-        },
-        a);
-    add(
-        "entry.access", "Entry descriptions: read/write access per state as the ESI's Access", kInfo,
-        [](Context& ctx) {
-            CONFORM_INFO(ctx);
-            for (const auto& r : esi_entries(*ctx.esi)) {
-                const auto& d = info.entries[{r.obj->index, r.e->subindex}];
-                const uint16_t want = expected_access(*r.e);
-                if ((d.access & 0x3F) != want)
-                    return fail(
-                        hex(r.obj->index) + ":" + dec(r.e->subindex) + " access bits (" + r.e->access +
-                            (r.e->write_restrictions.empty() ? "" : ", " + r.e->write_restrictions) + ")",
-                        hex(d.access & 0x3F, 2), hex(want, 2));
-            }
-            return pass();
-        },
-        a);
-    add(
-        "entry.pdo_mapping", "Entry descriptions: RxPDO/TxPDO mappable bits as the ESI's PdoMapping", kInfo,
-        [](Context& ctx) {
-            CONFORM_INFO(ctx);
-            for (const auto& r : esi_entries(*ctx.esi)) {
-                const auto& d = info.entries[{r.obj->index, r.e->subindex}];
-                const uint16_t want =
-                    static_cast<uint16_t>((r.e->pdo_mapping.find('R') != std::string::npos ? 0x40 : 0) |
-                                          (r.e->pdo_mapping.find('T') != std::string::npos ? 0x80 : 0));
-                if ((d.access & 0xC0) != want)
-                    return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " mapping bits",
-                                hex(d.access & 0xC0, 2), hex(want, 2));
-            }
-            return pass();
-        },
-        a);
+    // Each object description against the ESI, one field a test.
+    const struct {
+        const char* id;
+        const char* title;
+        std::optional<Outcome> (*check)(uint16_t, const EsiObject&, const master::ObjectDescription&);
+        Severity sev;
+    } object_fields[] = {
+        {"od.max_subindex", "Object descriptions: maximum subindex as the ESI",
+         [](uint16_t i, const EsiObject& o, const master::ObjectDescription& d) -> std::optional<Outcome> {
+             if (d.max_subindex != o.max_subindex())
+                 return fail(hex(i) + " max subindex", dec(d.max_subindex), dec(o.max_subindex()));
+             return std::nullopt;
+         },
+         Severity::Error},
+        {"od.data_type", "Object descriptions of VAR and ARRAY objects: data type as the ESI",
+         [](uint16_t i, const EsiObject& o, const master::ObjectDescription& d) -> std::optional<Outcome> {
+             std::string t = o.object_code == 7
+                                 ? o.type
+                                 : (o.object_code == 8 && o.entries.size() > 1 ? o.entries.back().type : "");
+             const uint16_t want = esi_coe_type(t);
+             if (want && d.data_type != want)
+                 return fail(hex(i) + " data type", hex(d.data_type), hex(want) + " (" + t + ")");
+             return std::nullopt;
+         },
+         Severity::Error},
+        {"od.name", "Object descriptions: name as the ESI",
+         [](uint16_t i, const EsiObject& o, const master::ObjectDescription& d) -> std::optional<Outcome> {
+             if (d.name != o.name) return fail(hex(i) + " name", d.name, o.name);
+             return std::nullopt;
+         },
+         Severity::Warning},
+    };
+    for (const auto& f : object_fields)
+        add(
+            f.id, f.title, kInfo, [check = f.check](Context& ctx) { return objects_vs_esi(ctx, check); }, a,
+            f.sev);
+    // Each entry description against the ESI, one field a test.
+    const struct {
+        const char* id;
+        const char* title;
+        std::optional<Outcome> (*check)(const EntryRef&, const master::EntryDescription&);
+    } entry_fields[] = {
+        {"entry.data_type", "Entry descriptions: data type as the ESI",
+         [](const EntryRef& r, const master::EntryDescription& d) -> std::optional<Outcome> {
+             const uint16_t want = esi_coe_type(r.e->type);
+             if (want && d.data_type != want)
+                 return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " data type", hex(d.data_type),
+                             hex(want) + " (" + r.e->type + ")");
+             return std::nullopt;
+         }},
+        {"entry.bit_length", "Entry descriptions: bit length as the ESI",
+         [](const EntryRef& r, const master::EntryDescription& d) -> std::optional<Outcome> {
+             if (d.bit_length != r.e->bit_size)
+                 return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " bit length", dec(d.bit_length),
+                             dec(r.e->bit_size));
+             return std::nullopt;
+         }},
+        {"entry.access", "Entry descriptions: read/write access per state as the ESI's Access",
+         [](const EntryRef& r, const master::EntryDescription& d) -> std::optional<Outcome> {
+             const uint16_t want = expected_access(*r.e);
+             if ((d.access & 0x3F) != want)
+                 return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " access bits (" + r.e->access +
+                                 (r.e->write_restrictions.empty() ? "" : ", " + r.e->write_restrictions) +
+                                 ")",
+                             hex(d.access & 0x3F, 2), hex(want, 2));
+             return std::nullopt;
+         }},
+        {"entry.pdo_mapping", "Entry descriptions: RxPDO/TxPDO mappable bits as the ESI's PdoMapping",
+         [](const EntryRef& r, const master::EntryDescription& d) -> std::optional<Outcome> {
+             const uint16_t want =
+                 static_cast<uint16_t>((r.e->pdo_mapping.find('R') != std::string::npos ? 0x40 : 0) |
+                                       (r.e->pdo_mapping.find('T') != std::string::npos ? 0x80 : 0));
+             if ((d.access & 0xC0) != want)
+                 return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " mapping bits",
+                             hex(d.access & 0xC0, 2), hex(want, 2));
+             return std::nullopt;
+         }},
+    };
+    for (const auto& f : entry_fields)
+        add(
+            f.id, f.title, kInfo, [check = f.check](Context& ctx) { return entries_vs_esi(ctx, check); }, a);
     add(
         "entry.name", "Entry descriptions: name as the ESI", kInfo,
         [](Context& ctx) {
@@ -385,41 +384,28 @@ void add_sdoinfo_tests(Catalogue& c) {
         a, Severity::Warning);
     add(
         "error.missing_object", "Object description of a missing object: error reply 0x06020000", kInfo,
+        {&Context::need_sdo_info},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_sdo_info());
-            CONFORM_PREOP(ctx);
-            uint16_t i = 0x5FFE;
-            while (ctx.esi && ctx.esi->object(i))
-                --i;
-            auto d = ctx.sdo->object_description(i);
-            if (d) return fail("described a missing object " + hex(i), d->name, "error 0x06020000");
-            if (d.error() != Error::SdoAbort) return fail("no error reply: " + ctx.sdo_error(d.error()));
-            return expect_eq("error code", hex(ctx.sdo->last_abort(), 8), hex(0x06020000, 8));
+            const uint16_t i = missing_index(ctx);
+            return expect_error_reply(ctx, ctx.sdo->object_description(i),
+                                      "described a missing object " + hex(i), 0x06020000);
         },
         "SDO information");
     add(
         "error.missing_subindex", "Entry description of a missing subindex of 0x1018: error reply 0x06090011",
-        kInfo,
+        kInfo, {&Context::need_sdo_info},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_sdo_info());
-            CONFORM_PREOP(ctx);
             auto n = ctx.upload_uint(0x1018, 0);
             if (!n) return fail("0x1018:00: " + ctx.sdo_error(n.error()));
-            auto d = ctx.sdo->entry_description(0x1018, static_cast<uint8_t>(*n + 1));
-            if (d) return fail("described a missing subindex", d->name, "error 0x06090011");
-            if (d.error() != Error::SdoAbort) return fail("no error reply: " + ctx.sdo_error(d.error()));
-            return expect_eq("error code", hex(ctx.sdo->last_abort(), 8), hex(0x06090011, 8));
+            return expect_error_reply(ctx, ctx.sdo->entry_description(0x1018, static_cast<uint8_t>(*n + 1)),
+                                      "described a missing subindex", 0x06090011);
         },
         "SDO information");
     add(
         "error.format", "SDO information error reply: opcode 7, complete, 4-byte abort code (length 10)",
-        kInfo,
+        kInfo, {&Context::need_sdo_info},
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_sdo_info());
-            CONFORM_PREOP(ctx);
-            uint16_t i = 0x5FFE;
-            while (ctx.esi && ctx.esi->object(i))
-                --i;
+            const uint16_t i = missing_index(ctx);
             SdoAnswer r = info_raw(ctx, 0x03, {static_cast<uint8_t>(i), static_cast<uint8_t>(i >> 8)});
             if (r.error != Error::Ok || r.mailbox_type != 3) return fail("no answer", r.describe());
             if ((r.p[2] & 0x7F) != 0x07) return fail("opcode", hex(r.p[2] & 0x7F, 2), "0x07");

@@ -20,13 +20,8 @@ int run_cstruct(master::Master& m, const SlaveArg& s) {
     auto img = m.sii_read_image(*a);
     if (!img) return report_error(nullptr, img.error(), "reading the SII of " + slave_label(*a));
     const esi::SiiInfo sii = esi::parse_sii(*img);
-    master::Mailbox mbx(m, *a);
-    if (master::Error e = open_coe_mailbox(m, mbx, *a); e != master::Error::Ok)
-        return report_error(nullptr, e, "opening the mailbox of " + slave_label(*a));
-    master::SdoClient sdo(mbx);
     std::vector<SyncView> syncs;
-    if (master::Error e = read_pdo_config(sdo, syncs); e != master::Error::Ok)
-        return report_error(&sdo, e, "reading the PDO configuration");
+    if (int rc = read_slave_pdo_config(m, *a, syncs); rc != kExitOk) return rc;
 
     const unsigned pos = a->value;  // the position (or station address) names the arrays
     const std::string name = sii.general ? sii.general->name : std::string();

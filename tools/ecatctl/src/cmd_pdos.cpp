@@ -17,13 +17,8 @@ int run_pdos(master::Master& m, const SlaveArg& s, bool quiet) {
     if (!a) return kExitUsage;
     esi::SiiInfo sii;
     if (auto img = m.sii_read_image(*a)) sii = esi::parse_sii(*img);
-    master::Mailbox mbx(m, *a);
-    if (master::Error e = open_coe_mailbox(m, mbx, *a); e != master::Error::Ok)
-        return report_error(nullptr, e, "opening the mailbox of " + slave_label(*a));
-    master::SdoClient sdo(mbx);
     std::vector<SyncView> syncs;
-    if (master::Error e = read_pdo_config(sdo, syncs); e != master::Error::Ok)
-        return report_error(&sdo, e, "reading the PDO configuration");
+    if (int rc = read_slave_pdo_config(m, *a, syncs); rc != kExitOk) return rc;
     const std::size_t n_sm = std::max<std::size_t>(sii.sync_managers.size(), 4);
     for (std::size_t i = 0; i < n_sm; ++i) {
         const SyncView* sv = nullptr;

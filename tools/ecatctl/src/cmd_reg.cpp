@@ -35,14 +35,29 @@ struct RegArgs {
     bool station = false;
 };
 
-int reg_read(master::Master& m, const RegArgs& r) {
+// The slave, the register address and the --type of a reg command.
+struct RegTarget {
+    master::Address slave;
+    uint64_t address = 0;
+    std::optional<ValueType> type;
+};
+
+// Fills t from r: kExitOk, or the exit code of the usage error it reported.
+int reg_target(const RegArgs& r, RegTarget& t) {
     auto a = named_slave(r.slave, r.station);
     if (!a) return kExitUsage;
     auto addr = parse_number(r.address, 0xFFFF);
     if (!addr) return usage_error("bad register address '" + r.address + "'");
-    std::optional<ValueType> type;
-    if (!r.type.empty() && !(type = parse_type(r.type))) return usage_error("bad type '" + r.type + "'");
-    std::size_t len = type ? type_size(*type) : 0;
+    if (!r.type.empty() && !(t.type = parse_type(r.type))) return usage_error("bad type '" + r.type + "'");
+    t.slave = *a;
+    t.address = *addr;
+    return kExitOk;
+}
+
+int reg_read(master::Master& m, const RegArgs& r) {
+    RegTarget t;
+    if (int rc = reg_target(r, t); rc != kExitOk) return rc;
+    std::size_t len = t.type ? type_size(*t.type) : 0;
     if (!r.length.empty()) {
         auto l = parse_number(r.length, master::kMaxDatagramData);
         if (!l || *l == 0)
@@ -51,32 +66,29 @@ int reg_read(master::Master& m, const RegArgs& r) {
         len = *l;
     }
     if (len == 0) return usage_error("give a length or --type");
-    if (type && len % type_size(*type) != 0) return usage_error("length is not a multiple of the type size");
-    if (*addr + len > 0x10000) return usage_error("register range runs past 0xffff");
+    if (t.type && len % type_size(*t.type) != 0)
+        return usage_error("length is not a multiple of the type size");
+    if (t.address + len > 0x10000) return usage_error("register range runs past 0xffff");
     std::vector<uint8_t> data(len);
-    if (Error e = m.read(*a, static_cast<uint16_t>(*addr), data); e != Error::Ok)
-        return fail(e, "reading " + slave_label(*a));
-    if (type) {
-        const std::size_t n = type_size(*type);
+    if (Error e = m.read(t.slave, static_cast<uint16_t>(t.address), data); e != Error::Ok)
+        return fail(e, "reading " + slave_label(t.slave));
+    if (t.type) {
+        const std::size_t n = type_size(*t.type);
         for (std::size_t i = 0; i < len; i += n)
-            std::printf("%s\n", format_value(*type, std::span<const uint8_t>(data).subspan(i, n)).c_str());
+            std::printf("%s\n", format_value(*t.type, std::span<const uint8_t>(data).subspan(i, n)).c_str());
     } else {
-        std::fputs(hex_dump(static_cast<uint32_t>(*addr), data).c_str(), stdout);
+        std::fputs(hex_dump(static_cast<uint32_t>(t.address), data).c_str(), stdout);
     }
     return kExitOk;
 }
 
 int reg_write(master::Master& m, const RegArgs& r) {
-    auto a = named_slave(r.slave, r.station);
-    if (!a) return kExitUsage;
-    auto addr = parse_number(r.address, 0xFFFF);
-    if (!addr) return usage_error("bad register address '" + r.address + "'");
-    std::optional<ValueType> type;
-    if (!r.type.empty() && !(type = parse_type(r.type))) return usage_error("bad type '" + r.type + "'");
+    RegTarget t;
+    if (int rc = reg_target(r, t); rc != kExitOk) return rc;
     std::vector<uint8_t> data;
     for (const std::string& v : r.values) {
-        if (type) {
-            auto b = encode_value(*type, v);
+        if (t.type) {
+            auto b = encode_value(*t.type, v);
             if (!b) return usage_error("value '" + v + "' does not fit " + r.type);
             data.insert(data.end(), b->begin(), b->end());
         } else {
@@ -87,9 +99,9 @@ int reg_write(master::Master& m, const RegArgs& r) {
     }
     if (data.empty() || data.size() > master::kMaxDatagramData)
         return usage_error("nothing to write, or too much");
-    if (*addr + data.size() > 0x10000) return usage_error("register range runs past 0xffff");
-    if (Error e = m.write(*a, static_cast<uint16_t>(*addr), data); e != Error::Ok)
-        return fail(e, "writing " + slave_label(*a));
+    if (t.address + data.size() > 0x10000) return usage_error("register range runs past 0xffff");
+    if (Error e = m.write(t.slave, static_cast<uint16_t>(t.address), data); e != Error::Ok)
+        return fail(e, "writing " + slave_label(t.slave));
     return kExitOk;
 }
 

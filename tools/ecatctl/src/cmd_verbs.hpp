@@ -39,6 +39,10 @@ struct SlaveArg {
 // A slave in INIT gets its mailbox SMs from its SII and goes to PREOP; one in PREOP or above keeps its SMs.
 master::Error open_coe_mailbox(master::Master& m, master::Mailbox& mbx, master::Address a);
 
+// The PDO assignment and mapping of slave a over CoE (mailbox opened by open_coe_mailbox), with names:
+// kExitOk, or the exit code of the error it reported.
+int read_slave_pdo_config(master::Master& m, master::Address a, std::vector<SyncView>& syncs);
+
 // Prints "ecatctl: <what>: <error>" (SDO aborts with code and text) and returns the exit code.
 int report_error(const master::SdoClient* sdo, master::Error e, const std::string& what);
 

@@ -50,6 +50,17 @@ std::string esc(const std::string& s) {
     return o;
 }
 
+// Each line of `text` (every line ends with '\n') with `indent` before it.
+std::string indented(const std::string& text, const std::string& indent) {
+    std::string out;
+    for (std::size_t i = 0; i < text.size();) {
+        const std::size_t nl = text.find('\n', i);
+        out += indent + text.substr(i, nl - i + 1);
+        i = nl + 1;
+    }
+    return out;
+}
+
 std::string hx(uint64_t v, int digits = 0) {
     char b[24];
     std::snprintf(b, sizeof b, "#x%0*llx", digits, static_cast<unsigned long long>(v));
@@ -231,21 +242,9 @@ int run_xml(master::Master& m, const XmlArgs& x) {
               "</Name>\n                <BitSize>" + std::to_string(bits) +
               "</BitSize>\n              </DataType>\n");
         // Structured types, indented one level deeper.
-        std::string indented;
-        for (std::size_t i = 0; i < structured.size();) {
-            const std::size_t nl = structured.find('\n', i);
-            indented += "      " + structured.substr(i, nl - i + 1);
-            i = nl + 1;
-        }
-        w(indented);
+        w(indented(structured, "      "));
         w("            </DataTypes>\n            <Objects>\n");
-        std::string ind_obj;
-        for (std::size_t i = 0; i < objects.size();) {
-            const std::size_t nl = objects.find('\n', i);
-            ind_obj += "    " + objects.substr(i, nl - i + 1);
-            i = nl + 1;
-        }
-        w(ind_obj);
+        w(indented(objects, "    "));
         w("            </Objects>\n          </Dictionary>\n        </Profile>\n");
     }
     for (uint8_t f : sii.fmmus) {

@@ -1,7 +1,5 @@
 #include "format.hpp"
 
-#include "esc/wire/sii.hpp"
-
 #include <cerrno>
 #include <charconv>
 #include <cstdio>
@@ -189,10 +187,6 @@ std::string hex_dump(uint32_t base, std::span<const uint8_t> data) {
     }
     if (!data.empty()) s += '\n';
     return s;
-}
-
-uint8_t sii_crc(std::span<const uint8_t> first14) {
-    return esc::sii::crc8(first14.data(), first14.size());
 }
 
 }  // namespace ecatctl

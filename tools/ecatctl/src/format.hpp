@@ -43,7 +43,4 @@ std::optional<std::vector<uint8_t>> encode_value(ValueType t, std::string_view t
 // 16 bytes per line: "0x0130: 02 00 00 00 ...", addresses starting at base.
 std::string hex_dump(uint32_t base, std::span<const uint8_t> data);
 
-// CRC-8 of SII words 0-6 (poly 0x07, init 0xFF), ETG.2010.
-uint8_t sii_crc(std::span<const uint8_t> first14);
-
 }  // namespace ecatctl

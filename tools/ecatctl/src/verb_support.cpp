@@ -30,6 +30,16 @@ Error open_coe_mailbox(master::Master& m, master::Mailbox& mbx, Address a) {
     return open_mailbox(m, mbx, a);
 }
 
+int read_slave_pdo_config(master::Master& m, Address a, std::vector<SyncView>& syncs) {
+    master::Mailbox mbx(m, a);
+    if (Error e = open_coe_mailbox(m, mbx, a); e != Error::Ok)
+        return report_error(nullptr, e, "opening the mailbox of " + slave_label(a));
+    master::SdoClient sdo(mbx);
+    if (Error e = read_pdo_config(sdo, syncs); e != Error::Ok)
+        return report_error(&sdo, e, "reading the PDO configuration");
+    return kExitOk;
+}
+
 int report_error(const master::SdoClient* sdo, Error e, const std::string& what) {
     if (sdo && e == Error::SdoAbort) {
         std::fprintf(stderr, "ecatctl: %s: SDO abort 0x%08x (%s)\n", what.c_str(), sdo->last_abort(),

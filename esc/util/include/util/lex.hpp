@@ -46,6 +46,9 @@ struct Word {
 // "" if line is text by the character rule above, else what is wrong with it.
 std::string text_error(std::string_view line);
 
+// s without the blanks (space, tab, CR) at either end.
+std::string_view trim_blanks(std::string_view s);
+
 // The words of one line (comment dropped). Throws LexError.
 std::vector<Word> split(std::string_view line);
 

@@ -236,20 +236,9 @@ ecat::StackStats Device::stack_stats() const {
 
 namespace {
 
-const char* state_text(od::AlState s) {
-    switch (s) {
-        case od::AlState::Init:
-            return "Init";
-        case od::AlState::PreOp:
-            return "Pre-Op";
-        case od::AlState::Boot:
-            return "Bootstrap";
-        case od::AlState::SafeOp:
-            return "Safe-Op";
-        case od::AlState::Op:
-            return "Op";
-    }
-    return "?";
+// The state names of the AL vocabulary (esc::al_state_name: INIT, PREOP, BOOT, SAFEOP, OP).
+std::string state_text(od::AlState s) {
+    return std::string(esc::al_state_name(s));
 }
 
 std::string requested_text(uint8_t requested) {
@@ -259,7 +248,7 @@ std::string requested_text(uint8_t requested) {
         case 0x03:
         case 0x04:
         case 0x08:
-            return state_text(static_cast<od::AlState>(requested));
+            return std::string(esc::al_state_name(requested));
         default:
             return "unknown state " + std::to_string(requested);
     }
