@@ -22,7 +22,6 @@
 #include "foe/image.hpp"
 #include "maxpos/maxpos.hpp"
 #include "od/device_config.hpp"
-#include "od/diag_texts.hpp"
 #include "util/le.hpp"
 #include "util/lex.hpp"
 #include "util/strfmt.hpp"
@@ -419,7 +418,7 @@ void Device::build() {
             p->diag = std::make_unique<coe::DiagnosisHistory>(p->dict, &p->coe->emergency());
         p->events = std::make_unique<coe::EventReporter>(p->coe->emergency(), p->diag.get(),
                                                          [this] { return system_time_ns(); });
-        p->events->set_text_ids(&od::diag_text_id);  // the texts the ESI lists as DiagMessages
+        p->events->set_texts(p->desc.diag_messages);  // the texts the ESI lists as DiagMessages
         p->stack->add_handler(*p->coe);
     }
     if (p->firmware) {
