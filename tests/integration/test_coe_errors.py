@@ -403,7 +403,8 @@ class DiagnosisHistoryThroughEcatctl(unittest.TestCase):
             # DiagMessages, ETG.2000) the text comes from the file. The file's text is changed here, so the
             # line shows it came from there and not from the built-in table.
             esi = os.path.join(bus.dir, "drive.xml")
-            subprocess.run([bus.slave_bin, "--write-esi", esi], check=True, timeout=60)
+            subprocess.run([bus.slave_bin, "--write-esi", esi], check=True, timeout=60, stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE)
             with open(esi, encoding="utf-8") as f:
                 xml = f.read()
             marker = "<TextId>#x8180</TextId>\n"
