@@ -32,7 +32,8 @@ void EventReporter::record(uint32_t diag_code, DiagType type, std::span<const Di
     history_->add(m, may_send_emergency);
 }
 
-void EventReporter::raise(uint16_t error_code, uint8_t error_register, std::span<const uint8_t> mfr) {
+void EventReporter::raise(uint16_t error_code, uint8_t error_register, std::span<const uint8_t> mfr,
+                          std::string_view text) {
     const auto begin = active_.begin();
     const auto end = begin + static_cast<std::ptrdiff_t>(active_count_);
     if (std::find(begin, end, error_code) == end && active_count_ < kMaxActive)
@@ -40,8 +41,9 @@ void EventReporter::raise(uint16_t error_code, uint8_t error_register, std::span
     emergency_.send(error_code, error_register, mfr);
     const DiagParam params[] = {DiagParam::byte_array(mfr.first(std::min<std::size_t>(mfr.size(), 5)))};
     // The emergency for an error is sent above already: the history must not send a second one.
-    record(DiagnosisHistory::from_emergency(error_code), DiagType::Error, params, false,
-           text_id_of(error_code));
+    uint16_t id = text_id_of(error_code);
+    if (id == 0 && !text.empty()) id = text_id_of(text);
+    record(DiagnosisHistory::from_emergency(error_code), DiagType::Error, params, false, id);
 }
 
 void EventReporter::clear(uint16_t error_code, uint8_t error_register) {

@@ -121,5 +121,8 @@ TEST_F(Events, ARaisedErrorCarriesTheTextIdOfItsCodesText) {
     Bytes n = message(7);
     EXPECT_EQ(le32(n, 0), 0x2310E800u);
     EXPECT_EQ(le16(n, 6), 0u);  // no text for 0x2310 (a text with error code 0 is not one)
-    EXPECT_EQ(server.emergency().pending(), 2u);
+    // Texts from an ESI name no code: the error's name (the application's) finds its text.
+    events.raise(0x3210, 0x04, mfr, "Not about a code");
+    EXPECT_EQ(le16(message(8), 6), 0x0043u);
+    EXPECT_EQ(server.emergency().pending(), 3u);
 }

@@ -1,9 +1,11 @@
 // The drive's diagnosis texts (ETG.1020 text ids; ETG.2000 DiagMessages) end to end: every error the drive's
 // table holds, raised by the drive core inside the composed device, is stored in 0x10F3 with the text id of
 // the device description's text for that code, and the ESI written from the same description lists that id
-// with that text, so a master (TwinCAT, ecatctl diag --esi) shows it. One test over the whole table.
+// with that text, so a master (TwinCAT, ecatctl diag --esi) shows it. One test over the whole table, for the
+// built-in MAXPOS and for the MAXPOS served from its own ESI.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -18,6 +20,7 @@
 #include "drive/wire/error_codes.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
+#include "esi/device/product.hpp"
 #include "esi/esi.hpp"
 #include "esi/esi_reader.hpp"
 #include "maxpos/maxpos.hpp"
@@ -44,18 +47,32 @@ std::optional<uint16_t> stored_text_id(od::Dictionary& dict, uint16_t code) {
     return std::nullopt;
 }
 
-TEST(DriveDiagTexts, EveryErrorTheDriveRaisesCarriesTheTextIdOfItsTextInTheEsi) {
+// The MAXPOS as the built-in product (its description binds each text to its error code), and as a device
+// read from its own generated ESI (`ecat-slave --esi`): the ESI carries no binding, the error's name finds
+// the text. Both must give every fault the same text id.
+std::shared_ptr<const od::Product> product(const std::string& which) {
+    if (which == "built-in") return nullptr;
+    const od::DeviceDescription d = maxpos::description();
+    return std::make_shared<const od::Product>(
+        esi::load_product(esi::read_esi_text(esi::build_esi(d, maxpos::dictionary(d)), "maxpos.xml"), ""));
+}
+
+class DriveDiagTexts : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(DriveDiagTexts, EveryErrorTheDriveRaisesCarriesTheTextIdOfItsTextInTheEsi) {
     const auto dir = test_support::make_temp_dir("softecat-diag-texts-");
     esc::ManualClock clock;
     clock.set(1'000'000'000);
     device::DeviceOptions options;
     options.state_dir = dir;
+    options.product = product(GetParam());
     std::ostringstream log;
     options.log = &log;
     esc::Esc esc(esc::EscConfig{}, clock);
     device::Device dev(esc, options);
     ASSERT_TRUE(dev.has_drive());
 
+    // The built-in description binds the texts to the codes; the ESI lists them.
     const od::DeviceDescription desc = maxpos::description();
     const esi::EsiDevice esi = esi::read_esi(esi::build_esi(desc, dev.dictionary()));
 
@@ -92,7 +109,14 @@ TEST(DriveDiagTexts, EveryErrorTheDriveRaisesCarriesTheTextIdOfItsTextInTheEsi) 
     EXPECT_EQ(checked, std::size(drive::kErrorTable));
 }
 
-TEST(DriveDiagTexts, TextIdsAreUniqueAcrossTheDrivesOwnTextsAndItsErrors) {
+INSTANTIATE_TEST_SUITE_P(Maxpos, DriveDiagTexts, ::testing::Values("built-in", "from-its-esi"),
+                         [](const ::testing::TestParamInfo<std::string>& p) {
+                             std::string n = p.param;
+                             std::replace(n.begin(), n.end(), '-', '_');
+                             return n;
+                         });
+
+TEST(DriveDiagTextIds, AreUniqueAcrossTheDrivesOwnTextsAndItsErrors) {
     const od::DeviceDescription desc = maxpos::description();
     std::set<uint16_t> ids;
     for (const od::DiagMessageText& t : desc.diag_messages) {

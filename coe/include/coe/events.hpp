@@ -39,7 +39,10 @@ class EventReporter {
     // raise() keeps its manufacturer bytes. Set before the cycle runs (it allocates once, here).
     void set_texts(std::span<const od::DiagMessageText> texts) { texts_.assign(texts.begin(), texts.end()); }
 
-    void raise(uint16_t error_code, uint8_t error_register, std::span<const uint8_t> mfr);
+    // `text`: the error's name, if the application has one; the text id of the text that names the code, else
+    // of the text equal to `text` (a device from an ESI whose DiagMessages has the error's name), else none.
+    void raise(uint16_t error_code, uint8_t error_register, std::span<const uint8_t> mfr,
+               std::string_view text = {});
     void clear(uint16_t error_code, uint8_t error_register);
     void diag(DiagType type, uint16_t code, std::string_view text);
 

@@ -605,14 +605,17 @@ void Device::on_restart() {
 // ---- drive::EventSink -------------------------------------------------------------------------------
 
 void Device::raise(uint16_t error_code, uint8_t error_register, const std::array<uint8_t, 5>& mfr) {
+    const drive::ErrorInfo* info = drive::find_error(error_code);
     if (options_.events != nullptr && options_.events->enabled(slave::LogLevel::Error)) {
-        const drive::ErrorInfo* info = drive::find_error(error_code);
         event(slave::LogLevel::Error, "drive fault " + hex16(error_code) + ": " +
                                           (info != nullptr ? std::string(info->name) : "unknown error"));
     }
     ++stats_.emergencies;
     ++stats_.diagnoses;
-    if (parts_->events) parts_->events->raise(error_code, error_register, mfr);
+    // The error's name finds the text of a device whose texts came from an ESI (no code binding there).
+    if (parts_->events)
+        parts_->events->raise(error_code, error_register, mfr,
+                              info != nullptr ? info->name : std::string_view());
 }
 
 void Device::clear(uint16_t error_code, uint8_t error_register) {
