@@ -7,6 +7,18 @@ namespace coe {
 EventReporter::EventReporter(Emergency& emergency, DiagnosisHistory* history, std::function<uint64_t()> clock)
     : emergency_(emergency), history_(history), clock_(std::move(clock)) {}
 
+uint16_t EventReporter::text_id_of(uint16_t error_code) const {
+    for (const od::DiagMessageText& t : texts_)
+        if (t.error_code == error_code && t.error_code != 0) return t.text_id;
+    return 0;
+}
+
+uint16_t EventReporter::text_id_of(std::string_view text) const {
+    for (const od::DiagMessageText& t : texts_)
+        if (t.text == text) return t.text_id;
+    return 0;
+}
+
 void EventReporter::record(uint32_t diag_code, DiagType type, std::span<const DiagParam> params,
                            bool may_send_emergency, uint16_t text_id) {
     if (history_ == nullptr) return;
@@ -20,7 +32,8 @@ void EventReporter::record(uint32_t diag_code, DiagType type, std::span<const Di
     history_->add(m, may_send_emergency);
 }
 
-void EventReporter::raise(uint16_t error_code, uint8_t error_register, std::span<const uint8_t> mfr) {
+void EventReporter::raise(uint16_t error_code, uint8_t error_register, std::span<const uint8_t> mfr,
+                          std::string_view text) {
     const auto begin = active_.begin();
     const auto end = begin + static_cast<std::ptrdiff_t>(active_count_);
     if (std::find(begin, end, error_code) == end && active_count_ < kMaxActive)
@@ -28,7 +41,9 @@ void EventReporter::raise(uint16_t error_code, uint8_t error_register, std::span
     emergency_.send(error_code, error_register, mfr);
     const DiagParam params[] = {DiagParam::byte_array(mfr.first(std::min<std::size_t>(mfr.size(), 5)))};
     // The emergency for an error is sent above already: the history must not send a second one.
-    record(DiagnosisHistory::from_emergency(error_code), DiagType::Error, params, false);
+    uint16_t id = text_id_of(error_code);
+    if (id == 0 && !text.empty()) id = text_id_of(text);
+    record(DiagnosisHistory::from_emergency(error_code), DiagType::Error, params, false, id);
 }
 
 void EventReporter::clear(uint16_t error_code, uint8_t error_register) {
@@ -42,7 +57,7 @@ void EventReporter::clear(uint16_t error_code, uint8_t error_register) {
 }
 
 void EventReporter::diag(DiagType type, uint16_t code, std::string_view text) {
-    const uint16_t id = text_ids_ != nullptr && !text.empty() ? text_ids_(text) : 0;
+    const uint16_t id = text.empty() ? 0 : text_id_of(text);
     if (id != 0) {
         record(code == 0 ? kManufacturerDiagCode : DiagnosisHistory::from_emergency(code), type, {}, true,
                id);

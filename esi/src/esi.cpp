@@ -11,7 +11,6 @@
 #include <stdexcept>
 
 #include "esi/model.hpp"
-#include "od/diag_texts.hpp"
 #include "type_names.hpp"
 
 namespace esi {
@@ -422,14 +421,16 @@ void dictionary(xmlNodePtr profile, const od::Dictionary& dict) {
 
 // ---- Diagnosis texts (ETG.2000 DiagMessages, the ids 0x10F3 messages carry) ---------------------------
 
-void diag_messages(xmlNodePtr profile) {
-    static const char* const kClass[] = {"information", "warning", "error"};
+// Whatever texts the description holds (the drive core's for the MAXPOS, a vendor file's for a device read
+// from its ESI), in their order; none, no element.
+void diag_messages(xmlNodePtr profile, const std::vector<od::DiagMessageText>& texts) {
+    if (texts.empty()) return;
     xmlNodePtr messages = child(profile, "DiagMessages");
-    for (const od::DiagText& t : od::drive_diag_texts()) {
+    for (const od::DiagMessageText& t : texts) {
         xmlNodePtr m = child(messages, "DiagMessage");
-        child(m, "TextId", hex_index(t.id));
-        named(m, "MessageText", std::string(t.text));
-        child(child(m, "Flags"), "DiagClass", kClass[t.type < 3 ? t.type : 0]);
+        child(m, "TextId", hex_index(t.text_id));
+        named(m, "MessageText", t.text);
+        if (!t.diag_class.empty()) child(child(m, "Flags"), "DiagClass", t.diag_class);
     }
 }
 
@@ -620,14 +621,14 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
     if (kIdentificationInAlStatusCode) child(info, "IdentificationReg134", "true");
     child(device, "GroupType", id.group_type);
 
-    if (!dict.objects().empty()) {  // a coupler has no dictionary
+    if (!dict.objects().empty() || !d.diag_messages.empty()) {  // a coupler has no dictionary
         xmlNodePtr profile = child(device, "Profile");
         if (m.profile_number != 0) {
             child(profile, "ProfileNo", std::to_string(m.profile_number));
             child(profile, "AddInfo", std::to_string(m.profile_add_info));
         }
-        dictionary(profile, dict);
-        if (dict.find(0x10F3) != nullptr) diag_messages(profile);
+        if (!dict.objects().empty()) dictionary(profile, dict);
+        diag_messages(profile, d.diag_messages);
     }
 
     for (FmmuUse f : m.fmmus)

@@ -357,8 +357,18 @@ EsiDevice read_device(Node dev, const TypeMap& types_in, uint32_t vendor, const 
     for (Node prof : children(dev, "Profile")) {
         if (Node p = child(prof, "ProfileNo")) d.profile_no = static_cast<uint32_t>(number(text(p)));
         if (Node p = child(prof, "AddInfo")) d.profile_add_info = static_cast<uint32_t>(number(text(p)));
-        for (Node m : children(child(prof, "DiagMessages"), "DiagMessage"))
-            d.diag_messages[static_cast<uint16_t>(number(text(m, "TextId")))] = name_text(m, "MessageText");
+        for (Node m : children(child(prof, "DiagMessages"), "DiagMessage")) {
+            const std::optional<int64_t> id = parse_esi_number(text(m, "TextId"));
+            if (!id || *id < 0 || *id > 0xFFFF) {  // not a text id a 0x10F3 message can carry
+                d.unsupported.push_back("Profile/DiagMessages/DiagMessage at line " +
+                                        std::to_string(line_of(m)) + " with TextId '" +
+                                        text(m, "TextId").substr(0, 24) + "' (not a 16-bit text id)");
+                continue;
+            }
+            d.diag_messages.push_back({static_cast<uint16_t>(*id), name_text(m, "MessageText"),
+                                       text(child(m, "Flags"), "DiagClass")});
+        }
+        if (child(prof, "DiagFile")) d.unsupported.push_back("Profile/DiagFile");
         Node dict = child(prof, "Dictionary");
         if (dict) d.has_dictionary = true;
         if (child(prof, "DictionaryFile")) d.unsupported.push_back("Profile/DictionaryFile");

@@ -91,8 +91,8 @@ TEST(EventsWithoutHistory, EmergenciesOnly) {
 }  // namespace
 
 TEST_F(Events, TextsWithAnIdAreStoredByIdWithoutTheText) {
-    events.set_text_ids(
-        [](std::string_view text) -> uint16_t { return text == "Homing attained" ? 0x8011 : 0; });
+    const od::DiagMessageText texts[] = {{0x8011, "Homing attained", "information", 0}};
+    events.set_texts(texts);
     events.diag(coe::DiagType::Info, 0, "Homing attained");
     events.diag(coe::DiagType::Warning, 0x8A80, "Negative limit");  // no id: the text as before
     Bytes i = message(6);
@@ -102,4 +102,27 @@ TEST_F(Events, TextsWithAnIdAreStoredByIdWithoutTheText) {
     Bytes w = message(7);
     EXPECT_EQ(le16(w, 4), 0x0101u);
     EXPECT_EQ(le16(w, 6), 0u);
+}
+
+// ETG.1020: the message an error raises carries the text id of the device's text for that code (the ESI's
+// DiagMessage), beside the emergency's manufacturer bytes; a code without a text, none.
+TEST_F(Events, ARaisedErrorCarriesTheTextIdOfItsCodesText) {
+    const od::DiagMessageText texts[] = {{0x0042, "Wire break", "error", 0x7320},
+                                         {0x0043, "Not about a code", "error", 0}};
+    events.set_texts(texts);
+    const std::array<uint8_t, 5> mfr{1, 2, 3, 4, 5};
+    events.raise(0x7320, 0x20, mfr);
+    events.raise(0x2310, 0x02, mfr);
+    Bytes m = message(6);
+    EXPECT_EQ(le32(m, 0), 0x7320E800u);
+    EXPECT_EQ(le16(m, 4), 0x0102u);  // error, the manufacturer bytes still as parameter
+    EXPECT_EQ(le16(m, 6), 0x0042u);
+    EXPECT_EQ(le16(m, 16), 0x1005u);
+    Bytes n = message(7);
+    EXPECT_EQ(le32(n, 0), 0x2310E800u);
+    EXPECT_EQ(le16(n, 6), 0u);  // no text for 0x2310 (a text with error code 0 is not one)
+    // Texts from an ESI name no code: the error's name (the application's) finds its text.
+    events.raise(0x3210, 0x04, mfr, "Not about a code");
+    EXPECT_EQ(le16(message(8), 6), 0x0043u);
+    EXPECT_EQ(server.emergency().pending(), 3u);
 }

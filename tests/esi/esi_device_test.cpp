@@ -182,6 +182,8 @@ std::vector<std::string> describe(const od::Product& p) {
         }
         out.push_back(o.str());
     }
+    for (const od::DiagMessageText& t : d.diag_messages)  // ETG.2000 DiagMessages, in order
+        add("diag", t.text_id, t.text, t.diag_class, t.error_code);
     std::ostringstream image;  // the device's own EEPROM image, byte for byte
     image << std::hex;
     for (uint8_t b : p.eeprom)
@@ -874,6 +876,83 @@ TEST(EsiDevices, ProfileNoNamesTheProfileWhenTheDeviceTypeDisagrees) {
     EXPECT_EQ(m.profile_add_info, 2);
     expect_same(describe(p), describe(q), "round trip");
     expect_same(describe(q), describe(round_trip(q)), "second round trip");
+}
+
+// A vendor's diagnosis texts (ETG.2000 Profile/DiagMessages) are the device's: read into its description with
+// the vendor's text ids, the English text of several languages, the class where given; written back by
+// --write-esi as they were, valid against the schema, and a fixed point of the round trip.
+TEST(EsiDevices, AVendorsDiagMessagesRoundTripWithItsOwnTextIds) {
+    const std::string xml =
+        "<?xml version=\"1.0\"?><EtherCATInfo><Vendor><Id>#x123</Id><Name>V</Name></Vendor><Descriptions>"
+        "<Devices><Device><Type ProductCode=\"#x78\" RevisionNo=\"#x1\">T78</Type><Name>T 78</Name>"
+        "<Profile><ProfileNo>5001</ProfileNo><Dictionary><DataTypes><DataType><Name>UINT</Name>"
+        "<BitSize>16</BitSize></DataType></DataTypes><Objects><Object><Index>#x6000</Index><Name>In</Name>"
+        "<Type>UINT</Type><BitSize>16</BitSize><Flags><Access>ro</Access></Flags></Object></Objects>"
+        "</Dictionary><DiagMessages>"
+        "<DiagMessage><TextId>#x4711</TextId><MessageText LcId=\"1031\">Drahtbruch</MessageText>"
+        "<MessageText LcId=\"1033\">Wire break on input</MessageText>"
+        "<Flags><DiagClass>error</DiagClass></Flags></DiagMessage>"
+        "<DiagMessage><TextId>#x0002</TextId><MessageText LcId=\"1033\">Calibration done</MessageText>"
+        "</DiagMessage>"
+        "<DiagMessage><TextId>17</TextId><MessageText>Supply low</MessageText>"
+        "<Flags><DiagClass>warning</DiagClass></Flags></DiagMessage>"
+        "</DiagMessages></Profile>"
+        "<Sm DefaultSize=\"128\" StartAddress=\"#x1000\" ControlByte=\"#x26\" Enable=\"1\">MBoxOut</Sm>"
+        "<Sm DefaultSize=\"128\" StartAddress=\"#x1080\" ControlByte=\"#x22\" Enable=\"1\">MBoxIn</Sm>"
+        "<Mailbox><CoE SdoInfo=\"true\"/></Mailbox></Device></Devices></Descriptions>"
+        "</EtherCATInfo>";
+    const od::Product p = esi::load_product(esi::read_esi_text(xml, "t78.xml"), "");
+    const std::vector<od::DiagMessageText> expected{
+        {0x4711, "Wire break on input", "error", 0},
+        {0x0002, "Calibration done", "", 0},
+        {17, "Supply low", "warning", 0},
+    };
+    EXPECT_EQ(p.description.diag_messages, expected);
+    std::string written;
+    const od::Product q = round_trip(p, &written);
+    for (const std::string& e : schema_errors(written))
+        ADD_FAILURE() << "written ESI: " << e;
+    EXPECT_EQ(q.description.diag_messages, expected);
+    const esi::EsiDevice back = esi::read_esi(written);
+    ASSERT_EQ(back.diag_messages.size(), 3u);
+    EXPECT_EQ(back.diag_messages[0].text_id, 0x4711);
+    EXPECT_EQ(back.diag_messages[0].text, "Wire break on input");
+    EXPECT_EQ(back.diag_messages[1].diag_class, "");  // no class declared: none invented
+    expect_same(describe(q), describe(round_trip(q)), "second round trip");
+}
+
+// Texts without a dictionary (a device whose ESI gives DiagMessages but no objects): a Profile with only
+// DiagMessages, valid against the schema.
+TEST(EsiDevices, TextsWithoutADictionaryGiveAProfileWithOnlyThem) {
+    od::DeviceDescription desc;
+    desc.mailbox_protocols = 0;
+    desc.diag_messages = {{0x0010, "Terminal overheated", "warning", 0}};
+    const std::string xml = esi::build_esi(desc, od::Dictionary{});
+    for (const std::string& e : schema_errors(xml))
+        ADD_FAILURE() << "written ESI: " << e;
+    const esi::EsiDevice back = esi::read_esi(xml);
+    EXPECT_FALSE(back.has_dictionary);
+    ASSERT_EQ(back.diag_messages.size(), 1u);
+    EXPECT_EQ(back.diag_messages[0].text, "Terminal overheated");
+}
+
+// A DiagMessage whose TextId no 0x10F3 message can carry is left out and said once; the others stay.
+TEST(EsiDevices, ADiagMessageWithABadTextIdIsWarnedAndSkipped) {
+    const std::string xml =
+        "<?xml version=\"1.0\"?><EtherCATInfo><Vendor><Id>#x123</Id><Name>V</Name></Vendor><Descriptions>"
+        "<Devices><Device><Type ProductCode=\"#x79\" RevisionNo=\"#x1\">T79</Type><Name>T 79</Name>"
+        "<Profile><DiagMessages>"
+        "<DiagMessage><TextId>#x10000</TextId><MessageText>Too big</MessageText></DiagMessage>"
+        "<DiagMessage><TextId>x</TextId><MessageText>No number</MessageText></DiagMessage>"
+        "<DiagMessage><TextId>#x0003</TextId><MessageText>Kept</MessageText></DiagMessage>"
+        "</DiagMessages></Profile></Device></Devices></Descriptions></EtherCATInfo>";
+    const esi::EsiDevice d = esi::read_esi(xml);
+    ASSERT_EQ(d.diag_messages.size(), 1u);
+    EXPECT_EQ(d.diag_messages[0].text_id, 3);
+    EXPECT_EQ(d.diag_messages[0].text, "Kept");
+    EXPECT_EQ(std::count_if(d.unsupported.begin(), d.unsupported.end(),
+                            [](const std::string& u) { return u.find("DiagMessage") != std::string::npos; }),
+              2);
 }
 
 // ---- Bad input, as a class ----------------------------------------------------------------------------

@@ -11,7 +11,6 @@
 #include "esi/esi.hpp"
 #include "esi/esi_reader.hpp"
 #include "esi/model.hpp"
-#include "od/diag_texts.hpp"
 #include "test_device.hpp"
 
 namespace {
@@ -127,15 +126,16 @@ TEST(EsiReadBackDrive, RxAndTxPdosExcludeEachOtherAsTheSlaveEnforces) {
     EXPECT_EQ(esi.pdo(0x1A00)->sm, 3);
 }
 
-TEST(EsiReadBackDrive, DiagMessagesCoverEveryTextIdWithTheWholeText) {
+TEST(EsiReadBackDrive, DiagMessagesAreTheDescriptionsTextsWithTheWholeText) {
     const esi_test::Device dev = esi_test::drive_device();
     const esi::EsiDevice esi = esi::read_esi(esi::build_esi(dev.description, dev.dictionary));
-    ASSERT_EQ(esi.diag_messages.size(), od::drive_diag_texts().size());
-    for (const od::DiagText& t : od::drive_diag_texts()) {
-        ASSERT_EQ(esi.diag_messages.count(t.id), 1u);
-        EXPECT_EQ(esi.diag_messages.at(t.id), t.text);
-        EXPECT_EQ(od::diag_text_id(t.text), t.id);
-        EXPECT_EQ(od::diag_text(t.id), t.text);
+    ASSERT_FALSE(dev.description.diag_messages.empty());
+    ASSERT_EQ(esi.diag_messages.size(), dev.description.diag_messages.size());
+    for (std::size_t i = 0; i < esi.diag_messages.size(); ++i) {
+        const od::DiagMessageText& t = dev.description.diag_messages[i];
+        EXPECT_EQ(esi.diag_messages[i].text_id, t.text_id);
+        EXPECT_EQ(esi.diag_messages[i].text, t.text);
+        EXPECT_EQ(esi.diag_messages[i].diag_class, t.diag_class);
     }
     EXPECT_TRUE(esi.coe_attributes.at("DiagHistory"));
     EXPECT_EQ(esi.mailbox_request_timeout_ms, dev.description.mailbox_request_timeout_ms);

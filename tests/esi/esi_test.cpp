@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "esi/esi.hpp"
+#include "esi/esi_reader.hpp"
 #include "esi/sii.hpp"
 #include "test_device.hpp"
 
@@ -567,6 +568,20 @@ TEST(Esi, EmptyDeviceGivesValidFiles) {
     EXPECT_TRUE(sii.tx_pdos.empty());
     ASSERT_TRUE(sii.general.has_value());
     EXPECT_EQ(sii.general->coe_details, 0);
+}
+
+// DiagMessages come from the device description, not from having a diagnosis history: a device with 0x10F3
+// and no texts (its messages carry their text as a parameter) writes none, and still says DiagHistory. (That
+// its ESI validates: EsiDevice/ValidatesAgainstTheSchema*, "small".)
+TEST(Esi, ADeviceWithAHistoryButNoTextsWritesNoDiagMessages) {
+    const Device d = esi_test::small_device();
+    ASSERT_NE(d.dictionary.find(0x10F3), nullptr);
+    ASSERT_TRUE(d.description.diag_messages.empty());
+    const std::string xml = esi::build_esi(d.description, d.dictionary);
+    EXPECT_EQ(xml.find("DiagMessage"), std::string::npos);
+    const esi::EsiDevice back = esi::read_esi(xml);
+    EXPECT_TRUE(back.diag_messages.empty());
+    EXPECT_TRUE(back.coe_attributes.at("DiagHistory"));
 }
 
 TEST(Esi, StateDependentAccessUsesRestrictions) {

@@ -4,6 +4,7 @@ scapy-crafted frames (FPWR into SM0, FPRD from SM1) where ecatctl never would. E
 the slave keeps answering, and the capture decodes in tshark without malformed packets.
 Codes: coe/include/coe/abort.hpp, ecat/include/ecat/mailbox_handler.hpp; decisions in docs/decisions/coe.md
 and docs/decisions/ecat.md."""
+import os
 import re
 import shutil
 import struct
@@ -403,6 +404,24 @@ class DiagnosisHistoryThroughEcatctl(unittest.TestCase):
             self.assertEqual(len(errors), 1, newest_first)
             self.assertEqual(errors[0][3], "error")
             self.assertTrue(errors[0][5].startswith("EtherCAT state machine error  [bytes "), newest_first)
+            # The fault's message carries its text id (ETG.1020): with the device's ESI (--write-esi, its
+            # DiagMessages, ETG.2000) the text comes from the file. The file's text is changed here, so the
+            # line shows it came from there and not from the built-in table.
+            esi = os.path.join(bus.dir, "drive.xml")
+            subprocess.run([bus.slave_bin, "--write-esi", esi], check=True, timeout=60, stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE)
+            with open(esi, encoding="utf-8") as f:
+                xml = f.read()
+            marker = "<TextId>#x8180</TextId>\n"
+            self.assertIn(marker, xml)
+            at = xml.index(marker) + len(marker)
+            xml = xml[:at] + re.sub(r"<MessageText LcId=\"1033\">[^<]*<", "<MessageText LcId=\"1033\">Link lost<",
+                                    xml[at:], count=1)
+            with open(esi, "w", encoding="utf-8") as f:
+                f.write(xml)
+            named = [m for m in self.LINE.findall(bus.ecatctl("diag", "--esi", esi).stdout) if m[4] == "8180e800"]
+            self.assertEqual(len(named), 1)
+            self.assertTrue(named[0][5].startswith("Link lost (EtherCAT state machine error)  [bytes "), named)
             # Newest first: time stamps do not increase; --oldest-first is the same list reversed.
             stamps = [(m[1], m[2]) for m in lines]  # same format on every line: compares as text
             self.assertEqual(stamps, sorted(stamps, reverse=True))

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "master/diag.hpp"
@@ -91,6 +93,23 @@ TEST(DiagDecode, ATextIdAboutAnErrorShowsTheTextThenTheErrorName) {
     EXPECT_EQ(master::diag_text(*e, names, texts),
               "Fault reset refused: cause still present (Following error)");
     EXPECT_EQ(master::diag_text(*e, names), "Following error");  // without the texts: the error's name
+}
+
+TEST(DiagDecode, AFaultWhoseTextIsItsErrorsNameSaysItOnce) {
+    // What the drive stores for a fault: the error's diag code, its text id, the manufacturer bytes.
+    auto b = message(0x8611E800, 0x0102, 0x8611, 9, {0x05, 0x10, 8, 8, 0, 0, 0});
+    auto e = master::decode_diag_message(b, 6);
+    ASSERT_TRUE(e);
+    auto names = [](uint16_t code) -> std::string_view { return code == 0x8611 ? "Following error" : ""; };
+    auto texts = [](uint16_t id) -> std::string_view { return id == 0x8611 ? "Following error" : ""; };
+    EXPECT_EQ(master::diag_text(*e, names, texts), "Following error");
+    // A lookup that holds state (the texts of an ESI read at run time, as ecatctl diag --esi does).
+    const std::map<uint16_t, std::string> from_esi{{0x8611, "Schleppfehler"}};
+    const master::TextIdLookup esi = [&from_esi](uint16_t id) -> std::string_view {
+        auto it = from_esi.find(id);
+        return it != from_esi.end() ? std::string_view(it->second) : std::string_view();
+    };
+    EXPECT_EQ(master::diag_text(*e, names, esi), "Schleppfehler (Following error)");
 }
 
 TEST(DiagDecode, AWarningNamedByItsCodeDoesNotRepeatItsCutText) {

@@ -4,20 +4,23 @@
 // glue's sink forwards its three calls here one to one.
 //
 //   raise(code, register, mfr) -> emergency (code, register, mfr) + 0x10F3 error message (diag code
-//                                  0xE800 | code << 16, the 5 manufacturer bytes as a byte-array parameter)
+//                                  0xE800 | code << 16, the text id of the code's text, the 5 manufacturer
+//                                  bytes as a byte-array parameter)
 //   clear(code, register)      -> when the last active error goes: the "no error" emergency (0x0000,
 //                                  register); warnings and unknown codes send nothing
 //   diag(type, code, text)     -> 0x10F3 message (0xE800 | code << 16, or 0xE000 manufacturer code when
-//                                  code is 0) with the text as an ASCII parameter
+//                                  code is 0) with the text's id, or the text as an ASCII parameter
 // Time stamps come from `clock` (DC system time in ns). Nothing allocates; safe inside the drive's cycle.
 #include <array>
 #include <cstdint>
 #include <functional>
 #include <span>
 #include <string_view>
+#include <vector>
 
 #include "coe/diagnosis.hpp"
 #include "coe/emergency.hpp"
+#include "od/device.hpp"
 
 namespace coe {
 
@@ -29,13 +32,17 @@ class EventReporter {
     // history may be null (no 0x10F3); clock may be empty (time stamp 0, flagged as local time).
     EventReporter(Emergency& emergency, DiagnosisHistory* history, std::function<uint64_t()> clock = {});
 
-    // Text ids (ETG.1020) of the device's diagnosis texts (e.g. od::diag_text_id): a diag() whose text has
-    // an id (not 0) is stored with that id and without the text parameter, so the master shows the whole
-    // text from the ESI's DiagMessages instead of what fits into one message. A plain function: no state.
-    using TextIdLookup = uint16_t (*)(std::string_view text);
-    void set_text_ids(TextIdLookup lookup) { text_ids_ = lookup; }
+    // The device's diagnosis texts (od::DeviceDescription::diag_messages, ETG.1020 text ids listed in its
+    // ESI's DiagMessages, ETG.2000), copied: a raise() of a code that a text names (error_code) and a diag()
+    // whose text is one of them (exact match) are stored with that text id, a diag() without the text
+    // parameter, so the master shows the whole text from the ESI instead of what fits into one message. The
+    // raise() keeps its manufacturer bytes. Set before the cycle runs (it allocates once, here).
+    void set_texts(std::span<const od::DiagMessageText> texts) { texts_.assign(texts.begin(), texts.end()); }
 
-    void raise(uint16_t error_code, uint8_t error_register, std::span<const uint8_t> mfr);
+    // `text`: the error's name, if the application has one; the text id of the text that names the code, else
+    // of the text equal to `text` (a device from an ESI whose DiagMessages has the error's name), else none.
+    void raise(uint16_t error_code, uint8_t error_register, std::span<const uint8_t> mfr,
+               std::string_view text = {});
     void clear(uint16_t error_code, uint8_t error_register);
     void diag(DiagType type, uint16_t code, std::string_view text);
 
@@ -50,7 +57,10 @@ class EventReporter {
     std::function<uint64_t()> clock_;
     std::array<uint16_t, kMaxActive> active_{};
     std::size_t active_count_ = 0;
-    TextIdLookup text_ids_ = nullptr;
+    uint16_t text_id_of(uint16_t error_code) const;
+    uint16_t text_id_of(std::string_view text) const;
+
+    std::vector<od::DiagMessageText> texts_;
 };
 
 }  // namespace coe

@@ -10,6 +10,7 @@
 #include <string>
 #include <string_view>
 
+#include "drive/wire/diag_texts.hpp"
 #include "od/device_config.hpp"
 #include "util/strfmt.hpp"
 #include "value_names.hpp"
@@ -664,6 +665,13 @@ DeviceDescription description() {
     // A request leaves SM0 at the next poll; the slowest answer is a 0x1010 save (file write and fsync).
     d.mailbox_request_timeout_ms = 100;
     d.mailbox_response_timeout_ms = 2000;
+    // The drive core's diagnosis texts (ETG.1020 text ids, ETG.2000 DiagMessages): its own messages, then one
+    // per error it can raise (§8.1, Table 8-141), whose 0x10F3 message carries the text's id.
+    static const char* const kClass[] = {"information", "warning", "error"};
+    for (const drive::DiagText& t : drive::kDiagTexts)
+        d.diag_messages.push_back({t.id, std::string(t.text), kClass[t.type < 3 ? t.type : 0], 0});
+    for (const drive::ErrorInfo& e : drive::kErrorTable)
+        d.diag_messages.push_back({drive::error_text_id(e.code), std::string(e.name), "error", e.code});
     return d;
 }
 

@@ -1126,6 +1126,11 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
         desc.pdo_sets.push_back(std::move(s));
     }
 
+    // ---- Diagnosis texts (Profile/DiagMessages): kept, so that --write-esi gives them back and the device's
+    // 0x10F3 messages with one of these texts carry the vendor's text id ----
+    for (const EsiDiagMessage& m : d.diag_messages)
+        desc.diag_messages.push_back({m.text_id, m.text, m.diag_class, 0});
+
     // ---- Entry names unique within an object (as the ESI's SubItems must be, and SDO information lists
     // them) ----
     for (auto& [index, o] : built.objects) {

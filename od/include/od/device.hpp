@@ -141,6 +141,22 @@ struct Slot {
     uint32_t pdo_increment = 0, index_increment = 0;
 };
 
+// A diagnosis text of the device (ETG.2000 Profile/DiagMessages/DiagMessage; ETG.1020 diagnosis history):
+// a 0x10F3 message carries the text id, the master shows the text its ESI gives for it. A product that runs
+// the drive core lists the drive's (drive/wire/diag_texts.hpp); a device read from a vendor's ESI keeps the
+// vendor's, and --write-esi writes back whatever is here.
+struct DiagMessageText {
+    uint16_t text_id = 0;  // TextId
+    std::string text;      // MessageText (the English one where a file gives several languages)
+    // Flags/DiagClass: "error", "warning" or "information"; empty: the file declares none.
+    std::string diag_class;
+    // The emergency error code (0x603F, CiA 402) whose 0x10F3 message carries this text id when the device
+    // raises it (coe::EventReporter); 0: none. Not part of the ESI (a vendor file's texts have 0): a message
+    // without an error code gets its id by its text.
+    uint16_t error_code = 0;
+    bool operator==(const DiagMessageText&) const = default;
+};
+
 struct DeviceDescription {
     Identity identity;
     MailboxLayout standard_mailbox;
@@ -176,6 +192,8 @@ struct DeviceDescription {
     // A modular device (empty: not modular). The PDOs of the slots' default modules are in the dictionary.
     std::vector<Slot> slots;
     std::vector<Module> modules;
+    // The device's diagnosis texts (empty: none; the ESI then has no DiagMessages).
+    std::vector<DiagMessageText> diag_messages;
 };
 
 }  // namespace od

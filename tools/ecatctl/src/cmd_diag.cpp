@@ -1,24 +1,29 @@
 // ecatctl diag [slave] [--oldest-first] [--new] [--ack]: the diagnosis history 0x10F3 (ETG.1020) read over
 // CoE SDO and printed as text: the header subindices, the flags, then one line per message with its time
-// stamp (DC system time), type, diag code, text and parameters. Texts of emergency-derived codes come from
-// the drive's error table (drive/wire/error_codes.hpp, od-free; ecatctl does not link the drive).
+// stamp (DC system time), type, diag code, text and parameters. A message's text id (ETG.1020) is named
+// from the device's ESI DiagMessages (ETG.2000) with --esi FILE, else from the built-in drive's texts
+// (drive/wire/diag_texts.hpp); emergency-derived codes from the drive's error table
+// (drive/wire/error_codes.hpp). Both od-free: ecatctl does not link the drive.
 #include "cmd_diag.hpp"
 
 #include "commands.hpp"
 
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "drive/wire/diag_texts.hpp"
 #include "drive/wire/error_codes.hpp"
+#include "esi/esi_reader.hpp"
 #include "format.hpp"
 #include "master/coe.hpp"
 #include "master/diag.hpp"
 #include "master/mailbox.hpp"
-#include "od/wire/diag_text_table.hpp"
 #include "util/json.hpp"
 #include "util/strfmt.hpp"
 
@@ -35,6 +40,13 @@ struct DiagArgs {
     bool only_new = false;
     bool ack = false;
     bool json = false;
+    std::string esi_path;  // --esi: the device's ESI, for its texts
+};
+
+// The ESI given with --esi, read before the master opens the link (a bad file: exit 2, nothing sent).
+struct EsiTexts {
+    esi::EsiFile file;
+    std::map<uint16_t, std::string> texts;  // of the device picked for the slave
 };
 
 std::string_view drive_error_name(uint16_t code) {
@@ -42,9 +54,33 @@ std::string_view drive_error_name(uint16_t code) {
     return {};
 }
 
-// The drive's diagnosis texts by id (what its ESI lists as DiagMessages).
+// The built-in drive's diagnosis texts by id (what its ESI lists as DiagMessages).
 std::string_view drive_text(uint16_t id) {
-    return od::diag_text_of(id);
+    return drive::diag_text_of(id);
+}
+
+// The device of the file that the slave is (0x1018:02 product code, :03 revision): the one with both, else
+// the only one with the product code, else the file's only device; nullptr if none fits.
+const esi::EsiDevice* pick_device(const esi::EsiFile& f, master::SdoClient& sdo) {
+    if (f.devices.size() == 1) return &f.devices.front();
+    uint8_t buf[4];
+    auto read32 = [&](uint8_t sub) -> std::optional<uint32_t> {
+        auto n = sdo.upload(0x1018, sub, buf);
+        if (!n || *n != 4) return std::nullopt;
+        return static_cast<uint32_t>(buf[0] | buf[1] << 8 | buf[2] << 16 | uint32_t{buf[3]} << 24);
+    };
+    const auto product = read32(2);
+    const auto revision = read32(3);
+    if (!product) return nullptr;
+    const esi::EsiDevice* by_product = nullptr;
+    std::size_t with_product = 0;
+    for (const esi::EsiDevice& d : f.devices) {
+        if (d.product_code != *product) continue;
+        if (revision && d.revision == *revision) return &d;
+        by_product = &d;
+        ++with_product;
+    }
+    return with_product == 1 ? by_product : nullptr;
 }
 
 int report(const master::SdoClient& sdo, Error e, const char* what) {
@@ -61,7 +97,7 @@ int report(const master::SdoClient& sdo, Error e, const char* what) {
     return e == Error::Timeout || e == Error::MailboxTimeout ? kExitNoSlave : kExitProtocol;
 }
 
-int run_diag(master::Master& m, const DiagArgs& d) {
+int run_diag(master::Master& m, const DiagArgs& d, EsiTexts* esi) {
     auto v = parse_number(d.slave, 0xFFFF);
     if (!v) {
         std::fprintf(stderr, "ecatctl: bad slave '%s'\n", d.slave.c_str());
@@ -75,6 +111,21 @@ int run_diag(master::Master& m, const DiagArgs& d) {
         return e == Error::Timeout ? kExitNoSlave : kExitProtocol;
     }
     master::SdoClient sdo(mbx);
+    master::TextIdLookup texts = drive_text;
+    if (esi != nullptr) {
+        const esi::EsiDevice* dev = pick_device(esi->file, sdo);
+        if (dev == nullptr) {
+            std::fprintf(stderr, "ecatctl: %s: no device of the file is the slave (0x1018:02/:03)\n",
+                         d.esi_path.c_str());
+            return kExitUsage;
+        }
+        for (const esi::EsiDiagMessage& t : dev->diag_messages)
+            esi->texts.emplace(t.text_id, t.text);
+        texts = [esi](uint16_t id) -> std::string_view {
+            auto it = esi->texts.find(id);
+            return it != esi->texts.end() ? std::string_view(it->second) : std::string_view();
+        };
+    }
     uint8_t buf[8];
     auto read_uint = [&](uint8_t sub, uint16_t& out) -> Error {
         auto n = sdo.upload(master::kDiagIndex, sub, buf);
@@ -141,7 +192,7 @@ int run_diag(master::Master& m, const DiagArgs& d) {
         if (!e) continue;  // an empty slot of a ring not yet full
         ++shown;
         if (!d.json) {
-            std::printf("%s\n", master::format_diag_line(*e, drive_error_name, drive_text).c_str());
+            std::printf("%s\n", master::format_diag_line(*e, drive_error_name, texts).c_str());
             continue;
         }
         w.begin_object()
@@ -151,7 +202,7 @@ int run_diag(master::Master& m, const DiagArgs& d) {
             .member("text_id", e->text_id)
             .member("timestamp_ns", e->timestamp_ns)
             .member("local_time", e->local_time)
-            .member("text", master::diag_text(*e, drive_error_name, drive_text))
+            .member("text", master::diag_text(*e, drive_error_name, texts))
             .key("parameters")
             .begin_array();
         for (const auto& p : e->params)
@@ -192,8 +243,22 @@ void add_diag_command(CLI::App& app, MasterRunner run, int& rc) {
     c->add_flag("--new", args->only_new, "Only messages newer than the acknowledged one");
     c->add_flag("--ack", args->ack, "Acknowledge up to the newest message afterwards (write 0x10F3:03)");
     c->add_flag("--json", args->json, "JSON on stdout (docs/ecatctl-json.md)");
+    c->add_option("--esi", args->esi_path,
+                  "The slave's ESI file: name text ids by its DiagMessages (default: the built-in drive's "
+                  "texts); a file of several devices is matched by the slave's 0x1018 identity");
     c->callback([args, run = std::move(run), &rc] {
-        rc = run([&](master::Master& m) { return run_diag(m, *args); });
+        std::shared_ptr<EsiTexts> esi;
+        if (!args->esi_path.empty()) {
+            try {
+                esi = std::make_shared<EsiTexts>();
+                esi->file = esi::read_esi_file(args->esi_path);
+            } catch (const std::exception& e) {
+                std::fprintf(stderr, "ecatctl: %s\n", e.what());
+                rc = kExitUsage;
+                return;
+            }
+        }
+        rc = run([&](master::Master& m) { return run_diag(m, *args, esi.get()); });
     });
 }
 

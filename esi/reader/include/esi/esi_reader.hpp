@@ -163,6 +163,14 @@ struct EsiPdoSet {
     std::map<int, std::vector<uint16_t>> sms;  // SyncManager number -> PDOs
 };
 
+// Profile/DiagMessages/DiagMessage (ETG.2000): a diagnosis text the device's 0x10F3 messages refer to by
+// text id (ETG.1020).
+struct EsiDiagMessage {
+    uint16_t text_id = 0;
+    std::string text;        // MessageText, the English one (LcId 1033) if there is one, else the first
+    std::string diag_class;  // Flags/DiagClass ("error", "warning", "information"); empty if not given
+};
+
 struct EsiDevice {
     uint32_t vendor_id = 0;
     std::string vendor_name;
@@ -199,8 +207,8 @@ struct EsiDevice {
     int line = 0;  // of the Device element
     int eeprom_line = 0;
     bool identification_reg134 = false;
-    std::map<uint16_t, std::string> diag_messages;  // Profile/DiagMessages: TextId -> MessageText
-    std::vector<uint8_t> image16x14;                // ImageData16x14, empty if none
+    std::vector<EsiDiagMessage> diag_messages;  // Profile/DiagMessages, in file order
+    std::vector<uint8_t> image16x14;            // ImageData16x14, empty if none
 
     const EsiObject* object(uint16_t index) const;
     const EsiPdo* pdo(uint16_t index) const;  // an RxPdo or TxPdo

@@ -22,7 +22,6 @@
 #include "foe/image.hpp"
 #include "maxpos/maxpos.hpp"
 #include "od/device_config.hpp"
-#include "od/diag_texts.hpp"
 #include "util/le.hpp"
 #include "util/lex.hpp"
 #include "util/strfmt.hpp"
@@ -408,7 +407,7 @@ void Device::build() {
             p->diag = std::make_unique<coe::DiagnosisHistory>(p->dict, &p->coe->emergency());
         p->events = std::make_unique<coe::EventReporter>(p->coe->emergency(), p->diag.get(),
                                                          [this] { return system_time_ns(); });
-        p->events->set_text_ids(&od::diag_text_id);  // the texts the ESI lists as DiagMessages
+        p->events->set_texts(p->desc.diag_messages);  // the texts the ESI lists as DiagMessages
         p->stack->add_handler(*p->coe);
     }
     if (p->firmware) {
@@ -595,14 +594,17 @@ void Device::on_restart() {
 // ---- drive::EventSink -------------------------------------------------------------------------------
 
 void Device::raise(uint16_t error_code, uint8_t error_register, const std::array<uint8_t, 5>& mfr) {
+    const drive::ErrorInfo* info = drive::find_error(error_code);
     if (options_.events != nullptr && options_.events->enabled(slave::LogLevel::Error)) {
-        const drive::ErrorInfo* info = drive::find_error(error_code);
         event(slave::LogLevel::Error, "drive fault " + hex16(error_code) + ": " +
                                           (info != nullptr ? std::string(info->name) : "unknown error"));
     }
     ++stats_.emergencies;
     ++stats_.diagnoses;
-    if (parts_->events) parts_->events->raise(error_code, error_register, mfr);
+    // The error's name finds the text of a device whose texts came from an ESI (no code binding there).
+    if (parts_->events)
+        parts_->events->raise(error_code, error_register, mfr,
+                              info != nullptr ? info->name : std::string_view());
 }
 
 void Device::clear(uint16_t error_code, uint8_t error_register) {

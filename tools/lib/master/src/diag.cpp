@@ -206,7 +206,7 @@ std::string_view emergency_class_name(uint16_t code) {
     }
 }
 
-std::string diag_text(const DiagEntry& e, ErrorNameLookup lookup, TextIdLookup texts) {
+std::string diag_text(const DiagEntry& e, ErrorNameLookup lookup, const TextIdLookup& texts) {
     // A text the device gives by id says more than the error it concerns (e.g. "Fault reset refused: cause
     // still present" about a following error): the text first, the error's name after it.
     if (e.text_id != 0 && texts != nullptr) {
@@ -215,7 +215,7 @@ std::string diag_text(const DiagEntry& e, ErrorNameLookup lookup, TextIdLookup t
             std::string s(t);
             if (e.from_emergency() && e.emergency_code() != 0 && lookup != nullptr) {
                 const std::string_view n = lookup(e.emergency_code());
-                if (!n.empty()) s += " (" + std::string(n) + ")";
+                if (!n.empty() && n != t) s += " (" + std::string(n) + ")";
             }
             return s;
         }
@@ -284,7 +284,7 @@ std::string format_diag_flags(uint16_t flags) {
     return s;
 }
 
-std::string format_diag_line(const DiagEntry& e, ErrorNameLookup lookup, TextIdLookup texts) {
+std::string format_diag_line(const DiagEntry& e, ErrorNameLookup lookup, const TextIdLookup& texts) {
     std::string s = util::strprintf(
         ":%02u  %s%s  %-7s  0x%08x  ", e.subindex, format_diag_time(e.timestamp_ns, e.local_time).c_str(),
         e.local_time ? " (local)" : "", std::string(diag_type_name(e.type)).c_str(), e.code);

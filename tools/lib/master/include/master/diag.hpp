@@ -3,6 +3,7 @@
 // coe/diagnosis.hpp): decoding of the message bytes, the order of the ring, readable text. Pure functions,
 // tested in tests/master/diag_test.cpp; `ecatctl diag` reads the object by SDO and prints with these.
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -72,9 +73,10 @@ std::string_view emergency_class_name(uint16_t code);
 // emergency-derived code), else the device's error name for an emergency-derived code (else its CiA 301
 // class), the ASCII parameter of a manufacturer message, "text id 0x...." otherwise.
 // texts: the device's text ids (ETG.1020 text id -> text, e.g. from its ESI DiagMessages); without it, or for
-// an id it does not know, "text id 0x....".
-using TextIdLookup = std::string_view (*)(uint16_t text_id);
-std::string diag_text(const DiagEntry& e, ErrorNameLookup lookup = nullptr, TextIdLookup texts = nullptr);
+// an id it does not know, "text id 0x....". A text that is the error's name is not followed by it again.
+using TextIdLookup = std::function<std::string_view(uint16_t text_id)>;
+std::string diag_text(const DiagEntry& e, ErrorNameLookup lookup = nullptr,
+                      const TextIdLookup& texts = nullptr);
 // DC system time in ns -> "12.345678901 s".
 // A message's time stamp: DC system time set to the wall time as "2026-11-27 02:46:36.600 UTC", otherwise
 // (local time, or a DC clock a year or less past its epoch) the time since the clock started,
@@ -86,6 +88,6 @@ std::string format_diag_flags(uint16_t flags);
 // A text parameter that the text shown already says (it was taken from it, or it is the start of the
 // device's name for the code, cut to the message's room) is not repeated among the parameters.
 std::string format_diag_line(const DiagEntry& e, ErrorNameLookup lookup = nullptr,
-                             TextIdLookup texts = nullptr);
+                             const TextIdLookup& texts = nullptr);
 
 }  // namespace master
