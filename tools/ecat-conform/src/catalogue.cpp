@@ -4,8 +4,8 @@
 namespace conform {
 
 const std::vector<std::string>& group_names() {
-    static const std::vector<std::string> g = {"esc", "sii", "esm", "mbx", "sdo",    "sdoinfo",
-                                               "pd",  "emcy", "dc", "foe", "cia402"};
+    static const std::vector<std::string> g = {"esc", "sii",  "esm", "mbx", "sdo",   "sdoinfo",
+                                               "pd",  "emcy", "dc",  "foe", "cia402"};
     return g;
 }
 

@@ -59,7 +59,8 @@ Outcome refused_request_emergency(Context& ctx) {
     CONFORM_NEED(ctx.need_state_machine());
     if (Error e = ctx.to_init(); e != Error::Ok) return fail("cannot reach INIT", err(e));
     CONFORM_PREOP(ctx);
-    if (is_drive(ctx)) return skip("a CiA 402 drive: its emergencies are those of its faults (cia402.fault.*)");
+    if (is_drive(ctx))
+        return skip("a CiA 402 drive: its emergencies are those of its faults (cia402.fault.*)");
     std::vector<uint8_t> raw;
     for (int i = 0; i < 16 && ctx.mbx_read_raw(raw, ctx.ms(30)) == Error::Ok; ++i) {
     }  // what earlier tests left in SM1
@@ -73,7 +74,8 @@ Outcome refused_request_emergency(Context& ctx) {
     if (auto r = ctx.upload_uint(0x1001, 0)) reg1001 = *r;
     (void)ctx.to_init();
     const std::string state = state_text(static_cast<uint8_t>(st.state | (st.error ? 0x10 : 0)));
-    if (st.state != 2 || !st.error) return skip("PREOP -> OP was not refused (" + state + "): see esm.invalid.*");
+    if (st.state != 2 || !st.error)
+        return skip("PREOP -> OP was not refused (" + state + "): see esm.invalid.*");
     if (emcy.empty()) return skip("no emergency for the refused request (an emergency is optional there)");
     // The first emergency is the one of the refusal; a later one may already be the "no error" of the
     // acknowledge.
