@@ -317,24 +317,31 @@ def sii_word(word, fn):
     return mutate
 
 
+def input_bytes(st, d):
+    """(logical address, offset in the datagram's data) of each input byte a logical read carries: the
+    bytes of the FMMUs the master set up active and with read direction."""
+    if d.cmd not in (LRD, LRW) or d.wkc == 0:
+        return
+    laddr = d.adp | (d.ado << 16)
+    for k in range(16):
+        f = 0x0600 + 16 * k
+        if not (st.mem[f + 12] & 1) or not (st.mem[f + 11] & 1):
+            continue
+        la, ln = st.reg(f, 4), st.reg(f + 4)
+        for i in range(ln):
+            if laddr <= la + i < laddr + d.n:
+                yield la + i, la + i - laddr
+
+
 def lrw_inputs_zero_in(state_code):
     """Logical reads: the inputs (FMMUs with read direction) replaced by zeros while AL status is state."""
 
     def mutate(st, d):
-        if d.cmd not in (LRD, LRW) or d.wkc == 0:
-            return
         if (st.scratch.get("al", 0) & 0x0F) != state_code:
             return
-        laddr = d.adp | (d.ado << 16)
         data = d.data
-        for k in range(16):
-            f = 0x0600 + 16 * k
-            if not (st.mem[f + 12] & 1) or not (st.mem[f + 11] & 1):
-                continue
-            la, ln = st.reg(f, 4), st.reg(f + 4)
-            for i in range(ln):
-                if laddr <= la + i < laddr + d.n:
-                    data[la + i - laddr] = 0
+        for _, off in input_bytes(st, d):
+            data[off] = 0
         d.data = data
 
     return mutate
@@ -358,19 +365,10 @@ def inputs_frozen(st, d):
             v = d.get(reg, 1)
             first = st.scratch.setdefault(("sm-last-buffer", n), v & 0x30)
             d.put(reg, (v & ~0x31) | first, 1)
-    if d.cmd not in (LRD, LRW) or d.wkc == 0:
-        return
-    laddr = d.adp | (d.ado << 16)
     data = d.data
     frozen = st.scratch.setdefault("inputs", {})
-    for k in range(16):
-        f = 0x0600 + 16 * k
-        if not (st.mem[f + 12] & 1) or not (st.mem[f + 11] & 1):
-            continue
-        la, ln = st.reg(f, 4), st.reg(f + 4)
-        for i in range(ln):
-            if laddr <= la + i < laddr + d.n:
-                data[la + i - laddr] = frozen.setdefault(la + i, data[la + i - laddr])
+    for la, off in input_bytes(st, d):
+        data[off] = frozen.setdefault(la, data[off])
     d.data = data
 
 
