@@ -583,7 +583,7 @@ MUTANTS = {
 # count as a kill. "*": the defect breaks discovery itself, every test fails with "cannot start".
 _GROUP_OF = {
     "esc": ("dl-status-", "al-status-", "features-", "dl-control-", "station-alias-", "fprw-", "aprd-", "fprd-"),
-    "mbx": ("sm-status-", "mbx-"),
+    "mbx": ("sm-status-", "mbx-", "io-emcy-"),
     "sii": ("sii-",),
     "esm": ("al-code-", "al-error-"),
     "sdo": ("sdo-", "coe-", "identity-", "device-type", "ca-", "sm-comm-"),
@@ -592,7 +592,6 @@ _GROUP_OF = {
     "sdoinfo": ("info-",),
     "foe": ("foe-",),
     "pd": ("inputs-", "lrw-", "io-inputs-"),
-    "emcy": ("io-emcy-",),
     "*": ("brd-", "liar-"),
 }
 

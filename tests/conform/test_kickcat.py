@@ -23,7 +23,7 @@ import harness  # noqa: E402
 
 # What the run after the mailbox defect covers (every group but the test that wedges the mailbox).
 AFTER_WEDGE = ("sdo.upload.*,sdo.download.*,sdo.abort.[!u]*,sdo.identity.*,sdo.device_type*,sdo.sm_types,"
-               "sdo.od.*,sdo.ca.*,sdo.pdo.*,sdoinfo.*,pd.*,emcy.*,dc.*,foe.*,cia402.*")
+               "sdo.od.*,sdo.ca.*,sdo.pdo.*,sdoinfo.*,pd.*,dc.*,foe.*,cia402.*")
 
 
 def simulator():

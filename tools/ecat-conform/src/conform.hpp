@@ -87,7 +87,7 @@ void add_sdo_tests(Catalogue& c);
 void add_sdoinfo_tests(Catalogue& c);
 void add_pd_tests(Catalogue& c);
 void add_io_tests(Catalogue& c);    // pd: inputs refreshed (tests_io.cpp)
-void add_emcy_tests(Catalogue& c);  // emergency of a device that is not a drive (tests_emcy.cpp)
+void add_emcy_tests(Catalogue& c);  // mbx: emergency of a device that is not a drive (tests_emcy.cpp)
 void add_dc_tests(Catalogue& c);
 void add_foe_tests(Catalogue& c);
 void add_cia402_tests(Catalogue& c);

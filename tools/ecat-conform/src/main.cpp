@@ -130,7 +130,7 @@ int main(int argc, char** argv) {
     app.add_option("--device", o.device,
                    "Device index in the ESI file (default: the one matching the SII identity)");
     app.add_option("--group", groups_arg,
-                   "Only these groups (comma separated): esc,sii,esm,mbx,sdo,sdoinfo,pd,emcy,dc,foe,cia402");
+                   "Only these groups (comma separated): esc,sii,esm,mbx,sdo,sdoinfo,pd,dc,foe,cia402");
     app.add_option("--filter", filter, "Only tests whose id matches this glob (comma separated globs)");
     app.add_flag("--list", list, "Print the catalogue and exit");
     app.add_flag("--markdown", markdown, "With --list: a markdown table");

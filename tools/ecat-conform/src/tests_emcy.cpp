@@ -1,5 +1,5 @@
-// Group emcy: the emergency of a device that is not a drive (a drive's emergencies are those of its
-// faults, cia402.fault.*, behind --allow-fault). Provoked safely: an AL request the state machine must
+// Group mbx, emergencies: the emergency of a device that is not a drive (a drive's emergencies are those of
+// its faults, cia402.fault.*, behind --allow-fault). Provoked safely: an AL request the state machine must
 // refuse (PREOP -> OP, ETG.1000.6: invalid state change 0x0011); nothing is written to outputs or flash.
 #include "testkit.hpp"
 
@@ -90,8 +90,8 @@ Outcome refused_request_emergency(Context& ctx) {
 }  // namespace
 
 void add_emcy_tests(Catalogue& c) {
-    Adder add{c, "emcy"};
-    add("refused_request",
+    Adder add{c, "mbx"};
+    add("emcy.refused_request",
         "A refused AL request (PREOP -> OP) of a device that is not a drive: its emergency, if it sends one, "
         "is 10 bytes of CoE service 1 with a non-zero error code, the generic and class bits in its error "
         "register, which equals 0x1001",
