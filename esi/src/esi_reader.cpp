@@ -133,7 +133,12 @@ void read_flags(Node flags, std::string& access, std::string& wr, std::string& r
         wr = attr(a, "WriteRestrictions");
         rr = attr(a, "ReadRestrictions");
     }
-    if (Node p = child(flags, "PdoMapping")) pdo = text(p);
+    if (Node p = child(flags, "PdoMapping")) {
+        // ETG.2000 (EtherCATBase.xsd) allows T, R, TR, RT and the same in lower case.
+        pdo = text(p);
+        for (char& c : pdo)
+            c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    }
     if (Node b = child(flags, "Backup")) backup = truthy(text(b));
     if (Node s = child(flags, "Setting")) setting = truthy(text(s));
 }

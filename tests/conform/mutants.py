@@ -317,27 +317,64 @@ def sii_word(word, fn):
     return mutate
 
 
+def input_bytes(st, d):
+    """(logical address, offset in the datagram's data) of each input byte a logical read carries: the
+    bytes of the FMMUs the master set up active and with read direction."""
+    if d.cmd not in (LRD, LRW) or d.wkc == 0:
+        return
+    laddr = d.adp | (d.ado << 16)
+    for k in range(16):
+        f = 0x0600 + 16 * k
+        if not (st.mem[f + 12] & 1) or not (st.mem[f + 11] & 1):
+            continue
+        la, ln = st.reg(f, 4), st.reg(f + 4)
+        for i in range(ln):
+            if laddr <= la + i < laddr + d.n:
+                yield la + i, la + i - laddr
+
+
 def lrw_inputs_zero_in(state_code):
     """Logical reads: the inputs (FMMUs with read direction) replaced by zeros while AL status is state."""
 
     def mutate(st, d):
-        if d.cmd not in (LRD, LRW) or d.wkc == 0:
-            return
         if (st.scratch.get("al", 0) & 0x0F) != state_code:
             return
-        laddr = d.adp | (d.ado << 16)
         data = d.data
-        for k in range(16):
-            f = 0x0600 + 16 * k
-            if not (st.mem[f + 12] & 1) or not (st.mem[f + 11] & 1):
-                continue
-            la, ln = st.reg(f, 4), st.reg(f + 4)
-            for i in range(ln):
-                if laddr <= la + i < laddr + d.n:
-                    data[la + i - laddr] = 0
+        for _, off in input_bytes(st, d):
+            data[off] = 0
         d.data = data
 
     return mutate
+
+
+def input_sms(st):
+    """SMs the master set up for inputs: active, buffered (mode 0), read by EtherCAT (direction 0)."""
+    for n in range(16):
+        base = 0x0800 + 8 * n
+        if (st.mem[base + 6] & 1) and (st.mem[base + 4] & 0x0F) == 0 and st.reg(base + 2):
+            yield n
+
+
+def inputs_frozen(st, d):
+    """A device whose application wrote its inputs once and then stopped (a hung task, a frozen IO
+    process): the input SM's status never shows another buffer written (bit 0 clear, bits 4-5 as first
+    read) and every logical read returns the inputs as they were first read, whatever values they hold."""
+    for n in input_sms(st):
+        reg = 0x0805 + 8 * n
+        if d.covers(reg, 1):
+            v = d.get(reg, 1)
+            first = st.scratch.setdefault(("sm-last-buffer", n), v & 0x30)
+            d.put(reg, (v & ~0x31) | first, 1)
+    data = d.data
+    frozen = st.scratch.setdefault("inputs", {})
+    for la, off in input_bytes(st, d):
+        data[off] = frozen.setdefault(la, data[off])
+    d.data = data
+
+
+def emergency(fn):
+    """A mutation of CoE emergencies (service 1): fn(m) changes the message in place."""
+    return mbx_rewriter(lambda st, m: (fn(m), m)[1] if coe(m)[0] == 1 and len(m) >= 16 else None)
 
 
 def adp_not_incremented(st, d):
@@ -525,6 +562,15 @@ MUTANTS = {
     "lrw-wkc-op": _m("ETG.1000.4 LRW working counter 3 (outputs written, inputs read)",
                      apply_all(track_al, lambda st, d: d.cmd == LRW and d.wkc == 3 and (st.scratch.get("al", 0) & 0x0F) == 8
                                and setattr(d, "wkc", 2))),
+    # -- a device without drive (DEVICE below: the slave and ecat-conform serve and read that ESI) --
+    "io-inputs-frozen": _m("ETG.1000.6 SAFEOP/OP inputs valid: the application writes the input SM every cycle "
+                           "(ESC SM status 0x0805+8n write event)", inputs_frozen),
+    "io-emcy-generic-bit": _m("CiA 301 / ETG.1000.6 emergency error register: bit 0 (generic) at any error",
+                              emergency(lambda m: m.__setitem__(10, m[10] & ~0x01))),
+    "io-emcy-code-zero": _m("ETG.1000.6 emergency: an error's code is not 0x0000 (error reset / no error)",
+                            emergency(lambda m: m[8:10] != b"\x00\x00" and struct.pack_into("<H", m, 8, 0))),
+    "io-emcy-length": _m("ETG.1000.6 emergency: mailbox length 10 (CoE header, code, register, 5 bytes)",
+                         emergency(lambda m: struct.pack_into("<H", m, 0, 8))),
     # -- DC --
     "dc-receive-static": _m("ETG.1000.4 DC receive time port 0 latched by a write to 0x0900",
                             lambda st, d: d.covers(0x0900, 4) and d.put(0x0900, st.scratch.setdefault("rt", d.get(0x0900, 4)), 4)),
@@ -537,7 +583,7 @@ MUTANTS = {
 # count as a kill. "*": the defect breaks discovery itself, every test fails with "cannot start".
 _GROUP_OF = {
     "esc": ("dl-status-", "al-status-", "features-", "dl-control-", "station-alias-", "fprw-", "aprd-", "fprd-"),
-    "mbx": ("sm-status-", "mbx-"),
+    "mbx": ("sm-status-", "mbx-", "io-emcy-"),
     "sii": ("sii-",),
     "esm": ("al-code-", "al-error-"),
     "sdo": ("sdo-", "coe-", "identity-", "device-type", "ca-", "sm-comm-"),
@@ -545,8 +591,18 @@ _GROUP_OF = {
     "cia402": ("supported-modes-", "statusword-", "emcy-"),
     "sdoinfo": ("info-",),
     "foe": ("foe-",),
-    "pd": ("inputs-", "lrw-"),
+    "pd": ("inputs-", "lrw-", "io-inputs-"),
     "*": ("brd-", "liar-"),
+}
+
+
+# Mutants of a device that is not the soft drive: (example ESI under esi/examples, ecat-slave --device, index
+# of that device in the file for ecat-conform --device). The others run against the drive.
+DEVICE = {
+    "io-inputs-frozen": ("digital-io.xml", "0x03f03052:0x00100000", 0),  # 8 digital inputs, no mailbox
+    "io-emcy-generic-bit": ("analog-in.xml", "0x0c203052:0x00140000", 0),  # CoE, inputs only, no 0x1001
+    "io-emcy-code-zero": ("analog-in.xml", "0x0c203052:0x00140000", 0),
+    "io-emcy-length": ("analog-in.xml", "0x0c203052:0x00140000", 0),
 }
 
 

@@ -120,10 +120,18 @@ class Conform(unittest.TestCase):
     mode = "clean"
     faults = []
 
-    def run_conform(self, fault=None, mutation=None, proxy=False):
+    def run_conform(self, fault=None, mutation=None, proxy=False, device=None):
+        """device: (example ESI, ecat-slave --device, ecat-conform --device) to serve another device than the
+        drive (mutants.DEVICE)."""
         work = tempfile.mkdtemp(prefix="ecat-conform-", dir=os.environ.get("ECAT_TEST_OUT"))
-        sii, esi = alias_images(work)
-        args = ["--eeprom", sii]
+        if device:
+            esi = os.path.join(HERE, "..", "..", "esi", "examples", device[0])
+            args = ["--esi", esi, "--device", device[1]]
+            device_args = ["--device", str(device[2])]
+        else:
+            sii, esi = alias_images(work)
+            args = ["--eeprom", sii]
+            device_args = []
         if fault:
             args += ["--fault", fault]
         with ConformBus(slave_args=args) as bus:
@@ -135,7 +143,7 @@ class Conform(unittest.TestCase):
             def run(iface):
                 t0 = time.monotonic()
                 cmd = [os.environ["ECAT_CONFORM"], "--iface", iface, "--esi", esi, "--foe-file", "MAXPOS", "--json",
-                       out, "--junit", junit, "--allow-fault"] + extra
+                       out, "--junit", junit, "--allow-fault"] + device_args + extra
                 try:
                     r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=120)
                 except subprocess.TimeoutExpired as e:
@@ -170,11 +178,12 @@ class Conform(unittest.TestCase):
         for name in names:
             kind = "mutant" if name in mutants.MUTANTS else "variation"
             clause, fn = (mutants.MUTANTS if kind == "mutant" else mutants.VARIATIONS)[name]
-            _, res, elapsed = self.run_conform(mutation=fn)
+            device = mutants.DEVICE.get(name)
+            _, res, elapsed = self.run_conform(mutation=fn, device=device)
             if kind == "variation" and any(x["status"] == "FAIL" for x in res["results"]):
                 # Once more: process data through a Python proxy on a loaded host can miss a watchdog. A
                 # variation that fails twice is a false alarm of the tool.
-                _, res, elapsed = self.run_conform(mutation=fn)
+                _, res, elapsed = self.run_conform(mutation=fn, device=device)
             failed = sorted(x["id"] for x in res["results"] if x["status"] == "FAIL")
             if kind == "mutant":
                 # Only failures in the group where the defect must be caught count as its kill.

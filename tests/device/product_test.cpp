@@ -269,15 +269,40 @@ TEST(ProductWithCoe, ServesSdoWithoutDriveAndFoe) {
     EXPECT_EQ(u16(pd.inputs(), 0), 0x4321);
 }
 
+// The CoE terminal, addressed and in Pre-Op with its mailbox.
+class CoeTerminalInPreOp : public ::testing::Test {
+  protected:
+    void to_preop() { ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(m, mbx, a)); }
+    Unit u{coe_terminal()};
+    UnitLink link{u};
+    Master m{link, test_support::in_process_master_options()};
+    const Address a = Address::station(0x1001);
+    Mailbox mbx{m, a};
+};
+
+// A device without drive reports a refused AL request as an emergency (ETG.1000.6 CoE emergency): code
+// 0xA000 (EtherCAT state machine transition error), error register 0x11 (CiA 301: generic, communication),
+// the AL status code in the first two bytes of the manufacturer-specific field.
+TEST_F(CoeTerminalInPreOp, ARefusedAlRequestIsReportedAsAnEmergency) {
+    ASSERT_NO_FATAL_FAILURE(to_preop());
+    AlStatus st;
+    EXPECT_NE(m.request_state(a, AlState::Op, &st), Error::Ok);  // Pre-Op -> Op: invalid (0x0011)
+    EXPECT_TRUE(st.error);
+    EXPECT_EQ(st.code, 0x0011);
+    MailboxMessage msg;
+    ASSERT_EQ(mbx.receive(msg), Error::Ok);
+    ASSERT_EQ(msg.type, MailboxType::CoE);
+    ASSERT_EQ(msg.payload.size(), 10u);
+    EXPECT_EQ(msg.payload[1] >> 4, 1);  // CoE service: emergency
+    EXPECT_EQ(u16(msg.payload, 2), 0xA000);
+    EXPECT_EQ(msg.payload[4], 0x11);
+    EXPECT_EQ(u16(msg.payload, 5), 0x0011);
+}
+
 // Every mailbox protocol the device does not serve (here all but CoE, FoE among them since it is not
 // declared) is answered with the mailbox error reply "unsupported protocol" (ETG.1000.4, code 0x0002).
-TEST(ProductWithCoe, EveryProtocolItDoesNotServeGetsTheUnsupportedProtocolError) {
-    Unit u(coe_terminal());
-    UnitLink link(u);
-    Master m(link, test_support::in_process_master_options());
-    const Address a = Address::station(0x1001);
-    Mailbox mbx(m, a);
-    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(m, mbx, a));
+TEST_F(CoeTerminalInPreOp, EveryProtocolItDoesNotServeGetsTheUnsupportedProtocolError) {
+    ASSERT_NO_FATAL_FAILURE(to_preop());
     for (const MailboxType type :
          {MailboxType::AoE, MailboxType::EoE, MailboxType::FoE, MailboxType::SoE, MailboxType::VoE,
           static_cast<MailboxType>(0x6), static_cast<MailboxType>(0xE)}) {

@@ -29,9 +29,11 @@ Catalogue build_catalogue() {
     add_sii_tests(c);
     add_esm_tests(c);
     add_mbx_tests(c);
+    add_emcy_tests(c);
     add_sdo_tests(c);
     add_sdoinfo_tests(c);
     add_pd_tests(c);
+    add_io_tests(c);
     add_dc_tests(c);
     add_foe_tests(c);
     add_cia402_tests(c);

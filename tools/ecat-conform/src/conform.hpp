@@ -86,6 +86,8 @@ void add_mbx_tests(Catalogue& c);
 void add_sdo_tests(Catalogue& c);
 void add_sdoinfo_tests(Catalogue& c);
 void add_pd_tests(Catalogue& c);
+void add_io_tests(Catalogue& c);    // pd: inputs refreshed (tests_io.cpp)
+void add_emcy_tests(Catalogue& c);  // mbx: emergency of a device that is not a drive (tests_emcy.cpp)
 void add_dc_tests(Catalogue& c);
 void add_foe_tests(Catalogue& c);
 void add_cia402_tests(Catalogue& c);
@@ -227,6 +229,15 @@ class Context {
     std::unique_ptr<master::Mailbox> mbx;
     std::unique_ptr<master::SdoClient> sdo;
     bool in_preop = false;  // set by to_preop, cleared by to_init
+    // A segmented transfer a test's own requests (sdo_raw) left open: ended after a failed test
+    // (end_open_sdo in sdo_util.hpp), so the next test's transfers are not refused for it.
+    struct OpenSdo {
+        uint16_t index = 0;
+        uint8_t sub = 0;
+        bool upload = false;
+        bool toggle = false;  // of the next segment
+    };
+    std::optional<OpenSdo> sdo_open;
 
     // ---- mailbox helpers ----
     // Writes a whole SM0 message (header included, padded to the SM length) as given.

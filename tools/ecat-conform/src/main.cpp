@@ -19,6 +19,7 @@
 #include "conform.hpp"
 #include "esc/link.hpp"
 #include "report.hpp"
+#include "sdo_util.hpp"
 #include "util/input_file.hpp"
 #include "util/strfmt.hpp"
 
@@ -316,6 +317,21 @@ int main(int argc, char** argv) {
             std::string
                 group_broken;  // id of the test that reported the group's failed start, "" when it started
             std::string lost;  // id of the test during which the slave stopped answering, "" while it answers
+            // Id of the test after which the slave's mailbox stopped serving (every request answered by a
+            // mailbox error or not at all, in PREOP), "" while it serves: a mailbox that a defect wedged for
+            // good is reported on that test, and the later failures that need it are not judged.
+            std::string mbx_dead, mbx_dead_why;
+            auto mailbox_fault = [&]() -> std::string {
+                if (!ctx.has_coe() || ctx.to_preop() != master::Error::Ok) return {};
+                auto v = ctx.upload_uint(0x1000, 0);
+                if (v ||
+                    (v.error() != master::Error::MailboxError && v.error() != master::Error::MailboxTimeout))
+                    return {};
+                return ctx.sdo_error(v.error());
+            };
+            auto about_mailbox = [](const conform::Outcome& x) {
+                return (x.message + " " + x.observed).find("mailbox") != std::string::npos;
+            };
             std::string previous = "none";  // id of the test run last
             const auto budget_d =
                 std::chrono::milliseconds(static_cast<long>(budget * 1000 * o.timeout_scale));
@@ -350,6 +366,11 @@ int main(int argc, char** argv) {
                     group_broken.clear();
                     ctx.al_timeouts = 0;
                     ctx.budget_end = s0 + budget_d;
+                    if (!mbx_dead.empty() && mailbox_fault().empty()) {
+                        ctx.notes.push_back("the slave's mailbox served again at the start of group " +
+                                            group + " (it had stopped after " + mbx_dead + ")");
+                        mbx_dead.clear();
+                    }
                     master::Error e = ctx.to_init();
                     if (e != master::Error::Ok) {
                         // Lost the slave (reset, unplugged)? Addresses again, then carry on.
@@ -384,10 +405,26 @@ int main(int argc, char** argv) {
                 }
                 if (r.outcome.status == Status::Pass && r.outcome.message.empty() && group_broken.empty()) {
                     ctx.budget_end = std::chrono::steady_clock::now() + budget_d;
+                    ctx.sdo_open.reset();
                     try {
                         r.outcome = t.run(ctx);
                     } catch (const std::exception& e) {
                         r.outcome = conform::fail(std::string("test aborted: ") + e.what());
+                    }
+                    if (r.outcome.status == Status::Fail) conform::end_open_sdo(ctx);
+                    if ((r.outcome.status == Status::Fail || r.outcome.status == Status::Warn) &&
+                        about_mailbox(r.outcome)) {
+                        if (!mbx_dead.empty()) {
+                            r.outcome = conform::skip(
+                                "not judged: the slave's mailbox stopped serving after " + mbx_dead + " (" +
+                                mbx_dead_why + "); here: " + r.outcome.message + " " + r.outcome.observed);
+                        } else if (std::string why = mailbox_fault(); !why.empty()) {
+                            mbx_dead = t.id;
+                            mbx_dead_why = why + " to an upload of 0x1000 in PREOP";
+                            r.outcome.message +=
+                                " (after this test the slave's mailbox serves no request: " + mbx_dead_why +
+                                "; the later failures that need it are not judged)";
+                        }
                     }
                     if (std::chrono::steady_clock::now() > ctx.budget_end && r.outcome.status == Status::Fail)
                         r.outcome.message += " (the test used up its budget of " +

@@ -24,9 +24,36 @@ struct SdoAnswer {
     }
 };
 
+// Whether the exchange leaves a segmented transfer open in the slave (ETG.1000.6 SDO services): a download
+// initiated with fewer bytes than its size, an upload answered with fewer bytes than its size, a segment
+// without the last-segment bit. An abort or an answer that is not an SDO one ends nothing the test knows of.
+inline void track_sdo_transfer(Context& ctx, const std::vector<uint8_t>& req, const SdoAnswer& a) {
+    if (req.size() < 3 || (req[1] >> 4) != 2) return;
+    if (req[2] == 0x80 || a.is_abort()) {
+        ctx.sdo_open.reset();
+        return;
+    }
+    if (a.error != master::Error::Ok || a.mailbox_type != 3 || a.p.size() < 3) return;
+    const uint8_t ccs = req[2] >> 5;
+    bool open = false;
+    if (ccs == 1) {  // initiate download: open unless expedited or all the indicated bytes came with it
+        open = !(req[2] & 0x02) && (req[2] & 0x01) && req.size() >= 10 && get32(&req[6]) > req.size() - 10;
+        if (open && req.size() >= 6) ctx.sdo_open = Context::OpenSdo{get16(&req[3]), req[5], false, false};
+    } else if (ccs == 2) {  // initiate upload: open when the response indicates more than it carries
+        open = (a.cmd() >> 5) == 2 && !(a.cmd() & 0x02) && (a.cmd() & 0x01) && a.p.size() >= 10 &&
+               get32(&a.p[6]) > a.p.size() - 10;
+        if (open && req.size() >= 6) ctx.sdo_open = Context::OpenSdo{get16(&req[3]), req[5], true, false};
+    } else if (ccs == 0 || ccs == 3) {  // a segment: open until the last one, the next with the other toggle
+        open = ccs == 0 ? !(req[2] & 0x01) : !(a.cmd() & 0x01);
+        if (ctx.sdo_open) ctx.sdo_open->toggle = !(req[2] & 0x10);
+    }
+    if (!open) ctx.sdo_open.reset();
+}
+
 inline SdoAnswer sdo_raw(Context& ctx, std::vector<uint8_t> coe) {
     SdoAnswer a;
     a.error = ctx.coe_request(coe, a.p, a.mailbox_type);
+    track_sdo_transfer(ctx, coe, a);
     return a;
 }
 
@@ -126,6 +153,31 @@ inline bool command_object(uint16_t index) {
 inline bool writable_in_preop(const EsiEntry& e) {
     return (e.access == "rw" || e.access == "wo") &&
            (e.write_restrictions.empty() || e.write_restrictions.find("PreOP") != std::string::npos);
+}
+
+// After a failed test that left a segmented transfer open (track_sdo_transfer), the transfer is ended so
+// that the slave's next transfers are not refused because of this test's: an upload by requesting its
+// segments to the last (any server takes that), a download by an Abort SDO Transfer request (ETG.1000.6:
+// either side may abort; unconfirmed, code 0x08000000 general error; a made-up last segment would write
+// the entry). SM1 is emptied after.
+inline void end_open_sdo(Context& ctx) {
+    if (!ctx.sdo_open || !ctx.mbx) return;
+    const Context::OpenSdo o = *ctx.sdo_open;
+    if (o.upload) {
+        for (int i = 0; i < 64 && ctx.sdo_open; ++i) {
+            std::vector<uint8_t> seg(10, 0);
+            seg[1] = 0x20;
+            seg[2] = static_cast<uint8_t>(0x60 | (ctx.sdo_open->toggle ? 0x10 : 0));
+            if (sdo_raw(ctx, seg).error != master::Error::Ok) break;
+        }
+    } else {
+        std::vector<uint8_t> r = {0x00, 0x20, 0x80, 0, 0, o.sub, 0, 0, 0, 0};
+        put16(&r[3], o.index);
+        put32(&r[6], 0x08000000);
+        (void)ctx.mbx->send(master::MailboxType::CoE, r);
+    }
+    ctx.sdo_open.reset();
+    ctx.mbx_resync();
 }
 
 }  // namespace conform

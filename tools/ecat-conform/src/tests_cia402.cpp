@@ -291,9 +291,28 @@ void add_cia402_tests(Catalogue& c) {
                     if (shown == static_cast<uint8_t>(md.value)) break;
                     std::this_thread::sleep_for(std::chrono::milliseconds(2));
                 }
+                std::string where = " (PREOP)";
+                if (shown != static_cast<uint8_t>(md.value)) {
+                    // A drive whose application runs only with process data (from SAFEOP on) switches its
+                    // mode there (IEC 61800-7-201 asks that 0x6061 show the mode in effect, not that PREOP
+                    // runs the application): the mode once more, in the image where 0x6060 is mapped.
+                    where = " (SAFEOP, process data running)";
+                    PdoMap m;
+                    if (ctx.to_safeop() == Error::Ok && read_map(ctx, m) == Error::Ok) {
+                        prefill_outputs(ctx, m);
+                        if (const MappedEntry* e = m.find_out(0x6060))
+                            image_set(ctx.pds->outputs(), *e, md.value);
+                        (void)ctx.download_uint(0x6060, 0, static_cast<uint8_t>(md.value), 1);
+                        for (int i = 0; i < 50 && shown != static_cast<uint8_t>(md.value); ++i) {
+                            (void)ctx.cycle(4);
+                            if (auto v = ctx.upload(0x6061, 0); v && !v->empty()) shown = (*v)[0];
+                        }
+                    }
+                    (void)ctx.to_preop();
+                }
                 if (old) (void)ctx.download_uint(0x6060, 0, *old, 1);
-                return expect_eq("0x6061 after 0x6060 = " + dec(md.value), dec(static_cast<int8_t>(shown)),
-                                 dec(md.value));
+                return expect_eq("0x6061 after 0x6060 = " + dec(md.value) + where,
+                                 dec(static_cast<int8_t>(shown)), dec(md.value));
             },
             "profile 402, mode in 0x6502");
     }

@@ -275,6 +275,32 @@ void Device::state_changed(od::AlState from, od::AlState to) {
 void Device::state_refused(od::AlState current, uint8_t requested, uint16_t code) {
     event(slave::LogLevel::Warn, std::string("refused AL state request ") + state_text(current) + " -> " +
                                      requested_text(requested) + ": AL status code " + al_code_text(code));
+    // The mailbox runs from Pre-Op on: a refusal in Init (or Bootstrap) has no mailbox to report through.
+    if (current != od::AlState::Init && current != od::AlState::Boot) io_state_error(code);
+}
+
+// A device without drive (no firmware error table of its own) reports a refused AL request as ETG.1000.6
+// does for CoE devices: emergency 0xA000 (EtherCAT state machine transition error), the AL status code in
+// the first two bytes of the manufacturer-specific field, the error register (CiA 301 0x1001: bit 0 generic,
+// bit 4 communication) kept in 0x1001 where the dictionary has it.
+void Device::io_state_error(uint16_t al_status_code) {
+    if (parts_->drive || !parts_->events) return;
+    constexpr uint16_t kStateMachineError = 0xA000;
+    constexpr uint8_t kRegister = 0x11;  // generic + communication
+    if (parts_->dict.find(0x1001, 0) != nullptr) (void)parts_->dict.set<uint8_t>(0x1001, 0, kRegister);
+    const std::array<uint8_t, 5> mfr{static_cast<uint8_t>(al_status_code & 0xFF),
+                                     static_cast<uint8_t>(al_status_code >> 8), 0, 0, 0};
+    io_state_error_ = true;
+    ++stats_.emergencies;
+    parts_->events->raise(kStateMachineError, kRegister, mfr);
+}
+
+void Device::io_state_error_clear() {
+    if (!io_state_error_) return;
+    io_state_error_ = false;
+    if (parts_->dict.find(0x1001, 0) != nullptr) (void)parts_->dict.set<uint8_t>(0x1001, 0, 0);
+    ++stats_.emergencies;
+    if (parts_->events) parts_->events->clear(0xA000, 0);  // the "no error" emergency (code 0x0000)
 }
 
 void Device::local_error(od::AlState state, uint16_t code) {
@@ -434,6 +460,7 @@ void Device::build() {
     if (parts_) ecat::add_stats(earlier_stacks_, parts_->stack->stats());
     parts_ = std::move(p);
     restart_pending_ = false;
+    io_state_error_ = false;
     outputs_lost_pending_ = false;
     last_cycle_ns_ = 0;
     ++stats_.builds;
@@ -539,6 +566,7 @@ uint16_t Device::check_transition(od::AlState /*from*/, od::AlState /*to*/) {
 }
 
 void Device::on_state_change(od::AlState from, od::AlState to) {
+    io_state_error_clear();  // a state change carried out: the refused request is over
     // Leaving Op by any path ends the outputs, whether or not on_outputs_lost() came first.
     if (from == od::AlState::Op && to != od::AlState::Op) {
         outputs_lost_pending_ = true;

@@ -228,6 +228,11 @@ class Device final : public ecat::Application, public drive::EventSink, public e
     std::set<uint32_t> held_;                               // keys of set_values_
     bool restart_pending_ = false;
     bool outputs_lost_pending_ = false;  // outputs ended in this poll(); reacted to when it returns
+    // A device without drive: its state machine error (a refused AL request) reported as an emergency
+    // (io_state_error) until the next state change clears it.
+    bool io_state_error_ = false;
+    void io_state_error(uint16_t al_status_code);
+    void io_state_error_clear();
     uint64_t free_run_due_ns() const { return (last_cycle_ns_ / kFreeRunNs + 1) * kFreeRunNs; }
     uint64_t last_cycle_ns_ = 0;  // last drive cycle (master's or our own); 0: none since the build
     DeviceStats stats_;

@@ -1,0 +1,101 @@
+// Group mbx, emergencies: the emergency of a device that is not a drive (a drive's emergencies are those of
+// its faults, cia402.fault.*, behind --allow-fault). Provoked safely: an AL request the state machine must
+// refuse (PREOP -> OP, ETG.1000.6: invalid state change 0x0011); nothing is written to outputs or flash.
+#include "testkit.hpp"
+
+namespace conform {
+
+namespace {
+
+using master::Error;
+constexpr const char* kEmcy =
+    "ETG.1000.6 CoE emergency (mailbox length 10, CoE service 1, error code, error register, 5 bytes); "
+    "CiA 301 error register 0x1001 (bit 0 generic at any error, class bits by error code)";
+
+// The CiA 301 error register bit that an error code's class sets (-1 when the class has none).
+int class_bit(uint16_t code) {
+    switch (code >> 12) {
+        case 0x2:
+            return 1;  // current
+        case 0x3:
+            return 2;  // voltage
+        case 0x4:
+            return 3;  // temperature
+        case 0x8:
+            return (code >> 8) == 0x81 || (code >> 8) == 0x82 ? 4 : -1;  // communication, protocol error
+        default:
+            return -1;
+    }
+}
+
+// The device is a CiA 402 drive (ESI profile, else 0x1000): its emergencies are tested as a drive's.
+bool is_drive(Context& ctx) {
+    if (ctx.esi && ctx.esi->profile_no) return *ctx.esi->profile_no == 402;
+    auto t = ctx.upload_uint(0x1000, 0);
+    return t && (*t & 0xFFFF) == 402;
+}
+
+// Every message a check of one emergency finds wrong, "" if none.
+std::string emergency_defects(std::span<const uint8_t> m, std::optional<uint64_t> reg1001) {
+    std::string bad;
+    auto add = [&](const std::string& s) { bad += (bad.empty() ? "" : "; ") + s; };
+    if (get16(m.data()) != 10) add("mailbox length " + dec(get16(m.data())) + ", not 10");
+    const uint16_t coe = get16(&m[6]);
+    if (coe & 0x01FF) add("CoE number field " + hex(coe & 0x01FF) + ", not 0");
+    if (coe & 0x0E00) add("CoE reserved bits 9-11 set (" + hex(coe, 4) + ")");
+    const uint16_t code = get16(&m[8]);
+    const uint8_t er = m[10];
+    if (code == 0) add("error code 0x0000 (no error) for an error");
+    if (!(er & 0x01)) add("error register " + hex(er, 2) + " without bit 0 (generic error)");
+    if (const int b = class_bit(code); b >= 0 && !(er & (1u << b)))
+        add("error register " + hex(er, 2) + " without bit " + dec(b) + " of the class of " + hex(code));
+    if (reg1001 && (*reg1001 & 0xFF) != er)
+        add("error register " + hex(er, 2) + " but 0x1001 reads " + hex(*reg1001 & 0xFF, 2));
+    return bad;
+}
+
+Outcome refused_request_emergency(Context& ctx) {
+    CONFORM_NEED(ctx.need_coe());
+    CONFORM_NEED(ctx.need_state_machine());
+    if (Error e = ctx.to_init(); e != Error::Ok) return fail("cannot reach INIT", err(e));
+    CONFORM_PREOP(ctx);
+    if (is_drive(ctx))
+        return skip("a CiA 402 drive: its emergencies are those of its faults (cia402.fault.*)");
+    std::vector<uint8_t> raw;
+    for (int i = 0; i < 16 && ctx.mbx_read_raw(raw, ctx.ms(30)) == Error::Ok; ++i) {
+    }  // what earlier tests left in SM1
+    const master::AlStatus st = ctx.request_raw(8, ctx.ms(2000));
+    std::vector<std::vector<uint8_t>> emcy;
+    for (int i = 0; i < 8 && ctx.mbx_read_raw(raw, ctx.ms(300)) == Error::Ok; ++i)
+        if (raw.size() >= 16 && (raw[5] & 0x0F) == 3 && (raw[7] >> 4) == 1) emcy.push_back(raw);
+    (void)ctx.ack_error();
+    ctx.mbx_resync();
+    std::optional<uint64_t> reg1001;
+    if (auto r = ctx.upload_uint(0x1001, 0)) reg1001 = *r;
+    (void)ctx.to_init();
+    const std::string state = state_text(static_cast<uint8_t>(st.state | (st.error ? 0x10 : 0)));
+    if (st.state != 2 || !st.error)
+        return skip("PREOP -> OP was not refused (" + state + "): see esm.invalid.*");
+    if (emcy.empty()) return skip("no emergency for the refused request (an emergency is optional there)");
+    // The first emergency is the one of the refusal; a later one may already be the "no error" of the
+    // acknowledge.
+    const auto& m = emcy.front();
+    const std::string got = bytes_hex(std::span<const uint8_t>(m).subspan(0, 16));
+    // 0x1001 is read after the acknowledge: it is compared only while no later emergency says it changed.
+    if (const std::string bad = emergency_defects(m, emcy.size() == 1 ? reg1001 : std::nullopt); !bad.empty())
+        return fail("emergency of the refused PREOP -> OP: " + bad, got);
+    return pass("emergency " + hex(get16(&m[8])) + " register " + hex(m[10], 2), got);
+}
+
+}  // namespace
+
+void add_emcy_tests(Catalogue& c) {
+    Adder add{c, "mbx"};
+    add("emcy.refused_request",
+        "A refused AL request (PREOP -> OP) of a device that is not a drive: its emergency, if it sends one, "
+        "is 10 bytes of CoE service 1 with a non-zero error code, the generic and class bits in its error "
+        "register, which equals 0x1001",
+        kEmcy, refused_request_emergency, "CoE, a state machine (no device emulation), not a CiA 402 drive");
+}
+
+}  // namespace conform
