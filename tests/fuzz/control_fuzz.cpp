@@ -21,14 +21,11 @@ namespace fuzz::control {
 namespace {
 
 struct Rig {
-    std::filesystem::path dir;
+    ScratchDir scratch;
+    const std::filesystem::path& dir = scratch.path;
     esc::ManualClock clock;
     std::unique_ptr<device::Line> line;
     Rig() {
-        std::string t = (std::filesystem::is_directory("/dev/shm") ? "/dev/shm" : "/tmp");
-        t += "/softecat-fuzz-control-XXXXXX";
-        if (::mkdtemp(t.data()) == nullptr) finding("cannot create a temporary directory");
-        dir = t;
         clock.set(1'000'000'000);
         device::LineOptions o;
         o.topology = ::slave::line_topology(2);
@@ -37,11 +34,7 @@ struct Rig {
         o.base.state_dir = dir;
         line = std::make_unique<device::Line>(clock, std::move(o));
     }
-    ~Rig() {
-        line.reset();
-        std::error_code ec;
-        std::filesystem::remove_all(dir, ec);
-    }
+    ~Rig() { line.reset(); }  // the devices before their directory
 };
 
 Rig& rig() {

@@ -7,8 +7,6 @@
 // does. Checked: nothing crashes (ASan, UBSan), every device's AL state is one of the five.
 // Per input: the products (read from the files once) are kept; the line (ESCs, devices) is built afresh on
 // emptied state directories, so every finding replays on its own.
-#include <stdlib.h>
-
 #include <algorithm>
 #include <filesystem>
 #include <memory>
@@ -32,7 +30,8 @@ namespace fuzz::esi_line {
 namespace {
 
 struct Prototype {
-    std::filesystem::path dir;  // the line's state directories, emptied for every input
+    ScratchDir scratch;  // the line's state directories, emptied for every input
+    const std::filesystem::path& dir = scratch.path;
     std::vector<std::shared_ptr<const od::Product>> products;
     Prototype() {
         std::vector<std::filesystem::path> files;
@@ -45,14 +44,6 @@ struct Prototype {
                 products.push_back(std::make_shared<const od::Product>(esi::load_product(file, d)));
         }
         if (products.empty()) finding("no example ESI device in " SOFTECAT_ESI_EXAMPLES);
-        std::string t = (std::filesystem::is_directory("/dev/shm") ? "/dev/shm" : "/tmp");
-        t += "/softecat-fuzz-esi-line-XXXXXX";
-        if (::mkdtemp(t.data()) == nullptr) finding("cannot create a temporary directory");
-        dir = t;
-    }
-    ~Prototype() {
-        std::error_code ec;
-        std::filesystem::remove_all(dir, ec);
     }
 };
 

@@ -3,12 +3,16 @@
 //   int fuzz::<name>::fuzz_one(const uint8_t* data, std::size_t size)
 // that the libFuzzer entry (entry.cpp, clang with -DSOFTECAT_FUZZ=ON) and the replay test (replay_test.cpp,
 // any compiler) both call, so every corpus and regression input is checked in a normal build too.
+#include <stdlib.h>
+
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <span>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -55,6 +59,24 @@ class Input {
     do {                                                           \
         if (!(cond)) ::fuzz::finding("fuzz check failed: " #cond); \
     } while (0)
+
+// A private directory for one process's state directories (tmpfs when there is one: no disk writes, cheap
+// fsync), removed when the process ends.
+struct ScratchDir {
+    std::filesystem::path path;
+    ScratchDir() {
+        std::string t = (std::filesystem::is_directory("/dev/shm") ? "/dev/shm" : "/tmp");
+        t += "/softecat-fuzz-XXXXXX";
+        if (::mkdtemp(t.data()) == nullptr) finding("cannot create a temporary directory");
+        path = t;
+    }
+    ~ScratchDir() {
+        std::error_code ec;
+        std::filesystem::remove_all(path, ec);
+    }
+    ScratchDir(const ScratchDir&) = delete;
+    ScratchDir& operator=(const ScratchDir&) = delete;
+};
 
 // A dictionary built once per process and put back into its built state before each input. Building the
 // drive's dictionary (some 400 entries with names, limits and validators) was most of what an input cost;

@@ -29,22 +29,8 @@
 namespace fuzz::loaders {
 namespace {
 
-// One private state directory per process (tmpfs when there is one: no disk writes, cheap fsync).
-struct StateDir {
-    std::filesystem::path path;
-    StateDir() {
-        std::string t = (std::filesystem::is_directory("/dev/shm") ? "/dev/shm" : "/tmp");
-        t += "/softecat-fuzz-XXXXXX";
-        if (::mkdtemp(t.data()) == nullptr) finding("cannot create a temporary directory");
-        path = t;
-    }
-    ~StateDir() {
-        std::error_code ec;
-        std::filesystem::remove_all(path, ec);
-    }
-};
 const std::filesystem::path& state_dir() {
-    static const StateDir dir;
+    static const ScratchDir dir;
     return dir.path;
 }
 
