@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <memory>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "esi/esi_reader.hpp"
 #include "fuzz_support.hpp"
 #include "harnesses.hpp"
+#include "slave/log.hpp"
 #include "slave/topology.hpp"
 
 #ifndef SOFTECAT_ESI_EXAMPLES
@@ -52,6 +54,17 @@ Prototype& prototype() {
     return p;
 }
 
+// The devices' warnings (the products' "declared but not emulated" lines, every build) and events go nowhere:
+// a line per input on stderr would cost more than the input.
+std::ostream& discard() {
+    static std::ostream null(nullptr);
+    return null;
+}
+::slave::Log& quiet_log() {
+    static ::slave::Log log(discard(), ::slave::LogLevel::Error);
+    return log;
+}
+
 }  // namespace
 
 int fuzz_one(const uint8_t* data, std::size_t size) {
@@ -67,6 +80,9 @@ int fuzz_one(const uint8_t* data, std::size_t size) {
         d.state_dir = sd.string();
     }
     o.base.state_dir = proto.dir;
+    o.base.log = &discard();
+    o.base.events = &quiet_log();
+    o.log = &quiet_log();
     o.products = proto.products;
     device::Line line(clock, std::move(o));
     line.poll(clock.now_ns());
