@@ -8,7 +8,7 @@ build="${BUILD_DIR:-$root/build}"
 targets=(ecat-slave ecatctl)
 if [ "$(id -u)" -ne 0 ]; then echo "demo: needs root (raw sockets and a veth pair); run it with sudo" >&2; exit 2; fi
 bash "$root/scripts/install-deps.sh"
-cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-RelWithDebInfo}" >/dev/null
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" >/dev/null
 
 # How much there is to build, and roughly how long it takes: about 5 CPU-seconds a step (a translation unit or a
 # link, RelWithDebInfo; the whole tree with its tests is ~300 steps and 26 CPU-minutes), shared by the cores.
