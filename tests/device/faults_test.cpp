@@ -102,12 +102,12 @@ TEST(FaultRegistry, ListsAreParsed) {
 
 // ---- The composed drive with faults, from the master library ------------------------------------------
 
-std::filesystem::path temp_dir() {
+std::filesystem::path faults_temp_dir() {
     return test_support::make_temp_dir("softdrive-faults-");
 }
 
 struct FaultyDrive : test_device::PoweredDevice {
-    std::filesystem::path dir = temp_dir();
+    std::filesystem::path dir = faults_temp_dir();
     std::unique_ptr<test_device::PoweredLink> link;
     std::unique_ptr<master::Master> m;
     std::unique_ptr<master::Mailbox> mbx;

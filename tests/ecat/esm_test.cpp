@@ -9,8 +9,6 @@ namespace {
 using Esm = StackTest;
 using od::AlState;
 
-constexpr uint16_t kErr = 0x10;
-
 // ---- Init ---------------------------------------------------------------------------------------------
 
 TEST_F(Esm, PowerOn_InitNoError) {

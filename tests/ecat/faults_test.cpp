@@ -9,8 +9,6 @@ namespace {
 
 using od::AlState;
 
-constexpr uint16_t kErr = 0x10;
-
 // Echoes each request back (CoE), counting the requests it was given.
 class Echo : public MailboxHandler {
   public:

@@ -18,6 +18,9 @@
 
 namespace ecat::test {
 
+// AL status (0x0130) bit 4: the error indication (ETG.1000.6 5.3.2).
+inline constexpr uint16_t kErr = 0x10;
+
 // A minimal master: one datagram per frame, position addressing of the single slave.
 class Master {
   public:

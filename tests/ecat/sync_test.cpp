@@ -6,7 +6,6 @@ namespace ecat::test {
 namespace {
 
 using od::AlState;
-constexpr uint16_t kErr = 0x10;
 
 class Sync : public StackTest {
   protected:

@@ -11,8 +11,6 @@ using namespace esc_test;
 
 namespace {
 
-constexpr uint64_t kT0 = 1'000'000'000;  // clock at construction (local time starts equal to it)
-
 struct DistributedClocks : EscFixture<kT0> {
     void SetUp() override {
         EscFixture::SetUp();

@@ -11,8 +11,6 @@ using namespace esc_test;
 
 namespace {
 
-constexpr uint64_t kT0 = 1'000'000'000;
-
 struct Escs {
     esc::ManualClock clk;
     std::optional<esc::Esc> clean, faulty;

@@ -10,6 +10,10 @@
 
 namespace esc_test {
 
+// The clock time (ns) the tests that need an absolute time set their ESC's clock to at construction (the
+// local time starts equal to it): 1 s, so that times before it are representable.
+inline constexpr uint64_t kT0 = 1'000'000'000;
+
 // Datagram commands as the raw command byte the tests put into a frame (esc/wire/datagram.hpp).
 constexpr uint8_t command_byte(esc::Command c) {
     return static_cast<uint8_t>(c);

@@ -12,8 +12,6 @@ using namespace esc_test;
 
 namespace {
 
-constexpr uint64_t kT0 = 1'000'000'000;
-
 uint16_t dl_status(esc::Esc& e) {
     return e.read_reg<uint16_t>(0x0110);  // PDI read: does not clear the DL status event
 }

@@ -39,7 +39,7 @@ StoreError install(FirmwareStore& s, const std::vector<uint8_t>& image, std::siz
     return {};
 }
 
-std::vector<uint8_t> image_v(uint32_t version, std::size_t size = 150'000) {
+std::vector<uint8_t> large_image(uint32_t version, std::size_t size = 150'000) {
     return build_image(foe_test::payload_bytes(size, version), kMaxpos, version);
 }
 
@@ -81,12 +81,12 @@ TEST(FoeStore, InstallAlternatesSlotsAndSurvivesReopen) {
     {
         FirmwareStore s(config(d.path));
         ASSERT_TRUE(s.open());
-        EXPECT_EQ(install(s, image_v(0x01200000)).code, ErrorCode::NotDefined);
+        EXPECT_EQ(install(s, large_image(0x01200000)).code, ErrorCode::NotDefined);
         ASSERT_TRUE(s.active_image());
         EXPECT_EQ(s.active_image()->slot, 0u);
         EXPECT_EQ(s.active_image()->header.version, 0x01200000u);
         EXPECT_EQ(s.active_image()->file_name, "MAXPOS_0120h_3001h_0000h_0000h.bin");
-        EXPECT_EQ(install(s, image_v(0x01300000)).code, ErrorCode::NotDefined);
+        EXPECT_EQ(install(s, large_image(0x01300000)).code, ErrorCode::NotDefined);
         EXPECT_EQ(s.active_image()->slot, 1u);
         ASSERT_TRUE(s.image(0));  // the previous image is kept in the other slot
         EXPECT_EQ(s.image(0)->header.version, 0x01200000u);
@@ -103,17 +103,17 @@ TEST(FoeStore, RefusedImagesLeaveTheActiveOne) {
     TempDir d;
     FirmwareStore s(config(d.path));
     ASSERT_TRUE(s.open());
-    ASSERT_EQ(install(s, image_v(0x01200000)).code, ErrorCode::NotDefined);
+    ASSERT_EQ(install(s, large_image(0x01200000)).code, ErrorCode::NotDefined);
 
     auto other = build_image(foe_test::payload_bytes(1000, 3), {0xFB, 0x30020000}, 0x01300000);
     EXPECT_EQ(install(s, other).code, ErrorCode::InvalidFirmware);
-    auto corrupt = image_v(0x01300000);
+    auto corrupt = large_image(0x01300000);
     corrupt[5000] ^= 0xFF;
     EXPECT_EQ(install(s, corrupt).code, ErrorCode::InvalidChecksum);
-    auto shortened = image_v(0x01300000);
+    auto shortened = large_image(0x01300000);
     shortened.resize(shortened.size() - 10);
     EXPECT_EQ(install(s, shortened).code, ErrorCode::FileHeaderError);
-    auto longer = image_v(0x01300000);
+    auto longer = large_image(0x01300000);
     longer.push_back(1);
     EXPECT_EQ(install(s, longer).code, ErrorCode::FileHeaderError);
     EXPECT_EQ(install(s, {1, 2, 3}).code, ErrorCode::FileHeaderError);
@@ -132,7 +132,7 @@ TEST(FoeStore, OversizedImageIsDiskFull) {
     c.max_image_bytes = 10'000;
     FirmwareStore s(c);
     ASSERT_TRUE(s.open());
-    EXPECT_EQ(install(s, image_v(0x01200000, 20'000)).code, ErrorCode::DiskFull);
+    EXPECT_EQ(install(s, large_image(0x01200000, 20'000)).code, ErrorCode::DiskFull);
 }
 
 TEST(FoeStore, CorruptedActiveSlotFallsBackToTheOtherAndRepairsThePointer) {
@@ -140,8 +140,8 @@ TEST(FoeStore, CorruptedActiveSlotFallsBackToTheOtherAndRepairsThePointer) {
     {
         FirmwareStore s(config(d.path));
         ASSERT_TRUE(s.open());
-        ASSERT_EQ(install(s, image_v(0x01200000)).code, ErrorCode::NotDefined);
-        ASSERT_EQ(install(s, image_v(0x01300000)).code, ErrorCode::NotDefined);
+        ASSERT_EQ(install(s, large_image(0x01200000)).code, ErrorCode::NotDefined);
+        ASSERT_EQ(install(s, large_image(0x01300000)).code, ErrorCode::NotDefined);
     }
     {
         std::fstream f(d.path / "slot1.bin", std::ios::in | std::ios::out | std::ios::binary);
@@ -157,7 +157,7 @@ TEST(FoeStore, CorruptedActiveSlotFallsBackToTheOtherAndRepairsThePointer) {
     std::getline(p, text);
     EXPECT_EQ(text, "slot0");
     // The next image goes to slot 1, never over the one that boots.
-    ASSERT_EQ(install(s, image_v(0x01400000)).code, ErrorCode::NotDefined);
+    ASSERT_EQ(install(s, large_image(0x01400000)).code, ErrorCode::NotDefined);
     EXPECT_EQ(s.active_image()->slot, 1u);
 }
 
@@ -166,7 +166,7 @@ TEST(FoeStore, GarbagePointerStillBoots) {
     {
         FirmwareStore s(config(d.path));
         ASSERT_TRUE(s.open());
-        ASSERT_EQ(install(s, image_v(0x01200000)).code, ErrorCode::NotDefined);
+        ASSERT_EQ(install(s, large_image(0x01200000)).code, ErrorCode::NotDefined);
     }
     std::ofstream(d.path / "active") << "slot7\n";
     FirmwareStore s(config(d.path));
@@ -188,8 +188,8 @@ TEST(FoeStore, StaleTempFilesAreRemovedAtOpen) {
 // The process dies just before storage step k, for every k: the previous image stays active (or, once the
 // pointer was switched, the new one), the device boots, and the next download works.
 TEST(FoeStore, KilledAtEveryStepLeavesABootableDevice) {
-    const auto old_image = image_v(0x01200000);
-    const auto new_image = image_v(0x01300000, 200'000);
+    const auto old_image = large_image(0x01200000);
+    const auto new_image = large_image(0x01300000, 200'000);
 
     // Dry run: the sequence of steps.
     std::vector<StoreStep> steps;
@@ -243,7 +243,7 @@ TEST(FoeStore, CommitStepsAreBounded) {
     c.read_back_chunk = 64 << 10;
     FirmwareStore s(c);
     ASSERT_TRUE(s.open());
-    const auto image = image_v(0x01300000, 1 << 20);
+    const auto image = large_image(0x01300000, 1 << 20);
     StoreError e;
     ASSERT_TRUE(s.begin_write(e));
     for (std::size_t off = 0; off < image.size(); off += 1012)
@@ -277,7 +277,7 @@ TEST(FoeStore, CommitStepsAreBounded) {
 // valid image stays active, and a download still works.
 TEST(FoeStore, CraftedSlotAndPointerFilesAreNotImages) {
     TempDir d;
-    const auto good = image_v(0x01200000);
+    const auto good = large_image(0x01200000);
     {
         FirmwareStore s(config(d.path));
         ASSERT_TRUE(s.open());
@@ -340,7 +340,7 @@ TEST(FoeStore, CraftedSlotAndPointerFilesAreNotImages) {
     std::filesystem::remove(slot1);
     FirmwareStore s(config(d.path));
     ASSERT_TRUE(s.open());
-    EXPECT_EQ(install(s, image_v(0x01300000)).code, ErrorCode::NotDefined);
+    EXPECT_EQ(install(s, large_image(0x01300000)).code, ErrorCode::NotDefined);
     EXPECT_EQ(s.active_image()->header.version, 0x01300000u);
 }
 
@@ -350,7 +350,7 @@ TEST(FoeStore, CraftedSlotAndPointerFilesAreNotImages) {
 // image at all, the built-in firmware), from the switch on the new image. A child process storing the image
 // is killed with SIGKILL just before each storage step in turn.
 TEST(FoeStore, FirstUpdateKilledAtEveryStepBootsOnlyWhatWasSwitchedTo) {
-    const auto new_image = image_v(0x01300000, 200'000);
+    const auto new_image = large_image(0x01300000, 200'000);
     std::vector<StoreStep> steps;
     {
         TempDir d;

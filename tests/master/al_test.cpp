@@ -7,7 +7,7 @@
 using namespace master;
 
 namespace {
-MasterOptions fast() {
+MasterOptions fast_al() {
     MasterOptions o;
     o.timeout = std::chrono::milliseconds(5);
     o.al_timeout = std::chrono::milliseconds(50);
@@ -17,7 +17,7 @@ MasterOptions fast() {
 
 TEST(AlState, RequestReachesTheState) {
     fake::Bus bus(1);
-    Master m(bus, fast());
+    Master m(bus, fast_al());
     AlStatus st;
     ASSERT_EQ(m.request_state(Address::position(0), AlState::PreOp, &st), Error::Ok);
     EXPECT_EQ(st.state, 0x02);
@@ -29,7 +29,7 @@ TEST(AlState, RefusalReturnsTheCodeAndIsAcknowledged) {
     fake::Bus bus(1);
     bus.slaves[0].refuse_state = 0x04;
     bus.slaves[0].refuse_code = 0x0011;
-    Master m(bus, fast());
+    Master m(bus, fast_al());
     AlStatus st;
     EXPECT_EQ(m.request_state(Address::position(0), AlState::SafeOp, &st), Error::AlRefused);
     EXPECT_TRUE(st.error);
@@ -46,7 +46,7 @@ TEST(AlState, PendingErrorIsAcknowledgedBeforeTheNewRequest) {
     fake::Bus bus(1);
     fake::put16(&bus.slaves[0].mem[0x0130], 0x0012);  // PREOP + error
     fake::put16(&bus.slaves[0].mem[0x0134], 0x001B);
-    Master m(bus, fast());
+    Master m(bus, fast_al());
     ASSERT_EQ(m.request_state(Address::position(0), AlState::Init), Error::Ok);
     ASSERT_GE(bus.slaves[0].al_control_log.size(), 2u);
     EXPECT_EQ(bus.slaves[0].al_control_log[0], 0x0012);  // ack in the current state
@@ -58,7 +58,7 @@ TEST(AlState, RefusalOfOpKeepsSafeOpWithTheCode) {
     fake::put16(&bus.slaves[0].mem[0x0130], 0x0004);
     bus.slaves[0].refuse_state = 0x08;
     bus.slaves[0].refuse_code = 0x001D;
-    Master m(bus, fast());
+    Master m(bus, fast_al());
     AlStatus st;
     EXPECT_EQ(m.request_state(Address::position(0), AlState::Op, &st), Error::AlRefused);
     EXPECT_EQ(st.state, 0x04);
@@ -69,7 +69,7 @@ TEST(AlState, RefusalOfOpKeepsSafeOpWithTheCode) {
 TEST(AlState, SlaveThatNeverGetsThereTimesOut) {
     fake::Bus bus(1);
     bus.slaves[0].al_ignore = true;
-    Master m(bus, fast());
+    Master m(bus, fast_al());
     const auto t0 = std::chrono::steady_clock::now();
     EXPECT_EQ(m.request_state(Address::position(0), AlState::PreOp), Error::AlTimeout);
     EXPECT_GE(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(50));
@@ -79,7 +79,7 @@ TEST(AlState, StatusReadsStateErrorAndCode) {
     fake::Bus bus(1);
     fake::put16(&bus.slaves[0].mem[0x0130], 0x0034);
     fake::put16(&bus.slaves[0].mem[0x0134], 0x001B);
-    Master m(bus, fast());
+    Master m(bus, fast_al());
     auto st = m.al_status(Address::position(0));
     ASSERT_TRUE(st.ok());
     EXPECT_EQ(st->state, 0x04);
@@ -90,7 +90,7 @@ TEST(AlState, StatusReadsStateErrorAndCode) {
 
 TEST(AlState, BroadcastRequestDrivesEverySlave) {
     fake::Bus bus(3);
-    Master m(bus, fast());
+    Master m(bus, fast_al());
     ASSERT_EQ(m.assign_station_addresses(3), Error::Ok);
     const uint16_t stations[] = {0x1001, 0x1002, 0x1003};
     ASSERT_EQ(m.request_state_all(AlState::PreOp, stations), Error::Ok);

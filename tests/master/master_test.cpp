@@ -7,7 +7,7 @@
 using namespace master;
 
 namespace {
-MasterOptions fast() {
+MasterOptions fast_retrying() {
     MasterOptions o;
     o.timeout = std::chrono::milliseconds(5);
     o.retries = 2;
@@ -18,7 +18,7 @@ MasterOptions fast() {
 TEST(MasterExchange, SeveralDatagramsInOneFrameGetTheirOwnWorkingCounters) {
     fake::Bus bus(2);
     bus.slaves[1].mem[0x0F80] = 0x5A;
-    Master m(bus, fast());
+    Master m(bus, fast_retrying());
     uint8_t a[2] = {}, b[1] = {}, c[1] = {0x77};
     Datagram d[3] = {{Command::BRD, 0, 0x0000, a},
                      {Command::APRD, static_cast<uint16_t>(0u - 1u), 0x0F80, b},
@@ -36,7 +36,7 @@ TEST(MasterExchange, SeveralDatagramsInOneFrameGetTheirOwnWorkingCounters) {
 
 TEST(MasterExchange, LostReplyIsRetriedWithAFreshIndex) {
     fake::Bus bus(1);
-    Master m(bus, fast());
+    Master m(bus, fast_retrying());
     bus.drop_next = 1;
     auto n = m.count_slaves();
     ASSERT_TRUE(n.ok());
@@ -48,7 +48,7 @@ TEST(MasterExchange, LostReplyIsRetriedWithAFreshIndex) {
 
 TEST(MasterExchange, GivesUpAfterTheRetriesWithTimeout) {
     fake::Bus bus(1);
-    Master m(bus, fast());
+    Master m(bus, fast_retrying());
     bus.drop_next = 100;
     const auto t0 = std::chrono::steady_clock::now();
     EXPECT_EQ(m.count_slaves().error(), Error::Timeout);
@@ -59,7 +59,7 @@ TEST(MasterExchange, GivesUpAfterTheRetriesWithTimeout) {
 TEST(MasterExchange, StaleRepliesAndOwnUnprocessedFramesAreNotTakenForTheAnswer) {
     fake::Bus bus(1);
     bus.slaves[0].mem[0x0F80] = 1;
-    Master m(bus, fast());
+    Master m(bus, fast_retrying());
     ASSERT_EQ(m.read_reg<uint8_t>(Address::position(0), 0x0F80).value(), 1);
     bus.echo_stale = true;
     bus.echo_own = true;
@@ -74,7 +74,7 @@ TEST(MasterExchange, StaleRepliesAndOwnUnprocessedFramesAreNotTakenForTheAnswer)
 TEST(MasterExchange, NoSlaveOnTheLoopMeansTimeout) {
     fake::Bus bus(0);  // frames come back untouched
     bus.echo_own = false;
-    Master m(bus, fast());
+    Master m(bus, fast_retrying());
     // The bus returns the unprocessed frame with the master's own source MAC: not a reply.
     EXPECT_EQ(m.count_slaves().error(), Error::Timeout);
 }
@@ -82,7 +82,7 @@ TEST(MasterExchange, NoSlaveOnTheLoopMeansTimeout) {
 TEST(MasterExchange, AcceptOwnSourceTakesAnUnchangedMacAsTheReply) {
     fake::Bus bus(0);  // frames come back untouched, with our source MAC
     bus.echo_own = false;
-    MasterOptions o = fast();
+    MasterOptions o = fast_retrying();
     o.accept_own_source = true;  // as ecat-conform runs: a slave that leaves the MAC as sent is still heard
     Master m(bus, o);
     uint8_t b[2] = {};
@@ -94,7 +94,7 @@ TEST(MasterExchange, AcceptOwnSourceTakesAnUnchangedMacAsTheReply) {
 
 TEST(MasterExchange, RejectsEmptyAndOversizedRequests) {
     fake::Bus bus(1);
-    Master m(bus, fast());
+    Master m(bus, fast_retrying());
     EXPECT_EQ(m.exchange(std::span<Datagram>()), Error::InvalidArgument);
     std::vector<uint8_t> big(kMaxDatagramData + 1);
     EXPECT_EQ(m.read(Address::position(0), 0x1000, big), Error::InvalidArgument);
@@ -103,7 +103,7 @@ TEST(MasterExchange, RejectsEmptyAndOversizedRequests) {
 
 TEST(MasterBus, CountsSlavesAndAssignsStationAddresses) {
     fake::Bus bus(3);
-    Master m(bus, fast());
+    Master m(bus, fast_retrying());
     auto n = m.count_slaves();
     ASSERT_TRUE(n.ok());
     ASSERT_EQ(*n, 3);
@@ -120,7 +120,7 @@ TEST(MasterBus, CountsSlavesAndAssignsStationAddresses) {
 
 TEST(MasterBus, AbsentSlaveGivesWorkingCounterError) {
     fake::Bus bus(1);
-    Master m(bus, fast());
+    Master m(bus, fast_retrying());
     ASSERT_EQ(m.assign_station_addresses(1), Error::Ok);
     EXPECT_EQ(m.read_reg<uint16_t>(Address::station(0x2000), 0x0000).error(), Error::WorkingCounter);
     EXPECT_EQ(m.read_reg<uint16_t>(Address::position(1), 0x0000).error(), Error::WorkingCounter);
@@ -129,7 +129,7 @@ TEST(MasterBus, AbsentSlaveGivesWorkingCounterError) {
 
 TEST(MasterBus, BroadcastWriteReportsHowManySlavesTookIt) {
     fake::Bus bus(4);
-    Master m(bus, fast());
+    Master m(bus, fast_retrying());
     const uint8_t v[2] = {0x34, 0x12};
     auto w = m.broadcast_write(0x0F80, v);
     ASSERT_TRUE(w.ok());
@@ -150,7 +150,7 @@ TEST(MasterNames, StatesAndCodes) {
 // busy_poll waits for replies without sleeping; matching, retries and the timeout work as before.
 TEST(MasterExchange, BusyPollMatchesRetriesAndTimesOutLikeTheDefault) {
     fake::Bus bus(1);
-    MasterOptions o = fast();
+    MasterOptions o = fast_retrying();
     o.busy_poll = true;
     Master m(bus, o);
     bus.drop_next = 1;
