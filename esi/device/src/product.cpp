@@ -479,18 +479,17 @@ const EsiDevice& select_device(const EsiFile& file, const std::string& spec_in) 
     const std::optional<int64_t> revision =
         colon == std::string::npos ? std::nullopt : parse_esi_number(spec.substr(colon + 1));
     const bool numeric = product && (colon == std::string::npos || revision);
-    for (const EsiDevice& d : file.devices) {
-        if (numeric) {
-            if (static_cast<uint32_t>(*product) == d.product_code &&
-                (!revision || static_cast<uint32_t>(*revision) == d.revision))
-                found.push_back(&d);
-        } else if (d.type_name == spec) {
-            found.push_back(&d);
-        }
-    }
-    if (found.empty() && !numeric)  // a Type in another case
+    if (numeric) {
+        // By identity: the revision given must be there; without one, the product code must have one.
+        const DeviceByIdentity m =
+            find_device(file, static_cast<uint32_t>(*product),
+                        revision ? std::optional<uint32_t>(static_cast<uint32_t>(*revision)) : std::nullopt);
+        if (revision ? m.revision_matched : m.with_product == 1) return *m.device;
         for (const EsiDevice& d : file.devices)
-            if (upper(d.type_name) == upper(spec)) found.push_back(&d);
+            if (d.product_code == static_cast<uint32_t>(*product) && !revision) found.push_back(&d);
+    } else {
+        found = find_devices_by_type(file, spec);
+    }
     if (found.size() == 1) return *found.front();
     if (found.empty())
         throw InputError(file.source, 0, "no device matches '" + spec + "'; the file has:" + listing());

@@ -210,14 +210,15 @@ std::string Context::setup() {
             EsiFile f = read_esi_file(opt.esi_path);
             int pick = opt.device;
             if (pick < 0) {
+                // The SII's identity picks the device (esi::find_device); the file's first without one.
                 pick = 0;
                 if (sii) {
-                    for (std::size_t i = 0; i < f.devices.size(); ++i)
-                        if (f.devices[i].product_code == sii->dword(0x0A) &&
-                            f.devices[i].revision == sii->dword(0x0C)) {
-                            pick = static_cast<int>(i);
-                            break;
-                        }
+                    const esi::DeviceByIdentity id = esi::find_device(f, sii->dword(0x0A), sii->dword(0x0C));
+                    if (id.device) pick = static_cast<int>(id.device - f.devices.data());
+                    if (id.device && !id.revision_matched)
+                        notes.push_back("slave " + std::to_string(opt.slave) +
+                                        ": no ESI device with the SII's revision; judged against revision " +
+                                        hex(id.device->revision, 8) + " of its product code");
                 }
             }
             if (pick >= static_cast<int>(f.devices.size()))
@@ -244,19 +245,17 @@ std::string Context::setup() {
             try {
                 EsiFile f = read_esi_file(path);
                 if (f.vendor_id != sii->dword(0x08)) continue;
-                for (const auto& d : f.devices) {
-                    if (d.product_code != sii->dword(0x0A)) continue;
-                    if (d.revision == sii->dword(0x0C)) {
-                        module_mapping_objects.clear();
-                        esi = as_configured(f, d, module_mapping_objects);
-                        return {};
-                    }
-                    if (!by_product) {
-                        std::set<uint16_t> mapping;
-                        by_product = as_configured(f, d, mapping);
-                        by_product_file = path;
-                        by_product_mapping = std::move(mapping);
-                    }
+                const esi::DeviceByIdentity id = esi::find_device(f, sii->dword(0x0A), sii->dword(0x0C));
+                if (id.device && id.revision_matched) {
+                    module_mapping_objects.clear();
+                    esi = as_configured(f, *id.device, module_mapping_objects);
+                    return {};
+                }
+                if (id.device && !by_product) {
+                    std::set<uint16_t> mapping;
+                    by_product = as_configured(f, *id.device, mapping);
+                    by_product_file = path;
+                    by_product_mapping = std::move(mapping);
                 }
             } catch (const std::exception&) {
             }
