@@ -506,61 +506,6 @@ od::Product load_product(const std::string& path, const std::string& spec) {
     return load_product(read_esi_file(path), spec);
 }
 
-namespace {
-
-// The module of each slot a "@MODULES" list names (load_product(file, spec)).
-std::vector<std::optional<uint32_t>> parse_module_list(const EsiFile& file, const EsiDevice& d,
-                                                       const std::string& list) {
-    std::vector<std::string> items;
-    std::size_t from = 0;
-    for (;;) {
-        const std::size_t comma = list.find(',', from);
-        std::string item = list.substr(from, comma == std::string::npos ? std::string::npos : comma - from);
-        while (!item.empty() && std::isspace(static_cast<unsigned char>(item.back())))
-            item.pop_back();
-        while (!item.empty() && std::isspace(static_cast<unsigned char>(item.front())))
-            item.erase(0, 1);
-        items.push_back(std::move(item));
-        if (comma == std::string::npos) break;
-        from = comma + 1;
-    }
-    const std::string device = d.type_name + " " + hex(d.product_code, 8) + ":" + hex(d.revision, 8);
-    if (d.slots.empty())
-        throw InputError(file.source, d.line, device + " has no slots: no modules to choose");
-    if (items.size() > d.slots.size())
-        throw InputError(file.source, d.line,
-                         std::to_string(items.size()) + " modules for the " + std::to_string(d.slots.size()) +
-                             " slots of " + device);
-    std::vector<std::optional<uint32_t>> out(d.slots.size());
-    for (std::size_t n = 0; n < items.size(); ++n) {
-        const std::string& item = items[n];
-        if (item.empty() || item == "-") continue;  // an empty slot
-        const EsiModule* m = nullptr;
-        if (const auto ident = parse_esi_number(item)) m = file.module(static_cast<uint32_t>(*ident));
-        for (std::size_t k = 0; m == nullptr && k < file.modules.size(); ++k)
-            if (upper(file.modules[k].type_name) == upper(item)) m = &file.modules[k];
-        const EsiSlot& slot = d.slots[n];
-        std::string offered;
-        for (uint32_t ident : slot.module_idents) {
-            const EsiModule* o = file.module(ident);
-            offered += " " + (o != nullptr ? o->type_name + " (" + hex(ident, 8) + ")" : hex(ident, 8));
-        }
-        if (m == nullptr)
-            throw InputError(file.source, slot.line,
-                             "slot " + std::to_string(n + 1) + ": no module '" + item +
-                                 "' in the file; the slot takes:" + offered);
-        if (std::find(slot.module_idents.begin(), slot.module_idents.end(), m->ident) ==
-            slot.module_idents.end())
-            throw InputError(file.source, slot.line,
-                             "slot " + std::to_string(n + 1) + " does not take module " + m->type_name +
-                                 "; it takes:" + offered);
-        out[n] = m->ident;
-    }
-    return out;
-}
-
-}  // namespace
-
 od::Product load_product(const EsiFile& file, const std::string& spec) {
     const EsiDevice& d = select_device(file, spec);
     const std::size_t at = spec.find('@');

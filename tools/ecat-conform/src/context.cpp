@@ -155,8 +155,12 @@ void assign_by_default(EsiDevice& d, const EsiPdo& p) {
 // entries they map). A slot without a default module, or a module the file lacks, stays empty. The mapping
 // objects of the modules' PDOs (0x1600.../0x1A00..., ETG.1000.6 PDO mapping) exist in the device's dictionary
 // although a module's own Dictionary does not list them: they go to mapping_objects.
-EsiDevice as_configured(const EsiFile& f, EsiDevice d, std::set<uint16_t>& mapping_objects) {
-    for (const esi::SlotModule& sm : esi::default_slot_modules(f, d)) {
+// The device with the modules of its slots (modules: a list as esi::parse_module_list takes, "" for each
+// slot's default), their PDOs and objects added as the slave serves them.
+EsiDevice as_configured(const EsiFile& f, EsiDevice d, std::set<uint16_t>& mapping_objects,
+                        const std::string& modules) {
+    const auto chosen = modules.empty() ? esi::default_modules(d) : esi::parse_module_list(f, d, modules);
+    for (const esi::SlotModule& sm : esi::slot_modules(f, d, chosen)) {
         if (sm.module == nullptr) continue;
         for (const esi::SlotPdo& sp : sm.pdos) {
             EsiPdo p = *sp.esi;
@@ -224,7 +228,8 @@ std::string Context::setup() {
             if (pick >= static_cast<int>(f.devices.size()))
                 return opt.esi_path + ": no device " + std::to_string(pick) + " (" +
                        std::to_string(f.devices.size()) + " in the file)";
-            esi = as_configured(f, f.devices[static_cast<std::size_t>(pick)], module_mapping_objects);
+            esi = as_configured(f, f.devices[static_cast<std::size_t>(pick)], module_mapping_objects,
+                                opt.modules);
         } catch (const std::exception& e) {
             return std::string("ESI: ") + e.what();
         }
@@ -248,12 +253,12 @@ std::string Context::setup() {
                 const esi::DeviceByIdentity id = esi::find_device(f, sii->dword(0x0A), sii->dword(0x0C));
                 if (id.device && id.revision_matched) {
                     module_mapping_objects.clear();
-                    esi = as_configured(f, *id.device, module_mapping_objects);
+                    esi = as_configured(f, *id.device, module_mapping_objects, opt.modules);
                     return {};
                 }
                 if (id.device && !by_product) {
                     std::set<uint16_t> mapping;
-                    by_product = as_configured(f, *id.device, mapping);
+                    by_product = as_configured(f, *id.device, mapping, opt.modules);
                     by_product_file = path;
                     by_product_mapping = std::move(mapping);
                 }

@@ -133,6 +133,11 @@ int main(int argc, char** argv) {
                    "ESI XML file: the expectation (object dictionary, PDOs, SMs, DC, ...)");
     app.add_option("--device", o.device,
                    "Device index in the ESI file (default: the one matching the SII identity)");
+    app.add_option(
+        "--modules", o.modules,
+        "A modular device's module in each slot, as the slave was configured (ecat-slave --device "
+        "SPEC@MODULES): Type names or idents, comma separated, '-' for an empty slot (default: each "
+        "slot's default module)");
     app.add_option("--group", groups_arg,
                    "Only these groups (comma separated): esc,sii,esm,mbx,sdo,sdoinfo,pd,dc,foe,cia402");
     app.add_option("--filter", filter, "Only tests whose id matches this glob (comma separated globs)");
