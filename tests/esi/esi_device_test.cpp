@@ -689,6 +689,11 @@ TEST(EsiExamples, TheModularDeviceServesTheModulesTheSpecChooses) {
         EXPECT_EQ(info.sync_managers[3].length, c.in_bytes);
         // Written back with the chosen modules as the slots' defaults: the same device again.
         expect_same(describe(p), describe(round_trip(p)), "round trip");
+        // The warning says whether the configuration is the default one (the third case names the defaults).
+        const std::string which = &c == &cases[2] ? "the default configuration" : "the chosen configuration";
+        EXPECT_TRUE(std::any_of(p.warnings.begin(), p.warnings.end(), [&](const std::string& w) {
+            return w.find(which) != std::string::npos;
+        })) << ::testing::PrintToString(p.warnings);
     }
     // Slot 2 holding AI2: its objects with the slot's index increment (0x6010 for slot 2).
     const od::Product two = esi::load_product(f, "EXM9000@-,EXM-AI2");

@@ -702,10 +702,8 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
             pdos.push_back(Pdo{&p, p.index, p.entries, p.sm, ""});
     std::map<uint16_t, std::pair<EsiObject, std::string>> module_objects;  // with the slot's increment
     std::string module_list;
-    bool chosen = false;  // a configuration other than the default
-    for (std::size_t n = 0; n < d.slots.size(); ++n)
-        if ((n < modules.size() ? modules[n] : std::nullopt) != d.slots[n].default_module) chosen = true;
-    for (const SlotModule& sm : slot_modules(file, d, modules)) {
+    const std::vector<SlotModule> served = slot_modules(file, d, modules);
+    for (const SlotModule& sm : served) {
         const std::size_t n = sm.slot;
         const EsiModule* m = sm.module;
         if (m == nullptr) {
@@ -764,6 +762,14 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
             }
         desc.modules.push_back(std::move(mod));
     }
+    // A configuration other than the default: another module (or none) in some slot than its default.
+    auto idents = [](const std::vector<SlotModule>& v) {
+        std::vector<std::pair<std::size_t, uint32_t>> out;
+        for (const SlotModule& sm : v)
+            out.emplace_back(sm.slot, sm.ident);
+        return out;
+    };
+    const bool chosen = idents(served) != idents(default_slot_modules(file, d));
     if (!d.slots.empty())
         ctx.warn(d.line, std::string("Slots: ") + (chosen ? "the chosen" : "the default") +
                              " configuration (" + (module_list.empty() ? "no modules" : module_list) +
