@@ -536,6 +536,38 @@ EsiFile read_doc(xmlDoc* doc, const std::string& source) {
 
 }  // namespace
 
+DeviceByIdentity find_device(const EsiFile& file, uint32_t product_code, std::optional<uint32_t> revision) {
+    DeviceByIdentity out;
+    for (const EsiDevice& d : file.devices) {
+        if (d.product_code != product_code) continue;
+        ++out.with_product;
+        if (out.revision_matched) continue;
+        if (revision && d.revision == *revision) {
+            out.device = &d;
+            out.revision_matched = true;
+        } else if (out.device == nullptr || d.revision > out.device->revision) {
+            out.device = &d;
+        }
+    }
+    return out;
+}
+
+std::vector<const EsiDevice*> find_devices_by_type(const EsiFile& file, const std::string& type) {
+    std::vector<const EsiDevice*> out;
+    for (const EsiDevice& d : file.devices)
+        if (d.type_name == type) out.push_back(&d);
+    if (!out.empty()) return out;
+    auto same = [](const std::string& a, const std::string& b) {
+        return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+                   return std::toupper(static_cast<unsigned char>(x)) ==
+                          std::toupper(static_cast<unsigned char>(y));
+               });
+    };
+    for (const EsiDevice& d : file.devices)
+        if (same(d.type_name, type)) out.push_back(&d);
+    return out;
+}
+
 std::optional<int64_t> parse_esi_number(const std::string& t) {
     if (t.empty()) return std::nullopt;
     std::string s = t;

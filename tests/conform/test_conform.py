@@ -1,7 +1,7 @@
 """ecat-conform against the soft slave over a veth pair: the clean slave passes every test, and each
 `ecat-slave --fault NAME` makes the test(s) named in faults.txt fail and no test of an unrelated group.
 
-usage: test_conform.py clean | noslave | dies | fault NAME [NAME ...] | mutant NAME [NAME ...]
+usage: test_conform.py clean | noslave | dies | stalls | fault NAME [NAME ...] | mutant NAME [NAME ...]
        | variation NAME [NAME ...] | table [NAME ...]
 mutant/variation: a proxy between ecat-conform and the clean slave rewrites the slave's answers
 (mutants.py); a mutant must make at least one test fail, a variation must raise no failure and no warning
@@ -259,6 +259,42 @@ class Conform(unittest.TestCase):
             self.assertEqual(statuses[-1], "FAIL")
             self.assertTrue(any("no longer answers" in x["message"] for x in res["results"]), stdout[-2000:])
             return
+        if self.mode == "stalls":
+            # The host stalls the slave (SIGSTOP for 300 ms, every second: a busy machine that deschedules it)
+            # during the sdo and mbx groups: no test fails for it, the stalls are noted; a slave that stops for
+            # good is still reported within a second (mode dies).
+            import signal
+            import threading
+            work = tempfile.mkdtemp(prefix="ecat-conform-", dir=os.environ.get("ECAT_TEST_OUT"))
+            sii, esi = alias_images(work)
+            with ConformBus(slave_args=["--eeprom", sii]) as bus:
+                out = os.path.join(work, "r.json")
+                p = subprocess.Popen([os.environ["ECAT_CONFORM"], "--iface", bus.iface, "--esi", esi, "--json", out,
+                                      "--group", "sdo,mbx"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                stalls = []
+
+                def stall():
+                    time.sleep(0.1)
+                    while p.poll() is None:
+                        bus.proc.send_signal(signal.SIGSTOP)
+                        time.sleep(0.3)
+                        bus.proc.send_signal(signal.SIGCONT)
+                        stalls.append(time.monotonic())
+                        time.sleep(1.0)
+
+                th = threading.Thread(target=stall)
+                th.start()
+                try:
+                    stdout, _ = p.communicate(timeout=120)
+                finally:
+                    th.join()
+            res = json.loads(pathlib.Path(out).read_text())
+            failed = [x["id"] + ": " + x["message"] for x in res["results"] if x["status"] == "FAIL"]
+            self.assertTrue(stalls)
+            self.assertEqual(failed, [], stdout[-3000:])
+            self.assertEqual(p.returncode, 0)
+            print(f"{len(stalls)} stalls; notes: {res.get('notes')}", file=sys.stderr)
+            return
         if self.mode == "stopped":
             # Stopped half-way (--deadline, then SIGTERM): valid JUnit and JSON of the tests done, the running
             # one marked as interrupted, exit code 3, the text report ends saying where it stopped.
@@ -407,7 +443,7 @@ class Conform(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) >= 2 and sys.argv[1] in ("clean", "fault", "noslave", "dies", "stopped", "liar", "line", "mutant", "variation", "contained", "foe_write",
+    if len(sys.argv) >= 2 and sys.argv[1] in ("clean", "fault", "noslave", "dies", "stalls", "stopped", "liar", "line", "mutant", "variation", "contained", "foe_write",
                                               "table"):
         Conform.mode = sys.argv[1]
         Conform.faults = sys.argv[2:]

@@ -689,6 +689,11 @@ TEST(EsiExamples, TheModularDeviceServesTheModulesTheSpecChooses) {
         EXPECT_EQ(info.sync_managers[3].length, c.in_bytes);
         // Written back with the chosen modules as the slots' defaults: the same device again.
         expect_same(describe(p), describe(round_trip(p)), "round trip");
+        // The warning says whether the configuration is the default one (the third case names the defaults).
+        const std::string which = &c == &cases[2] ? "the default configuration" : "the chosen configuration";
+        EXPECT_TRUE(std::any_of(p.warnings.begin(), p.warnings.end(), [&](const std::string& w) {
+            return w.find(which) != std::string::npos;
+        })) << ::testing::PrintToString(p.warnings);
     }
     // Slot 2 holding AI2: its objects with the slot's index increment (0x6010 for slot 2).
     const od::Product two = esi::load_product(f, "EXM9000@-,EXM-AI2");
@@ -1188,3 +1193,82 @@ TEST(EsiPublicFiles, EveryDeviceLoadsOrIsRefusedClearlyAndRoundTrips) {
 }
 
 }  // namespace
+
+// One way to pick a device of a file by identity (esi::find_device: ecat-conform by the SII, ecatctl by
+// 0x1018,
+// --device 0xPRODUCT:0xREVISION through select_device) and by Type (find_devices_by_type, --device TYPE).
+namespace {
+esi::EsiFile identity_file() {
+    auto device = [](const char* product, const char* revision, const char* type) {
+        return std::string("<Device><Type ProductCode=\"") + product + "\" RevisionNo=\"" + revision + "\">" +
+               type + "</Type><Name>" + type + "</Name></Device>";
+    };
+    return esi::read_esi_text(
+        "<?xml "
+        "version=\"1.0\"?><EtherCATInfo><Vendor><Id>#x123</Id><Name>V</Name></"
+        "Vendor><Descriptions><Devices>" +
+            device("#x10", "#x00010000", "A10") + device("#x10", "#x00030000", "A10") +
+            device("#x10", "#x00020000", "A10") + device("#x20", "#x00010000", "B20") +
+            device("#x30", "#x00010000", "C30-x") + "</Devices></Descriptions></EtherCATInfo>",
+        "identity.xml");
+}
+}  // namespace
+
+TEST(EsiFindDevice, ByProductAndRevision) {
+    const esi::EsiFile f = identity_file();
+    const esi::DeviceByIdentity m = esi::find_device(f, 0x10, 0x00020000);
+    ASSERT_NE(m.device, nullptr);
+    EXPECT_EQ(m.device, &f.devices[2]);
+    EXPECT_TRUE(m.revision_matched);
+    EXPECT_EQ(m.with_product, 3u);
+    EXPECT_EQ(esi::find_device(f, 0x20, 0x00010000).device, &f.devices[3]);
+    EXPECT_EQ(&esi::select_device(f, "0x10:0x00020000"), &f.devices[2]);
+    EXPECT_EQ(&esi::select_device(f, "#x20"), &f.devices[3]);
+}
+
+TEST(EsiFindDevice, SeveralRevisionsWithoutTheOneAskedForGiveTheHighest) {
+    const esi::EsiFile f = identity_file();
+    for (const std::optional<uint32_t> rev :
+         {std::optional<uint32_t>(0x00040000), std::optional<uint32_t>()}) {
+        const esi::DeviceByIdentity m = esi::find_device(f, 0x10, rev);
+        ASSERT_NE(m.device, nullptr);
+        EXPECT_EQ(m.device, &f.devices[1]);  // revision 0x00030000, not the file's first
+        EXPECT_FALSE(m.revision_matched);
+        EXPECT_EQ(m.with_product, 3u);
+    }
+    // --device must name one: a revision the file lacks, or a product code of several revisions, is an error
+    // that lists the devices.
+    EXPECT_THROW((void)esi::select_device(f, "0x10:0x00040000"), esi::InputError);
+    try {
+        (void)esi::select_device(f, "0x10");
+        ADD_FAILURE() << "0x10 names three revisions";
+    } catch (const esi::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("matches 3 devices"), std::string::npos) << e.what();
+    }
+}
+
+TEST(EsiFindDevice, NoneWithTheProductCode) {
+    const esi::EsiFile f = identity_file();
+    const esi::DeviceByIdentity m = esi::find_device(f, 0x99, 0x00010000);
+    EXPECT_EQ(m.device, nullptr);
+    EXPECT_FALSE(m.revision_matched);
+    EXPECT_EQ(m.with_product, 0u);
+    EXPECT_THROW((void)esi::select_device(f, "0x99"), esi::InputError);
+    EXPECT_TRUE(esi::find_devices_by_type(f, "D40").empty());
+    EXPECT_THROW((void)esi::select_device(f, "D40"), esi::InputError);
+}
+
+TEST(EsiFindDevice, ByTypeExactlyElseInAnyCase) {
+    const esi::EsiFile f = identity_file();
+    EXPECT_EQ(esi::find_devices_by_type(f, "B20"), std::vector<const esi::EsiDevice*>{&f.devices[3]});
+    EXPECT_EQ(esi::find_devices_by_type(f, "c30-X"), std::vector<const esi::EsiDevice*>{&f.devices[4]});
+    EXPECT_EQ(esi::find_devices_by_type(f, "A10").size(), 3u);
+    EXPECT_EQ(&esi::select_device(f, "c30-x"), &f.devices[4]);
+    EXPECT_THROW((void)esi::select_device(f, "A10"), esi::InputError);  // three devices of that Type
+}
+
+TEST(EsiFindDevice, ASpecMustNameADeviceOfAFileOfSeveral) {
+    const esi::EsiFile f = identity_file();
+    EXPECT_THROW((void)esi::select_device(f, ""), esi::InputError);
+    EXPECT_EQ(&esi::select_device(f, " B20 @ -"), &f.devices[3]);  // the module list is load_product's
+}

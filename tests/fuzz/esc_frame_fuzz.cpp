@@ -38,13 +38,8 @@ int fuzz_one(const uint8_t* data, std::size_t size) {
     e.load_eeprom(sii_image());
     for (int p = 1; p < esc::kPortCount; ++p)
         e.set_link(p, true);
-    Input in(data, size);
-    std::vector<uint8_t> frame;
-    frame.reserve(2048);
-    while (!in.empty()) {
-        const uint8_t control = in.u8();
-        const auto f = in.record();
-        frame.assign(f.begin(), f.end());
+    for_each_frame(data, size, [&](uint8_t control, std::vector<uint8_t>& frame) {
+        const std::size_t length = frame.size();
         const bool varied = (control & 0x80) != 0;
         const unsigned steps = varied ? (control >> 3) & 0x0Fu : control;
         clock.advance(uint64_t{steps} * 10'000);
@@ -52,11 +47,11 @@ int fuzz_one(const uint8_t* data, std::size_t size) {
         check.crc_bad = varied && (control & 0x04) != 0;
         const int out = e.receive(frame, varied ? control & 0x03 : 0, 0, check);
         FUZZ_CHECK(out >= -1 && out < esc::kPortCount);
-        FUZZ_CHECK(frame.size() == f.size());
+        FUZZ_CHECK(frame.size() == length);
         e.tick();
         (void)e.next_event_ns();
         (void)e.irq();
-    }
+    });
     return 0;
 }
 

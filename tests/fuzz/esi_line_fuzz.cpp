@@ -87,15 +87,9 @@ int fuzz_one(const uint8_t* data, std::size_t size) {
     device::Line line(clock, std::move(o));
     line.poll(clock.now_ns());
 
-    Input in(data, size);
-    std::vector<uint8_t> frame;
-    frame.reserve(2048);
-    while (!in.empty()) {
-        const uint8_t dt = in.u8();
-        const auto f = in.record();
+    for_each_frame(data, size, [&](uint8_t dt, std::vector<uint8_t>& frame) {
         clock.advance(uint64_t{dt} * 10'000);
         line.poll(clock.now_ns());
-        frame.assign(f.begin(), f.end());
         (void)line.segment().walk(frame, clock.now_ns());
         line.poll(clock.now_ns());
         for (std::size_t k = 0; k < line.size(); ++k) {
@@ -104,7 +98,7 @@ int fuzz_one(const uint8_t* data, std::size_t size) {
             const auto s = static_cast<uint8_t>(d->stack().state());
             FUZZ_CHECK(s == 1 || s == 2 || s == 3 || s == 4 || s == 8);
         }
-    }
+    });
     return 0;
 }
 

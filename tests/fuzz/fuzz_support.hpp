@@ -48,6 +48,22 @@ class Input {
     std::size_t at_ = 0;
 };
 
+// The input of the frame harnesses (slave, esc_frame, esi_line): records of [control byte][16-bit length]
+// [frame] to the end of the input. fn(control, frame) runs for each; frame is a copy of the record the
+// harness may change (an ESC writes into the frame it forwards), in one buffer reused for every record.
+template <class Fn>
+void for_each_frame(const uint8_t* data, std::size_t size, Fn&& fn) {
+    Input in(data, size);
+    std::vector<uint8_t> frame;
+    frame.reserve(2048);
+    while (!in.empty()) {
+        const uint8_t control = in.u8();
+        const auto record = in.record();
+        frame.assign(record.begin(), record.end());
+        fn(control, frame);
+    }
+}
+
 // A finding: abort, so that libFuzzer (and the replay test, through a death) reports it with a stack.
 [[noreturn]] inline void finding(const char* what) {
     // NOLINTNEXTLINE: stderr is the report channel of a fuzz target

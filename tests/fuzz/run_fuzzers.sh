@@ -4,8 +4,10 @@
 # Each harness runs SECONDS on a scratch copy of tests/fuzz/corpus/<harness> (the corpus in the tree is
 # not grown) with ASan + UBSan halting on the first error. Prints per harness the executions, executions
 # per second, corpus size and the result; crashing inputs go to BUILD_DIR/fuzz-artifacts/<harness>/.
-# Exit status 1 if any harness found something (or could not run). FUZZ_JOBS harnesses run at once (default:
-# the number of CPUs); the table is printed in the order given when all are done.
+# Exit status 1 if any harness found something (or could not run), or was interrupted: a run stopped by
+# SIGINT (libFuzzer exit 72, "run interrupted" in its log, no input written) is reported as "interrupted", not
+# as a finding, and still fails, so that a cut run never passes for a whole one. FUZZ_JOBS harnesses run at
+# once (default: the number of CPUs); the table is printed in the order given when all are done.
 set -uo pipefail
 build=${1:?build dir}; seconds=${2:?seconds per harness}; shift 2
 here=$(cd "$(dirname "$0")" && pwd)
@@ -32,10 +34,18 @@ run_one() {
     execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
     rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
     units=$(find "$work" -type f | wc -l)
-    if [ "$rc" -eq 0 ]; then result=ok; else result="FINDING (exit $rc, see $log)"; fi
+    local finding=1
+    if [ "$rc" -eq 0 ]; then
+        result=ok; finding=0
+    elif [ "$rc" -eq 72 ] && grep -q "run interrupted" "$log" && ! grep -q "Test unit written" "$log"; then
+        # Stopped from outside (SIGINT): nothing found in the part that ran, but the run is not whole.
+        result="interrupted (exit 72, see $log)"; finding=0
+    else
+        result="FINDING (exit $rc, see $log)"
+    fi
     {
         printf '%-14s %14s %10s %8s  %s\n' "$h" "${execs:-?}" "${rate:-?}" "$units" "$result"
-        if [ "$rc" -ne 0 ]; then grep -E "ERROR|runtime error|fuzz check|Test unit written" "$log" | head -5; fi
+        if [ "$finding" -ne 0 ]; then grep -E "ERROR|runtime error|fuzz check|Test unit written" "$log" | head -5; fi
     } >"$out"
     rm -rf "$work"
     return "$rc"

@@ -109,22 +109,16 @@ int fuzz_one(const uint8_t* data, std::size_t size) {
     esc.load_eeprom(proto.sii);
     stack.poll(clock.now_ns());
 
-    Input in(data, size);
-    std::vector<uint8_t> frame;
-    frame.reserve(2048);
-    while (!in.empty()) {
-        const uint8_t dt = in.u8();
-        const auto f = in.record();
+    for_each_frame(data, size, [&](uint8_t dt, std::vector<uint8_t>& frame) {
         clock.advance(uint64_t{dt} * 10'000);
         esc.tick();
         stack.poll(clock.now_ns());
-        frame.assign(f.begin(), f.end());
         esc.process_frame(frame);
         esc.tick();
         stack.poll(clock.now_ns());
         const auto s = static_cast<uint8_t>(stack.state());
         FUZZ_CHECK(s == 1 || s == 2 || s == 3 || s == 4 || s == 8);
-    }
+    });
     app.attach(nullptr, nullptr);
     return 0;
 }

@@ -304,6 +304,28 @@ def _settled(request, recorded, observed, later):
     return furthest
 
 
+def _same_poll_later(pairs, ids, i, end, settle_s):
+    """The later requests whose recorded answers frame i may be answered with (ahead): the identical requests
+    within settle_s, before the master's next write (end), and not past a recorded read that emptied a mailbox.
+    That read changes the slave's state as a write does: the mailbox is empty before the answer came and again
+    after it was read, and an empty answer to a poll that recorded the answer is the slave being behind (its
+    firmware has not written the answer yet), never ahead. A read recorded as emptying the mailbox ends the list
+    (it is the last one in it); when frame i is that read, nothing later is ahead of it."""
+    t = pairs[i][0]
+    if pairs[i][2] is not None and consumed(pairs[i][1], pairs[i][2]):
+        return []
+    out = []
+    for j in range(i + 1, end):
+        if pairs[j][0] - t > settle_s:
+            break
+        if ids[j] != ids[i] or pairs[j][2] is None:
+            continue
+        out.append(j)
+        if consumed(pairs[j][1], pairs[j][2]):
+            break
+    return out
+
+
 class Mismatch(AssertionError):
     pass
 
@@ -331,12 +353,18 @@ def _exchange(sock, frame, timeout):
     return harness.exchange(sock, bytes(fr), timeout, match=_is_reply)
 
 
-def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None):
+def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None, exchange=None):
     """Sends the recorded requests on iface and checks the replies; raises Mismatch at the first difference.
-    Returns counters {frames, checked, ahead, behind, resent, skipped}."""
-    sock = socket.socket(socket.AF_PACKET, socket.SOCK_RAW, socket.htons(ETH_P_ECAT))
-    sock.bind((iface, 0))
-    sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 20)
+    Returns counters {frames, checked, ahead, behind, resent, skipped}. exchange(frame, timeout) -> reply or None
+    replaces the link (iface is then not used): the rules' own tests answer with a simulated slave."""
+    sock = None
+    if exchange is None:
+        sock = socket.socket(socket.AF_PACKET, socket.SOCK_RAW, socket.htons(ETH_P_ECAT))
+        sock.bind((iface, 0))
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 20)
+
+        def exchange(frame, timeout):
+            return _exchange(sock, frame, timeout)
     ids = [request_identity(rq) for _t, rq, _rp in pairs]
     stats = {"frames": 0, "checked": 0, "ahead": 0, "behind": 0, "resent": 0, "skipped": 0, "kept_cycling": 0}
     skip = set()
@@ -364,7 +392,7 @@ def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None):
             lag = (time.monotonic() - t0) - (t - t0_rec)
             frame = clock.rewrite(request, lag)
             stats["frames"] += 1
-            observed = _exchange(sock, frame, reply_timeout)
+            observed = exchange(frame, reply_timeout)
             if read_only(request) and any(d[0] in LOGICAL for d in datagrams(request)):
                 last_cycle = frame
             if log and observed is None:
@@ -374,7 +402,7 @@ def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None):
             tries = 0
             while observed is None and read_only(request) and tries < 3:
                 tries += 1
-                observed = _exchange(sock, frame, reply_timeout)
+                observed = exchange(frame, reply_timeout)
             if observed is None:
                 raise Mismatch(f"frame {i + 1} ({describe(request, 0)}): no reply (recorded one)")
             stats["checked"] += 1
@@ -385,9 +413,7 @@ def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None):
             if read_only(request):
                 # The same poll later: identical requests within settle_s, up to the master's next write (after
                 # it the same read asks about something else, e.g. the next SII word).
-                end = next_write[i]
-                later = [j for j in range(i + 1, end) if pairs[j][0] - t <= settle_s]
-                later = [j for j in later if ids[j] == ids[i] and pairs[j][2] is not None]
+                later = _same_poll_later(pairs, ids, i, next_write[i], settle_s)
                 verdict = _settled(request, recorded, observed, [pairs[j][2] for j in later])
                 if verdict is not None and verdict > 0:
                     # Ahead: each datagram answered as in the recording or as a later identical request was.
@@ -407,10 +433,10 @@ def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None):
                         if last_cycle is not None and last_cycle is not frame and cycling:
                             # The master's cycle runs on while it polls (its own task or thread): the last
                             # process-data frame again, so watchdogs and clocks see what they saw in the recording.
-                            _exchange(sock, last_cycle, reply_timeout)
+                            exchange(last_cycle, reply_timeout)
                             stats["kept_cycling"] += 1
                         stats["resent"] += 1
-                        observed = _exchange(sock, frame, reply_timeout)
+                        observed = exchange(frame, reply_timeout)
                         if observed is None:
                             continue
                         verdict = _settled(request, recorded, observed, [pairs[j][2] for j in later])
@@ -429,7 +455,8 @@ def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None):
                         continue
             raise Mismatch(f"frame {i + 1} of {len(pairs)} (recorded at {t - t0_rec:.6f} s): {diff}")
     finally:
-        sock.close()
+        if sock is not None:
+            sock.close()
     if log:
         log(f"replayed {stats}")
     return stats

@@ -479,18 +479,17 @@ const EsiDevice& select_device(const EsiFile& file, const std::string& spec_in) 
     const std::optional<int64_t> revision =
         colon == std::string::npos ? std::nullopt : parse_esi_number(spec.substr(colon + 1));
     const bool numeric = product && (colon == std::string::npos || revision);
-    for (const EsiDevice& d : file.devices) {
-        if (numeric) {
-            if (static_cast<uint32_t>(*product) == d.product_code &&
-                (!revision || static_cast<uint32_t>(*revision) == d.revision))
-                found.push_back(&d);
-        } else if (d.type_name == spec) {
-            found.push_back(&d);
-        }
-    }
-    if (found.empty() && !numeric)  // a Type in another case
+    if (numeric) {
+        // By identity: the revision given must be there; without one, the product code must have one.
+        const DeviceByIdentity m =
+            find_device(file, static_cast<uint32_t>(*product),
+                        revision ? std::optional<uint32_t>(static_cast<uint32_t>(*revision)) : std::nullopt);
+        if (revision ? m.revision_matched : m.with_product == 1) return *m.device;
         for (const EsiDevice& d : file.devices)
-            if (upper(d.type_name) == upper(spec)) found.push_back(&d);
+            if (d.product_code == static_cast<uint32_t>(*product) && !revision) found.push_back(&d);
+    } else {
+        found = find_devices_by_type(file, spec);
+    }
     if (found.size() == 1) return *found.front();
     if (found.empty())
         throw InputError(file.source, 0, "no device matches '" + spec + "'; the file has:" + listing());
@@ -506,61 +505,6 @@ const EsiDevice& select_device(const EsiFile& file, const std::string& spec_in) 
 od::Product load_product(const std::string& path, const std::string& spec) {
     return load_product(read_esi_file(path), spec);
 }
-
-namespace {
-
-// The module of each slot a "@MODULES" list names (load_product(file, spec)).
-std::vector<std::optional<uint32_t>> parse_module_list(const EsiFile& file, const EsiDevice& d,
-                                                       const std::string& list) {
-    std::vector<std::string> items;
-    std::size_t from = 0;
-    for (;;) {
-        const std::size_t comma = list.find(',', from);
-        std::string item = list.substr(from, comma == std::string::npos ? std::string::npos : comma - from);
-        while (!item.empty() && std::isspace(static_cast<unsigned char>(item.back())))
-            item.pop_back();
-        while (!item.empty() && std::isspace(static_cast<unsigned char>(item.front())))
-            item.erase(0, 1);
-        items.push_back(std::move(item));
-        if (comma == std::string::npos) break;
-        from = comma + 1;
-    }
-    const std::string device = d.type_name + " " + hex(d.product_code, 8) + ":" + hex(d.revision, 8);
-    if (d.slots.empty())
-        throw InputError(file.source, d.line, device + " has no slots: no modules to choose");
-    if (items.size() > d.slots.size())
-        throw InputError(file.source, d.line,
-                         std::to_string(items.size()) + " modules for the " + std::to_string(d.slots.size()) +
-                             " slots of " + device);
-    std::vector<std::optional<uint32_t>> out(d.slots.size());
-    for (std::size_t n = 0; n < items.size(); ++n) {
-        const std::string& item = items[n];
-        if (item.empty() || item == "-") continue;  // an empty slot
-        const EsiModule* m = nullptr;
-        if (const auto ident = parse_esi_number(item)) m = file.module(static_cast<uint32_t>(*ident));
-        for (std::size_t k = 0; m == nullptr && k < file.modules.size(); ++k)
-            if (upper(file.modules[k].type_name) == upper(item)) m = &file.modules[k];
-        const EsiSlot& slot = d.slots[n];
-        std::string offered;
-        for (uint32_t ident : slot.module_idents) {
-            const EsiModule* o = file.module(ident);
-            offered += " " + (o != nullptr ? o->type_name + " (" + hex(ident, 8) + ")" : hex(ident, 8));
-        }
-        if (m == nullptr)
-            throw InputError(file.source, slot.line,
-                             "slot " + std::to_string(n + 1) + ": no module '" + item +
-                                 "' in the file; the slot takes:" + offered);
-        if (std::find(slot.module_idents.begin(), slot.module_idents.end(), m->ident) ==
-            slot.module_idents.end())
-            throw InputError(file.source, slot.line,
-                             "slot " + std::to_string(n + 1) + " does not take module " + m->type_name +
-                                 "; it takes:" + offered);
-        out[n] = m->ident;
-    }
-    return out;
-}
-
-}  // namespace
 
 od::Product load_product(const EsiFile& file, const std::string& spec) {
     const EsiDevice& d = select_device(file, spec);
@@ -758,10 +702,8 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
             pdos.push_back(Pdo{&p, p.index, p.entries, p.sm, ""});
     std::map<uint16_t, std::pair<EsiObject, std::string>> module_objects;  // with the slot's increment
     std::string module_list;
-    bool chosen = false;  // a configuration other than the default
-    for (std::size_t n = 0; n < d.slots.size(); ++n)
-        if ((n < modules.size() ? modules[n] : std::nullopt) != d.slots[n].default_module) chosen = true;
-    for (const SlotModule& sm : slot_modules(file, d, modules)) {
+    const std::vector<SlotModule> served = slot_modules(file, d, modules);
+    for (const SlotModule& sm : served) {
         const std::size_t n = sm.slot;
         const EsiModule* m = sm.module;
         if (m == nullptr) {
@@ -820,6 +762,14 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
             }
         desc.modules.push_back(std::move(mod));
     }
+    // A configuration other than the default: another module (or none) in some slot than its default.
+    auto idents = [](const std::vector<SlotModule>& v) {
+        std::vector<std::pair<std::size_t, uint32_t>> out;
+        for (const SlotModule& sm : v)
+            out.emplace_back(sm.slot, sm.ident);
+        return out;
+    };
+    const bool chosen = idents(served) != idents(default_slot_modules(file, d));
     if (!d.slots.empty())
         ctx.warn(d.line, std::string("Slots: ") + (chosen ? "the chosen" : "the default") +
                              " configuration (" + (module_list.empty() ? "no modules" : module_list) +

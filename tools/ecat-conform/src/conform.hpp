@@ -118,6 +118,8 @@ struct Options {
     std::string esi_path;
     std::string esi_dir;  // without esi_path: the ESI file of this directory whose device matches the SII
     int device = -1;      // -1: the device whose identity matches the slave
+    // The module of each slot of a modular device (esi::parse_module_list); empty: each slot's default.
+    std::string modules;
     double timeout_scale = 1.0;
     bool verbose = false;
     std::string foe_file;       // a file name the device's FoE server knows (Bootstrap firmware)

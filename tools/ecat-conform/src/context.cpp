@@ -155,8 +155,12 @@ void assign_by_default(EsiDevice& d, const EsiPdo& p) {
 // entries they map). A slot without a default module, or a module the file lacks, stays empty. The mapping
 // objects of the modules' PDOs (0x1600.../0x1A00..., ETG.1000.6 PDO mapping) exist in the device's dictionary
 // although a module's own Dictionary does not list them: they go to mapping_objects.
-EsiDevice as_configured(const EsiFile& f, EsiDevice d, std::set<uint16_t>& mapping_objects) {
-    for (const esi::SlotModule& sm : esi::default_slot_modules(f, d)) {
+// The device with the modules of its slots (modules: a list as esi::parse_module_list takes, "" for each
+// slot's default), their PDOs and objects added as the slave serves them.
+EsiDevice as_configured(const EsiFile& f, EsiDevice d, std::set<uint16_t>& mapping_objects,
+                        const std::string& modules) {
+    const auto chosen = modules.empty() ? esi::default_modules(d) : esi::parse_module_list(f, d, modules);
+    for (const esi::SlotModule& sm : esi::slot_modules(f, d, chosen)) {
         if (sm.module == nullptr) continue;
         for (const esi::SlotPdo& sp : sm.pdos) {
             EsiPdo p = *sp.esi;
@@ -210,20 +214,22 @@ std::string Context::setup() {
             EsiFile f = read_esi_file(opt.esi_path);
             int pick = opt.device;
             if (pick < 0) {
+                // The SII's identity picks the device (esi::find_device); the file's first without one.
                 pick = 0;
                 if (sii) {
-                    for (std::size_t i = 0; i < f.devices.size(); ++i)
-                        if (f.devices[i].product_code == sii->dword(0x0A) &&
-                            f.devices[i].revision == sii->dword(0x0C)) {
-                            pick = static_cast<int>(i);
-                            break;
-                        }
+                    const esi::DeviceByIdentity id = esi::find_device(f, sii->dword(0x0A), sii->dword(0x0C));
+                    if (id.device) pick = static_cast<int>(id.device - f.devices.data());
+                    if (id.device && !id.revision_matched)
+                        notes.push_back("slave " + std::to_string(opt.slave) +
+                                        ": no ESI device with the SII's revision; judged against revision " +
+                                        hex(id.device->revision, 8) + " of its product code");
                 }
             }
             if (pick >= static_cast<int>(f.devices.size()))
                 return opt.esi_path + ": no device " + std::to_string(pick) + " (" +
                        std::to_string(f.devices.size()) + " in the file)";
-            esi = as_configured(f, f.devices[static_cast<std::size_t>(pick)], module_mapping_objects);
+            esi = as_configured(f, f.devices[static_cast<std::size_t>(pick)], module_mapping_objects,
+                                opt.modules);
         } catch (const std::exception& e) {
             return std::string("ESI: ") + e.what();
         }
@@ -244,19 +250,17 @@ std::string Context::setup() {
             try {
                 EsiFile f = read_esi_file(path);
                 if (f.vendor_id != sii->dword(0x08)) continue;
-                for (const auto& d : f.devices) {
-                    if (d.product_code != sii->dword(0x0A)) continue;
-                    if (d.revision == sii->dword(0x0C)) {
-                        module_mapping_objects.clear();
-                        esi = as_configured(f, d, module_mapping_objects);
-                        return {};
-                    }
-                    if (!by_product) {
-                        std::set<uint16_t> mapping;
-                        by_product = as_configured(f, d, mapping);
-                        by_product_file = path;
-                        by_product_mapping = std::move(mapping);
-                    }
+                const esi::DeviceByIdentity id = esi::find_device(f, sii->dword(0x0A), sii->dword(0x0C));
+                if (id.device && id.revision_matched) {
+                    module_mapping_objects.clear();
+                    esi = as_configured(f, *id.device, module_mapping_objects, opt.modules);
+                    return {};
+                }
+                if (id.device && !by_product) {
+                    std::set<uint16_t> mapping;
+                    by_product = as_configured(f, *id.device, mapping, opt.modules);
+                    by_product_file = path;
+                    by_product_mapping = std::move(mapping);
                 }
             } catch (const std::exception&) {
             }

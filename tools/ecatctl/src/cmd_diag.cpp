@@ -25,6 +25,7 @@
 #include "master/diag.hpp"
 #include "master/mailbox.hpp"
 #include "util/json.hpp"
+#include "util/le.hpp"
 #include "util/strfmt.hpp"
 
 namespace ecatctl {
@@ -59,28 +60,19 @@ std::string_view drive_text(uint16_t id) {
     return drive::diag_text_of(id);
 }
 
-// The device of the file that the slave is (0x1018:02 product code, :03 revision): the one with both, else
-// the only one with the product code, else the file's only device; nullptr if none fits.
+// The device of the file that the slave is (0x1018:02 product code, :03 revision; esi::find_device), else the
+// file's only device; nullptr if none fits.
 const esi::EsiDevice* pick_device(const esi::EsiFile& f, master::SdoClient& sdo) {
     if (f.devices.size() == 1) return &f.devices.front();
-    uint8_t buf[4];
     auto read32 = [&](uint8_t sub) -> std::optional<uint32_t> {
+        uint8_t buf[4];
         auto n = sdo.upload(0x1018, sub, buf);
         if (!n || *n != 4) return std::nullopt;
-        return static_cast<uint32_t>(buf[0] | buf[1] << 8 | buf[2] << 16 | uint32_t{buf[3]} << 24);
+        return util::get32(buf);
     };
     const auto product = read32(2);
-    const auto revision = read32(3);
     if (!product) return nullptr;
-    const esi::EsiDevice* by_product = nullptr;
-    std::size_t with_product = 0;
-    for (const esi::EsiDevice& d : f.devices) {
-        if (d.product_code != *product) continue;
-        if (revision && d.revision == *revision) return &d;
-        by_product = &d;
-        ++with_product;
-    }
-    return with_product == 1 ? by_product : nullptr;
+    return esi::find_device(f, *product, read32(3)).device;
 }
 
 int report(const master::SdoClient& sdo, Error e, const char* what) {

@@ -238,6 +238,20 @@ EsiFile read_esi_text(const std::string& xml, const std::string& name = "esi.xml
 // The first device of an ESI text (throws as read_esi_text does).
 EsiDevice read_esi(const std::string& xml);
 
+// The device of a file that a slave of this identity is (the SII's words 0x0A/0x0C, or 0x1018:02/:03;
+// ETG.2000 Device/Type ProductCode and RevisionNo): the one with the product code and the revision; without a
+// revision, or when no device of the product code has it, the one of the product code with the highest
+// revision (revision_matched false: a later revision of a device describes the earlier ones' objects too, as
+// far as any does). device is nullptr when no device has the product code; with_product counts those that do.
+struct DeviceByIdentity {
+    const EsiDevice* device = nullptr;
+    bool revision_matched = false;
+    std::size_t with_product = 0;
+};
+DeviceByIdentity find_device(const EsiFile& file, uint32_t product_code, std::optional<uint32_t> revision);
+// The devices whose Type text is `type` (exactly; when none is, in any case), in file order.
+std::vector<const EsiDevice*> find_devices_by_type(const EsiFile& file, const std::string& type);
+
 // "#x1A00" / "0x1a00" / "6656" -> number; nullopt if not a number.
 std::optional<int64_t> parse_esi_number(const std::string& text);
 // Size in bits of a basic ESI type name (BOOL 1, USINT 8, ..., STRING(n) 8n), 0 if unknown.

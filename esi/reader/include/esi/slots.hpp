@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "esi/esi_reader.hpp"
@@ -40,5 +41,12 @@ std::vector<SlotModule> slot_modules(const EsiFile& f, const EsiDevice& d,
 // The default configuration: each slot's default module.
 std::vector<std::optional<uint32_t>> default_modules(const EsiDevice& d);
 std::vector<SlotModule> default_slot_modules(const EsiFile& f, const EsiDevice& d);
+// The modules a list names, one item per slot in order, comma-separated: a module's Type name (any case) or
+// ModuleIdent (0x, #x or decimal), "-" or nothing for an empty slot; slots past the list are empty
+// ("EXM-DI8,-,EXM-AI2"; ecat-slave --device SPEC@LIST, ecat-conform --modules LIST). Throws InputError naming
+// the file for a module the file lacks or the slot does not take, more items than slots, or a device
+// without slots.
+std::vector<std::optional<uint32_t>> parse_module_list(const EsiFile& f, const EsiDevice& d,
+                                                       const std::string& list);
 
 }  // namespace esi

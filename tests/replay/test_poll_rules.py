@@ -1,0 +1,98 @@
+"""The replay's poll rules (docs/decisions/replay.md, "Polls and timing") against a simulated slave: a recorded
+mailbox exchange (request written, SM1 polled until the answer comes, then polled empty) must replay against a
+slave that writes its answer at any legal moment (before the master's first poll, or after any number of them),
+and must not replay against one that answers twice or never. No root, no link: ecatreplay.replay() is given
+the simulated slave in place of the socket.
+
+The class these tests hold: every order in which the slave's firmware and the master may legally interleave.
+A recording holds one of them (here: the answer there at the first poll); a slower firmware answers the first
+polls empty, and an empty poll before the answer must never be taken for the empty poll after it (which would
+skip the read that empties the mailbox and find the answer still there one frame later)."""
+import os
+import struct
+import sys
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "integration"))
+import ecatreplay as er  # noqa: E402
+
+SM0, SM1, N = 0x1000, 0x1080, 16
+ANSWER = bytes([0x04, 0x00, 0x00, 0x00, 0x00, 0x20, 0x01, 0x00, 0x02, 0x00]) + bytes(N - 10)  # mailbox error
+EMPTY = bytes(N)
+REQUEST = bytes([0x08, 0x00, 0x00, 0x00, 0x00, 0x06]) + bytes(N - 6)  # reserved type 6
+
+
+def frame(cmd, ado, data, wkc=0, reply=False):
+    """An Ethernet frame with one datagram addressed to station 0x1001."""
+    dg = struct.pack("<BBHHHH", cmd, 0, 0x1001, ado, len(data), 0) + data + struct.pack("<H", wkc)
+    src = b"\x03" + bytes(5) if reply else b"\x01" + bytes(5)
+    return b"\xff" * 6 + src + struct.pack(">H", er.ETH_P_ECAT) + struct.pack("<H", len(dg) | 0x1000) + dg
+
+
+def recording(answered_at, polls_after):
+    """[(t, request, reply)]: the request written, `answered_at` empty polls, the answer, `polls_after` empty
+    polls, then the next request written (so the polls end at a write, as ecat-conform's do)."""
+    pairs, t = [], 0.0
+
+    def add(cmd, ado, data, rdata, wkc):
+        nonlocal t
+        pairs.append((t, frame(cmd, ado, data), frame(cmd, ado, rdata, wkc, reply=True)))
+        t += 0.0002
+
+    add(er.FPWR, SM0, REQUEST, REQUEST, 1)
+    for _ in range(answered_at):
+        add(er.FPRD, SM1, EMPTY, EMPTY, 0)
+    add(er.FPRD, SM1, EMPTY, ANSWER, 1)
+    for _ in range(polls_after):
+        add(er.FPRD, SM1, EMPTY, EMPTY, 0)
+    add(er.FPWR, SM0, REQUEST, REQUEST, 1)
+    return pairs
+
+
+class Slave:
+    """A mailbox slave: a written request is answered once, after its firmware let `delay` reads of SM1 go by
+    empty (its poll comes after theirs); `copies` > 1 is a faulty slave that writes the answer again."""
+
+    def __init__(self, delay, copies=1):
+        self.delay, self.copies = delay, copies
+        self.waiting, self.left = 0, 0
+
+    def __call__(self, request, _timeout):
+        cmd, _idx, _adp, ado, data, _wkc = er.datagrams(request)[0]
+        if cmd == er.FPWR and ado == SM0:
+            self.waiting, self.left = self.delay, self.copies
+            return frame(cmd, ado, data, 1, reply=True)
+        if cmd == er.FPRD and ado == SM1:
+            if self.left and self.waiting == 0:
+                self.left -= 1
+                return frame(cmd, ado, ANSWER, 1, reply=True)
+            self.waiting = max(0, self.waiting - 1)
+            return frame(cmd, ado, EMPTY, 0, reply=True)
+        return None
+
+
+class PollRules(unittest.TestCase):
+    def test_every_legal_timing_replays(self):
+        """The answer recorded at the first, second or fifth poll; the replayed slave's firmware answers before
+        the first poll or after up to ten: all pass."""
+        for answered_at in (0, 1, 4):
+            for delay in range(0, 11):
+                with self.subTest(recorded_at=answered_at, slave_delay=delay):
+                    stats = er.replay(recording(answered_at, 6), None, settle_s=0.5, exchange=Slave(delay))
+                    self.assertEqual(stats["checked"], stats["frames"])
+
+    def test_answer_twice_fails(self):
+        """A slave that puts its answer in SM1 a second time fails, whatever its timing."""
+        for delay in (0, 1, 3):
+            with self.subTest(slave_delay=delay):
+                with self.assertRaises(er.Mismatch):
+                    er.replay(recording(1, 6), None, settle_s=0.5, exchange=Slave(delay, copies=2))
+
+    def test_never_answering_fails(self):
+        with self.assertRaises(er.Mismatch):
+            er.replay(recording(1, 6), None, settle_s=0.2, exchange=Slave(10**6))
+
+
+if __name__ == "__main__":
+    unittest.main()
