@@ -101,6 +101,17 @@ void add_dc_tests(Catalogue& c) {
             if (*t1 <= *t0 || dt < 0.5 * dh || dt > 2.0 * dh)
                 return fail("system time over " + dec(static_cast<long long>(dh / 1e3)) + " us of host time",
                             dec(static_cast<long long>(dt / 1e3)) + " us", "about the same");
+            // Monotonic from read to read (ETG.1000.4 DC: the system time never goes back; a carry lost
+            // between the 32-bit halves, or a clock that is corrected backwards, shows here).
+            uint64_t last = *t1;
+            for (int i = 0; i < 16; ++i) {
+                auto t = rd64(ctx, esc::reg::kDcSystemTime);
+                if (!t) return fail("0x0910 unreadable");
+                if (*t < last)
+                    return fail("system time went back between two reads",
+                                hex(*t, 16) + " after " + hex(last, 16), "never less than the read before");
+                last = *t;
+            }
             return pass("advanced", dec(static_cast<long long>(dt / 1e3)) + " us");
         },
         a);
