@@ -844,8 +844,6 @@ UNSEEN = {
                                  statusword(lambda v: v & ~0x10 if (v & 0x6F) in (0x23, 0x27) else v)),
     "statusword-internal-limit": _m("CiA 402 statusword bit 11 (internal limit active) only at a limit",
                                     statusword(lambda v: v | 0x0800)),
-    "error-code-not-cleared": _m("CiA 402 0x603F error code back to 0 after a fault reset",
-                                 sticky_upload(0x603F, 0)),
 }
 MUTANTS.update(UNSEEN)
 
@@ -884,7 +882,6 @@ _GROUPS_UNSEEN = {
     "watchdog-": {"esc", "esm", "pd"}, "dc-": {"dc"}, "al-code-": {"esm"}, "mbx-": {"mbx"}, "sdo-": {"sdo"},
     "identity-": {"sdo"}, "sii-": {"sii"}, "pdo-": {"sdo", "pd"}, "sync-": {"sdo", "dc", "pd"},
     "info-": {"sdoinfo"}, "foe-": {"foe"}, "emcy-": {"cia402", "mbx"}, "statusword-": {"cia402"},
-    "error-code-": {"cia402"},
 }
 
 
@@ -935,6 +932,15 @@ VARIATIONS = {
                                 "silicon options", reg_rewriter(0x0008, set_bits(0x0030))),
     "foe-error-text": ("ETG.1000.6 FoE error request: the error text is optional",
                        foe_rewriter(lambda m: m[6] == 5 and struct.pack_into("<H", m, 0, 6))),
+    # -- legal variations of what the checks added against the unseen defects look at --
+    "error-code-kept": ("IEC 61800-7-201 0x603F error code: the last error that occurred; a drive may keep it "
+                        "after the fault reset", sticky_upload(0x603F, 0)),
+    "abort-state-general": ("ETG.1000.6 SDO abort codes: 0x08000020 is the general code of the 0x0800002x "
+                            "family (data cannot be transferred or stored)", abort_code({0x08000022: 0x08000020})),
+    "event-request-pending": ("ESC datasheet 0x0210: DC latch, DL status, AL status and SM events pending are "
+                              "defined bits, any value", reg_rewriter(0x0210, set_bits(0x0FFD))),
+    "eeprom-emulated": ("ESC datasheet 0x0502 bit 5: EEPROM emulated by the PDI (a silicon/firmware option)",
+                        reg_rewriter(0x0502, set_bits(0x0020))),
 }
 
 

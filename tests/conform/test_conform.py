@@ -339,6 +339,22 @@ class Conform(unittest.TestCase):
                 res = {x["id"]: x for x in json.loads(pathlib.Path(out).read_text())["results"]}
                 self.assertEqual(res["foe.write_complete"]["status"], "PASS", r.stdout[-3000:])
                 self.assertEqual(r.returncode, 0, r.stdout[-3000:])
+                # The image now stored is read back over FoE (foe.read_file): DATA packets numbered from 1.
+                r = subprocess.run([os.environ["ECAT_CONFORM"], "--iface", bus.iface, "--esi", esi, "--filter",
+                                    "foe.read_file", "--foe-file", "MAXPOS", "--json", out],
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=120)
+                x = json.loads(pathlib.Path(out).read_text())["results"][0]
+                self.assertEqual(x["status"], "PASS", r.stdout[-3000:])
+                self.assertTrue(x["observed"].startswith("1 2 "), x)  # packet numbers seen, not a refusal
+                # The unseen defects of the read path are caught there: DATA numbered from 0, a reserved byte.
+                for name in ("foe-data-packet-no", "foe-reserved"):
+                    with ProxyLink(bus.iface, mutants.MUTANTS[name][1]) as p:
+                        r = subprocess.run([os.environ["ECAT_CONFORM"], "--iface", p.iface, "--esi", esi,
+                                            "--filter", "foe.read_file", "--foe-file", "MAXPOS", "--json", out,
+                                            "--timeout-scale", "3"],
+                                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=120)
+                    x = json.loads(pathlib.Path(out).read_text())["results"][0]
+                    self.assertEqual(x["status"], "FAIL", f"{name}: {x}")
                 self.assertIn("3032 bytes", res["foe.write_complete"]["observed"])
                 sw = bus.ecatctl("upload", "0", "0x100A", "0").stdout
                 self.assertIn("0131h", sw)
