@@ -700,6 +700,10 @@ MUTANTS = {
                               emergency(lambda m: m.__setitem__(10, m[10] & ~0x01))),
     "io-emcy-code-zero": _m("ETG.1000.6 emergency: an error's code is not 0x0000 (error reset / no error)",
                             emergency(lambda m: m[8:10] != b"\x00\x00" and struct.pack_into("<H", m, 8, 0))),
+    "io-emcy-history-code": _m("ETG.1020 diagnosis history 0x10F3: the emergency stored with its code (diag code "
+                               "0xE800 | code << 16)",
+                               sdo_rewriter(lambda c, i, s, st: c == 0x41 and i == 0x10F3 and s >= 6,
+                                            lambda m: m.__setitem__(18, m[18] ^ 0x01))),
     "io-emcy-length": _m("ETG.1000.6 emergency: mailbox length 10 (CoE header, code, register, 5 bytes)",
                          emergency(lambda m: struct.pack_into("<H", m, 0, 8))),
     # -- DC --
@@ -872,6 +876,7 @@ DEVICE = {
     "io-emcy-generic-bit": ("analog-in.xml", "0x0c203052:0x00140000", 0),  # CoE, inputs only, no 0x1001
     "io-emcy-code-zero": ("analog-in.xml", "0x0c203052:0x00140000", 0),
     "io-emcy-length": ("analog-in.xml", "0x0c203052:0x00140000", 0),
+    "io-emcy-history-code": ("analog-in.xml", "0x0c203052:0x00140000", 0),
 }
 
 
