@@ -238,7 +238,10 @@ void add_dc_tests(Catalogue& c) {
                 auto s = ctx.rd<uint8_t>(0x098E);
                 pulse = pulse || (s && (*s & 0x01));
                 later = rd64(ctx, esc::reg::kDcStartTime);
-                advanced = first && later && *later >= *first + 1'000'000;
+                // By whole cycles and no further than the time waited: a jump of 2^32 ns (a high word that
+                // moved on while the low word stays) is not SYNC0 advancing.
+                advanced =
+                    first && later && *later >= *first + 1'000'000 && *later - *first < 10'000'000'000ull;
             }
             (void)ctx.wr<uint8_t>(esc::reg::kDcActivation, 0);
             if (!advanced)
