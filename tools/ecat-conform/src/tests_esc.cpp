@@ -655,9 +655,13 @@ void add_esc_tests(Catalogue& c) {
         "ETG.1000.4 DL control register 0x0100", dl_control_rw);
     add("reg.watchdog_rw",
         "Watchdog divider 0x0400, PDI and SM watchdog times 0x0410/0x0420: the value written reads back",
-        "ESC datasheet section II watchdog registers 0x0400-0x0420 (read/write for EtherCAT)", watchdog_rw);
+        "ETG.1000.4 register access; ESC datasheet section II watchdog registers 0x0400-0x0420 (read/write "
+        "for "
+        "EtherCAT)",
+        watchdog_rw);
     add("reg.event_request", "ECAT event request 0x0210: reserved bits 1 and 12-15 clear",
-        "ESC datasheet section II ECAT event request register 0x0210", [](Context& ctx) {
+        "ETG.1000.4 register access; ESC datasheet section II ECAT event request register 0x0210",
+        [](Context& ctx) {
             auto v = ctx.rd<uint16_t>(0x0210);
             if (!v) return fail("0x0210 unreadable", err(v.error()));
             if (*v & 0xF002) return fail("reserved bits set", hex(*v), "bits 1, 12-15 clear");

@@ -283,9 +283,8 @@ void add_pd_tests(Catalogue& c) {
         "op.esc_registers",
         "OP: SM and FMMU registers read back as configured, SMs not deactivated by the PDI, SM watchdog "
         "status active",
-        "ESC datasheet SyncManager 0x0800+8n (0x0806 activate, 0x0807 PDI control), FMMU 0x0600+16n, "
-        "watchdog "
-        "status 0x0440",
+        "ETG.1000.4 SyncManager and FMMU; ESC datasheet SyncManager 0x0800+8n (0x0806 activate, 0x0807 PDI "
+        "control), FMMU 0x0600+16n, watchdog status 0x0440",
         [](Context& ctx) { return op_registers(ctx); }, "process data (layout over CoE, else from the SII)");
     add(
         "remap.safeop",

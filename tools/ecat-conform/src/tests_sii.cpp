@@ -146,7 +146,8 @@ void add_sii_tests(Catalogue& c) {
     add("interface.status",
         "EEPROM control/status 0x0502 after a read: not busy, no command, write-enable or loading error, no "
         "checksum error with a correct checksum",
-        "ESC datasheet section II EEPROM control/status register 0x0502 (bits 11-15)", [](Context& ctx) {
+        "ETG.1000.4 SII access; ESC datasheet section II EEPROM control/status register 0x0502 (bits 11-15)",
+        [](Context& ctx) {
             uint8_t b[8];
             const auto e = ctx.m.sii_read(ctx.addr, 0, b);
             auto st = ctx.rd<uint16_t>(master::reg::SiiControl);
