@@ -173,6 +173,9 @@ Outcome fault_emergency(Context& ctx, bool generic_bit) {
         bytes_hex(std::span<const uint8_t>(m).subspan(0, std::min<std::size_t>(m.size(), 16)));
     if (get16(m.data()) != 10 || m.size() < 16)
         return fail("emergency length", dec(get16(m.data())), "10 (CoE header and 8 bytes)");
+    if (const uint16_t coe = get16(&m[6]); coe & 0x0FFF)
+        return fail("emergency CoE header: number (bits 0-8) and reserved bits 9-11 not 0", hex(coe),
+                    hex(0x1000));
     const uint16_t code = get16(&m[8]);
     const uint8_t er = m[10];
     if (code == 0)
@@ -443,9 +446,11 @@ void add_cia402_tests(Catalogue& c) {
         "profile 402, 0x605A = 5..8");
     add(
         "statusword.bits",
-        "Operation enabled, holding in CSP: statusword bit 9 remote set (the controlword is processed), "
-        "bit 11 internal limit and bit 13 following error clear, in the image and over SDO",
-        "IEC 61800-7-201 (CiA 402) statusword 0x6041 bits 9, 11, 13 (csp)",
+        "Operation enabled, holding in CSP: statusword state bits and bit 4 the same in the image and over "
+        "SDO, "
+        "bit 9 remote set (the controlword is processed), bit 11 internal limit and bit 13 following error "
+        "clear",
+        "IEC 61800-7-201 (CiA 402) statusword 0x6041 state bits 0-3, 5, 6 and bits 4, 9, 11, 13 (csp)",
         [](Context& ctx) {
             CONFORM_NEED(need_402_profile(ctx));
             Drive d(ctx);
@@ -463,9 +468,18 @@ void add_cia402_tests(Catalogue& c) {
             auto sdo = ctx.upload_uint(0x6041, 0);
             d.finish();
             if (!sdo) return fail("0x6041 upload: " + ctx.sdo_error(sdo.error()));
+            // The state bits (0-3, 5, 6: operation enabled is xxxx xxxx x01x 0111) and bit 4 (voltage
+            // enabled) are the same whichever way the statusword is read, in a steady state.
+            if ((*sdo & 0x7F) != (img & 0x7F))
+                return fail("statusword over SDO differs from the image in bits 0-6 (state, voltage enabled)",
+                            "SDO " + sw_text(static_cast<uint16_t>(*sdo)) + ", image " + sw_text(img),
+                            "the same bits 0-6");
             for (const auto& [where, sw] :
                  {std::pair<const char*, uint16_t>{"image", img}, {"SDO", static_cast<uint16_t>(*sdo)}}) {
                 const std::string w = std::string(where) + ": ";
+                if ((sw & 0x6F) != 0x27)
+                    return fail(w + "not operation enabled (bits 0-3, 5, 6)", sw_text(sw),
+                                "xxxx xxxx x01x 0111");
                 if (!(sw & 0x0200))
                     return fail(w + "bit 9 (remote) clear although the drive follows the controlword",
                                 sw_text(sw), "bit 9 set");

@@ -101,6 +101,20 @@ void add_dc_tests(Catalogue& c) {
             if (*t1 <= *t0 || dt < 0.5 * dh || dt > 2.0 * dh)
                 return fail("system time over " + dec(static_cast<long long>(dh / 1e3)) + " us of host time",
                             dec(static_cast<long long>(dt / 1e3)) + " us", "about the same");
+            // Monotonic from read to read (ETG.1000.4 DC: the system time never goes back; a carry lost
+            // between the 32-bit halves, or a clock that is corrected backwards, shows here).
+            uint64_t last = *t1;
+            for (int i = 0; i < 16; ++i) {
+                auto t = rd64(ctx, esc::reg::kDcSystemTime);
+                if (!t) return fail("0x0910 unreadable");
+                // A 32-bit system time (ESC features 0x0008 bit 3 clear: 0x0914-0x0917 read 0) wraps every
+                // 4.3 s: a wrap is not a step back.
+                const bool wrap32 = last < (1ull << 32) && *t < (1ull << 32) && last - *t > (1ull << 31);
+                if (*t < last && !wrap32)
+                    return fail("system time went back between two reads",
+                                hex(*t, 16) + " after " + hex(last, 16), "never less than the read before");
+                last = *t;
+            }
             return pass("advanced", dec(static_cast<long long>(dt / 1e3)) + " us");
         },
         a);
@@ -224,7 +238,10 @@ void add_dc_tests(Catalogue& c) {
                 auto s = ctx.rd<uint8_t>(0x098E);
                 pulse = pulse || (s && (*s & 0x01));
                 later = rd64(ctx, esc::reg::kDcStartTime);
-                advanced = first && later && *later >= *first + 1'000'000;
+                // By whole cycles and no further than the time waited: a jump of 2^32 ns (a high word that
+                // moved on while the low word stays) is not SYNC0 advancing.
+                advanced =
+                    first && later && *later >= *first + 1'000'000 && *later - *first < 10'000'000'000ull;
             }
             (void)ctx.wr<uint8_t>(esc::reg::kDcActivation, 0);
             if (!advanced)

@@ -1,6 +1,7 @@
 // Group mbx, emergencies: the emergency of a device that is not a drive (a drive's emergencies are those of
 // its faults, cia402.fault.*, behind --allow-fault). Provoked safely: an AL request the state machine must
 // refuse (PREOP -> OP, ETG.1000.6: invalid state change 0x0011); nothing is written to outputs or flash.
+#include "master/diag.hpp"
 #include "testkit.hpp"
 
 namespace conform {
@@ -10,7 +11,8 @@ namespace {
 using master::Error;
 constexpr const char* kEmcy =
     "ETG.1000.6 CoE emergency (mailbox length 10, CoE service 1, error code, error register, 5 bytes); "
-    "CiA 301 error register 0x1001 (bit 0 generic at any error, class bits by error code)";
+    "CiA 301 error register 0x1001 (bit 0 generic at any error, class bits by error code); ETG.1020 "
+    "diagnosis history 0x10F3 (emergencies stored as diag code 0xE800)";
 
 // The CiA 301 error register bit that an error code's class sets (-1 when the class has none).
 int class_bit(uint16_t code) {
@@ -54,6 +56,29 @@ std::string emergency_defects(std::span<const uint8_t> m, std::optional<uint64_t
     return bad;
 }
 
+// ETG.1020 diagnosis history: a device with 0x10F3 stores its emergencies there too, as messages with the
+// emergency-derived diag code (0xE800 in the low word, the error code above). "" when the history holds a
+// message with `code`, else what was found; nullopt when the device has no 0x10F3.
+std::optional<std::string> history_defect(Context& ctx, uint16_t code) {
+    auto newest = ctx.upload_uint(0x10F3, 2);
+    if (!newest) return std::nullopt;
+    master::DiagHeader h;
+    if (auto v = ctx.upload_uint(0x10F3, 1)) h.max_messages = static_cast<uint8_t>(*v);
+    h.newest = static_cast<uint8_t>(*newest);
+    if (auto v = ctx.upload_uint(0x10F3, 3)) h.acknowledged = static_cast<uint8_t>(*v);
+    if (h.newest == 0) return std::string("no message at all (0x10F3:02 = 0)");
+    std::string seen;
+    for (uint8_t sub : master::diag_message_order(h, true, false)) {
+        auto b = ctx.upload(0x10F3, sub);
+        if (!b) return "0x10F3:" + hex(sub, 2) + " upload: " + ctx.sdo_error(b.error());
+        auto e = master::decode_diag_message(*b, sub);
+        if (!e) continue;
+        if (e->from_emergency() && e->emergency_code() == code) return std::string();
+        seen += hex(e->code, 8) + " ";
+    }
+    return "diag codes " + (seen.empty() ? std::string("none") : seen);
+}
+
 Outcome refused_request_emergency(Context& ctx) {
     CONFORM_NEED(ctx.need_coe());
     CONFORM_NEED(ctx.need_state_machine());
@@ -72,6 +97,8 @@ Outcome refused_request_emergency(Context& ctx) {
     ctx.mbx_resync();
     std::optional<uint64_t> reg1001;
     if (auto r = ctx.upload_uint(0x1001, 0)) reg1001 = *r;
+    std::optional<std::string> history;
+    if (!emcy.empty()) history = history_defect(ctx, get16(&emcy.front()[8]));
     (void)ctx.to_init();
     const std::string state = state_text(static_cast<uint8_t>(st.state | (st.error ? 0x10 : 0)));
     if (st.state != 2 || !st.error)
@@ -84,6 +111,11 @@ Outcome refused_request_emergency(Context& ctx) {
     // 0x1001 is read after the acknowledge: it is compared only while no later emergency says it changed.
     if (const std::string bad = emergency_defects(m, emcy.size() == 1 ? reg1001 : std::nullopt); !bad.empty())
         return fail("emergency of the refused PREOP -> OP: " + bad, got);
+    if (history && !history->empty())
+        return fail("emergency " + hex(get16(&m[8])) +
+                        " not in the diagnosis history 0x10F3 (ETG.1020: diag code " +
+                        hex((static_cast<uint32_t>(get16(&m[8])) << 16) | 0xE800, 8) + ")",
+                    *history, "a message with that code");
     return pass("emergency " + hex(get16(&m[8])) + " register " + hex(m[10], 2), got);
 }
 
@@ -94,7 +126,7 @@ void add_emcy_tests(Catalogue& c) {
     add("emcy.refused_request",
         "A refused AL request (PREOP -> OP) of a device that is not a drive: its emergency, if it sends one, "
         "is 10 bytes of CoE service 1 with a non-zero error code, the generic and class bits in its error "
-        "register, which equals 0x1001",
+        "register, which equals 0x1001, and is stored in 0x10F3 where the device has it",
         kEmcy, refused_request_emergency, "CoE, a state machine (no device emulation), not a CiA 402 drive");
 }
 

@@ -265,6 +265,26 @@ Outcome features(Context& ctx) {
     return pass("features", hex(*f));
 }
 
+// Watchdog divider 0x0400, PDI watchdog time 0x0410, SM watchdog time 0x0420: read/write for EtherCAT (ESC
+// datasheet section II); each takes another value and reads it back, then its own value is put back.
+Outcome watchdog_rw(Context& ctx) {
+    std::string got, want;
+    for (uint16_t reg : {uint16_t{0x0400}, uint16_t{0x0410}, uint16_t{0x0420}}) {
+        auto before = ctx.rd<uint16_t>(reg);
+        if (!before) return fail(hex(reg) + " unreadable", err(before.error()));
+        const auto v = static_cast<uint16_t>(*before ^ 0x0011);
+        const Error w = ctx.wr<uint16_t>(reg, v);
+        auto after = ctx.rd<uint16_t>(reg);
+        (void)ctx.wr<uint16_t>(reg, *before);
+        auto restored = ctx.rd<uint16_t>(reg);
+        if (w != Error::Ok) return fail(hex(reg) + " not writable", err(w));
+        got += hex(reg) + ": " + (after ? hex(*after) : err(after.error())) + ", back " +
+               (restored ? hex(*restored) : err(restored.error())) + "; ";
+        want += hex(reg) + ": " + hex(v) + ", back " + hex(*before) + "; ";
+    }
+    return expect_eq("watchdog registers written and read back", got, want);
+}
+
 Outcome dl_control_rw(Context& ctx) {
     uint8_t before[4] = {};
     if (Error e = ctx.m.read(ctx.addr, 0x0100, before); e != Error::Ok)
@@ -633,6 +653,20 @@ void add_esc_tests(Catalogue& c) {
         "ESC datasheet register 0x0008 (ESC features supported); ETG.1000.4 datagram commands", features);
     add("reg.dl_control_rw", "DL control 0x0100: the value written reads back (loop control, forwarding)",
         "ETG.1000.4 DL control register 0x0100", dl_control_rw);
+    add("reg.watchdog_rw",
+        "Watchdog divider 0x0400, PDI and SM watchdog times 0x0410/0x0420: the value written reads back",
+        "ETG.1000.4 register access; ESC datasheet section II watchdog registers 0x0400-0x0420 (read/write "
+        "for "
+        "EtherCAT)",
+        watchdog_rw);
+    add("reg.event_request", "ECAT event request 0x0210: reserved bits 1 and 12-15 clear",
+        "ETG.1000.4 register access; ESC datasheet section II ECAT event request register 0x0210",
+        [](Context& ctx) {
+            auto v = ctx.rd<uint16_t>(0x0210);
+            if (!v) return fail("0x0210 unreadable", err(v.error()));
+            if (*v & 0xF002) return fail("reserved bits set", hex(*v), "bits 1, 12-15 clear");
+            return pass("0x0210", hex(*v));
+        });
     add(
         "reg.pdi_control", "PDI control 0x0140 loaded from SII word 0", "ETG.1000.6 SII configuration area",
         [](Context& ctx) {

@@ -17,6 +17,7 @@ constexpr const char* kBoot = "ETG.1000.6 BOOT state; SII bootstrap mailbox word
 struct FoeAnswer {
     Error error = Error::Ok;
     uint8_t opcode = 0;
+    uint8_t reserved = 0;  // the header's second byte (ETG.1000.6 FoE header: reserved, 0)
     uint32_t value = 0;
     std::string text;
     std::string describe() const {
@@ -47,6 +48,7 @@ FoeAnswer foe_request(Context& ctx, uint8_t opcode, uint32_t value, const std::s
             return a;
         }
         a.opcode = m.payload[0];
+        a.reserved = m.payload[1];
         a.value = get32(&m.payload[2]);
         a.text.assign(m.payload.begin() + 6, m.payload.end());
         break;
@@ -69,9 +71,62 @@ Outcome expect_foe_error(const FoeAnswer& a, std::initializer_list<uint32_t> cod
         want += (want.empty() ? "ERR " : " or ") + hex(c);
     if (a.error != Error::Ok) return fail(what + ": no FoE answer", a.describe(), want);
     if (a.opcode != 5) return fail(what + ": not refused", a.describe(), want);
+    if (a.reserved != 0)
+        return fail(what + ": FoE header byte 1 (reserved) not 0", hex(a.reserved, 2) + " in " + a.describe(),
+                    "0");
     for (auto c : codes)
         if (a.value == c) return pass(what, a.describe());
     return fail(what + ": FoE error code", a.describe(), want);
+}
+
+// FoE read of --foe-file in BOOT (reading changes nothing): either refused with an FoE error, or DATA packets
+// numbered from 1 up by one, header byte 1 reserved (0), each acknowledged with its number; the first
+// kReadPackets are read, then the read is ended with an error request (ETG.1000.6 FoE: either side may end a
+// transfer with an error) unless the file ended first (a packet shorter than the others).
+Outcome foe_read(Context& ctx) {
+    constexpr unsigned kReadPackets = 8;
+    FoeAnswer first;
+    std::vector<uint8_t> rrq(6, 0);
+    rrq[0] = 1;
+    put32(&rrq[2], ctx.opt.foe_password);
+    rrq.insert(rrq.end(), ctx.opt.foe_file.begin(), ctx.opt.foe_file.end());
+    if (Error e = ctx.mbx->send(master::MailboxType::FoE, rrq); e != Error::Ok)
+        return fail("read request not sent: " + err(e));
+    std::string seen;
+    // A DATA packet shorter than the mailbox allows (SM1 minus mailbox and FoE headers) ends the file.
+    const std::size_t full = ctx.mbx->config().in_size > 12 ? ctx.mbx->config().in_size - 12u : 0u;
+    for (uint32_t want = 1; want <= kReadPackets; ++want) {
+        master::MailboxMessage m;
+        Error e = ctx.mbx->receive(m, ctx.ms(1000));
+        while (e == Error::Ok && m.type != master::MailboxType::FoE && m.type != master::MailboxType::Error)
+            e = ctx.mbx->receive(m, ctx.ms(1000));
+        if (e != Error::Ok)
+            return fail(
+                "no answer to " + std::string(want == 1 ? "the read request" : "the ACK") + ": " + err(e),
+                seen);
+        if (m.type == master::MailboxType::Error) return fail("mailbox error answer", seen);
+        if (m.payload.size() < 6) return fail("FoE answer shorter than its header", bytes_hex(m.payload));
+        const uint8_t op = m.payload[0];
+        const uint32_t value = get32(&m.payload[2]);
+        if (op == 5 && want == 1) return pass("read refused (optional)", "ERR " + hex(value));
+        if (op == 6 && want == 1) return pass("read answered BUSY (not judged)", "BUSY " + dec(value));
+        if (op != 3)
+            return fail("answer to packet " + dec(want) + " not DATA", "opcode " + dec(op), "3 (DATA)");
+        seen += dec(value) + " ";
+        if (m.payload[1] != 0) return fail("DATA header byte 1 (reserved) not 0", hex(m.payload[1], 2), "0");
+        if (value != want) return fail("DATA packet number", seen, "1, 2, 3, ...");
+        const std::size_t n = m.payload.size() - 6;
+        std::vector<uint8_t> ack(6, 0);
+        ack[0] = 4;
+        put32(&ack[2], value);
+        (void)ctx.mbx->send(master::MailboxType::FoE, ack);
+        if (n < full) return pass("file read to its end", seen);
+    }
+    std::vector<uint8_t> end(6, 0);
+    end[0] = 5;
+    put32(&end[2], 0x8000);
+    (void)ctx.mbx->send(master::MailboxType::FoE, end);
+    return pass("DATA packets numbered from 1", seen);
 }
 
 #define CONFORM_BOOT(ctx)                                                                                  \
@@ -223,6 +278,20 @@ void add_foe_tests(Catalogue& c) {
             return expect_foe_error(r, {0x8001, 0x800F}, "read of an unknown name");
         },
         a);
+    add(
+        "read_file",
+        "FoE read of --foe-file in BOOT: refused with an FoE error, or DATA packets numbered from 1, each "
+        "acknowledged (the first 8, then the read is ended)",
+        kFoe,
+        [](Context& ctx) {
+            if (ctx.opt.foe_file.empty()) return skip("needs --foe-file (a file name the device knows)");
+            CONFORM_BOOT(ctx);
+            Outcome o = foe_read(ctx);
+            ctx.mbx_resync();
+            (void)ctx.to_init();
+            return o;
+        },
+        "--foe-file given");
     add(
         "write_complete",
         "A whole FoE write of --foe-image as --foe-file in BOOT: ACK 0 to the request, each DATA packet "

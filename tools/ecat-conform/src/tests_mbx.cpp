@@ -57,9 +57,10 @@ Outcome mailbox_error(Context& ctx, const std::vector<uint8_t>& msg, std::vector
         return fail(what + ": not a mailbox error reply",
                     "type " + dec(type) + " " + bytes_hex(std::span<const uint8_t>(r).subspan(0, 16)), want);
     const uint16_t len = get16(r.data());
-    if (len < 4 || get16(&r[6]) != 0x0001)
+    // ETG.1000.4 mailbox error reply: Type (0x0001) and Detail, length 4.
+    if (len != 4 || get16(&r[6]) != 0x0001)
         return fail(what + ": malformed mailbox error reply",
-                    "length " + dec(len) + " service " + hex(get16(&r[6])), want);
+                    "length " + dec(len) + " service " + hex(get16(&r[6])), "length 4, " + want);
     const uint16_t detail = get16(&r[8]);
     for (auto a : accepted)
         if (a == detail) return pass(what, "detail " + hex(detail));
@@ -209,6 +210,31 @@ void add_mbx_tests(Catalogue& c) {
             return pass("status", seen);
         },
         "CoE");
+    add(
+        "sm.config",
+        "SM0/SM1 in PREOP: registers read back as configured, not deactivated by the PDI (0x0807/0x080F bit "
+        "0)",
+        "ESC datasheet SyncManager registers 0x0800+8n (read/write for EtherCAT; 0x0807 PDI control bit 0: "
+        "SM "
+        "deactivated); ETG.1000.4 mailbox",
+        {&Context::need_mailbox},
+        [](Context& ctx) {
+            const auto& mc = ctx.mbx->config();
+            uint8_t r[16] = {};
+            if (Error e = ctx.m.read(ctx.addr, master::reg::Sm0, r); e != Error::Ok)
+                return fail("SM0/SM1 unreadable", err(e));
+            auto show = [](uint16_t start, uint16_t len, uint8_t control, uint8_t act, uint8_t pdi) {
+                return hex(start) + "/" + dec(len) + " control " + hex(control, 2) + " enable " +
+                       dec(act & 1) + " PDI deactivated " + dec(pdi & 1);
+            };
+            const std::string got = "SM0 " + show(get16(r), get16(r + 2), r[4], r[6], r[7]) + "; SM1 " +
+                                    show(get16(r + 8), get16(r + 10), r[12], r[14], r[15]);
+            const std::string want =
+                "SM0 " + show(mc.out_start, mc.out_size, master::Mailbox::kSm0ControlDefault, 1, 0) +
+                "; SM1 " + show(mc.in_start, mc.in_size, master::Mailbox::kSm1ControlDefault, 1, 0);
+            return expect_eq("SM0/SM1 registers", got, want);
+        },
+        "mailbox slave");
     add(
         "repeat.request", "Repeat request (SM1 toggle) puts the last response back, identical", kRepeat,
         {&Context::need_coe},

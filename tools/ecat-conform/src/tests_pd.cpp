@@ -168,6 +168,67 @@ Outcome logical_only(Context& ctx, master::Command cmd) {
                      dec(d.wkc), has ? "1" : "0");
 }
 
+// In OP with process data exchanged every cycle, the ESC registers the master configured read back as written
+// (ESC datasheet: SyncManager 0x0800+8n start, length, control and activate; FMMU 0x0600+16n, all read/write
+// for EtherCAT), the process-data SMs are not deactivated by the PDI (0x0807+8n bit 0) and the SM watchdog
+// status (0x0440 bit 0) says active: outputs come in time (1: active or disabled, 0: expired).
+Outcome op_registers(Context& ctx) {
+    CONFORM_NEED(ctx.need_pd_layout());
+    if (Error e = ctx.to_op(); e != Error::Ok) return fail("cannot reach OP: " + err(e));
+    if (!ctx.has_process_data()) return skip("no process data (no PDO assigned to a process-data SM)");
+    (void)ctx.cycle(5);
+    const auto& l = ctx.pds->layout();
+    std::string got, want;
+    struct Sm {
+        uint8_t n;
+        uint16_t start, length;
+        uint8_t control;
+    };
+    const Sm sms[2] = {{l.out_sm, l.sm2_start, l.sm2_length, l.sm2_control},
+                       {l.in_sm, l.sm3_start, l.sm3_length, l.sm3_control}};
+    for (const Sm& sm : sms) {
+        if (!sm.length || sm.n >= 16) continue;
+        uint8_t r[8] = {};
+        const auto base = static_cast<uint16_t>(master::reg::Sm0 + 8 * sm.n);
+        if (Error e = ctx.m.read(ctx.addr, base, r); e != Error::Ok)
+            return fail("SM" + dec(sm.n) + " unreadable", err(e));
+        (void)ctx.cycle(1);
+        const std::string n = "SM" + dec(sm.n) + " ";
+        got += n + hex(get16(r)) + "/" + dec(get16(r + 2)) + " control " + hex(r[4], 2) + " activate " +
+               hex(r[6] & 0x01, 2) + " PDI deactivated " + dec(r[7] & 0x01) + "; ";
+        want += n + hex(sm.start) + "/" + dec(sm.length) + " control " + hex(sm.control, 2) + " activate " +
+                hex(0x01, 2) + " PDI deactivated 0; ";
+    }
+    uint8_t f[32] = {};
+    if (Error e = ctx.m.read(ctx.addr, master::reg::Fmmu0, f); e != Error::Ok)
+        return fail("FMMU0/1 unreadable", err(e));
+    (void)ctx.cycle(1);
+    const uint32_t log0 = master::ProcessDataSession::kLogicalBase;
+    const uint32_t logs[2] = {log0, log0 + l.sm2_length};
+    const uint16_t lens[2] = {l.sm2_length, l.sm3_length}, phys[2] = {l.sm2_start, l.sm3_start};
+    const uint8_t types[2] = {0x02, 0x01};
+    for (int k = 0; k < 2; ++k) {
+        if (!lens[k]) continue;
+        const uint8_t* x = f + 16 * k;
+        const std::string n = "FMMU" + dec(k) + " ";
+        got += n + hex(get32(x), 8) + "/" + dec(get16(x + 4)) + " bits " + dec(x[6]) + "-" + dec(x[7]) +
+               " -> " + hex(get16(x + 8)) + "." + dec(x[10]) + " type " + hex(x[11], 2) + " enable " +
+               dec(x[12] & 1) + "; ";
+        want += n + hex(logs[k], 8) + "/" + dec(lens[k]) + " bits 0-7 -> " + hex(phys[k]) + ".0 type " +
+                hex(types[k], 2) + " enable 1; ";
+    }
+    // Only outputs written through an SM with the watchdog trigger (control bit 6) keep the watchdog
+    // running; an input-only device's watchdog may show expired (ESC datasheet 0x0420, 0x0440).
+    if (l.sm2_length && (l.sm2_control & 0x40)) {
+        auto wd = ctx.rd<uint16_t>(0x0440);
+        (void)ctx.cycle(1);
+        if (!wd) return fail("SM watchdog status 0x0440 unreadable", err(wd.error()));
+        got += "0x0440 bit 0 " + dec(*wd & 1);
+        want += "0x0440 bit 0 1";
+    }
+    return expect_eq("SM/FMMU registers as configured, watchdog status while outputs come", got, want);
+}
+
 }  // namespace
 
 void add_pd_tests(Catalogue& c) {
@@ -218,6 +279,13 @@ void add_pd_tests(Catalogue& c) {
         "ETG.1000.4 working counter of LWR",
         [](Context& ctx) { return logical_only(ctx, master::Command::LWR); },
         "process data (layout over CoE, else from the SII)");
+    add(
+        "op.esc_registers",
+        "OP: SM and FMMU registers read back as configured, SMs not deactivated by the PDI, SM watchdog "
+        "status active",
+        "ETG.1000.4 SyncManager and FMMU; ESC datasheet SyncManager 0x0800+8n (0x0806 activate, 0x0807 PDI "
+        "control), FMMU 0x0600+16n, watchdog status 0x0440",
+        [](Context& ctx) { return op_registers(ctx); }, "process data (layout over CoE, else from the SII)");
     add(
         "remap.safeop",
         "Another ESI RxPDO assigned in PREOP: SAFEOP with the new SM2 size and exact working counter", kPdEsi,

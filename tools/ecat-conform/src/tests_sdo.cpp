@@ -436,8 +436,7 @@ void add_sdo_tests(Catalogue& c) {
             auto v = ctx.upload_uint(0x1C12, 0);
             if (!v) return fail("0x1C12:00 upload: " + ctx.sdo_error(v.error()));
             SdoAnswer a = sdo_raw(ctx, sdo_req(0x2F, 0x1C12, 0, static_cast<uint32_t>(*v)));
-            return expect_abort(a, 0x1C12, 0, {0x08000022, 0x08000021, 0x06010002, 0x08000020},
-                                "0x1C12:00 in SAFEOP");
+            return expect_abort(a, 0x1C12, 0, {0x08000022, 0x06010002, 0x08000020}, "0x1C12:00 in SAFEOP");
         },
         "CoE");
     add(
@@ -453,7 +452,7 @@ void add_sdo_tests(Catalogue& c) {
             auto v = ctx.upload_uint(pdos[0], 0);
             if (!v) return fail(hex(pdos[0]) + ":00 upload: " + ctx.sdo_error(v.error()));
             SdoAnswer a = sdo_raw(ctx, sdo_req(0x2F, pdos[0], 0, static_cast<uint32_t>(*v)));
-            return expect_abort(a, pdos[0], 0, {0x08000022, 0x08000021, 0x06010002, 0x08000020},
+            return expect_abort(a, pdos[0], 0, {0x08000022, 0x06010002, 0x08000020},
                                 hex(pdos[0]) + ":00 in SAFEOP");
         },
         "CoE");
