@@ -22,7 +22,12 @@ Cycle::Cycle(StackContext& ctx, StateMachine& esm, SyncControl& sync, IrqLine ir
 }
 
 void Cycle::set_up_registers() {
-    ctx_.pdi.write_reg<uint32_t>(esc::reg::kAlEventMask, event_mask_);
+    write_mask(event_mask_);
+}
+
+void Cycle::write_mask(uint32_t mask) {
+    ctx_.pdi.write_reg<uint32_t>(esc::reg::kAlEventMask, mask);
+    written_mask_ = mask;
 }
 
 // ---- poll -------------------------------------------------------------------------------------------
@@ -96,7 +101,7 @@ uint64_t Cycle::next_deadline_ns() const {
 bool Cycle::esc_was_reset() {
     // The AL event mask is written only through the PDI (by this stack, at start); an ESC reset puts it
     // back to its reset value. On a device the ESC's reset would reset the controller behind it as well.
-    return ctx_.pdi.read_reg<uint32_t>(esc::reg::kAlEventMask) != event_mask_;
+    return ctx_.pdi.read_reg<uint32_t>(esc::reg::kAlEventMask) != written_mask_;
 }
 
 void Cycle::restart_after_esc_reset(uint64_t now_ns) {
@@ -130,6 +135,18 @@ void Cycle::update_irq_usable() {
     irq_usable_ = usable;
 }
 
+void Cycle::update_event_mask() {
+    // In Op, DC-synchronous, with SYNC0 in the AL event register: SYNC0 wakes the stack for the cycle, which
+    // reads the SM2 status itself, so the SM2/SM3 events of each frame are masked (written_mask()). Safe-Op
+    // keeps them: on the way to Op every frame's poll also looks at the DC activation, which a master may
+    // have renewed (the wait for the first SYNC0 of a new start time). Without the SYNC0 event the stack
+    // keeps them too, with its own estimate of the next SYNC0 as a deadline.
+    const bool masked = sync0_event_ && esm_.state() == AlState::Op;
+    const uint32_t mask =
+        masked ? event_mask_ & ~(esc::alev::sm(out_sm_) | esc::alev::sm(in_sm_)) : event_mask_;
+    if (mask != written_mask_) write_mask(mask);
+}
+
 // ---- Process data -----------------------------------------------------------------------------------
 
 void Cycle::start_process_data(uint64_t now_ns) {
@@ -139,6 +156,8 @@ void Cycle::start_process_data(uint64_t now_ns) {
     outputs_seen_ = false;
     outputs_reset_pending_ = false;
     sync_.start(now_ns);
+    constexpr uint8_t kSync0ToAlEvent = 0x08;  // 0x0151 bit 3
+    sync0_event_ = sync_.dc() && (ctx_.pdi.read_reg<uint8_t>(esc::reg::kSyncLatchConfig) & kSync0ToAlEvent);
     if (pd.rx_bytes() > 0) set_sm_pdi_deactivated(ctx_.pdi, out_sm_, false);
     if (pd.tx_bytes() > 0) {
         set_sm_pdi_deactivated(ctx_.pdi, in_sm_, false);
@@ -147,6 +166,7 @@ void Cycle::start_process_data(uint64_t now_ns) {
 }
 
 void Cycle::stop_process_data() {
+    sync0_event_ = false;
     if (ctx_.sms.outputs < 4) set_sm_pdi_deactivated(ctx_.pdi, ctx_.sms.outputs, true);
     if (ctx_.sms.inputs < 4) set_sm_pdi_deactivated(ctx_.pdi, ctx_.sms.inputs, true);
     ctx_.pd.clear();

@@ -387,6 +387,7 @@ void StateMachine::go(AlState to, uint64_t now_ns) {
     state_ = to;
     ++ctx_.stats.transitions;
     cycle_.update_irq_usable();
+    cycle_.update_event_mask();
     ctx_.mailbox.set_state(from, to);
     if (ctx_.events != nullptr) ctx_.events->state_changed(from, to);
     ctx_.app.on_state_change(from, to);

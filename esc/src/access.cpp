@@ -143,8 +143,8 @@ void Esc::Impl::reg_read(uint16_t a, uint8_t* dst, uint32_t n, Side side) {
 }
 
 bool Esc::Impl::reg_write(uint16_t a, const uint8_t* src, const uint8_t* bm, uint32_t n, Side side) {
-    const uint8_t* kind = side == Side::Ecat ? ecat_kind.data() : pdi_kind.data();
-    const uint8_t* wmask = side == Side::Ecat ? ecat_wmask.data() : pdi_wmask.data();
+    const uint8_t* kind = side == Side::Ecat ? tables.ecat_kind.data() : tables.pdi_kind.data();
+    const uint8_t* wmask = side == Side::Ecat ? tables.ecat_wmask.data() : tables.pdi_wmask.data();
     const bool reg_prot = reg_write_protected(side);
     const bool esc_prot = esc_write_protected(side);
     bool any = false;

@@ -1,6 +1,8 @@
 // The emulated ESC: construction, reset values, the public API and frame / datagram processing.
 #include <algorithm>
 #include <cstring>
+#include <memory>
+#include <mutex>
 
 #include "esc/wire/datagram.hpp"
 #include "esc_impl.hpp"
@@ -50,22 +52,34 @@ EscConfig clamped(EscConfig c) {
 }  // namespace
 
 Esc::Impl::Impl(const EscConfig& c, const Clock& clk) : cfg(clamped(c)), mem(cfg.process_ram_kib), time(clk) {
-    init_tables();
     reset_registers();
     sii.load_words(true);
 }
 
-void Esc::Impl::init_tables() {
+const Esc::Impl::RegTables& Esc::Impl::register_tables(uint8_t fmmu_count, uint8_t sm_count) {
+    // Built on first use for each pair of counts (at most 17 x 17 after clamping), kept for the process.
+    static std::mutex mu;
+    static std::array<std::unique_ptr<RegTables>, 17 * 17> built;
+    std::lock_guard lock(mu);
+    std::unique_ptr<RegTables>& t = built[static_cast<std::size_t>(fmmu_count) * 17 + sm_count];
+    if (!t) {
+        t = std::make_unique<RegTables>();
+        init_tables(*t, fmmu_count, sm_count);
+    }
+    return *t;
+}
+
+void Esc::Impl::init_tables(RegTables& t, uint8_t fmmu_count, uint8_t sm_count) {
     auto ecat = [&](uint16_t a, unsigned n, uint8_t kind, uint8_t mask = 0xFF) {
         for (unsigned i = 0; i < n; ++i) {
-            ecat_kind[a + i] = kind;
-            ecat_wmask[a + i] = mask;
+            t.ecat_kind[a + i] = kind;
+            t.ecat_wmask[a + i] = mask;
         }
     };
     auto pdi = [&](uint16_t a, unsigned n, uint8_t kind, uint8_t mask = 0xFF) {
         for (unsigned i = 0; i < n; ++i) {
-            pdi_kind[a + i] = kind;
-            pdi_wmask[a + i] = mask;
+            t.pdi_kind[a + i] = kind;
+            t.pdi_wmask[a + i] = mask;
         }
     };
     // ECAT side.
@@ -92,9 +106,9 @@ void Esc::Impl::init_tables() {
     ecat(0x0510, 1, kPlain, 0x01);         // MII: inert, stored
     ecat(0x0512, 4, kPlain);
     ecat(0x0516, 1, kPlain, 0x01);
-    for (unsigned n = 0; n < cfg.fmmu_count; ++n)
+    for (unsigned n = 0; n < fmmu_count; ++n)
         ecat(static_cast<uint16_t>(reg::kFmmu + 16 * n), 13, kSpecial);
-    for (unsigned n = 0; n < cfg.sm_count; ++n) {
+    for (unsigned n = 0; n < sm_count; ++n) {
         uint16_t b = static_cast<uint16_t>(reg::kSm + 8 * n);
         ecat(b, 5, kSpecial);
         ecat(static_cast<uint16_t>(b + 6), 1, kSpecial);
@@ -121,7 +135,7 @@ void Esc::Impl::init_tables() {
     pdi(reg::kAlEventMask, 4, kPlain);
     pdi(reg::kSiiPdiAccess, 1, kPlain, 0x01);
     pdi(reg::kSiiControl, 14, kSpecial);
-    for (unsigned n = 0; n < cfg.sm_count; ++n)
+    for (unsigned n = 0; n < sm_count; ++n)
         pdi(static_cast<uint16_t>(reg::kSm + 8 * n + 7), 1, kSpecial);
     pdi(reg::kDcActivation, 1, kSpecial);
     pdi(reg::kDcStartTime, 8, kSpecial);
@@ -410,15 +424,18 @@ void Esc::Impl::datagram(uint8_t* d, uint8_t* data, uint16_t len) {
     const uint16_t lock_before = sm.enabled_mask();
     uint16_t inc = 0;
     const uint8_t* wsrc = data;
+    DatagramScratch& sc = datagram_scratch();  // BRD/BRW OR-read, xxRW write data
+    uint8_t* scratch_a = sc.a.data();
+    uint8_t* scratch_ok = sc.ok.data();
     if (op == kReadWrite) {
-        std::memcpy(scratch_b.data(), data, len);
-        wsrc = scratch_b.data();
+        std::memcpy(sc.b.data(), data, len);
+        wsrc = sc.b.data();
     }
     if (op == kRead || op == kReadWrite) {
         bool any;
         if (or_read) {
-            std::memset(scratch_ok.data(), 0, len);
-            any = phys_read(ado, scratch_a.data(), scratch_ok.data(), len, Side::Ecat);
+            std::memset(scratch_ok, 0, len);
+            any = phys_read(ado, scratch_a, scratch_ok, len, Side::Ecat);
             for (uint16_t i = 0; i < len; ++i)
                 if (scratch_ok[i]) data[i] = static_cast<uint8_t>(data[i] | scratch_a[i]);
         } else {

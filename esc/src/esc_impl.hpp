@@ -27,9 +27,15 @@ struct Esc::Impl final {
     // ---------------------------------------------------------------- configuration
     EscConfig cfg;  // counts and RAM size clamped to what the address space holds
     mutable EscLock mu{cfg.thread_safe};
-    // Handling class and write mask of each register byte, per side (RegKind).
-    std::array<uint8_t, 0x1000> ecat_kind{}, pdi_kind{};
-    std::array<uint8_t, 0x1000> ecat_wmask{}, pdi_wmask{};
+    // Handling class and write mask of each register byte, per side (RegKind). A function of the FMMU and
+    // SM counts alone: one set for every ESC of that configuration (register_tables()), so the 16 KiB
+    // are read from the cache, not once per ESC of a line.
+    struct RegTables {
+        std::array<uint8_t, 0x1000> ecat_kind{}, pdi_kind{};
+        std::array<uint8_t, 0x1000> ecat_wmask{}, pdi_wmask{};
+    };
+    static const RegTables& register_tables(uint8_t fmmu_count, uint8_t sm_count);
+    const RegTables& tables{register_tables(cfg.fmmu_count, cfg.sm_count)};
 
     // ---------------------------------------------------------------- units
     Memory mem;
@@ -46,7 +52,6 @@ struct Esc::Impl final {
     bool frame_write_enable = false;      // 0x0020 written with bit 0 in this frame
     bool frame_esc_write_enable = false;  // 0x0030 likewise
     bool reset_written_this_frame = false;
-    std::array<uint8_t, 2048> scratch_a{}, scratch_b{}, scratch_ok{};  // BRD/BRW OR-read, xxRW write data
 
     // ---------------------------------------------------------------- ESC reset sequences
     uint8_t reset_progress_ecat = 0;
@@ -55,7 +60,7 @@ struct Esc::Impl final {
     EscStats stats{};
 
     // ---------------------------------------------------------------- functions
-    void init_tables();
+    static void init_tables(RegTables& t, uint8_t fmmu_count, uint8_t sm_count);
     void reset_registers();
     void rebuild_lookup();
 

@@ -23,6 +23,18 @@ concept PhysicalMemory = requires(P& p, uint32_t a, uint8_t* d, const uint8_t* s
     { p.phys_write(a, s, s, n, side) } -> std::same_as<bool>;
 };
 
+// Work areas of one datagram's processing (the largest datagram fits: its length field has 11 bits). One set
+// per thread, shared by every ESC the thread serves: an ESC never processes two datagrams at once, and a
+// runtime serving a line of 100 ESCs keeps one set in its cache instead of 100 (each ESC's own scratch was
+// 14 KiB of memory that every walk of a frame touched afresh).
+struct DatagramScratch {
+    std::array<uint8_t, 2048> a, b, ok, src;
+};
+inline DatagramScratch& datagram_scratch() {
+    thread_local DatagramScratch s;
+    return s;
+}
+
 struct FmmuMap {
     uint64_t lbit_start = 0;  // first mapped logical bit (absolute bit address)
     uint64_t lbit_end = 0;    // one past the last mapped logical bit
@@ -51,8 +63,6 @@ class Fmmus {
     uint8_t count_ = 0;
     std::array<FmmuMap, 16> map_{};
     uint8_t active_ = 0;
-    // Per-datagram work areas (no allocation per frame).
-    std::array<uint8_t, 2048> scratch_a{}, scratch_b{}, scratch_ok{}, lrw_src{};
 };
 
 // Mask of the bits [lo, hi] (inclusive) of a byte.
@@ -69,8 +79,18 @@ uint16_t Fmmus::logical(P& phys, Command cmd, uint32_t la, uint8_t* data, uint16
     const bool do_write = cmd != Command::LRD;  // LWR, LRW
     const uint8_t* wsrc = data;
     if (do_read && do_write) {
-        std::memcpy(lrw_src.data(), data, len);  // writes take the incoming data, reads happen first
-        wsrc = lrw_src.data();
+        // Writes take the incoming data, reads happen first: the bytes a write FMMU takes are kept (at their
+        // offsets in the datagram; nothing else of the copy is read).
+        uint8_t* src = datagram_scratch().src.data();
+        for (uint8_t k = 0; k < active_; ++k) {
+            const FmmuMap& f = map_[k];
+            if (!f.write) continue;
+            const uint64_t i0 = std::max(b0, f.lbit_start), i1 = std::min(b1, f.lbit_end);
+            if (i0 >= i1) continue;
+            const uint64_t j0 = (i0 >> 3) - la, j1 = ((i1 - 1) >> 3) - la;
+            std::memcpy(src + j0, data + j0, j1 - j0 + 1);
+        }
+        wsrc = src;
     }
     bool any_r = false, any_w = false;
     if (do_read) {
@@ -103,9 +123,11 @@ bool Fmmus::read(P& phys, const FmmuMap& f, uint64_t i0, uint64_t i1, uint32_t l
     const uint64_t pa1 = (pb0 + nbits - 1) >> 3;
     if (pa0 >= 0x10000) return false;
     const uint32_t np = static_cast<uint32_t>(std::min<uint64_t>(pa1, 0xFFFF) - pa0 + 1);
-    std::memset(scratch_ok.data(), 0, np);
-    if (!phys.phys_read(static_cast<uint32_t>(pa0), scratch_a.data(), scratch_ok.data(), np, Side::Ecat))
-        return false;
+    DatagramScratch& sc = datagram_scratch();
+    uint8_t* scratch_a = sc.a.data();
+    uint8_t* scratch_ok = sc.ok.data();
+    std::memset(scratch_ok, 0, np);
+    if (!phys.phys_read(static_cast<uint32_t>(pa0), scratch_a, scratch_ok, np, Side::Ecat)) return false;
     const uint64_t lbyte0 = i0 >> 3, lbyte1 = (i1 - 1) >> 3;
     if (((pb0 ^ i0) & 7) == 0) {
         // Same bit position in logical and physical bytes: byte-wise with edge masks.
@@ -143,7 +165,10 @@ bool Fmmus::write(P& phys, const FmmuMap& f, uint64_t i0, uint64_t i1, uint32_t 
     const uint64_t pa1 = (pb0 + nbits - 1) >> 3;
     if (pa0 >= 0x10000) return false;
     const uint32_t np = static_cast<uint32_t>(std::min<uint64_t>(pa1, 0xFFFF) - pa0 + 1);
-    std::memset(scratch_b.data(), 0, np);  // bit masks
+    DatagramScratch& sc = datagram_scratch();
+    uint8_t* scratch_a = sc.a.data();
+    uint8_t* scratch_b = sc.b.data();
+    std::memset(scratch_b, 0, np);  // bit masks
     const uint64_t lbyte0 = i0 >> 3, lbyte1 = (i1 - 1) >> 3;
     if (((pb0 ^ i0) & 7) == 0) {
         for (uint64_t j = lbyte0; j <= lbyte1; ++j) {
@@ -155,7 +180,7 @@ bool Fmmus::write(P& phys, const FmmuMap& f, uint64_t i0, uint64_t i1, uint32_t 
             scratch_a[k] = data[j - la];
         }
     } else {
-        std::memset(scratch_a.data(), 0, np);
+        std::memset(scratch_a, 0, np);
         for (uint64_t t = 0; t < nbits; ++t) {
             const uint64_t pbit = pb0 + t, lbit = i0 + t;
             const uint64_t k = (pbit >> 3) - pa0;
@@ -166,7 +191,7 @@ bool Fmmus::write(P& phys, const FmmuMap& f, uint64_t i0, uint64_t i1, uint32_t 
                 scratch_a[k] = static_cast<uint8_t>(scratch_a[k] | pm);
         }
     }
-    return phys.phys_write(static_cast<uint32_t>(pa0), scratch_a.data(), scratch_b.data(), np, Side::Ecat);
+    return phys.phys_write(static_cast<uint32_t>(pa0), scratch_a, scratch_b, np, Side::Ecat);
 }
 
 }  // namespace esc

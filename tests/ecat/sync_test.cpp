@@ -132,6 +132,8 @@ TEST_F(Sync, Dc_Sync0NotMappedToAlEvent_SeenThrough0x0990) {
     request(0x08);
     run_for(2'000'000, 250'000, true);
     EXPECT_EQ(al_status(), 0x08);
+    // Nothing else would wake it for the outputs: the SM events stay in the mask.
+    EXPECT_EQ(esc->read_reg<uint32_t>(0x0204), Stack::kEventMask);
     // A runtime that only wakes on the stack's deadline still runs one cycle per SYNC0.
     const int before = app.cycles;
     for (int i = 0; i < 5; ++i) {
@@ -140,6 +142,47 @@ TEST_F(Sync, Dc_Sync0NotMappedToAlEvent_SeenThrough0x0990) {
     }
     EXPECT_EQ(app.cycles - before, 5);
     EXPECT_EQ(stack->stats().cycles_exceeded, 0u);
+}
+
+// In Op, DC-synchronous with SYNC0 in the AL event register, the frame's SM2/SM3 events are masked (0x0204,
+// as a DC-synchronous firmware sets its interrupt mask): a frame leaves the interrupt line low and the stack
+// quiet, and the cycle at SYNC0 still takes the outputs the frame brought (no SM event counted missed).
+// Safe-Op and every state below keep the full mask; an ESC reset in Op is still noticed.
+TEST_F(Sync, Dc_OpMasksTheProcessDataSmEvents) {
+    constexpr uint32_t kSm2Sm3 = 0x0C00;
+    safeop_dc(1'000'000);
+    EXPECT_EQ(esc->read_reg<uint32_t>(0x0204), Stack::kEventMask);
+    run_for(3'000'000, 250'000, true);
+    request(0x08);
+    ASSERT_EQ(al_status(), 0x08);
+    EXPECT_EQ(esc->read_reg<uint32_t>(0x0204), Stack::kEventMask & ~kSm2Sm3);
+    run_for(2'000'000, 250'000, true);
+    const uint64_t missed = stack->stats().sm_events_missed;
+    std::vector<uint8_t> out{0x0F, 0x00, 0x44, 0x33, 0x22, 0x11}, in(6);
+    for (int k = 0; k < 3; ++k) {
+        exchange_pd(out, in);
+        EXPECT_FALSE(esc->irq());
+        EXPECT_TRUE(stack->quiet(clock.now_ns()));
+        const int cycles = app.cycles;
+        clock.set(stack->next_deadline_ns());  // the next SYNC0
+        poll();
+        EXPECT_EQ(app.cycles, cycles + 1);
+    }
+    EXPECT_EQ(stack->stats().sm_events_missed, missed);
+    EXPECT_EQ(u16(0x6040, 0), 0x000F);  // RxPDO 0x1600 = {0x6040, 0x607A}: taken at SYNC0
+    EXPECT_EQ(u32(0x607A, 0), 0x11223344u);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x04);
+    EXPECT_EQ(esc->read_reg<uint32_t>(0x0204), Stack::kEventMask);
+    request(0x08);
+    run_for(2'000'000, 250'000, true);
+    ASSERT_EQ(al_status(), 0x08);
+    for (uint8_t c : {uint8_t{'R'}, uint8_t{'E'}, uint8_t{'S'}})
+        master.wr<uint8_t>(0x0040, c);
+    run_for(2'000'000, 250'000, false);
+    EXPECT_EQ(stack->state(), AlState::Init);
+    EXPECT_EQ(stack->stats().esc_resets, 1u);
+    EXPECT_EQ(esc->read_reg<uint32_t>(0x0204), Stack::kEventMask);
 }
 
 TEST_F(Sync, Dc_SafeOpToOp_WaitsForSync0) {

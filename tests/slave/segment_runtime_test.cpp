@@ -4,6 +4,7 @@
 // brings a drive back in Init with its stored parameters; the hold queue of a delayed hop.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -123,6 +124,31 @@ TEST(SegmentRuntime, ThreeDrivesAreCountedAddressedAndTakenToPreOp) {
     }
     EXPECT_NE(bus.log_text.str().find("ecat-slave: drive2: AL state INIT -> PREOP"), std::string::npos)
         << bus.log_text.str();
+}
+
+// Line::next_deadline_ns() right after a pass is the earliest deadline of its devices, taken while the pass
+// visits them (the runtime asks for it after every pass); the device's own answer agrees, pass after pass,
+// as the devices' free-running drive cycles move their deadlines on, and after a device command.
+TEST(SegmentRuntime, TheLinesDeadlineAfterAPassIsItsEarliestDevices) {
+    SegmentBus bus(3);  // not started: the test runs the Line's passes itself
+    device::Line& line = *bus.line;
+    const auto earliest = [&line] {
+        uint64_t d = UINT64_MAX;
+        for (int k = 0; k < static_cast<int>(line.size()); ++k)
+            d = std::min(d, line.device(k)->next_deadline_ns());
+        return d;
+    };
+    uint64_t now = bus.clock.now_ns();
+    for (int pass = 0; pass < 4; ++pass) {
+        line.poll(now);
+        const uint64_t seen = line.next_deadline_ns();
+        EXPECT_NE(seen, UINT64_MAX) << pass;  // a drive outside Op runs its own cycle
+        EXPECT_EQ(seen, earliest()) << pass;
+        now = std::max(now, seen);
+    }
+    line.poll(now);
+    EXPECT_EQ(line.apply("slave 1 input 1 on").rfind("ok", 0), 0u);
+    EXPECT_EQ(line.next_deadline_ns(), earliest());
 }
 
 TEST(SegmentRuntime, APulledCableShortensTheLine) {

@@ -68,6 +68,7 @@
 #include "stats.hpp"
 #include "support/alloc_counter.hpp"
 #include "util/le.hpp"
+#include "util/strfmt.hpp"
 
 namespace {
 
@@ -184,7 +185,8 @@ struct Figures {
     std::size_t drives = 0;
     std::string label;                                   // the plan's
     std::size_t devices = 0, no_mailbox = 0, in_op = 0;  // mixed line: slaves, without mailbox, in OP at end
-    uint64_t faulted = 0;                                // drives with statusword bit 3 (fault) at the end
+    std::string not_op;    // the first of the others: position, AL state and AL status code
+    uint64_t faulted = 0;  // drives with statusword bit 3 (fault) at the end
     double followed_min = 0, followed_max = 0;  // mixed line: position actual's advance over the ramp's, 0..1
     bench::Summary walk, latency, rtt, echo, echo_thread;
     double cpu_percent = 0, cpu_us_per_cycle = 0, allocs_per_cycle = 0;
@@ -580,7 +582,10 @@ void print_figures(const Figures& f) {
             f.frames_per_cycle == 1 ? "" : "s", static_cast<unsigned long long>(f.cycles),
             static_cast<unsigned long long>(f.enabled), f.drives, static_cast<unsigned long long>(f.faulted),
             f.followed_min, f.followed_max, f.in_op, f.devices);
-    else
+    if (mixed && !f.not_op.empty())
+        std::printf("  not in OP at the end (position:AL status/AL status code, the first 8):%s\n",
+                    f.not_op.c_str());
+    if (!mixed)
         std::printf("\n%zu drive%s (%zu frame%s per cycle), %llu cycles, %llu enabled in CSP\n", f.drives,
                     f.drives == 1 ? "" : "s", f.frames_per_cycle, f.frames_per_cycle == 1 ? "" : "s",
                     static_cast<unsigned long long>(f.cycles), static_cast<unsigned long long>(f.enabled));

@@ -29,6 +29,14 @@ class Cycle {
     // with its process data in other SMs (ProcessDataSms) gets the SM events of those.
     static constexpr uint32_t kEventMask = 0x00000D55;
     uint32_t event_mask() const { return event_mask_; }
+    // The mask as written into 0x0204 now. In Op, DC-synchronous, with SYNC0 mapped to the AL event
+    // register (0x0151 bit 3), the process-data SM events are left out of it: the cycle runs at SYNC0 and
+    // reads the SM2 status there, so each frame's SM2/SM3 events would only wake the stack for a poll with
+    // nothing to do (the interrupt mask of a DC-synchronous firmware on a hardware ESC; ESC datasheet, AL
+    // event mask 0x0204). event_mask() in every other state.
+    uint32_t written_mask() const { return written_mask_; }
+    // Writes the mask the state asks for (after every state change).
+    void update_event_mask();
 
     Cycle(StackContext& ctx, StateMachine& esm, SyncControl& sync, IrqLine irq);
     Cycle(const Cycle&) = delete;
@@ -62,6 +70,7 @@ class Cycle {
 
   private:
     bool esc_was_reset();
+    void write_mask(uint32_t mask);
     void restart_after_esc_reset(uint64_t now_ns);
     void process_data_events(uint32_t events, uint64_t now_ns);
     void run_cycle(uint64_t now_ns, bool fresh_outputs);
@@ -73,6 +82,8 @@ class Cycle {
     IrqLine irq_;
 
     uint32_t event_mask_ = kEventMask;
+    uint32_t written_mask_ = 0;  // 0x0204 as this stack last wrote it
+    bool sync0_event_ = false;   // process data runs DC-synchronous and 0x0151 maps SYNC0 to 0x0220
     unsigned out_sm_ = 2;  // ctx_.sms, kNoSm mapped to an SM that is never used (its buffer stays empty)
     unsigned in_sm_ = 3;
     std::vector<uint8_t> sm2_buf_;

@@ -106,24 +106,38 @@ void Line::poll(uint64_t now_ns) {
     // comes. A quiet device (interrupt line low, no deadline due) is skipped without reading the clock: most
     // are, on each pass. One whose deadline falls due while the pass goes on is skipped as well; its
     // deadline, now past, brings the runtime straight back to serve it.
+    //
+    // Each device's next deadline is taken while it is at hand (its objects are in the cache right after the
+    // quiet check or the poll), for next_deadline_ns(), which the runtime asks right after this pass: a
+    // device's deadline changes only in its own poll or through a control command (which invalidates the
+    // figure). Frames served meanwhile change ESCs, not a firmware's deadlines; the one callback a frame
+    // can reach, an EEPROM write, only takes a pending save time away (the figure is then early, which
+    // costs a wake-up and loses nothing).
     uint64_t now = now_ns;
     bool fresh = true;  // now_ns is still the time: no device examined yet
+    uint64_t deadline = std::numeric_limits<uint64_t>::max();
     for (const auto& u : units_) {
-        if (!u->device) continue;
-        if (u->device->quiet(now)) {
+        Device* d = u->device.get();
+        if (d == nullptr) continue;
+        if (d->quiet(now)) {
             fresh = false;
+            deadline = std::min(deadline, d->next_deadline_ns());
             continue;
         }
         if (!fresh) now = std::max(now, clock_.now_ns());
-        u->device->poll(now);
+        d->poll(now);
+        deadline = std::min(deadline, d->next_deadline_ns());
         fresh = false;
         // Frames that came during this device's work are answered before the next device's (the runtime's
         // FrameService): a frame never waits for a pass over the whole line.
         serve_frames();
     }
+    deadline_ns_ = deadline;
+    deadline_known_ = true;
 }
 
 uint64_t Line::next_deadline_ns() const {
+    if (deadline_known_) return deadline_ns_;
     uint64_t deadline = std::numeric_limits<uint64_t>::max();
     for (const auto& u : units_)
         if (u->device) deadline = std::min(deadline, u->device->next_deadline_ns());
@@ -131,6 +145,7 @@ uint64_t Line::next_deadline_ns() const {
 }
 
 void Line::on_control(uint64_t /*now_ns*/) {
+    deadline_known_ = false;
     if (control_) control_->service([this](std::string_view line) { return apply(line); });
 }
 
@@ -151,6 +166,7 @@ bool Line::powered(int device) const {
 }
 
 Device* Line::device(int index) {
+    deadline_known_ = false;  // the caller may change the device
     return units_.at(static_cast<std::size_t>(index))->device.get();
 }
 
@@ -159,6 +175,7 @@ esc::Esc& Line::esc(int index) {
 }
 
 void Line::power(int index, bool on) {
+    deadline_known_ = false;
     Unit& u = *units_.at(static_cast<std::size_t>(index));
     if (on == (u.device != nullptr)) return;
     if (!on) {
@@ -213,6 +230,7 @@ std::string Line::segment_text() const {
 }
 
 std::string Line::apply(std::string_view line) {
+    deadline_known_ = false;  // a device command may change what a device waits for
     const std::string_view text = line;
     std::vector<std::string> w;
     std::size_t third = 0;  // where the third word begins (slave <k> <command ...>)

@@ -103,6 +103,10 @@ class Line final : public slave::SegmentFirmware {
     esc::Segment segment_;
     std::unique_ptr<ControlSocket> control_;
     LineStats stats_;
+    // The earliest device deadline as the last poll() found it; not known after a control command, a power
+    // change or a caller's access to a device (next_deadline_ns() then asks every device).
+    uint64_t deadline_ns_ = 0;
+    bool deadline_known_ = false;
 };
 
 }  // namespace device
