@@ -843,6 +843,11 @@ TEST(EsiDevices, VendorFormsLoadAsTheFileSaysAndRoundTrip) {
     // A version string longer than its STRING(4): the identity says what 0x100A serves.
     EXPECT_EQ(p.description.identity.software_version, "01.0");
     EXPECT_EQ(d.find(0x100A, 0)->default_string, "01.0");
+    // A DefaultData written as an ESI number: the number.
+    EXPECT_EQ(d.get<uint32_t>(0x8000, 0), 1000u);
+    // A ConfigData of two bytes: PDI control and ESC configuration from it, the other words default.
+    EXPECT_EQ(p.description.pdi_control, 0x05);
+    EXPECT_EQ(p.description.esc_config, 0x01);
     std::string written;
     const od::Product q = round_trip(p, &written);
     expect_same(describe(p), describe(q), "round trip");

@@ -728,14 +728,15 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
     }
 
     // ---- EEPROM ----
-    const std::vector<uint8_t>& cd = d.config_data.size() >= 10 ? d.config_data : d.eeprom_data;
-    if (cd.size() >= 10) {
-        desc.pdi_control = cd[0];
-        desc.esc_config = cd[1];
-        desc.pdi_config = static_cast<uint16_t>(cd[2] | cd[3] << 8);
-        desc.sync_pulse_length = static_cast<uint16_t>(cd[4] | cd[5] << 8);
-        desc.station_alias = static_cast<uint16_t>(cd[8] | cd[9] << 8);
-    }
+    // ConfigData gives the first bytes of SII words 0-7; vendors often give fewer than 14 (a digital
+    // terminal's "0201": PDI control and ESC configuration only, device emulation on): each word it gives is
+    // used, the others keep their defaults.
+    const std::vector<uint8_t>& cd = !d.config_data.empty() ? d.config_data : d.eeprom_data;
+    if (cd.size() >= 1) desc.pdi_control = cd[0];
+    if (cd.size() >= 2) desc.esc_config = cd[1];
+    if (cd.size() >= 4) desc.pdi_config = static_cast<uint16_t>(cd[2] | cd[3] << 8);
+    if (cd.size() >= 6) desc.sync_pulse_length = static_cast<uint16_t>(cd[4] | cd[5] << 8);
+    if (cd.size() >= 10) desc.station_alias = static_cast<uint16_t>(cd[8] | cd[9] << 8);
     uint32_t bytes = d.eeprom_bytes;
     if (bytes == 0) bytes = d.eeprom_data.empty() ? 2048 : static_cast<uint32_t>(d.eeprom_data.size());
     if (bytes % 128 != 0 || bytes > 512 * 1024) {
