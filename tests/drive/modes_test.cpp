@@ -285,6 +285,19 @@ TEST(Modes, CspTargetOutsideSoftwareLimitRaises8A82) {
     EXPECT_TRUE(r.rec.has(error_code::SoftwarePositionLimit));
 }
 
+// Software position limits 0/0 (min >= max: no range, as vendors' ESIs ship 0x607D) are off, as a position
+// range limit without a range is: a CSP target away from 0 is followed, no 0x8A82.
+TEST(Modes, SoftwareLimitsWithoutARangeAreOff) {
+    Rig r;
+    const int32_t start = r.fb().position_actual;
+    r.ax.params.sw_limit_min = 0;
+    r.ax.params.sw_limit_max = 0;
+    r.enable();
+    r.ax.command.target_position = start + 50;
+    r.run(20);
+    EXPECT_FALSE(r.rec.has(error_code::SoftwarePositionLimit));
+}
+
 TEST(Modes, LimitSwitchRaises8A81WhenDrivingIntoIt) {
     Rig r;
     r.ax.environment().set_positive_limit(3000);
