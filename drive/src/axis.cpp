@@ -370,8 +370,8 @@ void Axis::update_feedback() {
             if (ferr && dc_.power()) s |= sw::Bit13;
             break;
         case mode::ProfileVelocity: {
-            const double vlim =
-                static_cast<double>(std::min(params.max_profile_velocity, params.max_motor_speed));
+            const double vlim = static_cast<double>(
+                std::min(speed_limit(params.max_profile_velocity), speed_limit(params.max_motor_speed)));
             const double target =
                 sp_.halted()
                     ? 0.0

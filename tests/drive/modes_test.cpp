@@ -298,6 +298,23 @@ TEST(Modes, SoftwareLimitsWithoutARangeAreOff) {
     EXPECT_FALSE(r.rec.has(error_code::SoftwarePositionLimit));
 }
 
+// Speed limits 0x607F/0x6080 of 0 (as vendors' ESIs ship them) limit nothing: a CSP move is followed,
+// no 0x8A83, and a PV target is reached.
+TEST(Modes, SpeedLimitsOfZeroLimitNothing) {
+    Rig r;
+    const int32_t start = r.fb().position_actual;
+    r.ax.params.max_motor_speed = 0;
+    r.ax.params.max_profile_velocity = 0;
+    r.enable();
+    for (int k = 1; k <= 50; ++k) {
+        r.ax.command.target_position = start + 10 * k;
+        r.run(1);
+    }
+    r.run(100);
+    EXPECT_FALSE(r.rec.has(error_code::MaxSpeed));
+    EXPECT_NEAR(r.fb().position_actual, start + 500, 5);
+}
+
 TEST(Modes, LimitSwitchRaises8A81WhenDrivingIntoIt) {
     Rig r;
     r.ax.environment().set_positive_limit(3000);
