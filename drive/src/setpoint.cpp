@@ -13,6 +13,9 @@ namespace drive {
 using namespace detail;
 
 bool mode::supported(int8_t m, uint32_t announced) {
+    // 0x6502 = 0 announces no mode at all, as vendors' ESIs ship it where the device reports its own (Elmo
+    // Gold): it states nothing, and the modes the drive implements are taken.
+    if (announced == 0) announced = supported_drive_modes();
     return contains(kModesOfOperation, m) && (announced & mode_bit(m)) != 0;
 }
 
