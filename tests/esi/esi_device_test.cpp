@@ -848,10 +848,30 @@ TEST(EsiDevices, VendorFormsLoadAsTheFileSaysAndRoundTrip) {
     // A ConfigData of two bytes: PDI control and ESC configuration from it, the other words default.
     EXPECT_EQ(p.description.pdi_control, 0x05);
     EXPECT_EQ(p.description.esc_config, 0x01);
+    EXPECT_EQ(p.description.pdi_config, od::DeviceDescription{}.pdi_config);
     std::string written;
     const od::Product q = round_trip(p, &written);
     expect_same(describe(p), describe(q), "round trip");
     EXPECT_TRUE(schema_errors(written).empty()) << ::testing::PrintToString(schema_errors(written));
+}
+
+// A full ConfigData (14 bytes, SII words 0-6) is the SII's configuration area as given, the extended PDI
+// configuration (word 3) and the reserved words 5-6 included (a LAN925x evaluation slave sets them).
+TEST(EsiDevices, AFullConfigDataIsTheSiiConfigurationArea) {
+    const std::string xml =
+        "<?xml version=\"1.0\"?><EtherCATInfo><Vendor><Id>#xA5E</Id><Name>V</Name></Vendor><Descriptions>"
+        "<Devices><Device><Type ProductCode=\"#x79\" RevisionNo=\"#x1\">T79</Type><Name>T 79</Name>"
+        "<Eeprom><ByteSize>2048</ByteSize><ConfigData>800E00CC8813FF00000040C00000</ConfigData></Eeprom>"
+        "</Device></Devices></Descriptions></EtherCATInfo>";
+    const od::Product p = esi::load_product(esi::read_esi_text(xml, "t79.xml"), "");
+    const od::Dictionary d = p.make_dictionary(p.description);
+    const esi::DeviceModel m = esi::derive_model(p.description, d);
+    const std::array<uint8_t, 14> want = {0x80, 0x0E, 0x00, 0xCC, 0x88, 0x13, 0xFF,
+                                          0x00, 0x00, 0x00, 0x40, 0xC0, 0x00, 0x00};
+    EXPECT_EQ(m.config_data, want);
+    std::string written;
+    const od::Product q = round_trip(p, &written);
+    EXPECT_EQ(describe(p), describe(q));
 }
 
 // A Virtual PDO (ETG.2000: for the configuration tool, e.g. the DC activation register of a time-stamp

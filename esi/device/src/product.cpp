@@ -736,7 +736,10 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
     if (cd.size() >= 2) desc.esc_config = cd[1];
     if (cd.size() >= 4) desc.pdi_config = static_cast<uint16_t>(cd[2] | cd[3] << 8);
     if (cd.size() >= 6) desc.sync_pulse_length = static_cast<uint16_t>(cd[4] | cd[5] << 8);
+    if (cd.size() >= 8) desc.extended_pdi_config = static_cast<uint16_t>(cd[6] | cd[7] << 8);
     if (cd.size() >= 10) desc.station_alias = static_cast<uint16_t>(cd[8] | cd[9] << 8);
+    if (cd.size() >= 12) desc.config_words_5_6[0] = static_cast<uint16_t>(cd[10] | cd[11] << 8);
+    if (cd.size() >= 14) desc.config_words_5_6[1] = static_cast<uint16_t>(cd[12] | cd[13] << 8);
     uint32_t bytes = d.eeprom_bytes;
     if (bytes == 0) bytes = d.eeprom_data.empty() ? 2048 : static_cast<uint32_t>(d.eeprom_data.size());
     if (bytes % 128 != 0 || bytes > 512 * 1024) {
