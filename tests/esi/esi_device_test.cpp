@@ -855,53 +855,6 @@ TEST(EsiDevices, VendorFormsLoadAsTheFileSaysAndRoundTrip) {
     EXPECT_TRUE(schema_errors(written).empty()) << ::testing::PrintToString(schema_errors(written));
 }
 
-// A full ConfigData (14 bytes, SII words 0-6) is the SII's configuration area as given, the extended PDI
-// configuration (word 3) and the reserved words 5-6 included (a LAN925x evaluation slave sets them).
-TEST(EsiDevices, AFullConfigDataIsTheSiiConfigurationArea) {
-    const std::string xml =
-        "<?xml version=\"1.0\"?><EtherCATInfo><Vendor><Id>#xA5E</Id><Name>V</Name></Vendor><Descriptions>"
-        "<Devices><Device><Type ProductCode=\"#x79\" RevisionNo=\"#x1\">T79</Type><Name>T 79</Name>"
-        "<Eeprom><ByteSize>2048</ByteSize><ConfigData>800E00CC8813FF00000040C00000</ConfigData></Eeprom>"
-        "</Device></Devices></Descriptions></EtherCATInfo>";
-    const od::Product p = esi::load_product(esi::read_esi_text(xml, "t79.xml"), "");
-    const od::Dictionary d = p.make_dictionary(p.description);
-    const esi::DeviceModel m = esi::derive_model(p.description, d);
-    const std::array<uint8_t, 14> want = {0x80, 0x0E, 0x00, 0xCC, 0x88, 0x13, 0xFF,
-                                          0x00, 0x00, 0x00, 0x40, 0xC0, 0x00, 0x00};
-    EXPECT_EQ(m.config_data, want);
-    std::string written;
-    const od::Product q = round_trip(p, &written);
-    EXPECT_EQ(describe(p), describe(q));
-}
-
-// A Virtual PDO (ETG.2000: for the configuration tool, e.g. the DC activation register of a time-stamp
-// output terminal) that has the index of a real PDO: the device loads (not "declared twice"), the real PDO
-// is the mapping object, the virtual one is left out with a warning naming it.
-TEST(EsiDevices, AVirtualPdoWithTheIndexOfARealOneIsLeftOut) {
-    const std::string xml =
-        "<?xml version=\"1.0\"?><EtherCATInfo><Vendor><Id>#xA5E</Id><Name>V</Name></Vendor><Descriptions>"
-        "<Devices><Device><Type ProductCode=\"#x78\" RevisionNo=\"#x1\">T78</Type><Name>T 78</Name>"
-        "<Sm StartAddress=\"#x0f00\" ControlByte=\"#x44\" Enable=\"1\">Outputs</Sm>"
-        "<RxPdo Fixed=\"1\" Virtual=\"true\"><Index>#x1601</Index><Name>DC Sync Activate</Name><Entry>"
-        "<Index>#x1d09</Index><SubIndex>#x81</SubIndex><BitLen>8</BitLen><Name>Activate</Name>"
-        "<DataType>USINT</DataType></Entry></RxPdo>"
-        "<RxPdo Fixed=\"1\" Sm=\"0\"><Index>#x1600</Index><Name>Channel 1</Name><Entry><Index>#x7000</Index>"
-        "<SubIndex>1</SubIndex><BitLen>1</BitLen><Name>Output</Name><DataType>BOOL</DataType></Entry></RxPdo>"
-        "<RxPdo Fixed=\"1\" Sm=\"0\"><Index>#x1601</Index><Name>Channel 2</Name><Entry><Index>#x7010</Index>"
-        "<SubIndex>1</SubIndex><BitLen>1</BitLen><Name>Output</Name><DataType>BOOL</DataType></Entry></RxPdo>"
-        "</Device></Devices></Descriptions></EtherCATInfo>";
-    const od::Product p = esi::load_product(esi::read_esi_text(xml, "t78.xml"), "");
-    const od::Dictionary d = p.make_dictionary(p.description);
-    EXPECT_EQ(d.get<uint32_t>(0x1601, 1), 0x70100101u);
-    EXPECT_EQ(d.find(0x1D09, 0x81), nullptr);
-    EXPECT_TRUE(std::any_of(p.warnings.begin(), p.warnings.end(), [](const std::string& w) {
-        return w.find("t78.xml") != std::string::npos && w.find("0x1601 Virtual") != std::string::npos;
-    })) << ::testing::PrintToString(p.warnings);
-    std::string written;
-    const od::Product q = round_trip(p, &written);
-    EXPECT_EQ(describe(p), describe(q));
-}
-
 // A vendor drive whose ESI names profile 402 (Profile/ProfileNo) while its device type 0x1000 says something
 // else (0x00000004, as some vendors' files do): the ESI's ProfileNo names the profile a configuration tool
 // goes by (ETG.2000), so the device is a CiA 402 drive; 0x1000 is served as the vendor wrote it. The written
@@ -1221,6 +1174,51 @@ TEST(EsiBadInput, TruncatedAndMutatedExamplesNeverCrash) {
             }
         }
     }
+}
+
+// A full ConfigData (14 bytes, SII words 0-6) is the SII's configuration area as given, the extended PDI
+// configuration (word 3) and the reserved words 5-6 included (a LAN925x evaluation slave sets them).
+TEST(EsiDevices, AFullConfigDataIsTheSiiConfigurationArea) {
+    const std::string xml = wrap(
+        "<Device><Type ProductCode=\"#x79\" RevisionNo=\"#x1\">T79</Type><Name>T 79</Name>"
+        "<Eeprom><ByteSize>2048</ByteSize><ConfigData>800E00CC8813FF00000040C00000</ConfigData></Eeprom></"
+        "Device>");
+    const od::Product p = esi::load_product(esi::read_esi_text(xml, "t79.xml"), "");
+    const od::Dictionary d = p.make_dictionary(p.description);
+    const esi::DeviceModel m = esi::derive_model(p.description, d);
+    const std::array<uint8_t, 14> want = {0x80, 0x0E, 0x00, 0xCC, 0x88, 0x13, 0xFF,
+                                          0x00, 0x00, 0x00, 0x40, 0xC0, 0x00, 0x00};
+    EXPECT_EQ(m.config_data, want);
+    std::string written;
+    const od::Product q = round_trip(p, &written);
+    EXPECT_EQ(describe(p), describe(q));
+}
+
+// A Virtual PDO (ETG.2000: for the configuration tool, e.g. the DC activation register of a time-stamp
+// output terminal) that has the index of a real PDO: the device loads (not "declared twice"), the real PDO
+// is the mapping object, the virtual one is left out with a warning naming it.
+TEST(EsiDevices, AVirtualPdoWithTheIndexOfARealOneIsLeftOut) {
+    const std::string xml = wrap(
+        "<Device><Type ProductCode=\"#x78\" RevisionNo=\"#x1\">T78</Type><Name>T 78</Name>"
+        "<Sm StartAddress=\"#x0f00\" ControlByte=\"#x44\" Enable=\"1\">Outputs</Sm>"
+        "<RxPdo Fixed=\"1\" Virtual=\"true\"><Index>#x1601</Index><Name>DC Sync Activate</Name><Entry>"
+        "<Index>#x1d09</Index><SubIndex>#x81</SubIndex><BitLen>8</BitLen><Name>Activate</Name>"
+        "<DataType>USINT</DataType></Entry></RxPdo>"
+        "<RxPdo Fixed=\"1\" Sm=\"0\"><Index>#x1600</Index><Name>Channel 1</Name><Entry><Index>#x7000</Index>"
+        "<SubIndex>1</SubIndex><BitLen>1</BitLen><Name>Output</Name><DataType>BOOL</DataType></Entry></RxPdo>"
+        "<RxPdo Fixed=\"1\" Sm=\"0\"><Index>#x1601</Index><Name>Channel 2</Name><Entry><Index>#x7010</Index>"
+        "<SubIndex>1</SubIndex><BitLen>1</BitLen><Name>Output</Name><DataType>BOOL</DataType></Entry></RxPdo>"
+        "</Device>");
+    const od::Product p = esi::load_product(esi::read_esi_text(xml, "t78.xml"), "");
+    const od::Dictionary d = p.make_dictionary(p.description);
+    EXPECT_EQ(d.get<uint32_t>(0x1601, 1), 0x70100101u);
+    EXPECT_EQ(d.find(0x1D09, 0x81), nullptr);
+    EXPECT_TRUE(std::any_of(p.warnings.begin(), p.warnings.end(), [](const std::string& w) {
+        return w.find("t78.xml") != std::string::npos && w.find("0x1601 Virtual") != std::string::npos;
+    })) << ::testing::PrintToString(p.warnings);
+    std::string written;
+    const od::Product q = round_trip(p, &written);
+    EXPECT_EQ(describe(p), describe(q));
 }
 
 // ---- Public vendor ESI files (outside the repository) ---------------------------------------------------
