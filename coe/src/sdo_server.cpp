@@ -178,6 +178,8 @@ void CoeServer::handle_sdo(std::span<const uint8_t> sdo, std::size_t frame_size,
             return;
         case kCcsUploadInitiate:
             cancel_transfer();
+            if ((cmd & kCmdCompleteAccess) && !config_.complete_access)
+                return send_abort(wire::get16(sdo, 1), sdo[3], abort::CompleteAccessUnsupported, out);
             upload_initiate(wire::get16(sdo, 1), sdo[3], (cmd & kCmdCompleteAccess) != 0, out);
             return;
         case kCcsUploadSegment:
@@ -299,6 +301,7 @@ void CoeServer::download_initiate(std::span<const uint8_t> sdo, ecat::MailboxSen
     const uint8_t sub = sdo[3];
     bool ca = (cmd & kCmdCompleteAccess) != 0;
     if (config_.faults.download_abort_command) abort_command_ = cmd;
+    if (ca && !config_.complete_access) return send_abort(index, sub, abort::CompleteAccessUnsupported, out);
     const od::Object* obj = dict_.find(index);
     if (obj == nullptr)
         return send_abort(index, sub,

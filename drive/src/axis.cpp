@@ -35,7 +35,13 @@ double Axis::decel_limit(double rpm_s) const {
 }
 
 PositionFrame Axis::frame() const {
-    return {home_.shift(), params.range_min, params.range_max, params.sw_limit_min, params.sw_limit_max};
+    // Software position limits that define no range (min >= max: 0/0 as many vendors' ESIs ship 0x607D) are
+    // off, as a position range limit 0x607B without a range is.
+    constexpr int32_t kOffMin = std::numeric_limits<int32_t>::min(),
+                      kOffMax = std::numeric_limits<int32_t>::max();
+    const bool sw_on = params.sw_limit_max > params.sw_limit_min;
+    return {home_.shift(), params.range_min, params.range_max, sw_on ? params.sw_limit_min : kOffMin,
+            sw_on ? params.sw_limit_max : kOffMax};
 }
 
 DeviceControl::Options Axis::dc_options() const {
@@ -364,8 +370,8 @@ void Axis::update_feedback() {
             if (ferr && dc_.power()) s |= sw::Bit13;
             break;
         case mode::ProfileVelocity: {
-            const double vlim =
-                static_cast<double>(std::min(params.max_profile_velocity, params.max_motor_speed));
+            const double vlim = static_cast<double>(
+                std::min(speed_limit(params.max_profile_velocity), speed_limit(params.max_motor_speed)));
             const double target =
                 sp_.halted()
                     ? 0.0

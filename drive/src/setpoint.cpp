@@ -13,6 +13,9 @@ namespace drive {
 using namespace detail;
 
 bool mode::supported(int8_t m, uint32_t announced) {
+    // 0x6502 = 0 announces no mode at all, as vendors' ESIs ship it where the device reports its own (Elmo
+    // Gold): it states nothing, and the modes the drive implements are taken.
+    if (announced == 0) announced = supported_drive_modes();
     return contains(kModesOfOperation, m) && (announced & mode_bit(m)) != 0;
 }
 
@@ -156,7 +159,7 @@ LoopReference SetpointGenerator::tick(const Command& c, const Parameters& p, con
             return ref;
         }
         case mode::CyclicSyncVelocity: {
-            const double vmot = static_cast<double>(p.max_motor_speed);
+            const double vmot = static_cast<double>(speed_limit(p.max_motor_speed));
             const double v =
                 std::clamp(static_cast<double>(c.target_velocity) + c.velocity_offset, -vmot, vmot);
             control_ = Control::Velocity;
@@ -179,7 +182,8 @@ LoopReference SetpointGenerator::tick(const Command& c, const Parameters& p, con
         case mode::ProfilePosition: {
             const double acc = limit(p.profile_acceleration), dec = limit(p.profile_deceleration);
             const double qs = limit(p.quick_stop_deceleration);
-            const double vmax = std::min(p.profile_velocity, p.max_profile_velocity) * in.resolution / 60.0;
+            const double vmax =
+                std::min(p.profile_velocity, speed_limit(p.max_profile_velocity)) * in.resolution / 60.0;
             if (halted_) {
                 profile_.step_velocity(0.0, qs, qs, h);
             } else if (ppm_moving_) {
@@ -201,7 +205,8 @@ LoopReference SetpointGenerator::tick(const Command& c, const Parameters& p, con
         case mode::ProfileVelocity: {
             const double acc = limit(p.profile_acceleration), dec = limit(p.profile_deceleration);
             const double qs = limit(p.quick_stop_deceleration);
-            const double vlim = static_cast<double>(std::min(p.max_profile_velocity, p.max_motor_speed));
+            const double vlim = static_cast<double>(
+                std::min(speed_limit(p.max_profile_velocity), speed_limit(p.max_motor_speed)));
             const double v = std::clamp(static_cast<double>(c.target_velocity), -vlim, vlim);
             if (halted_)
                 profile_.step_velocity(0.0, qs, qs, h);

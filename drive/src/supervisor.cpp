@@ -120,7 +120,7 @@ Supervisor::Found Supervisor::limits(const Motion& m, const PositionFrame& f) {
 }
 
 bool Supervisor::overspeed(double speed_rad_s, uint32_t max_rpm) {
-    return std::abs(speed_rad_s) * 60.0 / kTwoPi > static_cast<double>(max_rpm);
+    return std::abs(speed_rad_s) * 60.0 / kTwoPi > static_cast<double>(speed_limit(max_rpm));
 }
 
 }  // namespace drive

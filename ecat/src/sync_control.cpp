@@ -87,7 +87,11 @@ uint16_t SyncControl::configure() {
     const ProcessData& pd = ctx_.pd;
     const uint8_t activation = pdi.read_reg<uint8_t>(esc::reg::kDcActivation);
     const uint32_t sync0_cycle = pdi.read_reg<uint32_t>(esc::reg::kDcSync0Cycle);
-    const uint16_t supported = static_cast<uint16_t>(get_u(kSmOutputParams, kSiSyncModesSupported, 0x0007));
+    // A 0x1C32:04 without any mode bit (bits 0-3: free run, SM, DC SYNC0/SYNC1) states no mode: 0, as
+    // SOES-based devices' ESIs declare it, or 0x0400, an Inovance ESI's "0004" written big-endian (its device
+    // runs DC). Such a device runs in every mode, as if the entry were absent.
+    uint16_t supported = static_cast<uint16_t>(get_u(kSmOutputParams, kSiSyncModesSupported, 0x0007));
+    if ((supported & 0x000F) == 0) supported = 0x0007;
     const uint32_t min_cycle = static_cast<uint32_t>(get_u(kSmOutputParams, kSiMinCycleTime, 0));
     const bool cyclic = activation & esc::reg::kDcActCyclic;
     const bool sync0 = cyclic && (activation & esc::reg::kDcActSync0);

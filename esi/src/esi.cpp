@@ -448,7 +448,7 @@ void pdo(xmlNodePtr device, const PdoInfo& p) {
     for (const PdoEntryInfo& e : p.entries) {
         xmlNodePtr en = child(n, "Entry");
         child(en, "Index", hex_index(e.index));
-        if (e.index != 0) child(en, "SubIndex", std::to_string(e.subindex));
+        if (e.index != 0 || e.subindex != 0) child(en, "SubIndex", std::to_string(e.subindex));
         child(en, "BitLen", std::to_string(e.bit_length));
         if (e.index != 0) {
             named(en, "Name", e.name);
@@ -471,7 +471,7 @@ void module_pdo(xmlNodePtr module, const od::ModulePdo& p) {
         xmlNodePtr en = child(n, "Entry");
         xmlNodePtr ei = child(en, "Index", hex_index(e.index));
         if (e.depend_on_slot && e.index != 0) attr(ei, "DependOnSlot", "true");
-        if (e.index != 0) child(en, "SubIndex", std::to_string(e.subindex));
+        if (e.index != 0 || e.subindex != 0) child(en, "SubIndex", std::to_string(e.subindex));
         child(en, "BitLen", std::to_string(e.bit_length));
         if (e.index != 0) {
             named(en, "Name", e.name);

@@ -143,9 +143,22 @@ void read_flags(Node flags, std::string& access, std::string& wr, std::string& r
     if (Node s = child(flags, "Setting")) setting = truthy(text(s));
 }
 
+// DefaultData/MinData/MaxData are hexBinary (the value's bytes, little endian); some vendor files write an
+// ESI number there instead ("#x0003d090"): read as the number it is.
+void read_data(Node d, std::vector<uint8_t>& data, std::optional<int64_t>& value) {
+    const std::string t = text(d);
+    if (t.size() > 2 && t[0] == '#' && (t[1] == 'x' || t[1] == 'X')) {
+        if (auto v = parse_esi_number(t)) {
+            value = *v;
+            return;
+        }
+    }
+    data = hex_bytes(t);
+}
+
 void read_info(Node info, EsiEntry& e) {
     if (!info) return;
-    if (Node d = child(info, "DefaultData")) e.default_data = hex_bytes(text(d));
+    if (Node d = child(info, "DefaultData")) read_data(d, e.default_data, e.default_value);
     if (Node d = child(info, "DefaultString")) {
         // The text as written (not trimmed: a default may end in spaces).
         xmlChar* t = xmlNodeGetContent(d);
@@ -154,8 +167,8 @@ void read_info(Node info, EsiEntry& e) {
         e.default_data.assign(str.begin(), str.end());
         e.default_is_string = true;
     }
-    if (Node d = child(info, "MinData")) e.min_data = hex_bytes(text(d));
-    if (Node d = child(info, "MaxData")) e.max_data = hex_bytes(text(d));
+    if (Node d = child(info, "MinData")) read_data(d, e.min_data, e.min);
+    if (Node d = child(info, "MaxData")) read_data(d, e.max_data, e.max);
     if (Node d = child(info, "MinValue")) e.min = parse_esi_number(text(d));
     if (Node d = child(info, "MaxValue")) e.max = parse_esi_number(text(d));
     if (Node d = child(info, "DefaultValue")) e.default_value = parse_esi_number(text(d));

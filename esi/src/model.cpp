@@ -293,8 +293,10 @@ DeviceModel derive_model(const od::DeviceDescription& d, const od::Dictionary& d
     m.config_data[1] = d.esc_config;
     put16(&m.config_data[2], d.pdi_config);
     put16(&m.config_data[4], d.sync_pulse_length);
-    put16(&m.config_data[6], 0);  // extended PDI configuration: not in the description
+    put16(&m.config_data[6], d.extended_pdi_config);
     put16(&m.config_data[8], d.station_alias);
+    put16(&m.config_data[10], d.config_words_5_6[0]);
+    put16(&m.config_data[12], d.config_words_5_6[1]);
     put16(&m.bootstrap[0], d.bootstrap_mailbox.out_start);
     put16(&m.bootstrap[2], d.bootstrap_mailbox.out_size);
     put16(&m.bootstrap[4], d.bootstrap_mailbox.in_start);

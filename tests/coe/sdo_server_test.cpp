@@ -316,6 +316,23 @@ TEST_F(SdoServer, AbortCompleteAccessFromSubindexAbove1Is06010000) {
     EXPECT_EQ(ask(sdo(0x50, 0x1018, 2)), abort_reply(0x1018, 2, 0x06010000));
 }
 
+// A device that does not announce complete access (ESI CoE CompleteAccess absent, SII CoE details bit 5
+// clear) aborts complete-access uploads and downloads with 0x06010004 (ETG.1000.6); single entries work.
+TEST(SdoServerWithoutCompleteAccess, CompleteAccessIsAbortedWith06010004) {
+    od::Dictionary dict = make_test_dictionary();
+    coe::CoeConfig config;
+    config.complete_access = false;
+    coe::CoeServer server{dict, [] { return od::AlState::PreOp; }, config};
+    RecordingSender out;
+    auto ask = [&](const Bytes& request) {
+        server.handle(request, out);
+        return out.messages.empty() ? Bytes{} : out.take().payload;
+    };
+    EXPECT_EQ(ask(sdo(0x50, 0x1018, 0)), abort_reply(0x1018, 0, 0x06010004));
+    EXPECT_EQ(ask(sdo(0x31, 0x1C12, 0)), abort_reply(0x1C12, 0, 0x06010004));
+    EXPECT_EQ(ask(sdo(0x40, 0x1018, 1)), (Bytes{0x00, 0x30, 0x43, 0x18, 0x10, 0x01, 0xFB, 0x00, 0x00, 0x00}));
+}
+
 TEST(SdoAbortCodes, EveryObjectModelResultMapsToItsStandardCode) {
     using S = od::Status;
     const std::pair<S, uint32_t> table[] = {

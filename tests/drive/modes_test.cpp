@@ -274,15 +274,45 @@ TEST(Modes, FollowingErrorTimeoutDelaysTheError) {
     EXPECT_FALSE(r.rec.has(error_code::FollowingError));  // the loop pulled it back in time
 }
 
-TEST(Modes, CspTargetOutsideSoftwareLimitRaises8A82) {
+// A CSP target `offset` from the start position with software position limits min/max (taken relative to
+// the start when `relative`), run for `cycles`: whether 0x8A82 was raised.
+bool csp_target_raises_8a82(int32_t min, int32_t max, bool relative, int32_t offset, int cycles) {
     Rig r;
     const int32_t start = r.fb().position_actual;
-    r.ax.params.sw_limit_min = start - 1000;
-    r.ax.params.sw_limit_max = start + 1000;
+    r.ax.params.sw_limit_min = relative ? start + min : min;
+    r.ax.params.sw_limit_max = relative ? start + max : max;
     r.enable();
-    r.ax.command.target_position = start + 1001;
-    r.run(1);
-    EXPECT_TRUE(r.rec.has(error_code::SoftwarePositionLimit));
+    r.ax.command.target_position = start + offset;
+    r.run(cycles);
+    return r.rec.has(error_code::SoftwarePositionLimit);
+}
+
+TEST(Modes, CspTargetOutsideSoftwareLimitRaises8A82) {
+    EXPECT_TRUE(csp_target_raises_8a82(-1000, 1000, true, 1001, 1));
+}
+
+// Software position limits 0/0 (min >= max: no range, as vendors' ESIs ship 0x607D) are off, as a position
+// range limit without a range is: a CSP target away from 0 is followed, no 0x8A82.
+TEST(Modes, SoftwareLimitsWithoutARangeAreOff) {
+    EXPECT_FALSE(csp_target_raises_8a82(0, 0, false, 50, 20));
+    EXPECT_FALSE(csp_target_raises_8a82(100, -100, false, 50, 20));  // min > max: no range either
+}
+
+// Speed limits 0x607F/0x6080 of 0 (as vendors' ESIs ship them) limit nothing: a CSP move is followed,
+// no 0x8A83.
+TEST(Modes, SpeedLimitsOfZeroLimitNothing) {
+    Rig r;
+    const int32_t start = r.fb().position_actual;
+    r.ax.params.max_motor_speed = 0;
+    r.ax.params.max_profile_velocity = 0;
+    r.enable();
+    for (int k = 1; k <= 50; ++k) {
+        r.ax.command.target_position = start + 10 * k;
+        r.run(1);
+    }
+    r.run(100);
+    EXPECT_FALSE(r.rec.has(error_code::MaxSpeed));
+    EXPECT_NEAR(r.fb().position_actual, start + 500, 5);
 }
 
 TEST(Modes, LimitSwitchRaises8A81WhenDrivingIntoIt) {

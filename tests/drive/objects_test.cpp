@@ -131,6 +131,15 @@ TEST(DriveObjects, ParametersAndCommandHoldTheDictionaryDefaults) {
     EXPECT_EQ(drv.axis().params.input_function[3], 26);
 }
 
+// 0x6502 = 0 (an ESI default of a device that reports its modes itself) announces nothing: the modes the
+// drive implements are taken; a 0x6502 that announces some restricts to those.
+TEST(DriveObjects, SupportedDriveModesZeroStatesNothing) {
+    EXPECT_TRUE(drive::mode::supported(8, 0));
+    EXPECT_TRUE(drive::mode::supported(1, 0));
+    EXPECT_FALSE(drive::mode::supported(8, 0x00000001));  // PP only
+    EXPECT_FALSE(drive::mode::supported(42, 0));
+}
+
 TEST(DriveObjects, ModesOfOperationAreOneSet) {
     od::Dictionary d = drive_dictionary();
     for (int m = -128; m <= 127; ++m) {

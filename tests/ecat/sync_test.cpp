@@ -375,6 +375,21 @@ TEST_F(Sync, FreeRunNotSupported_0x0027) {
     expect_safeop_refused(0x0027);
 }
 
+// A device whose 0x1C32:04 declares no mode at all (0, as SOES-based devices' ESIs do) is not refused: the
+// entry says nothing, the modes are those of a device without it.
+TEST_F(Sync, SyncModesSupportedZero_SaysNothing) {
+    ASSERT_EQ(dict.set<uint16_t>(0x1C32, 4, 0), od::Status::Ok);
+    go_safeop();
+    EXPECT_EQ(stack->sync_mode(), SyncMode::SmSync);
+}
+
+// ... nor does one with no mode bit at all (0x0400: an ESI's DefaultData "0004" written big-endian): DC runs.
+TEST_F(Sync, SyncModesSupportedWithoutModeBits_SaysNothing) {
+    ASSERT_EQ(dict.set<uint16_t>(0x1C32, 4, 0x0400), od::Status::Ok);
+    safeop_dc(1'000'000);
+    EXPECT_EQ(stack->sync_mode(), SyncMode::DcSync0);
+}
+
 TEST_F(Sync, UnknownSyncMode_0x0028) {
     ASSERT_NO_FATAL_FAILURE(preop_with_sync_mode(7));
     expect_safeop_refused(0x0028);

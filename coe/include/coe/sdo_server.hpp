@@ -29,6 +29,9 @@ struct CoeConfig {
     // A segmented transfer the master leaves alone this long is dropped and answered with abort 0x05040000.
     uint64_t transfer_timeout_ns = 2'000'000'000;
     std::size_t emergency_queue = 8;
+    // The device announces SDO complete access (SII General CoE details bit 5, ESI CoE CompleteAccess);
+    // without it a complete-access request is aborted with 0x06010004 (ETG.1000.6), as such devices do.
+    bool complete_access = true;
     CoeFaults faults;  // testing aid: deliberate deviations (coe/faults.hpp), all off
 };
 

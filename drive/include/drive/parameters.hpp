@@ -6,10 +6,17 @@
 // need from here without an Axis.
 #include <array>
 #include <cstdint>
+#include <limits>
 
 #include "drive/objects.hpp"
 
 namespace drive {
+
+// A speed limit (0x607F max profile velocity, 0x6080 max motor speed) of 0 limits nothing: vendors' ESIs
+// ship them 0 where the device sets its own (a limit of 0 would forbid every move).
+constexpr uint32_t speed_limit(uint32_t v) {
+    return v == 0 ? std::numeric_limits<uint32_t>::max() : v;
+}
 
 // Configuration objects. Defaults: the drive's, declared once in drive/objects.hpp (a dictionary that has the
 // object replaces them with its own every cycle).

@@ -430,6 +430,22 @@ std::pair<DataType, uint16_t> pdo_entry_type(const EsiPdoEntry& pe, Ctx& ctx) {
                           " bits and type '" + pe.data_type + "': no type of that length");
 }
 
+// The entry a PDO entry implies where the dictionary does not declare it: its default the type's zero (a
+// signed 0 for a signed type, as a declared entry's), a BITn entry limited to its bits (as to_entry does), so
+// that the entry reads back the same from the ESI softecat writes for it.
+od::Entry pdo_implied_entry(const EsiPdoEntry& pe, const std::pair<DataType, uint16_t>& t, uint16_t access) {
+    od::Entry e = u_entry(pe.index, pe.subindex, t.first, access, 0, pe.name);
+    e.bit_length = t.second;
+    if (od::is_string(t.first)) {
+        e.default_value = std::monostate{};
+    } else {
+        e.default_value = number_of(0, t.first, t.second);
+        if (t.first >= DataType::Bit1 && t.first <= DataType::Bit8)
+            e.maximum = uint64_t{(1u << t.second) - 1};
+    }
+    return e;
+}
+
 // The declared limits stay unless they exclude the (new) default.
 void keep_limits_around_default(od::Entry& e) {
     if (outside(e.default_value, e.minimum, e.maximum)) {
@@ -537,7 +553,12 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
     auto default_text = [&d](uint16_t index) -> std::string {
         const EsiObject* o = d.object(index);
         if (o == nullptr || o->entries.empty()) return {};
-        return trim_nul(o->entries[0].default_data);
+        // As the object serves it: a default longer than its STRING(n) is cut to n (to_entry).
+        std::string s = trim_nul(o->entries[0].default_data);
+        if (const auto t = entry_type(o->entries[0]);
+            t && od::is_string(t->first) && t->second != 0 && s.size() > t->second / 8u)
+            s.resize(t->second / 8u);
+        return s;
     };
     id.hardware_version = default_text(0x1009);
     id.software_version = default_text(0x100A);
@@ -651,14 +672,18 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
     }
 
     // ---- EEPROM ----
-    const std::vector<uint8_t>& cd = d.config_data.size() >= 10 ? d.config_data : d.eeprom_data;
-    if (cd.size() >= 10) {
-        desc.pdi_control = cd[0];
-        desc.esc_config = cd[1];
-        desc.pdi_config = static_cast<uint16_t>(cd[2] | cd[3] << 8);
-        desc.sync_pulse_length = static_cast<uint16_t>(cd[4] | cd[5] << 8);
-        desc.station_alias = static_cast<uint16_t>(cd[8] | cd[9] << 8);
-    }
+    // ConfigData gives the first bytes of SII words 0-7; vendors often give fewer than 14 (a digital
+    // terminal's "0201": PDI control and ESC configuration only, device emulation on): each word it gives is
+    // used, the others keep their defaults.
+    const std::vector<uint8_t>& cd = !d.config_data.empty() ? d.config_data : d.eeprom_data;
+    if (cd.size() >= 1) desc.pdi_control = cd[0];
+    if (cd.size() >= 2) desc.esc_config = cd[1];
+    if (cd.size() >= 4) desc.pdi_config = static_cast<uint16_t>(cd[2] | cd[3] << 8);
+    if (cd.size() >= 6) desc.sync_pulse_length = static_cast<uint16_t>(cd[4] | cd[5] << 8);
+    if (cd.size() >= 8) desc.extended_pdi_config = static_cast<uint16_t>(cd[6] | cd[7] << 8);
+    if (cd.size() >= 10) desc.station_alias = static_cast<uint16_t>(cd[8] | cd[9] << 8);
+    if (cd.size() >= 12) desc.config_words_5_6[0] = static_cast<uint16_t>(cd[10] | cd[11] << 8);
+    if (cd.size() >= 14) desc.config_words_5_6[1] = static_cast<uint16_t>(cd[12] | cd[13] << 8);
     uint32_t bytes = d.eeprom_bytes;
     if (bytes == 0) bytes = d.eeprom_data.empty() ? 2048 : static_cast<uint32_t>(d.eeprom_data.size());
     if (bytes % 128 != 0 || bytes > 512 * 1024) {
@@ -786,6 +811,22 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
                                     " (ETG.1000.6 PDO mapping objects): not served");
         it = pdos.erase(it);
     }
+    // A Virtual PDO (ETG.2000: for the configuration tool only, e.g. ESC register data such as the DC
+    // activation) that has the index of a real one: the real one is the mapping object; the virtual one is
+    // left out.
+    for (auto it = pdos.begin(); it != pdos.end();) {
+        const bool shadowed =
+            it->esi->is_virtual && std::any_of(pdos.begin(), pdos.end(), [&](const Pdo& q) {
+                return !q.esi->is_virtual && q.index == it->index && q.esi->rx == it->esi->rx;
+            });
+        if (!shadowed) {
+            ++it;
+            continue;
+        }
+        ctx.warn(it->esi->line,
+                 "PDO " + hex(it->index) + " Virtual has the index of a PDO that is not: left out");
+        it = pdos.erase(it);
+    }
     for (std::size_t i = 0; i < pdos.size(); ++i)
         for (std::size_t j = 0; j < i; ++j)
             if (pdos[i].index == pdos[j].index)
@@ -813,70 +854,113 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
     const bool declared_dictionary = !d.objects.empty();
 
     // ---- The objects the PDO entries map (a device without CoE declares none: process data needs them) ----
-    for (const Pdo& p : pdos) {
-        const bool rx = p.esi->rx;
-        for (const EsiPdoEntry& pe : p.entries) {
-            if (pe.index == 0) continue;  // padding
-            auto it = built.objects.find(pe.index);
-            const uint16_t pdo_access =
-                rx ? (od::access::RW | od::access::RxPdo) : (od::access::RO | od::access::TxPdo);
-            if (it == built.objects.end()) {
-                if (declared_dictionary)
-                    ctx.warn(pe.line, "PDO " + hex(p.index) + " maps " + where(pe.index, pe.subindex) +
-                                          ", which the dictionary does not declare; the object is added");
-                const auto t = pdo_entry_type(pe, ctx);
-                od::Object o;
-                o.index = pe.index;
-                o.code = pe.subindex == 0 ? od::ObjectCode::Var : od::ObjectCode::Record;
-                o.name = pe.subindex == 0 ? (pe.name.empty() ? p.esi->name : pe.name) : p.esi->name;
-                od::Entry e = u_entry(pe.index, pe.subindex, t.first, pdo_access, 0, pe.name);
-                e.bit_length = t.second;
-                if (od::is_string(t.first)) e.default_value = std::monostate{};
-                o.type = o.code == od::ObjectCode::Var ? t.first : static_cast<DataType>(0);
-                o.entries.push_back(std::move(e));
-                built.objects[pe.index] = std::move(o);
-                built.lines[pe.index] = pe.line;
-                continue;
+    // One mapped entry of PDO pdo_index: its object or entry added where the dictionary lacks it, made
+    // mappable in the PDO's direction where it is not. `element`: mapped by an RxPdo/TxPdo element (a VAR
+    // mapped with a subindex is then an error), else by a mapping object's default in the dictionary.
+    auto map_entry = [&](const EsiPdoEntry& pe, bool rx, uint16_t pdo_index, const std::string& pdo_name,
+                         bool element) {
+        if (pe.index == 0) return;  // padding
+        auto it = built.objects.find(pe.index);
+        const uint16_t pdo_access =
+            rx ? (od::access::RW | od::access::RxPdo) : (od::access::RO | od::access::TxPdo);
+        if (it == built.objects.end()) {
+            if (declared_dictionary)
+                ctx.warn(pe.line, "PDO " + hex(pdo_index) + " maps " + where(pe.index, pe.subindex) +
+                                      ", which the dictionary does not declare; the object is added");
+            const auto t = pdo_entry_type(pe, ctx);
+            od::Object o;
+            o.index = pe.index;
+            o.code = pe.subindex == 0 ? od::ObjectCode::Var : od::ObjectCode::Record;
+            o.name = pe.subindex == 0 ? (pe.name.empty() ? pdo_name : pe.name) : pdo_name;
+            od::Entry e = pdo_implied_entry(pe, t, pdo_access);
+            o.type = o.code == od::ObjectCode::Var ? t.first : static_cast<DataType>(0);
+            o.entries.push_back(std::move(e));
+            built.objects[pe.index] = std::move(o);
+            built.lines[pe.index] = pe.line;
+            return;
+        }
+        od::Object& o = it->second;
+        od::Entry* target = nullptr;
+        for (od::Entry& e : o.entries)
+            if (e.subindex == pe.subindex) target = &e;
+        if (target == nullptr) {
+            if (o.code == od::ObjectCode::Var) {
+                const std::string msg = "PDO " + hex(pdo_index) + " maps " + where(pe.index, pe.subindex) +
+                                        ", but " + hex(pe.index) + " (" + o.name +
+                                        ") is a VAR with subindex 0 only";
+                if (element) ctx.fail(pe.line, msg);
+                ctx.warn(pe.line, msg);
+                return;
             }
-            od::Object& o = it->second;
-            od::Entry* target = nullptr;
-            for (od::Entry& e : o.entries)
-                if (e.subindex == pe.subindex) target = &e;
-            if (target == nullptr) {
-                if (o.code == od::ObjectCode::Var)
-                    ctx.fail(pe.line, "PDO " + hex(p.index) + " maps " + where(pe.index, pe.subindex) +
-                                          ", but " + hex(pe.index) + " (" + o.name +
-                                          ") is a VAR with subindex 0 only");
-                if (declared_dictionary)
-                    ctx.warn(pe.line, "PDO " + hex(p.index) + " maps " + where(pe.index, pe.subindex) +
-                                          ", which the dictionary does not declare; the entry is added");
-                const auto t = pdo_entry_type(pe, ctx);
-                od::Entry e = u_entry(pe.index, pe.subindex, t.first, pdo_access, 0, pe.name);
-                e.bit_length = t.second;
-                if (od::is_string(t.first)) e.default_value = std::monostate{};
-                if (o.code == od::ObjectCode::Array && (o.type != t.first)) o.code = od::ObjectCode::Record;
-                o.entries.push_back(std::move(e));
-                std::sort(o.entries.begin(), o.entries.end(),
-                          [](const od::Entry& a, const od::Entry& b) { return a.subindex < b.subindex; });
-                if (!o.entries.empty() && o.entries[0].subindex == 0 && !declared_dictionary)
-                    o.entries[0].default_value = uint64_t{o.entries.back().subindex};
+            if (declared_dictionary)
+                ctx.warn(pe.line, "PDO " + hex(pdo_index) + " maps " + where(pe.index, pe.subindex) +
+                                      ", which the dictionary does not declare; the entry is added");
+            const auto t = pdo_entry_type(pe, ctx);
+            od::Entry e = pdo_implied_entry(pe, t, pdo_access);
+            if (o.code == od::ObjectCode::Array && (o.type != t.first)) o.code = od::ObjectCode::Record;
+            o.entries.push_back(std::move(e));
+            std::sort(o.entries.begin(), o.entries.end(),
+                      [](const od::Entry& a, const od::Entry& b) { return a.subindex < b.subindex; });
+            if (!o.entries.empty() && o.entries[0].subindex == 0 && !declared_dictionary)
+                o.entries[0].default_value = uint64_t{o.entries.back().subindex};
+            return;
+        }
+        if (target->bit_length != pe.bit_len)
+            ctx.warn(pe.line, "PDO " + hex(pdo_index) + " maps " + where(pe.index, pe.subindex) + " with " +
+                                  std::to_string(pe.bit_len) + " bits; the object has " +
+                                  std::to_string(target->bit_length));
+        const uint16_t flag = rx ? od::access::RxPdo : od::access::TxPdo;
+        if (!(target->access & flag)) {
+            if (declared_dictionary)
+                ctx.warn(pe.line, "PDO " + hex(pdo_index) + " maps " + where(pe.index, pe.subindex) +
+                                      ", which the dictionary does not flag " + (rx ? "RxPDO" : "TxPDO") +
+                                      " mappable; it is made mappable");
+            target->access |= flag;
+            // The elements of an ARRAY share one Flags (ETG.2000 ArrayInfo): all of them become
+            // mappable, so that the object stays an array (and is written back as one).
+            if (o.code == od::ObjectCode::Array)
+                for (od::Entry& e : o.entries)
+                    if (e.subindex != 0) e.access |= flag;
+        }
+    };
+    for (const Pdo& p : pdos)
+        for (const EsiPdoEntry& pe : p.entries)
+            map_entry(pe, p.esi->rx, p.index, p.esi->name, true);
+    // A Record of entries added from PDOs: subindex 0 (count) is added by od when missing.
+
+    // ---- Mapping objects the dictionary declares without an RxPdo/TxPdo element: what their defaults map
+    // is treated as a PDO element's entries are (they are PDOs a master may assign, and the ESI softecat
+    // writes describes every mapping object with an element) ----
+    {
+        std::set<uint16_t> with_element;
+        for (const Pdo& p : pdos)
+            with_element.insert(p.index);
+        struct Mapped {
+            EsiPdoEntry pe;
+            bool rx;
+            uint16_t pdo;
+            std::string name;
+        };
+        std::vector<Mapped> mapped_by_objects;
+        for (const auto& [index, mo] : built.objects) {
+            const bool rx = is_mapping(index, true);
+            if ((!rx && !is_mapping(index, false)) || with_element.count(index) || mo.entries.empty())
                 continue;
-            }
-            if (target->bit_length != pe.bit_len)
-                ctx.warn(pe.line, "PDO " + hex(p.index) + " maps " + where(pe.index, pe.subindex) + " with " +
-                                      std::to_string(pe.bit_len) + " bits; the object has " +
-                                      std::to_string(target->bit_length));
-            const uint16_t flag = rx ? od::access::RxPdo : od::access::TxPdo;
-            if (!(target->access & flag)) {
-                if (declared_dictionary)
-                    ctx.warn(pe.line, "PDO " + hex(p.index) + " maps " + where(pe.index, pe.subindex) +
-                                          ", which the dictionary does not flag " + (rx ? "RxPDO" : "TxPDO") +
-                                          " mappable; it is made mappable");
-                target->access |= flag;
+            const uint64_t count = mo.entries[0].subindex == 0 ? default_u(mo.entries[0]) : 0;
+            for (const od::Entry& slot : mo.entries) {
+                if (slot.subindex == 0 || slot.subindex > count) continue;
+                const auto word = static_cast<uint32_t>(default_u(slot));
+                EsiPdoEntry pe;
+                pe.index = static_cast<uint16_t>(word >> 16);
+                pe.subindex = static_cast<uint8_t>(word >> 8);
+                pe.bit_len = static_cast<uint8_t>(word);
+                pe.line = built.lines[index];
+                if (pe.index != 0 && pe.bit_len != 0) mapped_by_objects.push_back({pe, rx, index, mo.name});
             }
         }
+        for (const Mapped& m : mapped_by_objects)
+            map_entry(m.pe, m.rx, m.pdo, m.name, false);
     }
-    // A Record of entries added from PDOs: subindex 0 (count) is added by od when missing.
 
     // ---- The PDO mapping objects (0x16xx/0x1Axx) as the PDO elements declare them ----
     const bool coe = desc.mailbox_protocols & od::mailbox_protocol::CoE;

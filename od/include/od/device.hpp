@@ -178,6 +178,8 @@ struct DeviceDescription {
         0xCC00;  // SII word 1: 0x0151 = 0xCC, SYNC0/SYNC1 driven and mapped to AL event bits 2/3 (as EJ7211)
     uint16_t sync_pulse_length = 1000;  // SII word 2, 10 ns units
     uint16_t station_alias = 0;         // SII word 4
+    uint16_t extended_pdi_config = 0;   // SII word 3 (ESI ConfigData bytes 6-7)
+    uint16_t config_words_5_6[2] = {};  // SII words 5-6, reserved: kept as the ESI's ConfigData gives them
     // The device profile the ESI names (Profile/ProfileNo and AddInfo, ETG.2000), which a configuration tool
     // goes by; 0: the device type 0x1000 gives it (bits 0-15 the profile number, 16-31 additional
     // information, ETG.1000.6 / CiA 301). Vendor files whose 0x1000 disagrees keep both as written.

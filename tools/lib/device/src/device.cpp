@@ -426,6 +426,7 @@ void Device::build() {
     if (has_coe_part(options_, p->desc)) {
         coe::CoeConfig coe_config;
         coe_config.faults = options_.faults.coe;
+        coe_config.complete_access = (p->desc.coe_details & od::coe_details::CompleteAccess) != 0;
         p->coe = std::make_unique<coe::CoeServer>(
             p->dict, [raw] { return raw->stack->state(); }, coe_config);
         // The diagnosis history where the dictionary has its object (0x10F3, ETG.1020).
