@@ -15,6 +15,7 @@ import struct
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 import unittest
 
@@ -281,6 +282,35 @@ def drain(sock):
         pass
     finally:
         sock.setblocking(True)
+
+
+def during_control_flood(path, data, work):
+    """Runs work() while a thread keeps the control socket at path busy with the datagram data (sent from a socket
+    without an address: no answers, only work); returns (work's result, datagrams sent)."""
+    stop = threading.Event()
+    sent = [0]
+
+    def flooder():
+        s = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+        s.settimeout(0.5)
+        try:
+            while not stop.is_set():
+                try:
+                    s.sendto(data, path)
+                    sent[0] += 1
+                except (socket.timeout, BlockingIOError):
+                    pass
+        finally:
+            s.close()
+
+    t = threading.Thread(target=flooder)
+    t.start()
+    try:
+        result = work()
+    finally:
+        stop.set()
+        t.join()
+    return result, sent[0]
 
 
 def exchange(sock, frame, timeout=0.5, match=None):

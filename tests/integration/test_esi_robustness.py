@@ -290,30 +290,8 @@ class EsiLineWire(unittest.TestCase):
         coming for the whole run: every answered cycle has the full working counter, every device stays in OP."""
         flood = ("status\nslave all set real 1.5\nslave all get \"Eingang \u00e4\"\nslave lat status\nsegment\n"
                  * 40).encode()[:4000]
-        stop = threading.Event()
-        sent = [0]
-
-        def flooder():
-            s = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
-            s.settimeout(0.5)
-            try:
-                while not stop.is_set():
-                    try:
-                        s.sendto(flood, self.ctl)
-                        sent[0] += 1
-                    except (socket.timeout, BlockingIOError):
-                        pass
-            finally:
-                s.close()
-
-        t = threading.Thread(target=flooder)
-        t.start()
-        try:
-            s = self.m.run(1500)
-        finally:
-            stop.set()
-            t.join()
-        self.assertGreater(sent[0], 20, "the flood did not run")
+        s, sent = harness.during_control_flood(self.ctl, flood, lambda: self.m.run(1500))
+        self.assertGreater(sent, 20, "the flood did not run")
         self.assert_undisturbed(s, "flood")
         self.assertLessEqual(s["lost"] * 20, s["cycles"], s)
         self.assertEqual(send(self.ctl, "slave all get real"), 'ok 0x6000:0A "real"=1.5')
