@@ -8,7 +8,6 @@ import random
 import shutil
 import socket
 import struct
-import tempfile
 import threading
 import unittest
 
@@ -108,12 +107,9 @@ class EsiControlValues(unittest.TestCase):
         cls.esi = os.path.join(cls.tmp, "alltypes.xml")
         all_types_esi(cls.esi)
         cls.ctl = os.path.join(cls.tmp, "ctl.sock")
+        cls.addClassCleanup(shutil.rmtree, cls.tmp, True)
         cls.bus = harness.Bus(slave_args=["--esi", cls.esi, "--control", cls.ctl]).__enter__()
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.bus.close()
-        shutil.rmtree(cls.tmp, True)
+        cls.addClassCleanup(cls.bus.close)  # also when the set-up fails after this (tearDownClass would not run)
 
     def set(self, sub, value):
         return send(self.ctl, f"set 0x6000:{sub} {value}")
@@ -206,6 +202,7 @@ class EsiLineWire(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = harness.socket_dir()
+        cls.addClassCleanup(shutil.rmtree, cls.tmp, True)
         for f in os.listdir(EXAMPLES):
             if f.endswith(".xml"):
                 shutil.copy(os.path.join(EXAMPLES, f), cls.tmp)
@@ -223,7 +220,9 @@ class EsiLineWire(unittest.TestCase):
                     "device all esi=alltypes.xml\n")
         cls.ctl = os.path.join(cls.tmp, "ctl.sock")
         cls.bus = harness.Bus(slave_args=["--topology", topo, "--control", cls.ctl]).__enter__()
+        cls.addClassCleanup(cls.bus.close)  # also when the set-up fails after this (tearDownClass would not run)
         cls.m = harness.MiniMaster(cls.bus)
+        cls.addClassCleanup(cls.m.close)
         m = cls.m
         m.scan()
         m.discover()
@@ -245,11 +244,6 @@ class EsiLineWire(unittest.TestCase):
                 break
             cls.m.recover()
 
-    @classmethod
-    def tearDownClass(cls):
-        cls.m.close()
-        cls.bus.close()
-        shutil.rmtree(cls.tmp, True)
 
     def assert_undisturbed(self, s, what):
         m = self.m
