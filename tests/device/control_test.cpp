@@ -185,6 +185,20 @@ TEST(ControlCommands, NumbersAreCheckedBeforeAnyConversion) {
     EXPECT_EQ(ControlSocket::apply(*r.dev, "input \"4 on").rfind("error: unterminated string", 0), 0u);
 }
 
+// An answer is one line per command whatever the text in it: a name typed with the lexer's escapes (a line
+// feed, a tab, a quote) comes back escaped, not as a second, forged answer line (found by issue 24's campaign
+// run again: an ESI entry name "ud&#10;ok injected" answered "ok 0x6000:08 \"ud" and a line "ok injected").
+TEST(ControlCommands, AnAnswerIsOneLineWhateverTheNamesInIt) {
+    Rig r;
+    for (const char* line :
+         {"get \"a\\nok forged\"", "set \"x\\ty\\\"z\" 1", "\"bo\\ngus\"", "get \"\\\\\""}) {
+        const std::string answer = ControlSocket::apply(*r.dev, line);
+        EXPECT_EQ(answer.rfind("error: ", 0), 0u) << line << " -> " << answer;
+        EXPECT_EQ(answer.find_first_of("\n\t"), std::string::npos) << line << " -> " << answer;
+    }
+    EXPECT_EQ(ControlSocket::apply(*r.dev, "get \"a\\nok forged\""), "error: no entry named 'a\\nok forged'");
+}
+
 namespace {
 
 // A client socket bound to its own address (it gets the answers).

@@ -233,6 +233,35 @@ class LongPaths(unittest.TestCase):
         self.assertIn("not a regular file (a FIFO)", r.stderr)
 
 
+    def test_esi_files_that_are_not_regular_files(self):
+        """ecat-conform's --esi and --esi-dir, fwimage's --esi (issue 24's campaign run again on the ESI surfaces):
+        a FIFO without a writer, a device, a directory, a file past the limit or not EtherCATInfo is a usage error
+        naming the file, exit 2, before the bus is touched (ecat-conform ran every test, each failing with
+        'cannot start', exit 1; fwimage hung in the FIFO's open)."""
+        if not os.environ.get("ECAT_CONFORM"):
+            self.skipTest("ecat-conform not built")
+        fifo = os.path.join(self.dir, "fifo.xml")
+        os.mkfifo(fifo)
+        big = self.file("big.xml", b"<EtherCATInfo>")
+        os.truncate(big, (32 << 20) + 1)
+        junk = self.file("junk.xml", b"<EtherCATConfig/>")
+        for path, why in ((fifo, "not a regular file (a FIFO)"), ("/dev/zero", "not a regular file"),
+                          ("/dev/urandom", "not a regular file"), (self.dir, "not a regular file"),
+                          (big, "larger than 33554432 bytes: not an ESI file"), (junk, junk + ":1:")):
+            for r in (tool("ECAT_CONFORM", "--iface", "lo", "--esi", path),
+                      tool("FWIMAGE", "build", "--payload", junk, "--version", "1", "--esi", path, "-o",
+                           os.path.join(self.dir, "o"))):
+                err = r.stderr.decode(errors="replace")
+                self.assertEqual(r.returncode, 2, err)
+                self.assertIn(path, err)
+                self.assertIn(why, err)
+                self.assertEqual(len(err.strip().splitlines()), 1, err)
+        for path in (fifo, junk, os.path.join(self.dir, "none")):
+            r = tool("ECAT_CONFORM", "--iface", "lo", "--esi-dir", path)
+            self.assertEqual(r.returncode, 2, r.stderr)
+            self.assertIn(path, r.stderr.decode(errors="replace"))
+
+
 class ControlClient(unittest.TestCase):
     """`ecat-slave --control PATH --send LINE`, the project's own client of the control socket, against a stand-in
     server (the real one answers it in test_readme, through docs/segment.md): the answer printed whole, exit 0 on

@@ -72,30 +72,8 @@ class ControlSocket(unittest.TestCase):
         self.assertEqual((calm["wkc_errors"], calm["wkc_min"]), (0, m.expected_wkc), calm)
         flood = ("status\nsegment\n" * 145).encode()  # 290 lines, under 4096 bytes
         self.assertLess(len(flood), 4096)
-        stop = threading.Event()
-        sent = [0]
-
-        def flooder():
-            s = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)  # no address: no answers, only work
-            s.settimeout(0.5)
-            try:
-                while not stop.is_set():
-                    try:
-                        s.sendto(flood, self.ctl)
-                        sent[0] += 1
-                    except (socket.timeout, BlockingIOError):
-                        pass
-            finally:
-                s.close()
-
-        t = threading.Thread(target=flooder)
-        t.start()
-        try:
-            s = m.run(2000)
-        finally:
-            stop.set()
-            t.join()
-        self.assertGreater(sent[0], 20, "the flood did not run")
+        s, sent = harness.during_control_flood(self.ctl, flood, lambda: m.run(2000))
+        self.assertGreater(sent, 20, "the flood did not run")
         # Every answered cycle had the full working counter; the drives never left Op (a starved drive's
         # SyncManager watchdog would have taken it to Safe-Op with an error after 100 ms).
         self.assertEqual((s["wkc_errors"], s["wkc_min"], s["wkc_max"]), (0, m.expected_wkc, m.expected_wkc), s)

@@ -39,8 +39,12 @@ Buffer read_bounded(const std::filesystem::path& path, std::size_t max_bytes, st
         throw InputFileError(p + ": not a regular file (" + kind(st.st_mode) + "); the " + std::string(what) +
                              " must be a file");
     auto too_large = [&] {
-        return InputFileError(p + ": larger than " + std::to_string(max_bytes) + " bytes: not a " +
-                              std::string(what));
+        // "not an ESI file", "not a topology file": the article as the kind's first letter sounds (an
+        // initialism such as ESI or ENI is spoken from a vowel sound).
+        const bool an =
+            !what.empty() && std::string_view("AEFHILMNORSXaeiou").find(what[0]) != std::string_view::npos;
+        return InputFileError(p + ": larger than " + std::to_string(max_bytes) + " bytes: not " +
+                              (an ? "an " : "a ") + std::string(what));
     };
     if (st.st_size < 0 || static_cast<unsigned long long>(st.st_size) > max_bytes) throw too_large();
     // The regular file may still grow while it is read: read at most one byte more than allowed.

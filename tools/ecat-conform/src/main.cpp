@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -20,6 +21,7 @@
 
 #include "conform.hpp"
 #include "esc/link.hpp"
+#include "esi/esi_reader.hpp"
 #include "report.hpp"
 #include "sdo_util.hpp"
 #include "util/input_file.hpp"
@@ -178,6 +180,24 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "ecat-conform: %s\n", e.what());
             return 2;
         }
+    }
+
+    // The ESI files are the user's input: one that cannot be read (a FIFO, a device, a directory, too large,
+    // not EtherCATInfo) is a usage error naming the file and line, exit 2, before the bus is touched; not a
+    // run of tests that each fail with "cannot start". Files of --esi-dir that are not ESI are passed over
+    // there.
+    if (!o.esi_path.empty()) {
+        try {
+            (void)esi::read_esi_file(o.esi_path);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "ecat-conform: --esi %s\n", e.what());
+            return 2;
+        }
+    }
+    if (std::error_code ec; !o.esi_dir.empty() && !std::filesystem::is_directory(o.esi_dir, ec)) {
+        std::fprintf(stderr, "ecat-conform: --esi-dir %s: %s\n", o.esi_dir.c_str(),
+                     ec ? ec.message().c_str() : "not a directory");
+        return 2;
     }
 
     const conform::Catalogue catalogue = conform::build_catalogue();

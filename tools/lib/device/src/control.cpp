@@ -75,6 +75,29 @@ std::string lower(std::string_view s) {
     return r;
 }
 
+// Text in an answer, which is one line per command: an entry name comes from the ESI (a vendor's file may put
+// a line feed, a tab or a quote in it: "ud&#10;ok injected" answered a second, forged "ok" line) and a name
+// typed may hold "\n" escapes. Written with the lexer's escapes (\" \\ \t \n), other control bytes as \xNN,
+// so a quoted name in an answer can be typed back.
+std::string escaped(std::string_view s) {
+    std::string r;
+    r.reserve(s.size());
+    for (const char c : s) {
+        const auto u = static_cast<unsigned char>(c);
+        if (c == '"' || c == '\\')
+            r += '\\', r += c;
+        else if (c == '\t')
+            r += "\\t";
+        else if (c == '\n')
+            r += "\\n";
+        else if (u < 0x20 || u == 0x7F)
+            r += util::strprintf("\\x%02X", static_cast<unsigned>(u));
+        else
+            r += c;
+    }
+    return r;
+}
+
 std::string where(uint16_t index, uint8_t sub) {
     char b[16];
     std::snprintf(b, sizeof b, "0x%04X:%02X", static_cast<unsigned>(index), static_cast<unsigned>(sub));
@@ -124,16 +147,15 @@ Found find_entry(const Device& device, od::Dictionary& dict, std::string_view te
     } else if (hits.empty()) {
         // printf, not "literal" + std::string&& or a literal assigned: GCC 12 at -O3 misjudges those as
         // overlapping copies (-Werror=restrict, GCC bug 105651).
-        f.error = util::strprintf("no entry named '%.*s'", static_cast<int>(text.size()), text.data());
+        f.error = util::strprintf("no entry named '%s'", escaped(text).c_str());
     } else {
         std::string list;
         for (std::size_t i = 0; i < hits.size() && i < 8; ++i) {
             if (i) list += ' ';
             list += where(hits[i]->index, hits[i]->subindex);
         }
-        f.error = util::strprintf("'%.*s' names %zu entries (%s%s): give index:subindex",
-                                  static_cast<int>(text.size()), text.data(), hits.size(), list.c_str(),
-                                  hits.size() > 8 ? " ..." : "");
+        f.error = util::strprintf("'%s' names %zu entries (%s%s): give index:subindex", escaped(text).c_str(),
+                                  hits.size(), list.c_str(), hits.size() > 8 ? " ..." : "");
     }
     return f;
 }
@@ -141,7 +163,7 @@ Found find_entry(const Device& device, od::Dictionary& dict, std::string_view te
 // "0x7000:01 "Output"=1" for each entry of a list.
 void list_entries(std::ostringstream& s, const Device& device, std::span<const IoEntry> list) {
     for (const IoEntry& m : list)
-        s << ' ' << where(m.entry->index, m.entry->subindex) << " \"" << m.entry->name
+        s << ' ' << where(m.entry->index, m.entry->subindex) << " \"" << escaped(m.entry->name)
           << "\"=" << device.value_text(m.entry->index, m.entry->subindex);
 }
 
@@ -332,7 +354,7 @@ std::string ControlSocket::apply(Device& device, std::string_view line) {
     const bool drive_command = cmd == "input" || cmd == "sto" || cmd == "limit-neg" || cmd == "limit-pos" ||
                                cmd == "home" || cmd == "stops";
     if (drive_command && !device.has_drive())
-        return "error: '" + std::string(cmd) + "' acts on a drive; this device has none (get, set, status)";
+        return "error: '" + escaped(cmd) + "' acts on a drive; this device has none (get, set, status)";
     if (cmd == "input") {
         int pin = 0;
         if (w.size() != 3 || util::parse_number(w[1].text, pin, 1, 6) != util::NumberError::None ||
@@ -392,7 +414,7 @@ std::string ControlSocket::apply(Device& device, std::string_view line) {
         if (w.size() != 2) return "error: usage: get <entry name>|<index>:<subindex>";
         const Found f = find_entry(device, device.dictionary(), w[1].text);
         if (f.entry == nullptr) return "error: " + f.error;
-        return "ok " + where(f.entry->index, f.entry->subindex) + " \"" + f.entry->name +
+        return "ok " + where(f.entry->index, f.entry->subindex) + " \"" + escaped(f.entry->name) +
                "\"=" + device.value_text(f.entry->index, f.entry->subindex);
     }
     if (cmd == "set") {
@@ -405,7 +427,7 @@ std::string ControlSocket::apply(Device& device, std::string_view line) {
             return "error: " + error;
         return "ok " + where(index, sub) + "=" + device.value_text(index, sub);
     }
-    return "error: unknown command '" + std::string(cmd) +
+    return "error: unknown command '" + escaped(cmd) +
            "' (input, sto, limit-neg, limit-pos, home, stops, status, get, set)";
 }
 

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <iostream>
+#include <limits>
 #include <stdexcept>
 #include <system_error>
 
@@ -729,8 +730,12 @@ bool encode(const od::Entry& e, std::string_view text, std::vector<uint8_t>& raw
     if (bytes == 0 || bytes > 8 || od::is_string(e.type)) return false;
     raw.assign(bytes, 0);
     if (od::is_real(e.type)) {
+        // Finite and within the type's range: a REAL takes at most FLT_MAX (1e300 is refused, not stored as
+        // infinity); a value below the smallest subnormal rounds to zero, as any conversion rounds.
+        const double max = bytes == 4 ? static_cast<double>(std::numeric_limits<float>::max())
+                                      : std::numeric_limits<double>::max();
         double v = 0;
-        if (util::parse_number(text, v) != util::NumberError::None) return false;
+        if (util::parse_number(text, v, -max, max) != util::NumberError::None) return false;
         if (bytes == 4) {
             const auto f = static_cast<float>(v);
             std::memcpy(raw.data(), &f, 4);
@@ -814,7 +819,8 @@ std::string Device::value_text(uint16_t index, uint8_t sub) const {
         } else if (raw.size() == 8) {
             std::memcpy(&x, raw.data(), 8);
         }
-        return util::strprintf("%.9g", x);
+        // As many digits as the type needs to read back the same value: 9 for a REAL, 17 for an LREAL.
+        return util::strprintf("%.*g", raw.size() == 4 ? 9 : 17, x);
     }
     const unsigned width = std::min<unsigned>(e->bit_length, 64);
     if (width < 64) v &= (uint64_t{1} << width) - 1;
