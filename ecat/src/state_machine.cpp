@@ -1,5 +1,7 @@
 #include "ecat/state_machine.hpp"
 
+#include <algorithm>
+
 #include "ecat/cycle.hpp"
 #include "ecat/sync_control.hpp"
 
@@ -229,9 +231,36 @@ uint16_t StateMachine::check_mailbox(const od::MailboxLayout& layout, uint16_t c
     return ok0 && ok1 && apart ? al::NoError : code;
 }
 
+uint16_t StateMachine::check_module_idents() const {
+    // ETG.5001.1 (Modular Device Profile): the master may write the modules it configured into 0xF030
+    // (Configured Module Ident List); the device compares them with the modules it has, 0xF050 (Detected
+    // Module Ident List), slot by slot, at Pre-Op -> Safe-Op and refuses a difference with 0x0070. A count
+    // of 0 in 0xF030 configures nothing (no check); a slot past either count is empty (ident 0).
+    const od::Dictionary& dict = ctx_.dict;
+    if (dict.find(0xF030) == nullptr || dict.find(0xF050) == nullptr) return al::NoError;
+    auto u8 = [&dict](uint16_t index) -> unsigned {
+        const auto r = dict.raw(index, 0);
+        return r.size() == 1 ? r[0] : 0u;
+    };
+    auto ident = [&dict](uint16_t index, unsigned sub, unsigned count) -> uint32_t {
+        if (sub > count) return 0;
+        const auto r = dict.raw(index, static_cast<uint8_t>(sub));
+        if (r.size() != 4) return 0;
+        return static_cast<uint32_t>(r[0] | r[1] << 8 | r[2] << 16 | static_cast<uint32_t>(r[3]) << 24);
+    };
+    const unsigned configured = u8(0xF030);
+    if (configured == 0) return al::NoError;
+    const unsigned detected = u8(0xF050);
+    for (unsigned n = 1; n <= std::max(configured, detected); ++n)
+        if (ident(0xF030, n, configured) != ident(0xF050, n, detected)) return al::ModuleIdentMismatch;
+    return al::NoError;
+}
+
 uint16_t StateMachine::check_pre_op_to_safe_op() {
     const od::DeviceDescription& desc = ctx_.desc;
     ProcessData& pd = ctx_.pd;
+    // The modules the master configured are the ones the device has (before the PDOs they bring).
+    if (const uint16_t code = check_module_idents(); code != al::NoError) return code;
     // SM types as described (0x1C00).
     for (unsigned n = 0; n < desc.sync_managers.size() && n < 4; ++n) {
         const uint64_t kind = sync_.sm_type(n, static_cast<uint64_t>(desc.sync_managers[n].kind));

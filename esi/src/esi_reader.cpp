@@ -470,6 +470,7 @@ EsiDevice read_device(Node dev, const TypeMap& types_in, uint32_t vendor, const 
     if (Node slots = child(dev, "Slots")) {
         d.slot_pdo_increment = static_cast<uint32_t>(number(attr(slots, "SlotPdoIncrement")));
         d.slot_index_increment = static_cast<uint32_t>(number(attr(slots, "SlotIndexIncrement")));
+        d.download_module_ident_list = truthy(attr(slots, "DownloadModuleIdentList"));
         for (Node sl : children(slots, "Slot")) {
             EsiSlot slot;
             slot.name = name_text(sl);

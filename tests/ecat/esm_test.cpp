@@ -645,5 +645,82 @@ TEST_F(Esm, QuietUntilTheMasterWritesAlControlOrTheHousekeepingIsDue) {
     EXPECT_FALSE(stack->quiet(due));
 }
 
+// ETG.5001.1 module ident lists: at Pre-Op -> Safe-Op the modules the master configured (0xF030) must be the
+// ones the device detected (0xF050), slot by slot (a slot past a list's count is empty, ident 0); a
+// difference refuses the transition with 0x0070. A configured count of 0 configures nothing.
+od::Object module_ident_list(uint16_t index, uint16_t access, const std::vector<uint32_t>& idents) {
+    od::Object o;
+    o.index = index;
+    o.code = od::ObjectCode::Array;
+    o.type = od::DataType::Unsigned32;
+    o.name = index == 0xF030 ? "Configured module ident list" : "Detected module ident list";
+    od::Entry n;
+    n.index = index;
+    n.type = od::DataType::Unsigned8;
+    n.bit_length = 8;
+    n.access = access;
+    n.default_value = uint64_t{idents.size()};
+    o.entries.push_back(n);
+    for (std::size_t k = 0; k < idents.size(); ++k) {
+        od::Entry e = n;
+        e.subindex = static_cast<uint8_t>(k + 1);
+        e.type = od::DataType::Unsigned32;
+        e.bit_length = 32;
+        e.default_value = uint64_t{idents[k]};
+        o.entries.push_back(e);
+    }
+    return o;
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_ConfiguredModulesNotDetected_0x0070) {
+    const std::vector<uint32_t> detected = {0x1001, 0, 0x3001, 0};
+    dict.add(module_ident_list(0xF050, od::access::RO, detected));
+    dict.add(module_ident_list(0xF030, od::access::RW_PreOp, detected));
+    start();
+    struct Case {
+        const char* what;
+        uint8_t count;
+        std::vector<uint32_t> configured;  // subindex 1.. (written in Pre-Op as a master does)
+        uint16_t code;
+    };
+    const Case cases[] = {
+        {"as detected", 4, {0x1001, 0, 0x3001, 0}, 0},
+        {"another module in slot 3", 4, {0x1001, 0, 0x2001, 0}, 0x0070},
+        {"a module in an empty slot", 4, {0x1001, 0x2001, 0x3001, 0}, 0x0070},
+        {"slot 1 empty", 4, {0, 0, 0x3001, 0}, 0x0070},
+        {"three slots, the fourth empty as detected", 3, {0x1001, 0, 0x3001, 0x2001}, 0},
+        {"two slots: slot 3's module not configured", 2, {0x1001, 0, 0x3001, 0}, 0x0070},
+        {"nothing configured", 0, {0x2001, 0x2001, 0x2001, 0x2001}, 0},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.what);
+        request(0x11);  // Init, error acknowledged
+        go_preop();
+        ASSERT_EQ(dict.write(0xF030, 0, od::AlState::PreOp, std::vector<uint8_t>{0}), od::Status::Ok);
+        for (std::size_t k = 0; k < c.configured.size(); ++k) {
+            const uint32_t v = c.configured[k];
+            const std::vector<uint8_t> b = {static_cast<uint8_t>(v), static_cast<uint8_t>(v >> 8),
+                                            static_cast<uint8_t>(v >> 16), static_cast<uint8_t>(v >> 24)};
+            ASSERT_EQ(dict.write(0xF030, static_cast<uint8_t>(k + 1), od::AlState::PreOp, b), od::Status::Ok);
+        }
+        ASSERT_EQ(dict.write(0xF030, 0, od::AlState::PreOp, std::vector<uint8_t>{c.count}), od::Status::Ok);
+        configure_process_data(6, 6);
+        request(0x04);
+        EXPECT_EQ(al_status(), c.code ? (0x02 | kErr) : 0x04);
+        EXPECT_EQ(al_code(), c.code);
+    }
+}
+
+TEST_F(Esm, PS_PreOpToSafeOp_DetectedModulesWithoutConfiguredList) {
+    // A device with 0xF050 only (the master cannot configure modules): nothing to compare.
+    dict.add(module_ident_list(0xF050, od::access::RO, {0x1001, 0x2001}));
+    start();
+    go_preop();
+    configure_process_data(6, 6);
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x04);
+    EXPECT_EQ(al_code(), 0);
+}
+
 }  // namespace
 }  // namespace ecat::test

@@ -655,6 +655,54 @@ TEST(EsiExamples, TheModularDeviceServesTheDefaultModulesOfItsSlots) {
               1);
 }
 
+// ETG.5001.1 module ident lists: 0xF050 (Detected Module Ident List) says the module of each slot served, 0
+// for an empty slot, subindex 0 the number of slots; 0xF030 (Configured Module Ident List), which the master
+// writes, starts as the same list. The ESI's own defaults of these objects (modular-io.xml: 0xF050 count 0)
+// are not what is served.
+TEST(EsiExamples, TheModuleIdentListsSayTheModulesServed) {
+    const std::string f = example("modular-io.xml").string();
+    auto list = [](const od::Dictionary& d, uint16_t index) {
+        std::vector<uint32_t> out;
+        for (uint8_t k = 1; k <= d.get<uint8_t>(index, 0); ++k)
+            out.push_back(d.get<uint32_t>(index, k));
+        return out;
+    };
+    struct Case {
+        std::string spec;
+        std::vector<uint32_t> idents;
+    };
+    const Case cases[] = {
+        {"", {0x1001, 0x2001, 0x3001, 0}},  // each slot's default (slot 4 has none)
+        {"EXM9000@EXM-AI2,exm-ai2,-,#x00002001", {0x3001, 0x3001, 0, 0x2001}},
+        {"EXM9000@EXM-DI8", {0x1001, 0, 0, 0}},  // slots past the list are empty
+        {"EXM9000@-,-,-,-", {0, 0, 0, 0}},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.spec);
+        const od::Product p = esi::load_product(f, c.spec);
+        const od::Dictionary d = p.make_dictionary(p.description);
+        EXPECT_EQ(list(d, 0xF050), c.idents);
+        ASSERT_NE(d.find(0xF050, 0), nullptr);
+        EXPECT_FALSE(d.find(0xF050, 1)->access & od::access::WO);
+        // The file declares no 0xF030 and no DownloadModuleIdentList: none is added.
+        EXPECT_EQ(d.find(0xF030), nullptr);
+    }
+    // A file whose Slots say the master downloads the module ident list (DownloadModuleIdentList) gets both
+    // lists, 0xF030 writable in Pre-Op and starting as the detected list.
+    std::string text = read_all(f);
+    const std::string slots = "<Slots MaxSlotCount=";
+    ASSERT_NE(text.find(slots), std::string::npos);
+    text.replace(text.find(slots), slots.size(), "<Slots DownloadModuleIdentList=\"true\" MaxSlotCount=");
+    const esi::EsiFile file = esi::read_esi_text(text, "download.xml");
+    const od::Product p = esi::load_product(file, "EXM9000@EXM-DO8,-,EXM-DI8");
+    const od::Dictionary d = p.make_dictionary(p.description);
+    EXPECT_EQ(list(d, 0xF050), (std::vector<uint32_t>{0x2001, 0, 0x1001, 0}));
+    EXPECT_EQ(list(d, 0xF030), (std::vector<uint32_t>{0x2001, 0, 0x1001, 0}));
+    ASSERT_NE(d.find(0xF030, 1), nullptr);
+    EXPECT_TRUE(d.find(0xF030, 1)->access & od::access::WritePreOp);
+    EXPECT_TRUE(d.find(0xF030, 0)->access & od::access::WritePreOp);
+}
+
 // Another module configuration than the default, chosen in the device spec (SPEC@MODULES): each slot's PDOs,
 // objects and increments as the slot's module brings them, the SM sizes of the SII (what SOEM's slaveinfo and
 // a master without CoE read) and the assignment objects (what a CoE master reads) from the same modules.

@@ -326,6 +326,43 @@ def _same_poll_later(pairs, ids, i, end, settle_s):
     return out
 
 
+AL_CONTROL = 0x0120
+
+
+def _repeats_state_request(request, previous_write):
+    """True if request writes nothing but AL control (0x0120; its other datagrams read-only: reads, process data,
+    the clock) and is identical to the master's previous frame that was not read-only. A master that requests a
+    state again while it polls for it (libethercat every 5 ms until the slave is there) asks the same question:
+    when the slave's firmware completes the transition, earlier or later than in the recording, is timing."""
+    if previous_write is None:
+        return False
+    writes = [d for d in datagrams(request)
+              if not (d[0] in READS or d[0] in LOGICAL or d[0] in CLOCK or d[0] == NOP or _clock_write(d))]
+    return (bool(writes) and all(d[0] in PHYS_WRITES and d[3] == AL_CONTROL and len(d[4]) == 2 for d in writes)
+            and request_identity(request) == request_identity(previous_write))
+
+
+def _next_writes(pairs):
+    """For each frame, the index of the master's next frame that ends its polls' 'same poll later' list: the next
+    frame that is not read-only, except one that repeats the master's last state request (_repeats_state_request):
+    the polls before and after it ask whether the slave reached that state."""
+    ends = [len(pairs)] * len(pairs)
+    previous, ending = None, []
+    for k, (_t, rq, _rp) in enumerate(pairs):
+        if read_only(rq):
+            continue
+        if not _repeats_state_request(rq, previous):
+            ending.append(k)
+        previous = rq
+    nxt, e = len(pairs), len(ending) - 1
+    for k in range(len(pairs) - 1, -1, -1):
+        while e >= 0 and ending[e] > k:
+            nxt = ending[e]
+            e -= 1
+        ends[k] = nxt
+    return ends
+
+
 class Mismatch(AssertionError):
     pass
 
@@ -373,11 +410,7 @@ def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None, exchang
     # cyclic task beside its state machine), the replay keeps it running while it waits; a master that stopped
     # cycling (to see the watchdog trip) is not helped along.
     cycle_times = [t for t, rq, _rp in pairs if read_only(rq) and any(d[0] in LOGICAL for d in datagrams(rq))]
-    next_write, nxt = [0] * len(pairs), len(pairs)
-    for k in range(len(pairs) - 1, -1, -1):
-        next_write[k] = nxt
-        if not read_only(pairs[k][1]):
-            nxt = k
+    next_write = _next_writes(pairs)
     clock = ClockShift()
     t0_rec = pairs[0][0] if pairs else 0.0
     t0 = time.monotonic()

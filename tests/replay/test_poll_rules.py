@@ -72,7 +72,109 @@ class Slave:
         return None
 
 
+AL_CONTROL, AL_STATUS = 0x0120, 0x0130
+SAFEOP, OP, INIT = 0x04, 0x08, 0x01
+
+
+def al(state):
+    return struct.pack("<H", state)
+
+
+def state_recording(reached_at, polls, rewrite_every):
+    """[(t, request, reply)]: the slave in SAFEOP, the master requests OP and polls AL status `polls` times,
+    writing the OP request again before every `rewrite_every`-th poll (0: never; libethercat: every one), the
+    recorded slave in OP from poll `reached_at` on; then the master requests INIT and sees it."""
+    pairs, t = [], 0.0
+
+    def add(cmd, ado, data, rdata, wkc=1):
+        nonlocal t
+        pairs.append((t, frame(cmd, ado, data), frame(cmd, ado, rdata, wkc, reply=True)))
+        t += 0.0002
+
+    add(er.FPWR, AL_CONTROL, al(OP), al(OP))
+    for n in range(polls):
+        if rewrite_every and n and n % rewrite_every == 0:
+            add(er.FPWR, AL_CONTROL, al(OP), al(OP))
+        add(er.FPRD, AL_STATUS, al(0), al(OP if n >= reached_at else SAFEOP))
+    add(er.FPWR, AL_CONTROL, al(INIT), al(INIT))
+    add(er.FPRD, AL_STATUS, al(0), al(INIT))
+    return pairs
+
+
+class StateSlave:
+    """A slave in SAFEOP whose firmware completes a requested OP after `delay` reads of AL status (its poll comes
+    after theirs; a request repeated while it is pending changes nothing), and goes to INIT at once. Faults:
+    `early` goes to OP when SAFEOP is requested (a state nobody asked for); `falls_back` leaves OP again for
+    SAFEOP with the error flag after two reads in OP."""
+
+    def __init__(self, delay, early=False, falls_back=False):
+        self.delay, self.early, self.falls_back = delay, early, falls_back
+        self.state, self.pending, self.reads_in_op = SAFEOP, None, 0
+
+    def __call__(self, request, _timeout):
+        cmd, _idx, _adp, ado, data, _wkc = er.datagrams(request)[0]
+        if cmd == er.FPWR and ado == AL_CONTROL:
+            want = struct.unpack("<H", bytes(data))[0]
+            if want == OP or (want == SAFEOP and self.early):
+                if self.state != OP and self.pending is None:
+                    self.pending = self.delay
+            elif want == INIT:
+                self.state, self.pending = INIT, None
+            return frame(cmd, ado, data, 1, reply=True)
+        if cmd == er.FPRD and ado == AL_STATUS:
+            if self.pending is not None:
+                if self.pending == 0:
+                    self.state, self.pending = OP, None
+                else:
+                    self.pending -= 1
+            if self.state == OP:
+                self.reads_in_op += 1
+                if self.falls_back and self.reads_in_op > 2:
+                    self.state = SAFEOP | 0x10
+            return frame(cmd, ado, al(self.state), 1, reply=True)
+        return None
+
+
 class PollRules(unittest.TestCase):
+    def test_every_timing_of_a_state_change_replays(self):
+        """The recorded slave reached OP at the first, second or fifth poll; the master wrote its OP request once,
+        again before every poll (libethercat) or before every third; the replayed slave's firmware completes the
+        transition before the first poll or after up to ten: all pass. (With the old rule, a repeated request
+        ended the list of later polls, and a slave in OP sooner than recorded failed: libethercat-example_with_dc
+        at frame 4993 under load, AL status recorded SAFEOP, observed OP.)"""
+        for rewrite_every in (0, 1, 3):
+            for reached_at in (0, 1, 4):
+                for delay in range(0, 11):
+                    with self.subTest(rewrite_every=rewrite_every, recorded_at=reached_at, slave_delay=delay):
+                        stats = er.replay(state_recording(reached_at, 12, rewrite_every), None, settle_s=0.5,
+                                          exchange=StateSlave(delay))
+                        self.assertEqual(stats["checked"], stats["frames"])
+
+    def test_state_never_reached_fails(self):
+        for rewrite_every in (0, 1):
+            with self.subTest(rewrite_every=rewrite_every), self.assertRaises(er.Mismatch):
+                er.replay(state_recording(1, 12, rewrite_every), None, settle_s=0.2, exchange=StateSlave(10**6))
+
+    def test_state_left_again_fails(self):
+        """OP reached, then SAFEOP with the error flag: no recorded answer says that."""
+        for rewrite_every in (0, 1):
+            with self.subTest(rewrite_every=rewrite_every), self.assertRaises(er.Mismatch):
+                er.replay(state_recording(0, 12, rewrite_every), None, settle_s=0.2,
+                          exchange=StateSlave(0, falls_back=True))
+
+    def test_state_not_requested_yet_fails(self):
+        """A different request ends the list: a slave in OP while the master has only asked for SAFEOP (and polls
+        for it) fails, although OP is recorded after the master's OP request."""
+        pairs, t = [], 0.0
+        for cmd, ado, data, rdata in ([(er.FPWR, AL_CONTROL, al(SAFEOP), al(SAFEOP))] +
+                                      [(er.FPRD, AL_STATUS, al(0), al(SAFEOP))] * 3 +
+                                      [(er.FPWR, AL_CONTROL, al(OP), al(OP))] +
+                                      [(er.FPRD, AL_STATUS, al(0), al(OP))] * 3):
+            pairs.append((t, frame(cmd, ado, data), frame(cmd, ado, rdata, 1, reply=True)))
+            t += 0.0002
+        with self.assertRaises(er.Mismatch):
+            er.replay(pairs, None, settle_s=0.2, exchange=StateSlave(0, early=True))
+
     def test_every_legal_timing_replays(self):
         """The answer recorded at the first, second or fifth poll; the replayed slave's firmware answers before
         the first poll or after up to ten: all pass."""

@@ -52,6 +52,7 @@ class StateMachine {
     void follow(od::AlState to, uint64_t now_ns);           // device emulation: the state the ESC took
     uint16_t check_mailbox(const od::MailboxLayout& layout, uint16_t code);
     uint16_t check_bootstrap() const;
+    uint16_t check_module_idents() const;
     uint16_t check_pre_op_to_safe_op();
     uint16_t check_watchdog();
     bool op_conditions_met();

@@ -1021,6 +1021,73 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
         built.lines[p.index] = p.esi->line;
     }
 
+    // ---- The module ident lists of a modular device (ETG.5001.1 Modular Device Profile) ----
+    // 0xF050 Detected Module Ident List: the ident of the module served in each slot, 0 for an empty slot
+    // (or a module the file lacks, which is served as empty), subindex 0 the number of slots. 0xF030
+    // Configured Module Ident List: written by the master (Slots DownloadModuleIdentList), compared with
+    // 0xF050 by the stack at Pre-Op -> Safe-Op (AL status 0x0070); it starts as the detected list, so a
+    // master that does not download one is not refused. Where the dictionary lacks them and the file says
+    // the master downloads the list, both are added.
+    if (!d.slots.empty() && coe) {
+        std::vector<uint64_t> detected(d.slots.size(), 0);
+        for (const SlotModule& sm : served)
+            if (sm.module != nullptr && sm.slot < detected.size()) detected[sm.slot] = sm.ident;
+        if (detected.size() > 254) ctx.fail(d.line, "Slots: more than 254 slots for the module ident lists");
+        auto module_list_object = [&](uint16_t index, const char* name, uint16_t access) {
+            auto it = built.objects.find(index);
+            if (it != built.objects.end()) {
+                od::Object& o = it->second;
+                bool ok = o.code != od::ObjectCode::Var && !o.entries.empty() && o.entries[0].subindex == 0 &&
+                          o.entries[0].type == DataType::Unsigned8;
+                for (const od::Entry& e : o.entries)
+                    if (e.subindex != 0 && e.type != DataType::Unsigned32) ok = false;
+                if (ok) {
+                    o.entries[0].default_value = uint64_t{detected.size()};
+                    keep_limits_around_default(o.entries[0]);
+                    for (std::size_t k = 1; k <= detected.size(); ++k) {
+                        auto e = std::find_if(o.entries.begin(), o.entries.end(),
+                                              [k](const od::Entry& x) { return x.subindex == k; });
+                        if (e == o.entries.end()) {
+                            // Room for every slot: the entries the dictionary lacks, with the access of its
+                            // last one.
+                            const uint16_t acc = o.entries.back().access;
+                            o.entries.push_back(u_entry(index, static_cast<uint8_t>(k), DataType::Unsigned32,
+                                                        acc, 0, nth(static_cast<unsigned>(k))));
+                            e = o.entries.end() - 1;
+                        }
+                        e->default_value = detected[k - 1];
+                        keep_limits_around_default(*e);
+                    }
+                    // Subindices past the slots list nothing.
+                    for (od::Entry& e : o.entries)
+                        if (e.subindex > detected.size()) e.default_value = uint64_t{0};
+                    std::sort(o.entries.begin(), o.entries.end(),
+                              [](const od::Entry& a, const od::Entry& b) { return a.subindex < b.subindex; });
+                    return;
+                }
+                ctx.warn(built.lines[index], "object " + hex(index) + " (" + o.name +
+                                                 ") cannot hold a module ident list (UINT8 count, UDINT " +
+                                                 "idents); it is replaced");
+            } else if (!d.download_module_ident_list) {
+                return;
+            }
+            od::Object o;
+            o.index = index;
+            o.code = od::ObjectCode::Array;
+            o.type = DataType::Unsigned32;
+            o.name = name;
+            o.entries.push_back(
+                u_entry(index, 0, DataType::Unsigned8, access, detected.size(), "SubIndex 000"));
+            for (std::size_t k = 0; k < detected.size(); ++k)
+                o.entries.push_back(u_entry(index, static_cast<uint8_t>(k + 1), DataType::Unsigned32, access,
+                                            detected[k], nth(static_cast<unsigned>(k + 1))));
+            built.objects[index] = std::move(o);
+            built.lines[index] = d.line;
+        };
+        module_list_object(0xF030, "Configured module ident list", od::access::RW_PreOp);
+        module_list_object(0xF050, "Detected module ident list", od::access::RO);
+    }
+
     // ---- PDO rules and sets ----
     for (const Pdo& p : pdos)
         if (p.esi->mandatory || !p.esi->exclude.empty())

@@ -153,6 +153,11 @@ class Context {
     // A modular device: the mapping objects of its slots' default modules' PDOs (esi holds the device as
     // configured by default: its own PDOs and objects and those of the default modules).
     std::set<uint16_t> module_mapping_objects;
+    // The module of each slot of device d of f as the slave is judged: --modules, else what the slave's
+    // 0xF050 (Detected Module Ident List) says, else (with a note) each slot's default. Empty without slots.
+    std::vector<std::optional<uint32_t>> modules_of(const EsiFile& f, const EsiDevice& d);
+    std::optional<std::vector<uint32_t>> detected_modules;  // 0xF050 as read (once)
+    std::string detected_modules_error;                     // why 0xF050 could not be read
 
     // Scaled timeout, cut to what is left of the running test's budget (at least 1 ms): a slave that lies
     // or stops answering makes each wait short once the test has used its budget.

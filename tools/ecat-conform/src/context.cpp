@@ -155,11 +155,10 @@ void assign_by_default(EsiDevice& d, const EsiPdo& p) {
 // entries they map). A slot without a default module, or a module the file lacks, stays empty. The mapping
 // objects of the modules' PDOs (0x1600.../0x1A00..., ETG.1000.6 PDO mapping) exist in the device's dictionary
 // although a module's own Dictionary does not list them: they go to mapping_objects.
-// The device with the modules of its slots (modules: a list as esi::parse_module_list takes, "" for each
-// slot's default), their PDOs and objects added as the slave serves them.
+// The device with the modules of its slots (chosen: slot n's module ident, nullopt for an empty slot), their
+// PDOs and objects added as the slave serves them.
 EsiDevice as_configured(const EsiFile& f, EsiDevice d, std::set<uint16_t>& mapping_objects,
-                        const std::string& modules) {
-    const auto chosen = modules.empty() ? esi::default_modules(d) : esi::parse_module_list(f, d, modules);
+                        const std::vector<std::optional<uint32_t>>& chosen) {
     for (const esi::SlotModule& sm : esi::slot_modules(f, d, chosen)) {
         if (sm.module == nullptr) continue;
         for (const esi::SlotPdo& sp : sm.pdos) {
@@ -182,6 +181,59 @@ EsiDevice as_configured(const EsiFile& f, EsiDevice d, std::set<uint16_t>& mappi
 }
 
 }  // namespace
+
+std::vector<std::optional<uint32_t>> Context::modules_of(const EsiFile& f, const EsiDevice& d) {
+    if (d.slots.empty()) return {};
+    if (!opt.modules.empty()) return esi::parse_module_list(f, d, opt.modules);
+    // The modules the slave says it has: 0xF050, Detected Module Ident List (ETG.5001.1), subindex n the
+    // ident of slot n's module, 0 for an empty slot. Read once, in PREOP over CoE.
+    if (!detected_modules) {
+        detected_modules.emplace();
+        std::string why;
+        if (!has_coe()) {
+            why = "the slave has no CoE";
+        } else if (const Error e = to_preop(); e != Error::Ok) {
+            why = "PREOP not reached (" + std::string(master::to_string(e)) + ")";
+        } else if (auto n = upload_uint(0xF050, 0); !n) {
+            why = "0xF050:00 " + sdo_error(n.error());
+        } else {
+            for (uint64_t k = 1; k <= *n && why.empty(); ++k) {
+                if (auto v = upload_uint(0xF050, static_cast<uint8_t>(k)))
+                    detected_modules->push_back(static_cast<uint32_t>(*v));
+                else
+                    why = "0xF050:" + std::to_string(k) + " " + sdo_error(v.error());
+            }
+        }
+        if ((initial_state & 0x0F) == 0x01) (void)to_init();
+        if (!why.empty()) {
+            detected_modules->clear();
+            detected_modules_error = why;
+        }
+    }
+    if (!detected_modules_error.empty()) {
+        notes.push_back("slave " + std::to_string(opt.slave) +
+                        ": its modules could not be read from 0xF050 (" + detected_modules_error +
+                        "); judged against each slot's default module (--modules names them)");
+        return esi::default_modules(d);
+    }
+    std::vector<std::optional<uint32_t>> chosen(d.slots.size());
+    for (std::size_t n = 0; n < detected_modules->size(); ++n) {
+        const uint32_t ident = (*detected_modules)[n];
+        if (ident == 0) continue;
+        const bool taken =
+            n < d.slots.size() && std::find(d.slots[n].module_idents.begin(), d.slots[n].module_idents.end(),
+                                            ident) != d.slots[n].module_idents.end();
+        if (!taken) {
+            notes.push_back("slave " + std::to_string(opt.slave) + ": 0xF050 says slot " +
+                            std::to_string(n + 1) + " holds module " + hex(ident, 8) + ", which the ESI's " +
+                            (n < d.slots.size() ? "slot does not take" : "device has no such slot") +
+                            "; the slot is judged empty");
+            continue;
+        }
+        chosen[n] = ident;
+    }
+    return chosen;
+}
 
 std::string Context::setup() {
     auto n = m.count_slaves();
@@ -228,8 +280,8 @@ std::string Context::setup() {
             if (pick >= static_cast<int>(f.devices.size()))
                 return opt.esi_path + ": no device " + std::to_string(pick) + " (" +
                        std::to_string(f.devices.size()) + " in the file)";
-            esi = as_configured(f, f.devices[static_cast<std::size_t>(pick)], module_mapping_objects,
-                                opt.modules);
+            const EsiDevice& d = f.devices[static_cast<std::size_t>(pick)];
+            esi = as_configured(f, d, module_mapping_objects, modules_of(f, d));
         } catch (const std::exception& e) {
             return std::string("ESI: ") + e.what();
         }
@@ -253,12 +305,12 @@ std::string Context::setup() {
                 const esi::DeviceByIdentity id = esi::find_device(f, sii->dword(0x0A), sii->dword(0x0C));
                 if (id.device && id.revision_matched) {
                     module_mapping_objects.clear();
-                    esi = as_configured(f, *id.device, module_mapping_objects, opt.modules);
+                    esi = as_configured(f, *id.device, module_mapping_objects, modules_of(f, *id.device));
                     return {};
                 }
                 if (id.device && !by_product) {
                     std::set<uint16_t> mapping;
-                    by_product = as_configured(f, *id.device, mapping, opt.modules);
+                    by_product = as_configured(f, *id.device, mapping, modules_of(f, *id.device));
                     by_product_file = path;
                     by_product_mapping = std::move(mapping);
                 }

@@ -189,6 +189,9 @@ struct EsiDevice {
     std::vector<EsiSm> sms;
     std::vector<EsiSlot> slots;                                 // Slots/Slot, in order
     uint32_t slot_pdo_increment = 0, slot_index_increment = 0;  // Slots attributes (a Slot may override)
+    // Slots DownloadModuleIdentList: the configuration tool writes the configured module ident list
+    // (0xF030) to the device, which compares it with the modules it detected (0xF050; ETG.5001.1).
+    bool download_module_ident_list = false;
     std::vector<std::string> unsupported;  // elements present that a reader of this structure ignores
     std::vector<EsiPdo> rxpdos, txpdos;
     bool has_mailbox = false;
