@@ -320,7 +320,7 @@ int Runtime::serve_frames() {
 // converted to clock_ with the offset between the two clocks' "now", read once per burst (a step of the
 // real-time clock moves both). The result is kept within [the time the ESCs were last ticked to, now]: a
 // frame cannot arrive before what the ESCs already did, nor in the future (a stamp from another time base,
-// a clock step). Without stamps (loopback, pcap) the arrival is now, as before.
+// a clock step). Without stamps (LoopbackLink) the arrival is now, as before.
 uint64_t Runtime::arrival_ns(const esc::Link& link, uint64_t now, int64_t& offset, bool& offset_taken) const {
     const uint64_t stamp = link.rx_stamp_ns();
     if (stamp == 0) return now;
