@@ -7,6 +7,7 @@
 #include <net/if.h>
 #include <poll.h>
 #include <sys/socket.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -274,6 +275,39 @@ TEST_P(VethLink, DownAndMissingInterfacesAreClearErrors) {
         }
         slave::delete_interface("s0");
     });
+}
+
+uint64_t realtime_ns() {
+    timespec ts{};
+    ::clock_gettime(CLOCK_REALTIME, &ts);
+    return static_cast<uint64_t>(ts.tv_sec) * 1'000'000'000ull + static_cast<uint64_t>(ts.tv_nsec);
+}
+
+// Each frame carries the time the kernel delivered it (PacketLink: the ring slot's stamp; PcapLink: the same
+// through libpcap, CLOCK_REALTIME), not the time it was read: a frame read after the next was sent, 100 ms
+// later, still has its own arrival.
+TEST_P(VethLink, EachFrameCarriesItsArrivalNotTheTimeItWasRead) {
+    Pair p = make_pair(GetParam());
+    constexpr uint64_t kTruncation = 1000;  // a stamp in microseconds is up to that much earlier
+    const uint64_t before_first = realtime_ns();
+    ASSERT_TRUE(p.master->send(ecat_frame(60, 1)));
+    ::usleep(100'000);
+    const uint64_t before_second = realtime_ns();
+    ASSERT_TRUE(p.master->send(ecat_frame(60, 2)));
+    std::array<uint8_t, esc::kMaxFrameSize> buf{};
+    uint64_t stamps[2] = {};
+    for (uint8_t tag = 1; tag <= 2; ++tag) {
+        ASSERT_EQ(receive_within(*p.slave, buf, 2000), 60u);
+        ASSERT_EQ(buf[17], tag);
+        stamps[tag - 1] = p.slave->rx_stamp_ns();
+        const uint64_t read = realtime_ns();
+        EXPECT_GE(stamps[tag - 1] + kTruncation, tag == 1 ? before_first : before_second)
+            << "frame " << int{tag};
+        EXPECT_LE(stamps[tag - 1], read) << "frame " << int{tag};
+        EXPECT_LE(p.slave->stamp_now_ns() - read, 1'000'000'000ull)
+            << "the stamps' time base is CLOCK_REALTIME";
+    }
+    EXPECT_LT(stamps[0], before_second) << "the first frame's stamp is its arrival, not when it was read";
 }
 
 INSTANTIATE_TEST_SUITE_P(Backends, VethLink, ::testing::Values(std::string("pcap"), std::string("packet")),

@@ -150,6 +150,7 @@ std::size_t PacketLink::receive(std::span<uint8_t> buf) {
                 std::memcpy(buf.data(), data, n);
             }
             n = pad_to_minimum(buf, n);
+            stamp_ns_ = static_cast<uint64_t>(hdr->tp_sec) * 1'000'000'000ull + hdr->tp_nsec;
         }
         __atomic_store_n(&hdr->tp_status, static_cast<uint32_t>(TP_STATUS_KERNEL), __ATOMIC_RELEASE);
         next_ = (next_ + 1) % frame_count_;

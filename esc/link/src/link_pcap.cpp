@@ -37,6 +37,9 @@ PcapLink::PcapLink(const std::string& iface) : iface_(iface) {
     pcap_set_promisc(handle_, 1);
     pcap_set_immediate_mode(handle_, 1);
     pcap_set_timeout(handle_, 1);
+    // The kernel's receive time stamps to the nanosecond where libpcap can (rx_stamp_ns()); microseconds
+    // else.
+    (void)pcap_set_tstamp_precision(handle_, PCAP_TSTAMP_PRECISION_NANO);
     const int rc = pcap_activate(handle_);
     if (rc < 0) {
         const std::string detail = pcap_geterr(handle_);
@@ -55,6 +58,7 @@ PcapLink::PcapLink(const std::string& iface) : iface_(iface) {
                 fail(LinkError::Kind::System, "pcap_activate(" + iface + "): " + detail);
         }
     }
+    stamp_unit_ns_ = pcap_get_tstamp_precision(handle_) == PCAP_TSTAMP_PRECISION_NANO ? 1 : 1000;
     if (pcap_datalink(handle_) != DLT_EN10MB)
         fail(LinkError::Kind::BadArgument, "interface '" + iface + "' is not an Ethernet interface");
     if (pcap_setdirection(handle_, PCAP_D_IN) != 0)
@@ -82,6 +86,8 @@ std::size_t PcapLink::receive(std::span<uint8_t> buf) {
     if (rc != 1 || hdr == nullptr || data == nullptr) return 0;
     const std::size_t n = std::min<std::size_t>(hdr->caplen, buf.size());
     std::memcpy(buf.data(), data, n);
+    stamp_ns_ = static_cast<uint64_t>(hdr->ts.tv_sec) * 1'000'000'000ull +
+                static_cast<uint64_t>(hdr->ts.tv_usec) * stamp_unit_ns_;
     return pad_to_minimum(buf, n);
 }
 

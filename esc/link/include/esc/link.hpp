@@ -6,6 +6,8 @@
 //   UDP) esc/link_packet.hpp    PacketLink    AF_PACKET socket with a TPACKET_V2 memory-mapped receive ring
 //   esc/link_loopback.hpp  LoopbackLink  two in-process ends joined by frame queues (tests)
 //   esc/link_capture.hpp   PcapWriter    records frames to a .pcap file for Wireshark
+#include <time.h>
+
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -31,6 +33,18 @@ class Link {
     virtual bool send(std::span<const uint8_t> frame) = 0;
     // (extension) Short description for logs, e.g. "packet:ecat0".
     virtual std::string describe() const { return {}; }
+    // (extension) When the frame the last receive() returned arrived: the kernel's receive timestamp, in ns
+    // on the time base of stamp_now_ns() (CLOCK_REALTIME for the kernel's stamps); 0 if the link has none.
+    // A frame waits in the link while its reader is busy or descheduled; its stamp says when it came, so the
+    // ESC can take it at that time, as silicon does (docs/decisions/link.md, "Receive timestamps").
+    virtual uint64_t rx_stamp_ns() const { return 0; }
+    // (extension) Now, on the time base of rx_stamp_ns(). A reader converts a stamp to its own clock with the
+    // difference of the two clocks' "now".
+    virtual uint64_t stamp_now_ns() const {
+        timespec ts{};
+        ::clock_gettime(CLOCK_REALTIME, &ts);
+        return static_cast<uint64_t>(ts.tv_sec) * 1'000'000'000ull + static_cast<uint64_t>(ts.tv_nsec);
+    }
 };
 
 // Why a link could not be opened. The message says what to do about it.

@@ -7,7 +7,8 @@
 // after a retire timeout of at least a millisecond). Own transmissions are dropped by PACKET_IGNORE_OUTGOING
 // and, as a second line, by skipping slots marked PACKET_OUTGOING. The interface is put in promiscuous mode
 // (PACKET_MR_PROMISC) because masters do not always send to broadcast. Sends with send() on the bound socket,
-// bypassing the qdisc (PACKET_QDISC_BYPASS).
+// bypassing the qdisc (PACKET_QDISC_BYPASS). Each slot carries the kernel's receive time stamp
+// (rx_stamp_ns()).
 #include <string>
 
 #include "esc/link.hpp"
@@ -26,6 +27,9 @@ class PacketLink final : public Link {
     std::size_t receive(std::span<uint8_t> buf) override;
     bool send(std::span<const uint8_t> frame) override;
     std::string describe() const override { return "packet:" + iface_; }
+    // The ring slot's time stamp (tp_sec/tp_nsec, CLOCK_REALTIME): taken by the kernel when it delivered the
+    // frame to the socket, whether or not this process was running then.
+    uint64_t rx_stamp_ns() const override { return stamp_ns_; }
 
   private:
     std::string iface_;
@@ -35,7 +39,8 @@ class PacketLink final : public Link {
     std::size_t ring_size_ = 0;
     std::size_t frame_size_ = 0;
     std::size_t frame_count_ = 0;
-    std::size_t next_ = 0;  // ring slot to look at next
+    std::size_t next_ = 0;   // ring slot to look at next
+    uint64_t stamp_ns_ = 0;  // receive time stamp of the frame receive() returned last, 0: none
 };
 
 }  // namespace esc

@@ -315,18 +315,55 @@ int Runtime::serve_frames() {
     return n;
 }
 
-// Each frame from the master is walked through the segment.
+// A frame waits in the link while the runtime is busy, descheduled or stopped; a hardware ESC took it when it
+// came. So it is taken at its arrival: the link's receive time stamp (the kernel's, CLOCK_REALTIME)
+// converted to clock_ with the offset between the two clocks' "now", read once per burst (a step of the
+// real-time clock moves both). The result is kept within [the time the ESCs were last ticked to, now]: a
+// frame cannot arrive before what the ESCs already did, nor in the future (a stamp from another time base,
+// a clock step). Without stamps (LoopbackLink) the arrival is now, as before.
+uint64_t Runtime::arrival_ns(const esc::Link& link, uint64_t now, int64_t& offset, bool& offset_taken) const {
+    const uint64_t stamp = link.rx_stamp_ns();
+    if (stamp == 0) return now;
+    if (!offset_taken) {
+        offset = static_cast<int64_t>(clock_.now_ns() - link.stamp_now_ns());
+        offset_taken = true;
+    }
+    const int64_t at = static_cast<int64_t>(stamp) + offset;
+    const int64_t lo = static_cast<int64_t>(ticked_ns_), hi = static_cast<int64_t>(now);
+    return static_cast<uint64_t>(std::min(std::max(at, lo), hi));
+}
+
+// The ESCs' timers are silicon and run at their time: ticked to a frame's arrival before it is walked, a
+// SYNC0 pulse due before the frame comes before it, and a watchdog the frame refreshes in time does not
+// expire (ticking to now first expired the process-data watchdog of a slave stopped for longer than the
+// watchdog while the master's frames kept coming). An ESC on a clock of its own cannot be taken to a time
+// of clock_: it is ticked at its own now, after the burst (service()).
+void Runtime::tick_escs(uint64_t t) {
+    ticked_ns_ = t;
+    const int count = static_cast<int>(segment_.size());
+    for (int k = 0; k < count; ++k) {
+        if (!segment_.powered(k)) continue;
+        esc::Esc& e = segment_.esc(k);
+        if (&e.clock() == &clock_) e.tick(t);
+    }
+}
+
+// Each frame from the master is walked through the segment at its arrival.
 int Runtime::handle_frames() {
+    int64_t offset = 0;
+    bool offset_taken = false;
     int i = 0;
     for (; i < kMaxBurst; ++i) {
         const std::size_t len = link_.receive(buffer_);
         if (len == 0) break;
         const uint64_t rx_ns = clock_.now_ns();
+        const uint64_t at = arrival_ns(link_, rx_ns, offset, offset_taken);
         ++stats_.frames_received;
         if (reply_count_ != 0 && rx_ns - reply_first_ns_ >= kReplyCoalesceNs) flush_replies();
         std::span<uint8_t> frame(buffer_.data(), len);
         if (capture_ != nullptr) std::memcpy(in_copy_.data(), buffer_.data(), len);
-        const esc::Segment::Result result = segment_.walk(frame, rx_ns);
+        if (at > ticked_ns_) tick_escs(at);
+        const esc::Segment::Result result = segment_.walk(frame, at);
         const uint64_t done = clock_.now_ns();
         log_frame_time(done - rx_ns);
         stats_.frame_ns_total += done - rx_ns;
@@ -351,14 +388,17 @@ void Runtime::log_frame_time(uint64_t ns) {
 
 // Frames that come back on the out link (from the devices behind the external port).
 int Runtime::handle_out_frames() {
+    int64_t offset = 0;
+    bool offset_taken = false;
     int i = 0;
     for (; i < kMaxBurst; ++i) {
         const std::size_t len = out_->receive(buffer_);
         if (len == 0) break;
-        const uint64_t rx_ns = clock_.now_ns();
+        const uint64_t at = arrival_ns(*out_, clock_.now_ns(), offset, offset_taken);
         ++stats_.frames_resumed;
         std::span<uint8_t> frame(buffer_.data(), len);
-        const esc::Segment::Result result = segment_.resume(frame, rx_ns);
+        if (at > ticked_ns_) tick_escs(at);
+        const esc::Segment::Result result = segment_.resume(frame, at);
         segment_result(result, frame, clock_.now_ns());
         if (capture_ != nullptr && result.kind == esc::Segment::Result::Kind::Reply) capture_->write(frame);
     }
@@ -448,24 +488,24 @@ void Runtime::poll_carrier(uint64_t now) {
 }
 
 void Runtime::service() {
-    // One clock read for the segment: its ESCs count the runtime's clock (each with its own drift).
-    const uint64_t now = clock_.now_ns();
     ++stats_.services;
+    // Frames before the firmware: one that came while the last work ran (a burst, the control socket, a
+    // spin) is answered before the firmware runs (a look at the receive ring when none waits). Each is taken
+    // at its arrival, the ESCs' timers ticked to it first (tick_escs()): a SYNC0 pulse due before the frame
+    // arrived comes before it, as on hardware (answering the frame first put a cycle's LRW before the SYNC0
+    // that precedes it, and a chain of two processes counted SM events missed, integration_segment_chain),
+    // and one due after it comes after it.
+    serve_frames();
+    // Then the ESCs' timers to now, with one clock read for the segment: its ESCs count the runtime's clock
+    // (each with its own drift).
+    const uint64_t now = clock_.now_ns();
+    tick_escs(now);
     const int count = static_cast<int>(segment_.size());
     for (int k = 0; k < count; ++k) {
         if (!segment_.powered(k)) continue;
         esc::Esc& e = segment_.esc(k);
-        if (&e.clock() == &clock_)
-            e.tick(now);
-        else
-            e.tick();
+        if (&e.clock() != &clock_) e.tick();
     }
-    // Frames before the firmware: one that came while the last work ran (a burst, the control socket, a
-    // spin) is answered before the firmware runs (a look at the receive ring when none waits). After the
-    // ESCs' own timers, which are silicon and run at their time: a SYNC0 pulse due before the frame arrived
-    // comes before it, as on hardware (answering the frame first put a cycle's LRW before the SYNC0 that
-    // precedes it, and a chain of two processes counted SM events missed, integration_segment_chain).
-    serve_frames();
     if (hold_count_ != 0) release_held(now);
     if (carrier_check_) poll_carrier(now);
     if (firmware_ != nullptr) firmware_->poll(now);

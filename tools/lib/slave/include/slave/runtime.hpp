@@ -4,11 +4,13 @@
 // there is one loop and one frame path, whatever the number of devices.
 //
 //   epoll_wait(link fd, out link fd, timerfd, stop eventfd, firmware control fd)
-//   for each frame waiting (a burst, at most kMaxBurst):  rx time = clock now
-//       segment.walk(frame, rx time); a reply joins the burst's batch; record in/out to the capture
-//   send the batch; then tick every powered ESC and firmware.poll(now) (after the replies: the firmware
-//   never delays a frame); re-arm the timerfd (CLOCK_MONOTONIC, TFD_TIMER_ABSTIME) for the earliest of the
-//   ESCs' events, the firmware's deadline, a held reply and the carrier poll
+//   for each frame waiting (a burst, at most kMaxBurst):  rx time = when it arrived (the link's receive
+//       time stamp on the clock, else clock now); tick every powered ESC to it (a SYNC0 pulse or a watchdog
+//       due before the frame comes before it); segment.walk(frame, rx time); a reply joins the burst's
+//       batch; record in/out to the capture
+//   send the batch; then tick every powered ESC to now and firmware.poll(now) (after the replies: the
+//   firmware never delays a frame); re-arm the timerfd (CLOCK_MONOTONIC, TFD_TIMER_ABSTIME) for the earliest
+//   of the ESCs' events, the firmware's deadline, a held reply and the carrier poll
 //
 // How it waits for a timed event (a SYNC0 pulse, the application cycle, a watchdog) is a choice:
 //   default        sleeps on the timerfd to the deadline: the wake-up is as late as the platform's timer
@@ -151,6 +153,11 @@ class Runtime final : private FrameService {
     int handle_frames();          // returns the number of frames received
     int serve_frames() override;  // FrameService: frames that came while other work ran
     int handle_out_frames();
+    // When the frame link.receive() returned last arrived, on clock_: its receive time stamp converted with
+    // `offset` (clock_ minus the link's time base, taken once per burst into *offset_taken), kept within
+    // [ticked_ns_, now]; now if the link has no stamps.
+    uint64_t arrival_ns(const esc::Link& link, uint64_t now, int64_t& offset, bool& offset_taken) const;
+    void tick_escs(uint64_t t);  // every powered ESC on clock_ to t
     void segment_result(const esc::Segment::Result& result, std::span<uint8_t> frame, uint64_t now);
     void release_held(uint64_t now);
     void send_reply(std::span<const uint8_t> frame, uint64_t now);
@@ -185,6 +192,7 @@ class Runtime final : private FrameService {
     uint64_t last_pass_ns_ = 0;           // clock at the last pass of a busy loop, 0: not in one
     std::atomic<bool> stop_flag_{false};  // set with the stop eventfd, cheap to test while spinning
     int control_fd_ = -1;                 // the firmware's control descriptor registered with epoll, -1: none
+    uint64_t ticked_ns_ = 0;              // clock time the ESCs were last ticked to
     uint64_t deadline_ns_ = 0;            // next deadline, computed by service() (and when the parts change)
     uint64_t armed_ns_ = 0;               // deadline the timerfd is armed for; 0 = not armed or expired
     uint64_t flushed_frames_ = 0;         // capture frames already pushed to the file
