@@ -696,7 +696,8 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
     if (!d.slots.empty()) {
         xmlNodePtr slots = child(device, "Slots");
         for (const od::Slot& slot : d.slots) {
-            if (slot.module_idents.empty()) continue;  // the schema needs a ModuleIdent
+            // The schema needs a ModuleIdent or a ModuleClass (SlotType: a choice of the two).
+            if (slot.module_idents.empty() && slot.module_classes.empty()) continue;
             xmlNodePtr sl = child(slots, "Slot");
             attr(sl, "MinInstances", std::to_string(slot.min_instances));
             attr(sl, "MaxInstances", std::to_string(slot.max_instances));
@@ -707,6 +708,13 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
                 xmlNodePtr mi = child(sl, "ModuleIdent", hex32(ident));
                 if (ident == slot.default_module) attr(mi, "Default", "1");
             }
+            if (slot.module_idents.empty())
+                for (const od::ModuleClass& c : slot.module_classes) {
+                    xmlNodePtr mc = child(sl, "ModuleClass");
+                    child(mc, "Class", c.class_name);
+                    if (!c.any_vendor) child(mc, "VendorId", hex32(c.vendor_id));
+                    if (!c.name.empty()) named(mc, "Name", c.name);
+                }
         }
     }
 
@@ -727,6 +735,7 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
             xmlNodePtr mn = child(modules, "Module");
             xmlNodePtr t = child(mn, "Type", mod.type);
             attr(t, "ModuleIdent", hex32(mod.ident));
+            if (!mod.module_class.empty()) attr(t, "ModuleClass", mod.module_class);
             named(mn, "Name", mod.name.empty() ? mod.type : mod.name);
             for (const bool rx : {true, false})
                 for (const od::ModulePdo& p : mod.pdos)

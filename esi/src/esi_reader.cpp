@@ -486,7 +486,13 @@ EsiDevice read_device(Node dev, const TypeMap& types_in, uint32_t vendor, const 
                 slot.module_idents.push_back(ident);
                 if (truthy(attr(mi, "Default")) && !slot.default_module) slot.default_module = ident;
             }
-            if (child(sl, "ModuleClass")) d.unsupported.push_back("Slots/Slot/ModuleClass");
+            for (Node mc : children(sl, "ModuleClass")) {
+                EsiModuleClass c;
+                c.class_name = text(mc, "Class");
+                if (Node v = child(mc, "VendorId")) c.vendor_id = static_cast<uint32_t>(number(text(v)));
+                c.name = name_text(mc);
+                slot.module_classes.push_back(std::move(c));
+            }
             d.slots.push_back(std::move(slot));
         }
     }
@@ -507,6 +513,7 @@ EsiModule read_module(Node mod, const TypeMap& device_types) {
     Node type = child(mod, "Type");
     m.ident = static_cast<uint32_t>(number(attr(type, "ModuleIdent")));
     m.type_name = text(type);
+    m.module_class = attr(type, "ModuleClass");
     m.name = name_text(mod);
     m.line = line_of(mod);
     read_pdos(mod, "RxPdo", true, m.rxpdos);

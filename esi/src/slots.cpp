@@ -60,18 +60,28 @@ std::vector<std::optional<uint32_t>> parse_module_list(const EsiFile& file, cons
             const EsiModule* o = file.module(ident);
             offered += " " + (o != nullptr ? o->type_name + " (" + hex8(ident) + ")" : hex8(ident));
         }
+        for (const EsiModuleClass& c : slot.module_classes)
+            offered += " class " + c.class_name + (c.vendor_id ? " of vendor " + hex8(*c.vendor_id) : "");
         if (m == nullptr)
             throw InputError(file.source, slot.line,
                              "slot " + std::to_string(n + 1) + ": no module '" + item +
                                  "' in the file; the slot takes:" + offered);
-        if (std::find(slot.module_idents.begin(), slot.module_idents.end(), m->ident) ==
-            slot.module_idents.end())
+        if (!slot_takes(file, slot, *m))
             throw InputError(file.source, slot.line,
                              "slot " + std::to_string(n + 1) + " does not take module " + m->type_name +
                                  "; it takes:" + offered);
         out[n] = m->ident;
     }
     return out;
+}
+
+bool slot_takes(const EsiFile& f, const EsiSlot& s, const EsiModule& m) {
+    if (std::find(s.module_idents.begin(), s.module_idents.end(), m.ident) != s.module_idents.end())
+        return true;
+    if (m.module_class.empty()) return false;
+    return std::any_of(s.module_classes.begin(), s.module_classes.end(), [&](const EsiModuleClass& c) {
+        return c.class_name == m.module_class && (!c.vendor_id || *c.vendor_id == f.vendor_id);
+    });
 }
 
 std::vector<std::optional<uint32_t>> default_modules(const EsiDevice& d) {

@@ -22,6 +22,7 @@
 #include "esi/esi_reader.hpp"
 #include "esi/model.hpp"
 #include "esi/sii.hpp"
+#include "esi/slots.hpp"
 
 #ifndef SOFTECAT_ESI_SCHEMA
 #error "SOFTECAT_ESI_SCHEMA must be defined"
@@ -169,11 +170,15 @@ std::vector<std::string> describe(const od::Product& p) {
           << slot.index_increment << " takes";
         for (uint32_t x : slot.module_idents)
             o << " " << x;
+        for (const od::ModuleClass& c : slot.module_classes)
+            o << " class " << c.class_name << (c.any_vendor ? "" : " of ") << (c.any_vendor ? 0 : c.vendor_id)
+              << " '" << c.name << "'";
         out.push_back(o.str());
     }
     for (const od::Module& mod : d.modules) {
         std::ostringstream o;
-        o << std::hex << "module " << mod.ident << " " << mod.type << " '" << mod.name << "'";
+        o << std::hex << "module " << mod.ident << " " << mod.type << " class '" << mod.module_class << "' '"
+          << mod.name << "'";
         for (const od::ModulePdo& mp : mod.pdos) {
             o << " pdo " << mp.index << (mp.rx ? "r" : "t") << mp.sm << (mp.depend_on_slot ? "+" : "") << ":";
             for (const od::ModulePdoEntry& e : mp.entries)
@@ -653,6 +658,85 @@ TEST(EsiExamples, TheModularDeviceServesTheDefaultModulesOfItsSlots) {
     EXPECT_EQ(std::count_if(p.warnings.begin(), p.warnings.end(),
                             [](const std::string& w) { return w.find("Mailbox/EoE") != std::string::npos; }),
               1);
+}
+
+// ETG.2000 SlotType is a choice: a slot lists the modules it takes by ModuleIdent, or by ModuleClass (Class,
+// an optional VendorId), a module declaring its class in Type@ModuleClass. class-io.xml: slot 1 takes classes
+// exc_dig_in and exc_dig_out (of vendor 0x0A5E, the file's), slot 2 exc_dig_out, slot 3 exc_ana_in of another
+// vendor (so not the file's EXC-AI1).
+TEST(EsiExamples, ASlotTakesTheModulesOfTheClassesItNames) {
+    const std::string f = example("class-io.xml").string();
+    const esi::EsiFile file = esi::read_esi_file(f);
+    ASSERT_EQ(file.devices.size(), 1u);
+    const esi::EsiDevice& dev = file.devices[0];
+    EXPECT_TRUE(dev.unsupported.empty()) << ::testing::PrintToString(dev.unsupported);
+    ASSERT_EQ(dev.slots.size(), 3u);
+    ASSERT_EQ(dev.slots[0].module_classes.size(), 2u);
+    EXPECT_TRUE(dev.slots[0].module_idents.empty());
+    EXPECT_EQ(dev.slots[0].module_classes[0].class_name, "exc_dig_in");
+    EXPECT_FALSE(dev.slots[0].module_classes[0].vendor_id.has_value());
+    EXPECT_EQ(dev.slots[0].module_classes[0].name, "Digital input terminals");  // the English name
+    EXPECT_EQ(dev.slots[0].module_classes[1].vendor_id, 0x00000A5Eu);
+    ASSERT_EQ(file.modules.size(), 3u);
+    EXPECT_EQ(file.modules[0].module_class, "exc_dig_in");
+    const esi::EsiModule &di = file.modules[0], &dout = file.modules[1], &ai = file.modules[2];
+    EXPECT_TRUE(esi::slot_takes(file, dev.slots[0], di));
+    EXPECT_TRUE(esi::slot_takes(file, dev.slots[0], dout));
+    EXPECT_FALSE(esi::slot_takes(file, dev.slots[1], di));
+    EXPECT_TRUE(esi::slot_takes(file, dev.slots[1], dout));
+    EXPECT_FALSE(esi::slot_takes(file, dev.slots[2], ai));  // the class of vendor 2, not this file's vendor
+    esi::EsiFile other_vendor = file;
+    other_vendor.vendor_id = 2;
+    EXPECT_TRUE(esi::slot_takes(other_vendor, other_vendor.devices[0].slots[2], other_vendor.modules[2]));
+    EXPECT_FALSE(esi::slot_takes(other_vendor, other_vendor.devices[0].slots[0], other_vendor.modules[1]));
+
+    // No default for a class: the default configuration holds no modules.
+    EXPECT_TRUE(esi::default_slot_modules(file, dev).empty());
+    // A module list chooses by class: the slot's index increment moves the module's objects.
+    const od::Product p = esi::load_product(file, "EXC9150@EXC-DI4,#x2104");
+    const od::Dictionary d = p.make_dictionary(p.description);
+    ASSERT_NE(d.find(0x6000, 4), nullptr);
+    ASSERT_NE(d.find(0x7010, 4), nullptr);
+    EXPECT_EQ(d.find(0x7000, 1), nullptr);
+    // The written ESI cannot keep this choice (a ModuleClass marks no default): a warning per such slot says
+    // so.
+    EXPECT_EQ(
+        std::count_if(p.warnings.begin(), p.warnings.end(),
+                      [](const std::string& w) { return w.find("marks no default") != std::string::npos; }),
+        2)
+        << ::testing::PrintToString(p.warnings);
+    // A module of another class, or of the class of another vendor, is refused naming what the slot takes.
+    try {
+        (void)esi::load_product(file, "EXC9150@-,EXC-DI4");
+        ADD_FAILURE() << "slot 2 took a module of a class it does not name";
+    } catch (const esi::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("class exc_dig_out"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW((void)esi::load_product(file, "EXC9150@-,-,EXC-AI1"), esi::InputError);
+
+    // Written back: the classes of each slot, the class of each module a slot takes (EXC-AI1: none takes it),
+    // valid against the schema, read to the same device, and written again to the same text.
+    const od::Product q = esi::load_product(file, "");
+    ASSERT_EQ(q.description.slots.size(), 3u);
+    EXPECT_EQ(q.description.slots[2].module_classes.size(), 1u);
+    ASSERT_EQ(q.description.modules.size(), 2u);
+    EXPECT_EQ(q.description.modules[1].module_class, "exc_dig_out");
+    std::string xml;
+    const od::Product r = round_trip(q, &xml);
+    EXPECT_TRUE(schema_errors(xml).empty()) << ::testing::PrintToString(schema_errors(xml));
+    EXPECT_NE(xml.find("<Class>exc_dig_out</Class>"), std::string::npos);
+    EXPECT_NE(xml.find("ModuleClass=\"exc_dig_in\""), std::string::npos);
+    expect_same(describe(q), describe(r), "round trip");
+    std::string again;
+    (void)round_trip(r, &again);
+    EXPECT_EQ(xml, again);
+    const esi::EsiFile back = esi::read_esi_text(xml, "back.xml");
+    ASSERT_EQ(back.devices[0].slots.size(), 3u);
+    EXPECT_EQ(back.devices[0].slots[0].module_classes[1].vendor_id, 0x00000A5Eu);
+    EXPECT_FALSE(back.devices[0].slots[1].module_classes[0].vendor_id.has_value());
+    EXPECT_EQ(back.devices[0].slots[0].module_classes[0].name, "Digital input terminals");
+    EXPECT_EQ(esi::parse_module_list(back, back.devices[0], "EXC-DI4,EXC-DO4"),
+              (std::vector<std::optional<uint32_t>>{0x1104u, 0x2104u, std::nullopt}));
 }
 
 // ETG.5001.1 module ident lists: 0xF050 (Detected Module Ident List) says the module of each slot served, 0

@@ -757,11 +757,21 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
         s.min_instances = slot.min_instances;
         s.max_instances = slot.max_instances;
         s.module_idents = slot.module_idents;
-        // The module served in the slot: the ESI written back serves the same device.
+        for (const EsiModuleClass& c : slot.module_classes)
+            s.module_classes.push_back(
+                od::ModuleClass{c.class_name, !c.vendor_id.has_value(), c.vendor_id.value_or(0), c.name});
+        // The module served in the slot: the ESI written back serves the same device. A ModuleClass has no
+        // Default (ETG.2000 SlotType), so a slot that names classes is written empty by default.
         s.default_module = n < modules.size() ? modules[n].value_or(0) : 0;
+        if (s.default_module != 0 && slot.module_idents.empty())
+            ctx.warn(slot.line, "slot " + std::to_string(n + 1) +
+                                    " takes modules by ModuleClass, which marks no default: an ESI written "
+                                    "back (--write-esi) leaves the slot empty by default");
         s.pdo_increment = slot.pdo_increment.value_or(d.slot_pdo_increment);
         s.index_increment = slot.index_increment.value_or(d.slot_index_increment);
         offered.insert(slot.module_idents.begin(), slot.module_idents.end());
+        for (const EsiModule& m : file.modules)
+            if (slot_takes(file, slot, m)) offered.insert(m.ident);
         desc.slots.push_back(std::move(s));
     }
     for (const EsiModule& m : file.modules) {
@@ -769,6 +779,7 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
         od::Module mod;
         mod.ident = m.ident;
         mod.type = m.type_name;
+        mod.module_class = m.module_class;
         mod.name = m.name;
         for (const auto* list : {&m.rxpdos, &m.txpdos})
             for (const EsiPdo& p : *list) {

@@ -128,16 +128,25 @@ struct ModulePdo {
     std::vector<ModulePdoEntry> entries;
 };
 struct Module {
-    uint32_t ident = 0;  // ModuleIdent
-    std::string type;    // Type text
+    uint32_t ident = 0;        // ModuleIdent
+    std::string type;          // Type text
+    std::string module_class;  // Type ModuleClass ("": none)
     std::string name;
     std::vector<ModulePdo> pdos;
+};
+// A class of modules a slot takes (ETG.2000 Slot/ModuleClass): any module of that class, of that vendor.
+struct ModuleClass {
+    std::string class_name;
+    bool any_vendor = true;  // false: only vendor_id's
+    uint32_t vendor_id = 0;
+    std::string name;
 };
 struct Slot {
     std::string name;
     uint32_t min_instances = 0, max_instances = 1;
-    std::vector<uint32_t> module_idents;  // the modules it takes
-    uint32_t default_module = 0;          // 0: empty by default
+    std::vector<uint32_t> module_idents;      // the modules it takes
+    std::vector<ModuleClass> module_classes;  // or the classes of modules it takes
+    uint32_t default_module = 0;              // 0: empty by default
     uint32_t pdo_increment = 0, index_increment = 0;
 };
 

@@ -220,9 +220,12 @@ std::vector<std::optional<uint32_t>> Context::modules_of(const EsiFile& f, const
     for (std::size_t n = 0; n < detected_modules->size(); ++n) {
         const uint32_t ident = (*detected_modules)[n];
         if (ident == 0) continue;
+        const esi::EsiModule* mod = f.module(ident);
         const bool taken =
-            n < d.slots.size() && std::find(d.slots[n].module_idents.begin(), d.slots[n].module_idents.end(),
-                                            ident) != d.slots[n].module_idents.end();
+            n < d.slots.size() &&
+            (mod != nullptr ? esi::slot_takes(f, d.slots[n], *mod)
+                            : std::find(d.slots[n].module_idents.begin(), d.slots[n].module_idents.end(),
+                                        ident) != d.slots[n].module_idents.end());
         if (!taken) {
             notes.push_back("slave " + std::to_string(opt.slave) + ": 0xF050 says slot " +
                             std::to_string(n + 1) + " holds module " + hex(ident, 8) + ", which the ESI's " +

@@ -130,11 +130,20 @@ struct EsiOpMode {
 };
 
 // Slots/Slot: one place of a modular device and the modules it takes (ModuleIdent, the Default one).
+// Slot/ModuleClass: the slot takes any module whose Type ModuleClass is this class (of this vendor, when
+// given; a module's vendor is its file's).
+struct EsiModuleClass {
+    std::string class_name;             // Class
+    std::optional<uint32_t> vendor_id;  // VendorId
+    std::string name;                   // Name (the English one where a file gives several languages)
+};
+
 struct EsiSlot {
     std::string name;
     uint32_t min_instances = 0, max_instances = 0;
     std::vector<uint32_t> module_idents;
-    std::optional<uint32_t> default_module;                  // ModuleIdent with Default="1"
+    std::vector<EsiModuleClass> module_classes;  // instead of module_idents (ETG.2000 SlotType is a choice)
+    std::optional<uint32_t> default_module;      // ModuleIdent with Default="1"
     std::optional<uint32_t> pdo_increment, index_increment;  // SlotPdoIncrement / SlotIndexIncrement
     int line = 0;
 };
@@ -143,6 +152,7 @@ struct EsiSlot {
 struct EsiModule {
     uint32_t ident = 0;  // Type ModuleIdent
     std::string type_name;
+    std::string module_class;  // Type ModuleClass ("": none)
     std::string name;
     std::vector<EsiPdo> rxpdos, txpdos;
     std::map<uint16_t, EsiObject> objects;  // Profile/Dictionary/Objects (base indices)

@@ -38,11 +38,15 @@ struct SlotModule {
 // end: the slot is empty). The pointers point into f and d.
 std::vector<SlotModule> slot_modules(const EsiFile& f, const EsiDevice& d,
                                      const std::vector<std::optional<uint32_t>>& modules);
-// The default configuration: each slot's default module.
+// Whether slot s of a device of f takes module m: m's ident is one the slot lists, or m's Type ModuleClass is
+// a class the slot lists (and the class's VendorId, when given, is f's vendor).
+bool slot_takes(const EsiFile& f, const EsiSlot& s, const EsiModule& m);
+// The default configuration: each slot's default module (none in a slot that names classes).
 std::vector<std::optional<uint32_t>> default_modules(const EsiDevice& d);
 std::vector<SlotModule> default_slot_modules(const EsiFile& f, const EsiDevice& d);
 // The modules a list names, one item per slot in order, comma-separated: a module's Type name (any case) or
-// ModuleIdent (0x, #x or decimal), "-" or nothing for an empty slot; slots past the list are empty
+// ModuleIdent (0x, #x or decimal) of a module the slot takes (slot_takes), "-" or nothing for an empty slot;
+// slots past the list are empty
 // ("EXM-DI8,-,EXM-AI2"; ecat-slave --device SPEC@LIST, ecat-conform --modules LIST). Throws InputError naming
 // the file for a module the file lacks or the slot does not take, more items than slots, or a device
 // without slots.
