@@ -447,6 +447,30 @@ def sii_cat_byte(cat, off, fn):
     return mutate
 
 
+def sii_cat_removed(cats):
+    """SII reads of the header word of every category whose type is in `cats` read 0 (ETG.2010 category type
+    0, NOP: a category a reader passes over), as an EEPROM image without those categories would. The chain is
+    walked as in sii_cat_byte."""
+
+    def mutate(st, d):
+        if not d.covers(0x0508, 4):
+            return
+        a = st.reg(0x0504, 4)
+        n = min(d.ado + d.n, 0x0510) - 0x0508
+        words = st.scratch.setdefault("sii-words", {})
+        for i in range(n // 2):
+            words[a + i] = d.get(0x0508 + 2 * i)
+        w = 0x40
+        while w in words and words[w] != 0xFFFF:
+            if words[w] in cats and a <= w < a + n // 2:  # the header may be read before its length word
+                d.put(0x0508 + 2 * (w - a), 0)
+            if w + 1 not in words:
+                break
+            w += 2 + words[w + 1]
+
+    return mutate
+
+
 def abort_code(mapping, indices=None):
     """Abort SDO transfer requests whose code is in `mapping` get the mapped code (a wrong code for the
     situation), for `indices` only when given."""
@@ -952,6 +976,8 @@ VARIATIONS = {
                             "family (data cannot be transferred or stored)", abort_code({0x08000022: 0x08000020})),
     "event-request-pending": ("ESC datasheet 0x0210: DC latch, DL status, AL status and SM events pending are "
                               "defined bits, any value", reg_rewriter(0x0210, set_bits(0x0FFD))),
+    "sii-no-pdo-categories": ("ETG.2010 TxPDO/RxPDO categories: a slave with CoE describes its PDOs in its "
+                              "dictionary, an EEPROM image may leave the categories out", sii_cat_removed({50, 51})),
     "eeprom-emulated": ("ESC datasheet 0x0502 bit 5: EEPROM emulated by the PDI (a silicon/firmware option)",
                         reg_rewriter(0x0502, set_bits(0x0020))),
 }

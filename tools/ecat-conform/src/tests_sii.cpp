@@ -94,8 +94,15 @@ Outcome pdo_vs_esi(Context& ctx, uint16_t type) {
     CONFORM_NEED(ctx.need_sii());
     const auto& esi = type == kTxPdo ? ctx.esi->txpdos : ctx.esi->rxpdos;
     std::vector<SiiPdo> pdos;
-    if (const SiiCategory* c = ctx.sii->find(type)) parse_pdos(ctx.sii->data(*c), pdos);
+    const SiiCategory* category = ctx.sii->find(type);
+    if (category) parse_pdos(ctx.sii->data(*category), pdos);
     if (esi.empty() && pdos.empty()) return skip("no PDOs of this direction in ESI or SII");
+    // A slave with CoE describes its PDOs in its object dictionary (0x1C12/0x1C13 and the mapping objects),
+    // where masters read them; the SII's PDO categories are for devices without CoE (ETG.2010), and EEPROM
+    // images made for CoE devices often leave them out. One that is there must still be right.
+    if (!category && ctx.has_coe())
+        return skip(std::string("no ") + (type == kTxPdo ? "TXPDO" : "RXPDO") +
+                    " category: the slave announces CoE, whose dictionary describes its PDOs");
     std::map<uint16_t, const EsiPdo*> by_index;
     for (const auto& p : esi)
         by_index.emplace(p.index, &p);
