@@ -421,52 +421,60 @@ def od_list_reversed(st, m):
     return m
 
 
+def sii_read_categories(st, d):
+    """For a read of the SII data registers (0x0508..): (a, n, headers), where a is the word address read, n the
+    bytes of data the datagram covers, and headers the word addresses of the category headers (ETG.2010,
+    from word 0x40) known from the words the master has read so far (it reads the SII in order), as the proxy
+    sees them before any change. A header is listed as soon as it is read, before its length word. None for
+    other datagrams."""
+    if not d.covers(0x0508, 4):
+        return None
+    a = st.reg(0x0504, 4)
+    n = min(d.ado + d.n, 0x0510) - 0x0508
+    words = st.scratch.setdefault("sii-words", {})
+    for i in range(n // 2):
+        words[a + i] = d.get(0x0508 + 2 * i)
+    headers = []
+    w = 0x40
+    while w in words and words[w] != 0xFFFF:
+        headers.append((w, words[w]))
+        if w + 1 not in words:
+            break
+        w += 2 + words[w + 1]
+    return a, n, headers
+
+
 def sii_cat_byte(cat, off, fn):
-    """SII reads of byte `off` of the data of the first category of type `cat` (ETG.2010 categories from word
-    0x40): fn(byte) -> byte. The category chain is walked through the words the master has read so far (it
-    reads the SII in order), as the proxy sees them before any change."""
+    """SII reads of byte `off` of the data of the first category of type `cat`: fn(byte) -> byte."""
 
     def mutate(st, d):
-        if not d.covers(0x0508, 4):
+        r = sii_read_categories(st, d)
+        if r is None:
             return
-        a = st.reg(0x0504, 4)
-        n = min(d.ado + d.n, 0x0510) - 0x0508
-        words = st.scratch.setdefault("sii-words", {})
-        for i in range(n // 2):
-            words[a + i] = d.get(0x0508 + 2 * i)
-        w = 0x40
-        while w in words and w + 1 in words and words[w] != 0xFFFF:
-            if words[w] == cat:
+        a, n, headers = r
+        for w, kind in headers:
+            if kind == cat:
                 target = w + 2 + off // 2
                 if a <= target < a + n // 2:
                     reg = 0x0508 + 2 * (target - a) + off % 2
                     d.put(reg, fn(d.get(reg, 1)), 1)
                 return
-            w += 2 + words[w + 1]
 
     return mutate
 
 
 def sii_cat_removed(cats):
     """SII reads of the header word of every category whose type is in `cats` read 0 (ETG.2010 category type
-    0, NOP: a category a reader passes over), as an EEPROM image without those categories would. The chain is
-    walked as in sii_cat_byte."""
+    0, NOP: a category a reader passes over), as an EEPROM image without those categories would."""
 
     def mutate(st, d):
-        if not d.covers(0x0508, 4):
+        r = sii_read_categories(st, d)
+        if r is None:
             return
-        a = st.reg(0x0504, 4)
-        n = min(d.ado + d.n, 0x0510) - 0x0508
-        words = st.scratch.setdefault("sii-words", {})
-        for i in range(n // 2):
-            words[a + i] = d.get(0x0508 + 2 * i)
-        w = 0x40
-        while w in words and words[w] != 0xFFFF:
-            if words[w] in cats and a <= w < a + n // 2:  # the header may be read before its length word
+        a, n, headers = r
+        for w, kind in headers:
+            if kind in cats and a <= w < a + n // 2:
                 d.put(0x0508 + 2 * (w - a), 0)
-            if w + 1 not in words:
-                break
-            w += 2 + words[w + 1]
 
     return mutate
 
