@@ -117,10 +117,22 @@ void CoeServer::confirm_download(uint16_t index, uint8_t sub, ecat::MailboxSende
 // The AL state a download is checked against: with the pdo_map_in_safe_op fault, the PDO mapping and
 // assignment objects are writable in Safe-Op as in Pre-Op.
 od::AlState CoeServer::write_state(uint16_t index) const {
-    const bool pdo = (index >= 0x1600 && index <= 0x17FF) || (index >= 0x1A00 && index <= 0x1BFF) ||
-                     index == 0x1C12 || index == 0x1C13;
-    if (pdo && config_.faults.pdo_map_in_safe_op && state() == od::AlState::SafeOp) return od::AlState::PreOp;
+    if (is_pdo_object(index) && config_.faults.pdo_map_in_safe_op && state() == od::AlState::SafeOp)
+        return od::AlState::PreOp;
     return state();
+}
+
+bool CoeServer::is_pdo_object(uint16_t index) {
+    return (index >= 0x1600 && index <= 0x17FF) || (index >= 0x1A00 && index <= 0x1BFF) || index == 0x1C12 ||
+           index == 0x1C13;
+}
+
+// The PDO mapping and assignment change only in Pre-Op (ETG.1000.6 PDO mapping and assignment: a change in
+// Safe-Op or Op is refused with 0x08000022), whatever the access flags say: an ESI may declare 0x1C12 or
+// 0x1600 "rw" without a write restriction (Beckhoff terminals, Inovance drives), and the devices built from
+// it still refuse the change while their process data runs.
+bool CoeServer::pdo_locked(uint16_t index) const {
+    return is_pdo_object(index) && write_state(index) != od::AlState::PreOp;
 }
 
 void CoeServer::cancel_transfer() {
@@ -321,7 +333,8 @@ void CoeServer::download_initiate(std::span<const uint8_t> sdo, ecat::MailboxSen
             }
             return send_abort(index, sub, abort::ReadOnly, out);
         }
-        if (!e->writable(write_state(index))) return send_abort(index, sub, abort::WrongState, out);
+        if (!e->writable(write_state(index)) || pdo_locked(index))
+            return send_abort(index, sub, abort::WrongState, out);
         capacity = e->byte_size();
     }
     if (data_.size() < capacity) data_.resize(capacity);
@@ -427,6 +440,7 @@ void CoeServer::download_segment(std::span<const uint8_t> sdo, ecat::MailboxSend
 }
 
 uint32_t CoeServer::commit_download() {
+    if (pdo_locked(xfer_.index)) return abort::WrongState;
     std::span<const uint8_t> value(data_.data(), xfer_.done);
     od::Status st;
     if (xfer_.complete_access) {

@@ -298,6 +298,41 @@ TEST_F(SdoServer, AbortWrongState08000022) {
     EXPECT_EQ(ask(sdo(0x2F, 0x2003, 0, 1)), (Bytes{0x00, 0x30, 0x60, 0x03, 0x20, 0x00, 0, 0, 0, 0}));
 }
 
+// An ESI may declare the assignment and mapping objects "rw" in every state (Beckhoff terminals, Inovance
+// drives); the device still refuses their change while process data runs (ETG.1000.6 PDO assignment).
+TEST(SdoServerPdoObjects, ChangeRefusedOutsidePreOpWhateverTheAccessFlags) {
+    od::Dictionary d;
+    d.add(composite(0x1600, od::ObjectCode::Record, "RxPDO 1", od::DataType::PdoMapping,
+                    {entry(0, "Number of entries", od::DataType::Unsigned8, od::access::RW, uint64_t{1}),
+                     entry(1, "Entry 1", od::DataType::Unsigned32, od::access::RW, uint64_t{0x70000108})}));
+    d.add(
+        composite(0x1C12, od::ObjectCode::Array, "RxPDO assign", od::DataType::Unsigned16,
+                  {entry(0, "Number of assigned PDOs", od::DataType::Unsigned8, od::access::RW, uint64_t{1}),
+                   entry(1, "PDO 1", od::DataType::Unsigned16, od::access::RW, uint64_t{0x1600})}));
+    d.add(var(0x2000, "Setting", entry(0, "", od::DataType::Unsigned8, od::access::RW)));
+    od::AlState state = od::AlState::SafeOp;
+    coe::CoeServer server{d, [&state] { return state; }};
+    RecordingSender out;
+    auto ask = [&](const Bytes& request) {
+        server.handle(request, out);
+        return out.messages.empty() ? Bytes{} : out.take().payload;
+    };
+    for (od::AlState s : {od::AlState::SafeOp, od::AlState::Op}) {
+        state = s;
+        EXPECT_EQ(ask(sdo(0x2F, 0x1C12, 0, 1)), abort_reply(0x1C12, 0, 0x08000022));
+        EXPECT_EQ(ask(sdo(0x2F, 0x1600, 0, 1)), abort_reply(0x1600, 0, 0x08000022));
+        // Segmented too (normal download of 4 bytes, size indicated).
+        EXPECT_EQ(ask(Bytes{0x00, 0x20, 0x21, 0x00, 0x16, 0x01, 4, 0, 0, 0, 0x08, 0x01, 0x00, 0x70}),
+                  abort_reply(0x1600, 1, 0x08000022));
+        // Other "rw" objects stay writable.
+        EXPECT_EQ(ask(sdo(0x2F, 0x2000, 0, 5)), (Bytes{0x00, 0x30, 0x60, 0x00, 0x20, 0x00, 0, 0, 0, 0}));
+    }
+    EXPECT_EQ(d.get<uint8_t>(0x1C12, 0), 1);
+    state = od::AlState::PreOp;
+    EXPECT_EQ(ask(sdo(0x2F, 0x1C12, 0, 0)), (Bytes{0x00, 0x30, 0x60, 0x12, 0x1C, 0x00, 0, 0, 0, 0}));
+    EXPECT_EQ(d.get<uint8_t>(0x1C12, 0), 0);
+}
+
 TEST_F(SdoServer, AbortNotMappable06040041AndPdoLength06040042) {
     coe::install_pdo_validators(dict, coe::PdoLimits{4});
     EXPECT_EQ(ask(sdo(0x2F, 0x1600, 0, 0)), (Bytes{0x00, 0x30, 0x60, 0x00, 0x16, 0x00, 0, 0, 0, 0}));
