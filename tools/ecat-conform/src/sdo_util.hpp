@@ -130,14 +130,41 @@ inline Outcome expect_response(const SdoAnswer& a, uint8_t scs, uint16_t index, 
 struct EntryRef {
     const EsiObject* obj;
     const EsiEntry* e;
+    // 0x40 / 0x80 (the access bits of an entry description) when an RxPdo / TxPdo element of the ESI maps
+    // the entry: a PDO that maps it makes it mappable, whatever the dictionary's PdoMapping says.
+    uint16_t mapped = 0;
 };
 inline std::vector<EntryRef> esi_entries(const EsiDevice& d) {
     std::vector<EntryRef> v;
     for (const auto& [i, o] : d.objects)
-        for (const auto& e : o.entries)
-            v.push_back({&o, &e});
+        for (const auto& e : o.entries) {
+            EntryRef r{&o, &e};
+            for (const auto* pdos : {&d.rxpdos, &d.txpdos})
+                for (const auto& p : *pdos)
+                    for (const auto& pe : p.entries)
+                        if (pe.index == i && pe.subindex == e.subindex) r.mapped |= p.rx ? 0x40 : 0x80;
+            v.push_back(r);
+        }
     return v;
 }
+// A VISIBLE_STRING entry (ESI type STRING(n)): its BitSize is the capacity, the text may be shorter.
+inline bool visible_string(const EsiEntry& e) {
+    return esi_coe_type(e.type) == 0x0009;
+}
+// The capacity in bits a device declares for an entry: the ESI's BitSize, but at least the length of a
+// STRING's default text (a device holds its default; SOES' ESIs declare 0x1009 "STRING(0)", BitSize 0, with
+// the text "1.0").
+inline std::size_t default_text_bytes(const EsiEntry& e) {
+    if (!visible_string(e) || !e.default_is_string) return 0;
+    std::size_t n = e.default_data.size();
+    while (n > 0 && e.default_data[n - 1] == 0)
+        --n;
+    return n;
+}
+inline unsigned declared_bits(const EsiEntry& e) {
+    return std::max<unsigned>(e.bit_size, static_cast<unsigned>(8 * default_text_bytes(e)));
+}
+
 // An index of the manufacturer range the ESI has no object at (from 0x5FFE down; 0x5FFE without an ESI).
 inline uint16_t missing_index(Context& ctx) {
     for (uint16_t i = 0x5FFE; i > 0x2000; --i)

@@ -364,6 +364,14 @@ void add_esm_tests(Catalogue& c) {
             if (Error e = ctx.to_op(); e != Error::Ok)
                 return fail("cannot reach OP: " + err(e), status_text(ctx.last_status));
             if (!ctx.pds || !ctx.pds->layout().sm2_length) return skip("no outputs: no SM watchdog");
+            // The PD watchdog is fed only by writes to an SM whose control byte has the watchdog trigger
+            // (bit 6); it starts with the first such write. Outputs through an SM without it (ESI ControlByte
+            // #x24, as SOES- and SSC-based devices declare) never start it: nothing expires, nothing to react
+            // to (ESC datasheet section II, SM control 0x0804 bit 6 and process data watchdog 0x0420/0x0440).
+            if (!(ctx.pds->layout().sm2_control & 0x40))
+                return skip("the outputs SM has no watchdog trigger (control " +
+                            hex(ctx.pds->layout().sm2_control, 2) +
+                            ", bit 6 clear): the SM watchdog never runs");
             auto div = ctx.rd<uint16_t>(esc::reg::kWdDivider);
             auto wd = ctx.rd<uint16_t>(esc::reg::kWdTimePd);
             if (!div || !wd) return fail("watchdog registers unreadable");

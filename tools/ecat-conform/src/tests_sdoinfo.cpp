@@ -58,6 +58,32 @@ std::string list_text(const std::set<uint16_t>& s) {
     return r.empty() ? "(none)" : r;
 }
 
+// Objects the ESI declares outside its <Dictionary>, which a device built from it has although the dictionary
+// does not list them (ETG.2000: the Dictionary element need not be complete): the PDOs of its RxPdo/TxPdo
+// elements and the objects their entries map (type 1: all; type 2: RxPDO entries; type 3: TxPDO entries),
+// and for type 1 the objects ETG.1000.6 requires of every CoE device whose values the ESI gives elsewhere
+// (0x1000 device type, 0x1008-0x100A names and versions, 0x1018 identity from Type) and the SM communication
+// type and PDO assignment objects 0x1C00 and 0x1C10+n of its Sm elements.
+std::set<uint16_t> implied_objects(const EsiDevice& d, uint16_t type) {
+    std::set<uint16_t> r;
+    for (const auto* pdos : {&d.rxpdos, &d.txpdos}) {
+        const bool rx = pdos == &d.rxpdos;
+        if ((type == 2 && !rx) || (type == 3 && rx)) continue;
+        for (const auto& p : *pdos) {
+            if (type == 1) r.insert(p.index);
+            for (const auto& e : p.entries)
+                if (e.index != 0) r.insert(e.index);
+        }
+    }
+    if (type == 1) {
+        r.insert({0x1000, 0x1008, 0x1009, 0x100A, 0x1018});
+        if (!d.sms.empty()) r.insert(0x1C00);
+        for (std::size_t n = 0; n < d.sms.size() && n < 32; ++n)
+            r.insert(static_cast<uint16_t>(0x1C10 + n));
+    }
+    return r;
+}
+
 Outcome list_vs_esi(Context& ctx, uint16_t type, const std::function<bool(const EsiObject&)>& in_list) {
     CONFORM_NEED(ctx.need_sdo_info());
     CONFORM_NEED(ctx.need_esi());
@@ -68,11 +94,14 @@ Outcome list_vs_esi(Context& ctx, uint16_t type, const std::function<bool(const 
     for (const auto& [i, o] : ctx.esi->objects)
         if (in_list(o)) want.insert(i);
     if (type == 1) want.insert(ctx.module_mapping_objects.begin(), ctx.module_mapping_objects.end());
+    // Lists 1-3 may also name what the ESI declares outside its dictionary (implied_objects); lists 4 and 5
+    // (backup, settings) only what the dictionary flags.
+    const std::set<uint16_t> implied = type <= 3 ? implied_objects(*ctx.esi, type) : std::set<uint16_t>{};
     std::set<uint16_t> missing, extra;
     for (auto i : want)
         if (!got.count(i)) missing.insert(i);
     for (auto i : got)
-        if (!want.count(i)) extra.insert(i);
+        if (!want.count(i) && !implied.count(i)) extra.insert(i);
     if (missing.empty() && extra.empty()) return pass(dec(static_cast<long long>(got.size())) + " objects");
     return fail("list differs from the ESI", "missing " + list_text(missing) + "; extra " + list_text(extra),
                 "none missing, none extra");
@@ -280,9 +309,14 @@ void add_sdoinfo_tests(Catalogue& c) {
          }},
         {"entry.bit_length", "Entry descriptions: bit length as the ESI",
          [](const EntryRef& r, const master::EntryDescription& d) -> std::optional<Outcome> {
-             if (d.bit_length != r.e->bit_size)
-                 return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " bit length", dec(d.bit_length),
-                             dec(r.e->bit_size));
+             const unsigned want = declared_bits(*r.e);
+             if (d.bit_length != want)
+                 return fail(
+                     hex(r.obj->index) + ":" + dec(r.e->subindex) + " bit length", dec(d.bit_length),
+                     dec(want) + (want != r.e->bit_size ? " (the ESI declares " + r.e->type + ", BitSize " +
+                                                              dec(r.e->bit_size) + ", with a default of " +
+                                                              dec(want / 8) + " characters)"
+                                                        : ""));
              return std::nullopt;
          }},
         {"entry.access", "Entry descriptions: read/write access per state as the ESI's Access",
@@ -297,12 +331,18 @@ void add_sdoinfo_tests(Catalogue& c) {
          }},
         {"entry.pdo_mapping", "Entry descriptions: RxPDO/TxPDO mappable bits as the ESI's PdoMapping",
          [](const EntryRef& r, const master::EntryDescription& d) -> std::optional<Outcome> {
-             const uint16_t want =
+             const uint16_t declared =
                  static_cast<uint16_t>((r.e->pdo_mapping.find('R') != std::string::npos ? 0x40 : 0) |
                                        (r.e->pdo_mapping.find('T') != std::string::npos ? 0x80 : 0));
+             // An entry an ESI PDO maps is mappable in that direction although the dictionary leaves its
+             // PdoMapping out (the ESI contradicts itself; the device maps it, so it must say so).
+             const uint16_t want = declared | r.mapped;
              if ((d.access & 0xC0) != want)
                  return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " mapping bits",
-                             hex(d.access & 0xC0, 2), hex(want, 2));
+                             hex(d.access & 0xC0, 2),
+                             hex(want, 2) + (want != declared ? " (the ESI's PdoMapping " + hex(declared, 2) +
+                                                                    " and the PDOs that map it)"
+                                                              : ""));
              return std::nullopt;
          }},
     };
