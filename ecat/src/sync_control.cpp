@@ -123,7 +123,9 @@ uint16_t SyncControl::configure() {
         // The activation in 0x0981 must say what 0x1C32:01 says.
         if (dc_mode != sync0 || (mode == SyncMode::DcSync1 && !sync1)) return al::InvalidDcSyncConfig;
     } else if (sync0) {
-        mode = SyncMode::DcSync0;
+        // SYNC1 activated on a device that announces DC SYNC1 but not SYNC0 (0x1C32:04 bit 3 without bit 2,
+        // as Beckhoff's EL15xx and EJ7xxx do with their AssignActivate 0x0700 op modes): DC SYNC1.
+        mode = sync1 && (supported & 0x0008) && !(supported & 0x0004) ? SyncMode::DcSync1 : SyncMode::DcSync0;
     } else if (has_pd && (supported & 0x0002)) {
         mode = SyncMode::SmSync;
     } else if (supported & 0x0001) {
@@ -149,8 +151,9 @@ uint16_t SyncControl::configure() {
             break;
         case SyncMode::DcSync0:
         case SyncMode::DcSync1:
-            if (!(supported & 0x0004) || (mode == SyncMode::DcSync1 && !(supported & 0x0008)))
-                return al::SyncModeNotSupported;
+            // ETG.1020 0x1C32:04: bit 2 DC SYNC0, bit 3 DC SYNC1 (the application synchronises to SYNC1,
+            // which the ESC derives from SYNC0); each mode needs its own bit.
+            if (!(supported & (mode == SyncMode::DcSync1 ? 0x0008 : 0x0004))) return al::SyncModeNotSupported;
             if (sync0_cycle == 0) return al::DcInvalidSyncCycleTime;
             // Start time already past when activated (0x0984 bit 2): SYNC0 would not come (ESC datasheet,
             // Distributed Clocks, activation status).

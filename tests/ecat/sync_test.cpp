@@ -401,6 +401,21 @@ TEST_F(Sync, Dc_Sync1ModeNotSupported_0x0028) {
     expect_safeop_refused(0x0028);  // 0x1C32:04 = 0x0006: no SYNC1 mode
 }
 
+// A device that announces DC SYNC1 but not SYNC0 (0x1C32:04 0x000B: free run, SM, SYNC1; Beckhoff's counter
+// and motion terminals) runs DC SYNC1 when the master activates SYNC0 and SYNC1 (AssignActivate 0x0700), and
+// refuses SYNC0 alone.
+TEST_F(Sync, Dc_Sync1OnlyDevice_RunsSync1WithSync0AndSync1Activated) {
+    ASSERT_EQ(dict.set<uint16_t>(0x1C32, 4, 0x000B), od::Status::Ok);
+    ASSERT_NO_FATAL_FAILURE(safeop_dc(1'000'000, 0x07));
+    EXPECT_EQ(stack->sync_mode(), SyncMode::DcSync1);
+}
+
+TEST_F(Sync, Dc_Sync1OnlyDevice_RefusesSync0Alone_0x0028) {
+    ASSERT_EQ(dict.set<uint16_t>(0x1C32, 4, 0x000B), od::Status::Ok);
+    ASSERT_NO_FATAL_FAILURE(preop_dc(1'000'000, 0x03));
+    expect_safeop_refused(0x0028);
+}
+
 TEST_F(Sync, SmSync_CycleTimeTooSmall_0x002E) {
     go_preop();
     ASSERT_EQ(master_write32(0x1C32, 2, 50'000), od::Status::Ok);
