@@ -982,6 +982,11 @@ TEST(EsiDevices, VendorFormsLoadAsTheFileSaysAndRoundTrip) {
     EXPECT_EQ(d.find(0x100A, 0)->default_string, "01.0");
     // A DefaultData written as an ESI number: the number.
     EXPECT_EQ(d.get<uint32_t>(0x8000, 0), 1000u);
+    // An enum on USINT with BitSize 3 (a settings record's "DT0800EN03"): a 3-bit entry, as the file says.
+    ASSERT_NE(d.find(0x8010, 1), nullptr);
+    EXPECT_EQ(d.find(0x8010, 1)->type, od::DataType::Bit3);
+    EXPECT_EQ(d.find(0x8010, 1)->bit_length, 3u);
+    EXPECT_EQ(d.get<uint8_t>(0x8010, 1), 1u);
     // A ConfigData of two bytes: PDI control and ESC configuration from it, the other words default.
     EXPECT_EQ(p.description.pdi_control, 0x05);
     EXPECT_EQ(p.description.esc_config, 0x01);

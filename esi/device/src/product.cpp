@@ -62,8 +62,15 @@ std::optional<std::pair<DataType, uint16_t>> od_type(const std::string& name, ui
         {"FLOAT", DataType::Real32},        {"LREAL", DataType::Real64},
         {"DOUBLE", DataType::Real64},       {"BITARR8", DataType::Unsigned8},
         {"BITARR16", DataType::Unsigned16}, {"BITARR32", DataType::Unsigned32}};
-    if (auto it = scalars.find(t); it != scalars.end())
+    if (auto it = scalars.find(t); it != scalars.end()) {
+        // An unsigned type given fewer bits than its size: an enum on USINT with BitSize 3, as Beckhoff's
+        // settings records declare their "DT0800EN03" entries. The entry is that many bits (a BITn), as its
+        // SDO information describes it (ETG.1000.6 entry description: the bit length of the entry).
+        const bool is_unsigned = it->second == DataType::Unsigned8 || it->second == DataType::Unsigned16;
+        if (is_unsigned && declared_bits > 0 && declared_bits < 8)
+            return std::make_pair(static_cast<DataType>(0x002F + declared_bits), declared_bits);
         return std::make_pair(it->second, od::bit_size(it->second));
+    }
     if (t.size() == 4 && t.rfind("BIT", 0) == 0 && t[3] >= '1' && t[3] <= '8') {
         const auto n = static_cast<uint16_t>(t[3] - '0');
         return std::make_pair(static_cast<DataType>(0x002F + n), n);
