@@ -176,6 +176,18 @@ void read_info(Node info, EsiEntry& e) {
         if (auto v = parse_esi_number(text(u))) e.unit = static_cast<uint32_t>(*v);
 }
 
+// A limit or default of a signed type written as a hex number (`#xfe99` for an INT: -359, as Beckhoff writes
+// MinValue) is that type's two's complement: a value above the type's maximum can mean nothing else.
+void sign_extend_limits(EsiEntry& e) {
+    static const std::map<std::string, unsigned> signed_bits = {
+        {"SINT", 8}, {"INT", 16}, {"INT24", 24}, {"DINT", 32}};
+    auto it = signed_bits.find(e.type);
+    if (it == signed_bits.end()) return;
+    const int64_t half = int64_t{1} << (it->second - 1);
+    for (std::optional<int64_t>* v : {&e.min, &e.max, &e.default_value})
+        if (*v && **v >= half && **v < 2 * half) **v -= 2 * half;
+}
+
 void read_types(Node dict, TypeMap& types) {
     for (Node dt : children(child(dict, "DataTypes"), "DataType")) {
         DataType t;
@@ -254,6 +266,7 @@ EsiObject read_object(Node ob, const TypeMap& types) {
         e.line = o.line;
         read_info(info, e);
         resolve_type(e, types);
+        sign_extend_limits(e);
         o.type = e.type;  // a VAR of an enumerated type: its base type
         o.entries.push_back(e);
         return o;
@@ -306,6 +319,8 @@ EsiObject read_object(Node ob, const TypeMap& types) {
         if (array && matches == 0 && !n.empty() && target > 0) o.entries[target].name = n;
         read_info(child(infos[i], "Info"), o.entries[target]);
     }
+    for (EsiEntry& e : o.entries)
+        sign_extend_limits(e);
     return o;
 }
 

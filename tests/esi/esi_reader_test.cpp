@@ -287,3 +287,30 @@ TEST(EsiReader, OnlyARegularFileIsRead) {
 }
 
 }  // namespace
+
+// Limits of a signed type written as hex numbers (Beckhoff's MinValue #xfe99 for an INT): the type's two's
+// complement, -359..359; an unsigned type's hex limit stays as written.
+TEST(EsiReader, HexLimitsOfSignedTypesAreTwosComplement) {
+    const std::string xml =
+        "<EtherCATInfo><Vendor><Id>#x2</Id></Vendor><Descriptions><Devices><Device>"
+        "<Type ProductCode=\"#x1\" RevisionNo=\"#x1\">T</Type><Profile><Dictionary><DataTypes>"
+        "<DataType><Name>INT</Name><BitSize>16</BitSize></DataType>"
+        "<DataType><Name>UINT</Name><BitSize>16</BitSize></DataType></DataTypes><Objects>"
+        "<Object><Index>#x2003</Index><Name>Offset</Name><Type>INT</Type><BitSize>16</BitSize><Info>"
+        "<MinValue>#xfe99</MinValue><MaxValue>#x0167</MaxValue><DefaultValue>#xffff</DefaultValue></Info>"
+        "<Flags><Access>rw</Access></Flags></Object>"
+        "<Object><Index>#x2004</Index><Name>Span</Name><Type>UINT</Type><BitSize>16</BitSize><Info>"
+        "<MinValue>#x0001</MinValue><MaxValue>#xfe99</MaxValue></Info>"
+        "<Flags><Access>rw</Access></Flags></Object>"
+        "</Objects></Dictionary></Profile></Device></Devices></Descriptions></EtherCATInfo>";
+    const esi::EsiFile f = esi::read_esi_text(xml);
+    ASSERT_EQ(f.devices.size(), 1u);
+    const esi::EsiObject* o = f.devices[0].object(0x2003);
+    ASSERT_NE(o, nullptr);
+    EXPECT_EQ(o->entries[0].min, -359);
+    EXPECT_EQ(o->entries[0].max, 359);
+    EXPECT_EQ(o->entries[0].default_value, -1);
+    const esi::EsiObject* u = f.devices[0].object(0x2004);
+    ASSERT_NE(u, nullptr);
+    EXPECT_EQ(u->entries[0].max, 0xfe99);
+}
