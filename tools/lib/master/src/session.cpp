@@ -269,11 +269,20 @@ Error ProcessDataSession::configure(Slave& slave, const DcConfig& dc) {
             return e == Error::SdoAbort &&
                    (sdo->last_abort() == 0x06020000 || sdo->last_abort() == 0x06090011);
         };
-        const uint8_t mode_out[2] = {static_cast<uint8_t>(dc.enable ? 2 : 1), 0};
+        // DC SYNC1 (3) for an op mode that activates SYNC1 on a device that announces DC SYNC1 but not SYNC0
+        // (0x1C32:04 bit 3 without bit 2, ETG.1020: Beckhoff's EL15xx/EJ7xxx op modes with AssignActivate
+        // 0x0700), else DC SYNC0 (2).
+        uint8_t dc_mode = 2;
+        if (dc.enable && (dc.assign_activate & 0x0400)) {
+            uint8_t sup[2] = {};
+            if (auto n = sdo->upload(0x1C32, 4, sup); n && *n == 2 && (sup[0] & 0x0C) == 0x08) dc_mode = 3;
+        }
+        const uint8_t mode_out[2] = {static_cast<uint8_t>(dc.enable ? dc_mode : 1), 0};
         if (Error e = sdo->download(0x1C32, 1, mode_out); e != Error::Ok && !absent(e)) return e;
-        const uint8_t mode_in[2] = {static_cast<uint8_t>(dc.enable ? 2 : (layout.sm2_length ? 0x22 : 1)), 0};
+        const uint8_t mode_in[2] = {
+            static_cast<uint8_t>(dc.enable ? dc_mode : (layout.sm2_length ? 0x22 : 1)), 0};
         if (Error e = sdo->download(0x1C33, 1, mode_in); e != Error::Ok && !absent(e)) {
-            const uint8_t plain[2] = {static_cast<uint8_t>(dc.enable ? 2 : 1), 0};
+            const uint8_t plain[2] = {static_cast<uint8_t>(dc.enable ? dc_mode : 1), 0};
             if (sdo->download(0x1C33, 1, plain) != Error::Ok) return e;
         }
         if (dc.enable) {
