@@ -224,7 +224,13 @@ class Context {
     // without CoE, from the SII.
     master::Error discover_pd();
     // Sets up SMs/FMMUs for the discovered layout; a device without process data (a coupler) needs none.
+    // Without DC asked for, a device that runs only DC-synchronous gets the DC set-up of dc_only().
     master::Error configure_pd(const master::DcConfig& dc = {});
+    // A device that supports neither free run nor SM synchronisation (0x1C32:04, else 0x1C33:04, bits 0-1
+    // clear, a DC bit set; Beckhoff's EJ/ER servo terminals): the DC set-up of its ESI's op mode, 1 ms cycle.
+    // Read once in PREOP; nullopt for every other device.
+    std::optional<master::DcConfig> dc_only();
+    std::optional<std::optional<master::DcConfig>> dc_only_cache;
     bool has_process_data() const { return pds && (pds->layout().sm2_length || pds->layout().sm3_length); }
     // SAFEOP -> OP: exchanging process data where there is some, else by AL control alone.
     master::Error request_op(master::AlStatus& st);

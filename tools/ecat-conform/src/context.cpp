@@ -692,7 +692,37 @@ Error Context::discover_pd() {
 Error Context::configure_pd(const master::DcConfig& dc) {
     if (!pds) return Error::InvalidArgument;
     if (!has_process_data()) return Error::Ok;
+    if (!dc.enable)
+        if (auto d = dc_only()) return pds->configure(*d);
     return pds->configure(dc);
+}
+
+std::optional<master::DcConfig> Context::dc_only() {
+    if (dc_only_cache) return *dc_only_cache;
+    std::optional<master::DcConfig> r;
+    if (sdo && has_coe() && esi && esi->has_dc) {
+        master::Result<uint64_t> v = upload_uint(0x1C32, 4);
+        if (!v) v = upload_uint(0x1C33, 4);
+        // ETG.1020 0x1C32:04: bit 0 free run, bit 1 SM synchronous, bits 2-3 DC SYNC0/SYNC1.
+        if (v && !(*v & 0x0003) && (*v & 0x000C)) {
+            master::DcConfig d;
+            d.enable = true;
+            d.cycle_ns = 1'000'000;
+            d.start_delay = std::chrono::milliseconds(20);
+            d.assign_activate = (*v & 0x0004) ? 0x0300 : 0x0700;
+            for (const auto& mode : esi->op_modes)
+                if (mode.assign_activate & 0x0300) {
+                    d.assign_activate = mode.assign_activate;
+                    break;
+                }
+            r = d;
+            notes.push_back("the device runs only DC-synchronous (0x1C32:04 " + hex(*v) +
+                            "): process data is set up in DC mode (AssignActivate " + hex(d.assign_activate) +
+                            ") wherever a test does not choose the mode");
+        }
+    }
+    dc_only_cache = r;
+    return r;
 }
 
 Error Context::request_op(master::AlStatus& st) {

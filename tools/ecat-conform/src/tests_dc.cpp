@@ -286,8 +286,24 @@ void add_dc_tests(Catalogue& c) {
             CONFORM_PREOP(ctx);
             auto v = ctx.upload_uint(0x1C32, 4);
             if (!v) return fail("0x1C32:04: " + ctx.sdo_error(v.error()));
-            if (!(*v & 0x04))
-                return fail("SYNC0 synchronisation not in the supported sync modes", hex(*v), "bit 2 set");
+            // An op mode that activates SYNC1 too (AssignActivate bit 10) runs DC SYNC0 or DC SYNC1 (bit 3;
+            // ETG.1020 0x1C32:04 bits 2 and 3): either bit announces it.
+            const uint16_t assign = dc_assign(ctx);
+            const uint64_t want = (assign & 0x0400) ? 0x0C : 0x04;
+            if (!(*v & want)) {
+                const std::string bits = want == 0x0C ? "bit 2 or 3 set" : "bit 2 set";
+                const EsiObject* o = ctx.esi ? ctx.esi->object(0x1C32) : nullptr;
+                const EsiEntry* e = o ? o->entry(4) : nullptr;
+                if (e && e->default_data.size() == 2 &&
+                    (e->default_data[0] | (e->default_data[1] << 8)) == static_cast<int>(*v))
+                    return fail("the ESI declares a DC op mode (AssignActivate " + hex(assign) +
+                                    ") but its own 0x1C32:04 default " + hex(*v) +
+                                    " announces no such DC mode; the device serves the ESI's value",
+                                hex(*v), bits);
+                return fail("DC synchronisation of the ESI's op mode (AssignActivate " + hex(assign) +
+                                ") not in the supported sync modes",
+                            hex(*v), bits);
+            }
             return pass("supported", hex(*v));
         },
         a);

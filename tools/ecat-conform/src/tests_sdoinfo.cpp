@@ -302,7 +302,11 @@ void add_sdoinfo_tests(Catalogue& c) {
         {"entry.data_type", "Entry descriptions: data type as the ESI",
          [](const EntryRef& r, const master::EntryDescription& d) -> std::optional<Outcome> {
              const uint16_t want = esi_coe_type(r.e->type);
-             if (want && d.data_type != want)
+             // An unsigned type given fewer bits than its size (an enum on USINT with BitSize 3, Beckhoff's
+             // DTxxxxENyy) may be described as the BITn of its size.
+             const bool short_unsigned = (want == 0x0005 || want == 0x0006) && r.e->bit_size > 0 &&
+                                         r.e->bit_size < 8 && d.data_type == 0x002F + r.e->bit_size;
+             if (want && d.data_type != want && !short_unsigned)
                  return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " data type", hex(d.data_type),
                              hex(want) + " (" + r.e->type + ")");
              return std::nullopt;
