@@ -987,6 +987,9 @@ TEST(EsiDevices, VendorFormsLoadAsTheFileSaysAndRoundTrip) {
     EXPECT_EQ(d.find(0x8010, 1)->type, od::DataType::Bit3);
     EXPECT_EQ(d.find(0x8010, 1)->bit_length, 3u);
     EXPECT_EQ(d.get<uint8_t>(0x8010, 1), 1u);
+    // An ARRAY OF BYTE without a default: all its bytes, zeros (it uploads its fixed size).
+    ASSERT_NE(d.find(0x2010, 0), nullptr);
+    EXPECT_EQ(d.raw(0x2010, 0).size(), 4u);
     // A ConfigData of two bytes: PDI control and ESC configuration from it, the other words default.
     EXPECT_EQ(p.description.pdi_control, 0x05);
     EXPECT_EQ(p.description.esc_config, 0x01);

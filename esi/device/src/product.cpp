@@ -256,6 +256,10 @@ std::optional<od::Entry> to_entry(const EsiEntry& e, uint16_t index, const std::
                                  std::to_string(x.bit_length / 8) + " bytes");
             s.resize(x.bit_length / 8);
         }
+        // An OCTET_STRING ("ARRAY [0..n] OF BYTE") has the fixed size its type gives: it uploads all n+1
+        // bytes, zeros where the file gives no default (a device's byte array is not a text that ends early).
+        // The diagnosis messages of 0x10F3 vary in length (ETG.1020) and stay as given.
+        if (x.type == DataType::OctetString && index != 0x10F3) s.resize(x.bit_length / 8, '\0');
         x.default_string = s;
         return x;
     }
