@@ -308,9 +308,20 @@ void sub_item(xmlNodePtr dt, const Entry* idx_entry, const std::string& name, co
 // Emits the DataType(s) of a structured object; returns its type name and bit size.
 std::string structured_type(xmlNodePtr types, const Object& o, TypeSet& ts, uint32_t& bits) {
     const std::string name = dt_name(o.index);
-    if (uniform_array(o)) {
+    // An ARRAY without elements (an SM assignment of no PDO) is written as Beckhoff writes it: an ArrayInfo
+    // of 0 elements of its element type.
+    const bool empty_array =
+        o.code == ObjectCode::Array && o.entries.size() == 1 && o.entries[0].subindex == 0;
+    if (uniform_array(o) || empty_array) {
         const Entry& si0 = o.entries[0];
-        const Entry& el = o.entries[1];
+        Entry none;
+        if (empty_array) {
+            none.subindex = 1;
+            none.type = o.type;
+            none.bit_length = od::bit_size(o.type);
+            none.access = si0.access;
+        }
+        const Entry& el = empty_array ? none : o.entries[1];
         const std::string base = ts.use(el);
         const std::string si0_type = ts.use(si0);
         const auto n = static_cast<uint32_t>(o.entries.size() - 1);

@@ -990,6 +990,10 @@ TEST(EsiDevices, VendorFormsLoadAsTheFileSaysAndRoundTrip) {
     // An ARRAY OF BYTE without a default: all its bytes, zeros (it uploads its fixed size).
     ASSERT_NE(d.find(0x2010, 0), nullptr);
     EXPECT_EQ(d.raw(0x2010, 0).size(), 4u);
+    // An SM assignment ARRAY without elements (0 PDOs, Beckhoff's DT1C12ARR of 0 elements): still an ARRAY.
+    ASSERT_NE(d.find(0x1C10), nullptr);
+    EXPECT_EQ(d.find(0x1C10)->code, od::ObjectCode::Array);
+    EXPECT_EQ(d.find(0x1C10)->type, od::DataType::Unsigned16);
     // A ConfigData of two bytes: PDI control and ESC configuration from it, the other words default.
     EXPECT_EQ(p.description.pdi_control, 0x05);
     EXPECT_EQ(p.description.esc_config, 0x01);

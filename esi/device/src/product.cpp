@@ -362,10 +362,13 @@ std::optional<od::Object> to_object(const EsiObject& eo, uint16_t index, Ctx& ct
         for (std::size_t i = 2; i < o.entries.size(); ++i)
             if (o.entries[i].type != o.entries[1].type || o.entries[i].bit_length != o.entries[1].bit_length)
                 o.code = od::ObjectCode::Record;
-        if (o.entries.size() < 2) o.code = od::ObjectCode::Record;
+        // An SM assignment object without elements (0x1C12 of a device without outputs, 0x1C10 of a mailbox
+        // SM: Beckhoff, Synapticon) stays the ARRAY of UINT16 ETG.1000.6 makes it; any other ARRAY without
+        // elements has no element type to give and is a RECORD.
+        if (o.entries.size() < 2 && !(index >= 0x1C10 && index <= 0x1C2F)) o.code = od::ObjectCode::Record;
     }
     if (o.code == od::ObjectCode::Array) {
-        o.type = o.entries[1].type;
+        o.type = o.entries.size() < 2 ? DataType::Unsigned16 : o.entries[1].type;
     } else if (eo.type_index) {
         o.type = static_cast<DataType>(*eo.type_index);
     } else if (index == 0x1018) {
