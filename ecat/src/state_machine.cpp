@@ -306,7 +306,9 @@ uint16_t StateMachine::check_pre_op_to_safe_op() {
         if (d != nullptr && d->start != 0 && r.start != d->start) return s.code;
     }
     // No overlap of the active SM areas (a buffered SM occupies three times its length: ESC datasheet,
-    // SyncManager, 3-buffer mode).
+    // SyncManager, 3-buffer mode). A buffered SM of one byte and one over the register space (the
+    // digital-output SMs of a digital I/O ESC, 0x0F00-0x0F03, one byte each) have no buffers: they cover
+    // their own bytes only, as the ESC serves them (docs/decisions/esc.md).
     struct Area {
         uint32_t begin, end;
     };
@@ -315,7 +317,9 @@ uint16_t StateMachine::check_pre_op_to_safe_op() {
     for (unsigned n = 0; n < 4; ++n) {
         const SmRegs& r = regs[n];
         if (!(r.activate & esc::reg::kSmEnable) || r.length == 0) continue;
-        const uint32_t factor = (r.control & esc::reg::kSmModeMask) == esc::reg::kSmModeBuffered ? 3 : 1;
+        const bool buffers = (r.control & esc::reg::kSmModeMask) == esc::reg::kSmModeBuffered &&
+                             r.length > 1 && r.start >= esc::reg::kRamBase;
+        const uint32_t factor = buffers ? 3 : 1;
         areas[count++] = {r.start, r.start + factor * r.length};
     }
     for (std::size_t i = 0; i < count; ++i)

@@ -258,6 +258,78 @@ TEST_F(Esm, PS_PreOpToSafeOp_OverlappingSms_0x0017) {
     EXPECT_EQ(al_code(), 0x0017);
 }
 
+// A PDO assignment object (0x1C1n) with the PDOs given, read-only as a device without CoE has it.
+od::Object array_u16(uint16_t index, std::vector<uint16_t> pdos) {
+    od::Object o;
+    o.index = index;
+    o.code = od::ObjectCode::Array;
+    o.type = od::DataType::Unsigned16;
+    o.name = "SM assign";
+    auto add = [&o](uint8_t sub, od::DataType type, uint64_t value) {
+        od::Entry e;
+        e.subindex = sub;
+        e.type = type;
+        e.access = od::access::RO;
+        e.default_value = value;
+        e.name = "Sub " + std::to_string(sub);
+        o.entries.push_back(e);
+    };
+    add(0, od::DataType::Unsigned8, pdos.size());
+    for (std::size_t k = 0; k < std::max<std::size_t>(pdos.size(), 1); ++k)
+        add(static_cast<uint8_t>(k + 1), od::DataType::Unsigned16, k < pdos.size() ? pdos[k] : 0);
+    return o;
+}
+
+// A digital I/O device without mailbox whose outputs are the ESC's digital-output register (0x0F00-0x0F03),
+// one buffered SM of one byte per output byte (iTegva, Beckhoff EL20xx style ESIs: Sm StartAddress="#x0f02"
+// ControlByte="#x44", and "#x0f03"): such SMs have no three buffers (ESC datasheet, SyncManager: one-byte
+// buffered SMs; 0x0F00 digital I/O output data), so side by side they do not overlap. Before, Safe-Op
+// found them overlapping, ran without process data and the inputs SM stayed deactivated: every LRW had the
+// working counter 2 instead of 3.
+TEST_F(Esm, PS_PreOpToSafeOp_OneByteSmsOverRegistersDoNotOverlap) {
+    desc.standard_mailbox = {0, 0, 0, 0};
+    desc.bootstrap_mailbox = {0, 0, 0, 0};
+    desc.mailbox_protocols = 0;
+    desc.sync_managers = {{od::SmKind::Outputs, 0x0F02, 1, 0x44, true},
+                          {od::SmKind::Outputs, 0x0F03, 1, 0x44, true},
+                          {od::SmKind::Inputs, 0x1000, 2, 0x00, true}};
+    dict.add(array_u16(0x1C10, {0x1601}));
+    dict.add(array_u16(0x1C11, {}));
+    start();
+    request(0x02);
+    ASSERT_EQ(al_status(), 0x02);
+    // 0x1601: eight output bits; 0x1A01: 0x6041 (16 bits).
+    for (uint8_t k = 1; k <= 8; ++k) {
+        const uint32_t m = 0x20000001u | (static_cast<uint32_t>(k) << 8);
+        const uint8_t b[4] = {static_cast<uint8_t>(m), static_cast<uint8_t>(m >> 8),
+                              static_cast<uint8_t>(m >> 16), static_cast<uint8_t>(m >> 24)};
+        ASSERT_EQ(dict.write(0x1601, k, AlState::PreOp, b), od::Status::Ok);
+    }
+    ASSERT_EQ(dict.write(0x1601, 0, AlState::PreOp, std::vector<uint8_t>{8}), od::Status::Ok);
+    ASSERT_EQ(dict.write(0x1A01, 1, AlState::PreOp, std::vector<uint8_t>{0x10, 0x00, 0x41, 0x60}),
+              od::Status::Ok);
+    ASSERT_EQ(dict.write(0x1A01, 0, AlState::PreOp, std::vector<uint8_t>{1}), od::Status::Ok);
+    // SM2 is the inputs SM here: its assignment 0x1C12 takes 0x1A01.
+    ASSERT_EQ(dict.write(0x1C12, 0, AlState::PreOp, std::vector<uint8_t>{0}), od::Status::Ok);
+    ASSERT_EQ(dict.write(0x1C12, 1, AlState::PreOp, std::vector<uint8_t>{0x01, 0x1A}), od::Status::Ok);
+    ASSERT_EQ(dict.write(0x1C12, 0, AlState::PreOp, std::vector<uint8_t>{1}), od::Status::Ok);
+    // As SOEM configures it: both output SMs, one FMMU over both bytes, one over the inputs.
+    configure_sm(0, 0x0F02, 1, 0x44, true);
+    configure_sm(1, 0x0F03, 1, 0x44, true);
+    configure_sm(2, 0x1000, 2, 0x00, true);
+    configure_fmmu(0, kLogical, 2, 0x0F02, 2);
+    configure_fmmu(1, kLogical + 2, 2, 0x1000, 1);
+    request(0x04);
+    ASSERT_EQ(al_status(), 0x04) << "code " << std::hex << al_code();
+    poll();
+    std::vector<uint8_t> image = {0xA5, 0x5A, 0, 0};
+    EXPECT_EQ(master.lrw(kLogical, image), 3);  // +1 read (inputs SM), +2 write (the register SMs), once
+    uint8_t dout[2] = {};
+    master.read(0x0F02, dout);
+    EXPECT_EQ(dout[0], 0xA5);
+    EXPECT_EQ(dout[1], 0x5A);
+}
+
 TEST_F(Esm, PS_PreOpToSafeOp_InvalidOutputMapping_0x0025) {
     go_preop();
     // 0x6041 is not RxPDO-mappable.
