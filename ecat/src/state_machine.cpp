@@ -297,8 +297,15 @@ uint16_t StateMachine::check_pre_op_to_safe_op() {
         if (!enabled ||
             (r.length != s.bytes && !(s.sm == ctx_.sms.outputs && ctx_.faults.sm2_length_unchecked)))
             return s.code;
-        if ((r.control & esc::reg::kSmModeMask) != esc::reg::kSmModeBuffered) return al::InvalidSmTypes;
+        // Buffered (three buffers), or the one-buffer (mailbox mode) handshake where the device declares it
+        // for its process data (ETG.2000 Sm ControlByte #x22 on Inputs: Beckhoff AX2000/AX5000, EM7004,
+        // EL1254; ESC datasheet, SyncManager: 1-buffer mode). Any other mode is not what the device serves.
         const uint8_t expected = expected_control(s.sm, s.fallback_control);
+        const uint8_t mode = r.control & esc::reg::kSmModeMask;
+        if (mode != esc::reg::kSmModeBuffered &&
+            !(mode == esc::reg::kSmModeMailbox &&
+              (expected & esc::reg::kSmModeMask) == esc::reg::kSmModeMailbox))
+            return al::InvalidSmTypes;
         if ((r.control & esc::reg::kSmDirMask) != (expected & esc::reg::kSmDirMask) ||
             (r.control & esc::reg::kSmDirMask) != s.dir)
             return s.code;

@@ -247,6 +247,27 @@ TEST_F(Esm, PS_PreOpToSafeOp_Sm2MailboxMode_0x001C) {
     EXPECT_EQ(al_code(), 0x001C);
 }
 
+// A device whose ESI declares its inputs SM in mailbox mode (Sm ControlByte="#x22" on Inputs, as Beckhoff's
+// AX2000/AX5000, EM7004 and EL1254 files do): the one-buffer handshake is that device's process-data SM, so a
+// master configuring it from the SII reaches Safe-Op, and each LRW reads the inputs the stack wrote after
+// the previous outputs (ESC datasheet, SyncManager 1-buffer mode). Before, 0x001C refused it.
+TEST_F(Esm, PS_PreOpToSafeOp_InputsInMailboxModeAsDeclared) {
+    desc.sync_managers[3].control = 0x22;
+    start();
+    go_preop();
+    configure_process_data(6, 6);
+    configure_sm(3, kSm3Start, 6, 0x22, true);
+    request(0x04);
+    ASSERT_EQ(al_status(), 0x04) << "code " << std::hex << al_code();
+    request(0x08);
+    for (int k = 0; k < 3; ++k) {
+        std::vector<uint8_t> out(6, 0), in(6, 0);
+        EXPECT_EQ(exchange_pd(out, in), 3) << "cycle " << k;
+        poll();
+    }
+    EXPECT_EQ(al_status(), 0x08) << "code " << std::hex << al_code();
+}
+
 TEST_F(Esm, PS_PreOpToSafeOp_OverlappingSms_0x0017) {
     desc.sync_managers[3].start = 0;  // no fixed start for SM3: overlap is the only thing wrong
     start();
