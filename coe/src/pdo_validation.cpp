@@ -157,7 +157,7 @@ od::Status check_mapping_entry(const od::Dictionary& dict, bool rx, uint32_t val
     const od::Entry* e = dict.find(index, sub);
     if (e == nullptr) return od::Status::NotMappable;
     if (rx ? !e->rx_mappable() : !e->tx_mappable()) return od::Status::NotMappable;
-    if (e->bit_length != bits) return od::Status::NotMappable;
+    if (!e->mappable_with(bits)) return od::Status::NotMappable;
     return od::Status::Ok;
 }
 

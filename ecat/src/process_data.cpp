@@ -62,7 +62,7 @@ uint16_t ProcessData::build_side(uint16_t assign_index, bool rx, std::vector<Pdo
             if (length == 0) return code;
             if (!is_padding(index, sub)) {
                 const od::Entry* e = dict_.find(index, sub);
-                if (e == nullptr || e->bit_length != length) return code;
+                if (e == nullptr || !e->mappable_with(length)) return code;
                 if (rx ? !e->rx_mappable() : !e->tx_mappable()) return code;
                 if (plan.size() == kMaxEntries) return code;
                 const auto raw = dict_.raw(index, sub);

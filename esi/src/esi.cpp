@@ -554,7 +554,13 @@ std::string esi_type_name(od::DataType type, uint16_t bit_length) {
             break;
     }
     const uint16_t natural = od::bit_size(type);
-    if (natural > 1 && bit_length != 0 && bit_length < natural) return "BIT" + std::to_string(bit_length);
+    if (natural > 1 && bit_length != 0 && bit_length < natural) {
+        // A compact mapping of an integer's low-order bytes: the integer type of that width.
+        if (bit_length == 8) return od::is_signed(type) ? "SINT" : "USINT";
+        if (bit_length == 16) return od::is_signed(type) ? "INT" : "UINT";
+        if (bit_length == 32) return od::is_signed(type) ? "DINT" : "UDINT";
+        return "BIT" + std::to_string(bit_length);
+    }
     if (const char* n = detail::base_type_name(static_cast<uint16_t>(type))) return n;
     char b[16];
     std::snprintf(b, sizeof b, "DT%04X", static_cast<unsigned>(type));

@@ -65,7 +65,7 @@ void read_mapping(const od::Dictionary& dict, const od::Object& obj, PdoInfo& pd
                 if (!mappable)
                     warnings.push_back(where(obj.index, sub) + " maps " + where(pe.index, pe.subindex) +
                                        " which is not " + (pdo.rx ? "RxPDO" : "TxPDO") + " mappable");
-                if (target->bit_length != pe.bit_length)
+                if (!target->mappable_with(pe.bit_length))
                     warnings.push_back(where(obj.index, sub) + " maps " + where(pe.index, pe.subindex) +
                                        " with " + std::to_string(pe.bit_length) + " bits, the entry has " +
                                        std::to_string(target->bit_length));

@@ -61,6 +61,38 @@ TEST(ProcessDataPlan, PaddingTakesBitsButIsNotCopied) {
     EXPECT_EQ(pd.rx_plan()[1].bit_offset, 24u);
 }
 
+// A vendor's compact PDO maps an integer entry with fewer bits than it has (Beckhoff EJ7047: 0x6000:11,
+// UDINT, in a 16-bit TxPDO entry): the entry says so (pdo_bit_length, from the device's own PDOs), the
+// plan copies its low-order bits; another length is still an invalid mapping (ETG.1000.6, 0x0024).
+TEST(ProcessDataPlan, CompactMappingOfTheDevicesOwnPdosTakesTheLowBits) {
+    od::Dictionary d = make_dictionary();
+    od::Object o;
+    o.index = 0x2100;
+    o.code = od::ObjectCode::Var;
+    o.type = od::DataType::Unsigned32;
+    o.name = "Counter value";
+    od::Entry e;
+    e.subindex = 0;
+    e.type = od::DataType::Unsigned32;
+    e.access = od::access::RO | od::access::TxPdo;
+    e.default_value = uint64_t{0x12345678};
+    e.pdo_bit_length = 16;
+    e.name = o.name;
+    o.entries.push_back(e);
+    d.add(o);
+    ASSERT_EQ(d.set<uint8_t>(0x1A00, 0, 2), od::Status::Ok);
+    ASSERT_EQ(d.set<uint32_t>(0x1A00, 2, 0x21000010), od::Status::Ok);
+    ProcessData pd(d);
+    ASSERT_EQ(pd.build(), 0);
+    EXPECT_EQ(pd.tx_bits(), 32u);
+    std::vector<uint8_t> in(4, 0xEE);
+    pd.dictionary_to_inputs(in);
+    EXPECT_EQ(in[2], 0x78);
+    EXPECT_EQ(in[3], 0x56);
+    ASSERT_EQ(d.set<uint32_t>(0x1A00, 2, 0x21000008), od::Status::Ok);  // 8 bits: not a length it has
+    EXPECT_EQ(pd.build(), 0x0024);
+}
+
 TEST(ProcessDataPlan, MissingObject_0x0025) {
     od::Dictionary d = make_dictionary();
     ASSERT_EQ(d.set<uint32_t>(0x1600, 1, 0x50000010), od::Status::Ok);

@@ -1070,6 +1070,73 @@ TEST(EsiDevices, ProfileNoNamesTheProfileWhenTheDeviceTypeDisagrees) {
     expect_same(describe(q), describe(round_trip(q)), "second round trip");
 }
 
+// Two forms of Beckhoff's files (written here anew): an enumeration of BitSize 3 over BaseType USINT in a
+// record ("Safety Project State", EL6900), which is a 3-bit entry (CoE BIT3) and a TxPDO maps it with 3
+// bits; and a "compact" PDO that maps the low 16 bits of a UDINT entry (EJ7047's "Set counter value"). Both
+// are the device's own default PDOs, so they load without a warning, and the mapping objects map what the
+// file says; the written ESI reads back the same.
+TEST(EsiDevices, BitFieldEnumsAndCompactPdoEntriesAreMappedAsTheFileSays) {
+    const std::string xml =
+        "<?xml version=\"1.0\"?><EtherCATInfo><Vendor><Id>#x00000A5E</Id><Name>Example "
+        "Automation</Name></Vendor>"
+        "<Descriptions><Groups><Group><Type>Safety</Type><Name>Safety</Name></Group></Groups><Devices>"
+        "<Device Physics=\"YY\"><Type ProductCode=\"#x1af43052\" RevisionNo=\"#x00100000\">EXL6901</Type>"
+        "<Name>EXL6901 logic terminal</Name><GroupType>Safety</GroupType>"
+        "<Profile><ProfileNo>5001</ProfileNo><Dictionary><DataTypes>"
+        "<DataType><Name>USINT</Name><BitSize>8</BitSize></DataType>"
+        "<DataType><Name>UDINT</Name><BitSize>32</BitSize></DataType>"
+        "<DataType><Name>DT0800EN03</Name><BaseType>USINT</BaseType><BitSize>3</BitSize>"
+        "<EnumInfo><Text>OFFLINE</Text><Enum>0</Enum></EnumInfo><EnumInfo><Text>RUN</Text><Enum>1</Enum></"
+        "EnumInfo>"
+        "</DataType>"
+        "<DataType><Name>DTF100</Name><BitSize>64</BitSize>"
+        "<SubItem><SubIdx>0</SubIdx><Name>SubIndex "
+        "000</Name><Type>USINT</Type><BitSize>8</BitSize><BitOffs>0</BitOffs>"
+        "<Flags><Access>ro</Access></Flags></SubItem>"
+        "<SubItem><SubIdx>1</SubIdx><Name>Project State</Name><Type>DT0800EN03</Type><BitSize>3</BitSize>"
+        "<BitOffs>16</BitOffs><Flags><Access>ro</Access><PdoMapping>T</PdoMapping></Flags></SubItem>"
+        "<SubItem><SubIdx>17</SubIdx><Name>Counter value</Name><Type>UDINT</Type><BitSize>32</BitSize>"
+        "<BitOffs>32</BitOffs><Flags><Access>ro</Access><PdoMapping>T</PdoMapping></Flags></SubItem>"
+        "</DataType></DataTypes><Objects>"
+        "<Object><Index>#xf100</Index><Name>Device Status</Name><Type>DTF100</Type><BitSize>64</BitSize>"
+        "<Info><SubItem><Name>SubIndex 000</Name><Info><DefaultValue>#x11</DefaultValue></Info></SubItem>"
+        "<SubItem><Name>Project State</Name><Info><DefaultData>01</DefaultData></Info></SubItem>"
+        "<SubItem><Name>Counter value</Name><Info><DefaultData>78563412</DefaultData></Info></SubItem>"
+        "</Info><Flags><Access>ro</Access></Flags></Object>"
+        "</Objects></Dictionary></Profile>"
+        "<Sm DefaultSize=\"128\" StartAddress=\"#x1000\" ControlByte=\"#x26\" Enable=\"1\">MBoxOut</Sm>"
+        "<Sm DefaultSize=\"128\" StartAddress=\"#x1080\" ControlByte=\"#x22\" Enable=\"1\">MBoxIn</Sm>"
+        "<Sm StartAddress=\"#x1100\" ControlByte=\"#x24\" Enable=\"0\">Outputs</Sm>"
+        "<Sm StartAddress=\"#x1180\" ControlByte=\"#x20\" Enable=\"1\">Inputs</Sm>"
+        "<TxPdo Fixed=\"1\" Sm=\"3\"><Index>#x1a00</Index><Name>Status compact</Name>"
+        "<Entry><Index>#xf100</Index><SubIndex>1</SubIndex><BitLen>3</BitLen><Name>Project State</Name>"
+        "<DataType>BIT3</DataType></Entry>"
+        "<Entry><Index>#x0</Index><BitLen>13</BitLen></Entry>"
+        "<Entry><Index>#xf100</Index><SubIndex>17</SubIndex><BitLen>16</BitLen><Name>Counter value</Name>"
+        "<DataType>UINT</DataType></Entry></TxPdo>"
+        "<Mailbox><CoE SdoInfo=\"true\" PdoAssign=\"false\" PdoConfig=\"false\"/></Mailbox>"
+        "<Eeprom><ByteSize>2048</ByteSize><ConfigData>080E00CC88130000</ConfigData></Eeprom>"
+        "</Device></Devices></Descriptions></EtherCATInfo>";
+    const od::Product p = esi::load_product(esi::read_esi_text(xml, "exl6901.xml"), "");
+    EXPECT_TRUE(p.warnings.empty()) << ::testing::PrintToString(p.warnings);
+    const od::Dictionary d = p.make_dictionary(p.description);
+    ASSERT_NE(d.find(0xF100, 1), nullptr);
+    EXPECT_EQ(d.find(0xF100, 1)->type, od::DataType::Bit3);
+    EXPECT_EQ(d.find(0xF100, 1)->bit_length, 3u);
+    ASSERT_NE(d.find(0xF100, 0x11), nullptr);
+    EXPECT_EQ(d.find(0xF100, 0x11)->bit_length, 32u);
+    EXPECT_TRUE(d.find(0xF100, 0x11)->mappable_with(16));
+    EXPECT_FALSE(d.find(0xF100, 0x11)->mappable_with(8));
+    EXPECT_EQ(d.get<uint32_t>(0x1A00, 1), 0xF1000103u);
+    EXPECT_EQ(d.get<uint32_t>(0x1A00, 3), 0xF1001110u);
+    std::string written;
+    const od::Product q = round_trip(p, &written);
+    EXPECT_TRUE(q.warnings.empty()) << ::testing::PrintToString(q.warnings);
+    EXPECT_TRUE(schema_errors(written).empty()) << ::testing::PrintToString(schema_errors(written));
+    expect_same(describe(p), describe(q), "round trip");
+    EXPECT_TRUE(q.make_dictionary(q.description).find(0xF100, 0x11)->mappable_with(16));
+}
+
 // A vendor's diagnosis texts (ETG.2000 Profile/DiagMessages) are the device's: read into its description with
 // the vendor's text ids, the English text of several languages, the class where given; written back by
 // --write-esi as they were, valid against the schema, and a fixed point of the round trip.

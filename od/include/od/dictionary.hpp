@@ -35,7 +35,11 @@ struct Entry {
     uint8_t subindex = 0;
     std::string name;
     DataType type = DataType::Unsigned8;
-    uint16_t bit_length = 0;       // for strings: capacity in bits
+    uint16_t bit_length = 0;  // for strings: capacity in bits
+    // A shorter length the device's own PDOs map this integer entry with (its low-order bits), 0 if none: the
+    // "compact" PDOs of vendor files (Beckhoff EJ7047: 0x7000:11, UDINT, mapped with 16 bits). A mapping
+    // entry of this length is accepted as one of bit_length is.
+    uint16_t pdo_bit_length = 0;
     uint16_t access = access::RO;  // od::access bits, including PDO mappability, backup and settings
     Number default_value;
     Number minimum;
@@ -54,6 +58,10 @@ struct Entry {
     bool tx_mappable() const { return access & access::TxPdo; }
     bool backup() const { return access & access::Backup; }
     std::size_t byte_size() const { return (bit_length + 7u) / 8u; }
+    // A mapping entry may map this entry with `bits` bits: its own length, or the device's compact one.
+    bool mappable_with(unsigned bits) const {
+        return bits == bit_length || (bits != 0 && bits == pdo_bit_length);
+    }
 };
 
 struct Object {
