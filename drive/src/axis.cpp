@@ -325,8 +325,8 @@ void Axis::cycle(int64_t now_ns, int64_t dt_ns) {
             if (tick_ % kPositionDivider == 0) {
                 trajectory_tick(t);
                 if (dc_.power() && sp_.control() == Control::Position) {
-                    const bool internal_ff =
-                        sp_.mode() != mode::CyclicSyncPosition || dc_.stop() != StopKind::None;
+                    const bool internal_ff = sp_.mode() != mode::CyclicSyncPosition ||
+                                             dc_.stop() != StopKind::None || params.csp_own_feed_forward;
                     ctl_.position(sp_.demand_position(), sp_.demand_velocity(), sp_.demand_acceleration(),
                                   static_cast<double>(count_), internal_ff, plant_.torque_constant(),
                                   rad_per_inc_);
@@ -360,7 +360,7 @@ void Axis::update_feedback() {
         s |= sw::InternalLimit;
     if (home_.referenced()) s |= sw::Referenced;
     const bool oe = dc_.operational();
-    const bool ferr = params.following_error_window != kNoWindow &&
+    const bool ferr = following_error_checked(params.following_error_window) &&
                       std::abs(sp_.demand_position() - static_cast<double>(count_)) >
                           static_cast<double>(params.following_error_window);
     switch (sp_.mode()) {

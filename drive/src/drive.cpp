@@ -381,6 +381,11 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink, const VendorObjects& v
             bound_params[k] = in_raw(b.index, b.sub, vf.size, field);
     }
     // Without the device's motor data and tuning, the motor model's (as commission() writes them).
+    // Such a drive (a vendor's CiA 402 drive, tuned by its maker for its motor) follows a CSP trajectory
+    // as drives that interpolate the set-points do: with the velocity of its own demand fed forward, so a
+    // constant-speed ramp has no lag to speak of (the MAXPOS, whose position regulator the device declares,
+    // takes feed-forward only from the master's offsets 0x60B1/0x60B2, as its firmware specification says).
+    p.csp_own_feed_forward = !bound_params[static_cast<std::size_t>(Param::PositionBandwidth)];
     const MotorModel& m = axis_.motor();
     for (const auto& [param, value] : commissioned(m))
         if (!bound_params[static_cast<std::size_t>(param)]) {

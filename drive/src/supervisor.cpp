@@ -98,7 +98,7 @@ void Supervisor::standstill(double vel_avg_rpm, uint32_t window, uint16_t time_m
 
 bool Supervisor::following_error(bool checked, double ferr, uint32_t window, uint16_t timeout_ms,
                                  int64_t dt_ns) {
-    if (checked && window != kNoWindow && ferr > static_cast<double>(window)) {
+    if (checked && following_error_checked(window) && ferr > static_cast<double>(window)) {
         ferr_time_ms_ += static_cast<double>(dt_ns) * 1e-6;
         return ferr_time_ms_ >= timeout_ms;
     }

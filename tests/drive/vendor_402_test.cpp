@@ -274,6 +274,62 @@ TEST(Vendor402, FollowingErrorFaultsAndFaultResetRecovers) {
     EXPECT_EQ(r.sw() & 0x6F, 0x27);
 }
 
+// A vendor's drive as Ingenia's ESIs declare it: no encoder resolution (0x608F absent, the position unit is
+// the encoder increment), a following error window of 100 increments for 10 ms (0x6065/0x6066). The master
+// ramps the set-point as a CSP user does, 10 increments per 1 ms cycle from standstill: a drive that
+// interpolates the set-points feeds its own demand's velocity forward and stays well inside the window, as
+// the real one does (without the feed-forward the lag of a bare position loop, some 100 increments at this
+// speed, faulted it with 0x8611 within the first 20 ms).
+TEST(Vendor402, ACspRampStaysInsideAVendorsTightFollowingErrorWindow) {
+    od::Dictionary d = vendor_dictionary(0x00000380, 0, false);
+    ASSERT_EQ(sdo_write(d, 0x6065, 0, 100, 4), od::Status::Ok);
+    var(d, 0x6066, DataType::Unsigned16, RW, uint64_t{10}, "Following error time out");
+    drive::test::Recorder rec;
+    drive::Drive drv{d, &rec};
+    int64_t t = 0;
+    auto cycle = [&](int n) {
+        for (int i = 0; i < n; ++i, t += 1'000'000)
+            drv.cycle(t, 1'000'000);
+    };
+    auto sw = [&] { return d.get<uint16_t>(0x6041, 0); };
+    cycle(1);
+    d.set<int32_t>(0x607A, 0, d.get<int32_t>(0x6064, 0));
+    for (uint16_t c : {0x06, 0x07, 0x0F}) {
+        d.set<uint16_t>(0x6040, 0, c);
+        cycle(1);
+    }
+    ASSERT_EQ(sw() & 0x6F, 0x27) << std::hex << sw();
+    int32_t target = d.get<int32_t>(0x6064, 0);
+    const int32_t end = target + 2000;
+    int32_t worst = 0;
+    while (target < end) {
+        target += 20;
+        d.set<int32_t>(0x607A, 0, target);
+        cycle(2);
+        worst = std::max(worst, std::abs(d.get<int32_t>(0x60F4, 0)));
+        ASSERT_EQ(sw() & 0x6F, 0x27) << std::hex << sw() << " at " << target << ", error code 0x"
+                                     << d.get<uint16_t>(0x603F, 0);
+    }
+    cycle(200);
+    EXPECT_LT(worst, 100);
+    EXPECT_NEAR(d.get<int32_t>(0x6064, 0), end, 2);
+    EXPECT_EQ(d.get<uint16_t>(0x603F, 0), 0u);
+}
+
+// 0x6065 = 0 switches the following error monitoring off, as 0xFFFFFFFF does (CiA 402-2 / IEC 61800-7-201,
+// following error window): a set-point step the motor cannot follow is no fault then.
+TEST(Vendor402, AFollowingErrorWindowOfZeroSwitchesTheMonitoringOff) {
+    VendorRig r;
+    r.enable();
+    ASSERT_EQ(r.sw() & 0x6F, 0x27);
+    ASSERT_EQ(sdo_write(r.d, 0x6065, 0, 0, 4), od::Status::Ok);
+    r.d.set<int32_t>(0x607A, 0, r.position() + 100000);
+    r.cycle(50);
+    EXPECT_EQ(r.sw() & 0x6F, 0x27) << std::hex << r.sw();
+    EXPECT_EQ(r.d.get<uint16_t>(0x603F, 0), 0u);
+    EXPECT_FALSE(r.rec.has(drive::error_code::FollowingError));
+}
+
 TEST(Vendor402, QuickStopFollowsTheVendorsOptionCode) {
     VendorRig r;
     r.enable();

@@ -41,6 +41,10 @@ struct Parameters {
     uint32_t reset_time = vendor::PositionResetTime.def;  // :03 us
     uint32_t inertia = vendor::Inertia.def;               // :04 mg cm^2
     uint32_t friction = vendor::Friction.def;             // :05 nNm/rpm (viscous)
+    // CSP: the position loop feeds its own demand's velocity forward (and its inertia and friction), as a
+    // drive that interpolates the cyclic set-points does; false: only the master's 0x60B1/0x60B2 offsets
+    // (MAXPOS).
+    bool csp_own_feed_forward = false;
     // Option codes 0x6007, 0x605A..0x605E
     int16_t abort_connection = obj::AbortConnectionOptionCode.def;
     int16_t quick_stop = obj::QuickStopOptionCode.def;
