@@ -90,17 +90,7 @@ std::optional<std::pair<DataType, uint16_t>> od_type(const std::string& name, ui
 // The od type of an entry: its (resolved) ESI type, or, for a type the file defines as an array (a VAR of
 // an ArrayInfo type), an octet string of its size.
 std::optional<std::pair<DataType, uint16_t>> entry_type(const EsiEntry& e) {
-    if (auto t = od_type(e.type, e.bit_size)) {
-        // A bit field narrower than its base type: an enumeration of BitSize 3 over BaseType USINT
-        // (Beckhoff's DT0800EN03, "Safety Project State"), or a BitSize 2 entry of type USINT. It occupies
-        // its BitSize bits in the record and in PDOs (ETG.2000 DataType BitSize), so it is the CoE type
-        // BITn (ETG.1000.6 data types 0x0030-0x0037), not the base type's 8 bits.
-        const bool integer =
-            !od::is_real(t->first) && !od::is_string(t->first) && t->first != DataType::Boolean;
-        if (integer && e.bit_size >= 1 && e.bit_size < 8 && e.bit_size < t->second)
-            return std::make_pair(static_cast<DataType>(0x002F + e.bit_size), e.bit_size);
-        return t;
-    }
+    if (auto t = od_type(e.type, e.bit_size)) return t;
     if (e.type_known && e.bit_size > 0) return std::make_pair(DataType::OctetString, e.bit_size);
     return std::nullopt;
 }
