@@ -215,6 +215,45 @@ void add_dc_tests(Catalogue& c) {
         },
         a);
     add(
+        "system_time.difference",
+        "System time difference 0x092C after writes of 0x0910: bit 31 set for a received time ahead of the "
+        "local copy, clear for one behind, magnitude over 1 ms for 100 ms",
+        std::string(kDc) +
+            " (0x0910 ECAT write compared with the local copy, 0x092C mean difference: bit 31 local < "
+            "received; "
+            "0x0930 write resets the filters)",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            auto speed = ctx.rd<uint16_t>(0x0930);
+            if (!speed) return fail("0x0930 unreadable", err(speed.error()));
+            // One direction: the filters reset (0x0930 written with its own value), then 16 writes of the
+            // system time read just before, moved by `shift`; the difference read after.
+            auto probe = [&](int64_t shift) -> master::Result<uint32_t> {
+                (void)ctx.wr<uint16_t>(0x0930, *speed);
+                for (int i = 0; i < 16; ++i) {
+                    auto now = ctx.rd<uint64_t>(esc::reg::kDcSystemTime);
+                    if (!now) return now.error();
+                    (void)ctx.wr<uint32_t>(esc::reg::kDcSystemTime,
+                                           static_cast<uint32_t>(static_cast<int64_t>(*now) + shift));
+                }
+                return ctx.rd<uint32_t>(0x092C);
+            };
+            auto ahead = probe(100'000'000);
+            auto behind = probe(-100'000'000);
+            (void)ctx.wr<uint16_t>(0x0930, *speed);  // the control loop starts afresh
+            if (!ahead || !behind) return fail("0x0910/0x092C access failed");
+            const std::string got = "ahead " + hex(*ahead, 8) + ", behind " + hex(*behind, 8);
+            const uint32_t ms1 = 1'000'000;
+            if (!(*ahead & 0x80000000u) || (*ahead & 0x7FFFFFFFu) < ms1)
+                return fail("received time 100 ms ahead: not shown as local < received", got,
+                            "bit 31 set, magnitude >= 1 ms");
+            if ((*behind & 0x80000000u) || (*behind & 0x7FFFFFFFu) < ms1)
+                return fail("received time 100 ms behind: not shown as local >= received", got,
+                            "bit 31 clear, magnitude >= 1 ms");
+            return pass("difference follows the written time", got);
+        },
+        a);
+    add(
         "sync0.pulses", "SYNC0 activated: pulses come (0x098E status) and the next SYNC0 time advances", kDc,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_dc());

@@ -251,8 +251,9 @@ void add_sdo_tests(Catalogue& c) {
         },
         "ESI with an object larger than the mailbox");
     add(
-        "upload.toggle_sequence", "Segmented upload responses alternate the toggle bit from 0", kSdo,
-        {&Context::need_coe, &Context::need_esi},
+        "upload.toggle_sequence",
+        "Segmented upload responses alternate the toggle bit from 0; bit 0 (last segment) only in the last",
+        kSdo, {&Context::need_coe, &Context::need_esi},
         [](Context& ctx) {
             auto b = big_object(ctx);
             if (!b) return skip("no object larger than the mailbox in the ESI");
@@ -274,6 +275,13 @@ void add_sdo_tests(Catalogue& c) {
                     return fail("toggle of segment " + dec(n), dec((s.cmd() >> 4) & 1), dec(t));
                 const std::size_t len = s.p.size() == 10 ? 7u - ((s.cmd() >> 1) & 7u) : s.p.size() - 3;
                 done += len;
+                // Bit 0 of a segment (ETG.1000.6 upload segment response, c): set in the segment that
+                // completes the size indicated, clear in every one before it.
+                if (((s.cmd() & 1) != 0) != (done >= size))
+                    return fail("segment " + dec(n) + ": last-segment bit 0 against the bytes still due",
+                                hex(s.cmd(), 2) + " after " + dec(static_cast<long long>(done)) + " of " +
+                                    dec(static_cast<long long>(size)) + " bytes",
+                                done >= size ? "bit 0 set (no more segments)" : "bit 0 clear");
                 if (s.cmd() & 1) break;
             }
             if (done != size)
@@ -659,6 +667,18 @@ void add_sdo_tests(Catalogue& c) {
             "complete access announced");
     }
     add(
+        "ca.response_fields",
+        "Complete access upload of 0x1018 from subindex 0: response with the complete-access bit, index and "
+        "subindex echoed, size as the data",
+        kCa, {&Context::need_complete_access},
+        [](Context& ctx) {
+            SdoAnswer a = sdo_raw(ctx, sdo_req(0x50, 0x1018, 0));
+            Outcome o = expect_response(a, 2, 0x1018, 0, true, "complete access upload of 0x1018");
+            end_open_sdo(ctx);
+            return o;
+        },
+        "complete access announced");
+    add(
         "ca.upload_from_sub1",
         "Complete access upload of 0x1018 from subindex 1: the entries without subindex 0", kCa,
         {&Context::need_complete_access},
@@ -772,6 +792,61 @@ void add_sdo_tests(Catalogue& c) {
             auto again = ctx.upload_uint(p->index, 0);
             return expect_eq(hex(p->index) + ":00", again ? dec(static_cast<long long>(*again)) : "?",
                              dec(static_cast<long long>(*n)));
+        },
+        "ESI announces PdoConfig");
+    add(
+        "pdo.mapping_too_long",
+        "PDO mapping filled to its last subindex with its largest entry: taken, or refused with a code of "
+        "the "
+        "situation (0x06040042 PDO length exceeded and kin), never 'cannot be mapped' for a mappable object",
+        "ETG.1000.6 CoE PDO mapping; SDO abort codes 0x06040041/0x06040042/0x06040043",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            if (!ctx.esi->coe.pdo_config) return skip("the ESI does not announce PdoConfig");
+            CONFORM_PREOP(ctx);
+            const EsiPdo* p = nullptr;
+            for (const auto& x : ctx.esi->rxpdos)
+                if (!x.fixed && !x.entries.empty()) {
+                    p = &x;
+                    break;
+                }
+            if (!p) return skip("no configurable RxPDO");
+            const EsiObject* o = ctx.esi->object(p->index);
+            if (!o || o->entries.size() < 2)
+                return skip(hex(p->index) + " has no entries in the ESI dictionary");
+            const uint8_t last = o->entries.back().subindex;
+            const EsiPdoEntry* big = nullptr;
+            for (const auto& e : p->entries)
+                if (e.index && (!big || e.bit_len > big->bit_len)) big = &e;
+            if (!big) return skip("no mapped object in " + hex(p->index));
+            auto n = ctx.upload_uint(p->index, 0);
+            if (!n) return fail("upload: " + ctx.sdo_error(n.error()));
+            std::vector<uint64_t> entries;
+            for (uint8_t sub = 1; sub <= *n; ++sub) {
+                auto v = ctx.upload_uint(p->index, sub);
+                if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
+                entries.push_back(*v);
+            }
+            const uint64_t value = (static_cast<uint64_t>(big->index) << 16) |
+                                   (static_cast<uint64_t>(big->subindex) << 8) | big->bit_len;
+            Error e = ctx.download_uint(p->index, 0, 0, 1);
+            for (unsigned sub = 1; sub <= last && e == Error::Ok; ++sub)
+                e = ctx.download_uint(p->index, static_cast<uint8_t>(sub), value, 4);
+            if (e == Error::Ok) e = ctx.download_uint(p->index, 0, last, 1);
+            const uint32_t code = e == Error::SdoAbort ? ctx.sdo->last_abort() : 0;
+            // Put the mapping back.
+            Error r = ctx.download_uint(p->index, 0, 0, 1);
+            for (uint8_t sub = 1; sub <= *n && r == Error::Ok; ++sub)
+                r = ctx.download_uint(p->index, sub, entries[sub - 1u], 4);
+            if (r == Error::Ok) r = ctx.download_uint(p->index, 0, *n, 1);
+            const std::string what = dec(last) + " x " + hex(value, 8) + " in " + hex(p->index);
+            if (r != Error::Ok) return fail("mapping not restored: " + ctx.sdo_error(r));
+            if (e == Error::Ok) return pass(what + ": taken");
+            if (e != Error::SdoAbort) return fail(what + ": " + ctx.sdo_error(e));
+            for (uint32_t ok : {0x06040042u, 0x06040043u, 0x06090030u, 0x06090031u, 0x06090011u, 0x08000000u})
+                if (code == ok) return pass(what + ": refused", hex(code, 8));
+            return fail(what + ": refused with the code of another situation", hex(code, 8),
+                        "0x06040042 (or 0x06040043, 0x0609003x, 0x06090011, 0x08000000)");
         },
         "ESI announces PdoConfig");
 }
