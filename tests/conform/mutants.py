@@ -444,21 +444,32 @@ def sii_read_categories(st, d):
     return a, n, headers
 
 
+def sii_first_category(st, d, cat):
+    """For a read of the SII data registers: (a, n, w), the word address read, the bytes of data the datagram
+    covers and the header word of the first category of type `cat` (sii_read_categories); None when the
+    datagram is no such read or that category is not known yet."""
+    r = sii_read_categories(st, d)
+    if r is None:
+        return None
+    a, n, headers = r
+    for w, kind in headers:
+        if kind == cat:
+            return a, n, w
+    return None
+
+
 def sii_cat_byte(cat, off, fn):
     """SII reads of byte `off` of the data of the first category of type `cat`: fn(byte) -> byte."""
 
     def mutate(st, d):
-        r = sii_read_categories(st, d)
+        r = sii_first_category(st, d, cat)
         if r is None:
             return
-        a, n, headers = r
-        for w, kind in headers:
-            if kind == cat:
-                target = w + 2 + off // 2
-                if a <= target < a + n // 2:
-                    reg = 0x0508 + 2 * (target - a) + off % 2
-                    d.put(reg, fn(d.get(reg, 1)), 1)
-                return
+        a, n, w = r
+        target = w + 2 + off // 2
+        if a <= target < a + n // 2:
+            reg = 0x0508 + 2 * (target - a) + off % 2
+            d.put(reg, fn(d.get(reg, 1)), 1)
 
     return mutate
 
@@ -889,16 +900,13 @@ def sii_cat_length(cat, fn):
     """SII reads of the length word of the first category of type `cat`: fn(words) -> words."""
 
     def mutate(st, d):
-        r = sii_read_categories(st, d)
+        r = sii_first_category(st, d, cat)
         if r is None:
             return
-        a, n, headers = r
-        for w, kind in headers:
-            if kind == cat:
-                if a <= w + 1 < a + n // 2:
-                    reg = 0x0508 + 2 * (w + 1 - a)
-                    d.put(reg, fn(d.get(reg)))
-                return
+        a, n, w = r
+        if a <= w + 1 < a + n // 2:
+            reg = 0x0508 + 2 * (w + 1 - a)
+            d.put(reg, fn(d.get(reg)))
 
     return mutate
 

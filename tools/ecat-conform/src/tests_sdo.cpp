@@ -148,6 +148,41 @@ Outcome download_own_value(Context& ctx, Download how) {
     return pass(name);
 }
 
+// The first RxPDO of the ESI a master may remap (PdoConfig announced; not Fixed, with entries) in `p`, the
+// slave in PREOP; else the skip (or failure to reach PREOP) that says why not.
+Outcome remappable_rxpdo(Context& ctx, const EsiPdo*& p) {
+    CONFORM_NEED(ctx.need_esi());
+    if (!ctx.esi->coe.pdo_config) return skip("the ESI does not announce PdoConfig");
+    CONFORM_PREOP(ctx);
+    for (const auto& x : ctx.esi->rxpdos)
+        if (!x.fixed && !x.entries.empty()) {
+            p = &x;
+            return pass();
+        }
+    return skip("no configurable RxPDO");
+}
+
+// A mapping object's entries (subindex 1..:00) as read, for putting them back.
+master::Result<std::vector<uint64_t>> read_mapping(Context& ctx, uint16_t index) {
+    auto n = ctx.upload_uint(index, 0);
+    if (!n) return n.error();
+    std::vector<uint64_t> entries;
+    for (uint8_t sub = 1; sub <= *n; ++sub) {
+        auto v = ctx.upload_uint(index, sub);
+        if (!v) return v.error();
+        entries.push_back(*v);
+    }
+    return entries;
+}
+
+// Writes a mapping as a master does (ETG.1000.6 PDO mapping): subindex 0 to 0, the entries, the count.
+Error write_mapping(Context& ctx, uint16_t index, const std::vector<uint64_t>& entries) {
+    Error e = ctx.download_uint(index, 0, 0, 1);
+    for (std::size_t k = 0; k < entries.size() && e == Error::Ok; ++k)
+        e = ctx.download_uint(index, static_cast<uint8_t>(k + 1), entries[k], 4);
+    return e == Error::Ok ? ctx.download_uint(index, 0, entries.size(), 1) : e;
+}
+
 }  // namespace
 
 void add_sdo_tests(Catalogue& c) {
@@ -468,16 +503,8 @@ void add_sdo_tests(Catalogue& c) {
         "abort.mapping_sub0_nonzero", "Mapping entry written while subindex 0 is not 0: abort 0x06010003",
         "ETG.1000.6 CoE PDO mapping (subindex 0 set to 0 before entries change)",
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_esi());
-            if (!ctx.esi->coe.pdo_config) return skip("the ESI does not announce PdoConfig");
-            CONFORM_PREOP(ctx);
             const EsiPdo* p = nullptr;
-            for (const auto& x : ctx.esi->rxpdos)
-                if (!x.fixed && !x.entries.empty()) {
-                    p = &x;
-                    break;
-                }
-            if (!p) return skip("no configurable RxPDO");
+            if (Outcome o = remappable_rxpdo(ctx, p); o.status != Status::Pass) return o;
             auto v = ctx.upload_uint(p->index, 1);
             auto v2 = ctx.upload_uint(p->index, 2);
             if (!v || !v2) return fail(hex(p->index) + " upload failed");
@@ -765,33 +792,15 @@ void add_sdo_tests(Catalogue& c) {
         "pdo.mapping_rewrite", "PDO mapping rewritten in PREOP (subindex 0 to 0, entries, count) reads back",
         "ETG.1000.6 CoE PDO mapping",
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_esi());
-            if (!ctx.esi->coe.pdo_config) return skip("the ESI does not announce PdoConfig");
-            CONFORM_PREOP(ctx);
             const EsiPdo* p = nullptr;
-            for (const auto& x : ctx.esi->rxpdos)
-                if (!x.fixed && !x.entries.empty()) {
-                    p = &x;
-                    break;
-                }
-            if (!p) return skip("no configurable RxPDO");
-            auto n = ctx.upload_uint(p->index, 0);
-            if (!n) return fail("upload: " + ctx.sdo_error(n.error()));
-            std::vector<uint64_t> entries;
-            for (uint8_t s = 1; s <= *n; ++s) {
-                auto v = ctx.upload_uint(p->index, s);
-                if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
-                entries.push_back(*v);
-            }
-            Error e = ctx.download_uint(p->index, 0, 0, 1);
-            for (uint8_t s = 1; s <= *n && e == Error::Ok; ++s)
-                e = ctx.download_uint(p->index, s, entries[s - 1u], 4);
-            Error e2 = ctx.download_uint(p->index, 0, *n, 1);
-            if (e != Error::Ok || e2 != Error::Ok)
-                return fail("mapping write: " + ctx.sdo_error(e != Error::Ok ? e : e2));
+            if (Outcome o = remappable_rxpdo(ctx, p); o.status != Status::Pass) return o;
+            auto entries = read_mapping(ctx, p->index);
+            if (!entries) return fail("upload: " + ctx.sdo_error(entries.error()));
+            if (Error e = write_mapping(ctx, p->index, *entries); e != Error::Ok)
+                return fail("mapping write: " + ctx.sdo_error(e));
             auto again = ctx.upload_uint(p->index, 0);
             return expect_eq(hex(p->index) + ":00", again ? dec(static_cast<long long>(*again)) : "?",
-                             dec(static_cast<long long>(*n)));
+                             dec(static_cast<long long>(entries->size())));
         },
         "ESI announces PdoConfig");
     add(
@@ -801,16 +810,8 @@ void add_sdo_tests(Catalogue& c) {
         "situation (0x06040042 PDO length exceeded and kin), never 'cannot be mapped' for a mappable object",
         "ETG.1000.6 CoE PDO mapping; SDO abort codes 0x06040041/0x06040042/0x06040043",
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_esi());
-            if (!ctx.esi->coe.pdo_config) return skip("the ESI does not announce PdoConfig");
-            CONFORM_PREOP(ctx);
             const EsiPdo* p = nullptr;
-            for (const auto& x : ctx.esi->rxpdos)
-                if (!x.fixed && !x.entries.empty()) {
-                    p = &x;
-                    break;
-                }
-            if (!p) return skip("no configurable RxPDO");
+            if (Outcome o = remappable_rxpdo(ctx, p); o.status != Status::Pass) return o;
             const EsiObject* o = ctx.esi->object(p->index);
             if (!o || o->entries.size() < 2)
                 return skip(hex(p->index) + " has no entries in the ESI dictionary");
@@ -819,26 +820,13 @@ void add_sdo_tests(Catalogue& c) {
             for (const auto& e : p->entries)
                 if (e.index && (!big || e.bit_len > big->bit_len)) big = &e;
             if (!big) return skip("no mapped object in " + hex(p->index));
-            auto n = ctx.upload_uint(p->index, 0);
-            if (!n) return fail("upload: " + ctx.sdo_error(n.error()));
-            std::vector<uint64_t> entries;
-            for (uint8_t sub = 1; sub <= *n; ++sub) {
-                auto v = ctx.upload_uint(p->index, sub);
-                if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
-                entries.push_back(*v);
-            }
+            auto entries = read_mapping(ctx, p->index);
+            if (!entries) return fail("upload: " + ctx.sdo_error(entries.error()));
             const uint64_t value = (static_cast<uint64_t>(big->index) << 16) |
                                    (static_cast<uint64_t>(big->subindex) << 8) | big->bit_len;
-            Error e = ctx.download_uint(p->index, 0, 0, 1);
-            for (unsigned sub = 1; sub <= last && e == Error::Ok; ++sub)
-                e = ctx.download_uint(p->index, static_cast<uint8_t>(sub), value, 4);
-            if (e == Error::Ok) e = ctx.download_uint(p->index, 0, last, 1);
+            const Error e = write_mapping(ctx, p->index, std::vector<uint64_t>(last, value));
             const uint32_t code = e == Error::SdoAbort ? ctx.sdo->last_abort() : 0;
-            // Put the mapping back.
-            Error r = ctx.download_uint(p->index, 0, 0, 1);
-            for (uint8_t sub = 1; sub <= *n && r == Error::Ok; ++sub)
-                r = ctx.download_uint(p->index, sub, entries[sub - 1u], 4);
-            if (r == Error::Ok) r = ctx.download_uint(p->index, 0, *n, 1);
+            const Error r = write_mapping(ctx, p->index, *entries);  // put the mapping back
             const std::string what = dec(last) + " x " + hex(value, 8) + " in " + hex(p->index);
             if (r != Error::Ok) return fail("mapping not restored: " + ctx.sdo_error(r));
             if (e == Error::Ok) return pass(what + ": taken");
