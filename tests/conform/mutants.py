@@ -444,21 +444,32 @@ def sii_read_categories(st, d):
     return a, n, headers
 
 
+def sii_first_category(st, d, cat):
+    """For a read of the SII data registers: (a, n, w), the word address read, the bytes of data the datagram
+    covers and the header word of the first category of type `cat` (sii_read_categories); None when the
+    datagram is no such read or that category is not known yet."""
+    r = sii_read_categories(st, d)
+    if r is None:
+        return None
+    a, n, headers = r
+    for w, kind in headers:
+        if kind == cat:
+            return a, n, w
+    return None
+
+
 def sii_cat_byte(cat, off, fn):
     """SII reads of byte `off` of the data of the first category of type `cat`: fn(byte) -> byte."""
 
     def mutate(st, d):
-        r = sii_read_categories(st, d)
+        r = sii_first_category(st, d, cat)
         if r is None:
             return
-        a, n, headers = r
-        for w, kind in headers:
-            if kind == cat:
-                target = w + 2 + off // 2
-                if a <= target < a + n // 2:
-                    reg = 0x0508 + 2 * (target - a) + off % 2
-                    d.put(reg, fn(d.get(reg, 1)), 1)
-                return
+        a, n, w = r
+        target = w + 2 + off // 2
+        if a <= target < a + n // 2:
+            reg = 0x0508 + 2 * (target - a) + off % 2
+            d.put(reg, fn(d.get(reg, 1)), 1)
 
     return mutate
 
@@ -883,12 +894,281 @@ UNSEEN = {
 }
 MUTANTS.update(UNSEEN)
 
+
+# ---- blind round 2 (issue 23): defects written before ecat-conform's sources and tests were read ----------
+def sii_cat_length(cat, fn):
+    """SII reads of the length word of the first category of type `cat`: fn(words) -> words."""
+
+    def mutate(st, d):
+        r = sii_first_category(st, d, cat)
+        if r is None:
+            return
+        a, n, w = r
+        if a <= w + 1 < a + n // 2:
+            reg = 0x0508 + 2 * (w + 1 - a)
+            d.put(reg, fn(d.get(reg)))
+
+    return mutate
+
+
+def dc_offset_ignored(st, d):
+    """System time 0x0910 read as the local time: the offset the master wrote to 0x0920 is not added."""
+    if d.covers(0x0910, 4):
+        off = st.reg(0x0920, 8)
+        size = 8 if d.covers(0x0910, 8) else 4
+        if off:
+            d.put(0x0910, d.get(0x0910, size) - off, size)
+
+
+def al_refusal_shown_as(requested, shown):
+    """A refused request of state `requested` shown as done: AL status reads `shown` without the error bit and
+    AL status code 0, as long as the master's AL control asks for that state."""
+
+    def mutate(st, d):
+        if d.covers(0x0130):
+            v = d.get(0x0130)
+            fake = (st.mem[0x0120] & 0x0F) == requested and bool(v & 0x10) and (v & 0x0F) != requested
+            st.scratch["fake"] = fake
+            if fake:
+                d.put(0x0130, shown)
+        if st.scratch.get("fake") and d.covers(0x0134):
+            d.put(0x0134, 0)
+
+    return mutate
+
+
+def mbx_full_length_overrun(st, m):
+    """A reply that fills SM1 claims 2 bytes more than the mailbox holds (an off-by-header length)."""
+    size = st.reg(0x0802 + 8)
+    if size and 6 + mbx_len(m) == size:
+        struct.pack_into("<H", m, 0, mbx_len(m) + 2)
+        return m
+    return None
+
+
+def first_value_of(pred):
+    """Expedited uploads of the objects pred(index, sub) holds for always show the first value read there (a
+    write acknowledged but not applied)."""
+
+    def f(st, m):
+        svc, _ = coe(m)
+        if svc != 3 or len(m) < 16 or not is_expedited_upload(m[8]):
+            return None
+        key = ("first", struct.unpack_from("<H", m, 9)[0], m[11])
+        if not pred(key[1], key[2]):
+            return None
+        m[12:16] = st.scratch.setdefault(key, bytes(m[12:16]))
+        return m
+
+    return mbx_rewriter(f)
+
+
+def od_list_without(index):
+    """SDO information OD list of all objects (type 1) without `index` (fragments handled)."""
+
+    def f(st, m):
+        svc, _ = coe(m)
+        if svc != 8 or len(m) < 12 or (m[8] & 0x7F) != 0x02:
+            return None
+        first = not st.scratch.get("odl-cont")
+        st.scratch["odl-cont"] = bool(m[8] & 0x80)
+        if first:
+            st.scratch["odl-all"] = len(m) >= 14 and struct.unpack_from("<H", m, 12)[0] == 1
+        if not st.scratch.get("odl-all"):
+            return None
+        start = 14 if first else 12
+        end = 6 + mbx_len(m)
+        words = [struct.unpack_from("<H", m, o)[0] for o in range(start, end - 1, 2)]
+        if index not in words:
+            return None
+        words.remove(index)
+        body = b"".join(struct.pack("<H", w) for w in words)
+        m[start:end] = body + b"\x00\x00"
+        struct.pack_into("<H", m, 0, mbx_len(m) - 2)
+        return m
+
+    return mbx_rewriter(f)
+
+
+def emcy_reset_as_error(st, m):
+    """The error-reset emergency (code 0x0000) sent with the code of the last error instead."""
+    if coe(m)[0] != 1 or len(m) < 16:
+        return None
+    code = struct.unpack_from("<H", m, 8)[0]
+    if code:
+        st.scratch["emcy-last"] = code
+        return None
+    if "emcy-last" not in st.scratch:
+        return None
+    struct.pack_into("<H", m, 8, st.scratch["emcy-last"])
+    return m
+
+
+def foe_busy_forever(m):
+    """Every FoE error reply turned into BUSY (done 0 of 100): a server that never gets out of busy."""
+    if m[6] == 5:
+        m[6] = 6
+        struct.pack_into("<HH", m, 8, 0, 100)
+        struct.pack_into("<H", m, 0, 6)
+
+
+UNSEEN2 = {
+    # -- ESC registers --
+    "esc-fmmu-count": _m("ESC datasheet 0x0004: FMMUs supported, at least the ESI's Fmmu entries",
+                         reg_rewriter(0x0004, lambda v, st: min(v, 1), 1)),
+    "esc-sm-count": _m("ESC datasheet 0x0005: SyncManagers supported, at least the ESI's Sm entries",
+                       reg_rewriter(0x0005, lambda v, st: min(v, 2), 1)),
+    "esc-ram-size": _m("ESC datasheet 0x0006: process data RAM size (KiB) covers the SMs in use",
+                       reg_rewriter(0x0006, lambda v, st: 0, 1)),
+    "esc-port-desc-port0": _m("ESC datasheet 0x0007: port 0 described 'not implemented' while it carries the "
+                              "frames", reg_rewriter(0x0007, clear_bits(0x03), 1)),
+    "esc-dl-status-link-port0": _m("ETG.1000.4 DL status 0x0110 bit 4: physical link on port 0 that carries the "
+                                   "frames", reg_rewriter(0x0110, clear_bits(0x0010))),
+    "esc-rx-error-counter": _m("ESC datasheet 0x0300: RX error counters 0 on a clean link (cleared by a write)",
+                               reg_rewriter(0x0300, lambda v, st: max(v, 3), 1)),
+    "esc-pdi-control-not-sii": _m("ESC datasheet 0x0140 PDI control loaded from SII word 0 (ESI ConfigData)",
+                                  reg_rewriter(0x0140, lambda v, st: v ^ 0x01, 1)),
+    # -- DC --
+    "dc-offset-ignored": _m("ETG.1000.4 DC system time = local time + system time offset 0x0920",
+                            dc_offset_ignored),
+    "dc-diff-stuck": _m("ESC datasheet 0x092C system time difference follows the drift compensation",
+                        reg_rewriter(0x092C, lambda v, st: 0x00002710, 4)),
+    "dc-upper-zero": _m("ESC datasheet 0x0914: upper 32 bits of the 64-bit system time (features 0x0008 bit 3)",
+                        reg_rewriter(0x0914, lambda v, st: 0, 4)),
+    "dc-sync0-status": _m("ESC datasheet 0x098E bit 0: SYNC0 status set by the pulses while SYNC0 runs",
+                          reg_rewriter(0x098E, clear_bits(0x01), 1)),
+    # -- SII --
+    "sii-dc-assign-activate": _m("ETG.2010 SII DC category: AssignActivate as the ESI's OpMode",
+                                 sii_cat_byte(60, 15, lambda b: b ^ 0x02)),
+    "sii-general-name-index": _m("ETG.2010 SII General category: name string index within the strings",
+                                 sii_cat_byte(30, 3, lambda b: (b + 40) & 0xFF)),
+    "sii-strings-length": _m("ETG.2010 SII Strings category: each string's length byte",
+                             sii_cat_byte(10, 1, lambda b: b + 1)),
+    "sii-general-size": _m("ETG.2010 SII General category: length 16 words", sii_cat_length(30, lambda v: v - 1)),
+    "sii-fmmu-usage": _m("ETG.2010 SII FMMU category: FMMU0 usage as the ESI's Fmmu (outputs/inputs)",
+                         sii_cat_byte(40, 0, lambda b: {1: 2, 2: 1}.get(b, b))),
+    "sii-sm0-start": _m("ETG.2010 SII SyncM category: SM0 start as the ESI's Sm and SII word 0x18",
+                        sii_cat_byte(41, 0, lambda b: b ^ 0x40)),
+    "sii-bootstrap-mailbox": _m("ETG.2010 SII words 0x15/0x17: bootstrap mailbox sizes as the ESI's BootStrap",
+                                apply_all(sii_word(0x15, lambda v: 0), sii_word(0x17, lambda v: 0))),
+    "sii-tx-mailbox-offset": _m("ETG.2010 SII word 0x1A: standard send mailbox offset as the ESI's Sm (SM1)",
+                                sii_word(0x1A, lambda v: v + 0x40)),
+    "sii-rxpdo-sm": _m("ETG.2010 SII RxPDO category: SyncManager of the PDO (2, outputs)",
+                       sii_cat_byte(51, 3, lambda b: 3 if b == 2 else b)),
+    # -- ESM --
+    "al-code-unknown-state": _m("ETG.1000.6 AL status code 0x0012 for an unknown requested state",
+                                al_code_map({0x0012: 0x0011})),
+    "al-code-dc-config": _m("ETG.1000.6 AL status code 0x0030/0x0035/0x0036 for an invalid DC SYNC setting",
+                            al_code_map({0x0030: 0x0011, 0x0035: 0x0011, 0x0036: 0x0011})),
+    "al-code-mapping-swapped": _m("ETG.1000.6 AL status code 0x0024 input / 0x0025 output mapping invalid",
+                                  al_code_map({0x0024: 0x0025, 0x0025: 0x0024})),
+    "al-code-watchdog-config": _m("ETG.1000.6 AL status code 0x001F invalid watchdog configuration",
+                                  al_code_map({0x001F: 0x0011})),
+    "esm-preop-to-boot-shown": _m("ETG.1000.6 ESM: PREOP->BOOT invalid (0x0011), not shown as BOOT",
+                                  al_refusal_shown_as(3, 0x0003)),
+    # -- mailbox --
+    "mbx-error-channel-detail": _m("ETG.1000.4 mailbox error reply detail 0x0003 for a channel other than 0",
+                                   mbx_rewriter(lambda st, m: None if (m[5] & 0x0F) != 0 or len(m) < 10
+                                                or struct.unpack_from("<H", m, 8)[0] != 3 else
+                                                (struct.pack_into("<H", m, 8, 0x0002), m)[1])),
+    "mbx-full-length-overrun": _m("ETG.1000.4 mailbox header length: no more than SM1's size less the header",
+                                  mbx_rewriter(mbx_full_length_overrun)),
+    # -- CoE SDO --
+    "sdo-abort-toggle-general": _m("ETG.1000.6 abort 0x05030000 (toggle bit not alternated)",
+                                   abort_code({0x05030000: 0x08000000})),
+    "sdo-abort-range-as-length": _m("ETG.1000.6 abort 0x0609003x (value range) for a value out of range",
+                                    abort_code({0x06090030: 0x06070010, 0x06090031: 0x06070010,
+                                                0x06090032: 0x06070010})),
+    "sdo-abort-pdo-length": _m("ETG.1000.6 abort 0x06040042 (PDO length exceeded)",
+                               abort_code({0x06040042: 0x06040041})),
+    "sdo-ca-response-bit": _m("ETG.1000.6 SDO upload response to a complete access carries the complete-access bit",
+                              sdo_rewriter(lambda c, i, s, st: is_upload_resp(c) and len(st.request_coe()[1]) > 2
+                                           and st.request_coe()[1][2] & 0x10, lambda m: m.__setitem__(8, m[8] & ~0x10))),
+    "sdo-segment-last-bit": _m("ETG.1000.6 upload segment response: bit 0 (no more segments) in the last",
+                               sdo_rewriter(lambda c, i, s, st: (c & 0xE1) == 0x01,
+                                            lambda m: m.__setitem__(8, m[8] & ~0x01))),
+    "sdo-download-resp-reserved": _m("ETG.1000.6 SDO download response bytes 4-7 reserved (0)",
+                                     sdo_rewriter(lambda c, i, s, st: c == 0x60,
+                                                  lambda m: m.__setitem__(slice(12, 16), b"\x01\x00\x00\x00"))),
+    "sdo-write-not-applied": _m("ETG.1000.6 an SDO download acknowledged is done: the PDO assignment and mapping "
+                                "read back as written", first_value_of(lambda i, s: i in (0x1C12, 0x1C13)
+                                                                       or 0x1600 <= i < 0x1800 or 0x1A00 <= i < 0x1C00)),
+    # -- SDO information --
+    "info-list-missing-object": _m("ETG.1000.6 SDO information OD list (all objects) lists every object (0x1018)",
+                                   od_list_without(0x1018)),
+    "info-fragment-incomplete-bit": _m("ETG.1000.6 SDO information: incomplete bit set in every fragment but "
+                                       "the last", mbx_rewriter(lambda st, m: (m.__setitem__(8, m[8] & 0x7F), m)[1]
+                                                                if coe(m)[0] == 8 and len(m) >= 12 and m[8] & 0x80
+                                                                else None)),
+    "info-entry-datatype": _m("ETG.1000.6 SDO information entry description: data type as the dictionary "
+                              "(UNSIGNED16 given as INTEGER16)",
+                              info_of(0x06, lambda m: len(m) >= 18 and struct.unpack_from("<H", m, 16)[0] == 0x0006,
+                                      lambda m: struct.pack_into("<H", m, 16, 0x0003))),
+    "info-error-code": _m("ETG.1000.6 SDO information error request: abort 0x06020000 for an object that does "
+                          "not exist", sdo_info_rewriter(0x07, lambda m: len(m) >= 16 and struct.unpack_from(
+                              "<I", m, 12)[0] == 0x06020000 and struct.pack_into("<I", m, 12, 0x06090011))),
+    # -- PDO objects --
+    "pdo-assign-entry": _m("ETG.1000.6 0x1C12:01 assigned RxPDO as the ESI/SII (0x1600)",
+                           sdo_upload_of(0x1C12, 1, lambda m: m.__setitem__(12, m[12] ^ 0x01))),
+    # -- EMCY / diagnosis --
+    "emcy-1001-sticky": _m("CiA 301 / ETG.1000.6 0x1001 error register 0 once the error is gone",
+                           sticky_upload(0x1001, 0)),
+    "emcy-reset-as-error": _m("CiA 301 / ETG.1000.6 emergency error code 0x0000 (error reset) when the error "
+                              "is gone", mbx_rewriter(emcy_reset_as_error)),
+    "diag-newest-index": _m("ETG.1020 0x10F3:02 newest message: the subindex of the newest diagnosis message",
+                            sdo_upload_of(0x10F3, 2, lambda m: m[12] >= 6 and m.__setitem__(12, m[12] ^ 0x01))),
+    # -- FoE --
+    "foe-error-as-ack": _m("ETG.1000.6 FoE: a refused request answered with ERROR (opcode 5), not ACK",
+                           foe_rewriter(lambda m: m[6] == 5 and m.__setitem__(6, 4))),
+    "foe-busy-forever": _m("ETG.1000.6 FoE: a refused request answered with ERROR, not BUSY forever",
+                           foe_rewriter(foe_busy_forever)),
+    # -- CiA 402 --
+    "statusword-fault-bit": _m("CiA 402 statusword bit 3 (fault) in Fault", statusword(
+        lambda v: v & ~0x08 if (v & 0x4F) == 0x08 else v)),
+    "statusword-sod-bit": _m("CiA 402 statusword bit 6 (switch on disabled) in Switch on disabled", statusword(
+        lambda v: v & ~0x40 if (v & 0x4F) == 0x40 else v)),
+    "cia402-quickstop-option": _m("CiA 402 0x605A quick stop option code within the defined values",
+                                  sdo_upload_of(0x605A, 0, lambda m: m.__setitem__(slice(12, 14), b"\x09\x00"))),
+    "cia402-error-code-zero": _m("CiA 402 0x603F error code of the fault while in Fault",
+                                 sdo_upload_of(0x603F, 0, lambda m: m.__setitem__(slice(12, 14), b"\x00\x00"))),
+    # -- devices that are not the drive (DEVICE) --
+    "io-sii-mailbox-ghost": _m("ETG.2010 SII words 0x18/0x19: no standard mailbox for a device without one (ESI)",
+                               apply_all(sii_word(0x18, lambda v: v or 0x1000), sii_word(0x19, lambda v: v or 0x0080))),
+    "io-sii-sm-length": _m("ETG.2010 SII SyncM category: SM length as the ESI's Sm (the inputs' size)",
+                           sii_cat_byte(41, 2, lambda b: b + 1)),
+    "io-pdo-mapping-empty": _m("ETG.1000.6 0x1A00:00 number of mapped objects as the ESI's TxPDO",
+                               sdo_upload_of(0x1A00, 0, lambda m: m.__setitem__(12, 0))),
+}
+MUTANTS.update(UNSEEN2)
+
+# Where each defect of round 2 should be caught, decided from the standard (the area the clause belongs to).
+_GROUPS_UNSEEN2 = {
+    "esc-pdi-control-not-sii": {"esc", "sii"}, "dc-upper-zero": {"dc", "esc"},
+    "sii-dc-assign-activate": {"sii", "dc"}, "sii-bootstrap-mailbox": {"sii", "esm", "foe"},
+    "sii-tx-mailbox-offset": {"sii", "mbx"}, "mbx-full-length-overrun": {"mbx", "sdo", "sdoinfo"},
+    "sdo-write-not-applied": {"sdo", "pd"}, "pdo-assign-entry": {"sdo", "pd"},
+    "emcy-1001-sticky": {"cia402", "sdo", "mbx"}, "emcy-reset-as-error": {"cia402", "mbx"},
+    "diag-newest-index": {"sdo", "mbx", "cia402"}, "cia402-quickstop-option": {"cia402", "sdo"},
+    "io-pdo-mapping-empty": {"sdo", "pd"},
+}
+_PREFIX_UNSEEN2 = {"esc-": {"esc"}, "dc-": {"dc"}, "sii-": {"sii"}, "al-code-": {"esm"}, "esm-": {"esm"},
+                   "mbx-": {"mbx"}, "sdo-": {"sdo"}, "info-": {"sdoinfo"}, "foe-": {"foe"},
+                   "statusword-": {"cia402"}, "cia402-": {"cia402"}, "io-sii-": {"sii"}}
+
 # Unseen mutants the table run cannot kill, each with why (docs/conformance.md): reported, not failed on.
 TABLE_SURVIVORS = {
     "foe-data-packet-no": "the table's drive stores no image, so its FoE read is refused; killed by "
                           "test_conform.py foe_write, which reads a written image back",
     "sdo-segment-size-bits": "equivalent here: the drive's last upload segment is longer than 7 bytes, where the "
                              "size bits are unused",
+    # round 2 (UNSEEN2)
+    "dc-sync0-status": "never fires: the drive's SII sets a SYNC0 pulse length (0x0982), so 0x098E bit 0 is set "
+                       "only during the 1 us pulse and no read of any master sees it; not a defect of this slave",
+    "al-code-mapping-swapped": "not provoked: this slave checks PDO assignments and mappings when they are "
+                               "written (SDO aborts); its 0x0024/0x0025 refusal is left for more than 256 "
+                               "mapped entries per direction, which no test maps",
+    "sdo-abort-pdo-length": "not provoked on this slave: its PDO limit (160 bytes per SM) is above what one "
+                            "mapping object filled to its last subindex reaches (sdo.pdo.mapping_too_long: taken)",
 }
 
 
@@ -917,6 +1197,9 @@ DEVICE = {
     "io-emcy-code-zero": ("analog-in.xml", "0x0c203052:0x00140000", 0),
     "io-emcy-length": ("analog-in.xml", "0x0c203052:0x00140000", 0),
     "io-emcy-history-code": ("analog-in.xml", "0x0c203052:0x00140000", 0),
+    "io-sii-mailbox-ghost": ("digital-io.xml", "0x03f03052:0x00100000", 0),
+    "io-sii-sm-length": ("digital-io.xml", "0x03f03052:0x00100000", 0),
+    "io-pdo-mapping-empty": ("analog-in.xml", "0x0c203052:0x00140000", 0),
 }
 
 
@@ -932,6 +1215,13 @@ _GROUPS_UNSEEN = {
 
 def expected_groups(name):
     """The groups where mutant `name` must be caught ({"*"}: anywhere)."""
+    if name in UNSEEN2:
+        if name in _GROUPS_UNSEEN2:
+            return _GROUPS_UNSEEN2[name]
+        for prefix, groups in _PREFIX_UNSEEN2.items():
+            if name.startswith(prefix):
+                return groups
+        raise KeyError(f"mutant {name} has no group in _GROUPS_UNSEEN2")
     if name in UNSEEN:
         for prefix, groups in _GROUPS_UNSEEN.items():
             if name.startswith(prefix):
@@ -986,6 +1276,19 @@ VARIATIONS = {
                               "defined bits, any value", reg_rewriter(0x0210, set_bits(0x0FFD))),
     "sii-no-pdo-categories": ("ETG.2010 TxPDO/RxPDO categories: a slave with CoE describes its PDOs in its "
                               "dictionary, an EEPROM image may leave the categories out", sii_cat_removed({50, 51})),
+    # -- round 2 (written blind, with UNSEEN2): what a legal SDO server may do differently --
+    "sdo-expedited-unused-bytes": ("ETG.1000.6 SDO expedited upload: the bytes after the indicated size carry no "
+                                   "data (any value)", sdo_rewriter(lambda c, i, s, st: is_expedited_upload(c)
+                                                                    and (c & 0x01) and (c & 0x0C),
+                                                                    lambda m: m.__setitem__(
+                                                                        slice(16 - ((m[8] >> 2) & 3), 16),
+                                                                        b"\xAA" * ((m[8] >> 2) & 3)))),
+    "al-code-dc-general": ("ETG.1000.6 AL status codes: 0x0030 (invalid DC SYNC configuration) is the general "
+                           "code of the DC cycle-time codes 0x0035/0x0036",
+                           al_code_map({0x0035: 0x0030, 0x0036: 0x0030})),
+    "dc-diff-filtered": ("ESC datasheet 0x092C: a mean over a filter whose depth and start differ by silicon; "
+                         "the sign and the order of magnitude are what is defined",
+                         reg_rewriter(0x092C, lambda v, st: (v & 0x80000000) | ((v & 0x7FFFFFFF) >> 2), 4)),
     "eeprom-emulated": ("ESC datasheet 0x0502 bit 5: EEPROM emulated by the PDI (a silicon/firmware option)",
                         reg_rewriter(0x0502, set_bits(0x0020))),
 }
@@ -1000,6 +1303,7 @@ class Proxy:
         self.state = State()
         self.stop = threading.Event()
         self.errors = []
+        self.fired = 0  # reply frames the mutation changed (a mutation that never fires is no defect)
         self.outer = self._sock(outer)
         self.inner = self._sock(inner)
         self.thread = threading.Thread(target=self._run, daemon=True)
@@ -1040,8 +1344,10 @@ class Proxy:
                         self.inner.send(buf)
                     else:
                         if self.mutation:
+                            before = bytes(buf)
                             for d in datagrams(buf):
                                 self.mutation(self.state, d)
+                            self.fired += buf != before
                         self.outer.send(buf)
                 except Exception as e:  # a mutation bug must show, not hang the run
                     self.errors.append(repr(e))

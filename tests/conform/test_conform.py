@@ -157,6 +157,7 @@ class Conform(unittest.TestCase):
                 extra.extend(["--timeout-scale", "3"])
                 with ProxyLink(bus.iface, mutation) as p:
                     r, elapsed = run(p.iface)
+                self.last_fired = p.proxy.fired
                 self.assertEqual(p.proxy.errors, [], "the mutation raised")
             else:
                 r, elapsed = run(bus.iface)
@@ -186,6 +187,7 @@ class Conform(unittest.TestCase):
                 # variation that fails twice is a false alarm of the tool.
                 _, res, elapsed = self.run_conform(mutation=fn, device=device)
             failed = sorted(x["id"] for x in res["results"] if x["status"] == "FAIL")
+            anywhere = len(failed)
             if kind == "mutant":
                 # Only failures in the group where the defect must be caught count as its kill.
                 groups = mutants.expected_groups(name)
@@ -195,7 +197,8 @@ class Conform(unittest.TestCase):
                       if x["status"] in ("FAIL", "WARN") and x["id"] not in base_warn}
             ok = bool(failed) if kind == "mutant" else not failed and not warned
             rows.append((kind, name, clause, failed, warned, ok, elapsed, detail))
-            print(f"{kind} {name}: {'ok' if ok else 'NOT OK'} in {elapsed:.1f} s: {' '.join(failed[:6])}"
+            print(f"{kind} {name}: {'ok' if ok else 'NOT OK'} in {elapsed:.1f} s, changed {self.last_fired} "
+                  f"replies, {anywhere} failures in all: {' '.join(failed[:6])}"
                   f"{' warned ' + ' '.join(warned) if warned else ''}", file=sys.stderr, flush=True)
         return rows
 

@@ -87,7 +87,8 @@ inline Outcome expect_abort(const SdoAnswer& a, uint16_t index, uint8_t sub,
 
 // Every field the standard defines in an SDO upload (scs 2) or download (scs 3) response: mailbox type CoE,
 // CoE service 3 (SDO response) with the reserved bits 9-11 clear, the command specifier, the complete-access
-// bit set only for a complete access, index and subindex echoed, and the mailbox length of the response
+// bit set only for a complete access (and in an upload response to one), index and subindex echoed, the
+// reserved bytes of a download response 0, and the mailbox length of the response
 // type: 10 for an expedited upload or a download response, 10 + the data for a normal upload (the data
 // may continue in segments: then not more than the size indicated).
 inline Outcome expect_response(const SdoAnswer& a, uint8_t scs, uint16_t index, uint8_t sub, bool ca,
@@ -103,6 +104,11 @@ inline Outcome expect_response(const SdoAnswer& a, uint8_t scs, uint16_t index, 
     if ((c >> 5) != scs) return fail(what + ": command specifier", hex(c, 2), want);
     if ((c & 0x10) && !ca)
         return fail(what + ": complete-access bit set for a single entry", hex(c, 2), want);
+    // The upload response to a complete access says so (ETG.1000.6 SDO upload CA response, command 0x51):
+    // a master parses the data as the whole object only when the bit is set.
+    if (scs == 2 && ca && !(c & 0x10))
+        return fail(what + ": complete-access bit clear in the response to a complete access", hex(c, 2),
+                    "0x5x");
     if (get16(&a.p[3]) != index || a.p[5] != sub)
         return fail(what + ": index/subindex not echoed", hex(get16(&a.p[3])) + ":" + dec(a.p[5]),
                     hex(index) + ":" + dec(sub));
@@ -111,6 +117,9 @@ inline Outcome expect_response(const SdoAnswer& a, uint8_t scs, uint16_t index, 
             return fail(what + ": download response bits 0-3 reserved", hex(c, 2), "0x60");
         if (a.p.size() != 10)
             return fail(what + ": mailbox length of a download response", dec(a.p.size()), "10");
+        // ETG.1000.6 SDO download response: the 4 bytes after the subindex are reserved (0).
+        if (get32(&a.p[6]) != 0)
+            return fail(what + ": download response bytes 4-7 reserved", bytes_hex(a.p, 10), "00 00 00 00");
         return pass(what, hex(c, 2));
     }
     if (c & 0x02) {

@@ -154,6 +154,22 @@ std::optional<Outcome> faulted_drive(Context& ctx, Drive& d) {
     return std::nullopt;
 }
 
+// The emergencies (CoE service 1) that come in SM1 within 200 ms (scaled), read out while the drive's
+// process data keeps cycling (its watchdog fed); the mailbox client restarts after.
+std::vector<std::vector<uint8_t>> drain_emergencies(Context& ctx, Drive& d) {
+    std::vector<std::vector<uint8_t>> emcy;
+    std::vector<uint8_t> raw;
+    const auto until = std::chrono::steady_clock::now() + ctx.ms(200);
+    while (std::chrono::steady_clock::now() < until) {
+        d.run(1);
+        if (ctx.mbx_read_raw(raw, std::chrono::milliseconds(1)) == Error::Ok && (raw[5] & 0x0F) == 3 &&
+            raw.size() >= 16 && (raw[7] >> 4) == 1)
+            emcy.push_back(raw);
+    }
+    ctx.mbx_resync();
+    return emcy;
+}
+
 Outcome fault_emergency(Context& ctx, bool generic_bit) {
     Drive d(ctx);
     if (auto o = faulted_drive(ctx, d)) return *o;
@@ -566,19 +582,46 @@ void add_cia402_tests(Catalogue& c) {
         Severity::Warning);
     add(
         "fault_reset",
-        "Fault (from a communication loss while enabled) and fault reset (0x0080 edge): transition 15",
-        "IEC 61800-7-201 (CiA 402) transitions 13-15; 0x6007 abort connection option",
+        "Fault (from a communication loss while enabled) and fault reset (0x0080 edge): transition 15; the "
+        "statusword over SDO as in the image, then an error-reset emergency (if any) and 0x1001 bit 0 clear",
+        "IEC 61800-7-201 (CiA 402) transitions 13-15, statusword 0x6041; 0x6007 abort connection option; "
+        "CiA 301 / ETG.1000.6 emergency error code 0x0000 (error reset), error register 0x1001",
         [](Context& ctx) {
             Drive d(ctx);
             if (auto o = faulted_drive(ctx, d)) return *o;
+            // The statusword is one object, whichever way it is read: over SDO it shows the state the image
+            // shows (state bits 0-3, 5, 6), in Fault (read in SAFEOP, where no watchdog runs) and after the
+            // reset.
+            const uint16_t img_fault = d.status();
+            auto sdo_fault = ctx.upload_uint(0x6041, 0);
+            (void)drain_emergencies(ctx, d);
             master::AlStatus st;
             (void)ctx.pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st,
                                          [&d] { d.hold(); });
             (void)d.command(0x0000, kFault, 20);
             const bool ok = d.command(0x0080, kSod, 1000);
+            // After the reset (no error left): the emergencies sent end with "error reset" (code 0x0000,
+            // CiA 301 / ETG.1000.6), and 0x1001 has no generic error (bit 0). They are read out first: an
+            // SDO transfer would pass them over.
+            const auto emcy = drain_emergencies(ctx, d);
+            const uint16_t img_after = d.status();
+            auto sdo_after = ctx.upload_uint(0x6041, 0);
+            auto reg = ctx.upload_uint(0x1001, 0);
             const std::string s = sw_text(d.status());
             d.finish();
             if (!ok) return fail("fault reset edge did not leave fault", s, kSod.name);
+            if (sdo_fault && (*sdo_fault & 0x6F) != (img_fault & 0x6F))
+                return fail("in Fault, 0x6041 over SDO against the image",
+                            sw_text(static_cast<uint16_t>(*sdo_fault)), sw_text(img_fault));
+            if (sdo_after && (*sdo_after & 0x6F) != (img_after & 0x6F))
+                return fail("after the reset, 0x6041 over SDO against the image",
+                            sw_text(static_cast<uint16_t>(*sdo_after)), sw_text(img_after));
+            if (!emcy.empty() && get16(&emcy.back()[8]) != 0)
+                return fail("the last emergency after the fault reset is not \"error reset\" (code 0x0000)",
+                            bytes_hex(std::span<const uint8_t>(emcy.back()).subspan(0, 16)), "code 0x0000");
+            if (reg && (*reg & 0x01))
+                return fail("0x1001 still shows the generic error (bit 0) after the fault reset",
+                            hex(*reg, 2), "bit 0 clear");
             return pass("reset", s);
         },
         "profile 402 and --allow-fault");

@@ -119,6 +119,47 @@ Outcome refused_request_emergency(Context& ctx) {
     return pass("emergency " + hex(get16(&m[8])) + " register " + hex(m[10], 2), got);
 }
 
+// ETG.1020 diagnosis history 0x10F3 header against its messages: newest message (:02) 0 or within
+// 6..5+max (:01); the message it names is there and no stored message has a later time stamp.
+Outcome history_header(Context& ctx) {
+    CONFORM_NEED(ctx.need_coe());
+    CONFORM_PREOP(ctx);
+    auto newest = ctx.upload_uint(0x10F3, 2);
+    if (!newest) return skip("no diagnosis history 0x10F3");
+    master::DiagHeader h;
+    auto max = ctx.upload_uint(0x10F3, 1);
+    if (!max) return fail("0x10F3:01 (maximum messages) upload: " + ctx.sdo_error(max.error()));
+    h.max_messages = static_cast<uint8_t>(*max);
+    h.newest = static_cast<uint8_t>(*newest);
+    if (auto v = ctx.upload_uint(0x10F3, 3)) h.acknowledged = static_cast<uint8_t>(*v);
+    if (h.newest == 0) return pass("no message", "0x10F3:02 = 0");
+    if (h.newest < 6 || h.newest > 5 + h.max_messages)
+        return fail("0x10F3:02 (newest message) outside the message subindices", dec(h.newest),
+                    "0 or 6.." + dec(5 + h.max_messages));
+    auto b = ctx.upload(0x10F3, h.newest);
+    std::optional<master::DiagEntry> top;
+    if (b) top = master::decode_diag_message(*b, h.newest);
+    if (!top)
+        return fail("0x10F3:02 names subindex " + dec(h.newest) + ", which holds no message",
+                    b ? bytes_hex(*b, 16) : ctx.sdo_error(b.error()), "a diagnosis message");
+    unsigned n = 0;
+    for (uint8_t sub : master::diag_message_order(h, true, false)) {
+        if (sub == h.newest) continue;
+        if (n >= 64) break;  // enough to judge; a long ring costs one upload per message
+        auto m = ctx.upload(0x10F3, sub);
+        if (!m) continue;
+        auto e = master::decode_diag_message(*m, sub);
+        if (!e) continue;
+        ++n;
+        if (e->timestamp_ns > top->timestamp_ns)
+            return fail("0x10F3:02 names subindex " + dec(h.newest) + ", but subindex " + dec(sub) +
+                            " holds a later message",
+                        dec(static_cast<long long>(e->timestamp_ns)) + " ns",
+                        "<= " + dec(static_cast<long long>(top->timestamp_ns)) + " ns");
+    }
+    return pass("newest " + dec(h.newest), dec(n + 1) + " messages");
+}
+
 }  // namespace
 
 void add_emcy_tests(Catalogue& c) {
@@ -128,6 +169,10 @@ void add_emcy_tests(Catalogue& c) {
         "is 10 bytes of CoE service 1 with a non-zero error code, the generic and class bits in its error "
         "register, which equals 0x1001, and is stored in 0x10F3 where the device has it",
         kEmcy, refused_request_emergency, "CoE, a state machine (no device emulation), not a CiA 402 drive");
+    add("diag.history_header",
+        "Diagnosis history 0x10F3: newest message (:02) 0 or a message subindex, holding the latest message",
+        "ETG.1020 diagnosis history 0x10F3 (subindex 1 maximum messages, 2 newest message, 6.. messages)",
+        history_header, "CoE and 0x10F3");
 }
 
 }  // namespace conform

@@ -181,7 +181,8 @@ std::vector<uint8_t> datagram(Command c, uint8_t index, uint16_t adp, uint16_t a
 // DL status against the topology the tool sees: port 0 carries our frames (link, communication, open); a
 // slave with successors has another port open with communication; the last one has no communication on
 // any other port, and a port without link whose loop control is auto or auto-close is closed. Ports the
-// port descriptor 0x0007 says are not implemented show neither link nor communication.
+// port descriptor 0x0007 says are not implemented show neither link nor communication; port 0, which the
+// frames come in at, is implemented.
 Outcome dl_status_ports(Context& ctx) {
     auto s = ctx.rd<uint16_t>(esc::reg::kDlStatus);
     if (!s) return fail("0x0110 unreadable", err(s.error()));
@@ -202,6 +203,7 @@ Outcome dl_status_ports(Context& ctx) {
         const unsigned loop_cfg = (*ctl >> (2 * port)) & 3;
         const std::string p = "port " + dec(port) + ": ";
         if (port == 0) {
+            if (!implemented) bad(p + "0x0007 says not implemented, yet the frames come in there");
             if (!link) bad(p + "no link, yet the frames come in there");
             if (!comm) bad(p + "no communication, yet the frames come in there");
             if (closed && loop_cfg == 0)
@@ -667,15 +669,47 @@ void add_esc_tests(Catalogue& c) {
             if (*v & 0xF002) return fail("reserved bits set", hex(*v), "bits 1, 12-15 clear");
             return pass("0x0210", hex(*v));
         });
-    add(
-        "reg.pdi_control", "PDI control 0x0140 loaded from SII word 0", "ETG.1000.6 SII configuration area",
+    add("reg.pdi_control", "PDI control 0x0140 loaded from SII word 0",
+        "ETG.1000.6 SII configuration area; ESC datasheet 0x0140 (loaded from EEPROM word 0, also from the "
+        "data the PDI gives where it emulates the EEPROM)",
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_sii());
             auto p = ctx.rd<uint8_t>(esc::reg::kPdiControl);
             if (!p) return fail("0x0140 unreadable", err(p.error()));
             return expect_eq("PDI control", hex(*p, 2), hex(ctx.sii->word(0) & 0xFF, 2));
-        },
-        {}, Severity::Warning);
+        });
+    add("reg.error_counters",
+        "Error counters 0x0300-0x0313: cleared by a write; port 0 (the tool's frames), forwarded, processing "
+        "unit and port 0 lost link stay 0 over clean frames",
+        "ESC datasheet section II error counters 0x0300-0x0313 (a write clears); ETG.1000.4 frame "
+        "processing",
+        [](Context& ctx) {
+            std::vector<uint8_t> zero(0x14, 0);
+            if (Error e = ctx.m.write(ctx.addr, 0x0300, zero); e != Error::Ok)
+                return fail("write 0x0300-0x0313", err(e));
+            for (int i = 0; i < 20; ++i)
+                (void)ctx.rd<uint16_t>(esc::reg::kType);
+            uint8_t cnt[0x14] = {};
+            if (Error e = ctx.m.read(ctx.addr, 0x0300, cnt); e != Error::Ok)
+                return fail("0x0300-0x0313 unreadable", err(e));
+            // Ports other than 0 are left alone: what is cabled there (or not) is not the tool's to know.
+            const struct {
+                uint16_t reg;
+                const char* name;
+            } watched[] = {{0x0300, "port 0 invalid frames"},
+                           {0x0301, "port 0 RX errors"},
+                           {0x0308, "port 0 forwarded RX errors"},
+                           {0x030C, "processing unit errors"},
+                           {0x0310, "port 0 lost link"}};
+            std::string bad;
+            for (const auto& w : watched)
+                if (cnt[w.reg - 0x0300])
+                    bad += std::string(bad.empty() ? "" : ", ") + w.name + " " + dec(cnt[w.reg - 0x0300]);
+            if (!bad.empty())
+                return fail("counters not 0 after a clear and 20 clean frames: " + bad,
+                            bytes_hex(std::span<const uint8_t>(cnt, 0x14), 0x14), "0 on port 0");
+            return pass("cleared, stay 0", bytes_hex(std::span<const uint8_t>(cnt, 0x14), 0x14));
+        });
     add("reg.al_control_rw", "AL control 0x0120 accepts the master's request (INIT stays INIT)",
         "ETG.1000.6 AL control register", [](Context& ctx) {
             Sent s = send(ctx, Command::FPWR, ctx.station, 0x0120, le16(0x0001));

@@ -181,6 +181,57 @@ Outcome bad_pd_sm(Context& ctx, bool outputs, bool address) {
     return pass("refused", status_text(st));
 }
 
+// AL status codes a refusal of a DC or synchronisation setting may carry (ETG.1000.6 AL status codes):
+// sync error 0x001A, watchdog configuration 0x001F (with the SM watchdog test), inconsistent settings
+// 0x0026, the synchronisation family 0x0027-0x002E and the DC family 0x0030-0x0037.
+bool sync_refusal_code(uint16_t code, bool watchdog) {
+    return code == 0x001A || code == 0x0026 || (code >= 0x0027 && code <= 0x002E) ||
+           (code >= 0x0030 && code <= 0x0037) || (watchdog && code == 0x001F);
+}
+
+// PREOP -> SAFEOP with the process data and SYNC0 set up as a master does (ETG.1020 DC set-up: cycle time,
+// start time on the cycle grid ahead, then 0x0980/0x0981 AssignActivate), with the given AssignActivate and
+// cycle time, optionally with an SM watchdog of one divider unit (0x0420 = 1). A device may take the
+// setting (not judged here: it runs or reports later); a refusal must name it with a code of its family
+// (sync_refusal_code), not another situation's code.
+Outcome sync_setting(Context& ctx, uint16_t assign_activate, uint32_t cycle, bool short_watchdog,
+                     const std::string& what) {
+    CONFORM_NEED(ctx.need_dc());
+    CONFORM_NEED(ctx.need_pd_layout());
+    CONFORM_NEED(ctx.need_state_machine());
+    if (Error e = ctx.to_preop(); e != Error::Ok) return fail("cannot reach PREOP", err(e));
+    if (Error e = ctx.discover_pd(); e != Error::Ok) return fail("process-data layout: " + ctx.sdo_error(e));
+    if (short_watchdog && !ctx.pds->layout().sm2_length) return skip("no outputs: no SM watchdog");
+    auto wd = ctx.rd<uint16_t>(0x0420);
+    if (!wd) return fail("0x0420 unreadable", err(wd.error()));
+    if (short_watchdog && *wd == 0) return skip("process-data watchdog disabled (0x0420 = 0)");
+    master::DcConfig dc;
+    dc.enable = true;
+    dc.cycle_ns = cycle;
+    dc.assign_activate = assign_activate;
+    dc.start_delay = std::chrono::milliseconds(ctx.ms(100).count());
+    if (Error e = ctx.configure_pd(dc); e != Error::Ok) {
+        (void)ctx.wr<uint16_t>(esc::reg::kDcCyclicControl, 0);
+        return fail("process-data and DC set-up: " + ctx.sdo_error(e));
+    }
+    if (short_watchdog) (void)ctx.wr<uint16_t>(0x0420, 1);
+    const master::AlStatus st = ctx.request_raw(4, ctx.ms(2000));
+    (void)ctx.wr<uint16_t>(esc::reg::kDcCyclicControl, 0);
+    (void)ctx.wr<uint16_t>(0x0420, *wd);
+    (void)ctx.ack_error();
+    (void)ctx.to_init();
+    ctx.in_preop = false;
+    if (st.state == 4 && !st.error) return pass(what + ": taken", status_text(st));
+    if (st.state != 2 || !st.error)
+        return fail(what + ": neither SAFEOP nor refused in PREOP", status_text(st), "SAFEOP, or PREOP+ERR");
+    if (!sync_refusal_code(st.code, short_watchdog))
+        return fail(what + ": refused with the code of another situation", status_text(st),
+                    short_watchdog
+                        ? "0x001F, or a synchronisation code (0x001A, 0x0026-0x002E, 0x0030-0x0037)"
+                        : "a synchronisation code (0x001A, 0x0026-0x002E, 0x0030-0x0037)");
+    return pass(what + ": refused", status_text(st));
+}
+
 }  // namespace
 
 void add_esm_tests(Catalogue& c) {
@@ -291,6 +342,33 @@ void add_esm_tests(Catalogue& c) {
         "sm3.address", "PREOP -> SAFEOP with a wrong SM3 (inputs) start address: refused with 0x001E",
         std::string(kCodes) + " (0x001E)", [](Context& ctx) { return bad_pd_sm(ctx, false, true); },
         "inputs, no device emulation");
+    const std::string kDcCodes =
+        std::string(kCodes) +
+        " (0x0030 invalid DC SYNC configuration, 0x0035-0x0037 DC cycle times, "
+        "0x001F invalid watchdog configuration); ETG.1020 DC set-up; ESC datasheet DC activation 0x0981";
+    add(
+        "dc.sync0_cycle_zero",
+        "PREOP -> SAFEOP with SYNC0 activated at cycle time 0: taken, or refused with a DC/synchronisation "
+        "code",
+        kDcCodes, [](Context& ctx) { return sync_setting(ctx, 0x0300, 0, false, "SYNC0 with cycle time 0"); },
+        "DC, process data, no device emulation");
+    add(
+        "dc.sync1_without_sync0",
+        "PREOP -> SAFEOP with SYNC1 activated without SYNC0: taken, or refused with a DC/synchronisation "
+        "code",
+        kDcCodes,
+        [](Context& ctx) { return sync_setting(ctx, 0x0500, 1'000'000, false, "SYNC1 without SYNC0"); },
+        "DC, process data, no device emulation");
+    add(
+        "dc.watchdog_below_cycle",
+        "PREOP -> SAFEOP in SYNC0 mode (1 ms) with an SM watchdog of one divider unit: taken, or refused "
+        "with "
+        "0x001F or a synchronisation code",
+        kDcCodes,
+        [](Context& ctx) {
+            return sync_setting(ctx, 0x0300, 1'000'000, true, "SM watchdog below the cycle");
+        },
+        "DC, outputs with an SM watchdog, no device emulation");
     add("error.sticky", "With the error indication set, a request without acknowledge is not executed",
         "ETG.1000.6 AL control (error indication acknowledge)", [](Context& ctx) {
             CONFORM_NEED(ctx.need_state_machine());

@@ -367,6 +367,35 @@ void add_mbx_tests(Catalogue& c) {
         },
         "CoE", Severity::Warning);
     add(
+        "error.channel",
+        "Request on channel 1 (reserved): answered as on channel 0, or mailbox error 0x0003 (invalid "
+        "channel)",
+        kMbx,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            ctx.mbx_resync();
+            std::vector<uint8_t> m = message(3, 0, upload_1000());
+            m[4] = 0x01;  // channel 1
+            auto r = ask(ctx, m, ctx.ms(300));
+            ctx.mbx_resync();
+            const std::string want = "a CoE answer (channel ignored) or mailbox error detail 0x0003";
+            if (r.empty()) return fail("channel 1: no answer", "none", want);
+            const uint8_t type = r[5] & 0x0F;
+            if (type == 3) return pass("channel ignored", "CoE answer");
+            // ETG.1000.4 mailbox error reply detail 0x0003: invalid channel (0x0005, invalid header, names
+            // the same fault more generally).
+            if (type != 0 || get16(r.data()) != 4 || get16(&r[6]) != 0x0001)
+                return fail("channel 1: neither a CoE answer nor a mailbox error reply",
+                            "type " + dec(type) + " " + bytes_hex(std::span<const uint8_t>(r).subspan(0, 12)),
+                            want);
+            const uint16_t detail = get16(&r[8]);
+            if (detail != 0x0003 && detail != 0x0005)
+                return fail("channel 1: mailbox error detail", hex(detail), "0x0003 (or 0x0005)");
+            return pass("refused", "detail " + hex(detail));
+        },
+        "CoE");
+    add(
         "mailbox_after_error", "After a mailbox error, a correct request is answered normally", kMbx,
         {&Context::need_coe},
         [](Context& ctx) {

@@ -151,6 +151,41 @@ Outcome download_own_value(Context& ctx, Download how) {
     return pass(name);
 }
 
+// The first RxPDO of the ESI a master may remap (PdoConfig announced; not Fixed, with entries) in `p`, the
+// slave in PREOP; else the skip (or failure to reach PREOP) that says why not.
+Outcome remappable_rxpdo(Context& ctx, const EsiPdo*& p) {
+    CONFORM_NEED(ctx.need_esi());
+    if (!ctx.esi->coe.pdo_config) return skip("the ESI does not announce PdoConfig");
+    CONFORM_PREOP(ctx);
+    for (const auto& x : ctx.esi->rxpdos)
+        if (!x.fixed && !x.entries.empty()) {
+            p = &x;
+            return pass();
+        }
+    return skip("no configurable RxPDO");
+}
+
+// A mapping object's entries (subindex 1..:00) as read, for putting them back.
+master::Result<std::vector<uint64_t>> read_mapping(Context& ctx, uint16_t index) {
+    auto n = ctx.upload_uint(index, 0);
+    if (!n) return n.error();
+    std::vector<uint64_t> entries;
+    for (uint8_t sub = 1; sub <= *n; ++sub) {
+        auto v = ctx.upload_uint(index, sub);
+        if (!v) return v.error();
+        entries.push_back(*v);
+    }
+    return entries;
+}
+
+// Writes a mapping as a master does (ETG.1000.6 PDO mapping): subindex 0 to 0, the entries, the count.
+Error write_mapping(Context& ctx, uint16_t index, const std::vector<uint64_t>& entries) {
+    Error e = ctx.download_uint(index, 0, 0, 1);
+    for (std::size_t k = 0; k < entries.size() && e == Error::Ok; ++k)
+        e = ctx.download_uint(index, static_cast<uint8_t>(k + 1), entries[k], 4);
+    return e == Error::Ok ? ctx.download_uint(index, 0, entries.size(), 1) : e;
+}
+
 }  // namespace
 
 void add_sdo_tests(Catalogue& c) {
@@ -260,8 +295,9 @@ void add_sdo_tests(Catalogue& c) {
         },
         "ESI with an object larger than the mailbox");
     add(
-        "upload.toggle_sequence", "Segmented upload responses alternate the toggle bit from 0", kSdo,
-        {&Context::need_coe, &Context::need_esi},
+        "upload.toggle_sequence",
+        "Segmented upload responses alternate the toggle bit from 0; bit 0 (last segment) only in the last",
+        kSdo, {&Context::need_coe, &Context::need_esi},
         [](Context& ctx) {
             auto b = big_object(ctx);
             if (!b) return skip("no object larger than the mailbox in the ESI");
@@ -283,6 +319,13 @@ void add_sdo_tests(Catalogue& c) {
                     return fail("toggle of segment " + dec(n), dec((s.cmd() >> 4) & 1), dec(t));
                 const std::size_t len = s.p.size() == 10 ? 7u - ((s.cmd() >> 1) & 7u) : s.p.size() - 3;
                 done += len;
+                // Bit 0 of a segment (ETG.1000.6 upload segment response, c): set in the segment that
+                // completes the size indicated, clear in every one before it.
+                if (((s.cmd() & 1) != 0) != (done >= size))
+                    return fail("segment " + dec(n) + ": last-segment bit 0 against the bytes still due",
+                                hex(s.cmd(), 2) + " after " + dec(static_cast<long long>(done)) + " of " +
+                                    dec(static_cast<long long>(size)) + " bytes",
+                                done >= size ? "bit 0 set (no more segments)" : "bit 0 clear");
                 if (s.cmd() & 1) break;
             }
             if (done != size)
@@ -469,16 +512,8 @@ void add_sdo_tests(Catalogue& c) {
         "abort.mapping_sub0_nonzero", "Mapping entry written while subindex 0 is not 0: abort 0x06010003",
         "ETG.1000.6 CoE PDO mapping (subindex 0 set to 0 before entries change)",
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_esi());
-            if (!ctx.esi->coe.pdo_config) return skip("the ESI does not announce PdoConfig");
-            CONFORM_PREOP(ctx);
             const EsiPdo* p = nullptr;
-            for (const auto& x : ctx.esi->rxpdos)
-                if (!x.fixed && !x.entries.empty()) {
-                    p = &x;
-                    break;
-                }
-            if (!p) return skip("no configurable RxPDO");
+            if (Outcome o = remappable_rxpdo(ctx, p); o.status != Status::Pass) return o;
             auto v = ctx.upload_uint(p->index, 1);
             auto v2 = ctx.upload_uint(p->index, 2);
             if (!v || !v2) return fail(hex(p->index) + " upload failed");
@@ -672,6 +707,18 @@ void add_sdo_tests(Catalogue& c) {
             "complete access announced");
     }
     add(
+        "ca.response_fields",
+        "Complete access upload of 0x1018 from subindex 0: response with the complete-access bit, index and "
+        "subindex echoed, size as the data",
+        kCa, {&Context::need_complete_access},
+        [](Context& ctx) {
+            SdoAnswer a = sdo_raw(ctx, sdo_req(0x50, 0x1018, 0));
+            Outcome o = expect_response(a, 2, 0x1018, 0, true, "complete access upload of 0x1018");
+            end_open_sdo(ctx);
+            return o;
+        },
+        "complete access announced");
+    add(
         "ca.upload_from_sub1",
         "Complete access upload of 0x1018 from subindex 1: the entries without subindex 0", kCa,
         {&Context::need_complete_access},
@@ -758,33 +805,49 @@ void add_sdo_tests(Catalogue& c) {
         "pdo.mapping_rewrite", "PDO mapping rewritten in PREOP (subindex 0 to 0, entries, count) reads back",
         "ETG.1000.6 CoE PDO mapping",
         [](Context& ctx) {
-            CONFORM_NEED(ctx.need_esi());
-            if (!ctx.esi->coe.pdo_config) return skip("the ESI does not announce PdoConfig");
-            CONFORM_PREOP(ctx);
             const EsiPdo* p = nullptr;
-            for (const auto& x : ctx.esi->rxpdos)
-                if (!x.fixed && !x.entries.empty()) {
-                    p = &x;
-                    break;
-                }
-            if (!p) return skip("no configurable RxPDO");
-            auto n = ctx.upload_uint(p->index, 0);
-            if (!n) return fail("upload: " + ctx.sdo_error(n.error()));
-            std::vector<uint64_t> entries;
-            for (uint8_t s = 1; s <= *n; ++s) {
-                auto v = ctx.upload_uint(p->index, s);
-                if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
-                entries.push_back(*v);
-            }
-            Error e = ctx.download_uint(p->index, 0, 0, 1);
-            for (uint8_t s = 1; s <= *n && e == Error::Ok; ++s)
-                e = ctx.download_uint(p->index, s, entries[s - 1u], 4);
-            Error e2 = ctx.download_uint(p->index, 0, *n, 1);
-            if (e != Error::Ok || e2 != Error::Ok)
-                return fail("mapping write: " + ctx.sdo_error(e != Error::Ok ? e : e2));
+            if (Outcome o = remappable_rxpdo(ctx, p); o.status != Status::Pass) return o;
+            auto entries = read_mapping(ctx, p->index);
+            if (!entries) return fail("upload: " + ctx.sdo_error(entries.error()));
+            if (Error e = write_mapping(ctx, p->index, *entries); e != Error::Ok)
+                return fail("mapping write: " + ctx.sdo_error(e));
             auto again = ctx.upload_uint(p->index, 0);
             return expect_eq(hex(p->index) + ":00", again ? dec(static_cast<long long>(*again)) : "?",
-                             dec(static_cast<long long>(*n)));
+                             dec(static_cast<long long>(entries->size())));
+        },
+        "ESI announces PdoConfig");
+    add(
+        "pdo.mapping_too_long",
+        "PDO mapping filled to its last subindex with its largest entry: taken, or refused with a code of "
+        "the "
+        "situation (0x06040042 PDO length exceeded and kin), never 'cannot be mapped' for a mappable object",
+        "ETG.1000.6 CoE PDO mapping; SDO abort codes 0x06040041/0x06040042/0x06040043",
+        [](Context& ctx) {
+            const EsiPdo* p = nullptr;
+            if (Outcome o = remappable_rxpdo(ctx, p); o.status != Status::Pass) return o;
+            const EsiObject* o = ctx.esi->object(p->index);
+            if (!o || o->entries.size() < 2)
+                return skip(hex(p->index) + " has no entries in the ESI dictionary");
+            const uint8_t last = o->entries.back().subindex;
+            const EsiPdoEntry* big = nullptr;
+            for (const auto& e : p->entries)
+                if (e.index && (!big || e.bit_len > big->bit_len)) big = &e;
+            if (!big) return skip("no mapped object in " + hex(p->index));
+            auto entries = read_mapping(ctx, p->index);
+            if (!entries) return fail("upload: " + ctx.sdo_error(entries.error()));
+            const uint64_t value = (static_cast<uint64_t>(big->index) << 16) |
+                                   (static_cast<uint64_t>(big->subindex) << 8) | big->bit_len;
+            const Error e = write_mapping(ctx, p->index, std::vector<uint64_t>(last, value));
+            const uint32_t code = e == Error::SdoAbort ? ctx.sdo->last_abort() : 0;
+            const Error r = write_mapping(ctx, p->index, *entries);  // put the mapping back
+            const std::string what = dec(last) + " x " + hex(value, 8) + " in " + hex(p->index);
+            if (r != Error::Ok) return fail("mapping not restored: " + ctx.sdo_error(r));
+            if (e == Error::Ok) return pass(what + ": taken");
+            if (e != Error::SdoAbort) return fail(what + ": " + ctx.sdo_error(e));
+            for (uint32_t ok : {0x06040042u, 0x06040043u, 0x06090030u, 0x06090031u, 0x06090011u, 0x08000000u})
+                if (code == ok) return pass(what + ": refused", hex(code, 8));
+            return fail(what + ": refused with the code of another situation", hex(code, 8),
+                        "0x06040042 (or 0x06040043, 0x0609003x, 0x06090011, 0x08000000)");
         },
         "ESI announces PdoConfig");
 }

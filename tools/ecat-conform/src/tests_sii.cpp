@@ -113,6 +113,10 @@ Outcome pdo_vs_esi(Context& ctx, uint16_t type) {
         if (at == by_index.end()) return fail("the SII has PDO " + hex(p.index) + ", the ESI has none");
         if (sii_pdo_text(p) != esi_pdo_text(*at->second))
             return fail("PDO " + hex(p.index) + " differs", sii_pdo_text(p), esi_pdo_text(*at->second));
+        // The SyncManager byte (ETG.2010 PDO category, byte 3) of a PDO the ESI assigns by default (Sm
+        // attribute); 0xFF (not assigned) is left alone.
+        if (at->second->sm >= 0 && p.sm != 0xFF && p.sm != at->second->sm)
+            return fail("PDO " + hex(p.index) + " SyncManager", dec(p.sm), dec(at->second->sm) + " (ESI Sm)");
     }
     int optional_left_out = 0;
     for (const auto& p : esi) {
@@ -224,7 +228,8 @@ void add_sii_tests(Catalogue& c) {
             "ESI given");
     }
     add(
-        "header.std_mailbox_vs_esi", "Standard mailbox (words 0x18-0x1B) equals the ESI's MBoxOut/MBoxIn Sm",
+        "header.std_mailbox_vs_esi",
+        "Standard mailbox (words 0x18-0x1B) equals the ESI's MBoxOut/MBoxIn Sm (0 without a mailbox)",
         kSiiEsi,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_sii());
@@ -233,7 +238,16 @@ void add_sii_tests(Catalogue& c) {
             for (const char* t : {"MBoxOut", "MBoxIn"})
                 for (const auto& s : ctx.esi->sms)
                     if (s.type == t) want += hex(s.start) + "/" + dec(s.default_size) + " ";
-            if (want.empty()) return skip("the ESI has no mailbox SMs");
+            if (want.empty()) {
+                // ETG.2010 SII words 0x18-0x1B: 0 for a device without a mailbox. Nonzero words announce a
+                // mailbox a master would set up and talk to.
+                if (ctx.esi->has_mailbox) return skip("the ESI has a Mailbox element but no mailbox SMs");
+                std::string got;
+                for (unsigned w = 0x18; w <= 0x1B; ++w)
+                    got += hex(ctx.sii->word(w)) + " ";
+                return expect_eq("words 0x18-0x1B of a device without mailbox (the ESI has none)", got,
+                                 "0x0000 0x0000 0x0000 0x0000 ");
+            }
             std::string got = hex(ctx.sii->word(0x18)) + "/" + dec(ctx.sii->word(0x19)) + " " +
                               hex(ctx.sii->word(0x1A)) + "/" + dec(ctx.sii->word(0x1B)) + " ";
             return expect_eq("out/in start/size", got, want);
