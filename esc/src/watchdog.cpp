@@ -72,4 +72,11 @@ uint64_t Watchdogs::next_event(uint64_t now_clock) const {
     return r;
 }
 
+bool Watchdogs::settled() const {
+    const uint16_t dl = mem.r16(reg::kDlStatus);
+    if (mem.r16(reg::kWdTimePd) == 0 && !(mem.r16(reg::kWdStatusPd) & 0x0001)) return false;
+    if (mem.r16(reg::kWdTimePdi) == 0 || pdi_armed) return (dl & 0x0002) != 0;
+    return true;
+}
+
 }  // namespace esc

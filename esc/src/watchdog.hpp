@@ -21,6 +21,9 @@ class Watchdogs {
     void run(uint64_t now_clock);
     // Clock time at which run() has something to do next; UINT64_MAX if nothing.
     uint64_t next_event(uint64_t now_clock) const;
+    // False while run() would change a status bit whatever the time (a watchdog time written to 0, an armed
+    // PDI watchdog whose DL status bit is not yet set): run() is due at once then.
+    bool settled() const;
 
   private:
     Memory& mem;
