@@ -352,6 +352,7 @@ void Esc::Impl::end_of_frame(bool ok) {
             reset_progress_ecat = (ok && v == kSeq[0]) ? 1 : 0;
         }
         if (reset_progress_ecat == 3) {
+            timers_touched = true;
             reset_registers();
             sii.load_words(true);
         } else {
@@ -469,7 +470,13 @@ int Esc::Impl::receive_signalled(std::span<uint8_t> frame, int port, uint64_t rx
     const uint64_t processed = stats.frames_processed;
     const int r = receive(frame, port, rx_clock, check);
     if (stats.frames_processed != processed) {
-        sig->due_ns = due(time.frame_clock);
+        // Only a frame that may have moved a timer earlier makes the due time unknown (the runtime's next
+        // tick settles it); a process-data frame that re-triggers a running watchdog only moves it later,
+        // and a due time that is early costs one tick that finds nothing.
+        if (timers_touched || wd.take_started()) {
+            timers_touched = false;
+            sig->due_ns = 0;
+        }
         note_events(before);
     }
     if (sii.callbacks_pending()) {

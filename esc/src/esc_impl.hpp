@@ -62,6 +62,9 @@ struct Esc::Impl final {
     // ---------------------------------------------------------------- signals (EscSignals)
     EscSignals own_signals{};
     EscSignals* sig = &own_signals;
+    // An ECAT write reached the watchdog, SII, FMMU, SM or DC registers (0x0400-0x09FF) or the ESC was reset
+    // in this frame: its timers may have moved (EscSignals::due_ns unknown after the frame).
+    bool timers_touched = false;
 
     // ---------------------------------------------------------------- functions
     static void init_tables(RegTables& t, uint8_t fmmu_count, uint8_t sm_count);

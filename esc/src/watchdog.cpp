@@ -13,6 +13,7 @@ void Watchdogs::reset() {
 void Watchdogs::pd_trigger() {
     pd_last = time.now_clock();
     if (mem.r16(reg::kWdTimePd) != 0) {
+        if (!pd_armed) pd_started = true;
         pd_armed = true;
         mem.w16(reg::kWdStatusPd, static_cast<uint16_t>(mem.r16(reg::kWdStatusPd) | 0x0001));
     }

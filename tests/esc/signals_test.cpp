@@ -33,14 +33,18 @@ struct Signals : EscFixture<kT0> {
 TEST_F(Signals, DueFollowsWhatFramesAndTicksDo) {
     EXPECT_EQ(sig.due_ns, UINT64_MAX) << "nothing runs";
     const uint64_t start = start_sync0(1'000'000, 100'000);
-    EXPECT_EQ(sig.due_ns, start) << "known from the frame that activated SYNC0, without a tick";
+    EXPECT_EQ(sig.due_ns, 0u) << "a frame wrote the DC registers: unknown until a tick";
+    e->tick(clk.now_ns());
+    EXPECT_EQ(sig.due_ns, start);
     clk.set(start);
     e->tick(start);
     EXPECT_EQ(sig.due_ns, start + 1'000'000);
     // A frame that moves nothing leaves the exact figure.
     (void)fprd(*e, 0x0130, 2);
+    fpwr(*e, 0x0120, {0x01, 0x00});
     EXPECT_EQ(sig.due_ns, start + 1'000'000);
     fpwr(*e, 0x0981, {0x00});
+    e->tick(clk.now_ns());
     EXPECT_EQ(sig.due_ns, UINT64_MAX) << "deactivated by a frame";
 }
 
