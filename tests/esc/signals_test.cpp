@@ -33,7 +33,7 @@ struct Signals : EscFixture<kT0> {
 TEST_F(Signals, DueFollowsWhatFramesAndTicksDo) {
     EXPECT_EQ(sig.due_ns, UINT64_MAX) << "nothing runs";
     const uint64_t start = start_sync0(1'000'000, 100'000);
-    EXPECT_EQ(sig.due_ns, 0u) << "a frame wrote the DC registers: unknown until a tick";
+    EXPECT_EQ(sig.due_ns, 0u) << "a frame wrote the DC registers of a running SYNC0: unknown until a tick";
     e->tick(clk.now_ns());
     EXPECT_EQ(sig.due_ns, start);
     clk.set(start);
@@ -44,8 +44,9 @@ TEST_F(Signals, DueFollowsWhatFramesAndTicksDo) {
     fpwr(*e, 0x0120, {0x01, 0x00});
     EXPECT_EQ(sig.due_ns, start + 1'000'000);
     fpwr(*e, 0x0981, {0x00});
-    e->tick(clk.now_ns());
-    EXPECT_EQ(sig.due_ns, UINT64_MAX) << "deactivated by a frame";
+    EXPECT_EQ(sig.due_ns, UINT64_MAX) << "deactivated by a frame: nothing scheduled, the figure is exact";
+    fpwr(*e, 0x0910, le(12345, 8));  // a drift compensation write with nothing scheduled
+    EXPECT_EQ(sig.due_ns, UINT64_MAX);
 }
 
 TEST_F(Signals, PdiAccessLeavesDueUnknownUntilTheNextTick) {

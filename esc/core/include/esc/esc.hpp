@@ -74,9 +74,10 @@ struct EscStats {
 struct EscSignals {
     // Clock time before which tick() changes nothing (a SYNC0/SYNC1 pulse, a watchdog expiry, a watchdog
     // (re)start or a status bit to settle); never later than that, earlier only by a watchdog that a frame
-    // re-triggered since. 0: not known (after a PDI access, an EEPROM load, or a frame that wrote the
-    // watchdog, SII, FMMU, SM or DC registers, started the process-data watchdog or reset the ESC): tick()
-    // to find out. Exact after every tick() and a link change.
+    // re-triggered since. 0: not known (after a PDI access, an EEPROM load, or, while a SYNC pulse is
+    // scheduled, a frame that wrote the watchdog, SII, FMMU, SM or DC registers, started the process-data
+    // watchdog or reset the ESC): tick() to find out. Exact after every tick(), a link change and such a
+    // frame while no SYNC pulse is scheduled.
     uint64_t due_ns = 0;
     // Set (never cleared by the ESC) when a frame or a tick raised an AL event the AL event mask lets
     // through (0x0220 & 0x0204: the PDI interrupt line rose or a new event joined it), or a master wrote an
