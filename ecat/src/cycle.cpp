@@ -1,9 +1,11 @@
 #include "ecat/cycle.hpp"
 
 #include <algorithm>
+#include <array>
 
 #include "ecat/state_machine.hpp"
 #include "ecat/sync_control.hpp"
+#include "util/le.hpp"
 
 namespace ecat {
 
@@ -36,8 +38,15 @@ void Cycle::poll(uint64_t now_ns) {
     esc::Pdi& pdi = ctx_.pdi;
     last_now_ns_ = now_ns;
     if (quiet(now_ns)) return;  // nothing signalled and no timer due
-    if (!first_poll_ && esc_was_reset()) restart_after_esc_reset(now_ns);
-    uint32_t events = pdi.read_reg<uint32_t>(esc::reg::kAlEvent);
+    // The reset check and the AL event request in one PDI access: 0x0204 (AL event mask) to 0x0223 (AL event
+    // request), a range whose read has no side effect (the ECAT event request 0x0210 between them).
+    std::array<uint8_t, esc::reg::kAlEvent + 4 - esc::reg::kAlEventMask> regs{};
+    pdi.read(esc::reg::kAlEventMask, regs);
+    uint32_t events = util::get32(regs.data() + (esc::reg::kAlEvent - esc::reg::kAlEventMask));
+    if (!first_poll_ && esc_was_reset(util::get32(regs.data()))) {
+        restart_after_esc_reset(now_ns);
+        events = pdi.read_reg<uint32_t>(esc::reg::kAlEvent);
+    }
     if (first_poll_) {
         first_poll_ = false;
         events |= esc::alev::kAlControl;  // take over whatever the master requested before we started
@@ -98,10 +107,10 @@ uint64_t Cycle::next_deadline_ns() const {
 
 // ---- ESC reset --------------------------------------------------------------------------------------
 
-bool Cycle::esc_was_reset() {
+bool Cycle::esc_was_reset(uint32_t mask) const {
     // The AL event mask is written only through the PDI (by this stack, at start); an ESC reset puts it
     // back to its reset value. On a device the ESC's reset would reset the controller behind it as well.
-    return ctx_.pdi.read_reg<uint32_t>(esc::reg::kAlEventMask) != written_mask_;
+    return mask != written_mask_;
 }
 
 void Cycle::restart_after_esc_reset(uint64_t now_ns) {

@@ -1,6 +1,9 @@
 #include "ecat/sync_control.hpp"
 
 #include <algorithm>
+#include <array>
+
+#include "util/le.hpp"
 
 namespace ecat {
 namespace {
@@ -234,9 +237,7 @@ uint64_t SyncControl::next_deadline_ns(bool op) const {
 // The pulse that started this cycle is the one before the next (0x0990), on the SYNC0 grid; sys is 0x0910
 // read at the cycle start. A pulse that came between the two reads would make the difference negative or
 // longer than a period: such a sample is not taken (cycles_exceeded counts periods without a cycle).
-void SyncControl::sample_sync0_latency(uint64_t sys, uint64_t next_sync0, bool running) {
-    if (!running) return;
-    const uint32_t period = ctx_.pdi.read_reg<uint32_t>(esc::reg::kDcSync0Cycle);
+void SyncControl::sample_sync0_latency(uint64_t sys, uint64_t next_sync0, uint32_t period) {
     if (period == 0 || next_sync0 < period) return;
     const uint64_t pulse = next_sync0 - period;
     if (sys < pulse || sys - pulse >= period) return;
@@ -264,7 +265,12 @@ SyncControl::Sync0 SyncControl::sync0_events(uint32_t events, uint64_t now_ns, b
     // moving on; the latter also says how many periods passed since the last look.
     uint64_t periods = 0;
     // 0x0990 is the next pulse only while SYNC0 runs; otherwise it is whatever the master wrote.
-    const uint8_t activation = pdi.read_reg<uint8_t>(esc::reg::kDcActivation);
+    // 0x0981 (activation) to 0x0984 (activation status) in one PDI access, and 0x0990 (next SYNC0) to 0x09A3
+    // (SYNC0 cycle time) in another: neither range has a read side effect (0x098E, the acknowledge, is read
+    // on its own). Fewer accesses, the same registers.
+    std::array<uint8_t, esc::reg::kDcActivationStatus + 1 - esc::reg::kDcActivation> act{};
+    pdi.read(esc::reg::kDcActivation, act);
+    const uint8_t activation = act[0];
     const bool running = (activation & (esc::reg::kDcActCyclic | esc::reg::kDcActSync0)) ==
                          (esc::reg::kDcActCyclic | esc::reg::kDcActSync0);
     // 0x0984 bit 0: the first SYNC0 pulse of this activation is still pending (ESC datasheet, Distributed
@@ -272,13 +278,20 @@ SyncControl::Sync0 SyncControl::sync0_events(uint32_t events, uint64_t now_ns, b
     // seen before belongs to an earlier activation: a SYNC0 event still latched in 0x0220 bit 2 (it stays set
     // until 0x098E is read, also across a deactivation of 0x0981, so a session that ended in Pre-Op leaves
     // one behind) or the 0x0990 of the pulses before.
-    const bool first_pending =
-        running && (pdi.read_reg<uint8_t>(esc::reg::kDcActivationStatus) & kActFirstSync0Pending) != 0;
+    const bool first_pending = running && (act[esc::reg::kDcActivationStatus - esc::reg::kDcActivation] &
+                                           kActFirstSync0Pending) != 0;
     if (events & esc::alev::kSync0) {
         (void)pdi.read_reg<uint8_t>(esc::reg::kDcSync0Status);  // acknowledges the SYNC0 event
         if (!first_pending) periods = 1;
     }
-    const uint64_t next = running ? pdi.read_reg<uint64_t>(esc::reg::kDcStartTime) : next_sync0_sys_;
+    uint64_t next = next_sync0_sys_;
+    uint32_t period = 0;
+    if (running) {
+        std::array<uint8_t, esc::reg::kDcSync0Cycle + 4 - esc::reg::kDcStartTime> times{};
+        pdi.read(esc::reg::kDcStartTime, times);
+        next = util::get64(times.data());
+        period = util::get32(times.data() + (esc::reg::kDcSync0Cycle - esc::reg::kDcStartTime));
+    }
     const uint64_t sys = pdi.read_reg<uint64_t>(esc::reg::kDcSystemTime);  // local copy of system time
     if (first_pending || (running && !was_running_)) {
         // A new activation (ETG.1020, DC start-up: 0x0981 cleared, start time, 0x0981 set): forget the
@@ -321,7 +334,7 @@ SyncControl::Sync0 SyncControl::sync0_events(uint32_t events, uint64_t now_ns, b
         }
         for (auto& r : sync_error_)
             if (r.valid()) r.set(missed ? 1 : 0);
-        sample_sync0_latency(sys, next, running);
+        sample_sync0_latency(sys, next, period);
         return Sync0::RunCycle;
     }
     if (op && cycle_ns_ > 0 && now_ns >= sync0_loss_ns()) {

@@ -46,6 +46,7 @@ bool Esc::Impl::phys_read(uint32_t a, uint8_t* dst, uint8_t* ok, uint32_t n, Sid
 
 bool Esc::Impl::phys_write(uint32_t a, const uint8_t* src, const uint8_t* bm, uint32_t n, Side side) {
     const uint32_t end = a + n;
+    if (side == Side::Ecat && a < 0x0A00 && end > 0x0400) timers_touched = true;
     bool any = false;
     uint32_t p = a;
     const bool esc_protected = esc_write_protected(side);

@@ -55,6 +55,9 @@ class DistributedClocks {
     // Clock time of the next SYNC pulse; UINT64_MAX if none.
     uint64_t next_event(uint64_t now_clock) const;
 
+    // A SYNC0 or SYNC1 pulse is scheduled (next_event() has arithmetic to do).
+    bool armed() const { return sync0_armed || sync1_armed; }
+
   private:
     void latch(bool ok);
     void set_rate(double new_rate, uint64_t at_clock);

@@ -352,6 +352,7 @@ void Esc::Impl::end_of_frame(bool ok) {
             reset_progress_ecat = (ok && v == kSeq[0]) ? 1 : 0;
         }
         if (reset_progress_ecat == 3) {
+            timers_touched = true;
             reset_registers();
             sii.load_words(true);
         } else {
@@ -460,30 +461,53 @@ void Esc::Impl::datagram(uint8_t* d, uint8_t* data, uint16_t len) {
 Esc::Esc(const EscConfig& config, const Clock& clock) : impl_(std::make_unique<Impl>(config, clock)) {}
 Esc::~Esc() = default;
 
+// A frame at a port, with the signals kept: a frame the processing unit executed leaves the exact time of the
+// next timer event (its writes may have started, moved or stopped one), and a masked AL event it raised or
+// an EEPROM word it wrote wakes the PDI side.
+int Esc::Impl::receive_signalled(std::span<uint8_t> frame, int port, uint64_t rx_clock, FrameCheck* check,
+                                 std::unique_lock<EscLock>& lock) {
+    const uint32_t before = masked_events();
+    const uint64_t processed = stats.frames_processed;
+    const int r = receive(frame, port, rx_clock, check);
+    if (stats.frames_processed != processed) {
+        // Only a frame that may have moved a timer earlier makes the due time unknown (the runtime's next
+        // tick settles it); a process-data frame that re-triggers a running watchdog only moves it later,
+        // and a due time that is early costs one tick that finds nothing.
+        // With no SYNC pulse scheduled the exact figure costs a few loads (a master's drift compensation
+        // writes 0x0910 of every ESC in every cycle); with one, the DC arithmetic is left to the next tick,
+        // out of the frame's way.
+        if (timers_touched || wd.take_started()) {
+            timers_touched = false;
+            sig->due_ns = dc.armed() ? 0 : due(time.frame_clock);
+        }
+        note_events(before);
+    }
+    if (sii.callbacks_pending()) {
+        sig->wake = 1;
+        sii.flush_callbacks(lock);
+    }
+    return r;
+}
+
 bool Esc::process_frame(std::span<uint8_t> frame, uint64_t rx_time_ns) {
     std::unique_lock lock(impl_->mu);
-    const int r = impl_->receive(frame, 0, rx_time_ns, nullptr);
-    impl_->sii.flush_callbacks(lock);
-    return r == 0;
+    return impl_->receive_signalled(frame, 0, rx_time_ns, nullptr, lock) == 0;
 }
 
 int Esc::receive(std::span<uint8_t> frame, int port, uint64_t rx_clock_ns) {
     std::unique_lock lock(impl_->mu);
-    const int r = impl_->receive(frame, port, rx_clock_ns, nullptr);
-    impl_->sii.flush_callbacks(lock);
-    return r;
+    return impl_->receive_signalled(frame, port, rx_clock_ns, nullptr, lock);
 }
 
 int Esc::receive(std::span<uint8_t> frame, int port, uint64_t rx_clock_ns, FrameCheck& check) {
     std::unique_lock lock(impl_->mu);
-    const int r = impl_->receive(frame, port, rx_clock_ns, &check);
-    impl_->sii.flush_callbacks(lock);
-    return r;
+    return impl_->receive_signalled(frame, port, rx_clock_ns, &check, lock);
 }
 
 void Esc::set_link(int port, bool up) {
     std::lock_guard lock(impl_->mu);
     impl_->ports.set_link(port, up);
+    impl_->sig->due_ns = impl_->due(impl_->time.clock.now_ns());
 }
 
 bool Esc::link(int port) const {
@@ -508,6 +532,7 @@ void Esc::read(uint16_t address, std::span<uint8_t> out) {
     if (out.empty()) return;
     std::lock_guard lock(impl_->mu);
     impl_->wd.pdi_touch();
+    impl_->sig->due_ns = 0;  // the PDI watchdog restarts at the next tick
     std::memset(out.data(), 0, out.size());
     impl_->phys_read(address, out.data(), nullptr, static_cast<uint32_t>(out.size()), Side::Pdi);
     if (impl_->lookup_dirty) impl_->rebuild_lookup();
@@ -517,6 +542,7 @@ void Esc::write(uint16_t address, std::span<const uint8_t> in) {
     if (in.empty()) return;  // no access, as for read()
     std::unique_lock lock(impl_->mu);
     impl_->wd.pdi_touch();
+    impl_->sig->due_ns = 0;  // the PDI watchdog restarts at the next tick; a write may change a timer
     impl_->phys_write(address, in.data(), nullptr, static_cast<uint32_t>(in.size()), Side::Pdi);
     if (impl_->lookup_dirty) impl_->rebuild_lookup();
     impl_->sii.flush_callbacks(lock);
@@ -533,12 +559,27 @@ void Esc::tick() {
 
 void Esc::tick(uint64_t now_clock) {
     std::lock_guard lock(impl_->mu);
+    const uint32_t before = impl_->masked_events();
     impl_->wd.run(now_clock);
     impl_->dc.run(now_clock);
+    impl_->note_events(before);
+    impl_->sig->due_ns = impl_->due(now_clock);
 }
 
 uint64_t Esc::Impl::next_event(uint64_t now_clock) const {
     return std::min(dc.next_event(now_clock), wd.next_event(now_clock));
+}
+
+uint64_t Esc::Impl::due(uint64_t now_clock) const {
+    return wd.settled() ? next_event(now_clock) : now_clock;
+}
+
+void Esc::set_signals(EscSignals* signals) {
+    std::lock_guard lock(impl_->mu);
+    impl_->sig = signals != nullptr ? signals : &impl_->own_signals;
+    impl_->sig->due_ns = impl_->due(impl_->time.clock.now_ns());
+    impl_->sig->wake = impl_->masked_events() != 0 ? 1 : 0;
+    impl_->sig->clock = &impl_->time.clock;
 }
 
 uint64_t Esc::next_event_ns() const {
@@ -562,6 +603,7 @@ uint64_t Esc::local_time_ns() const {
 void Esc::load_eeprom(std::span<const uint8_t> image) {
     std::lock_guard lock(impl_->mu);
     impl_->sii.set_image(image.data(), image.size());
+    impl_->sig->due_ns = 0;  // tick() to settle what the loaded words set
     uint16_t c = impl_->mem.r16(reg::kSiiControl);
     c = static_cast<uint16_t>(impl_->sii.image().size() > 2048 ? (c | 0x0080) : (c & ~0x0080));
     impl_->mem.w16(reg::kSiiControl, c);

@@ -59,6 +59,13 @@ struct Esc::Impl final {
 
     EscStats stats{};
 
+    // ---------------------------------------------------------------- signals (EscSignals)
+    EscSignals own_signals{};
+    EscSignals* sig = &own_signals;
+    // An ECAT write reached the watchdog, SII, FMMU, SM or DC registers (0x0400-0x09FF) or the ESC was reset
+    // in this frame: its timers may have moved (EscSignals::due_ns unknown after the frame).
+    bool timers_touched = false;
+
     // ---------------------------------------------------------------- functions
     static void init_tables(RegTables& t, uint8_t fmmu_count, uint8_t sm_count);
     void reset_registers();
@@ -66,6 +73,9 @@ struct Esc::Impl final {
 
     // Frame processing.
     int receive(std::span<uint8_t> frame, int port, uint64_t rx_clock, FrameCheck* check);
+    // receive(), the EscSignals kept, the EEPROM write callbacks called (outside the lock).
+    int receive_signalled(std::span<uint8_t> frame, int port, uint64_t rx_clock, FrameCheck* check,
+                          std::unique_lock<EscLock>& lock);
     // What became of a frame at the processing unit: forwarded (processed or not), destroyed, or forwarded
     // with a frame error (hardware aborts it with a bad FCS and the forwarded-error marking).
     enum class Outcome { Forward, Destroy, Error };
@@ -102,6 +112,14 @@ struct Esc::Impl final {
                     const uint8_t* bm) const;
 
     uint64_t next_event(uint64_t now_clock) const;
+    // EscSignals::due_ns at now_clock: next_event(), or now while a watchdog status bit has to settle.
+    uint64_t due(uint64_t now_clock) const;
+    // The masked AL event request (what the PDI interrupt line shows).
+    uint32_t masked_events() const { return mem.r32(reg::kAlEvent) & mem.r32(reg::kAlEventMask); }
+    // After a frame or a tick: wake when a masked event rose that was not up before (events_before).
+    void note_events(uint32_t events_before) {
+        if ((masked_events() & ~events_before) != 0) sig->wake = 1;
+    }
 };
 
 }  // namespace esc

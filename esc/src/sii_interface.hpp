@@ -33,6 +33,7 @@ class SiiInterface {
         if (pending) run_pending(ok);
     }
     // Calls the write callback for the words written since the last flush, outside the lock.
+    bool callbacks_pending() const { return write_count != 0; }
     void flush_callbacks(std::unique_lock<EscLock>& lock) {
         if (write_count != 0) flush(lock);
     }

@@ -13,6 +13,7 @@ void Watchdogs::reset() {
 void Watchdogs::pd_trigger() {
     pd_last = time.now_clock();
     if (mem.r16(reg::kWdTimePd) != 0) {
+        if (!pd_armed) pd_started = true;
         pd_armed = true;
         mem.w16(reg::kWdStatusPd, static_cast<uint16_t>(mem.r16(reg::kWdStatusPd) | 0x0001));
     }
@@ -70,6 +71,13 @@ uint64_t Watchdogs::next_event(uint64_t now_clock) const {
         }
     }
     return r;
+}
+
+bool Watchdogs::settled() const {
+    const uint16_t dl = mem.r16(reg::kDlStatus);
+    if (mem.r16(reg::kWdTimePd) == 0 && !(mem.r16(reg::kWdStatusPd) & 0x0001)) return false;
+    if (mem.r16(reg::kWdTimePdi) == 0 || pdi_armed) return (dl & 0x0002) != 0;
+    return true;
 }
 
 }  // namespace esc

@@ -151,6 +151,46 @@ TEST(SegmentRuntime, TheLinesDeadlineAfterAPassIsItsEarliestDevices) {
     EXPECT_EQ(line.next_deadline_ns(), earliest());
 }
 
+// A device whose ESC signalled nothing and whose own deadline is not due is not looked at: no PDI access (a
+// PDI access leaves its ESC's due time unknown, 0), as a controller whose ESC keeps its interrupt line low
+// sleeps. An AL control request written by a frame raises the line: that device alone is served, in the next
+// pass; the runtime is told to come back at once if the frame came after the device's turn.
+TEST(SegmentRuntime, ALineLooksOnlyAtDevicesWithSomethingToDo) {
+    SegmentBus bus(3);  // not started: the test runs the passes and walks the frames itself
+    device::Line& line = *bus.line;
+    esc::Segment& segment = line.segment();
+    const uint64_t now = bus.clock.now_ns();
+    line.poll(now);
+    for (int k = 0; k < 3; ++k)
+        segment.esc(k).tick(now);  // settles what the first pass's PDI accesses left unknown
+    std::array<uint64_t, 3> due{};
+    for (std::size_t k = 0; k < 3; ++k) {
+        due[k] = segment.signals()[k].due_ns;
+        ASSERT_NE(due[k], 0u) << k;
+    }
+    line.poll(now);
+    for (std::size_t k = 0; k < 3; ++k)
+        EXPECT_EQ(segment.signals()[k].due_ns, due[k])
+            << "device " << k << " was accessed with nothing to do";
+    // Device 1 (auto-increment address -1): AL control = Pre-Op.
+    const std::array<uint8_t, 2> preop{0x02, 0x00};
+    std::vector<uint8_t> frame =
+        esc::wire::FrameBuilder().add(esc::Command::APWR, 0x11, 0xFFFF, 0x0120, preop).build(60);
+    ASSERT_EQ(segment.walk(frame, now).kind, esc::Segment::Result::Kind::Reply);
+    EXPECT_EQ(frame[16 + 10 + preop.size()], 1) << "one device written";
+    EXPECT_EQ(segment.signals()[1].wake, 1);
+    EXPECT_EQ(line.next_deadline_ns(), 0u) << "an event after the pass: the runtime comes back at once";
+    line.poll(now);
+    // AL status of device 1 read by the master: Pre-Op, or Init with the error flag (no mailbox SyncManagers
+    // were set up): the request was served either way.
+    std::vector<uint8_t> read =
+        esc::wire::FrameBuilder().add_zero(esc::Command::APRD, 0x12, 0xFFFF, 0x0130, 2).build(60);
+    ASSERT_EQ(segment.walk(read, now).kind, esc::Segment::Result::Kind::Reply);
+    EXPECT_NE(read[16 + 10] & 0x1F, 0x01) << "AL status still Init without error";
+    EXPECT_EQ(segment.signals()[0].due_ns, due[0]) << "device 0 was not looked at";
+    EXPECT_EQ(segment.signals()[2].due_ns, due[2]) << "device 2 was not looked at";
+}
+
 TEST(SegmentRuntime, APulledCableShortensTheLine) {
     SegmentBus bus(3);
     bus.start();

@@ -69,7 +69,8 @@ class Cycle {
     void update_irq_usable();
 
   private:
-    bool esc_was_reset();
+    // mask: the AL event mask 0x0204 as read now.
+    bool esc_was_reset(uint32_t mask) const;
     void write_mask(uint32_t mask);
     void restart_after_esc_reset(uint64_t now_ns);
     void process_data_events(uint32_t events, uint64_t now_ns);

@@ -56,7 +56,8 @@ class SyncControl {
   private:
     uint64_t get_u(uint16_t index, uint8_t sub, uint64_t fallback) const;
     void set_u(uint16_t index, uint8_t sub, uint64_t value);
-    void sample_sync0_latency(uint64_t sys, uint64_t next_sync0, bool running);
+    // period: the SYNC0 cycle time 0x09A0 read with next_sync0 (0: SYNC0 not running, no sample).
+    void sample_sync0_latency(uint64_t sys, uint64_t next_sync0, uint32_t period);
     uint64_t sync0_loss_ns() const;
 
     StackContext& ctx_;

@@ -64,7 +64,8 @@ struct Segment::Impl {
 
     SegmentTiming timing;
     std::vector<Device> devs;
-    std::vector<Hop> hops;  // hops[k]: the cable into device k from upstream
+    std::vector<EscSignals> signals;  // one per device, side by side (Segment::signals())
+    std::vector<Hop> hops;            // hops[k]: the cable into device k from upstream
     bool root_cable_up = true;
     int ext_dev = -1;
     int ext_port = -1;
@@ -253,7 +254,10 @@ struct Segment::Impl {
 Segment::Segment(SegmentTiming timing) : impl_(std::make_unique<Impl>()) {
     impl_->timing = timing;
 }
-Segment::~Segment() = default;
+Segment::~Segment() {
+    for (Impl::Device& dv : impl_->devs)
+        dv.esc->set_signals(nullptr);
+}
 
 int Segment::add(Esc& esc) {
     Impl::Device dv;
@@ -262,6 +266,9 @@ int Segment::add(Esc& esc) {
     const int index = static_cast<int>(impl_->devs.size());
     if (index == 0) dv.up_port = 0;
     impl_->devs.push_back(dv);
+    impl_->signals.emplace_back();
+    for (std::size_t k = 0; k < impl_->devs.size(); ++k)  // the array may have moved
+        impl_->devs[k].esc->set_signals(&impl_->signals[k]);
     Impl::Hop hop;
     hop.rng = 0x5EC7'0000'0000'0000ULL ^ (static_cast<uint64_t>(index) * 0x100000001B3ULL);
     impl_->hops.push_back(hop);
@@ -336,6 +343,14 @@ void Segment::set_external_link(bool up) {
 
 std::size_t Segment::size() const {
     return impl_->devs.size();
+}
+
+EscSignals* Segment::signals() {
+    return impl_->signals.data();
+}
+
+const EscSignals* Segment::signals() const {
+    return impl_->signals.data();
 }
 
 Esc& Segment::esc(int device) {
@@ -433,8 +448,9 @@ void Segment::replace(int device, Esc& esc) {
     Impl& m = *impl_;
     m.check_device(device, "replace");
     Impl::Device& dv = m.devs[static_cast<std::size_t>(device)];
-    dv.esc = &esc;
+    dv.esc = &esc;  // the one replaced may be gone already: not touched
     dv.descriptor = esc.port_descriptor();
+    esc.set_signals(&m.signals[static_cast<std::size_t>(device)]);
     m.apply_links(device);
 }
 

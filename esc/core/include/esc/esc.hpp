@@ -67,6 +67,26 @@ struct EscStats {
     uint64_t frames_bad_fcs = 0;
 };
 
+// What a runtime that serves many ESCs needs to find the few with work without touching the others: the
+// interrupt line of a hardware ESC to its controller, and when its timers next do something. The owner of
+// the ESC gives it one (Esc::set_signals; a segment keeps them side by side for its ESCs) and reads it; the
+// ESC keeps it up to date under its lock.
+struct EscSignals {
+    // Clock time before which tick() changes nothing (a SYNC0/SYNC1 pulse, a watchdog expiry, a watchdog
+    // (re)start or a status bit to settle); never later than that, earlier only by a watchdog that a frame
+    // re-triggered since. 0: not known (after a PDI access, an EEPROM load, or, while a SYNC pulse is
+    // scheduled, a frame that wrote the watchdog, SII, FMMU, SM or DC registers, started the process-data
+    // watchdog or reset the ESC): tick() to find out. Exact after every tick(), a link change and such a
+    // frame while no SYNC pulse is scheduled.
+    uint64_t due_ns = 0;
+    // Set (never cleared by the ESC) when a frame or a tick raised an AL event the AL event mask lets
+    // through (0x0220 & 0x0204: the PDI interrupt line rose or a new event joined it), or a master wrote an
+    // EEPROM word: the PDI side has something new to look at. The owner clears it when it looked.
+    uint8_t wake = 0;
+    // The clock due_ns counts (the ESC's Clock), set by set_signals().
+    const Clock* clock = nullptr;
+};
+
 class Esc final : public Pdi {
   public:
     Esc(const EscConfig& config, const Clock& clock);
@@ -102,6 +122,9 @@ class Esc final : public Pdi {
     void tick(uint64_t now_clock);
     uint64_t next_event_ns(uint64_t now_clock) const;
     const Clock& clock() const;
+    // Where the ESC keeps its EscSignals; null: a place of its own. Sets due_ns (as at the clock's now) and
+    // wake to the interrupt line's level.
+    void set_signals(EscSignals* signals);
     // Local clock of this ESC (DC local time, 0x0900 base), in ns.
     uint64_t local_time_ns() const;
 

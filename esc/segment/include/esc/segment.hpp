@@ -79,6 +79,10 @@ class Segment {
 
     std::size_t size() const;
     Esc& esc(int device);
+    // The EscSignals of devices 0..size()-1, side by side (valid until the next add()): a runtime finds the
+    // ESCs with a timer due and a line the devices with an event without touching the others.
+    EscSignals* signals();
+    const EscSignals* signals() const;
     // Device at the other end of (device, port), -1 if none (or the master / the external port).
     int neighbour(int device, int port) const;
     // Upstream port of a device (towards the master) and its parent (-1 for the root).

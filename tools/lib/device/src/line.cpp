@@ -103,44 +103,71 @@ void Line::event(slave::LogLevel level, const std::string& text) const {
 void Line::poll(uint64_t now_ns) {
     // Each device polled gets the time it is polled at: a pass over many devices takes a while, and a device
     // that compares its ESC's registers (read now) with a stale time would misjudge when its next SYNC0
-    // comes. A quiet device (interrupt line low, no deadline due) is skipped without reading the clock: most
-    // are, on each pass. One whose deadline falls due while the pass goes on is skipped as well; its
-    // deadline, now past, brings the runtime straight back to serve it.
+    // comes. One whose deadline falls due while the pass goes on is skipped; its deadline, now past, brings
+    // the runtime straight back to serve it.
     //
-    // Each device's next deadline is taken while it is at hand (its objects are in the cache right after the
-    // quiet check or the poll), for next_deadline_ns(), which the runtime asks right after this pass: a
-    // device's deadline changes only in its own poll or through a control command (which invalidates the
-    // figure). Frames served meanwhile change ESCs, not a firmware's deadlines; the one callback a frame
-    // can reach, an EEPROM write, only takes a pending save time away (the figure is then early, which
-    // costs a wake-up and loses nothing).
+    // A device is looked at only when something may be there for it, as the interrupt line of a hardware
+    // ESC wakes its controller: its ESC signalled a new event (EscSignals::wake: a frame or a tick raised a
+    // masked AL event, a master wrote the EEPROM), its own deadline is due, or its last poll left it not
+    // quiet (an event still pending, a mailbox message waiting for SM1, no usable interrupt line, ...; then
+    // it is asked on every pass, as before). The others cost a look at three arrays. After a control
+    // command, a power change or a caller's access to a device (deadline_known_ false) every device is
+    // asked once. A device's deadline changes only in its own poll or through those; frames served
+    // meanwhile change ESCs, which wake what they concern.
+    const std::size_t n = units_.size();
+    if (due_.size() != n) {
+        due_.assign(n, 0);
+        ask_.assign(n, 1);
+    }
+    if (!deadline_known_) std::fill(ask_.begin(), ask_.end(), uint8_t{1});
+    esc::EscSignals* sig = segment_.signals();
     uint64_t now = now_ns;
-    bool fresh = true;  // now_ns is still the time: no device examined yet
-    uint64_t deadline = std::numeric_limits<uint64_t>::max();
-    for (const auto& u : units_) {
-        Device* d = u->device.get();
-        if (d == nullptr) continue;
-        if (d->quiet(now)) {
-            fresh = false;
-            deadline = std::min(deadline, d->next_deadline_ns());
+    bool fresh = true;  // now_ns is still the time: no device polled yet
+    for (std::size_t k = 0; k < n; ++k) {
+        const bool woken = sig[k].wake != 0;
+        if (!woken && ask_[k] == 0 && due_[k] > now) continue;
+        sig[k].wake = 0;
+        Device* d = units_[k]->device.get();
+        if (d == nullptr) {
+            ask_[k] = 0;
+            due_[k] = std::numeric_limits<uint64_t>::max();
+            continue;
+        }
+        // Woken: polled at once (a poll that finds the device quiet returns at once). Asked or due: the
+        // quiet check first, which costs less than a poll when nothing is there after all.
+        if (!woken && d->quiet(now)) {
+            ask_[k] = 0;
+            due_[k] = d->next_deadline_ns();
             continue;
         }
         if (!fresh) now = std::max(now, clock_.now_ns());
         d->poll(now);
-        deadline = std::min(deadline, d->next_deadline_ns());
+        ask_[k] = d->quiet(now) ? 0 : 1;
+        due_[k] = d->next_deadline_ns();
         fresh = false;
         // Frames that came during this device's work are answered before the next device's (the runtime's
         // FrameService): a frame never waits for a pass over the whole line.
         serve_frames();
     }
-    deadline_ns_ = deadline;
     deadline_known_ = true;
 }
 
+// The earliest device deadline, or now (0) when an ESC signalled an event after its device was looked at
+// (a frame served during the pass, the runtime's ticks after it).
 uint64_t Line::next_deadline_ns() const {
-    if (deadline_known_) return deadline_ns_;
+    if (!deadline_known_) {
+        uint64_t deadline = std::numeric_limits<uint64_t>::max();
+        for (const auto& u : units_)
+            if (u->device) deadline = std::min(deadline, u->device->next_deadline_ns());
+        return deadline;
+    }
+    const std::size_t n = units_.size();
+    const esc::EscSignals* sig = segment_.signals();
     uint64_t deadline = std::numeric_limits<uint64_t>::max();
-    for (const auto& u : units_)
-        if (u->device) deadline = std::min(deadline, u->device->next_deadline_ns());
+    for (std::size_t k = 0; k < n; ++k) {
+        if (sig[k].wake != 0 && units_[k]->device) return 0;
+        deadline = std::min(deadline, due_[k]);
+    }
     return deadline;
 }
 

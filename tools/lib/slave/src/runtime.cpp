@@ -240,13 +240,19 @@ uint64_t Runtime::next_deadline_ns() const {
     return deadline_ns_;
 }
 
+// The ESCs on clock_ keep their next timer event in their EscSignals, side by side: a look at one array, not
+// at every ESC (after service() no signal is stale: tick_escs(ticked_ns_) settled those a PDI access left
+// unknown). An ESC on a clock of its own is asked.
 uint64_t Runtime::compute_deadline_ns(uint64_t now) const {
+    (void)now;
     uint64_t deadline = kNever;
     const int count = static_cast<int>(segment_.size());
+    const esc::EscSignals* sig = segment_.signals();
     for (int k = 0; k < count; ++k) {
+        if (sig[k].clock == &clock_ && sig[k].due_ns >= deadline) continue;
         if (!segment_.powered(k)) continue;
-        const esc::Esc& e = segment_.esc(k);
-        deadline = std::min(deadline, &e.clock() == &clock_ ? e.next_event_ns(now) : e.next_event_ns());
+        deadline =
+            std::min(deadline, sig[k].clock == &clock_ ? sig[k].due_ns : segment_.esc(k).next_event_ns());
     }
     if (hold_count_ != 0) deadline = std::min(deadline, hold_slots_[hold_head_].due_ns);
     if (carrier_check_) deadline = std::min(deadline, carrier_due_ns_);
@@ -338,13 +344,17 @@ uint64_t Runtime::arrival_ns(const esc::Link& link, uint64_t now, int64_t& offse
 // expire (ticking to now first expired the process-data watchdog of a slave stopped for longer than the
 // watchdog while the master's frames kept coming). An ESC on a clock of its own cannot be taken to a time
 // of clock_: it is ticked at its own now, after the burst (service()).
+//
+// Only the ESCs with something due by t are ticked (EscSignals::due_ns: exact after each frame the ESC
+// executed and each tick, 0 after a PDI access): a tick before it changes nothing, so the others are not
+// touched. An ESC on a clock of its own has its due time on that clock: it is left to service().
 void Runtime::tick_escs(uint64_t t) {
     ticked_ns_ = t;
     const int count = static_cast<int>(segment_.size());
+    esc::EscSignals* sig = segment_.signals();
     for (int k = 0; k < count; ++k) {
-        if (!segment_.powered(k)) continue;
-        esc::Esc& e = segment_.esc(k);
-        if (&e.clock() == &clock_) e.tick(t);
+        if (sig[k].clock != &clock_ || sig[k].due_ns > t || !segment_.powered(k)) continue;
+        segment_.esc(k).tick(t);
     }
 }
 
@@ -501,14 +511,17 @@ void Runtime::service() {
     const uint64_t now = clock_.now_ns();
     tick_escs(now);
     const int count = static_cast<int>(segment_.size());
-    for (int k = 0; k < count; ++k) {
-        if (!segment_.powered(k)) continue;
-        esc::Esc& e = segment_.esc(k);
-        if (&e.clock() != &clock_) e.tick();
-    }
+    const esc::EscSignals* sig = segment_.signals();
+    for (int k = 0; k < count; ++k)
+        if (sig[k].clock != &clock_ && segment_.powered(k)) segment_.esc(k).tick();
     if (hold_count_ != 0) release_held(now);
     if (carrier_check_) poll_carrier(now);
-    if (firmware_ != nullptr) firmware_->poll(now);
+    if (firmware_ != nullptr) {
+        firmware_->poll(now);
+        // The ESCs the firmware accessed (PDI watchdog restarted, registers written): their next event
+        // settled at the time they were ticked to, which fires nothing new (what was due by then has run).
+        tick_escs(ticked_ns_);
+    }
     // Capture: pushed to the file at most every kCaptureFlushNs, so a reader (or a SIGKILL) sees frames
     // that are at most that old, without a write() per frame.
     if (capture_ != nullptr && capture_->frames_written() != flushed_frames_ &&

@@ -103,9 +103,11 @@ class Line final : public slave::SegmentFirmware {
     esc::Segment segment_;
     std::unique_ptr<ControlSocket> control_;
     LineStats stats_;
-    // The earliest device deadline as the last poll() found it; not known after a control command, a power
-    // change or a caller's access to a device (next_deadline_ns() then asks every device).
-    uint64_t deadline_ns_ = 0;
+    // Per device, as the last poll() found it: its next deadline, and whether it must be asked on every pass
+    // (not quiet after its poll). Not known after a control command, a power change or a caller's access
+    // to a device (deadline_known_ false: next_deadline_ns() asks every device, the next poll() too).
+    std::vector<uint64_t> due_;
+    std::vector<uint8_t> ask_;
     bool deadline_known_ = false;
 };
 

@@ -1,0 +1,100 @@
+// EscSignals (esc/esc.hpp): what a runtime serving many ESCs reads instead of touching each ESC. due_ns says
+// when tick() next has something to do and must never be later than that (a late one loses a SYNC0 pulse or
+// a watchdog expiry); wake says that a frame or a tick raised an event the PDI interrupt line shows.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+
+#include "esc_fixture.hpp"
+
+using namespace esc_test;
+
+namespace {
+
+struct Signals : EscFixture<kT0> {
+    esc::EscSignals sig;
+    void SetUp() override {
+        EscFixture::SetUp();
+        fpwr(*e, 0x0410, {0x00, 0x00});  // PDI watchdog off: due_ns shows the DC events alone
+        e->set_signals(&sig);
+        e->tick(clk.now_ns());
+        sig.wake = 0;
+    }
+    void TearDown() override { e->set_signals(nullptr); }
+    uint64_t start_sync0(uint32_t cycle, int64_t start_in) {
+        EXPECT_EQ(fpwr(*e, 0x09A0, le(cycle, 4)).wkc, 1);
+        const uint64_t start = clk.now_ns() + static_cast<uint64_t>(start_in);
+        EXPECT_EQ(fpwr(*e, 0x0990, le(start, 8)).wkc, 1);
+        EXPECT_EQ(fpwr(*e, 0x0981, {0x03}).wkc, 1);
+        return start;
+    }
+};
+
+TEST_F(Signals, DueFollowsWhatFramesAndTicksDo) {
+    EXPECT_EQ(sig.due_ns, UINT64_MAX) << "nothing runs";
+    const uint64_t start = start_sync0(1'000'000, 100'000);
+    EXPECT_EQ(sig.due_ns, 0u) << "a frame wrote the DC registers of a running SYNC0: unknown until a tick";
+    e->tick(clk.now_ns());
+    EXPECT_EQ(sig.due_ns, start);
+    clk.set(start);
+    e->tick(start);
+    EXPECT_EQ(sig.due_ns, start + 1'000'000);
+    // A frame that moves nothing leaves the exact figure.
+    (void)fprd(*e, 0x0130, 2);
+    fpwr(*e, 0x0120, {0x01, 0x00});
+    EXPECT_EQ(sig.due_ns, start + 1'000'000);
+    fpwr(*e, 0x0981, {0x00});
+    EXPECT_EQ(sig.due_ns, UINT64_MAX) << "deactivated by a frame: nothing scheduled, the figure is exact";
+    fpwr(*e, 0x0910, le(12345, 8));  // a drift compensation write with nothing scheduled
+    EXPECT_EQ(sig.due_ns, UINT64_MAX);
+}
+
+TEST_F(Signals, PdiAccessLeavesDueUnknownUntilTheNextTick) {
+    fpwr(*e, 0x0410, le(1000, 2));  // PDI watchdog: 1000 increments
+    const uint64_t increment = (fprd(*e, 0x0400, 2).u16() + 2ull) * 40;
+    e->tick(clk.now_ns());
+    (void)e->read_reg<uint16_t>(0x0130);
+    EXPECT_EQ(sig.due_ns, 0u) << "the PDI watchdog restarts at the next tick";
+    clk.set(clk.now_ns() + 5'000);
+    e->tick(clk.now_ns());
+    EXPECT_EQ(sig.due_ns, clk.now_ns() + 1000 * increment) << "restarted at the tick";
+}
+
+TEST_F(Signals, WakeOnANewMaskedEventOnly) {
+    e->write_reg<uint32_t>(0x0204, 0x00000005);  // AL control and SYNC0
+    sig.wake = 0;
+    fpwr(*e, 0x0120, {0x02, 0x00});
+    EXPECT_EQ(sig.wake, 1) << "AL control written by a frame";
+    sig.wake = 0;
+    fpwr(*e, 0x0120, {0x02, 0x00});
+    EXPECT_EQ(sig.wake, 0) << "the event was still pending: nothing new for the PDI side";
+    (void)e->read_reg<uint16_t>(0x0120);  // acknowledges it
+    fpwr(*e, 0x0120, {0x04, 0x00});
+    EXPECT_EQ(sig.wake, 1);
+    sig.wake = 0;
+    const uint64_t start = start_sync0(1'000'000, 50'000);
+    clk.set(start - 1);
+    e->tick(start - 1);
+    EXPECT_EQ(sig.wake, 0);
+    clk.set(start);
+    e->tick(start);
+    EXPECT_EQ(sig.wake, 1) << "SYNC0 pulse in the AL event register";
+}
+
+TEST_F(Signals, MaskedOutEventsDoNotWake) {
+    e->write_reg<uint32_t>(0x0204, 0x00000004);  // SYNC0 only
+    sig.wake = 0;
+    fpwr(*e, 0x0120, {0x02, 0x00});
+    EXPECT_EQ(sig.wake, 0);
+}
+
+TEST_F(Signals, EepromWriteWakes) {
+    uint16_t written = 0;
+    e->on_eeprom_write([&](uint16_t, uint16_t value) { written = value; });
+    sig.wake = 0;
+    EXPECT_EQ(fpwr(*e, 0x0502, {0x81, 0x02, 0x10, 0x00, 0x00, 0x00, 0xEF, 0xBE}).wkc, 1);
+    EXPECT_EQ(written, 0xBEEF);
+    EXPECT_EQ(sig.wake, 1) << "the firmware keeps the written words";
+}
+
+}  // namespace
