@@ -151,7 +151,7 @@ class KickcatSimulator(unittest.TestCase):
         # modes once process data runs, its process data has the right working counters.
         for test in ("sdoinfo.list.txpdo", "sdoinfo.entry.pdo_mapping", "cia402.mode.csp", "cia402.mode.pp",
                      "pd.op.wkc", "pd.safeop.wkc", "pd.assign.rx_vs_esi", "pd.mapping.tx_vs_esi",
-                     "cia402.dc.enable_operation", "sdo.upload.toggle_sequence"):
+                     "cia402.dc.enable_operation", "sdo.upload.toggle_sequence", "sdo.upload.normal"):
             self.assert_status(res, test, "PASS")
 
 

@@ -232,6 +232,7 @@ void add_sdo_tests(Catalogue& c) {
             uint8_t sub = 0;
             std::size_t want = 0;
             bool text = false;
+            bool free_text = false;  // a STRING without a default text: its length is the device's
             if (ctx.esi) {
                 idx = 0;
                 for (const auto& r : esi_entries(*ctx.esi))
@@ -244,11 +245,21 @@ void add_sdo_tests(Catalogue& c) {
                         text = visible_string(*r.e);
                         break;
                     }
+                if (!idx)  // else a STRING without a default text: the device's text decides the form
+                    for (const auto& r : esi_entries(*ctx.esi))
+                        if (r.e->access != "wo" && r.e->bit_size > 32 && visible_string(*r.e) &&
+                            r.e->bit_size / 8u + 10 <= ctx.mbx->max_in_payload()) {
+                            idx = r.obj->index, sub = r.e->subindex, want = r.e->bit_size / 8u;
+                            text = free_text = true;
+                            break;
+                        }
                 if (!idx) return skip("no readable object of 5 bytes or more in the ESI");
             }
             SdoAnswer a = sdo_raw(ctx, sdo_req(0x40, idx, sub));
             if (a.is_abort() && !ctx.esi) return skip("0x1008 not present");
             if (a.error != Error::Ok || a.mailbox_type != 3) return fail("no SDO answer", a.describe());
+            if (free_text && (a.cmd() & 0xE3) == 0x43)  // a text of up to 4 bytes comes expedited (CiA 301)
+                return skip(hex(idx) + ":" + dec(sub) + " holds a text of 4 bytes or less: expedited");
             if (a.cmd() != 0x41)
                 return fail(hex(idx) + ":" + dec(sub) + " normal upload response command", a.describe(),
                             "0x41");
