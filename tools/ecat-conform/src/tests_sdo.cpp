@@ -235,24 +235,25 @@ void add_sdo_tests(Catalogue& c) {
             bool free_text = false;  // a STRING without a default text: its length is the device's
             if (ctx.esi) {
                 idx = 0;
-                for (const auto& r : esi_entries(*ctx.esi))
-                    // A STRING only with a default text of 5 bytes or more: its text may be shorter than
-                    // its capacity, and one of up to 4 bytes comes expedited.
-                    if (r.e->access != "wo" && r.e->bit_size > 32 &&
-                        r.e->bit_size / 8u + 10 <= ctx.mbx->max_in_payload() &&
-                        (!visible_string(*r.e) || default_text_bytes(*r.e) > 4)) {
-                        idx = r.obj->index, sub = r.e->subindex, want = r.e->bit_size / 8u;
-                        text = visible_string(*r.e);
-                        break;
-                    }
-                if (!idx)  // else a STRING without a default text: the device's text decides the form
+                const auto long_readable = [&](const EntryRef& r) {
+                    return r.e->access != "wo" && r.e->bit_size > 32 &&
+                           r.e->bit_size / 8u + 10 <= ctx.mbx->max_in_payload();
+                };
+                // A STRING only with a default text of 5 bytes or more: its text may be shorter than its
+                // capacity, and one of up to 4 bytes comes expedited. Else a STRING without such a default:
+                // the device's text decides the form.
+                for (const bool any_text : {false, true}) {
                     for (const auto& r : esi_entries(*ctx.esi))
-                        if (r.e->access != "wo" && r.e->bit_size > 32 && visible_string(*r.e) &&
-                            r.e->bit_size / 8u + 10 <= ctx.mbx->max_in_payload()) {
+                        if (long_readable(r) &&
+                            (any_text ? visible_string(*r.e)
+                                      : !visible_string(*r.e) || default_text_bytes(*r.e) > 4)) {
                             idx = r.obj->index, sub = r.e->subindex, want = r.e->bit_size / 8u;
-                            text = free_text = true;
+                            text = visible_string(*r.e);
+                            free_text = any_text;
                             break;
                         }
+                    if (idx) break;
+                }
                 if (!idx) return skip("no readable object of 5 bytes or more in the ESI");
             }
             SdoAnswer a = sdo_raw(ctx, sdo_req(0x40, idx, sub));
