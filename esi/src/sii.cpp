@@ -60,11 +60,14 @@ struct Writer {
 // anyway go first.
 enum class Compaction {
     None,
-    NoEntryNames,     // PDO entries without name strings (index 0: no string, ETG.2010)
-    NoPdoNames,       // PDOs without name strings
-    DefaultPdosOnly,  // only the default-assigned PDOs (a master without CoE can use no other)
-    NoPdos,           // a CoE device: no PDO categories (a master reads 0x1C1n and the mappings by SDO)
+    NoEntryNames,      // PDO entries without name strings (index 0: no string, ETG.2010)
+    NoPdoNames,        // PDOs without name strings
+    NoDcDescriptions,  // DC op modes without description strings (their names stay: a master selects by name)
+    DefaultPdosOnly,   // only the default-assigned PDOs (a master without CoE can use no other)
+    NoPdos,            // a CoE device: no PDO categories (a master reads 0x1C1n and the mappings by SDO)
+    NameIsOrder,       // General's device name is the order number's string (the long name is left out)
 };
+constexpr Compaction kLastCompaction = Compaction::NameIsOrder;
 
 // The content (header and categories, up to the End marker) at one compaction level.
 std::vector<uint8_t> build_content(const od::DeviceDescription& d, const DeviceModel& m, Compaction level) {
@@ -74,7 +77,8 @@ std::vector<uint8_t> build_content(const od::DeviceDescription& d, const DeviceM
     // that follows the General category's indices finds order, name and group there.
     const std::string order = d.identity.order_code.empty() ? d.identity.device_name : d.identity.order_code;
     const uint8_t order_idx = strings.add(order);
-    const uint8_t name_idx = strings.add(d.identity.device_name);
+    const uint8_t name_idx =
+        level >= Compaction::NameIsOrder ? order_idx : strings.add(d.identity.device_name);
     const uint8_t group_idx = strings.add(d.identity.group_type);
 
     // ---- General ----
@@ -146,7 +150,7 @@ std::vector<uint8_t> build_content(const od::DeviceDescription& d, const DeviceM
         dc.u16(mode.assign_activate);
         dc.u16(static_cast<uint16_t>(mode.cycle_time_sync0_factor));
         dc.u8(strings.add(mode.name));
-        dc.u8(strings.add(mode.description));
+        dc.u8(level >= Compaction::NoDcDescriptions ? 0 : strings.add(mode.description));
         dc.u32(0);
     }
 
@@ -197,15 +201,16 @@ std::vector<uint8_t> build_sii(const od::DeviceDescription& d, const od::Diction
         throw std::invalid_argument("SII: eeprom_bytes must be a positive multiple of 128 (1 KiBit)");
     const DeviceModel m = derive_model(d, dict);
     std::size_t full = 0;
-    for (const Compaction level : {Compaction::None, Compaction::NoEntryNames, Compaction::NoPdoNames,
-                                   Compaction::DefaultPdosOnly, Compaction::NoPdos}) {
+    for (const Compaction level :
+         {Compaction::None, Compaction::NoEntryNames, Compaction::NoPdoNames, Compaction::NoDcDescriptions,
+          Compaction::DefaultPdosOnly, Compaction::NoPdos, Compaction::NameIsOrder}) {
         std::vector<uint8_t> image = build_content(d, m, level);
         if (full == 0) full = image.size();
         if (image.size() <= d.eeprom_bytes) {
             image.resize(d.eeprom_bytes, 0xFF);
             return image;
         }
-        if (level == Compaction::NoPdos)
+        if (level == kLastCompaction)
             throw std::length_error("SII: content needs " + std::to_string(full) + " bytes (" +
                                     std::to_string(image.size()) + " at its most compact), the EEPROM has " +
                                     std::to_string(d.eeprom_bytes));

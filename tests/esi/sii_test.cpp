@@ -569,71 +569,142 @@ TEST(SiiBuild, ContentThatDoesNotFitThrows) {
 }
 
 // A vendor's SII fits the EEPROM its ESI declares. When softecat's full content does not, it leaves out, in
-// this order, the PDO entry names, the PDO names, the PDOs not assigned by default, and (a CoE device only)
-// the PDO categories; the identity strings, General, FMMU, SyncM and DC stay. Only when even that does not
-// fit is the content refused (load_product then warns and emulates a larger EEPROM).
+// this order, the PDO entry names, the PDO names, the DC op modes' descriptions, the PDOs not assigned by
+// default, (a CoE device only) the PDO categories, and last the long device name (General then names the
+// order number's string); FMMU, SyncM and DC with their mode names stay. Only when even that does not fit is
+// the content refused (load_product then warns and emulates a larger EEPROM). Each size is checked against
+// the level it shows: what a level leaves out, every later level leaves out too, and a larger EEPROM never
+// holds less.
+namespace compaction {
+void check_sizes(Device& d) {
+    const esi::DeviceModel m = esi::derive_model(d.description, d.dictionary);
+    const bool coe = d.description.mailbox_protocols & od::mailbox_protocol::CoE;
+    std::size_t assigned = 0, entries = 0, named_pdos = 0, described_modes = 0;
+    for (const esi::PdoInfo& p : m.pdos) {
+        assigned += p.sm >= 0;
+        for (const esi::PdoEntryInfo& e : p.entries)
+            entries += !e.name.empty();
+        named_pdos += !p.name.empty();
+    }
+    for (const od::DcOpMode& mode : d.description.dc_modes)
+        described_modes += !mode.description.empty();
+    const std::string& order = d.description.identity.order_code.empty() ? d.description.identity.device_name
+                                                                         : d.description.identity.order_code;
+    int last_level = -1, refused = 0;
+    for (uint16_t bytes = 128; bytes <= 4096; bytes = static_cast<uint16_t>(bytes + 128)) {
+        SCOPED_TRACE(bytes);
+        d.description.eeprom_bytes = bytes;
+        std::vector<uint8_t> img;
+        try {
+            img = esi::build_sii(d.description, d.dictionary);
+        } catch (const std::length_error&) {
+            EXPECT_EQ(last_level, -1) << "a smaller EEPROM held it";
+            ++refused;
+            continue;
+        }
+        ASSERT_EQ(img.size(), bytes);
+        const esi::SiiInfo info = esi::parse_sii(img);
+        EXPECT_TRUE(info.crc_ok);
+        EXPECT_TRUE(info.problems.empty()) << ::testing::PrintToString(info.problems);
+        ASSERT_TRUE(info.general);
+        EXPECT_EQ(info.general->order, order);
+        EXPECT_EQ(info.sync_managers.size(), m.sync_managers.size());
+        EXPECT_GE(info.fmmus.size(), m.fmmus.size());  // padded to whole words with 0xFF (unused)
+        ASSERT_EQ(info.dc_modes.size(), d.description.dc_modes.size());
+        for (std::size_t i = 0; i < info.dc_modes.size(); ++i)
+            EXPECT_EQ(info.dc_modes[i].name, d.description.dc_modes[i].name);  // names always stay
+        std::size_t pdos = 0, entry_names = 0, pdo_names = 0, descriptions = 0;
+        for (const auto* list : {&info.rx_pdos, &info.tx_pdos})
+            for (const esi::SiiPdo& p : *list) {
+                ++pdos;
+                pdo_names += p.name_idx != 0;
+                for (const esi::SiiPdoEntry& e : p.entries)
+                    entry_names += e.name_idx != 0;
+            }
+        for (const esi::SiiDcMode& mode : info.dc_modes)
+            descriptions += mode.description_idx != 0;
+        // The level this image shows, from the last thing left out: 0 full, 1 entry names, 2 PDO names, 3 DC
+        // descriptions, 4 non-default PDOs, 5 PDO categories, 6 the long name.
+        int level = 0;
+        if (info.general->name != d.description.identity.device_name)
+            level = 6;
+        else if (pdos == 0 && !m.pdos.empty())
+            level = 5;
+        else if (pdos < m.pdos.size())
+            level = 4;
+        else if (descriptions < described_modes)
+            level = 3;
+        else if (pdo_names < named_pdos)
+            level = 2;
+        else if (entry_names < entries)
+            level = 1;
+        if (level == 6) {
+            EXPECT_EQ(info.general->name, order);
+        }
+        if (level >= 1) {
+            EXPECT_EQ(entry_names, 0u);
+        }
+        if (level >= 2) {
+            EXPECT_EQ(pdo_names, 0u);
+        }
+        if (level >= 3) {
+            EXPECT_EQ(descriptions, 0u);
+        }
+        if (level >= 4) {
+            EXPECT_GE(pdos, level >= 5 ? 0u : assigned);
+        }
+        if (level >= 5) {
+            EXPECT_TRUE(coe) << "a device without CoE keeps the PDOs of its default assignment";
+            EXPECT_EQ(pdos, 0u);
+        }
+        if (last_level >= 0) {
+            EXPECT_LE(level, last_level) << "a larger EEPROM holds less";
+        }
+        last_level = level;
+    }
+    EXPECT_EQ(last_level, 0) << "4 KiB hold everything";
+    EXPECT_GT(refused, 0);  // 128 bytes: the header alone
+}
+}  // namespace compaction
+
 TEST(SiiBuild, ContentThatDoesNotFitIsCompactedInTheDocumentedOrder) {
     for (const auto& [name, make] : esi_test::all_devices()) {
         SCOPED_TRACE(name);
         Device d = make();
-        const esi::DeviceModel m = esi::derive_model(d.description, d.dictionary);
-        const bool coe = d.description.mailbox_protocols & od::mailbox_protocol::CoE;
-        std::size_t assigned = 0;
-        for (const esi::PdoInfo& p : m.pdos)
-            assigned += p.sm >= 0;
-        int full = 0, compact = 0, refused = 0;
-        for (uint16_t bytes = 128; bytes <= 4096; bytes = static_cast<uint16_t>(bytes + 128)) {
-            SCOPED_TRACE(bytes);
-            d.description.eeprom_bytes = bytes;
-            std::vector<uint8_t> img;
-            try {
-                img = esi::build_sii(d.description, d.dictionary);
-            } catch (const std::length_error&) {
-                EXPECT_EQ(full + compact, 0) << "a smaller EEPROM held it";
-                ++refused;
-                continue;
-            }
-            ASSERT_EQ(img.size(), bytes);
-            const esi::SiiInfo info = esi::parse_sii(img);
-            EXPECT_TRUE(info.crc_ok);
-            EXPECT_TRUE(info.problems.empty()) << ::testing::PrintToString(info.problems);
-            ASSERT_TRUE(info.general);
-            EXPECT_EQ(info.general->name, d.description.identity.device_name);
-            EXPECT_EQ(info.sync_managers.size(), m.sync_managers.size());
-            EXPECT_GE(info.fmmus.size(), m.fmmus.size());  // padded to whole words with 0xFF (unused)
-            EXPECT_EQ(info.dc_modes.size(), d.description.dc_modes.size());
-            std::vector<const esi::SiiPdo*> pdos;
-            for (const auto* list : {&info.rx_pdos, &info.tx_pdos})
-                for (const esi::SiiPdo& p : *list)
-                    pdos.push_back(&p);
-            bool entry_names = false, pdo_names = false;
-            for (const esi::SiiPdo* p : pdos) {
-                pdo_names = pdo_names || p->name_idx != 0;
-                for (const esi::SiiPdoEntry& e : p->entries)
-                    entry_names = entry_names || e.name_idx != 0;
-            }
-            if (entry_names) {  // nothing left out
-                EXPECT_EQ(pdos.size(), m.pdos.size());
-                ++full;
-                continue;
-            }
-            ++compact;
-            EXPECT_EQ(full, 0) << "compacted although a smaller EEPROM held it all";
-            if (pdo_names) {  // only the entry names left out
-                EXPECT_EQ(pdos.size(), m.pdos.size());
-            }
-            if (pdos.empty()) {
-                EXPECT_TRUE(coe) << "a device without CoE keeps the PDOs of its default assignment";
-            } else {
-                EXPECT_GE(pdos.size(), assigned);
-            }
-        }
-        EXPECT_GT(full, 0);
-        EXPECT_GT(refused, 0);  // 128 bytes: the header alone
-        if (name == "drive") {
-            EXPECT_GT(compact, 0);
+        compaction::check_sizes(d);
+    }
+}
+
+// A small CoE coupler with a long name and DC modes described at length, as old couplers are declared (256
+// bytes of EEPROM): every level down to the device name shown as the order number is reached at some size.
+TEST(SiiBuild, DcDescriptionsAndTheLongNameGoLast) {
+    Device d = esi_test::small_device();
+    d.description.identity.order_code = "CPL100";
+    // A name long enough that leaving it out makes the content fit one 128-byte step smaller.
+    d.description.identity.device_name = "CPL100 EtherCAT fieldbus coupler " + std::string(160, 'x');
+    d.description.dc_modes.clear();
+    for (int i = 0; i < 3; ++i) {
+        od::DcOpMode mode;
+        mode.name = "DcSync" + std::to_string(i);
+        mode.description = "Channel " + std::to_string(i) + " synchronised to SYNC0, described at length";
+        mode.assign_activate = 0x0300;
+        d.description.dc_modes.push_back(mode);
+    }
+    compaction::check_sizes(d);
+    // The sizes at which descriptions go and at which the name goes are both reached.
+    bool saw_descriptions_gone = false, saw_name_as_order = false;
+    for (uint16_t bytes = 128; bytes <= 1024; bytes = static_cast<uint16_t>(bytes + 128)) {
+        d.description.eeprom_bytes = bytes;
+        try {
+            const esi::SiiInfo info = esi::parse_sii(esi::build_sii(d.description, d.dictionary));
+            saw_name_as_order = saw_name_as_order || info.general->name == "CPL100";
+            for (const esi::SiiDcMode& mode : info.dc_modes)
+                saw_descriptions_gone = saw_descriptions_gone || mode.description_idx == 0;
+        } catch (const std::length_error&) {
         }
     }
+    EXPECT_TRUE(saw_descriptions_gone);
+    EXPECT_TRUE(saw_name_as_order);
 }
 
 TEST(SiiBuild, PaddedWithErasedBytesAndAliasInWord4) {
