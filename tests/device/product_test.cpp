@@ -269,6 +269,51 @@ TEST(ProductWithCoe, ServesSdoWithoutDriveAndFoe) {
     EXPECT_EQ(u16(pd.inputs(), 0), 0x4321);
 }
 
+// A device with one synchronisation type declares its sync modes read-only and refuses their write with
+// 0x06010002: the master takes the mode the device has (the state transition judges it), as it takes an
+// absent 0x1C32/0x1C33, and reaches Op.
+TEST(ProductWithCoe, SyncModesTheDeviceFixesAreTakenAsTheyAre) {
+    Unit u(coe_terminal(true));
+    UnitLink link(u);
+    Master m(link, test_support::in_process_master_options());
+    const Address a = Address::station(0x1001);
+    Mailbox mbx(m, a);
+    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(m, mbx, a));
+    SdoClient sdo(mbx);
+    const uint8_t sm_synchronous[2] = {0x22, 0};
+    ASSERT_EQ(sdo.download(0x1C33, 1, sm_synchronous), Error::SdoAbort);
+    ASSERT_EQ(sdo.last_abort(), 0x06010002u);
+
+    ProcessDataSession pd(m, a, sdo);
+    ASSERT_EQ(pd.discover(), Error::Ok);
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    AlStatus st;
+    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(100), &st), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(100), &st), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    EXPECT_EQ(pd.run(3, std::chrono::microseconds(100)), Error::Ok);
+}
+
+// A device with a mailbox and no process-data SM: the master finds no process data (not a broken SII) and
+// takes it to Op as it takes a coupler.
+TEST(ProductWithCoe, MailboxOnlyDeviceHasNoProcessDataAndReachesOp) {
+    Unit u(test_products::mailbox_only_terminal());
+    UnitLink link(u);
+    Master m(link, test_support::in_process_master_options());
+    const Address a = Address::station(0x1001);
+    Mailbox mbx(m, a);
+    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(m, mbx, a));
+    SdoClient sdo(mbx);
+    ProcessDataSession pd(m, a, sdo);
+    ASSERT_EQ(pd.discover(), Error::Ok);
+    EXPECT_EQ(pd.layout().sm2_length, 0);
+    EXPECT_EQ(pd.layout().sm3_length, 0);
+    AlStatus st;
+    for (const AlState s : {AlState::SafeOp, AlState::Op})
+        ASSERT_EQ(m.request_state(a, s, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
+}
+
 // The CoE terminal, addressed and in Pre-Op with its mailbox.
 class CoeTerminalInPreOp : public ::testing::Test {
   protected:

@@ -138,7 +138,9 @@ inline std::shared_ptr<const od::Product> io_terminal() {
 }
 
 // An analog terminal with CoE (SDO, SDO info) and no drive: standard mailbox, process data in SM2/SM3.
-inline std::shared_ptr<const od::Product> coe_terminal() {
+// `fixed_sync_modes`: 0x1C32:01 and 0x1C33:01 read-only, as a device with one synchronisation type declares
+// them (ETG.1020: "RW if more than one synchronization type is supported"; Beckhoff's EL1502 0x1C33).
+inline std::shared_ptr<const od::Product> coe_terminal(bool fixed_sync_modes = false) {
     auto p = std::make_shared<od::Product>();
     p->source = "hand-built CoE terminal";
     od::DeviceDescription& d = p->description;
@@ -148,18 +150,38 @@ inline std::shared_ptr<const od::Product> coe_terminal() {
     d.coe_details = od::coe_details::Sdo | od::coe_details::SdoInfo;
     d.sync_managers = {sm(od::SmKind::MBoxOut, 0x1000, 128, 0x26), sm(od::SmKind::MBoxIn, 0x1080, 128, 0x22),
                        sm(od::SmKind::Outputs, 0x1100, 3, 0x64), sm(od::SmKind::Inputs, 0x1180, 5, 0x20)};
-    p->make_dictionary = [](const od::DeviceDescription& desc) {
+    p->make_dictionary = [fixed_sync_modes](const od::DeviceDescription& desc) {
         od::Dictionary dict;
         add_identity(dict, desc);
         dict.add(array(0x1C00, "Sync manager type", od::DataType::Unsigned8, {1, 2, 3, 4}));
         // SM output/input parameters (ETG.1000.6): sync mode writable in Pre-Op, free run / SM-synchronous.
         constexpr uint16_t kRwPreOp = od::access::RO | od::access::WritePreOp;
+        const uint16_t sync_mode_access = fixed_sync_modes ? kRo : kRwPreOp;
         for (const uint16_t index : {uint16_t{0x1C32}, uint16_t{0x1C33}})
             dict.add(record(index, index == 0x1C32 ? "SM output parameter" : "SM input parameter",
-                            {entry(1, "Sync mode", od::DataType::Unsigned16, kRwPreOp, 1),
+                            {entry(1, "Sync mode", od::DataType::Unsigned16, sync_mode_access, 1),
                              entry(2, "Cycle time", od::DataType::Unsigned32, kRwPreOp, 0),
                              entry(4, "Sync modes supported", od::DataType::Unsigned16, kRo, 0x0003)}));
         add_io(dict, 0x1C12, 0x1C13);
+        return dict;
+    };
+    return p;
+}
+
+// A device with a mailbox and no process data (an EoE switch port, a gateway configured by CoE only): the
+// two mailbox SMs, CoE, identity objects and nothing mapped.
+inline std::shared_ptr<const od::Product> mailbox_only_terminal() {
+    auto p = std::make_shared<od::Product>();
+    p->source = "hand-built mailbox-only terminal";
+    od::DeviceDescription& d = p->description;
+    d.identity = identity(0x00009ABC);
+    d.bootstrap_mailbox = {0, 0, 0, 0};
+    d.mailbox_protocols = od::mailbox_protocol::CoE;
+    d.coe_details = od::coe_details::Sdo | od::coe_details::SdoInfo;
+    d.sync_managers = {sm(od::SmKind::MBoxOut, 0x1800, 128, 0x26), sm(od::SmKind::MBoxIn, 0x1C00, 128, 0x22)};
+    p->make_dictionary = [](const od::DeviceDescription& desc) {
+        od::Dictionary dict;
+        add_identity(dict, desc);
         return dict;
     };
     return p;

@@ -149,7 +149,14 @@ Error ProcessDataSession::discover(Slave& slave) {
     ProcessDataLayout& layout = slave.layout;
     auto img = m_.sii_read_image(slave.address);
     if (!img) return img.error();
-    if (!sii_layout(*img, layout, false)) return Error::SiiFormat;
+    if (!sii_layout(*img, layout, false)) {
+        // No process-data SM at all (a device with a mailbox only, e.g. an EoE switch port): no process data,
+        // as for a coupler without mailbox (discover_sii).
+        layout.sm2_length = layout.sm3_length = 0;
+        layout.rx_pdos.clear();
+        layout.tx_pdos.clear();
+        return Error::Ok;
+    }
     if (Error e = pdo_bytes(*slave.sdo, static_cast<uint16_t>(0x1C10 + layout.out_sm), layout.rx_pdos,
                             layout.sm2_length);
         e != Error::Ok)
@@ -277,11 +284,15 @@ Error ProcessDataSession::configure(Slave& slave, const DcConfig& dc) {
             uint8_t sup[2] = {};
             if (auto n = sdo->upload(0x1C32, 4, sup); n && *n == 2 && (sup[0] & 0x0C) == 0x08) dc_mode = 3;
         }
+        // A sync mode the device declares read-only (ETG.1020: RW only if more than one synchronisation type
+        // is supported; 0x1C33:01 often follows 0x1C32:01) is refused with 0x06010002: the device runs the
+        // one mode it has, and the state transition judges it, as for an absent object.
+        const auto fixed = [sdo](Error e) { return e == Error::SdoAbort && sdo->last_abort() == 0x06010002; };
         const uint8_t mode_out[2] = {static_cast<uint8_t>(dc.enable ? dc_mode : 1), 0};
-        if (Error e = sdo->download(0x1C32, 1, mode_out); e != Error::Ok && !absent(e)) return e;
+        if (Error e = sdo->download(0x1C32, 1, mode_out); e != Error::Ok && !absent(e) && !fixed(e)) return e;
         const uint8_t mode_in[2] = {
             static_cast<uint8_t>(dc.enable ? dc_mode : (layout.sm2_length ? 0x22 : 1)), 0};
-        if (Error e = sdo->download(0x1C33, 1, mode_in); e != Error::Ok && !absent(e)) {
+        if (Error e = sdo->download(0x1C33, 1, mode_in); e != Error::Ok && !absent(e) && !fixed(e)) {
             const uint8_t plain[2] = {static_cast<uint8_t>(dc.enable ? dc_mode : 1), 0};
             if (sdo->download(0x1C33, 1, plain) != Error::Ok) return e;
         }
@@ -289,9 +300,7 @@ Error ProcessDataSession::configure(Slave& slave, const DcConfig& dc) {
             uint8_t cyc[4];
             put32(cyc, dc.cycle_ns);
             // A read-only cycle time (the ESI's access; the slave takes it from SYNC0) is not an error.
-            if (Error e = sdo->download(0x1C32, 2, cyc);
-                e != Error::Ok && !absent(e) && !(e == Error::SdoAbort && sdo->last_abort() == 0x06010002))
-                return e;
+            if (Error e = sdo->download(0x1C32, 2, cyc); e != Error::Ok && !absent(e) && !fixed(e)) return e;
             (void)sdo->download(0x1C33, 2, cyc);  // some slaves derive it from 0x1C32 and refuse the write
         }
     }
