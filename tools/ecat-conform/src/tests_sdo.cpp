@@ -497,6 +497,8 @@ void add_sdo_tests(Catalogue& c) {
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_coe());
             if (Error e = ctx.to_safeop(); e != Error::Ok) return fail("cannot reach SAFEOP: " + err(e));
+            if (!ctx.has_process_data())
+                return skip("no process data (no PDO assigned to a process-data SM)");
             auto v = ctx.upload_uint(0x1C12, 0);
             if (!v) return fail("0x1C12:00 upload: " + ctx.sdo_error(v.error()));
             SdoAnswer a = sdo_raw(ctx, sdo_req(0x2F, 0x1C12, 0, static_cast<uint32_t>(*v)));
