@@ -239,12 +239,17 @@ void add_sdo_tests(Catalogue& c) {
                     return r.e->access != "wo" && r.e->bit_size > 32 &&
                            r.e->bit_size / 8u + 10 <= ctx.mbx->max_in_payload();
                 };
+                // A diagnosis message (0x10F3:06 and up, ETG.1020) is as long as the message it holds, empty
+                // slots 0 bytes, whatever the ESI's array size: never the entry judged.
+                const auto diag_message = [](const EntryRef& r) {
+                    return r.obj->index == 0x10F3 && r.e->subindex >= 6;
+                };
                 // A STRING only with a default text of 5 bytes or more: its text may be shorter than its
                 // capacity, and one of up to 4 bytes comes expedited. Else a STRING without such a default:
                 // the device's text decides the form.
                 for (const bool any_text : {false, true}) {
                     for (const auto& r : esi_entries(*ctx.esi))
-                        if (long_readable(r) &&
+                        if (long_readable(r) && !diag_message(r) &&
                             (any_text ? visible_string(*r.e)
                                       : !visible_string(*r.e) || default_text_bytes(*r.e) > 4)) {
                             idx = r.obj->index, sub = r.e->subindex, want = r.e->bit_size / 8u;
