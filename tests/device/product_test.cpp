@@ -162,6 +162,41 @@ TEST(ProductWithoutMailbox, ReachesOpWithProcessDataOnlyAndItsInputsFollowTheDef
     EXPECT_EQ(u16(pd.inputs(), 3), 0x55AA);
 }
 
+// An entry mapped both as output and as input holds what the master writes: the input model neither counts it
+// (although its name says counter) nor changes it, and the input shows the output written; an input-only
+// counter beside it still counts.
+TEST(ProductWithoutMailbox, AnEntryMappedBothWaysEchoesTheOutputAndIsNotModelled) {
+    Unit u(test_products::echo_terminal());
+    UnitLink link(u);
+    Master m(link, test_support::in_process_master_options());
+    const Address a = Address::station(0x1001);
+    ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
+    ProcessDataSession pd(m, std::span<const Address>(&a, 1));
+    ASSERT_EQ(pd.discover_sii(0), Error::Ok);
+    ASSERT_EQ(pd.layout(0).sm2_length, 2);
+    ASSERT_EQ(pd.layout(0).sm3_length, 4);
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    uint16_t written = 0x0100;
+    auto fill = [&] {
+        auto o = pd.outputs();
+        o[0] = static_cast<uint8_t>(written);
+        o[1] = static_cast<uint8_t>(written >> 8);
+    };
+    AlStatus st;
+    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(100), &st, fill), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(100), &st, fill), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    for (uint16_t v : {uint16_t{7}, uint16_t{7}, uint16_t{8}, uint16_t{0x1234}}) {
+        written = v;
+        const uint16_t cycles_before = u16(pd.inputs(), 2);
+        ASSERT_EQ(pd.run(3, std::chrono::microseconds(100), fill), Error::Ok);
+        EXPECT_EQ(u16(pd.inputs(), 0), v) << "the input shows the output written";
+        EXPECT_EQ(u.dev->dictionary().get<uint16_t>(0x6000, 0), v);
+        EXPECT_NE(u16(pd.inputs(), 2), cycles_before) << "the input-only counter counts";
+    }
+}
+
 // Outputs lost: an IO terminal's outputs go to their safe state, 0 (EL2xxx switch their outputs off on the
 // watchdog; the ESC's process-data watchdog: the PDI side sets the outputs safe), whether the master leaves
 // Op or stops writing (watchdog); they come back with the next outputs written in Op.

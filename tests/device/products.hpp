@@ -187,4 +187,39 @@ inline std::shared_ptr<const od::Product> mailbox_only_terminal() {
     return p;
 }
 
+// A terminal whose one object is mapped both ways (KickCAT's example slaves: 0x6000 "wdg_counter" in the
+// RxPDO and the TxPDO, PdoMapping "rt"): the master writes a watchdog counter and reads it back. Outputs in
+// SM0, inputs in SM1, no mailbox.
+inline std::shared_ptr<const od::Product> echo_terminal() {
+    auto p = std::make_shared<od::Product>();
+    p->source = "hand-built echo terminal";
+    od::DeviceDescription& d = p->description;
+    d.identity = identity(0x00004321);
+    d.standard_mailbox = {0, 0, 0, 0};
+    d.bootstrap_mailbox = {0, 0, 0, 0};
+    d.mailbox_protocols = 0;
+    d.coe_details = 0;
+    d.sync_managers = {sm(od::SmKind::Outputs, 0x1000, 2, 0x64), sm(od::SmKind::Inputs, 0x1100, 4, 0x20)};
+    p->make_dictionary = [](const od::DeviceDescription& desc) {
+        od::Dictionary dict;
+        add_identity(dict, desc);
+        dict.add(
+            record(0x1600, "Outputs", {entry(1, "SubIndex 001", od::DataType::Unsigned32, kRo, 0x60000010)}));
+        dict.add(record(0x1A00, "Inputs",
+                        {entry(1, "SubIndex 001", od::DataType::Unsigned32, kRo, 0x60000010),
+                         entry(2, "SubIndex 002", od::DataType::Unsigned32, kRo, 0x60010010)}));
+        dict.add(array(0x1C10, "RxPDO assign", od::DataType::Unsigned16, {0x1600}));
+        dict.add(array(0x1C11, "TxPDO assign", od::DataType::Unsigned16, {0x1A00}));
+        od::Object wdg = var(0x6000, "wdg_counter", od::DataType::Unsigned16, 0);
+        wdg.entries[0].access = kRx | od::access::TxPdo;
+        dict.add(wdg);
+        od::Object cycles = var(0x6001, "cycle counter", od::DataType::Unsigned16, 0);
+        cycles.entries[0].access = kTx;
+        dict.add(cycles);
+        return dict;
+    };
+    p->application = od::Application::None;
+    return p;
+}
+
 }  // namespace test_products

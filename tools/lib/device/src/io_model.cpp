@@ -43,6 +43,11 @@ void IoModel::build(const ecat::ProcessData& pd, const std::set<uint32_t>& held)
     for (const IoEntry& in : inputs_) {
         const uint32_t key = io_key(in.entry->index, in.entry->subindex);
         if (held.count(key) != 0) continue;
+        // An entry an output PDO maps too (a watchdog counter the master writes and reads back) holds what
+        // the master writes: its input shows that, neither counted nor mirrored from another output.
+        if (std::any_of(outputs_.begin(), outputs_.end(),
+                        [&in](const IoEntry& out) { return out.storage == in.storage; }))
+            continue;
         if (is_counter_name(in.entry->name)) {
             if (in.entry->bit_length <= 64) counters_.push_back({in.storage, in.entry->bit_length, key});
             continue;
