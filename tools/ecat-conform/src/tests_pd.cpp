@@ -79,12 +79,13 @@ Outcome sm_size_vs_esi(Context& ctx, bool outputs) {
     return expect_eq("SM" + dec(sm) + " bytes of the default assignment", dec(got), dec((bits + 7) / 8));
 }
 
-// A mapped output entry that is safe to change (not the controlword, not a mode), value via SDO readable.
-const MappedEntry* harmless_output(const PdoMap& m) {
+// The mapped output entries that are safe to change (not the controlword, not a mode), in mapping order.
+std::vector<const MappedEntry*> harmless_outputs(const PdoMap& m) {
+    std::vector<const MappedEntry*> r;
     for (const auto& e : m.outputs)
         if (e.index != 0x6040 && e.index != 0x6060 && e.bits >= 8 && e.bits % 8 == 0 && e.index >= 0x2000)
-            return &e;
-    return nullptr;
+            r.push_back(&e);
+    return r;
 }
 
 Outcome inputs_match(Context& ctx, uint8_t state) {
@@ -133,10 +134,20 @@ Outcome outputs(Context& ctx, bool op) {
     if (!ctx.has_process_data()) return skip("no process data (no PDO assigned to a process-data SM)");
     PdoMap m;
     if (Error x = read_map(ctx, m); x != Error::Ok) return fail("mapping: " + ctx.sdo_error(x));
-    const MappedEntry* o = harmless_output(m);
-    if (!o) return skip("no mapped output entry other than controlword and mode");
+    const std::vector<const MappedEntry*> candidates = harmless_outputs(m);
+    if (candidates.empty()) return skip("no mapped output entry other than controlword and mode");
     prefill_outputs(ctx, m);
-    auto before = ctx.upload_uint(o->index, o->sub);
+    // The first one SDO can read: an output object may be write-only (ETG.1000.6 access "wo"; the upload is
+    // refused with 0x06010001), and then what the outputs did to it cannot be seen by SDO.
+    const MappedEntry* o = nullptr;
+    master::Result<uint64_t> before = master::Error::InvalidArgument;
+    for (const MappedEntry* c : candidates) {
+        before = ctx.upload_uint(c->index, c->sub);
+        if (!before && before.error() == Error::SdoAbort && ctx.sdo->last_abort() == 0x06010001) continue;
+        o = c;
+        break;
+    }
+    if (!o) return skip("every mapped output entry is write-only (SDO abort 0x06010001)");
     if (!before) return fail("upload: " + ctx.sdo_error(before.error()));
     const uint64_t mask = o->bits >= 64 ? ~uint64_t{0} : (uint64_t{1} << o->bits) - 1;
     const uint64_t v = (*before + 7) & mask;
