@@ -284,9 +284,24 @@ Figures run_segment(const Plan& plan, double seconds, const std::string& backend
     mo.al_timeout = std::chrono::milliseconds(10'000);
     master::Master m(*master_link, mo);
     auto fail = [&](const std::string& what, Error e) {
+        // What the slave side saw, to tell a frame that never reached it from a reply that never came back
+        // (or a slave thread that did not run): the master's frames sent against the runtime's counts.
+        const slave::RuntimeStats rs = snapshot();
+        const master::MasterStats& ms = m.stats();
+        char seen[320];
+        std::snprintf(
+            seen, sizeof seen,
+            " (master: frames sent %llu, replies %llu, ignored %llu, timeouts %llu; slave: frames "
+            "received %llu, replies sent %llu, send errors %llu, wake-ups %llu)",
+            static_cast<unsigned long long>(ms.frames_sent),
+            static_cast<unsigned long long>(ms.frames_received),
+            static_cast<unsigned long long>(ms.frames_ignored), static_cast<unsigned long long>(ms.timeouts),
+            static_cast<unsigned long long>(rs.frames_received),
+            static_cast<unsigned long long>(rs.frames_sent), static_cast<unsigned long long>(rs.send_errors),
+            static_cast<unsigned long long>(rs.wakeups));
         runtime->request_stop();
         slave_thread.join();
-        throw std::runtime_error(what + ": " + std::string(master::to_string(e)));
+        throw std::runtime_error(what + ": " + std::string(master::to_string(e)) + seen);
     };
     auto bus = master::scan_bus(m, {.first_station = 0x1001, .identity = true});
     if (!bus) fail("scan", bus.error());
