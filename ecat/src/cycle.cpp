@@ -91,9 +91,9 @@ void Cycle::poll(uint64_t now_ns) {
     if (esm_.take_restart()) ctx_.app.on_restart();
 }
 
-bool Cycle::quiet(uint64_t now_ns) const {
-    return irq_ && irq_usable_ && !first_poll_ && ctx_.mailbox.queued() == 0 && !irq_() &&
-           now_ns < next_deadline_ns();
+bool Cycle::quiet(uint64_t now_ns, bool registers_unchanged) const {
+    return irq_ && (irq_usable_ || registers_unchanged) && !first_poll_ && ctx_.mailbox.queued() == 0 &&
+           !irq_() && now_ns < next_deadline_ns();
 }
 
 uint64_t Cycle::next_deadline_ns() const {

@@ -179,14 +179,16 @@ void DistributedClocks::fire_sync1(uint64_t t) {
     if (mem.r8(reg::kSyncLatchConfig) & 0x80) mem.set_al_event(alev::kSync1);
 }
 
-void DistributedClocks::run(uint64_t now_clock) {
-    if (!sync0_armed && !sync1_armed) return;
+bool DistributedClocks::run(uint64_t now_clock) {
+    if (!sync0_armed && !sync1_armed) return false;
+    bool fired = false;
     const uint64_t sys = local_at(now_clock) + mem.r64(reg::kDcOffset);
     const uint8_t act = mem.r8(reg::kDcActivation);
     for (int guard = 0; guard < 16; ++guard) {
         const uint64_t t0 = sync0_armed ? next_sync0 : kNever;
         const uint64_t t1 = sync1_armed ? next_sync1 : kNever;
         if (std::min(t0, t1) > sys) break;
+        fired = true;
         if (t0 <= t1) {
             // Internal SYNC0 event (drives SYNC1 even when the SYNC0 output is off).
             if (act & 0x02) fire_sync0(t0);
@@ -213,6 +215,7 @@ void DistributedClocks::run(uint64_t now_clock) {
         }
     }
     update_readback();
+    return fired;
 }
 
 // ---------------------------------------------------------------------------------------- construction

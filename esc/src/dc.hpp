@@ -50,8 +50,8 @@ class DistributedClocks {
         if (latch_pending) latch(ok);
     }
 
-    // SYNC0/SYNC1 generation up to now_clock.
-    void run(uint64_t now_clock);
+    // SYNC0/SYNC1 generation up to now_clock; true when a pulse fired (or a single shot ended).
+    bool run(uint64_t now_clock);
     // Clock time of the next SYNC pulse; UINT64_MAX if none.
     uint64_t next_event(uint64_t now_clock) const;
 

@@ -468,6 +468,7 @@ int Esc::Impl::receive_signalled(std::span<uint8_t> frame, int port, uint64_t rx
                                  std::unique_lock<EscLock>& lock) {
     const uint32_t before = masked_events();
     const uint64_t processed = stats.frames_processed;
+    ++sig->activity;
     const int r = receive(frame, port, rx_clock, check);
     if (stats.frames_processed != processed) {
         // Only a frame that may have moved a timer earlier makes the due time unknown (the runtime's next
@@ -560,8 +561,8 @@ void Esc::tick() {
 void Esc::tick(uint64_t now_clock) {
     std::lock_guard lock(impl_->mu);
     const uint32_t before = impl_->masked_events();
-    impl_->wd.run(now_clock);
-    impl_->dc.run(now_clock);
+    const bool wd_changed = impl_->wd.run(now_clock);
+    if (impl_->dc.run(now_clock) || wd_changed) ++impl_->sig->activity;
     impl_->note_events(before);
     impl_->sig->due_ns = impl_->due(now_clock);
 }

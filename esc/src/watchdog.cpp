@@ -19,17 +19,21 @@ void Watchdogs::pd_trigger() {
     }
 }
 
-void Watchdogs::run(uint64_t now) {
+bool Watchdogs::run(uint64_t now) {
+    bool changed = false;
     const uint64_t inc = increment_ns();
     const uint64_t tpd = mem.r16(reg::kWdTimePd) * inc;
     if (tpd == 0) {
         pd_armed = false;
-        mem.w16(reg::kWdStatusPd, static_cast<uint16_t>(mem.r16(reg::kWdStatusPd) | 0x0001));
+        const uint16_t st = mem.r16(reg::kWdStatusPd);
+        changed = (st & 0x0001) == 0;
+        mem.w16(reg::kWdStatusPd, static_cast<uint16_t>(st | 0x0001));
     } else if (pd_armed && now >= pd_last + tpd) {
         pd_armed = false;
         mem.w16(reg::kWdStatusPd, static_cast<uint16_t>(mem.r16(reg::kWdStatusPd) & ~0x0001));
         mem.count_error(reg::kWdCounterPd);
         mem.set_al_event(alev::kWatchdogPd);
+        changed = true;
     }
     const uint64_t tpdi = mem.r16(reg::kWdTimePdi) * inc;
     const uint16_t dl = mem.r16(reg::kDlStatus);
@@ -47,6 +51,7 @@ void Watchdogs::run(uint64_t now) {
             pdi_armed = false;
             ndl = static_cast<uint16_t>(dl & ~0x0002);
             mem.count_error(reg::kWdCounterPdi);
+            changed = true;
         } else {
             ndl = static_cast<uint16_t>(dl | 0x0002);
         }
@@ -54,7 +59,9 @@ void Watchdogs::run(uint64_t now) {
     if (ndl != dl) {
         mem.w16(reg::kDlStatus, ndl);
         mem.set_ecat_event(ecev::kDlStatus);
+        changed = true;
     }
+    return changed;
 }
 
 uint64_t Watchdogs::next_event(uint64_t now_clock) const {

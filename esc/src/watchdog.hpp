@@ -24,7 +24,8 @@ class Watchdogs {
     }
     // A PDI access happened: restarts the PDI watchdog at the next run().
     void pdi_touch() { pdi_touched = true; }
-    void run(uint64_t now_clock);
+    // True when it changed a register (a watchdog expired, a status bit changed).
+    bool run(uint64_t now_clock);
     // Clock time at which run() has something to do next; UINT64_MAX if nothing.
     uint64_t next_event(uint64_t now_clock) const;
     // False while run() would change a status bit whatever the time (a watchdog time written to 0, an armed

@@ -97,4 +97,40 @@ TEST_F(Signals, EepromWriteWakes) {
     EXPECT_EQ(sig.wake, 1) << "the firmware keeps the written words";
 }
 
+// activity: what a controller without a usable interrupt line (an SM without its PDI interrupt) would find
+// changed when it reads the registers. Every frame counts, whatever it does, and a tick that fired a SYNC
+// pulse or changed a watchdog; the PDI side's own accesses and a tick with nothing to do do not. Not raising
+// it for a change a frame or a timer made would leave such a device unpolled (device::Line); raising it for
+// nothing only costs a poll.
+TEST_F(Signals, ActivityCountsFramesAndTimerEventsNotPdiAccesses) {
+    const uint32_t a0 = sig.activity;
+    (void)fprd(*e, 0x0130, 2);
+    EXPECT_NE(sig.activity, a0) << "a frame (even one that reads)";
+    uint32_t a = sig.activity;
+    (void)e->read_reg<uint16_t>(0x0130);
+    e->write_reg<uint16_t>(0x0134, 0);
+    e->tick(clk.now_ns());
+    EXPECT_EQ(sig.activity, a) << "PDI accesses and a tick that only settles them";
+    const uint64_t start = start_sync0(1'000'000, 50'000);
+    a = sig.activity;
+    clk.set(start - 1);
+    e->tick(start - 1);
+    EXPECT_EQ(sig.activity, a) << "before the pulse";
+    clk.set(start);
+    e->tick(start);
+    EXPECT_NE(sig.activity, a) << "SYNC0 fired (0x098E changed) without any AL event mapped";
+    a = sig.activity;
+    // The process-data watchdog expiring (0x0440 bit 0 cleared) is a change too: a write through SM0 set up
+    // as a one-byte buffered output SM with the watchdog trigger starts it.
+    EXPECT_EQ(fpwr(*e, 0x0981, {0x00}).wkc, 1);  // SYNC0 off: the next tick has only the watchdog to do
+    EXPECT_EQ(fpwr(*e, 0x0800, {0x00, 0x10, 0x01, 0x00, 0x44, 0x00, 0x01, 0x00}).wkc, 1);
+    EXPECT_EQ(fpwr(*e, 0x1000, {0x5A}).wkc, 1);
+    a = sig.activity;
+    const uint64_t later = clk.now_ns() + 2'000'000'000ull;  // past any watchdog time
+    clk.set(later);
+    e->tick(later);
+    EXPECT_EQ(fprd(*e, 0x0440, 2).u16() & 1, 0) << "expired";
+    EXPECT_NE(sig.activity, a) << "the watchdog's expiry";
+}
+
 }  // namespace

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "device/line.hpp"
+#include "device/products.hpp"
 #include "esc/clock.hpp"
 #include "esc/link_loopback.hpp"
 #include "esc/wire/frame_builder.hpp"
@@ -22,6 +23,7 @@
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
+#include "master/session.hpp"
 #include "slave/log.hpp"
 #include "slave/runtime.hpp"
 #include "slave/topology.hpp"
@@ -47,10 +49,11 @@ master::MasterOptions master_options() {
 
 // N drives in a line, served by a runtime on the slave end of a loopback pair.
 struct SegmentBus {
-    explicit SegmentBus(int count)
+    explicit SegmentBus(int count, std::vector<std::shared_ptr<const od::Product>> products = {})
         : links(esc::LoopbackLink::make_pair(256)), log(log_text, slave::LogLevel::Debug) {
         device::LineOptions o;
         o.topology = slave::line_topology(count);
+        o.products = std::move(products);
         o.base.state_dir = dir.path;
         o.base.log = &warnings;
         o.log = &log;
@@ -189,6 +192,63 @@ TEST(SegmentRuntime, ALineLooksOnlyAtDevicesWithSomethingToDo) {
     EXPECT_NE(read[16 + 10] & 0x1F, 0x01) << "AL status still Init without error";
     EXPECT_EQ(segment.signals()[0].due_ns, due[0]) << "device 0 was not looked at";
     EXPECT_EQ(segment.signals()[2].due_ns, due[2]) << "device 2 was not looked at";
+}
+
+// A digital IO terminal without mailbox whose SMs have no PDI interrupt (control 0x44 and 0x00, as such
+// ESIs declare them) cannot use the interrupt line: its stack reads the registers themselves. It is polled
+// when a frame passed its ESC or a timer of it fired (EscSignals::activity), not on every pass of the line:
+// a pass in between (another device's SYNC0, a control command's pass, the runtime's timer) would find the
+// registers as its last poll left them. The process data still flows every cycle.
+TEST(SegmentRuntime, ATerminalThatReadsItsRegistersIsPolledWhenItsEscChanged) {
+    // With device emulation (ESC configuration bit 0, the ConfigData 0401 of such terminals): the ESC takes
+    // Init -> Op as it comes.
+    auto terminal = std::make_shared<od::Product>(*test_products::io_terminal());
+    terminal->description.esc_config = 0x01;
+    SegmentBus bus(2, {terminal, terminal});
+    device::Line& line = *bus.line;
+    bus.start();
+    master::Master m(bus.master_end(), master_options());
+    ASSERT_EQ(m.count_slaves().value(), 2);
+    ASSERT_EQ(m.assign_station_addresses(2), Error::Ok);
+    const std::array<Address, 2> slaves{Address::station(0x1001), Address::station(0x1002)};
+    master::ProcessDataSession pd(m, slaves, {});
+    for (std::size_t k = 0; k < 2; ++k)
+        ASSERT_EQ(pd.discover_sii(k), Error::Ok) << k;
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    for (const Address a : slaves)
+        ASSERT_EQ(m.request_state(a, AlState::Op), Error::Ok);
+    auto fill = [&pd] {
+        pd.outputs()[0] = 0x21;
+        pd.outputs()[3] = 0x43;
+    };
+    ASSERT_EQ(pd.run(5, std::chrono::microseconds(200), fill), Error::Ok);
+    bus.stop();  // the test runs the passes and walks the frames itself
+    ASSERT_EQ(line.device(0)->stack().state(), od::AlState::Op);
+    ASSERT_EQ(line.device(0)->dictionary().get<uint16_t>(0x7000, 1), 0x0021) << "outputs taken";
+    ASSERT_EQ(line.device(1)->dictionary().get<uint16_t>(0x7000, 1), 0x0043) << "outputs taken";
+
+    uint64_t now = bus.clock.now_ns();
+    line.poll(now);  // after line.device(): every device is asked once
+    const uint64_t polls = line.stats().polls;
+    for (int pass = 0; pass < 3; ++pass)
+        line.poll(now);
+    EXPECT_EQ(line.stats().polls, polls) << "passes with no frame and no timer event poll nobody";
+    // A frame that passes both ESCs (a BRD of the type register): each is polled once in the next pass.
+    std::vector<uint8_t> frame = brd_type_frame();
+    ASSERT_EQ(line.segment().walk(frame, now).kind, esc::Segment::Result::Kind::Reply);
+    line.poll(now);
+    EXPECT_EQ(line.stats().polls, polls + 2);
+    line.poll(now);
+    EXPECT_EQ(line.stats().polls, polls + 2);
+    // Process data written by a frame reaches the device in the pass after it.
+    std::vector<uint8_t> lrw = esc::wire::FrameBuilder()
+                                   .add(esc::Command::LWR, 0x43, 0x0000, 0x0001,
+                                        std::array<uint8_t, 6>{0x65, 0x00, 0x00, 0x87, 0x00, 0x00})
+                                   .build(60);
+    ASSERT_EQ(line.segment().walk(lrw, now).kind, esc::Segment::Result::Kind::Reply);
+    line.poll(now);
+    EXPECT_EQ(line.device(0)->dictionary().get<uint16_t>(0x7000, 1), 0x0065);
+    EXPECT_EQ(line.device(1)->dictionary().get<uint16_t>(0x7000, 1), 0x0087);
 }
 
 TEST(SegmentRuntime, APulledCableShortensTheLine) {

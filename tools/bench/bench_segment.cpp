@@ -190,6 +190,7 @@ struct Figures {
     double followed_min = 0, followed_max = 0;  // mixed line: position actual's advance over the ramp's, 0..1
     bench::Summary walk, latency, rtt, echo, echo_thread;
     double cpu_percent = 0, cpu_us_per_cycle = 0, allocs_per_cycle = 0;
+    double polls_per_cycle = 0;  // device firmware polls (device::LineStats::polls)
     double wakeups_per_cycle = 0, services_per_cycle = 0, timer_arms_per_cycle = 0, frames_per_wakeup = 0,
            replies_per_batch = 0;
     uint64_t frames_before_work = 0;  // frames found waiting before the timers/firmware or between devices
@@ -255,11 +256,13 @@ Figures run_segment(const Plan& plan, double seconds, const std::string& backend
     // The runtime's statistics are copied by its own thread on request (snapshot()), never read across.
     std::atomic<int> snap_state{0};
     slave::RuntimeStats snap;
+    uint64_t snap_polls = 0;
     std::thread slave_thread([&] {
         pthread_setname_np(pthread_self(), "segment-slave");  // for perf and top
         while (runtime->run_once(2)) {
             if (snap_state.load(std::memory_order_acquire) == 1) {
                 snap = runtime->stats();
+                snap_polls = line->stats().polls;
                 snap_state.store(2, std::memory_order_release);
             }
         }
@@ -281,9 +284,24 @@ Figures run_segment(const Plan& plan, double seconds, const std::string& backend
     mo.al_timeout = std::chrono::milliseconds(10'000);
     master::Master m(*master_link, mo);
     auto fail = [&](const std::string& what, Error e) {
+        // What the slave side saw, to tell a frame that never reached it from a reply that never came back
+        // (or a slave thread that did not run): the master's frames sent against the runtime's counts.
+        const slave::RuntimeStats rs = snapshot();
+        const master::MasterStats& ms = m.stats();
+        char seen[320];
+        std::snprintf(
+            seen, sizeof seen,
+            " (master: frames sent %llu, replies %llu, ignored %llu, timeouts %llu; slave: frames "
+            "received %llu, replies sent %llu, send errors %llu, wake-ups %llu)",
+            static_cast<unsigned long long>(ms.frames_sent),
+            static_cast<unsigned long long>(ms.frames_received),
+            static_cast<unsigned long long>(ms.frames_ignored), static_cast<unsigned long long>(ms.timeouts),
+            static_cast<unsigned long long>(rs.frames_received),
+            static_cast<unsigned long long>(rs.frames_sent), static_cast<unsigned long long>(rs.send_errors),
+            static_cast<unsigned long long>(rs.wakeups));
         runtime->request_stop();
         slave_thread.join();
-        throw std::runtime_error(what + ": " + std::string(master::to_string(e)));
+        throw std::runtime_error(what + ": " + std::string(master::to_string(e)) + seen);
     };
     auto bus = master::scan_bus(m, {.first_station = 0x1001, .identity = true});
     if (!bus) fail("scan", bus.error());
@@ -414,6 +432,7 @@ Figures run_segment(const Plan& plan, double seconds, const std::string& backend
         target0[k] = target[k];
     }
     const slave::RuntimeStats rs0 = snapshot();
+    const uint64_t polls0 = snap_polls;
     const alloc_counter::Scope allocs;
     walk_log.on.store(true);
     for (uint64_t done = 0; done < cycles; done += kBlock) {
@@ -439,6 +458,7 @@ Figures run_segment(const Plan& plan, double seconds, const std::string& backend
     walk_log.on.store(false);
     const uint64_t alloc_count = allocs.count();
     const slave::RuntimeStats rs1 = snapshot();
+    const uint64_t polls1 = snap_polls;
     for (std::size_t k : drive_slaves) {
         const uint16_t sw = util::get16(pd.inputs(k).data() + io[k].sw);
         if ((sw & 0x006F) == 0x0027) ++f.enabled;
@@ -467,6 +487,7 @@ Figures run_segment(const Plan& plan, double seconds, const std::string& backend
     f.wakeups_per_cycle = static_cast<double>(rs1.wakeups - rs0.wakeups) / window_cycles;
     f.timer_arms_per_cycle = static_cast<double>(rs1.timer_arms - rs0.timer_arms) / window_cycles;
     f.services_per_cycle = static_cast<double>(rs1.services - rs0.services) / window_cycles;
+    f.polls_per_cycle = static_cast<double>(polls1 - polls0) / window_cycles;
     f.spin_us_per_cycle = static_cast<double>(rs1.spin_ns_total - rs0.spin_ns_total) / 1000.0 / window_cycles;
     f.frames_per_wakeup = static_cast<double>(rs1.frames_received - rs0.frames_received) /
                           static_cast<double>(std::max<uint64_t>(1, rs1.wakeups - rs0.wakeups));
@@ -611,9 +632,10 @@ void print_figures(const Figures& f) {
             f.cpu_us_per_cycle, f.cpu_us_per_cycle / static_cast<double>(f.drives), f.cpu_percent);
     std::printf(
         "  slave wake-ups per cycle %.2f, passes over the line per cycle %.2f, timer arms per cycle %.2f, "
-        "frames per wake-up %.2f, replies per batch %.2f, awake waiting for deadlines %.1f us per cycle\n",
+        "frames per wake-up %.2f, replies per batch %.2f, awake waiting for deadlines %.1f us per cycle, "
+        "device polls per cycle %.1f\n",
         f.wakeups_per_cycle, f.services_per_cycle, f.timer_arms_per_cycle, f.frames_per_wakeup,
-        f.replies_per_batch, f.spin_us_per_cycle);
+        f.replies_per_batch, f.spin_us_per_cycle, f.polls_per_cycle);
     std::printf("  frames answered before the firmware's work or between devices: %llu\n",
                 static_cast<unsigned long long>(f.frames_before_work));
     std::printf("  missed cycles %llu, lost frames %llu, wkc errors %llu, allocations per cycle %.3f\n",

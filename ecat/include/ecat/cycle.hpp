@@ -47,8 +47,11 @@ class Cycle {
 
     void poll(uint64_t now_ns);
     // True if poll(now_ns) would return at once: the interrupt line is usable and low, no mailbox message
-    // waits to be sent, and no deadline is due.
-    bool quiet(uint64_t now_ns) const;
+    // waits to be sent, and no deadline is due. registers_unchanged: the caller knows that no frame and no
+    // timer event of the ESC changed its registers since the last poll (esc::EscSignals::activity); a stack
+    // without a usable interrupt line, which reads the registers themselves, would find what its last poll
+    // left there, so that alone does not keep it busy.
+    bool quiet(uint64_t now_ns, bool registers_unchanged = false) const;
     uint64_t next_deadline_ns() const;
     uint64_t last_now_ns() const { return last_now_ns_; }
 

@@ -54,7 +54,10 @@ class Stack {
     void poll(uint64_t now_ns) { cycle_.poll(now_ns); }
     // True if poll(now_ns) would return at once without a register read beyond the interrupt line: nothing
     // signalled, no deadline due. Lets a caller with many stacks skip those with nothing to do.
-    bool quiet(uint64_t now_ns) const { return cycle_.quiet(now_ns); }
+    // registers_unchanged: see Cycle::quiet().
+    bool quiet(uint64_t now_ns, bool registers_unchanged = false) const {
+        return cycle_.quiet(now_ns, registers_unchanged);
+    }
     // Time at which poll() must run again even if no frame arrives; UINT64_MAX if nothing is pending.
     uint64_t next_deadline_ns() const { return cycle_.next_deadline_ns(); }
 

@@ -83,6 +83,11 @@ struct EscSignals {
     // through (0x0220 & 0x0204: the PDI interrupt line rose or a new event joined it), or a master wrote an
     // EEPROM word: the PDI side has something new to look at. The owner clears it when it looked.
     uint8_t wake = 0;
+    // Counts up (wrapping) whenever the registers may have changed other than through the PDI: a frame
+    // passed the ESC (at any port), or a tick fired a SYNC pulse or changed a watchdog's state. A
+    // controller that cannot use the interrupt line (an SM without its PDI interrupt) has to look at the
+    // registers themselves; it finds nothing new in them before this changes.
+    uint32_t activity = 0;
     // The clock due_ns counts (the ESC's Clock), set by set_signals().
     const Clock* clock = nullptr;
 };

@@ -531,9 +531,9 @@ void Device::poll(uint64_t now_ns) {
     }
 }
 
-bool Device::quiet(uint64_t now_ns) const {
+bool Device::quiet(uint64_t now_ns, bool registers_unchanged) const {
     if (restart_pending_ || outputs_lost_pending_ || (parts_->drive && last_cycle_ns_ == 0)) return false;
-    if (!parts_->stack->quiet(now_ns)) return false;
+    if (!parts_->stack->quiet(now_ns, registers_unchanged)) return false;
     if (eeprom_dirty_ && (eeprom_save_ns_ == 0 || now_ns >= eeprom_save_ns_)) return false;
     if (!parts_->drive) return true;  // nothing runs on its own
     return parts_->stack->state() == od::AlState::Op || now_ns < free_run_due_ns();

@@ -109,40 +109,49 @@ void Line::poll(uint64_t now_ns) {
     // A device is looked at only when something may be there for it, as the interrupt line of a hardware
     // ESC wakes its controller: its ESC signalled a new event (EscSignals::wake: a frame or a tick raised a
     // masked AL event, a master wrote the EEPROM), its own deadline is due, or its last poll left it not
-    // quiet (an event still pending, a mailbox message waiting for SM1, no usable interrupt line, ...; then
-    // it is asked on every pass, as before). The others cost a look at three arrays. After a control
-    // command, a power change or a caller's access to a device (deadline_known_ false) every device is
-    // asked once. A device's deadline changes only in its own poll or through those; frames served
-    // meanwhile change ESCs, which wake what they concern.
+    // quiet (an event still pending, a mailbox message waiting for SM1, ...; then it is asked on every
+    // pass, as before). A device whose only reason not to be quiet is an interrupt line it cannot use (its
+    // SMs without the PDI interrupt, as the ESIs of digital IO terminals declare them) reads the registers
+    // themselves, as such a controller polls them: it is asked when its ESC's registers changed since its
+    // last poll (EscSignals::activity: a frame passed the ESC, or a timer fired), not on every pass; a
+    // poll in between would read what the last one left. The others cost a look at the arrays. After a
+    // control command, a power change or a caller's access to a device (deadline_known_ false) every
+    // device is asked once. A device's deadline changes only in its own poll or through those; frames
+    // served meanwhile change ESCs, which wake what they concern.
     const std::size_t n = units_.size();
     if (due_.size() != n) {
         due_.assign(n, 0);
-        ask_.assign(n, 1);
+        ask_.assign(n, kEveryPass);
+        seen_.assign(n, 0);
     }
-    if (!deadline_known_) std::fill(ask_.begin(), ask_.end(), uint8_t{1});
+    if (!deadline_known_) std::fill(ask_.begin(), ask_.end(), uint8_t{kEveryPass});
     esc::EscSignals* sig = segment_.signals();
     uint64_t now = now_ns;
     bool fresh = true;  // now_ns is still the time: no device polled yet
     for (std::size_t k = 0; k < n; ++k) {
         const bool woken = sig[k].wake != 0;
-        if (!woken && ask_[k] == 0 && due_[k] > now) continue;
+        if (!woken && due_[k] > now &&
+            (ask_[k] == kQuiet || (ask_[k] == kOnActivity && sig[k].activity == seen_[k])))
+            continue;
         sig[k].wake = 0;
         Device* d = units_[k]->device.get();
         if (d == nullptr) {
-            ask_[k] = 0;
+            ask_[k] = kQuiet;
             due_[k] = std::numeric_limits<uint64_t>::max();
             continue;
         }
         // Woken: polled at once (a poll that finds the device quiet returns at once). Asked or due: the
         // quiet check first, which costs less than a poll when nothing is there after all.
         if (!woken && d->quiet(now)) {
-            ask_[k] = 0;
+            ask_[k] = kQuiet;
             due_[k] = d->next_deadline_ns();
             continue;
         }
         if (!fresh) now = std::max(now, clock_.now_ns());
         d->poll(now);
-        ask_[k] = d->quiet(now) ? 0 : 1;
+        ++stats_.polls;
+        seen_[k] = sig[k].activity;  // a poll's own PDI accesses do not count
+        ask_[k] = d->quiet(now) ? kQuiet : d->quiet(now, true) ? kOnActivity : kEveryPass;
         due_[k] = d->next_deadline_ns();
         fresh = false;
         // Frames that came during this device's work are answered before the next device's (the runtime's

@@ -139,7 +139,9 @@ class Device final : public ecat::Application, public drive::EventSink, public e
     void poll(uint64_t now_ns);
     // True if poll(now_ns) would do nothing: the stack is quiet, no restart or reaction pending, no
     // free-running drive cycle or EEPROM save due. A line polls only the devices that are not.
-    bool quiet(uint64_t now_ns) const;
+    // registers_unchanged: no frame and no timer event changed the ESC's registers since the last poll
+    // (ecat::Cycle::quiet()).
+    bool quiet(uint64_t now_ns, bool registers_unchanged = false) const;
     uint64_t next_deadline_ns() const;
 
     // Which parts this device has (see the header comment); the accessors below of a part it has not

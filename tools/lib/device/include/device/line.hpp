@@ -55,6 +55,7 @@ struct LineStats {
     uint64_t link_changes = 0;           // cables pulled or plugged through link
     uint64_t fault_changes = 0;          // drop/corrupt/delay/clear commands
     std::vector<uint64_t> power_cycles;  // per device: times it was switched on again after an off
+    uint64_t polls = 0;                  // devices' firmware polled (Device::poll) by poll()
 };
 
 class Line final : public slave::SegmentFirmware {
@@ -103,11 +104,16 @@ class Line final : public slave::SegmentFirmware {
     esc::Segment segment_;
     std::unique_ptr<ControlSocket> control_;
     LineStats stats_;
-    // Per device, as the last poll() found it: its next deadline, and whether it must be asked on every pass
-    // (not quiet after its poll). Not known after a control command, a power change or a caller's access
-    // to a device (deadline_known_ false: next_deadline_ns() asks every device, the next poll() too).
+    // Per device, as the last poll() found it: its next deadline, and when it must be asked (kQuiet: only
+    // when woken or due; kEveryPass: not quiet after its poll; kOnActivity: quiet but for an interrupt
+    // line it cannot use, so it reads the registers themselves: asked when its ESC's registers changed,
+    // seen_ holding EscSignals::activity as of its last poll). Not known after a control command, a power
+    // change or a caller's access to a device (deadline_known_ false: next_deadline_ns() asks every
+    // device, the next poll() too).
+    enum Ask : uint8_t { kQuiet = 0, kEveryPass = 1, kOnActivity = 2 };
     std::vector<uint64_t> due_;
     std::vector<uint8_t> ask_;
+    std::vector<uint32_t> seen_;
     bool deadline_known_ = false;
 };
 
