@@ -167,14 +167,14 @@ void SetpointGenerator::command(const Command& cmd, uint16_t cw_prev, bool enabl
 void SetpointGenerator::next_setpoint(int64_t tgt, const PositionFrame& f, bool interpolate, int64_t now_ns,
                                       int64_t dt_ns) {
     // New target each cycle, interpolated linearly over the interpolation period (= this cycle when 0x60C2 is
-    // set, as MAXPOS sets it to the SYNC0 cycle; 0 = no interpolation).
+    // set, as MAXPOS sets it to the SYNC0 cycle; 0 = no interpolation). The new segment starts where the last
+    // one ends: the cycle that took it simulated its whole gap, whatever the gap to this cycle is. (Cut at
+    // this cycle's time instead, a short gap after a long one, a late slave's cycle or the jitter of a loaded
+    // host, put the demand back by the part of the last segment the axis had already run: a following error
+    // spike that a vendor's 100-increment window turned into a fault.)
     const double t_raw =
         f.range_on() ? f.unwrap(static_cast<int32_t>(tgt), ip_to_) : static_cast<double>(tgt - f.shift);
-    const double now_val =
-        ip_period_ > 0 ? ip_from_ + (ip_to_ - ip_from_) *
-                                        std::min(1.0, static_cast<double>(now_ns - ip_t0_) / ip_period_)
-                       : ip_to_;
-    ip_from_ = now_val;
+    ip_from_ = ip_to_;
     ip_to_ = t_raw;
     ip_t0_ = now_ns;
     ip_period_ = interpolate ? dt_ns : 0;

@@ -390,3 +390,45 @@ TEST(Vendor402Modes, ProfileTorqueHaltsAndQuickStops) {
 }
 
 }  // namespace
+
+namespace {
+
+// The drive cycles on the slave's clock (dt between two cycles), and a loaded host makes that clock uneven:
+// a slave process not scheduled for 6 ms meets the next cycle late, the set-point already six master cycles
+// on (the runtime serves the frames that waited before the firmware runs); or the gaps alternate 0.4/1.6 ms.
+// The master ramps 10 increments per 1 ms cycle against Ingenia's window (0x6065 = 100 increments, 0x6066 =
+// 10 ms): the axis must stay as close as on even cycles. (The interpolation cut the last set-point's segment
+// at the next cycle's time, so a short gap after a long one put the demand back by what the axis had
+// already run: 0x8611 within 30 cycles.)
+TEST(Vendor402Late, UnevenSlaveCyclesKeepACspRampInsideATightWindow) {
+    for (int pattern = 0; pattern < 3; ++pattern) {
+        SCOPED_TRACE(pattern);
+        od::Dictionary d = vendor_dictionary(0x00000380, 0, false);
+        ASSERT_EQ(sdo_write(d, 0x6065, 0, 100, 4), od::Status::Ok);
+        var(d, 0x6066, DataType::Unsigned16, RW, uint64_t{10}, "Following error time out");
+        VendorRig r(std::move(d));
+        r.enable();
+        ASSERT_EQ(r.sw() & kStateMask, kOe);
+        int32_t target = r.position();
+        int worst = 0;
+        for (int k = 0; k < 1000; ++k) {
+            int64_t dt = 1'000'000;
+            int32_t step = 10;
+            if (pattern == 1 && k % 50 == 10) {  // late by 5 ms: six cycles' set-points on
+                dt = 6'000'000;
+                step = 60;
+            }
+            if (pattern == 2) dt = k % 2 ? 400'000 : 1'600'000;  // jitter, the same mean
+            target += step;
+            r.d.set<int32_t>(0x607A, 0, target);
+            r.t += dt;
+            r.drv.cycle(r.t, dt);
+            worst = std::max(worst, std::abs(r.d.get<int32_t>(0x60F4, 0)));
+            ASSERT_EQ(r.sw() & kStateMask, kOe) << k << ": 0x" << std::hex << r.d.get<uint16_t>(0x603F, 0);
+        }
+        EXPECT_LT(worst, 50);
+        EXPECT_FALSE(r.rec.has(drive::error_code::FollowingError));
+    }
+}
+
+}  // namespace
