@@ -65,10 +65,10 @@ class Axis::Parts final : public DeviceControl::Parts {
     double stopping(StopKind kind, double decel_rpm_s) override {
         // A stop (quick stop, shutdown, fault) ends a running homing: interrupted, to be started again.
         a_.home_.interrupt(HomingPhase::Finished);
-        if (kind != StopKind::Ramp) return 0;
+        if (kind != StopKind::Ramp && kind != StopKind::Limit) return 0;
         // A ramp starts where the motor really is (position and speed), whatever the set-points did.
         a_.sp_.ramp_from(static_cast<double>(a_.count_), a_.ctl_.obs_vel * a_.res_ / kTwoPi);
-        return a_.decel_limit(decel_rpm_s);
+        return kind == StopKind::Ramp ? a_.decel_limit(decel_rpm_s) : 0.0;
     }
     void resumed() override { a_.sp_.resume(); }
     bool fault_reset() override {
@@ -114,7 +114,8 @@ void Axis::supervise(int64_t now_ns, int64_t dt_ns) {
     const int8_t m = sp_.mode();
     const bool homing = m == mode::Homing && home_.running();
     // Following error in the position-controlled modes.
-    const bool pos_mode = m == mode::CyclicSyncPosition || m == mode::ProfilePosition || m == mode::Homing;
+    const bool pos_mode = m == mode::CyclicSyncPosition || m == mode::ProfilePosition || m == mode::Homing ||
+                          m == mode::InterpolatedPosition;
     const double ferr = std::abs(sp_.demand_position() - static_cast<double>(count_));
     if (sup_.following_error(enabled && pos_mode, ferr, params.following_error_window,
                              params.following_error_timeout, dt_ns))
@@ -165,7 +166,21 @@ void Axis::trajectory_tick(int64_t t_ns) {
         sp_.follow(static_cast<double>(count_));
         return;
     }
-    if (dc_.stop() == StopKind::Ramp) {
+    if (dc_.stop() == StopKind::Limit && !dc_.ramp_done()) {
+        // At the current limit: all the current the drive may give (0x3001:02, the rated current while I2t
+        // limits), against the motion, until the motor stands; then the position loop holds it there.
+        const double speed = ctl_.obs_vel * res_ / kTwoPi;
+        if (sp_.brake(static_cast<double>(count_), speed, res_ / 60.0)) {
+            dc_.ramp_reached(true);
+            return;
+        }
+        LoopReference ref;
+        ref.cur_ref = (speed > 0 ? -1.0 : 1.0) *
+                      ctl_.current_limit(params.nominal_current, params.output_current_limit);
+        ctl_.follow(ref, Control::Torque);
+        return;
+    }
+    if (dc_.stop() == StopKind::Ramp || dc_.stop() == StopKind::Limit) {
         dc_.ramp_reached(sp_.ramp(dc_.stop_deceleration(), h));
         return;
     }
@@ -179,7 +194,9 @@ void Axis::trajectory_tick(int64_t t_ns) {
         sp_.from_profile();
         return;
     }
-    const SetpointGenerator::Inputs in{static_cast<double>(count_), ctl_.obs_vel, static_cast<double>(res_)};
+    const SetpointGenerator::Inputs in{
+        static_cast<double>(count_), ctl_.obs_vel, static_cast<double>(res_),
+        i_meas() / (std::max<double>(params.nominal_current, 1.0) * 1e-3) * 1e3};
     const LoopReference ref = sp_.tick(command, params, in, frame(), t_ns, h);
     ctl_.follow(ref, sp_.control());  // the loop the tick chose
 }
@@ -300,7 +317,7 @@ void Axis::cycle(int64_t now_ns, int64_t dt_ns) {
         dc_.start(*sink_);
     }
     tp_.configure(command.touch_probe_function);
-    if (command.mode != sp_.mode() && mode::supported(command.mode, params.supported_modes)) {
+    if (command.mode != sp_.mode() && mode::supported(command.mode, params.supported_modes, served_modes_)) {
         // A running homing ends with the mode: interrupted, to be started again.
         if (sp_.mode() == mode::Homing) home_.interrupt();
         sp_.switch_mode(command.mode, dc_.power(), static_cast<double>(count_));
@@ -407,6 +424,17 @@ void Axis::update_feedback() {
         case mode::CyclicSyncTorque:
             if (oe && dc_.stop() == StopKind::None) s |= sw::Bit12;
             break;
+        case mode::InterpolatedPosition:
+            // IEC 61800-7-201: bit 10 target reached (the last set-point reached and at rest; with halt or
+            // without the interpolation: at rest), bit 12 ip mode active; bit 13 is not defined in this mode.
+            if (oe && dc_.stop() == StopKind::None && sp_.ip_target_reached() && sup_.still())
+                s |= sw::TargetReached;
+            if (oe && dc_.stop() == StopKind::None && sp_.ip_active()) s |= sw::Bit12;
+            break;
+        case mode::ProfileTorque:
+            // Bit 10: the torque demand reached the target torque (with halt: the axis stands still).
+            if (oe && dc_.stop() == StopKind::None && sp_.torque_reached()) s |= sw::TargetReached;
+            break;
         default:
             break;
     }
@@ -424,6 +452,7 @@ void Axis::update_feedback() {
     f.velocity_averaged = clamp_i32(std::round(ctl_.vel_avg_rpm));
     const double in = std::max<double>(params.nominal_current, 1.0) * 1e-3;
     f.torque_actual = sat16(i_meas() / in * 1000.0);
+    f.torque_demand = sat16(dc_.power() ? ctl_.cur_ref / in * 1000.0 : 0.0);
     f.current_actual = sat16(i_meas() * 1000.0);
     f.current_demand = sat16(dc_.power() ? ctl_.cur_ref * 1000.0 : 0.0);
     f.current_averaged = sat16(ctl_.cur_avg_a * 1000.0);

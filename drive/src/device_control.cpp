@@ -13,10 +13,14 @@ void DeviceControl::enter(State s, EventSink& sink) {
 }
 
 void DeviceControl::begin_stop(StopKind kind, double decel_rpm_s, Parts& parts) {
+    // A deceleration of 0 is no ramp at all (it would never stop): vendors' ESIs ship 0x6084/0x6085 = 0 where
+    // the device's own tuning sets it (Synapticon, Novanta). The drive then stops as fast as it can: at the
+    // current limit.
+    if (kind == StopKind::Ramp && decel_rpm_s <= 0) kind = StopKind::Limit;
     stop_ = kind;
     ramp_done_ = false;
     const double decel = parts.stopping(kind, decel_rpm_s);
-    if (kind == StopKind::Ramp) {
+    if (kind == StopKind::Ramp || kind == StopKind::Limit) {
         stop_decel_ = decel;
     } else if (kind == StopKind::Disable) {
         power_ = false;
@@ -75,14 +79,18 @@ void DeviceControl::command(uint16_t c, const AxisFaults& faults, const Options&
                 break;
             case 11: {
                 // 0x605A (IEC 61800-7-201): 0 disable the drive function; 1/5 slow down on the slow-down ramp
-                // (0x6084), 2/6 on the quick stop ramp (0x6085), 3/4/7/8 on the current or voltage limit (the
-                // quick stop ramp here, see docs/decisions/drive.md). 0...4 then go on to Switch On Disabled
-                // (transition 12 once stopped), 5...8 stay in Quick Stop Active. The MAXPOS allows only 6.
+                // (0x6084), 2/6 on the quick stop ramp (0x6085), 3/4/7/8 on the current or voltage limit
+                // (both the current limit here, see docs/decisions/drive.md). 0...4 then go on to Switch On
+                // Disabled (transition 12 once stopped), 5...8 stay in Quick Stop Active. A
+                // manufacturer-specific code
+                // (< 0) stops on the quick stop ramp and stays. The MAXPOS allows only 6.
                 const int16_t code = o.quick_stop;
                 if (code == 0)
                     begin_stop(StopKind::Disable, 0, parts);
                 else if (code == 1 || code == 5)
                     begin_stop(StopKind::Ramp, o.profile_deceleration, parts);
+                else if (code == 3 || code == 4 || code == 7 || code == 8)
+                    begin_stop(StopKind::Limit, 0, parts);
                 else
                     begin_stop(StopKind::Ramp, o.quick_stop_deceleration, parts);
                 enter(State::QuickStopActive, sink);
@@ -120,6 +128,8 @@ void DeviceControl::react(Reaction rx, int16_t option, bool at_rest, const Optio
         begin_stop(StopKind::Disable, 0, parts);
     } else if (rx == Reaction::FaultReactionCode && option == 1) {
         begin_stop(StopKind::Ramp, o.profile_deceleration, parts);
+    } else if (rx == Reaction::FaultReactionCode && (option == 3 || option == 4)) {
+        begin_stop(StopKind::Limit, 0, parts);  // 0x605E 3/4: at the current (voltage) limit
     } else {
         begin_stop(StopKind::Ramp, o.quick_stop_deceleration, parts);
     }
@@ -135,7 +145,7 @@ void DeviceControl::react(Reaction rx, int16_t option, bool at_rest, const Optio
 void DeviceControl::settle(bool still, uint32_t standstill_window, uint16_t standstill_timeout_ms,
                            EventSink& sink, int64_t now_ns) {
     if (!pending_.active && !fra_) return;
-    if (stop_ == StopKind::Ramp && !ramp_done_) return;
+    if ((stop_ == StopKind::Ramp || stop_ == StopKind::Limit) && !ramp_done_) return;
     power_ = false;  // the ramp (if any) is over: power stage off
     const bool detection_off = standstill_window == 0xFFFFFFFFu;
     const bool timeout = standstill_timeout_ms != 0xFFFF &&

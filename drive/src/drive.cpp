@@ -178,7 +178,10 @@ bool Drive::out_raw(uint16_t index, uint8_t sub, std::size_t size, uint8_t* fiel
 template <typename T>
 void Drive::in_scaled(const Obj<T>& h, T& field, Unit unit) {
     static_assert(sizeof(T) == 4);
-    if (!scaled_ || (unit == Unit::Velocity && !velocity_per_second_)) return in(h, field);
+    if (!scaled_ || (unit == Unit::Velocity && !velocity_per_second_)) {
+        in(h, field);
+        return;
+    }
     Link l{};
     l.field = reinterpret_cast<uint8_t*>(&field);
     l.is_signed = std::is_signed_v<T>;
@@ -264,9 +267,9 @@ void Drive::store_positions() {
 }
 
 template <typename T>
-void Drive::in(const Obj<T>& h, T& field) {
+bool Drive::in(const Obj<T>& h, T& field) {
     static_assert(sizeof(T) == 1 || sizeof(T) == 2 || sizeof(T) == 4);
-    in_raw(h.index, h.sub, sizeof(T), reinterpret_cast<uint8_t*>(&field));
+    return in_raw(h.index, h.sub, sizeof(T), reinterpret_cast<uint8_t*>(&field));
 }
 
 template <typename T>
@@ -308,7 +311,10 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink, const VendorObjects& v
         using namespace obj;
         in(MotorType, p.motor_type);
         in(AbortConnectionOptionCode, p.abort_connection);
-        in(QuickStopOptionCode, p.quick_stop);
+        // Without 0x605A the profile's own default, 2 (IEC 61800-7-201: quick stop ramp, then switch on
+        // disabled), not the MAXPOS's 6: a vendor's drive whose ESI leaves the object out (Beckhoff EJ7211,
+        // Synapticon, Elmo) behaves as the profile says and as a master reading no 0x605A expects.
+        if (!in(QuickStopOptionCode, p.quick_stop)) p.quick_stop = kProfileQuickStopOptionCode;
         in(ShutdownOptionCode, p.shutdown);
         in(DisableOperationOptionCode, p.disable_operation);
         in(HaltOptionCode, p.halt);
@@ -325,6 +331,9 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink, const VendorObjects& v
         in_scaled(ProfileAcceleration, p.profile_acceleration, Unit::Velocity);
         in_scaled(ProfileDeceleration, p.profile_deceleration, Unit::Velocity);
         in_scaled(QuickStopDeceleration, p.quick_stop_deceleration, Unit::Velocity);
+        in(TorqueSlope, p.torque_slope);
+        in(TorqueProfileType, p.torque_profile_type);
+        in(InterpolationSubMode, p.interpolation_sub_mode);
         in_scaled(MaxAcceleration, p.max_acceleration, Unit::Velocity);
         in(HomingMethod, p.homing_method);
         in_scaled(HomingSpeedSwitchSearch, p.homing_speed_switch, Unit::Velocity);
@@ -345,6 +354,7 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink, const VendorObjects& v
         in_scaled(TargetPosition, c.target_position, Unit::Position);
         in_scaled(TargetVelocity, c.target_velocity, Unit::Velocity);
         in(TargetTorque, c.target_torque);
+        in_scaled(InterpolationDataPosition, c.ip_position, Unit::Position);
         in_scaled(PositionOffset, c.position_offset, Unit::Position);
         in_scaled(VelocityOffset, c.velocity_offset, Unit::Velocity);
         in(TorqueOffset, c.torque_offset);
@@ -355,6 +365,7 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink, const VendorObjects& v
         out_scaled(PositionActualValue, f.position_actual, Unit::Position);
         out_scaled(VelocityDemandValue, f.velocity_demand, Unit::Velocity);
         out_scaled(VelocityActualValue, f.velocity_actual, Unit::Velocity);
+        out(TorqueDemand, f.torque_demand);
         out(TorqueActualValue, f.torque_actual);
         out(CurrentActualValue, f.current_actual);
         out_scaled(FollowingErrorActualValue, f.following_error, Unit::Position);
@@ -393,20 +404,54 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink, const VendorObjects& v
             std::memcpy(field, &value, sizeof value);
         }
 
-    // A mode the drive does not implement or the device does not announce in 0x6502 is refused (IEC
-    // 61800-7-201: 0x6061 shows the mode the drive runs; an SDO write answers "value range exceeded").
+    // The modes this dictionary can serve: those the drive implements whose set-point object it has
+    // (drive::mode_setpoint_entry). 0x6502 announces what is served: the device's announcement without the
+    // modes the drive cannot serve here (the interpolated position mode of a dictionary without 0x60C1, a
+    // manufacturer-specific mode, the velocity mode); a 0x6502 of 0, which states nothing, announces every
+    // mode served (docs/decisions/device.md, "Modes a vendor's 0x6502 announces").
+    uint32_t served = 0;
+    for (int8_t mo : kModesOfOperation)
+        if (const SetpointEntry o = mode_setpoint_entry(mo);
+            o.index == 0 || dict_.find(o.index, o.sub) != nullptr)
+            served |= mode_bit(mo);
+    axis_.serve_modes(served);
+    if (const od::Entry* modes_entry =
+            dict_.find(obj::SupportedDriveModes.index, obj::SupportedDriveModes.sub);
+        modes_entry != nullptr && modes_entry->byte_size() == 4) {
+        const uint32_t announced = dict_.get<uint32_t>(obj::SupportedDriveModes.index, 0);
+        const uint32_t kept = (announced == 0 ? supported_drive_modes() : announced) & served;
+        withheld_modes_ = announced & ~kept;
+        if (kept != announced) (void)dict_.set<uint32_t>(obj::SupportedDriveModes.index, 0, kept);
+    }
+    // Only the linear interpolation (sub-mode 0x60C0 = 0) is served: 0x60C0 says so, and a master's write of
+    // another sub-mode is refused ("value range exceeded").
+    if (const od::Entry* ism = dict_.find(obj::InterpolationSubMode.index, obj::InterpolationSubMode.sub);
+        ism != nullptr && ism->byte_size() == 2) {
+        (void)dict_.set<int16_t>(obj::InterpolationSubMode.index, obj::InterpolationSubMode.sub, 0);
+        dict_.add_validator(
+            obj::InterpolationSubMode.index,
+            [](const od::Entry& e, std::span<const uint8_t> v) {
+                if (e.subindex != obj::InterpolationSubMode.sub || v.size() != 2) return od::Status::Ok;
+                return v[0] == 0 && v[1] == 0 ? od::Status::Ok : od::Status::InvalidValue;
+            },
+            this);
+    }
+
+    // A mode the drive does not implement, cannot serve, or the device does not announce in 0x6502 is refused
+    // (IEC 61800-7-201: 0x6061 shows the mode the drive runs; an SDO write answers "value range exceeded").
     if (dict_.find(obj::ModesOfOperation.index, obj::ModesOfOperation.sub)) {
         dict_.add_validator(
             obj::ModesOfOperation.index,
-            [d = &dict_](const od::Entry& e, std::span<const uint8_t> v) {
+            [d = &dict_, served](const od::Entry& e, std::span<const uint8_t> v) {
                 if (e.subindex != obj::ModesOfOperation.sub || v.size() != 1) return od::Status::Ok;
                 uint32_t announced = supported_drive_modes();
                 const od::Entry* sdm = d->find(obj::SupportedDriveModes.index, obj::SupportedDriveModes.sub);
                 if (sdm && sdm->byte_size() == 4)
                     announced =
                         d->get<uint32_t>(obj::SupportedDriveModes.index, obj::SupportedDriveModes.sub);
-                return mode::supported(static_cast<int8_t>(v[0]), announced) ? od::Status::Ok
-                                                                             : od::Status::InvalidValue;
+                return mode::supported(static_cast<int8_t>(v[0]), announced, served)
+                           ? od::Status::Ok
+                           : od::Status::InvalidValue;
             },
             this);
     }

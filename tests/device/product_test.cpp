@@ -6,6 +6,8 @@
 
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -16,6 +18,8 @@
 #include "device/device.hpp"
 #include "esc/clock.hpp"
 #include "esc/esc.hpp"
+#include "esi/device/product.hpp"
+#include "esi/esi_reader.hpp"
 #include "master/coe.hpp"
 #include "master/mailbox.hpp"
 #include "master/master.hpp"
@@ -515,4 +519,36 @@ TEST(ProductWithEepromImage, IsServedByteForByte) {
         if (i < 0x1C || i > 0x1F) {
             ASSERT_EQ(unit[i], image[i]) << "byte " << i;
         }
+}
+
+// A vendor's drive whose 0x6502 announces more than the drive core can serve: the example drive
+// (esi/examples/drive402.xml: PP, PV, PT, HM, IP, CSP, CSV, CST with their objects) announcing the velocity
+// mode (not implemented) and four manufacturer-specific modes as well. The running device announces what it
+// serves, says once at start what it took out, and refuses that in 0x6060; the description (what --write-esi
+// writes) keeps the ESI's value (docs/decisions/device.md, "Modes a vendor's 0x6502 announces").
+TEST(ProductWithDrive, Announces6502AsServedAndSaysWhatItTookOut) {
+    std::ifstream in(SOFTECAT_ESI_EXAMPLES "/drive402.xml", std::ios::binary);
+    std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string announced = "<DefaultData>ed030000</DefaultData>";
+    const std::size_t at = xml.find(announced);
+    ASSERT_NE(at, std::string::npos);
+    xml.replace(at, announced.size(), "<DefaultData>ef030f00</DefaultData>");  // 0x000F03EF
+    auto product =
+        std::make_shared<od::Product>(esi::load_product(esi::read_esi_text(xml, "drive402-more.xml"), ""));
+    EXPECT_EQ(product->make_dictionary(product->description).get<uint32_t>(0x6502, 0), 0x000F03EFu);
+    Unit u(product);
+    ASSERT_TRUE(u.dev->has_drive());
+    EXPECT_EQ(u.dev->dictionary().get<uint32_t>(0x6502, 0), 0x000003EDu);
+    EXPECT_EQ(u.dev->drive().withheld_modes(), 0x000F0002u);
+    const std::string log = u.log.str();
+    const std::string w =
+        "0x6502 announces modes the drive core does not serve on this dictionary (bits 0x000f0002)";
+    ASSERT_NE(log.find(w), std::string::npos) << log;
+    EXPECT_EQ(log.find(w), log.rfind(w));
+    auto write_mode = [&](uint8_t m) {
+        return u.dev->dictionary().write(0x6060, 0, od::AlState::PreOp, std::span<const uint8_t>(&m, 1));
+    };
+    EXPECT_EQ(write_mode(2), od::Status::InvalidValue);  // velocity mode
+    EXPECT_EQ(write_mode(7), od::Status::Ok);            // interpolated position: 0x60C1 is there
+    EXPECT_EQ(write_mode(4), od::Status::Ok);            // profile torque
 }

@@ -30,10 +30,15 @@ od::Status master_write(od::Dictionary& d, uint16_t index, uint8_t sub, int64_t 
 
 // The CiA 402 objects the drive knows that the MAXPOS has not got (MAXPOS firmware specification chapter 7:
 // no 0x608F, its resolution is 0x3000:05 from the encoder's pulses; no gear ratio 0x6091 or feed constant
-// 0x6092, its positions are increments).
+// 0x6092, its positions are increments; no profile torque mode (0x6087, 0x6088) or interpolated position
+// mode (0x60C0, 0x60C1), no torque demand 0x6074).
 bool maxpos_lacks(uint16_t index, uint8_t) {
-    return index == drive::obj::PositionEncoderIncrements.index ||
-           index == drive::obj::GearMotorRevolutions.index || index == drive::obj::FeedConstantFeed.index;
+    using namespace drive::obj;
+    for (uint16_t i : {PositionEncoderIncrements.index, GearMotorRevolutions.index, FeedConstantFeed.index,
+                       TorqueSlope.index, TorqueProfileType.index, InterpolationSubMode.index,
+                       InterpolationDataPosition.index, TorqueDemand.index})
+        if (index == i) return true;
+    return false;
 }
 std::size_t maxpos_lacks_count() {
     std::size_t n = 0;
@@ -41,6 +46,9 @@ std::size_t maxpos_lacks_count() {
         if (maxpos_lacks(o.index, o.sub)) ++n;
     return n;
 }
+
+// The MAXPOS's 0x6502 (MAXPOS firmware specification Table 7-140): PP, PV, HM, CSP, CSV, CST.
+constexpr uint32_t kMaxposModes = 0x000003A5;
 
 }  // namespace
 
@@ -58,8 +66,9 @@ TEST(DriveObjects, EveryHandleResolvesWithItsTypeAccessAndDefault) {
         EXPECT_EQ(e->byte_size(), o.size);
         EXPECT_EQ(od::is_signed(e->type), o.is_signed);
         EXPECT_EQ(od::bit_size(e->type), 8u * o.size);
-        EXPECT_EQ(e->default_value,
-                  o.is_signed ? od::Number{o.def} : od::Number{static_cast<uint64_t>(o.def)});
+        // 0x6502: the drive's default announces every mode it implements, the MAXPOS's the six it has.
+        const int64_t def = o.index == drive::obj::SupportedDriveModes.index ? kMaxposModes : o.def;
+        EXPECT_EQ(e->default_value, o.is_signed ? od::Number{def} : od::Number{static_cast<uint64_t>(def)});
         EXPECT_TRUE(e->readable(od::AlState::Op));
         if (o.role == drive::Role::Command) {
             EXPECT_TRUE(e->writable(od::AlState::Op));
@@ -122,7 +131,9 @@ TEST(DriveObjects, ParametersAndCommandHoldTheDictionaryDefaults) {
     od::Dictionary d = drive_dictionary();
     drive::Drive drv(d, nullptr, maxpos::drive_objects());
     drv.cycle(0, 0);  // loads every bound input from the dictionary's defaults
-    EXPECT_EQ(drv.axis().params, drive::Parameters{});
+    drive::Parameters expected;
+    expected.supported_modes = kMaxposModes;
+    EXPECT_EQ(drv.axis().params, expected);
     EXPECT_EQ(drv.axis().command, drive::Command{});
     // The comparison sees a differing value.
     ASSERT_EQ(d.set<uint8_t>(0x3142, 4, 26), od::Status::Ok);
@@ -145,12 +156,21 @@ TEST(DriveObjects, ModesOfOperationAreOneSet) {
     for (int m = -128; m <= 127; ++m) {
         const bool listed = drive::contains(drive::kModesOfOperation, m);
         EXPECT_EQ(drive::mode::supported(static_cast<int8_t>(m)), listed) << m;
+        // The MAXPOS's own set: the drive's without profile torque and interpolated position.
+        const bool maxpos = drive::contains(maxpos::kModesOfOperation, m);
+        EXPECT_TRUE(listed || !maxpos) << m;
+        EXPECT_EQ(maxpos,
+                  listed && m != drive::modes::ProfileTorque && m != drive::modes::InterpolatedPosition)
+            << m;
         const od::Status s =
             master_write(d, drive::obj::ModesOfOperation.index, drive::obj::ModesOfOperation.sub, m, 1);
-        EXPECT_EQ(s == od::Status::Ok, listed) << m;
+        EXPECT_EQ(s == od::Status::Ok, maxpos) << m;
     }
-    // 0x6502: PP, PV, HM, CSP, CSV, CST (IEC 61800-7-201 bit assignment).
+    // 0x6502: PP, PV, HM, CSP, CSV, CST (IEC 61800-7-201 bit assignment), with the drive on it as well.
     EXPECT_EQ(d.get<uint32_t>(drive::obj::SupportedDriveModes.index, 0), 0x000003A5u);
+    drive::Drive drv(d, nullptr, maxpos::drive_objects());
+    EXPECT_EQ(d.get<uint32_t>(drive::obj::SupportedDriveModes.index, 0), 0x000003A5u);
+    EXPECT_EQ(drv.withheld_modes(), 0u);
 }
 
 TEST(DriveObjects, HomingMethodsAreOneSet) {

@@ -611,10 +611,13 @@ TEST(EsiExamples, TheDriveIsACia402DriveWithItsOwnUnitsAndPdos) {
     const od::Dictionary d = p.make_dictionary(p.description);
     EXPECT_EQ(d.get<uint32_t>(0x1000, 0), 0x00020192u);
     EXPECT_EQ(d.get<uint32_t>(0x608F, 1), 1048576u);
-    EXPECT_EQ(d.get<uint32_t>(0x6502, 0), 0x3A5u);
+    EXPECT_EQ(d.get<uint32_t>(0x6502, 0), 0x3EDu);  // with profile torque and interpolated position
     EXPECT_EQ(d.get<int32_t>(0x607D, 1), -104857600);
     EXPECT_EQ(d.get<int8_t>(0x6098, 0), 35);
-    EXPECT_EQ(d.find(0x6060, 0)->enumeration.size(), 7u);
+    EXPECT_EQ(d.find(0x6060, 0)->enumeration.size(), 9u);
+    EXPECT_EQ(d.get<uint32_t>(0x6087, 0), 1000u);
+    EXPECT_TRUE(d.find(0x60C1, 1)->rx_mappable());
+    EXPECT_EQ(d.get<int8_t>(0x60C2, 2), -3);
     EXPECT_EQ(d.get<uint16_t>(0x1C12, 1), 0x1600);
     EXPECT_TRUE(d.find(0x1600, 1)->writable(od::AlState::PreOp));  // PdoConfig, not Fixed
     EXPECT_EQ(d.get<uint32_t>(0x2000, 0), 3000u);

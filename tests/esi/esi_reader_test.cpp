@@ -163,7 +163,7 @@ TEST(EsiReadBackDrive, EnumeratedEntriesNameExactlyTheValuesTheDriveTakes) {
         }
         return v;
     };
-    std::vector<int64_t> modes(drive::kModesOfOperation.begin(), drive::kModesOfOperation.end());
+    std::vector<int64_t> modes(maxpos::kModesOfOperation.begin(), maxpos::kModesOfOperation.end());
     EXPECT_EQ(values(0x6060, 0), modes);
     EXPECT_EQ(values(0x6061, 0), modes);
     std::vector<int64_t> homing(drive::kHomingMethods.begin(), drive::kHomingMethods.end());

@@ -53,6 +53,11 @@ class Axis {
     // Raise an error from outside (e.g. the communication side); reaction per its class.
     void raise_error(uint16_t code);
 
+    // The modes the device can serve (0x6502 bits; drive::Drive: those whose set-point object its dictionary
+    // has): a mode outside them is not taken, whatever 0x6502 says. Default: every mode the drive implements.
+    void serve_modes(uint32_t modes) { served_modes_ = modes; }
+    uint32_t served_modes() const { return served_modes_; }
+
     State state() const { return dc_.state(); }
     int8_t active_mode() const { return sp_.mode(); }
     bool power_on() const { return dc_.power(); }
@@ -124,6 +129,7 @@ class Axis {
     double km_plant_ = -1;
     bool plant_dirty_ = true;
     int64_t now_ns_ = 0;
+    uint32_t served_modes_ = supported_drive_modes();
 
     // encoder and inputs
     int64_t count_ = 0;  // raw encoder count

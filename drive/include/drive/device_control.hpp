@@ -13,7 +13,10 @@
 
 namespace drive {
 
-enum class StopKind : uint8_t { None, Ramp, Disable };
+// How a stop brings the motor to rest: a deceleration ramp (0x6084 or 0x6085), at the current limit (the
+// velocity loop brakes to zero speed with the current it may give: quick stop and fault reaction option codes
+// 3/4/7/8), or by switching the power stage off.
+enum class StopKind : uint8_t { None, Ramp, Limit, Disable };
 
 class DeviceControl {
   public:
@@ -24,8 +27,9 @@ class DeviceControl {
         virtual uint16_t enable_refused() = 0;
         // Transition 4 done: the loops and set-points start from where the motor is.
         virtual void powered() = 0;
-        // A stop began: a running homing is interrupted; a ramp starts from the actual motion. Returns the
-        // ramp's deceleration `decel_rpm_s` in inc/s^2, limited by 0x60C5 (unused for StopKind::Disable).
+        // A stop began: a running homing is interrupted; a ramp or a stop at the current limit starts from
+        // the actual motion. Returns the ramp's deceleration `decel_rpm_s` in inc/s^2, limited by 0x60C5
+        // (unused for the other kinds).
         virtual double stopping(StopKind kind, double decel_rpm_s) = 0;
         // Transition 16: the set-points hold where the quick-stop ramp got to.
         virtual void resumed() = 0;
@@ -62,7 +66,7 @@ class DeviceControl {
     // passed.
     void settle(bool still, uint32_t standstill_window, uint16_t standstill_timeout_ms, EventSink& sink,
                 int64_t now_ns);
-    // The stop ramp reached zero speed.
+    // The stop ramp (or the stop at the current limit) reached zero speed.
     void ramp_reached(bool at_zero) { ramp_done_ = at_zero || ramp_done_; }
     // End of the cycle: the controlword is the previous one from now on.
     void end_cycle(uint16_t controlword) { cw_prev_ = controlword; }

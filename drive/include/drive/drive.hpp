@@ -34,9 +34,12 @@ class Drive {
   public:
     // Binds the CiA 402 objects (drive/objects.hpp) the dictionary has, by index, and the vendor parameters
     // where `vendor` says; the rest run on the drive's defaults (the motor model's tuning, commissioned()).
-    // Registers a validator on 0x6060 that refuses a mode the drive does not implement or 0x6502 does not
-    // announce (InvalidValue, SDO abort 0x06090030), and one on each of `vendor.power_disable_only`: such
-    // writes answer WrongState (SDO abort 0x08000022) while the power stage is on.
+    // Serves the modes the drive implements whose set-point object the dictionary has: 0x6502 is set to
+    // what it announced of them (withheld_modes()). Registers a validator on 0x6060 that refuses a mode the
+    // drive does not serve or 0x6502 does not announce (InvalidValue, SDO abort 0x06090030), one on 0x60C0
+    // that refuses an interpolation sub-mode other than linear (0), and one on each of
+    // `vendor.power_disable_only`: such writes answer WrongState (SDO abort 0x08000022) while the power stage
+    // is on.
     explicit Drive(od::Dictionary& dictionary, EventSink* sink = nullptr, const VendorObjects& vendor = {});
     Drive(const Drive&) = delete;
     Drive& operator=(const Drive&) = delete;
@@ -55,6 +58,9 @@ class Drive {
     std::size_t missing() const { return missing_; }
     // Whether the drive found and bound this entry (a drive/objects.hpp handle or a vendor binding).
     bool binds(uint16_t index, uint8_t sub) const;
+    // The bits of the dictionary's 0x6502 the drive took out because it cannot serve those modes on this
+    // dictionary (0x6502 now announces the rest); 0: it serves every mode announced.
+    uint32_t withheld_modes() const { return withheld_modes_; }
 
   private:
     // What a scaled link converts: a position, or a velocity or acceleration.
@@ -71,7 +77,7 @@ class Drive {
         Unit unit;  // of a scaled link
     };
     template <typename T>
-    void in(const Obj<T>& object, T& field);
+    bool in(const Obj<T>& object, T& field);
     template <typename T>
     void out(const Obj<T>& object, const T& field);
     // A position (velocity, acceleration) object: through the factor group where the device has one
@@ -107,6 +113,7 @@ class Drive {
     Feedback fb_copy_;
     uint32_t resolution_ = 0;
     std::size_t bound_ = 0, missing_ = 0;
+    uint32_t withheld_modes_ = 0;
     // Read by the validators (the mailbox side); shared so a validator outliving the Drive stays safe.
     std::shared_ptr<std::atomic<bool>> powered_ = std::make_shared<std::atomic<bool>>(false);
 };

@@ -33,18 +33,49 @@ struct Obj {
     T def;  // the drive's default without the object
 };
 
+// 0x605A's default in IEC 61800-7-201 (2: quick stop ramp, then switch on disabled): what a drive whose
+// dictionary has no 0x605A does. The handle's default (6) is the MAXPOS's.
+inline constexpr int16_t kProfileQuickStopOptionCode = 2;
+
 // Modes of operation 0x6060 the drive implements (IEC 61800-7-201).
 namespace modes {
 inline constexpr int8_t ProfilePosition = 1;
 inline constexpr int8_t ProfileVelocity = 3;
+inline constexpr int8_t ProfileTorque = 4;
 inline constexpr int8_t Homing = 6;
+inline constexpr int8_t InterpolatedPosition = 7;
 inline constexpr int8_t CyclicSyncPosition = 8;
 inline constexpr int8_t CyclicSyncVelocity = 9;
 inline constexpr int8_t CyclicSyncTorque = 10;
 }  // namespace modes
-inline constexpr std::array<int8_t, 6> kModesOfOperation{
-    modes::ProfilePosition,    modes::ProfileVelocity,    modes::Homing,
-    modes::CyclicSyncPosition, modes::CyclicSyncVelocity, modes::CyclicSyncTorque};
+inline constexpr std::array<int8_t, 8> kModesOfOperation{
+    modes::ProfilePosition,      modes::ProfileVelocity,
+    modes::ProfileTorque,        modes::Homing,
+    modes::InterpolatedPosition, modes::CyclicSyncPosition,
+    modes::CyclicSyncVelocity,   modes::CyclicSyncTorque};
+// The entry a mode takes its set-point from ({0, 0}: none, the controlword alone): without it in the
+// dictionary the mode cannot be served, and the drive neither takes it nor announces it in 0x6502.
+struct SetpointEntry {
+    uint16_t index;
+    uint8_t sub;
+};
+constexpr SetpointEntry mode_setpoint_entry(int m) {
+    switch (m) {
+        case modes::ProfilePosition:
+        case modes::CyclicSyncPosition:
+            return {0x607A, 0};  // target position
+        case modes::ProfileVelocity:
+        case modes::CyclicSyncVelocity:
+            return {0x60FF, 0};  // target velocity
+        case modes::ProfileTorque:
+        case modes::CyclicSyncTorque:
+            return {0x6071, 0};  // target torque
+        case modes::InterpolatedPosition:
+            return {0x60C1, 1};  // interpolation data record, the position set-point
+        default:
+            return {0, 0};
+    }
+}
 // 0x6502 Supported Drive Modes: bit (mode - 1) for each mode (IEC 61800-7-201).
 constexpr uint32_t mode_bit(int m) {
     return m >= 1 && m <= 32 ? 1u << (m - 1) : 0u;
@@ -90,11 +121,14 @@ constexpr bool contains(const std::array<int8_t, N>& set, int v) {
     X(ProfileAcceleration,            0x6083, 0, uint32_t, 10000,   Parameter) \
     X(ProfileDeceleration,            0x6084, 0, uint32_t, 10000,   Parameter) \
     X(QuickStopDeceleration,          0x6085, 0, uint32_t, 15000,   Parameter) \
+    X(TorqueSlope,                    0x6087, 0, uint32_t, 0,       Parameter) /* 0: not set, no ramp */ \
+    X(TorqueProfileType,              0x6088, 0, int16_t,  0,       Parameter) \
     X(MaxAcceleration,                0x60C5, 0, uint32_t, 0xFFFFFFFF, Parameter) \
     X(HomingMethod,                   0x6098, 0, int8_t,   37,      Parameter) \
     X(HomingSpeedSwitchSearch,        0x6099, 1, uint32_t, 100,     Parameter) \
     X(HomingSpeedZeroSearch,          0x6099, 2, uint32_t, 10,      Parameter) \
     X(HomingAcceleration,             0x609A, 0, uint32_t, 1000,    Parameter) \
+    X(InterpolationSubMode,           0x60C0, 0, int16_t,  0,       Parameter) \
     X(InterpolationTimePeriodValue,   0x60C2, 1, uint8_t,  1,       Parameter) \
     X(InterpolationTimeIndex,         0x60C2, 2, int8_t,   -3,      Parameter) \
     X(TouchProbe1Source,              0x60D0, 1, int16_t,  -1,      Parameter) \
@@ -111,6 +145,7 @@ constexpr bool contains(const std::array<int8_t, N>& set, int v) {
     X(TargetPosition,                 0x607A, 0, int32_t,  0,       Command) \
     X(TargetVelocity,                 0x60FF, 0, int32_t,  0,       Command) \
     X(TargetTorque,                   0x6071, 0, int16_t,  0,       Command) \
+    X(InterpolationDataPosition,      0x60C1, 1, int32_t,  0,       Command) \
     X(PositionOffset,                 0x60B0, 0, int32_t,  0,       Command) \
     X(VelocityOffset,                 0x60B1, 0, int32_t,  0,       Command) \
     X(TorqueOffset,                   0x60B2, 0, int16_t,  0,       Command) \
@@ -122,6 +157,7 @@ constexpr bool contains(const std::array<int8_t, N>& set, int v) {
     X(PositionActualValue,            0x6064, 0, int32_t,  0,       Feedback) \
     X(VelocityDemandValue,            0x606B, 0, int32_t,  0,       Feedback) \
     X(VelocityActualValue,            0x606C, 0, int32_t,  0,       Feedback) \
+    X(TorqueDemand,                   0x6074, 0, int16_t,  0,       Feedback) \
     X(TorqueActualValue,              0x6077, 0, int16_t,  0,       Feedback) \
     X(CurrentActualValue,             0x6078, 0, int16_t,  0,       Feedback) \
     X(FollowingErrorActualValue,      0x60F4, 0, int32_t,  0,       Feedback) \

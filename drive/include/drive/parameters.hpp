@@ -66,6 +66,10 @@ struct Parameters {
     uint32_t profile_deceleration = obj::ProfileDeceleration.def;       // 0x6084 rpm/s
     uint32_t quick_stop_deceleration = obj::QuickStopDeceleration.def;  // 0x6085 rpm/s
     uint32_t max_acceleration = obj::MaxAcceleration.def;               // 0x60C5 rpm/s
+    // Profile torque: 0x6087 per mille of the rated torque per second (0 or 0xFFFFFFFF: no ramp), 0x6088
+    // (0 linear, 1 sin^2)
+    uint32_t torque_slope = obj::TorqueSlope.def;
+    int16_t torque_profile_type = obj::TorqueProfileType.def;
     // Homing
     int8_t homing_method = obj::HomingMethod.def;                            // 0x6098
     uint32_t homing_speed_switch = obj::HomingSpeedSwitchSearch.def;         // 0x6099:01 rpm
@@ -74,6 +78,8 @@ struct Parameters {
     int32_t home_position = vendor::HomePosition.def;                        // 0x30B0 inc
     int32_t home_offset_move = vendor::HomeOffsetMoveDistance.def;           // 0x30B1 inc
     uint16_t homing_current_threshold = vendor::HomingCurrentThreshold.def;  // 0x30B2 mA
+    // Interpolated position mode: sub-mode 0x60C0 (0 = linear interpolation, the one the drive serves)
+    int16_t interpolation_sub_mode = obj::InterpolationSubMode.def;
     // Interpolation 0x60C2 (value x 10^index s); 0 = no interpolation
     uint8_t interpolation_value = obj::InterpolationTimePeriodValue.def;
     int8_t interpolation_index = obj::InterpolationTimeIndex.def;
@@ -110,6 +116,7 @@ struct Command {
     int32_t target_position = obj::TargetPosition.def;            // 0x607A
     int32_t target_velocity = obj::TargetVelocity.def;            // 0x60FF
     int16_t target_torque = obj::TargetTorque.def;                // 0x6071
+    int32_t ip_position = obj::InterpolationDataPosition.def;     // 0x60C1:01
     int32_t position_offset = obj::PositionOffset.def;            // 0x60B0
     int32_t velocity_offset = obj::VelocityOffset.def;            // 0x60B1
     int16_t torque_offset = obj::TorqueOffset.def;                // 0x60B2
@@ -127,6 +134,7 @@ struct Feedback {
     int32_t velocity_demand = 0;         // 0x606B
     int32_t velocity_actual = 0;         // 0x606C (also 0x60E5:01)
     int32_t velocity_averaged = 0;       // 0x30D5 (also 0x60E5:09)
+    int16_t torque_demand = 0;           // 0x6074
     int16_t torque_actual = 0;           // 0x6077
     int16_t current_actual = 0;          // 0x6078
     int16_t current_demand = 0;          // 0x30D0

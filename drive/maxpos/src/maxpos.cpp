@@ -459,7 +459,7 @@ constexpr ValueSet kValueSets[] = {
     {0x1C33, 1, {1, 2, 34}, 3},                                                 // 7.2.18.1, T7-79
     {0x3000, 2, {0x01, 0x11, 0x21, 0x31}, 4},                                   // T7-88
     {0x3000, 3, {0x00, 0x30, 0x31, 0x32}, 4},                                   // T7-90
-    value_set(0x6060, 0, drive::kModesOfOperation),                             // T7-123
+    value_set(0x6060, 0, kModesOfOperation),                                     // T7-123
     value_set(0x6098, 0, drive::kHomingMethods),                                // T7-126
     {0x6402, 0, {1, 10}, 2},                                                    // T7-139
 };

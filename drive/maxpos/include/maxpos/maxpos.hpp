@@ -51,6 +51,12 @@ od::Product product(const std::filesystem::path& config_file = {});
 // §7.2.78-7.2.80, §7.2.100): pass to drive::Drive and drive::commission for a MAXPOS dictionary.
 const drive::VendorObjects& drive_objects();
 
+// The modes of operation the MAXPOS accepts in 0x6060 (MAXPOS firmware specification §7.2.53, Table 7-123;
+// 0x6502 = 0x000003A5): those of the drive core without profile torque and interpolated position.
+inline constexpr std::array<int8_t, 6> kModesOfOperation{
+    drive::modes::ProfilePosition,    drive::modes::ProfileVelocity,    drive::modes::Homing,
+    drive::modes::CyclicSyncPosition, drive::modes::CyclicSyncVelocity, drive::modes::CyclicSyncTorque};
+
 // 0x1C00:01..04: the communication type of SM0..SM3, in the order the device places them.
 inline constexpr std::array<od::SmKind, 4> kSmCommunicationTypes{od::SmKind::MBoxOut, od::SmKind::MBoxIn,
                                                                  od::SmKind::Outputs, od::SmKind::Inputs};

@@ -5,8 +5,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <iomanip>
 #include <iostream>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <system_error>
 
@@ -195,14 +197,24 @@ Device::Device(esc::Esc& esc, DeviceOptions options)
              sii_drift(image, id.vendor_id, id.product_code, id.revision, id.serial_number))
             event(slave::LogLevel::Warn, "the SII served: " + d);
     }
-    // What the product declares that is not emulated: said once.
-    if (options_.product && options_.announce_product)
-        for (const std::string& w : options_.product->warnings) {
+    // What the product declares that is not emulated: said once. A mode its 0x6502 announces that the drive
+    // core cannot serve is one of them: the drive took it out of 0x6502 (docs/decisions/device.md).
+    if (options_.product && options_.announce_product) {
+        std::vector<std::string> warnings = options_.product->warnings;
+        if (parts_ && parts_->drive && parts_->drive->withheld_modes() != 0) {
+            std::ostringstream w;
+            w << "0x6502 announces modes the drive core does not serve on this dictionary (bits 0x"
+              << std::hex << std::setw(8) << std::setfill('0') << parts_->drive->withheld_modes()
+              << "); 0x6502 announces the others";
+            warnings.push_back(w.str());
+        }
+        for (const std::string& w : warnings) {
             if (options_.events != nullptr)
                 event(slave::LogLevel::Warn, options_.product->source + ": " + w);
             else
                 log() << "softecat: " << options_.product->source << ": " << w << '\n';
         }
+    }
     // Registered once the device exists: a constructor that throws leaves no callback behind.
     if (options_.load_sii)
         esc_.on_eeprom_write([this](uint16_t address, uint16_t value) {
