@@ -228,6 +228,7 @@ TEST_F(MandatoryPdoRules, CountZeroOpensTheAssignmentTheCountIsChecked) {
 }
 
 TEST(PdoRules, MandatoryAndExcludeChecks) {
+    const od::Dictionary dict = maxpos::dictionary(maxpos::description());
     std::vector<od::PdoRule> rules(3);
     rules[0].pdo = 0x1600;
     rules[0].mandatory = true;
@@ -236,12 +237,92 @@ TEST(PdoRules, MandatoryAndExcludeChecks) {
     rules[2].pdo = 0x1A00;
     rules[2].mandatory = true;
     const std::vector<uint16_t> ok{0x1600, 0x1601}, no_mandatory{0x1601}, excluded{0x1600, 0x1602, 0x1601};
-    EXPECT_EQ(coe::check_pdo_rules(0x1C12, ok, rules), od::Status::Ok);
-    EXPECT_EQ(coe::check_pdo_rules(0x1C12, no_mandatory, rules), od::Status::Incompatible);
-    EXPECT_EQ(coe::check_pdo_rules(0x1C12, {}, rules), od::Status::Incompatible);
-    EXPECT_EQ(coe::check_pdo_rules(0x1C12, excluded, rules), od::Status::Incompatible);
+    EXPECT_EQ(coe::check_pdo_rules(dict, 0x1C12, ok, rules), od::Status::Ok);
+    EXPECT_EQ(coe::check_pdo_rules(dict, 0x1C12, no_mandatory, rules), od::Status::Incompatible);
+    EXPECT_EQ(coe::check_pdo_rules(dict, 0x1C12, {}, rules), od::Status::Incompatible);
+    EXPECT_EQ(coe::check_pdo_rules(dict, 0x1C12, excluded, rules), od::Status::Incompatible);
     // 0x1C13's rules do not apply to 0x1C12 and the other way round.
     const std::vector<uint16_t> tx{0x1A00};
-    EXPECT_EQ(coe::check_pdo_rules(0x1C13, tx, rules), od::Status::Ok);
-    EXPECT_EQ(coe::check_pdo_rules(0x1C13, {}, rules), od::Status::Incompatible);
+    EXPECT_EQ(coe::check_pdo_rules(dict, 0x1C13, tx, rules), od::Status::Ok);
+    EXPECT_EQ(coe::check_pdo_rules(dict, 0x1C13, {}, rules), od::Status::Incompatible);
+}
+
+// A PDO's direction is what the object model declares (od::Object::direction), not its index range: the
+// evaluation boards' ESIs name an RxPdo 0x1A00 and a TxPdo 0x1600 (from the controller's side), EL1262 a
+// TxPdo 0x1C00. The assignment of SM2 takes the RxPDO 0x1A00 and refuses the TxPDO 0x1600, and the mapping
+// objects check their entries in their own direction.
+TEST(PdoDirection, ComesFromTheObjectModelWhereverTheIndexLies) {
+    using od::access::RW_PreOp;
+    od::Dictionary dict;
+    auto var = [&](uint16_t index, od::DataType type, uint16_t access) {
+        od::Object o;
+        o.index = index;
+        o.type = type;
+        o.name = "v";
+        od::Entry e;
+        e.index = index;
+        e.type = type;
+        e.bit_length = 16;
+        e.access = access;
+        e.name = "v";
+        e.default_value = uint64_t{0};
+        o.entries.push_back(e);
+        dict.add(o);
+    };
+    var(0x7000, od::DataType::Unsigned16, od::access::RW | od::access::RxPdo);
+    var(0x6000, od::DataType::Unsigned16, od::access::RO | od::access::TxPdo);
+    auto object = [&](uint16_t index, od::PdoDirection dir, od::DataType type, std::vector<uint64_t> values) {
+        od::Object o;
+        o.index = index;
+        o.code = od::ObjectCode::Array;
+        o.type = type;
+        o.name = "o";
+        o.direction = dir;
+        od::Entry n;
+        n.index = index;
+        n.type = od::DataType::Unsigned8;
+        n.bit_length = 8;
+        n.access = RW_PreOp;
+        n.name = "n";
+        n.default_value = uint64_t{values.size()};
+        o.entries.push_back(n);
+        for (std::size_t k = 0; k < values.size(); ++k) {
+            od::Entry e = n;
+            e.subindex = static_cast<uint8_t>(k + 1);
+            e.type = type;
+            e.bit_length = type == od::DataType::Unsigned16 ? 16 : 32;
+            e.name = "e" + std::to_string(k + 1);
+            e.default_value = values[k];
+            o.entries.push_back(e);
+        }
+        dict.add(o);
+    };
+    object(0x1A00, od::PdoDirection::Rx, od::DataType::Unsigned32, {0x70000010});
+    object(0x1600, od::PdoDirection::Tx, od::DataType::Unsigned32, {0x60000010});
+    object(0x1C00, od::PdoDirection::Tx, od::DataType::Unsigned32, {0x60000010});
+    object(0x1C12, od::PdoDirection::Rx, od::DataType::Unsigned16, {0x1A00});
+    object(0x1C13, od::PdoDirection::Tx, od::DataType::Unsigned16, {0x1600, 0x1C00});
+    EXPECT_TRUE(dict.find(0x1C00)->is_pdo_mapping());
+    EXPECT_TRUE(dict.find(0x1C12)->is_pdo_assignment());
+    coe::install_pdo_validators(dict);
+    coe::CoeServer server{dict, [] { return od::AlState::PreOp; }};
+    RecordingSender out;
+    auto write = [&](uint16_t index, uint8_t sub, uint32_t value, uint8_t bytes) {
+        return expedited_download(server, out, index, sub, value, bytes);
+    };
+    EXPECT_EQ(write(0x1C12, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1C12, 1, 0x1600, 2), 0x06090030u);  // a TxPDO: not for an outputs SM
+    EXPECT_EQ(write(0x1C12, 1, 0x1A00, 2), 0u);           // the RxPDO at 0x1A00
+    EXPECT_EQ(write(0x1C12, 0, 1, 1), 0u);
+    EXPECT_EQ(write(0x1C13, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1C13, 1, 0x1A00, 2), 0x06090030u);
+    EXPECT_EQ(write(0x1C13, 1, 0x1C00, 2), 0u);  // the TxPDO at 0x1C00
+    EXPECT_EQ(write(0x1C13, 0, 1, 1), 0u);
+    // The RxPDO 0x1A00 maps outputs, not inputs; the TxPDO 0x1600 the other way round.
+    EXPECT_EQ(write(0x1A00, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1A00, 1, 0x60000010, 4), 0x06040041u);
+    EXPECT_EQ(write(0x1A00, 1, 0x70000010, 4), 0u);
+    EXPECT_EQ(write(0x1600, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1600, 1, 0x70000010, 4), 0x06040041u);
+    EXPECT_EQ(write(0x1600, 1, 0x60000010, 4), 0u);
 }
