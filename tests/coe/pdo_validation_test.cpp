@@ -6,6 +6,7 @@
 #include "coe/sdo_server.hpp"
 #include "coe_test_support.hpp"
 #include "maxpos/maxpos.hpp"
+#include "support/pdo_objects.hpp"
 
 using namespace coe_test;
 
@@ -252,50 +253,12 @@ TEST(PdoRules, MandatoryAndExcludeChecks) {
 // TxPdo 0x1C00. The assignment of SM2 takes the RxPDO 0x1A00 and refuses the TxPDO 0x1600, and the mapping
 // objects check their entries in their own direction.
 TEST(PdoDirection, ComesFromTheObjectModelWhereverTheIndexLies) {
-    using od::access::RW_PreOp;
     od::Dictionary dict;
-    auto var = [&](uint16_t index, od::DataType type, uint16_t access) {
-        od::Object o;
-        o.index = index;
-        o.type = type;
-        o.name = "v";
-        od::Entry e;
-        e.index = index;
-        e.type = type;
-        e.bit_length = 16;
-        e.access = access;
-        e.name = "v";
-        e.default_value = uint64_t{0};
-        o.entries.push_back(e);
-        dict.add(o);
-    };
-    var(0x7000, od::DataType::Unsigned16, od::access::RW | od::access::RxPdo);
-    var(0x6000, od::DataType::Unsigned16, od::access::RO | od::access::TxPdo);
+    const uint16_t rx = od::access::RW | od::access::RxPdo, tx = od::access::RO | od::access::TxPdo;
+    dict.add(test_support::pdo_var(0x7000, od::DataType::Unsigned16, 16, rx));
+    dict.add(test_support::pdo_var(0x6000, od::DataType::Unsigned16, 16, tx));
     auto object = [&](uint16_t index, od::PdoDirection dir, od::DataType type, std::vector<uint64_t> values) {
-        od::Object o;
-        o.index = index;
-        o.code = od::ObjectCode::Array;
-        o.type = type;
-        o.name = "o";
-        o.direction = dir;
-        od::Entry n;
-        n.index = index;
-        n.type = od::DataType::Unsigned8;
-        n.bit_length = 8;
-        n.access = RW_PreOp;
-        n.name = "n";
-        n.default_value = uint64_t{values.size()};
-        o.entries.push_back(n);
-        for (std::size_t k = 0; k < values.size(); ++k) {
-            od::Entry e = n;
-            e.subindex = static_cast<uint8_t>(k + 1);
-            e.type = type;
-            e.bit_length = type == od::DataType::Unsigned16 ? 16 : 32;
-            e.name = "e" + std::to_string(k + 1);
-            e.default_value = values[k];
-            o.entries.push_back(e);
-        }
-        dict.add(o);
+        dict.add(test_support::pdo_array(index, dir, type, values));
     };
     object(0x1A00, od::PdoDirection::Rx, od::DataType::Unsigned32, {0x70000010});
     object(0x1600, od::PdoDirection::Tx, od::DataType::Unsigned32, {0x60000010});

@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "fixture.hpp"
+#include "support/pdo_objects.hpp"
 
 namespace ecat::test {
 namespace {
@@ -273,48 +274,8 @@ TEST_F(ProcessDataLrw, CycleAllocatesNothing_PlanStable) {
 // (0x1C10 + n) and PDOs whose direction the object model declares wherever their index lies (RxPDO 0x1800,
 // TxPDO 0x1C00; EL2262, EL1262): each SM is checked against its own length, and outputs and inputs flow
 // through every SM.
-od::Object pd_var(uint16_t index, od::DataType type, uint16_t bits, uint16_t access) {
-    od::Object o;
-    o.index = index;
-    o.type = type;
-    o.name = "v";
-    od::Entry e;
-    e.index = index;
-    e.type = type;
-    e.bit_length = bits;
-    e.access = access;
-    e.name = "v";
-    e.default_value = uint64_t{0};
-    o.entries.push_back(e);
-    return o;
-}
-
-od::Object pd_array(uint16_t index, od::PdoDirection dir, od::DataType type, std::vector<uint64_t> values) {
-    od::Object o;
-    o.index = index;
-    o.code = od::ObjectCode::Array;
-    o.type = type;
-    o.name = "o";
-    o.direction = dir;
-    od::Entry n;
-    n.index = index;
-    n.type = od::DataType::Unsigned8;
-    n.bit_length = 8;
-    n.access = od::access::RW_PreOp;
-    n.name = "n";
-    n.default_value = uint64_t{values.size()};
-    o.entries.push_back(n);
-    for (std::size_t k = 0; k < values.size(); ++k) {
-        od::Entry e = n;
-        e.subindex = static_cast<uint8_t>(k + 1);
-        e.type = type;
-        e.bit_length = type == od::DataType::Unsigned16 ? 16 : 32;
-        e.name = "e" + std::to_string(k + 1);
-        e.default_value = values[k];
-        o.entries.push_back(e);
-    }
-    return o;
-}
+using test_support::pdo_array;
+using test_support::pdo_var;
 
 class SeveralSms : public StackTest {
   protected:
@@ -322,18 +283,18 @@ class SeveralSms : public StackTest {
         using od::PdoDirection;
         const uint16_t rx = od::access::RW | od::access::RxPdo, tx = od::access::RO | od::access::TxPdo;
         dict = od::Dictionary();
-        dict.add(pd_var(0x7000, od::DataType::Unsigned16, 16, rx));
-        dict.add(pd_var(0x7010, od::DataType::Unsigned8, 8, rx));
-        dict.add(pd_var(0x6000, od::DataType::Unsigned16, 16, tx));
-        dict.add(pd_var(0x6010, od::DataType::Unsigned8, 8, tx));
-        dict.add(pd_array(0x1600, PdoDirection::Rx, od::DataType::Unsigned32, {0x70000010}));
-        dict.add(pd_array(0x1800, PdoDirection::Rx, od::DataType::Unsigned32, {0x70100008}));
-        dict.add(pd_array(0x1A00, PdoDirection::Tx, od::DataType::Unsigned32, {0x60000010}));
-        dict.add(pd_array(0x1C00, PdoDirection::Tx, od::DataType::Unsigned32, {0x60100008}));
-        dict.add(pd_array(0x1C12, PdoDirection::Rx, od::DataType::Unsigned16, {0x1600}));
-        dict.add(pd_array(0x1C13, PdoDirection::Tx, od::DataType::Unsigned16, {0x1A00}));
-        dict.add(pd_array(0x1C14, PdoDirection::Rx, od::DataType::Unsigned16, {0x1800}));
-        dict.add(pd_array(0x1C15, PdoDirection::Tx, od::DataType::Unsigned16, {0x1C00}));
+        dict.add(pdo_var(0x7000, od::DataType::Unsigned16, 16, rx));
+        dict.add(pdo_var(0x7010, od::DataType::Unsigned8, 8, rx));
+        dict.add(pdo_var(0x6000, od::DataType::Unsigned16, 16, tx));
+        dict.add(pdo_var(0x6010, od::DataType::Unsigned8, 8, tx));
+        dict.add(pdo_array(0x1600, PdoDirection::Rx, od::DataType::Unsigned32, {0x70000010}));
+        dict.add(pdo_array(0x1800, PdoDirection::Rx, od::DataType::Unsigned32, {0x70100008}));
+        dict.add(pdo_array(0x1A00, PdoDirection::Tx, od::DataType::Unsigned32, {0x60000010}));
+        dict.add(pdo_array(0x1C00, PdoDirection::Tx, od::DataType::Unsigned32, {0x60100008}));
+        dict.add(pdo_array(0x1C12, PdoDirection::Rx, od::DataType::Unsigned16, {0x1600}));
+        dict.add(pdo_array(0x1C13, PdoDirection::Tx, od::DataType::Unsigned16, {0x1A00}));
+        dict.add(pdo_array(0x1C14, PdoDirection::Rx, od::DataType::Unsigned16, {0x1800}));
+        dict.add(pdo_array(0x1C15, PdoDirection::Tx, od::DataType::Unsigned16, {0x1C00}));
         desc.sync_managers.resize(6);
         const od::SmKind kinds[6] = {od::SmKind::MBoxOut, od::SmKind::MBoxIn,  od::SmKind::Outputs,
                                      od::SmKind::Inputs,  od::SmKind::Outputs, od::SmKind::Inputs};
