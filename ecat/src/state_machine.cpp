@@ -304,6 +304,11 @@ uint16_t StateMachine::check_pre_op_to_safe_op() {
             if (enabled && (s.sm == ctx_.sms.outputs || s.sm == ctx_.sms.inputs)) return s.code;
             continue;
         }
+        // A further SM of a direction that the master leaves off: its PDOs are not exchanged (a master that
+        // handles one SM per direction, as the project's own master library does), as an unused SM's. One
+        // that is on must be as its assignment says.
+        const bool first = s.sm == ctx_.sms.outputs || s.sm == ctx_.sms.inputs;
+        if (!enabled && !first) continue;
         if (!enabled ||
             (r.length != s.bytes && !(s.sm == ctx_.sms.outputs && ctx_.faults.sm2_length_unchecked)))
             return s.code;
@@ -372,7 +377,8 @@ void StateMachine::check_process_data_sms(uint64_t now_ns) {
         if (n >= ProcessData::kMaxSms) return true;  // no SM for this direction
         const SmRegs r = read_sm(ctx_.pdi, n);
         const bool enabled = (r.activate & esc::reg::kSmEnable) && r.length > 0;
-        if (bytes == 0) return !enabled || (n != ctx_.sms.outputs && n != ctx_.sms.inputs);
+        const bool first = n == ctx_.sms.outputs || n == ctx_.sms.inputs;
+        if (bytes == 0 || (!enabled && !first)) return !enabled || !first;
         const bool length_ok =
             r.length == bytes || (n == ctx_.sms.outputs && ctx_.faults.sm2_length_unchecked);
         return enabled && length_ok && r.start == start_address;

@@ -367,6 +367,17 @@ TEST_F(SeveralSms, EachSmIsCheckedAgainstTheLengthOfItsOwnAssignment) {
     EXPECT_EQ(al_code(), 0x001D);  // invalid output configuration
 }
 
+// A master that handles one SM per direction leaves SM4/SM5 off: the first SMs' PDOs are exchanged, the
+// others' not, as an unused SM's.
+TEST_F(SeveralSms, AFurtherSmTheMasterLeavesOffIsNotExchanged) {
+    go_preop();
+    configure_all();
+    configure_sm(4, 0x1300, 1, 0x64, false);
+    configure_sm(5, 0x1400, 1, 0x20, false);
+    request(0x04);
+    ASSERT_EQ(al_status(), 0x04) << "code " << std::hex << al_code();
+}
+
 TEST_F(SeveralSms, APdoOfTheOtherDirectionIsRefusedWhereverItsIndexLies) {
     // 0x1C14 (SM4, outputs) assigning the TxPDO 0x1C00: an invalid output mapping.
     ASSERT_EQ(dict.set<uint16_t>(0x1C14, 1, 0x1C00), od::Status::Ok);
