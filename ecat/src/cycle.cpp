@@ -19,6 +19,7 @@ Cycle::Cycle(StackContext& ctx, StateMachine& esm, SyncControl& sync, IrqLine ir
     if (has_mailbox(ctx_.desc)) event_mask_ |= esc::alev::sm(0);
     if (ctx_.sms.outputs < 4) event_mask_ |= esc::alev::sm(ctx_.sms.outputs);
     if (ctx_.sms.inputs < 4) event_mask_ |= esc::alev::sm(ctx_.sms.inputs);
+    base_event_mask_ = event_mask_;
     sm2_buf_.reserve(1024);
     sm3_buf_.reserve(1024);
 }
@@ -160,6 +161,19 @@ void Cycle::update_event_mask() {
 
 void Cycle::start_process_data(uint64_t now_ns) {
     ProcessData& pd = ctx_.pd;
+    // The SMs whose events drive the cycle: the first of each direction that carries PDOs (EL4732 assigns
+    // none to its first input SM), else the first of the direction; their events join the mask.
+    event_mask_ = base_event_mask_;
+    auto trigger = [this](std::span<const SmImage> images, unsigned& sm) {
+        for (const SmImage& im : images)
+            if (im.bytes > 0 && im.sm < ProcessData::kMaxSms) {
+                sm = im.sm;
+                event_mask_ |= esc::alev::sm(sm);
+                return;
+            }
+    };
+    trigger(pd.rx_sms(), out_sm_);
+    trigger(pd.tx_sms(), in_sm_);
     sm2_buf_.assign(pd.rx_bytes(), 0);
     sm3_buf_.assign(pd.tx_bytes(), 0);
     outputs_seen_ = false;
@@ -179,6 +193,9 @@ void Cycle::stop_process_data() {
         for (const unsigned n : *list)
             set_sm_pdi_deactivated(ctx_.pdi, n, true);
     ctx_.pd.clear();
+    out_sm_ = ctx_.sms.outputs < 4 ? ctx_.sms.outputs : 2;
+    in_sm_ = ctx_.sms.inputs < 4 ? ctx_.sms.inputs : 3;
+    event_mask_ = base_event_mask_;
     sm2_buf_.clear();
     sm3_buf_.clear();
     outputs_seen_ = false;

@@ -378,6 +378,30 @@ TEST_F(SeveralSms, AFurtherSmTheMasterLeavesOffIsNotExchanged) {
     ASSERT_EQ(al_status(), 0x04) << "code " << std::hex << al_code();
 }
 
+// The first output SM without PDOs (EL4732 assigns none to its first input SM): the next one that carries
+// PDOs drives the cycle, so its outputs are seen and taken and Op is reached.
+TEST_F(SeveralSms, TheFirstSmThatCarriesPdosDrivesTheCycle) {
+    ASSERT_EQ(dict.set<uint8_t>(0x1C12, 0, 0), od::Status::Ok);
+    go_preop();
+    configure_all();
+    configure_sm(2, 0x1100, 2, 0x64, false);  // no PDOs: off
+    request(0x04);
+    ASSERT_EQ(al_status(), 0x04) << "code " << std::hex << al_code();
+    std::vector<uint8_t> in(3);
+    const std::vector<uint8_t> out{0, 0, 0x56};
+    exchange_pd(out, in);
+    poll();
+    request(0x08);
+    for (int i = 0; i < 3 && al_status() != 0x08; ++i) {
+        exchange_pd(out, in);
+        advance(1'000'000);
+    }
+    ASSERT_EQ(al_status(), 0x08) << "code " << std::hex << al_code();
+    exchange_pd(out, in);
+    poll();
+    EXPECT_EQ(dict.get<uint8_t>(0x7010, 0), 0x56);
+}
+
 TEST_F(SeveralSms, APdoOfTheOtherDirectionIsRefusedWhereverItsIndexLies) {
     // 0x1C14 (SM4, outputs) assigning the TxPDO 0x1C00: an invalid output mapping.
     ASSERT_EQ(dict.set<uint16_t>(0x1C14, 1, 0x1C00), od::Status::Ok);

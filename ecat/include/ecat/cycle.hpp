@@ -83,9 +83,12 @@ class Cycle {
     IrqLine irq_;
 
     uint32_t event_mask_ = kEventMask;
-    uint32_t written_mask_ = 0;  // 0x0204 as this stack last wrote it
-    bool sync0_event_ = false;   // process data runs DC-synchronous and 0x0151 maps SYNC0 to 0x0220
-    unsigned out_sm_ = 2;  // ctx_.sms, kNoSm mapped to an SM that is never used (its buffer stays empty)
+    uint32_t base_event_mask_ = kEventMask;  // outside the process-data states
+    uint32_t written_mask_ = 0;              // 0x0204 as this stack last wrote it
+    bool sync0_event_ = false;  // process data runs DC-synchronous and 0x0151 maps SYNC0 to 0x0220
+    // The SMs whose events drive the cycle: ctx_.sms (kNoSm mapped to an SM that is never used, its buffer
+    // stays empty), in the process-data states the first of each direction that carries PDOs.
+    unsigned out_sm_ = 2;
     unsigned in_sm_ = 3;
     std::vector<uint8_t> sm2_buf_;  // the output image: every output SM's part (ProcessData::rx_sms())
     std::vector<uint8_t> sm3_buf_;  // the input image: every input SM's part (ProcessData::tx_sms())
