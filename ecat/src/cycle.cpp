@@ -206,8 +206,15 @@ void Cycle::write_inputs() {
     ctx_.pd.dictionary_to_inputs(sm3_buf_);
     const std::span<const uint8_t> image(sm3_buf_);
     for (const SmImage& im : ctx_.pd.tx_sms()) {
-        // An input SM on the register space carries the ESC's own registers: the device does not write them.
-        if (im.bytes == 0 || inputs_on_registers(ctx_.sms, ctx_.desc, im.sm)) continue;
+        if (im.bytes == 0) continue;
+        if (inputs_on_registers(ctx_.sms, ctx_.desc, im.sm)) {
+            // An input SM on the register space carries the ESC's own registers (DC latch, system time): the
+            // device does not write them; the entries its PDOs map show them (control socket, SDO).
+            const std::span<uint8_t> part = std::span<uint8_t>(sm3_buf_).subspan(im.offset, im.bytes);
+            ctx_.pdi.read(ctx_.desc.sync_managers[im.sm].start, part);
+            ctx_.pd.inputs_to_dictionary(sm3_buf_, im);
+            continue;
+        }
         ctx_.pdi.write(sm_start(im.sm), image.subspan(im.offset, im.bytes));
     }
 }

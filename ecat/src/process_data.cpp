@@ -140,4 +140,13 @@ void ProcessData::dictionary_to_inputs(std::span<uint8_t> sm3) const {
     }
 }
 
+void ProcessData::inputs_to_dictionary(std::span<const uint8_t> sm3, const SmImage& part) const {
+    const std::size_t first = part.offset * 8, end = (part.offset + part.bytes) * 8;
+    for (const PdoCopy& c : tx_) {
+        if (c.bit_offset < first || c.bit_offset + c.bits > end || c.bit_offset + c.bits > sm3.size() * 8)
+            continue;
+        copy_bits(sm3.data(), c.bit_offset, c.storage, 0, c.bits);
+    }
+}
+
 }  // namespace ecat

@@ -402,6 +402,26 @@ TEST_F(SeveralSms, TheFirstSmThatCarriesPdosDrivesTheCycle) {
     EXPECT_EQ(dict.get<uint8_t>(0x7010, 0), 0x56);
 }
 
+// An input SM after the first on the register space (EL1252's Virtual SM over the DC system time 0x0910): the
+// device writes nothing there (the master reads the register by an FMMU alone), and the entry its PDO maps
+// shows the register's value.
+TEST_F(SeveralSms, AnInputSmOnTheRegisterSpaceShowsTheEscsRegisters) {
+    const uint16_t tx = od::access::RO | od::access::TxPdo;
+    dict.add(pdo_var(0x2000, od::DataType::Unsigned64, 64, tx));
+    dict.add(pdo_array(0x1B00, od::PdoDirection::Tx, od::DataType::Unsigned32, {0x20000040}));
+    ASSERT_EQ(dict.set<uint16_t>(0x1C15, 1, 0x1B00), od::Status::Ok);
+    desc.sync_managers[5].start = 0x0910;
+    start();
+    go_preop();
+    configure_all();
+    configure_sm(5, 0x0910, 8, 0x20, false);  // not configured: only an FMMU over the register
+    request(0x04);
+    ASSERT_EQ(al_status(), 0x04) << "code " << std::hex << al_code();
+    const uint64_t shown = dict.get<uint64_t>(0x2000, 0);
+    EXPECT_NE(shown, 0u);
+    EXPECT_EQ(shown, master.rd<uint64_t>(0x0910));
+}
+
 TEST_F(SeveralSms, APdoOfTheOtherDirectionIsRefusedWhereverItsIndexLies) {
     // 0x1C14 (SM4, outputs) assigning the TxPDO 0x1C00: an invalid output mapping.
     ASSERT_EQ(dict.set<uint16_t>(0x1C14, 1, 0x1C00), od::Status::Ok);

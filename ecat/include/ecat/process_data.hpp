@@ -67,6 +67,9 @@ class ProcessData {
     void outputs_to_dictionary(std::span<const uint8_t> sm2) const;
     // Dictionary -> input image (every input SM's part); bits not mapped keep their value.
     void dictionary_to_inputs(std::span<uint8_t> sm3) const;
+    // Input image -> dictionary for the entries of one input SM's part: an input SM over the ESC's registers,
+    // whose values are the registers' (ecat::inputs_on_registers).
+    void inputs_to_dictionary(std::span<const uint8_t> sm3, const SmImage& part) const;
 
     // Copies n bits from src (starting at bit src_bit) to dst (starting at bit dst_bit), LSB first.
     static void copy_bits(const uint8_t* src, std::size_t src_bit, uint8_t* dst, std::size_t dst_bit,
