@@ -11,14 +11,15 @@ namespace coe {
 
 namespace {
 
-constexpr uint16_t kRxAssign = 0x1C12;
-constexpr uint16_t kTxAssign = 0x1C13;
-
-bool is_rx_mapping(uint16_t i) {
-    return i >= 0x1600 && i <= 0x17FF;
+// The direction of a process-data object as the object model declares it (od::Object::direction), wherever
+// its index lies; None for anything else.
+od::PdoDirection mapping_direction(const od::Dictionary& d, uint16_t pdo) {
+    const od::Object* o = d.find(pdo);
+    return o != nullptr && o->is_pdo_mapping() ? o->direction : od::PdoDirection::None;
 }
-bool is_tx_mapping(uint16_t i) {
-    return i >= 0x1A00 && i <= 0x1BFF;
+od::PdoDirection assignment_direction(const od::Dictionary& d, uint16_t assign) {
+    const od::Object* o = d.find(assign);
+    return o != nullptr && o->is_pdo_assignment() ? o->direction : od::PdoDirection::None;
 }
 
 uint8_t u8(const od::Dictionary& d, uint16_t i, uint8_t s) {
@@ -54,7 +55,7 @@ std::size_t assigned_bytes(const od::Dictionary& d, uint16_t assign, uint8_t cou
 
 od::Status check_mapping(const od::Dictionary& d, uint16_t pdo, const od::Entry& e,
                          std::span<const uint8_t> v, const PdoLimits& lim) {
-    const bool rx = is_rx_mapping(pdo);
+    const bool rx = mapping_direction(d, pdo) == od::PdoDirection::Rx;
     if (e.subindex != 0) {
         // ETG.1000.6 / ETG.1020: a mapping entry can be changed only while subindex 0 is 0.
         if (u8(d, pdo, 0) != 0) return od::Status::SubindexZeroFirst;
@@ -71,20 +72,24 @@ od::Status check_mapping(const od::Dictionary& d, uint16_t pdo, const od::Entry&
     }
     const std::size_t bits = bits_of(d, pdo, n);
     if ((bits + 7) / 8 > lim.max_sm_bytes) return od::Status::PdoLengthExceeded;
-    // If the PDO is assigned to its SyncManager, the SyncManager's image must still fit.
-    const uint16_t assign = rx ? kRxAssign : kTxAssign;
-    const uint8_t count = u8(d, assign, 0);
-    bool assigned = false;
-    for (uint8_t s = 1; s <= count && s != 0; ++s)
-        assigned = assigned || u16(d, assign, s) == pdo;
-    if (assigned && assigned_bytes(d, assign, count, pdo, bits) > lim.max_sm_bytes)
-        return od::Status::PdoLengthExceeded;
+    // Where the PDO is assigned to a SyncManager (any of its direction), that SyncManager's image must still
+    // fit.
+    for (const od::Object& a : d.objects()) {
+        if (!a.is_pdo_assignment() || a.direction != mapping_direction(d, pdo)) continue;
+        const uint8_t count = u8(d, a.index, 0);
+        bool assigned = false;
+        for (uint8_t s = 1; s <= count && s != 0; ++s)
+            assigned = assigned || u16(d, a.index, s) == pdo;
+        if (assigned && assigned_bytes(d, a.index, count, pdo, bits) > lim.max_sm_bytes)
+            return od::Status::PdoLengthExceeded;
+    }
     return od::Status::Ok;
 }
 
+// A PDO an assignment may hold: a mapping object of the assignment's direction.
 bool valid_pdo_for(const od::Dictionary& d, uint16_t assign, uint16_t pdo) {
-    bool range = assign == kRxAssign ? is_rx_mapping(pdo) : is_tx_mapping(pdo);
-    return range && d.find(pdo) != nullptr;
+    const od::PdoDirection dir = mapping_direction(d, pdo);
+    return dir != od::PdoDirection::None && dir == assignment_direction(d, assign);
 }
 
 // The PDOs an assignment holds with `count` entries.
@@ -95,7 +100,7 @@ od::Status rules_after(const od::Dictionary& d, uint16_t assign, uint8_t count,
     std::size_t n = 0;
     for (uint8_t s = 1; s <= count && s != 0; ++s)
         pdos[n++] = u16(d, assign, s);
-    return check_pdo_rules(assign, std::span<const uint16_t>(pdos.data(), n), rules);
+    return check_pdo_rules(d, assign, std::span<const uint16_t>(pdos.data(), n), rules);
 }
 
 od::Status check_assignment(const od::Dictionary& d, uint16_t assign, const od::Entry& e,
@@ -130,14 +135,32 @@ od::Status check_assignment(const od::Dictionary& d, uint16_t assign, const od::
 
 }  // namespace
 
-od::Status check_pdo_rules(uint16_t assign, std::span<const uint16_t> assigned,
+bool rule_applies(const od::Dictionary& dict, uint16_t assign, uint16_t pdo) {
+    const od::PdoDirection dir = assignment_direction(dict, assign);
+    if (dir == od::PdoDirection::None || mapping_direction(dict, pdo) != dir) return false;
+    // With several SyncManagers of one direction (EL1252's three input SMs), a PDO belongs to the one whose
+    // assignment holds it by default; with one, to that one.
+    bool others = false;
+    for (const od::Object& a : dict.objects())
+        others = others || (a.is_pdo_assignment() && a.direction == dir && a.index != assign);
+    if (!others) return true;
+    const od::Object* o = dict.find(assign);
+    const auto defaults = dict.default_raw(assign, 0);
+    const uint8_t count = defaults.empty() ? 0 : defaults[0];
+    for (uint8_t s = 1; s <= count && s != 0; ++s) {
+        const auto v = dict.default_raw(assign, s);
+        if (o->entry(s) != nullptr && v.size() >= 2 && wire::get16(v, 0) == pdo) return true;
+    }
+    return false;
+}
+
+od::Status check_pdo_rules(const od::Dictionary& dict, uint16_t assign, std::span<const uint16_t> assigned,
                            std::span<const od::PdoRule> rules) {
     auto holds = [&](uint16_t pdo) {
         return std::find(assigned.begin(), assigned.end(), pdo) != assigned.end();
     };
     for (const od::PdoRule& r : rules) {
-        const bool ours = assign == kRxAssign ? is_rx_mapping(r.pdo) : is_tx_mapping(r.pdo);
-        if (!ours) continue;
+        if (!rule_applies(dict, assign, r.pdo)) continue;
         if (r.mandatory && !holds(r.pdo)) return od::Status::Incompatible;
         if (!holds(r.pdo)) continue;
         for (uint16_t x : r.exclude)
@@ -175,11 +198,11 @@ void install_pdo_validators(od::Dictionary& dict, PdoLimits limits, std::span<co
     auto kept = std::make_shared<const std::vector<od::PdoRule>>(rules.begin(), rules.end());
     for (const auto& obj : dict.objects()) {
         const uint16_t index = obj.index;
-        if (is_rx_mapping(index) || is_tx_mapping(index)) {
+        if (obj.is_pdo_mapping()) {
             dict.add_validator(index, [d, index, limits](const od::Entry& e, std::span<const uint8_t> v) {
                 return check_mapping(*d, index, e, v, limits);
             });
-        } else if (index == kRxAssign || index == kTxAssign) {
+        } else if (obj.is_pdo_assignment()) {
             dict.add_validator(index,
                                [d, index, limits, kept](const od::Entry& e, std::span<const uint8_t> v) {
                                    return check_assignment(*d, index, e, v, limits, *kept);

@@ -122,9 +122,11 @@ od::AlState CoeServer::write_state(uint16_t index) const {
     return state();
 }
 
-bool CoeServer::is_pdo_object(uint16_t index) {
-    return (index >= 0x1600 && index <= 0x17FF) || (index >= 0x1A00 && index <= 0x1BFF) || index == 0x1C12 ||
-           index == 0x1C13;
+// A PDO mapping or assignment object as the object model declares it (od::Object::direction), wherever its
+// index lies.
+bool CoeServer::is_pdo_object(uint16_t index) const {
+    const od::Object* o = dict_.find(index);
+    return o != nullptr && o->direction != od::PdoDirection::None;
 }
 
 // The PDO mapping and assignment change only in Pre-Op (ETG.1000.6 PDO mapping and assignment: a change in

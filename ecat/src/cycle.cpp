@@ -19,6 +19,7 @@ Cycle::Cycle(StackContext& ctx, StateMachine& esm, SyncControl& sync, IrqLine ir
     if (has_mailbox(ctx_.desc)) event_mask_ |= esc::alev::sm(0);
     if (ctx_.sms.outputs < 4) event_mask_ |= esc::alev::sm(ctx_.sms.outputs);
     if (ctx_.sms.inputs < 4) event_mask_ |= esc::alev::sm(ctx_.sms.inputs);
+    base_event_mask_ = event_mask_;
     sm2_buf_.reserve(1024);
     sm3_buf_.reserve(1024);
 }
@@ -160,6 +161,19 @@ void Cycle::update_event_mask() {
 
 void Cycle::start_process_data(uint64_t now_ns) {
     ProcessData& pd = ctx_.pd;
+    // The SMs whose events drive the cycle: the first of each direction that carries PDOs (EL4732 assigns
+    // none to its first input SM), else the first of the direction; their events join the mask.
+    event_mask_ = base_event_mask_;
+    auto trigger = [this](std::span<const SmImage> images, unsigned& sm) {
+        for (const SmImage& im : images)
+            if (im.bytes > 0 && im.sm < ProcessData::kMaxSms) {
+                sm = im.sm;
+                event_mask_ |= esc::alev::sm(sm);
+                return;
+            }
+    };
+    trigger(pd.rx_sms(), out_sm_);
+    trigger(pd.tx_sms(), in_sm_);
     sm2_buf_.assign(pd.rx_bytes(), 0);
     sm3_buf_.assign(pd.tx_bytes(), 0);
     outputs_seen_ = false;
@@ -167,18 +181,21 @@ void Cycle::start_process_data(uint64_t now_ns) {
     sync_.start(now_ns);
     constexpr uint8_t kSync0ToAlEvent = 0x08;  // 0x0151 bit 3
     sync0_event_ = sync_.dc() && (ctx_.pdi.read_reg<uint8_t>(esc::reg::kSyncLatchConfig) & kSync0ToAlEvent);
-    if (pd.rx_bytes() > 0) set_sm_pdi_deactivated(ctx_.pdi, out_sm_, false);
-    if (pd.tx_bytes() > 0) {
-        set_sm_pdi_deactivated(ctx_.pdi, in_sm_, false);
-        write_inputs();  // valid inputs from the first Safe-Op frame on
-    }
+    for (const auto& images : {pd.rx_sms(), pd.tx_sms()})
+        for (const SmImage& im : images)
+            if (im.bytes > 0) set_sm_pdi_deactivated(ctx_.pdi, im.sm, false);
+    if (pd.tx_bytes() > 0) write_inputs();  // valid inputs from the first Safe-Op frame on
 }
 
 void Cycle::stop_process_data() {
     sync0_event_ = false;
-    if (ctx_.sms.outputs < 4) set_sm_pdi_deactivated(ctx_.pdi, ctx_.sms.outputs, true);
-    if (ctx_.sms.inputs < 4) set_sm_pdi_deactivated(ctx_.pdi, ctx_.sms.inputs, true);
+    for (const auto* list : {&ctx_.sms.all_outputs, &ctx_.sms.all_inputs})
+        for (const unsigned n : *list)
+            set_sm_pdi_deactivated(ctx_.pdi, n, true);
     ctx_.pd.clear();
+    out_sm_ = ctx_.sms.outputs < 4 ? ctx_.sms.outputs : 2;
+    in_sm_ = ctx_.sms.inputs < 4 ? ctx_.sms.inputs : 3;
+    event_mask_ = base_event_mask_;
     sm2_buf_.clear();
     sm3_buf_.clear();
     outputs_seen_ = false;
@@ -187,7 +204,19 @@ void Cycle::stop_process_data() {
 void Cycle::write_inputs() {
     if (sm3_buf_.empty() || (ctx_.faults.inputs_op_only && esm_.state() != AlState::Op)) return;
     ctx_.pd.dictionary_to_inputs(sm3_buf_);
-    ctx_.pdi.write(sm3_start_, sm3_buf_);
+    const std::span<const uint8_t> image(sm3_buf_);
+    for (const SmImage& im : ctx_.pd.tx_sms()) {
+        if (im.bytes == 0) continue;
+        if (inputs_on_registers(ctx_.sms, ctx_.desc, im.sm)) {
+            // An input SM on the register space carries the ESC's own registers (DC latch, system time): the
+            // device does not write them; the entries its PDOs map show them (control socket, SDO).
+            const std::span<uint8_t> part = std::span<uint8_t>(sm3_buf_).subspan(im.offset, im.bytes);
+            ctx_.pdi.read(ctx_.desc.sync_managers[im.sm].start, part);
+            ctx_.pd.inputs_to_dictionary(sm3_buf_, im);
+            continue;
+        }
+        ctx_.pdi.write(sm_start(im.sm), image.subspan(im.offset, im.bytes));
+    }
 }
 
 void Cycle::run_cycle(uint64_t now_ns, bool fresh_outputs) {
@@ -198,8 +227,12 @@ void Cycle::run_cycle(uint64_t now_ns, bool fresh_outputs) {
         fresh_outputs = false;
     }
     if (!sm2_buf_.empty()) {
-        // Reading SM2 from its first to its last byte takes the newest buffer and releases it.
-        if (fresh_outputs) ctx_.pdi.read(sm2_start_, sm2_buf_);
+        // Reading each output SM from its first to its last byte takes its newest buffer and releases it.
+        if (fresh_outputs) {
+            const std::span<uint8_t> image(sm2_buf_);
+            for (const SmImage& im : ctx_.pd.rx_sms())
+                if (im.bytes > 0) ctx_.pdi.read(sm_start(im.sm), image.subspan(im.offset, im.bytes));
+        }
         // Safe-Op: outputs are ignored, the application keeps its safe values.
         if ((esm_.state() == AlState::Op || ctx_.faults.outputs_in_safe_op) && fresh_outputs)
             ctx_.pd.outputs_to_dictionary(sm2_buf_);

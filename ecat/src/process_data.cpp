@@ -9,11 +9,15 @@ namespace ecat {
 ProcessData::ProcessData(od::Dictionary& dictionary) : dict_(dictionary) {
     rx_.reserve(kMaxEntries);
     tx_.reserve(kMaxEntries);
+    rx_sms_.reserve(kMaxSms);
+    tx_sms_.reserve(kMaxSms);
 }
 
 void ProcessData::clear() {
     rx_.clear();
     tx_.clear();
+    rx_sms_.clear();
+    tx_sms_.clear();
     rx_bits_ = 0;
     tx_bits_ = 0;
 }
@@ -37,20 +41,19 @@ bool is_padding(uint16_t index, uint8_t sub) {
 
 }  // namespace
 
-uint16_t ProcessData::build_side(uint16_t assign_index, bool rx, std::vector<PdoCopy>& plan,
-                                 std::size_t& bits) {
+uint16_t ProcessData::build_sm(unsigned sm, bool rx, std::vector<PdoCopy>& plan, std::size_t& bits) {
     const uint16_t code = rx ? esc::al::InvalidOutputMapping : esc::al::InvalidInputMapping;
-    const uint16_t first = rx ? 0x1600 : 0x1A00;
-    const uint16_t last = rx ? 0x17FF : 0x1BFF;
-    plan.clear();
-    bits = 0;
-    if (dict_.find(assign_index) == nullptr) return 0;  // no such SM: no process data in that direction
+    const od::PdoDirection dir = rx ? od::PdoDirection::Rx : od::PdoDirection::Tx;
+    const uint16_t assign_index = ProcessData::assign_index(sm);
+    if (dict_.find(assign_index) == nullptr) return 0;  // no assignment: no process data in that SM
     uint64_t pdo_count = 0;
     if (!read_unsigned(dict_, assign_index, 0, pdo_count)) return code;
     for (uint8_t i = 1; i <= pdo_count; ++i) {
         uint64_t pdo = 0;
         if (!read_unsigned(dict_, assign_index, i, pdo)) return code;
-        if (pdo < first || pdo > last || dict_.find(static_cast<uint16_t>(pdo)) == nullptr) return code;
+        // A mapping object of this direction, wherever its index lies (the object model carries it).
+        const od::Object* mapping = pdo <= 0xFFFF ? dict_.find(static_cast<uint16_t>(pdo)) : nullptr;
+        if (mapping == nullptr || !mapping->is_pdo_mapping() || mapping->direction != dir) return code;
         uint64_t entry_count = 0;
         if (!read_unsigned(dict_, static_cast<uint16_t>(pdo), 0, entry_count)) return code;
         for (uint8_t k = 1; k <= entry_count; ++k) {
@@ -77,13 +80,32 @@ uint16_t ProcessData::build_side(uint16_t assign_index, bool rx, std::vector<Pdo
     return 0;
 }
 
-uint16_t ProcessData::build(unsigned outputs_sm, unsigned inputs_sm) {
+uint16_t ProcessData::build(std::span<const unsigned> outputs_sms, std::span<const unsigned> inputs_sms) {
     clear();
     uint16_t code = 0;
-    if (outputs_sm < 32) code = build_side(assign_index(outputs_sm), true, rx_, rx_bits_);
-    if (code == 0 && inputs_sm < 32) code = build_side(assign_index(inputs_sm), false, tx_, tx_bits_);
+    auto side = [this, &code](std::span<const unsigned> sms, bool rx) {
+        std::vector<PdoCopy>& plan = rx ? rx_ : tx_;
+        std::vector<SmImage>& images = rx ? rx_sms_ : tx_sms_;
+        std::size_t& bits = rx ? rx_bits_ : tx_bits_;
+        for (const unsigned sm : sms) {
+            if (code != 0 || sm >= 32 || images.size() == kMaxSms) continue;
+            bits = (bits + 7) / 8 * 8;  // each SM's part starts on a byte of its own
+            const std::size_t first = bits;
+            code = build_sm(sm, rx, plan, bits);
+            images.push_back({sm, first / 8, (bits - first + 7) / 8});
+        }
+    };
+    side(outputs_sms, true);
+    side(inputs_sms, false);
     if (code != 0) clear();
     return code;
+}
+
+uint16_t ProcessData::build(unsigned outputs_sm, unsigned inputs_sm) {
+    const unsigned out[1] = {outputs_sm};
+    const unsigned in[1] = {inputs_sm};
+    return build(std::span<const unsigned>(out, outputs_sm < 32 ? 1 : 0),
+                 std::span<const unsigned>(in, inputs_sm < 32 ? 1 : 0));
 }
 
 void ProcessData::copy_bits(const uint8_t* src, std::size_t src_bit, uint8_t* dst, std::size_t dst_bit,
@@ -115,6 +137,15 @@ void ProcessData::dictionary_to_inputs(std::span<uint8_t> sm3) const {
     for (const PdoCopy& c : tx_) {
         if (c.bit_offset + c.bits > sm3.size() * 8) continue;
         copy_bits(c.storage, 0, sm3.data(), c.bit_offset, c.bits);
+    }
+}
+
+void ProcessData::inputs_to_dictionary(std::span<const uint8_t> sm3, const SmImage& part) const {
+    const std::size_t first = part.offset * 8, end = (part.offset + part.bytes) * 8;
+    for (const PdoCopy& c : tx_) {
+        if (c.bit_offset < first || c.bit_offset + c.bits > end || c.bit_offset + c.bits > sm3.size() * 8)
+            continue;
+        copy_bits(sm3.data(), c.bit_offset, c.storage, 0, c.bits);
     }
 }
 

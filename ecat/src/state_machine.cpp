@@ -1,6 +1,7 @@
 #include "ecat/state_machine.hpp"
 
 #include <algorithm>
+#include <array>
 
 #include "ecat/cycle.hpp"
 #include "ecat/sync_control.hpp"
@@ -266,8 +267,8 @@ uint16_t StateMachine::check_pre_op_to_safe_op() {
         const uint64_t kind = sync_.sm_type(n, static_cast<uint64_t>(desc.sync_managers[n].kind));
         if (kind != static_cast<uint64_t>(desc.sync_managers[n].kind)) return al::InvalidSmTypes;
     }
-    // Take over the PDO assignment and mapping.
-    if (const uint16_t code = pd.build(ctx_.sms.outputs, ctx_.sms.inputs); code != 0) return code;
+    // Take over the PDO assignment and mapping of every process-data SM.
+    if (const uint16_t code = pd.build(ctx_.sms.all_outputs, ctx_.sms.all_inputs); code != 0) return code;
 
     struct Side {
         unsigned sm;
@@ -276,14 +277,21 @@ uint16_t StateMachine::check_pre_op_to_safe_op() {
         uint16_t code;
         uint8_t fallback_control;
     };
-    const Side sides[2] = {
-        {ctx_.sms.outputs, pd.rx_bytes(), esc::reg::kSmDirWrite, al::InvalidOutputConfig, 0x64},
-        {ctx_.sms.inputs, pd.tx_bytes(), esc::reg::kSmDirRead, al::InvalidInputConfig, 0x20}};
-    SmRegs regs[4];
-    for (unsigned n = 0; n < 4; ++n)
+    // Each process-data SM with the length its own assignment gives (ETG.1000.6: 0x1C10 + n for SM n).
+    std::array<Side, 2 * ProcessData::kMaxSms> sides{};
+    std::size_t n_sides = 0;
+    for (const SmImage& im : pd.rx_sms())
+        sides[n_sides++] = {im.sm, im.bytes, esc::reg::kSmDirWrite, al::InvalidOutputConfig, 0x64};
+    for (const SmImage& im : pd.tx_sms())
+        if (!inputs_on_registers(ctx_.sms, desc, im.sm))
+            sides[n_sides++] = {im.sm, im.bytes, esc::reg::kSmDirRead, al::InvalidInputConfig, 0x20};
+    SmRegs regs[ProcessData::kMaxSms];
+    const std::size_t sm_regs = std::clamp<std::size_t>(desc.sync_managers.size(), 4, ProcessData::kMaxSms);
+    for (unsigned n = 0; n < sm_regs; ++n)
         regs[n] = read_sm(ctx_.pdi, n);
-    for (const Side& s : sides) {
-        if (s.sm >= 4) {
+    for (std::size_t i = 0; i < n_sides; ++i) {
+        const Side& s = sides[i];
+        if (s.sm >= sm_regs) {
             // No SM for this direction (a device with inputs only, or none): nothing mapped to check.
             if (s.bytes != 0) return s.code;
             continue;
@@ -291,9 +299,16 @@ uint16_t StateMachine::check_pre_op_to_safe_op() {
         const SmRegs& r = regs[s.sm];
         const bool enabled = (r.activate & esc::reg::kSmEnable) && r.length > 0;
         if (s.bytes == 0) {
-            if (enabled) return s.code;
+            // The first SM of a direction must be off without PDOs; a further one without PDOs (iTegva's
+            // second output byte, whose SM a master may enable with the FMMU over both) is left as it is.
+            if (enabled && (s.sm == ctx_.sms.outputs || s.sm == ctx_.sms.inputs)) return s.code;
             continue;
         }
+        // A further SM of a direction that the master leaves off: its PDOs are not exchanged (a master that
+        // handles one SM per direction, as the project's own master library does), as an unused SM's. One
+        // that is on must be as its assignment says.
+        const bool first = s.sm == ctx_.sms.outputs || s.sm == ctx_.sms.inputs;
+        if (!enabled && !first) continue;
         if (!enabled ||
             (r.length != s.bytes && !(s.sm == ctx_.sms.outputs && ctx_.faults.sm2_length_unchecked)))
             return s.code;
@@ -319,9 +334,9 @@ uint16_t StateMachine::check_pre_op_to_safe_op() {
     struct Area {
         uint32_t begin, end;
     };
-    Area areas[4];
+    Area areas[ProcessData::kMaxSms];
     std::size_t count = 0;
-    for (unsigned n = 0; n < 4; ++n) {
+    for (unsigned n = 0; n < sm_regs; ++n) {
         const SmRegs& r = regs[n];
         if (!(r.activate & esc::reg::kSmEnable) || r.length == 0) continue;
         const bool buffers = (r.control & esc::reg::kSmModeMask) == esc::reg::kSmModeBuffered &&
@@ -333,8 +348,10 @@ uint16_t StateMachine::check_pre_op_to_safe_op() {
         for (std::size_t j = i + 1; j < count; ++j)
             if (areas[i].begin < areas[j].end && areas[j].begin < areas[i].end) return al::InvalidSmConfig;
 
-    cycle_.set_sm_starts(ctx_.sms.outputs < 4 ? regs[ctx_.sms.outputs].start : 0,
-                         ctx_.sms.inputs < 4 ? regs[ctx_.sms.inputs].start : 0);
+    std::array<uint16_t, ProcessData::kMaxSms> starts{};
+    for (unsigned n = 0; n < sm_regs; ++n)
+        starts[n] = regs[n].start;
+    cycle_.set_sm_starts(starts);
     if (const uint16_t code = sync_.configure(); code != 0) return code;
     return check_watchdog();
 }
@@ -357,19 +374,23 @@ void StateMachine::check_process_data_sms(uint64_t now_ns) {
     // The master changed an SM while process data runs: SM2/SM3 must still be what Safe-Op was entered
     // with (ETG.1000.6 AL status codes 0x001D / 0x001E, Op or Safe-Op -> Safe-Op with error).
     auto still_valid = [this](unsigned n, std::size_t bytes, uint16_t start_address) {
-        if (n >= 4) return true;  // no SM for this direction
+        if (n >= ProcessData::kMaxSms) return true;  // no SM for this direction
         const SmRegs r = read_sm(ctx_.pdi, n);
         const bool enabled = (r.activate & esc::reg::kSmEnable) && r.length > 0;
-        if (bytes == 0) return !enabled;
+        const bool first = n == ctx_.sms.outputs || n == ctx_.sms.inputs;
+        if (bytes == 0 || (!enabled && !first)) return !enabled || !first;
         const bool length_ok =
             r.length == bytes || (n == ctx_.sms.outputs && ctx_.faults.sm2_length_unchecked);
         return enabled && length_ok && r.start == start_address;
     };
-    if (!still_valid(ctx_.sms.outputs, cycle_.output_bytes(), cycle_.sm2_start())) {
-        fall_back(AlState::SafeOp, al::InvalidOutputConfig, now_ns);
-    } else if (!still_valid(ctx_.sms.inputs, cycle_.input_bytes(), cycle_.sm3_start())) {
-        fall_back(AlState::SafeOp, al::InvalidInputConfig, now_ns);
-    }
+    // Every SM of both directions, each with its own part of the image.
+    for (const SmImage& im : ctx_.pd.rx_sms())
+        if (!still_valid(im.sm, im.bytes, cycle_.sm_start(im.sm)))
+            return fall_back(AlState::SafeOp, al::InvalidOutputConfig, now_ns);
+    for (const SmImage& im : ctx_.pd.tx_sms())
+        if (!inputs_on_registers(ctx_.sms, ctx_.desc, im.sm) &&
+            !still_valid(im.sm, im.bytes, cycle_.sm_start(im.sm)))
+            return fall_back(AlState::SafeOp, al::InvalidInputConfig, now_ns);
 }
 
 bool StateMachine::op_conditions_met() {

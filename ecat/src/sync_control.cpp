@@ -52,7 +52,15 @@ void SyncControl::set_u(uint16_t index, uint8_t sub, uint64_t value) {
     internal_write_ = false;
 }
 
+// 0x1C00 as the SyncManager type object; not a PDO a device without CoE names 0x1C00 (EL1262's TxPdo
+// 0x1C00: its mapping object, docs/decisions/esi.md "PDOs at any index").
+bool SyncControl::has_sm_type_object() const {
+    const od::Object* o = ctx_.dict.find(kSmType);
+    return o != nullptr && !o->is_pdo_mapping();
+}
+
 uint64_t SyncControl::sm_type(unsigned n, uint64_t fallback) const {
+    if (!has_sm_type_object()) return fallback;
     return get_u(kSmType, static_cast<uint8_t>(n + 1), fallback);
 }
 
@@ -60,7 +68,7 @@ void SyncControl::init_objects() {
     od::Dictionary& dict = ctx_.dict;
     const od::DeviceDescription& desc = ctx_.desc;
     // 0x1C00 reflects the SyncManager types of the description.
-    if (dict.find(kSmType) != nullptr && !desc.sync_managers.empty()) {
+    if (has_sm_type_object() && !desc.sync_managers.empty()) {
         for (std::size_t i = 0; i < desc.sync_managers.size() && i < 255; ++i)
             set_u(kSmType, static_cast<uint8_t>(i + 1), static_cast<uint8_t>(desc.sync_managers[i].kind));
     }

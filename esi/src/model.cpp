@@ -25,13 +25,6 @@ uint64_t default_of(const od::Entry* e) {
     return number_bits(e->default_value, e->type, e->bit_length).value_or(0);
 }
 
-bool is_rx_mapping(uint16_t index) {
-    return index >= 0x1600 && index <= 0x17FF;
-}
-bool is_tx_mapping(uint16_t index) {
-    return index >= 0x1A00 && index <= 0x1BFF;
-}
-
 void read_mapping(const od::Dictionary& dict, const od::Object& obj, PdoInfo& pdo,
                   std::vector<std::string>& warnings) {
     const od::Entry* count_entry = obj.entry(0);
@@ -107,12 +100,13 @@ std::optional<uint64_t> number_bits(const od::Number& n, od::DataType type, uint
 DeviceModel derive_model(const od::DeviceDescription& d, const od::Dictionary& dict) {
     DeviceModel m;
 
-    // ---- PDOs: every mapping object with its default mapping ----
+    // ---- PDOs: every mapping object with its default mapping, in the direction the object model declares
+    // (od::Object::direction), wherever its index lies ----
     for (const od::Object& obj : dict.objects()) {
-        if (!is_rx_mapping(obj.index) && !is_tx_mapping(obj.index)) continue;
+        if (!obj.is_pdo_mapping()) continue;
         PdoInfo pdo;
         pdo.index = obj.index;
-        pdo.rx = is_rx_mapping(obj.index);
+        pdo.rx = obj.rx();
         pdo.name = obj.name;
         read_mapping(dict, obj, pdo, m.warnings);
         m.pdos.push_back(std::move(pdo));

@@ -264,6 +264,7 @@ void Dictionary::add(Object object) {
     if (pos != im.objects.size()) {
         throw std::logic_error(util::strprintf("od: duplicate object 0x%04X", object.index));
     }
+    if (object.direction == PdoDirection::None) object.direction = standard_pdo_direction(object.index);
     std::sort(object.entries.begin(), object.entries.end(),
               [](const Entry& a, const Entry& b) { return a.subindex < b.subindex; });
     for (std::size_t i = 1; i < object.entries.size(); ++i)

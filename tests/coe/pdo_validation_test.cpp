@@ -6,6 +6,7 @@
 #include "coe/sdo_server.hpp"
 #include "coe_test_support.hpp"
 #include "maxpos/maxpos.hpp"
+#include "support/pdo_objects.hpp"
 
 using namespace coe_test;
 
@@ -228,6 +229,7 @@ TEST_F(MandatoryPdoRules, CountZeroOpensTheAssignmentTheCountIsChecked) {
 }
 
 TEST(PdoRules, MandatoryAndExcludeChecks) {
+    const od::Dictionary dict = maxpos::dictionary(maxpos::description());
     std::vector<od::PdoRule> rules(3);
     rules[0].pdo = 0x1600;
     rules[0].mandatory = true;
@@ -236,12 +238,54 @@ TEST(PdoRules, MandatoryAndExcludeChecks) {
     rules[2].pdo = 0x1A00;
     rules[2].mandatory = true;
     const std::vector<uint16_t> ok{0x1600, 0x1601}, no_mandatory{0x1601}, excluded{0x1600, 0x1602, 0x1601};
-    EXPECT_EQ(coe::check_pdo_rules(0x1C12, ok, rules), od::Status::Ok);
-    EXPECT_EQ(coe::check_pdo_rules(0x1C12, no_mandatory, rules), od::Status::Incompatible);
-    EXPECT_EQ(coe::check_pdo_rules(0x1C12, {}, rules), od::Status::Incompatible);
-    EXPECT_EQ(coe::check_pdo_rules(0x1C12, excluded, rules), od::Status::Incompatible);
+    EXPECT_EQ(coe::check_pdo_rules(dict, 0x1C12, ok, rules), od::Status::Ok);
+    EXPECT_EQ(coe::check_pdo_rules(dict, 0x1C12, no_mandatory, rules), od::Status::Incompatible);
+    EXPECT_EQ(coe::check_pdo_rules(dict, 0x1C12, {}, rules), od::Status::Incompatible);
+    EXPECT_EQ(coe::check_pdo_rules(dict, 0x1C12, excluded, rules), od::Status::Incompatible);
     // 0x1C13's rules do not apply to 0x1C12 and the other way round.
     const std::vector<uint16_t> tx{0x1A00};
-    EXPECT_EQ(coe::check_pdo_rules(0x1C13, tx, rules), od::Status::Ok);
-    EXPECT_EQ(coe::check_pdo_rules(0x1C13, {}, rules), od::Status::Incompatible);
+    EXPECT_EQ(coe::check_pdo_rules(dict, 0x1C13, tx, rules), od::Status::Ok);
+    EXPECT_EQ(coe::check_pdo_rules(dict, 0x1C13, {}, rules), od::Status::Incompatible);
+}
+
+// A PDO's direction is what the object model declares (od::Object::direction), not its index range: the
+// evaluation boards' ESIs name an RxPdo 0x1A00 and a TxPdo 0x1600 (from the controller's side), EL1262 a
+// TxPdo 0x1C00. The assignment of SM2 takes the RxPDO 0x1A00 and refuses the TxPDO 0x1600, and the mapping
+// objects check their entries in their own direction.
+TEST(PdoDirection, ComesFromTheObjectModelWhereverTheIndexLies) {
+    od::Dictionary dict;
+    const uint16_t rx = od::access::RW | od::access::RxPdo, tx = od::access::RO | od::access::TxPdo;
+    dict.add(test_support::pdo_var(0x7000, od::DataType::Unsigned16, 16, rx));
+    dict.add(test_support::pdo_var(0x6000, od::DataType::Unsigned16, 16, tx));
+    auto object = [&](uint16_t index, od::PdoDirection dir, od::DataType type, std::vector<uint64_t> values) {
+        dict.add(test_support::pdo_array(index, dir, type, values));
+    };
+    object(0x1A00, od::PdoDirection::Rx, od::DataType::Unsigned32, {0x70000010});
+    object(0x1600, od::PdoDirection::Tx, od::DataType::Unsigned32, {0x60000010});
+    object(0x1C00, od::PdoDirection::Tx, od::DataType::Unsigned32, {0x60000010});
+    object(0x1C12, od::PdoDirection::Rx, od::DataType::Unsigned16, {0x1A00});
+    object(0x1C13, od::PdoDirection::Tx, od::DataType::Unsigned16, {0x1600, 0x1C00});
+    EXPECT_TRUE(dict.find(0x1C00)->is_pdo_mapping());
+    EXPECT_TRUE(dict.find(0x1C12)->is_pdo_assignment());
+    coe::install_pdo_validators(dict);
+    coe::CoeServer server{dict, [] { return od::AlState::PreOp; }};
+    RecordingSender out;
+    auto write = [&](uint16_t index, uint8_t sub, uint32_t value, uint8_t bytes) {
+        return expedited_download(server, out, index, sub, value, bytes);
+    };
+    EXPECT_EQ(write(0x1C12, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1C12, 1, 0x1600, 2), 0x06090030u);  // a TxPDO: not for an outputs SM
+    EXPECT_EQ(write(0x1C12, 1, 0x1A00, 2), 0u);           // the RxPDO at 0x1A00
+    EXPECT_EQ(write(0x1C12, 0, 1, 1), 0u);
+    EXPECT_EQ(write(0x1C13, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1C13, 1, 0x1A00, 2), 0x06090030u);
+    EXPECT_EQ(write(0x1C13, 1, 0x1C00, 2), 0u);  // the TxPDO at 0x1C00
+    EXPECT_EQ(write(0x1C13, 0, 1, 1), 0u);
+    // The RxPDO 0x1A00 maps outputs, not inputs; the TxPDO 0x1600 the other way round.
+    EXPECT_EQ(write(0x1A00, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1A00, 1, 0x60000010, 4), 0x06040041u);
+    EXPECT_EQ(write(0x1A00, 1, 0x70000010, 4), 0u);
+    EXPECT_EQ(write(0x1600, 0, 0, 1), 0u);
+    EXPECT_EQ(write(0x1600, 1, 0x70000010, 4), 0x06040041u);
+    EXPECT_EQ(write(0x1600, 1, 0x60000010, 4), 0u);
 }

@@ -1,8 +1,10 @@
-// Process data: the copy plan built from 0x1C12/0x1C13 and the mapping objects, bit-exact copies, and the
-// SM2 -> dictionary -> application -> dictionary -> SM3 path through LRW frames.
+// Process data: the copy plan built from 0x1C12/0x1C13 (0x1C10 + n of every process-data SM) and the mapping
+// objects, bit-exact copies, and the SM2 -> dictionary -> application -> dictionary -> SM3 path through LRW
+// frames (every SM of a direction where a device has several).
 #include <cstring>
 
 #include "fixture.hpp"
+#include "support/pdo_objects.hpp"
 
 namespace ecat::test {
 namespace {
@@ -265,6 +267,169 @@ TEST_F(ProcessDataLrw, CycleAllocatesNothing_PlanStable) {
     EXPECT_EQ(stack->process_data().rx_plan().data(), plan);
     EXPECT_EQ(dict.get<int32_t>(0x607A, 0), 99);
     EXPECT_GE(stack->stats().cycles, 100u);
+}
+
+// ---- Several SMs of one direction, PDOs at any index ----------------------------------------------------
+// A device with two output SMs (SM2, SM4) and two input SMs (SM3, SM5), each with its own assignment
+// (0x1C10 + n) and PDOs whose direction the object model declares wherever their index lies (RxPDO 0x1800,
+// TxPDO 0x1C00; EL2262, EL1262): each SM is checked against its own length, and outputs and inputs flow
+// through every SM.
+using test_support::pdo_array;
+using test_support::pdo_var;
+
+class SeveralSms : public StackTest {
+  protected:
+    void SetUp() override {
+        using od::PdoDirection;
+        const uint16_t rx = od::access::RW | od::access::RxPdo, tx = od::access::RO | od::access::TxPdo;
+        dict = od::Dictionary();
+        dict.add(pdo_var(0x7000, od::DataType::Unsigned16, 16, rx));
+        dict.add(pdo_var(0x7010, od::DataType::Unsigned8, 8, rx));
+        dict.add(pdo_var(0x6000, od::DataType::Unsigned16, 16, tx));
+        dict.add(pdo_var(0x6010, od::DataType::Unsigned8, 8, tx));
+        dict.add(pdo_array(0x1600, PdoDirection::Rx, od::DataType::Unsigned32, {0x70000010}));
+        dict.add(pdo_array(0x1800, PdoDirection::Rx, od::DataType::Unsigned32, {0x70100008}));
+        dict.add(pdo_array(0x1A00, PdoDirection::Tx, od::DataType::Unsigned32, {0x60000010}));
+        dict.add(pdo_array(0x1C00, PdoDirection::Tx, od::DataType::Unsigned32, {0x60100008}));
+        dict.add(pdo_array(0x1C12, PdoDirection::Rx, od::DataType::Unsigned16, {0x1600}));
+        dict.add(pdo_array(0x1C13, PdoDirection::Tx, od::DataType::Unsigned16, {0x1A00}));
+        dict.add(pdo_array(0x1C14, PdoDirection::Rx, od::DataType::Unsigned16, {0x1800}));
+        dict.add(pdo_array(0x1C15, PdoDirection::Tx, od::DataType::Unsigned16, {0x1C00}));
+        desc.sync_managers.resize(6);
+        const od::SmKind kinds[6] = {od::SmKind::MBoxOut, od::SmKind::MBoxIn,  od::SmKind::Outputs,
+                                     od::SmKind::Inputs,  od::SmKind::Outputs, od::SmKind::Inputs};
+        const uint16_t starts[6] = {0x1000, 0x1080, 0x1100, 0x1200, 0x1300, 0x1400};
+        for (unsigned n = 0; n < 6; ++n) {
+            desc.sync_managers[n].kind = kinds[n];
+            desc.sync_managers[n].start = starts[n];
+            desc.sync_managers[n].control = od::default_sm_control(kinds[n]);
+        }
+        start();
+    }
+    // SM2 2 bytes + SM4 1 byte of outputs at kLogical, SM3 2 bytes + SM5 1 byte of inputs behind them.
+    void configure_all(uint16_t sm4_length = 1) {
+        configure_sm(2, 0x1100, 2, 0x64, true);
+        configure_sm(3, 0x1200, 2, 0x20, true);
+        configure_sm(4, 0x1300, sm4_length, 0x64, true);
+        configure_sm(5, 0x1400, 1, 0x20, true);
+        configure_fmmu(0, kLogical, 2, 0x1100, 2);
+        configure_fmmu(1, kLogical + 2, 1, 0x1300, 2);
+        configure_fmmu(2, kLogical + 3, 2, 0x1200, 1);
+        configure_fmmu(3, kLogical + 5, 1, 0x1400, 1);
+        rx_bytes = 3;
+        tx_bytes = 3;
+    }
+};
+
+TEST_F(SeveralSms, EachSmCarriesItsOwnPdosBothWays) {
+    go_preop();
+    configure_all();
+    request(0x04);
+    ASSERT_EQ(al_status(), 0x04) << "code " << std::hex << al_code();
+    const ProcessData& pd = stack->process_data();
+    ASSERT_EQ(pd.rx_sms().size(), 2u);
+    EXPECT_EQ(pd.rx_sms()[1].sm, 4u);
+    EXPECT_EQ(pd.rx_sms()[1].offset, 2u);
+    EXPECT_EQ(pd.rx_sms()[1].bytes, 1u);
+    ASSERT_EQ(pd.tx_sms().size(), 2u);
+    EXPECT_EQ(pd.tx_sms()[1].sm, 5u);
+    EXPECT_EQ(pd.rx_bytes(), 3u);
+    EXPECT_EQ(pd.tx_bytes(), 3u);
+    std::vector<uint8_t> in(3);
+    const std::vector<uint8_t> out{0x34, 0x12, 0x56};
+    exchange_pd(out, in);
+    poll();
+    request(0x08);
+    ASSERT_EQ(al_status(), 0x08) << "code " << std::hex << al_code();
+    app.cycle_hook = [this] {
+        // Each input follows its output: the second pair travels through SM4 and SM5 only.
+        dict.set<uint16_t>(0x6000, 0, static_cast<uint16_t>(dict.get<uint16_t>(0x7000, 0) + 1));
+        dict.set<uint8_t>(0x6010, 0, static_cast<uint8_t>(dict.get<uint8_t>(0x7010, 0) + 1));
+    };
+    EXPECT_EQ(exchange_pd(out, in), 3);  // read + write
+    poll();
+    EXPECT_EQ(dict.get<uint16_t>(0x7000, 0), 0x1234);
+    EXPECT_EQ(dict.get<uint8_t>(0x7010, 0), 0x56);
+    exchange_pd(out, in);
+    poll();
+    exchange_pd(out, in);
+    EXPECT_EQ(in[0] | (in[1] << 8), 0x1235);
+    EXPECT_EQ(in[2], 0x57);
+    // The SM type object is not written over the TxPDO 0x1C00 (a device without CoE names PDOs so).
+    EXPECT_EQ(dict.get<uint32_t>(0x1C00, 1), 0x60100008u);
+}
+
+TEST_F(SeveralSms, EachSmIsCheckedAgainstTheLengthOfItsOwnAssignment) {
+    go_preop();
+    configure_all(2);  // SM4 carries 1 byte, not 2
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x12);  // Pre-Op with error
+    EXPECT_EQ(al_code(), 0x001D);  // invalid output configuration
+}
+
+// A master that handles one SM per direction leaves SM4/SM5 off: the first SMs' PDOs are exchanged, the
+// others' not, as an unused SM's.
+TEST_F(SeveralSms, AFurtherSmTheMasterLeavesOffIsNotExchanged) {
+    go_preop();
+    configure_all();
+    configure_sm(4, 0x1300, 1, 0x64, false);
+    configure_sm(5, 0x1400, 1, 0x20, false);
+    request(0x04);
+    ASSERT_EQ(al_status(), 0x04) << "code " << std::hex << al_code();
+}
+
+// The first output SM without PDOs (EL4732 assigns none to its first input SM): the next one that carries
+// PDOs drives the cycle, so its outputs are seen and taken and Op is reached.
+TEST_F(SeveralSms, TheFirstSmThatCarriesPdosDrivesTheCycle) {
+    ASSERT_EQ(dict.set<uint8_t>(0x1C12, 0, 0), od::Status::Ok);
+    go_preop();
+    configure_all();
+    configure_sm(2, 0x1100, 2, 0x64, false);  // no PDOs: off
+    request(0x04);
+    ASSERT_EQ(al_status(), 0x04) << "code " << std::hex << al_code();
+    std::vector<uint8_t> in(3);
+    const std::vector<uint8_t> out{0, 0, 0x56};
+    exchange_pd(out, in);
+    poll();
+    request(0x08);
+    for (int i = 0; i < 3 && al_status() != 0x08; ++i) {
+        exchange_pd(out, in);
+        advance(1'000'000);
+    }
+    ASSERT_EQ(al_status(), 0x08) << "code " << std::hex << al_code();
+    exchange_pd(out, in);
+    poll();
+    EXPECT_EQ(dict.get<uint8_t>(0x7010, 0), 0x56);
+}
+
+// An input SM after the first on the register space (EL1252's Virtual SM over the DC system time 0x0910): the
+// device writes nothing there (the master reads the register by an FMMU alone), and the entry its PDO maps
+// shows the register's value.
+TEST_F(SeveralSms, AnInputSmOnTheRegisterSpaceShowsTheEscsRegisters) {
+    const uint16_t tx = od::access::RO | od::access::TxPdo;
+    dict.add(pdo_var(0x2000, od::DataType::Unsigned64, 64, tx));
+    dict.add(pdo_array(0x1B00, od::PdoDirection::Tx, od::DataType::Unsigned32, {0x20000040}));
+    ASSERT_EQ(dict.set<uint16_t>(0x1C15, 1, 0x1B00), od::Status::Ok);
+    desc.sync_managers[5].start = 0x0910;
+    start();
+    go_preop();
+    configure_all();
+    configure_sm(5, 0x0910, 8, 0x20, false);  // not configured: only an FMMU over the register
+    request(0x04);
+    ASSERT_EQ(al_status(), 0x04) << "code " << std::hex << al_code();
+    const uint64_t shown = dict.get<uint64_t>(0x2000, 0);
+    EXPECT_NE(shown, 0u);
+    EXPECT_EQ(shown, master.rd<uint64_t>(0x0910));
+}
+
+TEST_F(SeveralSms, APdoOfTheOtherDirectionIsRefusedWhereverItsIndexLies) {
+    // 0x1C14 (SM4, outputs) assigning the TxPDO 0x1C00: an invalid output mapping.
+    ASSERT_EQ(dict.set<uint16_t>(0x1C14, 1, 0x1C00), od::Status::Ok);
+    go_preop();
+    configure_all();
+    request(0x04);
+    EXPECT_EQ(al_status(), 0x12);
+    EXPECT_EQ(al_code(), 0x0025);
 }
 
 }  // namespace

@@ -278,6 +278,79 @@ class EsiDevices(unittest.TestCase):
                         mm.close()
                     self.assertTrue(bus.slave_alive(), bus.slave_output())
 
+    def test_every_sm_of_a_direction_carries_its_own_pdos(self):
+        """A terminal with two output and two input SyncManagers (tests/esi/fixtures/several-sms.xml: RxPdo 0x1600
+        on SM0, RxPdo 0x1800 on SM1, TxPdo 0x1A00 on SM2, TxPdo 0x1C00 on SM3): a master that configures all
+        four as the SII says gets the outputs of both output SMs into the device and the inputs (which mirror
+        them: same names and types) back through both input SMs; one that sets the second output SM up with
+        another length is refused SAFEOP (0x001D); one that leaves the second SMs off (a master of one SM per
+        direction) exchanges the first ones' PDOs only."""
+        d = {"file": os.path.join(HERE, "..", "esi", "fixtures", "several-sms.xml"), "spec": "EXD2262"}
+        bus, ctl = self.serve(d)
+        with bus:
+            bus.ecatctl("scan")  # station address 0x1001
+            mm = harness.MiniMaster(bus)
+            try:
+                sms = [(0x1000, 2, 0x64), (0x1200, 2, 0x64), (0x1400, 2, 0x20), (0x1600, 2, 0x20)]
+
+                def configure(count, sm1_length=2):
+                    """The SMs and FMMUs as the SII gives them: all four, or (count 1) the first of each direction."""
+                    fm = b""
+                    for n, (start, length, control) in enumerate(sms):
+                        used = count == 2 or n in (0, 2)
+                        mm.fpwr(0x1001, 0x0800 + 8 * n, bytes(8))
+                        if used:
+                            length = sm1_length if n == 1 else length
+                            mm.fpwr(0x1001, 0x0800 + 8 * n, struct.pack("<HHBBBB", start, length, control, 0, 1, 0))
+                        fm += struct.pack("<IHBBHBBBxxx", 0x10000 + 2 * n, length, 0, 7, start, 0,
+                                          2 if control == 0x64 else 1, 1 if used else 0)
+                    mm.fpwr(0x1001, 0x0600, fm)
+
+                def state(want):
+                    mm.fpwr(0x1001, 0x0120, struct.pack("<H", want))
+                    deadline = time.monotonic() + 5
+                    while True:
+                        al = struct.unpack("<H", mm.fprd(0x1001, 0x0130, 2))[0]
+                        if (al & 0x0F) == want or al & 0x10 or time.monotonic() > deadline:
+                            return al
+                        time.sleep(0.01)
+
+                def cycle(out, n):
+                    r = None
+                    for _ in range(n):
+                        r = mm.txrx([(harness.LRW, 0x0000, 0x0001, out + bytes(4))]) or r
+                        time.sleep(0.001)
+                    return r
+
+                def to_op(out):
+                    for want in (4, 8):
+                        mm.fpwr(0x1001, 0x0120, struct.pack("<H", want))
+                        cycle(out, 20)
+                        self.assertEqual(state(want), want, f"AL code 0x{mm.al_code(0x1001):04x}")
+                    r = cycle(out, 20)
+                    self.assertIsNotNone(r)
+                    self.assertEqual(r[0][1], 3)  # read + write
+                    return r[0][0][4:]
+
+                self.assertEqual(state(2), 2)
+                configure(2, sm1_length=1)
+                self.assertEqual(state(4), 0x12)
+                self.assertEqual(mm.al_code(0x1001), 0x001D)
+                mm.fpwr(0x1001, 0x0120, struct.pack("<H", 0x12))  # acknowledge, back to PREOP
+                self.assertEqual(state(2), 2)
+                configure(2)
+                out = bytes([0x34, 0x12, 0x56, 0x78])
+                self.assertEqual(to_op(out), out, "the inputs of SM2 and SM3 mirror the outputs of SM0 and SM1")
+                status = harness.control(ctl, "status")
+                self.assertIn('0x7010:01 "Channel 2"=86', status)
+                self.assertIn('0x7010:02 "Channel 2 extra"=120', status)
+                self.assertEqual(state(2), 2)
+                configure(1)
+                self.assertEqual(to_op(bytes([0x78, 0x56, 0, 0]))[:2], bytes([0x78, 0x56]))
+            finally:
+                mm.close()
+            self.assertTrue(bus.slave_alive(), bus.slave_output())
+
     def test_modular_devices_serve_the_modules_their_spec_chooses(self):
         """A modular device (Slots/Modules) with another module configuration than the default, chosen in the
         device spec (SPEC@MODULE,MODULE,...): slot n takes the module after its default in the list it offers. The

@@ -90,7 +90,7 @@ class CoeServer final : public ecat::MailboxHandler {
     void send_abort(uint16_t index, uint8_t sub, uint32_t code, ecat::MailboxSender& out);
     void confirm_download(uint16_t index, uint8_t sub, ecat::MailboxSender& out);  // faults only
     od::AlState write_state(uint16_t index) const;
-    static bool is_pdo_object(uint16_t index);
+    bool is_pdo_object(uint16_t index) const;
     bool pdo_locked(uint16_t index) const;
     void cancel_transfer();
 

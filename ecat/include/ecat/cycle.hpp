@@ -2,8 +2,10 @@
 // The cycle of ecat::Stack: the poll loop (AL event request 0x0220 and its dispatch to the state machine,
 // the mailbox and the process data), the ESC-reset restart, the process-data watchdog, and the process data
 // exchange itself (SM2 outputs into the dictionary, the application cycle, inputs out through SM3; other SMs
-// where the description puts the process data) at the moments SyncControl says. It owns the process-data
-// images (sized at Safe-Op, never per frame) and the interrupt-line bookkeeping.
+// where the description puts the process data, every SM of a direction where it has several) at the moments
+// SyncControl says. It owns the process-data images (sized at Safe-Op, never per frame) and the
+// interrupt-line bookkeeping.
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -56,16 +58,14 @@ class Cycle {
     uint64_t last_now_ns() const { return last_now_ns_; }
 
     // Process data, started at Safe-Op entry and stopped when leaving the process-data states.
-    void set_sm_starts(uint16_t sm2, uint16_t sm3) {
-        sm2_start_ = sm2;
-        sm3_start_ = sm3;
-    }
+    // The start address of each SM as the master configured it (SM n at [n]).
+    void set_sm_starts(const std::array<uint16_t, ProcessData::kMaxSms>& starts) { sm_start_ = starts; }
     void start_process_data(uint64_t now_ns);
     void stop_process_data();
+    // The whole output/input image (every SM of the direction, ctx_.pd's SmImage parts).
     std::size_t output_bytes() const { return sm2_buf_.size(); }
     std::size_t input_bytes() const { return sm3_buf_.size(); }
-    uint16_t sm2_start() const { return sm2_start_; }
-    uint16_t sm3_start() const { return sm3_start_; }
+    uint16_t sm_start(unsigned n) const { return n < sm_start_.size() ? sm_start_[n] : 0; }
     bool outputs_seen() const { return outputs_seen_; }
 
     // Whether the interrupt line covers every SM event the stack waits on (SM control bit 5 set).
@@ -86,14 +86,16 @@ class Cycle {
     IrqLine irq_;
 
     uint32_t event_mask_ = kEventMask;
-    uint32_t written_mask_ = 0;  // 0x0204 as this stack last wrote it
-    bool sync0_event_ = false;   // process data runs DC-synchronous and 0x0151 maps SYNC0 to 0x0220
-    unsigned out_sm_ = 2;  // ctx_.sms, kNoSm mapped to an SM that is never used (its buffer stays empty)
+    uint32_t base_event_mask_ = kEventMask;  // outside the process-data states
+    uint32_t written_mask_ = 0;              // 0x0204 as this stack last wrote it
+    bool sync0_event_ = false;  // process data runs DC-synchronous and 0x0151 maps SYNC0 to 0x0220
+    // The SMs whose events drive the cycle: ctx_.sms (kNoSm mapped to an SM that is never used, its buffer
+    // stays empty), in the process-data states the first of each direction that carries PDOs.
+    unsigned out_sm_ = 2;
     unsigned in_sm_ = 3;
-    std::vector<uint8_t> sm2_buf_;
-    std::vector<uint8_t> sm3_buf_;
-    uint16_t sm2_start_ = 0;
-    uint16_t sm3_start_ = 0;
+    std::vector<uint8_t> sm2_buf_;  // the output image: every output SM's part (ProcessData::rx_sms())
+    std::vector<uint8_t> sm3_buf_;  // the input image: every input SM's part (ProcessData::tx_sms())
+    std::array<uint16_t, ProcessData::kMaxSms> sm_start_{};
     bool outputs_seen_ = false;
     // Device emulation, digital I/O configuration 0x0150 bit 3: the outputs are reset with the next output
     // event after a watchdog expiry rather than at the expiry (ESC datasheet section II, 0x0150).

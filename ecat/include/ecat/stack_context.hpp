@@ -4,6 +4,7 @@
 // Internal to the stack; applications use ecat/stack.hpp.
 #include <cstdint>
 #include <iosfwd>
+#include <vector>
 
 #include "ecat/application.hpp"
 #include "ecat/event_sink.hpp"
@@ -46,25 +47,43 @@ void add_stats(StackStats& total, const StackStats& more);
 // The statistics as "stack.<name> <value>" lines (latencies in ns), for logs and benchmark scripts.
 void print_stats(std::ostream& out, const StackStats& stats);
 
-// The SyncManagers that carry process data: the first SM of kind Outputs and of kind Inputs in the
-// description (ETG.2000 Sm elements; a device without mailbox has them at SM0/SM1, a device with one at
-// SM2/SM3). A description without SyncManagers: SM2/SM3. kNoSm: no SM for that direction.
+// The SyncManagers that carry process data: every SM of kind Outputs and of kind Inputs in the description,
+// in SM order (ETG.2000 Sm elements; a device without mailbox has them from SM0 on, a device with one from
+// SM2 on; EL1252 has three input SMs). `outputs`/`inputs` are the first of each (the SM whose events drive
+// the cycle and whose watchdog watches the outputs). A description without SyncManagers: SM2/SM3. kNoSm: no
+// SM for that direction.
 struct ProcessDataSms {
     static constexpr unsigned kNoSm = ProcessData::kNoSm;
     unsigned outputs = 2;
     unsigned inputs = 3;
+    std::vector<unsigned> all_outputs{2};
+    std::vector<unsigned> all_inputs{3};
 };
 
 inline ProcessDataSms process_data_sms(const od::DeviceDescription& desc) {
     ProcessDataSms s;
     if (desc.sync_managers.empty()) return s;
     s.outputs = s.inputs = ProcessDataSms::kNoSm;
-    for (unsigned n = 0; n < desc.sync_managers.size() && n < 16; ++n) {
+    s.all_outputs.clear();
+    s.all_inputs.clear();
+    for (unsigned n = 0; n < desc.sync_managers.size() && n < ProcessData::kMaxSms; ++n) {
         const od::SmKind k = desc.sync_managers[n].kind;
-        if (k == od::SmKind::Outputs && s.outputs == ProcessDataSms::kNoSm) s.outputs = n;
-        if (k == od::SmKind::Inputs && s.inputs == ProcessDataSms::kNoSm) s.inputs = n;
+        if (k == od::SmKind::Outputs) s.all_outputs.push_back(n);
+        if (k == od::SmKind::Inputs) s.all_inputs.push_back(n);
     }
+    if (!s.all_outputs.empty()) s.outputs = s.all_outputs.front();
+    if (!s.all_inputs.empty()) s.inputs = s.all_inputs.front();
     return s;
+}
+
+// An input SM after the first one that lies on the register space (below the process data RAM, ESC datasheet
+// 0x1000): a Virtual SM of the ESI over the ESC's own registers (EL1252's DC latch 0x09AE and system time
+// 0x0910, EL1262's 0x0998). Its data are those registers: the device writes nothing there and the master may
+// map them by an FMMU alone, so its SM is not checked either.
+inline bool inputs_on_registers(const ProcessDataSms& s, const od::DeviceDescription& desc, unsigned sm) {
+    return sm != s.inputs && sm < desc.sync_managers.size() &&
+           desc.sync_managers[sm].kind == od::SmKind::Inputs && desc.sync_managers[sm].start != 0 &&
+           desc.sync_managers[sm].start < esc::reg::kRamBase;
 }
 
 // True if the description declares a mailbox: an SM of kind MBoxOut/MBoxIn (or, without SyncManagers,

@@ -24,6 +24,7 @@ class SyncControl {
     void init_objects();
     // 0x1C00:n+1 (SM n's type) as the master left it; fallback if absent.
     uint64_t sm_type(unsigned n, uint64_t fallback) const;
+    bool has_sm_type_object() const;
     // Pre-Op -> Safe-Op: chooses the sync mode and cycle from 0x1C32/0x1C33 and 0x0980..0x09A3; an AL
     // status code if the configuration cannot run, else 0 (and 0x1C32/0x1C33 then say what runs).
     uint16_t configure();

@@ -383,10 +383,6 @@ std::optional<od::Object> to_object(const EsiObject& eo, uint16_t index, Ctx& ct
     return o;
 }
 
-bool is_mapping(uint16_t index, bool rx) {
-    return rx ? (index >= 0x1600 && index <= 0x17FF) : (index >= 0x1A00 && index <= 0x1BFF);
-}
-
 uint64_t default_u(const od::Entry& e) {
     if (auto p = std::get_if<uint64_t>(&e.default_value)) return *p;
     if (auto p = std::get_if<int64_t>(&e.default_value)) return static_cast<uint64_t>(*p);
@@ -824,18 +820,6 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
         ctx.warn(d.line, std::string("Slots: ") + (chosen ? "the chosen" : "the default") +
                              " configuration (" + (module_list.empty() ? "no modules" : module_list) +
                              ") is served; another is chosen by the device spec (SPEC@MODULE,MODULE,...)");
-    // A PDO whose index is not a mapping object index of its direction cannot be described by a mapping
-    // object (and so not by SDO information, the SII or the ESI softecat writes): left out.
-    for (auto it = pdos.begin(); it != pdos.end();) {
-        if (is_mapping(it->index, it->esi->rx)) {
-            ++it;
-            continue;
-        }
-        ctx.warn(it->esi->line, std::string(it->esi->rx ? "RxPdo " : "TxPdo ") + hex(it->index) +
-                                    " outside " + (it->esi->rx ? "0x1600-0x17FF" : "0x1A00-0x1BFF") +
-                                    " (ETG.1000.6 PDO mapping objects): not served");
-        it = pdos.erase(it);
-    }
     // A Virtual PDO (ETG.2000: for the configuration tool only, e.g. ESC register data such as the DC
     // activation) that has the index of a real one: the real one is the mapping object; the virtual one is
     // left out.
@@ -974,8 +958,11 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
         };
         std::vector<Mapped> mapped_by_objects;
         for (const auto& [index, mo] : built.objects) {
-            const bool rx = is_mapping(index, true);
-            if ((!rx && !is_mapping(index, false)) || with_element.count(index) || mo.entries.empty())
+            // Only the standard ranges tell a direction here: the file names no PDO for the object.
+            const od::PdoDirection dir = od::standard_pdo_direction(index);
+            const bool rx = dir == od::PdoDirection::Rx;
+            if (dir == od::PdoDirection::None || od::is_assignment_index(index) ||
+                with_element.count(index) || mo.entries.empty())
                 continue;
             const uint64_t count = mo.entries[0].subindex == 0 ? default_u(mo.entries[0]) : 0;
             for (const od::Entry& slot : mo.entries) {
@@ -993,10 +980,42 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
             map_entry(m.pe, m.rx, m.pdo, m.name, false);
     }
 
-    // ---- The PDO mapping objects (0x16xx/0x1Axx) as the PDO elements declare them ----
+    // ---- The PDO mapping objects as the PDO elements declare them, at the PDO's index wherever it lies (the
+    // direction is the element's: od::Object::direction) ----
     const bool coe = desc.mailbox_protocols & od::mailbox_protocol::CoE;
+    // A PDO whose index is an object of another kind cannot be a mapping object too; a device that names its
+    // PDOs so (EL1262 TxPdo 0x1C00, the AX5000's 0x1018) has no CoE, or does not show those PDOs as objects,
+    // and its PDOs live in its SII and ESI only. Here the SyncManager objects (ETG.1000.6 0x1C10-0x1C4F,
+    // the process data's own) and, with CoE, the objects every CoE device has, or an object the file declares
+    // that cannot hold a mapping, keep their index; the PDO is left out with a warning
+    // (docs/decisions/esi.md, "PDOs at any index").
+    for (auto it = pdos.begin(); it != pdos.end();) {
+        const uint16_t index = it->index;
+        std::string taken;
+        if (index >= 0x1C10 && index <= 0x1C4F) {
+            taken = "a SyncManager object (ETG.1000.6)";
+        } else if (coe && (index == 0x1000 || index == 0x1001 || index == 0x1008 || index == 0x1009 ||
+                           index == 0x100A || index == 0x1018 || index == 0x1C00)) {
+            taken = "an object every CoE device has (ETG.1000.6)";
+        } else if (auto o = built.objects.find(index);
+                   o != built.objects.end() && od::standard_pdo_direction(index) == od::PdoDirection::None) {
+            const od::Object& x = o->second;
+            bool mapping_shape = x.code != od::ObjectCode::Var && !x.entries.empty();
+            for (const od::Entry& e : x.entries)
+                if (e.subindex != 0 && e.type != DataType::Unsigned32) mapping_shape = false;
+            if (!mapping_shape) taken = "object " + hex(index) + " (" + x.name + ")";
+        }
+        if (taken.empty()) {
+            ++it;
+            continue;
+        }
+        ctx.warn(it->esi->line, std::string(it->esi->rx ? "RxPdo " : "TxPdo ") + hex(index) +
+                                    ": the index is " + taken + "; the PDO is not served");
+        it = pdos.erase(it);
+    }
     for (const Pdo& p : pdos) {
         const bool rx = p.esi->rx;
+        const od::PdoDirection dir = rx ? od::PdoDirection::Rx : od::PdoDirection::Tx;
         std::vector<uint64_t> words;
         for (const EsiPdoEntry& e : p.entries)
             words.push_back(uint64_t{e.index} << 16 | uint64_t{e.subindex} << 8 | e.bit_len);
@@ -1023,6 +1042,7 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
                                           ": the dictionary's default mapping differs from the " +
                                           (rx ? "RxPdo" : "TxPdo") + " element; the element is served");
             if (fits) {
+                o.direction = dir;
                 o.entries[0].default_value = uint64_t{words.size()};
                 for (od::Entry& e : o.entries) {
                     // Subindices past the count keep what the dictionary declares (nothing maps them).
@@ -1041,6 +1061,7 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
         o.index = p.index;
         o.code = od::ObjectCode::Record;
         o.type = DataType::PdoMapping;
+        o.direction = dir;
         o.name = p.esi->name.empty() ? std::string(rx ? "RxPDO " : "TxPDO ") + hex(p.index) : p.esi->name;
         o.entries.push_back(u_entry(p.index, 0, DataType::Unsigned8, access, words.size(), "SubIndex 000"));
         for (std::size_t k = 0; k < words.size(); ++k)
@@ -1158,6 +1179,7 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
                 if (e == nullptr || e->type != DataType::Unsigned16) ok = false;
             }
             if (ok) {
+                o.direction = rx ? od::PdoDirection::Rx : od::PdoDirection::Tx;
                 o.entries[0].default_value = uint64_t{assigned.size()};
                 for (od::Entry& e : o.entries) {
                     // Subindices past the count keep what the dictionary declares (nothing is assigned
@@ -1175,6 +1197,7 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
         o.index = index;
         o.code = od::ObjectCode::Array;
         o.type = DataType::Unsigned16;
+        o.direction = rx ? od::PdoDirection::Rx : od::PdoDirection::Tx;
         o.name = rx ? (n == 2 ? "RxPDO assign" : "SM" + std::to_string(n) + " RxPDO assign")
                     : (n == 3 ? "TxPDO assign" : "SM" + std::to_string(n) + " TxPDO assign");
         o.entries.push_back(u_entry(index, 0, DataType::Unsigned8, access, assigned.size(), "SubIndex 000"));
@@ -1250,7 +1273,10 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
         s.name = set.name;
         for (const auto& [sm, list] : set.sms)
             for (uint16_t index : list) {
-                bool rx = index >= 0x1600 && index <= 0x17FF;
+                // The direction of the SM the set assigns it to, else the PDO's own.
+                bool rx = false;
+                for (const Pdo& p : pdos)
+                    if (p.index == index) rx = p.esi->rx;
                 if (sm >= 0 && static_cast<std::size_t>(sm) < desc.sync_managers.size())
                     rx = desc.sync_managers[static_cast<std::size_t>(sm)].kind == od::SmKind::Outputs;
                 (rx ? s.rx : s.tx).push_back(index);
@@ -1308,7 +1334,8 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
                 set_string(dd.identity.hardware_version);
             if (o.index == 0x100A && dd.identity.software_version != loaded.software_version)
                 set_string(dd.identity.software_version);
-            if (o.index == 0x1018)
+            if (o.index == 0x1018 &&
+                o.direction == od::PdoDirection::None)  // not a PDO named 0x1018 (AX5201)
                 for (od::Entry& e : o.entries) {
                     if (e.type != DataType::Unsigned32) continue;
                     if (e.subindex == 1) e.default_value = uint64_t{dd.identity.vendor_id};

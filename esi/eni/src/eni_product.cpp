@@ -71,6 +71,7 @@ struct Plan {
     std::map<uint16_t, std::string> app_names;
     struct Mapping {
         uint16_t index = 0;
+        bool rx = false;  // the ENI's RxPdo or TxPdo element, wherever the index lies
         std::string name;
         bool fixed = false;
         std::vector<uint32_t> entries;  // index << 16 | sub << 8 | bits
@@ -78,7 +79,8 @@ struct Plan {
     };
     std::vector<Mapping> mappings;
     struct Assign {
-        uint16_t index = 0;  // 0x1C10 + SM
+        uint16_t index = 0;                                   // 0x1C10 + SM
+        od::PdoDirection direction = od::PdoDirection::None;  // the SM's (Outputs: Rx, Inputs: Tx)
         std::vector<uint16_t> pdos;
         uint8_t capacity = 0;
     };
@@ -86,6 +88,12 @@ struct Plan {
     std::vector<uint8_t> sm_types;  // 0x1C00: 1 MBoxOut, 2 MBoxIn, 3 Outputs, 4 Inputs, 0 unused
     bool coe = false;
 };
+
+od::PdoDirection direction_of(od::SmKind k) {
+    if (k == od::SmKind::Outputs) return od::PdoDirection::Rx;
+    if (k == od::SmKind::Inputs) return od::PdoDirection::Tx;
+    return od::PdoDirection::None;
+}
 
 uint8_t sm_type_code(const std::string& type) {
     if (type == "MBoxOut") return 1;
@@ -148,7 +156,8 @@ od::Dictionary build(const Plan& plan, const od::DeviceDescription& d) {
         o.index = m.index;
         o.code = od::ObjectCode::Record;
         o.type = DataType::PdoMapping;
-        o.name = m.name.empty() ? (m.index < 0x1A00 ? "RxPDO " : "TxPDO ") + hex(m.index, 4) : m.name;
+        o.direction = m.rx ? od::PdoDirection::Rx : od::PdoDirection::Tx;
+        o.name = m.name.empty() ? (m.rx ? "RxPDO " : "TxPDO ") + hex(m.index, 4) : m.name;
         const uint16_t a = m.fixed ? acc::RO : acc::RW_PreOp;
         od::Entry n = u_entry(0, DataType::Unsigned8, a, m.entries.size(), "Number of mapped objects");
         n.maximum = uint64_t{m.capacity};
@@ -177,6 +186,7 @@ od::Dictionary build(const Plan& plan, const od::DeviceDescription& d) {
         o.index = as.index;
         o.code = od::ObjectCode::Array;
         o.type = DataType::Unsigned16;
+        o.direction = as.direction;
         o.name = "SM" + std::to_string(as.index - 0x1C10) + " PDO assignment";
         od::Entry n =
             u_entry(0, DataType::Unsigned8, acc::RW_PreOp, as.pdos.size(), "Number of assigned PDOs");
@@ -309,8 +319,8 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
         const std::string what = (pdo.rx ? "RxPdo " : "TxPdo ") + hex(pdo.index, 4) + " entry " +
                                  entry_name(e.index, e.subindex) + " '" + e.name + "'";
         const bool own = e.index == 0x1000 || e.index == 0x1008 || e.index == 0x1018 || e.index == 0x1C00 ||
-                         (e.index & 0xFFF0) == 0x1C10 || (e.index >= 0x1600 && e.index <= 0x17FF) ||
-                         (e.index >= 0x1A00 && e.index <= 0x1BFF);
+                         (e.index & 0xFFF0) == 0x1C10 || pd.pdo(e.index) != nullptr ||
+                         od::standard_pdo_direction(e.index) != od::PdoDirection::None;
         if (own) {
             warn.push_back(who + ": " + what +
                            ": an object the slave declares itself (identity, SyncManager or "
@@ -355,6 +365,7 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
         for (const Pdo& pdo : *list) {
             Plan::Mapping m;
             m.index = pdo.index;
+            m.rx = pdo.rx;
             m.name = pdo.name;
             m.fixed = pdo.fixed;
             for (const PdoEntry& e : pdo.entries) {
@@ -379,6 +390,7 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
         sd.default_size = static_cast<uint16_t>((bits + 7) / 8);
         Plan::Assign as;
         as.index = static_cast<uint16_t>(0x1C10 + n);
+        as.direction = direction_of(sd.kind);
         as.pdos = pdos;
         const std::size_t same_direction =
             sd.kind == od::SmKind::Outputs ? pd.rxpdos.size() : pd.txpdos.size();
@@ -392,6 +404,7 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
             !sm_pdos.count(static_cast<int>(n))) {
             Plan::Assign as;
             as.index = static_cast<uint16_t>(0x1C10 + n);
+            as.direction = direction_of(k);
             as.capacity =
                 static_cast<uint8_t>(k == od::SmKind::Outputs ? pd.rxpdos.size() : pd.txpdos.size());
             plan->assigns.push_back(std::move(as));
@@ -405,8 +418,8 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
             const std::string what = "CoE InitCmd " + entry_name(c.index, c.subindex) +
                                      (c.comment.empty() ? "" : " ('" + c.comment + "')");
             // The communication objects the product declares itself: grow them to what the master writes.
-            if ((c.index & 0xFFF0) == 0x1C10 || (c.index >= 0x1600 && c.index <= 0x17FF) ||
-                (c.index >= 0x1A00 && c.index <= 0x1BFF)) {
+            if ((c.index & 0xFFF0) == 0x1C10 || pd.pdo(c.index) != nullptr ||
+                od::standard_pdo_direction(c.index) != od::PdoDirection::None) {
                 if (c.complete_access) {
                     warn.push_back(who + ": " + what +
                                    " by complete access: the object is declared from the PDOs, "
@@ -424,6 +437,7 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
                         static_cast<std::size_t>(c.index - 0x1C10) < d.sync_managers.size()) {
                         Plan::Assign as;
                         as.index = c.index;
+                        as.direction = direction_of(d.sync_managers[c.index - 0x1C10u].kind);
                         as.capacity = c.subindex;
                         plan->assigns.push_back(std::move(as));
                     } else {

@@ -1,6 +1,7 @@
 #pragma once
 // What the SII image and the ESI file both say about the device, derived once from od::DeviceDescription and
-// od::Dictionary: the default PDO mapping (0x1600-/0x1A00- read through the assignment objects 0x1C1n), the
+// od::Dictionary: the default PDO mapping (the mapping objects, in the direction od::Object::direction gives,
+// read through the assignment objects 0x1C1n), the
 // SyncManager layout with the process-data sizes that mapping gives, the FMMU usage, the profile number
 // (0x1000) and the EEPROM configuration words. build_sii() and build_esi() both render this, so the two
 // files cannot disagree with each other or with the dictionary.
@@ -26,7 +27,7 @@ struct PdoEntryInfo {
 };
 
 struct PdoInfo {
-    uint16_t index = 0;                 // 0x1600.. (RxPDO) or 0x1A00.. (TxPDO)
+    uint16_t index = 0;                 // usually 0x1600.. (RxPDO) or 0x1A00.. (TxPDO), but any index
     bool rx = false;                    // true: RxPDO (master -> slave, outputs)
     std::string name;                   // the mapping object's name
     int sm = -1;                        // SyncManager that assigns it by default (0x1C1n), -1 = not assigned

@@ -70,6 +70,14 @@ struct Object {
     std::string name;
     DataType type = DataType::Unsigned8;  // VAR: its type; ARRAY: element type; RECORD: record type code
     std::vector<Entry> entries;           // sorted by subindex; VAR has exactly one (subindex 0)
+    // Process data: the direction of the PDO this mapping object describes, or of the SM this assignment
+    // object (0x1C10 + n) assigns to; None for every other object. Declared by the product where it knows
+    // it (an ESI's RxPdo/TxPdo element and Sm kinds, an ENI's); left None, Dictionary::add() gives the
+    // standard ranges' (standard_pdo_direction). Nothing else tells a PDO's direction by its index.
+    PdoDirection direction = PdoDirection::None;
+    bool is_pdo_mapping() const { return direction != PdoDirection::None && !is_assignment_index(index); }
+    bool is_pdo_assignment() const { return direction != PdoDirection::None && is_assignment_index(index); }
+    bool rx() const { return direction == PdoDirection::Rx; }
     uint8_t max_subindex() const { return entries.empty() ? 0 : entries.back().subindex; }
     const Entry* entry(uint8_t sub) const;
 };

@@ -42,6 +42,24 @@ enum class DataType : uint16_t {
 
 enum class ObjectCode : uint8_t { Var = 0x07, Array = 0x08, Record = 0x09 };
 
+// The process-data direction of a PDO mapping object (the PDO's: Rx = outputs, master -> slave; Tx = inputs)
+// or of a SyncManager's PDO assignment object (its SM's). None: not a process-data object.
+enum class PdoDirection : uint8_t { None, Rx, Tx };
+
+// The PDO assignment objects, 0x1C10 + n for SM n (ETG.1000.6, SyncManager PDO assignment).
+constexpr bool is_assignment_index(uint16_t index) {
+    return index >= 0x1C10 && index <= 0x1C2F;
+}
+// The direction ETG.1000.6's standard index ranges give: RxPDO mapping 0x1600-0x17FF and SM2's assignment
+// 0x1C12, TxPDO mapping 0x1A00-0x1BFF and SM3's assignment 0x1C13. Only a default for a declaration that
+// states no direction (Object::direction): vendors' devices put PDOs elsewhere (RxPdo 0x1A00 on Beckhoff's
+// evaluation boards, TxPdo 0x1C00 on EL1262) and the direction then comes from their ESI.
+constexpr PdoDirection standard_pdo_direction(uint16_t index) {
+    if ((index >= 0x1600 && index <= 0x17FF) || index == 0x1C12) return PdoDirection::Rx;
+    if ((index >= 0x1A00 && index <= 0x1BFF) || index == 0x1C13) return PdoDirection::Tx;
+    return PdoDirection::None;
+}
+
 // EtherCAT AL states, for state-dependent access ("rw only in Pre-Op"): the AL vocabulary's
 // (esc/wire/al.hpp).
 using AlState = esc::AlState;

@@ -180,11 +180,18 @@ inline uint16_t missing_index(Context& ctx) {
         if (!ctx.esi || !ctx.esi->object(i)) return i;
     return 0x5FFE;
 }
-inline bool command_object(uint16_t index) {
+inline bool command_object(const EsiDevice& esi, uint16_t index) {
     // Store/restore parameters (signature commands), diagnosis history, PDO mapping/assignment: writing
-    // them has effects beyond the value; tests of plain entries leave them out.
+    // them has effects beyond the value; tests of plain entries leave them out. A PDO's mapping object is
+    // wherever the ESI's RxPdo/TxPdo names it, not only in the standard ranges.
+    auto names_pdo = [&](const std::vector<EsiPdo>& pdos) {
+        for (const EsiPdo& p : pdos)
+            if (p.index == index) return true;
+        return false;
+    };
     return index == 0x1010 || index == 0x1011 || index == 0x10F3 || (index >= 0x1600 && index <= 0x1BFF) ||
-           index == 0x1C12 || index == 0x1C13 || index == 0x6040;
+           (index >= 0x1C10 && index <= 0x1C2F) || index == 0x6040 || names_pdo(esi.rxpdos) ||
+           names_pdo(esi.txpdos);
 }
 inline bool writable_in_preop(const EsiEntry& e) {
     return (e.access == "rw" || e.access == "wo") &&

@@ -20,7 +20,8 @@ const EntryRef* pick_rw(Context& ctx, std::vector<EntryRef>& store, unsigned bit
     if (!ctx.esi) return nullptr;
     store = esi_entries(*ctx.esi);
     for (const auto& r : store) {
-        if (command_object(r.obj->index) || !writable_in_preop(*r.e) || r.e->access != "rw") continue;
+        if (command_object(*ctx.esi, r.obj->index) || !writable_in_preop(*r.e) || r.e->access != "rw")
+            continue;
         if (r.e->bit_size < bits_min || r.e->bit_size > bits_max || r.e->bit_size % 8) continue;
         if (r.e->type.rfind("STRING", 0) == 0) continue;
         if (need_limits) {

@@ -117,6 +117,7 @@ std::string access_flags(uint16_t access, const char* indent) {
 struct PdoObject {
     PdoView view;
     int sm = -1;
+    bool rx = false;  // the direction of the SM that assigns it, else the SII's PDO category, else the range
 };
 
 Error read_mapping(master::SdoClient& sdo, uint16_t index, PdoView& pv) {
@@ -198,8 +199,18 @@ int run_xml(master::Master& m, const XmlArgs& x) {
                      std::to_string(bit) + "</BitSize>\n";
             }
             objects += o + "          </Object>\n";
-            if ((index >= 0x1600 && index <= 0x17FF) || (index >= 0x1A00 && index <= 0x1BFF)) {
+            // A mapping object: one in the standard ranges, or one the SII's PDO categories name (a device
+            // may put its PDOs at other indices; the direction is then the category's, not the range's).
+            bool sii_rx = false, sii_tx = false;
+            for (const auto& sp : sii.rx_pdos)
+                sii_rx = sii_rx || sp.index == index;
+            for (const auto& sp : sii.tx_pdos)
+                sii_tx = sii_tx || sp.index == index;
+            const bool range_rx = index >= 0x1600 && index <= 0x17FF;
+            const bool range_tx = index >= 0x1A00 && index <= 0x1BFF;
+            if (sii_rx || sii_tx || range_rx || range_tx) {
                 PdoObject p;
+                p.rx = sii_rx || (!sii_tx && range_rx);
                 p.view.name = od->name;
                 if (Error e = read_mapping(sdo, index, p.view); e != Error::Ok)
                     return report_error(&sdo, e, "reading PDO mapping " + hx(index, 4));
@@ -211,7 +222,10 @@ int run_xml(master::Master& m, const XmlArgs& x) {
             return report_error(&sdo, e, "reading the PDO assignment");
         for (const auto& sv : syncs)
             for (const auto& p : sv.pdos)
-                if (auto it = pdos.find(p.index); it != pdos.end()) it->second.sm = sv.sm;
+                if (auto it = pdos.find(p.index); it != pdos.end()) {
+                    it->second.sm = sv.sm;
+                    it->second.rx = sv.output;  // the SM's direction is the PDO's
+                }
     }
 
     std::string x_out;
@@ -262,7 +276,7 @@ int run_xml(master::Master& m, const XmlArgs& x) {
     }
     for (bool rx : {true, false})
         for (const auto& [index, p] : pdos) {
-            if ((index < 0x1A00) != rx) continue;
+            if (p.rx != rx) continue;
             std::string s = std::string("        <") + (rx ? "RxPdo" : "TxPdo");
             if (p.sm >= 0) s += " Sm=\"" + std::to_string(p.sm) + "\"";
             s += ">\n          <Index>" + hx(index, 4) + "</Index>\n          <Name LcId=\"1033\">" +
