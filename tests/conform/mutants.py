@@ -1449,18 +1449,12 @@ def list_type_as_all(st, m):
 
 
 def fragments_not_decreasing(st, m):
-    """SDO information: the fragments-left count of every fragment but the last is the count of the first."""
+    """SDO information: every fragment but the last counts itself in its fragments-left (an off by one: 2, 0 for
+    two fragments), so the count does not go down by one from fragment to fragment."""
     svc, _ = coe(m)
-    if svc != 8 or len(m) < 12:
+    if svc != 8 or len(m) < 12 or not (m[8] & 0x80):
         return None
-    if not (m[8] & 0x80):
-        st.scratch["frag-first"] = None
-        return None
-    first = st.scratch.get("frag-first")
-    if first is None:
-        st.scratch["frag-first"] = struct.unpack_from("<H", m, 10)[0]
-        return None
-    struct.pack_into("<H", m, 10, first)
+    struct.pack_into("<H", m, 10, struct.unpack_from("<H", m, 10)[0] + 1)
     return m
 
 
@@ -1753,22 +1747,24 @@ def expedited_as_normal(st, m):
     return m
 
 
-def foe_error_text_added(st, m):
-    """FoE error request with an error text after the code."""
-    if (m[5] & 0x0F) != 4 or len(m) < 12 or m[6] != 5 or mbx_len(m) != 6:
+def foe_error_text_other(st, m):
+    """FoE error request with another error text after the code (same length)."""
+    if (m[5] & 0x0F) != 4 or len(m) < 12 or m[6] != 5 or mbx_len(m) <= 6:
         return None
-    text = b"error"
-    if len(m) < 12 + len(text):
-        return None
-    m[12:12 + len(text)] = text
-    struct.pack_into("<H", m, 0, 6 + len(text))
+    n = min(mbx_len(m), len(m) - 6) - 6
+    m[12:12 + n] = (b"Fehler " * n)[:n]
     return m
 
 
 def statusword_manufacturer_bits(st, d):
     """Statusword bits 14-15 (manufacturer specific) set, in SDO uploads of 0x6041 and in the process data (the
-    drive maps 0x6041 first in its TxPDOs)."""
-    offs = [off for _, off in input_bytes(st, d)]
+    drive maps 0x6041 first in its TxPDOs): the first input bytes of the FMMU onto an input SM, not those of
+    an FMMU a test maps onto registers."""
+    starts = {st.sm_start(n) for n in input_sms(st)}
+    offs = [off for la, off in input_bytes(st, d)
+            if any(st.reg(0x0600 + 16 * k + 8) in starts and st.reg(0x0600 + 16 * k, 4) <= la
+                   < st.reg(0x0600 + 16 * k, 4) + st.reg(0x0600 + 16 * k + 4) for k in range(16)
+                   if st.mem[0x0600 + 16 * k + 12] & 1)]
     if len(offs) >= 2:
         data = d.data
         data[offs[1]] |= 0xC0
@@ -1794,8 +1790,8 @@ VARIATIONS.update({
                                                     expedited_size_unspecified)),
     "sdo-upload-normal-short": ("CiA 301 / ETG.1000.6 upload: the server chooses the transfer type; a normal "
                                 "upload response may carry 1..4 bytes", mbx_rewriter(expedited_as_normal)),
-    "foe-error-text-added": ("ETG.1000.6 FoE error request: an optional error text after the code",
-                             mbx_rewriter(foe_error_text_added)),
+    "foe-error-text-other": ("ETG.1000.6 FoE error request: the error text after the code is free",
+                             mbx_rewriter(foe_error_text_other)),
     "statusword-manufacturer-bits": ("CiA 402 statusword bits 14-15 manufacturer specific, any value",
                                      apply_all(statusword(lambda v: v | 0xC000), statusword_manufacturer_bits)),
     "sm-status-irq-pending": ("ESC datasheet SM status 0x0805 bit 0: interrupt write pending until the PDI reads",
