@@ -410,14 +410,20 @@ def od_list_reversed(st, m):
     """SDO information: the OD list answer (one fragment) with its indices in reverse order (the standard
     does not order the list)."""
     svc, _ = coe(m)
-    if svc != 8 or len(m) < 14 or m[8] != 0x02:  # last (complete) fragment only
+    if svc != 8 or len(m) < 14 or (m[8] & 0x7F) != 0x02:
         return None
-    n = mbx_len(m)
-    if struct.unpack_from("<H", m, 12)[0] != 1 or n < 12:
+    # Every fragment of a list of all objects (type 1, in the first fragment's list-type word) reversed in
+    # itself: the list as a whole is out of order (a list that comes in several fragments, too).
+    first = not st.scratch.get("olr-cont")
+    st.scratch["olr-cont"] = bool(m[8] & 0x80)
+    if first:
+        st.scratch["olr-all"] = struct.unpack_from("<H", m, 12)[0] == 1
+    if not st.scratch.get("olr-all"):
         return None
-    idx = [struct.unpack_from("<H", m, 14 + 2 * i)[0] for i in range((n - 8) // 2)]
+    start, n = (14 if first else 12), mbx_len(m)
+    idx = [struct.unpack_from("<H", m, o)[0] for o in range(start, 6 + n - 1, 2)]
     for i, v in enumerate(reversed(idx)):
-        struct.pack_into("<H", m, 14 + 2 * i, v)
+        struct.pack_into("<H", m, start + 2 * i, v)
     return m
 
 
@@ -1169,6 +1175,10 @@ TABLE_SURVIVORS = {
                                "mapped entries per direction, which no test maps",
     "sdo-abort-pdo-length": "not provoked on this slave: its PDO limit (160 bytes per SM) is above what one "
                             "mapping object filled to its last subindex reaches (sdo.pdo.mapping_too_long: taken)",
+    # round 3 (UNSEEN3)
+    "sdo-segment-data-rotated": "never fires: the only segmented upload of the drive (0x10F3 by complete "
+                                "access) holds zeros after its first part, so rotated segment data is the same "
+                                "data; not a defect of this slave",
 }
 
 
@@ -1772,11 +1782,13 @@ def statusword_manufacturer_bits(st, d):
 
 
 def sm_status_irq_pending(st, d):
-    """SM0 status 0x0805 bit 0 (interrupt write) still set while the mailbox is full (the PDI has not read yet)."""
-    if d.covers(0x0805, 1):
-        v = d.get(0x0805, 1)
-        if v & 0x08:
-            d.put(0x0805, v | 0x01, 1)
+    """Mailbox SM status 0x0805/0x080D bit 1 (interrupt read) still pending while the mailbox is empty (bit 3
+    clear): the buffer was read and the PDI has not taken the interrupt yet."""
+    for reg in (0x0805, 0x080D):
+        if d.covers(reg, 1):
+            v = d.get(reg, 1)
+            if not v & 0x08:
+                d.put(reg, v | 0x02, 1)
 
 
 VARIATIONS.update({
@@ -1794,7 +1806,8 @@ VARIATIONS.update({
                              mbx_rewriter(foe_error_text_other)),
     "statusword-manufacturer-bits": ("CiA 402 statusword bits 14-15 manufacturer specific, any value",
                                      apply_all(statusword(lambda v: v | 0xC000), statusword_manufacturer_bits)),
-    "sm-status-irq-pending": ("ESC datasheet SM status 0x0805 bit 0: interrupt write pending until the PDI reads",
+    "sm-status-irq-pending": ("ESC datasheet SM status 0x0805+8n bit 1: interrupt read pending until the PDI "
+                              "takes it",
                               sm_status_irq_pending),
     "eeprom-read-4-bytes": ("ESC datasheet 0x0502 bit 6 = 0: an ESC that reads 4 bytes of SII data per command",
                             apply_all(reg_rewriter(0x0502, clear_bits(0x0040)), eeprom_second_half_zero)),
