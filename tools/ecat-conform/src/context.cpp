@@ -453,10 +453,20 @@ Error Context::to_init() {
     sdo.reset();
     mbx.reset();
     const auto deadline = Clock::now() + ms(5000);
+    // A slave that reached INIT but keeps its error indication through the acknowledge (a defect the esm
+    // tests report) is taken as in INIT after 200 ms (scaled): waiting the whole time again in every test
+    // would stretch the run without telling more.
+    std::optional<Clock::time_point> init_with_error;
     for (;;) {
         (void)m.write_reg<uint16_t>(addr, master::reg::AlControl, 0x0011);
         auto s = m.read_reg<uint16_t>(addr, master::reg::AlStatus);
         if (s && (*s & 0x1F) == 0x01) break;
+        if (s && (*s & 0x0F) == 0x01) {
+            if (!init_with_error) init_with_error = Clock::now();
+            if (Clock::now() - *init_with_error >= ms(200)) break;
+        } else {
+            init_with_error.reset();
+        }
         if (Clock::now() >= deadline) return s ? Error::AlTimeout : s.error();
         std::this_thread::sleep_for(std::chrono::microseconds(500));
     }
@@ -590,7 +600,20 @@ master::Result<std::vector<uint8_t>> Context::upload(uint16_t index, uint8_t sub
     std::vector<uint8_t> buf(8192);
     auto r = sdo->upload(index, sub, buf, ca);
     if (!r) return r.error();
-    buf.resize(*r);
+    std::size_t n = *r;
+    // An expedited response without the size indicated carries the value in its 4 bytes (CiA 301 /
+    // ETG.1000.6, as IgH and SOEM take it): the entry's (object's, for a complete access) size as the ESI
+    // declares it.
+    if (!sdo->last_size_indicated() && n == 4 && esi) {
+        if (const EsiObject* o = esi->object(index)) {
+            const EsiEntry* e = ca ? nullptr : o->entry(sub);
+            // From subindex 1, a complete access leaves out subindex 0 and its padding (16 bits).
+            const unsigned whole = ca && sub == 1 && o->bit_size > 16 ? o->bit_size - 16u : o->bit_size;
+            const unsigned bits = ca ? whole : e ? e->bit_size : 0;
+            if (bits > 0 && bits % 8 == 0 && bits < 32) n = bits / 8;
+        }
+    }
+    buf.resize(n);
     return buf;
 }
 

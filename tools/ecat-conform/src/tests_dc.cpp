@@ -221,13 +221,32 @@ void add_dc_tests(Catalogue& c) {
         },
         a);
     add(
-        "sync0.cycle_rw", "SYNC0 cycle time 0x09A0 writable and read back", kDc,
+        "sync0.cycle_rw", "SYNC0 and SYNC1 cycle times 0x09A0/0x09A4 writable and read back", kDc,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_dc());
             (void)ctx.wr<uint8_t>(esc::reg::kDcActivation, 0);
+            // SYNC1 cycle time (ESC datasheet 0x09A4, read/write for ECAT) written with a value of its own
+            // and put back: a register that keeps its old value shows.
+            auto sync1 = ctx.rd<uint32_t>(0x09A4);
+            (void)ctx.wr<uint32_t>(0x09A4, 500'000);
+            auto got1 = ctx.rd<uint32_t>(0x09A4);
+            if (sync1) (void)ctx.wr<uint32_t>(0x09A4, *sync1);
             (void)ctx.wr<uint32_t>(esc::reg::kDcSync0Cycle, 1'000'000);
             auto got = ctx.rd<uint32_t>(esc::reg::kDcSync0Cycle);
-            return expect_eq("0x09A0", got ? dec(*got) : "?", "1000000");
+            return expect_eq("0x09A0, 0x09A4", (got ? dec(*got) : "?") + ", " + (got1 ? dec(*got1) : "?"),
+                             "1000000, 500000");
+        },
+        a);
+    add(
+        "sync.pulse_length", "SYNC pulse length 0x0982 as loaded from SII word 2", kDc,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            CONFORM_NEED(ctx.need_sii());
+            // ESC datasheet section II 0x0982 (pulse length of SYNC signals, in 10 ns): loaded from the
+            // EEPROM at address 0x0002 (ETG.2010 SII word 2).
+            auto v = ctx.rd<uint16_t>(0x0982);
+            if (!v) return fail("0x0982 unreadable", err(v.error()));
+            return expect_eq("0x0982", hex(*v), hex(ctx.sii->word(2)));
         },
         a);
     add(
@@ -296,7 +315,10 @@ void add_dc_tests(Catalogue& c) {
             const uint64_t ahead = static_cast<uint64_t>(ctx.ms(20).count()) + 1;
             (void)ctx.wr<uint64_t>(esc::reg::kDcStartTime, (*now / 1'000'000 + ahead) * 1'000'000);
             (void)ctx.wr<uint8_t>(esc::reg::kDcActivation, 0x03);
+            // Cyclic operation and SYNC0 enabled read back as written (ESC datasheet 0x0981 bits 0-2).
+            auto act = ctx.rd<uint8_t>(esc::reg::kDcActivation);
             auto first = rd64(ctx, esc::reg::kDcStartTime);
+            const auto t_first = std::chrono::steady_clock::now();
             bool pulse = false, advanced = false;
             master::Result<uint64_t> later = Error::Timeout;
             const auto until =
@@ -306,12 +328,19 @@ void add_dc_tests(Catalogue& c) {
                 auto s = ctx.rd<uint8_t>(0x098E);
                 pulse = pulse || (s && (*s & 0x01));
                 later = rd64(ctx, esc::reg::kDcStartTime);
-                // By whole cycles and no further than the time waited: a jump of 2^32 ns (a high word that
-                // moved on while the low word stays) is not SYNC0 advancing.
+                // By whole cycles and no further than the time waited (plus a cycle): a jump of 2^32 ns (a
+                // high word that moved on while the low word stays) is not SYNC0 advancing.
+                const auto waited =
+                    static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                              std::chrono::steady_clock::now() - t_first)
+                                              .count());
                 advanced =
-                    first && later && *later >= *first + 1'000'000 && *later - *first < 10'000'000'000ull;
+                    first && later && *later >= *first + 1'000'000 && *later - *first <= waited + 2'000'000;
             }
             (void)ctx.wr<uint8_t>(esc::reg::kDcActivation, 0);
+            if (!act || (*act & 0x07) != 0x03)
+                return fail("DC activation 0x0981 bits 0-2 read back after writing 0x03",
+                            act ? hex(*act, 2) : "unreadable", "0x03 (cyclic operation, SYNC0)");
             if (!advanced)
                 return fail(
                     "next SYNC0 time 0x0990 does not advance within 100 ms of the start (no SYNC0 pulses)",

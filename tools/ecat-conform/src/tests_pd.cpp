@@ -197,6 +197,9 @@ Outcome op_registers(Context& ctx) {
     CONFORM_NEED(ctx.need_pd_layout());
     if (Error e = ctx.to_op(); e != Error::Ok) return fail("cannot reach OP: " + err(e));
     if (!ctx.has_process_data()) return skip("no process data (no PDO assigned to a process-data SM)");
+    // The watchdog counters 0x0442/0x0443 cleared (a write to either clears both, ESC datasheet section II):
+    // while outputs come every cycle, the process-data counter must stay 0 (it counts expiries only).
+    (void)ctx.wr<uint16_t>(0x0442, 0);
     (void)ctx.cycle(5);
     const auto& l = ctx.pds->layout();
     std::string got, want;
@@ -246,6 +249,11 @@ Outcome op_registers(Context& ctx) {
         if (!wd) return fail("SM watchdog status 0x0440 unreadable", err(wd.error()));
         got += "0x0440 bit 0 " + dec(*wd & 1);
         want += "0x0440 bit 0 1";
+        auto wc = ctx.rd<uint8_t>(0x0442);
+        (void)ctx.cycle(1);
+        if (!wc) return fail("SM watchdog counter 0x0442 unreadable", err(wc.error()));
+        got += ", 0x0442 " + dec(*wc);
+        want += ", 0x0442 0";
     }
     return expect_eq("SM/FMMU registers as configured, watchdog status while outputs come", got, want);
 }
@@ -303,9 +311,9 @@ void add_pd_tests(Catalogue& c) {
     add(
         "op.esc_registers",
         "OP: SM and FMMU registers read back as configured, SMs not deactivated by the PDI, SM watchdog "
-        "status active",
+        "status active, no watchdog expiry counted (0x0442)",
         "ETG.1000.4 SyncManager and FMMU; ESC datasheet SyncManager 0x0800+8n (0x0806 activate, 0x0807 PDI "
-        "control), FMMU 0x0600+16n, watchdog status 0x0440",
+        "control), FMMU 0x0600+16n, watchdog status 0x0440, watchdog counter 0x0442",
         [](Context& ctx) { return op_registers(ctx); }, "process data (layout over CoE, else from the SII)");
     add(
         "remap.safeop",

@@ -311,6 +311,17 @@ void add_sdoinfo_tests(Catalogue& c) {
                              hex(want) + " (" + r.e->type + ")");
              return std::nullopt;
          }},
+        {"entry.value_info",
+         "Entry descriptions: the value info of the response names only elements the request asked for",
+         [](const EntryRef& r, const master::EntryDescription& d) -> std::optional<Outcome> {
+             // ETG.1000.6 Get Entry Description: the response's value info says which of the elements asked
+             // for (unit type 0x08, default 0x10, minimum 0x20, maximum 0x40) follow; a device may leave some
+             // out, never add one (a master would take its bytes for the name). Asked: 0x70 (descriptions()).
+             if (d.value_info & ~0x70)
+                 return fail(hex(r.obj->index) + ":" + dec(r.e->subindex) + " value info of the response",
+                             hex(d.value_info, 2), "bits of 0x70 (the request's) only");
+             return std::nullopt;
+         }},
         {"entry.bit_length", "Entry descriptions: bit length as the ESI",
          [](const EntryRef& r, const master::EntryDescription& d) -> std::optional<Outcome> {
              const unsigned want = declared_bits(*r.e);

@@ -118,6 +118,7 @@ Result<std::size_t> SdoClient::upload(uint16_t index, uint8_t sub, std::span<uin
         abort(index, sub, kAbortCommand);
         return Error::MailboxProtocol;
     }
+    last_size_indicated_ = (cmd & 0x01) != 0;
     if (cmd & 0x02) {  // expedited: data in the 4-byte field
         const std::size_t n = (cmd & 0x01) ? 4u - ((cmd >> 2) & 0x03) : 4u;
         if (n > out.size()) return Error::BufferTooSmall;

@@ -59,6 +59,10 @@ class SdoClient {
 
     // Abort code of the last Error::SdoAbort (from the slave, or sent by us when we gave up).
     uint32_t last_abort() const { return last_abort_; }
+    // Whether the last successful upload said its size: false for an expedited response with the size
+    // indicator clear (CiA 301 / ETG.1000.6: "data set size not indicated"), whose 4 bytes upload() returns;
+    // a caller that knows the entry's size takes that many of them.
+    bool last_size_indicated() const { return last_size_indicated_; }
     // Detail code of the last Error::MailboxError (ETG.1000.6 mailbox error reply).
     uint16_t last_mailbox_error() const { return last_mailbox_error_; }
     uint64_t emergencies() const { return emergencies_; }
@@ -75,6 +79,7 @@ class SdoClient {
     Mailbox& mbx_;
     std::vector<uint8_t> req_;
     uint32_t last_abort_ = 0;
+    bool last_size_indicated_ = true;
     uint16_t last_mailbox_error_ = 0;
     uint64_t emergencies_ = 0;
     EmergencyMessage last_emergency_;

@@ -67,6 +67,8 @@ class Mailbox {
     std::chrono::milliseconds timeout() const { return timeout_; }
     void set_timeout(std::chrono::milliseconds t) { timeout_ = t; }
     uint64_t repeats() const { return repeats_; }  // repeat requests issued after lost read replies
+    // Counter (header byte 5 bits 4-6) of the last message receive() returned.
+    uint8_t last_rx_counter() const { return last_rx_counter_; }
 
   private:
     Error read_sm1(bool& got);
