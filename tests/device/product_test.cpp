@@ -69,6 +69,18 @@ void preop_without_mailbox(Master& m, Address a) {
     ASSERT_EQ(m.request_state(a, AlState::PreOp, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
 }
 
+// A device with CoE made from `product`, addressed and in Pre-Op with its mailbox, and an SDO client.
+struct CoeUnitInPreOp {
+    explicit CoeUnitInPreOp(std::shared_ptr<const od::Product> product) : u(std::move(product)) {}
+    void to_preop() { ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(m, mbx, a)); }
+    Unit u;
+    UnitLink link{u};
+    Master m{link, test_support::in_process_master_options()};
+    const Address a = Address::station(0x1001);
+    Mailbox mbx{m, a};
+    SdoClient sdo{mbx};
+};
+
 }  // namespace
 
 TEST(ProductWithoutMailbox, HasOnlyTheProcessDataPartsAndSaysItsWarningsOnce) {
@@ -312,13 +324,11 @@ TEST(ProductWithCoe, ServesSdoWithoutDriveAndFoe) {
 // 0x06010002: the master takes the mode the device has (the state transition judges it), as it takes an
 // absent 0x1C32/0x1C33, and reaches Op.
 TEST(ProductWithCoe, SyncModesTheDeviceFixesAreTakenAsTheyAre) {
-    Unit u(coe_terminal(true));
-    UnitLink link(u);
-    Master m(link, test_support::in_process_master_options());
-    const Address a = Address::station(0x1001);
-    Mailbox mbx(m, a);
-    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(m, mbx, a));
-    SdoClient sdo(mbx);
+    CoeUnitInPreOp t(coe_terminal(true));
+    ASSERT_NO_FATAL_FAILURE(t.to_preop());
+    Master& m = t.m;
+    const Address a = t.a;
+    SdoClient& sdo = t.sdo;
     const uint8_t sm_synchronous[2] = {0x22, 0};
     ASSERT_EQ(sdo.download(0x1C33, 1, sm_synchronous), Error::SdoAbort);
     ASSERT_EQ(sdo.last_abort(), 0x06010002u);
@@ -337,13 +347,11 @@ TEST(ProductWithCoe, SyncModesTheDeviceFixesAreTakenAsTheyAre) {
 // A device with a mailbox and no process-data SM: the master finds no process data (not a broken SII) and
 // takes it to Op as it takes a coupler.
 TEST(ProductWithCoe, MailboxOnlyDeviceHasNoProcessDataAndReachesOp) {
-    Unit u(test_products::mailbox_only_terminal());
-    UnitLink link(u);
-    Master m(link, test_support::in_process_master_options());
-    const Address a = Address::station(0x1001);
-    Mailbox mbx(m, a);
-    ASSERT_NO_FATAL_FAILURE(test_support::one_slave_in_preop(m, mbx, a));
-    SdoClient sdo(mbx);
+    CoeUnitInPreOp t(test_products::mailbox_only_terminal());
+    ASSERT_NO_FATAL_FAILURE(t.to_preop());
+    Master& m = t.m;
+    const Address a = t.a;
+    SdoClient& sdo = t.sdo;
     ProcessDataSession pd(m, a, sdo);
     ASSERT_EQ(pd.discover(), Error::Ok);
     EXPECT_EQ(pd.layout().sm2_length, 0);

@@ -113,17 +113,33 @@ inline od::Identity identity(uint32_t product) {
     return id;
 }
 
+// The parts every hand-built product shares: its source, identity and SMs, no Bootstrap mailbox, and either
+// no mailbox at all or CoE with SDO information on the standard mailbox (the default one).
+inline std::shared_ptr<od::Product> base_product(std::string source, uint32_t product_code,
+                                                 std::vector<od::SyncManagerDefault> sms, bool coe) {
+    auto p = std::make_shared<od::Product>();
+    p->source = std::move(source);
+    od::DeviceDescription& d = p->description;
+    d.identity = identity(product_code);
+    d.bootstrap_mailbox = {0, 0, 0, 0};
+    if (coe) {
+        d.mailbox_protocols = od::mailbox_protocol::CoE;
+        d.coe_details = od::coe_details::Sdo | od::coe_details::SdoInfo;
+    } else {
+        d.standard_mailbox = {0, 0, 0, 0};
+        d.mailbox_protocols = 0;
+        d.coe_details = 0;
+    }
+    d.sync_managers = std::move(sms);
+    return p;
+}
+
 // A digital IO terminal without mailbox: outputs in SM0 (0x0F00, 0x44), inputs in SM1 (0x1000, 0x00).
 inline std::shared_ptr<const od::Product> io_terminal() {
-    auto p = std::make_shared<od::Product>();
-    p->source = "hand-built IO terminal";
+    auto p = base_product("hand-built IO terminal", 0x00001234,
+                          {sm(od::SmKind::Outputs, 0x0F00, 3, 0x44), sm(od::SmKind::Inputs, 0x1000, 5, 0x00)},
+                          false);
     od::DeviceDescription& d = p->description;
-    d.identity = identity(0x00001234);
-    d.standard_mailbox = {0, 0, 0, 0};
-    d.bootstrap_mailbox = {0, 0, 0, 0};
-    d.mailbox_protocols = 0;
-    d.coe_details = 0;
-    d.sync_managers = {sm(od::SmKind::Outputs, 0x0F00, 3, 0x44), sm(od::SmKind::Inputs, 0x1000, 5, 0x00)};
     d.pdi_control = 0x04;  // digital IO
     d.esc_config = 0;
     p->make_dictionary = [](const od::DeviceDescription& desc) {
@@ -141,15 +157,11 @@ inline std::shared_ptr<const od::Product> io_terminal() {
 // `fixed_sync_modes`: 0x1C32:01 and 0x1C33:01 read-only, as a device with one synchronisation type declares
 // them (ETG.1020: "RW if more than one synchronization type is supported"; Beckhoff's EL1502 0x1C33).
 inline std::shared_ptr<const od::Product> coe_terminal(bool fixed_sync_modes = false) {
-    auto p = std::make_shared<od::Product>();
-    p->source = "hand-built CoE terminal";
-    od::DeviceDescription& d = p->description;
-    d.identity = identity(0x00005678);
-    d.bootstrap_mailbox = {0, 0, 0, 0};
-    d.mailbox_protocols = od::mailbox_protocol::CoE;
-    d.coe_details = od::coe_details::Sdo | od::coe_details::SdoInfo;
-    d.sync_managers = {sm(od::SmKind::MBoxOut, 0x1000, 128, 0x26), sm(od::SmKind::MBoxIn, 0x1080, 128, 0x22),
-                       sm(od::SmKind::Outputs, 0x1100, 3, 0x64), sm(od::SmKind::Inputs, 0x1180, 5, 0x20)};
+    auto p =
+        base_product("hand-built CoE terminal", 0x00005678,
+                     {sm(od::SmKind::MBoxOut, 0x1000, 128, 0x26), sm(od::SmKind::MBoxIn, 0x1080, 128, 0x22),
+                      sm(od::SmKind::Outputs, 0x1100, 3, 0x64), sm(od::SmKind::Inputs, 0x1180, 5, 0x20)},
+                     true);
     p->make_dictionary = [fixed_sync_modes](const od::DeviceDescription& desc) {
         od::Dictionary dict;
         add_identity(dict, desc);
@@ -171,14 +183,9 @@ inline std::shared_ptr<const od::Product> coe_terminal(bool fixed_sync_modes = f
 // A device with a mailbox and no process data (an EoE switch port, a gateway configured by CoE only): the
 // two mailbox SMs, CoE, identity objects and nothing mapped.
 inline std::shared_ptr<const od::Product> mailbox_only_terminal() {
-    auto p = std::make_shared<od::Product>();
-    p->source = "hand-built mailbox-only terminal";
-    od::DeviceDescription& d = p->description;
-    d.identity = identity(0x00009ABC);
-    d.bootstrap_mailbox = {0, 0, 0, 0};
-    d.mailbox_protocols = od::mailbox_protocol::CoE;
-    d.coe_details = od::coe_details::Sdo | od::coe_details::SdoInfo;
-    d.sync_managers = {sm(od::SmKind::MBoxOut, 0x1800, 128, 0x26), sm(od::SmKind::MBoxIn, 0x1C00, 128, 0x22)};
+    auto p = base_product(
+        "hand-built mailbox-only terminal", 0x00009ABC,
+        {sm(od::SmKind::MBoxOut, 0x1800, 128, 0x26), sm(od::SmKind::MBoxIn, 0x1C00, 128, 0x22)}, true);
     p->make_dictionary = [](const od::DeviceDescription& desc) {
         od::Dictionary dict;
         add_identity(dict, desc);
@@ -191,15 +198,9 @@ inline std::shared_ptr<const od::Product> mailbox_only_terminal() {
 // RxPDO and the TxPDO, PdoMapping "rt"): the master writes a watchdog counter and reads it back. Outputs in
 // SM0, inputs in SM1, no mailbox.
 inline std::shared_ptr<const od::Product> echo_terminal() {
-    auto p = std::make_shared<od::Product>();
-    p->source = "hand-built echo terminal";
-    od::DeviceDescription& d = p->description;
-    d.identity = identity(0x00004321);
-    d.standard_mailbox = {0, 0, 0, 0};
-    d.bootstrap_mailbox = {0, 0, 0, 0};
-    d.mailbox_protocols = 0;
-    d.coe_details = 0;
-    d.sync_managers = {sm(od::SmKind::Outputs, 0x1000, 2, 0x64), sm(od::SmKind::Inputs, 0x1100, 4, 0x20)};
+    auto p = base_product("hand-built echo terminal", 0x00004321,
+                          {sm(od::SmKind::Outputs, 0x1000, 2, 0x64), sm(od::SmKind::Inputs, 0x1100, 4, 0x20)},
+                          false);
     p->make_dictionary = [](const od::DeviceDescription& desc) {
         od::Dictionary dict;
         add_identity(dict, desc);
