@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <vector>
 
 #include "ecat/cycle.hpp"
 #include "ecat/sync_control.hpp"
@@ -267,8 +268,17 @@ uint16_t StateMachine::check_pre_op_to_safe_op() {
         const uint64_t kind = sync_.sm_type(n, static_cast<uint64_t>(desc.sync_managers[n].kind));
         if (kind != static_cast<uint64_t>(desc.sync_managers[n].kind)) return al::InvalidSmTypes;
     }
-    // Take over the PDO assignment and mapping of every process-data SM.
-    if (const uint16_t code = pd.build(ctx_.sms.all_outputs, ctx_.sms.all_inputs); code != 0) return code;
+    // Take over the PDO assignment and mapping of every process-data SM. The PDOs of an input SM on the
+    // register space map the ESC's own registers (Beckhoff's 0x1Dxx:yy for register 0xxxyy, EL1202-0100's
+    // Virtual SM over 0x0990): where the dictionary has no object for them, that SM is left out of the
+    // image, and the device's own process data runs without it.
+    if (uint16_t code = pd.build(ctx_.sms.all_outputs, ctx_.sms.all_inputs); code != 0) {
+        std::vector<unsigned> own;
+        for (const unsigned n : ctx_.sms.all_inputs)
+            if (!inputs_on_registers(ctx_.sms, desc, n)) own.push_back(n);
+        if (own.size() == ctx_.sms.all_inputs.size()) return code;
+        if (code = pd.build(ctx_.sms.all_outputs, own); code != 0) return code;
+    }
 
     struct Side {
         unsigned sm;

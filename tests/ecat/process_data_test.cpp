@@ -422,6 +422,30 @@ TEST_F(SeveralSms, AnInputSmOnTheRegisterSpaceShowsTheEscsRegisters) {
     EXPECT_EQ(shown, master.rd<uint64_t>(0x0910));
 }
 
+// The PDO of an input SM on the register space maps the ESC register itself the way Beckhoff writes it
+// (0x1Dxx:yy for register 0xxxyy: EL1202-0100's 0x1D09:90 over 0x0990), an object no dictionary has: the
+// device's own process data still runs (the first input SM's data is exchanged, Safe-Op and the inputs as
+// without that SM), instead of refusing the mapping (0x0024) or, with device emulation, running without data.
+TEST_F(SeveralSms, AnInputSmOnTheRegisterSpaceWhosePdoMapsNoObjectLeavesTheRestRunning) {
+    dict.add(pdo_array(0x1B00, od::PdoDirection::Tx, od::DataType::Unsigned32, {0x1D090940}));
+    ASSERT_EQ(dict.set<uint16_t>(0x1C15, 1, 0x1B00), od::Status::Ok);
+    desc.sync_managers[5].start = 0x0990;
+    start();
+    go_preop();
+    configure_all();
+    configure_sm(5, 0x0990, 8, 0x20, false);  // only the first input SM is set up, as a one-SM master does
+    request(0x04);
+    ASSERT_EQ(al_status(), 0x04) << "code " << std::hex << al_code();
+    ASSERT_EQ(dict.set<uint16_t>(0x6000, 0, 0x4321), od::Status::Ok);
+    std::vector<uint8_t> in(3);
+    const std::vector<uint8_t> out(3, 0);
+    exchange_pd(out, in);
+    poll();
+    exchange_pd(out, in);
+    EXPECT_EQ(in[0] | (in[1] << 8), 0x4321) << "the first input SM's data";
+    EXPECT_EQ(master.rd<uint8_t>(0x0807 + 8 * 3) & 0x01, 0) << "SM3 not deactivated by the PDI";
+}
+
 TEST_F(SeveralSms, APdoOfTheOtherDirectionIsRefusedWhereverItsIndexLies) {
     // 0x1C14 (SM4, outputs) assigning the TxPDO 0x1C00: an invalid output mapping.
     ASSERT_EQ(dict.set<uint16_t>(0x1C14, 1, 0x1C00), od::Status::Ok);
