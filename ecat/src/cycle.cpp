@@ -124,7 +124,7 @@ void Cycle::restart_after_esc_reset(uint64_t now_ns) {
     // The register set-up of the constructor, lost with the reset.
     set_up_registers();
     for (unsigned n = 0; n < 4; ++n)
-        set_sm_pdi_deactivated(ctx_.pdi, n, true);
+        hold_sm_until_started(ctx_.pdi, n);
     esm_.write_status();
     update_irq_usable();
     first_poll_ = true;      // take over whatever the master requested since the reset
@@ -191,7 +191,7 @@ void Cycle::stop_process_data() {
     sync0_event_ = false;
     for (const auto* list : {&ctx_.sms.all_outputs, &ctx_.sms.all_inputs})
         for (const unsigned n : *list)
-            set_sm_pdi_deactivated(ctx_.pdi, n, true);
+            hold_sm_until_started(ctx_.pdi, n);
     ctx_.pd.clear();
     out_sm_ = ctx_.sms.outputs < 4 ? ctx_.sms.outputs : 2;
     in_sm_ = ctx_.sms.inputs < 4 ? ctx_.sms.inputs : 3;

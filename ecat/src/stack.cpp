@@ -27,7 +27,7 @@ Stack::Stack(esc::Pdi& pdi, od::Dictionary& dictionary, const od::DeviceDescript
     esm_.write_status();
     // Mailbox and process-data SMs stay deactivated from the PDI side until their state starts them.
     for (unsigned n = 0; n < 4; ++n)
-        set_sm_pdi_deactivated(pdi, n, true);
+        hold_sm_until_started(pdi, n);
     sync_.init_objects();
 }
 

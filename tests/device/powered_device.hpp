@@ -20,6 +20,7 @@ struct PoweredDevice {
     std::unique_ptr<esc::Esc> esc;
     std::unique_ptr<device::Device> dev;
     uint64_t frame_ns = 20'000;  // slave time that passes with each frame
+    bool firmware_runs = true;   // false: the controller is busy elsewhere, only the ESC answers frames
 
     PoweredDevice() { clock.set(1'000'000'000); }
     // A power cycle: a new ESC, a new Device (which logs to `log`).
@@ -45,7 +46,10 @@ struct PoweredDevice {
     bool frame(std::vector<uint8_t>& f) {
         clock.advance(frame_ns);
         const bool back = esc->process_frame(f);
-        service();
+        if (firmware_runs)
+            service();
+        else
+            esc->tick();
         return back;
     }
 };

@@ -464,6 +464,38 @@ TEST(ProductWithDeviceEmulation, FollowsTheStateTheEscTookWithItsProcessData) {
     EXPECT_EQ(t.u.dev->stack().state(), od::AlState::SafeOp);
 }
 
+// Device emulation means no controller is needed for the state or the process data: the ESC reports the state
+// the master asked for at once, and its SMs run as the master set them up, however late the stack behind gets
+// to look (a busy controller, a line's runtime under load). The stack holds no SM off from the PDI side, from
+// power-on and on every way back down; the first cycle after the request has the full working counter.
+TEST(ProductWithDeviceEmulation, RunsItsProcessDataBeforeTheControllerLooks) {
+    EmulatedTerminal t;
+    t.u.firmware_runs = false;  // after power-on the controller does not get to look until the end
+    ASSERT_NO_FATAL_FAILURE(t.to_op());
+    auto fill = [&] {
+        t.pd.outputs()[0] = 0x21;
+        t.pd.outputs()[1] = 0x43;
+    };
+    EXPECT_EQ(t.pd.run(3, std::chrono::microseconds(100), fill), Error::Ok)
+        << "working counter " << t.pd.last_wkc() << " of " << t.pd.expected_wkc();
+    EXPECT_EQ(t.u.dev->stack().state(), od::AlState::Init) << "the controller has not looked yet";
+    t.u.firmware_runs = true;
+    ASSERT_EQ(t.pd.run(3, std::chrono::microseconds(100), fill), Error::Ok);
+    EXPECT_EQ(t.u.dev->stack().state(), od::AlState::Op);
+    EXPECT_EQ(t.u.dev->dictionary().get<uint16_t>(0x7000, 1), 0x4321);
+    // Down to Init, seen by the controller, and up again while it is busy.
+    for (const AlState down : {AlState::Init, AlState::PreOp, AlState::SafeOp}) {
+        SCOPED_TRACE(static_cast<int>(down));
+        t.u.firmware_runs = true;
+        ASSERT_EQ(t.m.request_state(t.a, down), Error::Ok);
+        t.u.service();
+        t.u.firmware_runs = false;
+        ASSERT_EQ(t.m.request_state(t.a, AlState::Op), Error::Ok);
+        EXPECT_EQ(t.pd.run(3, std::chrono::microseconds(100), fill), Error::Ok)
+            << "working counter " << t.pd.last_wkc() << " of " << t.pd.expected_wkc();
+    }
+}
+
 // Device emulation with the outputs on the digital-output registers (0x0F00, SM control 0x44): the master's
 // writes through that SM trigger the process-data watchdog; when it expires the ESC keeps Op, shows the
 // expiry in 0x0440 bit 0, and the device's outputs go to 0 at once (0x0150 bit 3 = 0) or are held until the

@@ -145,4 +145,13 @@ inline void set_sm_pdi_deactivated(esc::Pdi& pdi, unsigned n, bool deactivated) 
     pdi.write_reg<uint8_t>(esc::reg::sm_base(n) + esc::reg::kSmPdiControl, v);
 }
 
+// Holds SM n off from the PDI side until its state starts it (Init, an ESC reset, the way back from Safe-Op).
+// A device whose ESC follows the master's AL control by itself (device emulation, ESC configuration 0x0141
+// bit 0: the IO terminals without a controller) has nobody who would hold it: its SMs run as soon as the
+// master enables them, in the state the ESC already reports, whenever the stack behind gets to look.
+inline void hold_sm_until_started(esc::Pdi& pdi, unsigned n) {
+    const bool device_emulation = (pdi.read_reg<uint8_t>(esc::reg::kEscConfig) & 0x01) != 0;
+    set_sm_pdi_deactivated(pdi, n, !device_emulation);
+}
+
 }  // namespace ecat

@@ -432,6 +432,9 @@ void Device::build() {
     if (options_.load_sii) {
         image = built_sii(options_, p->desc, p->dict);
         eeprom_writes_.apply(image);
+        // Loaded before the controller starts, as an ESC loads its EEPROM at power-on: the stack finds the
+        // ESC configuration (device emulation, 0x0141) the device runs with.
+        esc_.load_eeprom(image);
     }
 
     p->stack = std::make_unique<ecat::Stack>(esc_, p->dict, p->desc, *this, [this] { return esc_.irq(); });
@@ -470,7 +473,6 @@ void Device::build() {
     }
     if (!p->drive) p->io = std::make_unique<IoModel>();
 
-    if (options_.load_sii) esc_.load_eeprom(image);
     if (parts_) ecat::add_stats(earlier_stacks_, parts_->stack->stats());
     parts_ = std::move(p);
     restart_pending_ = false;
