@@ -200,6 +200,39 @@ TEST_F(DeviceAssembly, IdentityInTheSiiEqualsObject1018AndTheEsi) {
     EXPECT_EQ(std::string(name.begin(), name.begin() + static_cast<long>(*n)), id.device_name);
 }
 
+// A transfer given up on (its answer came after the client's timeout: a lossy or loaded link, a busy
+// controller) leaves its late answer in the slave's out-mailbox. The next transfers start with the
+// out-mailbox read empty: each gets its own answer, not the one before it, for uploads, downloads and SDO
+// information alike; emergencies waiting there are kept as ever.
+TEST_F(DeviceAssembly, ALateAnswerIsNotTakenForTheNextTransfers) {
+    mbx.set_timeout(std::chrono::milliseconds(20));
+    std::array<uint8_t, 64> b{};
+    for (int round = 0; round < 3; ++round) {
+        SCOPED_TRACE(round);
+        drive.firmware_runs = false;  // the request reaches SM0; nobody answers in time
+        const uint16_t index = round == 1 ? 0x1008 : 0x1018;
+        EXPECT_EQ(sdo.upload(index, round == 1 ? 0 : 2, b).error(), Error::MailboxTimeout);
+        drive.firmware_runs = true;
+        drive.service();  // the late answer is now waiting in SM1
+        EXPECT_EQ(sdo_u32(0x1018, 1), drive.dev->description().identity.vendor_id);
+        EXPECT_EQ(sdo.stale_answers(), static_cast<uint64_t>(round + 1));
+    }
+    const uint8_t window[4] = {0x34, 0x12, 0, 0};
+    drive.firmware_runs = false;
+    EXPECT_EQ(sdo.download(0x6065, 0, window), Error::MailboxTimeout);
+    drive.firmware_runs = true;
+    drive.service();
+    EXPECT_EQ(sdo_u32(0x6065, 0), 0x1234u) << "the download was done, its answer late";
+    drive.firmware_runs = false;
+    EXPECT_EQ(sdo.upload(0x6065, 0, b).error(), Error::MailboxTimeout);
+    drive.firmware_runs = true;
+    drive.service();
+    const auto od = sdo.object_description(0x1018);
+    ASSERT_TRUE(od.ok()) << master::to_string(od.error());
+    EXPECT_EQ(od->index, 0x1018);
+    EXPECT_EQ(sdo.stale_answers(), 5u);
+}
+
 TEST_F(DeviceAssembly, ReachesOpWithTheDefaultMappingAndTheDriveMovesInCsp) {
     ProcessDataSession pd(m, a, sdo);
     ASSERT_NO_FATAL_FAILURE(to_op(pd));

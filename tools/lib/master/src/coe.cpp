@@ -49,7 +49,31 @@ Error SdoClient::prepare() {
     // The mailbox may have been (re)configured since construction: follow its size (allocates only then).
     if (mbx_.max_out_payload() < 10 || mbx_.max_in_payload() < 10) return Error::MailboxNotConfigured;
     if (req_.size() != mbx_.max_out_payload()) req_.assign(mbx_.max_out_payload(), 0);
+    take_stale();
     return Error::Ok;
+}
+
+void SdoClient::take_stale() {
+    // What the slave put in its out-mailbox since the last transfer: emergencies (kept as ever) and the late
+    // answers of transfers given up on. Bounded: a slave that keeps SM1 full is the transfer's problem.
+    constexpr int kMaxWaiting = 8;
+    MailboxMessage msg;
+    for (int i = 0; i < kMaxWaiting; ++i) {
+        if (mbx_.receive(msg, std::chrono::milliseconds(0)) != Error::Ok) return;
+        if (!take_emergency(msg)) ++stale_answers_;
+    }
+}
+
+bool SdoClient::take_emergency(const MailboxMessage& msg) {
+    const auto p = msg.payload;
+    if (msg.type != MailboxType::CoE || p.size() < 2 || (p[1] >> 4) != kServiceEmergency) return false;
+    if (p.size() >= 10) {
+        last_emergency_.code = get16(p.data() + 2);
+        last_emergency_.error_register = p[4];
+        std::copy_n(p.begin() + 5, 5, last_emergency_.data.begin());
+    }
+    ++emergencies_;
+    return true;
 }
 
 Error SdoClient::send(std::size_t length) {
@@ -75,17 +99,8 @@ Error SdoClient::response(MailboxMessage& msg, uint8_t wanted) {
             last_mailbox_error_ = p.size() >= 4 ? get16(p.data() + 2) : 0;
             return Error::MailboxError;
         }
-        if (msg.type != MailboxType::CoE || p.size() < 2) continue;  // not for us
+        if (msg.type != MailboxType::CoE || p.size() < 2 || take_emergency(msg)) continue;  // not for us
         const uint8_t service = static_cast<uint8_t>(p[1] >> 4);
-        if (service == kServiceEmergency) {
-            if (p.size() >= 10) {
-                last_emergency_.code = get16(p.data() + 2);
-                last_emergency_.error_register = p[4];
-                std::copy_n(p.begin() + 5, 5, last_emergency_.data.begin());
-            }
-            ++emergencies_;
-            continue;
-        }
         if (wanted == kServiceSdoInfo) {
             if (service != kServiceSdoInfo) continue;
             if (p.size() < 6) return Error::MailboxProtocol;

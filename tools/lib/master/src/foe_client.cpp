@@ -56,6 +56,7 @@ Error FoeClient::receive(uint8_t& opcode, uint32_t& value, std::span<const uint8
 
 Result<std::vector<uint8_t>> FoeClient::read(std::string_view name, uint32_t password, std::size_t max_size) {
     if (!mbx_.config().valid()) return Error::MailboxNotConfigured;
+    mbx_.drain();  // a late answer of an abandoned transfer is not this one's
     const std::size_t full = mbx_.max_in_payload() - 6;  // a full DATA packet from the slave
     if (Error e = send(kRead, password,
                        std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(name.data()), name.size()));
@@ -93,6 +94,7 @@ Result<std::vector<uint8_t>> FoeClient::read(std::string_view name, uint32_t pas
 
 Error FoeClient::write(std::string_view name, std::span<const uint8_t> data, uint32_t password) {
     if (!mbx_.config().valid()) return Error::MailboxNotConfigured;
+    mbx_.drain();  // a late answer of an abandoned transfer is not this one's
     const std::size_t full = mbx_.max_out_payload() - 6;
     if (Error e = send(kWrite, password,
                        std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(name.data()), name.size()));

@@ -67,9 +67,16 @@ class SdoClient {
     uint16_t last_mailbox_error() const { return last_mailbox_error_; }
     uint64_t emergencies() const { return emergencies_; }
     const EmergencyMessage& last_emergency() const { return last_emergency_; }
+    // Messages found waiting in the slave's out-mailbox when a transfer started, other than emergencies: the
+    // late answers of transfers given up on (a timeout on a lossy or loaded link). Each transfer starts with
+    // the out-mailbox read empty, as SOEM's SDO functions do, so a late answer is never taken for the next
+    // transfer's (which would put every later transfer one answer behind).
+    uint64_t stale_answers() const { return stale_answers_; }
 
   private:
     Error prepare();
+    void take_stale();
+    bool take_emergency(const MailboxMessage& message);
     Error send(std::size_t length);
     Error response(MailboxMessage& message, uint8_t service = 3);
     // Sends one SDO info request and collects every fragment of the answer (after the 6-byte head).
@@ -82,6 +89,7 @@ class SdoClient {
     bool last_size_indicated_ = true;
     uint16_t last_mailbox_error_ = 0;
     uint64_t emergencies_ = 0;
+    uint64_t stale_answers_ = 0;
     EmergencyMessage last_emergency_;
 };
 
