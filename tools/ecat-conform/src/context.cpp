@@ -239,7 +239,22 @@ std::vector<std::optional<uint32_t>> Context::modules_of(const EsiFile& f, const
 }
 
 std::string Context::setup() {
-    auto n = m.count_slaves();
+    // A read of the set-up that goes unanswered is tried again for up to a second (scaled): a host that
+    // stalls the slave for a moment (a busy machine descheduling it) must not leave the run without the SII,
+    // the station addresses or the ESC configuration, every later test skipped or judged on the wrong
+    // mailbox. A slave that stays silent is reported after that second, as before.
+    const auto patience_end = Clock::now() + ms(1000);
+    bool repeated = false;
+    auto patient = [&](auto read) {
+        auto r = read();
+        while (!r && r.error() == Error::Timeout && Clock::now() < patience_end) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            repeated = true;
+            r = read();
+        }
+        return r;
+    };
+    auto n = patient([&] { return m.count_slaves(); });
     if (!n)
         return "no slave answered on " + opt.iface + " (" + std::string(master::to_string(n.error())) + ")";
     slave_count = *n;
@@ -247,15 +262,22 @@ std::string Context::setup() {
         return "slave position " + std::to_string(opt.slave) + " not on the bus (" +
                std::to_string(slave_count) + " slave(s))";
     pos = master::Address::position(static_cast<uint16_t>(-static_cast<int>(opt.slave)));
-    if (Error e = m.assign_station_addresses(slave_count); e != Error::Ok)
-        return "assigning station addresses: " + std::string(master::to_string(e));
+    if (auto e = patient([&]() -> master::Result<int> {
+            const Error r = m.assign_station_addresses(slave_count);
+            if (r != Error::Ok) return r;
+            return 0;
+        });
+        !e)
+        return "assigning station addresses: " + std::string(master::to_string(e.error()));
     station = static_cast<uint16_t>(0x1001 + opt.slave);
     addr = master::Address::station(station);
-    if (auto s = m.al_status(addr)) initial_state = s->state;
+    if (auto s = patient([&] { return m.al_status(addr); })) initial_state = s->state;
     // What the ESC itself does: the ESC configuration register as the SII loaded it.
-    if (auto c = m.read_reg<uint8_t>(addr, esc::reg::kEscConfig)) device_emulation = *c & 0x01;
+    if (auto c = patient([&] { return m.read_reg<uint8_t>(addr, esc::reg::kEscConfig); }))
+        device_emulation = *c & 0x01;
     // The whole EEPROM, as big as word 0x3E says.
-    auto img = m.sii_read_image(addr, true);
+    auto img = patient([&] { return m.sii_read_image(addr, true); });
+    if (repeated) notes.push_back("set-up reads went unanswered and were repeated (a stalled host?)");
     if (img) {
         SiiImage s;
         s.bytes = std::move(*img);
