@@ -35,6 +35,7 @@
 using namespace master;
 using test_products::coe_terminal;
 using test_products::io_terminal;
+using test_products::two_sm_terminal;
 
 namespace {
 
@@ -42,12 +43,12 @@ namespace {
 struct Unit : test_device::PoweredDevice {
     std::filesystem::path dir;
 
-    explicit Unit(std::shared_ptr<const od::Product> product)
+    explicit Unit(std::shared_ptr<const od::Product> product, const esc::EscConfig& config = {})
         : dir(test_support::make_temp_dir("softecat-product-")) {
         device::DeviceOptions o;
         o.product = std::move(product);
         o.state_dir = dir;
-        power_on(o);
+        power_on(o, config);
     }
     ~Unit() {
         dev.reset();
@@ -109,12 +110,13 @@ TEST(ProductWithoutMailbox, ReachesOpWithProcessDataOnlyAndItsInputsFollowTheDef
     ProcessDataSession pd(m, std::span<const Address>(&a, 1));
     ASSERT_EQ(pd.discover_sii(0), Error::Ok);
     const ProcessDataLayout& l = pd.layout(0);
-    EXPECT_EQ(l.out_sm, 0);
-    EXPECT_EQ(l.in_sm, 1);
-    EXPECT_EQ(l.sm2_start, 0x0F00);
-    EXPECT_EQ(l.sm3_start, 0x1000);
-    ASSERT_EQ(l.sm2_length, 3);
-    ASSERT_EQ(l.sm3_length, 5);
+    ASSERT_EQ(l.sms.size(), 2u);
+    EXPECT_EQ(l.sms[0].index, 0);
+    EXPECT_EQ(l.sms[1].index, 1);
+    EXPECT_EQ(l.sms[0].start, 0x0F00);
+    EXPECT_EQ(l.sms[1].start, 0x1000);
+    ASSERT_EQ(l.output_bytes(), 3u);
+    ASSERT_EQ(l.input_bytes(), 5u);
     ASSERT_EQ(pd.configure(), Error::Ok);
     auto fill = [&] {
         auto o = pd.outputs();
@@ -189,8 +191,8 @@ TEST(ProductWithoutMailbox, AnEntryMappedBothWaysEchoesTheOutputAndIsNotModelled
     ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
     ProcessDataSession pd(m, std::span<const Address>(&a, 1));
     ASSERT_EQ(pd.discover_sii(0), Error::Ok);
-    ASSERT_EQ(pd.layout(0).sm2_length, 2);
-    ASSERT_EQ(pd.layout(0).sm3_length, 4);
+    ASSERT_EQ(pd.layout(0).output_bytes(), 2u);
+    ASSERT_EQ(pd.layout(0).input_bytes(), 4u);
     ASSERT_EQ(pd.configure(), Error::Ok);
     uint16_t written = 0x0100;
     auto fill = [&] {
@@ -303,8 +305,8 @@ TEST(ProductWithCoe, ServesSdoWithoutDriveAndFoe) {
 
     ProcessDataSession pd(m, a, sdo);
     ASSERT_EQ(pd.discover(), Error::Ok);
-    EXPECT_EQ(pd.layout().sm2_length, 3);
-    EXPECT_EQ(pd.layout().sm3_length, 5);
+    EXPECT_EQ(pd.layout().output_bytes(), 3u);
+    EXPECT_EQ(pd.layout().input_bytes(), 5u);
     ASSERT_EQ(pd.configure(), Error::Ok);
     auto fill = [&] {
         auto o = pd.outputs();
@@ -354,8 +356,8 @@ TEST(ProductWithCoe, MailboxOnlyDeviceHasNoProcessDataAndReachesOp) {
     SdoClient& sdo = t.sdo;
     ProcessDataSession pd(m, a, sdo);
     ASSERT_EQ(pd.discover(), Error::Ok);
-    EXPECT_EQ(pd.layout().sm2_length, 0);
-    EXPECT_EQ(pd.layout().sm3_length, 0);
+    EXPECT_EQ(pd.layout().output_bytes(), 0u);
+    EXPECT_EQ(pd.layout().input_bytes(), 0u);
     AlStatus st;
     for (const AlState s : {AlState::SafeOp, AlState::Op})
         ASSERT_EQ(m.request_state(a, s, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
@@ -506,7 +508,7 @@ TEST(ProductWithDeviceEmulation, OutputsOnTheRegistersGoToZeroWhenTheWatchdogExp
         SCOPED_TRACE(at_next_event ? "0x0150 bit 3 = 1" : "0x0150 bit 3 = 0");
         EmulatedTerminal t(at_next_event ? 0x08 : 0x00);
         ASSERT_NO_FATAL_FAILURE(t.to_op());
-        ASSERT_EQ(t.pd.layout(0).sm2_start, 0x0F00);
+        ASSERT_EQ(t.pd.layout(0).first(true)->start, 0x0F00);
         auto fill = [&] {
             auto o = t.pd.outputs();
             o[0] = 0x34;
@@ -591,4 +593,122 @@ TEST(ProductWithDrive, Announces6502AsServedAndSaysWhatItTookOut) {
     EXPECT_EQ(write_mode(2), od::Status::InvalidValue);  // velocity mode
     EXPECT_EQ(write_mode(7), od::Status::Ok);            // interpolated position: 0x60C1 is there
     EXPECT_EQ(write_mode(4), od::Status::Ok);            // profile torque
+}
+
+namespace {
+
+// The two-SM terminal's outputs (SM of 0x1600: 0x7000:01 Value, 0x7000:02 Output; SM of 0x1601: 0x7010:01
+// Channel 2) in the session's image: outputs SM by SM in SM order.
+void fill_two_sm(ProcessDataSession& pd) {
+    auto o = pd.outputs();
+    o[0] = 0x21;
+    o[1] = 0x43;
+    o[2] = 0x01;
+    o[3] = 0x65;
+    o[4] = 0x87;
+}
+
+// OP with the exact working counter, then the inputs of both inputs SMs: 0x6000:01 mirrors Value, 0x6000:03
+// keeps 0x1234 (first SM), 0x6010:01 mirrors Channel 2, 0x6010:02 keeps 0x5A (second SM).
+void expect_two_sm_exchange(ProcessDataSession& pd) {
+    // Four FMMUs, one LRW: the ESC counts the datagram once per direction, 2 for the outputs written and 1
+    // for the inputs read (ESC datasheet section I, working counter), not once per FMMU.
+    EXPECT_EQ(pd.expected_wkc(), 3);
+    AlStatus st;
+    const auto fill = [&pd] { fill_two_sm(pd); };
+    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(100), &st, fill), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(100), &st, fill), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(pd.run(5, std::chrono::microseconds(100), fill), Error::Ok);
+    EXPECT_EQ(pd.last_wkc(), 3);
+    const auto in = pd.inputs();
+    EXPECT_EQ(u16(in, 0), 0x4321);
+    EXPECT_EQ(u16(in, 3), 0x1234);
+    EXPECT_EQ(u16(in, 5), 0x8765);
+    EXPECT_EQ(in[7], 0x5A);
+}
+
+}  // namespace
+
+// A device with two outputs SMs (SM2, SM4) and two inputs SMs (SM3, SM5), PDOs assigned by 0x1C12..0x1C15
+// (ETG.1000.6: 0x1C10 + n for SM n): the session sets up all four with an FMMU each, the outputs of both SMs
+// reach the dictionary and the inputs of both come back, with the exact working counter.
+TEST(ProductWithSeveralSms, EveryProcessDataSmIsMappedOverCoe) {
+    CoeUnitInPreOp t(two_sm_terminal(true));
+    ASSERT_NO_FATAL_FAILURE(t.to_preop());
+    ProcessDataSession pd(t.m, t.a, t.sdo);
+    ASSERT_EQ(pd.discover(), Error::Ok);
+    const ProcessDataLayout& l = pd.layout();
+    ASSERT_EQ(l.sms.size(), 4u);
+    const uint8_t index[4] = {2, 3, 4, 5};
+    const uint16_t length[4] = {3, 5, 2, 3};
+    for (std::size_t k = 0; k < 4; ++k) {
+        EXPECT_EQ(l.sms[k].index, index[k]);
+        EXPECT_EQ(l.sms[k].outputs, k % 2 == 0);
+        EXPECT_EQ(l.sms[k].length, length[k]);
+    }
+    EXPECT_EQ(l.pdos(true), (std::vector<uint16_t>{0x1600, 0x1601}));
+    EXPECT_EQ(l.pdos(false), (std::vector<uint16_t>{0x1A00, 0x1A01}));
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    ASSERT_EQ(pd.outputs().size(), 5u);
+    ASSERT_EQ(pd.inputs().size(), 8u);
+    ASSERT_NO_FATAL_FAILURE(expect_two_sm_exchange(pd));
+    uint8_t b[4] = {};
+    ASSERT_TRUE(t.sdo.upload(0x7000, 1, b).ok());
+    EXPECT_EQ(u16(b, 0), 0x4321);
+    ASSERT_TRUE(t.sdo.upload(0x7010, 1, b).ok());
+    EXPECT_EQ(u16(b, 0), 0x8765);
+    // SM4 and SM5 as the SII declares them, each read by its own FMMU (FMMU1: SM4, outputs after SM2's;
+    // FMMU3: SM5, inputs after SM3's).
+    uint8_t f[64] = {};
+    ASSERT_EQ(t.m.read(t.a, reg::Fmmu0, f), Error::Ok);
+    EXPECT_EQ(u16(f, 16 + 8), 0x1200);
+    EXPECT_EQ(f[16 + 11], 0x02);
+    EXPECT_EQ(f[48 + 8] | (f[48 + 9] << 8), 0x1280);
+    EXPECT_EQ(f[48 + 11], 0x01);
+}
+
+// Without mailbox the layout comes from the SII alone: every SM of type 3/4 of the SyncM category with the
+// PDOs the RxPDO/TxPDO categories assign to it, here outputs in SM0/SM2 and inputs in SM1/SM3.
+TEST(ProductWithSeveralSms, EveryProcessDataSmIsMappedFromTheSiiAlone) {
+    Unit u(two_sm_terminal(false));
+    UnitLink link(u);
+    Master m(link, test_support::in_process_master_options());
+    const Address a = Address::station(0x1001);
+    ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
+    ProcessDataSession pd(m, std::span<const Address>(&a, 1));
+    ASSERT_EQ(pd.discover_sii(0), Error::Ok);
+    const ProcessDataLayout& l = pd.layout(0);
+    ASSERT_EQ(l.sms.size(), 4u);
+    EXPECT_EQ(l.sms[2].index, 2);
+    EXPECT_EQ(l.sms[3].index, 3);
+    EXPECT_EQ(l.sms[3].start, 0x1200);
+    EXPECT_EQ(l.sms[3].pdos, (std::vector<uint16_t>{0x1A01}));
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    ASSERT_EQ(pd.outputs().size(), 5u);
+    ASSERT_EQ(pd.inputs().size(), 8u);
+    ASSERT_NO_FATAL_FAILURE(expect_two_sm_exchange(pd));
+}
+
+// A slave with fewer FMMUs (ESC 0x0004) than SMs carrying data cannot map its image: the session says so and
+// configures nothing, rather than mapping part of it.
+TEST(ProductWithSeveralSms, TooFewFmmusIsAnErrorAndNothingIsConfigured) {
+    esc::EscConfig three;
+    three.fmmu_count = 3;
+    Unit u(two_sm_terminal(false), three);
+    UnitLink link(u);
+    Master m(link, test_support::in_process_master_options());
+    const Address a = Address::station(0x1001);
+    ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
+    ProcessDataSession pd(m, std::span<const Address>(&a, 1));
+    ASSERT_EQ(pd.discover_sii(0), Error::Ok);
+    EXPECT_EQ(pd.configure(), Error::TooFewFmmus);
+    EXPECT_NE(to_string(Error::TooFewFmmus).find("FMMU"), std::string::npos);
+    for (uint8_t n = 0; n < 4; ++n)
+        EXPECT_EQ(m.read_reg<uint8_t>(a, static_cast<uint16_t>(0x0806 + 8 * n)).value() & 0x01, 0)
+            << "SM" << +n;
+    for (uint8_t n = 0; n < 3; ++n)
+        EXPECT_EQ(m.read_reg<uint8_t>(a, static_cast<uint16_t>(0x060C + 16 * n)).value() & 0x01, 0)
+            << "FMMU" << +n;
 }
