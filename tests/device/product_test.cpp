@@ -33,6 +33,7 @@
 #include "support/wire_link.hpp"
 
 using namespace master;
+using test_products::byte_outputs_terminal;
 using test_products::coe_terminal;
 using test_products::io_terminal;
 using test_products::two_sm_terminal;
@@ -711,4 +712,41 @@ TEST(ProductWithSeveralSms, TooFewFmmusIsAnErrorAndNothingIsConfigured) {
     for (uint8_t n = 0; n < 3; ++n)
         EXPECT_EQ(m.read_reg<uint8_t>(a, static_cast<uint16_t>(0x060C + 16 * n)).value() & 0x01, 0)
             << "FMMU" << +n;
+}
+
+// SMs one after the other in memory share one FMMU (one logical range onto one physical range, as SOEM and
+// TwinCAT map them): the four one-byte outputs SMs on 0x0F00..0x0F03 fit the one FMMU of an ESC with one,
+// and every byte reaches its SM.
+TEST(ProductWithSeveralSms, AdjacentSmsShareOneFmmu) {
+    esc::EscConfig one;
+    one.fmmu_count = 1;
+    Unit u(byte_outputs_terminal(), one);
+    UnitLink link(u);
+    Master m(link, test_support::in_process_master_options());
+    const Address a = Address::station(0x1001);
+    ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
+    ProcessDataSession pd(m, std::span<const Address>(&a, 1));
+    ASSERT_EQ(pd.discover_sii(0), Error::Ok);
+    ASSERT_EQ(pd.layout(0).sms.size(), 4u);
+    const auto fmmus = pd.layout(0).fmmus();
+    ASSERT_EQ(fmmus.size(), 1u);
+    EXPECT_EQ(fmmus[0].physical, 0x0F00);
+    EXPECT_EQ(fmmus[0].length, 4);
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    ASSERT_EQ(pd.outputs().size(), 4u);
+    EXPECT_EQ(pd.expected_wkc(), 2);
+    const auto fill = [&pd] {
+        for (uint8_t k = 0; k < 4; ++k)
+            pd.outputs()[k] = static_cast<uint8_t>(0x11 * (k + 1));
+    };
+    AlStatus st;
+    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(100), &st, fill), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(100), &st, fill), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(pd.run(5, std::chrono::microseconds(100), fill), Error::Ok);
+    uint8_t out[4] = {};
+    ASSERT_EQ(m.read(a, 0x0F00, out), Error::Ok);
+    EXPECT_EQ(out[0], 0x11);
+    EXPECT_EQ(out[3], 0x44);
 }

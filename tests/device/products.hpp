@@ -226,6 +226,39 @@ inline std::shared_ptr<const od::Product> two_sm_terminal(bool coe) {
     return p;
 }
 
+// A digital output terminal without mailbox with one byte of outputs in each of SM0..SM3, on the digital
+// output registers 0x0F00..0x0F03 (as Beckhoff's FB1111 "Dig. Out" and iTegva's E7.820.004 declare them,
+// with one FMMU for all four): RxPDO 0x1600 + k maps 0x7000:0(k+1) "Output k" U8.
+inline std::shared_ptr<const od::Product> byte_outputs_terminal() {
+    std::vector<od::SyncManagerDefault> sms;
+    for (uint16_t k = 0; k < 4; ++k)
+        sms.push_back(sm(od::SmKind::Outputs, static_cast<uint16_t>(0x0F00 + k), 1, 0x44));
+    auto p = base_product("hand-built byte outputs terminal", 0x00001111, std::move(sms), false);
+    od::DeviceDescription& d = p->description;
+    d.fmmus = {1};
+    d.pdi_control = 0x04;  // digital IO
+    d.esc_config = 0;
+    p->application = od::Application::None;
+    p->make_dictionary = [](const od::DeviceDescription& desc) {
+        od::Dictionary dict;
+        add_identity(dict, desc);
+        std::vector<od::Entry> outputs;
+        for (uint8_t k = 0; k < 4; ++k) {
+            const auto pdo = static_cast<uint16_t>(0x1600 + k);
+            const uint64_t mapping = 0x70000008 | (uint64_t{k + 1u} << 8);
+            dict.add(record(pdo, "Output " + std::to_string(k),
+                            {entry(1, "SubIndex 001", od::DataType::Unsigned32, kRo, mapping)}));
+            dict.add(
+                array(static_cast<uint16_t>(0x1C10 + k), "RxPDO assign", od::DataType::Unsigned16, {pdo}));
+            outputs.push_back(entry(static_cast<uint8_t>(k + 1), "Output " + std::to_string(k),
+                                    od::DataType::Unsigned8, kRx, 0));
+        }
+        dict.add(record(0x7000, "Outputs", std::move(outputs)));
+        return dict;
+    };
+    return p;
+}
+
 // A device with a mailbox and no process data (an EoE switch port, a gateway configured by CoE only): the
 // two mailbox SMs, CoE, identity objects and nothing mapped.
 inline std::shared_ptr<const od::Product> mailbox_only_terminal() {

@@ -225,28 +225,24 @@ Outcome op_registers(Context& ctx) {
         want += n + hex(sm.start) + "/" + dec(sm.length) + " control " + hex(sm.control, 2) + " activate " +
                 hex(0x01, 2) + " PDI deactivated 0; ";
     }
-    // One FMMU per SM with data from FMMU0 on, in image order: the outputs SMs (write), then the inputs SMs
-    // (read), each at its place in the image (the session's set-up).
-    const std::size_t count = l.sms_with_data();
-    std::vector<uint8_t> f(16 * count);
+    // The FMMUs of the layout from FMMU0 on (the session's set-up: outputs SMs, then inputs SMs, adjacent
+    // ones sharing an FMMU), each at its place in the image.
+    const std::vector<master::ProcessDataLayout::Fmmu> fmmus = l.fmmus();
+    std::vector<uint8_t> f(16 * fmmus.size());
     if (Error e = ctx.m.read(ctx.addr, master::reg::Fmmu0, f); e != Error::Ok)
-        return fail("FMMU0-" + dec(count - 1) + " unreadable", err(e));
+        return fail("FMMU0-" + dec(fmmus.size() - 1) + " unreadable", err(e));
     (void)ctx.cycle(1);
-    std::size_t k = 0;
-    for (const bool out : {true, false}) {
-        uint32_t logical = master::ProcessDataSession::kLogicalBase + (out ? 0 : l.output_bytes());
-        for (const master::ProcessDataSm& sm : l.sms) {
-            if (sm.outputs != out || !sm.length) continue;
-            const uint8_t* x = f.data() + 16 * k;
-            const std::string n = "FMMU" + dec(k) + " ";
-            got += n + hex(get32(x), 8) + "/" + dec(get16(x + 4)) + " bits " + dec(x[6]) + "-" + dec(x[7]) +
-                   " -> " + hex(get16(x + 8)) + "." + dec(x[10]) + " type " + hex(x[11], 2) + " enable " +
-                   dec(x[12] & 1) + "; ";
-            want += n + hex(logical, 8) + "/" + dec(sm.length) + " bits 0-7 -> " + hex(sm.start) +
-                    ".0 type " + hex(out ? 0x02 : 0x01, 2) + " enable 1; ";
-            logical += sm.length;
-            ++k;
-        }
+    for (std::size_t k = 0; k < fmmus.size(); ++k) {
+        const master::ProcessDataLayout::Fmmu& want_f = fmmus[k];
+        const uint32_t logical = master::ProcessDataSession::kLogicalBase +
+                                 (want_f.outputs ? 0 : l.output_bytes()) + want_f.offset;
+        const uint8_t* x = f.data() + 16 * k;
+        const std::string n = "FMMU" + dec(k) + " ";
+        got += n + hex(get32(x), 8) + "/" + dec(get16(x + 4)) + " bits " + dec(x[6]) + "-" + dec(x[7]) +
+               " -> " + hex(get16(x + 8)) + "." + dec(x[10]) + " type " + hex(x[11], 2) + " enable " +
+               dec(x[12] & 1) + "; ";
+        want += n + hex(logical, 8) + "/" + dec(want_f.length) + " bits 0-7 -> " + hex(want_f.physical) +
+                ".0 type " + hex(want_f.outputs ? 0x02 : 0x01, 2) + " enable 1; ";
     }
     // Only outputs written through an SM with the watchdog trigger (control bit 6) keep the watchdog
     // running; an input-only device's watchdog may show expired (ESC datasheet 0x0420, 0x0440).

@@ -295,39 +295,35 @@ Error ProcessDataSession::configure(Slave& slave, const DcConfig& dc) {
         if (Error e = m_.write(a, base, off); e != Error::Ok) return e;
         if (Error e = m_.write(a, base, r); e != Error::Ok) return e;
     }
-    // One FMMU per SM with data, in image order: the outputs SMs (write) at this slave's place among the
-    // outputs, then the inputs SMs (read) among the inputs; the slave's other FMMUs disabled (ESC datasheet
+    // The FMMUs of layout.fmmus() from FMMU0 on: the outputs ones (write) at this slave's place among the
+    // outputs, the inputs ones (read) among the inputs; the slave's other FMMUs disabled (ESC datasheet
     // section I §7). check_fmmus() made sure there are enough.
     std::array<uint8_t, 16 * 16> fm{};
     std::size_t used = 0;
-    for (const bool outputs : {true, false}) {
-        uint32_t logical = kLogicalBase + (outputs ? slave.out_offset : out_bytes_ + slave.in_offset);
-        for (const ProcessDataSm& sm : layout.sms) {
-            if (sm.outputs != outputs || !sm.length) continue;
-            uint8_t* f = fm.data() + 16 * used++;
-            put32(f, logical);
-            put16(f + 4, sm.length);
-            f[6] = 0;
-            f[7] = 7;
-            put16(f + 8, sm.start);
-            f[10] = 0;
-            f[11] = outputs ? 0x02 : 0x01;
-            f[12] = 1;
-            logical += sm.length;
-        }
+    for (const ProcessDataLayout::Fmmu& x : layout.fmmus()) {
+        if (used == 16) break;
+        uint8_t* f = fm.data() + 16 * used++;
+        put32(f, kLogicalBase + (x.outputs ? slave.out_offset : out_bytes_ + slave.in_offset) + x.offset);
+        put16(f + 4, x.length);
+        f[6] = 0;
+        f[7] = 7;
+        put16(f + 8, x.physical);
+        f[10] = 0;
+        f[11] = x.outputs ? 0x02 : 0x01;
+        f[12] = 1;
     }
     const std::size_t count = std::min<std::size_t>(slave.fmmus, 16);
     return m_.write(a, reg::Fmmu0, std::span<const uint8_t>(fm.data(), 16 * count));
 }
 
-// Every slave's FMMU count (ESC 0x0004) against its SMs with data, before any is configured: a slave with
-// too few cannot map its image and is not set up half.
+// Every slave's FMMU count (ESC 0x0004) against the FMMUs its layout needs, before any is configured: a
+// slave with too few cannot map its image and is not set up half.
 Error ProcessDataSession::check_fmmus() {
     for (Slave& s : slaves_) {
         auto n = m_.read_reg<uint8_t>(s.address, 0x0004);
         if (!n) return n.error();
         s.fmmus = *n;
-        if (s.layout.sms_with_data() > std::min<std::size_t>(*n, 16)) return Error::TooFewFmmus;
+        if (s.layout.fmmus().size() > std::min<std::size_t>(*n, 16)) return Error::TooFewFmmus;
     }
     return Error::Ok;
 }

@@ -3,7 +3,8 @@
 // section I §8.1, §7; AL states: ETG.1000.6; distributed clocks: ESC datasheet section I §9, ETG.1020):
 // discovers each slave's process-data layout (every SM of type 3 (outputs) and 4 (inputs) of the SII SyncM
 // category, sizes from their PDO assignment 0x1C10+n and the mapping objects over CoE, or from the SII's
-// RxPDO/TxPDO categories), sets up every process-data SM and one FMMU per SM that carries data into one
+// RxPDO/TxPDO categories), sets up every process-data SM and one FMMU per SM that carries data (SMs adjacent
+// in memory share one, ProcessDataLayout::fmmus()) into one
 // logical image (the outputs of all slaves back to back, then their inputs; within a slave in SM order),
 // optionally distributed clocks (delays and offsets measured over the line, SYNC0 on every slave with the
 // same start time), and exchanges outputs and inputs with one LRW per cycle (split over several frames, sent
@@ -54,7 +55,7 @@ struct ProcessDataLayout {
     }
     uint32_t output_bytes() const { return bytes(true); }
     uint32_t input_bytes() const { return bytes(false); }
-    // SMs that carry data: each needs an FMMU.
+    // SMs that carry data.
     std::size_t sms_with_data() const {
         std::size_t n = 0;
         for (const ProcessDataSm& sm : sms)
@@ -70,6 +71,34 @@ struct ProcessDataLayout {
             if (!any) any = &sm;
         }
         return any;
+    }
+    // The FMMUs the layout needs, in the order the session sets them up from FMMU0 on: the outputs SMs with
+    // data (write) in SM order, then the inputs SMs (read), each at its offset within its direction's part
+    // of the image; an SM that starts where the previous one of the list ends in memory shares its FMMU
+    // (one logical range onto one physical range: FB1111's four one-byte outputs SMs 0x0F00..0x0F03 under
+    // the one FMMU its ESI declares, as SOEM and TwinCAT map them).
+    struct Fmmu {
+        bool outputs = true;
+        uint32_t offset = 0;  // within the outputs (inputs) of the slave
+        uint16_t length = 0, physical = 0;
+    };
+    std::vector<Fmmu> fmmus() const {
+        std::vector<Fmmu> r;
+        for (const bool outputs : {true, false}) {
+            uint32_t offset = 0;
+            bool joinable = false;
+            for (const ProcessDataSm& sm : sms) {
+                if (sm.outputs != outputs || !sm.length) continue;
+                if (joinable && r.back().physical + r.back().length == sm.start &&
+                    r.back().length + sm.length <= 0xFFFF)
+                    r.back().length = static_cast<uint16_t>(r.back().length + sm.length);
+                else
+                    r.push_back(Fmmu{outputs, offset, sm.length, sm.start});
+                joinable = true;
+                offset += sm.length;
+            }
+        }
+        return r;
     }
     // The PDOs assigned to the SMs of this direction, in SM order.
     std::vector<uint16_t> pdos(bool outputs) const {
@@ -124,11 +153,10 @@ class ProcessDataSession {
     const ProcessDataLayout& layout(std::size_t k = 0) const { return slaves_[k].layout; }
     void set_layout(std::size_t k, const ProcessDataLayout& layout) { slaves_[k].layout = layout; }
     // For each slave: sync mode objects (0x1C32:01, 0x1C33:01): DC SYNC0 (2) with dc.enable, else
-    // SM-synchronous (1); every process-data SM (those without data disabled); one FMMU per SM with data,
-    // from FMMU0 on in image order (outputs, write; then inputs, read), the slave's other FMMUs disabled.
-    // A slave with fewer FMMUs (ESC 0x0004) than SMs with data: Error::TooFewFmmus, before any slave is
-    // touched. With dc.enable also the delays and offsets (dc.measure) and SYNC0
-    // (0x0980/0x09A0/0x0990/0x0981) with one start time for all.
+    // SM-synchronous (1); every process-data SM (those without data disabled); the FMMUs of
+    // ProcessDataLayout::fmmus() from FMMU0 on, the slave's other FMMUs disabled. A slave with fewer FMMUs
+    // (ESC 0x0004) than that: Error::TooFewFmmus, before any slave is touched. With dc.enable also the delays
+    // and offsets (dc.measure) and SYNC0 (0x0980/0x09A0/0x0990/0x0981) with one start time for all.
     Error configure(const DcConfig& dc = {});
 
     // One process-data exchange: outputs() go out, inputs() come back. Returns Error::WorkingCounter if
