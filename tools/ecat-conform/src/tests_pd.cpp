@@ -81,7 +81,17 @@ Outcome sm_size_vs_esi(Context& ctx, bool outputs) {
         got += "SM" + dec(sm.index) + " " + dec(sm.length) + " ";
         want += "SM" + dec(sm.index) + " " + dec((bits + 7) / 8) + " ";
     }
-    if (names.empty()) return skip(std::string("no ") + (outputs ? "outputs" : "inputs") + " SM in the SII");
+    if (names.empty()) {
+        // No SM of this direction: the ESI must assign no PDO of it to any SM either.
+        unsigned bits = 0;
+        for (const auto& p : outputs ? ctx.esi->rxpdos : ctx.esi->txpdos)
+            if (p.sm >= 0) bits += p.bits();
+        if (bits)
+            return fail(std::string("the ESI assigns ") + (outputs ? "RxPdos" : "TxPdos") +
+                            " to an SM, the SII has no " + (outputs ? "outputs" : "inputs") + " SM",
+                        "0 bytes", dec((bits + 7) / 8) + " bytes");
+        return skip(std::string("no ") + (outputs ? "outputs" : "inputs") + " SM and no PDO assigned to one");
+    }
     return expect_eq(names + " bytes of the default assignment", got, want);
 }
 
