@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <memory>
 #include <optional>
@@ -64,6 +65,16 @@ uint16_t u16(std::span<const uint8_t> b, std::size_t at) {
     return static_cast<uint16_t>(b[at] | (b[at + 1] << 8));
 }
 
+// Safe-Op, then Op, `fill` before every exchange, then `cycles` more exchanges in Op, each without error.
+void session_to_op(ProcessDataSession& pd, const std::function<void()>& fill, uint64_t cycles) {
+    AlStatus st;
+    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(100), &st, fill), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(100), &st, fill), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(pd.run(cycles, std::chrono::microseconds(100), fill), Error::Ok);
+}
+
 // The one slave addressed and taken to Pre-Op, no mailbox configured.
 void preop_without_mailbox(Master& m, Address a) {
     ASSERT_NO_FATAL_FAILURE(test_support::one_slave_addressed(m));
@@ -81,6 +92,18 @@ struct CoeUnitInPreOp {
     const Address a = Address::station(0x1001);
     Mailbox mbx{m, a};
     SdoClient sdo{mbx};
+};
+
+// A device without mailbox made from `product` (on an ESC of that configuration), the in-process master
+// before it and a process-data session for it, its layout to be read from the SII (discover_sii).
+struct SiiUnit {
+    explicit SiiUnit(std::shared_ptr<const od::Product> product, const esc::EscConfig& config = {})
+        : u(std::move(product), config) {}
+    Unit u;
+    UnitLink link{u};
+    Master m{link, test_support::in_process_master_options()};
+    const Address a = Address::station(0x1001);
+    ProcessDataSession pd{m, std::span<const Address>(&a, 1)};
 };
 
 }  // namespace
@@ -314,12 +337,7 @@ TEST(ProductWithCoe, ServesSdoWithoutDriveAndFoe) {
         o[0] = 0x21;
         o[1] = 0x43;
     };
-    AlStatus st;
-    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(100), &st, fill), Error::Ok)
-        << "AL code 0x" << std::hex << st.code;
-    ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(100), &st, fill), Error::Ok)
-        << "AL code 0x" << std::hex << st.code;
-    ASSERT_EQ(pd.run(3, std::chrono::microseconds(100), fill), Error::Ok);
+    ASSERT_NO_FATAL_FAILURE(session_to_op(pd, fill, 3));
     EXPECT_EQ(u16(pd.inputs(), 0), 0x4321);
 }
 
@@ -423,8 +441,9 @@ TEST_F(CoeTerminalInPreOp, EveryProtocolItDoesNotServeGetsTheUnsupportedProtocol
 namespace {
 
 // The IO terminal with device emulation (ESC configuration 0x0141 bit 0) and the in-process master before it.
-struct EmulatedTerminal {
-    explicit EmulatedTerminal(std::optional<uint16_t> pdi_config = std::nullopt) : u(product(pdi_config)) {}
+struct EmulatedTerminal : SiiUnit {
+    explicit EmulatedTerminal(std::optional<uint16_t> pdi_config = std::nullopt)
+        : SiiUnit(product(pdi_config)) {}
     static std::shared_ptr<od::Product> product(std::optional<uint16_t> pdi_config) {
         auto p = std::make_shared<od::Product>(*io_terminal());
         p->description.esc_config = 0x01;
@@ -440,11 +459,6 @@ struct EmulatedTerminal {
         ASSERT_EQ(m.request_state(a, AlState::Op, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
         EXPECT_EQ(st.code, 0);
     }
-    Unit u;
-    UnitLink link{u};
-    Master m{link, test_support::in_process_master_options()};
-    const Address a = Address::station(0x1001);
-    ProcessDataSession pd{m, std::span<const Address>(&a, 1)};
 };
 
 }  // namespace
@@ -615,13 +629,8 @@ void expect_two_sm_exchange(ProcessDataSession& pd) {
     // Four FMMUs, one LRW: the ESC counts the datagram once per direction, 2 for the outputs written and 1
     // for the inputs read (ESC datasheet section I, working counter), not once per FMMU.
     EXPECT_EQ(pd.expected_wkc(), 3);
-    AlStatus st;
-    const auto fill = [&pd] { fill_two_sm(pd); };
-    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(100), &st, fill), Error::Ok)
-        << "AL code 0x" << std::hex << st.code;
-    ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(100), &st, fill), Error::Ok)
-        << "AL code 0x" << std::hex << st.code;
-    ASSERT_EQ(pd.run(5, std::chrono::microseconds(100), fill), Error::Ok);
+    ASSERT_NO_FATAL_FAILURE(session_to_op(
+        pd, [&pd] { fill_two_sm(pd); }, 5));
     EXPECT_EQ(pd.last_wkc(), 3);
     const auto in = pd.inputs();
     EXPECT_EQ(u16(in, 0), 0x4321);
@@ -629,6 +638,21 @@ void expect_two_sm_exchange(ProcessDataSession& pd) {
     EXPECT_EQ(u16(in, 5), 0x8765);
     EXPECT_EQ(in[7], 0x5A);
 }
+
+// A device without mailbox on an ESC of `fmmus` FMMUs, in Pre-Op, its layout read from its SII alone.
+struct SiiUnitInPreOp : SiiUnit {
+    SiiUnitInPreOp(std::shared_ptr<const od::Product> product, uint8_t fmmus)
+        : SiiUnit(std::move(product), esc(fmmus)) {}
+    static esc::EscConfig esc(uint8_t fmmus) {
+        esc::EscConfig c;
+        c.fmmu_count = fmmus;
+        return c;
+    }
+    void discover() {
+        ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
+        ASSERT_EQ(pd.discover_sii(0), Error::Ok);
+    }
+};
 
 }  // namespace
 
@@ -673,13 +697,9 @@ TEST(ProductWithSeveralSms, EveryProcessDataSmIsMappedOverCoe) {
 // Without mailbox the layout comes from the SII alone: every SM of type 3/4 of the SyncM category with the
 // PDOs the RxPDO/TxPDO categories assign to it, here outputs in SM0/SM2 and inputs in SM1/SM3.
 TEST(ProductWithSeveralSms, EveryProcessDataSmIsMappedFromTheSiiAlone) {
-    Unit u(two_sm_terminal(false));
-    UnitLink link(u);
-    Master m(link, test_support::in_process_master_options());
-    const Address a = Address::station(0x1001);
-    ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
-    ProcessDataSession pd(m, std::span<const Address>(&a, 1));
-    ASSERT_EQ(pd.discover_sii(0), Error::Ok);
+    SiiUnitInPreOp t(two_sm_terminal(false), 8);
+    ASSERT_NO_FATAL_FAILURE(t.discover());
+    ProcessDataSession& pd = t.pd;
     const ProcessDataLayout& l = pd.layout(0);
     ASSERT_EQ(l.sms.size(), 4u);
     EXPECT_EQ(l.sms[2].index, 2);
@@ -695,16 +715,11 @@ TEST(ProductWithSeveralSms, EveryProcessDataSmIsMappedFromTheSiiAlone) {
 // A slave with fewer FMMUs (ESC 0x0004) than SMs carrying data cannot map its image: the session says so and
 // configures nothing, rather than mapping part of it.
 TEST(ProductWithSeveralSms, TooFewFmmusIsAnErrorAndNothingIsConfigured) {
-    esc::EscConfig three;
-    three.fmmu_count = 3;
-    Unit u(two_sm_terminal(false), three);
-    UnitLink link(u);
-    Master m(link, test_support::in_process_master_options());
-    const Address a = Address::station(0x1001);
-    ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
-    ProcessDataSession pd(m, std::span<const Address>(&a, 1));
-    ASSERT_EQ(pd.discover_sii(0), Error::Ok);
-    EXPECT_EQ(pd.configure(), Error::TooFewFmmus);
+    SiiUnitInPreOp t(two_sm_terminal(false), 3);
+    ASSERT_NO_FATAL_FAILURE(t.discover());
+    Master& m = t.m;
+    const Address a = t.a;
+    EXPECT_EQ(t.pd.configure(), Error::TooFewFmmus);
     EXPECT_NE(to_string(Error::TooFewFmmus).find("FMMU"), std::string::npos);
     for (uint8_t n = 0; n < 4; ++n)
         EXPECT_EQ(m.read_reg<uint8_t>(a, static_cast<uint16_t>(0x0806 + 8 * n)).value() & 0x01, 0)
@@ -718,15 +733,9 @@ TEST(ProductWithSeveralSms, TooFewFmmusIsAnErrorAndNothingIsConfigured) {
 // TwinCAT map them): the four one-byte outputs SMs on 0x0F00..0x0F03 fit the one FMMU of an ESC with one,
 // and every byte reaches its SM.
 TEST(ProductWithSeveralSms, AdjacentSmsShareOneFmmu) {
-    esc::EscConfig one;
-    one.fmmu_count = 1;
-    Unit u(byte_outputs_terminal(), one);
-    UnitLink link(u);
-    Master m(link, test_support::in_process_master_options());
-    const Address a = Address::station(0x1001);
-    ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
-    ProcessDataSession pd(m, std::span<const Address>(&a, 1));
-    ASSERT_EQ(pd.discover_sii(0), Error::Ok);
+    SiiUnitInPreOp t(byte_outputs_terminal(), 1);
+    ASSERT_NO_FATAL_FAILURE(t.discover());
+    ProcessDataSession& pd = t.pd;
     ASSERT_EQ(pd.layout(0).sms.size(), 4u);
     const auto fmmus = pd.layout(0).fmmus();
     ASSERT_EQ(fmmus.size(), 1u);
@@ -739,14 +748,9 @@ TEST(ProductWithSeveralSms, AdjacentSmsShareOneFmmu) {
         for (uint8_t k = 0; k < 4; ++k)
             pd.outputs()[k] = static_cast<uint8_t>(0x11 * (k + 1));
     };
-    AlStatus st;
-    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(100), &st, fill), Error::Ok)
-        << "AL code 0x" << std::hex << st.code;
-    ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(100), &st, fill), Error::Ok)
-        << "AL code 0x" << std::hex << st.code;
-    ASSERT_EQ(pd.run(5, std::chrono::microseconds(100), fill), Error::Ok);
+    ASSERT_NO_FATAL_FAILURE(session_to_op(pd, fill, 5));
     uint8_t out[4] = {};
-    ASSERT_EQ(m.read(a, 0x0F00, out), Error::Ok);
+    ASSERT_EQ(t.m.read(t.a, 0x0F00, out), Error::Ok);
     EXPECT_EQ(out[0], 0x11);
     EXPECT_EQ(out[3], 0x44);
 }
