@@ -173,6 +173,8 @@ void write_pd_json(master::ProcessDataSession& pd, const master::CycleStats& bef
                     }
                     bit += e.bit_length;
                 }
+            bit =
+                (bit + 7) / 8 * 8;  // the next SM's data starts on a byte of the image (the session's layout)
         }
         w.end_array();
     }
