@@ -694,6 +694,29 @@ TEST(ProductWithSeveralSms, EveryProcessDataSmIsMappedOverCoe) {
     EXPECT_EQ(f[48 + 11], 0x01);
 }
 
+// A device need not have the assignment object of an SM nothing is assigned to (abort "object does not
+// exist"): that SM takes what the SII assigns to it, here nothing, and stays off; the others run.
+TEST(ProductWithSeveralSms, AnSmWithoutAssignmentObjectTakesTheSiisPdos) {
+    CoeUnitInPreOp t(two_sm_terminal(true, false));
+    ASSERT_NO_FATAL_FAILURE(t.to_preop());
+    ProcessDataSession pd(t.m, t.a, t.sdo);
+    ASSERT_EQ(pd.discover(), Error::Ok);
+    const ProcessDataLayout& l = pd.layout();
+    ASSERT_EQ(l.sms.size(), 4u);
+    EXPECT_EQ(l.sms[2].length, 0);
+    EXPECT_EQ(l.sms[3].length, 0);
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    ASSERT_EQ(pd.outputs().size(), 3u);
+    ASSERT_EQ(pd.inputs().size(), 5u);
+    const auto fill = [&pd] {
+        pd.outputs()[0] = 0x21;
+        pd.outputs()[1] = 0x43;
+    };
+    ASSERT_NO_FATAL_FAILURE(session_to_op(pd, fill, 5));
+    EXPECT_EQ(pd.last_wkc(), 3);
+    EXPECT_EQ(u16(pd.inputs(), 0), 0x4321);
+}
+
 // Without mailbox the layout comes from the SII alone: every SM of type 3/4 of the SyncM category with the
 // PDOs the RxPDO/TxPDO categories assign to it, here outputs in SM0/SM2 and inputs in SM1/SM3.
 TEST(ProductWithSeveralSms, EveryProcessDataSmIsMappedFromTheSiiAlone) {

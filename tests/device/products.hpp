@@ -185,8 +185,9 @@ inline std::shared_ptr<const od::Product> coe_terminal(bool fixed_sync_modes = f
 // outputs in SM0/SM2, inputs in SM1/SM3. The first pair carries the PDOs of add_io (3 and 5 bytes), the
 // second RxPDO 0x1601 (0x7010:01 "Channel 2" U16: 2 bytes) and TxPDO 0x1A01 (0x6010:01 "Channel 2" U16
 // mirrors it, 0x6010:02 "Status 2" U8 keeps 0x5A: 3 bytes). Four FMMUs for the process data, one for the
-// mailbox state (ESI Fmmu elements).
-inline std::shared_ptr<const od::Product> two_sm_terminal(bool coe) {
+// mailbox state (ESI Fmmu elements). `second_assigned` false: the second pair has no assignment objects
+// (nothing assigned to it, as a device whose further SMs are unused need not have them).
+inline std::shared_ptr<const od::Product> two_sm_terminal(bool coe, bool second_assigned = true) {
     std::vector<od::SyncManagerDefault> sms;
     if (coe) {
         sms = {sm(od::SmKind::MBoxOut, 0x1000, 128, 0x26), sm(od::SmKind::MBoxIn, 0x1080, 128, 0x22),
@@ -206,7 +207,7 @@ inline std::shared_ptr<const od::Product> two_sm_terminal(bool coe) {
         p->application = od::Application::None;
     }
     const uint16_t first = coe ? 0x1C12 : 0x1C10;  // the assignment object of the first outputs SM
-    p->make_dictionary = [first](const od::DeviceDescription& desc) {
+    p->make_dictionary = [first, second_assigned](const od::DeviceDescription& desc) {
         od::Dictionary dict;
         add_identity(dict, desc);
         add_io(dict, first, static_cast<uint16_t>(first + 1));
@@ -215,8 +216,12 @@ inline std::shared_ptr<const od::Product> two_sm_terminal(bool coe) {
         dict.add(record(0x1A01, "Inputs 2",
                         {entry(1, "SubIndex 001", od::DataType::Unsigned32, kRo, 0x60100110),
                          entry(2, "SubIndex 002", od::DataType::Unsigned32, kRo, 0x60100208)}));
-        dict.add(array(static_cast<uint16_t>(first + 2), "RxPDO assign", od::DataType::Unsigned16, {0x1601}));
-        dict.add(array(static_cast<uint16_t>(first + 3), "TxPDO assign", od::DataType::Unsigned16, {0x1A01}));
+        if (second_assigned) {
+            dict.add(
+                array(static_cast<uint16_t>(first + 2), "RxPDO assign", od::DataType::Unsigned16, {0x1601}));
+            dict.add(
+                array(static_cast<uint16_t>(first + 3), "TxPDO assign", od::DataType::Unsigned16, {0x1A01}));
+        }
         dict.add(record(0x6010, "Inputs 2",
                         {entry(1, "Channel 2", od::DataType::Unsigned16, kTx, 0),
                          entry(2, "Status 2", od::DataType::Unsigned8, kTx, 0x5A)}));

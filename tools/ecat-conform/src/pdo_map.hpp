@@ -67,8 +67,9 @@ inline master::Error read_map(Context& ctx, PdoMap& m) {
         // An SM without assignment object (the session took its PDOs from the SII) has no entries to name.
         const auto e = read_assign(ctx, static_cast<uint16_t>(0x1C10 + sm.index),
                                    sm.outputs ? m.outputs : m.inputs, 8 * at);
-        if (e != master::Error::Ok && !(e == master::Error::SdoAbort && ctx.sdo->last_abort() == 0x06020000))
-            return e;
+        const bool absent = e == master::Error::SdoAbort &&
+                            (ctx.sdo->last_abort() == 0x06020000 || ctx.sdo->last_abort() == 0x06090011);
+        if (e != master::Error::Ok && !absent) return e;
         at += sm.length;
     }
     return master::Error::Ok;

@@ -130,9 +130,10 @@ std::vector<ProcessDataSm> sii_sms(const std::vector<uint8_t>& s, bool pdos) {
 
 Error ProcessDataSession::discover(Slave& slave) {
     // The process-data SMs from the SII, the PDOs of each from its assignment object 0x1C10 + n (ETG.1000.6).
-    // An SM whose assignment object the device does not have (abort 0x06020000: a device with fixed PDOs
-    // need not have it) keeps the PDOs its SII assigns to it. No process-data SM at all (a device with a
-    // mailbox only, e.g. an EoE switch port): no process data, as for a coupler without mailbox.
+    // An SM whose assignment object the device does not have (abort 0x06020000 object, 0x06090011 subindex
+    // does not exist: a device with fixed PDOs need not have it) keeps the PDOs its SII assigns to it. No
+    // process-data SM at all (a device with a mailbox only, e.g. an EoE switch port): no process data, as for
+    // a coupler without mailbox.
     auto img = m_.sii_read_image(slave.address);
     if (!img) return img.error();
     std::vector<ProcessDataSm> sms = sii_sms(*img, true);
@@ -140,7 +141,9 @@ Error ProcessDataSession::discover(Slave& slave) {
         std::vector<uint16_t> pdos;
         uint16_t bytes = 0;
         const Error e = pdo_bytes(*slave.sdo, static_cast<uint16_t>(0x1C10 + sm.index), pdos, bytes);
-        if (e == Error::SdoAbort && slave.sdo->last_abort() == 0x06020000) continue;
+        if (e == Error::SdoAbort &&
+            (slave.sdo->last_abort() == 0x06020000 || slave.sdo->last_abort() == 0x06090011))
+            continue;
         if (e != Error::Ok) return e;
         sm.pdos = std::move(pdos);
         sm.length = bytes;
