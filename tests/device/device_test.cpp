@@ -236,8 +236,8 @@ TEST_F(DeviceAssembly, ALateAnswerIsNotTakenForTheNextTransfers) {
 TEST_F(DeviceAssembly, ReachesOpWithTheDefaultMappingAndTheDriveMovesInCsp) {
     ProcessDataSession pd(m, a, sdo);
     ASSERT_NO_FATAL_FAILURE(to_op(pd));
-    EXPECT_EQ(pd.layout().rx_pdos, (std::vector<uint16_t>{0x1600}));
-    EXPECT_EQ(pd.layout().tx_pdos, (std::vector<uint16_t>{0x1A00}));
+    EXPECT_EQ(pd.layout().pdos(true), (std::vector<uint16_t>{0x1600}));
+    EXPECT_EQ(pd.layout().pdos(false), (std::vector<uint16_t>{0x1A00}));
     drive.frame_ns = 1'000'000;  // one cycle = 1 ms of slave time from now on
     const int32_t start = take<int32_t>(pd.inputs(), in_pos);
     ASSERT_NO_FATAL_FAILURE(enable(pd, start));

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <memory>
 #include <optional>
@@ -33,8 +34,10 @@
 #include "support/wire_link.hpp"
 
 using namespace master;
+using test_products::byte_outputs_terminal;
 using test_products::coe_terminal;
 using test_products::io_terminal;
+using test_products::two_sm_terminal;
 
 namespace {
 
@@ -42,12 +45,12 @@ namespace {
 struct Unit : test_device::PoweredDevice {
     std::filesystem::path dir;
 
-    explicit Unit(std::shared_ptr<const od::Product> product)
+    explicit Unit(std::shared_ptr<const od::Product> product, const esc::EscConfig& config = {})
         : dir(test_support::make_temp_dir("softecat-product-")) {
         device::DeviceOptions o;
         o.product = std::move(product);
         o.state_dir = dir;
-        power_on(o);
+        power_on(o, config);
     }
     ~Unit() {
         dev.reset();
@@ -60,6 +63,16 @@ using UnitLink = test_device::PoweredLink;
 
 uint16_t u16(std::span<const uint8_t> b, std::size_t at) {
     return static_cast<uint16_t>(b[at] | (b[at + 1] << 8));
+}
+
+// Safe-Op, then Op, `fill` before every exchange, then `cycles` more exchanges in Op, each without error.
+void session_to_op(ProcessDataSession& pd, const std::function<void()>& fill, uint64_t cycles) {
+    AlStatus st;
+    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(100), &st, fill), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(100), &st, fill), Error::Ok)
+        << "AL code 0x" << std::hex << st.code;
+    ASSERT_EQ(pd.run(cycles, std::chrono::microseconds(100), fill), Error::Ok);
 }
 
 // The one slave addressed and taken to Pre-Op, no mailbox configured.
@@ -79,6 +92,18 @@ struct CoeUnitInPreOp {
     const Address a = Address::station(0x1001);
     Mailbox mbx{m, a};
     SdoClient sdo{mbx};
+};
+
+// A device without mailbox made from `product` (on an ESC of that configuration), the in-process master
+// before it and a process-data session for it, its layout to be read from the SII (discover_sii).
+struct SiiUnit {
+    explicit SiiUnit(std::shared_ptr<const od::Product> product, const esc::EscConfig& config = {})
+        : u(std::move(product), config) {}
+    Unit u;
+    UnitLink link{u};
+    Master m{link, test_support::in_process_master_options()};
+    const Address a = Address::station(0x1001);
+    ProcessDataSession pd{m, std::span<const Address>(&a, 1)};
 };
 
 }  // namespace
@@ -109,12 +134,13 @@ TEST(ProductWithoutMailbox, ReachesOpWithProcessDataOnlyAndItsInputsFollowTheDef
     ProcessDataSession pd(m, std::span<const Address>(&a, 1));
     ASSERT_EQ(pd.discover_sii(0), Error::Ok);
     const ProcessDataLayout& l = pd.layout(0);
-    EXPECT_EQ(l.out_sm, 0);
-    EXPECT_EQ(l.in_sm, 1);
-    EXPECT_EQ(l.sm2_start, 0x0F00);
-    EXPECT_EQ(l.sm3_start, 0x1000);
-    ASSERT_EQ(l.sm2_length, 3);
-    ASSERT_EQ(l.sm3_length, 5);
+    ASSERT_EQ(l.sms.size(), 2u);
+    EXPECT_EQ(l.sms[0].index, 0);
+    EXPECT_EQ(l.sms[1].index, 1);
+    EXPECT_EQ(l.sms[0].start, 0x0F00);
+    EXPECT_EQ(l.sms[1].start, 0x1000);
+    ASSERT_EQ(l.output_bytes(), 3u);
+    ASSERT_EQ(l.input_bytes(), 5u);
     ASSERT_EQ(pd.configure(), Error::Ok);
     auto fill = [&] {
         auto o = pd.outputs();
@@ -189,8 +215,8 @@ TEST(ProductWithoutMailbox, AnEntryMappedBothWaysEchoesTheOutputAndIsNotModelled
     ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
     ProcessDataSession pd(m, std::span<const Address>(&a, 1));
     ASSERT_EQ(pd.discover_sii(0), Error::Ok);
-    ASSERT_EQ(pd.layout(0).sm2_length, 2);
-    ASSERT_EQ(pd.layout(0).sm3_length, 4);
+    ASSERT_EQ(pd.layout(0).output_bytes(), 2u);
+    ASSERT_EQ(pd.layout(0).input_bytes(), 4u);
     ASSERT_EQ(pd.configure(), Error::Ok);
     uint16_t written = 0x0100;
     auto fill = [&] {
@@ -303,20 +329,15 @@ TEST(ProductWithCoe, ServesSdoWithoutDriveAndFoe) {
 
     ProcessDataSession pd(m, a, sdo);
     ASSERT_EQ(pd.discover(), Error::Ok);
-    EXPECT_EQ(pd.layout().sm2_length, 3);
-    EXPECT_EQ(pd.layout().sm3_length, 5);
+    EXPECT_EQ(pd.layout().output_bytes(), 3u);
+    EXPECT_EQ(pd.layout().input_bytes(), 5u);
     ASSERT_EQ(pd.configure(), Error::Ok);
     auto fill = [&] {
         auto o = pd.outputs();
         o[0] = 0x21;
         o[1] = 0x43;
     };
-    AlStatus st;
-    ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(100), &st, fill), Error::Ok)
-        << "AL code 0x" << std::hex << st.code;
-    ASSERT_EQ(pd.request_state(AlState::Op, std::chrono::microseconds(100), &st, fill), Error::Ok)
-        << "AL code 0x" << std::hex << st.code;
-    ASSERT_EQ(pd.run(3, std::chrono::microseconds(100), fill), Error::Ok);
+    ASSERT_NO_FATAL_FAILURE(session_to_op(pd, fill, 3));
     EXPECT_EQ(u16(pd.inputs(), 0), 0x4321);
 }
 
@@ -354,8 +375,8 @@ TEST(ProductWithCoe, MailboxOnlyDeviceHasNoProcessDataAndReachesOp) {
     SdoClient& sdo = t.sdo;
     ProcessDataSession pd(m, a, sdo);
     ASSERT_EQ(pd.discover(), Error::Ok);
-    EXPECT_EQ(pd.layout().sm2_length, 0);
-    EXPECT_EQ(pd.layout().sm3_length, 0);
+    EXPECT_EQ(pd.layout().output_bytes(), 0u);
+    EXPECT_EQ(pd.layout().input_bytes(), 0u);
     AlStatus st;
     for (const AlState s : {AlState::SafeOp, AlState::Op})
         ASSERT_EQ(m.request_state(a, s, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
@@ -420,8 +441,9 @@ TEST_F(CoeTerminalInPreOp, EveryProtocolItDoesNotServeGetsTheUnsupportedProtocol
 namespace {
 
 // The IO terminal with device emulation (ESC configuration 0x0141 bit 0) and the in-process master before it.
-struct EmulatedTerminal {
-    explicit EmulatedTerminal(std::optional<uint16_t> pdi_config = std::nullopt) : u(product(pdi_config)) {}
+struct EmulatedTerminal : SiiUnit {
+    explicit EmulatedTerminal(std::optional<uint16_t> pdi_config = std::nullopt)
+        : SiiUnit(product(pdi_config)) {}
     static std::shared_ptr<od::Product> product(std::optional<uint16_t> pdi_config) {
         auto p = std::make_shared<od::Product>(*io_terminal());
         p->description.esc_config = 0x01;
@@ -437,11 +459,6 @@ struct EmulatedTerminal {
         ASSERT_EQ(m.request_state(a, AlState::Op, &st), Error::Ok) << "AL code 0x" << std::hex << st.code;
         EXPECT_EQ(st.code, 0);
     }
-    Unit u;
-    UnitLink link{u};
-    Master m{link, test_support::in_process_master_options()};
-    const Address a = Address::station(0x1001);
-    ProcessDataSession pd{m, std::span<const Address>(&a, 1)};
 };
 
 }  // namespace
@@ -506,7 +523,7 @@ TEST(ProductWithDeviceEmulation, OutputsOnTheRegistersGoToZeroWhenTheWatchdogExp
         SCOPED_TRACE(at_next_event ? "0x0150 bit 3 = 1" : "0x0150 bit 3 = 0");
         EmulatedTerminal t(at_next_event ? 0x08 : 0x00);
         ASSERT_NO_FATAL_FAILURE(t.to_op());
-        ASSERT_EQ(t.pd.layout(0).sm2_start, 0x0F00);
+        ASSERT_EQ(t.pd.layout(0).first(true)->start, 0x0F00);
         auto fill = [&] {
             auto o = t.pd.outputs();
             o[0] = 0x34;
@@ -591,4 +608,172 @@ TEST(ProductWithDrive, Announces6502AsServedAndSaysWhatItTookOut) {
     EXPECT_EQ(write_mode(2), od::Status::InvalidValue);  // velocity mode
     EXPECT_EQ(write_mode(7), od::Status::Ok);            // interpolated position: 0x60C1 is there
     EXPECT_EQ(write_mode(4), od::Status::Ok);            // profile torque
+}
+
+namespace {
+
+// The two-SM terminal's outputs (SM of 0x1600: 0x7000:01 Value, 0x7000:02 Output; SM of 0x1601: 0x7010:01
+// Channel 2) in the session's image: outputs SM by SM in SM order.
+void fill_two_sm(ProcessDataSession& pd) {
+    auto o = pd.outputs();
+    o[0] = 0x21;
+    o[1] = 0x43;
+    o[2] = 0x01;
+    o[3] = 0x65;
+    o[4] = 0x87;
+}
+
+// OP with the exact working counter, then the inputs of both inputs SMs: 0x6000:01 mirrors Value, 0x6000:03
+// keeps 0x1234 (first SM), 0x6010:01 mirrors Channel 2, 0x6010:02 keeps 0x5A (second SM).
+void expect_two_sm_exchange(ProcessDataSession& pd) {
+    // Four FMMUs, one LRW: the ESC counts the datagram once per direction, 2 for the outputs written and 1
+    // for the inputs read (ESC datasheet section I, working counter), not once per FMMU.
+    EXPECT_EQ(pd.expected_wkc(), 3);
+    ASSERT_NO_FATAL_FAILURE(session_to_op(
+        pd, [&pd] { fill_two_sm(pd); }, 5));
+    EXPECT_EQ(pd.last_wkc(), 3);
+    const auto in = pd.inputs();
+    EXPECT_EQ(u16(in, 0), 0x4321);
+    EXPECT_EQ(u16(in, 3), 0x1234);
+    EXPECT_EQ(u16(in, 5), 0x8765);
+    EXPECT_EQ(in[7], 0x5A);
+}
+
+// A device without mailbox on an ESC of `fmmus` FMMUs, in Pre-Op, its layout read from its SII alone.
+struct SiiUnitInPreOp : SiiUnit {
+    SiiUnitInPreOp(std::shared_ptr<const od::Product> product, uint8_t fmmus)
+        : SiiUnit(std::move(product), esc(fmmus)) {}
+    static esc::EscConfig esc(uint8_t fmmus) {
+        esc::EscConfig c;
+        c.fmmu_count = fmmus;
+        return c;
+    }
+    void discover() {
+        ASSERT_NO_FATAL_FAILURE(preop_without_mailbox(m, a));
+        ASSERT_EQ(pd.discover_sii(0), Error::Ok);
+    }
+};
+
+}  // namespace
+
+// A device with two outputs SMs (SM2, SM4) and two inputs SMs (SM3, SM5), PDOs assigned by 0x1C12..0x1C15
+// (ETG.1000.6: 0x1C10 + n for SM n): the session sets up all four with an FMMU each, the outputs of both SMs
+// reach the dictionary and the inputs of both come back, with the exact working counter.
+TEST(ProductWithSeveralSms, EveryProcessDataSmIsMappedOverCoe) {
+    CoeUnitInPreOp t(two_sm_terminal(true));
+    ASSERT_NO_FATAL_FAILURE(t.to_preop());
+    ProcessDataSession pd(t.m, t.a, t.sdo);
+    ASSERT_EQ(pd.discover(), Error::Ok);
+    const ProcessDataLayout& l = pd.layout();
+    ASSERT_EQ(l.sms.size(), 4u);
+    const uint8_t index[4] = {2, 3, 4, 5};
+    const uint16_t length[4] = {3, 5, 2, 3};
+    for (std::size_t k = 0; k < 4; ++k) {
+        EXPECT_EQ(l.sms[k].index, index[k]);
+        EXPECT_EQ(l.sms[k].outputs, k % 2 == 0);
+        EXPECT_EQ(l.sms[k].length, length[k]);
+    }
+    EXPECT_EQ(l.pdos(true), (std::vector<uint16_t>{0x1600, 0x1601}));
+    EXPECT_EQ(l.pdos(false), (std::vector<uint16_t>{0x1A00, 0x1A01}));
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    ASSERT_EQ(pd.outputs().size(), 5u);
+    ASSERT_EQ(pd.inputs().size(), 8u);
+    ASSERT_NO_FATAL_FAILURE(expect_two_sm_exchange(pd));
+    uint8_t b[4] = {};
+    ASSERT_TRUE(t.sdo.upload(0x7000, 1, b).ok());
+    EXPECT_EQ(u16(b, 0), 0x4321);
+    ASSERT_TRUE(t.sdo.upload(0x7010, 1, b).ok());
+    EXPECT_EQ(u16(b, 0), 0x8765);
+    // SM4 and SM5 as the SII declares them, each read by its own FMMU (FMMU1: SM4, outputs after SM2's;
+    // FMMU3: SM5, inputs after SM3's).
+    uint8_t f[64] = {};
+    ASSERT_EQ(t.m.read(t.a, reg::Fmmu0, f), Error::Ok);
+    EXPECT_EQ(u16(f, 16 + 8), 0x1200);
+    EXPECT_EQ(f[16 + 11], 0x02);
+    EXPECT_EQ(f[48 + 8] | (f[48 + 9] << 8), 0x1280);
+    EXPECT_EQ(f[48 + 11], 0x01);
+}
+
+// A device need not have the assignment object of an SM nothing is assigned to (abort "object does not
+// exist"): that SM takes what the SII assigns to it, here nothing, and stays off; the others run.
+TEST(ProductWithSeveralSms, AnSmWithoutAssignmentObjectTakesTheSiisPdos) {
+    CoeUnitInPreOp t(two_sm_terminal(true, false));
+    ASSERT_NO_FATAL_FAILURE(t.to_preop());
+    ProcessDataSession pd(t.m, t.a, t.sdo);
+    ASSERT_EQ(pd.discover(), Error::Ok);
+    const ProcessDataLayout& l = pd.layout();
+    ASSERT_EQ(l.sms.size(), 4u);
+    EXPECT_EQ(l.sms[2].length, 0);
+    EXPECT_EQ(l.sms[3].length, 0);
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    ASSERT_EQ(pd.outputs().size(), 3u);
+    ASSERT_EQ(pd.inputs().size(), 5u);
+    const auto fill = [&pd] {
+        pd.outputs()[0] = 0x21;
+        pd.outputs()[1] = 0x43;
+    };
+    ASSERT_NO_FATAL_FAILURE(session_to_op(pd, fill, 5));
+    EXPECT_EQ(pd.last_wkc(), 3);
+    EXPECT_EQ(u16(pd.inputs(), 0), 0x4321);
+}
+
+// Without mailbox the layout comes from the SII alone: every SM of type 3/4 of the SyncM category with the
+// PDOs the RxPDO/TxPDO categories assign to it, here outputs in SM0/SM2 and inputs in SM1/SM3.
+TEST(ProductWithSeveralSms, EveryProcessDataSmIsMappedFromTheSiiAlone) {
+    SiiUnitInPreOp t(two_sm_terminal(false), 8);
+    ASSERT_NO_FATAL_FAILURE(t.discover());
+    ProcessDataSession& pd = t.pd;
+    const ProcessDataLayout& l = pd.layout(0);
+    ASSERT_EQ(l.sms.size(), 4u);
+    EXPECT_EQ(l.sms[2].index, 2);
+    EXPECT_EQ(l.sms[3].index, 3);
+    EXPECT_EQ(l.sms[3].start, 0x1200);
+    EXPECT_EQ(l.sms[3].pdos, (std::vector<uint16_t>{0x1A01}));
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    ASSERT_EQ(pd.outputs().size(), 5u);
+    ASSERT_EQ(pd.inputs().size(), 8u);
+    ASSERT_NO_FATAL_FAILURE(expect_two_sm_exchange(pd));
+}
+
+// A slave with fewer FMMUs (ESC 0x0004) than SMs carrying data cannot map its image: the session says so and
+// configures nothing, rather than mapping part of it.
+TEST(ProductWithSeveralSms, TooFewFmmusIsAnErrorAndNothingIsConfigured) {
+    SiiUnitInPreOp t(two_sm_terminal(false), 3);
+    ASSERT_NO_FATAL_FAILURE(t.discover());
+    Master& m = t.m;
+    const Address a = t.a;
+    EXPECT_EQ(t.pd.configure(), Error::TooFewFmmus);
+    EXPECT_NE(to_string(Error::TooFewFmmus).find("FMMU"), std::string::npos);
+    for (uint8_t n = 0; n < 4; ++n)
+        EXPECT_EQ(m.read_reg<uint8_t>(a, static_cast<uint16_t>(0x0806 + 8 * n)).value() & 0x01, 0)
+            << "SM" << +n;
+    for (uint8_t n = 0; n < 3; ++n)
+        EXPECT_EQ(m.read_reg<uint8_t>(a, static_cast<uint16_t>(0x060C + 16 * n)).value() & 0x01, 0)
+            << "FMMU" << +n;
+}
+
+// SMs one after the other in memory share one FMMU (one logical range onto one physical range, as SOEM and
+// TwinCAT map them): the four one-byte outputs SMs on 0x0F00..0x0F03 fit the one FMMU of an ESC with one,
+// and every byte reaches its SM.
+TEST(ProductWithSeveralSms, AdjacentSmsShareOneFmmu) {
+    SiiUnitInPreOp t(byte_outputs_terminal(), 1);
+    ASSERT_NO_FATAL_FAILURE(t.discover());
+    ProcessDataSession& pd = t.pd;
+    ASSERT_EQ(pd.layout(0).sms.size(), 4u);
+    const auto fmmus = pd.layout(0).fmmus();
+    ASSERT_EQ(fmmus.size(), 1u);
+    EXPECT_EQ(fmmus[0].physical, 0x0F00);
+    EXPECT_EQ(fmmus[0].length, 4);
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    ASSERT_EQ(pd.outputs().size(), 4u);
+    EXPECT_EQ(pd.expected_wkc(), 2);
+    const auto fill = [&pd] {
+        for (uint8_t k = 0; k < 4; ++k)
+            pd.outputs()[k] = static_cast<uint8_t>(0x11 * (k + 1));
+    };
+    ASSERT_NO_FATAL_FAILURE(session_to_op(pd, fill, 5));
+    uint8_t out[4] = {};
+    ASSERT_EQ(t.m.read(t.a, 0x0F00, out), Error::Ok);
+    EXPECT_EQ(out[0], 0x11);
+    EXPECT_EQ(out[3], 0x44);
 }

@@ -180,6 +180,90 @@ inline std::shared_ptr<const od::Product> coe_terminal(bool fixed_sync_modes = f
     return p;
 }
 
+// A terminal with two outputs SMs and two inputs SMs, each with its own PDO (as Beckhoff's EL2262 or drives
+// with a second channel): with CoE (standard mailbox) outputs in SM2/SM4, inputs in SM3/SM5; without mailbox
+// outputs in SM0/SM2, inputs in SM1/SM3. The first pair carries the PDOs of add_io (3 and 5 bytes), the
+// second RxPDO 0x1601 (0x7010:01 "Channel 2" U16: 2 bytes) and TxPDO 0x1A01 (0x6010:01 "Channel 2" U16
+// mirrors it, 0x6010:02 "Status 2" U8 keeps 0x5A: 3 bytes). Four FMMUs for the process data, one for the
+// mailbox state (ESI Fmmu elements). `second_assigned` false: the second pair has no assignment objects
+// (nothing assigned to it, as a device whose further SMs are unused need not have them).
+inline std::shared_ptr<const od::Product> two_sm_terminal(bool coe, bool second_assigned = true) {
+    std::vector<od::SyncManagerDefault> sms;
+    if (coe) {
+        sms = {sm(od::SmKind::MBoxOut, 0x1000, 128, 0x26), sm(od::SmKind::MBoxIn, 0x1080, 128, 0x22),
+               sm(od::SmKind::Outputs, 0x1100, 3, 0x64),   sm(od::SmKind::Inputs, 0x1180, 5, 0x20),
+               sm(od::SmKind::Outputs, 0x1200, 2, 0x64),   sm(od::SmKind::Inputs, 0x1280, 3, 0x20)};
+    } else {
+        sms = {sm(od::SmKind::Outputs, 0x0F00, 3, 0x64), sm(od::SmKind::Inputs, 0x1000, 5, 0x20),
+               sm(od::SmKind::Outputs, 0x1100, 2, 0x64), sm(od::SmKind::Inputs, 0x1200, 3, 0x20)};
+    }
+    auto p = base_product(coe ? "hand-built two-SM CoE terminal" : "hand-built two-SM IO terminal",
+                          coe ? 0x00002262 : 0x00001262, std::move(sms), coe);
+    od::DeviceDescription& d = p->description;
+    d.fmmus = coe ? std::vector<uint8_t>{1, 1, 2, 2, 3} : std::vector<uint8_t>{1, 1, 2, 2};
+    if (!coe) {
+        d.pdi_control = 0x04;  // digital IO
+        d.esc_config = 0;
+        p->application = od::Application::None;
+    }
+    const uint16_t first = coe ? 0x1C12 : 0x1C10;  // the assignment object of the first outputs SM
+    p->make_dictionary = [first, second_assigned](const od::DeviceDescription& desc) {
+        od::Dictionary dict;
+        add_identity(dict, desc);
+        add_io(dict, first, static_cast<uint16_t>(first + 1));
+        dict.add(record(0x1601, "Outputs 2",
+                        {entry(1, "SubIndex 001", od::DataType::Unsigned32, kRo, 0x70100110)}));
+        dict.add(record(0x1A01, "Inputs 2",
+                        {entry(1, "SubIndex 001", od::DataType::Unsigned32, kRo, 0x60100110),
+                         entry(2, "SubIndex 002", od::DataType::Unsigned32, kRo, 0x60100208)}));
+        if (second_assigned) {
+            dict.add(
+                array(static_cast<uint16_t>(first + 2), "RxPDO assign", od::DataType::Unsigned16, {0x1601}));
+            dict.add(
+                array(static_cast<uint16_t>(first + 3), "TxPDO assign", od::DataType::Unsigned16, {0x1A01}));
+        }
+        dict.add(record(0x6010, "Inputs 2",
+                        {entry(1, "Channel 2", od::DataType::Unsigned16, kTx, 0),
+                         entry(2, "Status 2", od::DataType::Unsigned8, kTx, 0x5A)}));
+        dict.add(record(0x7010, "Outputs 2", {entry(1, "Channel 2", od::DataType::Unsigned16, kRx, 0)}));
+        return dict;
+    };
+    return p;
+}
+
+// A digital output terminal without mailbox with one byte of outputs in each of SM0..SM3, on the digital
+// output registers 0x0F00..0x0F03 (as Beckhoff's FB1111 "Dig. Out" and iTegva's E7.820.004 declare them,
+// with one FMMU for all four): RxPDO 0x1600 + k maps 0x7000:0(k+1) "Output k" U8.
+inline std::shared_ptr<const od::Product> byte_outputs_terminal() {
+    std::vector<od::SyncManagerDefault> sms;
+    for (uint16_t k = 0; k < 4; ++k)
+        sms.push_back(sm(od::SmKind::Outputs, static_cast<uint16_t>(0x0F00 + k), 1, 0x44));
+    auto p = base_product("hand-built byte outputs terminal", 0x00001111, std::move(sms), false);
+    od::DeviceDescription& d = p->description;
+    d.fmmus = {1};
+    d.pdi_control = 0x04;  // digital IO
+    d.esc_config = 0;
+    p->application = od::Application::None;
+    p->make_dictionary = [](const od::DeviceDescription& desc) {
+        od::Dictionary dict;
+        add_identity(dict, desc);
+        std::vector<od::Entry> outputs;
+        for (uint8_t k = 0; k < 4; ++k) {
+            const auto pdo = static_cast<uint16_t>(0x1600 + k);
+            const uint64_t mapping = 0x70000008 | (uint64_t{k + 1u} << 8);
+            dict.add(record(pdo, "Output " + std::to_string(k),
+                            {entry(1, "SubIndex 001", od::DataType::Unsigned32, kRo, mapping)}));
+            dict.add(
+                array(static_cast<uint16_t>(0x1C10 + k), "RxPDO assign", od::DataType::Unsigned16, {pdo}));
+            outputs.push_back(entry(static_cast<uint8_t>(k + 1), "Output " + std::to_string(k),
+                                    od::DataType::Unsigned8, kRx, 0));
+        }
+        dict.add(record(0x7000, "Outputs", std::move(outputs)));
+        return dict;
+    };
+    return p;
+}
+
 // A device with a mailbox and no process data (an EoE switch port, a gateway configured by CoE only): the
 // two mailbox SMs, CoE, identity objects and nothing mapped.
 inline std::shared_ptr<const od::Product> mailbox_only_terminal() {

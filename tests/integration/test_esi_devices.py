@@ -29,13 +29,14 @@ def number(text):
 
 
 def pdo_bits(pdos, sm_of):
-    """Bits of the PDOs assigned by default (those with an Sm attribute) to the SM of each direction."""
+    """Bits of the PDOs assigned by default (those with an Sm attribute) to the SMs of each direction (a device
+    may have several: SM2 and SM4 for outputs, ...)."""
     bits = {"out": 0, "in": 0}
     for kind, pdo in pdos:
         if pdo.get("Sm") is None:
             continue
         side = "out" if kind == "RxPdo" else "in"
-        if sm_of.get(side) is not None and int(pdo.get("Sm")) != sm_of[side]:
+        if sm_of.get(side) is not None and int(pdo.get("Sm")) not in sm_of["all_" + side]:
             continue
         for e in pdo.findall("Entry"):
             bits[side] += number(e.findtext("BitLen"))
@@ -57,7 +58,9 @@ def example_devices():
         for dev in root.findall("Descriptions/Devices/Device"):
             sms = [s.text.strip() for s in dev.findall("Sm")]
             sm_of = {"out": sms.index("Outputs") if "Outputs" in sms else None,
-                     "in": sms.index("Inputs") if "Inputs" in sms else None}
+                     "in": sms.index("Inputs") if "Inputs" in sms else None,
+                     "all_out": [n for n, kind in enumerate(sms) if kind == "Outputs"],
+                     "all_in": [n for n, kind in enumerate(sms) if kind == "Inputs"]}
             yield path, root, modules, dev, sm_of
 
 
@@ -349,6 +352,28 @@ class EsiDevices(unittest.TestCase):
                 self.assertEqual(to_op(bytes([0x78, 0x56, 0, 0]))[:2], bytes([0x78, 0x56]))
             finally:
                 mm.close()
+            self.assertTrue(bus.slave_alive(), bus.slave_output())
+
+    def test_ecatctl_pd_maps_every_sm_of_a_direction(self):
+        """The same terminal through the master library's process-data session (ecatctl pd, no mailbox: the layout
+        from the SII alone): every SM with PDOs set up with an FMMU of its own, OP with the working counter 3
+        (the ESC counts an LRW once per direction, not per FMMU), the outputs of both output SMs in the device
+        and back through both input SMs."""
+        d = {"file": os.path.join(HERE, "..", "esi", "fixtures", "several-sms.xml"), "spec": "EXD2262"}
+        bus, ctl = self.serve(d)
+        with bus:
+            r = bus.ecatctl("pd", "0", "-n", "50", "--outputs", "0x34", "0x12", "0x56", "0x78", "--keep", check=False)
+            self.assertEqual(r.returncode, 0, r.stdout + r.stderr + bus.slave_output())
+            m = LAYOUT.search(r.stdout)
+            self.assertIsNotNone(m, r.stdout)
+            self.assertEqual((int(m.group(3)), int(m.group(6))), (4, 4), r.stdout)
+            self.assertIn("SM0 0x1000 2 bytes outputs; SM1 0x1200 2 bytes outputs; SM2 0x1400 2 bytes inputs; "
+                          "SM3 0x1600 2 bytes inputs;", r.stdout)
+            self.assertRegex(r.stdout, r"wkc errors 0 \(expected wkc 3\)")
+            self.assertIn("0x0000: 34 12 56 78", r.stdout, "the inputs of SM2 and SM3 mirror the outputs of SM0 and SM1")
+            status = harness.control(ctl, "status")
+            self.assertIn('0x7010:01 "Channel 2"=86', status)
+            self.assertIn('0x7010:02 "Channel 2 extra"=120', status)
             self.assertTrue(bus.slave_alive(), bus.slave_output())
 
     def test_modular_devices_serve_the_modules_their_spec_chooses(self):

@@ -81,18 +81,14 @@ struct Line {
 // The layout of a small drive: 4 output bytes in SM2, 6 input bytes in SM3.
 ProcessDataLayout small_layout() {
     ProcessDataLayout l;
-    l.sm2_start = 0x1100;
-    l.sm2_length = 4;
-    l.sm3_start = 0x1180;
-    l.sm3_length = 6;
+    l.add(2, true, 0x1100, 4, 0x64).add(3, false, 0x1180, 6, 0x20);
     return l;
 }
 
 // A larger drive: 12 output bytes, 20 input bytes (a hundred of them need more than one frame).
 ProcessDataLayout big_layout() {
-    ProcessDataLayout l = small_layout();
-    l.sm2_length = 12;
-    l.sm3_length = 20;
+    ProcessDataLayout l;
+    l.add(2, true, 0x1100, 12, 0x64).add(3, false, 0x1180, 20, 0x20);
     return l;
 }
 

@@ -238,12 +238,17 @@ TEST_P(WithSlave, ProcessDataSessionReachesOpAndExchanges) {
     const auto& l = pd.layout();
     // The layout the slave expects: its own SM defaults and PDO sizes.
     ASSERT_GE(slave.desc.sync_managers.size(), 4u);
-    EXPECT_EQ(l.sm2_start, slave.desc.sync_managers[2].start);
-    EXPECT_EQ(l.sm3_start, slave.desc.sync_managers[3].start);
-    EXPECT_EQ(l.sm2_length, slave.desc.sync_managers[2].default_size);
-    EXPECT_EQ(l.sm3_length, slave.desc.sync_managers[3].default_size);
-    EXPECT_EQ(l.rx_pdos, (std::vector<uint16_t>{0x1600}));
-    EXPECT_EQ(l.tx_pdos, (std::vector<uint16_t>{0x1A00}));
+    ASSERT_EQ(l.sms.size(), 2u);
+    EXPECT_EQ(l.sms[0].index, 2);
+    EXPECT_TRUE(l.sms[0].outputs);
+    EXPECT_EQ(l.sms[1].index, 3);
+    EXPECT_FALSE(l.sms[1].outputs);
+    EXPECT_EQ(l.sms[0].start, slave.desc.sync_managers[2].start);
+    EXPECT_EQ(l.sms[1].start, slave.desc.sync_managers[3].start);
+    EXPECT_EQ(l.sms[0].length, slave.desc.sync_managers[2].default_size);
+    EXPECT_EQ(l.sms[1].length, slave.desc.sync_managers[3].default_size);
+    EXPECT_EQ(l.pdos(true), (std::vector<uint16_t>{0x1600}));
+    EXPECT_EQ(l.pdos(false), (std::vector<uint16_t>{0x1A00}));
     ASSERT_EQ(pd.configure(), Error::Ok) << std::hex << sdo.last_abort();
     AlStatus st;
     ASSERT_EQ(pd.request_state(AlState::SafeOp, std::chrono::microseconds(200), &st), Error::Ok)

@@ -231,7 +231,7 @@ class Context {
     // Read once in PREOP; nullopt for every other device.
     std::optional<master::DcConfig> dc_only();
     std::optional<std::optional<master::DcConfig>> dc_only_cache;
-    bool has_process_data() const { return pds && (pds->layout().sm2_length || pds->layout().sm3_length); }
+    bool has_process_data() const { return pds && pds->layout().sms_with_data() > 0; }
     // SAFEOP -> OP: exchanging process data where there is some, else by AL control alone.
     master::Error request_op(master::AlStatus& st);
     std::unique_ptr<master::ProcessDataSession> pds;

@@ -27,11 +27,12 @@ struct PdoMap {
     }
 };
 
-inline master::Error read_assign(Context& ctx, uint16_t assign, std::vector<MappedEntry>& out) {
-    out.clear();
+// The entries of the PDOs that `assign` (0x1C10 + n) assigns, appended to `out` from bit `off` of the
+// direction's image on.
+inline master::Error read_assign(Context& ctx, uint16_t assign, std::vector<MappedEntry>& out,
+                                 std::size_t off = 0) {
     auto n = ctx.upload_uint(assign, 0);
     if (!n) return n.error();
-    std::size_t off = 0;
     for (uint8_t i = 1; i <= *n; ++i) {
         auto p = ctx.upload_uint(assign, i);
         if (!p) return p.error();
@@ -49,9 +50,29 @@ inline master::Error read_assign(Context& ctx, uint16_t assign, std::vector<Mapp
     return master::Error::Ok;
 }
 
+// Outputs and inputs as the session lays them out: each process-data SM with data in SM order, from the byte
+// where the previous one ended (ETG.1000.6: SM n's PDOs are those of 0x1C10 + n); without a session's
+// layout, SM2 and SM3.
 inline master::Error read_map(Context& ctx, PdoMap& m) {
-    if (auto e = read_assign(ctx, 0x1C12, m.outputs); e != master::Error::Ok) return e;
-    return read_assign(ctx, 0x1C13, m.inputs);
+    m.outputs.clear();
+    m.inputs.clear();
+    if (!ctx.pds) {
+        if (auto e = read_assign(ctx, 0x1C12, m.outputs); e != master::Error::Ok) return e;
+        return read_assign(ctx, 0x1C13, m.inputs);
+    }
+    std::size_t out_bytes = 0, in_bytes = 0;
+    for (const master::ProcessDataSm& sm : ctx.pds->layout().sms) {
+        if (!sm.length) continue;
+        std::size_t& at = sm.outputs ? out_bytes : in_bytes;
+        // An SM without assignment object (the session took its PDOs from the SII) has no entries to name.
+        const auto e = read_assign(ctx, static_cast<uint16_t>(0x1C10 + sm.index),
+                                   sm.outputs ? m.outputs : m.inputs, 8 * at);
+        const bool absent = e == master::Error::SdoAbort &&
+                            (ctx.sdo->last_abort() == 0x06020000 || ctx.sdo->last_abort() == 0x06090011);
+        if (e != master::Error::Ok && !absent) return e;
+        at += sm.length;
+    }
+    return master::Error::Ok;
 }
 
 inline uint64_t image_get(std::span<const uint8_t> img, const MappedEntry& e) {

@@ -1,5 +1,6 @@
 // Group esm: the EtherCAT state machine: every valid transition, every invalid request with its AL status
 // code, error acknowledge, mailbox and process-data SM checks, the SM watchdog, Bootstrap, identification.
+#include <algorithm>
 #include <thread>
 
 #include "testkit.hpp"
@@ -162,15 +163,12 @@ Outcome bad_pd_sm(Context& ctx, bool outputs, bool address) {
     if (Error e = ctx.discover_pd(); e != Error::Ok) return fail("process-data layout: " + ctx.sdo_error(e));
     if (Error e = ctx.configure_pd(); e != Error::Ok) return fail("process-data set-up: " + ctx.sdo_error(e));
     const auto& l = ctx.pds->layout();
-    if (outputs && !l.sm2_length) return skip("no outputs (SM2 length 0)");
-    if (!outputs && !l.sm3_length) return skip("no inputs (SM3 length 0)");
-    // The SMs of outputs and inputs are SM2/SM3 with a mailbox, SM0/SM1 on a device without one.
-    if (outputs)
-        (void)write_sm(ctx, l.out_sm, static_cast<uint16_t>(l.sm2_start + (address ? 0x40 : 0)),
-                       static_cast<uint16_t>(l.sm2_length + (address ? 0 : 1)), l.sm2_control, true);
-    else
-        (void)write_sm(ctx, l.in_sm, static_cast<uint16_t>(l.sm3_start + (address ? 0x40 : 0)),
-                       static_cast<uint16_t>(l.sm3_length + (address ? 0 : 1)), l.sm3_control, true);
+    if (!l.bytes(outputs))
+        return skip(outputs ? "no outputs (no RxPDO assigned)" : "no inputs (no TxPDO assigned)");
+    // The first SM of the direction with data: SM2/SM3 with a mailbox, SM0/SM1 on a device without one.
+    const master::ProcessDataSm& sm = *l.first(outputs);
+    (void)write_sm(ctx, sm.index, static_cast<uint16_t>(sm.start + (address ? 0x40 : 0)),
+                   static_cast<uint16_t>(sm.length + (address ? 0 : 1)), sm.control, true);
     master::AlStatus st = ctx.request_raw(4, ctx.ms(2000));
     (void)ctx.ack_error();
     ctx.in_preop = false;
@@ -201,7 +199,7 @@ Outcome sync_setting(Context& ctx, uint16_t assign_activate, uint32_t cycle, boo
     CONFORM_NEED(ctx.need_state_machine());
     if (Error e = ctx.to_preop(); e != Error::Ok) return fail("cannot reach PREOP", err(e));
     if (Error e = ctx.discover_pd(); e != Error::Ok) return fail("process-data layout: " + ctx.sdo_error(e));
-    if (short_watchdog && !ctx.pds->layout().sm2_length) return skip("no outputs: no SM watchdog");
+    if (short_watchdog && !ctx.pds->layout().output_bytes()) return skip("no outputs: no SM watchdog");
     auto wd = ctx.rd<uint16_t>(0x0420);
     if (!wd) return fail("0x0420 unreadable", err(wd.error()));
     if (short_watchdog && *wd == 0) return skip("process-data watchdog disabled (0x0420 = 0)");
@@ -441,15 +439,17 @@ void add_esm_tests(Catalogue& c) {
             CONFORM_NEED(ctx.need_pd_layout());
             if (Error e = ctx.to_op(); e != Error::Ok)
                 return fail("cannot reach OP: " + err(e), status_text(ctx.last_status));
-            if (!ctx.pds || !ctx.pds->layout().sm2_length) return skip("no outputs: no SM watchdog");
+            if (!ctx.pds || !ctx.pds->layout().output_bytes()) return skip("no outputs: no SM watchdog");
             // The PD watchdog is fed only by writes to an SM whose control byte has the watchdog trigger
             // (bit 6); it starts with the first such write. Outputs through an SM without it (ESI ControlByte
             // #x24, as SOES- and SSC-based devices declare) never start it: nothing expires, nothing to react
             // to (ESC datasheet section II, SM control 0x0804 bit 6 and process data watchdog 0x0420/0x0440).
-            if (!(ctx.pds->layout().sm2_control & 0x40))
-                return skip("the outputs SM has no watchdog trigger (control " +
-                            hex(ctx.pds->layout().sm2_control, 2) +
-                            ", bit 6 clear): the SM watchdog never runs");
+            const master::ProcessDataLayout& l = ctx.pds->layout();
+            if (std::none_of(l.sms.begin(), l.sms.end(), [](const master::ProcessDataSm& sm) {
+                    return sm.outputs && sm.length && (sm.control & 0x40);
+                }))
+                return skip("no outputs SM has the watchdog trigger (control " +
+                            hex(l.first(true)->control, 2) + ", bit 6 clear): the SM watchdog never runs");
             auto div = ctx.rd<uint16_t>(esc::reg::kWdDivider);
             auto wd = ctx.rd<uint16_t>(esc::reg::kWdTimePd);
             if (!div || !wd) return fail("watchdog registers unreadable");

@@ -28,9 +28,9 @@ Outcome inputs_refreshed(Context& ctx, uint8_t state) {
     CONFORM_NEED(ctx.need_pd_layout());
     Error e = state == 8 ? ctx.to_op() : ctx.to_safeop();
     if (e != Error::Ok) return fail("cannot reach " + state_text(state) + ": " + err(e));
-    if (!ctx.pds || !ctx.pds->layout().sm3_length)
-        return skip("no inputs (no TxPDO assigned to the inputs SM)");
-    const unsigned sm = ctx.pds->layout().in_sm;
+    if (!ctx.pds || !ctx.pds->layout().input_bytes())
+        return skip("no inputs (no TxPDO assigned to an inputs SM)");
+    const unsigned sm = ctx.pds->layout().first(false)->index;  // the first inputs SM with data
     const auto reg = static_cast<uint16_t>(esc::reg::sm_base(sm) + esc::reg::kSmStatus);
     (void)ctx.cycle(3);
     const auto end = std::chrono::steady_clock::now() + ctx.ms(500);

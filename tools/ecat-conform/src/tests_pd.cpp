@@ -70,13 +70,29 @@ Outcome sm_size_vs_esi(Context& ctx, bool outputs) {
     CONFORM_NEED(ctx.need_esi());
     CONFORM_PREOP(ctx);
     if (Error e = ctx.discover_pd(); e != Error::Ok) return fail("layout: " + ctx.sdo_error(e));
-    const auto& l = ctx.pds->layout();
-    const int sm = outputs ? l.out_sm : l.in_sm;
-    unsigned bits = 0;
-    for (const auto& p : outputs ? ctx.esi->rxpdos : ctx.esi->txpdos)
-        if (p.sm == sm) bits += p.bits();
-    const unsigned got = outputs ? l.sm2_length : l.sm3_length;
-    return expect_eq("SM" + dec(sm) + " bytes of the default assignment", dec(got), dec((bits + 7) / 8));
+    // Every SM of the direction (a device may have several: SM2 and SM4 for outputs, ...).
+    std::string got, want, names;
+    for (const master::ProcessDataSm& sm : ctx.pds->layout().sms) {
+        if (sm.outputs != outputs) continue;
+        unsigned bits = 0;
+        for (const auto& p : outputs ? ctx.esi->rxpdos : ctx.esi->txpdos)
+            if (p.sm == sm.index) bits += p.bits();
+        names += (names.empty() ? "SM" : "/SM") + dec(sm.index);
+        got += "SM" + dec(sm.index) + " " + dec(sm.length) + " ";
+        want += "SM" + dec(sm.index) + " " + dec((bits + 7) / 8) + " ";
+    }
+    if (names.empty()) {
+        // No SM of this direction: the ESI must assign no PDO of it to any SM either.
+        unsigned bits = 0;
+        for (const auto& p : outputs ? ctx.esi->rxpdos : ctx.esi->txpdos)
+            if (p.sm >= 0) bits += p.bits();
+        if (bits)
+            return fail(std::string("the ESI assigns ") + (outputs ? "RxPdos" : "TxPdos") +
+                            " to an SM, the SII has no " + (outputs ? "outputs" : "inputs") + " SM",
+                        "0 bytes", dec((bits + 7) / 8) + " bytes");
+        return skip(std::string("no ") + (outputs ? "outputs" : "inputs") + " SM and no PDO assigned to one");
+    }
+    return expect_eq(names + " bytes of the default assignment", got, want);
 }
 
 // The mapped output entries that are safe to change (not the controlword, not a mode), in mapping order.
@@ -97,11 +113,14 @@ Outcome inputs_match(Context& ctx, uint8_t state) {
         // never writes then show up as the pattern, not as stale values of an earlier run.
         master::ProcessDataSession s(ctx.m, ctx.addr, *ctx.sdo);
         if (Error x = s.discover(); x != Error::Ok) return fail("layout: " + ctx.sdo_error(x));
-        std::vector<uint8_t> pattern(3u * s.layout().sm3_length, 0xA5);
-        for (std::size_t k = 0; k < pattern.size(); k += 256) {
-            const std::size_t n = std::min<std::size_t>(256, pattern.size() - k);
-            (void)ctx.m.write(ctx.addr, static_cast<uint16_t>(s.layout().sm3_start + k),
-                              std::span<const uint8_t>(pattern.data() + k, n));
+        for (const master::ProcessDataSm& sm : s.layout().sms) {
+            if (sm.outputs) continue;
+            std::vector<uint8_t> pattern(3u * sm.length, 0xA5);
+            for (std::size_t k = 0; k < pattern.size(); k += 256) {
+                const std::size_t n = std::min<std::size_t>(256, pattern.size() - k);
+                (void)ctx.m.write(ctx.addr, static_cast<uint16_t>(sm.start + k),
+                                  std::span<const uint8_t>(pattern.data() + k, n));
+            }
         }
     }
     Error e = state == 8 ? ctx.to_op() : ctx.to_safeop();
@@ -178,13 +197,13 @@ Outcome logical_only(Context& ctx, master::Command cmd) {
     if (Error e = ctx.to_op(); e != Error::Ok) return fail("cannot reach OP: " + err(e));
     if (!ctx.has_process_data()) return skip("no process data (no PDO assigned to a process-data SM)");
     const auto& l = ctx.pds->layout();
-    std::vector<uint8_t> img(static_cast<std::size_t>(l.sm2_length) + l.sm3_length);
+    std::vector<uint8_t> img(static_cast<std::size_t>(l.output_bytes()) + l.input_bytes());
     if (cmd == master::Command::LWR)
         std::copy(ctx.pds->outputs().begin(), ctx.pds->outputs().end(), img.begin());
     master::Datagram d = master::Datagram::logical(cmd, master::ProcessDataSession::kLogicalBase, img);
     if (Error e = ctx.m.exchange(d); e != Error::Ok) return fail("no reply", err(e));
     (void)ctx.cycle(2);
-    const bool has = cmd == master::Command::LRD ? l.sm3_length > 0 : l.sm2_length > 0;
+    const bool has = cmd == master::Command::LRD ? l.input_bytes() > 0 : l.output_bytes() > 0;
     return expect_eq(std::string(cmd == master::Command::LRD ? "LRD" : "LWR") + " over outputs and inputs",
                      dec(d.wkc), has ? "1" : "0");
 }
@@ -203,47 +222,43 @@ Outcome op_registers(Context& ctx) {
     (void)ctx.cycle(5);
     const auto& l = ctx.pds->layout();
     std::string got, want;
-    struct Sm {
-        uint8_t n;
-        uint16_t start, length;
-        uint8_t control;
-    };
-    const Sm sms[2] = {{l.out_sm, l.sm2_start, l.sm2_length, l.sm2_control},
-                       {l.in_sm, l.sm3_start, l.sm3_length, l.sm3_control}};
-    for (const Sm& sm : sms) {
-        if (!sm.length || sm.n >= 16) continue;
+    for (const master::ProcessDataSm& sm : l.sms) {
+        if (!sm.length || sm.index >= 16) continue;
         uint8_t r[8] = {};
-        const auto base = static_cast<uint16_t>(master::reg::Sm0 + 8 * sm.n);
+        const auto base = static_cast<uint16_t>(master::reg::Sm0 + 8 * sm.index);
         if (Error e = ctx.m.read(ctx.addr, base, r); e != Error::Ok)
-            return fail("SM" + dec(sm.n) + " unreadable", err(e));
+            return fail("SM" + dec(sm.index) + " unreadable", err(e));
         (void)ctx.cycle(1);
-        const std::string n = "SM" + dec(sm.n) + " ";
+        const std::string n = "SM" + dec(sm.index) + " ";
         got += n + hex(get16(r)) + "/" + dec(get16(r + 2)) + " control " + hex(r[4], 2) + " activate " +
                hex(r[6] & 0x01, 2) + " PDI deactivated " + dec(r[7] & 0x01) + "; ";
         want += n + hex(sm.start) + "/" + dec(sm.length) + " control " + hex(sm.control, 2) + " activate " +
                 hex(0x01, 2) + " PDI deactivated 0; ";
     }
-    uint8_t f[32] = {};
+    // The FMMUs of the layout from FMMU0 on (the session's set-up: outputs SMs, then inputs SMs, adjacent
+    // ones sharing an FMMU), each at its place in the image.
+    const std::vector<master::ProcessDataLayout::Fmmu> fmmus = l.fmmus();
+    std::vector<uint8_t> f(16 * fmmus.size());
     if (Error e = ctx.m.read(ctx.addr, master::reg::Fmmu0, f); e != Error::Ok)
-        return fail("FMMU0/1 unreadable", err(e));
+        return fail("FMMU0-" + dec(fmmus.size() - 1) + " unreadable", err(e));
     (void)ctx.cycle(1);
-    const uint32_t log0 = master::ProcessDataSession::kLogicalBase;
-    const uint32_t logs[2] = {log0, log0 + l.sm2_length};
-    const uint16_t lens[2] = {l.sm2_length, l.sm3_length}, phys[2] = {l.sm2_start, l.sm3_start};
-    const uint8_t types[2] = {0x02, 0x01};
-    for (int k = 0; k < 2; ++k) {
-        if (!lens[k]) continue;
-        const uint8_t* x = f + 16 * k;
+    for (std::size_t k = 0; k < fmmus.size(); ++k) {
+        const master::ProcessDataLayout::Fmmu& want_f = fmmus[k];
+        const uint32_t logical = master::ProcessDataSession::kLogicalBase +
+                                 (want_f.outputs ? 0 : l.output_bytes()) + want_f.offset;
+        const uint8_t* x = f.data() + 16 * k;
         const std::string n = "FMMU" + dec(k) + " ";
         got += n + hex(get32(x), 8) + "/" + dec(get16(x + 4)) + " bits " + dec(x[6]) + "-" + dec(x[7]) +
                " -> " + hex(get16(x + 8)) + "." + dec(x[10]) + " type " + hex(x[11], 2) + " enable " +
                dec(x[12] & 1) + "; ";
-        want += n + hex(logs[k], 8) + "/" + dec(lens[k]) + " bits 0-7 -> " + hex(phys[k]) + ".0 type " +
-                hex(types[k], 2) + " enable 1; ";
+        want += n + hex(logical, 8) + "/" + dec(want_f.length) + " bits 0-7 -> " + hex(want_f.physical) +
+                ".0 type " + hex(want_f.outputs ? 0x02 : 0x01, 2) + " enable 1; ";
     }
     // Only outputs written through an SM with the watchdog trigger (control bit 6) keep the watchdog
     // running; an input-only device's watchdog may show expired (ESC datasheet 0x0420, 0x0440).
-    if (l.sm2_length && (l.sm2_control & 0x40)) {
+    if (std::any_of(l.sms.begin(), l.sms.end(), [](const master::ProcessDataSm& sm) {
+            return sm.outputs && sm.length && (sm.control & 0x40);
+        })) {
         auto wd = ctx.rd<uint16_t>(0x0440);
         (void)ctx.cycle(1);
         if (!wd) return fail("SM watchdog status 0x0440 unreadable", err(wd.error()));
@@ -275,11 +290,17 @@ void add_pd_tests(Catalogue& c) {
         "mapping.tx_vs_esi", "TxPDO mapping objects equal the ESI's TxPdo entries", kPdEsi,
         [](Context& ctx) { return mapping_vs_esi(ctx, false); }, "CoE and ESI");
     add(
-        "sm2.size_vs_esi", "SM2 size of the default assignment equals the ESI's RxPdo bit lengths", kPdEsi,
-        [](Context& ctx) { return sm_size_vs_esi(ctx, true); }, "ESI (layout over CoE, else from the SII)");
+        "sm2.size_vs_esi",
+        "Outputs SM sizes (SM2, and SM4... where the device has them) of the default assignment equal the "
+        "ESI's RxPdo bit lengths per SM",
+        kPdEsi, [](Context& ctx) { return sm_size_vs_esi(ctx, true); },
+        "ESI (layout over CoE, else from the SII)");
     add(
-        "sm3.size_vs_esi", "SM3 size of the default assignment equals the ESI's TxPdo bit lengths", kPdEsi,
-        [](Context& ctx) { return sm_size_vs_esi(ctx, false); }, "ESI (layout over CoE, else from the SII)");
+        "sm3.size_vs_esi",
+        "Inputs SM sizes (SM3, and SM5... where the device has them) of the default assignment equal the "
+        "ESI's TxPdo bit lengths per SM",
+        kPdEsi, [](Context& ctx) { return sm_size_vs_esi(ctx, false); },
+        "ESI (layout over CoE, else from the SII)");
     add(
         "safeop.wkc", "SAFEOP: LRW over outputs and inputs has the exact working counter", kPd,
         [](Context& ctx) { return cycle_wkc(ctx, 4); }, "process data (layout over CoE, else from the SII)");
@@ -336,7 +357,10 @@ void add_pd_tests(Catalogue& c) {
             (void)ctx.download_uint(0x1C12, 1, other->index, 2);
             (void)ctx.download_uint(0x1C12, 0, 1, 1);
             Error e = ctx.to_safeop();
-            std::string got = e == Error::Ok ? dec(ctx.pds->layout().sm2_length) : "not reached: " + err(e);
+            std::string got = "not reached: " + err(e);
+            if (e == Error::Ok)
+                for (const master::ProcessDataSm& sm : ctx.pds->layout().sms)
+                    if (sm.index == 2) got = dec(sm.length);
             Error cy = e == Error::Ok ? (ctx.cycle(3), ctx.pds->cycle()) : e;
             (void)ctx.to_preop();
             (void)ctx.download_uint(0x1C12, 0, 0, 1);

@@ -533,8 +533,8 @@ void add_sdo_tests(Catalogue& c) {
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_coe());
             if (Error e = ctx.to_safeop(); e != Error::Ok) return fail("cannot reach SAFEOP: " + err(e));
-            const auto& pdos =
-                ctx.pds->layout().rx_pdos.empty() ? ctx.pds->layout().tx_pdos : ctx.pds->layout().rx_pdos;
+            const std::vector<uint16_t> rx = ctx.pds->layout().pdos(true);
+            const std::vector<uint16_t> pdos = rx.empty() ? ctx.pds->layout().pdos(false) : rx;
             if (pdos.empty()) return skip("no PDO assigned");
             auto v = ctx.upload_uint(pdos[0], 0);
             if (!v) return fail(hex(pdos[0]) + ":00 upload: " + ctx.sdo_error(v.error()));

@@ -173,6 +173,8 @@ void write_pd_json(master::ProcessDataSession& pd, const master::CycleStats& bef
                     }
                     bit += e.bit_length;
                 }
+            bit =
+                (bit + 7) / 8 * 8;  // the next SM's data starts on a byte of the image (the session's layout)
         }
         w.end_array();
     }
@@ -255,9 +257,25 @@ int process_data(master::Master& m, const PdArgs& p) {
     }
     master::ProcessDataSession& pd = *session;
     const auto& l = pd.layout();
-    if (!p.json)
-        std::printf("outputs: SM%u 0x%04x, %u bytes; inputs: SM%u 0x%04x, %u bytes\n", l.out_sm, l.sm2_start,
-                    l.sm2_length, l.in_sm, l.sm3_start, l.sm3_length);
+    if (!p.json) {
+        // The first SM of each direction and the direction's bytes; a device with several SMs of a direction
+        // (SM2 and SM4 for outputs, ...) gets each of them listed on a second line.
+        const master::ProcessDataSm none{};
+        const master::ProcessDataSm* o = l.first(true);
+        const master::ProcessDataSm* i = l.first(false);
+        if (!o) o = &none;
+        if (!i) i = &none;
+        std::printf("outputs: SM%u 0x%04x, %u bytes; inputs: SM%u 0x%04x, %u bytes\n", o->index, o->start,
+                    l.output_bytes(), i->index, i->start, l.input_bytes());
+        if (l.sms_with_data() > (l.output_bytes() ? 1u : 0u) + (l.input_bytes() ? 1u : 0u)) {
+            std::printf("process-data SMs:");
+            for (const master::ProcessDataSm& sm : l.sms)
+                if (sm.length)
+                    std::printf(" SM%u 0x%04x %u bytes %s;", sm.index, sm.start, sm.length,
+                                sm.outputs ? "outputs" : "inputs");
+            std::printf("\n");
+        }
+    }
     master::DcConfig dc;
     dc.enable = p.dc;
     dc.cycle_ns = p.cycle_us * 1000u;

@@ -92,8 +92,7 @@ int to_safeop_op(master::Master& m, Address a, bool op) {
             return report_error(e, "reading the process-data layout of " + slave_label(a));
     }
     master::ProcessDataSession& pd = *session;
-    if (pd.layout().sm2_length + pd.layout().sm3_length ==
-        0) {  // no process data (a coupler): no SM, no FMMU
+    if (pd.layout().output_bytes() + pd.layout().input_bytes() == 0) {  // no process data (a coupler)
         if (int rc = go(m, a, AlState::SafeOp, "SAFEOP"); rc != kExitOk || !op) return rc;
         return go(m, a, AlState::Op, "OP");
     }

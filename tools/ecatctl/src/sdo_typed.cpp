@@ -91,6 +91,7 @@ void print_image(const char* title, const std::vector<SyncView>& syncs, bool out
                 }
                 bit += e.bit_length;
             }
+        bit = (bit + 7) / 8 * 8;  // the next SM's data starts on a byte of the image (the session's layout)
     }
 }
 

@@ -53,6 +53,8 @@ std::string_view to_string(Error e) {
             return "buffer too small";
         case Error::FoeError:
             return "FoE error reply";
+        case Error::TooFewFmmus:
+            return "the slave has fewer FMMUs (ESC 0x0004) than process-data SyncManagers with data";
     }
     return "unknown error";
 }

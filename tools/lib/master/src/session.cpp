@@ -3,6 +3,7 @@
 #include "master/session.hpp"
 
 #include <algorithm>
+#include <array>
 #include <iterator>
 #include <thread>
 #include <utility>
@@ -78,16 +79,13 @@ Error ProcessDataSession::discover() {
 
 namespace {
 
-// The process-data SMs from the SII SyncM category (41): start, control, and index of the first SM of
-// type 3 (outputs) and 4 (inputs); the PDOs of the TxPDO (50) / RxPDO (51) categories assigned to them
-// (sizes, for a slave without mailbox). false: no process-data SM.
-bool sii_layout(const std::vector<uint8_t>& s, ProcessDataLayout& layout, bool pdos) {
-    bool out = false, in = false;
-    uint32_t rx_bits = 0, tx_bits = 0;
-    if (pdos) {
-        layout.rx_pdos.clear();
-        layout.tx_pdos.clear();
-    }
+// The SII's process-data SMs (SyncM category 41, ETG.1000.6: per SM 8 bytes, start, default length, control,
+// status, enable, type): every SM of type 3 (outputs) and 4 (inputs), in SM order. With `pdos`, each one's
+// PDOs and bytes from the TxPDO (50) / RxPDO (51) categories (per PDO 8 bytes: index, entries, SM, ...; then
+// 8 per entry, bit length at byte 5): an RxPDO counts for an outputs SM, a TxPDO for an inputs SM.
+std::vector<ProcessDataSm> sii_sms(const std::vector<uint8_t>& s, bool pdos) {
+    std::vector<ProcessDataSm> sms;
+    std::vector<uint32_t> bits;
     for (int pass = 0; pass < 2; ++pass) {  // SMs first: the PDO categories refer to their indices
         for (std::size_t w = sii::FirstCategory; 2 * w + 4 <= s.size();) {
             const uint16_t type = get16(&s[2 * w]);
@@ -96,75 +94,61 @@ bool sii_layout(const std::vector<uint8_t>& s, ProcessDataLayout& layout, bool p
             const std::size_t data = 2 * w + 4;
             const std::size_t end = std::min<std::size_t>(data + 2u * len, s.size());
             if (pass == 0 && type == 41) {
-                for (std::size_t k = 0; data + (k + 1) * 8 <= end; ++k) {
+                for (std::size_t k = 0; data + (k + 1) * 8 <= end && k < 16; ++k) {
                     const uint8_t* sm = &s[data + 8 * k];
-                    const uint8_t kind = sm[7];
-                    if (kind == 3 && !out) {
-                        layout.sm2_start = get16(sm);
-                        layout.sm2_control = sm[4];
-                        layout.out_sm = static_cast<uint8_t>(k);
-                        out = true;
-                    } else if (kind == 4 && !in) {
-                        layout.sm3_start = get16(sm);
-                        layout.sm3_control = sm[4];
-                        layout.in_sm = static_cast<uint8_t>(k);
-                        in = true;
-                    }
+                    if (sm[7] != 3 && sm[7] != 4) continue;
+                    sms.push_back(
+                        ProcessDataSm{static_cast<uint8_t>(k), sm[7] == 3, get16(sm), 0, sm[4], {}});
                 }
+                bits.assign(sms.size(), 0);
             } else if (pass == 1 && pdos && (type == 50 || type == 51)) {
-                // ETG.1000.6 TxPDO/RxPDO category: per PDO 8 bytes (index, entries, SM, ...), then 8 per
-                // entry (..., bit length at byte 5).
                 for (std::size_t p = data; p + 8 <= end;) {
                     const uint16_t index = get16(&s[p]);
                     const uint8_t entries = s[p + 2];
-                    const uint8_t sm = s[p + 3];
-                    uint32_t bits = 0;
+                    const uint8_t n = s[p + 3];
+                    uint32_t pdo_bits = 0;
                     std::size_t q = p + 8;
                     for (uint8_t e = 0; e < entries && q + 8 <= end; ++e, q += 8)
-                        bits += s[q + 5];
-                    if (type == 51 && out && sm == layout.out_sm) {
-                        rx_bits += bits;
-                        layout.rx_pdos.push_back(index);
-                    } else if (type == 50 && in && sm == layout.in_sm) {
-                        tx_bits += bits;
-                        layout.tx_pdos.push_back(index);
-                    }
+                        pdo_bits += s[q + 5];
+                    for (std::size_t i = 0; i < sms.size(); ++i)
+                        if (sms[i].index == n && sms[i].outputs == (type == 51)) {
+                            bits[i] += pdo_bits;
+                            sms[i].pdos.push_back(index);
+                        }
                     p = q;
                 }
             }
             w += 2 + len;
         }
     }
-    if (pdos) {
-        layout.sm2_length = static_cast<uint16_t>((rx_bits + 7) / 8);
-        layout.sm3_length = static_cast<uint16_t>((tx_bits + 7) / 8);
-    }
-    return out || in;
+    for (std::size_t i = 0; i < sms.size(); ++i)
+        sms[i].length = static_cast<uint16_t>((bits[i] + 7) / 8);
+    return sms;
 }
 
 }  // namespace
 
 Error ProcessDataSession::discover(Slave& slave) {
-    // The process-data SMs from the SII, the PDOs from the assignment objects of those SMs (0x1C10 + n).
-    ProcessDataLayout& layout = slave.layout;
+    // The process-data SMs from the SII, the PDOs of each from its assignment object 0x1C10 + n (ETG.1000.6).
+    // An SM whose assignment object the device does not have (abort 0x06020000 object, 0x06090011 subindex
+    // does not exist: a device with fixed PDOs need not have it) keeps the PDOs its SII assigns to it. No
+    // process-data SM at all (a device with a mailbox only, e.g. an EoE switch port): no process data, as for
+    // a coupler without mailbox.
     auto img = m_.sii_read_image(slave.address);
     if (!img) return img.error();
-    if (!sii_layout(*img, layout, false)) {
-        // No process-data SM at all (a device with a mailbox only, e.g. an EoE switch port): no process data,
-        // as for a coupler without mailbox (discover_sii).
-        layout.sm2_length = layout.sm3_length = 0;
-        layout.rx_pdos.clear();
-        layout.tx_pdos.clear();
-        return Error::Ok;
+    std::vector<ProcessDataSm> sms = sii_sms(*img, true);
+    for (ProcessDataSm& sm : sms) {
+        std::vector<uint16_t> pdos;
+        uint16_t bytes = 0;
+        const Error e = pdo_bytes(*slave.sdo, static_cast<uint16_t>(0x1C10 + sm.index), pdos, bytes);
+        if (e == Error::SdoAbort &&
+            (slave.sdo->last_abort() == 0x06020000 || slave.sdo->last_abort() == 0x06090011))
+            continue;
+        if (e != Error::Ok) return e;
+        sm.pdos = std::move(pdos);
+        sm.length = bytes;
     }
-    if (Error e = pdo_bytes(*slave.sdo, static_cast<uint16_t>(0x1C10 + layout.out_sm), layout.rx_pdos,
-                            layout.sm2_length);
-        e != Error::Ok)
-        return e;
-    if (Error e = pdo_bytes(*slave.sdo, static_cast<uint16_t>(0x1C10 + layout.in_sm), layout.tx_pdos,
-                            layout.sm3_length);
-        e != Error::Ok)
-        return e;
+    slave.layout.sms = std::move(sms);
     return Error::Ok;
 }
 
@@ -172,30 +156,25 @@ Error ProcessDataSession::discover_sii(std::size_t k) {
     Slave& slave = slaves_.at(k);
     auto img = m_.sii_read_image(slave.address);
     if (!img) return img.error();
-    ProcessDataLayout layout;
-    if (!sii_layout(*img, layout, true)) {
-        // No process-data SM at all (a coupler): no process data.
-        layout.sm2_length = layout.sm3_length = 0;
-    }
-    slave.layout = layout;
+    slave.layout.sms = sii_sms(*img, true);  // none (a coupler): no process data
     return Error::Ok;
 }
 
 std::span<uint8_t> ProcessDataSession::outputs(std::size_t k) {
     const Slave& s = slaves_[k];
     if (image_.empty()) return {};
-    return {image_.data() + s.out_offset, s.layout.sm2_length};
+    return {image_.data() + s.out_offset, s.layout.output_bytes()};
 }
 
 std::span<const uint8_t> ProcessDataSession::inputs(std::size_t k) const {
     const Slave& s = slaves_[k];
     if (image_.empty()) return {};
-    return {image_.data() + out_bytes_ + s.in_offset, s.layout.sm3_length};
+    return {image_.data() + out_bytes_ + s.in_offset, s.layout.input_bytes()};
 }
 
 uint16_t ProcessDataSession::expected_wkc(std::size_t k) const {
     const ProcessDataLayout& l = slaves_[k].layout;
-    return static_cast<uint16_t>((l.sm2_length ? 2 : 0) + (l.sm3_length ? 1 : 0));
+    return static_cast<uint16_t>((l.output_bytes() ? 2 : 0) + (l.input_bytes() ? 1 : 0));
 }
 
 uint16_t ProcessDataSession::expected_wkc() const {
@@ -217,10 +196,11 @@ Error ProcessDataSession::configure(const DcConfig& dc) {
     for (Slave& s : slaves_) {
         s.out_offset = out_bytes_;
         s.in_offset = in_bytes_;
-        out_bytes_ += s.layout.sm2_length;
-        in_bytes_ += s.layout.sm3_length;
+        out_bytes_ += s.layout.output_bytes();
+        in_bytes_ += s.layout.input_bytes();
     }
     if (out_bytes_ + in_bytes_ == 0) return Error::InvalidArgument;
+    if (Error e = check_fmmus(); e != Error::Ok) return e;
     for (Slave& s : slaves_)
         if (Error e = configure(s, dc); e != Error::Ok) return e;
     image_.assign(static_cast<std::size_t>(out_bytes_) + in_bytes_, 0);
@@ -228,8 +208,8 @@ Error ProcessDataSession::configure(const DcConfig& dc) {
     // (so that each slave counts once); each frame knows its share of the working counter.
     std::vector<std::size_t> ends;
     for (const Slave& s : slaves_) {
-        ends.push_back(s.out_offset + s.layout.sm2_length);
-        ends.push_back(out_bytes_ + s.in_offset + s.layout.sm3_length);
+        ends.push_back(s.out_offset + s.layout.output_bytes());
+        ends.push_back(out_bytes_ + s.in_offset + s.layout.input_bytes());
     }
     std::sort(ends.begin(), ends.end());
     chunks_.clear();
@@ -244,9 +224,9 @@ Error ProcessDataSession::configure(const DcConfig& dc) {
         c.dg[0] =
             Datagram::logical(Command::LRW, kLogicalBase + pos, std::span<uint8_t>(image_.data() + at, len));
         for (const Slave& s : slaves_) {
-            if (overlaps(pos, static_cast<uint32_t>(len), s.out_offset, s.layout.sm2_length))
+            if (overlaps(pos, static_cast<uint32_t>(len), s.out_offset, s.layout.output_bytes()))
                 c.expected_wkc += 2;
-            if (overlaps(pos, static_cast<uint32_t>(len), out_bytes_ + s.in_offset, s.layout.sm3_length))
+            if (overlaps(pos, static_cast<uint32_t>(len), out_bytes_ + s.in_offset, s.layout.input_bytes()))
                 c.expected_wkc += 1;
         }
         chunks_.push_back(c);
@@ -291,7 +271,7 @@ Error ProcessDataSession::configure(Slave& slave, const DcConfig& dc) {
         const uint8_t mode_out[2] = {static_cast<uint8_t>(dc.enable ? dc_mode : 1), 0};
         if (Error e = sdo->download(0x1C32, 1, mode_out); e != Error::Ok && !absent(e) && !fixed(e)) return e;
         const uint8_t mode_in[2] = {
-            static_cast<uint8_t>(dc.enable ? dc_mode : (layout.sm2_length ? 0x22 : 1)), 0};
+            static_cast<uint8_t>(dc.enable ? dc_mode : (layout.output_bytes() ? 0x22 : 1)), 0};
         if (Error e = sdo->download(0x1C33, 1, mode_in); e != Error::Ok && !absent(e) && !fixed(e)) {
             const uint8_t plain[2] = {static_cast<uint8_t>(dc.enable ? dc_mode : 1), 0};
             if (sdo->download(0x1C33, 1, plain) != Error::Ok) return e;
@@ -304,47 +284,51 @@ Error ProcessDataSession::configure(Slave& slave, const DcConfig& dc) {
             (void)sdo->download(0x1C33, 2, cyc);  // some slaves derive it from 0x1C32 and refuse the write
         }
     }
-    // SM2/SM3: disabled first, then start, length, control and activate in one write (ESC datasheet section I
-    // §8).
-    uint8_t sm[16] = {};
-    const uint8_t off[16] = {};
-    put16(sm + 0, layout.sm2_start);
-    put16(sm + 2, layout.sm2_length);
-    sm[4] = layout.sm2_control;
-    sm[6] = layout.sm2_length ? 1 : 0;
-    put16(sm + 8, layout.sm3_start);
-    put16(sm + 10, layout.sm3_length);
-    sm[12] = layout.sm3_control;
-    sm[14] = layout.sm3_length ? 1 : 0;
-    if (layout.out_sm == 2 && layout.in_sm == 3) {
-        if (Error e = m_.write(a, static_cast<uint16_t>(reg::Sm0 + 16), off); e != Error::Ok) return e;
-        if (Error e = m_.write(a, static_cast<uint16_t>(reg::Sm0 + 16), sm); e != Error::Ok) return e;
-    } else {
-        // Process data in other SMs (SM0/SM1 of a device without mailbox): each SM on its own.
-        const std::pair<uint8_t, const uint8_t*> sms[2] = {{layout.out_sm, sm}, {layout.in_sm, sm + 8}};
-        for (const auto& [n, regs] : sms) {
-            if (n >= 16) continue;
-            const auto base = static_cast<uint16_t>(reg::Sm0 + 8 * n);
-            if (Error e = m_.write(a, base, std::span<const uint8_t>(off, 8)); e != Error::Ok) return e;
-            if (Error e = m_.write(a, base, std::span<const uint8_t>(regs, 8)); e != Error::Ok) return e;
-        }
+    // Every process-data SM: disabled first, then start, length, control and activate in one write (ESC
+    // datasheet section I §8); one carrying nothing stays disabled.
+    const uint8_t off[8] = {};
+    for (const ProcessDataSm& sm : layout.sms) {
+        if (sm.index >= 16) continue;
+        uint8_t r[8] = {};
+        put16(r + 0, sm.start);
+        put16(r + 2, sm.length);
+        r[4] = sm.control;
+        r[6] = sm.length ? 1 : 0;
+        const auto base = static_cast<uint16_t>(reg::Sm0 + 8 * sm.index);
+        if (Error e = m_.write(a, base, off); e != Error::Ok) return e;
+        if (Error e = m_.write(a, base, r); e != Error::Ok) return e;
     }
-    // FMMU0: outputs (write), FMMU1: inputs (read), at this slave's places in the image (ESC datasheet
-    // section I §7).
-    uint8_t fm[32] = {};
-    auto fmmu = [](uint8_t* f, uint32_t logical, uint16_t length, uint16_t physical, uint8_t type) {
-        put32(f, logical);
-        put16(f + 4, length);
+    // The FMMUs of layout.fmmus() from FMMU0 on: the outputs ones (write) at this slave's place among the
+    // outputs, the inputs ones (read) among the inputs; the slave's other FMMUs disabled (ESC datasheet
+    // section I §7). check_fmmus() made sure there are enough.
+    std::array<uint8_t, 16 * 16> fm{};
+    std::size_t used = 0;
+    for (const ProcessDataLayout::Fmmu& x : layout.fmmus()) {
+        if (used == 16) break;
+        uint8_t* f = fm.data() + 16 * used++;
+        put32(f, kLogicalBase + (x.outputs ? slave.out_offset : out_bytes_ + slave.in_offset) + x.offset);
+        put16(f + 4, x.length);
         f[6] = 0;
         f[7] = 7;
-        put16(f + 8, physical);
+        put16(f + 8, x.physical);
         f[10] = 0;
-        f[11] = type;
-        f[12] = length ? 1 : 0;
-    };
-    fmmu(fm, kLogicalBase + slave.out_offset, layout.sm2_length, layout.sm2_start, 0x02);
-    fmmu(fm + 16, kLogicalBase + out_bytes_ + slave.in_offset, layout.sm3_length, layout.sm3_start, 0x01);
-    return m_.write(a, reg::Fmmu0, fm);
+        f[11] = x.outputs ? 0x02 : 0x01;
+        f[12] = 1;
+    }
+    const std::size_t count = std::min<std::size_t>(slave.fmmus, 16);
+    return m_.write(a, reg::Fmmu0, std::span<const uint8_t>(fm.data(), 16 * count));
+}
+
+// Every slave's FMMU count (ESC 0x0004) against the FMMUs its layout needs, before any is configured: a
+// slave with too few cannot map its image and is not set up half.
+Error ProcessDataSession::check_fmmus() {
+    for (Slave& s : slaves_) {
+        auto n = m_.read_reg<uint8_t>(s.address, 0x0004);
+        if (!n) return n.error();
+        s.fmmus = *n;
+        if (s.layout.fmmus().size() > std::min<std::size_t>(*n, 16)) return Error::TooFewFmmus;
+    }
+    return Error::Ok;
 }
 
 Error ProcessDataSession::configure_dc(const DcConfig& dc) {

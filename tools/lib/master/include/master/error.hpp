@@ -26,6 +26,7 @@ enum class Error : uint8_t {
     SdoAbort,              // the SDO server aborted the transfer (abort code tells why)
     BufferTooSmall,        // the caller's buffer cannot hold the answer
     FoeError,              // the FoE server answered with an ERR packet (code and text kept by the client)
+    TooFewFmmus,           // the slave has fewer FMMUs (ESC 0x0004) than process-data SMs with data
 };
 
 std::string_view to_string(Error e);

@@ -1,13 +1,18 @@
 #pragma once
 // A cyclic process-data session with one slave or a whole line of them (buffered SMs and FMMUs: ESC datasheet
 // section I §8.1, §7; AL states: ETG.1000.6; distributed clocks: ESC datasheet section I §9, ETG.1020):
-// discovers each slave's process-data layout (SM2/SM3 from the SII SyncM category, sizes from the PDO
-// assignment 0x1C12/0x1C13 and the mapping objects over CoE), sets up its SM2/SM3 and two FMMUs into one
-// logical image (the outputs of all slaves back to back, then their inputs), optionally distributed clocks
-// (delays and offsets measured over the line, SYNC0 on every slave with the same start time), and exchanges
-// outputs and inputs with one LRW per cycle (split over several frames, sent back to back, only when the
-// image does not fit one), plus an FRMW of the reference clock's system time when DC is on. Expected working
-// counter: the sum over the slaves of 2 (outputs written) + 1 (inputs read). cycle() allocates nothing.
+// discovers each slave's process-data layout (every SM of type 3 (outputs) and 4 (inputs) of the SII SyncM
+// category, sizes from their PDO assignment 0x1C10+n and the mapping objects over CoE, or from the SII's
+// RxPDO/TxPDO categories), sets up every process-data SM and one FMMU per SM that carries data (SMs adjacent
+// in memory share one, ProcessDataLayout::fmmus()) into one
+// logical image (the outputs of all slaves back to back, then their inputs; within a slave in SM order),
+// optionally distributed clocks (delays and offsets measured over the line, SYNC0 on every slave with the
+// same start time), and exchanges outputs and inputs with one LRW per cycle (split over several frames, sent
+// back to back, only when the image does not fit one), plus an FRMW of the reference clock's system time when
+// DC is on. Expected working counter: the sum over the slaves of 2 (outputs written) + 1 (inputs read),
+// whatever the number of FMMUs: an ESC counts a datagram once per slave and direction when at least one of
+// its FMMUs read or wrote (ESC datasheet section I, "Working counter"; ETG.1000.4 LRW). cycle() allocates
+// nothing.
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -20,15 +25,88 @@
 
 namespace master {
 
+// One process-data SyncManager: an SM of type 3 (outputs, RxPDOs) or 4 (inputs, TxPDOs) in the SII SyncM
+// category (ETG.1000.6; ETG.2000 Sm elements), with the PDOs assigned to it and their bytes.
+struct ProcessDataSm {
+    uint8_t index = 0;  // SM n
+    bool outputs = true;
+    uint16_t start = 0;
+    uint16_t length = 0;  // bytes of the assigned PDOs; 0: the SM carries nothing and stays disabled
+    uint8_t control = 0;
+    std::vector<uint16_t> pdos;  // assigned PDOs (0x1C10+n, else the SII's PDOs of SM n), in order
+};
+
 struct ProcessDataLayout {
-    uint16_t sm2_start = 0, sm2_length = 0;  // outputs (RxPDOs), bytes
-    uint8_t sm2_control = 0x64;
-    uint16_t sm3_start = 0, sm3_length = 0;  // inputs (TxPDOs), bytes
-    uint8_t sm3_control = 0x20;
-    std::vector<uint16_t> rx_pdos, tx_pdos;  // assigned PDOs
-    // The SyncManagers of outputs and inputs (the SII's first SM of type 3 / 4): SM2/SM3 with a mailbox,
-    // SM0/SM1 on a device without one (ETG.2000 Sm elements).
-    uint8_t out_sm = 2, in_sm = 3;
+    // Every process-data SM of the slave, in SM order: SM2/SM3 (and SM4, SM5, ... on devices with several
+    // per direction) with a mailbox, from SM0 on a device without one.
+    std::vector<ProcessDataSm> sms;
+
+    // Adds an SM (a layout made by hand, for set_layout()).
+    ProcessDataLayout& add(uint8_t index, bool outputs, uint16_t start, uint16_t length, uint8_t control) {
+        sms.push_back(ProcessDataSm{index, outputs, start, length, control, {}});
+        return *this;
+    }
+    // Bytes of the outputs (inputs): the sum over the SMs of that direction.
+    uint32_t bytes(bool outputs) const {
+        uint32_t n = 0;
+        for (const ProcessDataSm& sm : sms)
+            if (sm.outputs == outputs) n += sm.length;
+        return n;
+    }
+    uint32_t output_bytes() const { return bytes(true); }
+    uint32_t input_bytes() const { return bytes(false); }
+    // SMs that carry data.
+    std::size_t sms_with_data() const {
+        std::size_t n = 0;
+        for (const ProcessDataSm& sm : sms)
+            n += sm.length ? 1 : 0;
+        return n;
+    }
+    // The first SM of this direction that carries data, else the first of this direction; nullptr: none.
+    const ProcessDataSm* first(bool outputs) const {
+        const ProcessDataSm* any = nullptr;
+        for (const ProcessDataSm& sm : sms) {
+            if (sm.outputs != outputs) continue;
+            if (sm.length) return &sm;
+            if (!any) any = &sm;
+        }
+        return any;
+    }
+    // The FMMUs the layout needs, in the order the session sets them up from FMMU0 on: the outputs SMs with
+    // data (write) in SM order, then the inputs SMs (read), each at its offset within its direction's part
+    // of the image; an SM that starts where the previous one of the list ends in memory shares its FMMU
+    // (one logical range onto one physical range: FB1111's four one-byte outputs SMs 0x0F00..0x0F03 under
+    // the one FMMU its ESI declares, as SOEM and TwinCAT map them).
+    struct Fmmu {
+        bool outputs = true;
+        uint32_t offset = 0;  // within the outputs (inputs) of the slave
+        uint16_t length = 0, physical = 0;
+    };
+    std::vector<Fmmu> fmmus() const {
+        std::vector<Fmmu> r;
+        for (const bool outputs : {true, false}) {
+            uint32_t offset = 0;
+            bool joinable = false;
+            for (const ProcessDataSm& sm : sms) {
+                if (sm.outputs != outputs || !sm.length) continue;
+                if (joinable && r.back().physical + r.back().length == sm.start &&
+                    r.back().length + sm.length <= 0xFFFF)
+                    r.back().length = static_cast<uint16_t>(r.back().length + sm.length);
+                else
+                    r.push_back(Fmmu{outputs, offset, sm.length, sm.start});
+                joinable = true;
+                offset += sm.length;
+            }
+        }
+        return r;
+    }
+    // The PDOs assigned to the SMs of this direction, in SM order.
+    std::vector<uint16_t> pdos(bool outputs) const {
+        std::vector<uint16_t> r;
+        for (const ProcessDataSm& sm : sms)
+            if (sm.outputs == outputs) r.insert(r.end(), sm.pdos.begin(), sm.pdos.end());
+        return r;
+    }
 };
 
 struct DcConfig {
@@ -75,8 +153,10 @@ class ProcessDataSession {
     const ProcessDataLayout& layout(std::size_t k = 0) const { return slaves_[k].layout; }
     void set_layout(std::size_t k, const ProcessDataLayout& layout) { slaves_[k].layout = layout; }
     // For each slave: sync mode objects (0x1C32:01, 0x1C33:01): DC SYNC0 (2) with dc.enable, else
-    // SM-synchronous (1); SM2/SM3, FMMU0 (outputs, write) and FMMU1 (inputs, read). With dc.enable also the
-    // delays and offsets (dc.measure) and SYNC0 (0x0980/0x09A0/0x0990/0x0981) with one start time for all.
+    // SM-synchronous (1); every process-data SM (those without data disabled); the FMMUs of
+    // ProcessDataLayout::fmmus() from FMMU0 on, the slave's other FMMUs disabled. A slave with fewer FMMUs
+    // (ESC 0x0004) than that: Error::TooFewFmmus, before any slave is touched. With dc.enable also the delays
+    // and offsets (dc.measure) and SYNC0 (0x0980/0x09A0/0x0990/0x0981) with one start time for all.
     Error configure(const DcConfig& dc = {});
 
     // One process-data exchange: outputs() go out, inputs() come back. Returns Error::WorkingCounter if
@@ -113,6 +193,7 @@ class ProcessDataSession {
         SdoClient* sdo = nullptr;
         ProcessDataLayout layout;
         uint32_t out_offset = 0, in_offset = 0;  // in the image
+        uint8_t fmmus = 0;                       // ESC 0x0004, read by configure()
     };
     // One frame of the cycle: an LRW over part of the image (the FRMW of DC rides in the first).
     struct Chunk {
@@ -122,6 +203,7 @@ class ProcessDataSession {
     };
     Error discover(Slave& s);
     Error pdo_bytes(SdoClient& sdo, uint16_t assign_index, std::vector<uint16_t>& pdos, uint16_t& bytes);
+    Error check_fmmus();
     Error configure(Slave& s, const DcConfig& dc);
     Error configure_dc(const DcConfig& dc);
     Error write_al_control(AlState state, bool acknowledge, uint8_t current);
