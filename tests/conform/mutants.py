@@ -1176,6 +1176,15 @@ TABLE_SURVIVORS = {
     "sdo-abort-pdo-length": "not provoked on this slave: its PDO limit (160 bytes per SM) is above what one "
                             "mapping object filled to its last subindex reaches (sdo.pdo.mapping_too_long: taken)",
     # round 3 (UNSEEN3)
+    # round 4 (UNSEEN4)
+    "esc-dl-status-pdi-watchdog": "caught in pd (pd.op.esc_registers: DL status bit 1 while the process data "
+                                  "runs), not in esc where it was placed blind: in INIT an idle application may "
+                                  "let the PDI watchdog expire, so bit 1 is judged only in OP",
+    "sync-error-flag-stuck": "never fires: the drive's 0x1C32/0x1C33 have subindices 0-5 only (no :20); a "
+                             "mistake of the mutant, not rewritten after the tool was read",
+    "cia402-mode-display-pd-stuck": "not closed in round 4: 0x6061 in the process data is compared with the mode "
+                                    "over SDO only where the drive applies its mode (OP, outputs valid); a first "
+                                    "try in SAFEOP failed the clean drive through the proxy and was taken out",
     "sdo-segment-data-rotated": "never fires: the only segmented upload of the drive (0x10F3 by complete "
                                 "access) holds zeros after its first part, so rotated segment data is the same "
                                 "data; not a defect of this slave",
