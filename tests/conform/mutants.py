@@ -1182,9 +1182,6 @@ TABLE_SURVIVORS = {
                                   "let the PDI watchdog expire, so bit 1 is judged only in OP",
     "sync-error-flag-stuck": "never fires: the drive's 0x1C32/0x1C33 have subindices 0-5 only (no :20); a "
                              "mistake of the mutant, not rewritten after the tool was read",
-    "cia402-mode-display-pd-stuck": "not closed in round 4: 0x6061 in the process data is compared with the mode "
-                                    "over SDO only where the drive applies its mode (OP, outputs valid); a first "
-                                    "try in SAFEOP failed the clean drive through the proxy and was taken out",
     "sdo-segment-data-rotated": "never fires: the only segmented upload of the drive (0x10F3 by complete "
                                 "access) holds zeros after its first part, so rotated segment data is the same "
                                 "data; not a defect of this slave",

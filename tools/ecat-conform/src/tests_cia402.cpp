@@ -395,7 +395,34 @@ void add_cia402_tests(Catalogue& c) {
                     }
                     (void)ctx.to_preop();
                 }
+                // The same display in the process data, where the inputs map 0x6061 (a PDO is a second way to
+                // read the object): in OP, outputs valid, 0x6060 set where the outputs map it; the drive
+                // stays in switch on disabled (controlword 0), nothing moves.
+                std::string pd_shown;
+                if (shown == static_cast<uint8_t>(md.value)) {
+                    Drive d(ctx);
+                    if (d.start().empty()) {
+                        if (const MappedEntry* in = d.map.find_in(0x6061)) {
+                            if (d.mode)
+                                image_set(ctx.pds->outputs(), *d.mode, static_cast<uint8_t>(md.value));
+                            else
+                                (void)ctx.download_uint(0x6060, 0, static_cast<uint8_t>(md.value), 1);
+                            uint64_t v = 0xFF;
+                            for (int i = 0; i < 200 && v != static_cast<uint8_t>(md.value); ++i) {
+                                d.run(1);
+                                v = image_get(ctx.pds->inputs(), *in) & 0xFF;
+                            }
+                            if (v != static_cast<uint8_t>(md.value)) pd_shown = dec(static_cast<int8_t>(v));
+                        }
+                    }
+                    d.finish();
+                    (void)ctx.to_preop();
+                }
                 if (old) (void)ctx.download_uint(0x6060, 0, *old, 1);
+                if (!pd_shown.empty())
+                    return fail("0x6061 in the process data (OP) after 0x6060 = " + dec(md.value) +
+                                    ", while over SDO it shows the mode",
+                                pd_shown, dec(md.value));
                 return expect_eq("0x6061 after 0x6060 = " + dec(md.value) + where,
                                  dec(static_cast<int8_t>(shown)), dec(md.value));
             },
