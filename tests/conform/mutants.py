@@ -926,14 +926,15 @@ def dc_offset_ignored(st, d):
             d.put(0x0910, d.get(0x0910, size) - off, size)
 
 
-def al_refusal_shown_as(requested, shown):
-    """A refused request of state `requested` shown as done: AL status reads `shown` without the error bit and
-    AL status code 0, as long as the master's AL control asks for that state."""
+def al_refusal_shown_as(requested, shown, from_state=None):
+    """A refused request of state `requested` (from `from_state`, any if None) shown as done: AL status reads
+    `shown` without the error bit and AL status code 0, as long as the master's AL control asks for that state."""
 
     def mutate(st, d):
         if d.covers(0x0130):
             v = d.get(0x0130)
-            fake = (st.mem[0x0120] & 0x0F) == requested and bool(v & 0x10) and (v & 0x0F) != requested
+            fake = ((st.mem[0x0120] & 0x0F) == requested and bool(v & 0x10) and (v & 0x0F) != requested
+                    and (from_state is None or (v & 0x0F) == from_state))
             st.scratch["fake"] = fake
             if fake:
                 d.put(0x0130, shown)
@@ -1852,18 +1853,7 @@ def safeop_to_preop_refused(st, d):
 def refusal_from_shown_done(from_state, requested):
     """A change from `from_state` to `requested` that the slave refuses (wrong SM settings, DC, watchdog ...)
     shown as done: AL status reads `requested` without the error bit, code 0 (a slave that checks nothing)."""
-
-    def mutate(st, d):
-        if d.covers(0x0130):
-            v = d.get(0x0130)
-            fake = (st.mem[0x0120] & 0x0F) == requested and (v & 0x1F) == (0x10 | from_state)
-            st.scratch["rfs"] = fake
-            if fake:
-                d.put(0x0130, requested)
-        if st.scratch.get("rfs") and d.covers(0x0134):
-            d.put(0x0134, 0)
-
-    return mutate
+    return al_refusal_shown_as(requested, requested, from_state)
 
 
 def watchdog_stays_op(st, d):
