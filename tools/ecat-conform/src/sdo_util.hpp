@@ -106,9 +106,9 @@ inline Outcome expect_response(const SdoAnswer& a, uint8_t scs, uint16_t index, 
         return fail(what + ": complete-access bit set for a single entry", hex(c, 2), want);
     // The upload response to a complete access says so (ETG.1000.6 SDO upload CA response, command 0x51):
     // a master parses the data as the whole object only when the bit is set.
-    if (scs == 2 && ca && !(c & 0x10))
+    if (ca && !(c & 0x10))
         return fail(what + ": complete-access bit clear in the response to a complete access", hex(c, 2),
-                    "0x5x");
+                    scs == 2 ? "0x5x" : "0x70");
     if (get16(&a.p[3]) != index || a.p[5] != sub)
         return fail(what + ": index/subindex not echoed", hex(get16(&a.p[3])) + ":" + dec(a.p[5]),
                     hex(index) + ":" + dec(sub));

@@ -68,6 +68,30 @@ std::string need_writable(const Context& ctx, uint16_t index, uint8_t sub) {
     return {};
 }
 
+// What 0x1C32/0x1C33 say while the slave runs synchronised (ETG.1020): the minimum cycle time (:05) is no
+// more than the cycle it runs at (:02), and the sync error (:20) is not set without a cause the slave counts
+// (SM event missed :0B, cycle time too small :0C). Subindices the device does not have are left out.
+std::string sync_objects_running(Context& ctx) {
+    std::string problems;
+    for (uint16_t index : {uint16_t{0x1C32}, uint16_t{0x1C33}}) {
+        const std::string o = hex(index);
+        auto cycle = ctx.upload_uint(index, 2);
+        auto min = ctx.upload_uint(index, 5);
+        if (cycle && min && *cycle && *min > *cycle)
+            problems += o + ":05 minimum cycle " + dec(static_cast<long long>(*min)) +
+                        " ns above the cycle it runs at (" + o + ":02 " +
+                        dec(static_cast<long long>(*cycle)) + " ns); ";
+        auto error = ctx.upload_uint(index, 0x20);
+        if (!error || !*error) continue;
+        auto missed = ctx.upload_uint(index, 0x0B);
+        auto small = ctx.upload_uint(index, 0x0C);
+        if ((!missed || !*missed) && (!small || !*small))
+            problems +=
+                o + ":20 sync error set, yet no SM event missed (:0B) or cycle too small (:0C) counted; ";
+    }
+    return problems;
+}
+
 Outcome dc_state(Context& ctx, bool op) {
     CONFORM_NEED(ctx.need_dc());
     CONFORM_NEED(ctx.need_coe());
@@ -88,12 +112,20 @@ Outcome dc_state(Context& ctx, bool op) {
     (void)ctx.cycle(30);
     master::AlStatus st;
     Error o = ctx.pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st);
+    std::string sync;
+    if (o == Error::Ok) {
+        (void)ctx.cycle(30);
+        sync = sync_objects_running(ctx);
+    }
     (void)ctx.to_init();
     if (o != Error::Ok)
         return fail(
             "OP in DC mode: " + err(o),
             state_text(static_cast<uint8_t>(st.state | (st.error ? 0x10 : 0))) + " code " + hex(st.code),
             "OP");
+    if (!sync.empty())
+        return fail("OP in DC mode: the synchronisation objects contradict the cycle that runs: " + sync,
+                    sync, "0x1C3x:05 <= :02, :20 only with a counted cause");
     return pass("OP in DC mode");
 }
 
@@ -160,7 +192,15 @@ void add_dc_tests(Catalogue& c) {
             auto l = rd64(ctx, esc::reg::kDcSystemTime);
             if (!r || !l) return fail("registers unreadable");
             if (*r == 0) return fail("0x0918 is 0", "0", "a local time");
-            return pass("latched", hex(*r, 16));
+            // Every latch takes a new time (as 0x0900): a second write to 0x0900 after a wait moves 0x0918.
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));
+            (void)ctx.m.broadcast_write(esc::reg::kDcRecvTime0, z);
+            auto r2 = rd64(ctx, esc::reg::kDcRecvTimePu);
+            if (!r2) return fail("0x0918 unreadable");
+            if (*r2 == *r)
+                return fail("0x0918 unchanged by a second latch (write to 0x0900) 2 ms later", hex(*r2, 16),
+                            "a new time");
+            return pass("latched", hex(*r, 16) + ", then " + hex(*r2, 16));
         },
         a);
     add(
@@ -216,7 +256,13 @@ void add_dc_tests(Catalogue& c) {
             if (Error e = ctx.m.read(ctx.addr, esc::reg::kDcRecvTime0, t); e != Error::Ok)
                 return fail("0x0900-0x090F unreadable", err(e));
             const uint32_t p0 = get32(t), p1 = get32(t + 4);
-            if (p1 != 0 && p1 < p0) return fail("port 1 time before port 0 time", dec(p1), ">= " + dec(p0));
+            // Port 1 latches only where the frame passes it (ESC datasheet 0x0904): open, with communication
+            // (DL status 0x0110 bits 10-11). A closed port's receive time is whatever it held: not judged.
+            auto dl = ctx.rd<uint16_t>(esc::reg::kDlStatus);
+            if (!dl) return fail("0x0110 unreadable", err(dl.error()));
+            const bool port1_passes = (*dl & 0x0800) && !(*dl & 0x0400);
+            if (port1_passes && p1 != 0 && p1 < p0)
+                return fail("port 1 time before port 0 time", dec(p1), ">= " + dec(p0));
             return pass("port 0 " + dec(p0) + ", port 1 " + dec(p1));
         },
         a);
@@ -337,7 +383,13 @@ void add_dc_tests(Catalogue& c) {
                 advanced =
                     first && later && *later >= *first + 1'000'000 && *later - *first <= waited + 2'000'000;
             }
+            // Activation status 0x0984 bit 0 (first SYNC0 pulse pending) clears with the first pulse.
+            auto act_status = ctx.rd<uint8_t>(0x0984);
             (void)ctx.wr<uint8_t>(esc::reg::kDcActivation, 0);
+            if (advanced && act_status && (*act_status & 0x01))
+                return fail(
+                    "activation status 0x0984 bit 0 (first SYNC0 pulse pending) still set after the pulses",
+                    hex(*act_status, 2), "bit 0 clear");
             if (!act || (*act & 0x07) != 0x03)
                 return fail("DC activation 0x0981 bits 0-2 read back after writing 0x03",
                             act ? hex(*act, 2) : "unreadable", "0x03 (cyclic operation, SYNC0)");

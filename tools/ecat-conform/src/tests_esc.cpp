@@ -229,6 +229,8 @@ Outcome dl_status_ports(Context& ctx) {
 }
 
 Outcome al_status_bits(Context& ctx) {
+    // From INIT, whatever the test before left (a failed test is not put back to INIT by the runner).
+    (void)ctx.to_init();
     for (int round = 0; round < 2; ++round) {
         if (round == 1 && ctx.need_mailbox().empty() && ctx.to_preop() != Error::Ok)
             return fail("cannot reach PREOP for the second reading");
@@ -576,6 +578,14 @@ void add_esc_tests(Catalogue& c) {
             const bool dc = *f & 0x0004;
             if (ctx.esi->has_dc && !dc)
                 return fail("the ESI has Dc but the ESC has no DC", hex(*f), "bit 2 set");
+            // Bit 3 (64-bit DC): a 32-bit DC unit reads 0 in 0x0914-0x0917, the upper half of the system
+            // time; a system time that counts there is 64 bits wide, whatever bit 3 says.
+            if (dc && !(*f & 0x0008)) {
+                auto hi = ctx.rd<uint32_t>(0x0914);
+                if (hi && *hi)
+                    return fail("bit 3 clear (32-bit DC), yet the system time's upper half 0x0914 counts",
+                                hex(*f) + ", 0x0914 " + hex(*hi, 8), "bit 3 set, or 0x0914 = 0");
+            }
             return pass("features", hex(*f));
         },
         "ESI given");
@@ -669,14 +679,19 @@ void add_esc_tests(Catalogue& c) {
             if (*v & 0xF002) return fail("reserved bits set", hex(*v), "bits 1, 12-15 clear");
             return pass("0x0210", hex(*v));
         });
-    add("reg.pdi_control", "PDI control 0x0140 loaded from SII word 0",
-        "ETG.1000.6 SII configuration area; ESC datasheet 0x0140 (loaded from EEPROM word 0, also from the "
-        "data the PDI gives where it emulates the EEPROM)",
+    add("reg.pdi_control",
+        "PDI control 0x0140 and PDI/sync configuration 0x0150-0x0151 loaded from SII words 0-1",
+        "ETG.1000.6 SII configuration area; ESC datasheet 0x0140 (loaded from EEPROM word 0), 0x0150-0x0151 "
+        "(from word 1), also from the data the PDI gives where it emulates the EEPROM",
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_sii());
             auto p = ctx.rd<uint8_t>(esc::reg::kPdiControl);
             if (!p) return fail("0x0140 unreadable", err(p.error()));
-            return expect_eq("PDI control", hex(*p, 2), hex(ctx.sii->word(0) & 0xFF, 2));
+            auto cfg = ctx.rd<uint16_t>(0x0150);
+            if (!cfg) return fail("0x0150 unreadable", err(cfg.error()));
+            return expect_eq("PDI control 0x0140, PDI configuration 0x0150-0x0151",
+                             hex(*p, 2) + ", " + hex(*cfg),
+                             hex(ctx.sii->word(0) & 0xFF, 2) + ", " + hex(ctx.sii->word(1)));
         });
     add("reg.error_counters",
         "Error counters 0x0300-0x0313: cleared by a write; port 0 (the tool's frames), forwarded, processing "

@@ -270,6 +270,16 @@ Outcome op_registers(Context& ctx) {
         got += ", 0x0442 " + dec(*wc);
         want += ", 0x0442 0";
     }
+    // DL status 0x0110 bit 1 (PDI watchdog: 1 reloaded, 0 expired): in OP the application on the PDI reads
+    // and writes the process data SMs every cycle, which reloads it (ESC datasheet 0x0110, 0x0410); a PDI
+    // watchdog time of 0 switches it off.
+    if (auto pdi_wd = ctx.rd<uint16_t>(0x0410); pdi_wd && *pdi_wd && ctx.has_mailbox()) {
+        auto dl = ctx.rd<uint16_t>(esc::reg::kDlStatus);
+        (void)ctx.cycle(1);
+        if (!dl) return fail("DL status 0x0110 unreadable", err(dl.error()));
+        got += std::string(got.empty() ? "" : ", ") + "0x0110 bit 1 " + dec((*dl >> 1) & 1);
+        want += std::string(want.empty() ? "" : ", ") + "0x0110 bit 1 1";
+    }
     return expect_eq("SM/FMMU registers as configured, watchdog status while outputs come", got, want);
 }
 

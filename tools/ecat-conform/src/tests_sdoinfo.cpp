@@ -222,12 +222,19 @@ void add_sdoinfo_tests(Catalogue& c) {
             if (r.error != Error::Ok || r.p.size() < 6) return fail("no answer", r.describe());
             int n = 0;
             uint16_t left = get16(&r.p[4]);
+            // Every fragment is a new mailbox message with the next counter (ETG.1000.4), not the transfer's.
+            uint8_t counter = ctx.mbx->last_rx_counter();
             while (r.p[2] & 0x80) {
                 master::MailboxMessage msg;
                 if (Error e = ctx.mbx->receive(msg, ctx.ms(500)); e != Error::Ok)
                     return fail("fragment " + dec(n + 1) + ": " + err(e));
                 if (msg.payload.size() < 6)
                     return fail("fragment too short", dec(static_cast<long long>(msg.payload.size())));
+                if (msg.counter == 0 || msg.counter == counter)
+                    return fail(
+                        "fragment " + dec(n + 1) + ": mailbox counter of the fragment before it, or 0",
+                        dec(msg.counter), "1..7, not " + dec(counter));
+                counter = msg.counter;
                 r.p.assign(msg.payload.begin(), msg.payload.end());
                 const uint16_t now = get16(&r.p[4]);
                 if (now + 1 != left) return fail("fragments left", dec(now), dec(left - 1));
@@ -381,6 +388,36 @@ void add_sdoinfo_tests(Catalogue& c) {
             return pass();
         },
         a, Severity::Warning);
+    add(
+        "names.visible",
+        "Object and entry description names: visible characters only (no terminator, no control character)",
+        "ETG.1000.6 SDO information object/entry description: the name (VISIBLE_STRING) is the rest of the "
+        "message",
+        [](Context& ctx) {
+            CONFORM_INFO(ctx);
+            // A name whose length comes from the mailbox length: a C terminator or padding sent with it, or a
+            // length that runs past the name, shows as NUL or control characters a master puts on screen.
+            auto control = [](const std::string& n) {
+                return std::any_of(n.begin(), n.end(), [](char ch) {
+                    const auto u = static_cast<unsigned char>(ch);
+                    return u < 0x20 || u == 0x7F;
+                });
+            };
+            auto shown = [](const std::string& n) {
+                return bytes_hex(
+                    std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(n.data()), n.size()), 48);
+            };
+            for (const auto& [i, d] : info.objects)
+                if (control(d.name))
+                    return fail(hex(i) + " object name holds a control character", shown(d.name),
+                                "visible characters");
+            for (const auto& [k, d] : info.entries)
+                if (control(d.name))
+                    return fail(hex(k.first) + ":" + dec(k.second) + " entry name holds a control character",
+                                shown(d.name), "visible characters");
+            return pass(dec(static_cast<long long>(info.objects.size() + info.entries.size())) + " names");
+        },
+        a);
     add(
         "entry.default", "Entry descriptions: default value (value info 0x10) as the ESI's DefaultData",
         kInfo,

@@ -21,6 +21,7 @@ std::string esi_sm(const EsiSm& s) {
 struct SiiPdo {
     uint16_t index = 0;
     uint8_t sm = 0;
+    uint16_t flags = 0;                // ETG.2010 PDO flags (bytes 6-7)
     std::vector<std::string> entries;  // "idx:sub/bits"
 };
 
@@ -32,6 +33,7 @@ std::string parse_pdos(std::span<const uint8_t> d, std::vector<SiiPdo>& out) {
         pdo.index = get16(&d[p]);
         const uint8_t n = d[p + 2];
         pdo.sm = d[p + 3];
+        pdo.flags = get16(&d[p + 6]);
         p += 8;
         if (p + 8u * n > d.size())
             return "PDO " + hex(pdo.index) + " announces " + dec(n) + " entries past the category end";
@@ -117,6 +119,15 @@ Outcome pdo_vs_esi(Context& ctx, uint16_t type) {
         // attribute); 0xFF (not assigned) is left alone.
         if (at->second->sm >= 0 && p.sm != 0xFF && p.sm != at->second->sm)
             return fail("PDO " + hex(p.index) + " SyncManager", dec(p.sm), dec(at->second->sm) + " (ESI Sm)");
+        // The flags a master acts on (ETG.2010 PDO flags): PdoMandatory and PdoFixedContent as the ESI's
+        // Mandatory and Fixed attributes (a fixed PDO is not remapped, a mandatory one is always assigned).
+        const uint16_t mask = esc::sii::pdo_flags::Mandatory | esc::sii::pdo_flags::FixedContent;
+        const uint16_t want =
+            static_cast<uint16_t>((at->second->mandatory ? esc::sii::pdo_flags::Mandatory : 0) |
+                                  (at->second->fixed ? esc::sii::pdo_flags::FixedContent : 0));
+        if ((p.flags & mask) != want)
+            return fail("PDO " + hex(p.index) + " flags (bit 0 PdoMandatory, bit 4 PdoFixedContent)",
+                        hex(p.flags & mask), hex(want) + " (ESI Mandatory/Fixed)");
     }
     int optional_left_out = 0;
     for (const auto& p : esi) {
@@ -503,6 +514,37 @@ void add_sii_tests(Catalogue& c) {
             return expect_eq("CoE details", hex(b & 0x3F, 2), hex(want, 2));
         },
         "ESI has CoE");
+    add("general.ports_flags",
+        "General category: physical ports as the ESC's port descriptor 0x0007 (port 0 in use), flag 'not "
+        "LRW' "
+        "only where 0x0008 says LRW is not supported",
+        "ETG.2010 SII General category (bytes 11, 16-17); ESC datasheet 0x0007, 0x0008 bit 9",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            const SiiCategory* g = ctx.sii->find(kGeneral);
+            if (!g || g->length < 18) return skip("no General category of 18 bytes or more");
+            const uint8_t* b = &ctx.sii->bytes[g->offset];
+            const uint16_t ports = get16(b + 16);
+            auto desc = ctx.rd<uint8_t>(0x0007);
+            auto features = ctx.rd<uint16_t>(0x0008);
+            if (!desc || !features) return fail("0x0007/0x0008 unreadable");
+            // ETG.2010 physical port (4 bits a port): 0 not used, 1 MII, 3 EBUS, 4 fast hot connect; 0x0007
+            // two bits a port, 00 not implemented. A port 0 (where the frames come in) not used, or a port
+            // the SII uses that the ESC does not implement, is a description the line does not have.
+            std::string bad;
+            if (ports && !(ports & 0x000F)) bad = "port 0 'not used', yet the frames come in there";
+            for (int p = 0; p < 4 && bad.empty(); ++p)
+                if (((ports >> (4 * p)) & 0x0F) && !((*desc >> (2 * p)) & 3))
+                    bad = "port " + dec(p) + " in use, yet 0x0007 says not implemented";
+            if (bad.empty() && (b[11] & 0x02) && !(*features & 0x0200))
+                bad = "flag 'not LRW' (byte 11 bit 1), yet 0x0008 bit 9 clear (LRW supported)";
+            if (!bad.empty())
+                return fail(bad,
+                            "ports " + hex(ports) + ", flags " + hex(b[11], 2) + " (0x0007 " + hex(*desc, 2) +
+                                ", 0x0008 " + hex(*features) + ")",
+                            "as the ESC");
+            return pass("ports " + hex(ports) + ", flags " + hex(b[11], 2));
+        });
     add(
         "esi.foe_details", "General FoE details (byte 6) match the ESI's FoE element", kSiiEsi,
         [](Context& ctx) {
