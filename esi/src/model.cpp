@@ -120,6 +120,7 @@ DeviceModel derive_model(const od::DeviceDescription& d, const od::Dictionary& d
             continue;
         }
         found->mandatory = found->mandatory || rule.mandatory;
+        if (rule.fixed) found->fixed = *rule.fixed;
         for (uint16_t x : rule.exclude) {
             bool known = false;
             for (const auto& p : m.pdos)

@@ -215,7 +215,7 @@ TEST_F(DrivePdoRules, TxPdosFollowTheSameRule) {
 class MandatoryPdoRules : public DrivePdoRules {
   protected:
     void SetUp() override {
-        desc.pdo_rules = {od::PdoRule{0x1A00, true, {}}};
+        desc.pdo_rules = {od::PdoRule{0x1A00, true, {}, std::nullopt}};
         coe::install_pdo_validators(dict, {}, desc.pdo_rules);
     }
 };

@@ -1226,6 +1226,65 @@ TEST(EsiDevices, BitFieldEnumsAndCompactPdoEntriesAreMappedAsTheFileSays) {
     EXPECT_TRUE(q.make_dictionary(q.description).find(0xF100, 0x11)->mappable_with(16));
 }
 
+// Fixed, as the SII's PdoFixedContent flag and the written ESI state it, is what each PDO element declares:
+// a vendor's dictionary may declare a PDO's mapping object read-only (EL66xx, CX, AX5000 do, for Mandatory
+// Virtual PDOs) while the element is not Fixed; the devices' EEPROMs follow the element. The mapping object
+// stays as read-only as the dictionary says.
+TEST(EsiDevices, APdosFixedFlagIsWhatItsElementDeclares) {
+    auto mapping = [](const char* index, const char* access) {
+        return std::string("<Object><Index>") + index +
+               "</Index><Name>TxPDO map</Name><Type>DT1A00</Type><BitSize>48</BitSize><Info>"
+               "<SubItem><Name>SubIndex 000</Name><Info><DefaultValue>1</DefaultValue></Info></SubItem>"
+               "<SubItem><Name>SubIndex "
+               "001</Name><Info><DefaultValue>#x60000010</DefaultValue></Info></SubItem>"
+               "</Info><Flags><Access>" +
+               access + "</Access></Flags></Object>";
+    };
+    auto tx = [](const char* attrs, const char* index) {
+        return std::string("<TxPdo ") + attrs + " Sm=\"3\"><Index>" + index +
+               "</Index><Name>In</Name><Entry><Index>#x6000</Index><SubIndex>0</SubIndex><BitLen>16</BitLen>"
+               "<Name>In</Name><DataType>UINT</DataType></Entry></TxPdo>";
+    };
+    const std::string xml =
+        "<?xml version=\"1.0\"?><EtherCATInfo><Vendor><Id>#x123</Id><Name>V</Name></Vendor><Descriptions>"
+        "<Devices><Device><Type ProductCode=\"#x79\" RevisionNo=\"#x1\">T79</Type><Name>T 79</Name>"
+        "<Profile><ProfileNo>5001</ProfileNo><Dictionary><DataTypes>"
+        "<DataType><Name>UINT</Name><BitSize>16</BitSize></DataType>"
+        "<DataType><Name>USINT</Name><BitSize>8</BitSize></DataType>"
+        "<DataType><Name>UDINT</Name><BitSize>32</BitSize></DataType>"
+        "<DataType><Name>DT1A00</Name><BitSize>48</BitSize>"
+        "<SubItem><SubIdx>0</SubIdx><Name>SubIndex 000</Name><Type>USINT</Type><BitSize>8</BitSize>"
+        "<BitOffs>0</BitOffs><Flags><Access>ro</Access></Flags></SubItem>"
+        "<SubItem><SubIdx>1</SubIdx><Name>SubIndex 001</Name><Type>UDINT</Type><BitSize>32</BitSize>"
+        "<BitOffs>16</BitOffs><Flags><Access>ro</Access></Flags></SubItem></DataType></DataTypes><Objects>"
+        "<Object><Index>#x6000</Index><Name>In</Name><Type>UINT</Type><BitSize>16</BitSize>"
+        "<Flags><Access>ro</Access><PdoMapping>T</PdoMapping></Flags></Object>" +
+        mapping("#x1A00", "ro") + mapping("#x1A01", "ro") +
+        "</Objects></Dictionary></Profile>"
+        "<Sm DefaultSize=\"128\" StartAddress=\"#x1000\" ControlByte=\"#x26\" Enable=\"1\">MBoxOut</Sm>"
+        "<Sm DefaultSize=\"128\" StartAddress=\"#x1080\" ControlByte=\"#x22\" Enable=\"1\">MBoxIn</Sm>"
+        "<Sm StartAddress=\"#x1100\" ControlByte=\"#x24\" Enable=\"0\">Outputs</Sm>"
+        "<Sm StartAddress=\"#x1180\" ControlByte=\"#x20\" Enable=\"1\">Inputs</Sm>" +
+        tx("Mandatory=\"1\"", "#x1A00") + tx("Fixed=\"1\"", "#x1A01") +
+        "<Mailbox><CoE SdoInfo=\"true\" PdoAssign=\"false\" PdoConfig=\"false\"/></Mailbox>"
+        "<Eeprom><ByteSize>2048</ByteSize><ConfigData>080E00CC88130000</ConfigData></Eeprom>"
+        "</Device></Devices></Descriptions></EtherCATInfo>";
+    const od::Product p = esi::load_product(esi::read_esi_text(xml, "t79.xml"), "");
+    const od::Dictionary d = p.make_dictionary(p.description);
+    EXPECT_FALSE(d.find(0x1A00, 0)->writable(od::AlState::PreOp)) << "read-only as the dictionary says";
+    const esi::DeviceModel m = esi::derive_model(p.description, d);
+    std::map<uint16_t, std::pair<bool, bool>> flags;  // fixed, mandatory
+    for (const esi::PdoInfo& pdo : m.pdos)
+        flags[pdo.index] = {pdo.fixed, pdo.mandatory};
+    EXPECT_EQ(flags[0x1A00], std::make_pair(false, true)) << "not Fixed, Mandatory: as the element";
+    EXPECT_EQ(flags[0x1A01], std::make_pair(true, false));
+    std::string written;
+    const od::Product q = round_trip(p, &written);
+    EXPECT_NE(written.find("<TxPdo Mandatory=\"1\""), std::string::npos) << written;
+    EXPECT_EQ(written.find("Fixed=\"1\" Mandatory"), std::string::npos) << written;
+    expect_same(describe(p), describe(q), "round trip");
+}
+
 // A vendor's diagnosis texts (ETG.2000 Profile/DiagMessages) are the device's: read into its description with
 // the vendor's text ids, the English text of several languages, the class where given; written back by
 // --write-esi as they were, valid against the schema, and a fixed point of the round trip.

@@ -1142,8 +1142,7 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
 
     // ---- PDO rules and sets ----
     for (const Pdo& p : pdos)
-        if (p.esi->mandatory || !p.esi->exclude.empty())
-            desc.pdo_rules.push_back(od::PdoRule{p.index, p.esi->mandatory, p.esi->exclude});
+        desc.pdo_rules.push_back(od::PdoRule{p.index, p.esi->mandatory, p.esi->exclude, p.esi->fixed});
 
     // ---- The assignment objects 0x1C10 + n of the process-data SMs, defaults from the PDOs' Sm ----
     const bool assignable = coe && d.coe.pdo_assign;

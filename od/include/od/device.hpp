@@ -3,6 +3,7 @@
 // supported protocols, DC modes. Declared once here; the SII image and the ESI file (esi/), the state
 // machine's checks (ecat/) and object 0x1018 all read it.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -70,13 +71,17 @@ struct SyncManagerDefault {
 };
 
 // What the ESI says about one PDO besides its mapping (ETG.2000 RxPdo/TxPdo): Mandatory (the master must
-// assign it to its SyncManager) and Exclude (PDOs that must not be assigned together with it). Fixed comes
-// from the mapping object's access (not writable in any state). The SDO server refuses a 0x1C12/0x1C13
-// assignment that breaks these (coe::install_pdo_validators), so the ESI and the slave cannot disagree.
+// assign it to its SyncManager) and Exclude (PDOs that must not be assigned together with it). The SDO server
+// refuses a 0x1C12/0x1C13 assignment that breaks these (coe::install_pdo_validators), so the ESI and the
+// slave cannot disagree. Fixed, as the SII's PdoFixedContent flag and the written ESI state it: as the PDO
+// element declares it where there is one (a vendor's ESI may declare a mapping object read-only in its
+// dictionary and the PDO not Fixed; its devices' EEPROMs follow the element), else from the mapping object's
+// access (not writable in any state).
 struct PdoRule {
     uint16_t pdo = 0;  // 0x1600.. / 0x1A00..
     bool mandatory = false;
     std::vector<uint16_t> exclude;
+    std::optional<bool> fixed;  // declared by a PDO element; unset: from the mapping object's access
 };
 
 // A predefined PDO set a configuration tool offers (ESI Info/VendorSpecific/TwinCAT/AlternativeSmMapping, as
