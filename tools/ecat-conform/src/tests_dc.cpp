@@ -70,7 +70,8 @@ std::string need_writable(const Context& ctx, uint16_t index, uint8_t sub) {
 
 // What 0x1C32/0x1C33 say while the slave runs synchronised (ETG.1020): the minimum cycle time (:05) is no
 // more than the cycle it runs at (:02), and the sync error (:20) is not set without a cause the slave counts
-// (SM event missed :0B, cycle time too small :0C). Subindices the device does not have are left out.
+// (SM event missed :0B, cycle time too small :0C), where it has both counters. Subindices the device does
+// not have are left out.
 std::string sync_objects_running(Context& ctx) {
     std::string problems;
     for (uint16_t index : {uint16_t{0x1C32}, uint16_t{0x1C33}}) {
@@ -85,7 +86,9 @@ std::string sync_objects_running(Context& ctx) {
         if (!error || !*error) continue;
         auto missed = ctx.upload_uint(index, 0x0B);
         auto small = ctx.upload_uint(index, 0x0C);
-        if (!missed && !small) continue;  // a device without the counters has no way to show the cause
+        // Either cause may set the flag (ETG.1020: SM events missed, cycle time too small); judged only where
+        // the device has a counter for each, or the cause may be one it cannot count.
+        if (!missed || !small) continue;
         if ((!missed || !*missed) && (!small || !*small))
             problems +=
                 o + ":20 sync error set, yet no SM event missed (:0B) or cycle too small (:0C) counted; ";
