@@ -179,10 +179,7 @@ void StateMachine::request_checked(AlState to, uint64_t now_ns) {
 }
 
 bool StateMachine::device_emulation() const {
-    // ESC configuration 0x0141 bit 0 (from SII word 0): the ESC copies AL control into AL status itself
-    // (ESC datasheet, AL status; the ConfigData of IO terminals without a controller). Such a device has no
-    // state machine of its own that could refuse a request.
-    return (ctx_.pdi.read_reg<uint8_t>(esc::reg::kEscConfig) & 0x01) != 0;
+    return ecat::device_emulation(ctx_.pdi);
 }
 
 void StateMachine::follow(AlState to, uint64_t now_ns) {

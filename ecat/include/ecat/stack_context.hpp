@@ -145,13 +145,18 @@ inline void set_sm_pdi_deactivated(esc::Pdi& pdi, unsigned n, bool deactivated) 
     pdi.write_reg<uint8_t>(esc::reg::sm_base(n) + esc::reg::kSmPdiControl, v);
 }
 
+// ESC configuration 0x0141 bit 0, device emulation (loaded from SII word 0): the ESC copies AL control into
+// AL status itself (ESC datasheet, AL status; the ConfigData of IO terminals without a controller). Such a
+// device has no state machine of its own that could refuse a request.
+inline bool device_emulation(esc::Pdi& pdi) {
+    return (pdi.read_reg<uint8_t>(esc::reg::kEscConfig) & 0x01) != 0;
+}
+
 // Holds SM n off from the PDI side until its state starts it (Init, an ESC reset, the way back from Safe-Op).
-// A device whose ESC follows the master's AL control by itself (device emulation, ESC configuration 0x0141
-// bit 0: the IO terminals without a controller) has nobody who would hold it: its SMs run as soon as the
-// master enables them, in the state the ESC already reports, whenever the stack behind gets to look.
+// A device with device emulation has nobody who would hold it: its SMs run as soon as the master enables
+// them, in the state the ESC already reports, whenever the stack behind gets to look.
 inline void hold_sm_until_started(esc::Pdi& pdi, unsigned n) {
-    const bool device_emulation = (pdi.read_reg<uint8_t>(esc::reg::kEscConfig) & 0x01) != 0;
-    set_sm_pdi_deactivated(pdi, n, !device_emulation);
+    set_sm_pdi_deactivated(pdi, n, !device_emulation(pdi));
 }
 
 }  // namespace ecat

@@ -21,6 +21,11 @@
 
 namespace conform {
 
+// How long (scaled by --timeout-scale) a slave that stopped answering is waited for before it is called lost:
+// between two tests, and in each read of the set-up. A busy host may deschedule the slave (or this tool) for
+// a few hundred milliseconds; a slave that is gone is still reported within it.
+inline constexpr int kAnswerGraceMs = 1000;
+
 // The ESI reader is the project's one od-free reader (esi/esi_reader.hpp, target esi_reader).
 using esi::esi_basic_bits;
 using esi::esi_coe_type;

@@ -239,11 +239,11 @@ std::vector<std::optional<uint32_t>> Context::modules_of(const EsiFile& f, const
 }
 
 std::string Context::setup() {
-    // A read of the set-up that goes unanswered is tried again for up to a second (scaled): a host that
-    // stalls the slave for a moment (a busy machine descheduling it) must not leave the run without the SII,
-    // the station addresses or the ESC configuration, every later test skipped or judged on the wrong
-    // mailbox. A slave that stays silent is reported after that second, as before.
-    const auto patience_end = Clock::now() + ms(1000);
+    // A read of the set-up that goes unanswered is tried again for up to kAnswerGraceMs (scaled): a host that
+    // stalls the slave for a moment must not leave the run without the SII, the station addresses or the ESC
+    // configuration, every later test skipped or judged on the wrong mailbox. A slave that stays silent is
+    // reported after that, as before.
+    const auto patience_end = Clock::now() + ms(kAnswerGraceMs);
     bool repeated = false;
     auto patient = [&](auto read) {
         auto r = read();

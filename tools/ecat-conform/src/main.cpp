@@ -55,8 +55,6 @@ bool selected(const conform::TestCase& t, const std::set<std::string>& groups, c
 // hold every finished test and the running one marked as interrupted (written before it started); the
 // handler only ends the text report with a prepared line and exits.
 constexpr int kExitStopped = 3;
-// How long (scaled by --timeout-scale) a slave that stopped answering is waited for before it is called lost.
-constexpr int kAnswerGraceMs = 1000;
 char g_stop_line[512] = "\nstopped\n";
 volatile std::sig_atomic_t g_stop_len = 9;
 
@@ -366,7 +364,7 @@ int main(int argc, char** argv) {
             // busy host may deschedule the slave (or this tool) for a few hundred milliseconds, and a
             // conformance verdict must not depend on that; a slave that is gone is still reported within it.
             const auto answer_grace =
-                std::chrono::milliseconds(static_cast<long>(kAnswerGraceMs * o.timeout_scale));
+                std::chrono::milliseconds(static_cast<long>(conform::kAnswerGraceMs * o.timeout_scale));
             // Waits (up to answer_grace) until the slave answers at its station address again, giving it its
             // address again when it lost it (reset); returns how long it did not answer, or nothing.
             auto answers_again = [&]() -> std::optional<std::chrono::milliseconds> {

@@ -55,13 +55,8 @@ Error SdoClient::prepare() {
 
 void SdoClient::take_stale() {
     // What the slave put in its out-mailbox since the last transfer: emergencies (kept as ever) and the late
-    // answers of transfers given up on. Bounded: a slave that keeps SM1 full is the transfer's problem.
-    constexpr int kMaxWaiting = 8;
-    MailboxMessage msg;
-    for (int i = 0; i < kMaxWaiting; ++i) {
-        if (mbx_.receive(msg, std::chrono::milliseconds(0)) != Error::Ok) return;
-        if (!take_emergency(msg)) ++stale_answers_;
-    }
+    // answers of transfers given up on (counted).
+    stale_answers_ += mbx_.drain([this](const MailboxMessage& msg) { return take_emergency(msg); });
 }
 
 bool SdoClient::take_emergency(const MailboxMessage& msg) {

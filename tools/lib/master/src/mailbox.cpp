@@ -188,12 +188,15 @@ Error Mailbox::receive(MailboxMessage& message, std::chrono::milliseconds timeou
     }
 }
 
-void Mailbox::drain() {
-    if (!config_.valid()) return;
-    bool got = false;
-    for (int i = 0; i < 8; ++i) {
-        if (read_sm1(got) != Error::Ok || !got) return;
+std::size_t Mailbox::drain(const std::function<bool(const MailboxMessage&)>& keep) {
+    constexpr int kMaxWaiting = 8;
+    std::size_t dropped = 0;
+    MailboxMessage msg;
+    for (int i = 0; i < kMaxWaiting; ++i) {
+        if (receive(msg, std::chrono::milliseconds(0)) != Error::Ok) break;
+        if (!keep || !keep(msg)) ++dropped;
     }
+    return dropped;
 }
 
 }  // namespace master

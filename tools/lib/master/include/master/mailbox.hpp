@@ -5,6 +5,7 @@
 // lost. Buffers are allocated once, at configure(); send/receive allocate nothing.
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -61,8 +62,11 @@ class Mailbox {
     // Waits for one message from SM1. A mailbox error reply (type 0) is returned as a message too.
     Error receive(MailboxMessage& message);
     Error receive(MailboxMessage& message, std::chrono::milliseconds timeout);
-    // Reads and drops whatever waits in SM1 (a reply left over from an earlier, abandoned exchange).
-    void drain();
+    // Reads SM1 empty before an exchange: what waits there is a late answer of an exchange given up on, or
+    // a message the slave sent by itself (an emergency). `keep` is offered each message and returns true for
+    // one its owner takes; the others are dropped and counted (the return value). Bounded: a slave that keeps
+    // SM1 full is the next exchange's problem.
+    std::size_t drain(const std::function<bool(const MailboxMessage&)>& keep = {});
 
     std::chrono::milliseconds timeout() const { return timeout_; }
     void set_timeout(std::chrono::milliseconds t) { timeout_ = t; }
