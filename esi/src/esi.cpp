@@ -610,6 +610,8 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
     attr(type, "RevisionNo", hex32(id.revision));
     named(device, "Name", id.device_name);
     xmlNodePtr info = child(device, "Info");
+    if (d.ebus_current_ma != 0)
+        child(child(info, "Electrical"), "EBusCurrent", std::to_string(d.ebus_current_ma));
     if (d.mailbox_request_timeout_ms != 0 || d.mailbox_response_timeout_ms != 0) {
         xmlNodePtr timeout = child(child(info, "Mailbox"), "Timeout");
         child(timeout, "RequestTimeout", std::to_string(d.mailbox_request_timeout_ms));
@@ -635,7 +637,9 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
             }
         }
     }
-    if (kIdentificationInAlStatusCode) child(info, "IdentificationReg134", "true");
+    if (d.identification_register != 0)
+        child(info, "IdentificationAdo", hex_index(d.identification_register));
+    if (d.identification_al_status) child(info, "IdentificationReg134", "true");
     child(device, "GroupType", id.group_type);
 
     if (!dict.objects().empty() || !d.diag_messages.empty()) {  // a coupler has no dictionary
@@ -669,7 +673,7 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
         namespace mp = od::mailbox_protocol;
         namespace cd = od::coe_details;
         xmlNodePtr mbx = child(device, "Mailbox");
-        if (kMailboxDataLinkLayer) attr(mbx, "DataLinkLayer", "true");
+        if (d.mailbox_data_link_layer) attr(mbx, "DataLinkLayer", "true");
         if (d.mailbox_protocols & mp::AoE) child(mbx, "AoE");
         if (d.mailbox_protocols & mp::EoE) child(mbx, "EoE");
         if (d.mailbox_protocols & mp::CoE) {

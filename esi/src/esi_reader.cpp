@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
@@ -371,6 +372,12 @@ EsiDevice read_device(Node dev, const TypeMap& types_in, uint32_t vendor, const 
     if (auto g = group_names.find(d.group_type); g != group_names.end()) d.group_name = g->second;
     Node info = child(dev, "Info");
     d.identification_reg134 = truthy(text(info, "IdentificationReg134"));
+    if (Node ado = child(info, "IdentificationAdo"))
+        if (auto v = parse_esi_number(text(ado)); v && *v > 0 && *v <= 0xFFFF)
+            d.identification_ado = static_cast<uint16_t>(*v);
+    if (Node ebus = child(child(info, "Electrical"), "EBusCurrent"))
+        if (auto v = parse_esi_number(text(ebus)); v && *v >= INT16_MIN && *v <= INT16_MAX)
+            d.ebus_current_ma = static_cast<int32_t>(*v);
     for (Node alt : children(child(child(info, "VendorSpecific"), "TwinCAT"), "AlternativeSmMapping")) {
         EsiPdoSet set;
         set.name = name_text(alt);

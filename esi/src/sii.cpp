@@ -92,10 +92,14 @@ std::vector<uint8_t> build_content(const od::DeviceDescription& d, const DeviceM
         general[6] = static_cast<uint8_t>(d.foe_details | 0x01);
     if (d.mailbox_protocols & od::mailbox_protocol::EoE) general[7] = 0x01;
     general[9] = m.profile_number == 402 ? 1 : 0;  // DS402 channels
-    general[11] = kGeneralFlags;
+    general[11] = general_flags(d);
+    general[12] = static_cast<uint8_t>(static_cast<uint16_t>(d.ebus_current_ma));
+    general[13] = static_cast<uint8_t>(static_cast<uint16_t>(d.ebus_current_ma) >> 8);
     general[14] = group_idx;
     general[16] = static_cast<uint8_t>(kPhysicalPorts);
     general[17] = static_cast<uint8_t>(kPhysicalPorts >> 8);
+    general[18] = static_cast<uint8_t>(d.identification_register);
+    general[19] = static_cast<uint8_t>(d.identification_register >> 8);
 
     // ---- FMMU ----
     std::vector<uint8_t> fmmu;

@@ -851,6 +851,11 @@ UNSEEN = {
                        sii_cat_byte(41, 2 * 8 + 7, lambda b: 4 if b == 3 else b)),
     "sii-general-ca-bit": _m("ETG.2010 SII General category CoE details bit 5 (complete access) as the ESI",
                              sii_cat_byte(30, 5, lambda b: b & ~0x20)),
+    "sii-general-dll-flag": _m("ETG.2010 SII General category flags bit 2 (mailbox data link layer) as the "
+                               "ESI's Mailbox DataLinkLayer", sii_cat_byte(30, 11, lambda b: b & ~0x04)),
+    "sii-general-ident-flag": _m("ETG.2010 SII General category flags bit 3 (identification in AL status "
+                                 "code) as the ESI's IdentificationReg134",
+                                 sii_cat_byte(30, 11, lambda b: b & ~0x08)),
     "sii-txpdo-bitlen": _m("ETG.2010 SII TxPDO category: entry bit length as the ESI",
                            sii_cat_byte(50, 8 + 5, lambda b: b + 8)),
     # -- PDO objects --

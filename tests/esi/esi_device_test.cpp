@@ -112,6 +112,8 @@ std::vector<std::string> describe(const od::Product& p) {
     add("protocols", d.mailbox_protocols, "coe", int{d.coe_details}, "timeouts", d.mailbox_request_timeout_ms,
         d.mailbox_response_timeout_ms);
     add("config", int{d.pdi_control}, int{d.esc_config}, d.pdi_config, d.sync_pulse_length, d.station_alias);
+    add("general", d.mailbox_data_link_layer, d.identification_al_status, d.identification_register,
+        d.ebus_current_ma);
     add("application", int(p.application), "profile", m.profile_number, m.profile_add_info);
     for (const esi::SmInfo& sm : m.sync_managers)
         add("sm", int(sm.kind), sm.start, sm.size, int{sm.control}, sm.enable, sm.min_size, sm.max_size);
@@ -1283,6 +1285,61 @@ TEST(EsiDevices, APdosFixedFlagIsWhatItsElementDeclares) {
     EXPECT_NE(written.find("<TxPdo Mandatory=\"1\""), std::string::npos) << written;
     EXPECT_EQ(written.find("Fixed=\"1\" Mandatory"), std::string::npos) << written;
     expect_same(describe(p), describe(q), "round trip");
+}
+
+// What the SII General category says of the device besides its mailbox protocols is what its ESI declares,
+// field by field, in both values: the mailbox data link layer (flags bit 2, Mailbox DataLinkLayer), the
+// identification in AL status code (bit 3, Info/IdentificationReg134), the identification register (bit 4 and
+// bytes 18-19, Info/IdentificationAdo) and the E-Bus current (bytes 12-13, Info/Electrical/EBusCurrent);
+// --write-esi writes each back.
+TEST(EsiDevices, TheSiiGeneralFieldsAreWhatTheEsiDeclares) {
+    struct Case {
+        const char* info;
+        const char* mailbox;
+        uint8_t flags;
+        uint16_t ident_register;
+        int16_t ebus;
+    };
+    const Case cases[] = {
+        {"", "<Mailbox><CoE/></Mailbox>", 0x00, 0, 0},
+        {"", "<Mailbox DataLinkLayer=\"true\"><CoE/></Mailbox>", 0x04, 0, 0},
+        {"<IdentificationReg134>true</IdentificationReg134>", "<Mailbox DataLinkLayer=\"1\"><CoE/></Mailbox>",
+         0x0C, 0, 0},
+        {"<Electrical><EBusCurrent>130</EBusCurrent></Electrical><IdentificationAdo>#x0012</"
+         "IdentificationAdo>",
+         "<Mailbox><CoE/></Mailbox>", 0x10, 0x0012, 130},
+        {"<Electrical><EBusCurrent>-2000</EBusCurrent></Electrical>"
+         "<IdentificationAdo>18</IdentificationAdo><IdentificationReg134>1</IdentificationReg134>",
+         "", 0x18, 0x0012, -2000},  // a coupler feeding the E-Bus, without mailbox
+    };
+    for (const Case& c : cases) {
+        const bool mbx = *c.mailbox != '\0';
+        const std::string xml =
+            std::string(
+                "<?xml version=\"1.0\"?><EtherCATInfo><Vendor><Id>#x123</Id><Name>V</Name></Vendor>"
+                "<Descriptions><Devices><Device Physics=\"YY\"><Type ProductCode=\"#x7A\" "
+                "RevisionNo=\"#x1\">T7A</Type><Name>T 7A</Name><Info>") +
+            c.info + "</Info>" +
+            (mbx ? "<Sm DefaultSize=\"128\" StartAddress=\"#x1000\" ControlByte=\"#x26\" "
+                   "Enable=\"1\">MBoxOut</Sm>"
+                   "<Sm DefaultSize=\"128\" StartAddress=\"#x1080\" ControlByte=\"#x22\" "
+                   "Enable=\"1\">MBoxIn</Sm>"
+                 : "") +
+            c.mailbox +
+            "<Eeprom><ByteSize>2048</ByteSize><ConfigData>080E00CC88130000</ConfigData></Eeprom>"
+            "</Device></Devices></Descriptions></EtherCATInfo>";
+        SCOPED_TRACE(std::string(c.info) + " " + c.mailbox);
+        const od::Product p = esi::load_product(esi::read_esi_text(xml, "t7a.xml"), "");
+        const od::Dictionary d = p.make_dictionary(p.description);
+        const esi::SiiInfo sii = esi::parse_sii(esi::build_sii(p.description, d));
+        ASSERT_TRUE(sii.general.has_value());
+        EXPECT_EQ(sii.general->flags & 0x1C, c.flags);
+        EXPECT_EQ(sii.general->physical_memory_address, c.ident_register);
+        EXPECT_EQ(sii.general->ebus_current_ma, c.ebus);
+        std::string written;
+        const od::Product q = round_trip(p, &written);
+        expect_same(describe(p), describe(q), "round trip");
+    }
 }
 
 // A vendor's diagnosis texts (ETG.2000 Profile/DiagMessages) are the device's: read into its description with

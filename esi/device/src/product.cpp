@@ -729,6 +729,10 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
     }
     desc.mailbox_request_timeout_ms = d.mailbox_request_timeout_ms.value_or(0);
     desc.mailbox_response_timeout_ms = d.mailbox_response_timeout_ms.value_or(0);
+    desc.mailbox_data_link_layer = d.has_mailbox && d.mailbox_data_link_layer;
+    desc.identification_al_status = d.identification_reg134;
+    desc.identification_register = d.identification_ado.value_or(0);
+    desc.ebus_current_ma = static_cast<int16_t>(d.ebus_current_ma.value_or(0));
 
     // ---- The PDOs: the device's own and those of the module of each slot (its default, or as chosen) ----
     std::vector<Pdo> pdos;

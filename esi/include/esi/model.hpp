@@ -64,16 +64,17 @@ enum class FmmuUse : uint8_t { Unused = 0x00, Outputs = 0x01, Inputs = 0x02, MBo
 // Physical ports: two MII ports (as the MAXPOS, and as esc::EscConfig's 0x0007 default 0x0F).
 constexpr uint16_t kPhysicalPorts = 0x0011;  // SII General bytes 16-17: 4 bits per port, 1 = MII
 constexpr const char* kPhysics = "YY";       // ESI Device Physics
-// Mailbox data link layer: ecat/ serves the SM1 repeat request and drops a repeated request with the same
-// non-zero counter (ecat/src/mailbox.cpp). SII General flags bit 2, ESI Mailbox DataLinkLayer.
-constexpr bool kMailboxDataLinkLayer = true;
-// Device identification in AL status code 0x0134 on AL control bit 5 (ecat/src/stack.cpp).
-// SII General flags bit 3 (IdentALSts), ESI Info/IdentificationReg134.
-constexpr bool kIdentificationInAlStatusCode = true;
 // Segmented SDO transfers (coe/src/sdo_server.cpp, both directions). ESI Mailbox/CoE SegmentedSdo.
 constexpr bool kSegmentedSdo = true;
-constexpr uint8_t kGeneralFlags =
-    (kMailboxDataLinkLayer ? 0x04 : 0) | (kIdentificationInAlStatusCode ? 0x08 : 0);
+// SII General flags (ETG.2010, byte 11) as the description announces them: bit 2 mailbox data link layer
+// (ecat/ serves the SM1 repeat request and drops a repeated request with the same non-zero counter for every
+// device), bit 3 identification in AL status code 0x0134 on AL control bit 5 (ecat/src/stack.cpp), bit 4
+// identification in the ESC register of bytes 18-19.
+inline uint8_t general_flags(const od::DeviceDescription& d) {
+    return static_cast<uint8_t>((d.mailbox_protocols != 0 && d.mailbox_data_link_layer ? 0x04 : 0) |
+                                (d.identification_al_status ? 0x08 : 0) |
+                                (d.identification_register != 0 ? 0x10 : 0));
+}
 
 struct DeviceModel {
     std::vector<PdoInfo>

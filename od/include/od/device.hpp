@@ -205,6 +205,17 @@ struct DeviceDescription {
     // slave may take to take a request out of SM0 and to answer it (0: not declared).
     uint32_t mailbox_request_timeout_ms = 0;
     uint32_t mailbox_response_timeout_ms = 0;
+    // What the SII General category and the ESI say of the device besides its mailbox (ETG.2010 General
+    // flags, ETG.2000 Mailbox/Info): the mailbox data link layer (ESI Mailbox DataLinkLayer, flag bit 2: the
+    // slave serves the SM1 repeat and drops a repeated request), the device identification in AL status
+    // code 0x0134 (Info/IdentificationReg134, bit 3), or in an ESC register (Info/IdentificationAdo, bit 4
+    // and bytes 18-19; 0: none), and the E-Bus current (Info/Electrical/EBusCurrent, mA, bytes 12-13). The
+    // stack itself serves the repeat and the identification in 0x0134 for every device; the description says
+    // what the device announces, as its vendor's EEPROM does.
+    bool mailbox_data_link_layer = true;
+    bool identification_al_status = true;
+    uint16_t identification_register = 0;
+    int16_t ebus_current_ma = 0;
     // A modular device (empty: not modular). The PDOs of the slots' default modules are in the dictionary.
     std::vector<Slot> slots;
     std::vector<Module> modules;

@@ -556,6 +556,36 @@ void add_sii_tests(Catalogue& c) {
         },
         "ESI given");
     add(
+        "esi.general", "General flags, identification register and E-Bus current match the ESI", kSiiEsi,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_NEED(ctx.need_sii());
+            const SiiCategory* g = ctx.sii->find(kGeneral);
+            if (!g || g->length < 20) return skip("no General category of 20 bytes or more");
+            const uint8_t* b = &ctx.sii->bytes[g->offset];
+            const auto& e = *ctx.esi;
+            // ETG.2010 General byte 11: bit 2 mailbox data link layer (ESI Mailbox DataLinkLayer), bit 3
+            // identification in AL status code (Info/IdentificationReg134), bit 4 identification in the ESC
+            // register of bytes 18-19 (Info/IdentificationAdo). A master configured from the ESI and one
+            // that reads the SII must find the same device: each field the ESI declares, both ways.
+            const uint8_t want_flags = static_cast<uint8_t>(
+                (e.has_mailbox && e.mailbox_data_link_layer ? 0x04 : 0) |
+                (e.identification_reg134 ? 0x08 : 0) | (e.identification_ado ? 0x10 : 0));
+            std::string got = "flags " + hex(b[11] & 0x1C, 2);
+            std::string want = "flags " + hex(want_flags, 2);
+            if (e.identification_ado) {
+                got += ", identification register " + hex(get16(b + 18));
+                want += ", identification register " + hex(*e.identification_ado);
+            }
+            if (e.ebus_current_ma) {
+                got += ", E-Bus current " + std::to_string(static_cast<int16_t>(get16(b + 12))) + " mA";
+                want += ", E-Bus current " + std::to_string(*e.ebus_current_ma) + " mA";
+            }
+            return expect_eq("General (bits 2 DataLinkLayer, 3 IdentificationReg134, 4 IdentificationAdo)",
+                             got, want);
+        },
+        "ESI given");
+    add(
         "esi.names", "General category order number and name equal the ESI's Type and Name", kSiiEsi,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_esi());

@@ -220,6 +220,10 @@ struct EsiDevice {
     int line = 0;  // of the Device element
     int eeprom_line = 0;
     bool identification_reg134 = false;
+    // Info/IdentificationAdo: the ESC register that holds the device identification (a master reads it
+    // there; SII General flag IdentPhyM and bytes 18-19).
+    std::optional<uint16_t> identification_ado;
+    std::optional<int32_t> ebus_current_ma;     // Info/Electrical/EBusCurrent (negative: the device feeds)
     std::vector<EsiDiagMessage> diag_messages;  // Profile/DiagMessages, in file order
     std::vector<uint8_t> image16x14;            // ImageData16x14, empty if none
 
