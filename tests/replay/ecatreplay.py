@@ -62,6 +62,9 @@ TIMING_BITS = {
 }
 SETTLE_S = 2.0  # how far (in recording time) an answer may come ahead of or behind the recording
 CYCLE_GAP_S = 0.05  # a recorded process-data frame this soon after a poll: the master's cycle was running
+# The replay's own pause between two process-data frames beyond the recording's, from which a slave's watchdog
+# (100 ms by default) or its DC synchronisation check may rightly react: the host stalled the replay.
+STALL_LIMIT_S = 0.05
 SM_STATUS_MASKED_FROM = 2  # SM status (byte 5) of SM2 and up: buffer states of process data, timing
 
 
@@ -367,6 +370,12 @@ class Mismatch(AssertionError):
     pass
 
 
+class HostStall(Mismatch):
+    """A mismatch after the replay itself fell behind the recording's process-data cycle by more than
+    STALL_LIMIT_S: the slave may have answered the gap the host made rather than the recording (a stalled
+    host), so the verdict is not the slave's."""
+
+
 def _is_reply(request, data):
     """The slave's answer to request: source address bit 1 set (an ESC sets it) and the request's datagram keys,
     walked as an ESC walks them (keys())."""
@@ -414,6 +423,23 @@ def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None, exchang
     clock = ClockShift()
     t0_rec = pairs[0][0] if pairs else 0.0
     t0 = time.monotonic()
+    # The longest pause of the replay's own process data beyond the recording's: (excess s, frame number).
+    stall = [0.0, 0]
+    last_pd = [None, None]  # monotonic time and recorded time of the last process-data frame sent
+
+    def sent_pd(t_rec, i):
+        now = time.monotonic()
+        if last_pd[0] is not None:
+            excess = (now - last_pd[0]) - (t_rec - last_pd[1])
+            if excess > stall[0]:
+                stall[:] = [excess, i + 1]
+        last_pd[:] = [now, t_rec]
+
+    def mismatch(text):
+        if stall[0] > STALL_LIMIT_S:
+            return HostStall(f"{text} (the replay itself had paused its process data {stall[0] * 1000:.0f} ms "
+                             f"longer than the recording before frame {stall[1]}: a stalled host)")
+        return Mismatch(text)
     try:
         for i, (t, request, recorded) in enumerate(pairs):
             if i in skip:
@@ -426,6 +452,8 @@ def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None, exchang
             frame = clock.rewrite(request, lag)
             stats["frames"] += 1
             observed = exchange(frame, reply_timeout)
+            if any(d[0] in LOGICAL for d in datagrams(request)):
+                sent_pd(t, i)
             if read_only(request) and any(d[0] in LOGICAL for d in datagrams(request)):
                 last_cycle = frame
             if log and observed is None:
@@ -437,7 +465,7 @@ def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None, exchang
                 tries += 1
                 observed = exchange(frame, reply_timeout)
             if observed is None:
-                raise Mismatch(f"frame {i + 1} ({describe(request, 0)}): no reply (recorded one)")
+                raise mismatch(f"frame {i + 1} ({describe(request, 0)}): no reply (recorded one)")
             stats["checked"] += 1
             diff = difference(request, recorded, observed)
             if diff is None:
@@ -467,6 +495,7 @@ def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None, exchang
                             # The master's cycle runs on while it polls (its own task or thread): the last
                             # process-data frame again, so watchdogs and clocks see what they saw in the recording.
                             exchange(last_cycle, reply_timeout)
+                            last_pd[0] = time.monotonic()
                             stats["kept_cycling"] += 1
                         stats["resent"] += 1
                         observed = exchange(frame, reply_timeout)
@@ -486,7 +515,7 @@ def replay(pairs, iface, settle_s=SETTLE_S, reply_timeout=0.5, log=None, exchang
                         if diff is None:
                             clock.learn(request, recorded, observed, lag)
                         continue
-            raise Mismatch(f"frame {i + 1} of {len(pairs)} (recorded at {t - t0_rec:.6f} s): {diff}")
+            raise mismatch(f"frame {i + 1} of {len(pairs)} (recorded at {t - t0_rec:.6f} s): {diff}")
     finally:
         if sock is not None:
             sock.close()

@@ -196,5 +196,65 @@ class PollRules(unittest.TestCase):
             er.replay(recording(1, 6), None, settle_s=0.2, exchange=Slave(10**6))
 
 
+class CyclingSlave:
+    """A slave in OP whose process-data watchdog expires when the process data pauses longer than 100 ms (the
+    ESC's default): it then reports SAFEOP with error 0x001B. `stall_at`: the process-data frame (1-based) before
+    which the host stalls the replay for `stall_s` (the exchange itself sleeps, as a descheduled master
+    would); `defect`: reports SAFEOP + error without any pause."""
+
+    def __init__(self, stall_at=None, stall_s=0.0, defect=False):
+        import time
+        self.time = time
+        self.stall_at, self.stall_s, self.defect = stall_at, stall_s, defect
+        self.frames, self.last, self.tripped = 0, None, False
+
+    def __call__(self, request, _timeout):
+        cmd, _idx, _adp, ado, data, _wkc = er.datagrams(request)[0]
+        if cmd == er.LRW:
+            self.frames += 1
+            if self.frames == self.stall_at:
+                self.time.sleep(self.stall_s)
+            now = self.time.monotonic()
+            if self.last is not None and now - self.last > 0.1:
+                self.tripped = True
+            self.last = now
+            return frame(cmd, ado, data, 3, reply=True)
+        if cmd == er.FPRD and ado == AL_STATUS:
+            bad = self.tripped or self.defect
+            return frame(cmd, ado, al(0x14 if bad else OP), 1, reply=True)
+        return None
+
+
+def cycling_recording(frames=40):
+    """[(t, request, reply)]: process data every 2 ms, AL status read (OP) after every tenth frame."""
+    pairs, t = [], 0.0
+    for k in range(frames):
+        pairs.append((t, frame(er.LRW, 0, bytes(4)), frame(er.LRW, 0, bytes(4), 3, reply=True)))
+        t += 0.002
+        if k % 10 == 9:
+            pairs.append((t, frame(er.FPRD, AL_STATUS, bytes(2)), frame(er.FPRD, AL_STATUS, al(OP), 1, reply=True)))
+            t += 0.0002
+    return pairs
+
+
+class HostStalls(unittest.TestCase):
+    """The class: a verdict that depends on the host keeping the replay's pace. A slave that answers a pause
+    the host made (its watchdog trips) is told apart from one that is wrong by itself: the first mismatch is
+    a HostStall (test_replay.py replays it again), the second a Mismatch."""
+
+    def test_a_pause_of_the_replay_makes_the_mismatch_a_host_stall(self):
+        with self.assertRaises(er.HostStall) as cm:
+            er.replay(cycling_recording(), None, settle_s=0.05, exchange=CyclingSlave(stall_at=15, stall_s=0.15))
+        self.assertIn("paused its process data", str(cm.exception))
+
+    def test_a_slave_wrong_by_itself_is_a_mismatch(self):
+        with self.assertRaises(er.Mismatch) as cm:
+            er.replay(cycling_recording(), None, settle_s=0.05, exchange=CyclingSlave(defect=True))
+        self.assertNotIsInstance(cm.exception, er.HostStall)
+
+    def test_the_same_slave_without_a_pause_replays(self):
+        er.replay(cycling_recording(), None, settle_s=0.05, exchange=CyclingSlave())
+
+
 if __name__ == "__main__":
     unittest.main()

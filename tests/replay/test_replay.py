@@ -17,13 +17,20 @@ ONLY = os.environ.get("ECAT_REPLAY_ONLY")  # a name, to replay one recording
 
 
 def replay(name, pcap, side, extra_args=()):
-    """Starts the slave as the recording's was started (sidecar slave_args), on a fresh veth pair, and replays."""
+    """Starts the slave as the recording's was started (sidecar slave_args), on a fresh veth pair, and replays.
+    A mismatch after the host stalled the replay (ecatreplay.HostStall) is not the slave's: the replay starts
+    again with a fresh slave, up to three times in all."""
     pairs = ecatreplay.pair(ecatreplay.read_pcap(pcap))
-    with harness.Bus(slave_args=list(side["slave_args"]) + list(extra_args)) as bus:
-        try:
-            return ecatreplay.replay(pairs, bus.iface)
-        except ecatreplay.Mismatch as e:
-            raise ecatreplay.Mismatch(f"{name}: {e}\nslave: {bus.slave_output()[-1500:]}") from None
+    for attempt in range(1, 4):
+        with harness.Bus(slave_args=list(side["slave_args"]) + list(extra_args)) as bus:
+            try:
+                return ecatreplay.replay(pairs, bus.iface)
+            except ecatreplay.HostStall as e:
+                if attempt == 3:
+                    raise ecatreplay.Mismatch(f"{name}: {e}\nslave: {bus.slave_output()[-1500:]}") from None
+                print(f"{name}: replayed again (attempt {attempt + 1}): {e}", file=sys.stderr)
+            except ecatreplay.Mismatch as e:
+                raise ecatreplay.Mismatch(f"{name}: {e}\nslave: {bus.slave_output()[-1500:]}") from None
 
 
 class Replay(unittest.TestCase):
