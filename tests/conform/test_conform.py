@@ -304,6 +304,45 @@ class Conform(unittest.TestCase):
             self.assertEqual(p.returncode, 0)
             print(f"{len(stalls)} stalls; notes: {res.get('notes')}", file=sys.stderr)
             return
+        if self.mode == "tool_stalls":
+            # The host stalls the tool instead: SIGSTOP of ecat-conform for 250 ms just after it reported every
+            # second test of the drive's state machine (cia402.dc.*, each runs the drive with process data), so
+            # the stall lands in the next one while it cycles. The slave's watchdog (100 ms) trips and the drive leaves its state, rightly. The
+            # tool sees its own process data paused, runs a test that failed once more (a test before the
+            # next stall) and notes it: no failure for the host's doing.
+            import re
+            import signal
+            work = tempfile.mkdtemp(prefix="ecat-conform-", dir=os.environ.get("ECAT_TEST_OUT"))
+            sii, esi = alias_images(work)
+            with ConformBus(slave_args=["--eeprom", sii]) as bus:
+                out = os.path.join(work, "r.json")
+                p = subprocess.Popen([os.environ["ECAT_CONFORM"], "--iface", bus.iface, "--esi", esi, "--json", out,
+                                      "--group", "pd,cia402"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                                     text=True, bufsize=1)
+                stalls, seen, lines = 0, 0, []
+                try:
+                    for line in p.stdout:
+                        lines.append(line)
+                        if not re.search(r"\bcia402\.dc\.", line):
+                            continue
+                        seen += 1
+                        if seen % 2 == 1:
+                            time.sleep((0.03, 0.07, 0.12)[stalls % 3])  # early, middle, late in the next test
+                            p.send_signal(signal.SIGSTOP)
+                            time.sleep(0.25)
+                            p.send_signal(signal.SIGCONT)
+                            stalls += 1
+                    p.wait(timeout=240)
+                finally:
+                    if p.poll() is None:
+                        p.kill()
+            res = json.loads(pathlib.Path(out).read_text())
+            failed = [x["id"] + ": " + x["message"] for x in res["results"] if x["status"] == "FAIL"]
+            self.assertGreaterEqual(stalls, 4, "".join(lines[-40:]))
+            self.assertEqual(failed, [], f"notes: {res.get('notes')}\n" + "".join(lines[-60:]))
+            self.assertEqual(p.returncode, 0)
+            print(f"{stalls} stalls of the tool; notes: {res.get('notes')}", file=sys.stderr)
+            return
         if self.mode == "stopped":
             # Stopped half-way (--deadline, then SIGTERM): valid JUnit and JSON of the tests done, the running
             # one marked as interrupted, exit code 3, the text report ends saying where it stopped.
@@ -468,7 +507,7 @@ class Conform(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) >= 2 and sys.argv[1] in ("clean", "fault", "noslave", "dies", "stalls", "stopped", "liar", "line", "mutant", "variation", "contained", "foe_write",
+    if len(sys.argv) >= 2 and sys.argv[1] in ("clean", "fault", "noslave", "dies", "stalls", "tool_stalls", "stopped", "liar", "line", "mutant", "variation", "contained", "foe_write",
                                               "table"):
         Conform.mode = sys.argv[1]
         Conform.faults = sys.argv[2:]

@@ -7,6 +7,7 @@
 #include <deque>
 #include <filesystem>
 #include <memory>
+#include <thread>
 #include <vector>
 
 #include "coe/sdo_server.hpp"
@@ -268,6 +269,13 @@ TEST_P(WithSlave, ProcessDataSessionReachesOpAndExchanges) {
     // Inputs come from it: statusword (0x6041) is the first mapped TxPDO entry.
     EXPECT_EQ(pd.inputs()[0] | (pd.inputs()[1] << 8), slave.dict.get<uint16_t>(0x6041, 0));
     EXPECT_EQ(m.al_status(a)->state, 0x08);
+    // The master's own longest pause between two cycles (what a slave's watchdog sees): counted from the
+    // last reset, at least as long as the caller slept.
+    pd.reset_gap_max();
+    EXPECT_EQ(pd.stats().gap_max.count(), 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    ASSERT_EQ(pd.cycle(), Error::Ok);
+    EXPECT_GE(pd.stats().gap_max, std::chrono::milliseconds(30));
 }
 
 TEST_P(WithSlave, SdoInformationListsAndDescribesTheDictionary) {

@@ -240,6 +240,12 @@ class Context {
     // SAFEOP -> OP: exchanging process data where there is some, else by AL control alone.
     master::Error request_op(master::AlStatus& st);
     std::unique_ptr<master::ProcessDataSession> pds;
+    // The longest pause of this tool's own process-data cycles since pd_gap_reset() (over every session of
+    // the test): a slave whose watchdog or DC synchronisation check saw that pause reacted rightly.
+    std::chrono::nanoseconds pd_gap() const;
+    void pd_gap_reset();
+    void drop_pds();  // ends the process-data session, keeping its longest pause
+    std::chrono::nanoseconds pd_gap_dropped{0};
     master::AlStatus last_status;  // of the last refused to_* call
     unsigned al_timeouts = 0;      // requests of this group neither reached nor refused within their wait
     bool al_note = false;

@@ -471,7 +471,7 @@ Error Context::ack_error() {
 
 Error Context::to_init() {
     in_preop = false;
-    pds.reset();
+    drop_pds();
     sdo.reset();
     mbx.reset();
     const auto deadline = Clock::now() + ms(5000);
@@ -509,7 +509,7 @@ Error Context::to_init() {
 
 bool Context::esc_reset() {
     in_preop = false;
-    pds.reset();
+    drop_pds();
     sdo.reset();
     mbx.reset();
     for (const uint8_t v : {uint8_t{0x52}, uint8_t{0x45}, uint8_t{0x53}})
@@ -724,8 +724,22 @@ Error Context::to_op() {
     return e;
 }
 
-Error Context::discover_pd() {
+std::chrono::nanoseconds Context::pd_gap() const {
+    return std::max(pd_gap_dropped, pds ? pds->stats().gap_max : std::chrono::nanoseconds{0});
+}
+
+void Context::pd_gap_reset() {
+    pd_gap_dropped = {};
+    if (pds) pds->reset_gap_max();
+}
+
+void Context::drop_pds() {
+    if (pds) pd_gap_dropped = std::max(pd_gap_dropped, pds->stats().gap_max);
     pds.reset();
+}
+
+Error Context::discover_pd() {
+    drop_pds();
     if (sdo && has_coe()) {
         pds = std::make_unique<master::ProcessDataSession>(m, addr, *sdo);
         return pds->discover();

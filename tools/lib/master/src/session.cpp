@@ -389,6 +389,10 @@ Error ProcessDataSession::configure_dc(const DcConfig& dc) {
 Error ProcessDataSession::cycle() {
     if (image_.empty()) return Error::InvalidArgument;
     const auto t0 = Clock::now();
+    if (stats_.cycles > 0)
+        stats_.gap_max = std::max(
+            stats_.gap_max, std::chrono::duration_cast<std::chrono::nanoseconds>(t0 - last_cycle_start_));
+    last_cycle_start_ = t0;
     ++stats_.cycles;
     for (Chunk& c : chunks_)
         c.dg[0].wkc = 0;  // a frame that does not come back counts nothing

@@ -129,6 +129,9 @@ struct CycleStats {
     std::chrono::nanoseconds rtt_min{std::chrono::nanoseconds::max()};
     std::chrono::nanoseconds rtt_max{0};
     std::chrono::nanoseconds rtt_sum{0};
+    // Longest time between the starts of two cycles: the master's own pauses, which a slave's process-data
+    // watchdog or DC synchronisation check sees as a communication gap.
+    std::chrono::nanoseconds gap_max{0};
 };
 
 class ProcessDataSession {
@@ -174,6 +177,7 @@ class ProcessDataSession {
     std::size_t frames_per_cycle() const { return chunks_.size(); }
     uint64_t reference_time() const { return ref_time_; }  // DC system time read in the last cycle
     const CycleStats& stats() const { return stats_; }
+    void reset_gap_max() { stats_.gap_max = {}; }  // the longest pause is counted afresh from here
     // The slaves as the DC measurement saw them (topology, delays, offsets); empty without dc.measure.
     std::span<const SlaveInfo> dc_slaves() const { return dc_slaves_; }
     // AL status of every slave, read in as few frames as fit (after a working-counter error: who is gone or
@@ -221,6 +225,7 @@ class ProcessDataSession {
     uint16_t last_wkc_ = 0;
     uint64_t ref_time_ = 0;
     CycleStats stats_;
+    std::chrono::steady_clock::time_point last_cycle_start_{};
     std::vector<SlaveInfo> dc_slaves_;
     std::vector<AlStatus> states_;
     std::vector<uint8_t> state_buf_;
