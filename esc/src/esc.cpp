@@ -480,7 +480,10 @@ int Esc::Impl::receive_signalled(std::span<uint8_t> frame, int port, uint64_t rx
         if (timers_touched || wd.take_started()) {
             timers_touched = false;
             sig->due_ns = dc.armed() ? 0 : due(time.frame_clock);
+        } else if (dc_time_touched && dc.armed()) {
+            sig->due_ns = 0;
         }
+        dc_time_touched = false;
         note_events(before);
     }
     if (sii.callbacks_pending()) {
