@@ -557,6 +557,7 @@ void Device::prefetch(int stage) const {
         case 1: {  // reads esc_ and parts_
             __builtin_prefetch(&esc_);
             const Parts* p = parts_.get();
+            if (p == nullptr) break;
             __builtin_prefetch(&p->stack);
             __builtin_prefetch(&p->drive);
             __builtin_prefetch(&p->io);
@@ -564,6 +565,7 @@ void Device::prefetch(int stage) const {
         }
         default:  // reads the Esc object and the parts
             esc_.prefetch(false);
+            if (!parts_) break;
             if (parts_->stack) parts_->stack->prefetch();
             if (parts_->io) __builtin_prefetch(parts_->io.get());
             break;
