@@ -4,6 +4,21 @@
 #include <ostream>
 
 namespace ecat {
+
+void Stack::prefetch() const {
+    const auto lines = [](const void* p, std::size_t n) {
+        const auto* b = static_cast<const char*>(p);
+        for (std::size_t off = 0; off < std::min<std::size_t>(n, 4 * 64); off += 64)
+            __builtin_prefetch(b + off, 1, 3);
+    };
+    lines(&cycle_, sizeof cycle_);
+    lines(&esm_, sizeof esm_);
+    lines(&sync_, sizeof sync_);
+    lines(&ctx_, sizeof ctx_);
+    lines(&pd_, sizeof pd_);
+    lines(&mailbox_, 2 * 64);
+    lines(&stats_, 64);
+}
 namespace {
 
 std::size_t max_mailbox(const od::DeviceDescription& d) {

@@ -46,7 +46,16 @@ bool Esc::Impl::phys_read(uint32_t a, uint8_t* dst, uint8_t* ok, uint32_t n, Sid
 
 bool Esc::Impl::phys_write(uint32_t a, const uint8_t* src, const uint8_t* bm, uint32_t n, Side side) {
     const uint32_t end = a + n;
-    if (side == Side::Ecat && a < 0x0A00 && end > 0x0400) timers_touched = true;
+    if (side == Side::Ecat && a < 0x0A00 && end > 0x0400) {
+        // The DC time registers (receive times, system time, offset, delay, speed counter and filters) move
+        // no timer of their own, only the SYNC pulses through the local time: they leave the due time
+        // alone unless a pulse is scheduled. A master's drift compensation writes 0x0910 of every ESC in
+        // every cycle.
+        if (a >= reg::kDcRecvTime0 && end <= reg::kDcCyclicControl)
+            dc_time_touched = true;
+        else
+            timers_touched = true;
+    }
     bool any = false;
     uint32_t p = a;
     const bool esc_protected = esc_write_protected(side);

@@ -6,6 +6,7 @@
 
 #include "esc/wire/datagram.hpp"
 #include "esc_impl.hpp"
+#include "prefetch.hpp"
 #include "util/le.hpp"
 
 namespace esc {
@@ -480,7 +481,10 @@ int Esc::Impl::receive_signalled(std::span<uint8_t> frame, int port, uint64_t rx
         if (timers_touched || wd.take_started()) {
             timers_touched = false;
             sig->due_ns = dc.armed() ? 0 : due(time.frame_clock);
+        } else if (dc_time_touched && dc.armed()) {
+            sig->due_ns = 0;
         }
+        dc_time_touched = false;
         note_events(before);
     }
     if (sii.callbacks_pending()) {
@@ -503,6 +507,32 @@ int Esc::receive(std::span<uint8_t> frame, int port, uint64_t rx_clock_ns) {
 int Esc::receive(std::span<uint8_t> frame, int port, uint64_t rx_clock_ns, FrameCheck& check) {
     std::unique_lock lock(impl_->mu);
     return impl_->receive_signalled(frame, port, rx_clock_ns, &check, lock);
+}
+
+void Esc::prefetch(bool deep) const {
+    const Impl& m = *impl_;
+    if (deep) {
+        m.fmmu.prefetch_ram(m.mem);
+        return;
+    }
+    prefetch_lines(&m, 2 * kCacheLine);  // configuration, lock, register tables
+    // The registers a cyclic frame reads or writes: station address and write enables, DL control, the
+    // event registers, the watchdogs, the SyncManagers' status, the DC system time and its filter; then
+    // the units' state.
+    for (const uint16_t a : {0x0000, 0x0100, 0x0200, 0x0220, 0x0400, 0x0440, 0x0800, 0x0810, 0x0900, 0x0920})
+        prefetch_lines(&m.mem.regs[a], 1);
+    prefetch_lines(&m.mem.ram, sizeof m.mem.ram + sizeof m.mem.ram_end);
+    prefetch_lines(&m.time, sizeof m.time);
+    prefetch_lines(&m.wd, sizeof m.wd);
+    m.sm.prefetch();
+    m.fmmu.prefetch_state();
+    prefetch_lines(&m.dc, sizeof m.dc);
+    prefetch_lines(&m.ports, sizeof m.ports);
+    prefetch_lines(&m.sii, sizeof m.sii);
+    prefetch_lines(&m.lookup_dirty, 1);
+    prefetch_lines(&m.frame_write_enable, 3);
+    prefetch_lines(&m.stats, sizeof m.stats);
+    prefetch_lines(&m.sig, sizeof m.sig + sizeof m.timers_touched);
 }
 
 void Esc::set_link(int port, bool up) {

@@ -65,6 +65,9 @@ struct Esc::Impl final {
     // An ECAT write reached the watchdog, SII, FMMU, SM or DC registers (0x0400-0x09FF) or the ESC was reset
     // in this frame: its timers may have moved (EscSignals::due_ns unknown after the frame).
     bool timers_touched = false;
+    // An ECAT write reached only the DC time registers (0x0900-0x097F) in this frame: the due time moves
+    // only if a SYNC pulse is scheduled.
+    bool dc_time_touched = false;
 
     // ---------------------------------------------------------------- functions
     static void init_tables(RegTables& t, uint8_t fmmu_count, uint8_t sm_count);

@@ -2,6 +2,10 @@
 // physical memory is a template in fmmu.hpp, so that its physical accesses call Esc::Impl directly.
 #include "fmmu.hpp"
 
+#include <algorithm>
+
+#include "prefetch.hpp"
+
 namespace esc {
 
 void Fmmus::rebuild() {
@@ -24,6 +28,21 @@ void Fmmus::rebuild() {
         f.read = type & 0x01;
         f.write = type & 0x02;
         map_[active_++] = f;
+    }
+}
+
+void Fmmus::prefetch_state() const {
+    prefetch_lines(&active_, sizeof active_ + 2 * sizeof(FmmuMap));  // the count and the first two mappings
+}
+
+void Fmmus::prefetch_ram(const Memory& m) const {
+    for (uint8_t k = 0; k < active_; ++k) {
+        const uint64_t pa = map_[k].pbit_start >> 3;
+        if (pa < reg::kRamBase || pa >= m.ram_end) continue;
+        // The mapped bytes and, for a 3-buffer SM behind them, its other two buffers (at most four lines).
+        const uint64_t bytes = ((map_[k].lbit_end - map_[k].lbit_start + 7) >> 3) * 3;
+        const uint64_t n = std::min<uint64_t>({bytes, 4 * kCacheLine, m.ram_end - pa});
+        prefetch_lines(&m.ram[pa - reg::kRamBase], n);
     }
 }
 

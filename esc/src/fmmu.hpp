@@ -52,6 +52,11 @@ class Fmmus {
     // memory phys. Returns the working-counter increment.
     template <PhysicalMemory P>
     uint16_t logical(P& phys, Command cmd, uint32_t la, uint8_t* data, uint16_t len);
+    // Ask for the cache lines a logical datagram reads here without waiting for them (Esc::prefetch): the
+    // count and the first mappings (reads nothing); the process RAM the active mappings map, with room for a
+    // 3-buffer SyncManager behind each (reads the mappings: after prefetch_state() had time to work).
+    void prefetch_state() const;
+    void prefetch_ram(const Memory& m) const;
 
   private:
     template <PhysicalMemory P>
@@ -61,8 +66,8 @@ class Fmmus {
 
     const Memory& mem;
     uint8_t count_ = 0;
+    uint8_t active_ = 0;  // before the maps: a frame reads it with the first of them, in one cache line
     std::array<FmmuMap, 16> map_{};
-    uint8_t active_ = 0;
 };
 
 // Mask of the bits [lo, hi] (inclusive) of a byte.

@@ -6,6 +6,8 @@
 
 #include "sync_manager.hpp"
 
+#include "prefetch.hpp"
+
 namespace esc {
 
 void SyncManagers::reset_state(unsigned n) {
@@ -178,6 +180,13 @@ void SyncManagers::reset() {
     }
     pending_mask_ = 0;
     pdi_disabled_mask_ = 0;
+}
+
+void SyncManagers::prefetch() const {
+    // Reads nothing: the counts, masks and first areas, and the state of SMs 0-3 (mailbox and process data).
+    prefetch_lines(this, static_cast<std::size_t>(reinterpret_cast<const char*>(&areas_[2]) -
+                                                  reinterpret_cast<const char*>(this)));
+    prefetch_lines(&sm[0], 4 * sizeof(SyncManager));
 }
 
 void SyncManagers::rebuild() {

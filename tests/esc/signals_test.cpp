@@ -49,6 +49,53 @@ TEST_F(Signals, DueFollowsWhatFramesAndTicksDo) {
     EXPECT_EQ(sig.due_ns, UINT64_MAX);
 }
 
+// The DC time registers (0x0900-0x097F: receive times, system time, offset, delay, speed counter, filters)
+// move no timer of their own, only the SYNC pulses through the local time: a frame that writes any of them
+// leaves the exact figure while no pulse is scheduled (no tick needed: a master's drift compensation writes
+// 0x0910 of every ESC of a line in every cycle), and makes it unknown while one is.
+TEST_F(Signals, DcTimeRegisterWritesMoveTheDueTimeOnlyWithASyncPulseScheduled) {
+    for (uint16_t a = 0x0900; a < 0x0980; ++a) {
+        fpwr(*e, a, {0x5A});
+        EXPECT_EQ(sig.due_ns, e->next_event_ns(clk.now_ns()))
+            << "nothing scheduled, write of 0x" << std::hex << a;
+    }
+    fpwr(*e, 0x0910, le(12345, 8));
+    EXPECT_EQ(sig.due_ns, UINT64_MAX);
+    for (uint16_t a = 0x0900; a < 0x0980; ++a) {
+        // A fresh ESC each time: the bytes written before would move its system time off the start time.
+        e.emplace(esc::EscConfig{}, clk);
+        set_station(*e, 0x1001);
+        fpwr(*e, 0x0410, {0x00, 0x00});
+        e->set_signals(&sig);
+        start_sync0(1'000'000, 100'000);
+        e->tick(clk.now_ns());
+        ASSERT_NE(sig.due_ns, 0u);
+        ASSERT_NE(sig.due_ns, UINT64_MAX) << "SYNC0 scheduled";
+        fpwr(*e, a, {0x5A});
+        EXPECT_EQ(sig.due_ns, 0u) << "SYNC0 scheduled, write of 0x" << std::hex << a;
+    }
+}
+
+// Whatever a frame writes into the timer registers (watchdogs, SII, FMMU, SM, DC; every byte, with or without
+// a SYNC pulse scheduled), due_ns is never later than the ESC's next event afterwards: 0 (unknown) or a time
+// at or before it.
+TEST_F(Signals, NoFrameWriteLeavesTheDueTimeLate) {
+    for (const bool sync : {false, true}) {
+        for (uint16_t a = 0x0400; a < 0x0A00; ++a) {
+            SCOPED_TRACE(testing::Message() << "sync " << sync << ", write of 0x" << std::hex << a);
+            e.emplace(esc::EscConfig{}, clk);
+            set_station(*e, 0x1001);
+            fpwr(*e, 0x0410, {0x00, 0x00});
+            e->set_signals(&sig);
+            if (sync) start_sync0(1'000'000, 100'000);
+            e->tick(clk.now_ns());
+            fpwr(*e, a, {0xFF});
+            const uint64_t next = e->next_event_ns(clk.now_ns());
+            EXPECT_TRUE(sig.due_ns == 0 || sig.due_ns <= next) << sig.due_ns << " after " << next;
+        }
+    }
+}
+
 TEST_F(Signals, PdiAccessLeavesDueUnknownUntilTheNextTick) {
     fpwr(*e, 0x0410, le(1000, 2));  // PDI watchdog: 1000 increments
     const uint64_t increment = (fprd(*e, 0x0400, 2).u16() + 2ull) * 40;

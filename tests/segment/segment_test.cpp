@@ -453,6 +453,8 @@ TEST_F(SegmentTest, LostLinksCountedOncePerLoss) {
     EXPECT_EQ(brd_count(), 3);
 }
 
+// The loops a master sets change the walk behind the segment's back: its prefetch hints (the order it last
+// computed, Esc::prefetch) are stale here, which costs speed and must change no result.
 TEST_F(SegmentTest, LoopControlFromTheMaster) {
     line(4);
     // DL control 0x0101 of device 1: port 1 "always closed" (bits 3:2 = 11): the line ends there.

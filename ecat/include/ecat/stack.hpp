@@ -60,6 +60,10 @@ class Stack {
     }
     // Time at which poll() must run again even if no frame arrives; UINT64_MAX if nothing is pending.
     uint64_t next_deadline_ns() const { return cycle_.next_deadline_ns(); }
+    // Asks the memory system for the first cache lines of each unit a poll reads (the cycle, the state
+    // machine, SYNC control, the process data, the mailbox) without waiting for them and without reading
+    // anything: a caller that polls many stacks in turn lets their cache misses overlap (device::Line).
+    void prefetch() const;
 
     // Application-detected error (e.g. a fatal device fault): sets the error indication with the code
     // and falls back to fallback if that is lower than the current state.

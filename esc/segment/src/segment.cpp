@@ -66,6 +66,10 @@ struct Segment::Impl {
     std::vector<Device> devs;
     std::vector<EscSignals> signals;  // one per device, side by side (Segment::signals())
     std::vector<Hop> hops;            // hops[k]: the cable into device k from upstream
+    // ahead[k]: the device whose processing unit a frame meets after k's (order()), -1 after the last. A
+    // hint for the walk's prefetching (Esc::prefetch), refreshed when the wiring or a link changes here; a
+    // stale one (a master changed a loop) costs speed, never a result.
+    std::vector<int> ahead;
     bool root_cable_up = true;
     int ext_dev = -1;
     int ext_port = -1;
@@ -172,7 +176,36 @@ struct Segment::Impl {
             if (pt.peer >= 0) apply_links(pt.peer);
     }
 
+    void update_ahead() {
+        ahead.assign(devs.size(), -1);
+        if (devs.empty() || !devs[0].powered || !root_cable_up) return;
+        std::vector<int> seq;
+        seq.reserve(devs.size());
+        visit(0, 0, seq);
+        for (std::size_t i = 0; i + 1 < seq.size(); ++i)
+            ahead[static_cast<std::size_t>(seq[i])] = seq[i + 1];
+    }
+
     // ---- the walk --------------------------------------------------------------------------------
+    // Before the frame enters the processing unit of device d: the state of the devices it meets next is
+    // asked for, in three stages a step apart, each needing what the one before brought: the Device entry
+    // and the Esc object three ahead, the ESC's own state two ahead (through the Esc object), the process
+    // RAM one ahead (through the FMMU mappings). Changes nothing.
+    void prefetch_after(int d) const {
+        const std::size_t n = ahead.size();
+        const int a1 = static_cast<std::size_t>(d) < n ? ahead[static_cast<std::size_t>(d)] : -1;
+        if (a1 < 0) return;
+        devs[static_cast<std::size_t>(a1)].esc->prefetch(true);
+        const int a2 = ahead[static_cast<std::size_t>(a1)];
+        if (a2 < 0) return;
+        devs[static_cast<std::size_t>(a2)].esc->prefetch(false);
+        const int a3 = ahead[static_cast<std::size_t>(a2)];
+        if (a3 < 0) return;
+        __builtin_prefetch(&devs[static_cast<std::size_t>(a3)]);
+        __builtin_prefetch(devs[static_cast<std::size_t>(a3)].esc);
+        __builtin_prefetch(&hops[static_cast<std::size_t>(a3)]);
+    }
+
     // A frame crossing a cable: false if the cable loses it.
     static bool survives(Hop& h) {
         if (h.drop_per_crossing > 0.0 && uniform(h.rng) < h.drop_per_crossing) {
@@ -189,6 +222,7 @@ struct Segment::Impl {
         r.kind = Result::Kind::Dropped;
         for (std::size_t step = 0; step < limit; ++step) {
             Device& dv = devs[static_cast<std::size_t>(d)];
+            if (port == 0) prefetch_after(d);
             const int out = dv.esc->receive(frame, port, t, check);
             if (out < 0) return r;
             if (t != 0) t += port == 0 ? timing.processing_delay_ns : timing.forwarding_delay_ns;
@@ -272,6 +306,7 @@ int Segment::add(Esc& esc) {
     Impl::Hop hop;
     hop.rng = 0x5EC7'0000'0000'0000ULL ^ (static_cast<uint64_t>(index) * 0x100000001B3ULL);
     impl_->hops.push_back(hop);
+    impl_->update_ahead();
     return index;
 }
 
@@ -305,6 +340,7 @@ void Segment::connect(int a, int a_port, int b, int b_port, int64_t cable_delay_
     m.recompute_tree();
     for (std::size_t d = 0; d < m.devs.size(); ++d)
         m.apply_links(static_cast<int>(d));
+    m.update_ahead();
 }
 
 void Segment::set_external(int device, int port, std::function<void(std::span<const uint8_t>)> send) {
@@ -430,6 +466,7 @@ void Segment::set_cable(int device, int port, bool up) {
     } else {
         throw std::invalid_argument("Segment::set_cable: " + where(device, port) + " has no cable");
     }
+    m.update_ahead();
 }
 
 void Segment::set_power(int device, bool on) {
@@ -437,6 +474,7 @@ void Segment::set_power(int device, bool on) {
     m.check_device(device, "set_power");
     m.devs[static_cast<std::size_t>(device)].powered = on;
     m.apply_links_with_peers(device);
+    m.update_ahead();
 }
 
 bool Segment::powered(int device) const {
@@ -452,6 +490,7 @@ void Segment::replace(int device, Esc& esc) {
     dv.descriptor = esc.port_descriptor();
     esc.set_signals(&m.signals[static_cast<std::size_t>(device)]);
     m.apply_links(device);
+    m.update_ahead();
 }
 
 void Segment::set_hop_faults(int hop, const HopFaults& faults) {

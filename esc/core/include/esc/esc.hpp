@@ -110,6 +110,14 @@ class Esc final : public Pdi {
     // an ESC alone on its wire: true when the frame leaves through port 0 again.
     bool process_frame(std::span<uint8_t> frame, uint64_t rx_time_ns = 0);
 
+    // Asks the memory system for the state a frame's pass through this ESC touches, without waiting for it
+    // and without changing anything: a segment calls it for the ESCs a frame meets next while this one
+    // processes it, so that the cache misses of a line's ESCs overlap instead of adding up (the walk of a
+    // line whose state was evicted since the last cycle is mostly such misses). Two stages: the ESC's own
+    // state (the registers of the cyclic datagrams, SyncManagers, FMMUs, DC, ports, counters; reads only
+    // the pointer to it), then, deep, the process RAM its FMMUs map (reads the mappings: a step later).
+    void prefetch(bool deep) const;
+
     // ---- PDI side ---------------------------------------------------------------------------------
     // An empty span is no access (no side effect, the PDI watchdog is not triggered).
     void read(uint16_t address, std::span<uint8_t> out) override;

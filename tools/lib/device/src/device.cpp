@@ -545,6 +545,33 @@ void Device::poll(uint64_t now_ns) {
     }
 }
 
+void Device::prefetch(int stage) const {
+    switch (stage) {
+        case 0:  // this object: what poll() and quiet() read of it (reads nothing)
+            __builtin_prefetch(this);
+            __builtin_prefetch(&parts_);
+            __builtin_prefetch(&restart_pending_);
+            __builtin_prefetch(&last_cycle_ns_);
+            __builtin_prefetch(&eeprom_dirty_);
+            break;
+        case 1: {  // reads esc_ and parts_
+            __builtin_prefetch(&esc_);
+            const Parts* p = parts_.get();
+            if (p == nullptr) break;
+            __builtin_prefetch(&p->stack);
+            __builtin_prefetch(&p->drive);
+            __builtin_prefetch(&p->io);
+            break;
+        }
+        default:  // reads the Esc object and the parts
+            esc_.prefetch(false);
+            if (!parts_) break;
+            if (parts_->stack) parts_->stack->prefetch();
+            if (parts_->io) __builtin_prefetch(parts_->io.get());
+            break;
+    }
+}
+
 bool Device::quiet(uint64_t now_ns, bool registers_unchanged) const {
     if (restart_pending_ || outputs_lost_pending_ || (parts_->drive && last_cycle_ns_ == 0)) return false;
     if (!parts_->stack->quiet(now_ns, registers_unchanged)) return false;

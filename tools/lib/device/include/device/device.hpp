@@ -137,6 +137,13 @@ class Device final : public ecat::Application, public drive::EventSink, public e
 
     // Firmware entry points (slave::Firmware through an adapter).
     void poll(uint64_t now_ns);
+    // Asks the memory system for the state a poll reads first, without waiting for it and without changing
+    // anything, in stages that a caller polling many devices runs over all of them in turn, each needing
+    // what the one before brought into the cache: 0 this object, 1 the parts it holds and the Esc object,
+    // 2 the stack's units, the IO model and the ESC's own state (device::Line::poll). The state of devices
+    // last touched a cycle ago is mostly evicted on a shared host; asked for together, their cache misses
+    // overlap instead of adding up, one device after the other.
+    void prefetch(int stage) const;
     // True if poll(now_ns) would do nothing: the stack is quiet, no restart or reaction pending, no
     // free-running drive cycle or EEPROM save due. A line polls only the devices that are not.
     // registers_unchanged: no frame and no timer event changed the ESC's registers since the last poll
