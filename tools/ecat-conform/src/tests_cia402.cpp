@@ -366,7 +366,7 @@ void add_cia402_tests(Catalogue& c) {
         add(
             std::string("mode.") + md.id,
             std::string("Mode ") + dec(md.value) + " (" + md.name +
-                ") of 0x6502 accepted by 0x6060 and shown by 0x6061",
+                ") of 0x6502 accepted by 0x6060 (read back) and shown by 0x6061",
             kModes,
             [md](Context& ctx) {
                 CONFORM_NEED(need_402_profile(ctx));
@@ -378,6 +378,14 @@ void add_cia402_tests(Catalogue& c) {
                 auto old = ctx.upload_uint(0x6060, 0);
                 if (Error e = ctx.download_uint(0x6060, 0, static_cast<uint8_t>(md.value), 1); e != Error::Ok)
                     return fail("0x6060 = " + dec(md.value) + ": " + ctx.sdo_error(e));
+                // An acknowledged download is stored (ETG.1000.6 SDO download: the response confirms the
+                // write): 0x6060 reads back the mode written, whatever 0x6061 shows later.
+                if (auto back = ctx.upload(0x6060, 0); back && !back->empty() &&
+                                                       (*back)[0] != static_cast<uint8_t>(md.value)) {
+                    if (old) (void)ctx.download_uint(0x6060, 0, *old, 1);
+                    return fail("0x6060 = " + dec(md.value) + " acknowledged, but 0x6060 reads back another value",
+                                dec(static_cast<int8_t>((*back)[0])), dec(md.value));
+                }
                 uint64_t shown = 0xFF;
                 for (int i = 0; i < 100; ++i) {
                     auto v = ctx.upload(0x6061, 0);

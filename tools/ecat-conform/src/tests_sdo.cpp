@@ -2,6 +2,7 @@
 // the object dictionary against the ESI, identity against the SII, PDO assignment/mapping rules.
 #include <thread>
 
+#include "report.hpp"
 #include "sdo_util.hpp"
 
 namespace conform {
@@ -590,6 +591,27 @@ void add_sdo_tests(Catalogue& c) {
             auto v = ctx.upload(0x1000, 0);
             if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
             return expect_eq("0x1000", bytes_hex(*v), bytes_hex(o->entries[0].default_data));
+        },
+        "ESI given");
+    add(
+        "device_name_vs_esi", "0x1008 manufacturer device name equals the ESI's DefaultString (read-only object)",
+        "ETG.1000.6 0x1008 manufacturer device name; ETG.2000 Dictionary/Objects/Object/Info/DefaultString",
+        {&Context::need_coe, &Context::need_esi},
+        [](Context& ctx) {
+            const EsiObject* o = ctx.esi->object(0x1008);
+            const EsiEntry* e = o ? o->entry(0) : nullptr;
+            if (!e || e->default_data.empty() || !e->default_is_string)
+                return skip("no 0x1008 DefaultString in the ESI");
+            if (e->access != "ro") return skip("0x1008 writable in the ESI (" + e->access + ")");
+            auto v = ctx.upload(0x1008, 0);
+            if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
+            // A device may pad the string to its declared size with NULs (VISIBLE_STRING): compared without.
+            auto text = [](std::vector<uint8_t> b) {
+                while (!b.empty() && b.back() == 0)
+                    b.pop_back();
+                return std::string(b.begin(), b.end());
+            };
+            return expect_eq("0x1008", printable(text(*v)), printable(text(e->default_data)));
         },
         "ESI given");
     add(

@@ -166,9 +166,11 @@ void add_sii_tests(Catalogue& c) {
                              bytes_hex(std::span<const uint8_t>(ctx.sii->bytes).subspan(0, 128), 128));
         });
     add("interface.status",
-        "EEPROM control/status 0x0502 after a read: not busy, no command, write-enable or loading error, no "
-        "checksum error with a correct checksum",
-        "ETG.1000.4 SII access; ESC datasheet section II EEPROM control/status register 0x0502 (bits 11-15)",
+        "EEPROM interface 0x0500-0x0502 after a read: not busy, no command, write-enable or loading error, no "
+        "checksum error with a correct checksum; the PDI does not hold the EEPROM, write enable cleared, "
+        "address algorithm as the EEPROM size",
+        "ETG.1000.4 SII access; ESC datasheet section II EEPROM interface 0x0500-0x0502 (bits 0, 7, 11-15 of "
+        "0x0502, bit 0 of 0x0500/0x0501)",
         [](Context& ctx) {
             uint8_t b[8];
             const auto e = ctx.m.sii_read(ctx.addr, 0, b);
@@ -184,7 +186,31 @@ void add_sii_tests(Catalogue& c) {
             if (*st & mask)
                 return fail("error or busy bits after a successful read", hex(*st),
                             std::string("bits ") + (crc_ok ? "11-15" : "13-15") + " clear");
-            return pass("0x0502", hex(*st));
+            // The other defined bits of the interface (ESC datasheet section II, 0x0500-0x0502), each against
+            // what the read just showed: the ECAT side had the EEPROM (its command completed); the PDI can
+            // hold it (0x0501 bit 0) only where 0x0500 bit 0 offers it; write enable (0x0502 bit 0) clears
+            // itself with the next frame and reads 1 only while the PDI has the EEPROM.
+            auto cfg = ctx.rd<uint16_t>(master::reg::SiiConfig);
+            if (!cfg) return fail("0x0500 unreadable", err(cfg.error()));
+            const bool offered = *cfg & 0x0001, pdi_holds = *cfg & 0x0100;
+            if (pdi_holds && !offered)
+                return fail("0x0501 bit 0 (PDI has EEPROM access) without the offer of 0x0500 bit 0, right after "
+                            "an ECAT read completed",
+                            "0x0500 = " + hex(*cfg), "0x0501 bit 0 clear");
+            if ((*st & 0x0001) && !pdi_holds)
+                return fail("0x0502 bit 0 (ECAT write enable) set after a read command", hex(*st),
+                            "clear (self-clearing with the next frame)");
+            // Bit 7: the address algorithm, 1 address byte for 1-16 Kbit EEPROMs, 2 from 32 Kbit; SII word
+            // 0x3E gives the size (Kbit - 1). An EEPROM emulated by the PDI (bit 5) has no algorithm.
+            if (!(*st & 0x0020) && ctx.sii) {
+                const unsigned kbit = ctx.sii->word(0x3E) + 1u;
+                const bool two = *st & 0x0080;
+                if (two != (kbit > 16))
+                    return fail("0x0502 bit 7 (EEPROM address algorithm) against the EEPROM size", hex(*st),
+                                std::string(kbit > 16 ? "2" : "1") + " address byte(s) for " + dec(kbit) +
+                                    " Kbit (SII word 0x3E)");
+            }
+            return pass("0x0500/0x0502", hex(*cfg) + " / " + hex(*st));
         });
     add("header.checksum", "Checksum of words 0-6 in word 7 (CRC-8, polynomial 0x07, seed 0xFF)", kSii,
         [](Context& ctx) {
