@@ -279,6 +279,24 @@ void add_foe_tests(Catalogue& c) {
         },
         a);
     add(
+        "unexpected_packet",
+        "FoE ACK and DATA packets with no transfer running, in BOOT: each refused with error 0x8004 (illegal)",
+        kFoe,
+        [](Context& ctx) {
+            CONFORM_BOOT(ctx);
+            // ETG.1000.6 FoE: a packet the server's state does not expect (an ACK without a read, DATA
+            // without a write) is an illegal request; the answer is an error request with 0x8004.
+            FoeAnswer ack = foe_request(ctx, 4, 1, "");
+            ctx.mbx_resync();
+            FoeAnswer data = foe_request(ctx, 3, 1, "ecat-conform");
+            ctx.mbx_resync();
+            (void)ctx.to_init();
+            if (Outcome o = expect_foe_error(ack, {0x8004}, "ACK 1 without a read"); o.status != Status::Pass)
+                return o;
+            return expect_foe_error(data, {0x8004}, "DATA 1 without a write");
+        },
+        a);
+    add(
         "read_file",
         "FoE read of --foe-file in BOOT: refused with an FoE error, or DATA packets numbered from 1, each "
         "acknowledged (the first 8, then the read is ended)",

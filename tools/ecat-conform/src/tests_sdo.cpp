@@ -907,6 +907,95 @@ void add_sdo_tests(Catalogue& c) {
         },
         "ESI announces PdoConfig");
     add(
+        "pdo.mapping_not_mappable",
+        "An object the ESI does not declare RxPDO-mappable written into a mapping: refused with 0x06040041 "
+        "(cannot be mapped; 0x06040043 as the general code), at the entry or at subindex 0, or at the latest "
+        "by PREOP -> SAFEOP; restored",
+        "ETG.1000.6 CoE PDO mapping; SDO abort code 0x06040041",
+        [](Context& ctx) {
+            const EsiPdo* p = nullptr;
+            if (Outcome o = remappable_rxpdo(ctx, p); o.status != Status::Pass) return o;
+            // 0x1018:01 (vendor id) where the ESI leaves it unmappable, else the first such entry of 8..32 bits.
+            uint16_t obj = 0;
+            const EsiEntry* bad = nullptr;
+            for (const auto& [index, o] : ctx.esi->objects)
+                for (const auto& e : o.entries)
+                    if (e.subindex > 0 && e.pdo_mapping.find('R') == std::string::npos && e.access != "wo" &&
+                        (e.bit_size == 8 || e.bit_size == 16 || e.bit_size == 32) &&
+                        (!bad || (index == 0x1018 && e.subindex == 1))) {
+                        obj = index;
+                        bad = &e;
+                    }
+            if (!bad) return skip("no unmappable entry in the ESI dictionary");
+            const uint32_t value = static_cast<uint32_t>(obj) << 16 | static_cast<uint32_t>(bad->subindex) << 8 |
+                                   bad->bit_size;
+            auto entries = read_mapping(ctx, p->index);
+            if (!entries) return fail("upload: " + ctx.sdo_error(entries.error()));
+            const std::string what = hex(obj) + ":" + dec(bad->subindex) + " into " + hex(p->index);
+            Outcome o = pass();
+            if (ctx.download_uint(p->index, 0, 0, 1) != Error::Ok) {
+                o = fail(hex(p->index) + ":00 = 0 refused");
+            } else if (SdoAnswer a = sdo_raw(ctx, sdo_req(0x23, p->index, 1, value)); a.is_abort()) {
+                o = expect_abort(a, p->index, 1, {0x06040041, 0x06040043}, what);
+            } else if (SdoAnswer b = sdo_raw(ctx, sdo_req(0x2F, p->index, 0, 1)); b.is_abort()) {
+                o = expect_abort(b, p->index, 0, {0x06040041, 0x06040043}, what + ", at subindex 0");
+            } else {
+                // Taken by both writes: a device may check at PREOP -> SAFEOP instead; it must refuse there.
+                const Error e = ctx.to_safeop();
+                (void)ctx.to_preop();
+                o = e == Error::Ok ? fail(what + ": taken, and SAFEOP reached with it", "acknowledged",
+                                          "abort 0x06040041 or a refused PREOP -> SAFEOP")
+                                   : pass(what + ": refused at PREOP -> SAFEOP", err(e));
+            }
+            (void)write_mapping(ctx, p->index, *entries);
+            return o;
+        },
+        "ESI announces PdoConfig");
+    add(
+        "pdo.assign_unknown_pdo",
+        "A PDO index that does not exist (not in the ESI, no object) assigned to 0x1C12: refused with an abort, "
+        "at the entry or at subindex 0, or at the latest by PREOP -> SAFEOP; restored",
+        "ETG.1000.6 CoE PDO assignment 0x1C12 (only existing PDOs of the SM's direction)",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            if (!ctx.esi->coe.pdo_assign) return skip("the ESI does not announce PdoAssign");
+            CONFORM_PREOP(ctx);
+            uint16_t none = 0;
+            for (uint16_t i = 0x17FF; i >= 0x1600 && !none; --i) {
+                bool listed = ctx.esi->object(i) != nullptr;
+                for (const auto& x : ctx.esi->rxpdos)
+                    listed = listed || x.index == i;
+                if (!listed) none = i;
+            }
+            if (!none) return skip("every RxPDO index is used");
+            auto before = read_mapping(ctx, 0x1C12);  // the assignment, read as a mapping (:00, :01..)
+            if (!before) return fail("0x1C12 upload: " + ctx.sdo_error(before.error()));
+            auto put_back = [&ctx, &before]() {
+                (void)ctx.download_uint(0x1C12, 0, 0, 1);
+                for (std::size_t k = 0; k < before->size(); ++k)
+                    (void)ctx.download_uint(0x1C12, static_cast<uint8_t>(k + 1), (*before)[k], 2);
+                (void)ctx.download_uint(0x1C12, 0, before->size(), 1);
+            };
+            const std::string what = hex(none) + " (no such PDO) into 0x1C12:01";
+            Outcome o = pass();
+            if (ctx.download_uint(0x1C12, 0, 0, 1) != Error::Ok) {
+                o = fail("0x1C12:00 = 0 refused");
+            } else if (SdoAnswer a = sdo_raw(ctx, sdo_req(0x2B, 0x1C12, 1, none)); a.is_abort()) {
+                o = pass(what + ": refused", a.describe());
+            } else if (SdoAnswer b = sdo_raw(ctx, sdo_req(0x2F, 0x1C12, 0, 1)); b.is_abort()) {
+                o = pass(what + ": refused at subindex 0", b.describe());
+            } else {
+                const Error e = ctx.to_safeop();
+                (void)ctx.to_preop();
+                o = e == Error::Ok ? fail(what + ": acknowledged, and SAFEOP reached with it", "acknowledged",
+                                          "an abort, or a refused PREOP -> SAFEOP")
+                                   : pass(what + ": refused at PREOP -> SAFEOP", err(e));
+            }
+            put_back();
+            return o;
+        },
+        "ESI announces PdoAssign");
+    add(
         "pdo.mapping_too_long",
         "PDO mapping filled to its last subindex with its largest entry: taken, or refused with a code of "
         "the "
