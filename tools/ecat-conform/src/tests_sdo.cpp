@@ -570,6 +570,26 @@ void add_sdo_tests(Catalogue& c) {
             return expect_abort(a, p->index, 1, {0x06010003}, hex(p->index) + ":01");
         },
         "ESI announces PdoConfig", Severity::Warning);
+    add(
+        "abort.mapping_sub0_nonzero_code",
+        "Mapping entry written while subindex 0 is not 0, where refused: with 0x06010003 or the general "
+        "0x06010000 of its family, not a code of another situation",
+        "ETG.1000.6 SDO abort codes (0x06010003: subindex cannot be written, SI0 must be 0 for write access)",
+        [](Context& ctx) {
+            const EsiPdo* p = nullptr;
+            if (Outcome o = remappable_rxpdo(ctx, p); o.status != Status::Pass) return o;
+            auto v = ctx.upload_uint(p->index, 1);
+            auto v2 = ctx.upload_uint(p->index, 2);
+            if (!v || !v2) return fail(hex(p->index) + " upload failed");
+            SdoAnswer a = sdo_raw(ctx, sdo_req(0x23, p->index, 1, static_cast<uint32_t>(*v2)));
+            if (!a.is_abort()) {
+                (void)ctx.download_uint(p->index, 1, *v, 4);
+                return skip("taken (see sdo.abort.mapping_sub0_nonzero, a warning)");
+            }
+            // Taking the write is a warning of its own; a refusal must name this situation.
+            return expect_abort(a, p->index, 1, {0x06010003, 0x06010000}, hex(p->index) + ":01");
+        },
+        "ESI announces PdoConfig");
     for (auto [sub, word, name] : {std::tuple<uint8_t, std::size_t, const char*>{1, 0x08, "vendor"},
                                    {2, 0x0A, "product"},
                                    {3, 0x0C, "revision"},
