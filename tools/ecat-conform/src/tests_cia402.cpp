@@ -350,11 +350,11 @@ void add_cia402_tests(Catalogue& c) {
         a);
     add(
         "option_codes",
-        "Option codes 0x6007, 0x605A-0x605E (where present) hold a defined value or a manufacturer-specific one "
-        "(negative)",
-        "IEC 61800-7-201 (CiA 402) option codes: 0x6007 abort connection 0..3, 0x605A quick stop 0..8, 0x605B "
-        "shutdown 0..1, 0x605C disable operation 0..1, 0x605D halt 1..4, 0x605E fault reaction 0..4; "
-        "-32768..-1 manufacturer specific, the rest reserved",
+        "Option codes 0x6007, 0x605A-0x605E (where present) hold a defined value or a "
+        "manufacturer-specific one (negative)",
+        "IEC 61800-7-201 (CiA 402) option codes: 0x6007 abort connection 0..3, 0x605A quick stop 0..8, "
+        "0x605B shutdown 0..1, 0x605C disable operation 0..1, 0x605D halt 1..4, 0x605E fault reaction "
+        "0..4; -32768..-1 manufacturer specific, the rest reserved",
         [](Context& ctx) {
             CONFORM_NEED(need_402_profile(ctx));
             CONFORM_PREOP(ctx);
@@ -409,11 +409,12 @@ void add_cia402_tests(Catalogue& c) {
                     return fail("0x6060 = " + dec(md.value) + ": " + ctx.sdo_error(e));
                 // An acknowledged download is stored (ETG.1000.6 SDO download: the response confirms the
                 // write): 0x6060 reads back the mode written, whatever 0x6061 shows later.
-                if (auto back = ctx.upload(0x6060, 0); back && !back->empty() &&
-                                                       (*back)[0] != static_cast<uint8_t>(md.value)) {
+                if (auto back = ctx.upload(0x6060, 0);
+                    back && !back->empty() && (*back)[0] != static_cast<uint8_t>(md.value)) {
                     if (old) (void)ctx.download_uint(0x6060, 0, *old, 1);
-                    return fail("0x6060 = " + dec(md.value) + " acknowledged, but 0x6060 reads back another value",
-                                dec(static_cast<int8_t>((*back)[0])), dec(md.value));
+                    return fail(
+                        "0x6060 = " + dec(md.value) + " acknowledged, but 0x6060 reads back another value",
+                        dec(static_cast<int8_t>((*back)[0])), dec(md.value));
                 }
                 uint64_t shown = 0xFF;
                 for (int i = 0; i < 100; ++i) {
@@ -601,9 +602,8 @@ void add_cia402_tests(Catalogue& c) {
     add(
         "statusword.bits",
         "Operation enabled, holding in CSP: statusword state bits and bit 4 the same in the image and over "
-        "SDO, "
-        "bit 9 remote set (the controlword is processed), bit 11 internal limit and bit 13 following error "
-        "clear",
+        "SDO, bit 9 remote set (the controlword is processed), bit 11 internal limit and bit 13 following "
+        "error clear",
         "IEC 61800-7-201 (CiA 402) statusword 0x6041 state bits 0-3, 5, 6 and bits 4, 9, 11, 13 (csp)",
         [](Context& ctx) {
             CONFORM_NEED(need_402_profile(ctx));
@@ -706,11 +706,9 @@ void add_cia402_tests(Catalogue& c) {
     add(
         "fault.emergency",
         "Fault (communication loss while enabled): its emergency has 8 bytes, a non-zero error code as "
-        "0x603F, "
-        "the error register as 0x1001",
+        "0x603F, the error register as 0x1001",
         "ETG.1000.6 CoE emergency; ETG.1000.4 mailbox counter; CiA 301 error register 0x1001; IEC "
-        "61800-7-201 "
-        "error code 0x603F",
+        "61800-7-201 error code 0x603F",
         [](Context& ctx) { return fault_emergency(ctx, false); }, "profile 402 and --allow-fault");
     add(
         "fault.emergency_generic_bit", "The fault's emergency error register has bit 0 (generic error) set",

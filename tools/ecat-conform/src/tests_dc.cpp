@@ -214,9 +214,10 @@ void add_dc_tests(Catalogue& c) {
             if (!p0) return fail("0x0900 unreadable");
             const int64_t lead = static_cast<int32_t>(static_cast<uint32_t>(*r2) - *p0);
             if (lead < 0 || lead > 1'000'000)
-                return fail("receive time port 0 (0x0900) against the processing unit's (0x0918) of the same latch",
-                            dec(static_cast<long long>(lead)) + " ns from port 0 to the processing unit",
-                            "0 .. 1 ms (port 0 first)");
+                return fail(
+                    "receive time port 0 (0x0900) against the processing unit's (0x0918) of the same latch",
+                    dec(static_cast<long long>(lead)) + " ns from port 0 to the processing unit",
+                    "0 .. 1 ms (port 0 first)");
             return pass("latched", hex(*r, 16) + ", then " + hex(*r2, 16) + "; port 0 " +
                                        dec(static_cast<long long>(lead)) + " ns before");
         },
@@ -319,8 +320,7 @@ void add_dc_tests(Catalogue& c) {
         "magnitude over 1 ms (the datasheet's sign, set for local < received, a warning)",
         std::string(kDc) +
             " (0x0910 ECAT write compared with the local copy, 0x092C mean difference: bit 31 local < "
-            "received; "
-            "0x0930 write resets the filters)",
+            "received; 0x0930 write resets the filters)",
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_dc());
             auto speed = ctx.rd<uint16_t>(0x0930);
@@ -468,10 +468,10 @@ void add_dc_tests(Catalogue& c) {
         a);
     add(
         "sync_modes_taken.1c32",
-        "Every synchronization type 0x1C32:01 takes (0 free run, 1 SM2 event) is announced in 0x1C32:04 (bit 0, "
-        "bit 1)",
-        "ETG.1020 0x1C32:01 synchronization type, 0x1C32:04 supported synchronization types (bit 0 free run, "
-        "bit 1 synchronous with the SM event, bits 2-3 DC)",
+        "Every synchronization type 0x1C32:01 takes (0 free run, 1 SM2 event) is announced in 0x1C32:04 "
+        "(bit 0, bit 1)",
+        "ETG.1020 0x1C32:01 synchronization type, 0x1C32:04 supported synchronization types (bit 0 free "
+        "run, bit 1 synchronous with the SM event, bits 2-3 DC)",
         [](Context& ctx) {
             CONFORM_NEED(need_sync_object(ctx, 0x1C32));
             CONFORM_NEED(need_writable(ctx, 0x1C32, 1));
@@ -481,8 +481,8 @@ void add_dc_tests(Catalogue& c) {
             auto old = ctx.upload_uint(0x1C32, 1);
             std::string taken;
             std::optional<Outcome> bad;
-            for (const auto& [type, bit, name] : {std::tuple<uint16_t, uint64_t, const char*>{0, 0x01, "free run"},
-                                                  {1, 0x02, "SM2 event"}}) {
+            for (const auto& [type, bit, name] :
+                 {std::tuple<uint16_t, uint64_t, const char*>{0, 0x01, "free run"}, {1, 0x02, "SM2 event"}}) {
                 // A refusal (abort) says the type is not supported: only a write acknowledged and read back
                 // is taken.
                 if (ctx.download_uint(0x1C32, 1, type, 2) != Error::Ok) continue;
@@ -490,7 +490,8 @@ void add_dc_tests(Catalogue& c) {
                 if (!got || *got != type) continue;
                 taken += std::string(taken.empty() ? "" : ", ") + dec(type);
                 if (!(*sup & bit) && !bad)
-                    bad = fail("0x1C32:01 = " + dec(type) + " (" + name + ") taken, but 0x1C32:04 does not announce it",
+                    bad = fail("0x1C32:01 = " + dec(type) + " (" + name +
+                                   ") taken, but 0x1C32:04 does not announce it",
                                hex(*sup, 4), "bit " + dec(bit == 1 ? 0 : 1) + " set");
             }
             if (old) (void)ctx.download_uint(0x1C32, 1, *old, 2);

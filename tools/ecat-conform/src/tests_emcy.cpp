@@ -10,9 +10,9 @@ namespace {
 
 using master::Error;
 constexpr const char* kEmcy =
-    "ETG.1000.6 CoE emergency (mailbox length 10, CoE service 1, error code, error register, 5 bytes); "
-    "CiA 301 error register 0x1001 (bit 0 generic at any error, class bits by error code); ETG.1020 "
-    "diagnosis history 0x10F3 (emergencies stored as diag code 0xE800)";
+    "ETG.1000.6 CoE emergency (mailbox length 10, CoE service 1, error code, error register, 5 bytes); CiA "
+    "301 error register 0x1001 (bit 0 generic at any error, class bits by error code); ETG.1020 diagnosis "
+    "history 0x10F3 (emergencies stored as diag code 0xE800)";
 
 // The CiA 301 error register bit that an error code's class sets (-1 when the class has none).
 int class_bit(uint16_t code) {
@@ -192,14 +192,14 @@ Outcome history_header(Context& ctx) {
 void add_emcy_tests(Catalogue& c) {
     Adder add{c, "mbx"};
     add("emcy.refused_request",
-        "A refused AL request (PREOP -> OP) of a device that is not a drive: its emergency, if it sends one, "
-        "is 10 bytes of CoE service 1 with a non-zero error code, the generic and class bits in its error "
-        "register, which equals 0x1001, and is stored in 0x10F3 where the device has it",
+        "A refused AL request (PREOP -> OP) of a device that is not a drive: its emergency, if it sends "
+        "one, is 10 bytes of CoE service 1 with a non-zero error code, the generic and class bits in its "
+        "error register, which equals 0x1001, and is stored in 0x10F3 where the device has it",
         kEmcy, refused_request_emergency, "CoE, a state machine (no device emulation), not a CiA 402 drive");
     add("diag.history_header",
-        "Diagnosis history 0x10F3: newest message (:02) 0 or a message subindex, holding the latest message; "
-        "maximum messages (:01) within 6..:00, flags (:05) without reserved bits, new messages available (:04) "
-        "FALSE once the newest is read (overwrite mode)",
+        "Diagnosis history 0x10F3: newest message (:02) 0 or a message subindex, holding the latest "
+        "message; maximum messages (:01) within 6..:00, flags (:05) without reserved bits, new messages "
+        "available (:04) FALSE once the newest is read (overwrite mode)",
         "ETG.1020 diagnosis history 0x10F3 (subindex 1 maximum messages, 2 newest message, 4 new messages "
         "available, 5 flags, 6.. messages)",
         history_header, "CoE and 0x10F3");

@@ -728,11 +728,13 @@ void add_esc_tests(Catalogue& c) {
         });
     add("reg.al_event_request",
         "AL event request 0x0220 bit 0 (AL control event) clear once a requested state change is done",
-        "ESC datasheet section II AL event request 0x0220 (bit 0 set by an ECAT write to AL control, cleared "
+        "ETG.1000.4 register access; ESC datasheet section II AL event request 0x0220 (bit 0 set by an ECAT "
+        "write to AL control, cleared "
         "when the PDI reads 0x0120); 0x0141 bit 0 device emulation",
         [](Context& ctx) {
             if (auto cfg = ctx.rd<uint8_t>(esc::reg::kEscConfig); cfg && (*cfg & 0x01))
-                return skip("device emulation (0x0141 bit 0): the ESC copies AL control, no application reads it");
+                return skip(
+                    "device emulation (0x0141 bit 0): the ESC copies AL control, no application reads it");
             CONFORM_NEED(ctx.need_state_machine());
             if (ctx.to_init() != Error::Ok) return fail("cannot reach INIT");
             // INIT -> PREOP: the application read AL control to make the change, so the event is taken.
@@ -747,7 +749,8 @@ void add_esc_tests(Catalogue& c) {
     add("reg.esc_reset",
         "ESC reset ('R', 'E', 'S' to 0x0040) from PREOP: where the device has one (its station address is "
         "cleared), AL status is back to INIT",
-        "ESC datasheet section II ESC reset ECAT 0x0040 (the ESC and the application restart: AL status INIT)",
+        "ETG.1000.4 register access; ESC datasheet section II ESC reset ECAT 0x0040 (the ESC and the "
+        "application restart: AL status INIT)",
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_state_machine());
             if (Error e = ctx.to_preop(); e != Error::Ok) return fail("cannot reach PREOP", err(e));
@@ -770,8 +773,10 @@ void add_esc_tests(Catalogue& c) {
                 return fail("AL status after an ESC reset from PREOP", hex(*al), "INIT (0x0001)");
             return pass("reset to INIT", hex(*al));
         });
-    add("reg.process_ram", "Process RAM outside the SyncManagers (its last 8 bytes, in INIT) reads back as written",
-        "ESC datasheet section II process data RAM 0x1000 (size 0x0006): read/write for EtherCAT",
+    add("reg.process_ram",
+        "Process RAM outside the SyncManagers (its last 8 bytes, in INIT) reads back as written",
+        "ETG.1000.4 register access; ESC datasheet section II process data RAM 0x1000 (size 0x0006): "
+        "read/write for EtherCAT",
         [](Context& ctx) {
             auto kb = ctx.rd<uint8_t>(0x0006);
             if (!kb) return fail("0x0006 unreadable", err(kb.error()));

@@ -128,8 +128,8 @@ Outcome foe_read(Context& ctx) {
         Error e2 = ctx.mbx->receive(r, ctx.ms(1000));
         while (e2 == Error::Ok && r.type != master::MailboxType::FoE && r.type != master::MailboxType::Error)
             e2 = ctx.mbx->receive(r, ctx.ms(1000));
-        const bool refused =
-            e2 == Error::Ok && r.type == master::MailboxType::FoE && r.payload.size() >= 6 && r.payload[0] == 5;
+        const bool refused = e2 == Error::Ok && r.type == master::MailboxType::FoE && r.payload.size() >= 6 &&
+                             r.payload[0] == 5;
         if (refused && get32(&r.payload[2]) == 0x8005)
             return pass(std::string(n < full ? "file read to its end" : "DATA packets numbered from 1") +
                             "; ACK " + dec(value + 5) + " refused with 0x8005",
@@ -303,7 +303,8 @@ void add_foe_tests(Catalogue& c) {
         a);
     add(
         "unexpected_packet",
-        "FoE ACK and DATA packets with no transfer running, in BOOT: each refused with error 0x8004 (illegal)",
+        "FoE ACK and DATA packets with no transfer running, in BOOT: each refused with error 0x8004, "
+        "illegal",
         kFoe,
         [](Context& ctx) {
             CONFORM_BOOT(ctx);

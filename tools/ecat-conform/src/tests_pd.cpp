@@ -372,8 +372,7 @@ void add_pd_tests(Catalogue& c) {
         "ETG.1000.4 working counter of LWR",
         [](Context& ctx) { return logical_only(ctx, master::Command::LWR); },
         "process data (layout over CoE, else from the SII)");
-    add(
-        "op.logical_guard",
+    add("op.logical_guard",
         "OP: LRW over the image with 8 guard bytes before and after: the guard bytes come back unchanged, "
         "working counter as without them",
         "ETG.1000.4 logical addressing (a slave processes only the bytes its FMMUs map)", logical_guard,

@@ -614,7 +614,8 @@ void add_sdo_tests(Catalogue& c) {
         },
         "ESI given");
     add(
-        "device_name_vs_esi", "0x1008 manufacturer device name equals the ESI's DefaultString (read-only object)",
+        "device_name_vs_esi",
+        "0x1008 manufacturer device name equals the ESI's DefaultString (read-only object)",
         "ETG.1000.6 0x1008 manufacturer device name; ETG.2000 Dictionary/Objects/Object/Info/DefaultString",
         {&Context::need_coe, &Context::need_esi},
         [](Context& ctx) {
@@ -807,8 +808,8 @@ void add_sdo_tests(Catalogue& c) {
     }
     add(
         "ca.response_fields",
-        "Complete access upload of 0x1018 from subindex 0: response with the complete-access bit, index and "
-        "subindex echoed, size as the data",
+        "Complete access upload of 0x1018 from subindex 0: response with the complete-access bit, index "
+        "and subindex echoed, size as the data",
         kCa, {&Context::need_complete_access},
         [](Context& ctx) {
             SdoAnswer a = sdo_raw(ctx, sdo_req(0x50, 0x1018, 0));
@@ -929,13 +930,14 @@ void add_sdo_tests(Catalogue& c) {
     add(
         "pdo.mapping_not_mappable",
         "An object the ESI does not declare RxPDO-mappable written into a mapping: refused with 0x06040041 "
-        "(cannot be mapped; 0x06040043 as the general code), at the entry or at subindex 0, or at the latest "
-        "by PREOP -> SAFEOP; restored",
+        "(cannot be mapped; 0x06040043 as the general code), at the entry or at subindex 0, or at the "
+        "latest by PREOP -> SAFEOP; restored",
         "ETG.1000.6 CoE PDO mapping; SDO abort code 0x06040041",
         [](Context& ctx) {
             const EsiPdo* p = nullptr;
             if (Outcome o = remappable_rxpdo(ctx, p); o.status != Status::Pass) return o;
-            // 0x1018:01 (vendor id) where the ESI leaves it unmappable, else the first such entry of 8..32 bits.
+            // 0x1018:01 (vendor id) where the ESI leaves it unmappable, else the first such entry of 8..32
+            // bits.
             uint16_t obj = 0;
             const EsiEntry* bad = nullptr;
             for (const auto& [index, o] : ctx.esi->objects)
@@ -947,8 +949,8 @@ void add_sdo_tests(Catalogue& c) {
                         bad = &e;
                     }
             if (!bad) return skip("no unmappable entry in the ESI dictionary");
-            const uint32_t value = static_cast<uint32_t>(obj) << 16 | static_cast<uint32_t>(bad->subindex) << 8 |
-                                   bad->bit_size;
+            const uint32_t value =
+                static_cast<uint32_t>(obj) << 16 | static_cast<uint32_t>(bad->subindex) << 8 | bad->bit_size;
             auto entries = read_mapping(ctx, p->index);
             if (!entries) return fail("upload: " + ctx.sdo_error(entries.error()));
             const std::string what = hex(obj) + ":" + dec(bad->subindex) + " into " + hex(p->index);
@@ -973,8 +975,8 @@ void add_sdo_tests(Catalogue& c) {
         "ESI announces PdoConfig");
     add(
         "pdo.assign_unknown_pdo",
-        "A PDO index that does not exist (not in the ESI, no object) assigned to 0x1C12: refused with an abort, "
-        "at the entry or at subindex 0, or at the latest by PREOP -> SAFEOP; restored",
+        "A PDO index that does not exist (not in the ESI, no object) assigned to 0x1C12: refused with an "
+        "abort, at the entry or at subindex 0, or at the latest by PREOP -> SAFEOP; restored",
         "ETG.1000.6 CoE PDO assignment 0x1C12 (only existing PDOs of the SM's direction)",
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_esi());
@@ -1018,8 +1020,8 @@ void add_sdo_tests(Catalogue& c) {
     add(
         "pdo.mapping_too_long",
         "PDO mapping filled to its last subindex with its largest entry: taken, or refused with a code of "
-        "the "
-        "situation (0x06040042 PDO length exceeded and kin), never 'cannot be mapped' for a mappable object",
+        "the situation (0x06040042 PDO length exceeded and kin), never 'cannot be mapped' for a mappable "
+        "object",
         "ETG.1000.6 CoE PDO mapping; SDO abort codes 0x06040041/0x06040042/0x06040043",
         [](Context& ctx) {
             const EsiPdo* p = nullptr;

@@ -166,11 +166,11 @@ void add_sii_tests(Catalogue& c) {
                              bytes_hex(std::span<const uint8_t>(ctx.sii->bytes).subspan(0, 128), 128));
         });
     add("interface.status",
-        "EEPROM interface 0x0500-0x0502 after a read: not busy, no command, write-enable or loading error, no "
-        "checksum error with a correct checksum; the PDI does not hold the EEPROM, write enable cleared, "
-        "address algorithm as the EEPROM size",
-        "ETG.1000.4 SII access; ESC datasheet section II EEPROM interface 0x0500-0x0502 (bits 0, 7, 11-15 of "
-        "0x0502, bit 0 of 0x0500/0x0501)",
+        "EEPROM interface 0x0500-0x0502 after a read: not busy, no command, write-enable or loading error, "
+        "no checksum error with a correct checksum; the PDI does not hold the EEPROM, write enable "
+        "cleared, address algorithm as the EEPROM size",
+        "ETG.1000.4 SII access; ESC datasheet section II EEPROM interface 0x0500-0x0502 (bits 0, 7, 11-15 "
+        "of 0x0502, bit 0 of 0x0500/0x0501)",
         [](Context& ctx) {
             uint8_t b[8];
             const auto e = ctx.m.sii_read(ctx.addr, 0, b);
@@ -194,9 +194,10 @@ void add_sii_tests(Catalogue& c) {
             if (!cfg) return fail("0x0500 unreadable", err(cfg.error()));
             const bool offered = *cfg & 0x0001, pdi_holds = *cfg & 0x0100;
             if (pdi_holds && !offered)
-                return fail("0x0501 bit 0 (PDI has EEPROM access) without the offer of 0x0500 bit 0, right after "
-                            "an ECAT read completed",
-                            "0x0500 = " + hex(*cfg), "0x0501 bit 0 clear");
+                return fail(
+                    "0x0501 bit 0 (PDI has EEPROM access) without the offer of 0x0500 bit 0, right after "
+                    "an ECAT read completed",
+                    "0x0500 = " + hex(*cfg), "0x0501 bit 0 clear");
             if ((*st & 0x0001) && !pdi_holds)
                 return fail("0x0502 bit 0 (ECAT write enable) set after a read command", hex(*st),
                             "clear (self-clearing with the next frame)");
@@ -542,8 +543,7 @@ void add_sii_tests(Catalogue& c) {
         "ESI has CoE");
     add("general.ports_flags",
         "General category: physical ports as the ESC's port descriptor 0x0007 (port 0 in use), flag 'not "
-        "LRW' "
-        "only where 0x0008 says LRW is not supported",
+        "LRW' only where 0x0008 says LRW is not supported",
         "ETG.2010 SII General category (bytes 11, 16-17); ESC datasheet 0x0007, 0x0008 bit 9",
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_sii());
