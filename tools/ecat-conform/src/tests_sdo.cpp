@@ -1,5 +1,6 @@
 // Group sdo: CoE SDO transfers (expedited, normal, segmented, complete access), the standard abort codes,
 // the object dictionary against the ESI, identity against the SII, PDO assignment/mapping rules.
+#include <functional>
 #include <thread>
 
 #include "report.hpp"
@@ -177,6 +178,19 @@ Outcome remappable_rxpdo(Context& ctx, const EsiPdo*& p) {
     return skip("no configurable RxPDO");
 }
 
+// An entry of the first configurable RxPDO written while its subindex 0 is not 0: another valid entry
+// (subindex 2's) into subindex 1, a real change of an active mapping; a write taken is undone. The answer in
+// `a`; an outcome other than a pass where the test cannot run.
+Outcome entry_written_while_active(Context& ctx, const EsiPdo*& p, SdoAnswer& a) {
+    if (Outcome o = remappable_rxpdo(ctx, p); o.status != Status::Pass) return o;
+    auto v = ctx.upload_uint(p->index, 1);
+    auto v2 = ctx.upload_uint(p->index, 2);
+    if (!v || !v2) return fail(hex(p->index) + " upload failed");
+    a = sdo_raw(ctx, sdo_req(0x23, p->index, 1, static_cast<uint32_t>(*v2)));
+    if (!a.is_abort()) (void)ctx.download_uint(p->index, 1, *v, 4);
+    return pass();
+}
+
 // A mapping object's entries (subindex 1..:00) as read, for putting them back.
 master::Result<std::vector<uint64_t>> read_mapping(Context& ctx, uint16_t index) {
     auto n = ctx.upload_uint(index, 0);
@@ -191,11 +205,31 @@ master::Result<std::vector<uint64_t>> read_mapping(Context& ctx, uint16_t index)
 }
 
 // Writes a mapping as a master does (ETG.1000.6 PDO mapping): subindex 0 to 0, the entries, the count.
-Error write_mapping(Context& ctx, uint16_t index, const std::vector<uint64_t>& entries) {
+Error write_mapping(Context& ctx, uint16_t index, const std::vector<uint64_t>& entries,
+                    uint8_t entry_bytes = 4) {
     Error e = ctx.download_uint(index, 0, 0, 1);
     for (std::size_t k = 0; k < entries.size() && e == Error::Ok; ++k)
-        e = ctx.download_uint(index, static_cast<uint8_t>(k + 1), entries[k], 4);
+        e = ctx.download_uint(index, static_cast<uint8_t>(k + 1), entries[k], entry_bytes);
     return e == Error::Ok ? ctx.download_uint(index, 0, entries.size(), 1) : e;
+}
+
+// A mapping or assignment the slave must refuse, written as a master does: subindex 0 to 0, `value` into
+// subindex 1 (`bytes` long), subindex 0 to 1. The refusal may come at the entry, at subindex 0 or, at the
+// latest, as a refused PREOP -> SAFEOP; judge(abort, subindex) judges an abort.
+Outcome refused_pdo_write(Context& ctx, uint16_t index, uint32_t value, uint8_t bytes,
+                          const std::string& what,
+                          const std::function<Outcome(const SdoAnswer&, uint8_t)>& judge) {
+    if (ctx.download_uint(index, 0, 0, 1) != Error::Ok) return fail(hex(index) + ":00 = 0 refused");
+    if (SdoAnswer a = sdo_raw(ctx, sdo_req(bytes == 2 ? 0x2B : 0x23, index, 1, value)); a.is_abort())
+        return judge(a, 1);
+    if (SdoAnswer b = sdo_raw(ctx, sdo_req(0x2F, index, 0, 1)); b.is_abort()) return judge(b, 0);
+    // Taken by both writes: a device may check at PREOP -> SAFEOP instead; it must refuse there.
+    const Error e = ctx.to_safeop();
+    (void)ctx.to_preop();
+    if (e == Error::Ok)
+        return fail(what + ": taken, and SAFEOP reached with it", "acknowledged",
+                    "an abort, or a refused PREOP -> SAFEOP");
+    return pass(what + ": refused at PREOP -> SAFEOP", err(e));
 }
 
 }  // namespace
@@ -560,13 +594,8 @@ void add_sdo_tests(Catalogue& c) {
         "ETG.1000.6 CoE PDO mapping (subindex 0 set to 0 before entries change)",
         [](Context& ctx) {
             const EsiPdo* p = nullptr;
-            if (Outcome o = remappable_rxpdo(ctx, p); o.status != Status::Pass) return o;
-            auto v = ctx.upload_uint(p->index, 1);
-            auto v2 = ctx.upload_uint(p->index, 2);
-            if (!v || !v2) return fail(hex(p->index) + " upload failed");
-            // Another valid entry (subindex 2's) into subindex 1: a real change of an active mapping.
-            SdoAnswer a = sdo_raw(ctx, sdo_req(0x23, p->index, 1, static_cast<uint32_t>(*v2)));
-            if (!a.is_abort()) (void)ctx.download_uint(p->index, 1, *v, 4);
+            SdoAnswer a;
+            if (Outcome o = entry_written_while_active(ctx, p, a); o.status != Status::Pass) return o;
             return expect_abort(a, p->index, 1, {0x06010003}, hex(p->index) + ":01");
         },
         "ESI announces PdoConfig", Severity::Warning);
@@ -577,16 +606,10 @@ void add_sdo_tests(Catalogue& c) {
         "ETG.1000.6 SDO abort codes (0x06010003: subindex cannot be written, SI0 must be 0 for write access)",
         [](Context& ctx) {
             const EsiPdo* p = nullptr;
-            if (Outcome o = remappable_rxpdo(ctx, p); o.status != Status::Pass) return o;
-            auto v = ctx.upload_uint(p->index, 1);
-            auto v2 = ctx.upload_uint(p->index, 2);
-            if (!v || !v2) return fail(hex(p->index) + " upload failed");
-            SdoAnswer a = sdo_raw(ctx, sdo_req(0x23, p->index, 1, static_cast<uint32_t>(*v2)));
-            if (!a.is_abort()) {
-                (void)ctx.download_uint(p->index, 1, *v, 4);
-                return skip("taken (see sdo.abort.mapping_sub0_nonzero, a warning)");
-            }
+            SdoAnswer a;
+            if (Outcome o = entry_written_while_active(ctx, p, a); o.status != Status::Pass) return o;
             // Taking the write is a warning of its own; a refusal must name this situation.
+            if (!a.is_abort()) return skip("taken (see sdo.abort.mapping_sub0_nonzero, a warning)");
             return expect_abort(a, p->index, 1, {0x06010003, 0x06010000}, hex(p->index) + ":01");
         },
         "ESI announces PdoConfig");
@@ -954,21 +977,11 @@ void add_sdo_tests(Catalogue& c) {
             auto entries = read_mapping(ctx, p->index);
             if (!entries) return fail("upload: " + ctx.sdo_error(entries.error()));
             const std::string what = hex(obj) + ":" + dec(bad->subindex) + " into " + hex(p->index);
-            Outcome o = pass();
-            if (ctx.download_uint(p->index, 0, 0, 1) != Error::Ok) {
-                o = fail(hex(p->index) + ":00 = 0 refused");
-            } else if (SdoAnswer a = sdo_raw(ctx, sdo_req(0x23, p->index, 1, value)); a.is_abort()) {
-                o = expect_abort(a, p->index, 1, {0x06040041, 0x06040043}, what);
-            } else if (SdoAnswer b = sdo_raw(ctx, sdo_req(0x2F, p->index, 0, 1)); b.is_abort()) {
-                o = expect_abort(b, p->index, 0, {0x06040041, 0x06040043}, what + ", at subindex 0");
-            } else {
-                // Taken by both writes: a device may check at PREOP -> SAFEOP instead; it must refuse there.
-                const Error e = ctx.to_safeop();
-                (void)ctx.to_preop();
-                o = e == Error::Ok ? fail(what + ": taken, and SAFEOP reached with it", "acknowledged",
-                                          "abort 0x06040041 or a refused PREOP -> SAFEOP")
-                                   : pass(what + ": refused at PREOP -> SAFEOP", err(e));
-            }
+            const Outcome o = refused_pdo_write(
+                ctx, p->index, value, 4, what, [&p, &what](const SdoAnswer& a, uint8_t sub) {
+                    return expect_abort(a, p->index, sub, {0x06040041, 0x06040043},
+                                        what + (sub ? "" : ", at subindex 0"));
+                });
             (void)write_mapping(ctx, p->index, *entries);
             return o;
         },
@@ -992,28 +1005,12 @@ void add_sdo_tests(Catalogue& c) {
             if (!none) return skip("every RxPDO index is used");
             auto before = read_mapping(ctx, 0x1C12);  // the assignment, read as a mapping (:00, :01..)
             if (!before) return fail("0x1C12 upload: " + ctx.sdo_error(before.error()));
-            auto put_back = [&ctx, &before]() {
-                (void)ctx.download_uint(0x1C12, 0, 0, 1);
-                for (std::size_t k = 0; k < before->size(); ++k)
-                    (void)ctx.download_uint(0x1C12, static_cast<uint8_t>(k + 1), (*before)[k], 2);
-                (void)ctx.download_uint(0x1C12, 0, before->size(), 1);
-            };
             const std::string what = hex(none) + " (no such PDO) into 0x1C12:01";
-            Outcome o = pass();
-            if (ctx.download_uint(0x1C12, 0, 0, 1) != Error::Ok) {
-                o = fail("0x1C12:00 = 0 refused");
-            } else if (SdoAnswer a = sdo_raw(ctx, sdo_req(0x2B, 0x1C12, 1, none)); a.is_abort()) {
-                o = pass(what + ": refused", a.describe());
-            } else if (SdoAnswer b = sdo_raw(ctx, sdo_req(0x2F, 0x1C12, 0, 1)); b.is_abort()) {
-                o = pass(what + ": refused at subindex 0", b.describe());
-            } else {
-                const Error e = ctx.to_safeop();
-                (void)ctx.to_preop();
-                o = e == Error::Ok ? fail(what + ": acknowledged, and SAFEOP reached with it", "acknowledged",
-                                          "an abort, or a refused PREOP -> SAFEOP")
-                                   : pass(what + ": refused at PREOP -> SAFEOP", err(e));
-            }
-            put_back();
+            const Outcome o =
+                refused_pdo_write(ctx, 0x1C12, none, 2, what, [&what](const SdoAnswer& a, uint8_t sub) {
+                    return pass(what + (sub ? ": refused" : ": refused at subindex 0"), a.describe());
+                });
+            (void)write_mapping(ctx, 0x1C12, *before, 2);
             return o;
         },
         "ESI announces PdoAssign");
