@@ -2417,8 +2417,9 @@ _GROUPS_UNSEEN5 = {
 
 VARIATIONS.update({
     # -- round 5 (written blind, with UNSEEN5) --
+    # The drive sets bit 8 itself: the variation flips it (set bits alone would change no reply).
     "statusword-bit8-manufacturer": ("CiA 402 / IEC 61800-7-201 statusword bit 8: manufacturer specific, any value",
-                                     apply_all(statusword(lambda v: v | 0x0100), statusword_pd_bits(0x0100))),
+                                     statusword_sdo_pd(lambda v: v ^ 0x0100)),
     "dl-status-enhanced-link": ("ESC datasheet 0x0110 bit 2 (enhanced link detection active) with 0x0008 bit 6 "
                                 "(enhanced link detection MII supported): silicon options",
                                 apply_all(reg_rewriter(0x0008, set_bits(0x0040)),
