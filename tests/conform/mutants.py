@@ -1190,8 +1190,9 @@ TABLE_SURVIVORS = {
     "esc-eeprom-address-bytes": "equivalent on this slave: it emulates its EEPROM (0x0502 bit 5), where the "
                                 "address algorithm (bit 7) has no meaning; sii.interface.status judges bit 7 "
                                 "against SII word 0x3E for a real EEPROM only; a mistake of the mutant",
-    "al-code-fatal-sync-as-sync": "not provoked: no test stops SYNC0 while the slave is in OP; not closed (the "
-                                  "code for SYNC0 lost, 0x002C against 0x001A, is left open)",
+    "al-code-fatal-sync-as-sync": "not provoked (no test stops SYNC0 while the slave is in OP), and no defect: a "
+                                  "loss of sync in OP may be reported with 0x001A or 0x002C (the project's protocol "
+                                  "digest, ETG.1000.6 AL status codes, read after the tool); a mistake of the mutant",
     "foe-packet-number-as-illegal": "the table's drive stores no image, so its FoE read is refused; killed by "
                                     "test_conform.py foe_write (foe.read_file acknowledges the last packet read "
                                     "with a wrong number)",
