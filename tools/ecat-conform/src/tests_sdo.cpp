@@ -649,9 +649,10 @@ void add_sdo_tests(Catalogue& c) {
             if (e->access != "ro") return skip("0x1008 writable in the ESI (" + e->access + ")");
             auto v = ctx.upload(0x1008, 0);
             if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
-            // A device may pad the string to its declared size with NULs (VISIBLE_STRING): compared without.
+            // A device may pad the string to its declared size with NULs or blanks (VISIBLE_STRING): compared
+            // without.
             auto text = [](std::vector<uint8_t> b) {
-                while (!b.empty() && b.back() == 0)
+                while (!b.empty() && (b.back() == 0 || b.back() == ' '))
                     b.pop_back();
                 return std::string(b.begin(), b.end());
             };
