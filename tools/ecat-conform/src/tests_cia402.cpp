@@ -359,7 +359,8 @@ void add_cia402_tests(Catalogue& c) {
         "Option codes 0x6007, 0x605A-0x605E (where present) hold a defined value or a "
         "manufacturer-specific one (negative)",
         "IEC 61800-7-201 (CiA 402) option codes: 0x6007 abort connection 0..3, 0x605A quick stop 0..8, "
-        "0x605B shutdown 0..1, 0x605C disable operation 0..1, 0x605D halt 1..4, 0x605E fault reaction "
+        "0x605B shutdown 0..1, 0x605C disable operation 0..1, 0x605D halt 1..4 (0 taken too), 0x605E fault "
+        "reaction "
         "0..4; -32768..-1 manufacturer specific, the rest reserved",
         [](Context& ctx) {
             CONFORM_NEED(need_402_profile(ctx));
@@ -370,7 +371,7 @@ void add_cia402_tests(Catalogue& c) {
             };
             std::string seen;
             for (const Option& o : {Option{0x6007, 0, 3}, Option{0x605A, 0, 8}, Option{0x605B, 0, 1},
-                                    Option{0x605C, 0, 1}, Option{0x605D, 1, 4}, Option{0x605E, 0, 4}}) {
+                                    Option{0x605C, 0, 1}, Option{0x605D, 0, 4}, Option{0x605E, 0, 4}}) {
                 auto v = ctx.upload(o.index, 0);
                 if (!v || v->size() != 2) continue;  // absent (optional), or not INTEGER16: not judged here
                 const int code = static_cast<int16_t>(get16(v->data()));

@@ -384,9 +384,9 @@ void add_mbx_tests(Catalogue& c) {
             if (r.size() < 10 || (r[5] & 0x0F) != 0 || get16(r.data()) != 4 || get16(&r[6]) != 0x0001)
                 return skip("no mailbox error reply (see mbx.error.coe_unknown_service)");
             const uint16_t detail = get16(&r[8]);
-            if (detail != 0x0004 && detail != 0x0001 && detail != 0x0006)
+            if (detail != 0x0004 && detail != 0x0001 && detail != 0x0005 && detail != 0x0006)
                 return fail("CoE service 0: the mailbox error detail names another fault", hex(detail),
-                            "0x0004 (service not supported), 0x0001 or 0x0006");
+                            "0x0004 (service not supported), 0x0001, 0x0005 or 0x0006");
             return pass("CoE service 0", "detail " + hex(detail));
         },
         "CoE");

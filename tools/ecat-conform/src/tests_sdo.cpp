@@ -185,7 +185,8 @@ Outcome entry_written_while_active(Context& ctx, const EsiPdo*& p, SdoAnswer& a)
     if (Outcome o = remappable_rxpdo(ctx, p); o.status != Status::Pass) return o;
     auto v = ctx.upload_uint(p->index, 1);
     auto v2 = ctx.upload_uint(p->index, 2);
-    if (!v || !v2) return fail(hex(p->index) + " upload failed");
+    if (!v || !v2)
+        return fail(hex(p->index) + ":01/:02 upload: " + ctx.sdo_error(!v ? v.error() : v2.error()));
     a = sdo_raw(ctx, sdo_req(0x23, p->index, 1, static_cast<uint32_t>(*v2)));
     if (!a.is_abort()) (void)ctx.download_uint(p->index, 1, *v, 4);
     return pass();
@@ -966,8 +967,8 @@ void add_sdo_tests(Catalogue& c) {
             const EsiEntry* bad = nullptr;
             for (const auto& [index, o] : ctx.esi->objects)
                 for (const auto& e : o.entries)
-                    if (e.subindex > 0 && e.pdo_mapping.find('R') == std::string::npos && e.access != "wo" &&
-                        (e.bit_size == 8 || e.bit_size == 16 || e.bit_size == 32) &&
+                    if (e.subindex > 0 && e.pdo_mapping.find_first_of("Rr") == std::string::npos &&
+                        e.access != "wo" && (e.bit_size == 8 || e.bit_size == 16 || e.bit_size == 32) &&
                         (!bad || (index == 0x1018 && e.subindex == 1))) {
                         obj = index;
                         bad = &e;

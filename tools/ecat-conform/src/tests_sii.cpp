@@ -201,18 +201,29 @@ void add_sii_tests(Catalogue& c) {
             if ((*st & 0x0001) && !pdi_holds)
                 return fail("0x0502 bit 0 (ECAT write enable) set after a read command", hex(*st),
                             "clear (self-clearing with the next frame)");
-            // Bit 7: the address algorithm, 1 address byte for 1-16 Kbit EEPROMs, 2 from 32 Kbit; SII word
-            // 0x3E gives the size (Kbit - 1). An EEPROM emulated by the PDI (bit 5) has no algorithm.
-            if (!(*st & 0x0020) && ctx.sii) {
-                const unsigned kbit = ctx.sii->word(0x3E) + 1u;
-                const bool two = *st & 0x0080;
-                if (two != (kbit > 16))
-                    return fail("0x0502 bit 7 (EEPROM address algorithm) against the EEPROM size", hex(*st),
-                                std::string(kbit > 16 ? "2" : "1") + " address byte(s) for " + dec(kbit) +
-                                    " Kbit (SII word 0x3E)");
-            }
             return pass("0x0500/0x0502", hex(*cfg) + " / " + hex(*st));
         });
+    add(
+        "interface.address_algorithm",
+        "EEPROM address algorithm 0x0502 bit 7 (1 address byte: up to 16 Kbit) holds the EEPROM size of SII "
+        "word 0x3E (a real EEPROM, not one the PDI emulates)",
+        "ETG.1000.4 SII access; ESC datasheet section II 0x0502 bit 7 (1 address byte for 1-16 Kbit EEPROMs, "
+        "2 "
+        "from 32 Kbit), bit 5 (EEPROM emulated by the PDI); ETG.2010 SII word 0x3E (size in Kbit - 1)",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            auto st = ctx.rd<uint16_t>(master::reg::SiiControl);
+            if (!st) return fail("0x0502 unreadable", err(st.error()));
+            if (*st & 0x0020) return skip("EEPROM emulated by the PDI (0x0502 bit 5): no address algorithm");
+            // Only the impossible direction is judged: an SII image may be smaller than its EEPROM (2 address
+            // bytes with a size of 16 Kbit or less), but one address byte cannot reach past 16 Kbit.
+            const unsigned kbit = ctx.sii->word(0x3E) + 1u;
+            if (!(*st & 0x0080) && kbit > 16)
+                return fail("one EEPROM address byte (0x0502 bit 7 clear) for a larger EEPROM", hex(*st),
+                            "bit 7 set for " + dec(kbit) + " Kbit (SII word 0x3E)");
+            return pass("0x0502", hex(*st) + ", " + dec(kbit) + " Kbit");
+        },
+        "an SII", Severity::Warning);
     add("header.checksum", "Checksum of words 0-6 in word 7 (CRC-8, polynomial 0x07, seed 0xFF)", kSii,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_sii());
