@@ -1188,8 +1188,9 @@ TABLE_SURVIVORS = {
                                 "data; not a defect of this slave",
     # round 5 (UNSEEN5)
     "esc-eeprom-address-bytes": "equivalent on this slave: it emulates its EEPROM (0x0502 bit 5), where the "
-                                "address algorithm (bit 7) has no meaning; sii.interface.status judges bit 7 "
-                                "against SII word 0x3E for a real EEPROM only; a mistake of the mutant",
+                                "address algorithm (bit 7) has no meaning; sii.interface.address_algorithm "
+                                "judges bit 7 against SII word 0x3E for a real EEPROM only; a mistake of the "
+                                "mutant",
     "al-code-fatal-sync-as-sync": "not provoked (no test stops SYNC0 while the slave is in OP), and no defect: a "
                                   "loss of sync in OP may be reported with 0x001A or 0x002C (the project's protocol "
                                   "digest, ETG.1000.6 AL status codes, read after the tool); a mistake of the mutant",
