@@ -729,8 +729,7 @@ void add_esc_tests(Catalogue& c) {
     add("reg.al_event_request",
         "AL event request 0x0220 bit 0 (AL control event) clear once a requested state change is done",
         "ETG.1000.4 register access; ESC datasheet section II AL event request 0x0220 (bit 0 set by an ECAT "
-        "write to AL control, cleared "
-        "when the PDI reads 0x0120); 0x0141 bit 0 device emulation",
+        "write to AL control, cleared when the PDI reads 0x0120); 0x0141 bit 0 device emulation",
         [](Context& ctx) {
             if (auto cfg = ctx.rd<uint8_t>(esc::reg::kEscConfig); cfg && (*cfg & 0x01))
                 return skip(
@@ -782,7 +781,8 @@ void add_esc_tests(Catalogue& c) {
             if (!kb) return fail("0x0006 unreadable", err(kb.error()));
             if (*kb == 0) return skip("no process RAM (0x0006 = 0)");
             if (ctx.to_init() != Error::Ok) return fail("cannot reach INIT");
-            const uint16_t at = static_cast<uint16_t>(0x1000u + 1024u * *kb - 8u);
+            // The RAM ends where 0x0006 says, within the ESC's 64 KiB address space.
+            const uint16_t at = static_cast<uint16_t>(std::min(0x1000u + 1024u * *kb, 0x10000u) - 8u);
             uint8_t old[8] = {};
             if (Error e = ctx.m.read(ctx.addr, at, old); e != Error::Ok)
                 return fail(hex(at) + " unreadable", err(e));
