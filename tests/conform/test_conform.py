@@ -430,8 +430,9 @@ class Conform(unittest.TestCase):
                 x = json.loads(pathlib.Path(out).read_text())["results"][0]
                 self.assertEqual(x["status"], "PASS", r.stdout[-3000:])
                 self.assertTrue(x["observed"].startswith("1 2 "), x)  # packet numbers seen, not a refusal
-                # The unseen defects of the read path are caught there: DATA numbered from 0, a reserved byte.
-                for name in ("foe-data-packet-no", "foe-reserved"):
+                # The unseen defects of the read path are caught there: DATA numbered from 0, a reserved byte,
+                # a wrong ACK refused with another code than 0x8005.
+                for name in ("foe-data-packet-no", "foe-reserved", "foe-packet-number-as-illegal"):
                     with ProxyLink(bus.iface, mutants.MUTANTS[name][1]) as p:
                         r = subprocess.run([os.environ["ECAT_CONFORM"], "--iface", p.iface, "--esi", esi,
                                             "--filter", "foe.read_file", "--foe-file", "MAXPOS", "--json", out,

@@ -1,6 +1,8 @@
 // Group dc: distributed clocks: system time, receive-time latch, offset and delay registers, SYNC0
 // activation, SAFEOP/OP in DC mode, the sync manager parameter objects 0x1C32/0x1C33.
+#include <optional>
 #include <thread>
+#include <tuple>
 
 #include "sdo_util.hpp"
 
@@ -187,7 +189,8 @@ void add_dc_tests(Catalogue& c) {
         },
         a);
     add(
-        "receive_time.local", "Receive time of processing unit 0x0918 latched with port 0", kDc,
+        "receive_time.local",
+        "Receive time of processing unit 0x0918 latched with port 0, port 0's time (0x0900) no later", kDc,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_dc());
             uint8_t z[4] = {};
@@ -204,7 +207,19 @@ void add_dc_tests(Catalogue& c) {
             if (*r2 == *r)
                 return fail("0x0918 unchanged by a second latch (write to 0x0900) 2 ms later", hex(*r2, 16),
                             "a new time");
-            return pass("latched", hex(*r, 16) + ", then " + hex(*r2, 16));
+            // Both latched by the same frame, which enters at port 0 (the tool's side) before it reaches the
+            // processing unit: 0x0900 (32 bits of the local time) is no later than 0x0918's low word, and
+            // not by more than a frame's pass through the ESC.
+            auto p0 = ctx.rd<uint32_t>(esc::reg::kDcRecvTime0);
+            if (!p0) return fail("0x0900 unreadable");
+            const int64_t lead = static_cast<int32_t>(static_cast<uint32_t>(*r2) - *p0);
+            if (lead < 0 || lead > 1'000'000)
+                return fail(
+                    "receive time port 0 (0x0900) against the processing unit's (0x0918) of the same latch",
+                    dec(static_cast<long long>(lead)) + " ns from port 0 to the processing unit",
+                    "0 .. 1 ms (port 0 first)");
+            return pass("latched", hex(*r, 16) + ", then " + hex(*r2, 16) + "; port 0 " +
+                                       dec(static_cast<long long>(lead)) + " ns before");
         },
         a);
     add(
@@ -305,8 +320,7 @@ void add_dc_tests(Catalogue& c) {
         "magnitude over 1 ms (the datasheet's sign, set for local < received, a warning)",
         std::string(kDc) +
             " (0x0910 ECAT write compared with the local copy, 0x092C mean difference: bit 31 local < "
-            "received; "
-            "0x0930 write resets the filters)",
+            "received; 0x0930 write resets the filters)",
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_dc());
             auto speed = ctx.rd<uint16_t>(0x0930);
@@ -450,6 +464,39 @@ void add_dc_tests(Catalogue& c) {
             auto got = ctx.upload_uint(0x1C32, 1);
             if (old) (void)ctx.download_uint(0x1C32, 1, *old, 2);
             return expect_eq("0x1C32:01", got ? dec(static_cast<long long>(*got)) : "?", "2");
+        },
+        a);
+    add(
+        "sync_modes_taken.1c32",
+        "Every synchronization type 0x1C32:01 takes (0 free run, 1 SM2 event) is announced in 0x1C32:04 "
+        "(bit 0, bit 1)",
+        "ETG.1020 0x1C32:01 synchronization type, 0x1C32:04 supported synchronization types (bit 0 free "
+        "run, bit 1 synchronous with the SM event, bits 2-3 DC)",
+        [](Context& ctx) {
+            CONFORM_NEED(need_sync_object(ctx, 0x1C32));
+            CONFORM_NEED(need_writable(ctx, 0x1C32, 1));
+            CONFORM_PREOP(ctx);
+            auto sup = ctx.upload_uint(0x1C32, 4);
+            if (!sup) return fail("0x1C32:04: " + ctx.sdo_error(sup.error()));
+            auto old = ctx.upload_uint(0x1C32, 1);
+            std::string taken;
+            std::optional<Outcome> bad;
+            for (const auto& [type, bit, name] :
+                 {std::tuple<uint16_t, uint64_t, const char*>{0, 0x01, "free run"}, {1, 0x02, "SM2 event"}}) {
+                // A refusal (abort) says the type is not supported: only a write acknowledged and read back
+                // is taken.
+                if (ctx.download_uint(0x1C32, 1, type, 2) != Error::Ok) continue;
+                auto got = ctx.upload_uint(0x1C32, 1);
+                if (!got || *got != type) continue;
+                taken += std::string(taken.empty() ? "" : ", ") + dec(type);
+                if (!(*sup & bit) && !bad)
+                    bad = fail("0x1C32:01 = " + dec(type) + " (" + name +
+                                   ") taken, but 0x1C32:04 does not announce it",
+                               hex(*sup, 4), "bit " + dec(bit == 1 ? 0 : 1) + " set");
+            }
+            if (old) (void)ctx.download_uint(0x1C32, 1, *old, 2);
+            if (bad) return *bad;
+            return pass(taken.empty() ? "neither 0 nor 1 taken" : "taken " + taken, hex(*sup, 4));
         },
         a);
     add(

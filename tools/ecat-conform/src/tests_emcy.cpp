@@ -10,9 +10,9 @@ namespace {
 
 using master::Error;
 constexpr const char* kEmcy =
-    "ETG.1000.6 CoE emergency (mailbox length 10, CoE service 1, error code, error register, 5 bytes); "
-    "CiA 301 error register 0x1001 (bit 0 generic at any error, class bits by error code); ETG.1020 "
-    "diagnosis history 0x10F3 (emergencies stored as diag code 0xE800)";
+    "ETG.1000.6 CoE emergency (mailbox length 10, CoE service 1, error code, error register, 5 bytes); CiA "
+    "301 error register 0x1001 (bit 0 generic at any error, class bits by error code); ETG.1020 diagnosis "
+    "history 0x10F3 (emergencies stored as diag code 0xE800)";
 
 // The CiA 301 error register bit that an error code's class sets (-1 when the class has none).
 int class_bit(uint16_t code) {
@@ -132,7 +132,24 @@ Outcome history_header(Context& ctx) {
     h.max_messages = static_cast<uint8_t>(*max);
     h.newest = static_cast<uint8_t>(*newest);
     if (auto v = ctx.upload_uint(0x10F3, 3)) h.acknowledged = static_cast<uint8_t>(*v);
-    if (h.newest == 0) return pass("no message", "0x10F3:02 = 0");
+    // The other header fields, each against the structure: the messages are subindices 6..:00, so :01 names
+    // no more than those; :05 defines bits 0-5 (emergency, three suppress bits, acknowledge mode, overflow),
+    // the rest is reserved; :04 (new messages available) is TRUE only with a message not yet read.
+    if (auto top = ctx.upload_uint(0x10F3, 0); top && static_cast<int>(*max) > static_cast<int>(*top) - 5)
+        return fail("0x10F3:01 (maximum messages) more than the message subindices 6..:00", dec(*max),
+                    "<= " + dec(static_cast<int>(*top) - 5) + " (:00 = " + dec(*top) + ")");
+    auto flags = ctx.upload_uint(0x10F3, 5);
+    if (flags && (*flags & 0xFFC0))
+        return fail("0x10F3:05 (flags): reserved bits 6-15 set", hex(*flags, 4), "bits 0-5 only");
+    auto available = [&ctx]() -> std::optional<uint64_t> {
+        auto v = ctx.upload_uint(0x10F3, 4);
+        return v ? std::optional<uint64_t>(*v & 1) : std::nullopt;
+    };
+    if (h.newest == 0) {
+        if (auto a = available(); a && *a)
+            return fail("0x10F3:04 (new messages available) TRUE without any message (:02 = 0)", "1", "0");
+        return pass("no message", "0x10F3:02 = 0");
+    }
     if (h.newest < 6 || h.newest > 5 + h.max_messages)
         return fail("0x10F3:02 (newest message) outside the message subindices", dec(h.newest),
                     "0 or 6.." + dec(5 + h.max_messages));
@@ -142,6 +159,16 @@ Outcome history_header(Context& ctx) {
     if (!top)
         return fail("0x10F3:02 names subindex " + dec(h.newest) + ", which holds no message",
                     b ? bytes_hex(*b, 16) : ctx.sdo_error(b.error()), "a diagnosis message");
+    // The newest message was just read: in overwrite mode (:05 bit 4 clear) nothing is left unread, unless
+    // a message came meanwhile (:02 moved).
+    if (flags && !(*flags & 0x0010)) {
+        auto a = available();
+        auto again = ctx.upload_uint(0x10F3, 2);
+        if (a && *a && again && *again == h.newest)
+            return fail("0x10F3:04 (new messages available) still TRUE after the newest message (:" +
+                            dec(h.newest) + ") was read, overwrite mode",
+                        "1", "0");
+    }
     unsigned n = 0;
     for (uint8_t sub : master::diag_message_order(h, true, false)) {
         if (sub == h.newest) continue;
@@ -165,13 +192,16 @@ Outcome history_header(Context& ctx) {
 void add_emcy_tests(Catalogue& c) {
     Adder add{c, "mbx"};
     add("emcy.refused_request",
-        "A refused AL request (PREOP -> OP) of a device that is not a drive: its emergency, if it sends one, "
-        "is 10 bytes of CoE service 1 with a non-zero error code, the generic and class bits in its error "
-        "register, which equals 0x1001, and is stored in 0x10F3 where the device has it",
+        "A refused AL request (PREOP -> OP) of a device that is not a drive: its emergency, if it sends "
+        "one, is 10 bytes of CoE service 1 with a non-zero error code, the generic and class bits in its "
+        "error register, which equals 0x1001, and is stored in 0x10F3 where the device has it",
         kEmcy, refused_request_emergency, "CoE, a state machine (no device emulation), not a CiA 402 drive");
     add("diag.history_header",
-        "Diagnosis history 0x10F3: newest message (:02) 0 or a message subindex, holding the latest message",
-        "ETG.1020 diagnosis history 0x10F3 (subindex 1 maximum messages, 2 newest message, 6.. messages)",
+        "Diagnosis history 0x10F3: newest message (:02) 0 or a message subindex, holding the latest "
+        "message; maximum messages (:01) within 6..:00, flags (:05) without reserved bits, new messages "
+        "available (:04) FALSE once the newest is read (overwrite mode)",
+        "ETG.1020 diagnosis history 0x10F3 (subindex 1 maximum messages, 2 newest message, 4 new messages "
+        "available, 5 flags, 6.. messages)",
         history_header, "CoE and 0x10F3");
 }
 

@@ -1,5 +1,6 @@
 // Group esc: datagram commands and their working counters, addressing, frames, ESC registers.
 #include <algorithm>
+#include <optional>
 #include <thread>
 
 #include "testkit.hpp"
@@ -724,6 +725,77 @@ void add_esc_tests(Catalogue& c) {
                 return fail("counters not 0 after a clear and 20 clean frames: " + bad,
                             bytes_hex(std::span<const uint8_t>(cnt, 0x14), 0x14), "0 on port 0");
             return pass("cleared, stay 0", bytes_hex(std::span<const uint8_t>(cnt, 0x14), 0x14));
+        });
+    add("reg.al_event_request",
+        "AL event request 0x0220 bit 0 (AL control event) clear once a requested state change is done",
+        "ETG.1000.4 register access; ESC datasheet section II AL event request 0x0220 (bit 0 set by an ECAT "
+        "write to AL control, cleared when the PDI reads 0x0120); 0x0141 bit 0 device emulation",
+        [](Context& ctx) {
+            if (auto cfg = ctx.rd<uint8_t>(esc::reg::kEscConfig); cfg && (*cfg & 0x01))
+                return skip(
+                    "device emulation (0x0141 bit 0): the ESC copies AL control, no application reads it");
+            CONFORM_NEED(ctx.need_state_machine());
+            if (ctx.to_init() != Error::Ok) return fail("cannot reach INIT");
+            // INIT -> PREOP: the application read AL control to make the change, so the event is taken.
+            if (Error e = ctx.to_preop(); e != Error::Ok) return fail("cannot reach PREOP", err(e));
+            auto ev = ctx.rd<uint32_t>(0x0220);
+            if (!ev) return fail("0x0220 unreadable", err(ev.error()));
+            if (*ev & 0x01)
+                return fail("AL control event still pending after the change to PREOP was done", hex(*ev, 8),
+                            "bit 0 clear (the application read AL control)");
+            return pass("0x0220", hex(*ev, 8));
+        });
+    add("reg.esc_reset",
+        "ESC reset ('R', 'E', 'S' to 0x0040) from PREOP: where the device has one (its station address is "
+        "cleared), AL status is back to INIT",
+        "ETG.1000.4 register access; ESC datasheet section II ESC reset ECAT 0x0040 (the ESC and the "
+        "application restart: AL status INIT)",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_state_machine());
+            if (Error e = ctx.to_preop(); e != Error::Ok) return fail("cannot reach PREOP", err(e));
+            if (!ctx.esc_reset()) {
+                (void)ctx.to_init();
+                return skip("no ESC reset (the station address still answers after the sequence)");
+            }
+            (void)ctx.m.assign_station_addresses(ctx.slave_count);
+            std::optional<uint16_t> al;
+            for (int i = 0; i < 50; ++i) {
+                if (auto v = ctx.rd<uint16_t>(esc::reg::kAlStatus)) {
+                    al = *v;
+                    if ((*v & 0x0F) == 0x01) break;
+                }
+                std::this_thread::sleep_for(ctx.ms(20));
+            }
+            (void)ctx.to_init();
+            if (!al) return fail("AL status unreadable after the ESC reset");
+            if ((*al & 0x0F) != 0x01)
+                return fail("AL status after an ESC reset from PREOP", hex(*al), "INIT (0x0001)");
+            return pass("reset to INIT", hex(*al));
+        });
+    add("reg.process_ram",
+        "Process RAM outside the SyncManagers (its last 8 bytes, in INIT) reads back as written",
+        "ETG.1000.4 register access; ESC datasheet section II process data RAM 0x1000 (size 0x0006): "
+        "read/write for EtherCAT",
+        [](Context& ctx) {
+            auto kb = ctx.rd<uint8_t>(0x0006);
+            if (!kb) return fail("0x0006 unreadable", err(kb.error()));
+            if (*kb == 0) return skip("no process RAM (0x0006 = 0)");
+            if (ctx.to_init() != Error::Ok) return fail("cannot reach INIT");
+            // The RAM ends where 0x0006 says, within the ESC's 64 KiB address space.
+            const uint16_t at = static_cast<uint16_t>(std::min(0x1000u + 1024u * *kb, 0x10000u) - 8u);
+            uint8_t old[8] = {};
+            if (Error e = ctx.m.read(ctx.addr, at, old); e != Error::Ok)
+                return fail(hex(at) + " unreadable", err(e));
+            uint8_t pattern[8], back[8] = {};
+            for (int i = 0; i < 8; ++i)
+                pattern[i] = static_cast<uint8_t>(0xA5 ^ (old[i] + 0x11 * (i + 1)));
+            Error w = ctx.m.write(ctx.addr, at, pattern);
+            Error r = ctx.m.read(ctx.addr, at, back);
+            (void)ctx.m.write(ctx.addr, at, old);
+            if (w != Error::Ok) return fail("write " + hex(at), err(w));
+            if (r != Error::Ok) return fail("read back " + hex(at), err(r));
+            return expect_eq("RAM " + hex(at) + "..+7", bytes_hex(std::span<const uint8_t>(back, 8), 8),
+                             bytes_hex(std::span<const uint8_t>(pattern, 8), 8));
         });
     add("reg.al_control_rw", "AL control 0x0120 accepts the master's request (INIT stays INIT)",
         "ETG.1000.6 AL control register", [](Context& ctx) {

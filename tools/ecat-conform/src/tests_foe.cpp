@@ -116,16 +116,39 @@ Outcome foe_read(Context& ctx) {
         if (m.payload[1] != 0) return fail("DATA header byte 1 (reserved) not 0", hex(m.payload[1], 2), "0");
         if (value != want) return fail("DATA packet number", seen, "1, 2, 3, ...");
         const std::size_t n = m.payload.size() - 6;
+        // The last packet read (the file's short one, or the last the tool reads) is answered with the ACK
+        // of another number: the server refuses it with 0x8005 (packet number wrong), which ends the read.
+        const bool last = n < full || want == kReadPackets;
         std::vector<uint8_t> ack(6, 0);
         ack[0] = 4;
-        put32(&ack[2], value);
+        put32(&ack[2], last ? value + 5 : value);
         (void)ctx.mbx->send(master::MailboxType::FoE, ack);
-        if (n < full) return pass("file read to its end", seen);
+        if (!last) continue;
+        master::MailboxMessage r;
+        Error e2 = ctx.mbx->receive(r, ctx.ms(1000));
+        while (e2 == Error::Ok && r.type != master::MailboxType::FoE && r.type != master::MailboxType::Error)
+            e2 = ctx.mbx->receive(r, ctx.ms(1000));
+        const bool refused = e2 == Error::Ok && r.type == master::MailboxType::FoE && r.payload.size() >= 6 &&
+                             r.payload[0] == 5;
+        if (refused && get32(&r.payload[2]) == 0x8005)
+            return pass(std::string(n < full ? "file read to its end" : "DATA packets numbered from 1") +
+                            "; ACK " + dec(value + 5) + " refused with 0x8005",
+                        seen);
+        if (!refused) {
+            // Not ended by the server: the tool ends the read.
+            std::vector<uint8_t> end(6, 0);
+            end[0] = 5;
+            put32(&end[2], 0x8000);
+            (void)ctx.mbx->send(master::MailboxType::FoE, end);
+        }
+        const std::string got = e2 != Error::Ok                      ? std::string("no answer")
+                                : r.type != master::MailboxType::FoE ? std::string("a mailbox error reply")
+                                : r.payload.size() < 6               ? std::string("a short FoE packet")
+                                : refused                            ? "ERR " + hex(get32(&r.payload[2]))
+                                                                     : "opcode " + dec(r.payload[0]);
+        return fail("ACK " + dec(value + 5) + " to DATA " + dec(value) + " (packet number wrong)", got,
+                    "ERR 0x8005");
     }
-    std::vector<uint8_t> end(6, 0);
-    end[0] = 5;
-    put32(&end[2], 0x8000);
-    (void)ctx.mbx->send(master::MailboxType::FoE, end);
     return pass("DATA packets numbered from 1", seen);
 }
 
@@ -279,9 +302,28 @@ void add_foe_tests(Catalogue& c) {
         },
         a);
     add(
+        "unexpected_packet",
+        "FoE ACK and DATA packets with no transfer running, in BOOT: each refused with error 0x8004, "
+        "illegal",
+        kFoe,
+        [](Context& ctx) {
+            CONFORM_BOOT(ctx);
+            // ETG.1000.6 FoE: a packet the server's state does not expect (an ACK without a read, DATA
+            // without a write) is an illegal request; the answer is an error request with 0x8004.
+            FoeAnswer ack = foe_request(ctx, 4, 1, "");
+            ctx.mbx_resync();
+            FoeAnswer data = foe_request(ctx, 3, 1, "ecat-conform");
+            ctx.mbx_resync();
+            (void)ctx.to_init();
+            if (Outcome o = expect_foe_error(ack, {0x8004}, "ACK 1 without a read"); o.status != Status::Pass)
+                return o;
+            return expect_foe_error(data, {0x8004}, "DATA 1 without a write");
+        },
+        a);
+    add(
         "read_file",
         "FoE read of --foe-file in BOOT: refused with an FoE error, or DATA packets numbered from 1, each "
-        "acknowledged (the first 8, then the read is ended)",
+        "acknowledged (up to 8; the last with a wrong number, refused with 0x8005)",
         kFoe,
         [](Context& ctx) {
             if (ctx.opt.foe_file.empty()) return skip("needs --foe-file (a file name the device knows)");

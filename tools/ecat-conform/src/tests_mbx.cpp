@@ -212,11 +212,10 @@ void add_mbx_tests(Catalogue& c) {
         "CoE");
     add(
         "sm.config",
-        "SM0/SM1 in PREOP: registers read back as configured, not deactivated by the PDI (0x0807/0x080F bit "
-        "0)",
+        "SM0/SM1 in PREOP: registers read back as configured, not deactivated by the PDI (0x0807/0x080F "
+        "bit 0)",
         "ESC datasheet SyncManager registers 0x0800+8n (read/write for EtherCAT; 0x0807 PDI control bit 0: "
-        "SM "
-        "deactivated); ETG.1000.4 mailbox",
+        "SM deactivated); ETG.1000.4 mailbox",
         {&Context::need_mailbox},
         [](Context& ctx) {
             const auto& mc = ctx.mbx->config();
@@ -366,6 +365,31 @@ void add_mbx_tests(Catalogue& c) {
             return mailbox_error(ctx, message(3, 0, p), {0x0001, 0x0004, 0x0006}, "CoE service 0");
         },
         "CoE", Severity::Warning);
+    add(
+        "error.coe_unknown_service_detail",
+        "CoE request with an unknown service (0) answered with a mailbox error reply: its detail names "
+        "this fault (0x0004 service not supported; 0x0001 syntax or 0x0006 size too short as general "
+        "readings), not another one (0x0002 unsupported protocol for a protocol the device serves, 0x0003 "
+        "channel, 0x0008 size)",
+        kMbx,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_PREOP(ctx);
+            ctx.mbx_resync();
+            uint8_t p[10] = {0x00, 0x00, 0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0};
+            auto r = ask(ctx, message(3, 0, p), ctx.ms(300));
+            ctx.mbx_resync();
+            // Whether a mailbox error reply comes at all is error.coe_unknown_service's (a warning); judged
+            // here is only a reply that is one.
+            if (r.size() < 10 || (r[5] & 0x0F) != 0 || get16(r.data()) != 4 || get16(&r[6]) != 0x0001)
+                return skip("no mailbox error reply (see mbx.error.coe_unknown_service)");
+            const uint16_t detail = get16(&r[8]);
+            if (detail != 0x0004 && detail != 0x0001 && detail != 0x0005 && detail != 0x0006)
+                return fail("CoE service 0: the mailbox error detail names another fault", hex(detail),
+                            "0x0004 (service not supported), 0x0001, 0x0005 or 0x0006");
+            return pass("CoE service 0", "detail " + hex(detail));
+        },
+        "CoE");
     add(
         "error.channel",
         "Request on channel 1 (reserved): answered as on channel 0, or mailbox error 0x0003 (invalid "

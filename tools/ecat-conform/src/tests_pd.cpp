@@ -208,6 +208,39 @@ Outcome logical_only(Context& ctx, master::Command cmd) {
                      dec(d.wkc), has ? "1" : "0");
 }
 
+// LRW over the image with 8 guard bytes before and after it (logical addresses no FMMU maps): the slave
+// reads and writes only the bytes of its FMMUs, so the guard bytes come back as sent (on a line they are the
+// next slave's), and the working counter is the image's.
+Outcome logical_guard(Context& ctx) {
+    CONFORM_NEED(ctx.need_pd_layout());
+    if (Error e = ctx.to_op(); e != Error::Ok) return fail("cannot reach OP: " + err(e));
+    if (!ctx.has_process_data()) return skip("no process data (no PDO assigned to a process-data SM)");
+    constexpr std::size_t kGuard = 8;
+    const auto& l = ctx.pds->layout();
+    const std::size_t n = static_cast<std::size_t>(l.output_bytes()) + l.input_bytes();
+    std::vector<uint8_t> img(n + 2 * kGuard);
+    for (std::size_t i = 0; i < img.size(); ++i)
+        img[i] = static_cast<uint8_t>(0x5A ^ (i * 0x1D));
+    std::copy(ctx.pds->outputs().begin(), ctx.pds->outputs().end(), img.begin() + kGuard);
+    const std::vector<uint8_t> sent = img;
+    master::Datagram d = master::Datagram::logical(
+        master::Command::LRW, master::ProcessDataSession::kLogicalBase - static_cast<uint32_t>(kGuard), img);
+    if (Error e = ctx.m.exchange(d); e != Error::Ok) return fail("no reply", err(e));
+    (void)ctx.cycle(2);
+    std::string changed;
+    for (std::size_t i = 0; i < img.size(); ++i) {
+        if (i >= kGuard && i < kGuard + n) continue;
+        if (img[i] != sent[i])
+            changed += (changed.empty() ? "" : " ") +
+                       std::string(i < kGuard ? "before-" + dec(static_cast<long long>(kGuard - i))
+                                              : "after+" + dec(static_cast<long long>(i - kGuard - n))) +
+                       ":" + hex(sent[i], 2) + "->" + hex(img[i], 2);
+    }
+    if (!changed.empty())
+        return fail("bytes outside the slave's FMMUs changed by the LRW", changed, "guard bytes as sent");
+    return expect_eq("LRW with guard bytes: working counter", dec(d.wkc), dec(ctx.pds->expected_wkc()));
+}
+
 // In OP with process data exchanged every cycle, the ESC registers the master configured read back as written
 // (ESC datasheet: SyncManager 0x0800+8n start, length, control and activate; FMMU 0x0600+16n, all read/write
 // for EtherCAT), the process-data SMs are not deactivated by the PDI (0x0807+8n bit 0) and the SM watchdog
@@ -338,6 +371,11 @@ void add_pd_tests(Catalogue& c) {
         "op.lwr_wkc", "OP: LWR over the image: working counter 1 (only the outputs are writable)",
         "ETG.1000.4 working counter of LWR",
         [](Context& ctx) { return logical_only(ctx, master::Command::LWR); },
+        "process data (layout over CoE, else from the SII)");
+    add("op.logical_guard",
+        "OP: LRW over the image with 8 guard bytes before and after: the guard bytes come back unchanged, "
+        "working counter as without them",
+        "ETG.1000.4 logical addressing (a slave processes only the bytes its FMMUs map)", logical_guard,
         "process data (layout over CoE, else from the SII)");
     add(
         "op.esc_registers",

@@ -1,7 +1,9 @@
 // Group sdo: CoE SDO transfers (expedited, normal, segmented, complete access), the standard abort codes,
 // the object dictionary against the ESI, identity against the SII, PDO assignment/mapping rules.
+#include <functional>
 #include <thread>
 
+#include "report.hpp"
 #include "sdo_util.hpp"
 
 namespace conform {
@@ -176,6 +178,20 @@ Outcome remappable_rxpdo(Context& ctx, const EsiPdo*& p) {
     return skip("no configurable RxPDO");
 }
 
+// An entry of the first configurable RxPDO written while its subindex 0 is not 0: another valid entry
+// (subindex 2's) into subindex 1, a real change of an active mapping; a write taken is undone. The answer in
+// `a`; an outcome other than a pass where the test cannot run.
+Outcome entry_written_while_active(Context& ctx, const EsiPdo*& p, SdoAnswer& a) {
+    if (Outcome o = remappable_rxpdo(ctx, p); o.status != Status::Pass) return o;
+    auto v = ctx.upload_uint(p->index, 1);
+    auto v2 = ctx.upload_uint(p->index, 2);
+    if (!v || !v2)
+        return fail(hex(p->index) + ":01/:02 upload: " + ctx.sdo_error(!v ? v.error() : v2.error()));
+    a = sdo_raw(ctx, sdo_req(0x23, p->index, 1, static_cast<uint32_t>(*v2)));
+    if (!a.is_abort()) (void)ctx.download_uint(p->index, 1, *v, 4);
+    return pass();
+}
+
 // A mapping object's entries (subindex 1..:00) as read, for putting them back.
 master::Result<std::vector<uint64_t>> read_mapping(Context& ctx, uint16_t index) {
     auto n = ctx.upload_uint(index, 0);
@@ -190,11 +206,31 @@ master::Result<std::vector<uint64_t>> read_mapping(Context& ctx, uint16_t index)
 }
 
 // Writes a mapping as a master does (ETG.1000.6 PDO mapping): subindex 0 to 0, the entries, the count.
-Error write_mapping(Context& ctx, uint16_t index, const std::vector<uint64_t>& entries) {
+Error write_mapping(Context& ctx, uint16_t index, const std::vector<uint64_t>& entries,
+                    uint8_t entry_bytes = 4) {
     Error e = ctx.download_uint(index, 0, 0, 1);
     for (std::size_t k = 0; k < entries.size() && e == Error::Ok; ++k)
-        e = ctx.download_uint(index, static_cast<uint8_t>(k + 1), entries[k], 4);
+        e = ctx.download_uint(index, static_cast<uint8_t>(k + 1), entries[k], entry_bytes);
     return e == Error::Ok ? ctx.download_uint(index, 0, entries.size(), 1) : e;
+}
+
+// A mapping or assignment the slave must refuse, written as a master does: subindex 0 to 0, `value` into
+// subindex 1 (`bytes` long), subindex 0 to 1. The refusal may come at the entry, at subindex 0 or, at the
+// latest, as a refused PREOP -> SAFEOP; judge(abort, subindex) judges an abort.
+Outcome refused_pdo_write(Context& ctx, uint16_t index, uint32_t value, uint8_t bytes,
+                          const std::string& what,
+                          const std::function<Outcome(const SdoAnswer&, uint8_t)>& judge) {
+    if (ctx.download_uint(index, 0, 0, 1) != Error::Ok) return fail(hex(index) + ":00 = 0 refused");
+    if (SdoAnswer a = sdo_raw(ctx, sdo_req(bytes == 2 ? 0x2B : 0x23, index, 1, value)); a.is_abort())
+        return judge(a, 1);
+    if (SdoAnswer b = sdo_raw(ctx, sdo_req(0x2F, index, 0, 1)); b.is_abort()) return judge(b, 0);
+    // Taken by both writes: a device may check at PREOP -> SAFEOP instead; it must refuse there.
+    const Error e = ctx.to_safeop();
+    (void)ctx.to_preop();
+    if (e == Error::Ok)
+        return fail(what + ": taken, and SAFEOP reached with it", "acknowledged",
+                    "an abort, or a refused PREOP -> SAFEOP");
+    return pass(what + ": refused at PREOP -> SAFEOP", err(e));
 }
 
 }  // namespace
@@ -559,16 +595,25 @@ void add_sdo_tests(Catalogue& c) {
         "ETG.1000.6 CoE PDO mapping (subindex 0 set to 0 before entries change)",
         [](Context& ctx) {
             const EsiPdo* p = nullptr;
-            if (Outcome o = remappable_rxpdo(ctx, p); o.status != Status::Pass) return o;
-            auto v = ctx.upload_uint(p->index, 1);
-            auto v2 = ctx.upload_uint(p->index, 2);
-            if (!v || !v2) return fail(hex(p->index) + " upload failed");
-            // Another valid entry (subindex 2's) into subindex 1: a real change of an active mapping.
-            SdoAnswer a = sdo_raw(ctx, sdo_req(0x23, p->index, 1, static_cast<uint32_t>(*v2)));
-            if (!a.is_abort()) (void)ctx.download_uint(p->index, 1, *v, 4);
+            SdoAnswer a;
+            if (Outcome o = entry_written_while_active(ctx, p, a); o.status != Status::Pass) return o;
             return expect_abort(a, p->index, 1, {0x06010003}, hex(p->index) + ":01");
         },
         "ESI announces PdoConfig", Severity::Warning);
+    add(
+        "abort.mapping_sub0_nonzero_code",
+        "Mapping entry written while subindex 0 is not 0, where refused: with 0x06010003 or the general "
+        "0x06010000 of its family, not a code of another situation",
+        "ETG.1000.6 SDO abort codes (0x06010003: subindex cannot be written, SI0 must be 0 for write access)",
+        [](Context& ctx) {
+            const EsiPdo* p = nullptr;
+            SdoAnswer a;
+            if (Outcome o = entry_written_while_active(ctx, p, a); o.status != Status::Pass) return o;
+            // Taking the write is a warning of its own; a refusal must name this situation.
+            if (!a.is_abort()) return skip("taken (see sdo.abort.mapping_sub0_nonzero, a warning)");
+            return expect_abort(a, p->index, 1, {0x06010003, 0x06010000}, hex(p->index) + ":01");
+        },
+        "ESI announces PdoConfig");
     for (auto [sub, word, name] : {std::tuple<uint8_t, std::size_t, const char*>{1, 0x08, "vendor"},
                                    {2, 0x0A, "product"},
                                    {3, 0x0C, "revision"},
@@ -590,6 +635,29 @@ void add_sdo_tests(Catalogue& c) {
             auto v = ctx.upload(0x1000, 0);
             if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
             return expect_eq("0x1000", bytes_hex(*v), bytes_hex(o->entries[0].default_data));
+        },
+        "ESI given");
+    add(
+        "device_name_vs_esi",
+        "0x1008 manufacturer device name equals the ESI's DefaultString (read-only object)",
+        "ETG.1000.6 0x1008 manufacturer device name; ETG.2000 Dictionary/Objects/Object/Info/DefaultString",
+        {&Context::need_coe, &Context::need_esi},
+        [](Context& ctx) {
+            const EsiObject* o = ctx.esi->object(0x1008);
+            const EsiEntry* e = o ? o->entry(0) : nullptr;
+            if (!e || e->default_data.empty() || !e->default_is_string)
+                return skip("no 0x1008 DefaultString in the ESI");
+            if (e->access != "ro") return skip("0x1008 writable in the ESI (" + e->access + ")");
+            auto v = ctx.upload(0x1008, 0);
+            if (!v) return fail("upload: " + ctx.sdo_error(v.error()));
+            // A device may pad the string to its declared size with NULs or blanks (VISIBLE_STRING): compared
+            // without.
+            auto text = [](std::vector<uint8_t> b) {
+                while (!b.empty() && (b.back() == 0 || b.back() == ' '))
+                    b.pop_back();
+                return std::string(b.begin(), b.end());
+            };
+            return expect_eq("0x1008", printable(text(*v)), printable(text(e->default_data)));
         },
         "ESI given");
     add(
@@ -765,8 +833,8 @@ void add_sdo_tests(Catalogue& c) {
     }
     add(
         "ca.response_fields",
-        "Complete access upload of 0x1018 from subindex 0: response with the complete-access bit, index and "
-        "subindex echoed, size as the data",
+        "Complete access upload of 0x1018 from subindex 0: response with the complete-access bit, index "
+        "and subindex echoed, size as the data",
         kCa, {&Context::need_complete_access},
         [](Context& ctx) {
             SdoAnswer a = sdo_raw(ctx, sdo_req(0x50, 0x1018, 0));
@@ -885,10 +953,74 @@ void add_sdo_tests(Catalogue& c) {
         },
         "ESI announces PdoConfig");
     add(
+        "pdo.mapping_not_mappable",
+        "An object the ESI does not declare RxPDO-mappable written into a mapping: refused with 0x06040041 "
+        "(cannot be mapped; 0x06040043 as the general code), at the entry or at subindex 0, or at the "
+        "latest by PREOP -> SAFEOP; restored",
+        "ETG.1000.6 CoE PDO mapping; SDO abort code 0x06040041",
+        [](Context& ctx) {
+            const EsiPdo* p = nullptr;
+            if (Outcome o = remappable_rxpdo(ctx, p); o.status != Status::Pass) return o;
+            // 0x1018:01 (vendor id) where the ESI leaves it unmappable, else the first such entry of 8..32
+            // bits.
+            uint16_t obj = 0;
+            const EsiEntry* bad = nullptr;
+            for (const auto& [index, o] : ctx.esi->objects)
+                for (const auto& e : o.entries)
+                    if (e.subindex > 0 && e.pdo_mapping.find_first_of("Rr") == std::string::npos &&
+                        e.access != "wo" && (e.bit_size == 8 || e.bit_size == 16 || e.bit_size == 32) &&
+                        (!bad || (index == 0x1018 && e.subindex == 1))) {
+                        obj = index;
+                        bad = &e;
+                    }
+            if (!bad) return skip("no unmappable entry in the ESI dictionary");
+            const uint32_t value =
+                static_cast<uint32_t>(obj) << 16 | static_cast<uint32_t>(bad->subindex) << 8 | bad->bit_size;
+            auto entries = read_mapping(ctx, p->index);
+            if (!entries) return fail("upload: " + ctx.sdo_error(entries.error()));
+            const std::string what = hex(obj) + ":" + dec(bad->subindex) + " into " + hex(p->index);
+            const Outcome o = refused_pdo_write(
+                ctx, p->index, value, 4, what, [&p, &what](const SdoAnswer& a, uint8_t sub) {
+                    return expect_abort(a, p->index, sub, {0x06040041, 0x06040043},
+                                        what + (sub ? "" : ", at subindex 0"));
+                });
+            (void)write_mapping(ctx, p->index, *entries);
+            return o;
+        },
+        "ESI announces PdoConfig");
+    add(
+        "pdo.assign_unknown_pdo",
+        "A PDO index that does not exist (not in the ESI, no object) assigned to 0x1C12: refused with an "
+        "abort, at the entry or at subindex 0, or at the latest by PREOP -> SAFEOP; restored",
+        "ETG.1000.6 CoE PDO assignment 0x1C12 (only existing PDOs of the SM's direction)",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            if (!ctx.esi->coe.pdo_assign) return skip("the ESI does not announce PdoAssign");
+            CONFORM_PREOP(ctx);
+            uint16_t none = 0;
+            for (uint16_t i = 0x17FF; i >= 0x1600 && !none; --i) {
+                bool listed = ctx.esi->object(i) != nullptr;
+                for (const auto& x : ctx.esi->rxpdos)
+                    listed = listed || x.index == i;
+                if (!listed) none = i;
+            }
+            if (!none) return skip("every RxPDO index is used");
+            auto before = read_mapping(ctx, 0x1C12);  // the assignment, read as a mapping (:00, :01..)
+            if (!before) return fail("0x1C12 upload: " + ctx.sdo_error(before.error()));
+            const std::string what = hex(none) + " (no such PDO) into 0x1C12:01";
+            const Outcome o =
+                refused_pdo_write(ctx, 0x1C12, none, 2, what, [&what](const SdoAnswer& a, uint8_t sub) {
+                    return pass(what + (sub ? ": refused" : ": refused at subindex 0"), a.describe());
+                });
+            (void)write_mapping(ctx, 0x1C12, *before, 2);
+            return o;
+        },
+        "ESI announces PdoAssign");
+    add(
         "pdo.mapping_too_long",
         "PDO mapping filled to its last subindex with its largest entry: taken, or refused with a code of "
-        "the "
-        "situation (0x06040042 PDO length exceeded and kin), never 'cannot be mapped' for a mappable object",
+        "the situation (0x06040042 PDO length exceeded and kin), never 'cannot be mapped' for a mappable "
+        "object",
         "ETG.1000.6 CoE PDO mapping; SDO abort codes 0x06040041/0x06040042/0x06040043",
         [](Context& ctx) {
             const EsiPdo* p = nullptr;

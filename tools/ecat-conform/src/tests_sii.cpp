@@ -166,9 +166,11 @@ void add_sii_tests(Catalogue& c) {
                              bytes_hex(std::span<const uint8_t>(ctx.sii->bytes).subspan(0, 128), 128));
         });
     add("interface.status",
-        "EEPROM control/status 0x0502 after a read: not busy, no command, write-enable or loading error, no "
-        "checksum error with a correct checksum",
-        "ETG.1000.4 SII access; ESC datasheet section II EEPROM control/status register 0x0502 (bits 11-15)",
+        "EEPROM interface 0x0500-0x0502 after a read: not busy, no command, write-enable or loading error, "
+        "no checksum error with a correct checksum; the PDI does not hold the EEPROM, write enable "
+        "cleared, address algorithm as the EEPROM size",
+        "ETG.1000.4 SII access; ESC datasheet section II EEPROM interface 0x0500-0x0502 (bits 0, 7, 11-15 "
+        "of 0x0502, bit 0 of 0x0500/0x0501)",
         [](Context& ctx) {
             uint8_t b[8];
             const auto e = ctx.m.sii_read(ctx.addr, 0, b);
@@ -184,8 +186,44 @@ void add_sii_tests(Catalogue& c) {
             if (*st & mask)
                 return fail("error or busy bits after a successful read", hex(*st),
                             std::string("bits ") + (crc_ok ? "11-15" : "13-15") + " clear");
-            return pass("0x0502", hex(*st));
+            // The other defined bits of the interface (ESC datasheet section II, 0x0500-0x0502), each against
+            // what the read just showed: the ECAT side had the EEPROM (its command completed); the PDI can
+            // hold it (0x0501 bit 0) only where 0x0500 bit 0 offers it; write enable (0x0502 bit 0) clears
+            // itself with the next frame and reads 1 only while the PDI has the EEPROM.
+            auto cfg = ctx.rd<uint16_t>(master::reg::SiiConfig);
+            if (!cfg) return fail("0x0500 unreadable", err(cfg.error()));
+            const bool offered = *cfg & 0x0001, pdi_holds = *cfg & 0x0100;
+            if (pdi_holds && !offered)
+                return fail(
+                    "0x0501 bit 0 (PDI has EEPROM access) without the offer of 0x0500 bit 0, right after "
+                    "an ECAT read completed",
+                    "0x0500 = " + hex(*cfg), "0x0501 bit 0 clear");
+            if ((*st & 0x0001) && !pdi_holds)
+                return fail("0x0502 bit 0 (ECAT write enable) set after a read command", hex(*st),
+                            "clear (self-clearing with the next frame)");
+            return pass("0x0500/0x0502", hex(*cfg) + " / " + hex(*st));
         });
+    add(
+        "interface.address_algorithm",
+        "EEPROM address algorithm 0x0502 bit 7 (1 address byte: up to 16 Kbit) holds the EEPROM size of SII "
+        "word 0x3E (a real EEPROM, not one the PDI emulates)",
+        "ETG.1000.4 SII access; ESC datasheet section II 0x0502 bit 7 (1 address byte for 1-16 Kbit EEPROMs, "
+        "2 "
+        "from 32 Kbit), bit 5 (EEPROM emulated by the PDI); ETG.2010 SII word 0x3E (size in Kbit - 1)",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            auto st = ctx.rd<uint16_t>(master::reg::SiiControl);
+            if (!st) return fail("0x0502 unreadable", err(st.error()));
+            if (*st & 0x0020) return skip("EEPROM emulated by the PDI (0x0502 bit 5): no address algorithm");
+            // Only the impossible direction is judged: an SII image may be smaller than its EEPROM (2 address
+            // bytes with a size of 16 Kbit or less), but one address byte cannot reach past 16 Kbit.
+            const unsigned kbit = ctx.sii->word(0x3E) + 1u;
+            if (!(*st & 0x0080) && kbit > 16)
+                return fail("one EEPROM address byte (0x0502 bit 7 clear) for a larger EEPROM", hex(*st),
+                            "bit 7 set for " + dec(kbit) + " Kbit (SII word 0x3E)");
+            return pass("0x0502", hex(*st) + ", " + dec(kbit) + " Kbit");
+        },
+        "an SII", Severity::Warning);
     add("header.checksum", "Checksum of words 0-6 in word 7 (CRC-8, polynomial 0x07, seed 0xFF)", kSii,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_sii());
@@ -516,8 +554,7 @@ void add_sii_tests(Catalogue& c) {
         "ESI has CoE");
     add("general.ports_flags",
         "General category: physical ports as the ESC's port descriptor 0x0007 (port 0 in use), flag 'not "
-        "LRW' "
-        "only where 0x0008 says LRW is not supported",
+        "LRW' only where 0x0008 says LRW is not supported",
         "ETG.2010 SII General category (bytes 11, 16-17); ESC datasheet 0x0007, 0x0008 bit 9",
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_sii());
