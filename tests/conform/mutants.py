@@ -1205,9 +1205,6 @@ TABLE_SURVIVORS = {
     "diag-message-type-info": "never fires: the table run reads the diagnosis messages before a fault is "
                               "provoked (info messages only then), and no test judges the type of an "
                               "emergency's message; not closed",
-    "sii-general-ebus-current": "not closed: the ESI reader does not carry Electrical/EBusCurrent, and the "
-                                "project's SII builder writes 0 there whatever the ESI says (esi/src/sii.cpp): "
-                                "the check needs the esi room first",
 }
 
 

@@ -614,10 +614,9 @@ void add_sii_tests(Catalogue& c) {
                 got += ", identification register " + hex(get16(b + 18));
                 want += ", identification register " + hex(*e.identification_ado);
             }
-            if (e.ebus_current_ma) {
-                got += ", E-Bus current " + std::to_string(static_cast<int16_t>(get16(b + 12))) + " mA";
-                want += ", E-Bus current " + std::to_string(*e.ebus_current_ma) + " mA";
-            }
+            // The E-Bus current: an ESI without Electrical/EBusCurrent describes a device that draws none.
+            got += ", E-Bus current " + std::to_string(static_cast<int16_t>(get16(b + 12))) + " mA";
+            want += ", E-Bus current " + std::to_string(e.ebus_current_ma.value_or(0)) + " mA";
             return expect_eq("General (bits 2 DataLinkLayer, 3 IdentificationReg134, 4 IdentificationAdo)",
                              got, want);
         },
