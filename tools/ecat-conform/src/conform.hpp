@@ -207,8 +207,8 @@ class Context {
     master::Error to_init();
     // ESC reset (ESC datasheet section II, 0x0040 "ESC Reset ECAT": 'R', 'E', 'S' written in three
     // consecutive frames), for a slave that cannot be brought back to INIT otherwise. True if the ESC was
-    // reset: it no longer answers at its station address (the reset clears 0x0010); the caller assigns
-    // addresses again. False where the ESC has no reset (it still answers there).
+    // reset: 0x0010, read by position, no longer holds its station address (the reset clears it). False
+    // where the ESC has no reset. The station addresses are assigned again either way.
     bool esc_reset();
     // INIT -> PREOP with the standard mailbox; sets up mbx/sdo. Idempotent when already in PREOP.
     master::Error to_preop();
