@@ -147,11 +147,15 @@ class KickcatSimulator(unittest.TestCase):
         self.assert_status(res, "sdo.identity.vendor", "PASS")
         # SDO information error reply: 6 bytes of CoE instead of 10.
         self.assert_status(res, "sdoinfo.error.format", "FAIL", "length")
+        # The segments of an upload carry no new mailbox counter (found since the counter rule covers every
+        # segment, blind round 4): its ESI declares the mailbox data link layer, whose master drops a reply
+        # with the counter of the one before as a repeat (ETG.1000.4 mailbox header, Cnt).
+        self.assert_status(res, "sdo.upload.toggle_sequence", "FAIL", "counter")
         # What it does right: lower-case PdoMapping of its ESI is legal (ETG.2000), its drive switches
         # modes once process data runs, its process data has the right working counters.
         for test in ("sdoinfo.list.txpdo", "sdoinfo.entry.pdo_mapping", "cia402.mode.csp", "cia402.mode.pp",
                      "pd.op.wkc", "pd.safeop.wkc", "pd.assign.rx_vs_esi", "pd.mapping.tx_vs_esi",
-                     "cia402.dc.enable_operation", "sdo.upload.toggle_sequence", "sdo.upload.normal"):
+                     "cia402.dc.enable_operation", "sdo.upload.normal"):
             self.assert_status(res, test, "PASS")
 
 
