@@ -8,13 +8,15 @@ namespace esc {
 
 inline constexpr std::size_t kCacheLine = 64;
 
-// Every cache line of [p, p + n), for writing (the walk writes most of what it reads).
+// Every cache line of [p, p + n), for writing (the walk writes most of what it reads). The line addresses
+// are integers made pointers, never pointer arithmetic: the first line may start before p, and a pointer
+// moved outside its object is undefined behaviour (UBSan's pointer-overflow check) even if never read.
 inline void prefetch_lines(const void* p, std::size_t n) {
-    const auto* b = static_cast<const char*>(p);
-    const auto first = reinterpret_cast<std::uintptr_t>(b) & ~(kCacheLine - 1);
-    const auto last = (reinterpret_cast<std::uintptr_t>(b) + (n == 0 ? 0 : n - 1)) & ~(kCacheLine - 1);
+    const auto begin = reinterpret_cast<std::uintptr_t>(p);
+    const auto first = begin & ~(kCacheLine - 1);
+    const auto last = (begin + (n == 0 ? 0 : n - 1)) & ~(kCacheLine - 1);
     for (std::uintptr_t a = first; a <= last; a += kCacheLine)
-        __builtin_prefetch(b + (a - reinterpret_cast<std::uintptr_t>(b)), 1, 3);
+        __builtin_prefetch(reinterpret_cast<const void*>(a), 1, 3);
 }
 
 }  // namespace esc
