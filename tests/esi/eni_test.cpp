@@ -8,11 +8,15 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <regex>
 #include <string>
 
+#include "esi/device/product.hpp"
+#include "esi/eni/eni_modules.hpp"
 #include "esi/eni/eni_product.hpp"
 #include "esi/eni/eni_reader.hpp"
+#include "esi/slots.hpp"
 
 namespace {
 
@@ -478,3 +482,130 @@ TEST(EniProduct, UnemulatedThingsAreWarningsOnePerElement) {
 }
 
 }  // namespace
+
+// A modular device served from its ESI gets the modules the ENI was configured with (eni_modules.hpp), by the
+// class of ways an ENI says so: the configured module ident list 0xF030 the master downloads (complete access
+// from subindex 0 or 1, or one subindex at a time), else the PDOs of each slot's module; a configuration no
+// module reproduces is refused with the PDO that no slot explains.
+namespace modules {
+
+const std::string kModularEsi = std::string(SOFTECAT_SOURCE_DIR) + "/esi/examples/modular-io.xml";
+const std::string kModularEni = std::string(SOFTECAT_SOURCE_DIR) + "/esi/eni/examples/modular-line.xml";
+constexpr uint32_t kDi8 = 0x1001, kDo8 = 0x2001, kAi2 = 0x3001;
+using Modules = std::vector<std::optional<uint32_t>>;
+
+esi::eni::CoeInitCmd f030(uint8_t sub, bool ca, std::vector<uint8_t> data) {
+    esi::eni::CoeInitCmd c;
+    c.transitions = {"PS"};
+    c.ccs = 1;
+    c.index = 0xF030;
+    c.subindex = sub;
+    c.complete_access = ca;
+    c.data = std::move(data);
+    return c;
+}
+
+std::vector<uint8_t> le32(uint32_t v) {
+    return {uint8_t(v), uint8_t(v >> 8), uint8_t(v >> 16), uint8_t(v >> 24)};
+}
+
+TEST(EniModules, ThePdosOfTheEniChooseEachSlotsModule) {
+    const esi::EsiFile f = esi::read_esi_file(kModularEsi);
+    const esi::eni::Config eni = esi::eni::read_eni_file(kModularEni);
+    ASSERT_EQ(eni.slaves.size(), 1u);
+    const auto m = esi::eni::modules_from_eni(f, f.devices.at(0), eni.slaves[0]);
+    ASSERT_TRUE(m);
+    EXPECT_EQ(m->modules, (Modules{kAi2, kAi2, std::nullopt, kDo8}));
+    EXPECT_EQ(m->how, "its PDOs");
+    // The product built with them has the ENI's PDOs and not the default modules': EXM-AI2's two entries in
+    // 0x1A00 and 0x1A01, EXM-DO8's 0x1603, nothing at 0x1601 (default EXM-DO8) or 0x1A02 (default EXM-AI2).
+    const od::Product p = esi::load_product(f, f.devices.at(0), m->modules);
+    const od::Dictionary dict = p.make_dictionary(p.description);
+    for (uint16_t index : {0x1A00, 0x1A01, 0x1603})
+        EXPECT_NE(dict.find(index), nullptr) << std::hex << index;
+    for (uint16_t index : {0x1601, 0x1A02})
+        EXPECT_EQ(dict.find(index), nullptr) << std::hex << index;
+    EXPECT_EQ(dict.find(0x1A00)->entries.size(), 3u);  // :00 and two 16-bit values
+}
+
+TEST(EniModules, TheDefaultModulesWhereTheEniHasTheirPdos) {
+    const esi::EsiFile f = esi::read_esi_file(kModularEsi);
+    esi::eni::Config eni = esi::eni::read_eni_file(kModularEni);
+    esi::eni::Slave s = eni.slaves[0];
+    // The ENI as the default configuration would give it: DI8 in slot 1, DO8 in 2, AI2 in 3.
+    s.process_data.rxpdos.clear();
+    s.process_data.txpdos.clear();
+    esi::eni::Pdo di{false, 0x1A00, 3, true, false, "DI", {}, 0};
+    for (uint8_t k = 1; k <= 8; ++k)
+        di.entries.push_back({0x6000, k, 1, "In", "BOOL"});
+    esi::eni::Pdo do8{true, 0x1601, 2, true, false, "DO", {}, 0};
+    for (uint8_t k = 1; k <= 8; ++k)
+        do8.entries.push_back({0x7010, k, 1, "Out", "BOOL"});
+    esi::eni::Pdo ai{
+        false, 0x1A02, 3, true, false, "AI", {{0x6020, 1, 16, "V1", "INT"}, {0x6020, 2, 16, "V2", "INT"}}, 0};
+    s.process_data.txpdos = {di, ai};
+    s.process_data.rxpdos = {do8};
+    const auto m = esi::eni::modules_from_eni(f, f.devices.at(0), s);
+    ASSERT_TRUE(m);
+    EXPECT_EQ(m->modules, (Modules{kDi8, kDo8, kAi2, std::nullopt}));
+    EXPECT_EQ(m->modules, esi::default_modules(f.devices.at(0)));
+}
+
+TEST(EniModules, TheConfiguredModuleIdentListEveryWayItIsWritten) {
+    const esi::EsiFile f = esi::read_esi_file(kModularEsi);
+    const esi::eni::Config eni = esi::eni::read_eni_file(kModularEni);
+    const Modules want{kDo8, std::nullopt, kDi8, kAi2};
+    std::vector<uint8_t> from1;
+    for (uint32_t v : {kDo8, 0u, kDi8, kAi2})
+        for (uint8_t b : le32(v))
+            from1.push_back(b);
+    std::vector<uint8_t> from0{4, 0};
+    from0.insert(from0.end(), from1.begin(), from1.end());
+    std::vector<std::vector<esi::eni::CoeInitCmd>> ways{
+        {f030(0, true, from0)},
+        {f030(1, true, from1)},
+        {f030(0, false, {0}), f030(1, false, le32(kDo8)), f030(3, false, le32(kDi8)),
+         f030(4, false, le32(kAi2)), f030(0, false, {4})},
+    };
+    for (const auto& cmds : ways) {
+        esi::eni::Slave s = eni.slaves[0];  // its PDOs say otherwise: the list wins
+        s.mailbox.coe_init_cmds.insert(s.mailbox.coe_init_cmds.begin(), cmds.begin(), cmds.end());
+        const auto m = esi::eni::modules_from_eni(f, f.devices.at(0), s);
+        ASSERT_TRUE(m);
+        EXPECT_EQ(m->modules, want);
+        EXPECT_EQ(m->how, "its 0xF030 init command");
+    }
+    // A list naming a module the file lacks, or a truncated complete access: the PDOs decide.
+    for (const auto& bad : {f030(1, false, le32(0x9999)), f030(0, true, {4, 0, 1, 0x10})}) {
+        esi::eni::Slave s = eni.slaves[0];
+        s.mailbox.coe_init_cmds.push_back(bad);
+        const auto m = esi::eni::modules_from_eni(f, f.devices.at(0), s);
+        ASSERT_TRUE(m);
+        EXPECT_EQ(m->how, "its PDOs");
+        EXPECT_EQ(m->modules, (Modules{kAi2, kAi2, std::nullopt, kDo8}));
+    }
+}
+
+TEST(EniModules, APdoNoModuleExplainsIsRefusedAndNamed) {
+    const esi::EsiFile f = esi::read_esi_file(kModularEsi);
+    const esi::eni::Config eni = esi::eni::read_eni_file(kModularEni);
+    // Every way a PDO can differ from each module's: another bit length, another subindex, an entry more, an
+    // index no slot has.
+    for (int variant = 0; variant < 4; ++variant) {
+        esi::eni::Slave s = eni.slaves[0];
+        esi::eni::Pdo& p = s.process_data.txpdos.at(1);  // 0x1A01, slot 2's EXM-AI2
+        if (variant == 0) p.entries[1].bit_len = 32;
+        if (variant == 1) p.entries[1].subindex = 3;
+        if (variant == 2) p.entries.push_back({0x6010, 3, 16, "V3", "INT"});
+        if (variant == 3) p.index = 0x1A09;
+        std::string why;
+        EXPECT_FALSE(esi::eni::modules_from_eni(f, f.devices.at(0), s, &why)) << variant;
+        EXPECT_NE(why.find(variant == 3 ? "0x1A09" : "0x1A01"), std::string::npos) << why;
+    }
+    // A device without slots: nothing to choose.
+    const esi::EsiFile plain =
+        esi::read_esi_file(std::string(SOFTECAT_SOURCE_DIR) + "/esi/examples/analog-in.xml");
+    EXPECT_FALSE(esi::eni::modules_from_eni(plain, plain.devices.at(0), eni.slaves[0]));
+}
+
+}  // namespace modules

@@ -151,13 +151,13 @@ class EniMaster:
 
 
 class EniLine(unittest.TestCase):
-    def run_line(self, args):
+    def run_line(self, args, eni=EXAMPLE):
         require_eni(self)
         with harness.Bus(slave_args=args) as bus:
-            m = EniMaster(bus, EXAMPLE)
+            m = EniMaster(bus, eni)
             self.addCleanup(m.close)
             # Found in the ENI's order, with the ENI's identities.
-            self.assertEqual(m.mm.count_slaves(), 5)
+            self.assertEqual(m.mm.count_slaves(), len(m.slaves))
             out = bus.ecatctl("scan").stdout
             rows = []
             for line in out.splitlines():
@@ -187,6 +187,20 @@ class EniLine(unittest.TestCase):
         self.assertEqual(log.count("served from"), 5, log)
         for esi in ("coupler.xml", "digital-io.xml", "analog-in.xml", "drive402.xml"):
             self.assertIn(esi, log)
+
+    def test_modular_device_gets_the_enis_modules(self):
+        # A modular device whose ENI configures modules other than the ESI's defaults (esi/eni/examples/
+        # modular-line.xml): served from its ESI with those modules, it takes the ENI's PDO assignment and SM
+        # lengths and reaches Op with the ENI's working counters; with the defaults the master's assignment of
+        # 0x1603 is aborted and the line stops in PREOP.
+        eni = os.path.join(SOURCE, "esi", "eni", "examples", "modular-line.xml")
+        log = self.run_line(["--eni", eni, "--esi-dir", os.path.join(SOURCE, "esi", "examples")], eni)
+        self.assertIn("modular-io.xml", log)
+        self.assertIn("modules EXM-AI2,EXM-AI2,-,EXM-DO8 (from its PDOs)", log)
+        self.assertNotIn("the default modules are served", log)
+        # From the ENI's data alone the same line reaches Op as well.
+        log = self.run_line(["--eni", eni], eni)
+        self.assertIn("(ENI data)", log)
 
     def test_topology_with_esi_devices(self):
         # A mixed line written by hand: a coupler and a digital input terminal from their ESIs (one device of a

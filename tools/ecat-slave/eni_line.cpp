@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "esi/device/product.hpp"
+#include "esi/eni/eni_modules.hpp"
 #include "esi/eni/eni_product.hpp"
 #include "esi/eni/eni_reader.hpp"
 
@@ -67,12 +68,32 @@ EniLine eni_line(const std::string& file, const EsiIndex* esis) {
     for (std::size_t k = 0; k < eni.slaves.size(); ++k) {
         const esi::eni::Slave& s = eni.slaves[k];
         std::shared_ptr<od::Product> product;
+        std::string modules_note;  // the module configuration taken from the ENI, said in the report
         if (esis) {
             auto it =
                 esis->devices.find(std::make_tuple(s.info.vendor_id, s.info.product_code, s.info.revision));
-            if (it != esis->devices.end())
-                product =
-                    std::make_shared<od::Product>(esi::load_product(*it->second.file, *it->second.device));
+            if (it != esis->devices.end()) {
+                // A modular device gets the modules the master was configured with (eni_modules.hpp).
+                const esi::EsiFile& f = *it->second.file;
+                const esi::EsiDevice& dev = *it->second.device;
+                std::string why;
+                if (auto m = esi::eni::modules_from_eni(f, dev, s, &why)) {
+                    product = std::make_shared<od::Product>(esi::load_product(f, dev, m->modules));
+                    std::string list;
+                    for (const auto& id : m->modules) {
+                        const esi::EsiModule* mod = id ? f.module(*id) : nullptr;
+                        list += (list.empty() ? "" : ",") + (mod ? mod->type_name : std::string("-"));
+                    }
+                    modules_note = "; modules " + list + " (from " + m->how + ")";
+                } else {
+                    product = std::make_shared<od::Product>(esi::load_product(f, dev));
+                    if (!why.empty())
+                        product->warnings.push_back(eni.where(s.line) +
+                                                    ": the default modules are served, as the ENI's "
+                                                    "configuration matches none: " +
+                                                    why);
+                }
+            }
         }
         std::string other_revisions;  // an ESI of DIR with this device in other revisions: said, not used
         if (esis && !product)
@@ -100,7 +121,7 @@ EniLine eni_line(const std::string& file, const EsiIndex* esis) {
         std::snprintf(station, sizeof station, "0x%04X", s.info.phys_addr);
         out.report.push_back(
             "ENI slave " + std::to_string(k) + " '" + s.info.name + "' (station address " + station +
-            " from the master): served from " + product->source +
+            " from the master): served from " + product->source + modules_note +
             (product->warnings.empty()
                  ? ""
                  : "; not emulated: " + std::to_string(product->warnings.size()) + " (said below)") +

@@ -1,0 +1,148 @@
+// The module configuration an ENI slave was configured with (see eni_modules.hpp).
+#include "esi/eni/eni_modules.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <tuple>
+
+#include "esi/slots.hpp"
+
+namespace esi::eni {
+
+namespace {
+
+// An entry as both files can state it: index, subindex (0 for a gap) and bit length.
+using Entry = std::tuple<uint16_t, uint8_t, uint16_t>;
+
+std::string hex4(uint32_t v) {
+    char b[16];
+    std::snprintf(b, sizeof b, "0x%04X", v);
+    return b;
+}
+
+uint32_t le32(const std::vector<uint8_t>& d, std::size_t at) {
+    return uint32_t(d[at]) | uint32_t(d[at + 1]) << 8 | uint32_t(d[at + 2]) << 16 | uint32_t(d[at + 3]) << 24;
+}
+
+bool takes(const EsiFile& f, const EsiDevice& d, std::size_t slot, uint32_t ident) {
+    const EsiModule* m = f.module(ident);
+    return m != nullptr && slot < d.slots.size() && slot_takes(f, d.slots[slot], *m);
+}
+
+// 1. The configured module ident list the master downloads (0xF030, ETG.5001.1): complete access from
+// subindex 0 (8-bit count, a padding byte, then the idents) or 1 (the idents), or one subindex at a time.
+std::optional<std::vector<std::optional<uint32_t>>> from_f030(const EsiFile& f, const EsiDevice& d,
+                                                              const Slave& s) {
+    std::map<std::size_t, uint32_t> idents;  // slot -> ident
+    bool seen = false;
+    for (const CoeInitCmd& c : s.mailbox.coe_init_cmds) {
+        if (c.index != 0xF030 || c.ccs != 1 || c.disabled) continue;
+        if (c.complete_access) {
+            const std::size_t first = c.subindex == 0 ? 2 : 0;
+            if (c.subindex > 1 || c.data.size() < first) return std::nullopt;
+            const std::size_t count = c.subindex == 0 ? c.data[0] : (c.data.size() - first) / 4;
+            if (c.data.size() < first + 4 * count) return std::nullopt;
+            for (std::size_t k = 0; k < count; ++k)
+                idents[k] = le32(c.data, first + 4 * k);
+            seen = true;
+        } else if (c.subindex >= 1 && c.data.size() == 4) {
+            idents[c.subindex - 1u] = le32(c.data, 0);
+            seen = true;
+        }
+    }
+    if (!seen) return std::nullopt;
+    std::vector<std::optional<uint32_t>> modules(d.slots.size());
+    for (const auto& [slot, ident] : idents) {
+        if (ident == 0) continue;
+        if (!takes(f, d, slot, ident)) return std::nullopt;
+        modules[slot] = ident;
+    }
+    return modules;
+}
+
+}  // namespace
+
+std::optional<EniModules> modules_from_eni(const EsiFile& f, const EsiDevice& d, const Slave& s,
+                                           std::string* why) {
+    if (d.slots.empty()) return std::nullopt;
+    if (auto m = from_f030(f, d, s)) return EniModules{std::move(*m), "its 0xF030 init command"};
+
+    std::map<uint16_t, std::vector<Entry>> eni;  // the ENI slave's PDOs
+    std::map<uint16_t, int> eni_line;
+    for (const auto* list : {&s.process_data.rxpdos, &s.process_data.txpdos})
+        for (const Pdo& p : *list) {
+            std::vector<Entry>& e = eni[p.index];
+            for (const PdoEntry& x : p.entries)
+                e.emplace_back(x.index, x.index == 0 ? uint8_t{0} : x.subindex, x.bit_len);
+            eni_line[p.index] = p.line;
+        }
+    auto matches = [&](const SlotPdo& p) {
+        auto it = eni.find(p.index);
+        if (it == eni.end() || it->second.size() != p.entries.size()) return false;
+        for (std::size_t k = 0; k < p.entries.size(); ++k) {
+            const EsiPdoEntry& x = p.entries[k];
+            if (it->second[k] != Entry{x.index, x.index == 0 ? uint8_t{0} : x.subindex, x.bit_len})
+                return false;
+        }
+        return true;
+    };
+
+    EniModules out;
+    out.how = "its PDOs";
+    out.modules.resize(d.slots.size());
+    std::set<uint16_t> explained;  // ENI PDOs the device or a chosen module declares
+    for (const auto* list : {&d.rxpdos, &d.txpdos})
+        for (const EsiPdo& p : *list)
+            explained.insert(p.index);
+    for (std::size_t n = 0; n < d.slots.size(); ++n) {
+        const EsiSlot& slot = d.slots[n];
+        std::vector<uint32_t> candidates;  // the default first, then the slot's own list, then by class
+        if (slot.default_module) candidates.push_back(*slot.default_module);
+        for (uint32_t id : slot.module_idents)
+            candidates.push_back(id);
+        for (const EsiModule& m : f.modules)
+            if (slot_takes(f, slot, m)) candidates.push_back(m.ident);
+        std::optional<uint32_t> best;
+        std::size_t best_pdos = 0;
+        std::vector<uint16_t> best_indices;
+        for (uint32_t id : candidates) {
+            std::vector<std::optional<uint32_t>> probe(n + 1);
+            probe[n] = id;
+            const std::vector<SlotModule> placed = slot_modules(f, d, probe);
+            if (placed.empty() || placed[0].module == nullptr || placed[0].pdos.empty()) continue;
+            if (!std::all_of(placed[0].pdos.begin(), placed[0].pdos.end(), matches)) continue;
+            if (placed[0].pdos.size() <= best_pdos) continue;  // the most PDOs; on a tie the earlier
+            best = id;
+            best_pdos = placed[0].pdos.size();
+            best_indices.clear();
+            for (const SlotPdo& p : placed[0].pdos)
+                best_indices.push_back(p.index);
+        }
+        if (!best && slot.default_module) {
+            // No module's PDOs are the ENI's: the default stays where it has no PDOs (a module the PDOs
+            // cannot tell) or where the slot must hold a module.
+            const std::vector<SlotModule> placed = slot_modules(f, d, [&] {
+                std::vector<std::optional<uint32_t>> v(n + 1);
+                v[n] = slot.default_module;
+                return v;
+            }());
+            if (slot.min_instances > 0 || placed.empty() || placed[0].pdos.empty())
+                best = slot.default_module;
+        }
+        out.modules[n] = best;
+        explained.insert(best_indices.begin(), best_indices.end());
+    }
+    for (const auto& [index, entries] : eni)
+        if (!explained.count(index)) {
+            if (why)
+                *why =
+                    "line " + std::to_string(eni_line[index]) + ": PDO " + hex4(index) +
+                    " of the ENI is the PDO of no module its slots take (at that slot, with those entries)";
+            return std::nullopt;
+        }
+    return out;
+}
+
+}  // namespace esi::eni
