@@ -608,4 +608,42 @@ TEST(EniModules, APdoNoModuleExplainsIsRefusedAndNamed) {
     EXPECT_FALSE(esi::eni::modules_from_eni(plain, plain.devices.at(0), eni.slaves[0]));
 }
 
+// What the master was configured for and the ESI's device lacks: every PDO of the ENI that the device does
+// not declare, or whose entries differ from the device's fixed PDO; nothing for a consistent pair.
+TEST(EniModules, PdoMismatchesNameWhatTheDeviceLacks) {
+    const esi::EsiFile f = esi::read_esi_file(kModularEsi);
+    const esi::eni::Config eni = esi::eni::read_eni_file(kModularEni);
+    const esi::eni::Slave& s = eni.slaves[0];
+    EXPECT_TRUE(esi::eni::pdo_mismatches(f, f.devices.at(0), {kAi2, kAi2, std::nullopt, kDo8}, s).empty());
+    // Served with its defaults (DI8, DO8, AI2, -): 0x1A00 is DI8's (eight bits, not two values), 0x1A01 and
+    // 0x1603 are no PDO of that configuration.
+    const auto w = esi::eni::pdo_mismatches(f, f.devices.at(0), esi::default_modules(f.devices.at(0)), s);
+    ASSERT_EQ(w.size(), 3u);
+    std::string all;
+    for (const auto& x : w) {
+        EXPECT_GT(x.line, 0);
+        all += x.what + "\n";
+    }
+    EXPECT_NE(all.find("TxPDO 0x1A00 maps other entries than the device's fixed PDO"), std::string::npos)
+        << all;
+    EXPECT_NE(all.find("TxPDO 0x1A01 is not a PDO of the device"), std::string::npos) << all;
+    EXPECT_NE(all.find("RxPDO 0x1603 is not a PDO of the device"), std::string::npos) << all;
+    // The example line and the example ESIs agree, slave by slave.
+    const esi::eni::Config mixed = esi::eni::read_eni_file(kExample);
+    for (const esi::eni::Slave& x : mixed.slaves) {
+        bool found = false;
+        for (const char* name : {"coupler.xml", "digital-io.xml", "analog-in.xml", "drive402.xml"}) {
+            const esi::EsiFile e =
+                esi::read_esi_file(std::string(SOFTECAT_SOURCE_DIR) + "/esi/examples/" + name);
+            for (const esi::EsiDevice& d : e.devices)
+                if (d.product_code == x.info.product_code && d.revision == x.info.revision) {
+                    found = true;
+                    EXPECT_TRUE(esi::eni::pdo_mismatches(e, d, esi::default_modules(d), x).empty())
+                        << x.info.name;
+                }
+        }
+        EXPECT_TRUE(found) << x.info.name;
+    }
+}
+
 }  // namespace modules

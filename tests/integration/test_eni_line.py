@@ -198,6 +198,7 @@ class EniLine(unittest.TestCase):
         self.assertIn("modular-io.xml", log)
         self.assertIn("modules EXM-AI2,EXM-AI2,-,EXM-DO8 (from its PDOs)", log)
         self.assertNotIn("the default modules are served", log)
+        self.assertNotIn("not a PDO of the device", log)
         # From the ENI's data alone the same line reaches Op as well.
         log = self.run_line(["--eni", eni], eni)
         self.assertIn("(ENI data)", log)

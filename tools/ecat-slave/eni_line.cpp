@@ -10,6 +10,7 @@
 #include "esi/eni/eni_modules.hpp"
 #include "esi/eni/eni_product.hpp"
 #include "esi/eni/eni_reader.hpp"
+#include "esi/slots.hpp"
 
 namespace ecat_slave {
 
@@ -77,7 +78,9 @@ EniLine eni_line(const std::string& file, const EsiIndex* esis) {
                 const esi::EsiFile& f = *it->second.file;
                 const esi::EsiDevice& dev = *it->second.device;
                 std::string why;
+                std::vector<std::optional<uint32_t>> modules = esi::default_modules(dev);
                 if (auto m = esi::eni::modules_from_eni(f, dev, s, &why)) {
+                    modules = m->modules;
                     product = std::make_shared<od::Product>(esi::load_product(f, dev, m->modules));
                     std::string list;
                     for (const auto& id : m->modules) {
@@ -93,6 +96,11 @@ EniLine eni_line(const std::string& file, const EsiIndex* esis) {
                                                     "configuration matches none: " +
                                                     why);
                 }
+                // What the master was configured for and the device lacks, said at start: the master will
+                // stop where a real device like it would stop it.
+                for (const esi::eni::PdoMismatch& w : esi::eni::pdo_mismatches(f, dev, modules, s))
+                    product->warnings.push_back(eni.where(w.line) + ": " + w.what + " (" + it->second.path +
+                                                ")");
             }
         }
         std::string other_revisions;  // an ESI of DIR with this device in other revisions: said, not used

@@ -62,7 +62,47 @@ std::optional<std::vector<std::optional<uint32_t>>> from_f030(const EsiFile& f, 
     return modules;
 }
 
+std::vector<Entry> entries_of(const Pdo& p) {
+    std::vector<Entry> e;
+    for (const PdoEntry& x : p.entries)
+        e.emplace_back(x.index, x.index == 0 ? uint8_t{0} : x.subindex, x.bit_len);
+    return e;
+}
+
+std::vector<Entry> entries_of(const std::vector<EsiPdoEntry>& entries) {
+    std::vector<Entry> e;
+    for (const EsiPdoEntry& x : entries)
+        e.emplace_back(x.index, x.index == 0 ? uint8_t{0} : x.subindex, x.bit_len);
+    return e;
+}
+
 }  // namespace
+
+std::vector<PdoMismatch> pdo_mismatches(const EsiFile& f, const EsiDevice& d,
+                                        const std::vector<std::optional<uint32_t>>& modules, const Slave& s) {
+    struct Declared {
+        std::vector<Entry> entries;
+        bool fixed = false;
+    };
+    std::map<uint16_t, Declared> device;  // the device's own PDOs, then its modules' at their slots
+    for (const auto* list : {&d.rxpdos, &d.txpdos})
+        for (const EsiPdo& p : *list)
+            device[p.index] = {entries_of(p.entries), p.fixed};
+    for (const SlotModule& m : slot_modules(f, d, modules))
+        for (const SlotPdo& p : m.pdos)
+            device[p.index] = {entries_of(p.entries), p.esi != nullptr && p.esi->fixed};
+    std::vector<PdoMismatch> out;
+    for (const auto* list : {&s.process_data.rxpdos, &s.process_data.txpdos})
+        for (const Pdo& p : *list) {
+            auto it = device.find(p.index);
+            const std::string pdo = std::string("the ENI's ") + (p.rx ? "RxPDO " : "TxPDO ") + hex4(p.index);
+            if (it == device.end())
+                out.push_back({p.line, pdo + " is not a PDO of the device"});
+            else if (it->second.fixed && it->second.entries != entries_of(p))
+                out.push_back({p.line, pdo + " maps other entries than the device's fixed PDO"});
+        }
+    return out;
+}
 
 std::optional<EniModules> modules_from_eni(const EsiFile& f, const EsiDevice& d, const Slave& s,
                                            std::string* why) {

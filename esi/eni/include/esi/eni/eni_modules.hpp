@@ -32,4 +32,16 @@ struct EniModules {
 std::optional<EniModules> modules_from_eni(const EsiFile& f, const EsiDevice& d, const Slave& slave,
                                            std::string* why = nullptr);
 
+// What the master configured that device d of f with these modules (one per slot; none for a device without
+// slots) does not have, one line per PDO of the ENI slave: a PDO the device does not declare, or a Fixed PDO
+// of the device whose entries differ from the ENI's (a PDO the master may map, it maps by its CoE init
+// commands), with the ENI's line of that PDO. Empty: the device is what the master was configured for.
+struct PdoMismatch {
+    int line = 0;
+    std::string what;
+};
+std::vector<PdoMismatch> pdo_mismatches(const EsiFile& f, const EsiDevice& d,
+                                        const std::vector<std::optional<uint32_t>>& modules,
+                                        const Slave& slave);
+
 }  // namespace esi::eni
