@@ -156,6 +156,16 @@ inline std::vector<EntryRef> esi_entries(const EsiDevice& d) {
         }
     return v;
 }
+// An object whose value the standard makes the device's own state, not a configuration an ESI can give: it is
+// not compared with the ESI's DefaultData (a device's value, and the default it describes, may differ from
+// it). ETG.1000.6 / CiA 301 0x1001 error register; ETG.1020 0x10F3 diagnosis history and 0x10F8 timestamp;
+// ETG.1020 0x1C32/0x1C33 SM synchronisation (measured times and counters); ETG.5001.1 0xF040 detected
+// address list and 0xF050 detected module ident list (the modules plugged in) and the diagnosis area
+// 0xA000-0xAFFF. The serial number 0x1018:04 is per device (a caller's own rule).
+inline bool device_state_object(uint16_t index) {
+    return index == 0x1001 || index == 0x10F3 || index == 0x10F8 || index == 0x1C32 || index == 0x1C33 ||
+           index == 0xF040 || index == 0xF050 || (index >= 0xA000 && index <= 0xAFFF);
+}
 // A VISIBLE_STRING entry (ESI type STRING(n)): its BitSize is the capacity, the text may be shorter.
 inline bool visible_string(const EsiEntry& e) {
     return esi_coe_type(e.type) == 0x0009;

@@ -764,9 +764,7 @@ void add_sdo_tests(Catalogue& c) {
             for (const auto& r : esi_entries(*ctx.esi)) {
                 if (r.e->access != "ro" || !r.e->pdo_mapping.empty() || r.e->default_data.empty()) continue;
                 if (r.obj->index == 0x1018 && r.e->subindex == 4) continue;  // serial number: per device
-                if (r.obj->index == 0x1001 || r.obj->index == 0x10F3 || r.obj->index == 0x1C32 ||
-                    r.obj->index == 0x1C33)
-                    continue;
+                if (device_state_object(r.obj->index)) continue;
                 if (r.e->type.rfind("STRING", 0) == 0) continue;
                 auto v = ctx.upload(r.obj->index, r.e->subindex);
                 if (!v) continue;

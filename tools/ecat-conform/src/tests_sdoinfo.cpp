@@ -426,7 +426,8 @@ void add_sdoinfo_tests(Catalogue& c) {
             unsigned n = 0;
             for (const auto& r : esi_entries(*ctx.esi)) {
                 const auto& d = info.entries[{r.obj->index, r.e->subindex}];
-                if (!(d.value_info & 0x10) || r.e->default_data.empty() || r.e->type.rfind("STRING", 0) == 0)
+                if (!(d.value_info & 0x10) || r.e->default_data.empty() ||
+                    r.e->type.rfind("STRING", 0) == 0 || device_state_object(r.obj->index))
                     continue;
                 const std::size_t off = (d.value_info & 0x08) ? 4 : 0;
                 const std::size_t len = (d.bit_length + 7u) / 8u;
