@@ -646,4 +646,37 @@ TEST(EniModules, PdoMismatchesNameWhatTheDeviceLacks) {
     }
 }
 
+// From the ENI's data alone, an object the master writes whole from subindex 0 as a count, its padding byte
+// and that many values of one size (0xF030, ETG.5001.1) is that array; written again the same way it stays
+// one object; any other complete-access structure is not emulated and said.
+TEST(EniModules, AnArrayWrittenWholeIsServedFromTheEniData) {
+    esi::eni::Config eni = esi::eni::read_eni_file(kModularEni);
+    auto& cmds = eni.slaves[0].mailbox.coe_init_cmds;
+    std::vector<uint8_t> list{4, 0};
+    for (uint32_t v : {kAi2, kAi2, 0u, kDo8})
+        for (uint8_t b : le32(v))
+            list.push_back(b);
+    cmds.push_back(f030(0, true, list));
+    cmds.push_back(f030(0, true, list));                        // again, in another transition
+    esi::eni::CoeInitCmd odd = f030(0, true, {2, 0, 1, 2, 3});  // two entries in three bytes
+    odd.index = 0x8000;
+    cmds.push_back(odd);
+    const od::Product p = esi::eni::product_from_eni(eni, 0);
+    const od::Dictionary dict = p.make_dictionary(p.description);
+    const od::Object* o = dict.find(0xF030);
+    ASSERT_NE(o, nullptr);
+    ASSERT_EQ(o->entries.size(), 5u);
+    EXPECT_EQ(std::get<uint64_t>(o->entries[0].default_value), 4u);
+    EXPECT_EQ(o->entries[1].type, od::DataType::Unsigned32);
+    EXPECT_EQ(std::get<uint64_t>(o->entries[1].default_value), kAi2);
+    EXPECT_EQ(std::get<uint64_t>(o->entries[4].default_value), kDo8);
+    EXPECT_NE(o->entries[4].access & od::access::WritePreOp, 0);
+    std::string warnings;
+    for (const auto& w : p.warnings)
+        warnings += w + "\n";
+    EXPECT_EQ(warnings.find("0xF030"), std::string::npos) << warnings;
+    EXPECT_NE(warnings.find("0x8000"), std::string::npos) << warnings;
+    EXPECT_EQ(dict.find(0x8000), nullptr);
+}
+
 }  // namespace modules

@@ -133,11 +133,15 @@ class EniMaster:
             for coe in slave.findall("Mailbox/CoE/InitCmds/InitCmd"):
                 if t in [x.text for x in coe.findall("Transition")] and num(coe.findtext("Ccs")) == 1:
                     data = bytes.fromhex(coe.findtext("Data"))
+                    where = ["--station", str(num(slave.findtext("Info/PhysAddr"))),
+                             hex(num(coe.findtext("Index"))), str(num(coe.findtext("SubIndex")))]
+                    if coe.get("CompleteAccess") in ("true", "1"):
+                        # The whole object from the subindex, the ENI's bytes as they are.
+                        self.bus.ecatctl("download", "--complete", *where, *[hex(b) for b in data])
+                        continue
                     # The ENI's bytes as one value of their size (ecatctl takes single values by the entry's type).
                     kind = {1: "u8", 2: "u16", 4: "u32", 8: "u64"}[len(data)]
-                    self.bus.ecatctl("download", "--station", str(num(slave.findtext("Info/PhysAddr"))),
-                                     hex(num(coe.findtext("Index"))), str(num(coe.findtext("SubIndex"))),
-                                     str(int.from_bytes(data, "little")), "--type", kind)
+                    self.bus.ecatctl("download", *where, str(int.from_bytes(data, "little")), "--type", kind)
         if target >= 4:
             self.cycle(150)  # SYNC0 of the DC slaves starts 100 ms from their start time
         for slave, cmd in al:
@@ -202,6 +206,20 @@ class EniLine(unittest.TestCase):
         # From the ENI's data alone the same line reaches Op as well.
         log = self.run_line(["--eni", eni], eni)
         self.assertIn("(ENI data)", log)
+        # A configuration tool writes a device's module list whole (complete access of 0xF030, ETG.5001.1) when
+        # its ESI asks for it: from the ENI's data the slave holds the array the master writes, and the line
+        # reaches Op; with the ESI the list chooses the modules.
+        with tempfile.TemporaryDirectory() as d:
+            f030 = os.path.join(d, "f030.xml")
+            ca = ("<InitCmd Fixed=\"true\" CompleteAccess=\"true\"><Transition>PS</Transition>"
+                  "<Comment><![CDATA[configured module ident list]]></Comment><Timeout>0</Timeout><Ccs>1</Ccs>"
+                  "<Index>#xf030</Index><SubIndex>0</SubIndex><Data>040001300000013000000000000001200000</Data>"
+                  "</InitCmd>")
+            with open(eni) as src, open(f030, "w") as out:
+                out.write(src.read().replace("<CoE>\n\t\t\t\t\t<InitCmds>\n", "<CoE>\n\t\t\t\t\t<InitCmds>\n" + ca, 1))
+            log = self.run_line(["--eni", f030], f030)
+            self.assertIn("served from", log)
+            self.assertNotIn("by complete access", log, "the array is served, nothing said")
 
     def test_topology_with_esi_devices(self):
         # A mixed line written by hand: a coupler and a digital input terminal from their ESIs (one device of a

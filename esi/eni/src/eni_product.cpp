@@ -450,6 +450,47 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
             }
             if (c.index == 0x1000 || c.index == 0x1008 || c.index == 0x1018 || c.index == 0x1C00) continue;
             if (c.complete_access) {
+                // A complete access from subindex 0 with the count, its padding byte (ETG.1000.6: subindex 0
+                // takes 16 bits in a complete access) and that many values of one size is an array the master
+                // writes whole, as ETG.5001.1's configured module ident list 0xF030: served as that array,
+                // holding what the master writes. Any other structure is not in the ENI.
+                const std::size_t n = c.data.empty() ? 0 : c.data[0];
+                const std::size_t k = n == 0 || c.data.size() <= 2 ? 0 : (c.data.size() - 2) / n;
+                const bool array = c.ccs == 1 && c.subindex == 0 && k != 0 && (c.data.size() - 2) % n == 0 &&
+                                   (k == 1 || k == 2 || k == 4 || k == 8);
+                if (array && plan->app.count(c.index)) {
+                    // Written whole again (another transition): the same array, or a structure it cannot be.
+                    const auto& subs = plan->app.at(c.index);
+                    const bool same =
+                        subs.size() == n + 1 && std::all_of(subs.begin(), subs.end(), [&](const auto& x) {
+                            return x.first == 0 || x.second.type == type_of_size(k);
+                        });
+                    if (same) continue;
+                } else if (array) {
+                    auto& subs = plan->app[c.index];
+                    plan->app_names[c.index] = c.comment.empty() ? "Object " + hex(c.index, 4) : c.comment;
+                    const uint16_t writable = static_cast<uint16_t>(od::access::RO | od::access::WritePreOp |
+                                                                    od::access::WriteSafeOp);
+                    od::Entry count;
+                    count.subindex = 0;
+                    count.name = "SubIndex 000";
+                    count.type = od::DataType::Unsigned8;
+                    count.access = writable;
+                    count.default_value = n;
+                    subs.emplace(uint8_t{0}, std::move(count));
+                    for (std::size_t i = 1; i <= n; ++i) {
+                        od::Entry e;
+                        e.subindex = static_cast<uint8_t>(i);
+                        e.name = entry_name(c.index, e.subindex);
+                        e.type = type_of_size(k);
+                        e.access = writable;
+                        const auto at = c.data.begin() + static_cast<std::ptrdiff_t>(2 + (i - 1) * k);
+                        e.default_value =
+                            little_endian(std::vector<uint8_t>(at, at + static_cast<std::ptrdiff_t>(k)));
+                        subs.emplace(e.subindex, std::move(e));
+                    }
+                    continue;
+                }
                 warn.push_back(who + ": " + what +
                                " by complete access: the object's structure is not in the ENI; "
                                "not emulated (the master's transfer is refused)");
