@@ -363,6 +363,7 @@ EsiDevice read_device(Node dev, const TypeMap& types_in, uint32_t vendor, const 
     d.vendor_id = vendor;
     d.vendor_name = vendor_name;
     d.line = line_of(dev);
+    if (xmlHasProp(dev, reinterpret_cast<const xmlChar*>("Physics"))) d.physics = attr(dev, "Physics");
     Node type = child(dev, "Type");
     d.type_name = text(type);
     d.product_code = static_cast<uint32_t>(number(attr(type, "ProductCode")));

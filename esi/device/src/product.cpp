@@ -733,6 +733,23 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
     desc.identification_al_status = d.identification_reg134;
     desc.identification_register = d.identification_ado.value_or(0);
     desc.ebus_current_ma = static_cast<int16_t>(d.ebus_current_ma.value_or(0));
+    // Physics (ETG.2000 PhysicsType, pattern [Y,K,H, ]{0,4}): one character per port from port 0, Y MII, K
+    // E-Bus, H MII with fast hot connect, a blank no port. The pattern's commas are the character class's
+    // separators, not a port type; lowercase is not in it. Port 0 is where the master's frames come in (ESC
+    // datasheet, frame processing), so a device without it could not be reached. Without the attribute (or
+    // with it empty) the device has two MII ports (od::DeviceDescription's default), as before Physics was
+    // read.
+    if (d.physics && !d.physics->empty()) {
+        const std::string& ph = *d.physics;
+        if (ph.size() > 4 || ph.find_first_not_of("YKH ") != std::string::npos)
+            ctx.fail(d.line, "Device Physics '" + ph +
+                                 "': one character per port, at most 4: Y (MII), K (E-Bus), H or a blank "
+                                 "(ETG.2000 PhysicsType)");
+        if (ph[0] == ' ')
+            ctx.fail(d.line, "Device Physics '" + ph +
+                                 "': port 0 has no port type; the master's frames enter a device there");
+        desc.physics = ph;
+    }
 
     // ---- The PDOs: the device's own and those of the module of each slot (its default, or as chosen) ----
     std::vector<Pdo> pdos;
