@@ -1411,6 +1411,80 @@ TEST(EsiDevices, PhysicsGivesTheSiiPortsTheEscPortsAndIsWrittenBack) {
     }
 }
 
+// Forms of vendor round 6 (docs/devices.md): an Sm's Enable is a number (ETG.2000 HexDecValue; the SII
+// enable byte, bit 0 enable: SMC's "9" is enabled, in OP only); a process-data Sm whose text names one
+// direction and whose control byte the other is served as the control byte says (ESC datasheet 0x0804 bits
+// 2-3), its PDOs with it; an SM assignment object declared as a record of UINT16 entries is the ARRAY
+// ETG.1000.6 makes it. Each loads, is said where it is taken otherwise than written, and round-trips.
+TEST(EsiDevices, RoundSixFormsLoadAsTheEscAndTheStandardServeThem) {
+    const std::string pdos =
+        "<RxPdo Fixed=\"1\" Mandatory=\"1\" Sm=\"0\"><Index>#x1600</Index><Name>Outputs</Name>"
+        "<Entry><Index>#x7000</Index><SubIndex>1</SubIndex><BitLen>8</BitLen><Name>Byte0</Name>"
+        "<DataType>UINT8</DataType></Entry></RxPdo>"
+        "<TxPdo Fixed=\"1\" Mandatory=\"1\" Sm=\"1\"><Index>#x1a00</Index><Name>Inputs</Name>"
+        "<Entry><Index>#x6000</Index><SubIndex>1</SubIndex><BitLen>8</BitLen><Name>Byte0</Name>"
+        "<DataType>UINT8</DataType></Entry></TxPdo>";
+    const std::string xml =
+        "<?xml version=\"1.0\"?><EtherCATInfo><Vendor><Id>276</Id><Name>V</Name></Vendor><Descriptions>"
+        "<Devices><Device Physics=\"YY\"><Type ProductCode=\"#x7C\" RevisionNo=\"#x0\">T7C</Type>"
+        "<Name>T 7C</Name>"
+        "<Sm StartAddress=\"#x0f00\" ControlByte=\"#x46\" Enable=\"9\" DefaultSize=\"0\">Outputs</Sm>"
+        "<Sm StartAddress=\"#x1000\" ControlByte=\"#x0\" Enable=\"1\" DefaultSize=\"0\">Outputs</Sm>" +
+        pdos + "</Device></Devices></Descriptions></EtherCATInfo>";
+    const od::Product p = esi::load_product(esi::read_esi_text(xml, "t7c.xml"), "");
+    ASSERT_EQ(p.description.sync_managers.size(), 2u);
+    EXPECT_TRUE(p.description.sync_managers[0].enable) << "Enable=\"9\": bit 0 set";
+    EXPECT_EQ(p.description.sync_managers[0].kind, od::SmKind::Outputs);
+    EXPECT_EQ(p.description.sync_managers[1].kind, od::SmKind::Inputs)
+        << "control byte #x0: the master reads";
+    ASSERT_EQ(p.warnings.size(), 1u);
+    EXPECT_NE(p.warnings[0].find("t7c.xml:1: Sm 'Outputs' with control byte 0x00"), std::string::npos)
+        << p.warnings[0];
+    const od::Dictionary dict = p.make_dictionary(p.description);
+    const esi::DeviceModel m = esi::derive_model(p.description, dict);
+    for (const esi::PdoInfo& pdo : m.pdos)
+        EXPECT_EQ(pdo.sm, pdo.rx ? 0 : 1) << std::hex << pdo.index;
+    std::string written;
+    expect_same(describe(p), describe(round_trip(p, &written)), "round trip");
+    EXPECT_EQ(schema_errors(written), std::vector<std::string>{});
+
+    // 0x1C12 as a record of UINT16 entries, two of which the count uses one.
+    const std::string coe =
+        "<?xml version=\"1.0\"?><EtherCATInfo><Vendor><Id>#x123</Id><Name>V</Name></Vendor><Descriptions>"
+        "<Devices><Device Physics=\"YY\"><Type ProductCode=\"#x7D\" RevisionNo=\"#x1\">T7D</Type>"
+        "<Name>T 7D</Name><Profile><Dictionary><DataTypes>"
+        "<DataType><Name>USINT</Name><BitSize>8</BitSize></DataType>"
+        "<DataType><Name>UINT</Name><BitSize>16</BitSize></DataType>"
+        "<DataType><Name>DT1C12</Name><BitSize>48</BitSize>"
+        "<SubItem><SubIdx>0</SubIdx><Name>SubIndex 000</Name><Type>USINT</Type><BitSize>8</BitSize>"
+        "<BitOffs>0</BitOffs><Flags><Access WriteRestrictions=\"PreOP\">rw</Access></Flags></SubItem>"
+        "<SubItem><SubIdx>1</SubIdx><Name>PDO 0</Name><Type>UINT</Type><BitSize>16</BitSize>"
+        "<BitOffs>16</BitOffs><Flags><Access WriteRestrictions=\"PreOP\">rw</Access></Flags></SubItem>"
+        "<SubItem><SubIdx>2</SubIdx><Name>PDO 1</Name><Type>UINT</Type><BitSize>16</BitSize>"
+        "<BitOffs>32</BitOffs><Flags><Access WriteRestrictions=\"PreOP\">rw</Access></Flags></SubItem>"
+        "</DataType></DataTypes><Objects>"
+        "<Object><Index>#x1c12</Index><Name>RxPDO assign</Name><Type>DT1C12</Type><BitSize>48</BitSize>"
+        "<Info><SubItem><Name>SubIndex 000</Name><Info><DefaultData>01</DefaultData></Info></SubItem>"
+        "<SubItem><Name>PDO 0</Name><Info><DefaultData>0016</DefaultData></Info></SubItem>"
+        "<SubItem><Name>PDO 1</Name><Info><DefaultData>0000</DefaultData></Info></SubItem></Info></Object>"
+        "</Objects></Dictionary></Profile>"
+        "<Sm StartAddress=\"#x1000\" ControlByte=\"#x26\" Enable=\"1\" DefaultSize=\"128\">MBoxOut</Sm>"
+        "<Sm StartAddress=\"#x1080\" ControlByte=\"#x22\" Enable=\"1\" DefaultSize=\"128\">MBoxIn</Sm>"
+        "<Sm StartAddress=\"#x1100\" ControlByte=\"#x64\" Enable=\"1\">Outputs</Sm>"
+        "<RxPdo Fixed=\"1\" Sm=\"2\"><Index>#x1600</Index><Name>Out</Name>"
+        "<Entry><Index>#x7000</Index><SubIndex>1</SubIndex><BitLen>16</BitLen><Name>Word</Name>"
+        "<DataType>UINT</DataType></Entry></RxPdo>"
+        "<Mailbox><CoE CompleteAccess=\"true\"/></Mailbox></Device></Devices></Descriptions></EtherCATInfo>";
+    const od::Product q = esi::load_product(esi::read_esi_text(coe, "t7d.xml"), "");
+    const od::Dictionary qd = q.make_dictionary(q.description);
+    const od::Object* a = qd.find(0x1C12);
+    ASSERT_NE(a, nullptr);
+    EXPECT_EQ(a->code, od::ObjectCode::Array);
+    EXPECT_EQ(a->type, od::DataType::Unsigned16);
+    expect_same(describe(q), describe(round_trip(q, &written)), "round trip");
+    EXPECT_EQ(schema_errors(written), std::vector<std::string>{});
+}
+
 // A vendor's diagnosis texts (ETG.2000 Profile/DiagMessages) are the device's: read into its description with
 // the vendor's text ids, the English text of several languages, the class where given; written back by
 // --write-esi as they were, valid against the schema, and a fixed point of the round trip.

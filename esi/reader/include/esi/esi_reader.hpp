@@ -83,6 +83,7 @@ struct EsiSm {
     uint16_t default_size = 0;
     std::optional<uint32_t> min_size, max_size;  // MinSize/MaxSize attributes, if given
     uint8_t control = 0;
+    bool has_control = false;  // ControlByte given
     bool enable = false;
     bool watchdog = false;  // Watchdog attribute
     bool is_virtual = false;
