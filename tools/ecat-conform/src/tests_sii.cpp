@@ -483,15 +483,20 @@ void add_sii_tests(Catalogue& c) {
             if (Outcome o = expect_eq("SMs start/size/control/enable", got, want); o.status != Status::Pass)
                 return o;
             // The SM type byte (ETG.2010 SyncM: 1 mailbox out, 2 mailbox in, 3 outputs, 4 inputs) as the
-            // ESI's Sm text says; an Sm of another text is not compared.
+            // ESI's Sm text says; an Sm of another text is not compared. A process-data Sm whose ControlByte
+            // names the other direction (ESC datasheet 0x0804 bits 2-3: 00 the master reads, 01 it writes;
+            // buffered mode) is the buffer the ESC makes of it: its type is the control byte's.
             std::string tgot, twant;
             for (std::size_t n = 0; n < ctx.esi->sms.size() && n < types.size(); ++n) {
-                const std::string& t = ctx.esi->sms[n].type;
-                const int want_type = t == "MBoxOut"   ? 1
-                                      : t == "MBoxIn"  ? 2
-                                      : t == "Outputs" ? 3
-                                      : t == "Inputs"  ? 4
-                                                       : -1;
+                const EsiSm& sm = ctx.esi->sms[n];
+                const std::string& t = sm.type;
+                int want_type = t == "MBoxOut"   ? 1
+                                : t == "MBoxIn"  ? 2
+                                : t == "Outputs" ? 3
+                                : t == "Inputs"  ? 4
+                                                 : -1;
+                if ((want_type == 3 || want_type == 4) && sm.has_control && (sm.control & 0x03) != 0x02)
+                    want_type = ((sm.control >> 2) & 0x03) == 0x01 ? 3 : 4;
                 if (want_type < 0) continue;
                 tgot += "SM" + dec(static_cast<long long>(n)) + " " + dec(types[n]) + " ";
                 twant += "SM" + dec(static_cast<long long>(n)) + " " + dec(want_type) + " ";
