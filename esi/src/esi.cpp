@@ -604,7 +604,7 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
     named(group, "Name", id.group_type);
 
     xmlNodePtr device = child(child(descriptions, "Devices"), "Device");
-    attr(device, "Physics", kPhysics);
+    attr(device, "Physics", d.physics);
     xmlNodePtr type = child(device, "Type", id.order_code.empty() ? id.device_name : id.order_code);
     attr(type, "ProductCode", hex32(id.product_code));
     attr(type, "RevisionNo", hex32(id.revision));
@@ -617,8 +617,12 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
         child(timeout, "RequestTimeout", std::to_string(d.mailbox_request_timeout_ms));
         child(timeout, "ResponseTimeout", std::to_string(d.mailbox_response_timeout_ms));
     }
-    for (int port = 0; port < 2; ++port)
-        child(child(info, "Port"), "Type", "MII");  // kPhysicalPorts
+    // One Info/Port per character of Physics (ETG.2000: MII, EBUS or NONE), as the SII General category's
+    // physical ports say them.
+    for (std::size_t port = 0; port < d.physics.size() && port < 4; ++port) {
+        const char c = d.physics[port];
+        child(child(info, "Port"), "Type", c == 'Y' || c == 'H' ? "MII" : c == 'K' ? "EBUS" : "NONE");
+    }
     if (!m.pdo_sets.empty()) {
         // Where TwinCAT and the vendors' CiA 402 drives carry their predefined PDO sets.
         xmlNodePtr twincat = child(child(info, "VendorSpecific"), "TwinCAT");

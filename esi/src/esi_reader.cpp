@@ -363,6 +363,7 @@ EsiDevice read_device(Node dev, const TypeMap& types_in, uint32_t vendor, const 
     d.vendor_id = vendor;
     d.vendor_name = vendor_name;
     d.line = line_of(dev);
+    if (xmlHasProp(dev, reinterpret_cast<const xmlChar*>("Physics"))) d.physics = attr(dev, "Physics");
     Node type = child(dev, "Type");
     d.type_name = text(type);
     d.product_code = static_cast<uint32_t>(number(attr(type, "ProductCode")));
@@ -427,7 +428,14 @@ EsiDevice read_device(Node dev, const TypeMap& types_in, uint32_t vendor, const 
         if (auto v = parse_esi_number(attr(s, "MinSize"))) sm.min_size = static_cast<uint32_t>(*v);
         if (auto v = parse_esi_number(attr(s, "MaxSize"))) sm.max_size = static_cast<uint32_t>(*v);
         sm.control = static_cast<uint8_t>(number(attr(s, "ControlByte")));
-        sm.enable = truthy(attr(s, "Enable"));
+        sm.has_control = xmlHasProp(s, reinterpret_cast<const xmlChar*>("ControlByte")) != nullptr;
+        // Enable is a HexDecValue (ETG.2000), the SII SyncM enable byte (ETG.2010: bit 0 enable; bits 1-3
+        // fixed content, virtual, enable in OP only): "1", "#x01", "9" (enabled, in OP only) are all enabled.
+        {
+            const std::string en = attr(s, "Enable");
+            const std::optional<int64_t> v = parse_esi_number(en);
+            sm.enable = truthy(en) || (v && (*v & 1));
+        }
         sm.watchdog = truthy(attr(s, "Watchdog"));
         sm.is_virtual = truthy(attr(s, "Virtual"));
         sm.type = text(s);

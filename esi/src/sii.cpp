@@ -96,8 +96,9 @@ std::vector<uint8_t> build_content(const od::DeviceDescription& d, const DeviceM
     general[12] = static_cast<uint8_t>(static_cast<uint16_t>(d.ebus_current_ma));
     general[13] = static_cast<uint8_t>(static_cast<uint16_t>(d.ebus_current_ma) >> 8);
     general[14] = group_idx;
-    general[16] = static_cast<uint8_t>(kPhysicalPorts);
-    general[17] = static_cast<uint8_t>(kPhysicalPorts >> 8);
+    const uint16_t ports = physics_sii_ports(d.physics);  // the ESI's Physics (ETG.2010 General 16-17)
+    general[16] = static_cast<uint8_t>(ports);
+    general[17] = static_cast<uint8_t>(ports >> 8);
     general[18] = static_cast<uint8_t>(d.identification_register);
     general[19] = static_cast<uint8_t>(d.identification_register >> 8);
 

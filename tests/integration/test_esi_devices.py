@@ -28,6 +28,14 @@ def number(text):
     return int(t[2:], 16) if t.lower().startswith("#x") else int(t, 0)
 
 
+def port_descriptor(physics):
+    """ESC register 0x0007 as the ESI's Physics declares the ports (ETG.2000: one character per port, Y MII, K E-Bus,
+    H MII with fast hot connect, a blank none; ESC datasheet: 2 bits a port, 11 MII, 10 EBUS, 00 not implemented);
+    without Physics two MII ports."""
+    code = {"Y": 3, "H": 3, "K": 2}
+    return sum(code.get(c, 0) << (2 * p) for p, c in enumerate((physics or "YY")[:4]))
+
+
 def pdo_bits(pdos, sm_of):
     """Bits of the PDOs assigned by default (those with an Sm attribute) to the SMs of each direction (a device
     may have several: SM2 and SM4 for outputs, ...)."""
@@ -85,7 +93,7 @@ def examples():
         out.append({"file": path, "spec": f"0x{product:08x}:0x{revision:08x}", "vendor": vendor,
                     "product": product, "revision": revision, "type": (t.text or "").strip(),
                     "out_bytes": (bits["out"] + 7) // 8, "in_bytes": (bits["in"] + 7) // 8,
-                    "mailbox": dev.find("Mailbox") is not None,
+                    "mailbox": dev.find("Mailbox") is not None, "physics": dev.get("Physics"),
                     "eeprom_data": dev.find("Eeprom/Data") is not None,
                     "out_sm_start": number(sm_out.get("StartAddress")) if sm_out is not None else None,
                     "out_sm_control": number(sm_out.get("ControlByte")) if sm_out is not None else None,
@@ -123,6 +131,9 @@ class EsiDevices(unittest.TestCase):
         self.assertEqual(int(product, 16), d["product"], r.stdout)
         self.assertEqual(int(revision, 16), d["revision"], r.stdout)
         self.assertIn(d["type"], name + r.stdout, "the name from the ESI")
+        # The ESC has the ports the ESI's Physics declares (0x0007).
+        reg = bus.ecatctl("reg", "read", "0", "0x0007", "1").stdout.split()
+        self.assertEqual(int(reg[1], 16), port_descriptor(d["physics"]), f"0x0007 for Physics {d['physics']!r}")
 
     def check_op(self, bus, d, ctl):
         if d["out_bytes"] + d["in_bytes"] == 0 and d["mailbox"]:
@@ -191,7 +202,9 @@ class EsiDevices(unittest.TestCase):
         """Every way ecatctl brings slaves up works for every kind of device on one line: with and without
         mailbox (a coupler, digital IO terminals), with an EEPROM image of its own, modular; a mailbox verb on
         a slave without mailbox says so."""
-        devices = examples()
+        # A device without port 1 (Physics "Y": an end device) can only end the line.
+        devices = sorted(examples(), key=lambda d: not port_descriptor(d["physics"]) & 0x0C)
+        self.assertTrue(all(port_descriptor(d["physics"]) & 0x0C for d in devices[:-1]), "one end device at most")
         with tempfile.TemporaryDirectory() as tmp:
             topo = os.path.join(tmp, "line.topo")
             with open(topo, "w") as f:
@@ -491,6 +504,17 @@ class EsiErrors(unittest.TestCase):
             self.assertIn("bad.xml", r.stderr)
             r = self.run_slave("--esi", os.path.join(tmp, "missing.xml"))
             self.assertEqual(r.returncode, 2, r.stderr)
+
+    def test_a_line_of_a_device_without_port_1_is_a_usage_error(self):
+        """--slaves N of a device whose Physics has no port 1 ("Y": an end device): no line to build (exit 2)."""
+        end = next(d for d in examples() if not port_descriptor(d["physics"]) & 0x0C)
+        with tempfile.TemporaryDirectory() as tmp:
+            r = subprocess.run([os.environ["ECAT_SLAVE"], "--esi", end["file"], "--device", end["spec"], "--slaves",
+                                "2", "--iface", "softecat-none0", "--state-dir", tmp], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, timeout=60)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn("no port 1", r.stderr)
+        self.assertIn(os.path.basename(end["file"]), r.stderr)
 
     def test_write_esi_and_write_sii_round_trip(self):
         with tempfile.TemporaryDirectory() as tmp:

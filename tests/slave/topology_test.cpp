@@ -121,6 +121,53 @@ TEST(Topology, DevicesFromAnEsi) {
         "device");
 }
 
+// A device given by esi= has the ports its ESI's Physics declares (ETG.2000), asked of the caller once per
+// such device without ports=; ports= written wins; a port the Physics does not declare cannot be plugged
+// into, and a device that cannot be served is an error at its line.
+TEST(Topology, AnEsiDeviceHasThePortsItsPhysicsDeclares) {
+    int asked = 0;
+    const slave::PortsOfEsi ports = [&asked](const slave::TopologyDevice& d) -> uint8_t {
+        ++asked;
+        if (d.esi.ends_with("bad.xml")) throw std::runtime_error("bad.xml:3: not an ESI");
+        if (d.device_spec == "END") return 0x03;     // "Y": port 0 only
+        if (d.device_spec == "BRANCH") return 0x8F;  // "YY K": ports 0, 1 and 3 (E-Bus)
+        return 0x0A;                                 // "KK": E-Bus in and out
+    };
+    const auto t = slave::parse_topology(
+        "device c esi=c.xml device=BRANCH\n"
+        "device k esi=k.xml device=KK at=c:3\n"
+        "device e esi=e.xml device=END at=c:1\n"
+        "device j esi=e.xml device=END ports=4 at=k:1\n"
+        "device m at=j:2\n",
+        "line.topo", "/etc/softecat", ports);
+    EXPECT_EQ(asked, 3) << "not for a device with ports= or without esi=";
+    ASSERT_EQ(t.devices.size(), 5u);
+    EXPECT_EQ(t.devices[0].port_descriptor(), 0x8F);
+    EXPECT_EQ(t.devices[1].port_descriptor(), 0x0A);
+    EXPECT_EQ(t.devices[2].port_descriptor(), 0x03);
+    EXPECT_EQ(t.devices[3].port_descriptor(), 0xFF) << "ports= written wins";
+    EXPECT_EQ(t.devices[4].port_descriptor(), 0x0F) << "the built-in drive";
+    EXPECT_EQ(t.devices[1].parent_port, 3);
+    const auto error = [&ports](const std::string& text) {
+        try {
+            (void)slave::parse_topology(text, "line.topo", "/etc/softecat", ports);
+        } catch (const slave::TopologyError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_EQ(error("device c esi=c.xml device=BRANCH\ndevice d at=c:2\n"),
+              "line.topo:2: at=c:2: device 'c' has only ports 0, 1, 3 (its ESI's Physics; ports=4 for a "
+              "junction)");
+    EXPECT_EQ(error("device e esi=e.xml device=END\ndevice d\n"),
+              "line.topo:2: at=e:1: device 'e' has only ports 0 (its ESI's Physics; ports=4 for a junction)");
+    EXPECT_EQ(error("device a\ndevice b esi=k.xml device=KK port=2 at=a:1\n"),
+              "line.topo:2: port=2: the device has only ports 0..1");
+    EXPECT_EQ(error("device a\ndevice b esi=bad.xml\n"), "line.topo:2: device b: bad.xml:3: not an ESI");
+    // Without a callback (parse_topology's default) an esi= device has two ports, as before.
+    EXPECT_EQ(parse("device e esi=e.xml device=END\ndevice d\n").devices[0].port_descriptor(), 0x0F);
+}
+
 TEST(Topology, ALoopIsRefused) {
     const std::string e = error_of("device r ports=4\ndevice a at=b:1\ndevice b at=a:1\n");
     EXPECT_EQ(e.rfind("line.topo:2: device 'a' is part of a loop", 0), 0u) << e;

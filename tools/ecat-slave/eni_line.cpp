@@ -10,6 +10,7 @@
 #include "esi/eni/eni_modules.hpp"
 #include "esi/eni/eni_product.hpp"
 #include "esi/eni/eni_reader.hpp"
+#include "esi/model.hpp"
 #include "esi/slots.hpp"
 
 namespace ecat_slave {
@@ -125,6 +126,9 @@ EniLine eni_line(const std::string& file, const EsiIndex* esis) {
             d.parent_port = 1;
         }
         d.ports = port_has_phy(s.info.physics, 2) || port_has_phy(s.info.physics, 3) ? 4 : 2;
+        // The ESC has the ports the device's Physics declares (its ESI's, or the ENI's; ETG.2000), so that
+        // 0x0007 and the SII General category agree; a port the wiring uses is added below.
+        d.descriptor = esi::physics_port_descriptor(product->description.physics);
         char station[16];
         std::snprintf(station, sizeof station, "0x%04X", s.info.phys_addr);
         out.report.push_back(
@@ -142,7 +146,11 @@ EniLine eni_line(const std::string& file, const EsiIndex* esis) {
         slave::TopologyDevice& d = out.topology.devices[k];
         if (d.parent < 0 || d.parent >= static_cast<int>(k))
             throw esi::eni::EniError(eni.where(d.line) + ": PreviousPort names no slave before this one");
-        if (d.parent_port >= 2) out.topology.devices[static_cast<std::size_t>(d.parent)].ports = 4;
+        slave::TopologyDevice& parent = out.topology.devices[static_cast<std::size_t>(d.parent)];
+        if (d.parent_port >= 2) parent.ports = 4;
+        if (d.parent_port < 4 && !parent.has_port(d.parent_port))
+            parent.descriptor =
+                static_cast<uint8_t>(parent.port_descriptor() | (0x3u << (2 * d.parent_port)));
         for (std::size_t j = 1; j < k; ++j)
             if (out.topology.devices[j].parent == d.parent &&
                 out.topology.devices[j].parent_port == d.parent_port)

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string_view>
@@ -22,6 +23,7 @@
 #include "esc/link.hpp"
 #include "esi/device/product.hpp"
 #include "esi/eni/eni_reader.hpp"
+#include "esi/model.hpp"
 #include "od/device_config.hpp"
 #include "send_control.hpp"
 #include "slave/log.hpp"
@@ -258,6 +260,8 @@ int main(int argc, char** argv) {
             std::cerr << "ecat-slave: " << e.what() << '\n';
             return slave::kExitUsage;
         }
+        // The ESC has the ports the ESI's Physics declares (ETG.2000; ESC register 0x0007).
+        options.port_descriptor = esi::physics_port_descriptor(device.product->description.physics);
     }
     device.state_dir = state_dir;
     slave::Log log(std::cerr, quiet ? slave::LogLevel::Error : *slave::parse_log_level(log_level),
@@ -370,6 +374,7 @@ int main(int argc, char** argv) {
         return slave::kExitUsage;
     }
     device::LineOptions line;
+    std::map<std::pair<std::string, std::string>, std::shared_ptr<const od::Product>> esi_products;
     if (!eni_file.empty() && !topology_file.empty()) {
         std::cerr << "ecat-slave: --eni and --topology both describe the line: give one\n";
         return slave::kExitUsage;
@@ -391,9 +396,32 @@ int main(int argc, char** argv) {
             line.products = std::move(eni.products);
             for (const std::string& r : eni.report)
                 std::cerr << "ecat-slave: " << r << '\n';
+        } else if (topology_file.empty()) {
+            line.topology = slave::line_topology(slaves);
+            if (device.product) {
+                // --esi with --slaves N / --out-iface: each unit has the ports of the ESI's Physics; the line
+                // runs through port 1 of each (and of the last, to --out-iface).
+                const uint8_t ports = options.port_descriptor;
+                if ((ports & 0x0C) == 0 && (slaves > 1 || !options.out_iface.empty())) {
+                    std::cerr << "ecat-slave: " << esi_file << ": the device has no port 1 (its Physics '"
+                              << device.product->description.physics << "'): "
+                              << (slaves > 1 ? "no line of --slaves " + std::to_string(slaves)
+                                             : std::string("nothing leads to --out-iface"))
+                              << '\n';
+                    return slave::kExitUsage;
+                }
+                for (slave::TopologyDevice& d : line.topology.devices)
+                    d.descriptor = ports;
+            }
         } else {
+            // A device given by esi= has the ports its ESI's Physics declares: its product is made once
+            // here and served below.
             line.topology =
-                topology_file.empty() ? slave::line_topology(slaves) : slave::load_topology(topology_file);
+                slave::load_topology(topology_file, [&esi_products](const slave::TopologyDevice& d) {
+                    auto& p = esi_products[{d.esi, d.device_spec}];
+                    if (!p) p = std::make_shared<const od::Product>(esi::load_product(d.esi, d.device_spec));
+                    return esi::physics_port_descriptor(p->description.physics);
+                });
         }
     } catch (const slave::TopologyError& e) {
         std::cerr << "ecat-slave: " << e.what() << '\n';
@@ -411,7 +439,9 @@ int main(int argc, char** argv) {
         const slave::TopologyDevice& d = line.topology.devices[k];
         if (d.esi.empty()) continue;
         try {
-            line.products[k] = std::make_shared<const od::Product>(esi::load_product(d.esi, d.device_spec));
+            auto& p = esi_products[{d.esi, d.device_spec}];
+            if (!p) p = std::make_shared<const od::Product>(esi::load_product(d.esi, d.device_spec));
+            line.products[k] = p;
         } catch (const std::exception& e) {
             std::cerr << "ecat-slave: " << line.topology.where(d.line) << "device " << d.name << ": "
                       << e.what() << '\n';

@@ -357,6 +357,15 @@ std::optional<od::Object> to_object(const EsiObject& eo, uint16_t index, Ctx& ct
     }
     if (s0.subindex == 0 && std::holds_alternative<std::monostate>(s0.default_value))
         s0.default_value = uint64_t{o.entries.back().subindex};
+    // An SM assignment object (ETG.1000.6 0x1C10-0x1C2F: an ARRAY of UNSIGNED16) that a file declares as a
+    // record of UINT16 entries (a DT1C12 with SubItems and no ArrayInfo: a Bohigh drive) is the ARRAY the
+    // standard makes it: a complete access and SDO information show it as every other device's, the entries
+    // after the count bounded by subindex 0 (docs/decisions/coe.md, "Complete access").
+    if (o.code == od::ObjectCode::Record && index >= 0x1C10 && index <= 0x1C2F && o.entries.size() >= 2 &&
+        o.entries[0].subindex == 0 &&
+        std::all_of(o.entries.begin() + 1, o.entries.end(),
+                    [](const od::Entry& e) { return e.type == DataType::Unsigned16 && e.bit_length == 16; }))
+        o.code = od::ObjectCode::Array;
     if (o.code == od::ObjectCode::Array) {
         // An od ARRAY holds elements of one type; otherwise it is served as a RECORD.
         for (std::size_t i = 2; i < o.entries.size(); ++i)
@@ -581,6 +590,17 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
             sm.kind = od::SmKind::MBoxOut;
         } else if (t == "MBOXIN") {
             sm.kind = od::SmKind::MBoxIn;
+        } else if ((t == "OUTPUTS" || t == "INPUTS") && s.has_control && (s.control & 0x03) != 0x02 &&
+                   (((s.control >> 2) & 0x03) == 0x01) != (t == "OUTPUTS")) {
+            // The text names one direction, the control byte the other (ESC datasheet 0x0804 bits 2-3: 00 the
+            // master reads, 01 it writes): the ESC serves the buffer as the control byte says, and so do a
+            // master that reads the SII and the PDOs the file assigns to it (SMC's EX250: SM1 "Outputs" with
+            // #x0 carrying the TxPdo). Taken from the control byte, said once.
+            const bool write = ((s.control >> 2) & 0x03) == 0x01;
+            sm.kind = write ? od::SmKind::Outputs : od::SmKind::Inputs;
+            ctx.warn(s.line, "Sm '" + s.type + "' with control byte " + hex(s.control, 2) + " (the master " +
+                                 (write ? "writes" : "reads") + " it): taken as " +
+                                 (write ? "Outputs" : "Inputs") + ", as the ESC serves it");
         } else if (t == "OUTPUTS") {
             sm.kind = od::SmKind::Outputs;
         } else if (t == "INPUTS") {
@@ -733,6 +753,23 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
     desc.identification_al_status = d.identification_reg134;
     desc.identification_register = d.identification_ado.value_or(0);
     desc.ebus_current_ma = static_cast<int16_t>(d.ebus_current_ma.value_or(0));
+    // Physics (ETG.2000 PhysicsType, pattern [Y,K,H, ]{0,4}): one character per port from port 0, Y MII, K
+    // E-Bus, H MII with fast hot connect, a blank no port. The pattern's commas are the character class's
+    // separators, not a port type; lowercase is not in it. Port 0 is where the master's frames come in (ESC
+    // datasheet, frame processing), so a device without it could not be reached. Without the attribute (or
+    // with it empty) the device has two MII ports (od::DeviceDescription's default), as before Physics was
+    // read.
+    if (d.physics && !d.physics->empty()) {
+        const std::string& ph = *d.physics;
+        if (ph.size() > 4 || ph.find_first_not_of("YKH ") != std::string::npos)
+            ctx.fail(d.line, "Device Physics '" + ph +
+                                 "': one character per port, at most 4: Y (MII), K (E-Bus), H or a blank "
+                                 "(ETG.2000 PhysicsType)");
+        if (ph[0] == ' ')
+            ctx.fail(d.line, "Device Physics '" + ph +
+                                 "': port 0 has no port type; the master's frames enter a device there");
+        desc.physics = ph;
+    }
 
     // ---- The PDOs: the device's own and those of the module of each slot (its default, or as chosen) ----
     std::vector<Pdo> pdos;

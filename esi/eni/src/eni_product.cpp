@@ -246,6 +246,11 @@ od::Product product_from_eni(const Config& config, std::size_t index) {
                                 ? s.info.name.substr(open + 1, close - open - 1)
                                 : d.identity.device_name;
     d.identity.group_type = "ENI";
+    // The slave's ports (Info/Physics, as the ESI's Device Physics: one character per port, ETG.2000); one
+    // that is not a port type, or none at port 0, leaves the two MII ports.
+    if (const std::string& ph = s.info.physics;
+        !ph.empty() && ph.size() <= 4 && ph[0] != ' ' && ph.find_first_not_of("YKH ") == std::string::npos)
+        d.physics = ph;
     d.identity.hardware_version.clear();
     d.identity.software_version.clear();
 

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "od/device.hpp"
@@ -60,10 +61,32 @@ struct SmInfo {
 // ESI Fmmu text / SII FMMU category byte.
 enum class FmmuUse : uint8_t { Unused = 0x00, Outputs = 0x01, Inputs = 0x02, MBoxState = 0x03 };
 
+// The device's ports (od::DeviceDescription::physics, ETG.2000 Device Physics: one character per port).
+// A character that is not a port type (the reader refuses those: esi_device) counts as no port.
+// ESC datasheet, register 0x0007 (port descriptor): 2 bits per port from port 0, 00 not implemented, 10 EBUS,
+// 11 MII. 'Y' and 'H' are MII ports, 'K' an E-Bus port.
+inline uint8_t physics_port_descriptor(std::string_view physics) {
+    uint8_t d = 0;
+    for (std::size_t p = 0; p < physics.size() && p < 4; ++p) {
+        const char c = physics[p];
+        const unsigned code = c == 'Y' || c == 'H' ? 0x3u : c == 'K' ? 0x2u : 0x0u;
+        d = static_cast<uint8_t>(d | (code << (2 * p)));
+    }
+    return d;
+}
+// ETG.2010 SII General category bytes 16-17 (physical ports): 4 bits per port from port 0, 0 not used,
+// 1 MII, 3 EBUS, 4 fast hot connect.
+inline uint16_t physics_sii_ports(std::string_view physics) {
+    uint16_t w = 0;
+    for (std::size_t p = 0; p < physics.size() && p < 4; ++p) {
+        const char c = physics[p];
+        const unsigned code = c == 'Y' ? 0x1u : c == 'K' ? 0x3u : c == 'H' ? 0x4u : 0x0u;
+        w = static_cast<uint16_t>(w | (code << (4 * p)));
+    }
+    return w;
+}
+
 // Properties of the stack itself rather than of one device, so not in od::DeviceDescription:
-// Physical ports: two MII ports (as the MAXPOS, and as esc::EscConfig's 0x0007 default 0x0F).
-constexpr uint16_t kPhysicalPorts = 0x0011;  // SII General bytes 16-17: 4 bits per port, 1 = MII
-constexpr const char* kPhysics = "YY";       // ESI Device Physics
 // Segmented SDO transfers (coe/src/sdo_server.cpp, both directions). ESI Mailbox/CoE SegmentedSdo.
 constexpr bool kSegmentedSdo = true;
 // SII General flags (ETG.2010, byte 11) as the description announces them: bit 2 mailbox data link layer

@@ -214,6 +214,10 @@ struct DeviceDescription {
     // what the device announces, as its vendor's EEPROM does.
     bool mailbox_data_link_layer = true;
     bool identification_al_status = true;
+    // The device's ports (ETG.2000 Device Physics): one character per port 0..3, 'Y' MII (100BASE-TX), 'K'
+    // E-Bus (LVDS), 'H' MII with fast hot connect, ' ' (or past the end) none. The ESC's port descriptor
+    // 0x0007 and the SII General category's physical ports follow it (esi/model.hpp).
+    std::string physics = "YY";
     uint16_t identification_register = 0;
     int16_t ebus_current_ma = 0;
     // A modular device (empty: not modular). The PDOs of the slots' default modules are in the dictionary.

@@ -483,15 +483,20 @@ void add_sii_tests(Catalogue& c) {
             if (Outcome o = expect_eq("SMs start/size/control/enable", got, want); o.status != Status::Pass)
                 return o;
             // The SM type byte (ETG.2010 SyncM: 1 mailbox out, 2 mailbox in, 3 outputs, 4 inputs) as the
-            // ESI's Sm text says; an Sm of another text is not compared.
+            // ESI's Sm text says; an Sm of another text is not compared. A process-data Sm whose ControlByte
+            // names the other direction (ESC datasheet 0x0804 bits 2-3: 00 the master reads, 01 it writes;
+            // buffered mode) is the buffer the ESC makes of it: its type is the control byte's.
             std::string tgot, twant;
             for (std::size_t n = 0; n < ctx.esi->sms.size() && n < types.size(); ++n) {
-                const std::string& t = ctx.esi->sms[n].type;
-                const int want_type = t == "MBoxOut"   ? 1
-                                      : t == "MBoxIn"  ? 2
-                                      : t == "Outputs" ? 3
-                                      : t == "Inputs"  ? 4
-                                                       : -1;
+                const EsiSm& sm = ctx.esi->sms[n];
+                const std::string& t = sm.type;
+                int want_type = t == "MBoxOut"   ? 1
+                                : t == "MBoxIn"  ? 2
+                                : t == "Outputs" ? 3
+                                : t == "Inputs"  ? 4
+                                                 : -1;
+                if ((want_type == 3 || want_type == 4) && sm.has_control && (sm.control & 0x03) != 0x02)
+                    want_type = ((sm.control >> 2) & 0x03) == 0x01 ? 3 : 4;
                 if (want_type < 0) continue;
                 tgot += "SM" + dec(static_cast<long long>(n)) + " " + dec(types[n]) + " ";
                 twant += "SM" + dec(static_cast<long long>(n)) + " " + dec(want_type) + " ";
@@ -552,6 +557,49 @@ void add_sii_tests(Catalogue& c) {
             return expect_eq("CoE details", hex(b & 0x3F, 2), hex(want, 2));
         },
         "ESI has CoE");
+    add(
+        "esi.physics",
+        "General physical ports and the ESC's port descriptor 0x0007 as the ESI's Device Physics",
+        "ETG.2000 Device Physics; ETG.2010 SII General category (bytes 16-17); ESC datasheet 0x0007",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_NEED(ctx.need_sii());
+            if (!ctx.esi->physics || ctx.esi->physics->empty()) return skip("the ESI declares no Physics");
+            const std::string& ph = *ctx.esi->physics;
+            const SiiCategory* g = ctx.sii->find(kGeneral);
+            if (!g || g->length < 18) return fail("no General category of 18 bytes or more");
+            const uint16_t ports = get16(&ctx.sii->bytes[g->offset + 16]);
+            auto desc = ctx.rd<uint8_t>(0x0007);
+            if (!desc) return fail("0x0007 unreadable");
+            // One character per port from port 0 (ETG.2000): Y 100BASE-TX (MII), K E-Bus (LVDS), H MII with
+            // fast hot connect, a blank or none: no port. ETG.2010 ports nibble: 1 MII, 3 EBUS, 4 fast hot
+            // connect, 0 not used; 0x0007 two bits: 11 MII, 10 EBUS, 00 not implemented.
+            std::string bad;
+            for (int p = 0; p < 4 && bad.empty(); ++p) {
+                const char kind =
+                    static_cast<std::size_t>(p) < ph.size() ? ph[static_cast<std::size_t>(p)] : ' ';
+                const unsigned nib = (ports >> (4 * p)) & 0x0Fu, esc = (*desc >> (2 * p)) & 0x03u;
+                const bool nib_ok = kind == 'Y'   ? nib == 1
+                                    : kind == 'K' ? nib == 3
+                                    : kind == 'H' ? nib == 4 || nib == 1
+                                                  : nib == 0;
+                const bool esc_ok = kind == 'Y' || kind == 'H' ? esc == 3 : kind == 'K' ? esc == 2 : esc == 0;
+                const std::string port = "port " + dec(p) + " ('" + std::string(1, kind) + "')";
+                if (!nib_ok)
+                    bad = port + ": SII physical port " + dec(nib);
+                else if (!esc_ok)
+                    bad = port + ": 0x0007 says " +
+                          (esc == 0   ? "not implemented"
+                           : esc == 1 ? "not configured"
+                           : esc == 2 ? "EBUS"
+                                      : "MII");
+            }
+            if (!bad.empty())
+                return fail(bad, "ports " + hex(ports) + ", 0x0007 " + hex(*desc, 2),
+                            "Physics \"" + ph + "\"");
+            return pass("Physics \"" + ph + "\": ports " + hex(ports) + ", 0x0007 " + hex(*desc, 2));
+        },
+        "ESI given");
     add("general.ports_flags",
         "General category: physical ports as the ESC's port descriptor 0x0007 (port 0 in use), flag 'not "
         "LRW' only where 0x0008 says LRW is not supported",

@@ -143,6 +143,20 @@ Error read_mapping(master::SdoClient& sdo, uint16_t index, PdoView& pv) {
     return Error::Ok;
 }
 
+// ETG.2000 Device Physics from the SII General category's physical ports (ETG.2010 bytes 16-17, 4 bits a
+// port: 1 MII -> Y, 3 EBUS -> K, 4 fast hot connect -> H, 0 not used -> a blank; trailing blanks dropped).
+// Two MII ports when the SII says none or port 0 is not used.
+std::string physics_of(uint16_t ports) {
+    std::string p;
+    for (int k = 0; k < 4; ++k) {
+        const unsigned n = (ports >> (4 * k)) & 0x0Fu;
+        p += n == 1 ? 'Y' : n == 3 ? 'K' : n == 4 ? 'H' : ' ';
+    }
+    while (!p.empty() && p.back() == ' ')
+        p.pop_back();
+    return p.empty() || p[0] == ' ' ? "YY" : p;
+}
+
 int run_xml(master::Master& m, const XmlArgs& x) {
     auto a = x.slave.address();
     if (!a) return kExitUsage;
@@ -243,8 +257,9 @@ int run_xml(master::Master& m, const XmlArgs& x) {
     w("  <Descriptions>\n    <Groups>\n      <Group>\n        <Type>" + esc(group) +
       "</Type>\n        <Name LcId=\"1033\">" + esc(group) +
       "</Name>\n      </Group>\n    </Groups>\n    <Devices>\n");
-    w("      <Device Physics=\"YY\">\n        <Type ProductCode=\"" + hx(sii.product_code, 8) +
-      "\" RevisionNo=\"" + hx(sii.revision, 8) + "\">" + esc(order) + "</Type>\n");
+    w("      <Device Physics=\"" + physics_of(sii.general ? sii.general->physical_ports : 0) +
+      "\">\n        <Type ProductCode=\"" + hx(sii.product_code, 8) + "\" RevisionNo=\"" +
+      hx(sii.revision, 8) + "\">" + esc(order) + "</Type>\n");
     w("        <Name LcId=\"1033\">" + esc(dev_name) + "</Name>\n");
     w("        <GroupType>" + esc(group) + "</GroupType>\n");
     if (coe) {

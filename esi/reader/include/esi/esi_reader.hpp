@@ -83,6 +83,7 @@ struct EsiSm {
     uint16_t default_size = 0;
     std::optional<uint32_t> min_size, max_size;  // MinSize/MaxSize attributes, if given
     uint8_t control = 0;
+    bool has_control = false;  // ControlByte given
     bool enable = false;
     bool watchdog = false;  // Watchdog attribute
     bool is_virtual = false;
@@ -224,6 +225,7 @@ struct EsiDevice {
     // there; SII General flag IdentPhyM and bytes 18-19).
     std::optional<uint16_t> identification_ado;
     std::optional<int32_t> ebus_current_ma;     // Info/Electrical/EBusCurrent (negative: the device feeds)
+    std::optional<std::string> physics;         // the Physics attribute as written (blanks kept), if any
     std::vector<EsiDiagMessage> diag_messages;  // Profile/DiagMessages, in file order
     std::vector<uint8_t> image16x14;            // ImageData16x14, empty if none
 

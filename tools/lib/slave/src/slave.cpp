@@ -231,6 +231,7 @@ int run_slave(const SlaveOptions& options, std::ostream& out, std::ostream& err)
 
         esc::EscConfig config;
         config.process_ram_kib = options.ram_kib;
+        config.port_descriptor = options.port_descriptor;
         config.faults = options.esc_faults;
         config.thread_safe = false;  // the runtime below is the only thread that calls it
         esc::SystemClock clock;

@@ -39,6 +39,7 @@ std::string name_error(std::string_view name) {
 struct Parser {
     Topology topo;
     std::string base_dir;
+    PortsOfEsi ports_of_esi;
     int line_no = 0;
     // Unresolved at= of each device (name, port, line); resolved when the whole file is read, so a device
     // may be plugged into one declared further down.
@@ -128,6 +129,7 @@ struct Parser {
             } else if (key == "ports") {
                 d.ports = static_cast<int>(integer(key, value, 2, 4));
                 if (d.ports == 3) fail("ports=3: an ESC has 2 or 4 ports");
+                d.ports_given = true;
             } else if (key == "serial") {
                 d.serial = static_cast<uint32_t>(integer(key, value, 0, 0xFFFFFFFF));
             } else if (key == "drift-ppm") {
@@ -155,9 +157,16 @@ struct Parser {
             fail(
                 "esi= and config= together: config= configures the built-in drive, esi= serves another "
                 "device");
-        if (d.port >= d.ports)
-            fail("port=" + std::to_string(d.port) + ": the device has only ports 0.." +
-                 std::to_string(d.ports - 1));
+        if (!d.esi.empty() && !d.ports_given && ports_of_esi) {
+            try {
+                d.descriptor = ports_of_esi(d);
+            } catch (const std::exception& e) {
+                fail("device " + d.name + ": " + e.what());
+            }
+            if (d.descriptor == 0) fail("device " + d.name + ": its ESI declares no port");
+        }
+        if (!d.has_port(d.port))
+            fail("port=" + std::to_string(d.port) + ": the device has only ports " + d.port_list());
         if (topo.devices.empty()) {
             if (a.given) fail("the first device is the root (its port 0 faces the master); it takes no at=");
             if (d.port != 0) fail("the first device is the root: it faces the master with port 0");
@@ -206,9 +215,10 @@ struct Parser {
         std::map<std::pair<int, int>, int> used;
         auto take = [&](int dev, int port, int line, const std::string& what) {
             const TopologyDevice& d = topo.devices[static_cast<std::size_t>(dev)];
-            if (port >= d.ports)
-                fail_at(line, what + ": device '" + d.name + "' has only ports 0.." +
-                                  std::to_string(d.ports - 1) + " (ports=4 for a junction)");
+            if (!d.has_port(port))
+                fail_at(line, what + ": device '" + d.name + "' has only ports " + d.port_list() +
+                                  (d.descriptor != 0 ? " (its ESI's Physics; ports=4 for a junction)"
+                                                     : " (ports=4 for a junction)"));
             const auto [it, fresh] = used.emplace(std::make_pair(dev, port), line);
             if (!fresh)
                 fail_at(line, what + ": port " + std::to_string(port) + " of '" + d.name +
@@ -269,14 +279,30 @@ int Topology::find(std::string_view name_or_index) const {
     return -1;
 }
 
+std::string TopologyDevice::port_list() const {
+    std::string s;
+    int n = 0;  // ports 0..n-1 all there
+    while (n < 4 && has_port(n))
+        ++n;
+    bool contiguous = true;
+    for (int p = n; p < 4; ++p)
+        contiguous = contiguous && !has_port(p);
+    if (contiguous && n > 1) return "0.." + std::to_string(n - 1);
+    for (int p = 0; p < 4; ++p)
+        if (has_port(p)) s += (s.empty() ? "" : ", ") + std::to_string(p);
+    return s;
+}
+
 std::string Topology::where(int line) const {
     return file + ":" + std::to_string(line) + ": ";
 }
 
-Topology parse_topology(std::string_view text, const std::string& file, const std::string& base_dir) {
+Topology parse_topology(std::string_view text, const std::string& file, const std::string& base_dir,
+                        const PortsOfEsi& ports_of_esi) {
     Parser p;
     p.topo.file = file;
     p.base_dir = base_dir;
+    p.ports_of_esi = ports_of_esi;
     while (!text.empty()) {
         ++p.line_no;
         const std::size_t nl = text.find('\n');
@@ -287,7 +313,7 @@ Topology parse_topology(std::string_view text, const std::string& file, const st
     return std::move(p.topo);
 }
 
-Topology load_topology(const std::string& file) {
+Topology load_topology(const std::string& file, const PortsOfEsi& ports_of_esi) {
     std::string text;
     try {
         text = util::read_input_file(file, kMaxTopologyBytes, "topology file");
@@ -295,7 +321,7 @@ Topology load_topology(const std::string& file) {
         throw TopologyError(e.what());
     }
     const std::filesystem::path parent = std::filesystem::path(file).parent_path();
-    return parse_topology(text, file, parent.string());
+    return parse_topology(text, file, parent.string(), ports_of_esi);
 }
 
 Topology line_topology(int count) {

@@ -50,6 +50,7 @@ struct SlaveOptions {
     std::string eeprom_file;          // binary SII image
     bool eeprom_write_back = true;    // write the image back to eeprom_file at exit if the master changed it
     uint32_t ram_kib = 8;             // process RAM size (ESC register 0x0006)
+    uint8_t port_descriptor = 0x0F;   // the ESC's ports (register 0x0007; a device's ESI Physics)
     bool verbose = false;             // print statistics (runtime, ESC, firmware report) at exit
     std::string stats_file;           // write the same statistics as "name value" lines here at exit
     int rt_priority = 0;              // > 0: SCHED_FIFO at this priority and all memory locked (mlockall)

@@ -14,7 +14,9 @@
 // file with several (product code and revision "0x07d83052:0x00110000", or its Type name), as ecat-slave's
 // --esi/--device do. config=, esi= and state-dir= are relative to the topology file's folder. at= defaults to
 // the previous device's port 1 (a line); the first device is the root (its port 0 faces the master). port= is
-// the device's own port facing upstream (default 0). ports=4 makes a four-port (junction-capable) ESC.
+// the device's own port facing upstream (default 0). ports=4 makes a four-port (junction-capable) ESC. A
+// device given by esi= has the ports its ESI's Physics declares (ETG.2000: "YY" ports 0 and 1, "Y" port 0
+// only, "YY K" ports 0, 1 and 3) unless ports= is written.
 // `external` names the port that leads to --out-iface (default: port 1 of the last device).
 //
 // NAME: 1..64 characters of [A-Za-z0-9_.-], beginning with a letter or a digit, not a number, unique; it
@@ -24,6 +26,7 @@
 // Errors are reported as "FILE:LINE: message" (TopologyError), for an unknown key or statement, an
 // unknown device, a port used twice or missing on the ESC, a loop, a bad number or a duplicate name.
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -46,13 +49,17 @@ class TopologyError : public std::runtime_error {
 
 struct TopologyDevice {
     std::string name;
-    std::string config;       // device configuration file (resolved), empty: the built-in drive
-    std::string esi;          // ESI file of the device (resolved), empty: not from an ESI
-    std::string device_spec;  // device= of a file with several devices, empty: the only one
-    int parent = -1;          // index of the upstream device, -1: the root (faces the master)
-    int parent_port = 1;      // port of the parent this device is plugged into
-    int port = 0;             // this device's own port facing upstream
-    int ports = 2;            // 2: ports 0 and 1 (port descriptor 0x0F), 4: ports 0-3 (0xFF)
+    std::string config;        // device configuration file (resolved), empty: the built-in drive
+    std::string esi;           // ESI file of the device (resolved), empty: not from an ESI
+    std::string device_spec;   // device= of a file with several devices, empty: the only one
+    int parent = -1;           // index of the upstream device, -1: the root (faces the master)
+    int parent_port = 1;       // port of the parent this device is plugged into
+    int port = 0;              // this device's own port facing upstream
+    int ports = 2;             // 2: ports 0 and 1 (port descriptor 0x0F), 4: ports 0-3 (0xFF)
+    bool ports_given = false;  // ports= was written
+    // The ESC's port descriptor (0x0007, ESC datasheet: 2 bits per port, 00 not implemented) when the device
+    // says which ports it has (esi=: its ESI's Physics, unless ports= is written); 0: from ports.
+    uint8_t descriptor = 0;
     std::optional<uint32_t> serial;
     double drift_ppm = 0.0;
     int64_t offset_ns = 0;
@@ -60,7 +67,10 @@ struct TopologyDevice {
     std::string state_dir;  // resolved; empty: <state-dir>/NAME
     int line = 0;           // where it is declared (for messages about it)
 
-    uint8_t port_descriptor() const { return ports == 4 ? 0xFF : 0x0F; }
+    uint8_t port_descriptor() const { return descriptor != 0 ? descriptor : ports == 4 ? 0xFF : 0x0F; }
+    bool has_port(int p) const { return p >= 0 && p < 4 && ((port_descriptor() >> (2 * p)) & 0x03) != 0; }
+    // "0, 1" (the ports it has), for messages.
+    std::string port_list() const;
 };
 
 struct Topology {
@@ -78,11 +88,17 @@ struct Topology {
     std::string where(int line) const;
 };
 
+// The port descriptor of a device given by esi= (its ESI's Physics, ETG.2000), asked for each such device
+// without ports=; it throws (any std::exception) when the device cannot be served, which the parser reports
+// at the device's line. Empty: such devices have ports 0 and 1 (MII).
+using PortsOfEsi = std::function<uint8_t(const TopologyDevice&)>;
+
 // Parses the text of a topology file. file names it in messages; base_dir resolves relative paths.
 // Throws TopologyError.
-Topology parse_topology(std::string_view text, const std::string& file, const std::string& base_dir);
+Topology parse_topology(std::string_view text, const std::string& file, const std::string& base_dir,
+                        const PortsOfEsi& ports_of_esi = {});
 // Reads and parses a file. Throws TopologyError (also when the file cannot be read).
-Topology load_topology(const std::string& file);
+Topology load_topology(const std::string& file, const PortsOfEsi& ports_of_esi = {});
 // The line of N drives that `--slaves N` means: drive1..driveN, serial numbers 1..N, each plugged into
 // the previous one's port 1; state directories are left empty (the caller decides).
 Topology line_topology(int count);
