@@ -84,6 +84,13 @@ std::string sync_objects_running(Context& ctx) {
             problems += o + ":05 minimum cycle " + dec(static_cast<long long>(*min)) +
                         " ns above the cycle it runs at (" + o + ":02 " +
                         dec(static_cast<long long>(*cycle)) + " ns); ";
+        // ETG.1020: in the synchronous modes the inputs run at the outputs' cycle, 0x1C33:02 as 0x1C32:02.
+        if (index == 0x1C33) {
+            auto out_cycle = ctx.upload_uint(0x1C32, 2);
+            if (cycle && out_cycle && *cycle && *out_cycle && *cycle != *out_cycle)
+                problems += "0x1C33:02 cycle " + dec(static_cast<long long>(*cycle)) +
+                            " ns, not 0x1C32:02's " + dec(static_cast<long long>(*out_cycle)) + " ns; ";
+        }
         auto error = ctx.upload_uint(index, 0x20);
         if (!error || !*error) continue;
         auto missed = ctx.upload_uint(index, 0x0B);
@@ -497,6 +504,42 @@ void add_dc_tests(Catalogue& c) {
             if (old) (void)ctx.download_uint(0x1C32, 1, *old, 2);
             if (bad) return *bad;
             return pass(taken.empty() ? "neither 0 nor 1 taken" : "taken " + taken, hex(*sup, 4));
+        },
+        a);
+    add(
+        "sync_modes_announced.1c32",
+        "Every synchronization type 0x1C32:04 announces (bit 0 free run, bit 1 SM2 event) is taken by "
+        "0x1C32:01 and read back",
+        "ETG.1020 0x1C32:04 supported synchronization types, 0x1C32:01 synchronization type",
+        [](Context& ctx) {
+            CONFORM_NEED(need_sync_object(ctx, 0x1C32));
+            CONFORM_NEED(need_writable(ctx, 0x1C32, 1));
+            CONFORM_PREOP(ctx);
+            auto sup = ctx.upload_uint(0x1C32, 4);
+            if (!sup) return fail("0x1C32:04: " + ctx.sdo_error(sup.error()));
+            auto old = ctx.upload_uint(0x1C32, 1);
+            std::optional<Outcome> bad;
+            std::string taken;
+            for (const auto& [type, bit, name] :
+                 {std::tuple<uint16_t, uint64_t, const char*>{0, 0x01, "free run"}, {1, 0x02, "SM2 event"}}) {
+                if (!(*sup & bit)) continue;
+                Error e = ctx.download_uint(0x1C32, 1, type, 2);
+                auto got = ctx.upload_uint(0x1C32, 1);
+                if (e != Error::Ok || !got || *got != type) {
+                    if (!bad)
+                        bad = fail(
+                            "0x1C32:04 announces " + std::string(name) + " (bit " + dec(bit == 1 ? 0 : 1) +
+                                "), but 0x1C32:01 = " + dec(type) + " is not taken",
+                            e != Error::Ok ? ctx.sdo_error(e)
+                                           : "reads back " + (got ? dec(static_cast<long long>(*got)) : "?"),
+                            dec(type) + " taken and read back");
+                    continue;
+                }
+                taken += std::string(taken.empty() ? "" : ", ") + dec(type);
+            }
+            if (old) (void)ctx.download_uint(0x1C32, 1, *old, 2);
+            if (bad) return *bad;
+            return pass(taken.empty() ? "neither bit 0 nor 1 announced" : "taken " + taken, hex(*sup, 4));
         },
         a);
     add(
