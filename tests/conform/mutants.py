@@ -1196,15 +1196,30 @@ TABLE_SURVIVORS = {
                                 "address algorithm (bit 7) has no meaning; sii.interface.address_algorithm "
                                 "judges bit 7 against SII word 0x3E for a real EEPROM only; a mistake of the "
                                 "mutant",
-    "al-code-fatal-sync-as-sync": "not provoked (no test stops SYNC0 while the slave is in OP), and no defect: a "
-                                  "loss of sync in OP may be reported with 0x001A or 0x002C (the project's protocol "
-                                  "digest, ETG.1000.6 AL status codes, read after the tool); a mistake of the mutant",
+    "al-code-fatal-sync-as-sync": "no defect: a loss of sync in OP may be reported with 0x001A or 0x002C (the "
+                                  "project's protocol digest, ETG.1000.6 AL status codes, read after the tool); a "
+                                  "mistake of the mutant. Provoked since round 6 (dc.sync0_stopped_in_op), which "
+                                  "takes either code",
     "foe-packet-number-as-illegal": "the table's drive stores no image, so its FoE read is refused; killed by "
                                     "test_conform.py foe_write (foe.read_file acknowledges the last packet read "
                                     "with a wrong number)",
-    "diag-message-type-info": "never fires: the table run reads the diagnosis messages before a fault is "
-                              "provoked (info messages only then), and no test judges the type of an "
-                              "emergency's message; not closed",
+    # round 6 (UNSEEN6)
+    "pd-outputs-counted-safeop": "never fires, and no defect: the slave's output SM counts an LRW in SAFEOP "
+                                 "(working counter 3, as an ESC whose SM2 stays enabled does); ETG.1000.6 SAFEOP "
+                                 "leaves the outputs unapplied, not uncounted; a mistake of the mutant",
+    "dc-diff-sign-inverted": "caught as a warning only (dc.system_time.difference): the datasheet's sign of "
+                             "0x092C is judged as a warning by the project's decision (KickCAT's emulation has "
+                             "it the other way round); not a kill",
+    "diag-ack-not-applied": "never fires: no test writes 0x10F3:03 (an acknowledge, or 0 deleting the history, "
+                            "cannot be put back); not closed",
+    "al-code-sm-types-as-output-config": "not provoked: the slave gives 0x001C for SM types against 0x1C00 "
+                                         "(read-only) or a process-data SM not in buffered mode, and ETG.1000.6 "
+                                         "does not settle 0x001C against 0x001D for an SM2 of the wrong mode; "
+                                         "not closed",
+    "al-code-sm-overlap-as-mailbox": "not provoked: the drive's SM addresses are fixed, a moved SM is refused for "
+                                     "its address (0x001D/0x001E) before any overlap is seen; not closed",
+    "al-code-sync-mode-unsupported": "not provoked: the drive aborts 0x1C32:01 = 3 at the write (its maximum is "
+                                     "2), no transition sees an unsupported mode; not closed",
 }
 
 
@@ -2673,13 +2688,28 @@ def eeprom_slow_busy(st, d):
         d.put(0x0502, d.get(0x0502) | 0x8000)
 
 
-def serial_absent(st, d):
-    """Serial number 0 (not given) alike in SII words 0x0E/0x0F and 0x1018:04 (expedited and complete access)."""
-    sii_word(0x0E, lambda v: 0)(st, d)
-    sii_word(0x0F, lambda v: 0)(st, d)
-    sdo_upload_of(0x1018, 4, lambda m: m.__setitem__(slice(12, 16), b"\x00\x00\x00\x00"))(st, d)
-    ca_upload(lambda m, o: struct.unpack_from("<H", m, 9)[0] == 0x1018 and m[o] >= 4 and len(m) >= o + 18
-              and m.__setitem__(slice(o + 14, o + 18), b"\x00\x00\x00\x00"))(st, d)
+def serial_other(st, d):
+    """Another serial number (0x12345678), alike in SII words 0x0E/0x0F and 0x1018:04 (expedited and complete
+    access): a device whose serial is set in production, not the 0 (not given) of the soft slave."""
+    sii_word(0x0E, lambda v: 0x5678)(st, d)
+    sii_word(0x0F, lambda v: 0x1234)(st, d)
+    sdo_upload_of(0x1018, 4, lambda m: m.__setitem__(slice(12, 16), b"\x78\x56\x34\x12"))(st, d)
+    mbx_rewriter(serial_in_ca)(st, d)
+
+
+def serial_in_ca(st, m):
+    """0x1018:04 = 0x12345678 in a complete-access upload of 0x1018 from subindex 0 or 1."""
+    svc, _ = coe(m)
+    t, req = st.request_coe()
+    if svc != 3 or t != 3 or len(req) < 6 or not (req[2] & 0x10) or (m[8] & 0xE0) != 0x40 or m[8] & 0x02:
+        return None
+    if struct.unpack_from("<H", req, 3)[0] != 0x1018 or req[5] not in (0, 1):
+        return None
+    at = 16 + (2 if req[5] == 0 else 0) + 12  # data, :00 and its padding byte, :01-:03
+    if struct.unpack_from("<I", m, 12)[0] < at - 16 + 4 or len(m) < at + 4:
+        return None
+    m[at:at + 4] = b"\x78\x56\x34\x12"
+    return m
 
 
 VARIATIONS.update({
@@ -2689,8 +2719,10 @@ VARIATIONS.update({
     "statusword-voltage-in-sod": ("CiA 402 statusword bit 4 (voltage enabled): high voltage applied, 'x' in every "
                                   "state of the state table (set in Switch on disabled)",
                                   statusword_sdo_pd(lambda v: v | 0x10 if (v & 0x4F) == 0x40 else v)),
-    "serial-number-absent": ("ETG.1000.6 0x1018:04 / ETG.2010 SII words 0x0E-0x0F: serial number 0 (not given), "
-                             "alike in both", serial_absent),
+    # Written blind as "serial number 0 (not given)", which the soft slave already serves (no reply changed):
+    # now a serial number set, the other way round.
+    "serial-number-other": ("ETG.1000.6 0x1018:04 / ETG.2010 SII words 0x0E-0x0F: the serial number is the "
+                            "device's own, any value, alike in both", serial_other),
 })
 
 
