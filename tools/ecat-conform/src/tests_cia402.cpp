@@ -5,6 +5,7 @@
 #include <optional>
 #include <thread>
 
+#include "master/diag.hpp"
 #include "pdo_map.hpp"
 
 namespace conform {
@@ -242,6 +243,58 @@ Outcome fault_emergency(Context& ctx, bool generic_bit) {
     if (code603f && (*code603f & 0xFFFF) != code)
         return fail("emergency error code against 0x603F", hex(code), hex(*code603f & 0xFFFF));
     return pass("emergency", got);
+}
+
+// ETG.1020 diagnosis history: a drive with 0x10F3 stores the emergency of its fault as a message (diag code
+// 0xE800 | error code << 16), newer than what the history held before (0x10F3:02 newest message moves to
+// it), and of type warning or error (flags bits 0-3; info is for what is no fault). The history is only read.
+Outcome fault_history(Context& ctx) {
+    if (!ctx.opt.allow_fault) return skip("provokes a drive fault: needs --allow-fault");
+    CONFORM_NEED(need_402_profile(ctx));
+    CONFORM_PREOP(ctx);
+    auto before = ctx.upload_uint(0x10F3, 2);
+    if (!before) return skip("no diagnosis history 0x10F3");
+    auto max = ctx.upload_uint(0x10F3, 1);
+    if (!max || *max == 0) return skip("0x10F3:01 (maximum messages) unreadable or 0 (history.header's)");
+    Drive d(ctx);
+    if (auto o = faulted_drive(ctx, d)) return *o;
+    const auto emcy = drain_emergencies(ctx, d);
+    auto after = ctx.upload_uint(0x10F3, 2);
+    master::DiagHeader h;
+    h.max_messages = static_cast<uint8_t>(*max);
+    h.newest = after ? static_cast<uint8_t>(*after) : 0;
+    std::vector<master::DiagEntry> fresh;  // newest first, down to the newest of before the fault
+    if (after && *after != *before)
+        for (uint8_t sub : master::diag_message_order(h, true, false)) {
+            if (sub == *before) break;
+            auto b = ctx.upload(0x10F3, sub);
+            if (!b) continue;
+            if (auto e = master::decode_diag_message(*b, sub)) fresh.push_back(*e);
+        }
+    d.finish();
+    uint16_t code = 0;
+    for (const auto& x : emcy)
+        if (get16(&x[8]) != 0) code = get16(&x[8]);
+    if (code == 0) return skip("the drive sent no emergency for the fault (cia402.fault_reset judges that)");
+    if (!after) return fail("0x10F3:02 unreadable after the fault: " + ctx.sdo_error(after.error()));
+    if (*after == *before)
+        return fail("0x10F3:02 (newest message) did not move with the fault's emergency " + hex(code),
+                    dec(*after) + " before and after", "a newer message");
+    for (const auto& e : fresh)
+        if (e.from_emergency() && e.emergency_code() == code) {
+            if (e.type == 0)
+                return fail(
+                    "the fault's emergency " + hex(code) + " stored as an info message (flags type 0)",
+                    "type 0 (info) at :" + dec(e.subindex), "1 (warning) or 2 (error)");
+            return pass("stored",
+                        "diag code " + hex(e.code, 8) + " type " + dec(e.type) + " at :" + dec(e.subindex));
+        }
+    std::string seen;
+    for (const auto& e : fresh)
+        seen += hex(e.code, 8) + " ";
+    return fail("the fault's emergency " + hex(code) + " is not among the messages stored since",
+                seen.empty() ? "none" : seen,
+                "diag code " + hex((static_cast<uint32_t>(code) << 16) | 0xE800, 8));
 }
 
 Outcome transition(Context& ctx, const DsState& from, uint16_t c, const DsState& want, const char* what) {
@@ -610,7 +663,7 @@ void add_cia402_tests(Catalogue& c) {
         "statusword.bits",
         "Operation enabled, holding in CSP: statusword state bits and bit 4 the same in the image and over "
         "SDO, bit 9 remote set (the controlword is processed), bit 11 internal limit and bit 13 following "
-        "error clear",
+        "error clear; 0x6040 over SDO reads the controlword of the image",
         "IEC 61800-7-201 (CiA 402) statusword 0x6041 state bits 0-3, 5, 6 and bits 4, 9, 11, 13 (csp)",
         [](Context& ctx) {
             CONFORM_NEED(need_402_profile(ctx));
@@ -627,8 +680,14 @@ void add_cia402_tests(Catalogue& c) {
             d.run(20);
             const uint16_t img = d.status();
             auto sdo = ctx.upload_uint(0x6041, 0);
+            auto cw = ctx.upload_uint(0x6040, 0);
             d.finish();
             if (!sdo) return fail("0x6041 upload: " + ctx.sdo_error(sdo.error()));
+            // The controlword is one object too: over SDO it reads what the process data write into it
+            // (enable operation 0x000F: bits 0-3 and 7, the command bits of IEC 61800-7-201).
+            if (cw && (*cw & 0x008F) != 0x000F)
+                return fail("0x6040 over SDO does not read back the controlword the process data write",
+                            hex(*cw & 0xFFFF), "0x000f (bits 0-3, 7)");
             // The state bits (0-3, 5, 6: operation enabled is xxxx xxxx x01x 0111) and bit 4 (voltage
             // enabled) are the same whichever way the statusword is read, in a steady state.
             if ((*sdo & 0x7F) != (img & 0x7F))
@@ -722,6 +781,12 @@ void add_cia402_tests(Catalogue& c) {
         "ETG.1000.6 CoE emergency; CiA 301 error register 0x1001 bit 0 (generic error, at any error)",
         [](Context& ctx) { return fault_emergency(ctx, true); }, "profile 402 and --allow-fault",
         Severity::Warning);
+    add("fault.diag_history",
+        "Fault (communication loss while enabled): its emergency stored in the diagnosis history 0x10F3 as a "
+        "newer message (:02 moves), diag code 0xE800 with the error code, type warning or error",
+        "ETG.1020 diagnosis history 0x10F3 (:02 newest message; message diag code, flags bits 0-3 type); "
+        "ETG.1000.6 CoE emergency",
+        fault_history, "profile 402, 0x10F3 and --allow-fault");
     add(
         "fault_reset",
         "Fault (from a communication loss while enabled) and fault reset (0x0080 edge): transition 15; the "
@@ -735,8 +800,9 @@ void add_cia402_tests(Catalogue& c) {
             // shows (state bits 0-3, 5, 6), in Fault (read in SAFEOP, where no watchdog runs) and after the
             // reset.
             const uint16_t img_fault = d.status();
+            // The emergencies of the fault, read out before any SDO transfer could pass them over.
+            const auto fault_emcy = drain_emergencies(ctx, d);
             auto sdo_fault = ctx.upload_uint(0x6041, 0);
-            (void)drain_emergencies(ctx, d);
             master::AlStatus st;
             (void)ctx.pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st,
                                          [&d] { d.hold(); });
@@ -761,6 +827,26 @@ void add_cia402_tests(Catalogue& c) {
             if (!emcy.empty() && get16(&emcy.back()[8]) != 0)
                 return fail("the last emergency after the fault reset is not \"error reset\" (code 0x0000)",
                             bytes_hex(std::span<const uint8_t>(emcy.back()).subspan(0, 16)), "code 0x0000");
+            // CiA 301 / ETG.1000.6 emergency: one message when an error occurs, one (code 0x0000) when it is
+            // gone. A drive that signals its faults by emergency signals the reset too, and one that signals
+            // a reset had an error to signal: either message alone is a lost emergency.
+            bool fault_sent = false;
+            for (const auto& x : fault_emcy)
+                fault_sent = fault_sent || get16(&x[8]) != 0;
+            if (fault_sent && emcy.empty())
+                return fail(
+                    "an emergency for the fault, but none (\"error reset\", code 0x0000) after the reset",
+                    "no emergency", "an emergency with code 0x0000");
+            if (!emcy.empty() && !fault_sent)
+                return fail(
+                    "an \"error reset\" emergency after the reset, but no emergency for the fault itself",
+                    "reset " + bytes_hex(std::span<const uint8_t>(emcy.back()).subspan(0, 16)),
+                    "the fault's emergency (a non-zero error code) first");
+            // The error register an emergency carries is 0x1001 as it is then (CiA 301): after the reset,
+            // with no error left, the register of the fault is gone.
+            if (!emcy.empty() && reg && emcy.back()[10] != (*reg & 0xFF))
+                return fail("the \"error reset\" emergency's error register against 0x1001 after the reset",
+                            hex(emcy.back()[10], 2), hex(*reg & 0xFF, 2));
             if (reg && (*reg & 0x01))
                 return fail("0x1001 still shows the generic error (bit 0) after the fault reset",
                             hex(*reg, 2), "bit 0 clear");

@@ -84,6 +84,13 @@ std::string sync_objects_running(Context& ctx) {
             problems += o + ":05 minimum cycle " + dec(static_cast<long long>(*min)) +
                         " ns above the cycle it runs at (" + o + ":02 " +
                         dec(static_cast<long long>(*cycle)) + " ns); ";
+        // ETG.1020: in the synchronous modes the inputs run at the outputs' cycle, 0x1C33:02 as 0x1C32:02.
+        if (index == 0x1C33) {
+            auto out_cycle = ctx.upload_uint(0x1C32, 2);
+            if (cycle && out_cycle && *cycle && *out_cycle && *cycle != *out_cycle)
+                problems += "0x1C33:02 cycle " + dec(static_cast<long long>(*cycle)) +
+                            " ns, not 0x1C32:02's " + dec(static_cast<long long>(*out_cycle)) + " ns; ";
+        }
         auto error = ctx.upload_uint(index, 0x20);
         if (!error || !*error) continue;
         auto missed = ctx.upload_uint(index, 0x0B);
@@ -133,6 +140,86 @@ Outcome dc_state(Context& ctx, bool op) {
         return fail("OP in DC mode: the synchronisation objects contradict the cycle that runs: " + sync,
                     sync, "0x1C3x:05 <= :02, :20 only with a counted cause");
     return pass("OP in DC mode");
+}
+
+// AL status codes a refusal that concerns synchronisation may carry (ETG.1000.6 AL status codes): sync error
+// 0x001A, inconsistent settings 0x0026, the synchronisation family 0x0027-0x002E, the DC family
+// 0x0030-0x0037.
+bool sync_code(uint16_t code) {
+    return code == 0x001A || code == 0x0026 || (code >= 0x0027 && code <= 0x002E) ||
+           (code >= 0x0030 && code <= 0x0037);
+}
+
+// SAFEOP in the ESI's DC op mode, then OP requested while the process data run without a pause (the SM
+// watchdog fed): with SYNC0 not yet started (its start time 30 s ahead: no pulse comes), or (stop) with SYNC0
+// running, OP reached and then SYNC0 switched off (0x0981 = 0). A device may take OP before its first pulse
+// (judged only when refused) and must leave OP once SYNC0 is gone; either way a refusal names the missing
+// synchronisation (0x002D no sync, 0x002C fatal sync, 0x001A, another synchronisation or DC code), not the
+// SM watchdog's 0x001B or another situation's. The slave is taken back to INIT, SYNC0 off.
+Outcome sync0_missing(Context& ctx, bool stop) {
+    CONFORM_NEED(ctx.need_dc());
+    CONFORM_NEED(ctx.need_coe());
+    CONFORM_NEED(ctx.need_state_machine());
+    if (stop && !ctx.opt.allow_fault)
+        return skip("stops SYNC0 in OP (a drive's fault reaction may follow): needs --allow-fault");
+    master::DcConfig dc;
+    dc.enable = true;
+    dc.cycle_ns = 1'000'000;
+    dc.assign_activate = dc_assign(ctx);
+    dc.start_delay = std::chrono::milliseconds(stop ? 20 : 30'000);
+    auto back = [&ctx] {
+        (void)ctx.wr<uint16_t>(esc::reg::kDcCyclicControl, 0);
+        (void)ctx.ack_error();
+        (void)ctx.to_init();
+    };
+    if (Error e = ctx.to_safeop(dc); e != Error::Ok) {
+        back();
+        return skip("SAFEOP in DC mode not reached (dc.safeop_dc judges that): " + err(e));
+    }
+    (void)ctx.cycle(30);
+    master::AlStatus st;
+    Error o = ctx.pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st);
+    const auto text = [](const master::AlStatus& x) {
+        return state_text(static_cast<uint8_t>(x.state | (x.error ? 0x10 : 0))) + " code " + hex(x.code);
+    };
+    if (!stop) {
+        back();
+        if (o == Error::Ok && st.state == 8 && !st.error)
+            return pass("OP taken before the first SYNC0", text(st));
+        if (!st.error) return pass("OP not reached, no refusal (" + err(o) + ")", text(st));
+        if (!sync_code(st.code))
+            return fail(
+                "OP without SYNC0 pulses refused with the code of another situation (the process data "
+                "ran without a pause)",
+                text(st), "a synchronisation code (0x002D no sync, 0x001A, 0x0027-0x002E, 0x0030-0x0037)");
+        return pass("refused", text(st));
+    }
+    if (o != Error::Ok || st.state != 8) {
+        back();
+        return skip("OP in DC mode not reached (dc.op_dc judges that): " + text(st));
+    }
+    (void)ctx.cycle(20);
+    (void)ctx.wr<uint8_t>(esc::reg::kDcActivation, 0);  // SYNC0 off, the process data go on
+    master::AlStatus now;
+    bool left = false;
+    for (int i = 0; i < 300 && !left; ++i) {
+        (void)ctx.cycle(10);
+        auto r = ctx.rd<uint16_t>(master::reg::AlStatus);
+        if (!r) continue;
+        now.state = static_cast<uint8_t>(*r & 0x0F);
+        now.error = *r & 0x10;
+        left = now.state != 8;
+    }
+    if (auto c = ctx.rd<uint16_t>(master::reg::AlStatusCode)) now.code = *c;
+    back();
+    if (!left)
+        return fail("OP kept for 3 s after SYNC0 stopped (0x0981 = 0) in DC mode", text(now),
+                    "SAFEOP+ERR with a synchronisation code");
+    if (!now.error || !sync_code(now.code))
+        return fail("SYNC0 stopped in OP: the slave left OP without naming the lost synchronisation",
+                    text(now),
+                    "SAFEOP+ERR, code 0x002C (fatal sync), 0x001A or another synchronisation code");
+    return pass("left OP", text(now));
 }
 
 }  // namespace
@@ -425,6 +512,22 @@ void add_dc_tests(Catalogue& c) {
         "op_dc", "SAFEOP -> OP in the ESI's DC op mode with SYNC0 running", kDc,
         [](Context& ctx) { return dc_state(ctx, true); }, a);
     add(
+        "op_without_sync0",
+        "SAFEOP -> OP in the ESI's DC op mode before the first SYNC0 pulse (start 30 s ahead), process data "
+        "running: taken, or refused with a synchronisation code (0x002D), not the SM watchdog's",
+        std::string(kDc) +
+            "; ETG.1000.6 AL status codes 0x002D (no sync error), 0x001A-0x0037 family; "
+            "ETG.1020 SAFEOP -> OP in DC mode",
+        [](Context& ctx) { return sync0_missing(ctx, false); }, a);
+    add(
+        "sync0_stopped_in_op",
+        "SYNC0 stopped (0x0981 = 0) while in OP in the ESI's DC op mode, process data running: the slave "
+        "leaves OP with the error indication and a synchronisation code (0x002C)",
+        std::string(kDc) +
+            "; ETG.1000.6 AL status codes 0x002C (fatal sync error), 0x001A; ETG.1020 "
+            "synchronisation lost in OP",
+        [](Context& ctx) { return sync0_missing(ctx, true); }, "DC announced and --allow-fault");
+    add(
         "sync_modes.1c32", "0x1C32:04 announces DC SYNC0 (bit 2) when the ESI has a SYNC0 op mode", kSync,
         [](Context& ctx) {
             CONFORM_NEED(need_sync_object(ctx, 0x1C32));
@@ -497,6 +600,42 @@ void add_dc_tests(Catalogue& c) {
             if (old) (void)ctx.download_uint(0x1C32, 1, *old, 2);
             if (bad) return *bad;
             return pass(taken.empty() ? "neither 0 nor 1 taken" : "taken " + taken, hex(*sup, 4));
+        },
+        a);
+    add(
+        "sync_modes_announced.1c32",
+        "Every synchronization type 0x1C32:04 announces (bit 0 free run, bit 1 SM2 event) is taken by "
+        "0x1C32:01 and read back",
+        "ETG.1020 0x1C32:04 supported synchronization types, 0x1C32:01 synchronization type",
+        [](Context& ctx) {
+            CONFORM_NEED(need_sync_object(ctx, 0x1C32));
+            CONFORM_NEED(need_writable(ctx, 0x1C32, 1));
+            CONFORM_PREOP(ctx);
+            auto sup = ctx.upload_uint(0x1C32, 4);
+            if (!sup) return fail("0x1C32:04: " + ctx.sdo_error(sup.error()));
+            auto old = ctx.upload_uint(0x1C32, 1);
+            std::optional<Outcome> bad;
+            std::string taken;
+            for (const auto& [type, bit, name] :
+                 {std::tuple<uint16_t, uint64_t, const char*>{0, 0x01, "free run"}, {1, 0x02, "SM2 event"}}) {
+                if (!(*sup & bit)) continue;
+                Error e = ctx.download_uint(0x1C32, 1, type, 2);
+                auto got = ctx.upload_uint(0x1C32, 1);
+                if (e != Error::Ok || !got || *got != type) {
+                    if (!bad)
+                        bad = fail(
+                            "0x1C32:04 announces " + std::string(name) + " (bit " + dec(bit == 1 ? 0 : 1) +
+                                "), but 0x1C32:01 = " + dec(type) + " is not taken",
+                            e != Error::Ok ? ctx.sdo_error(e)
+                                           : "reads back " + (got ? dec(static_cast<long long>(*got)) : "?"),
+                            dec(type) + " taken and read back");
+                    continue;
+                }
+                taken += std::string(taken.empty() ? "" : ", ") + dec(type);
+            }
+            if (old) (void)ctx.download_uint(0x1C32, 1, *old, 2);
+            if (bad) return *bad;
+            return pass(taken.empty() ? "neither bit 0 nor 1 announced" : "taken " + taken, hex(*sup, 4));
         },
         a);
     add(

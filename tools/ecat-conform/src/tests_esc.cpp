@@ -797,10 +797,16 @@ void add_esc_tests(Catalogue& c) {
             return expect_eq("RAM " + hex(at) + "..+7", bytes_hex(std::span<const uint8_t>(back, 8), 8),
                              bytes_hex(std::span<const uint8_t>(pattern, 8), 8));
         });
-    add("reg.al_control_rw", "AL control 0x0120 accepts the master's request (INIT stays INIT)",
-        "ETG.1000.6 AL control register", [](Context& ctx) {
+    add("reg.al_control_rw",
+        "AL control 0x0120 accepts the master's request (INIT stays INIT) and reads back the value written",
+        "ETG.1000.6 AL control register; ESC datasheet 0x0120 AL control (read/write for EtherCAT)",
+        [](Context& ctx) {
             Sent s = send(ctx, Command::FPWR, ctx.station, 0x0120, le16(0x0001));
-            return check_wkc(s, 1, "FPWR AL control");
+            Outcome o = check_wkc(s, 1, "FPWR AL control");
+            if (o.status != Status::Pass) return o;
+            Sent r = send(ctx, Command::FPRD, ctx.station, 0x0120, std::vector<uint8_t>(2, 0));
+            if (Outcome w = check_wkc(r, 1, "FPRD AL control"); w.status != Status::Pass) return w;
+            return expect_eq("0x0120 after 0x0001 written", hex(get16(r.data.data())), hex(0x0001));
         });
     add("reg.rw_offset_span", "A read spanning several registers (0x0000..0x00FF) counts once",
         "ETG.1000.4 working counter (one increment per datagram)", [](Context& ctx) {

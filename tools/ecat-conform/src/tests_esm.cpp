@@ -230,6 +230,61 @@ Outcome sync_setting(Context& ctx, uint16_t assign_activate, uint32_t cycle, boo
     return pass(what + ": refused", status_text(st));
 }
 
+// PREOP -> SAFEOP synchronous with the SM2 event (0x1C32:01 = 1) at a cycle time (0x1C32:02) half the minimum
+// the slave names (0x1C32:05). Refused at the write (an abort) or at the transition, the refusal names the
+// cycle (0x002E cycle time too small, or 0x001A / 0x0026-0x002D of the synchronisation family), not a DC
+// code (0x0030-0x0037: no DC runs) or another situation's. Taken is not judged. 0x1C32:01/:02 are written
+// back in PREOP, the slave left in INIT.
+Outcome sm_cycle_below_min(Context& ctx) {
+    CONFORM_NEED(ctx.need_coe());
+    CONFORM_NEED(ctx.need_pd_layout());
+    CONFORM_NEED(ctx.need_state_machine());
+    if (Error e = ctx.to_preop(); e != Error::Ok) return fail("cannot reach PREOP", err(e));
+    auto sup = ctx.upload_uint(0x1C32, 4);
+    auto min = ctx.upload_uint(0x1C32, 5);
+    auto old1 = ctx.upload_uint(0x1C32, 1);
+    auto old2 = ctx.upload_uint(0x1C32, 2);
+    if (!sup || !(*sup & 0x02)) return skip("0x1C32:04 does not announce SM2-event synchronisation (bit 1)");
+    if (!min || *min < 2 || !old1 || !old2)
+        return skip("no 0x1C32:05 minimum cycle time (or :01/:02 unreadable)");
+    auto restore = [&] {
+        (void)ctx.ack_error();
+        (void)ctx.to_preop();
+        (void)ctx.download_uint(0x1C32, 2, *old2, 4);
+        (void)ctx.download_uint(0x1C32, 1, *old1, 2);
+        (void)ctx.to_init();
+        ctx.in_preop = false;
+    };
+    if (ctx.download_uint(0x1C32, 1, 1, 2) != Error::Ok) {
+        restore();
+        return skip("0x1C32:01 = 1 (SM2 event) not taken");
+    }
+    const uint64_t cycle = *min / 2;
+    if (Error e = ctx.download_uint(0x1C32, 2, cycle, 4); e != Error::Ok) {
+        restore();
+        return pass("refused at the write of 0x1C32:02 = " + dec(static_cast<long long>(cycle)),
+                    ctx.sdo_error(e));
+    }
+    Error e = ctx.discover_pd();
+    if (e == Error::Ok) e = ctx.configure_pd();
+    if (e != Error::Ok) {
+        restore();
+        return fail("process-data set-up: " + ctx.sdo_error(e));
+    }
+    const master::AlStatus st = ctx.request_raw(4, ctx.ms(2000));
+    restore();
+    const std::string what = "SM2-event synchronisation at " + dec(static_cast<long long>(cycle)) +
+                             " ns, below 0x1C32:05 = " + dec(static_cast<long long>(*min)) + " ns";
+    if (st.state == 4 && !st.error) return pass(what + ": taken", status_text(st));
+    if (st.state != 2 || !st.error)
+        return fail(what + ": neither SAFEOP nor refused in PREOP", status_text(st), "SAFEOP, or PREOP+ERR");
+    const bool sync_family = st.code == 0x001A || (st.code >= 0x0026 && st.code <= 0x002E);
+    if (!sync_family)
+        return fail(what + ": refused with the code of another situation", status_text(st),
+                    "0x002E (cycle time too small), or 0x001A / 0x0026-0x002D; not a DC code (no DC runs)");
+    return pass(what + ": refused", status_text(st));
+}
+
 }  // namespace
 
 void add_esm_tests(Catalogue& c) {
@@ -367,6 +422,13 @@ void add_esm_tests(Catalogue& c) {
             return sync_setting(ctx, 0x0300, 1'000'000, true, "SM watchdog below the cycle");
         },
         "DC, outputs with an SM watchdog, no device emulation");
+    add("sync.sm_cycle_below_min",
+        "PREOP -> SAFEOP synchronous with the SM2 event at half the minimum cycle time 0x1C32:05: taken, or "
+        "refused with 0x002E (or another synchronisation code), not a DC code",
+        std::string(kCodes) +
+            " (0x002E cycle time too small; 0x0030-0x0037 are DC's); ETG.1020 0x1C32:01, "
+            ":02, :05",
+        sm_cycle_below_min, "CoE, 0x1C32 with SM2-event synchronisation, no device emulation");
     add("error.sticky", "With the error indication set, a request without acknowledge is not executed",
         "ETG.1000.6 AL control (error indication acknowledge)", [](Context& ctx) {
             CONFORM_NEED(ctx.need_state_machine());

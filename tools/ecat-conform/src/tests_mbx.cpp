@@ -61,6 +61,12 @@ Outcome mailbox_error(Context& ctx, const std::vector<uint8_t>& msg, std::vector
     if (len != 4 || get16(&r[6]) != 0x0001)
         return fail(what + ": malformed mailbox error reply",
                     "length " + dec(len) + " service " + hex(get16(&r[6])), "length 4, " + want);
+    // A mailbox error reply is a new message of the slave like any other: it carries the next counter, 1..7
+    // (ETG.1000.4 mailbox header counter; 0 is only the start value, response.counter), else a master that
+    // keeps the counter of the last reply may take it for a repeat, or for no message at all.
+    if (((r[5] >> 4) & 7) == 0)
+        return fail(what + ": mailbox error reply with counter 0 (only a start value)", hex(r[5], 2),
+                    "counter 1..7 (byte 5 bits 4-6)");
     const uint16_t detail = get16(&r[8]);
     for (auto a : accepted)
         if (a == detail) return pass(what, "detail " + hex(detail));

@@ -703,6 +703,61 @@ void add_sdo_tests(Catalogue& c) {
         },
         "ESI given");
     add(
+        "store.wrong_signature",
+        "0x1010/0x1011 :01 written without the signature (\"save\"/\"load\"): refused with an abort "
+        "(0x08000020 or another 0x080000xx), nothing stored or restored",
+        "CiA 301 / ETG.1000.6 store parameters 0x1010, restore default parameters 0x1011: the signature "
+        "0x65766173 \"save\" / 0x64616F6C \"load\"; another value is refused (abort 0x08000020)",
+        {&Context::need_coe},
+        [](Context& ctx) {
+            std::string seen;
+            for (uint16_t i : {uint16_t{0x1010}, uint16_t{0x1011}}) {
+                auto caps = ctx.upload_uint(i, 1);
+                if (!caps) continue;  // the object (optional) is not there
+                // One letter off the signature: a value a device must not take for the command. A device that
+                // refuses it changes nothing; one that acknowledges it has not checked the signature.
+                const uint32_t wrong = i == 0x1010 ? 0x65766174u : 0x64616F6Du;
+                SdoAnswer a = sdo_raw(ctx, sdo_req(0x23, i, 1, wrong));
+                if (a.error != Error::Ok) return fail(hex(i) + ":01: " + a.describe());
+                if (!a.is_abort())
+                    return fail(hex(i) + ":01 = " + hex(wrong, 8) + " (not the signature) acknowledged",
+                                a.describe(), "an abort (0x08000020)");
+                if ((a.abort_code() & 0xFFFFFF00u) != 0x08000000u)
+                    return fail(hex(i) + ":01 with a wrong signature: abort code", hex(a.abort_code(), 8),
+                                "0x08000020 (data cannot be stored), or another 0x080000xx");
+                seen += hex(i) + " " + hex(a.abort_code(), 8) + " ";
+            }
+            if (seen.empty()) return skip("no 0x1010/0x1011");
+            return pass("refused", seen);
+        },
+        "CoE, 0x1010 or 0x1011");
+    add(
+        "od.subindex0_highest",
+        "Subindex 0 of every ESI object with entries names a subindex that exists (its highest, or the count "
+        "of an array's entries)",
+        "ETG.1000.6 / CiA 301 object dictionary: subindex 0 of a RECORD is the highest subindex supported, "
+        "of "
+        "an ARRAY the number of entries",
+        {&Context::need_coe, &Context::need_esi},
+        [](Context& ctx) {
+            unsigned n = 0;
+            for (const auto& [i, o] : ctx.esi->objects) {
+                if (o.entries.size() < 2 || o.entries[0].subindex != 0 || o.entries[0].access == "wo")
+                    continue;
+                auto top = ctx.upload(i, 0);
+                if (!top || top->size() != 1 || (*top)[0] == 0) continue;  // od.size / od.present judge those
+                const uint8_t k = (*top)[0];
+                SdoAnswer a = sdo_raw(ctx, sdo_req(0x40, i, k));
+                if (a.error != Error::Ok) return fail(hex(i) + ":" + dec(k) + ": " + a.describe());
+                ++n;
+                if (a.is_abort() && a.abort_code() == 0x06090011)
+                    return fail(hex(i) + ":00 = " + dec(k) + ", but subindex " + dec(k) + " does not exist",
+                                "abort 0x06090011", "subindex " + dec(k) + " uploads");
+            }
+            return pass(dec(n) + " objects");
+        },
+        "ESI given");
+    add(
         "od.size", "Every readable entry of the ESI uploads with its declared size", kOd,
         {&Context::need_coe, &Context::need_esi},
         [](Context& ctx) {

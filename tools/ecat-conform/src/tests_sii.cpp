@@ -166,11 +166,11 @@ void add_sii_tests(Catalogue& c) {
                              bytes_hex(std::span<const uint8_t>(ctx.sii->bytes).subspan(0, 128), 128));
         });
     add("interface.status",
-        "EEPROM interface 0x0500-0x0502 after a read: not busy, no command, write-enable or loading error, "
+        "EEPROM interface 0x0500-0x0507 after a read: not busy, no command, write-enable or loading error, "
         "no checksum error with a correct checksum; the PDI does not hold the EEPROM, write enable "
-        "cleared, address algorithm as the EEPROM size",
+        "cleared; the EEPROM address 0x0504 reads back the address of the command",
         "ETG.1000.4 SII access; ESC datasheet section II EEPROM interface 0x0500-0x0502 (bits 0, 7, 11-15 "
-        "of 0x0502, bit 0 of 0x0500/0x0501)",
+        "of 0x0502, bit 0 of 0x0500/0x0501), 0x0504 EEPROM address (read/write for EtherCAT)",
         [](Context& ctx) {
             uint8_t b[8];
             const auto e = ctx.m.sii_read(ctx.addr, 0, b);
@@ -201,6 +201,15 @@ void add_sii_tests(Catalogue& c) {
             if ((*st & 0x0001) && !pdi_holds)
                 return fail("0x0502 bit 0 (ECAT write enable) set after a read command", hex(*st),
                             "clear (self-clearing with the next frame)");
+            // 0x0504-0x0507 EEPROM address: the address of the command, as written (read/write for
+            // EtherCAT), not moved on by the read it served: one read of word 7 leaves 7 there.
+            if (auto w7 = ctx.m.sii_read_word(ctx.addr, 7); !w7)
+                return fail("SII read of word 7: " + err(w7.error()));
+            auto a = ctx.rd<uint32_t>(0x0504);
+            if (!a) return fail("0x0504 unreadable", err(a.error()));
+            if (*a != 7)
+                return fail("0x0504 (EEPROM address) after a read of word 7", hex(*a, 8),
+                            "0x00000007 (the address written)");
             return pass("0x0500/0x0502", hex(*cfg) + " / " + hex(*st));
         });
     add(
@@ -360,6 +369,19 @@ void add_sii_tests(Catalogue& c) {
                 return fail("string " + dec(i + 1) + " runs past the category",
                             dec(static_cast<long long>(p)), "< " + dec(static_cast<long long>(d.size())));
             p += 1 + d[p];
+        }
+        // ETG.2010 STRINGS: the count, then that many strings; what follows in the category's words is no
+        // more than padding (0x00, or 0xFF of an erased EEPROM). A string after the counted ones is one the
+        // count left out: a reader that goes by the count loses it (and the indices that name it).
+        if (p < d.size()) {
+            const uint8_t pad = d[p];
+            const bool padding =
+                (pad == 0x00 || pad == 0xFF) && std::all_of(d.begin() + static_cast<std::ptrdiff_t>(p),
+                                                            d.end(), [pad](uint8_t b) { return b == pad; });
+            if (!padding)
+                return fail(
+                    "data after the " + dec(d[0]) + " counted strings (a string the count leaves out)",
+                    bytes_hex(d.subspan(p), 16), "padding (0x00 or 0xff) only");
         }
         return pass(dec(d[0]) + " strings");
     });
@@ -667,6 +689,59 @@ void add_sii_tests(Catalogue& c) {
             want += ", E-Bus current " + std::to_string(e.ebus_current_ma.value_or(0)) + " mA";
             return expect_eq("General (bits 2 DataLinkLayer, 3 IdentificationReg134, 4 IdentificationAdo)",
                              got, want);
+        },
+        "ESI given");
+    add("general.protocol_details",
+        "General CoE, FoE, EoE details and SoE channels (bytes 5-8) only for protocols of word 0x1C",
+        "ETG.2010 SII General category bytes 5 (CoE details), 6 (FoE details), 7 (EoE details), 8 (SoE "
+        "channels) and word 0x1C (mailbox protocols)",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_sii());
+            const SiiCategory* g = ctx.sii->find(kGeneral);
+            if (!g || g->length < 9) return skip("no General category of 9 bytes or more");
+            const uint8_t* b = &ctx.sii->bytes[g->offset];
+            const uint16_t proto = ctx.sii->word(0x1C);
+            // Each details byte describes a protocol's features; bit 0 of CoE/FoE/EoE details enables the
+            // protocol, the SoE byte counts its channels. A protocol the mailbox protocols word does not
+            // announce has nothing to describe: a master that reads one or the other must find the same.
+            struct P {
+                const char* name;
+                uint8_t value;
+                uint16_t bit;
+            };
+            std::string got, want;
+            for (const P& p : {P{"CoE", static_cast<uint8_t>(b[5] & 1), 0x04},
+                               P{"FoE", static_cast<uint8_t>(b[6] & 1), 0x08},
+                               P{"EoE", static_cast<uint8_t>(b[7] & 1), 0x02}, P{"SoE", b[8], 0x10}}) {
+                if (p.value && !(proto & p.bit)) {
+                    got += std::string(p.name) + " details " + hex(p.value, 2) + " ";
+                    want += std::string(p.name) + " not in word 0x1C " + hex(proto) + " ";
+                }
+            }
+            if (!got.empty()) return fail("details of a protocol the SII does not announce", got, want);
+            return pass("details", "bytes 5-8 " + hex(b[5], 2) + " " + hex(b[6], 2) + " " + hex(b[7], 2) +
+                                       " " + hex(b[8], 2) + ", word 0x1C " + hex(proto));
+        });
+    add(
+        "esi.order_name_present",
+        "General category order number and name strings present where the ESI gives a Type and a Name",
+        "ETG.2010 SII General category bytes 2 (order number string) and 3 (name string); ETG.2000 "
+        "Device/Type, Device/Name",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_NEED(ctx.need_sii());
+            const SiiCategory* g = ctx.sii->find(kGeneral);
+            if (!g || g->length < 4) return skip("no General category");
+            auto d = ctx.sii->data(*g);
+            // The texts may differ (esi.names warns: language, abbreviation); a missing string is a lost
+            // field.
+            if (!ctx.esi->type_name.empty() && (d[2] == 0 || ctx.sii->string(d[2]).empty()))
+                return fail("no order number string (General byte 2 = " + dec(d[2]) + ")", "none",
+                            "\"" + ctx.esi->type_name + "\"");
+            if (!ctx.esi->name.empty() && (d[3] == 0 || ctx.sii->string(d[3]).empty()))
+                return fail("no name string (General byte 3 = " + dec(d[3]) + ")", "none",
+                            "\"" + ctx.esi->name + "\"");
+            return pass("present", ctx.sii->string(d[2]) + " / " + ctx.sii->string(d[3]));
         },
         "ESI given");
     add(
