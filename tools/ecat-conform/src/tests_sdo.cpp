@@ -812,7 +812,8 @@ void add_sdo_tests(Catalogue& c) {
         },
         "ESI given");
     add(
-        "od.defaults", "Read-only, unmapped entries hold the ESI's default value", kOd,
+        "od.defaults",
+        "Read-only, unmapped entries hold the ESI's default value (device-state objects aside)", kOd,
         {&Context::need_coe, &Context::need_esi},
         [](Context& ctx) {
             unsigned n = 0;

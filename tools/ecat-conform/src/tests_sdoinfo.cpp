@@ -419,7 +419,9 @@ void add_sdoinfo_tests(Catalogue& c) {
         },
         a);
     add(
-        "entry.default", "Entry descriptions: default value (value info 0x10) as the ESI's DefaultData",
+        "entry.default",
+        "Entry descriptions: default value (value info 0x10) as the ESI's DefaultData (device-state objects "
+        "aside)",
         kInfo,
         [](Context& ctx) {
             CONFORM_INFO(ctx);
