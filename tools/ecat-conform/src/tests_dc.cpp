@@ -222,6 +222,43 @@ Outcome sync0_missing(Context& ctx, bool stop) {
     return pass("left OP", text(now));
 }
 
+// The synchronization types 0 (free run) and 1 (SM2 event) of 0x1C32:01 (ETG.1020), each written in PREOP and
+// read back, beside what 0x1C32:04 announces for it (bit 0, bit 1); 0x1C32:01 is put back. Both directions of
+// the relation are tests of their own (sync_modes_taken, sync_modes_announced).
+struct SyncType {
+    uint16_t type;
+    uint64_t bit;
+    const char* name;
+    bool taken = false;
+    std::string refused;  // why it was not taken: the abort, or what it read back
+};
+struct SyncTypes {
+    uint64_t supported = 0;
+    std::vector<SyncType> types;
+};
+std::optional<SyncTypes> probe_sync_types(Context& ctx, std::string& error) {
+    auto sup = ctx.upload_uint(0x1C32, 4);
+    if (!sup) {
+        error = "0x1C32:04: " + ctx.sdo_error(sup.error());
+        return std::nullopt;
+    }
+    SyncTypes out;
+    out.supported = *sup;
+    auto old = ctx.upload_uint(0x1C32, 1);
+    for (SyncType t : {SyncType{0, 0x01, "free run", false, {}}, SyncType{1, 0x02, "SM2 event", false, {}}}) {
+        // A refusal (abort) says the type is not supported: only a write acknowledged and read back is taken.
+        const Error e = ctx.download_uint(0x1C32, 1, t.type, 2);
+        auto got = ctx.upload_uint(0x1C32, 1);
+        t.taken = e == Error::Ok && got && *got == t.type;
+        if (!t.taken)
+            t.refused = e != Error::Ok ? ctx.sdo_error(e)
+                                       : "reads back " + (got ? dec(static_cast<long long>(*got)) : "?");
+        out.types.push_back(std::move(t));
+    }
+    if (old) (void)ctx.download_uint(0x1C32, 1, *old, 2);
+    return out;
+}
+
 }  // namespace
 
 void add_dc_tests(Catalogue& c) {
@@ -579,27 +616,19 @@ void add_dc_tests(Catalogue& c) {
             CONFORM_NEED(need_sync_object(ctx, 0x1C32));
             CONFORM_NEED(need_writable(ctx, 0x1C32, 1));
             CONFORM_PREOP(ctx);
-            auto sup = ctx.upload_uint(0x1C32, 4);
-            if (!sup) return fail("0x1C32:04: " + ctx.sdo_error(sup.error()));
-            auto old = ctx.upload_uint(0x1C32, 1);
+            std::string error;
+            const auto probe = probe_sync_types(ctx, error);
+            if (!probe) return fail(error);
             std::string taken;
-            std::optional<Outcome> bad;
-            for (const auto& [type, bit, name] :
-                 {std::tuple<uint16_t, uint64_t, const char*>{0, 0x01, "free run"}, {1, 0x02, "SM2 event"}}) {
-                // A refusal (abort) says the type is not supported: only a write acknowledged and read back
-                // is taken.
-                if (ctx.download_uint(0x1C32, 1, type, 2) != Error::Ok) continue;
-                auto got = ctx.upload_uint(0x1C32, 1);
-                if (!got || *got != type) continue;
-                taken += std::string(taken.empty() ? "" : ", ") + dec(type);
-                if (!(*sup & bit) && !bad)
-                    bad = fail("0x1C32:01 = " + dec(type) + " (" + name +
-                                   ") taken, but 0x1C32:04 does not announce it",
-                               hex(*sup, 4), "bit " + dec(bit == 1 ? 0 : 1) + " set");
+            for (const SyncType& t : probe->types) {
+                if (!t.taken) continue;
+                taken += std::string(taken.empty() ? "" : ", ") + dec(t.type);
+                if (!(probe->supported & t.bit))
+                    return fail("0x1C32:01 = " + dec(t.type) + " (" + t.name +
+                                    ") taken, but 0x1C32:04 does not announce it",
+                                hex(probe->supported, 4), "bit " + dec(t.bit == 1 ? 0 : 1) + " set");
             }
-            if (old) (void)ctx.download_uint(0x1C32, 1, *old, 2);
-            if (bad) return *bad;
-            return pass(taken.empty() ? "neither 0 nor 1 taken" : "taken " + taken, hex(*sup, 4));
+            return pass(taken.empty() ? "neither 0 nor 1 taken" : "taken " + taken, hex(probe->supported, 4));
         },
         a);
     add(
@@ -611,31 +640,21 @@ void add_dc_tests(Catalogue& c) {
             CONFORM_NEED(need_sync_object(ctx, 0x1C32));
             CONFORM_NEED(need_writable(ctx, 0x1C32, 1));
             CONFORM_PREOP(ctx);
-            auto sup = ctx.upload_uint(0x1C32, 4);
-            if (!sup) return fail("0x1C32:04: " + ctx.sdo_error(sup.error()));
-            auto old = ctx.upload_uint(0x1C32, 1);
-            std::optional<Outcome> bad;
+            std::string error;
+            const auto probe = probe_sync_types(ctx, error);
+            if (!probe) return fail(error);
             std::string taken;
-            for (const auto& [type, bit, name] :
-                 {std::tuple<uint16_t, uint64_t, const char*>{0, 0x01, "free run"}, {1, 0x02, "SM2 event"}}) {
-                if (!(*sup & bit)) continue;
-                Error e = ctx.download_uint(0x1C32, 1, type, 2);
-                auto got = ctx.upload_uint(0x1C32, 1);
-                if (e != Error::Ok || !got || *got != type) {
-                    if (!bad)
-                        bad = fail(
-                            "0x1C32:04 announces " + std::string(name) + " (bit " + dec(bit == 1 ? 0 : 1) +
-                                "), but 0x1C32:01 = " + dec(type) + " is not taken",
-                            e != Error::Ok ? ctx.sdo_error(e)
-                                           : "reads back " + (got ? dec(static_cast<long long>(*got)) : "?"),
-                            dec(type) + " taken and read back");
-                    continue;
-                }
-                taken += std::string(taken.empty() ? "" : ", ") + dec(type);
+            for (const SyncType& t : probe->types) {
+                if (!(probe->supported & t.bit)) continue;
+                if (!t.taken)
+                    return fail("0x1C32:04 announces " + std::string(t.name) + " (bit " +
+                                    dec(t.bit == 1 ? 0 : 1) + "), but 0x1C32:01 = " + dec(t.type) +
+                                    " is not taken",
+                                t.refused, dec(t.type) + " taken and read back");
+                taken += std::string(taken.empty() ? "" : ", ") + dec(t.type);
             }
-            if (old) (void)ctx.download_uint(0x1C32, 1, *old, 2);
-            if (bad) return *bad;
-            return pass(taken.empty() ? "neither bit 0 nor 1 announced" : "taken " + taken, hex(*sup, 4));
+            return pass(taken.empty() ? "neither bit 0 nor 1 announced" : "taken " + taken,
+                        hex(probe->supported, 4));
         },
         a);
     add(
