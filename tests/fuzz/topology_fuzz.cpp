@@ -34,15 +34,16 @@ int fuzz_one(const uint8_t* data, std::size_t size) {
         FUZZ_CHECK(d.name[0] != '.' && d.name[0] != '-' && d.name[0] != '_');
         FUZZ_CHECK(names.insert(d.name).second);
         FUZZ_CHECK(d.state_dir.empty() || dirs.insert(d.state_dir).second);
-        FUZZ_CHECK(d.ports == 2 || d.ports == 4);
-        FUZZ_CHECK(d.port >= 0 && d.port < d.ports);
+        FUZZ_CHECK(d.port_descriptor() == 0x0F ||
+                   d.port_descriptor() == 0xFF);  // no esi= callback: 2 or 4 ports
+        FUZZ_CHECK(d.has_port(d.port));
         FUZZ_CHECK(ports.emplace(static_cast<int>(i), d.port).second);
         if (i == 0) {
             FUZZ_CHECK(d.parent == -1);
             continue;
         }
         FUZZ_CHECK(d.parent >= 0 && static_cast<std::size_t>(d.parent) < t.devices.size());
-        FUZZ_CHECK(d.parent_port >= 0 && d.parent_port < t.devices[static_cast<std::size_t>(d.parent)].ports);
+        FUZZ_CHECK(t.devices[static_cast<std::size_t>(d.parent)].has_port(d.parent_port));
         FUZZ_CHECK(ports.emplace(d.parent, d.parent_port).second);
         // Follows its parents to the root in fewer steps than there are devices (no loop).
         int p = d.parent;

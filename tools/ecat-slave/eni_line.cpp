@@ -125,10 +125,11 @@ EniLine eni_line(const std::string& file, const EsiIndex* esis) {
             d.parent = static_cast<int>(k) - 1;
             d.parent_port = 1;
         }
-        d.ports = port_has_phy(s.info.physics, 2) || port_has_phy(s.info.physics, 3) ? 4 : 2;
         // The ESC has the ports the device's Physics declares (its ESI's, or the ENI's; ETG.2000), so that
         // 0x0007 and the SII General category agree; a port the wiring uses is added below.
         d.descriptor = esi::physics_port_descriptor(product->description.physics);
+        if (d.descriptor == 0)  // no Physics: two ports, four if the ENI's own Physics names port 2 or 3
+            d.descriptor = port_has_phy(s.info.physics, 2) || port_has_phy(s.info.physics, 3) ? 0xFF : 0x0F;
         char station[16];
         std::snprintf(station, sizeof station, "0x%04X", s.info.phys_addr);
         out.report.push_back(
@@ -147,10 +148,8 @@ EniLine eni_line(const std::string& file, const EsiIndex* esis) {
         if (d.parent < 0 || d.parent >= static_cast<int>(k))
             throw esi::eni::EniError(eni.where(d.line) + ": PreviousPort names no slave before this one");
         slave::TopologyDevice& parent = out.topology.devices[static_cast<std::size_t>(d.parent)];
-        if (d.parent_port >= 2) parent.ports = 4;
         if (d.parent_port < 4 && !parent.has_port(d.parent_port))
-            parent.descriptor =
-                static_cast<uint8_t>(parent.port_descriptor() | (0x3u << (2 * d.parent_port)));
+            parent.descriptor = static_cast<uint8_t>(parent.descriptor | (0x3u << (2 * d.parent_port)));
         for (std::size_t j = 1; j < k; ++j)
             if (out.topology.devices[j].parent == d.parent &&
                 out.topology.devices[j].parent_port == d.parent_port)

@@ -127,8 +127,9 @@ struct Parser {
             } else if (key == "port") {
                 d.port = static_cast<int>(integer(key, value, 0, esc::kPortCount - 1));
             } else if (key == "ports") {
-                d.ports = static_cast<int>(integer(key, value, 2, 4));
-                if (d.ports == 3) fail("ports=3: an ESC has 2 or 4 ports");
+                const auto ports = integer(key, value, 2, 4);
+                if (ports == 3) fail("ports=3: an ESC has 2 or 4 ports");
+                d.descriptor = ports == 4 ? 0xFF : 0x0F;
                 d.ports_given = true;
             } else if (key == "serial") {
                 d.serial = static_cast<uint32_t>(integer(key, value, 0, 0xFFFFFFFF));
@@ -164,6 +165,7 @@ struct Parser {
                 fail("device " + d.name + ": " + e.what());
             }
             if (d.descriptor == 0) fail("device " + d.name + ": its ESI declares no port");
+            d.ports_from_esi = true;
         }
         if (!d.has_port(d.port))
             fail("port=" + std::to_string(d.port) + ": the device has only ports " + d.port_list());
@@ -217,8 +219,8 @@ struct Parser {
             const TopologyDevice& d = topo.devices[static_cast<std::size_t>(dev)];
             if (!d.has_port(port))
                 fail_at(line, what + ": device '" + d.name + "' has only ports " + d.port_list() +
-                                  (d.descriptor != 0 ? " (its ESI's Physics; ports=4 for a junction)"
-                                                     : " (ports=4 for a junction)"));
+                                  (d.ports_from_esi ? " (its ESI's Physics; ports=4 for a junction)"
+                                                    : " (ports=4 for a junction)"));
             const auto [it, fresh] = used.emplace(std::make_pair(dev, port), line);
             if (!fresh)
                 fail_at(line, what + ": port " + std::to_string(port) + " of '" + d.name +

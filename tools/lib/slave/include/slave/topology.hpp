@@ -49,17 +49,17 @@ class TopologyError : public std::runtime_error {
 
 struct TopologyDevice {
     std::string name;
-    std::string config;        // device configuration file (resolved), empty: the built-in drive
-    std::string esi;           // ESI file of the device (resolved), empty: not from an ESI
-    std::string device_spec;   // device= of a file with several devices, empty: the only one
-    int parent = -1;           // index of the upstream device, -1: the root (faces the master)
-    int parent_port = 1;       // port of the parent this device is plugged into
-    int port = 0;              // this device's own port facing upstream
-    int ports = 2;             // 2: ports 0 and 1 (port descriptor 0x0F), 4: ports 0-3 (0xFF)
-    bool ports_given = false;  // ports= was written
-    // The ESC's port descriptor (0x0007, ESC datasheet: 2 bits per port, 00 not implemented) when the device
-    // says which ports it has (esi=: its ESI's Physics, unless ports= is written); 0: from ports.
-    uint8_t descriptor = 0;
+    std::string config;       // device configuration file (resolved), empty: the built-in drive
+    std::string esi;          // ESI file of the device (resolved), empty: not from an ESI
+    std::string device_spec;  // device= of a file with several devices, empty: the only one
+    int parent = -1;          // index of the upstream device, -1: the root (faces the master)
+    int parent_port = 1;      // port of the parent this device is plugged into
+    int port = 0;             // this device's own port facing upstream
+    // The ESC's ports as its port descriptor 0x0007 (ESC datasheet: 2 bits per port, 00 not implemented):
+    // ports 0 and 1 unless ports=4 (a junction, 0xFF) or, for esi=, its ESI's Physics says otherwise.
+    uint8_t descriptor = 0x0F;
+    bool ports_given = false;     // ports= was written
+    bool ports_from_esi = false;  // descriptor is the ESI's Physics
     std::optional<uint32_t> serial;
     double drift_ppm = 0.0;
     int64_t offset_ns = 0;
@@ -67,8 +67,8 @@ struct TopologyDevice {
     std::string state_dir;  // resolved; empty: <state-dir>/NAME
     int line = 0;           // where it is declared (for messages about it)
 
-    uint8_t port_descriptor() const { return descriptor != 0 ? descriptor : ports == 4 ? 0xFF : 0x0F; }
-    bool has_port(int p) const { return p >= 0 && p < 4 && ((port_descriptor() >> (2 * p)) & 0x03) != 0; }
+    uint8_t port_descriptor() const { return descriptor; }
+    bool has_port(int p) const { return p >= 0 && p < 4 && ((descriptor >> (2 * p)) & 0x03) != 0; }
     // "0, 1" (the ports it has), for messages.
     std::string port_list() const;
 };
