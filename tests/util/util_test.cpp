@@ -173,6 +173,15 @@ TEST(Strprintf, KeepsTextOfAnyLength) {
     EXPECT_EQ(util::strprintf("%d", -7), "-7");
 }
 
+// The one hex spelling of messages: upper-case digits, at least as many as asked, never cut.
+TEST(Strprintf, HexHasAtLeastTheDigitsAskedAndNeverCuts) {
+    EXPECT_EQ(util::hex(0x1C12), "0x1C12");
+    EXPECT_EQ(util::hex(0x7, 2), "0x07");
+    EXPECT_EQ(util::hex(0x00110000, 8), "0x00110000");
+    EXPECT_EQ(util::hex(0x12345, 4), "0x12345");
+    EXPECT_EQ(util::hex(0xFFFFFFFFFFFFFFFFull, 4), "0xFFFFFFFFFFFFFFFF");
+}
+
 // The reader walks a chain as an ESC does (docs/decisions/esc.md, "Frame tolerance"): the header Length is
 // not evaluated, a datagram past the end of the frame is malformed, EtherCAT in UDP/IP is found.
 TEST(FrameBuilder, ReaderIgnoresTheHeaderLengthAndFindsUdp) {

@@ -18,4 +18,8 @@ std::string strprintf(const char* fmt, ...) {
     return out;
 }
 
+std::string hex(unsigned long long v, int digits) {
+    return strprintf("0x%0*llX", digits, v);
+}
+
 }  // namespace util

@@ -16,17 +16,14 @@
 #include "esc/wire/sii.hpp"
 #include "esi/sii.hpp"
 #include "esi/slots.hpp"
+#include "util/strfmt.hpp"
 
 namespace esi {
 namespace {
 
 using od::DataType;
 
-std::string hex(uint32_t v, int digits = 4) {
-    char b[24];
-    std::snprintf(b, sizeof b, "0x%0*X", digits, static_cast<unsigned>(v));
-    return b;
-}
+using util::hex;
 std::string where(uint16_t index, uint8_t sub) {
     return hex(index) + ":" + hex(sub, 2).substr(2);
 }

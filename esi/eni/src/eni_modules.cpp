@@ -2,12 +2,12 @@
 #include "esi/eni/eni_modules.hpp"
 
 #include <algorithm>
-#include <cstdio>
 #include <map>
 #include <set>
 #include <tuple>
 
 #include "esi/slots.hpp"
+#include "util/strfmt.hpp"
 
 namespace esi::eni {
 
@@ -15,12 +15,6 @@ namespace {
 
 // An entry as both files can state it: index, subindex (0 for a gap) and bit length.
 using Entry = std::tuple<uint16_t, uint8_t, uint16_t>;
-
-std::string hex4(uint32_t v) {
-    char b[16];
-    std::snprintf(b, sizeof b, "0x%04X", v);
-    return b;
-}
 
 uint32_t le32(const std::vector<uint8_t>& d, std::size_t at) {
     return uint32_t(d[at]) | uint32_t(d[at + 1]) << 8 | uint32_t(d[at + 2]) << 16 | uint32_t(d[at + 3]) << 24;
@@ -95,7 +89,8 @@ std::vector<PdoMismatch> pdo_mismatches(const EsiFile& f, const EsiDevice& d,
     for (const auto* list : {&s.process_data.rxpdos, &s.process_data.txpdos})
         for (const Pdo& p : *list) {
             auto it = device.find(p.index);
-            const std::string pdo = std::string("the ENI's ") + (p.rx ? "RxPDO " : "TxPDO ") + hex4(p.index);
+            const std::string pdo =
+                std::string("the ENI's ") + (p.rx ? "RxPDO " : "TxPDO ") + util::hex(p.index);
             if (it == device.end())
                 out.push_back({p.line, pdo + " is not a PDO of the device"});
             else if (it->second.fixed && it->second.entries != entries_of(p))
@@ -113,20 +108,12 @@ std::optional<EniModules> modules_from_eni(const EsiFile& f, const EsiDevice& d,
     std::map<uint16_t, int> eni_line;
     for (const auto* list : {&s.process_data.rxpdos, &s.process_data.txpdos})
         for (const Pdo& p : *list) {
-            std::vector<Entry>& e = eni[p.index];
-            for (const PdoEntry& x : p.entries)
-                e.emplace_back(x.index, x.index == 0 ? uint8_t{0} : x.subindex, x.bit_len);
+            eni[p.index] = entries_of(p);
             eni_line[p.index] = p.line;
         }
     auto matches = [&](const SlotPdo& p) {
         auto it = eni.find(p.index);
-        if (it == eni.end() || it->second.size() != p.entries.size()) return false;
-        for (std::size_t k = 0; k < p.entries.size(); ++k) {
-            const EsiPdoEntry& x = p.entries[k];
-            if (it->second[k] != Entry{x.index, x.index == 0 ? uint8_t{0} : x.subindex, x.bit_len})
-                return false;
-        }
-        return true;
+        return it != eni.end() && it->second == entries_of(p.entries);
     };
 
     EniModules out;
@@ -178,7 +165,7 @@ std::optional<EniModules> modules_from_eni(const EsiFile& f, const EsiDevice& d,
         if (!explained.count(index)) {
             if (why)
                 *why =
-                    "line " + std::to_string(eni_line[index]) + ": PDO " + hex4(index) +
+                    "line " + std::to_string(eni_line[index]) + ": PDO " + util::hex(index) +
                     " of the ENI is the PDO of no module its slots take (at that slot, with those entries)";
             return std::nullopt;
         }

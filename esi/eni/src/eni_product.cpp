@@ -2,20 +2,18 @@
 #include "esi/eni/eni_product.hpp"
 
 #include <algorithm>
-#include <cstdio>
 #include <map>
 #include <memory>
 #include <stdexcept>
+
+#include "util/strfmt.hpp"
 
 namespace esi::eni {
 
 namespace {
 
-std::string hex(uint32_t v, int digits) {
-    char b[16];
-    std::snprintf(b, sizeof b, "0x%0*X", digits, v);
-    return b;
-}
+using util::hex;
+
 std::string entry_name(uint16_t index, uint8_t sub) {
     return hex(index, 4) + ":" + hex(sub, 2);
 }

@@ -8,4 +8,7 @@ namespace util {
 // The text std::printf(fmt, ...) would print, whole; "" if fmt is invalid for the arguments.
 std::string strprintf(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 
+// "0x" and v in upper-case hex digits, at least `digits` of them: 0x1C12, 0x0007, 0x00000002.
+std::string hex(unsigned long long v, int digits = 4);
+
 }  // namespace util

@@ -6,7 +6,6 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <cstdio>
 #include <cstring>
 
 #include "esc/wire/sii.hpp"
@@ -14,6 +13,7 @@
 #include "util/atomic_file.hpp"
 #include "util/crc.hpp"
 #include "util/le.hpp"
+#include "util/strfmt.hpp"
 
 namespace device {
 
@@ -104,11 +104,7 @@ std::vector<std::string> sii_drift(std::span<const uint8_t> image, uint32_t vend
                       " bytes, too short for the SII header and identity (32 bytes)");
         return out;
     }
-    auto hex = [](uint32_t v, int digits) {
-        char b[16];
-        std::snprintf(b, sizeof b, "0x%0*X", digits, static_cast<unsigned>(v));
-        return std::string(b);
-    };
+    using util::hex;
     const uint8_t crc = esc::sii::crc8(image.data(), 14);
     if (crc != image[14])
         out.push_back("SII checksum (word 7) is " + hex(image[14], 2) + ", words 0-6 give " + hex(crc, 2) +
