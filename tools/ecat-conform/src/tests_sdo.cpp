@@ -863,7 +863,7 @@ void add_sdo_tests(Catalogue& c) {
             "Complete access upload of " + hex(index) +
                 " from subindex 0: subindex 0 padded to 16 bits (padding value free), then the entries",
             kCa,
-            [index](Context& ctx) {
+            [index = index](Context& ctx) {
                 CONFORM_NEED(ctx.need_complete_access());
                 CONFORM_PREOP(ctx);
                 auto n = ctx.upload_uint(index, 0);
