@@ -121,9 +121,9 @@ class Conform(unittest.TestCase):
     mode = "clean"
     faults = []
 
-    def run_conform(self, fault=None, mutation=None, proxy=False, device=None):
+    def run_conform(self, fault=None, mutation=None, proxy=False, device=None, groups=None):
         """device: (example ESI, ecat-slave --device, ecat-conform --device) to serve another device than the
-        drive (mutants.DEVICE)."""
+        drive (mutants.DEVICE); groups: only these groups of the catalogue (ecat-conform --group)."""
         work = tempfile.mkdtemp(prefix="ecat-conform-", dir=os.environ.get("ECAT_TEST_OUT"))
         if device:
             esi = os.path.join(HERE, "..", "..", "esi", "examples", device[0])
@@ -139,7 +139,7 @@ class Conform(unittest.TestCase):
             out = os.path.join(work, "result.json")
             junit = os.path.join(work, "result.xml")
 
-            extra = []
+            extra = ["--group", ",".join(sorted(groups))] if groups else []
 
             def run(iface):
                 t0 = time.monotonic()
@@ -173,6 +173,9 @@ class Conform(unittest.TestCase):
         if any(n in mutants.VARIATIONS for n in names):
             # Variations are judged against the warnings of the same run without a mutation.
             _, base, _ = self.run_conform(proxy=True)
+            if any(x["status"] == "FAIL" for x in base["results"]):
+                # Once more, as a variation is (below): the proxy on a loaded host can miss a watchdog.
+                _, base, _ = self.run_conform(proxy=True)
             base_fail = sorted(x["id"] for x in base["results"] if x["status"] == "FAIL")
             self.assertEqual(base_fail, [], "the unmutated run through the proxy fails")
             base_warn = {x["id"] for x in base["results"] if x["status"] == "WARN"}
@@ -181,7 +184,13 @@ class Conform(unittest.TestCase):
             kind = "mutant" if name in mutants.MUTANTS else "variation"
             clause, fn = (mutants.MUTANTS if kind == "mutant" else mutants.VARIATIONS)[name]
             device = mutants.DEVICE.get(name)
-            _, res, elapsed = self.run_conform(mutation=fn, device=device)
+            # A mutant counts as killed only by a failure in the groups where it must be caught, so the CI
+            # subset (mode "mutant") runs just those groups: the same verdict, a fraction of the catalogue. The
+            # table (mode "table") runs everything, for its "caught anywhere" figure.
+            groups = mutants.expected_groups(name) if kind == "mutant" and self.mode == "mutant" else None
+            if groups and "*" in groups:
+                groups = None
+            _, res, elapsed = self.run_conform(mutation=fn, device=device, groups=groups)
             if kind == "variation" and any(x["status"] == "FAIL" for x in res["results"]):
                 # Once more: process data through a Python proxy on a loaded host can miss a watchdog. A
                 # variation that fails twice is a false alarm of the tool.
