@@ -1210,8 +1210,6 @@ TABLE_SURVIVORS = {
     "dc-diff-sign-inverted": "caught as a warning only (dc.system_time.difference): the datasheet's sign of "
                              "0x092C is judged as a warning by the project's decision (KickCAT's emulation has "
                              "it the other way round); not a kill",
-    "diag-ack-not-applied": "never fires: no test writes 0x10F3:03 (an acknowledge, or 0 deleting the history, "
-                            "cannot be put back); not closed",
     "al-code-sm-types-as-output-config": "not provoked: the slave gives 0x001C for SM types against 0x1C00 "
                                          "(read-only) or a process-data SM not in buffered mode, and ETG.1000.6 "
                                          "does not settle 0x001C against 0x001D for an SM2 of the wrong mode; "

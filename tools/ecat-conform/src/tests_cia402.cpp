@@ -247,7 +247,8 @@ Outcome fault_emergency(Context& ctx, bool generic_bit) {
 
 // ETG.1020 diagnosis history: a drive with 0x10F3 stores the emergency of its fault as a message (diag code
 // 0xE800 | error code << 16), newer than what the history held before (0x10F3:02 newest message moves to
-// it), and of type warning or error (flags bits 0-3; info is for what is no fault). The history is only read.
+// it), and of type warning or error (flags bits 0-3; info is for what is no fault). The message is then
+// acknowledged (0x10F3:03), as a master acknowledges what it has read; nothing is deleted.
 Outcome fault_history(Context& ctx) {
     if (!ctx.opt.allow_fault) return skip("provokes a drive fault: needs --allow-fault");
     CONFORM_NEED(need_402_profile(ctx));
@@ -286,8 +287,23 @@ Outcome fault_history(Context& ctx) {
                 return fail(
                     "the fault's emergency " + hex(code) + " stored as an info message (flags type 0)",
                     "type 0 (info) at :" + dec(e.subindex), "1 (warning) or 2 (error)");
-            return pass("stored",
-                        "diag code " + hex(e.code, 8) + " type " + dec(e.type) + " at :" + dec(e.subindex));
+            // ETG.1020: writing a message's subindex to 0x10F3:03 acknowledges the messages up to it, and
+            // :03 reads back what was written. Acknowledging the fault's message is what a master does with
+            // it; a refusal is left to the sdo group (an abort is an answer), a write taken but not kept is
+            // a defect here.
+            const std::string where =
+                "diag code " + hex(e.code, 8) + " type " + dec(e.type) + " at :" + dec(e.subindex);
+            CONFORM_PREOP(ctx);                // the drive was left in INIT
+            (void)ctx.upload_uint(0x10F3, 3);  // what it held: a device that keeps it shows it again
+            if (Error w = ctx.download_uint(0x10F3, 3, e.subindex, 1); w != Error::Ok)
+                return pass("stored (its acknowledgement not taken: " + ctx.sdo_error(w) + ")", where);
+            auto acked = ctx.upload_uint(0x10F3, 3);
+            if (!acked || *acked != e.subindex)
+                return fail("0x10F3:03 (newest acknowledged message) = " + dec(e.subindex) +
+                                " acknowledged, but it reads another value",
+                            acked ? dec(*acked) : "unreadable: " + ctx.sdo_error(acked.error()),
+                            dec(e.subindex));
+            return pass("stored and acknowledged", where);
         }
     std::string seen;
     for (const auto& e : fresh)
@@ -783,9 +799,10 @@ void add_cia402_tests(Catalogue& c) {
         Severity::Warning);
     add("fault.diag_history",
         "Fault (communication loss while enabled): its emergency stored in the diagnosis history 0x10F3 as a "
-        "newer message (:02 moves), diag code 0xE800 with the error code, type warning or error",
-        "ETG.1020 diagnosis history 0x10F3 (:02 newest message; message diag code, flags bits 0-3 type); "
-        "ETG.1000.6 CoE emergency",
+        "newer message (:02 moves), diag code 0xE800 with the error code, type warning or error; its "
+        "acknowledgement (:03) read back",
+        "ETG.1020 diagnosis history 0x10F3 (:02 newest message, :03 newest acknowledged message; message "
+        "diag code, flags bits 0-3 type); ETG.1000.6 CoE emergency",
         fault_history, "profile 402, 0x10F3 and --allow-fault");
     add(
         "fault_reset",
