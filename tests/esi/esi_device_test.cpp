@@ -264,8 +264,9 @@ TEST(EsiExamples, EveryDeviceLoadsAsItsFileSays) {
             // Every PDO as declared: index, direction, entries, the SM that assigns it by default.
             // (and every mapping object the dictionary declares without an RxPdo/TxPdo element)
             std::size_t declared_pdos = d.rxpdos.size() + d.txpdos.size();
-            for (const auto& [index, eo] : d.objects)
-                if (index >= 0x1600 && index <= 0x1BFF && (index <= 0x17FF || index >= 0x1A00) &&
+            for (const auto& object : d.objects)
+                if (const uint16_t index = object.first;
+                    index >= 0x1600 && index <= 0x1BFF && (index <= 0x17FF || index >= 0x1A00) &&
                     std::none_of(d.rxpdos.begin(), d.rxpdos.end(),
                                  [&](auto& x) { return x.index == index; }) &&
                     std::none_of(d.txpdos.begin(), d.txpdos.end(), [&](auto& x) { return x.index == index; }))
@@ -986,7 +987,8 @@ TEST(EsiDevices, APdosDirectionIsItsElementsWhereverItsIndexLies) {
         EXPECT_TRUE(m.warnings.empty()) << ::testing::PrintToString(m.warnings);
         const std::vector<uint8_t> image = esi::build_sii(p.description, d);
         const esi::SiiInfo sii = esi::parse_sii(image);
-        for (const auto& [index, rx] : c.pdos) {
+        for (const auto& [index_, rx] : c.pdos) {
+            const uint16_t index = index_;  // a variable, so the lambdas below can capture it (clang 14)
             SCOPED_TRACE(index);
             const od::Object* o = d.find(index);
             ASSERT_NE(o, nullptr);
@@ -1017,7 +1019,8 @@ TEST(EsiDevices, APdosDirectionIsItsElementsWhereverItsIndexLies) {
         const od::Product q = round_trip(p, &xml);
         EXPECT_TRUE(schema_errors(xml).empty());
         const esi::EsiDevice back = esi::read_esi(xml);
-        for (const auto& [index, rx] : c.pdos) {
+        for (const auto& [index_, rx] : c.pdos) {
+            const uint16_t index = index_;  // a variable, so the lambdas below can capture it (clang 14)
             const auto& list = rx ? back.rxpdos : back.txpdos;
             EXPECT_TRUE(std::any_of(list.begin(), list.end(), [&](auto& x) { return x.index == index; }))
                 << index;
