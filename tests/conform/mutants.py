@@ -3103,6 +3103,10 @@ UNSEEN7 = {
 }
 MUTANTS.update(UNSEEN7)
 
+# The table's drive has no 0x6092 (no reply to change): this defect runs against the example drive that has
+# the object (found by its count of changed replies, after the tool was read).
+DEVICE["cia402-feed-constant-zero"] = ("drive402.xml", "0x00057200:0x00010002", 0)
+
 # Where each defect of round 7 should be caught, decided from the standard before reading the tool.
 _GROUPS_UNSEEN7 = {
     "esc-write-protect-set": {"esc"}, "esc-pu-error-counter": {"esc"}, "esc-phys-rw-offset-readback": {"esc"},
