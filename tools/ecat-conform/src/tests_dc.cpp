@@ -132,8 +132,11 @@ Outcome dc_state(Context& ctx, bool op) {
         (void)ctx.cycle(30);
         // The system time the cycle's FRMW carried back (the reference clock's, ETG.1000.4 DC drift
         // compensation), against the same register read directly right after the last cycle.
-        ref = ctx.pds->reference_time();
-        direct = rd64(ctx, esc::reg::kDcSystemTime);
+        // (Only where the cycle has frames: the FRMW rides in the first.)
+        if (ctx.has_process_data()) {
+            ref = ctx.pds->reference_time();
+            direct = rd64(ctx, esc::reg::kDcSystemTime);
+        }
         sync = sync_objects_running(ctx);
     }
     (void)ctx.to_init();
