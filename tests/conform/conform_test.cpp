@@ -169,6 +169,22 @@ TEST(Sii, WalksCategoriesAndChecksums) {
     EXPECT_EQ(esc::sii::crc8(m.data(), m.size()), 0);
 }
 
+// SII PDO entries (ETG.2010: PDO header of 8 bytes, entries of 8: index, subindex, name, data type, bit
+// length, flags): a data type of fixed size must name the entry's bit length.
+TEST(Sii, PdoEntryDataTypeAgainstBitLength) {
+    std::vector<uint8_t> pdo = {0x00, 0x1A, 3, 3, 0,    0,  0, 0,   // 0x1A00, 3 entries, SM3
+                                0x41, 0x60, 0, 0, 0x06, 16, 0, 0,   // 0x6041:00 UNSIGNED16, 16 bits
+                                0x64, 0x60, 0, 0, 0x04, 32, 0, 0,   // 0x6064:00 INTEGER32, 32 bits
+                                0x00, 0x00, 0, 0, 0x00, 8,  0, 0};  // padding (index 0), not judged
+    EXPECT_EQ(sii_pdo_entry_types(pdo), "");
+    pdo[12] = 0x07;  // the statusword given as UNSIGNED32 with 16 bits
+    EXPECT_NE(sii_pdo_entry_types(pdo).find("0x6041"), std::string::npos);
+    pdo[12] = 0x33;  // BIT4 with 16 bits
+    EXPECT_NE(sii_pdo_entry_types(pdo), "");
+    pdo[12] = 0x01;  // BOOLEAN: ESIs map it as 1 or 8 bits, not judged
+    EXPECT_EQ(sii_pdo_entry_types(pdo), "");
+}
+
 // A small JSON well-formedness checker (the report's JSON must load anywhere).
 struct Json {
     const std::string& s;

@@ -117,6 +117,10 @@ struct SiiImage {
     void parse();
 };
 
+// The first entry of an SII TxPDO/RxPDO category's data whose data type (ETG.2010 PDO entry byte 4) is of a
+// fixed size other than its bit length (byte 5), as text; "" when every entry agrees (tests_sii.cpp).
+std::string sii_pdo_entry_types(std::span<const uint8_t> category_data);
+
 struct Options {
     std::string iface;
     uint16_t slave = 0;

@@ -3,6 +3,7 @@
 // 0x6502 accepted by 0x6060 and shown by 0x6061. The axis is held: in CSP the target follows the actual
 // position every cycle, so enabling the drive does not move it.
 #include <optional>
+#include <set>
 #include <thread>
 
 #include "master/diag.hpp"
@@ -287,6 +288,11 @@ Outcome fault_history(Context& ctx) {
                 return fail(
                     "the fault's emergency " + hex(code) + " stored as an info message (flags type 0)",
                     "type 0 (info) at :" + dec(e.subindex), "1 (warning) or 2 (error)");
+            // ETG.1020 diagnosis message bytes 8-15: the time stamp of the event (ns of the device's time, DC
+            // system time where it has DC): 0 tells no time at all.
+            if (e.timestamp_ns == 0)
+                return fail("the fault's message " + hex(e.code, 8) + " carries time stamp 0",
+                            "0 at :" + dec(e.subindex), "the time of the event");
             // ETG.1020: writing a message's subindex to 0x10F3:03 acknowledges the messages up to it, and
             // :03 reads back what was written. Acknowledging the fault's message is what a master does with
             // it; a refusal is left to the sdo group (an abort is an answer), a write taken but not kept is
@@ -454,6 +460,60 @@ void add_cia402_tests(Catalogue& c) {
         },
         a);
     add(
+        "parameters.consistent",
+        "Parameter objects (where present) agree with themselves: limit pairs 0x607B/0x607D in order, ratio "
+        "denominators 0x608F:02/0x6090:02/0x6091:02/0x6092:02 not 0, 0x60FD bits 4-15 reserved, 0x60B9 "
+        "enabled bits as 0x60B8",
+        "IEC 61800-7-201 (CiA 402): 0x607B position range limit and 0x607D software position limit (:01 min, "
+        ":02 max); 0x608F/0x6090 encoder resolution, 0x6091 gear ratio, 0x6092 feed constant (:02 a "
+        "divisor); "
+        "0x60FD digital inputs bits 4-15 reserved; 0x60B9 touch probe status bits 0/8 (enabled) as 0x60B8 "
+        "bits 0/8",
+        [](Context& ctx) {
+            CONFORM_NEED(need_402_profile(ctx));
+            CONFORM_PREOP(ctx);
+            // Read only; each object is optional (absent or of another size: not judged here).
+            auto i32 = [&](uint16_t i, uint8_t s) -> std::optional<int32_t> {
+                auto v = ctx.upload(i, s);
+                if (!v || v->size() != 4) return std::nullopt;
+                return static_cast<int32_t>(get32(v->data()));
+            };
+            std::string seen;
+            for (uint16_t i : {0x607B, 0x607D}) {
+                auto lo = i32(i, 1), hi = i32(i, 2);
+                if (!lo || !hi) continue;
+                seen += hex(i) + " ";
+                if (*lo > *hi)
+                    return fail(hex(i) + " :01 minimum above :02 maximum", dec(*lo) + " > " + dec(*hi),
+                                "minimum <= maximum");
+            }
+            for (uint16_t i : {0x608F, 0x6090, 0x6091, 0x6092}) {
+                auto v = ctx.upload(i, 2);
+                if (!v || v->size() != 4) continue;
+                seen += hex(i) + " ";
+                if (get32(v->data()) == 0) return fail(hex(i) + ":02 (a divisor) is 0", "0", "not 0");
+            }
+            if (auto v = ctx.upload(0x60FD, 0); v && v->size() == 4) {
+                seen += "0x60fd ";
+                if (get32(v->data()) & 0xFFF0)
+                    return fail("0x60FD reserved bits 4-15 set", hex(get32(v->data()), 8), "bits 4-15 clear");
+            }
+            auto fn = ctx.upload(0x60B8, 0);
+            auto st = ctx.upload(0x60B9, 0);
+            if (fn && st && fn->size() == 2 && st->size() == 2) {
+                seen += "0x60b8/0x60b9 ";
+                const uint16_t f = get16(fn->data()), s = get16(st->data());
+                // A probe shown enabled that the function word does not enable (the other way round may lag a
+                // write by a cycle; nothing here writes 0x60B8).
+                if ((s & 0x0101) & ~(f & 0x0101))
+                    return fail("0x60B9 shows a touch probe enabled that 0x60B8 does not enable",
+                                hex(s) + " (0x60B8 " + hex(f) + ")", "bits 0/8 as 0x60B8");
+            }
+            if (seen.empty()) return skip("none of these objects");
+            return pass("consistent", seen);
+        },
+        a);
+    add(
         "pdo.control_status", "Controlword in the default RxPDO and statusword in the default TxPDO",
         "ETG.6010 CiA 402 drive profile over EtherCAT (process data)",
         [](Context& ctx) {
@@ -573,6 +633,38 @@ void add_cia402_tests(Catalogue& c) {
         "done)",
         "ETG.1000.6 SDO download response (the value is stored); IEC 61800-7-201 (CiA 402) 0x6060",
         [](Context& ctx) { return unsupported_mode(ctx, true); }, a);
+    add(
+        "homing.method_unlisted",
+        "A homing method 0x60E3 does not list, written to 0x6098, is refused (the old method written back)",
+        "IEC 61800-7-201 (CiA 402) 0x60E3 supported homing methods, 0x6098 homing method; ETG.1000.6 SDO "
+        "abort "
+        "(value range, 0x0609003x): a value the device declares unsupported is not taken",
+        [](Context& ctx) {
+            CONFORM_NEED(need_402_profile(ctx));
+            CONFORM_PREOP(ctx);
+            auto count = ctx.upload_uint(0x60E3, 0);
+            auto old = ctx.upload(0x6098, 0);
+            if (!count || !old || old->size() != 1) return skip("no 0x60E3 or 0x6098 (INTEGER8)");
+            std::set<int> listed;
+            for (unsigned s = 1; s <= *count && s < 255; ++s) {
+                auto v = ctx.upload(0x60E3, static_cast<uint8_t>(s));
+                if (!v || v->empty()) return fail("0x60E3:" + dec(s) + " (within :00) unreadable");
+                listed.insert(static_cast<int8_t>((*v)[0]));
+            }
+            // A method of the standard's numbering (1-35, 37) that the list leaves out: only the SDO write,
+            // nothing starts homing (that needs operation enabled and controlword bit 4).
+            int bad = 0;
+            for (int mth = 1; mth <= 37 && !bad; ++mth)
+                if (mth != 36 && !listed.count(mth)) bad = mth;
+            if (!bad) return skip("every standard homing method is listed");
+            Error e = ctx.download_uint(0x6098, 0, static_cast<uint8_t>(bad), 1);
+            (void)ctx.download(0x6098, 0, *old);
+            if (e == Error::SdoAbort) return pass("refused", ctx.sdo_error(e));
+            if (e != Error::Ok) return pass("not acknowledged", ctx.sdo_error(e));
+            return fail("0x6098 = " + dec(bad) + " (not in 0x60E3) acknowledged", "acknowledged",
+                        "an abort (0x06090030)");
+        },
+        a);
     add(
         "dc.shutdown", "Transition 2: shutdown (0x0006) in switch on disabled -> ready to switch on", kDev,
         [](Context& ctx) { return transition(ctx, kSod, 0x0006, kRtso, "transition 2"); }, a);
@@ -799,10 +891,10 @@ void add_cia402_tests(Catalogue& c) {
         Severity::Warning);
     add("fault.diag_history",
         "Fault (communication loss while enabled): its emergency stored in the diagnosis history 0x10F3 as a "
-        "newer message (:02 moves), diag code 0xE800 with the error code, type warning or error; its "
-        "acknowledgement (:03) read back",
+        "newer message (:02 moves), diag code 0xE800 with the error code, type warning or error, a time "
+        "stamp; its acknowledgement (:03) read back",
         "ETG.1020 diagnosis history 0x10F3 (:02 newest message, :03 newest acknowledged message; message "
-        "diag code, flags bits 0-3 type); ETG.1000.6 CoE emergency",
+        "diag code, flags bits 0-3 type, time stamp); ETG.1000.6 CoE emergency",
         fault_history, "profile 402, 0x10F3 and --allow-fault");
     add(
         "fault_reset",

@@ -126,8 +126,17 @@ Outcome dc_state(Context& ctx, bool op) {
     master::AlStatus st;
     Error o = ctx.pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st);
     std::string sync;
+    uint64_t ref = 0;
+    master::Result<uint64_t> direct = Error::Timeout;
     if (o == Error::Ok) {
         (void)ctx.cycle(30);
+        // The system time the cycle's FRMW carried back (the reference clock's, ETG.1000.4 DC drift
+        // compensation), against the same register read directly right after the last cycle.
+        // (Only where the cycle has frames: the FRMW rides in the first.)
+        if (ctx.has_process_data()) {
+            ref = ctx.pds->reference_time();
+            direct = rd64(ctx, esc::reg::kDcSystemTime);
+        }
         sync = sync_objects_running(ctx);
     }
     (void)ctx.to_init();
@@ -136,6 +145,13 @@ Outcome dc_state(Context& ctx, bool op) {
             "OP in DC mode: " + err(o),
             state_text(static_cast<uint8_t>(st.state | (st.error ? 0x10 : 0))) + " code " + hex(st.code),
             "OP");
+    if (direct) {
+        const int64_t lag = static_cast<int64_t>(*direct - ref);
+        if (lag < 0 || lag > static_cast<int64_t>(ctx.ms(1000).count()) * 1'000'000)
+            return fail("system time carried by the cycle's FRMW of 0x0910 against 0x0910 read right after",
+                        hex(ref, 16) + " (FRMW), " + hex(*direct, 16) + " (read)",
+                        "the same clock, the read no earlier and within 1 s");
+    }
     if (!sync.empty())
         return fail("OP in DC mode: the synchronisation objects contradict the cycle that runs: " + sync,
                     sync, "0x1C3x:05 <= :02, :20 only with a counted cause");
@@ -342,6 +358,22 @@ void add_dc_tests(Catalogue& c) {
                     "receive time port 0 (0x0900) against the processing unit's (0x0918) of the same latch",
                     dec(static_cast<long long>(lead)) + " ns from port 0 to the processing unit",
                     "0 .. 1 ms (port 0 first)");
+            // The whole register is the local time (64 bits where the ESC has 64-bit DC, 0x0008 bit 3; the
+            // low 32 bits else): plus the system time offset 0x0920 it is the system time of the latch,
+            // which a read of 0x0910 right after can only follow (ESC datasheet 0x0918, 0x0920).
+            auto feat = ctx.rd<uint16_t>(0x0008);
+            auto off = rd64(ctx, esc::reg::kDcOffset);
+            auto sys = rd64(ctx, esc::reg::kDcSystemTime);
+            if (feat && off && sys) {
+                const bool dc64 = *feat & 0x08;
+                uint64_t lag = *sys - (*r2 + *off);
+                if (!dc64) lag &= 0xFFFFFFFFull;
+                if (lag > static_cast<uint64_t>(ctx.ms(1000).count()) * 1'000'000)
+                    return fail(
+                        "0x0918 plus the offset 0x0920 against the system time 0x0910 read after it",
+                        hex(*r2, 16) + " + " + hex(*off, 16) + " against " + hex(*sys, 16),
+                        std::string(dc64 ? "64" : "32") + " bits of the same time, no later than 0x0910");
+            }
             return pass("latched", hex(*r, 16) + ", then " + hex(*r2, 16) + "; port 0 " +
                                        dec(static_cast<long long>(lead)) + " ns before");
         },
@@ -427,6 +459,36 @@ void add_dc_tests(Catalogue& c) {
         },
         a);
     add(
+        "latch.status_time",
+        "Latch status 0x09AE/0x09AF: an edge event only with the time it latched (0x09B0-0x09CF not 0)", kDc,
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_dc());
+            // ESC datasheet 0x09AE/0x09AF latch0/1 status bit 0 (event positive edge) and bit 1 (event
+            // negative edge): set by an edge, whose time the latch registers then hold (0x09B0 latch0
+            // positive edge, 0x09B8 negative, 0x09C0/0x09C8 latch1). Read only: an event without a time is a
+            // status bit that no edge set.
+            uint8_t st[2] = {};
+            if (Error e = ctx.m.read(ctx.addr, 0x09AE, st); e != Error::Ok)
+                return fail("0x09AE unreadable", err(e));
+            std::string seen;
+            for (int unit = 0; unit < 2; ++unit)
+                for (int edge = 0; edge < 2; ++edge) {
+                    if (!(st[unit] & (1u << edge))) continue;
+                    const uint16_t reg = static_cast<uint16_t>(0x09B0 + 16 * unit + 8 * edge);
+                    auto t = rd64(ctx, reg);
+                    if (!t) return fail(hex(reg) + " unreadable");
+                    if (*t == 0)
+                        return fail("latch" + dec(unit) + (edge ? " negative" : " positive") +
+                                        " edge event without a latched time",
+                                    hex(st[unit], 2) + ", " + hex(reg) + " = 0",
+                                    "a time where the event bit is set");
+                    seen += hex(reg) + " ";
+                }
+            return pass(seen.empty() ? "no latch event" : "events with their times",
+                        hex(st[0], 2) + " " + hex(st[1], 2));
+        },
+        a);
+    add(
         "sync.pulse_length", "SYNC pulse length 0x0982 as loaded from SII word 2", kDc,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_dc());
@@ -449,6 +511,11 @@ void add_dc_tests(Catalogue& c) {
             CONFORM_NEED(ctx.need_dc());
             auto speed = ctx.rd<uint16_t>(0x0930);
             if (!speed) return fail("0x0930 unreadable", err(speed.error()));
+            // ESC datasheet 0x0930 speed counter start: 15 bits, 0x0080 at least (0x1000 after reset); 0, or
+            // a value outside 0x0080-0x3FFF, is no bandwidth the drift compensation can run with.
+            if ((*speed & 0x7FFF) < 0x0080 || (*speed & 0x7FFF) > 0x3FFF)
+                return fail("speed counter start 0x0930 outside 0x0080-0x3FFF", hex(*speed),
+                            "0x0080..0x3FFF");
             // One direction: the filters reset (0x0930 written with its own value), then 16 writes of the
             // system time read just before, moved by `shift`; the difference read after.
             auto probe = [&](int64_t shift) -> master::Result<uint32_t> {
@@ -501,7 +568,8 @@ void add_dc_tests(Catalogue& c) {
             // Start 20 ms (scaled) ahead: the writes before the activation take round trips, and a start time
             // already past when SYNC0 is activated only comes again when the system time wraps.
             const uint64_t ahead = static_cast<uint64_t>(ctx.ms(20).count()) + 1;
-            (void)ctx.wr<uint64_t>(esc::reg::kDcStartTime, (*now / 1'000'000 + ahead) * 1'000'000);
+            const uint64_t start = (*now / 1'000'000 + ahead) * 1'000'000;
+            (void)ctx.wr<uint64_t>(esc::reg::kDcStartTime, start);
             (void)ctx.wr<uint8_t>(esc::reg::kDcActivation, 0x03);
             // Cyclic operation and SYNC0 enabled read back as written (ESC datasheet 0x0981 bits 0-2).
             auto act = ctx.rd<uint8_t>(esc::reg::kDcActivation);
@@ -539,6 +607,13 @@ void add_dc_tests(Catalogue& c) {
                 return fail(
                     "next SYNC0 time 0x0990 does not advance within 100 ms of the start (no SYNC0 pulses)",
                     later ? hex(*later, 16) : "?", "> " + (first ? hex(*first, 16) : "?"));
+            // Every pulse falls on the start time plus whole cycles (ESC datasheet 0x0990 next SYNC0 pulse,
+            // 0x09A0 SYNC0 cycle time): a pulse off that grid is out of phase with every other slave's.
+            for (const auto& t : {first, later})
+                if (t && ((*t < start) || (*t - start) % 1'000'000 != 0))
+                    return fail("next SYNC0 time 0x0990 off the start time plus whole cycles",
+                                hex(*t, 16) + " (start " + hex(start, 16) + ", cycle 1 ms)",
+                                "start + k * 1 ms");
             return pass("pulses");
         },
         a);

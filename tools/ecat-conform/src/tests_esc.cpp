@@ -672,6 +672,34 @@ void add_esc_tests(Catalogue& c) {
         "for "
         "EtherCAT)",
         watchdog_rw);
+    add("reg.protection_offset",
+        "Write protection 0x0020/0x0030 off (no master of this run enables it), physical read/write offset "
+        "0x0108 reads back as written",
+        "ETG.1000.4 register access; ESC datasheet section II 0x0020 register write protection, 0x0030 ESC "
+        "write "
+        "protection (bit 0, 0 after reset; bits 1-7 reserved), 0x0108-0x0109 physical read/write offset "
+        "(read/write for EtherCAT)",
+        [](Context& ctx) {
+            for (uint16_t reg : {uint16_t{0x0020}, uint16_t{0x0030}}) {
+                auto v = ctx.rd<uint8_t>(reg);
+                if (!v) return fail(hex(reg) + " unreadable", err(v.error()));
+                // Set, the ESC would refuse the register writes this run makes (and reads back).
+                if (*v)
+                    return fail(hex(reg) + " write protection on, or reserved bits set", hex(*v, 2), "0x00");
+            }
+            auto before = ctx.rd<uint16_t>(0x0108);
+            if (!before) return fail("0x0108 unreadable", err(before.error()));
+            const auto v = static_cast<uint16_t>(*before ^ 0x0101);
+            const Error w = ctx.wr<uint16_t>(0x0108, v);
+            auto after = ctx.rd<uint16_t>(0x0108);
+            (void)ctx.wr<uint16_t>(0x0108, *before);
+            auto restored = ctx.rd<uint16_t>(0x0108);
+            if (w != Error::Ok) return fail("0x0108 not writable", err(w));
+            return expect_eq("0x0108 written and read back, then put back",
+                             (after ? hex(*after) : err(after.error())) + ", " +
+                                 (restored ? hex(*restored) : err(restored.error())),
+                             hex(v) + ", " + hex(*before));
+        });
     add("reg.event_request", "ECAT event request 0x0210: reserved bits 1 and 12-15 clear",
         "ETG.1000.4 register access; ESC datasheet section II ECAT event request register 0x0210",
         [](Context& ctx) {

@@ -461,6 +461,16 @@ void add_sdo_tests(Catalogue& c) {
         },
         "CoE");
     add(
+        "abort.missing_subindex_var",
+        "Upload of subindex 1 of a VAR object (0x1000 device type): abort 0x06090011, not the value", kAbort,
+        {&Context::need_coe},
+        [](Context& ctx) {
+            // A VAR has subindex 0 only (ETG.1000.6 / CiA 301 object code VAR): a server that ignores the
+            // subindex of a VAR answers every subindex with the value.
+            return expect_abort(sdo_raw(ctx, sdo_req(0x40, 0x1000, 1)), 0x1000, 1, {0x06090011}, "0x1000:1");
+        },
+        "CoE");
+    add(
         "abort.write_read_only",
         "Download to the read-only 0x1018:01: abort 0x06010002 (or the general 0x06010000 of its family)",
         kAbort, {&Context::need_coe},
@@ -809,6 +819,79 @@ void add_sdo_tests(Catalogue& c) {
                 if (++n >= 40) break;
             }
             return pass(dec(n) + " entries");
+        },
+        "ESI given");
+    add(
+        "od.writable_in_op",
+        "Device-profile entries the ESI declares writable in OP (not mapped) take a download in OP: their "
+        "own "
+        "value written back is acknowledged",
+        "ETG.1000.6 SDO download; ETG.2000 object access per state (Access rw, WriteRestrictions); "
+        "ETG.1000.6 "
+        "abort 0x08000022 only where the state forbids the access",
+        [](Context& ctx) {
+            CONFORM_NEED(ctx.need_coe());
+            CONFORM_NEED(ctx.need_esi());
+            CONFORM_NEED(ctx.need_pd_layout());
+            // Entries 0x6000-0x6FFF writable in OP by the ESI (rw without restrictions, or restrictions that
+            // name OP), of 1, 2 or 4 bytes, that no ESI PDO maps (a mapped entry is written by the process
+            // data) and that are no command or device-state object: the value read is written back unchanged.
+            auto in_op = [](const EsiEntry& e) {
+                if (e.access != "rw") return false;
+                if (e.write_restrictions.empty()) return true;
+                std::size_t at = 0;
+                const std::string& w = e.write_restrictions;
+                while (at <= w.size()) {
+                    const std::size_t end = std::min(w.find('_', at), w.size());
+                    if (w.compare(at, end - at, "OP") == 0) return true;
+                    at = end + 1;
+                }
+                return false;
+            };
+            auto mapped = [&](uint16_t i, uint8_t s) {
+                for (const auto* list : {&ctx.esi->rxpdos, &ctx.esi->txpdos})
+                    for (const EsiPdo& p : *list)
+                        for (const auto& pe : p.entries)
+                            if (pe.index == i && pe.subindex == s) return true;
+                return false;
+            };
+            std::vector<const EsiEntry*> pick;
+            std::vector<uint16_t> pick_index;
+            for (const auto& r : esi_entries(*ctx.esi)) {
+                const uint16_t i = r.obj->index;
+                if (i < 0x6000 || i > 0x6FFF || !in_op(*r.e) ||
+                    (r.e->bit_size != 8 && r.e->bit_size != 16 && r.e->bit_size != 32))
+                    continue;
+                if (command_object(*ctx.esi, i) || device_state_object(i) || mapped(i, r.e->subindex))
+                    continue;
+                pick.push_back(r.e);
+                pick_index.push_back(i);
+                if (pick.size() >= 8) break;
+            }
+            if (pick.empty()) return skip("no unmapped device-profile entry writable in OP in the ESI");
+            if (Error e = ctx.to_op(); e != Error::Ok) return fail("cannot reach OP: " + err(e));
+            std::string done;
+            for (std::size_t k = 0; k < pick.size(); ++k) {
+                const uint16_t i = pick_index[k];
+                const uint8_t s = pick[k]->subindex;
+                (void)ctx.cycle(2);
+                auto v = ctx.upload_uint(i, s);
+                (void)ctx.cycle(2);
+                if (!v) continue;  // unreadable: the od tests' matter
+                Error e = ctx.download_uint(i, s, *v, pick[k]->bit_size / 8u);
+                (void)ctx.cycle(2);
+                if (e != Error::Ok) {
+                    (void)ctx.to_init();
+                    return fail(hex(i) + ":" + dec(s) +
+                                    " (writable in OP by the ESI) written in OP with its own "
+                                    "value",
+                                ctx.sdo_error(e), "acknowledged");
+                }
+                done += hex(i) + ":" + dec(s) + " ";
+            }
+            (void)ctx.to_init();
+            if (done.empty()) return skip("none of the entries uploads");
+            return pass("acknowledged in OP", done);
         },
         "ESI given");
     add(

@@ -478,6 +478,46 @@ void add_sdoinfo_tests(Catalogue& c) {
         },
         a, Severity::Warning);
     add(
+        "entry.value_range",
+        "Entry descriptions: the slave's own minimum not above its maximum, its default between them",
+        "ETG.1000.6 SDO information entry description value info: default, minimum and maximum value of the "
+        "entry (one range, whatever the ESI says)",
+        [](Context& ctx) {
+            CONFORM_INFO(ctx);
+            // Judged against the description itself, not the ESI (entry.limits compares with the ESI as a
+            // warning): a maximum below the minimum, or a default outside them, is a range no value fits.
+            unsigned n = 0;
+            for (const auto& [k, d] : info.entries) {
+                const bool is_signed = d.data_type >= 0x0002 && d.data_type <= 0x0004;
+                const bool is_unsigned = d.data_type >= 0x0005 && d.data_type <= 0x0007;
+                if ((d.value_info & 0x60) != 0x60 || !(is_signed || is_unsigned) || d.bit_length > 32 ||
+                    d.bit_length % 8 || d.bit_length == 0)
+                    continue;
+                const std::size_t len = d.bit_length / 8u;
+                const std::size_t def = (d.value_info & 0x08) ? 4 : 0;
+                const std::size_t lo = def + ((d.value_info & 0x10) ? len : 0);
+                if (d.values.size() < lo + 2 * len) continue;
+                auto val = [&](std::size_t o) {
+                    uint64_t v = 0;
+                    for (std::size_t b = 0; b < len; ++b)
+                        v |= static_cast<uint64_t>(d.values[o + b]) << (8 * b);
+                    if (is_signed) return static_cast<int64_t>(v << (64 - 8 * len)) >> (64 - 8 * len);
+                    return static_cast<int64_t>(v);
+                };
+                ++n;
+                const std::string at = hex(k.first) + ":" + dec(k.second);
+                if (val(lo) > val(lo + len))
+                    return fail(at + ": maximum below minimum", dec(val(lo)) + ".." + dec(val(lo + len)),
+                                "minimum <= maximum");
+                if ((d.value_info & 0x10) && (val(def) < val(lo) || val(def) > val(lo + len)))
+                    return fail(at + ": default outside minimum..maximum", dec(val(def)),
+                                dec(val(lo)) + ".." + dec(val(lo + len)));
+            }
+            if (!n) return skip("no entry description carries minimum and maximum");
+            return pass(dec(n) + " entries");
+        },
+        a);
+    add(
         "error.missing_object", "Object description of a missing object: error reply 0x06020000", kInfo,
         {&Context::need_sdo_info},
         [](Context& ctx) {

@@ -8,6 +8,49 @@
 
 namespace conform {
 
+// Each PDO entry's data type (ETG.2010 PDO entry byte 4, the CoE base type's index) against its bit length
+// (byte 5): a type of fixed size names that size (BIT1-BIT8 their bits; 0, padding, BOOLEAN, which ESIs map
+// as 1 or 8 bits, or a type of no fixed size, is not judged). "" or the first entry that disagrees.
+std::string sii_pdo_entry_types(std::span<const uint8_t> d) {
+    auto bits_of = [](uint8_t t) -> unsigned {
+        switch (t) {
+            case 0x02:
+            case 0x05:
+                return 8;  // INTEGER8, UNSIGNED8
+            case 0x03:
+            case 0x06:
+                return 16;  // INTEGER16, UNSIGNED16
+            case 0x04:
+            case 0x07:
+            case 0x08:
+                return 32;  // INTEGER32, UNSIGNED32, REAL32
+            case 0x10:
+            case 0x16:
+                return 24;  // INTEGER24, UNSIGNED24
+            case 0x11:
+            case 0x15:
+            case 0x1B:
+                return 64;  // REAL64, INTEGER64, UNSIGNED64
+            default:
+                return (t >= 0x30 && t <= 0x37) ? t - 0x2Fu : 0;  // BIT1..BIT8
+        }
+    };
+    std::size_t p = 0;
+    while (p + 8 <= d.size()) {
+        const uint16_t pdo = get16(&d[p]);
+        const uint8_t n = d[p + 2];
+        p += 8;
+        for (uint8_t i = 0; i < n && p + 8 <= d.size(); ++i, p += 8) {
+            const unsigned want = bits_of(d[p + 4]);
+            if (get16(&d[p]) != 0 && want && d[p + 5] != want)
+                return "PDO " + hex(pdo) + " entry " + hex(get16(&d[p])) + ":" + dec(d[p + 2]) +
+                       " data type " + hex(d[p + 4], 2) + " (" + dec(want) + " bits) with bit length " +
+                       dec(d[p + 5]);
+        }
+    }
+    return {};
+}
+
 namespace {
 
 constexpr const char* kSii = "ETG.1000.6 Slave Information Interface (SII) content";
@@ -84,6 +127,7 @@ Outcome pdo_category(Context& ctx, uint16_t type) {
         if (p.sm != 0xFF && p.sm >= sms && sms)
             return fail("PDO " + hex(p.index) + " names SM " + dec(p.sm), dec(p.sm),
                         "< " + dec(static_cast<long long>(sms)));
+    if (auto e = sii_pdo_entry_types(ctx.sii->data(*ctx.sii->find(type))); !e.empty()) return fail(e);
     return pass(dec(static_cast<long long>(pdos.size())) + " PDOs");
 }
 
@@ -460,9 +504,11 @@ void add_sii_tests(Catalogue& c) {
             }
             return pass(dec(static_cast<long long>(d.size() / 8)) + " SMs");
         });
-    add("cat.txpdo", "TXPDO category: PDOs and entries fit, SM index valid", kSii,
+    add("cat.txpdo",
+        "TXPDO category: PDOs and entries fit, SM index valid, entry data types of their bit length", kSii,
         [](Context& ctx) { return pdo_category(ctx, kTxPdo); });
-    add("cat.rxpdo", "RXPDO category: PDOs and entries fit, SM index valid", kSii,
+    add("cat.rxpdo",
+        "RXPDO category: PDOs and entries fit, SM index valid, entry data types of their bit length", kSii,
         [](Context& ctx) { return pdo_category(ctx, kRxPdo); });
     add("cat.dc", "DC category: 24 bytes per op mode", kSii, [](Context& ctx) {
         Outcome o = category_present(ctx, kDc, "DC");
