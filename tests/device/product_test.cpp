@@ -777,3 +777,42 @@ TEST(ProductWithSeveralSms, AdjacentSmsShareOneFmmu) {
     EXPECT_EQ(out[0], 0x11);
     EXPECT_EQ(out[3], 0x44);
 }
+
+// A vendor's ESI that declares 0x10F3 (ETG.1020 Diagnosis History) with :00..:05 only, no subindex for a
+// message (Weidmueller's UR20 coupler, vendor round 7): the device starts and serves the object as the values
+// it declares, without a history, and says so once (docs/decisions/device.md, "A 0x10F3 without messages").
+TEST(ProductWithCoe, ADiagnosisHistoryWithoutRoomForMessagesIsServedAsDeclared) {
+    const std::string sub =
+        R"(<SubItem><SubIdx>%</SubIdx><Name>S%</Name><Type>USINT</Type><BitSize>8</BitSize>
+<BitOffs>@</BitOffs><Flags><Access>ro</Access></Flags></SubItem>)";
+    std::string items;
+    for (int n = 0; n <= 5; ++n) {
+        std::string s = sub;
+        s.replace(s.find('%'), 1, std::to_string(n));
+        s.replace(s.find('%'), 1, std::to_string(n));
+        s.replace(s.find('@'), 1, std::to_string(n == 0 ? 0 : 8 + 8 * n));
+        items += s;
+    }
+    const std::string xml = R"(<?xml version="1.0"?>
+<EtherCATInfo><Vendor><Id>#x00000A5E</Id><Name>Example</Name></Vendor><Descriptions><Groups><Group>
+<Type>G</Type><Name>G</Name></Group></Groups><Devices><Device Physics="YY">
+<Type ProductCode="#x00000200" RevisionNo="#x00000001">DH1</Type><Name>DH1</Name><GroupType>G</GroupType>
+<Profile><Dictionary><DataTypes><DataType><Name>USINT</Name><BitSize>8</BitSize></DataType>
+<DataType><Name>DT10F3</Name><BitSize>56</BitSize>)" +
+                            items + R"(</DataType></DataTypes><Objects>
+<Object><Index>#x10F3</Index><Name>Diagnosis History</Name><Type>DT10F3</Type><BitSize>56</BitSize>
+<Info><SubItem><Name>S0</Name><Info><DefaultData>05</DefaultData></Info></SubItem>
+<SubItem><Name>S1</Name><Info><DefaultData>07</DefaultData></Info></SubItem></Info></Object>
+</Objects></Dictionary></Profile>
+<Sm DefaultSize="128" StartAddress="#x1000" ControlByte="#x26" Enable="1">MBoxOut</Sm>
+<Sm DefaultSize="128" StartAddress="#x1080" ControlByte="#x22" Enable="1">MBoxIn</Sm>
+<Mailbox><CoE SdoInfo="1"/></Mailbox></Device></Devices></Descriptions></EtherCATInfo>)";
+    auto product = std::make_shared<od::Product>(esi::load_product(esi::read_esi_text(xml, "dh1.xml"), ""));
+    Unit u(product);
+    ASSERT_TRUE(u.dev->has_coe());
+    const std::string log = u.log.str();
+    const std::string w = "0x10F3 has no message subindex (:06 and after) (ETG.1020 Diagnosis History)";
+    ASSERT_NE(log.find(w), std::string::npos) << log;
+    EXPECT_EQ(log.find(w), log.rfind(w));
+    EXPECT_EQ(u.dev->dictionary().get<uint8_t>(0x10F3, 1), 7u);  // the declared value, not a history's count
+}
