@@ -816,3 +816,32 @@ TEST(ProductWithCoe, ADiagnosisHistoryWithoutRoomForMessagesIsServedAsDeclared) 
     EXPECT_EQ(log.find(w), log.rfind(w));
     EXPECT_EQ(u.dev->dictionary().get<uint8_t>(0x10F3, 1), 7u);  // the declared value, not a history's count
 }
+
+// A device whose 0x1C32:04 announces free run and DC but not the SM-synchronous mode (0x0005, Weidmueller's
+// UR20 coupler, vendor round 7): it refuses PREOP -> SAFEOP in SM-synchronous mode (0x0028), so the master
+// library's session asks for free run (0x1C32:01 = 0) and reaches Op (tools/lib/master session.cpp).
+TEST(ProductWithDrive, AMasterSessionAsksFreeRunOfADeviceWithoutSmSynchronousMode) {
+    std::ifstream in(SOFTECAT_ESI_EXAMPLES "/drive402.xml", std::ios::binary);
+    std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string supported =
+        "<Name>Sync modes supported</Name>\n\t\t\t\t\t\t\t\t\t\t<Info>\n\t\t\t\t\t\t\t\t\t\t\t"
+        "<DefaultData>0700</DefaultData>";
+    const std::size_t at = xml.find(supported);
+    ASSERT_NE(at, std::string::npos);
+    xml.replace(at + supported.size() - 18, 4, "0500");  // 0x0005: free run, DC SYNC0
+    auto product =
+        std::make_shared<od::Product>(esi::load_product(esi::read_esi_text(xml, "drive-0005.xml"), ""));
+    CoeUnitInPreOp t(product);
+    ASSERT_NO_FATAL_FAILURE(t.to_preop());
+    uint8_t sup[2] = {};
+    ASSERT_TRUE(t.sdo.upload(0x1C32, 4, sup).ok());
+    ASSERT_EQ(sup[0], 0x05);
+    ProcessDataSession pd(t.m, t.a, t.sdo);
+    ASSERT_EQ(pd.discover(), Error::Ok);
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    ASSERT_NO_FATAL_FAILURE(session_to_op(
+        pd, [] {}, 3));
+    uint8_t mode[2] = {0xFF, 0xFF};
+    ASSERT_TRUE(t.sdo.upload(0x1C32, 1, mode).ok());
+    EXPECT_EQ(mode[0], 0);  // free run
+}
