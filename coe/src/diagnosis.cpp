@@ -84,22 +84,36 @@ std::size_t DiagnosisHistory::encode(const DiagMessage& m, std::span<uint8_t> ou
     return at;
 }
 
+std::string DiagnosisHistory::unusable(const od::Dictionary& dict) {
+    const od::Object* obj = dict.find(kIndex);
+    if (obj == nullptr) return {};
+    for (uint8_t sub = 1; sub <= kSubFlags; ++sub)
+        if (obj->entry(sub) == nullptr) return "0x10F3 lacks :01..:05";
+    std::size_t slots = 0, capacity = 0;
+    for (const auto& e : obj->entries) {
+        if (e.subindex < kFirstMessage) continue;
+        if (e.subindex != kFirstMessage + slots) return "0x10F3 messages are not contiguous from :06";
+        capacity = capacity == 0 ? e.byte_size() : std::min(capacity, e.byte_size());
+        ++slots;
+    }
+    if (slots == 0) return "0x10F3 has no message subindex (:06 and after)";
+    if (slots > kMaxMessages) return "0x10F3 has more than 250 messages";
+    if (capacity < kHead) return "0x10F3 has a message shorter than 16 bytes";
+    return {};
+}
+
 DiagnosisHistory::DiagnosisHistory(od::Dictionary& dict, Emergency* emergency)
     : dict_(dict), emergency_(emergency) {
     const od::Object* obj = dict_.find(kIndex);
     if (obj == nullptr) throw std::logic_error("coe::DiagnosisHistory: the dictionary has no 0x10F3");
-    for (uint8_t sub = 1; sub <= kSubFlags; ++sub)
-        if (obj->entry(sub) == nullptr)
-            throw std::logic_error("coe::DiagnosisHistory: 0x10F3 lacks :01..:05");
+    if (const std::string why = unusable(dict_); !why.empty())
+        throw std::logic_error("coe::DiagnosisHistory: " + why +
+                               " (it needs :01..:05 and 1..250 contiguous messages of at least 16 bytes)");
     for (const auto& e : obj->entries) {
         if (e.subindex < kFirstMessage) continue;
-        if (e.subindex != kFirstMessage + slots_)
-            throw std::logic_error("coe::DiagnosisHistory: 0x10F3 messages must be contiguous from :06");
         capacity_ = capacity_ == 0 ? e.byte_size() : std::min(capacity_, e.byte_size());
         ++slots_;
     }
-    if (slots_ == 0 || slots_ > kMaxMessages || capacity_ < kHead)
-        throw std::logic_error("coe::DiagnosisHistory: 0x10F3 needs 1..250 messages of at least 16 bytes");
     buf_.resize(capacity_);
     updating_ = true;
     set_u8(kSubMax, static_cast<uint8_t>(slots_));

@@ -8,6 +8,7 @@
 #include <cctype>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <stdexcept>
 
@@ -523,7 +524,13 @@ EsiDevice read_device(Node dev, const TypeMap& types_in, uint32_t vendor, const 
                 c.name = name_text(mc);
                 slot.module_classes.push_back(std::move(c));
             }
-            d.slots.push_back(std::move(slot));
+            // One entry per slot the element stands for (MaxInstances; 0 or absent: one), as many as the
+            // module ident lists hold in all.
+            const std::size_t count = std::max<std::size_t>(1, slot.max_instances);
+            for (std::size_t k = 0; k < count && d.slots.size() < kMaxSlots; ++k) {
+                slot.instance = static_cast<uint32_t>(k);
+                d.slots.push_back(slot);
+            }
         }
     }
     if (Node ee = child(dev, "Eeprom")) {
@@ -560,17 +567,39 @@ EsiModule read_module(Node mod, const TypeMap& device_types) {
     return m;
 }
 
-EsiFile read_doc(xmlDoc* doc, const std::string& source) {
+// What a document must be: an ESI (EtherCATInfo with devices), or the file an InfoReference names, whose
+// modules are read (an EtherCATModule file, ETG.2000 EtherCATModule.xsd: Vendor and Modules; or an
+// EtherCATInfo, whose Descriptions/Modules are taken).
+enum class DocKind { Esi, ModuleFile };
+
+EsiFile read_doc(xmlDoc* doc, const std::string& source, DocKind kind) {
     std::unique_ptr<xmlDoc, void (*)(xmlDoc*)> guard(doc, xmlFreeDoc);
     Node root = xmlDocGetRootElement(doc);
     if (!root) throw InputError(source, 0, "no root element");
+    if (kind == DocKind::ModuleFile && is(root, "EtherCATModule")) {
+        EsiFile f;
+        f.source = source;
+        f.vendor_id = static_cast<uint32_t>(number(text(child(root, "Vendor"), "Id")));
+        f.vendor_name = name_text(child(root, "Vendor"));
+        TypeMap none;
+        for (Node mod : children(child(root, "Modules"), "Module"))
+            f.modules.push_back(read_module(mod, none));
+        return f;
+    }
     if (!is(root, "EtherCATInfo"))
         throw InputError(source, line_of(root),
-                         "root element is " + name_of(root) + ", not EtherCATInfo: not an ESI file");
+                         "root element is " + name_of(root) + ", not EtherCATInfo" +
+                             (kind == DocKind::ModuleFile ? " or EtherCATModule" : "") + ": not an ESI file");
     EsiFile f;
     f.source = source;
     f.vendor_id = static_cast<uint32_t>(number(text(child(root, "Vendor"), "Id")));
     f.vendor_name = name_text(child(root, "Vendor"));
+    for (Node ref : children(root, "InfoReference")) {
+        EsiInfoReference r;
+        r.reference = text(ref);
+        r.line = line_of(ref);
+        f.info_references.push_back(std::move(r));
+    }
     Node desc = child(root, "Descriptions");
     std::map<std::string, std::string> group_names;
     for (Node g : children(child(desc, "Groups"), "Group"))
@@ -580,6 +609,7 @@ EsiFile read_doc(xmlDoc* doc, const std::string& source) {
         f.devices.push_back(read_device(dev, none, f.vendor_id, f.vendor_name, group_names));
     for (Node mod : children(child(desc, "Modules"), "Module"))
         f.modules.push_back(read_module(mod, none));
+    if (kind == DocKind::ModuleFile) return f;
     if (f.devices.empty())
         throw InputError(source, line_of(desc ? desc : root), "no Device in Descriptions/Devices");
     return f;
@@ -749,7 +779,7 @@ void on_error(void*, xmlErrorPtr e) {
         t_state->message.pop_back();
 }
 
-EsiFile parse_esi(const std::string& xml, const std::string& name) {
+EsiFile parse_esi(const std::string& xml, const std::string& name, DocKind kind = DocKind::Esi) {
     if (xml.size() > kMaxEsiBytes)
         throw InputError(name, 0, "larger than " + std::to_string(kMaxEsiBytes) + " bytes: not an ESI file");
     if (xml.empty()) throw InputError(name, 0, "empty file: not an ESI file");
@@ -778,21 +808,81 @@ EsiFile parse_esi(const std::string& xml, const std::string& name) {
         }
         throw InputError(name, state.error_line, "not well-formed XML: " + state.message);
     }
-    return read_doc(doc, name);
+    return read_doc(doc, name, kind);
 }
 
-}  // namespace
-
-EsiFile read_esi_file(const std::string& path) {
-    std::string text;
+std::string read_text(const std::string& path, const char* what) {
     try {
-        text = util::read_input_file(path, kMaxEsiBytes, "ESI file");
+        return util::read_input_file(path, kMaxEsiBytes, what);
     } catch (const util::InputFileError& e) {
         std::string m = e.what();  // "PATH: what went wrong"
         if (m.rfind(path + ": ", 0) == 0) m.erase(0, path.size() + 2);
         throw InputError(path, 0, m);
     }
-    return parse_esi(text, path);
+}
+
+bool same_name(const std::string& a, const std::string& b) {
+    return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+               return std::tolower(static_cast<unsigned char>(x)) ==
+                      std::tolower(static_cast<unsigned char>(y));
+           });
+}
+
+// The file an InfoReference names, for the ESI at `esi_path` (docs/decisions/esi.md, "InfoReference"): the
+// reference with '\' read as a directory separator (the files are written on Windows), relative to the ESI's
+// directory; if there is none, a file of the reference's last name in the ESI's directory; either matched
+// without regard to case where the exact name is missing (Windows names are case-blind). Empty if none.
+std::string resolve_reference(const std::string& esi_path, std::string ref, std::string& looked) {
+    namespace fs = std::filesystem;
+    std::replace(ref.begin(), ref.end(), '\\', '/');
+    const fs::path base = fs::path(esi_path).parent_path();
+    const fs::path given(ref);
+    std::vector<fs::path> candidates{given.is_absolute() ? given : base / given};
+    if (given.has_filename() && candidates.front() != base / given.filename())
+        candidates.push_back(base / given.filename());
+    for (const fs::path& c : candidates) {
+        looked += (looked.empty() ? "" : ", ") + c.string();
+        std::error_code ec;
+        if (fs::is_regular_file(c, ec)) return c.string();
+        const fs::path dir = c.parent_path().empty() ? fs::path(".") : c.parent_path();
+        for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+            if (same_name(it->path().filename().string(), c.filename().string()) &&
+                fs::is_regular_file(it->path(), ec))
+                return it->path().string();
+    }
+    return {};
+}
+
+}  // namespace
+
+EsiFile read_esi_file(const std::string& path) {
+    EsiFile f = parse_esi(read_text(path, "ESI file"), path);
+    for (EsiInfoReference& r : f.info_references) {
+        if (r.reference.empty()) {
+            r.problem = "names no file";
+            continue;
+        }
+        std::string looked;
+        const std::string file = resolve_reference(path, r.reference, looked);
+        if (file.empty()) {
+            r.problem = "no such file (looked for " + looked + ")";
+            continue;
+        }
+        try {
+            const EsiFile other = parse_esi(read_text(file, "InfoReference file"), file, DocKind::ModuleFile);
+            r.resolved = file;
+            for (const EsiModule& m : other.modules)
+                if (f.module(m.ident) == nullptr) {
+                    f.modules.push_back(m);
+                    ++r.modules;
+                }
+            if (other.modules.empty()) r.problem = file + " has no Module";
+        } catch (const InputError& e) {
+            // The device itself is described without it: said, and served without the modules.
+            r.problem = std::string("not read: ") + e.what();
+        }
+    }
+    return f;
 }
 
 EsiFile read_esi_text(const std::string& xml, const std::string& name) {

@@ -777,3 +777,71 @@ TEST(ProductWithSeveralSms, AdjacentSmsShareOneFmmu) {
     EXPECT_EQ(out[0], 0x11);
     EXPECT_EQ(out[3], 0x44);
 }
+
+// A vendor's ESI that declares 0x10F3 (ETG.1020 Diagnosis History) with :00..:05 only, no subindex for a
+// message (Weidmueller's UR20 coupler, vendor round 7): the device starts and serves the object as the values
+// it declares, without a history, and says so once (docs/decisions/device.md, "A 0x10F3 without messages").
+TEST(ProductWithCoe, ADiagnosisHistoryWithoutRoomForMessagesIsServedAsDeclared) {
+    const std::string sub =
+        R"(<SubItem><SubIdx>%</SubIdx><Name>S%</Name><Type>USINT</Type><BitSize>8</BitSize>
+<BitOffs>@</BitOffs><Flags><Access>ro</Access></Flags></SubItem>)";
+    std::string items;
+    for (int n = 0; n <= 5; ++n) {
+        std::string s = sub;
+        s.replace(s.find('%'), 1, std::to_string(n));
+        s.replace(s.find('%'), 1, std::to_string(n));
+        s.replace(s.find('@'), 1, std::to_string(n == 0 ? 0 : 8 + 8 * n));
+        items += s;
+    }
+    const std::string xml = R"(<?xml version="1.0"?>
+<EtherCATInfo><Vendor><Id>#x00000A5E</Id><Name>Example</Name></Vendor><Descriptions><Groups><Group>
+<Type>G</Type><Name>G</Name></Group></Groups><Devices><Device Physics="YY">
+<Type ProductCode="#x00000200" RevisionNo="#x00000001">DH1</Type><Name>DH1</Name><GroupType>G</GroupType>
+<Profile><Dictionary><DataTypes><DataType><Name>USINT</Name><BitSize>8</BitSize></DataType>
+<DataType><Name>DT10F3</Name><BitSize>56</BitSize>)" +
+                            items + R"(</DataType></DataTypes><Objects>
+<Object><Index>#x10F3</Index><Name>Diagnosis History</Name><Type>DT10F3</Type><BitSize>56</BitSize>
+<Info><SubItem><Name>S0</Name><Info><DefaultData>05</DefaultData></Info></SubItem>
+<SubItem><Name>S1</Name><Info><DefaultData>07</DefaultData></Info></SubItem></Info></Object>
+</Objects></Dictionary></Profile>
+<Sm DefaultSize="128" StartAddress="#x1000" ControlByte="#x26" Enable="1">MBoxOut</Sm>
+<Sm DefaultSize="128" StartAddress="#x1080" ControlByte="#x22" Enable="1">MBoxIn</Sm>
+<Mailbox><CoE SdoInfo="1"/></Mailbox></Device></Devices></Descriptions></EtherCATInfo>)";
+    auto product = std::make_shared<od::Product>(esi::load_product(esi::read_esi_text(xml, "dh1.xml"), ""));
+    Unit u(product);
+    ASSERT_TRUE(u.dev->has_coe());
+    const std::string log = u.log.str();
+    const std::string w = "0x10F3 has no message subindex (:06 and after) (ETG.1020 Diagnosis History)";
+    ASSERT_NE(log.find(w), std::string::npos) << log;
+    EXPECT_EQ(log.find(w), log.rfind(w));
+    EXPECT_EQ(u.dev->dictionary().get<uint8_t>(0x10F3, 1), 7u);  // the declared value, not a history's count
+}
+
+// A device whose 0x1C32:04 announces free run and DC but not the SM-synchronous mode (0x0005, Weidmueller's
+// UR20 coupler, vendor round 7): it refuses PREOP -> SAFEOP in SM-synchronous mode (0x0028), so the master
+// library's session asks for free run (0x1C32:01 = 0) and reaches Op (tools/lib/master session.cpp).
+TEST(ProductWithDrive, AMasterSessionAsksFreeRunOfADeviceWithoutSmSynchronousMode) {
+    std::ifstream in(SOFTECAT_ESI_EXAMPLES "/drive402.xml", std::ios::binary);
+    std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string supported =
+        "<Name>Sync modes supported</Name>\n\t\t\t\t\t\t\t\t\t\t<Info>\n\t\t\t\t\t\t\t\t\t\t\t"
+        "<DefaultData>0700</DefaultData>";
+    const std::size_t at = xml.find(supported);
+    ASSERT_NE(at, std::string::npos);
+    xml.replace(at + supported.size() - 18, 4, "0500");  // 0x0005: free run, DC SYNC0
+    auto product =
+        std::make_shared<od::Product>(esi::load_product(esi::read_esi_text(xml, "drive-0005.xml"), ""));
+    CoeUnitInPreOp t(product);
+    ASSERT_NO_FATAL_FAILURE(t.to_preop());
+    uint8_t sup[2] = {};
+    ASSERT_TRUE(t.sdo.upload(0x1C32, 4, sup).ok());
+    ASSERT_EQ(sup[0], 0x05);
+    ProcessDataSession pd(t.m, t.a, t.sdo);
+    ASSERT_EQ(pd.discover(), Error::Ok);
+    ASSERT_EQ(pd.configure(), Error::Ok);
+    ASSERT_NO_FATAL_FAILURE(session_to_op(
+        pd, [] {}, 3));
+    uint8_t mode[2] = {0xFF, 0xFF};
+    ASSERT_TRUE(t.sdo.upload(0x1C32, 1, mode).ok());
+    EXPECT_EQ(mode[0], 0);  // free run
+}

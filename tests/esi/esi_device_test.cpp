@@ -1964,3 +1964,184 @@ TEST(EsiFindDevice, ASpecMustNameADeviceOfAFileOfSeveral) {
     EXPECT_THROW((void)esi::select_device(f, ""), esi::InputError);
     EXPECT_EQ(&esi::select_device(f, " B20 @ -"), &f.devices[3]);  // the module list is load_product's
 }
+
+// ---- Vendor round 7: modules in the file an InfoReference names, a Slot of several instances ------------
+
+// A terminal bus coupler as modular IO vendors write it: one Slot element that stands for up to 8 terminals
+// (MaxInstances), taking them by ModuleClass, and the terminals in a separate EtherCATModule file that the
+// ESI names in InfoReference with a Windows path.
+const char* const kTerminalBusEsi = R"(<?xml version="1.0" encoding="utf-8"?>
+<EtherCATInfo Version="1.12">
+	<InfoReference>Terminals\tb-terminals.xml</InfoReference>
+	<Vendor><Id>#x00000A5E</Id><Name>Example Terminals</Name></Vendor>
+	<Descriptions>
+		<Groups><Group><Type>Couplers</Type><Name>Couplers</Name></Group></Groups>
+		<Devices>
+			<Device Physics="YY">
+				<Type ProductCode="#x00000100" RevisionNo="#x00000001">TB100</Type>
+				<Name>TB100 terminal bus coupler</Name>
+				<GroupType>Couplers</GroupType>
+				<Fmmu>Outputs</Fmmu>
+				<Fmmu>Inputs</Fmmu>
+				<Fmmu>MBoxState</Fmmu>
+				<Sm DefaultSize="128" StartAddress="#x1000" ControlByte="#x26" Enable="1">MBoxOut</Sm>
+				<Sm DefaultSize="128" StartAddress="#x1080" ControlByte="#x22" Enable="1">MBoxIn</Sm>
+				<Sm StartAddress="#x1100" ControlByte="#x64" Enable="1">Outputs</Sm>
+				<Sm StartAddress="#x1400" ControlByte="#x20" Enable="1">Inputs</Sm>
+				<Mailbox><CoE SdoInfo="1" CompleteAccess="1"/></Mailbox>
+				<Slots DownloadModuleIdentList="true" SlotIndexIncrement="#x10" SlotPdoIncrement="1">
+					<Slot MinInstances="1" MaxInstances="8">
+						<Name>Terminals</Name>
+						<ModuleClass><Class>tb_di</Class><Name>Digital inputs</Name></ModuleClass>
+						<ModuleClass><Class>tb_do</Class><Name>Digital outputs</Name></ModuleClass>
+					</Slot>
+				</Slots>
+			</Device>
+		</Devices>
+	</Descriptions>
+</EtherCATInfo>
+)";
+
+const char* const kTerminalBusModules = R"(<?xml version="1.0" encoding="utf-8"?>
+<EtherCATModule Version="1.12">
+	<Vendor><Id>2654</Id><Name>Example Terminals</Name></Vendor>
+	<Modules>
+		<Module>
+			<Type ModuleClass="tb_di" ModuleIdent="#x00000011">TB-DI2</Type>
+			<Name>TB-DI2 two digital inputs</Name>
+			<TxPdo Fixed="1" Mandatory="1" Sm="3">
+				<Index DependOnSlot="1">#x1A00</Index>
+				<Name>Inputs</Name>
+				<Entry><Index DependOnSlot="1">#x6000</Index><SubIndex>1</SubIndex><BitLen>1</BitLen><Name>DI1</Name><DataType>BOOL</DataType></Entry>
+				<Entry><Index DependOnSlot="1">#x6000</Index><SubIndex>2</SubIndex><BitLen>1</BitLen><Name>DI2</Name><DataType>BOOL</DataType></Entry>
+				<Entry><Index>#x0</Index><BitLen>6</BitLen></Entry>
+			</TxPdo>
+		</Module>
+		<Module>
+			<Type ModuleClass="tb_do" ModuleIdent="#x00000012">TB-DO2</Type>
+			<Name>TB-DO2 two digital outputs</Name>
+			<RxPdo Fixed="1" Mandatory="1" Sm="2">
+				<Index DependOnSlot="1">#x1600</Index>
+				<Name>Outputs</Name>
+				<Entry><Index DependOnSlot="1">#x7000</Index><SubIndex>1</SubIndex><BitLen>1</BitLen><Name>DO1</Name><DataType>BOOL</DataType></Entry>
+				<Entry><Index DependOnSlot="1">#x7000</Index><SubIndex>2</SubIndex><BitLen>1</BitLen><Name>DO2</Name><DataType>BOOL</DataType></Entry>
+				<Entry><Index>#x0</Index><BitLen>6</BitLen></Entry>
+			</RxPdo>
+		</Module>
+	</Modules>
+</EtherCATModule>
+)";
+
+bool any_warning(const od::Product& p, const std::string& part) {
+    return std::any_of(p.warnings.begin(), p.warnings.end(),
+                       [&](const std::string& w) { return w.find(part) != std::string::npos; });
+}
+
+TEST(EsiInfoReference, TheModulesOfTheFileItNamesAreOfferedToTheSlots) {
+    // Where the vendor ships it: the reference's path, '\' a directory separator, relative to the ESI.
+    {
+        TempDir t;
+        const std::string esi = t.write("tb100.xml", kTerminalBusEsi);
+        fs::create_directory(t.dir / "Terminals");
+        t.write("Terminals/tb-terminals.xml", kTerminalBusModules);
+        const esi::EsiFile f = esi::read_esi_file(esi);
+        ASSERT_EQ(f.info_references.size(), 1u);
+        EXPECT_EQ(f.info_references[0].reference, "Terminals\\tb-terminals.xml");
+        EXPECT_EQ(f.info_references[0].line, 3);
+        EXPECT_EQ(f.info_references[0].modules, 2u);
+        EXPECT_TRUE(f.info_references[0].problem.empty()) << f.info_references[0].problem;
+        EXPECT_EQ(fs::path(f.info_references[0].resolved), t.dir / "Terminals" / "tb-terminals.xml");
+        ASSERT_EQ(f.modules.size(), 2u);
+        EXPECT_EQ(f.modules[0].type_name, "TB-DI2");
+        EXPECT_EQ(f.modules[1].module_class, "tb_do");
+        const od::Product p = esi::load_product(f, "TB100@TB-DI2,TB-DO2");
+        EXPECT_FALSE(any_warning(p, "InfoReference")) << ::testing::PrintToString(p.warnings);
+        const od::Dictionary d = p.make_dictionary(p.description);
+        EXPECT_NE(d.find(0x6000, 2), nullptr);
+        EXPECT_NE(d.find(0x7010, 1), nullptr);  // slot 2: the index increment moves the module's objects
+    }
+    // Copied next to the ESI, its name in another case: found by its last name, without regard to case.
+    {
+        TempDir t;
+        const std::string esi = t.write("tb100.xml", kTerminalBusEsi);
+        t.write("TB-Terminals.XML", kTerminalBusModules);
+        const esi::EsiFile f = esi::read_esi_file(esi);
+        EXPECT_EQ(f.modules.size(), 2u);
+        EXPECT_EQ(fs::path(f.info_references[0].resolved), t.dir / "TB-Terminals.XML");
+    }
+    // Missing, or not well-formed: the device is still served, without the modules, and a warning naming the
+    // InfoReference's line says why; a module chosen from it is refused naming what the slot takes.
+    for (const char* second : {"", "<EtherCATModule><Modules>"}) {
+        TempDir t;
+        const std::string esi = t.write("tb100.xml", kTerminalBusEsi);
+        if (*second) t.write("tb-terminals.xml", second);
+        const esi::EsiFile f = esi::read_esi_file(esi);
+        EXPECT_TRUE(f.modules.empty());
+        ASSERT_EQ(f.info_references.size(), 1u);
+        EXPECT_NE(f.info_references[0].problem.find(*second ? "not well-formed" : "no such file"),
+                  std::string::npos)
+            << f.info_references[0].problem;
+        const od::Product p = esi::load_product(f, "");
+        EXPECT_TRUE(any_warning(p, esi + ":3: InfoReference 'Terminals\\tb-terminals.xml'"))
+            << ::testing::PrintToString(p.warnings);
+        EXPECT_THROW((void)esi::load_product(f, "TB100@TB-DI2"), esi::InputError);
+    }
+    // A text read without a file has no directory to look in: the reference is kept, no module read.
+    const esi::EsiFile text = esi::read_esi_text(kTerminalBusEsi, "tb100.xml");
+    ASSERT_EQ(text.info_references.size(), 1u);
+    EXPECT_TRUE(text.modules.empty());
+    // An EtherCATModule file is not an ESI of its own (no device): refused naming its root.
+    TempDir t;
+    expect_input_error(t.write("terminals.xml", kTerminalBusModules), "", 2, "EtherCATModule");
+}
+
+TEST(EsiSlots, ASlotWithMaxInstancesStandsForThatManySlotsInARow) {
+    TempDir t;
+    const std::string esi = t.write("tb100.xml", kTerminalBusEsi);
+    t.write("tb-terminals.xml", kTerminalBusModules);
+    const esi::EsiFile f = esi::read_esi_file(esi);
+    const esi::EsiDevice& dev = f.devices[0];
+    ASSERT_EQ(dev.slots.size(), 8u);
+    for (std::size_t n = 0; n < dev.slots.size(); ++n) {
+        EXPECT_EQ(dev.slots[n].instance, n);
+        EXPECT_EQ(dev.slots[n].name, "Terminals");
+    }
+    // Three terminals in a row: each slot's PDO and objects moved by its position.
+    const od::Product p = esi::load_product(f, "TB100@TB-DI2,TB-DO2,TB-DI2");
+    const od::Dictionary d = p.make_dictionary(p.description);
+    EXPECT_NE(d.find(0x6000, 1), nullptr);
+    EXPECT_NE(d.find(0x7010, 2), nullptr);
+    EXPECT_NE(d.find(0x6020, 2), nullptr);
+    EXPECT_NE(d.find(0x1A00, 1), nullptr);
+    EXPECT_NE(d.find(0x1601, 1), nullptr);
+    EXPECT_NE(d.find(0x1A02, 1), nullptr);
+    // The detected module ident list (ETG.5001.1 0xF050) lists the three, not the eight the slot could take.
+    const od::Entry* count = d.find(0xF050, 0);
+    ASSERT_NE(count, nullptr);
+    EXPECT_EQ(esi::number_bits(count->default_value, od::DataType::Unsigned8, 8), 3u);
+    ASSERT_NE(d.find(0xF050, 2), nullptr);
+    EXPECT_EQ(esi::number_bits(d.find(0xF050, 2)->default_value, od::DataType::Unsigned32, 32), 0x12u);
+    // The further instances holding modules cannot be the written ESI's default: said per slot.
+    EXPECT_TRUE(any_warning(p, "slot 3 is instance 3 of a Slot with MaxInstances 8"))
+        << ::testing::PrintToString(p.warnings);
+    // More modules than instances: refused, counting the slots.
+    try {
+        (void)esi::load_product(
+            f, "TB100@" + std::string("TB-DI2,TB-DI2,TB-DI2,TB-DI2,TB-DI2,TB-DI2,TB-DI2,TB-DI2,TB-DI2"));
+        ADD_FAILURE() << "nine modules in eight slots";
+    } catch (const esi::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("9 modules for the 8 slots"), std::string::npos) << e.what();
+    }
+    // Written back: the Slot element once, with its MaxInstances, read back to the eight slots again.
+    const od::Product q = esi::load_product(f, "");
+    ASSERT_EQ(q.description.slots.size(), 1u);
+    EXPECT_EQ(q.description.slots[0].max_instances, 8u);
+    std::string xml;
+    (void)round_trip(q, &xml);
+    const esi::EsiFile back = esi::read_esi_text(xml, "round-trip.xml");
+    EXPECT_EQ(back.devices[0].slots.size(), 8u);
+    // A huge MaxInstances is as many slots as the module ident lists hold.
+    std::string huge = kTerminalBusEsi;
+    huge.replace(huge.find("MaxInstances=\"8\""), 16, "MaxInstances=\"1000\"");
+    EXPECT_EQ(esi::read_esi_text(huge, "huge.xml").devices[0].slots.size(), esi::kMaxSlots);
+}

@@ -64,12 +64,25 @@ def example_devices():
             if t is not None and t.get("ModuleIdent"):
                 modules[number(t.get("ModuleIdent"))] = m
         for dev in root.findall("Descriptions/Devices/Device"):
-            sms = [s.text.strip() for s in dev.findall("Sm")]
+            sms = [sm_kind(s) for s in dev.findall("Sm")]
             sm_of = {"out": sms.index("Outputs") if "Outputs" in sms else None,
                      "in": sms.index("Inputs") if "Inputs" in sms else None,
                      "all_out": [n for n, kind in enumerate(sms) if kind == "Outputs"],
                      "all_in": [n for n, kind in enumerate(sms) if kind == "Inputs"]}
             yield path, root, modules, dev, sm_of
+
+
+def sm_kind(sm):
+    """An Sm's kind: its text, or, without one (a master's export: exported.xml), what its ControlByte makes it
+    in the ESC (bits 0-1 10 mailbox, bits 2-3 01 the master writes)."""
+    text = (sm.text or "").strip()
+    if text or sm.get("ControlByte") is None:
+        return text
+    c = number(sm.get("ControlByte"))
+    write = (c >> 2) & 3 == 1
+    if c & 3 == 2:
+        return "MBoxOut" if write else "MBoxIn"
+    return "Outputs" if write else "Inputs"
 
 
 def examples():

@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -79,6 +80,11 @@ class DiagnosisHistory {
 
     // Installs the write/read semantics on 0x10F3. emergency may be null (flag b0 then cannot be set).
     // Throws std::logic_error if the dictionary has no usable 0x10F3. Must not outlive dict, must not move.
+    // Why the dictionary's 0x10F3 cannot hold a history (ETG.1020: :01..:05 and at least one message
+    // subindex from :06 on, contiguous, of at least 16 bytes, at most 250 of them); empty if it can, or if
+    // there is no 0x10F3. A device described by a vendor's ESI that declares 0x10F3 without room for
+    // messages serves the object as stored values instead (docs/decisions/device.md).
+    static std::string unusable(const od::Dictionary& dict);
     DiagnosisHistory(od::Dictionary& dict, Emergency* emergency = nullptr);
     ~DiagnosisHistory();  // takes its hooks off the dictionary, which may outlive it
     DiagnosisHistory(const DiagnosisHistory&) = delete;

@@ -674,6 +674,13 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
                                  "error 'unsupported protocol')");
     for (const std::string& what : d.unsupported)
         ctx.warn(d.line, what + ": declared; softecat does not emulate it");
+    // The files InfoReference names, whose modules the slots may take: one that was not read is said, with
+    // why (the device is served without its modules).
+    if (!d.slots.empty())
+        for (const EsiInfoReference& r : file.info_references)
+            if (!r.problem.empty())
+                ctx.warn(r.line, "InfoReference '" + r.reference + "': " + r.problem +
+                                     "; the modules it holds are not offered to the slots");
 
     // ---- FMMUs ----
     for (const std::string& f : d.fmmus) {
@@ -800,6 +807,16 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
     std::set<uint32_t> offered;
     for (std::size_t n = 0; n < d.slots.size(); ++n) {
         const EsiSlot& slot = d.slots[n];
+        if (slot.instance != 0) {
+            // A further slot of a Slot element with MaxInstances: written back once, as the element; a module
+            // in it is in the configuration served, not in the ESI's default.
+            if (n < modules.size() && modules[n])
+                ctx.warn(slot.line, "slot " + std::to_string(n + 1) + " is instance " +
+                                        std::to_string(slot.instance + 1) + " of a Slot with MaxInstances " +
+                                        std::to_string(slot.max_instances) +
+                                        ": an ESI written back (--write-esi) leaves it empty by default");
+            continue;
+        }
         od::Slot s;
         s.name = slot.name;
         s.min_instances = slot.min_instances;
@@ -1122,6 +1139,13 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
         std::vector<uint64_t> detected(d.slots.size(), 0);
         for (const SlotModule& sm : served)
             if (sm.module != nullptr && sm.slot < detected.size()) detected[sm.slot] = sm.ident;
+        // The further instances of a Slot with MaxInstances that hold no module, at the end, are not slots of
+        // this configuration (a coupler lists the modules plugged, not the 64 it could take): left out.
+        while (!detected.empty() && detected.back() == 0) {
+            const EsiSlot& last = d.slots[detected.size() - 1];
+            if (last.instance == 0 || last.instance < last.min_instances) break;
+            detected.pop_back();
+        }
         if (detected.size() > 254) ctx.fail(d.line, "Slots: more than 254 slots for the module ident lists");
         auto module_list_object = [&](uint16_t index, const char* name, uint16_t access) {
             auto it = built.objects.find(index);

@@ -62,6 +62,9 @@ std::string emergency_defects(std::span<const uint8_t> m, std::optional<uint64_t
 std::optional<std::string> history_defect(Context& ctx, uint16_t code) {
     auto newest = ctx.upload_uint(0x10F3, 2);
     if (!newest) return std::nullopt;
+    // A 0x10F3 whose subindices end before :06 (ETG.1020: the messages start there) has no room for one: a
+    // vendor's ESI may declare the header only (Weidmueller's UR20); nothing to look for.
+    if (auto top = ctx.upload_uint(0x10F3, 0); top && *top < 6) return std::nullopt;
     master::DiagHeader h;
     if (auto v = ctx.upload_uint(0x10F3, 1)) h.max_messages = static_cast<uint8_t>(*v);
     h.newest = static_cast<uint8_t>(*newest);

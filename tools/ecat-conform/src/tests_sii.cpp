@@ -61,6 +61,19 @@ std::string esi_sm(const EsiSm& s) {
     return hex(s.start) + "/" + dec(s.default_size) + "/" + hex(s.control, 2) + "/" + (s.enable ? "1" : "0");
 }
 
+// What an Sm is: its text where it is one of the four ETG.2000 names; an Sm without such a text (a master's
+// export of the device writes none: IgH's `ethercat xml`, TwinCAT's online description) is what its
+// ControlByte makes of it in the ESC (datasheet 0x0804: bits 0-1 10 mailbox, 00 buffered; bits 2-3 01 the
+// master writes, 00 it reads), as the slave and a master reading the SII take it. "" if neither says.
+std::string sm_kind(const EsiSm& s) {
+    for (const char* t : {"MBoxOut", "MBoxIn", "Outputs", "Inputs"})
+        if (s.type == t) return t;
+    if (!s.has_control) return {};
+    const bool write = ((s.control >> 2) & 0x03) == 0x01;
+    if ((s.control & 0x03) == 0x02) return write ? "MBoxOut" : "MBoxIn";
+    return write ? "Outputs" : "Inputs";
+}
+
 struct SiiPdo {
     uint16_t index = 0;
     uint8_t sm = 0;
@@ -339,7 +352,7 @@ void add_sii_tests(Catalogue& c) {
             std::string want;
             for (const char* t : {"MBoxOut", "MBoxIn"})
                 for (const auto& s : ctx.esi->sms)
-                    if (s.type == t) want += hex(s.start) + "/" + dec(s.default_size) + " ";
+                    if (sm_kind(s) == t) want += hex(s.start) + "/" + dec(s.default_size) + " ";
             if (want.empty()) {
                 // ETG.2010 SII words 0x18-0x1B: 0 for a device without a mailbox. Nonzero words announce a
                 // mailbox a master would set up and talk to.
@@ -539,7 +552,8 @@ void add_sii_tests(Catalogue& c) {
                 EsiSm s = ctx.esi->sms[n];
                 // A process-data Sm without DefaultSize leaves the size to the configuration (ETG.2000 Sm):
                 // the SII may carry 0 or the size of the PDOs the ESI assigns to it by default.
-                if (s.default_size == 0 && (s.type == "Outputs" || s.type == "Inputs") && n < sizes.size()) {
+                if (s.default_size == 0 && (sm_kind(s) == "Outputs" || sm_kind(s) == "Inputs") &&
+                    n < sizes.size()) {
                     unsigned bits = 0;
                     for (const auto* list : {&ctx.esi->rxpdos, &ctx.esi->txpdos})
                         for (const EsiPdo& p : *list)
@@ -557,7 +571,7 @@ void add_sii_tests(Catalogue& c) {
             std::string tgot, twant;
             for (std::size_t n = 0; n < ctx.esi->sms.size() && n < types.size(); ++n) {
                 const EsiSm& sm = ctx.esi->sms[n];
-                const std::string& t = sm.type;
+                const std::string t = sm_kind(sm);
                 int want_type = t == "MBoxOut"   ? 1
                                 : t == "MBoxIn"  ? 2
                                 : t == "Outputs" ? 3
@@ -578,9 +592,32 @@ void add_sii_tests(Catalogue& c) {
             CONFORM_NEED(ctx.need_esi());
             CONFORM_NEED(ctx.need_sii());
             std::string got, want;
+            std::vector<uint8_t> usages;
             if (const SiiCategory* f = ctx.sii->find(kFmmu))
                 for (uint8_t b : ctx.sii->data(*f))
-                    if (b != 0 && b != 0xFF) got += dec(b) + " ";
+                    if (b != 0 && b != 0xFF) {
+                        got += dec(b) + " ";
+                        usages.push_back(b);
+                    }
+            if (ctx.esi->fmmus.empty()) {
+                // The ESI declares no Fmmu (ETG.2000: optional; a master's export writes none): the SII's
+                // FMMU usage is the device's, and must fit its SMs: an FMMU for outputs, inputs or the
+                // mailbox state only where an Sm of that kind is (ETG.2010 FMMU category: 1 outputs,
+                // 2 inputs, 3 SyncM status).
+                bool out = false, in = false, mbox = false;
+                for (const EsiSm& s : ctx.esi->sms) {
+                    const std::string k = sm_kind(s);
+                    out = out || k == "Outputs";
+                    in = in || k == "Inputs";
+                    mbox = mbox || k == "MBoxIn";
+                }
+                for (uint8_t b : usages)
+                    if ((b == 1 && !out) || (b == 2 && !in) || (b == 3 && !mbox) || b > 3)
+                        return fail(
+                            "FMMU usage " + dec(b) + " without an Sm of that kind (the ESI declares no Fmmu)",
+                            got, "usages its Sms allow");
+                return pass("the ESI declares no Fmmu; the SII's usages fit its Sms", got);
+            }
             for (const auto& f : ctx.esi->fmmus)
                 want += (f == "Outputs" ? "1 " : f == "Inputs" ? "2 " : f == "MBoxState" ? "3 " : "? ");
             return expect_eq("FMMU usage", got, want);

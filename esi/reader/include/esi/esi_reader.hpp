@@ -147,7 +147,14 @@ struct EsiSlot {
     std::optional<uint32_t> default_module;      // ModuleIdent with Default="1"
     std::optional<uint32_t> pdo_increment, index_increment;  // SlotPdoIncrement / SlotIndexIncrement
     int line = 0;
+    // A Slot element stands for up to MaxInstances slots in a row (ETG.2000 SlotType; a coupler's one
+    // "Terminals" slot with MaxInstances 64 takes 64 modules): EsiDevice::slots holds one entry per slot,
+    // `instance` counting the entries of one element from 0 (the ESI written back has the element once).
+    uint32_t instance = 0;
 };
+
+// The most slots a device is given (ETG.5001.1: the module ident lists 0xF030/0xF050 have 254 entries).
+constexpr std::size_t kMaxSlots = 254;
 
 // Descriptions/Modules/Module: what a slot of a modular device can hold.
 struct EsiModule {
@@ -235,12 +242,25 @@ struct EsiDevice {
     uint16_t mailbox_protocols() const;
 };
 
+// An InfoReference of the file (ETG.2000 EtherCATInfo/InfoReference: another file that belongs to the
+// description; vendors of modular devices keep the modules the slots take in an EtherCATModule file named so,
+// e.g. "Modules\Io.xml") and what became of it. read_esi_file reads it relative to the ESI's directory
+// (docs/decisions/esi.md, "InfoReference").
+struct EsiInfoReference {
+    std::string reference;    // as written
+    int line = 0;             // of the InfoReference element
+    std::string resolved;     // the file read; empty if none was
+    std::size_t modules = 0;  // modules taken from it (a module the file has itself is not replaced)
+    std::string problem;      // why no module was taken; empty if the file was read
+};
+
 struct EsiFile {
     std::string source;  // the path (or name) messages give
     uint32_t vendor_id = 0;
     std::string vendor_name;
     std::vector<EsiDevice> devices;
-    std::vector<EsiModule> modules;  // Descriptions/Modules
+    std::vector<EsiModule> modules;  // Descriptions/Modules, then those of the files InfoReference names
+    std::vector<EsiInfoReference> info_references;
     const EsiModule* module(uint32_t ident) const;
 };
 

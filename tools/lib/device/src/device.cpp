@@ -162,6 +162,7 @@ struct Device::Parts {
     std::unique_ptr<ecat::Stack> stack;
     std::unique_ptr<coe::CoeServer> coe;
     std::unique_ptr<coe::DiagnosisHistory> diag;
+    std::string diag_unusable;  // why a product's 0x10F3 holds no history (empty: it does, or there is none)
     std::unique_ptr<coe::EventReporter> events;
     std::unique_ptr<drive::Drive> drive;
     std::unique_ptr<IoModel> io;  // a device without application
@@ -208,6 +209,11 @@ Device::Device(esc::Esc& esc, DeviceOptions options)
               << "); 0x6502 announces the others";
             warnings.push_back(w.str());
         }
+        if (parts_ && !parts_->diag_unusable.empty())
+            warnings.push_back(
+                parts_->diag_unusable +
+                " (ETG.1020 Diagnosis History): 0x10F3 serves the values the description gives, "
+                "without a diagnosis history");
         for (const std::string& w : warnings) {
             if (options_.events != nullptr)
                 event(slave::LogLevel::Warn, options_.product->source + ": " + w);
@@ -446,7 +452,11 @@ void Device::build() {
         p->coe = std::make_unique<coe::CoeServer>(
             p->dict, [raw] { return raw->stack->state(); }, coe_config);
         // The diagnosis history where the dictionary has its object (0x10F3, ETG.1020).
-        if (!options_.product || p->dict.find(0x10F3) != nullptr)
+        // A product whose 0x10F3 has no room for messages (a vendor ESI that declares :00..:05 only) serves
+        // the object as the values it declares, without a history: said once with the product's warnings.
+        if (options_.product && p->dict.find(0x10F3) != nullptr)
+            p->diag_unusable = coe::DiagnosisHistory::unusable(p->dict);
+        if (!options_.product || (p->dict.find(0x10F3) != nullptr && p->diag_unusable.empty()))
             p->diag = std::make_unique<coe::DiagnosisHistory>(p->dict, &p->coe->emergency());
         p->events = std::make_unique<coe::EventReporter>(p->coe->emergency(), p->diag.get(),
                                                          [this] { return system_time_ns(); });

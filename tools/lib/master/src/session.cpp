@@ -268,12 +268,24 @@ Error ProcessDataSession::configure(Slave& slave, const DcConfig& dc) {
         // is supported; 0x1C33:01 often follows 0x1C32:01) is refused with 0x06010002: the device runs the
         // one mode it has, and the state transition judges it, as for an absent object.
         const auto fixed = [sdo](Error e) { return e == Error::SdoAbort && sdo->last_abort() == 0x06010002; };
-        const uint8_t mode_out[2] = {static_cast<uint8_t>(dc.enable ? dc_mode : 1), 0};
+        // Without DC: synchronous with the SM event (1), unless 0x1C32:04 announces free run (bit 0) and not
+        // the SM-synchronous mode (bit 1; ETG.1020 supported synchronization types), as a coupler that runs
+        // free or in DC does (Weidmueller's UR20: 0x0005): then free run (0), which it takes.
+        bool free_run = false;
+        if (!dc.enable) {
+            uint8_t sup[2] = {};
+            if (auto n = sdo->upload(0x1C32, 4, sup); n && *n == 2 && (sup[0] & 0x03) == 0x01)
+                free_run = true;
+        }
+        const uint8_t sm_mode = free_run ? 0 : 1;
+        const uint8_t mode_out[2] = {static_cast<uint8_t>(dc.enable ? dc_mode : sm_mode), 0};
         if (Error e = sdo->download(0x1C32, 1, mode_out); e != Error::Ok && !absent(e) && !fixed(e)) return e;
-        const uint8_t mode_in[2] = {
-            static_cast<uint8_t>(dc.enable ? dc_mode : (layout.output_bytes() ? 0x22 : 1)), 0};
+        const uint8_t mode_in[2] = {static_cast<uint8_t>(dc.enable  ? dc_mode
+                                                         : free_run ? 0
+                                                                    : (layout.output_bytes() ? 0x22 : 1)),
+                                    0};
         if (Error e = sdo->download(0x1C33, 1, mode_in); e != Error::Ok && !absent(e) && !fixed(e)) {
-            const uint8_t plain[2] = {static_cast<uint8_t>(dc.enable ? dc_mode : 1), 0};
+            const uint8_t plain[2] = {static_cast<uint8_t>(dc.enable ? dc_mode : sm_mode), 0};
             if (sdo->download(0x1C33, 1, plain) != Error::Ok) return e;
         }
         if (dc.enable) {
