@@ -257,8 +257,9 @@ class Context {
     std::unique_ptr<master::Mailbox> mbx;
     std::unique_ptr<master::SdoClient> sdo;
     bool in_preop = false;  // set by to_preop, cleared by to_init
-    // A segmented transfer a test's own requests (sdo_raw) left open: ended after a failed test
-    // (end_open_sdo in sdo_util.hpp), so the next test's transfers are not refused for it.
+    // A segmented transfer a test's own requests (sdo_raw) left open: ended after every test, and by a test
+    // before its next request where it only wanted the first answer (end_open_sdo in sdo_util.hpp), so that
+    // no transfer starts while another is in progress.
     struct OpenSdo {
         uint16_t index = 0;
         uint8_t sub = 0;

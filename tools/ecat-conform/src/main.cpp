@@ -467,7 +467,9 @@ int main(int argc, char** argv) {
                         } catch (const std::exception& e) {
                             r.outcome = conform::fail(std::string("test aborted: ") + e.what());
                         }
-                        if (r.outcome.status == Status::Fail) conform::end_open_sdo(ctx);
+                        // A transfer a test's raw requests left open is ended whatever the test's outcome:
+                        // a master starts no new transfer while one is in progress (ETG.1000.6 SDO).
+                        conform::end_open_sdo(ctx);
                         if (m.stats().timeouts != unanswered) return "frames went unanswered during it";
                         if (const auto pause = ctx.pd_gap(); pause > kOwnPauseLimit)
                             return "this tool's process data paused " +

@@ -208,11 +208,12 @@ inline bool writable_in_preop(const EsiEntry& e) {
            (e.write_restrictions.empty() || e.write_restrictions.find("PreOP") != std::string::npos);
 }
 
-// After a failed test that left a segmented transfer open (track_sdo_transfer), the transfer is ended so
-// that the slave's next transfers are not refused because of this test's: an upload by requesting its
-// segments to the last (any server takes that), a download by an Abort SDO Transfer request (ETG.1000.6:
-// either side may abort; unconfirmed, code 0x08000000 general error; a made-up last segment would write
-// the entry). SM1 is emptied after.
+// A segmented transfer left open (track_sdo_transfer) is ended, after a test or by a test that only wanted
+// the first answer, so that the slave's next transfers do not meet this one (a master starts no transfer
+// while another is in progress, ETG.1000.6 SDO; an emulator was seen to stop serving): an upload by
+// requesting its segments to the last (any server takes that), a download by an Abort SDO Transfer request
+// (ETG.1000.6: either side may abort; unconfirmed, code 0x08000000 general error; a made-up last segment
+// would write the entry). SM1 is emptied after.
 inline void end_open_sdo(Context& ctx) {
     if (!ctx.sdo_open || !ctx.mbx) return;
     const Context::OpenSdo o = *ctx.sdo_open;
