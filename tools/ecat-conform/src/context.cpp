@@ -469,6 +469,27 @@ Error Context::ack_error() {
     }
 }
 
+bool Context::reached_despite_error(uint8_t want, master::AlStatus& st) {
+    if (!st.error || st.state != want) return false;
+    const master::AlStatus shown = st;
+    if (ack_error() != Error::Ok) return false;
+    auto s = m.read_reg<uint16_t>(addr, master::reg::AlStatus);
+    if (!s || (*s & 0x1F) != want) return false;
+    if (!(error_flag_noted & want)) {
+        error_flag_noted |= want;
+        notes.push_back("the slave showed " + state_text(want) +
+                        " with the error indication set (AL status " +
+                        hex(static_cast<uint16_t>(shown.state | 0x10)) + ", code " + hex(shown.code) +
+                        ") after it was requested; acknowledged, it stayed in " + state_text(want) +
+                        " and the tests that needed the state ran (the esm tests judge the indication)");
+    }
+    st.state = want;
+    st.error = false;
+    st.code = 0;
+    if (auto c = m.read_reg<uint16_t>(addr, master::reg::AlStatusCode)) st.code = *c;
+    return true;
+}
+
 Error Context::to_init() {
     in_preop = false;
     drop_pds();
@@ -536,6 +557,7 @@ Error Context::to_preop() {
         // A device without mailbox (no standard mailbox in the SII): INIT -> PREOP with no SM set up
         // (ETG.1000.6 ESM: the mailbox is checked only where the device has one).
         last_status = request_raw(0x02, ms(5000));
+        (void)reached_despite_error(0x02, last_status);
         if (last_status.state != 0x02 || last_status.error) {
             (void)ack_error();
             return Error::AlRefused;
@@ -546,6 +568,7 @@ Error Context::to_preop() {
     mbx = std::make_unique<master::Mailbox>(m, addr, ms(1000));
     if (Error e = mbx->configure_from_sii(); e != Error::Ok) return e;
     master::AlStatus st = request_raw(0x02, ms(5000));
+    (void)reached_despite_error(0x02, st);
     last_status = st;
     if (st.state != 0x02 || st.error) {
         (void)ack_error();
@@ -712,6 +735,7 @@ Error Context::to_safeop(const master::DcConfig& dc) {
     if (Error e = discover_pd(); e != Error::Ok) return e;
     if (Error e = configure_pd(dc); e != Error::Ok) return e;
     last_status = request_raw(0x04, ms(5000));
+    (void)reached_despite_error(0x04, last_status);
     if (last_status.state != 0x04 || last_status.error) {
         (void)ack_error();
         return Error::AlRefused;
@@ -725,7 +749,7 @@ Error Context::to_op() {
         if (Error e = to_safeop(); e != Error::Ok) return e;
     }
     master::AlStatus st;
-    Error e = request_op(st);
+    Error e = enter_op(st);
     last_status = st;
     return e;
 }
@@ -790,14 +814,19 @@ std::optional<master::DcConfig> Context::dc_only() {
     return r;
 }
 
-Error Context::request_op(master::AlStatus& st) {
+Error Context::request_op(master::AlStatus& st, const std::function<void()>& each_cycle) {
     if (!has_process_data()) {
         st = request_raw(0x08, ms(5000));
         if (st.state == 0x08 && !st.error) return Error::Ok;
         return st.error ? Error::AlRefused : Error::AlTimeout;
     }
     (void)cycle(3);
-    return pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st);
+    return pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st, each_cycle);
+}
+
+Error Context::enter_op(master::AlStatus& st, const std::function<void()>& each_cycle) {
+    const Error e = request_op(st, each_cycle);
+    return e == Error::AlRefused && reached_despite_error(0x08, st) ? Error::Ok : e;
 }
 
 Error Context::to_boot() {
@@ -805,6 +834,7 @@ Error Context::to_boot() {
     mbx = std::make_unique<master::Mailbox>(m, addr, ms(1000));
     if (Error e = mbx->configure_from_sii(true); e != Error::Ok) return e;
     last_status = request_raw(0x03, ms(5000));
+    (void)reached_despite_error(0x03, last_status);
     if (last_status.state != 0x03 || last_status.error) {
         (void)ack_error();
         return Error::AlRefused;

@@ -77,9 +77,7 @@ struct Drive {
         (void)ctx.cycle(3);
         hold();
         master::AlStatus st;
-        if (Error e = ctx.pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st,
-                                             [this] { hold(); });
-            e != Error::Ok)
+        if (Error e = ctx.enter_op(st, [this] { hold(); }); e != Error::Ok)
             return "cannot reach OP: " + err(e) + " (" + al_code_text(st.code) + ")";
         run(10);
         return {};
@@ -913,8 +911,7 @@ void add_cia402_tests(Catalogue& c) {
             const auto fault_emcy = drain_emergencies(ctx, d);
             auto sdo_fault = ctx.upload_uint(0x6041, 0);
             master::AlStatus st;
-            (void)ctx.pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st,
-                                         [&d] { d.hold(); });
+            (void)ctx.enter_op(st, [&d] { d.hold(); });
             (void)d.command(0x0000, kFault, 20);
             const bool ok = d.command(0x0080, kSod, 1000);
             // After the reset (no error left): the emergencies sent end with "error reset" (code 0x0000,

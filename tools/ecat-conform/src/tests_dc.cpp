@@ -124,7 +124,7 @@ Outcome dc_state(Context& ctx, bool op) {
     if (!op) return pass("SAFEOP in DC mode");
     (void)ctx.cycle(30);
     master::AlStatus st;
-    Error o = ctx.pds->request_state(master::AlState::Op, std::chrono::microseconds(1000), &st);
+    Error o = ctx.enter_op(st);
     std::string sync;
     uint64_t ref = 0;
     master::Result<uint64_t> direct = Error::Timeout;

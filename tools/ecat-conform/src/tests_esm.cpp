@@ -76,6 +76,11 @@ Outcome valid(Context& ctx, uint8_t from, uint8_t to) {
     const std::string want = state_text(to) + " code " + hex(0);
     if (st.state != to || st.error) {
         (void)ctx.ack_error();
+        if (st.state == to)
+            return fail(
+                "the state was reached but shown with the error indication (AL status bit 4 belongs to "
+                "a refused or left state)",
+                status_text(st), want);
         return fail("transition refused or not completed", status_text(st), want);
     }
     if (to == 1) ctx.in_preop = false;
