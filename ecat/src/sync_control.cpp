@@ -21,6 +21,30 @@ constexpr uint8_t kSiCycleExceeded = 0x0C;
 constexpr uint8_t kSiSyncError = 0x20;
 
 constexpr uint64_t kDefaultFreeRunCycleNs = 1'000'000;
+
+// Whether a synchronization type written to 0x1C32:01 / 0x1C33:01 may be taken, given the :04 announcement
+// (ETG.1020 Synchronization: bit 0 free run, bit 1 synchronous with the SM event, bit 2 DC SYNC0, bit 3 DC
+// SYNC1; 34, synchronous with the SM2 event, only for the inputs' 0x1C33). As the SSC's CheckSyncTypeValue:
+// free run is always taken (a device without it refuses it at Pre-Op -> Safe-Op, 0x0027); a type that is not
+// announced, or no type at all, is refused with abort 0x06090030. Unlike the SSC, SM-synchronous does not
+// depend on the outputs assigned so far: a master may write 0x1C32:01 before or after the PDO assignment.
+bool sync_type_taken(uint16_t index, uint64_t type, uint64_t supported) {
+    switch (type) {
+        case static_cast<uint16_t>(SyncMode::FreeRun):
+            return true;
+        case static_cast<uint16_t>(SyncMode::SmSync):
+            return supported & 0x0002;
+        case static_cast<uint16_t>(SyncMode::DcSync0):
+            return supported & 0x0004;
+        case static_cast<uint16_t>(SyncMode::DcSync1):
+            return supported & 0x0008;
+        case static_cast<uint16_t>(SyncMode::SmSync2):
+            return index == kSmInputParams && (supported & 0x0002);
+        default:
+            return false;
+    }
+}
+
 // 0x0984 bit 0: first SYNC0 pulse pending (ESC datasheet, Distributed Clocks, activation status).
 constexpr uint8_t kActFirstSync0Pending = 0x01;
 
@@ -71,6 +95,28 @@ void SyncControl::init_objects() {
     if (has_sm_type_object() && !desc.sync_managers.empty()) {
         for (std::size_t i = 0; i < desc.sync_managers.size() && i < 255; ++i)
             set_u(kSmType, static_cast<uint8_t>(i + 1), static_cast<uint8_t>(desc.sync_managers[i].kind));
+    }
+    // A synchronization type the device does not announce is refused when written (sync_type_taken) rather
+    // than taken and refused only at Pre-Op -> Safe-Op: the master learns which write was wrong. The
+    // announcement is the object's own :04, else 0x1C32:04, with the rule of configure() for a :04 without
+    // mode bits (free run, SM-synchronous and DC SYNC0).
+    for (const uint16_t index : {kSmOutputParams, kSmInputParams}) {
+        if (dict.find(index, kSiSyncMode) == nullptr) continue;
+        dict.add_validator(
+            index,
+            [this, index](const od::Entry& e, std::span<const uint8_t> v) {
+                if (e.subindex != kSiSyncMode || v.empty() || v.size() > 8) return od::Status::Ok;
+                uint64_t type = 0;
+                for (std::size_t i = 0; i < v.size(); ++i)
+                    type |= static_cast<uint64_t>(v[i]) << (8 * i);
+                const uint64_t outputs = get_u(kSmOutputParams, kSiSyncModesSupported, 0x0007);
+                uint64_t supported = index == kSmOutputParams
+                                         ? outputs
+                                         : get_u(kSmInputParams, kSiSyncModesSupported, outputs);
+                if ((supported & 0x000F) == 0) supported = 0x0007;
+                return sync_type_taken(index, type, supported) ? od::Status::Ok : od::Status::InvalidValue;
+            },
+            this);
     }
     // Notice master writes of the sync mode (SDO in Pre-Op), so Pre-Op -> Safe-Op can check them.
     if (dict.find(kSmOutputParams) != nullptr) {

@@ -390,15 +390,40 @@ TEST_F(Sync, SyncModesSupportedWithoutModeBits_SaysNothing) {
     EXPECT_EQ(stack->sync_mode(), SyncMode::DcSync0);
 }
 
-TEST_F(Sync, UnknownSyncMode_0x0028) {
-    ASSERT_NO_FATAL_FAILURE(preop_with_sync_mode(7));
-    expect_safeop_refused(0x0028);
+// A synchronization type written to 0x1C32:01 / 0x1C33:01 is refused when the device does not announce it in
+// :04 (abort 0x06090030), every type against every announcement: free run is always taken (as the SSC; a
+// device without it refuses Safe-Op, 0x0027, above), 34 (SM2 event) only by the inputs' 0x1C33, a value that
+// names no type never. What was refused leaves the entry as it was.
+TEST_F(Sync, SyncTypeWrite_TakenOnlyWhereAnnounced) {
+    go_preop();
+    const uint16_t types[] = {0, 1, 2, 3, 4, 7, 0x21, 0x22, 0xFFFF};
+    for (const uint16_t supported :
+         {0x0001, 0x0002, 0x0004, 0x0006, 0x0007, 0x0008, 0x000B, 0x000F, 0x400C}) {
+        ASSERT_EQ(dict.set<uint16_t>(0x1C32, 4, supported), od::Status::Ok);
+        ASSERT_EQ(dict.set<uint16_t>(0x1C33, 4, supported), od::Status::Ok);
+        for (const uint16_t index : {uint16_t{0x1C32}, uint16_t{0x1C33}}) {
+            for (const uint16_t type : types) {
+                const uint16_t before = u16(index, 1);
+                const bool announced = type == 0 || (type == 1 && (supported & 0x2)) ||
+                                       (type == 2 && (supported & 0x4)) || (type == 3 && (supported & 0x8)) ||
+                                       (type == 0x22 && index == 0x1C33 && (supported & 0x2));
+                const od::Status st = master_write16(index, 1, type);
+                EXPECT_EQ(st, announced ? od::Status::Ok : od::Status::InvalidValue)
+                    << std::hex << index << ":01 = " << type << " with :04 = " << supported;
+                EXPECT_EQ(u16(index, 1), announced ? type : before);
+            }
+        }
+    }
 }
 
-TEST_F(Sync, Dc_Sync1ModeNotSupported_0x0028) {
-    ASSERT_NO_FATAL_FAILURE(preop_with_sync_mode(3));
-    enable_dc(1'000'000, 0x07);
-    expect_safeop_refused(0x0028);  // 0x1C32:04 = 0x0006: no SYNC1 mode
+// A :04 without any mode bit announces every type but DC SYNC1, as configure() runs them (0x0400: an ESI's
+// DefaultData "0004" written big-endian).
+TEST_F(Sync, SyncTypeWrite_NoModeBitsTakesWhatRuns) {
+    go_preop();
+    ASSERT_EQ(dict.set<uint16_t>(0x1C32, 4, 0x0400), od::Status::Ok);
+    for (const uint16_t type : {0, 1, 2})
+        EXPECT_EQ(master_write16(0x1C32, 1, type), od::Status::Ok) << type;
+    EXPECT_EQ(master_write16(0x1C32, 1, 3), od::Status::InvalidValue);
 }
 
 // A device that announces DC SYNC1 but not SYNC0 (0x1C32:04 0x000B: free run, SM, SYNC1; Beckhoff's counter
