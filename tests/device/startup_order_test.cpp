@@ -73,8 +73,14 @@ enum class Encoding {
 };
 // When the process data is set up.
 enum class Phase { Init, PreOp };
-// In which order: sync type and assignment first, SMs before FMMUs, in SM order; or all of it reversed.
+// In which order: sync type and assignment first, SMs before FMMUs, in SM order, DC last; or all of it
+// reversed.
 enum class Order { Forward, Reversed };
+// Distributed clocks (ESC datasheet section I, DC; ETG.1020 DC start-up): none, or SYNC0 set up as SOEM does
+// (0x0981 cleared, the SYNC0 cycle 0x09A0, the 64-bit start time 0x0990, then 0x0981 = 3), as IgH does
+// (SYNC0 and SYNC1 cycles in one 8-byte write, the start time, then AssignActivate as one word at 0x0980), or
+// with the start time written before the cycle.
+enum class Dc { None, Soem, IghWord, StartFirst };
 
 struct Case {
     const char* file;
@@ -82,6 +88,7 @@ struct Case {
     Encoding encoding;
     Phase phase;
     Order order;
+    Dc dc = Dc::None;
 };
 
 void PrintTo(const Case& c, std::ostream* os) {
@@ -97,6 +104,8 @@ std::string name_of(const testing::TestParamInfo<Case>& info) {
     n += std::string("_") + enc[static_cast<int>(c.encoding)];
     n += c.phase == Phase::Init ? "_InInit" : "_InPreOp";
     n += c.order == Order::Forward ? "_Forward" : "_Reversed";
+    static const char* const dc[] = {"", "_DcSoem", "_DcIghWord", "_DcStartFirst"};
+    n += dc[static_cast<int>(c.dc)];
     return n;
 }
 
@@ -274,9 +283,11 @@ TEST_P(StartupOrder, ReachesOpWithTheExactWorkingCounter) {
     auto coe_writes = [&] {
         if (!coe) return;
         uint8_t sup[2] = {};
-        if (auto n = sdo.upload(0x1C32, 4, sup); n && *n == 2 && (sup[0] & 0x02)) {
-            const uint8_t one[2] = {1, 0};
-            EXPECT_EQ(sdo.download(0x1C32, 1, one), Error::Ok);
+        const uint8_t type = c.dc == Dc::None ? 1 : 2;  // SM-synchronous, or DC SYNC0
+        if (auto n = sdo.upload(0x1C32, 4, sup);
+            n && *n == 2 && (sup[0] & (c.dc == Dc::None ? 0x02 : 0x04))) {
+            const uint8_t v[2] = {type, 0};
+            EXPECT_EQ(sdo.download(0x1C32, 1, v), Error::Ok);
         }
         for (const bool outputs : {true, false}) {
             const uint16_t index = outputs ? 0x1C12 : 0x1C13;
@@ -291,15 +302,54 @@ TEST_P(StartupOrder, ReachesOpWithTheExactWorkingCounter) {
             EXPECT_EQ(sdo.download(index, 0, std::span<const uint8_t>(&count, 1)), Error::Ok);
         }
     };
+    // SYNC0 every millisecond from 2 ms after the system time read now.
+    auto dc_writes = [&] {
+        if (c.dc == Dc::None) return;
+        auto now = m.read_reg<uint64_t>(kSlave, reg::DcSystemTime);
+        ASSERT_TRUE(static_cast<bool>(now));
+        const uint64_t start = *now + 2'000'000;
+        uint8_t start_bytes[8], cycles[8] = {};
+        for (int i = 0; i < 8; ++i)
+            start_bytes[i] = static_cast<uint8_t>(start >> (8 * i));
+        const uint32_t cycle = 1'000'000;
+        for (int i = 0; i < 4; ++i)
+            cycles[i] = static_cast<uint8_t>(cycle >> (8 * i));
+        switch (c.dc) {
+            case Dc::Soem:
+                ASSERT_EQ(m.write_reg<uint8_t>(kSlave, 0x0981, 0), Error::Ok);
+                ASSERT_EQ(m.write(kSlave, 0x09A0, std::span<const uint8_t>(cycles, 4)), Error::Ok);
+                ASSERT_EQ(m.write(kSlave, 0x0990, start_bytes), Error::Ok);
+                ASSERT_EQ(m.write_reg<uint8_t>(kSlave, 0x0981, 0x03), Error::Ok);
+                break;
+            case Dc::IghWord:
+                ASSERT_EQ(m.write(kSlave, 0x09A0, cycles), Error::Ok);
+                ASSERT_EQ(m.write(kSlave, 0x0990, start_bytes), Error::Ok);
+                ASSERT_EQ(m.write_reg<uint16_t>(kSlave, 0x0980, 0x0300), Error::Ok);
+                break;
+            case Dc::StartFirst:
+                ASSERT_EQ(m.write(kSlave, 0x0990, start_bytes), Error::Ok);
+                ASSERT_EQ(m.write(kSlave, 0x09A0, std::span<const uint8_t>(cycles, 4)), Error::Ok);
+                ASSERT_EQ(m.write_reg<uint16_t>(kSlave, 0x0980, 0x0300), Error::Ok);
+                break;
+            case Dc::None:
+                break;
+        }
+    };
     if (c.phase == Phase::PreOp) {
         if (c.order == Order::Forward) {
             coe_writes();
             ASSERT_NO_FATAL_FAILURE(write_all(pd));
+            ASSERT_NO_FATAL_FAILURE(dc_writes());
         } else {
+            ASSERT_NO_FATAL_FAILURE(dc_writes());
             ASSERT_NO_FATAL_FAILURE(write_all(pd));
             coe_writes();
         }
+    } else if (c.order == Order::Forward) {
+        coe_writes();
+        ASSERT_NO_FATAL_FAILURE(dc_writes());
     } else {
+        ASSERT_NO_FATAL_FAILURE(dc_writes());
         coe_writes();
     }
 
@@ -329,6 +379,14 @@ TEST_P(StartupOrder, ReachesOpWithTheExactWorkingCounter) {
     EXPECT_FALSE(s->error) << "AL status code 0x" << std::hex << s->code;
     for (int i = 0; i < 5; ++i)
         EXPECT_EQ(lrw(), expected) << "in OP, cycle " << i;
+    if (c.dc != Dc::None) {
+        // What runs is DC SYNC0 (0x1C32:01 says what runs, ETG.1020), where the device has the object.
+        uint8_t mode[2] = {};
+        if (auto n = sdo.upload(0x1C32, 1, mode))
+            EXPECT_EQ(mode[0], 2);
+        else
+            EXPECT_EQ(sdo.last_abort(), 0x06020000u) << "0x1C32 neither read nor absent";
+    }
 }
 
 std::vector<Case> cases() {
@@ -345,6 +403,12 @@ std::vector<Case> cases() {
             for (const Phase p : {Phase::Init, Phase::PreOp})
                 for (const Order o : {Order::Forward, Order::Reversed})
                     r.push_back({file, spec, e, p, o});
+    // The DC devices with SYNC0 set up in each of the ways, in each phase and order.
+    for (const char* file : {"drive402.xml", "analog-in.xml"})
+        for (const Dc dc : {Dc::Soem, Dc::IghWord, Dc::StartFirst})
+            for (const Phase p : {Phase::Init, Phase::PreOp})
+                for (const Order o : {Order::Forward, Order::Reversed})
+                    r.push_back({file, "", Encoding::Block, p, o, dc});
     return r;
 }
 
