@@ -6,7 +6,9 @@
 // configuration written while deactivated, the activation taken with it or later) and ETG.1000.6 (ESM: the
 // process-data SMs and FMMUs are checked at PREOP -> SAFEOP) allow each of them, so the device must take
 // each: the class is every order, not the one the tests' master library happens to use. (Not legal, so not
-// tried: the activation byte before the configuration it enables, which the ESC then locks.)
+// tried: the activation byte before the configuration it enables, which the ESC then locks.) The DC devices
+// also set SYNC0 up in each way masters do (SOEM, IgH, the start time first), before or after the process
+// data and the sync type.
 #include <gtest/gtest.h>
 
 #include <algorithm>
