@@ -439,11 +439,15 @@ Drive::Drive(od::Dictionary& dictionary, EventSink* sink, const VendorObjects& v
 
     // A mode the drive does not implement, cannot serve, or the device does not announce in 0x6502 is refused
     // (IEC 61800-7-201: 0x6061 shows the mode the drive runs; an SDO write answers "value range exceeded").
+    // 0 is taken: "no mode change / no mode assigned" (IEC 61800-7-201 0x6060), the value a vendor's
+    // dictionary holds before a master chooses a mode; the drive keeps the mode it runs, as with 0 in the
+    // process data.
     if (dict_.find(obj::ModesOfOperation.index, obj::ModesOfOperation.sub)) {
         dict_.add_validator(
             obj::ModesOfOperation.index,
             [d = &dict_, served](const od::Entry& e, std::span<const uint8_t> v) {
-                if (e.subindex != obj::ModesOfOperation.sub || v.size() != 1) return od::Status::Ok;
+                if (e.subindex != obj::ModesOfOperation.sub || v.size() != 1 || v[0] == 0)
+                    return od::Status::Ok;
                 uint32_t announced = supported_drive_modes();
                 const od::Entry* sdm = d->find(obj::SupportedDriveModes.index, obj::SupportedDriveModes.sub);
                 if (sdm && sdm->byte_size() == 4)

@@ -190,6 +190,11 @@ TEST(Vendor402Modes, AnAnnouncedModeTheDictionaryCannotServeIsWithheld) {
     EXPECT_EQ(sdo_write(d, 0x6060, 0, 1, 1), od::Status::Ok);
     drv.cycle(0, 1'000'000);
     ASSERT_EQ(d.get<int8_t>(0x6061, 0), 1);
+    // 0, "no mode change" (IEC 61800-7-201), is taken and changes nothing: the value a vendor dictionary
+    // holds before a master chooses a mode can be written back.
+    EXPECT_EQ(sdo_write(d, 0x6060, 0, 0, 1), od::Status::Ok);
+    drv.cycle(500'000, 1'000'000);
+    EXPECT_EQ(d.get<int8_t>(0x6061, 0), 1);
     // Through process data (no SDO check) neither.
     d.set<int8_t>(0x6060, 0, 7);
     drv.cycle(1'000'000, 1'000'000);

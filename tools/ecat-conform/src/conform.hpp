@@ -268,6 +268,11 @@ class Context {
 
     std::unique_ptr<master::Mailbox> mbx;
     std::unique_ptr<master::SdoClient> sdo;
+    // Ends the SDO client (to_init, esc_reset), keeping its last abort and mailbox error for sdo_error().
+    void drop_sdo();
+    bool dropped = false;
+    uint32_t dropped_abort = 0;
+    uint16_t dropped_mailbox_error = 0;
     bool in_preop = false;  // set by to_preop, cleared by to_init
     // A segmented transfer a test's own requests (sdo_raw) left open: ended after every test, and by a test
     // before its next request where it only wanted the first answer (end_open_sdo in sdo_util.hpp), so that

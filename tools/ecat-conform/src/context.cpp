@@ -493,7 +493,7 @@ bool Context::reached_despite_error(uint8_t want, master::AlStatus& st) {
 Error Context::to_init() {
     in_preop = false;
     drop_pds();
-    sdo.reset();
+    drop_sdo();
     mbx.reset();
     const auto deadline = Clock::now() + ms(5000);
     // A slave that reached INIT but keeps its error indication through the acknowledge (a defect the esm
@@ -531,7 +531,7 @@ Error Context::to_init() {
 bool Context::esc_reset() {
     in_preop = false;
     drop_pds();
-    sdo.reset();
+    drop_sdo();
     mbx.reset();
     for (const uint8_t v : {uint8_t{0x52}, uint8_t{0x45}, uint8_t{0x53}})
         if (m.write_reg<uint8_t>(addr, esc::reg::kEscResetEcat, v) != Error::Ok) return false;
@@ -637,12 +637,24 @@ Error Context::coe_request(std::span<const uint8_t> coe, std::vector<uint8_t>& a
     }
 }
 
+void Context::drop_sdo() {
+    if (sdo) {
+        dropped_abort = sdo->last_abort();
+        dropped_mailbox_error = sdo->last_mailbox_error();
+        dropped = true;
+    }
+    sdo.reset();
+}
+
 std::string Context::sdo_error(Error e) const {
-    if (e == Error::SdoAbort && sdo)
-        return util::strprintf("SDO abort 0x%08x (%s)", sdo->last_abort(),
-                               std::string(master::sdo_abort_text(sdo->last_abort())).c_str());
-    if (e == Error::MailboxError && sdo)
-        return util::strprintf("mailbox error 0x%04x", sdo->last_mailbox_error());
+    // The client's last answer, or (a test that went back to INIT before reporting) the dropped client's.
+    const bool known = sdo || dropped;
+    const uint32_t abort = sdo ? sdo->last_abort() : dropped_abort;
+    const uint16_t mailbox_error = sdo ? sdo->last_mailbox_error() : dropped_mailbox_error;
+    if (e == Error::SdoAbort && known)
+        return util::strprintf("SDO abort 0x%08x (%s)", abort,
+                               std::string(master::sdo_abort_text(abort)).c_str());
+    if (e == Error::MailboxError && known) return util::strprintf("mailbox error 0x%04x", mailbox_error);
     return std::string(master::to_string(e));
 }
 
