@@ -16,6 +16,12 @@ namespace {
 // Building
 // ---------------------------------------------------------------------------------------------------
 
+// The strings category addresses its strings by one byte (ETG.2010: index 1-255, 0 none): a content that
+// needs more distinct strings is compacted as one that does not fit the EEPROM is (build_sii).
+struct TooManyStrings : std::length_error {
+    TooManyStrings() : std::length_error("SII: more than 255 distinct strings") {}
+};
+
 class StringTable {
   public:
     // 1-based index of the string (0 for the empty string). Equal strings share one index.
@@ -24,7 +30,7 @@ class StringTable {
         const std::string v = s.substr(0, 255);  // one length byte
         for (std::size_t i = 0; i < strings_.size(); ++i)
             if (strings_[i] == v) return static_cast<uint8_t>(i + 1);
-        if (strings_.size() >= 255) throw std::length_error("SII: more than 255 distinct strings");
+        if (strings_.size() >= 255) throw TooManyStrings();
         strings_.push_back(v);
         return static_cast<uint8_t>(strings_.size());
     }
@@ -209,7 +215,15 @@ std::vector<uint8_t> build_sii(const od::DeviceDescription& d, const od::Diction
     for (const Compaction level :
          {Compaction::None, Compaction::NoEntryNames, Compaction::NoPdoNames, Compaction::NoDcDescriptions,
           Compaction::DefaultPdosOnly, Compaction::NoPdos, Compaction::NameIsOrder}) {
-        std::vector<uint8_t> image = build_content(d, m, level);
+        std::vector<uint8_t> image;
+        try {
+            image = build_content(d, m, level);
+        } catch (const TooManyStrings&) {
+            // A device whose PDO entries, PDOs and op modes name more than 255 strings (a measurement
+            // module with hundreds of channel PDOs): the names go as the EEPROM's size would make them go.
+            if (level == kLastCompaction) throw;
+            continue;
+        }
         if (full == 0) full = image.size();
         if (image.size() <= d.eeprom_bytes) {
             image.resize(d.eeprom_bytes, 0xFF);
