@@ -60,6 +60,39 @@ struct Writer {
     }
 };
 
+// The data type of an SII PDO entry (ETG.2010 TXPDO/RXPDO entry): the mapped entry's, or, where a PDO maps
+// fewer bits than the entry has (a "compact" PDO mapping a 32-bit counter as 16 bits next to one that maps it
+// whole), the standard type of the mapped length in the entry's family, so that type and bit length agree as
+// the vendor's SII has them (its ESI's PDO entry DataType). 0 (none) for padding and lengths without a type.
+uint8_t entry_type_code(const PdoEntryInfo& e) {
+    if (e.entry == nullptr) return 0;
+    const uint16_t bits = od::bit_size(e.type);
+    if (bits == 0 || bits == e.bit_length) return static_cast<uint8_t>(e.type);
+    const bool s = od::is_signed(e.type);
+    od::DataType t{};
+    switch (e.bit_length) {
+        case 8:
+            t = s ? od::DataType::Integer8 : od::DataType::Unsigned8;
+            break;
+        case 16:
+            t = s ? od::DataType::Integer16 : od::DataType::Unsigned16;
+            break;
+        case 24:
+            t = s ? od::DataType::Integer24 : od::DataType::Unsigned24;
+            break;
+        case 32:
+            t = s ? od::DataType::Integer32 : od::DataType::Unsigned32;
+            break;
+        case 64:
+            t = s ? od::DataType::Integer64 : od::DataType::Unsigned64;
+            break;
+        default:
+            if (e.bit_length < 1 || e.bit_length > 7) return 0;
+            t = static_cast<od::DataType>(static_cast<uint16_t>(od::DataType::Bit1) + e.bit_length - 1);
+    }
+    return static_cast<uint8_t>(t);
+}
+
 // What the SII leaves out when the full content does not fit the EEPROM, in this order
 // (docs/decisions/esi.md): the categories a configuration tool needs stay (strings of the identity, General,
 // FMMU, SyncM, DC, the PDOs of the default assignment); names that the ESI and the CoE dictionary carry
@@ -145,7 +178,7 @@ std::vector<uint8_t> build_content(const od::DeviceDescription& d, const DeviceM
             w.u16(e.index);
             w.u8(e.subindex);
             w.u8(level >= Compaction::NoEntryNames ? 0 : strings.add(e.name));
-            w.u8(e.entry != nullptr ? static_cast<uint8_t>(e.type) : 0);
+            w.u8(entry_type_code(e));
             w.u8(e.bit_length);
             w.u16(0);
         }

@@ -2250,3 +2250,53 @@ TEST(EsiDevices, MoreNamesThanTheSiiStringsAddressAreLeftOutAsForASmallEeprom) {
     ASSERT_TRUE(sii.general);
     EXPECT_EQ(sii.general->order, "MM300");
 }
+
+// A PDO that maps fewer bits of an entry than the entry has (a "compact" PDO mapping a 32-bit counter value
+// as 16 bits, next to the PDO that maps it whole): the SII's PDO entry carries the type of the mapped length
+// in the entry's family (UINT for 16 bits of a UDINT), as the vendor's SII has it from the PDO entry's
+// DataType, never a type whose size contradicts the entry's bit length.
+TEST(EsiDevices, ACompactPdoEntryCarriesTheTypeOfItsMappedLengthInTheSii) {
+    TempDir t;
+    const std::string path = t.write(
+        "compact.xml",
+        wrap("<Device Physics=\"YY\"><Type ProductCode=\"#x79\" "
+             "RevisionNo=\"#x1\">ENC1</Type><Name>Encoder</Name>\n"
+             "<Profile><Dictionary><DataTypes>"
+             "<DataType><Name>USINT</Name><BitSize>8</BitSize></DataType>"
+             "<DataType><Name>UDINT</Name><BitSize>32</BitSize></DataType>"
+             "<DataType><Name>DT7000</Name><BitSize>48</BitSize>"
+             "<SubItem><SubIdx>0</SubIdx><Name>SubIndex 000</Name><Type>USINT</Type><BitSize>8</BitSize>"
+             "<BitOffs>0</BitOffs><Flags><Access>ro</Access></Flags></SubItem>"
+             "<SubItem><SubIdx>17</SubIdx><Name>Set counter "
+             "value</Name><Type>UDINT</Type><BitSize>32</BitSize>"
+             "<BitOffs>16</BitOffs><Flags><Access>ro</Access><PdoMapping>R</PdoMapping></Flags></SubItem>"
+             "</DataType></DataTypes><Objects>"
+             "<Object><Index>#x7000</Index><Name>ENC Outputs</Name><Type>DT7000</Type><BitSize>48</BitSize>"
+             "<Info><SubItem><Name>SubIndex 000</Name><Info><DefaultData>11</DefaultData></Info></SubItem>"
+             "</Info></Object></Objects></Dictionary></Profile>\n"
+             "<Sm StartAddress=\"#x1000\" ControlByte=\"#x64\" Enable=\"1\">Outputs</Sm>\n"
+             "<RxPdo Fixed=\"1\" Sm=\"0\"><Index>#x1600</Index><Name>ENC Control compact</Name>"
+             "<Entry><Index>#x7000</Index><SubIndex>17</SubIndex><BitLen>16</BitLen><Name>Set counter value"
+             "</Name><DataType>UINT</DataType></Entry></RxPdo>\n"
+             "<RxPdo Fixed=\"1\"><Index>#x1601</Index><Name>ENC Control</Name>"
+             "<Entry><Index>#x7000</Index><SubIndex>17</SubIndex><BitLen>32</BitLen><Name>Set counter value"
+             "</Name><DataType>UDINT</DataType></Entry></RxPdo>\n"
+             "</Device>"));
+    const od::Product p = esi::load_product(path, "");
+    const od::Dictionary dict = p.make_dictionary(p.description);
+    const esi::SiiInfo sii = esi::parse_sii(esi::build_sii(p.description, dict));
+    ASSERT_EQ(sii.rx_pdos.size(), 2u);
+    for (const esi::SiiPdo& x : sii.rx_pdos) {
+        ASSERT_EQ(x.entries.size(), 1u);
+        const esi::SiiPdoEntry& e = x.entries[0];
+        EXPECT_EQ(e.index, 0x7000);
+        EXPECT_EQ(e.subindex, 17);
+        if (x.index == 0x1600) {
+            EXPECT_EQ(e.bit_length, 16);
+            EXPECT_EQ(e.data_type, static_cast<uint8_t>(od::DataType::Unsigned16));
+        } else {
+            EXPECT_EQ(e.bit_length, 32);
+            EXPECT_EQ(e.data_type, static_cast<uint8_t>(od::DataType::Unsigned32));
+        }
+    }
+}
