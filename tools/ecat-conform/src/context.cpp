@@ -776,7 +776,7 @@ std::optional<master::DcConfig> Context::dc_only() {
             d.start_delay = std::chrono::milliseconds(20);
             d.assign_activate = (*v & 0x0004) ? 0x0300 : 0x0700;
             for (const auto& mode : esi->op_modes)
-                if (mode.assign_activate & 0x0300) {
+                if ((mode.assign_activate & 0x0300) == 0x0300) {  // cyclic unit and SYNC0 (0x0981 bits 0-1)
                     d.assign_activate = mode.assign_activate;
                     break;
                 }
