@@ -900,22 +900,23 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
         it = pdos.erase(it);
     }
     // A device PDO flagged OverwrittenByModule (ETG.2000 PdoType) whose index a configured module's PDO has:
-    // the module's PDO takes its place (an IO-Link master's port PDOs, replaced by the device's module).
-    // Without such a module the device's own PDO stays.
-    for (auto it = pdos.begin(); it != pdos.end();) {
-        const bool replaced =
-            it->module.empty() && it->esi->overwritten_by_module &&
-            std::any_of(pdos.begin(), pdos.end(), [&](const Pdo& q) {
-                return !q.module.empty() && q.index == it->index && q.esi->rx == it->esi->rx;
-            });
-        if (!replaced) {
-            ++it;
-            continue;
-        }
-        ctx.warn(it->esi->line, "PDO " + hex(it->index) +
-                                    " OverwrittenByModule: the PDO of that index of a configured module is "
-                                    "served in its place");
-        it = pdos.erase(it);
+    // the module's PDO takes its place, in its position among the device's PDOs (the order of the default
+    // assignment; an IO-Link master's port PDOs, replaced by the modules of its port slots). Without such a
+    // module the device's own PDO stays.
+    for (std::size_t i = 0; i < pdos.size(); ++i) {
+        if (!pdos[i].module.empty() || !pdos[i].esi->overwritten_by_module) continue;
+        const auto by = std::find_if(pdos.begin(), pdos.end(), [&](const Pdo& q) {
+            return !q.module.empty() && q.index == pdos[i].index && q.esi->rx == pdos[i].esi->rx;
+        });
+        if (by == pdos.end()) continue;
+        ctx.warn(pdos[i].esi->line, "PDO " + hex(pdos[i].index) +
+                                        " OverwrittenByModule: the PDO of that index of module " +
+                                        by->module + " is served in its place");
+        const std::size_t j = static_cast<std::size_t>(by - pdos.begin());
+        Pdo module_pdo = std::move(*by);
+        pdos.erase(by);
+        if (j < i) --i;
+        pdos[i] = std::move(module_pdo);
     }
     for (std::size_t i = 0; i < pdos.size(); ++i)
         for (std::size_t j = 0; j < i; ++j)
