@@ -670,8 +670,25 @@ std::string build_esi(const od::DeviceDescription& d, const od::Dictionary& dict
         attr(sm, "Enable", s.enable ? "1" : "0");
     }
     const std::set<uint16_t> in_slots = slot_pdos(d);
-    for (std::size_t i : m.pdo_order)
-        if (!in_slots.count(m.pdos[i].index)) pdo(device, m.pdos[i]);
+    for (std::size_t k = 0; k < m.pdo_order.size(); ++k) {
+        const PdoInfo& p = m.pdos[m.pdo_order[k]];
+        if (!in_slots.count(p.index)) {
+            pdo(device, p);
+            continue;
+        }
+        // A module's PDO served before one of the device's own of its direction stands in a device PDO's
+        // place (ETG.2000 OverwrittenByModule, as the vendor declared it): written as such a device PDO
+        // without entries, so that a re-read puts the module's PDO in the same place of the assignment.
+        const bool before_own = std::any_of(
+            m.pdo_order.begin() + static_cast<std::ptrdiff_t>(k) + 1, m.pdo_order.end(),
+            [&](std::size_t j) { return m.pdos[j].rx == p.rx && !in_slots.count(m.pdos[j].index); });
+        if (!before_own) continue;
+        xmlNodePtr n = child(device, p.rx ? "RxPdo" : "TxPdo");
+        if (p.sm >= 0) attr(n, "Sm", std::to_string(p.sm));
+        attr(n, "OverwrittenByModule", "true");
+        child(n, "Index", hex_index(p.index));
+        named(n, "Name", p.name);
+    }
 
     if (d.mailbox_protocols != 0) {
         namespace mp = od::mailbox_protocol;

@@ -338,6 +338,7 @@ void read_pdos(Node parent, const char* tag, bool rx, std::vector<EsiPdo>& out) 
         pdo.fixed = truthy(attr(p, "Fixed"));
         pdo.mandatory = truthy(attr(p, "Mandatory"));
         pdo.is_virtual = truthy(attr(p, "Virtual"));
+        pdo.overwritten_by_module = truthy(attr(p, "OverwrittenByModule"));
         pdo.name = name_text(p);
         pdo.line = line_of(p);
         for (Node x : children(p, "Exclude"))
@@ -367,6 +368,7 @@ EsiDevice read_device(Node dev, const TypeMap& types_in, uint32_t vendor, const 
     if (xmlHasProp(dev, reinterpret_cast<const xmlChar*>("Physics"))) d.physics = attr(dev, "Physics");
     Node type = child(dev, "Type");
     d.type_name = text(type);
+    d.has_product_code = !xml::trim(attr(type, "ProductCode")).empty();
     d.product_code = static_cast<uint32_t>(number(attr(type, "ProductCode")));
     d.revision = static_cast<uint32_t>(number(attr(type, "RevisionNo")));
     d.name = name_text(dev);

@@ -16,6 +16,12 @@ namespace {
 // Building
 // ---------------------------------------------------------------------------------------------------
 
+// The strings category addresses its strings by one byte (ETG.2010: index 1-255, 0 none): a content that
+// needs more distinct strings is compacted as one that does not fit the EEPROM is (build_sii).
+struct TooManyStrings : std::length_error {
+    TooManyStrings() : std::length_error("SII: more than 255 distinct strings") {}
+};
+
 class StringTable {
   public:
     // 1-based index of the string (0 for the empty string). Equal strings share one index.
@@ -24,7 +30,7 @@ class StringTable {
         const std::string v = s.substr(0, 255);  // one length byte
         for (std::size_t i = 0; i < strings_.size(); ++i)
             if (strings_[i] == v) return static_cast<uint8_t>(i + 1);
-        if (strings_.size() >= 255) throw std::length_error("SII: more than 255 distinct strings");
+        if (strings_.size() >= 255) throw TooManyStrings();
         strings_.push_back(v);
         return static_cast<uint8_t>(strings_.size());
     }
@@ -53,6 +59,39 @@ struct Writer {
         b.insert(b.end(), d.begin(), d.end());
     }
 };
+
+// The data type of an SII PDO entry (ETG.2010 TXPDO/RXPDO entry): the mapped entry's, or, where a PDO maps
+// fewer bits than the entry has (a "compact" PDO mapping a 32-bit counter as 16 bits next to one that maps it
+// whole), the standard type of the mapped length in the entry's family, so that type and bit length agree as
+// the vendor's SII has them (its ESI's PDO entry DataType). 0 (none) for padding and lengths without a type.
+uint8_t entry_type_code(const PdoEntryInfo& e) {
+    if (e.entry == nullptr) return 0;
+    const uint16_t bits = od::bit_size(e.type);
+    if (bits == 0 || bits == e.bit_length) return static_cast<uint8_t>(e.type);
+    const bool s = od::is_signed(e.type);
+    od::DataType t{};
+    switch (e.bit_length) {
+        case 8:
+            t = s ? od::DataType::Integer8 : od::DataType::Unsigned8;
+            break;
+        case 16:
+            t = s ? od::DataType::Integer16 : od::DataType::Unsigned16;
+            break;
+        case 24:
+            t = s ? od::DataType::Integer24 : od::DataType::Unsigned24;
+            break;
+        case 32:
+            t = s ? od::DataType::Integer32 : od::DataType::Unsigned32;
+            break;
+        case 64:
+            t = s ? od::DataType::Integer64 : od::DataType::Unsigned64;
+            break;
+        default:
+            if (e.bit_length < 1 || e.bit_length > 7) return 0;
+            t = static_cast<od::DataType>(static_cast<uint16_t>(od::DataType::Bit1) + e.bit_length - 1);
+    }
+    return static_cast<uint8_t>(t);
+}
 
 // What the SII leaves out when the full content does not fit the EEPROM, in this order
 // (docs/decisions/esi.md): the categories a configuration tool needs stay (strings of the identity, General,
@@ -139,7 +178,7 @@ std::vector<uint8_t> build_content(const od::DeviceDescription& d, const DeviceM
             w.u16(e.index);
             w.u8(e.subindex);
             w.u8(level >= Compaction::NoEntryNames ? 0 : strings.add(e.name));
-            w.u8(e.entry != nullptr ? static_cast<uint8_t>(e.type) : 0);
+            w.u8(entry_type_code(e));
             w.u8(e.bit_length);
             w.u16(0);
         }
@@ -209,7 +248,15 @@ std::vector<uint8_t> build_sii(const od::DeviceDescription& d, const od::Diction
     for (const Compaction level :
          {Compaction::None, Compaction::NoEntryNames, Compaction::NoPdoNames, Compaction::NoDcDescriptions,
           Compaction::DefaultPdosOnly, Compaction::NoPdos, Compaction::NameIsOrder}) {
-        std::vector<uint8_t> image = build_content(d, m, level);
+        std::vector<uint8_t> image;
+        try {
+            image = build_content(d, m, level);
+        } catch (const TooManyStrings&) {
+            // A device whose PDO entries, PDOs and op modes name more than 255 strings (a measurement
+            // module with hundreds of channel PDOs): the names go as the EEPROM's size would make them go.
+            if (level == kLastCompaction) throw;
+            continue;
+        }
         if (full == 0) full = image.size();
         if (image.size() <= d.eeprom_bytes) {
             image.resize(d.eeprom_bytes, 0xFF);

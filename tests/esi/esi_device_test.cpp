@@ -1634,6 +1634,29 @@ TEST(EsiBadInput, APhysicsThatIsNotAPortListIsRefusedWithItsLine) {
     }
 }
 
+// A device whose Type has no ProductCode (ETG.2000 leaves it optional) has no ESC: a passive terminal of an
+// E-Bus station, as vendors' system-terminal files list them next to their active devices (end, shield and
+// potential feed terminals). It is refused by name and line, never served as product 0; the file's other
+// devices load, and the listing says which devices are passive.
+TEST(EsiBadInput, ADeviceWithoutProductCodeIsRefusedWithItsLineAndTheOthersLoad) {
+    TempDir t;
+    const std::string path = t.write(
+        "passive.xml", wrap("<Device Physics=\"KK\" Invisible=\"1\"><Type>PT9010</Type>"
+                            "<Name>End terminal</Name></Device>\n"
+                            "<Device Physics=\"KK\"><Type ProductCode=\"\" RevisionNo=\"#x1\">PT9011</Type>"
+                            "<Name>Shield terminal</Name></Device>\n"
+                            "<Device Physics=\"KK\"><Type ProductCode=\"#x2332\" RevisionNo=\"#x10\">"
+                            "PT9110</Type><Name>Power feed with diagnostics</Name></Device>"));
+    expect_input_error(path, "PT9010", 5, "has no ProductCode");
+    expect_input_error(path, "PT9011", 6, "without an EtherCAT slave controller");
+    const od::Product p = esi::load_product(path, "PT9110");
+    EXPECT_EQ(p.description.identity.product_code, 0x2332u);
+    const auto listing = esi::list_devices(esi::read_esi_file(path));
+    ASSERT_EQ(listing.size(), 3u);
+    EXPECT_NE(listing[0].find("no ProductCode"), std::string::npos) << listing[0];
+    EXPECT_EQ(listing[2].find("no ProductCode"), std::string::npos) << listing[2];
+}
+
 TEST(EsiBadInput, NotAnEtherCATInfo) {
     TempDir t;
     expect_input_error(
@@ -2144,4 +2167,149 @@ TEST(EsiSlots, ASlotWithMaxInstancesStandsForThatManySlotsInARow) {
     std::string huge = kTerminalBusEsi;
     huge.replace(huge.find("MaxInstances=\"8\""), 16, "MaxInstances=\"1000\"");
     EXPECT_EQ(esi::read_esi_text(huge, "huge.xml").devices[0].slots.size(), esi::kMaxSlots);
+}
+
+// ---- Vendor round 8 forms -------------------------------------------------------------------------------
+
+// A device PDO flagged OverwrittenByModule (ETG.2000 PdoType), as an IO-Link master box declares its port
+// PDOs: the module configured in the slot brings a PDO of the same index, which takes the device's place (it
+// was refused as "declared twice"). With the slot left empty the device's own PDO is served.
+TEST(EsiDevices, APdoOverwrittenByModuleGivesWayToTheConfiguredModulesPdo) {
+    TempDir t;
+    const std::string path =
+        t.write("iolm.xml",
+                wrap("<Device Physics=\"YY\"><Type ProductCode=\"#x77\" RevisionNo=\"#x1\">IOLM4</Type>"
+                     "<Name>IO-Link master</Name>\n"
+                     "<Sm StartAddress=\"#x1100\" ControlByte=\"#x20\" Enable=\"1\">Inputs</Sm>\n"
+                     "<TxPdo Mandatory=\"1\" Sm=\"0\" OverwrittenByModule=\"1\"><Index>#x1a01</Index>"
+                     "<Name>Port 1 inputs</Name></TxPdo>\n"
+                     "<TxPdo Fixed=\"1\" Mandatory=\"1\" Sm=\"0\"><Index>#x1a00</Index><Name>Status</Name>"
+                     "<Entry><Index>#x6000</Index><SubIndex>1</SubIndex><BitLen>16</BitLen><Name>State</Name>"
+                     "<DataType>UINT</DataType></Entry></TxPdo>\n"
+                     "<Slots><Slot MinInstances=\"0\" MaxInstances=\"1\"><Name>Port 1</Name>"
+                     "<ModuleIdent Default=\"1\">#x10</ModuleIdent></Slot></Slots>\n"
+                     "</Device>",
+                     "<Modules><Module><Type ModuleIdent=\"#x10\">PORT-IN2</Type><Name>Two input bytes</Name>"
+                     "<TxPdo Fixed=\"1\" Sm=\"0\"><Index>#x1a01</Index><Name>Port 1 process data</Name>"
+                     "<Entry><Index>#x6010</Index><SubIndex>1</SubIndex><BitLen>16</BitLen><Name>Data</Name>"
+                     "<DataType>UINT</DataType></Entry></TxPdo></Module></Modules>"));
+    auto pdo = [](const od::Product& p, uint16_t index) -> esi::PdoInfo {
+        const od::Dictionary dict = p.make_dictionary(p.description);
+        for (const esi::PdoInfo& x : esi::derive_model(p.description, dict).pdos)
+            if (x.index == index) return x;
+        ADD_FAILURE() << "no PDO " << index;
+        return {};
+    };
+    const od::Product p = esi::load_product(path, "");
+    const esi::PdoInfo port = pdo(p, 0x1A01);
+    ASSERT_EQ(port.entries.size(), 1u);
+    EXPECT_EQ(port.entries[0].index, 0x6010);
+    EXPECT_EQ(port.sm, 0);
+    EXPECT_EQ(pdo(p, 0x1A00).entries.size(), 1u);
+    EXPECT_TRUE(any_warning(p, "OverwrittenByModule")) << ::testing::PrintToString(p.warnings);
+    // In the device PDO's place: the default assignment keeps the device's order (port PDO first).
+    {
+        const od::Dictionary dict = p.make_dictionary(p.description);
+        const esi::DeviceModel m = esi::derive_model(p.description, dict);
+        std::vector<uint16_t> order;
+        for (std::size_t i : m.pdo_order)
+            if (m.pdos[i].sm == 0) order.push_back(m.pdos[i].index);
+        EXPECT_EQ(order, (std::vector<uint16_t>{0x1A01, 0x1A00}));
+    }
+    // Written back: the module's PDO goes with its module, and the device's place for it is written as a
+    // device PDO without entries flagged OverwrittenByModule, so the re-read assigns it in the same place.
+    std::string xml;
+    const od::Product q = round_trip(p, &xml);
+    EXPECT_NE(xml.find("OverwrittenByModule=\"true\""), std::string::npos);
+    EXPECT_EQ(describe(q), describe(p));
+    // No module in the slot: the device's own (empty) port PDO.
+    const od::Product empty = esi::load_product(path, "IOLM4@-");
+    EXPECT_TRUE(pdo(empty, 0x1A01).entries.empty());
+}
+
+// More distinct names than the SII's strings category can address (one index byte, ETG.2010): a measurement
+// module whose PDO entries name hundreds of channels. The names go as they go for an EEPROM that is too
+// small (PDO entry names first); the device loads, every PDO is in the SII (it was refused: "no SII can be
+// built for this device: more than 255 distinct strings").
+TEST(EsiDevices, MoreNamesThanTheSiiStringsAddressAreLeftOutAsForASmallEeprom) {
+    std::string pdos;
+    for (int p = 0; p < 2; ++p) {
+        pdos += "<TxPdo Fixed=\"1\" Sm=\"0\"><Index>#x1a0" + std::to_string(p) + "</Index><Name>Channels " +
+                std::to_string(p) + "</Name>";
+        for (int e = 1; e <= 150; ++e)
+            pdos += "<Entry><Index>#x60" + std::to_string(p) + "0</Index><SubIndex>" + std::to_string(e) +
+                    "</SubIndex><BitLen>8</BitLen><Name>Channel " + std::to_string(p * 150 + e) +
+                    "</Name><DataType>USINT</DataType></Entry>";
+        pdos += "</TxPdo>\n";
+    }
+    TempDir t;
+    const std::string path = t.write(
+        "many.xml", wrap("<Device Physics=\"YY\"><Type ProductCode=\"#x78\" RevisionNo=\"#x1\">MM300</Type>"
+                         "<Name>Measurement module</Name>\n"
+                         "<Sm StartAddress=\"#x1100\" ControlByte=\"#x20\" Enable=\"1\">Inputs</Sm>\n" +
+                         pdos + "<Eeprom><ByteSize>32768</ByteSize></Eeprom></Device>"));
+    const od::Product p = esi::load_product(path, "");
+    const od::Dictionary dict = p.make_dictionary(p.description);
+    const esi::SiiInfo sii =
+        esi::parse_sii(p.eeprom.empty() ? esi::build_sii(p.description, dict) : p.eeprom);
+    EXPECT_TRUE(sii.crc_ok);
+    ASSERT_EQ(sii.tx_pdos.size(), 2u);
+    for (const esi::SiiPdo& x : sii.tx_pdos) {
+        EXPECT_EQ(x.entries.size(), 150u);
+        EXPECT_NE(x.name_idx, 0);  // the PDO names stay
+        for (const esi::SiiPdoEntry& e : x.entries)
+            EXPECT_EQ(e.name_idx, 0);
+    }
+    ASSERT_TRUE(sii.general);
+    EXPECT_EQ(sii.general->order, "MM300");
+}
+
+// A PDO that maps fewer bits of an entry than the entry has (a "compact" PDO mapping a 32-bit counter value
+// as 16 bits, next to the PDO that maps it whole): the SII's PDO entry carries the type of the mapped length
+// in the entry's family (UINT for 16 bits of a UDINT), as the vendor's SII has it from the PDO entry's
+// DataType, never a type whose size contradicts the entry's bit length.
+TEST(EsiDevices, ACompactPdoEntryCarriesTheTypeOfItsMappedLengthInTheSii) {
+    TempDir t;
+    const std::string path = t.write(
+        "compact.xml",
+        wrap("<Device Physics=\"YY\"><Type ProductCode=\"#x79\" "
+             "RevisionNo=\"#x1\">ENC1</Type><Name>Encoder</Name>\n"
+             "<Profile><Dictionary><DataTypes>"
+             "<DataType><Name>USINT</Name><BitSize>8</BitSize></DataType>"
+             "<DataType><Name>UDINT</Name><BitSize>32</BitSize></DataType>"
+             "<DataType><Name>DT7000</Name><BitSize>48</BitSize>"
+             "<SubItem><SubIdx>0</SubIdx><Name>SubIndex 000</Name><Type>USINT</Type><BitSize>8</BitSize>"
+             "<BitOffs>0</BitOffs><Flags><Access>ro</Access></Flags></SubItem>"
+             "<SubItem><SubIdx>17</SubIdx><Name>Set counter "
+             "value</Name><Type>UDINT</Type><BitSize>32</BitSize>"
+             "<BitOffs>16</BitOffs><Flags><Access>ro</Access><PdoMapping>R</PdoMapping></Flags></SubItem>"
+             "</DataType></DataTypes><Objects>"
+             "<Object><Index>#x7000</Index><Name>ENC Outputs</Name><Type>DT7000</Type><BitSize>48</BitSize>"
+             "<Info><SubItem><Name>SubIndex 000</Name><Info><DefaultData>11</DefaultData></Info></SubItem>"
+             "</Info></Object></Objects></Dictionary></Profile>\n"
+             "<Sm StartAddress=\"#x1000\" ControlByte=\"#x64\" Enable=\"1\">Outputs</Sm>\n"
+             "<RxPdo Fixed=\"1\" Sm=\"0\"><Index>#x1600</Index><Name>ENC Control compact</Name>"
+             "<Entry><Index>#x7000</Index><SubIndex>17</SubIndex><BitLen>16</BitLen><Name>Set counter value"
+             "</Name><DataType>UINT</DataType></Entry></RxPdo>\n"
+             "<RxPdo Fixed=\"1\"><Index>#x1601</Index><Name>ENC Control</Name>"
+             "<Entry><Index>#x7000</Index><SubIndex>17</SubIndex><BitLen>32</BitLen><Name>Set counter value"
+             "</Name><DataType>UDINT</DataType></Entry></RxPdo>\n"
+             "</Device>"));
+    const od::Product p = esi::load_product(path, "");
+    const od::Dictionary dict = p.make_dictionary(p.description);
+    const esi::SiiInfo sii = esi::parse_sii(esi::build_sii(p.description, dict));
+    ASSERT_EQ(sii.rx_pdos.size(), 2u);
+    for (const esi::SiiPdo& x : sii.rx_pdos) {
+        ASSERT_EQ(x.entries.size(), 1u);
+        const esi::SiiPdoEntry& e = x.entries[0];
+        EXPECT_EQ(e.index, 0x7000);
+        EXPECT_EQ(e.subindex, 17);
+        if (x.index == 0x1600) {
+            EXPECT_EQ(e.bit_length, 16);
+            EXPECT_EQ(e.data_type, static_cast<uint8_t>(od::DataType::Unsigned16));
+        } else {
+            EXPECT_EQ(e.bit_length, 32);
+            EXPECT_EQ(e.data_type, static_cast<uint8_t>(od::DataType::Unsigned32));
+        }
+    }
 }

@@ -483,7 +483,8 @@ struct Pdo {
 std::vector<std::string> list_devices(const EsiFile& file) {
     std::vector<std::string> out;
     for (const EsiDevice& d : file.devices)
-        out.push_back(d.type_name + " " + hex(d.product_code, 8) + ":" + hex(d.revision, 8) + " " + d.name);
+        out.push_back(d.type_name + " " + hex(d.product_code, 8) + ":" + hex(d.revision, 8) + " " + d.name +
+                      (d.has_product_code ? "" : " (no ProductCode: no EtherCAT slave controller)"));
     return out;
 }
 
@@ -552,6 +553,13 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d) {
 od::Product load_product(const EsiFile& file, const EsiDevice& d,
                          const std::vector<std::optional<uint32_t>>& modules) {
     Ctx ctx{file.source, {}};
+    // ETG.2000 leaves Type/@ProductCode optional for a device without an ESC (a passive terminal: Beckhoff's
+    // end, shield and potential feed terminals). A master never sees one on the wire (it has no registers,
+    // no SII, no identity), so there is nothing to serve: refused, not served as product 0.
+    if (!d.has_product_code)
+        ctx.fail(d.line, "device " + d.type_name +
+                             " has no ProductCode: a device without an EtherCAT slave controller (a passive "
+                             "terminal) is not on the wire and cannot be served");
     od::Product product;
     product.source = file.source + ", device " + d.type_name + " rev " + hex(d.revision, 8);
     od::DeviceDescription desc;
@@ -890,6 +898,25 @@ od::Product load_product(const EsiFile& file, const EsiDevice& d,
         ctx.warn(it->esi->line,
                  "PDO " + hex(it->index) + " Virtual has the index of a PDO that is not: left out");
         it = pdos.erase(it);
+    }
+    // A device PDO flagged OverwrittenByModule (ETG.2000 PdoType) whose index a configured module's PDO has:
+    // the module's PDO takes its place, in its position among the device's PDOs (the order of the default
+    // assignment; an IO-Link master's port PDOs, replaced by the modules of its port slots). Without such a
+    // module the device's own PDO stays.
+    for (std::size_t i = 0; i < pdos.size(); ++i) {
+        if (!pdos[i].module.empty() || !pdos[i].esi->overwritten_by_module) continue;
+        const auto by = std::find_if(pdos.begin(), pdos.end(), [&](const Pdo& q) {
+            return !q.module.empty() && q.index == pdos[i].index && q.esi->rx == pdos[i].esi->rx;
+        });
+        if (by == pdos.end()) continue;
+        ctx.warn(pdos[i].esi->line, "PDO " + hex(pdos[i].index) +
+                                        " OverwrittenByModule: the PDO of that index of module " +
+                                        by->module + " is served in its place");
+        const std::size_t j = static_cast<std::size_t>(by - pdos.begin());
+        Pdo module_pdo = std::move(*by);
+        pdos.erase(by);
+        if (j < i) --i;
+        pdos[i] = std::move(module_pdo);
     }
     for (std::size_t i = 0; i < pdos.size(); ++i)
         for (std::size_t j = 0; j < i; ++j)

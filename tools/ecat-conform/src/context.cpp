@@ -167,8 +167,19 @@ EsiDevice as_configured(const EsiFile& f, EsiDevice d, std::set<uint16_t>& mappi
             p.entries = sp.entries;
             if (!d.objects.count(p.index) && !sm.module->objects.count(p.index))
                 mapping_objects.insert(p.index);
+            // A device PDO flagged OverwrittenByModule (ETG.2000 PdoType) of this index gives way to the
+            // module's, in its place in the device's assignment (as the slave serves it: an IO-Link master's
+            // port PDOs).
+            std::vector<EsiPdo>& own = p.rx ? d.rxpdos : d.txpdos;
+            const auto replaced = std::find_if(own.begin(), own.end(), [&p](const EsiPdo& x) {
+                return x.overwritten_by_module && x.index == p.index;
+            });
+            if (replaced != own.end()) {
+                *replaced = std::move(p);
+                continue;
+            }
             if (p.sm >= 0) assign_by_default(d, p);
-            (p.rx ? d.rxpdos : d.txpdos).push_back(std::move(p));
+            own.push_back(std::move(p));
         }
         for (const esi::SlotObject& o : sm.objects)
             if (!d.objects.count(o.index)) {
@@ -812,7 +823,7 @@ std::optional<master::DcConfig> Context::dc_only() {
             d.start_delay = std::chrono::milliseconds(20);
             d.assign_activate = (*v & 0x0004) ? 0x0300 : 0x0700;
             for (const auto& mode : esi->op_modes)
-                if (mode.assign_activate & 0x0300) {
+                if ((mode.assign_activate & 0x0300) == 0x0300) {  // cyclic unit and SYNC0 (0x0981 bits 0-1)
                     d.assign_activate = mode.assign_activate;
                     break;
                 }

@@ -19,11 +19,31 @@ master::Result<uint64_t> rd64(Context& ctx, uint16_t reg) {
     return ctx.rd<uint64_t>(reg);
 }
 
+// An op mode generates SYNC0 when its AssignActivate switches on the cyclic unit and SYNC0 (0x0981 bits 0 and
+// 1: 0x0300 in the word). One that switches on the cyclic unit alone (0x0120, 0x0130: 0x0981 = 0x01, the
+// latch units assigned) uses DC for latches or time stamps only and runs free or SM-synchronous.
+bool generates_sync0(uint16_t assign_activate) {
+    return (assign_activate & 0x0300) == 0x0300;
+}
+
 uint16_t dc_assign(const Context& ctx) {
     if (ctx.esi)
         for (const auto& m : ctx.esi->op_modes)
-            if (m.assign_activate & 0x0300) return m.assign_activate;
+            if (generates_sync0(m.assign_activate)) return m.assign_activate;
     return 0x0300;
+}
+
+// The SYNC0 tests judge the device in the ESI's SYNC0 op mode: an ESI whose Dc/OpMode list has none (only
+// free run, or Beckhoff's "DCLATCH" with AssignActivate 0x0120) offers no such mode to a configuration tool
+// (ETG.2000 Dc/OpMode), and its 0x1C32:04 rightly announces none.
+std::string need_sync0_op_mode(const Context& ctx) {
+    if (!ctx.esi || ctx.esi->op_modes.empty()) return {};
+    std::string modes;
+    for (const auto& m : ctx.esi->op_modes) {
+        if (generates_sync0(m.assign_activate)) return {};
+        modes += (modes.empty() ? "" : ", ") + m.name + " " + hex(m.assign_activate);
+    }
+    return "no op mode of the ESI generates SYNC0 (AssignActivate " + modes + ")";
 }
 
 // The sync manager parameter object of the outputs (0x1C32) or the inputs (0x1C33) is there for an SM that
@@ -107,6 +127,7 @@ std::string sync_objects_running(Context& ctx) {
 
 Outcome dc_state(Context& ctx, bool op) {
     CONFORM_NEED(ctx.need_dc());
+    CONFORM_NEED(need_sync0_op_mode(ctx));
     CONFORM_NEED(ctx.need_coe());
     master::DcConfig dc;
     dc.enable = true;
@@ -174,6 +195,7 @@ bool sync_code(uint16_t code) {
 // SM watchdog's 0x001B or another situation's. The slave is taken back to INIT, SYNC0 off.
 Outcome sync0_missing(Context& ctx, bool stop) {
     CONFORM_NEED(ctx.need_dc());
+    CONFORM_NEED(need_sync0_op_mode(ctx));
     CONFORM_NEED(ctx.need_coe());
     CONFORM_NEED(ctx.need_state_machine());
     if (stop && !ctx.opt.allow_fault)
@@ -643,6 +665,7 @@ void add_dc_tests(Catalogue& c) {
         "sync_modes.1c32", "0x1C32:04 announces DC SYNC0 (bit 2) when the ESI has a SYNC0 op mode", kSync,
         [](Context& ctx) {
             CONFORM_NEED(need_sync_object(ctx, 0x1C32));
+            CONFORM_NEED(need_sync0_op_mode(ctx));
             CONFORM_PREOP(ctx);
             auto v = ctx.upload_uint(0x1C32, 4);
             if (!v) return fail("0x1C32:04: " + ctx.sdo_error(v.error()));

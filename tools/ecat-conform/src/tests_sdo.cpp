@@ -234,6 +234,20 @@ Outcome refused_pdo_write(Context& ctx, uint16_t index, uint32_t value, uint8_t 
     return pass(what + ": refused at PREOP -> SAFEOP", err(e));
 }
 
+// An ESI that announces PdoAssign but declares the SM's assignment object read-only (Beckhoff's EKM1101:
+// 0x1C12 "ro", its one RxPDO fixed): the assignment cannot be written whatever PdoAssign says, and
+// od.read_only judges that a write is refused. "" when the ESI lets the assignment be written.
+std::string need_assign_writable(const Context& ctx, uint16_t index) {
+    if (!ctx.esi) return {};
+    const EsiObject* o = ctx.esi->object(index);
+    if (!o) return {};
+    for (uint8_t sub : {uint8_t{0}, uint8_t{1}})
+        if (const EsiEntry* e = o->entry(sub); e && e->access == "ro")
+            return "the ESI declares " + hex(index) + ":" + hex(sub, 2) +
+                   " read-only (od.read_only checks that a write is refused)";
+    return {};
+}
+
 }  // namespace
 
 void add_sdo_tests(Catalogue& c) {
@@ -1008,6 +1022,7 @@ void add_sdo_tests(Catalogue& c) {
             CONFORM_NEED(ctx.need_complete_access());
             CONFORM_NEED(ctx.need_esi());
             if (!ctx.esi->coe.pdo_assign) return skip("the ESI does not announce PdoAssign");
+            CONFORM_NEED(need_assign_writable(ctx, 0x1C12));
             CONFORM_PREOP(ctx);
             auto ca = ctx.upload(0x1C12, 0, true);
             if (!ca) return fail("complete access upload: " + ctx.sdo_error(ca.error()));
@@ -1048,6 +1063,7 @@ void add_sdo_tests(Catalogue& c) {
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_esi());
             if (!ctx.esi->coe.pdo_assign) return skip("the ESI does not announce PdoAssign");
+            CONFORM_NEED(need_assign_writable(ctx, 0x1C12));
             CONFORM_PREOP(ctx);
             // Only the subindices the assignment has are read: an empty one (no outputs) may have
             // subindex 0 alone (ETG.1000.6 PDO assignment: subindices 1..n exist up to the maximum).
@@ -1137,6 +1153,7 @@ void add_sdo_tests(Catalogue& c) {
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_esi());
             if (!ctx.esi->coe.pdo_assign) return skip("the ESI does not announce PdoAssign");
+            CONFORM_NEED(need_assign_writable(ctx, 0x1C12));
             CONFORM_PREOP(ctx);
             uint16_t none = 0;
             for (uint16_t i = 0x17FF; i >= 0x1600 && !none; --i) {

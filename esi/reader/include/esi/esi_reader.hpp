@@ -112,6 +112,9 @@ struct EsiPdo {
     std::vector<EsiPdoEntry> entries;
     bool is_virtual = false;      // Virtual attribute
     bool depend_on_slot = false;  // Index DependOnSlot
+    // OverwrittenByModule (ETG.2000 PdoType): a module of the configuration may bring a PDO of this index,
+    // which then takes this one's place.
+    bool overwritten_by_module = false;
     int line = 0;
     unsigned bits() const;
 };
@@ -194,6 +197,10 @@ struct EsiDevice {
     std::string vendor_name;
     uint32_t product_code = 0;
     uint32_t revision = 0;
+    // Type/@ProductCode is optional in ETG.2000: a device without one has no EtherCAT slave controller (a
+    // passive terminal of an E-Bus station: end, shield, potential feed terminals). Nothing of it is on the
+    // wire, so it cannot be served (load_product refuses it, naming its line).
+    bool has_product_code = true;
     std::string type_name;  // <Type> text (order number)
     std::vector<EsiPdoSet> pdo_sets;
     std::string name;  // Name with LcId 1033 (English) if given, else the first Name
