@@ -109,7 +109,8 @@ void SyncControl::init_objects() {
                 uint64_t type = 0;
                 for (std::size_t i = 0; i < v.size(); ++i)
                     type |= static_cast<uint64_t>(v[i]) << (8 * i);
-                const uint64_t outputs = get_u(kSmOutputParams, kSiSyncModesSupported, 0x0007);
+                const uint64_t outputs = get_u(kSmOutputParams, kSiSyncModesSupported,
+                                               get_u(kSmInputParams, kSiSyncModesSupported, 0x0007));
                 uint64_t supported = index == kSmOutputParams
                                          ? outputs
                                          : get_u(kSmInputParams, kSiSyncModesSupported, outputs);
@@ -147,7 +148,9 @@ uint16_t SyncControl::configure() {
     // A 0x1C32:04 without any mode bit (bits 0-3: free run, SM, DC SYNC0/SYNC1) states no mode: 0, as
     // SOES-based devices' ESIs declare it, or 0x0400, an Inovance ESI's "0004" written big-endian (its device
     // runs DC). Such a device runs in every mode, as if the entry were absent.
-    uint16_t supported = static_cast<uint16_t>(get_u(kSmOutputParams, kSiSyncModesSupported, 0x0007));
+    // The announcement is 0x1C32:04, else (a device with inputs only has 0x1C33 alone) 0x1C33:04.
+    uint16_t supported = static_cast<uint16_t>(
+        get_u(kSmOutputParams, kSiSyncModesSupported, get_u(kSmInputParams, kSiSyncModesSupported, 0x0007)));
     if ((supported & 0x000F) == 0) supported = 0x0007;
     const uint32_t min_cycle = static_cast<uint32_t>(get_u(kSmOutputParams, kSiMinCycleTime, 0));
     const bool cyclic = activation & esc::reg::kDcActCyclic;

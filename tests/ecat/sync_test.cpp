@@ -416,6 +416,25 @@ TEST_F(Sync, SyncTypeWrite_TakenOnlyWhereAnnounced) {
     }
 }
 
+// A device with inputs only has 0x1C33 alone (ETG.1020): its 0x1C33:04 is the announcement. Free run only
+// (0x8001, as Beckhoff's inputs-only system terminals declare): 1 is refused when written, and the device
+// runs free, not SM-synchronous, at PREOP -> SAFEOP.
+TEST_F(Sync, InputsOnlyDevice_0x1C33AnnouncesItsTypes) {
+    od::Dictionary inputs_only;
+    for (const od::Object& o : dict.objects())
+        if (o.index != 0x1C32) inputs_only.add(o);
+    dict = std::move(inputs_only);
+    ASSERT_EQ(dict.set<uint16_t>(0x1C33, 4, 0x8001), od::Status::Ok);
+    start();
+    go_preop();
+    EXPECT_EQ(master_write16(0x1C33, 1, 1), od::Status::InvalidValue);
+    EXPECT_EQ(master_write16(0x1C33, 1, 0), od::Status::Ok);
+    configure_process_data(6, 6);
+    request(0x04);
+    ASSERT_EQ(al_status(), 0x04) << std::hex << al_code();
+    EXPECT_EQ(stack->sync_mode(), SyncMode::FreeRun);
+}
+
 // A :04 without any mode bit announces every type but DC SYNC1, as configure() runs them (0x0400: an ESI's
 // DefaultData "0004" written big-endian).
 TEST_F(Sync, SyncTypeWrite_NoModeBitsTakesWhatRuns) {

@@ -329,5 +329,8 @@ std::string hex(uint64_t v, int digits = 4);
 std::string bytes_hex(std::span<const uint8_t> b, std::size_t max = 32);
 std::string al_code_text(uint16_t code);
 std::string state_text(uint8_t s);
+// Why the SYNC0 tests cannot run ("" if they can): the ESI lists op modes and none generates SYNC0
+// (tests_dc.cpp).
+std::string need_sync0_op_mode(const Context& ctx);
 
 }  // namespace conform

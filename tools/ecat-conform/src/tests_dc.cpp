@@ -33,6 +33,8 @@ uint16_t dc_assign(const Context& ctx) {
     return 0x0300;
 }
 
+}  // namespace
+
 // The SYNC0 tests judge the device in the ESI's SYNC0 op mode: an ESI whose Dc/OpMode list has none (only
 // free run, or Beckhoff's "DCLATCH" with AssignActivate 0x0120) offers no such mode to a configuration tool
 // (ETG.2000 Dc/OpMode), and its 0x1C32:04 rightly announces none.
@@ -45,6 +47,8 @@ std::string need_sync0_op_mode(const Context& ctx) {
     }
     return "no op mode of the ESI generates SYNC0 (AssignActivate " + modes + ")";
 }
+
+namespace {
 
 // The sync manager parameter object of the outputs (0x1C32) or the inputs (0x1C33) is there for an SM that
 // carries process data (ETG.1020 synchronisation: 0x1C32 describes the outputs SM, 0x1C33 the inputs SM): a
@@ -695,6 +699,7 @@ void add_dc_tests(Catalogue& c) {
         [](Context& ctx) {
             CONFORM_NEED(need_sync_object(ctx, 0x1C32));
             CONFORM_NEED(need_writable(ctx, 0x1C32, 1));
+            CONFORM_NEED(need_sync0_op_mode(ctx));  // a device without a SYNC0 mode rightly refuses 2
             CONFORM_PREOP(ctx);
             auto old = ctx.upload_uint(0x1C32, 1);
             if (Error e = ctx.download_uint(0x1C32, 1, 2, 2); e != Error::Ok)
@@ -792,6 +797,7 @@ void add_dc_tests(Catalogue& c) {
         [](Context& ctx) {
             CONFORM_NEED(need_sync_object(ctx, 0x1C33));
             CONFORM_NEED(need_writable(ctx, 0x1C33, 1));
+            CONFORM_NEED(need_sync0_op_mode(ctx));  // a device without a SYNC0 mode rightly refuses 2
             CONFORM_PREOP(ctx);
             auto old = ctx.upload_uint(0x1C33, 1);
             Error e = ctx.download_uint(0x1C33, 1, 2, 2);

@@ -200,6 +200,7 @@ bool sync_refusal_code(uint16_t code, bool watchdog) {
 Outcome sync_setting(Context& ctx, uint16_t assign_activate, uint32_t cycle, bool short_watchdog,
                      const std::string& what) {
     CONFORM_NEED(ctx.need_dc());
+    CONFORM_NEED(need_sync0_op_mode(ctx));  // DC SYNC settings of a device that has a SYNC0 mode
     CONFORM_NEED(ctx.need_pd_layout());
     CONFORM_NEED(ctx.need_state_machine());
     if (Error e = ctx.to_preop(); e != Error::Ok) return fail("cannot reach PREOP", err(e));

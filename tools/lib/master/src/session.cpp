@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <iterator>
+#include <optional>
 #include <thread>
 #include <utility>
 
@@ -256,37 +257,48 @@ Error ProcessDataSession::configure(Slave& slave, const DcConfig& dc) {
             return e == Error::SdoAbort &&
                    (sdo->last_abort() == 0x06020000 || sdo->last_abort() == 0x06090011);
         };
+        // A sync mode the device declares read-only (ETG.1020: RW only if more than one synchronisation type
+        // is supported; 0x1C33:01 often follows 0x1C32:01) is refused with 0x06010002: the device runs the
+        // one mode it has, and the state transition judges it, as for an absent object.
+        const auto fixed = [sdo](Error e) { return e == Error::SdoAbort && sdo->last_abort() == 0x06010002; };
+        // A type the device does not announce in :04 may be refused at the write with 0x06090030 (value range
+        // exceeded, as the SSC's CheckSyncTypeValue does): the device then runs the mode its SMs and 0x0981
+        // give, and PREOP -> SAFEOP judges that, as for a read-only sync type.
+        const auto not_taken = [sdo, &fixed](Error e) {
+            return fixed(e) || (e == Error::SdoAbort && sdo->last_abort() == 0x06090030);
+        };
+        // The supported types: 0x1C32:04, else (a device with inputs only) 0x1C33:04.
+        const auto supported = [sdo]() -> std::optional<uint8_t> {
+            uint8_t sup[2] = {};
+            for (const uint16_t index : {uint16_t{0x1C32}, uint16_t{0x1C33}})
+                if (auto n = sdo->upload(index, 4, sup); n && *n == 2) return sup[0];
+            return std::nullopt;
+        };
         // DC SYNC1 (3) for an op mode that activates SYNC1 on a device that announces DC SYNC1 but not SYNC0
         // (0x1C32:04 bit 3 without bit 2, ETG.1020: Beckhoff's EL15xx/EJ7xxx op modes with AssignActivate
         // 0x0700), else DC SYNC0 (2).
         uint8_t dc_mode = 2;
         if (dc.enable && (dc.assign_activate & 0x0400)) {
-            uint8_t sup[2] = {};
-            if (auto n = sdo->upload(0x1C32, 4, sup); n && *n == 2 && (sup[0] & 0x0C) == 0x08) dc_mode = 3;
+            if (auto sup = supported(); sup && (*sup & 0x0C) == 0x08) dc_mode = 3;
         }
-        // A sync mode the device declares read-only (ETG.1020: RW only if more than one synchronisation type
-        // is supported; 0x1C33:01 often follows 0x1C32:01) is refused with 0x06010002: the device runs the
-        // one mode it has, and the state transition judges it, as for an absent object.
-        const auto fixed = [sdo](Error e) { return e == Error::SdoAbort && sdo->last_abort() == 0x06010002; };
         // Without DC: synchronous with the SM event (1), unless 0x1C32:04 announces free run (bit 0) and not
         // the SM-synchronous mode (bit 1; ETG.1020 supported synchronization types), as a coupler that runs
         // free or in DC does (Weidmueller's UR20: 0x0005): then free run (0), which it takes.
         bool free_run = false;
         if (!dc.enable) {
-            uint8_t sup[2] = {};
-            if (auto n = sdo->upload(0x1C32, 4, sup); n && *n == 2 && (sup[0] & 0x03) == 0x01)
-                free_run = true;
+            if (auto sup = supported(); sup && (*sup & 0x03) == 0x01) free_run = true;
         }
         const uint8_t sm_mode = free_run ? 0 : 1;
         const uint8_t mode_out[2] = {static_cast<uint8_t>(dc.enable ? dc_mode : sm_mode), 0};
-        if (Error e = sdo->download(0x1C32, 1, mode_out); e != Error::Ok && !absent(e) && !fixed(e)) return e;
+        if (Error e = sdo->download(0x1C32, 1, mode_out); e != Error::Ok && !absent(e) && !not_taken(e))
+            return e;
         const uint8_t mode_in[2] = {static_cast<uint8_t>(dc.enable  ? dc_mode
                                                          : free_run ? 0
                                                                     : (layout.output_bytes() ? 0x22 : 1)),
                                     0};
         if (Error e = sdo->download(0x1C33, 1, mode_in); e != Error::Ok && !absent(e) && !fixed(e)) {
             const uint8_t plain[2] = {static_cast<uint8_t>(dc.enable ? dc_mode : sm_mode), 0};
-            if (sdo->download(0x1C33, 1, plain) != Error::Ok) return e;
+            if (Error e2 = sdo->download(0x1C33, 1, plain); e2 != Error::Ok && !not_taken(e2)) return e;
         }
         if (dc.enable) {
             uint8_t cyc[4];
