@@ -3156,21 +3156,6 @@ def eeprom_command_kept(st, d):
             d.put(0x0502, v | (cmd << 8))
 
 
-def sync1_status_ghost(st, d):
-    """SYNC1 status 0x098F bit 0 set while SYNC1 is not activated (0x0981 bit 2 as the master wrote it)."""
-    if d.covers(0x098F, 1) and not st.mem[0x0981] & 0x04:
-        d.put(0x098F, d.get(0x098F, 1) | 0x01, 1)
-
-
-def receive_time_free_running(st, d):
-    """Receive time port 0 (0x0900) latched on every frame, not only on a write to 0x0900: reads after the
-    first since the last latch show a later time."""
-    if d.cmd in WRITES and d.wkc and d.ado <= 0x0900 < d.ado + d.n:
-        st.scratch["rt-reads"] = 0
-    if d.covers(0x0900, 4):
-        k = st.scratch["rt-reads"] = st.scratch.get("rt-reads", 0) + 1
-        if k > 1:
-            d.put(0x0900, d.get(0x0900, 4) + 40 * (k - 1), 4)
 
 
 def ecat_event_al_status_lost(st, d):
@@ -3181,7 +3166,7 @@ def ecat_event_al_status_lost(st, d):
 
 def op_lost_after_cycles(st, d):
     """OP left for SAFEOP + error (0x001B) after 200 process data cycles although the master keeps cycling (a
-    watchdog that counts too fast), until the master writes AL control."""
+    watchdog that counts too fast; 20 cycles), until the master writes AL control."""
     if _al_control_written(d) is not None:
         st.scratch["opn"] = 0
         st.scratch.pop("op-lost", None)
@@ -3192,7 +3177,7 @@ def op_lost_after_cycles(st, d):
             st.scratch.pop("op-lost", None)
     if d.cmd in (LRD, LRW, LWR) and d.wkc and st.scratch.get("al-real", 0) & 0x0F == 8:
         st.scratch["opn"] = st.scratch.get("opn", 0) + 1
-        if st.scratch["opn"] >= 200:
+        if st.scratch["opn"] >= 20:
             st.scratch["op-lost"] = True
     if st.scratch.get("op-lost"):
         if d.covers(0x0130):
@@ -3289,17 +3274,6 @@ def segment_after_last_answered(st, m):
     return m
 
 
-def sm_event_missed_counting(st, m):
-    """0x1C32:0B / 0x1C33:0B (SM event missed counter) count up on every read of a clean run."""
-    svc, _ = coe(m)
-    if svc != 3 or len(m) < 16 or not is_expedited_upload(m[8]) or m[11] not in (0x0B, 0x0C):
-        return None
-    if struct.unpack_from("<H", m, 9)[0] not in (0x1C32, 0x1C33):
-        return None
-    k = st.scratch["missed"] = st.scratch.get("missed", 0) + 1
-    struct.pack_into("<H", m, 12, struct.unpack_from("<H", m, 12)[0] + k)
-    return m
-
 
 def od_list_duplicate(st, m):
     """SDO information: the list of all objects (type 1) names its first object a second time at its end."""
@@ -3369,13 +3343,6 @@ def default_outside_range(st, m):
     return m
 
 
-def foe_packet_high_word(m):
-    """FoE data packets: the packet number's upper 16 bits not cleared (a 16-bit number and a reserved word
-    left as it was)."""
-    if m[6] == 3:
-        n = struct.unpack_from("<I", m, 8)[0]
-        struct.pack_into("<I", m, 8, (n & 0xFFFF) | (n & 0xFFFF) << 16)
-
 
 def foe_error_zero(m):
     """FoE error requests with error code 0 (no code set)."""
@@ -3443,13 +3410,6 @@ def sii_end_missing(st, d):
             d.put(0x0508 + 2 * i, 0)
 
 
-def sm0_write_full_counted(st, d):
-    """A write to the mailbox SM0 while it is full (ESC: not taken, working counter 0) answered with working
-    counter 1, though the data were dropped."""
-    s0 = st.sm_start(0)
-    if d.cmd in (FPWR, APWR) and s0 >= 0x1000 and d.ado == s0 and d.wkc == 0:
-        d.wkc = 1
-
 
 def readonly_id_write_kept(st, d):
     """Writes to the ESC's read-only identity registers 0x0000-0x000F (type, revision, build, counts, RAM size,
@@ -3464,20 +3424,6 @@ def readonly_id_write_kept(st, d):
             if d.ado <= a < d.ado + d.n:
                 d.put(a, v, 1)
 
-
-def logical_unmapped_counted(st, d):
-    """A logical datagram that addresses no byte of any active FMMU answered with working counter 1 (ESC
-    datasheet: only an FMMU match counts)."""
-    if d.cmd not in (LRD, LWR, LRW) or d.wkc != 0:
-        return
-    laddr = d.adp | (d.ado << 16)
-    for k in range(16):
-        f = 0x0600 + 16 * k
-        if st.mem[f + 12] & 1:
-            la, ln = st.reg(f, 4), st.reg(f + 4)
-            if la < laddr + d.n and laddr < la + ln:
-                return
-    d.wkc = 1
 
 
 def rxpdo_category_as_txpdo(st, d):
@@ -3498,29 +3444,106 @@ def _bytes_reversed(st, m):
     m[12:16] = bytes(reversed(m[12:16]))
 
 
+def eeprom_address_with_command_late(st, d):
+    """SII reads started by one write of command and address together (0x0502-0x0507, the order a master may
+    use): the slave runs the command before it takes the new address, so the data are those of the address
+    written before."""
+    if d.cmd in WRITES and d.wkc and d.ado <= 0x0502 and 0x0506 <= d.ado + d.n:
+        st.scratch["ee-combined"] = True
+    elif d.cmd in WRITES and d.wkc and d.ado <= 0x0502 < d.ado + d.n:
+        st.scratch["ee-combined"] = False
+    if not d.covers(0x0508, 4):
+        return
+    n = min(d.ado + d.n, 0x0510) - 0x0508
+    now = bytes(d.buf[d.d0 + 0x0508 - d.ado:d.d0 + 0x0508 - d.ado + n])
+    a = st.reg(0x0504, 4)
+    prev = st.scratch.get("ee-prev")
+    if st.scratch.get("ee-combined") and prev is not None and prev[0] != a and len(prev[1]) >= n:
+        d.buf[d.d0 + 0x0508 - d.ado:d.d0 + 0x0508 - d.ado + n] = prev[1][:n]
+    if prev is None or prev[0] != a:
+        st.scratch["ee-prev"] = (a, now)
+
+
+def sii_string_nul_padded(st, d):
+    """SII strings category: the first string's last character read as NUL (a fixed-width field padded with
+    NULs, counted in the length)."""
+    r = sii_first_category(st, d, 10)
+    if r is None:
+        return
+    a, n, w = r
+    words = st.scratch["sii-words"]
+    if w + 2 not in words:
+        return
+    length = words[w + 2] >> 8  # data byte 1: the first string's length
+    if length < 2:
+        return
+    off = 1 + length  # its last character
+    target = w + 2 + off // 2
+    if a <= target < a + n // 2:
+        reg = 0x0508 + 2 * (target - a) + off % 2
+        d.put(reg, 0, 1)
+
+
+def diag_param_count(m, at):
+    """Diagnosis message flags bits 8-15: one parameter more than the message carries."""
+    f = struct.unpack_from("<H", m, at + 4)[0]
+    struct.pack_into("<H", m, at + 4, (f & 0x00FF) | ((((f >> 8) + 1) & 0xFF) << 8))
+
+
+def diag_code_swapped(m, at):
+    """Emergency-derived diagnosis codes (0xE800 with the error code in the upper word) with the halves
+    swapped."""
+    c = struct.unpack_from("<I", m, at)[0]
+    if c & 0xFFFF == 0xE800:
+        struct.pack_into("<I", m, at, (c >> 16) | (c & 0xFFFF) << 16)
+
+
+
+
+def assign_subindex_refused(st, m):
+    """Downloads to the PDO assignment 0x1C12/0x1C13 subindex by subindex (not complete access) aborted with
+    0x06010000: the slave takes the assignment only by complete access."""
+    svc, _ = coe(m)
+    t, req = st.request_coe()
+    if svc != 3 or t != 3 or len(req) < 6 or m[8] != 0x60:
+        return None
+    if (req[2] & 0xE0) != 0x20 or req[2] & 0x10:
+        return None
+    if struct.unpack_from("<H", req, 3)[0] not in (0x1C12, 0x1C13):
+        return None
+    m[7] = (m[7] & 0x0F) | 0x20
+    m[8] = 0x80
+    struct.pack_into("<I", m, 12, 0x06010000)
+    return m
+
+
+def string_entry_length_over(st, m):
+    """SDO information entry descriptions of VISIBLE_STRING entries (data type 9) one character longer than the
+    string the object holds."""
+    svc, _ = coe(m)
+    if svc != 8 or len(m) < 20 or (m[8] & 0x7F) != 0x06 or struct.unpack_from("<H", m, 16)[0] != 0x0009:
+        return None
+    struct.pack_into("<H", m, 18, struct.unpack_from("<H", m, 18)[0] + 8)
+    return m
+
+
+def _u32_to(value):
+    def fn(st, m):
+        struct.pack_into("<I", m, 12, value)
+
+    return fn
+
+
 UNSEEN8 = {
     # -- ESC registers --
     "esc-eeprom-command-kept": _m("ESC datasheet 0x0502 bits 8-10 command: self-clearing, 0 once the command is "
                                   "done (busy bit 15 clear)", eeprom_command_kept),
     "esc-ecat-event-al-status-lost": _m("ESC datasheet 0x0210 ECAT event request bit 3: AL status event, set when AL "
                                         "status changed, cleared by reading 0x0130", ecat_event_al_status_lost),
-    "esc-sm0-write-full-counted": _m("ESC datasheet mailbox SM: a write to a full mailbox buffer is not taken and "
-                                     "not counted (working counter 0)", sm0_write_full_counted),
     # -- DC --
-    "dc-filter-depth-reset": _m("ESC datasheet 0x0934/0x0935 system time difference / speed counter filter depth: "
-                                "4 and 12 after reset, read/write", reg_rewriter(0x0934, lambda v, st: 0)),
-    "dc-latch-control-readback": _m("ESC datasheet 0x09A8 latch0 control (bit 0 positive edge single/continuous): "
-                                    "reads back as written", reg_rewriter(0x09A8, lambda v, st: v ^ 0x01, 1)),
-    "dc-cyclic-unit-control-readback": _m("ESC datasheet 0x0980 cyclic unit control: bit 0 (SYNC out unit owned by "
-                                          "EtherCAT 0 / PDI 1) reads back as written",
-                                          reg_rewriter(0x0980, lambda v, st: v ^ 0x01, 1)),
-    "dc-sync1-status-ghost": _m("ESC datasheet 0x098F SYNC1 status: 0 while SYNC1 is not activated (0x0981 bit 2)",
-                                sync1_status_ghost),
-    "dc-receive-time-free-running": _m("ESC datasheet 0x0900 receive time port 0: latched by a write to 0x0900 only, "
-                                       "the same on every read until the next latch", receive_time_free_running),
     # -- ESM --
     "esm-op-lost-after-cycles": _m("ETG.1000.6 ESM / ESC datasheet SM watchdog: OP kept while the master writes "
-                                   "the outputs in time (no 0x001B after 200 cycles)", op_lost_after_cycles),
+                                   "the outputs in time (no 0x001B after 20 cycles)", op_lost_after_cycles),
     "esm-invalid-transition-accepted": _m("ETG.1000.6 ESM state transitions: INIT -> SAFEOP/OP and PREOP -> OP are "
                                           "refused (error, 0x0011), not done", invalid_transition_accepted),
     "esm-error-cleared-without-ack": _m("ETG.1000.6 AL status error indication: reset only by a request with the "
@@ -3535,8 +3558,6 @@ UNSEEN8 = {
     "sdo-segment-after-last-answered": _m("ETG.1000.6/CiA 301 upload segment request without a segmented upload in "
                                           "progress: Abort 0x05040001, no segment",
                                           mbx_rewriter(segment_after_last_answered)),
-    "sync-sm-event-missed-counting": _m("ETG.1020 0x1C32/0x1C33:0B SM event missed counter and :0C cycle time too "
-                                        "small: 0 while no event is missed", mbx_rewriter(sm_event_missed_counting)),
     # -- SDO information --
     "info-list-duplicate-object": _m("ETG.1000.6 SDO information OD list: each object once",
                                      mbx_rewriter(od_list_duplicate)),
@@ -3545,8 +3566,6 @@ UNSEEN8 = {
     "info-entry-default-outside-range": _m("ETG.1000.6 SDO information entry description: the default value lies "
                                            "within minimum and maximum", mbx_rewriter(default_outside_range)),
     # -- FoE --
-    "foe-packet-number-high-word": _m("ETG.1000.6 FoE data: packet number is UDINT (upper 16 bits 0 for the "
-                                      "first 65535 packets)", foe_rewriter(foe_packet_high_word)),
     "foe-error-code-zero": _m("ETG.1000.6 FoE error request: an error code (0x8000-0x800F or vendor), not 0",
                               foe_rewriter(foe_error_zero)),
     # -- CiA 402 --
@@ -3572,8 +3591,6 @@ UNSEEN8 = {
     "esc-readonly-id-write-kept": _m("ESC datasheet 0x0000-0x000F (type, revision, build, FMMU/SM count, RAM size, "
                                      "port descriptor, features): read-only for EtherCAT, a write changes nothing",
                                      readonly_id_write_kept),
-    "pd-logical-unmapped-counted": _m("ETG.1000.4/ESC datasheet logical addressing: a slave counts a logical datagram "
-                                      "only where one of its active FMMUs matches", logical_unmapped_counted),
     "sii-rxpdo-category-as-txpdo": _m("ETG.2010 category types: RxPDO 51 (outputs), TxPDO 50 (inputs)",
                                       rxpdo_category_as_txpdo),
     "cia402-si-unit-byte-order": _m("ETG.6010/CiA 402 0x60A8/0x60A9 SI unit: byte 3 prefix, byte 2 numerator unit, "
@@ -3583,31 +3600,49 @@ UNSEEN8 = {
     "cia402-module-profile-list-zero": _m("ETG.5001.1 0xF010 module profile list: each module's profile (402 for a "
                                           "CiA 402 axis), not 0",
                                           upload_value(0xF010, 1, lambda st, m: m.__setitem__(slice(12, 16), bytes(4)))),
+    "esc-eeprom-address-with-command-late": _m("ESC datasheet 0x0502-0x0507: a command written together with its "
+                                               "address acts on that address", eeprom_address_with_command_late),
+    "sii-dc-sync0-factor-zero": _m("ETG.2010 DC category: Sync0 cycle factor as the ESI's CycleTimeSync0 Factor (1), "
+                                   "not 0", sii_cat_byte(60, 40, lambda b: 0)),
+    "sii-string-nul-padded": _m("ETG.2010 strings category: each string its characters (the ESI's text), no NUL "
+                                "padding counted in the length", sii_string_nul_padded),
+    "diag-parameter-count-wrong": _m("ETG.1020 diagnosis message flags bits 8-15: the number of parameters the "
+                                     "message carries", diag_message(diag_param_count)),
+    "diag-code-halves-swapped": _m("ETG.1020 diagnosis code of an emergency: 0xE800 in the lower word, the error "
+                                   "code in the upper", diag_message(diag_code_swapped)),
+    "pdo-assign-subindex-write-refused": _m("ETG.1020 PDO assignment: written subindex by subindex (sub 0 = 0, "
+                                            "entries, sub 0 = n); complete access is optional",
+                                            mbx_rewriter(assign_subindex_refused)),
+    "info-entry-string-length-over": _m("ETG.1000.6 SDO information entry description: bit length of a string "
+                                        "entry is the string's size (as the upload returns it)",
+                                        mbx_rewriter(string_entry_length_over)),
+    "cia402-max-profile-velocity-below-profile": _m("CiA 402 0x607F max profile velocity: limits 0x6081 profile "
+                                                    "velocity (a default profile velocity within it)",
+                                                    upload_value(0x607F, 0, _u32_to(1))),
 }
 MUTANTS.update(UNSEEN8)
 
 # Where each defect of round 8 should be caught, decided from the standard before reading the tool.
 _GROUPS_UNSEEN8 = {
     "esc-eeprom-command-kept": {"esc", "sii"}, "esc-ecat-event-al-status-lost": {"esc", "esm"},
-    "esc-sm0-write-full-counted": {"esc", "mbx"},
-    "dc-filter-depth-reset": {"dc", "esc"}, "dc-latch-control-readback": {"dc", "esc"},
-    "dc-cyclic-unit-control-readback": {"dc", "esc"}, "dc-sync1-status-ghost": {"dc"},
-    "dc-receive-time-free-running": {"dc"},
     "esm-op-lost-after-cycles": {"esm", "pd"}, "esm-invalid-transition-accepted": {"esm"},
     "esm-error-cleared-without-ack": {"esm"},
     "mbx-repeat-regenerated": {"mbx"},
     "sdo-expedited-size-ignored": {"sdo", "cia402"}, "sdo-segment-after-last-answered": {"sdo"},
-    "sync-sm-event-missed-counting": {"sdo", "dc", "pd"},
     "info-list-duplicate-object": {"sdoinfo"}, "info-object-name-last-char-lost": {"sdoinfo"},
-    "info-entry-default-outside-range": {"sdoinfo"},
-    "foe-packet-number-high-word": {"foe"}, "foe-error-code-zero": {"foe"},
+    "info-entry-default-outside-range": {"sdoinfo"}, "foe-error-code-zero": {"foe"},
     "cia402-mode-display-one-behind": {"cia402"}, "cia402-interpolation-exponent-positive": {"cia402"},
     "cia402-error-code-not-emcy-code": {"cia402"}, "cia402-homing-list-empty": {"cia402"},
     "sii-general-pdo-assign-bits": {"sii"}, "sii-category-end-missing": {"sii"},
     "diag-acknowledged-out-of-range": {"sdo", "cia402"},
-    "esc-readonly-id-write-kept": {"esc"}, "pd-logical-unmapped-counted": {"pd", "esc"},
+    "esc-readonly-id-write-kept": {"esc"},
     "sii-rxpdo-category-as-txpdo": {"sii", "pd"}, "cia402-si-unit-byte-order": {"cia402"},
     "cia402-module-profile-list-zero": {"cia402", "sdo"},
+    "esc-eeprom-address-with-command-late": {"esc", "sii"}, "sii-dc-sync0-factor-zero": {"sii", "dc"},
+    "sii-string-nul-padded": {"sii"}, "diag-parameter-count-wrong": {"sdo", "cia402"},
+    "diag-code-halves-swapped": {"sdo", "cia402"},
+    "pdo-assign-subindex-write-refused": {"sdo", "pd"},
+    "info-entry-string-length-over": {"sdoinfo", "sdo"}, "cia402-max-profile-velocity-below-profile": {"cia402"},
 }
 
 
