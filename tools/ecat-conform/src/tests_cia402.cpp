@@ -280,6 +280,15 @@ Outcome fault_history(Context& ctx) {
     if (*after == *before)
         return fail("0x10F3:02 (newest message) did not move with the fault's emergency " + hex(code),
                     dec(*after) + " before and after", "a newer message");
+    // ETG.1020 diagnosis message flags bits 8-15: the number of parameters that follow the 16 fixed bytes,
+    // each its own flags (kind and data type or length) and data. A count the bytes do not hold (or a
+    // parameter that cannot be delimited) leaves a master reading past the message or losing its text.
+    for (const auto& e : fresh)
+        if (e.truncated)
+            return fail("message " + hex(e.code, 8) + " at :" + dec(e.subindex) +
+                            ": its flags announce more parameters than it holds (or one of no known size)",
+                        dec(static_cast<long long>(e.params.size())) + " delimited",
+                        "the count of flags 8-15");
     for (const auto& e : fresh)
         if (e.from_emergency() && e.emergency_code() == code) {
             if (e.type == 0)
@@ -461,12 +470,12 @@ void add_cia402_tests(Catalogue& c) {
         "parameters.consistent",
         "Parameter objects (where present) agree with themselves: limit pairs 0x607B/0x607D in order, ratio "
         "denominators 0x608F:02/0x6090:02/0x6091:02/0x6092:02 not 0, 0x60FD bits 4-15 reserved, 0x60B9 "
-        "enabled bits as 0x60B8",
+        "enabled bits as 0x60B8, 0xF010 module profiles not 0",
         "IEC 61800-7-201 (CiA 402): 0x607B position range limit and 0x607D software position limit (:01 min, "
         ":02 max); 0x608F/0x6090 encoder resolution, 0x6091 gear ratio, 0x6092 feed constant (:02 a "
         "divisor); "
         "0x60FD digital inputs bits 4-15 reserved; 0x60B9 touch probe status bits 0/8 (enabled) as 0x60B8 "
-        "bits 0/8",
+        "bits 0/8; ETG.5001.1 0xF010 module profile list",
         [](Context& ctx) {
             CONFORM_NEED(need_402_profile(ctx));
             CONFORM_PREOP(ctx);
@@ -506,6 +515,17 @@ void add_cia402_tests(Catalogue& c) {
                 if ((s & 0x0101) & ~(f & 0x0101))
                     return fail("0x60B9 shows a touch probe enabled that 0x60B8 does not enable",
                                 hex(s) + " (0x60B8 " + hex(f) + ")", "bits 0/8 as 0x60B8");
+            }
+            // ETG.5001.1 modular device profile: 0xF010 module profile list, one entry per module (:00 the
+            // count), each the profile number of its module (402 for a drive axis); 0 names no profile.
+            if (auto n = ctx.upload(0xF010, 0); n && n->size() == 1 && (*n)[0] > 0) {
+                seen += "0xf010 ";
+                for (unsigned s = 1; s <= (*n)[0]; ++s) {
+                    auto v = ctx.upload(0xF010, static_cast<uint8_t>(s));
+                    if (v && v->size() == 4 && get32(v->data()) == 0)
+                        return fail("0xF010:" + dec(s) + " (module profile) is 0", "0",
+                                    "the module's profile number");
+                }
             }
             if (seen.empty()) return skip("none of these objects");
             return pass("consistent", seen);
@@ -551,10 +571,28 @@ void add_cia402_tests(Catalogue& c) {
                         dec(static_cast<int8_t>((*back)[0])), dec(md.value));
                 }
                 uint64_t shown = 0xFF;
+                // IEC 61800-7-201: 0x6061 shows the mode in effect now. A drive may take its time to switch,
+                // so the display is first read after a settling time; a display that shows the new mode at
+                // the read right after, not at that one, follows the reads (it answers with the value of the
+                // read before), not the time: it shows a mode no longer in effect to every single read.
+                std::this_thread::sleep_for(ctx.ms(100));
+                std::optional<uint8_t> first;
                 for (int i = 0; i < 100; ++i) {
                     auto v = ctx.upload(0x6061, 0);
                     if (v && !v->empty()) shown = (*v)[0];
-                    if (shown == static_cast<uint8_t>(md.value)) break;
+                    if (i == 0 && v && !v->empty()) first = (*v)[0];
+                    if (shown == static_cast<uint8_t>(md.value)) {
+                        if (i == 1 && first && *first != static_cast<uint8_t>(md.value)) {
+                            if (old) (void)ctx.download_uint(0x6060, 0, *old, 1);
+                            return fail(
+                                "0x6061 showed the mode written only at the read after the first, "
+                                "right after it (a display one read late)",
+                                dec(static_cast<int8_t>(*first)) + " then " + dec(md.value),
+                                dec(md.value) + " at the first read after " +
+                                    dec(static_cast<long long>(ctx.ms(100).count())) + " ms");
+                        }
+                        break;
+                    }
                     std::this_thread::sleep_for(std::chrono::milliseconds(2));
                 }
                 std::string where = " (PREOP)";
@@ -890,9 +928,9 @@ void add_cia402_tests(Catalogue& c) {
     add("fault.diag_history",
         "Fault (communication loss while enabled): its emergency stored in the diagnosis history 0x10F3 as a "
         "newer message (:02 moves), diag code 0xE800 with the error code, type warning or error, a time "
-        "stamp; its acknowledgement (:03) read back",
+        "stamp, the parameters its flags count; its acknowledgement (:03) read back",
         "ETG.1020 diagnosis history 0x10F3 (:02 newest message, :03 newest acknowledged message; message "
-        "diag code, flags bits 0-3 type, time stamp); ETG.1000.6 CoE emergency",
+        "diag code, flags bits 0-3 type and 8-15 parameter count, time stamp); ETG.1000.6 CoE emergency",
         fault_history, "profile 402, 0x10F3 and --allow-fault");
     add(
         "fault_reset",

@@ -1,5 +1,6 @@
 // Group esc: datagram commands and their working counters, addressing, frames, ESC registers.
 #include <algorithm>
+#include <chrono>
 #include <optional>
 #include <thread>
 
@@ -707,6 +708,36 @@ void add_esc_tests(Catalogue& c) {
             if (!v) return fail("0x0210 unreadable", err(v.error()));
             if (*v & 0xF002) return fail("reserved bits set", hex(*v), "bits 1, 12-15 clear");
             return pass("0x0210", hex(*v));
+        });
+    add("reg.al_status_event",
+        "ECAT event request 0x0210 bit 3: set when the slave changes AL status (PREOP -> INIT)",
+        "ESC datasheet section II ECAT event request 0x0210 bit 3 (AL status event: AL status changed by the "
+        "PDI, cleared by reading AL status 0x0130-0x0131); ETG.1000.4 datagram IRQ field",
+        [](Context& ctx) {
+            CONFORM_PREOP(ctx);
+            // Reading AL status clears a pending event. (Bit 3 is not required clear right after it: a
+            // firmware that writes AL status again, even the same value, raises it again.)
+            (void)ctx.rd<uint16_t>(master::reg::AlStatus);
+            if (Error e = ctx.wr<uint16_t>(master::reg::AlControl, 0x0001); e != Error::Ok)
+                return fail("AL control write", err(e));
+            // Watched without reading 0x0130 (that read clears the event): the bit comes with the change.
+            bool seen = false;
+            const auto until = std::chrono::steady_clock::now() +
+                               std::chrono::milliseconds(static_cast<int>(2000 * ctx.opt.timeout_scale));
+            while (!seen && std::chrono::steady_clock::now() < until) {
+                auto ev = ctx.rd<uint16_t>(0x0210);
+                seen = ev && (*ev & 0x0008);
+                if (!seen) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+            }
+            auto al = ctx.rd<uint16_t>(master::reg::AlStatus);
+            (void)ctx.to_init();
+            if (!al) return fail("0x0130 unreadable", err(al.error()));
+            if ((*al & 0x0F) != 0x01)
+                return skip("the slave did not reach INIT (esm.preop_to_init judges that)");
+            if (!seen)
+                return fail("AL status changed to INIT, 0x0210 bit 3 never set", hex(*al),
+                            "bit 3 set until 0x0130 is read");
+            return pass("set by the change of AL status");
         });
     add("reg.pdi_control",
         "PDI control 0x0140 and PDI/sync configuration 0x0150-0x0151 loaded from SII words 0-1",

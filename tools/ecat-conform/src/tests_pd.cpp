@@ -1,6 +1,7 @@
 // Group pd: process data: default PDO layout against the ESI, SAFEOP and OP with working counters, inputs
 // valid in SAFEOP, outputs applied in OP only, logical commands, a remapped assignment.
 #include <algorithm>
+#include <chrono>
 #include <thread>
 
 #include "pdo_map.hpp"
@@ -316,6 +317,47 @@ Outcome op_registers(Context& ctx) {
     return expect_eq("SM/FMMU registers as configured, watchdog status while outputs come", got, want);
 }
 
+// OP held while the master exchanges process data in time: for about a second (longer than the SM watchdog
+// of the default settings) the outputs come every 2 ms; then AL status must still be OP without error. A
+// slave that leaves OP (a watchdog that counts too fast, an application that gives up) drops the outputs a
+// machine relies on. A master whose own frames were late past the watchdog time proves nothing: skipped.
+Outcome op_state_kept(Context& ctx) {
+    CONFORM_NEED(ctx.need_pd_layout());
+    if (Error e = ctx.to_op(); e != Error::Ok) return fail("cannot reach OP: " + err(e));
+    if (!ctx.pds || !ctx.has_process_data()) return skip("no process data");
+    auto div = ctx.rd<uint16_t>(0x0400);
+    auto wd = ctx.rd<uint16_t>(0x0420);
+    // ESC datasheet: watchdog time = 0x0420 * (0x0400 + 2) * 40 ns; 0 switches the watchdog off.
+    const double wd_ms = div && wd ? *wd * (*div + 2.0) * 40e-6 : 0.0;
+    const auto end = std::chrono::steady_clock::now() + ctx.ms(1000);
+    auto last_ok = std::chrono::steady_clock::now();
+    double worst_ms = 0;
+    unsigned cycles = 0, lost = 0;
+    while (std::chrono::steady_clock::now() < end) {
+        const Error e = ctx.pds->cycle();
+        const auto now = std::chrono::steady_clock::now();
+        if (e == Error::Ok) {
+            worst_ms = std::max(worst_ms, std::chrono::duration<double, std::milli>(now - last_ok).count());
+            last_ok = now;
+        } else {
+            ++lost;
+        }
+        ++cycles;
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    auto al = ctx.rd<uint16_t>(master::reg::AlStatus);
+    auto code = ctx.rd<uint16_t>(esc::reg::kAlStatusCode);
+    if (!al) return fail("AL status unreadable after the cycles", err(al.error()));
+    const std::string got = hex(*al) + " code " + (code ? hex(*code) : std::string("unreadable")) +
+                            " after " + dec(cycles) + " cycles (" + dec(lost) + " lost, longest gap " +
+                            dec(static_cast<long long>(worst_ms)) + " ms, watchdog " +
+                            dec(static_cast<long long>(wd_ms)) + " ms)";
+    if ((*al & 0x1F) == 0x08) return pass("OP kept", got);
+    if (wd_ms > 0 && worst_ms >= wd_ms)
+        return skip("the master's own process data came later than the watchdog time: " + got);
+    return fail("left OP while the master exchanged process data every 2 ms", got, "0x0008 (OP, no error)");
+}
+
 }  // namespace
 
 void add_pd_tests(Catalogue& c) {
@@ -377,6 +419,11 @@ void add_pd_tests(Catalogue& c) {
         "working counter as without them",
         "ETG.1000.4 logical addressing (a slave processes only the bytes its FMMUs map)", logical_guard,
         "process data (layout over CoE, else from the SII)");
+    add(
+        "op.state_kept", "OP: kept for a second of process data every 2 ms (AL status still OP, no error)",
+        "ETG.1000.6 state machine (OP while the outputs come in time); ESC datasheet SM watchdog 0x0420 with "
+        "divider 0x0400",
+        [](Context& ctx) { return op_state_kept(ctx); }, "process data (layout over CoE, else from the SII)");
     add(
         "op.esc_registers",
         "OP: SM and FMMU registers read back as configured, SMs not deactivated by the PDI, SM watchdog "

@@ -390,7 +390,8 @@ void add_sdoinfo_tests(Catalogue& c) {
         a, Severity::Warning);
     add(
         "names.visible",
-        "Object and entry description names: visible characters only (no terminator, no control character)",
+        "Object and entry description names: visible characters only (no terminator, no control character), "
+        "not the ESI's name cut short",
         "ETG.1000.6 SDO information object/entry description: the name (VISIBLE_STRING) is the rest of the "
         "message",
         [](Context& ctx) {
@@ -415,6 +416,27 @@ void add_sdoinfo_tests(Catalogue& c) {
                 if (control(d.name))
                     return fail(hex(k.first) + ":" + dec(k.second) + " entry name holds a control character",
                                 shown(d.name), "visible characters");
+            // The other side of the same length: a name one to three characters short of the ESI's, which it
+            // begins, cut inside a word (an off-by-one that drops the last character, a terminator counted
+            // off), is the ESI's name cut, not another name (a shorter name ending at a word, or any other
+            // name, is sdoinfo.od.name's and sdoinfo.entry.name's, warnings).
+            auto cut = [](const std::string& got, const std::string& esi) {
+                return !got.empty() && got.size() < esi.size() && esi.size() - got.size() <= 3 &&
+                       esi.compare(0, got.size(), got) == 0 && got.back() != ' ' && esi[got.size()] != ' ';
+            };
+            for (const auto& [i, o] : ctx.esi->objects) {
+                const auto at = info.objects.find(i);
+                if (at != info.objects.end() && cut(at->second.name, o.name))
+                    return fail(hex(i) + " object name cut short of the ESI's", at->second.name, o.name);
+                if (o.object_code == 7) continue;  // a VAR's entry is named after the object
+                for (const auto& e : o.entries) {
+                    if (o.object_code == 8 && e.subindex > 0) continue;  // array elements share one name
+                    const auto en = info.entries.find({i, e.subindex});
+                    if (en != info.entries.end() && cut(en->second.name, e.name))
+                        return fail(hex(i) + ":" + dec(e.subindex) + " entry name cut short of the ESI's",
+                                    en->second.name, e.name);
+                }
+            }
             return pass(dec(static_cast<long long>(info.objects.size() + info.entries.size())) + " names");
         },
         a);

@@ -129,18 +129,29 @@ Outcome category_present(Context& ctx, uint16_t type, const char* name) {
     return pass();
 }
 
+// Every category of a PDO type (ETG.2010: TxPDO/RxPDO categories may repeat, one per PDO or a few PDOs
+// each; a reader that takes the first only misses the rest): their PDOs in order, or the first parse error.
+std::string parse_pdo_categories(const Context& ctx, uint16_t type, std::vector<SiiPdo>& pdos) {
+    for (const auto& k : ctx.sii->categories)
+        if (k.type == type)
+            if (auto e = parse_pdos(ctx.sii->data(k), pdos); !e.empty()) return e;
+    return {};
+}
+
 Outcome pdo_category(Context& ctx, uint16_t type) {
     Outcome o = category_present(ctx, type, type == kTxPdo ? "TXPDO" : "RXPDO");
     if (o.status != Status::Pass) return o;
     std::vector<SiiPdo> pdos;
-    if (auto e = parse_pdos(ctx.sii->data(*ctx.sii->find(type)), pdos); !e.empty()) return fail(e);
+    if (auto e = parse_pdo_categories(ctx, type, pdos); !e.empty()) return fail(e);
     const SiiCategory* sm = ctx.sii->find(kSyncM);
     const std::size_t sms = sm ? sm->length / 8 : 0;
     for (const auto& p : pdos)
         if (p.sm != 0xFF && p.sm >= sms && sms)
             return fail("PDO " + hex(p.index) + " names SM " + dec(p.sm), dec(p.sm),
                         "< " + dec(static_cast<long long>(sms)));
-    if (auto e = sii_pdo_entry_types(ctx.sii->data(*ctx.sii->find(type))); !e.empty()) return fail(e);
+    for (const auto& k : ctx.sii->categories)
+        if (k.type == type)
+            if (auto e = sii_pdo_entry_types(ctx.sii->data(k)); !e.empty()) return fail(e);
     return pass(dec(static_cast<long long>(pdos.size())) + " PDOs");
 }
 
@@ -154,7 +165,7 @@ Outcome pdo_vs_esi(Context& ctx, uint16_t type) {
     const auto& esi = type == kTxPdo ? ctx.esi->txpdos : ctx.esi->rxpdos;
     std::vector<SiiPdo> pdos;
     const SiiCategory* category = ctx.sii->find(type);
-    if (category) parse_pdos(ctx.sii->data(*category), pdos);
+    if (category) parse_pdo_categories(ctx, type, pdos);
     if (esi.empty() && pdos.empty()) return skip("no PDOs of this direction in ESI or SII");
     // A slave with CoE describes its PDOs in its object dictionary (0x1C12/0x1C13 and the mapping objects),
     // where masters read them; the SII's PDO categories are for devices without CoE (ETG.2010), and EEPROM
@@ -415,33 +426,43 @@ void add_sii_tests(Catalogue& c) {
                 if (n[t] > 1) return fail("category " + dec(t) + " repeated", dec(n[t]), "1");
             return pass();
         });
-    add("cat.strings", "STRINGS category: count and lengths fit the category", kSii, [](Context& ctx) {
-        Outcome o = category_present(ctx, kStrings, "STRINGS");
-        if (o.status != Status::Pass) return o;
-        auto d = ctx.sii->data(*ctx.sii->find(kStrings));
-        if (d.empty()) return fail("empty STRINGS category");
-        std::size_t p = 1;
-        for (unsigned i = 0; i < d[0]; ++i) {
-            if (p >= d.size() || p + 1 + d[p] > d.size())
-                return fail("string " + dec(i + 1) + " runs past the category",
-                            dec(static_cast<long long>(p)), "< " + dec(static_cast<long long>(d.size())));
-            p += 1 + d[p];
-        }
-        // ETG.2010 STRINGS: the count, then that many strings; what follows in the category's words is no
-        // more than padding (0x00, or 0xFF of an erased EEPROM). A string after the counted ones is one the
-        // count left out: a reader that goes by the count loses it (and the indices that name it).
-        if (p < d.size()) {
-            const uint8_t pad = d[p];
-            const bool padding =
-                (pad == 0x00 || pad == 0xFF) && std::all_of(d.begin() + static_cast<std::ptrdiff_t>(p),
-                                                            d.end(), [pad](uint8_t b) { return b == pad; });
-            if (!padding)
-                return fail(
-                    "data after the " + dec(d[0]) + " counted strings (a string the count leaves out)",
-                    bytes_hex(d.subspan(p), 16), "padding (0x00 or 0xff) only");
-        }
-        return pass(dec(d[0]) + " strings");
-    });
+    add("cat.strings", "STRINGS category: count and lengths fit the category, no control characters", kSii,
+        [](Context& ctx) {
+            Outcome o = category_present(ctx, kStrings, "STRINGS");
+            if (o.status != Status::Pass) return o;
+            auto d = ctx.sii->data(*ctx.sii->find(kStrings));
+            if (d.empty()) return fail("empty STRINGS category");
+            std::size_t p = 1;
+            for (unsigned i = 0; i < d[0]; ++i) {
+                if (p >= d.size() || p + 1 + d[p] > d.size())
+                    return fail("string " + dec(i + 1) + " runs past the category",
+                                dec(static_cast<long long>(p)), "< " + dec(static_cast<long long>(d.size())));
+                // A string is its characters (ETG.2010 STRINGS: length, then the text the ESI gives): a
+                // control character (a NUL of a fixed-width field padded out, a terminator counted in the
+                // length) makes the name a master shows and compares another one. Bytes from 0x80 (a code
+                // page's letters) are text.
+                for (std::size_t k = p + 1; k < p + 1 + d[p]; ++k)
+                    if (d[k] < 0x20 || d[k] == 0x7F)
+                        return fail("string " + dec(i + 1) + " holds a control character at position " +
+                                        dec(static_cast<long long>(k - p)),
+                                    bytes_hex(d.subspan(p + 1, d[p]), 32), "visible characters only");
+                p += 1 + d[p];
+            }
+            // ETG.2010 STRINGS: the count, then that many strings; what follows in the category's words is no
+            // more than padding (0x00, or 0xFF of an erased EEPROM). A string after the counted ones is one
+            // the count left out: a reader that goes by the count loses it (and the indices that name it).
+            if (p < d.size()) {
+                const uint8_t pad = d[p];
+                const bool padding = (pad == 0x00 || pad == 0xFF) &&
+                                     std::all_of(d.begin() + static_cast<std::ptrdiff_t>(p), d.end(),
+                                                 [pad](uint8_t b) { return b == pad; });
+                if (!padding)
+                    return fail(
+                        "data after the " + dec(d[0]) + " counted strings (a string the count leaves out)",
+                        bytes_hex(d.subspan(p), 16), "padding (0x00 or 0xff) only");
+            }
+            return pass(dec(d[0]) + " strings");
+        });
     add("cat.general", "General category present (mailbox slaves) and 32 bytes long", kSii, [](Context& ctx) {
         CONFORM_NEED(ctx.need_sii());
         const SiiCategory* g = ctx.sii->find(kGeneral);
@@ -630,20 +651,42 @@ void add_sii_tests(Catalogue& c) {
         "esi.rxpdo", "RXPDO category: PDOs as the ESI's RxPdo, every default-assigned or mandatory one",
         kSiiEsi, [](Context& ctx) { return pdo_vs_esi(ctx, kRxPdo); }, "ESI given");
     add(
-        "esi.dc", "DC category op modes equal the ESI's Dc/OpMode (AssignActivate, SYNC0 cycle)", kSiiEsi,
+        "esi.dc",
+        "DC category op modes equal the ESI's Dc/OpMode (AssignActivate; SYNC0 cycle time, shift and factor)",
+        kSiiEsi,
         [](Context& ctx) {
             CONFORM_NEED(ctx.need_esi());
             CONFORM_NEED(ctx.need_sii());
             if (!ctx.esi->has_dc) return skip("the ESI has no Dc element");
             std::string got, want;
-            if (const SiiCategory* dc = ctx.sii->find(kDc)) {
-                auto d = ctx.sii->data(*dc);
-                for (std::size_t i = 0; i + 24 <= d.size(); i += 24)
-                    got += hex(get16(&d[i + 14])) + " ";
-            }
+            std::span<const uint8_t> d;
+            if (const SiiCategory* dc = ctx.sii->find(kDc)) d = ctx.sii->data(*dc);
+            for (std::size_t i = 0; i + 24 <= d.size(); i += 24)
+                got += hex(get16(&d[i + 14])) + " ";
             for (const auto& m : ctx.esi->op_modes)
                 want += hex(m.assign_activate) + " ";
-            return expect_eq("AssignActivate per op mode", got, want);
+            if (Outcome o = expect_eq("AssignActivate per op mode", got, want); o.status != Status::Pass)
+                return o;
+            // ETG.2010 DC category, per op mode (24 bytes): SYNC0 cycle time (0-3), SYNC0 shift (4-7), SYNC1
+            // shift (8-11), SYNC1 cycle factor (12-13), AssignActivate (14-15), SYNC0 cycle factor (16-17).
+            // The SYNC0 timing of a mode that activates SYNC0 as the ESI's OpMode gives it: the cycle time,
+            // the shift, and the factor where the ESI writes one (a factor of 0 names no cycle).
+            got.clear();
+            want.clear();
+            for (std::size_t n = 0; n < ctx.esi->op_modes.size() && 24 * n + 24 <= d.size(); ++n) {
+                const auto& m = ctx.esi->op_modes[n];
+                if (!(m.assign_activate & 0x0200)) continue;
+                const uint8_t* e = &d[24 * n];
+                got += m.name + ": " + dec(get32(e)) + "/" + dec(static_cast<int32_t>(get32(e + 4)));
+                want += m.name + ": " + dec(m.cycle_time_sync0) + "/" + dec(m.shift_time_sync0);
+                if (m.cycle_time_sync0_factor) {
+                    got += " factor " + dec(static_cast<int16_t>(get16(e + 16)));
+                    want += " factor " + dec(*m.cycle_time_sync0_factor);
+                }
+                got += "; ";
+                want += "; ";
+            }
+            return expect_eq("SYNC0 cycle time/shift (factor) per op mode", got, want);
         },
         "ESI has Dc");
     add(
