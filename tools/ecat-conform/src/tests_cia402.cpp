@@ -517,12 +517,22 @@ void add_cia402_tests(Catalogue& c) {
                                 hex(s) + " (0x60B8 " + hex(f) + ")", "bits 0/8 as 0x60B8");
             }
             // ETG.5001.1 modular device profile: 0xF010 module profile list, one entry per module (:00 the
-            // count), each the profile number of its module (402 for a drive axis); 0 names no profile.
+            // count), each the profile number of its module (402 for a drive axis); 0 names no profile. A
+            // slot without a module (its ident 0 in 0xF050, the detected modules, else in 0xF030, the
+            // configured ones: a modular device whose default configuration leaves slots empty) has no
+            // profile to name.
+            auto empty_slot = [&](unsigned s) {
+                for (const uint16_t list : {0xF050, 0xF030}) {
+                    auto id = ctx.upload(list, static_cast<uint8_t>(s));
+                    if (id && id->size() == 4) return get32(id->data()) == 0;
+                }
+                return false;
+            };
             if (auto n = ctx.upload(0xF010, 0); n && n->size() == 1 && (*n)[0] > 0) {
                 seen += "0xf010 ";
                 for (unsigned s = 1; s <= (*n)[0]; ++s) {
                     auto v = ctx.upload(0xF010, static_cast<uint8_t>(s));
-                    if (v && v->size() == 4 && get32(v->data()) == 0)
+                    if (v && v->size() == 4 && get32(v->data()) == 0 && !empty_slot(s))
                         return fail("0xF010:" + dec(s) + " (module profile) is 0", "0",
                                     "the module's profile number");
                 }
